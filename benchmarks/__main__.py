@@ -1,0 +1,51 @@
+"""Runner: ``python -m benchmarks [NAME ...] [--quick] [--list]``."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from pathlib import Path
+
+from .common import RESULTS_DIR, markdown_table, write_result
+
+
+def available() -> list[str]:
+    here = Path(__file__).resolve().parent
+    return sorted(m.name[len("bench_"):] for m in pkgutil.iter_modules([str(here)]) if m.name.startswith("bench_"))
+
+
+def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
+    names = names or available()
+    unknown = [n for n in names if n not in available()]
+    if unknown:
+        raise SystemExit(f"unknown benchmark(s) {unknown}; available: {', '.join(available())}")
+    written = []
+    for n in names:
+        mod = importlib.import_module(f"benchmarks.bench_{n}")
+        print(f"== benchmark {n}: {mod.__doc__.strip().splitlines()[0] if mod.__doc__ else ''}", flush=True)
+        result = mod.run(quick=quick)
+        jp, mp = write_result(n, result, out_dir)
+        print(markdown_table(result["columns"], result["rows"]))
+        print(f"-> {jp}\n-> {mp}\n", flush=True)
+        written += [jp, mp]
+    return written
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks", description="Run anthroarm's benchmarks.")
+    ap.add_argument("names", nargs="*", help=f"benchmarks to run (default: all): {', '.join(available())}")
+    ap.add_argument("--quick", action="store_true", help="fewer samples, for smoke tests")
+    ap.add_argument("--list", action="store_true", help="list the benchmarks and exit")
+    ap.add_argument("--out", default=None, help=f"output folder (default {RESULTS_DIR})")
+    a = ap.parse_args(argv)
+    if a.list:
+        print("\n".join(available()))
+        return 0
+    run(a.names, quick=a.quick, out_dir=a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,87 @@
+"""Shared helpers of the benchmarks: timing, environment description, result writing."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import time
+from pathlib import Path
+from statistics import median
+
+RESULTS_DIR = Path(__file__).resolve().parent / "results"
+
+
+def time_call(fn, *, number: int = 1, repeat: int = 7, min_time: float = 0.0) -> float:
+    """Median wall time (s) of one call of ``fn`` over ``repeat`` runs of ``number`` calls.
+
+    ``number`` grows (doubling) until one run lasts at least ``min_time`` seconds."""
+    fn()  # warm-up
+    if min_time > 0:
+        while True:
+            t0 = time.perf_counter()
+            for _ in range(number):
+                fn()
+            if time.perf_counter() - t0 >= min_time or number >= 1 << 20:
+                break
+            number *= 2
+    runs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        for _ in range(number):
+            fn()
+        runs.append((time.perf_counter() - t0) / number)
+    return median(runs)
+
+
+def environment() -> dict:
+    import numpy
+    import pinocchio
+
+    return {
+        "python": platform.python_version(),
+        "machine": platform.machine(),
+        "processor": platform.processor() or platform.machine(),
+        "cpus": os.cpu_count(),
+        "numpy": numpy.__version__,
+        "pinocchio": pinocchio.__version__,
+        "date": time.strftime("%Y-%m-%d %H:%M:%S"),
+    }
+
+
+def markdown_table(columns: list[str], rows: list[list]) -> str:
+    def fmt(x):
+        if isinstance(x, float):
+            if x == 0:
+                return "0"
+            if abs(x) >= 1000 or abs(x) < 0.01:
+                return f"{x:.3g}"
+            return f"{x:.3f}".rstrip("0").rstrip(".")
+        return str(x)
+
+    out = ["| " + " | ".join(columns) + " |", "|" + "|".join("---" for _ in columns) + "|"]
+    out += ["| " + " | ".join(fmt(x) for x in r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[Path, Path]:
+    """Write ``<name>.json`` and ``<name>.md``; ``result`` has title, columns, rows, notes."""
+    out = Path(out_dir) if out_dir else RESULTS_DIR
+    out.mkdir(parents=True, exist_ok=True)
+    result = dict(result)
+    result.setdefault("environment", environment())
+    jp, mp = out / f"{name}.json", out / f"{name}.md"
+    tmp = jp.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(result, indent=1, default=float))
+    os.replace(tmp, jp)
+    md = [f"# {result.get('title', name)}", ""]
+    if result.get("notes"):
+        md += [result["notes"], ""]
+    md.append(markdown_table(result["columns"], result["rows"]))
+    env = result["environment"]
+    md += ["", f"Machine: {env['processor']}, {env['cpus']} CPUs, Python {env['python']}, numpy {env['numpy']}, "
+           f"pinocchio {env['pinocchio']}; {env['date']}."]
+    tmp = mp.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(md) + "\n")
+    os.replace(tmp, mp)
+    return jp, mp

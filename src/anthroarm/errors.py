@@ -1,0 +1,63 @@
+"""Typed exceptions of anthroarm.
+
+Every error a user can cause (a bad file, a bad array, an unknown name) raises one of these,
+with a message that names the file, the joint or the value at fault.  Value errors on arrays
+derive from :class:`ValueError` so that ``except ValueError`` keeps working.
+"""
+
+from __future__ import annotations
+
+
+class AnthroarmError(Exception):
+    """Base class of every exception raised on purpose by anthroarm."""
+
+
+class URDFError(AnthroarmError):
+    """A URDF file cannot be used.  ``path`` names the file."""
+
+    def __init__(self, path, problem: str):
+        self.path = str(path)
+        self.problem = problem
+        super().__init__(f"{self.path}: {problem}")
+
+
+class URDFNotFoundError(URDFError, FileNotFoundError):
+    """The URDF path does not exist."""
+
+
+class URDFSyntaxError(URDFError):
+    """The file is not well-formed XML, or not a URDF ``<robot>``."""
+
+
+class URDFSecurityError(URDFError):
+    """The file uses a DTD / entity declarations (entity bombs, external entities)."""
+
+
+class URDFStructureError(URDFError):
+    """Kinematic structure is invalid: cycles, unknown links, unknown joint types, bad numbers."""
+
+
+class MeshNotFoundError(URDFError, FileNotFoundError):
+    """A mesh referenced by the URDF cannot be found."""
+
+
+class PackagePathError(URDFError):
+    """A ``package://`` URI names an unknown package or escapes its package directory."""
+
+
+class UnknownModelError(AnthroarmError, KeyError):
+    """A catalog name that does not exist.  The message lists the catalog."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
+
+
+class UnknownFrameError(AnthroarmError, KeyError):
+    """A frame name that does not exist in the model.  The message lists valid frames."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+class UnsupportedModelError(AnthroarmError):
+    """The model has a feature an algorithm does not support (e.g. a free-flyer joint)."""

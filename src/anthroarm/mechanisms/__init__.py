@@ -1,0 +1,1 @@
+"""Closed-chain mechanisms: four-bar, RSSR, RRSS, RCCC, dyads, finger and thumb linkages."""

@@ -1,0 +1,100 @@
+"""The model catalog: the book's arms as parameter tables (-> URDF) and example-robot-data arms.
+
+>>> import anthroarm as aa
+>>> aa.models.names()            # doctest: +ELLIPSIS
+['human_arm7', 'planar2r', 'prosthetic_arm', ...]
+>>> spec = aa.models.spec("prosthetic_arm", L2=0.240)   # the caption's forearm length
+>>> urdf_text = aa.models.urdf_text("human_arm7", height=1.62, mass=55, sex="female")
+
+The generated URDFs of the default parameters are committed in ``urdf/`` (a test proves they
+equal the generator's output); :func:`write_urdfs` regenerates them.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import UnknownModelError
+from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
+from .erd import ERD_ARMS, ErdArm
+from .human import human_arm7, segment_parameters
+from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
+
+BOOK_MODELS = {
+    "prosthetic_arm": prosthetic_arm,
+    "human_arm7": human_arm7,
+    "sixr_arm": sixr_arm,
+    "unimate5": unimate5,
+    "rrprr5": rrprr5,
+    "planar2r": planar2r,
+}
+
+#: folder of the committed URDFs (repository checkout) — package data copy lives next to this file
+REPO_URDF_DIR = Path(__file__).resolve().parents[3] / "urdf"
+PACKAGE_URDF_DIR = Path(__file__).resolve().parent / "urdf"
+
+
+def names() -> list[str]:
+    """Every catalog name: the book's models, then the example-robot-data arms."""
+    return sorted(BOOK_MODELS) + sorted(ERD_ARMS)
+
+
+def book_names() -> list[str]:
+    return sorted(BOOK_MODELS)
+
+
+def _unknown(name) -> UnknownModelError:
+    return UnknownModelError(f"unknown model {name!r}; the catalog has: {', '.join(names())}")
+
+
+def spec(name: str, **params) -> ChainSpec:
+    """Parameter table of a book model; ``params`` are the builder's keyword arguments."""
+    if name not in BOOK_MODELS:
+        raise _unknown(name)
+    try:
+        return BOOK_MODELS[name](**params)
+    except TypeError as exc:
+        import inspect
+
+        sig = inspect.signature(BOOK_MODELS[name])
+        raise ValueError(f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})") from None
+
+
+def urdf_text(name: str, **params) -> str:
+    """URDF text of a book model with the given parameters."""
+    return to_urdf(spec(name, **params))
+
+
+def urdf_path(name: str) -> Path:
+    """Path of the committed URDF of a catalog model (default parameters)."""
+    if name in ERD_ARMS:
+        return ERD_ARMS[name].urdf_path()
+    if name not in BOOK_MODELS:
+        raise _unknown(name)
+    for d in (PACKAGE_URDF_DIR, REPO_URDF_DIR):
+        p = d / f"{name}.urdf"
+        if p.is_file():
+            return p
+    return REPO_URDF_DIR / f"{name}.urdf"
+
+
+def write_urdfs(out_dir=None) -> list[Path]:
+    """(Re)generate the URDFs of all book models with default parameters into ``out_dir``."""
+    from ..urdf_io import atomic_write_text
+
+    out = Path(out_dir) if out_dir is not None else REPO_URDF_DIR
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for n in sorted(BOOK_MODELS):
+        p = out / f"{n}.urdf"
+        atomic_write_text(p, urdf_text(n))
+        paths.append(p)
+    return paths
+
+
+__all__ = [
+    "BOOK_MODELS", "ERD_ARMS", "ErdArm", "ChainSpec", "DHRow", "JointSpec", "LinkSpec",
+    "dh_matrix", "from_dh", "to_urdf", "names", "book_names", "spec", "urdf_text", "urdf_path",
+    "write_urdfs", "human_arm7", "prosthetic_arm", "sixr_arm", "unimate5", "rrprr5", "planar2r",
+    "segment_parameters",
+]

@@ -1,0 +1,152 @@
+"""The 7-DOF human-like arm of §6-3 (Fig. 6-5/6-6) with anthropometric segments.
+
+Kinematics (book §6-3, l. 3927–3989): shoulder S at the origin, joints about x, y, z at S;
+elbow about x at E = (0, 0, −l1); wrist about z, y, x at W = E + (0, 0, −l2); hand point H at
+W + (0, 0, −l3).  At q = 0 the arm hangs along −z; z is up, y points forward (anterior) and x
+to the person's right (lateral for a right arm).  Orientations are Eq. (6-34)–(6-36):
+C_E = Cx1 Cy2, C_W = C_E Cz3 Cx4, C_H = C_W Cz5 Cy6 Cx7.
+
+Segment lengths, masses, centres of mass and radii of gyration come from de Leva (1996),
+"Adjustments to Zatsiorsky–Seluyanov's segment inertia parameters", J. Biomech. 29(9),
+Table 4, scaled by body height (lengths, linearly) and body mass (masses, linearly):
+
+======== ===== ======= ======= ====== =========================
+segment  sex   length  mass %  CoM %  radii of gyration % (sag, trans, long)
+======== ===== ======= ======= ====== =========================
+upperarm male  281.7   2.71    57.72  28.5, 26.9, 15.8
+forearm  male  268.9   1.62    45.74  27.6, 26.5, 12.1
+hand     male   86.2   0.61    79.00  62.8, 51.3, 40.1
+upperarm female 275.1  2.55    57.54  27.8, 26.0, 14.8
+forearm  female 264.3  1.38    45.59  26.1, 25.7,  9.4
+hand     female  78.0  0.56    74.74  53.1, 45.4, 33.5
+======== ===== ======= ======= ====== =========================
+
+Lengths in mm for the reference statures 1741 mm (male) and 1735 mm (female); the hand segment
+runs from the wrist joint centre to the 3rd metacarpale, and H is placed at its end.
+
+Joint ranges (degrees), from the book's Table 2.2 (l. 527–534) where it has a row:
+
+========================= ====== =========== ===================================================
+joint                     axis   range       source
+========================= ====== =========== ===================================================
+shoulder_flexion          x      −50 … 180   Table 2.2 θ2 (+180, −(40…60): mid value −50)
+shoulder_abduction        y     −180 … 30    not in Table 2.2: AAOS abduction 180, adduction 30
+shoulder_rotation         z      −90 … 90    Table 2.2 θ3 (upper-arm rotation ±90)
+elbow_flexion             x       −5 … 145   Table 2.2 θ4
+forearm_pronation         z      −90 … 90    Table 2.2 θ5
+wrist_deviation           y      −30 … 20    not in Table 2.2 (book notes: missing row); AAOS
+wrist_flexion             x      −70 … 55    Table 2.2 θ6 (+(50…60): mid value 55, −70)
+========================= ====== =========== ===================================================
+
+For a right arm, abduction (hand moving to +x) is a negative rotation about +y; flexion moves
+the hand forward (+y).  Table 2.2's θ1 (internal/external rotation +45/−90) overlaps its θ3;
+we read θ3 as the humeral rotation and do not use θ1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .spec import ChainSpec, JointSpec, homogeneous, rod_link
+
+deg = np.pi / 180.0
+
+DE_LEVA_1996 = {
+    # name: (length mm, mass fraction, com fraction from proximal, (r_sag, r_trans, r_long) fractions)
+    "male": {
+        "stature": 1741.0,
+        "upperarm": (281.7, 0.0271, 0.5772, (0.285, 0.269, 0.158)),
+        "forearm": (268.9, 0.0162, 0.4574, (0.276, 0.265, 0.121)),
+        "hand": (86.2, 0.0061, 0.7900, (0.628, 0.513, 0.401)),
+    },
+    "female": {
+        "stature": 1735.0,
+        "upperarm": (275.1, 0.0255, 0.5754, (0.278, 0.260, 0.148)),
+        "forearm": (264.3, 0.0138, 0.4559, (0.261, 0.257, 0.094)),
+        "hand": (78.0, 0.0056, 0.7474, (0.531, 0.454, 0.335)),
+    },
+}
+
+HUMAN_ARM7_LIMITS_DEG = {
+    "shoulder_flexion": (-50.0, 180.0),
+    "shoulder_abduction": (-180.0, 30.0),
+    "shoulder_rotation": (-90.0, 90.0),
+    "elbow_flexion": (-5.0, 145.0),
+    "forearm_pronation": (-90.0, 90.0),
+    "wrist_deviation": (-30.0, 20.0),
+    "wrist_flexion": (-70.0, 55.0),
+}
+
+
+def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> dict:
+    """Length (m), mass (kg), CoM distance from the proximal joint (m) and radii of gyration
+    (m; sagittal, transverse, longitudinal) of upper arm, forearm and hand (de Leva 1996)."""
+    if sex not in DE_LEVA_1996:
+        raise ValueError(f"sex must be 'male' or 'female', got {sex!r}")
+    if not (0.5 <= height <= 2.6):
+        raise ValueError(f"body height {height} m is outside 0.5…2.6 m")
+    if not (10.0 <= mass <= 300.0):
+        raise ValueError(f"body mass {mass} kg is outside 10…300 kg")
+    tab = DE_LEVA_1996[sex]
+    k = height * 1000.0 / tab["stature"]
+    out = {}
+    for seg in ("upperarm", "forearm", "hand"):
+        L_mm, mf, cf, radii = tab[seg]
+        L = L_mm * k / 1000.0
+        out[seg] = {"length": L, "mass": mf * mass, "com": cf * L, "radii": tuple(r * L for r in radii)}
+    return out
+
+
+def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> ChainSpec:
+    """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg."""
+    seg = segment_parameters(height, mass, sex)
+    l1, l2, l3 = (seg[s]["length"] for s in ("upperarm", "forearm", "hand"))
+    X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+    lim = {k: (a * deg, b * deg) for k, (a, b) in HUMAN_ARM7_LIMITS_DEG.items()}
+    tiny = 0.02  # kg: virtual links between co-located joints
+
+    def virtual(name):
+        return rod_link(name, [0, 0, 0], mass=0.0, joint_mass=tiny, radius=0.03)
+
+    def anthropo(name, s, key, radius):
+        p = seg[key]
+        r_sag, r_trans, r_long = p["radii"]
+        return rod_link(
+            name, s, mass=p["mass"], radius=radius, joint_mass=0.0,
+            com_fraction=p["com"] / p["length"], radii_of_gyration=(r_sag, r_trans, r_long),
+        )
+
+    joints = [
+        JointSpec("shoulder_flexion", "revolute", homogeneous(), axis=X, link=virtual("shoulder_link1"),
+                  lower=lim["shoulder_flexion"][0], upper=lim["shoulder_flexion"][1], effort=80.0),
+        JointSpec("shoulder_abduction", "revolute", homogeneous(), axis=Y, link=virtual("shoulder_link2"),
+                  lower=lim["shoulder_abduction"][0], upper=lim["shoulder_abduction"][1], effort=80.0),
+        JointSpec("shoulder_rotation", "revolute", homogeneous(), axis=Z,
+                  link=anthropo("upper_arm", [0, 0, -l1], "upperarm", 0.045),
+                  lower=lim["shoulder_rotation"][0], upper=lim["shoulder_rotation"][1], effort=40.0),
+        JointSpec("elbow_flexion", "revolute", homogeneous(p=[0, 0, -l1]), axis=X,
+                  link=rod_link("elbow_link", [0, 0, 0], mass=0.0, joint_mass=tiny, radius=0.04),
+                  lower=lim["elbow_flexion"][0], upper=lim["elbow_flexion"][1], effort=60.0),
+        JointSpec("forearm_pronation", "revolute", homogeneous(), axis=Z,
+                  link=anthropo("forearm", [0, 0, -l2], "forearm", 0.035),
+                  lower=lim["forearm_pronation"][0], upper=lim["forearm_pronation"][1], effort=10.0),
+        JointSpec("wrist_deviation", "revolute", homogeneous(p=[0, 0, -l2]), axis=Y,
+                  link=virtual("wrist_link"),
+                  lower=lim["wrist_deviation"][0], upper=lim["wrist_deviation"][1], effort=10.0),
+        JointSpec("wrist_flexion", "revolute", homogeneous(), axis=X,
+                  link=anthropo("hand", [0, 0, -l3], "hand", 0.03),
+                  lower=lim["wrist_flexion"][0], upper=lim["wrist_flexion"][1], effort=10.0),
+    ]
+    return ChainSpec(
+        name="human_arm7",
+        description=(
+            "7-DOF human-like right arm (book §6-3, Fig. 6-5/6-6): shoulder x-y-z, elbow x, wrist z-y-x, "
+            "hanging along -z; y forward, x to the right; tool = hand point H."
+        ),
+        joints=joints,
+        tool_name="hand_point",
+        tool_origin=homogeneous(p=[0, 0, -l3]),
+        source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
+        inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg",
+        params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},
+    )

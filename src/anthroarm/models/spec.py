@@ -1,0 +1,335 @@
+"""Parameter tables of serial arms and their URDF.
+
+A :class:`ChainSpec` is the single source of a catalog arm: joints (type, axis, placement in
+the parent link, limits), links (mass, centre of mass, inertia) and the tool frame.  From it
+:func:`to_urdf` writes the URDF that Pinocchio and yourdfpy load; nothing else writes URDF.
+
+Two ways to fill a spec:
+* :func:`from_dh` — the book's H-D table, Eq. (6-12): ``A = Rz(θ) Tz(s) Tx(h) Rx(α)`` (classic,
+  distal DH).  URDF joint *j* sits at DH frame *j−1* with axis +z, its origin is the static
+  part of row *j−1*, so every joint variable equals the book's θ_j (or s for a prismatic row)
+  and constant offsets live in the joint origins.
+* a list of :class:`JointSpec` written by hand (the 7-DOF human arm of §6-3, the planar 2R).
+
+Units: metres, radians, kilograms.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Default linear density (kg/m) and radius (m) of the book arms' links, which print no masses:
+#: an aluminium tube Ø50 × 3 mm with its fittings weighs about 1.5 kg/m.
+DEFAULT_LINEAR_DENSITY = 1.5
+DEFAULT_LINK_RADIUS = 0.025
+#: mass (kg) of a joint housing lumped at each joint origin, so that co-located wrist joints
+#: still carry a positive-definite inertia.
+DEFAULT_JOINT_MASS = 0.1
+
+
+def rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1.0, 0], [-s, 0, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def homogeneous(R=None, p=None) -> np.ndarray:
+    T = np.eye(4)
+    if R is not None:
+        T[:3, :3] = R
+    if p is not None:
+        T[:3, 3] = p
+    return T
+
+
+def rpy_from_matrix(R: np.ndarray) -> tuple[float, float, float]:
+    """URDF roll-pitch-yaw (R = Rz(y) Ry(p) Rx(r)) of a rotation matrix."""
+    sy = -R[2, 0]
+    sy = min(1.0, max(-1.0, sy))
+    pitch = float(np.arcsin(sy))
+    if abs(sy) < 1.0 - 1e-12:
+        roll = float(np.arctan2(R[2, 1], R[2, 2]))
+        yaw = float(np.arctan2(R[1, 0], R[0, 0]))
+    else:  # gimbal lock: put everything in yaw
+        roll = 0.0
+        yaw = float(np.arctan2(-R[0, 1], R[1, 1]))
+    return roll, pitch, yaw
+
+
+@dataclass
+class LinkSpec:
+    """Rigid-body parameters of one link, in the link frame (the frame of its parent joint)."""
+
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))  # about the com
+    #: vector from the link origin to the next joint (or tool); drawn as a capsule
+    segment: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    radius: float = DEFAULT_LINK_RADIUS
+
+
+@dataclass
+class JointSpec:
+    """One joint and the link it moves.  ``origin`` places the joint frame in the parent link."""
+
+    name: str
+    type: str  # "revolute" | "prismatic"
+    origin: np.ndarray
+    axis: tuple = (0.0, 0.0, 1.0)
+    lower: float = -np.pi
+    upper: float = np.pi
+    effort: float = 100.0
+    velocity: float = 3.0
+    link: LinkSpec | None = None
+
+
+@dataclass
+class DHRow:
+    """One row of the book's H-D table, Eq. (6-12): ``A = Rz(θ) Tz(s) Tx(h) Rx(α)``.
+
+    ``kind`` is "R" (variable θ = q + offset) or "P" (variable s = q + offset).  For an "R" row
+    ``theta`` is ignored and ``offset`` is added to q; for a "P" row ``s`` is ignored.
+    """
+
+    kind: str
+    alpha: float
+    s: float = 0.0
+    h: float = 0.0
+    theta: float = 0.0
+    offset: float = 0.0
+    lower: float = -np.pi
+    upper: float = np.pi
+
+
+@dataclass
+class ChainSpec:
+    name: str
+    description: str
+    joints: list[JointSpec]
+    tool_name: str = "tool"
+    tool_origin: np.ndarray = field(default_factory=lambda: np.eye(4))
+    base_link: str = "base_link"
+    source: str = ""
+    inertia_source: str = ""
+    dh: list[DHRow] | None = None
+    tool_dh: np.ndarray | None = None  # tool pose in the last DH frame (for closed forms)
+    params: dict = field(default_factory=dict)
+
+    @property
+    def nq(self) -> int:
+        return len(self.joints)
+
+
+def dh_matrix(row: DHRow, q: float) -> np.ndarray:
+    """The book's A matrix, Eq. (6-12), of one row at joint value q."""
+    if row.kind == "R":
+        theta, s = q + row.offset, row.s
+    else:
+        theta, s = row.theta, q + row.offset
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(row.alpha), np.sin(row.alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, row.h * ct],
+            [st, ct * ca, -ct * sa, row.h * st],
+            [0.0, sa, ca, s],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def dh_static(row: DHRow) -> np.ndarray:
+    """Static part S of a row: ``A(q) = Rz(q) S`` (R) or ``A(q) = Tz(q) S`` (P)."""
+    return dh_matrix(row, 0.0)
+
+
+def rod_link(name: str, segment, mass: float | None = None, radius: float = DEFAULT_LINK_RADIUS,
+             joint_mass: float = DEFAULT_JOINT_MASS, com_fraction: float = 0.5,
+             radii_of_gyration: tuple | None = None) -> LinkSpec:
+    """A link modelled as a uniform solid cylinder along ``segment`` plus a point-ish sphere
+    (radius ``radius``) of ``joint_mass`` at the link origin.
+
+    ``radii_of_gyration`` (k_perp1, k_perp2, k_axial) in metres override the cylinder formula
+    (used for anthropometric segments).  Returns mass, com and inertia about the com.
+    """
+    seg = np.asarray(segment, float)
+    L = float(np.linalg.norm(seg))
+    m_rod = DEFAULT_LINEAR_DENSITY * L if mass is None else float(mass)
+    u = seg / L if L > 1e-12 else np.array([0.0, 0.0, 1.0])
+    c_rod = com_fraction * seg
+    if radii_of_gyration is None:
+        i_perp = m_rod * (3 * radius**2 + L**2) / 12.0
+        i_ax = m_rod * radius**2 / 2.0
+        I_rod = i_perp * (np.eye(3) - np.outer(u, u)) + i_ax * np.outer(u, u)
+    else:
+        k1, k2, ka = radii_of_gyration
+        # two perpendicular directions to u
+        e1 = np.cross(u, [1.0, 0, 0])
+        if np.linalg.norm(e1) < 1e-6:
+            e1 = np.cross(u, [0, 1.0, 0])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(u, e1)
+        I_rod = m_rod * (k1**2 * np.outer(e1, e1) + k2**2 * np.outer(e2, e2) + ka**2 * np.outer(u, u))
+    m_j = float(joint_mass)
+    I_j = 0.4 * m_j * radius**2 * np.eye(3)
+    m = m_rod + m_j
+    com = (m_rod * c_rod) / m if m > 0 else np.zeros(3)
+    # parallel-axis theorem to the common com
+    def shift(mass, c):
+        d = c - com
+        return mass * (d @ d * np.eye(3) - np.outer(d, d))
+
+    I = I_rod + shift(m_rod, c_rod) + I_j + shift(m_j, np.zeros(3))
+    return LinkSpec(name=name, mass=m, com=com, inertia=0.5 * (I + I.T), segment=seg, radius=radius)
+
+
+def from_dh(name: str, description: str, rows: list[DHRow], tool: np.ndarray, *, source: str,
+            joint_names=None, link_masses=None, params=None, tool_name="tool",
+            inertia_source: str | None = None) -> ChainSpec:
+    """Build a :class:`ChainSpec` from an H-D table (Eq. (6-12)) and the tool pose in the last
+    DH frame.  Joint j's origin in link j−1 is the static part S_{j−1} of row j−1 (S_0 = I)."""
+    n = len(rows)
+    joint_names = joint_names or [f"joint{j + 1}" for j in range(n)]
+    statics = [dh_static(r) for r in rows]
+    joints = []
+    for j, row in enumerate(rows):
+        origin = np.eye(4) if j == 0 else statics[j - 1]
+        nxt = statics[j] @ tool if j == n - 1 else statics[j]
+        seg = nxt[:3, 3]
+        m = None if link_masses is None else link_masses[j]
+        link = rod_link(f"link{j + 1}", seg, mass=m)
+        joints.append(
+            JointSpec(
+                name=joint_names[j],
+                type="revolute" if row.kind == "R" else "prismatic",
+                origin=origin,
+                lower=row.lower,
+                upper=row.upper,
+                velocity=2.0 if row.kind == "R" else 0.5,
+                link=link,
+            )
+        )
+    return ChainSpec(
+        name=name,
+        description=description,
+        joints=joints,
+        tool_name=tool_name,
+        tool_origin=statics[-1] @ tool,
+        source=source,
+        inertia_source=inertia_source
+        or (
+            f"not printed in the book: each link is a uniform cylinder of {DEFAULT_LINEAR_DENSITY} kg/m, "
+            f"radius {DEFAULT_LINK_RADIUS} m, plus a {DEFAULT_JOINT_MASS} kg joint housing at its origin"
+        ),
+        dh=rows,
+        tool_dh=tool,
+        params=dict(params or {}),
+    )
+
+
+# ----------------------------------------------------------------------------------------
+# URDF writer
+
+
+def _num(x: float) -> str:
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    return repr(x)
+
+
+def _vec(v) -> str:
+    return " ".join(_num(x) for x in v)
+
+
+def _origin(T: np.ndarray, indent: str) -> str:
+    r, p, y = rpy_from_matrix(T[:3, :3])
+    return f'{indent}<origin xyz="{_vec(T[:3, 3])}" rpy="{_vec((r, p, y))}"/>\n'
+
+
+def _visuals(link: LinkSpec, indent: str) -> str:
+    out = []
+    # sphere at the joint centre
+    out.append(
+        f"{indent}<visual>\n{indent}  <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n"
+        f"{indent}  <geometry><sphere radius=\"{_num(1.3 * link.radius)}\"/></geometry>\n"
+        f"{indent}  <material name=\"joint\"><color rgba=\"0.85 0.45 0.2 1\"/></material>\n{indent}</visual>\n"
+    )
+    L = float(np.linalg.norm(link.segment))
+    if L > 1e-9:
+        u = link.segment / L
+        # rotation taking +z to u
+        z = np.array([0.0, 0.0, 1.0])
+        v = np.cross(z, u)
+        c = float(z @ u)
+        if np.linalg.norm(v) < 1e-12:
+            R = np.eye(3) if c > 0 else rot_x(np.pi)
+        else:
+            vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+            R = np.eye(3) + vx + vx @ vx * (1.0 / (1.0 + c))
+        T = homogeneous(R, link.segment / 2)
+        out.append(
+            f"{indent}<visual>\n{_origin(T, indent + '  ')}"
+            f"{indent}  <geometry><cylinder radius=\"{_num(link.radius)}\" length=\"{_num(L)}\"/></geometry>\n"
+            f"{indent}  <material name=\"link\"><color rgba=\"0.75 0.78 0.82 1\"/></material>\n{indent}</visual>\n"
+        )
+    return "".join(out)
+
+
+def _inertial(link: LinkSpec, indent: str) -> str:
+    if link.mass <= 0:
+        return ""
+    I = link.inertia
+    return (
+        f"{indent}<inertial>\n{indent}  <origin xyz=\"{_vec(link.com)}\" rpy=\"0 0 0\"/>\n"
+        f"{indent}  <mass value=\"{_num(link.mass)}\"/>\n"
+        f"{indent}  <inertia ixx=\"{_num(I[0, 0])}\" ixy=\"{_num(I[0, 1])}\" ixz=\"{_num(I[0, 2])}\" "
+        f"iyy=\"{_num(I[1, 1])}\" iyz=\"{_num(I[1, 2])}\" izz=\"{_num(I[2, 2])}\"/>\n{indent}</inertial>\n"
+    )
+
+
+def to_urdf(spec: ChainSpec) -> str:
+    """URDF text of a chain.  Deterministic: the same spec always gives the same bytes."""
+    lines = ['<?xml version="1.0"?>\n']
+    lines.append("<!-- Generated by anthroarm.models from its parameter table; do not edit.\n")
+    lines.append(f"     {spec.description}\n     Source: {spec.source}\n     Inertia: {spec.inertia_source}\n")
+    if spec.params:
+        lines.append("     Parameters: " + ", ".join(f"{k}={v}" for k, v in spec.params.items()) + "\n")
+    lines.append("-->\n")
+    lines.append(f'<robot name="{spec.name}">\n')
+    lines.append(f'  <link name="{spec.base_link}"/>\n')
+    parent = spec.base_link
+    for j in spec.joints:
+        link = j.link or LinkSpec(name=f"{j.name}_link")
+        lines.append(f'  <joint name="{j.name}" type="{j.type}">\n')
+        lines.append(f'    <parent link="{parent}"/>\n    <child link="{link.name}"/>\n')
+        lines.append(_origin(j.origin, "    "))
+        lines.append(f'    <axis xyz="{_vec(j.axis)}"/>\n')
+        lines.append(
+            f'    <limit lower="{_num(j.lower)}" upper="{_num(j.upper)}" effort="{_num(j.effort)}" velocity="{_num(j.velocity)}"/>\n'
+        )
+        lines.append("  </joint>\n")
+        lines.append(f'  <link name="{link.name}">\n')
+        lines.append(_inertial(link, "    "))
+        lines.append(_visuals(link, "    "))
+        lines.append("  </link>\n")
+        parent = link.name
+    lines.append(f'  <joint name="{spec.tool_name}_joint" type="fixed">\n')
+    lines.append(f'    <parent link="{parent}"/>\n    <child link="{spec.tool_name}"/>\n')
+    lines.append(_origin(spec.tool_origin, "    "))
+    lines.append("  </joint>\n")
+    lines.append(f'  <link name="{spec.tool_name}"/>\n')
+    lines.append("</robot>\n")
+    return "".join(lines)
