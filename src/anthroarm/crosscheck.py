@@ -22,6 +22,7 @@ import numpy as np
 #: dotted names of row providers, run in this order
 PROVIDERS: list[str] = [
     "anthroarm.kinematics.checks:rows",
+    "anthroarm.design.structure:reach_rows",
 ]
 
 
