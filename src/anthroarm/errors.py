@@ -61,3 +61,11 @@ class UnknownFrameError(AnthroarmError, KeyError):
 
 class UnsupportedModelError(AnthroarmError):
     """The model has a feature an algorithm does not support (e.g. a free-flyer joint)."""
+
+
+class ViewerError(AnthroarmError):
+    """The meshcat viewer cannot do what was asked (server not running, no answer, ...)."""
+
+
+class ViewerPortInUseError(ViewerError, OSError):
+    """The requested viewer port on 127.0.0.1 is already taken."""
