@@ -1,0 +1,173 @@
+"""Hostile and malformed URDF files: each raises a typed anthroarm exception naming the file."""
+
+import os
+from pathlib import Path
+
+import pytest
+
+import anthroarm as aa
+from anthroarm import errors
+
+GOOD_JOINT = """
+  <joint name="j1" type="revolute">
+    <parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>"""
+
+
+def write(tmp_path, body, name="robot.urdf", head='<?xml version="1.0"?>\n'):
+    p = tmp_path / name
+    p.write_text(head + body)
+    return p
+
+
+def robot_xml(links="<link name='base'/><link name='l1'/>", joints=GOOD_JOINT, extra=""):
+    return f"<robot name='t'>{links}{joints}{extra}</robot>"
+
+
+def test_minimal_good_file_loads(tmp_path):
+    r = aa.load(str(write(tmp_path, robot_xml())))
+    assert r.nq == 1 and r.joint_names == ["j1"]
+
+
+def test_missing_file():
+    with pytest.raises(errors.URDFNotFoundError, match="does_not_exist.urdf"):
+        aa.load("/nonexistent/does_not_exist.urdf")
+
+
+def test_malformed_xml(tmp_path):
+    p = write(tmp_path, "<robot name='t'><link name='a'></robot>")
+    with pytest.raises(errors.URDFSyntaxError, match="robot.urdf.*malformed XML"):
+        aa.load(str(p))
+
+
+def test_not_a_robot(tmp_path):
+    with pytest.raises(errors.URDFSyntaxError, match="expected <robot>"):
+        aa.load(str(write(tmp_path, "<sdf/>")))
+
+
+def test_entity_expansion_bomb_is_rejected_before_parsing(tmp_path):
+    bomb = '<!DOCTYPE lolz [<!ENTITY lol "lol">' + "".join(
+        f'<!ENTITY lol{i} "{("&lol%s;" % (i - 1 if i else "")) * 10}">' for i in range(1, 10)
+    ) + "]>"
+    p = write(tmp_path, bomb + "<robot name='t'><link name='&lol9;'/></robot>")
+    with pytest.raises(errors.URDFSecurityError, match="entity"):
+        aa.load(str(p))
+
+
+def test_external_entity_is_rejected(tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("top secret")
+    p = write(tmp_path, f'<!DOCTYPE r [<!ENTITY xxe SYSTEM "file://{secret}">]>'
+                        "<robot name='t'><link name='&xxe;'/></robot>")
+    with pytest.raises(errors.URDFSecurityError):
+        aa.load(str(p))
+
+
+def test_kinematic_cycle(tmp_path):
+    joints = GOOD_JOINT + """
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="base"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"""
+    with pytest.raises(errors.URDFStructureError, match="cycle|two joints"):
+        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+
+
+def test_closed_loop_child_with_two_parents(tmp_path):
+    links = "<link name='base'/><link name='l1'/><link name='l2'/>"
+    joints = GOOD_JOINT + """
+  <joint name="j2" type="fixed"><parent link="base"/><child link="l2"/></joint>
+  <joint name="j3" type="fixed"><parent link="l2"/><child link="l1"/></joint>"""
+    with pytest.raises(errors.URDFStructureError, match="child of two joints"):
+        aa.load(str(write(tmp_path, robot_xml(links=links, joints=joints))))
+
+
+def test_unknown_joint_type(tmp_path):
+    joints = GOOD_JOINT.replace('type="revolute"', 'type="ball"')
+    with pytest.raises(errors.URDFStructureError, match="unknown type 'ball'"):
+        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+
+
+def test_unknown_link(tmp_path):
+    joints = GOOD_JOINT.replace('child link="l1"', 'child link="l9"')
+    with pytest.raises(errors.URDFStructureError, match="'l9' is not defined"):
+        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "1e400", "abc"])
+def test_bad_numbers(tmp_path, bad):
+    joints = GOOD_JOINT.replace('xyz="0 0 0.1"', f'xyz="0 0 {bad}"')
+    with pytest.raises(errors.URDFStructureError, match="j1.*origin xyz"):
+        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+
+
+def test_inverted_limits(tmp_path):
+    joints = GOOD_JOINT.replace('lower="-1" upper="1"', 'lower="1" upper="-1"')
+    with pytest.raises(errors.URDFStructureError, match="lower limit"):
+        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+
+
+def test_negative_mass(tmp_path):
+    links = "<link name='base'/><link name='l1'><inertial><mass value='-2'/></inertial></link>"
+    with pytest.raises(errors.URDFStructureError, match="mass"):
+        aa.load(str(write(tmp_path, robot_xml(links=links))))
+
+
+def mesh_link(uri):
+    return f"<link name='base'/><link name='l1'><visual><geometry><mesh filename='{uri}'/></geometry></visual></link>"
+
+
+def test_missing_mesh_names_the_file(tmp_path):
+    p = write(tmp_path, robot_xml(links=mesh_link("meshes/arm.stl")))
+    with pytest.raises(errors.MeshNotFoundError, match="meshes/arm.stl"):
+        aa.load(str(p))
+    # opting out of the mesh check still loads the kinematics
+    assert aa.load(str(p), check_meshes=False).nq == 1
+
+
+def test_package_uri_escaping_its_package(tmp_path):
+    pkg = tmp_path / "my_pkg"
+    (pkg / "urdf").mkdir(parents=True)
+    outside = tmp_path / "outside.stl"
+    outside.write_text("solid x\nendsolid x\n")
+    p = write(pkg / "urdf", robot_xml(links=mesh_link("package://my_pkg/../outside.stl")))
+    with pytest.raises(errors.PackagePathError, match="escapes"):
+        aa.load(str(p))
+
+
+def test_package_uri_inside_package_resolves(tmp_path):
+    pkg = tmp_path / "my_pkg"
+    (pkg / "urdf").mkdir(parents=True)
+    (pkg / "meshes").mkdir()
+    (pkg / "meshes" / "a.stl").write_text("solid x\nendsolid x\n")
+    p = write(pkg / "urdf", robot_xml(links=mesh_link("package://my_pkg/meshes/a.stl")))
+    r = aa.load(str(p))
+    assert r.info.meshes["package://my_pkg/meshes/a.stl"] == (pkg / "meshes" / "a.stl").resolve()
+
+
+def test_unknown_package(tmp_path):
+    p = write(tmp_path, robot_xml(links=mesh_link("package://nowhere/a.stl")))
+    with pytest.raises(errors.PackagePathError, match="unknown package 'nowhere'"):
+        aa.load(str(p))
+
+
+def test_huge_file_is_refused(tmp_path, monkeypatch):
+    import anthroarm.urdf_io as io
+
+    monkeypatch.setattr(io, "MAX_URDF_BYTES", 100)
+    with pytest.raises(errors.URDFSecurityError, match="larger than"):
+        aa.load(str(write(tmp_path, robot_xml())))
+
+
+def test_errors_are_anthroarm_errors():
+    for cls in (errors.URDFNotFoundError, errors.URDFSyntaxError, errors.URDFSecurityError,
+                errors.URDFStructureError, errors.MeshNotFoundError, errors.PackagePathError):
+        assert issubclass(cls, errors.AnthroarmError)
+
+
+def test_atomic_write_leaves_nothing_on_missing_folder(tmp_path):
+    from anthroarm.urdf_io import atomic_write_text
+
+    with pytest.raises(FileNotFoundError):
+        atomic_write_text(tmp_path / "nope" / "x.urdf", "text")
+    assert not any(tmp_path.iterdir())
