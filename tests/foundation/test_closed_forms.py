@@ -132,13 +132,14 @@ def test_printed_002_4_54_v_fails():
 
 
 def test_printed_002_4_52_x_fails():
-    """002 (4-52) x as printed: h2 cos θ3 (θ3 = 0 is fixed, so cos θ3 = 1) where cos θ2 belongs."""
+    """002 (4-52) x as printed (l. 388): P(S5 C4 cos θ3 − C5 S2) where cos θ2 belongs (θ3 = 0 is the
+    fixed angle of the prismatic row, so cos θ3 = 1)."""
     r = aa.load("rrprr5")
     p = r.spec.params
     Q = r.random_q(50, 10)
     t1, t2, s2, t4, t5 = Q.T
     C1, S1, C2, S2, C4, S4, C5, S5 = (f(t) for t in (t1, t2, t4, t5) for f in (np.cos, np.sin))
-    x_printed = (p["p"] * (S5 * C4 * C2 - C5 * S2) + s2 * S2 + p["h2"] * 1.0) * C1 + p["p"] * S5 * S4 * S1
+    x_printed = (p["p"] * (S5 * C4 * 1.0 - C5 * S2) + s2 * S2 + p["h2"] * C2) * C1 + p["p"] * S5 * S4 * S1
     assert np.abs(x_printed - r.fk(Q)[:, 0, 3]).max() > 0.01
 
 
