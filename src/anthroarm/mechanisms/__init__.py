@@ -1,1 +1,11 @@
-"""Closed-chain mechanisms: four-bar, RSSR, RRSS, RCCC, dyads, finger and thumb linkages."""
+"""Closed-chain mechanisms: four-bar, RSSR, RRSS, RCCC, dyads, finger and thumb linkages.
+
+Part B (four-bar, RSSR, RRSS, dyads, thumb, finger, Pinocchio closed loops):
+
+>>> from anthroarm.mechanisms import fourbar
+>>> s = fourbar(4.0, 1.5, 3.5, 3.0, 0.7, omega2=2.0)     # book Fig. 5-1, corrected (5-12)-(5-22)
+"""
+
+from .fourbar import (CouplerPoint, FourBarRange, FourBarState, coupler_point, fourbar, fourbar_acceleration,
+                      fourbar_cartesian, fourbar_grashof, fourbar_input_range, fourbar_points, fourbar_position,
+                      fourbar_velocity, transmission_angle)

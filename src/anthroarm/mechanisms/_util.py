@@ -1,0 +1,145 @@
+"""Private helpers of :mod:`anthroarm.mechanisms`: input validation and 3x3 rotation algebra.
+
+The rotation helpers are the 002 text's matrices (book notation in brackets):
+
+* ``skew(u)`` = [P_u], the cross-product matrix, 002 line 185 and Eq. (6-89) with the
+  *standard* sign pattern (the print swaps u_x and u_z, see docs/errata.md);
+* ``rot(theta, u)`` = [R_{theta,u}] = -[P_u]^2 cos(theta) + [P_u] sin(theta) + [Q_u], Eq. (6-89),
+  equal to Rodrigues' form (6-88) and to ``pin.exp3(theta * u)``;
+* ``W(thetadot, u)`` = [W_{thetadot,u}] = thetadot [P_u], Eq. (6-91);
+* ``Wdot(thetadot, thetaddot, u)`` = [E] = thetaddot [P_u] + thetadot^2 [P_u]^2, Eq. (6-92)
+  for a fixed axis (002 (4-28)).
+
+All frames are world frames, right-handed, SI units.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: tolerance on |u| - 1 for an axis to count as a unit vector
+UNIT_TOL = 1e-9
+
+
+def finite_scalar(name: str, x) -> float:
+    """``float(x)`` or ``ValueError`` naming ``name`` when x is not a finite real scalar."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real scalar, got {x!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    return v
+
+
+def positive_length(name: str, x) -> float:
+    v = finite_scalar(name, x)
+    if v <= 0.0:
+        raise ValueError(f"{name} must be a positive length, got {x!r}")
+    return v
+
+
+def finite_array(name: str, x, shape=None) -> np.ndarray:
+    """Float array (copy) of ``x``; ``ValueError`` naming ``name`` for a wrong shape or NaN/inf.
+
+    ``shape`` may contain ``None`` for "any size" in that position (checked from the end)."""
+    try:
+        a = np.array(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real array, got {x!r}") from None
+    if shape is not None:
+        tail = a.shape[len(a.shape) - len(shape):] if len(a.shape) >= len(shape) else None
+        if tail is None or len(a.shape) != len(shape) or any(s is not None and s != t for s, t in zip(shape, tail)):
+            raise ValueError(f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite, got {x!r}")
+    return a
+
+
+def point3(name: str, x) -> np.ndarray:
+    return finite_array(name, x, (3,))
+
+
+def unit_axis(name: str, u) -> np.ndarray:
+    """A 3-vector that must already be a unit vector (|u| = 1 within 1e-9); ``ValueError`` otherwise."""
+    a = finite_array(name, u, (3,))
+    n = float(np.linalg.norm(a))
+    if n == 0.0:
+        raise ValueError(f"{name} is a zero-length axis: {a.tolist()}")
+    if abs(n - 1.0) > UNIT_TOL:
+        raise ValueError(f"{name} must be a unit vector, |{name}| = {n!r} for {a.tolist()}")
+    return a / n
+
+
+def skew(u) -> np.ndarray:
+    """[P_u]: skew(u) @ x == cross(u, x).  Batched over leading axes."""
+    u = np.asarray(u, dtype=float)
+    z = np.zeros(u.shape[:-1])
+    return np.stack([np.stack([z, -u[..., 2], u[..., 1]], -1),
+                     np.stack([u[..., 2], z, -u[..., 0]], -1),
+                     np.stack([-u[..., 1], u[..., 0], z], -1)], -2)
+
+
+def rot(theta, u) -> np.ndarray:
+    """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in theta."""
+    theta = np.asarray(theta, dtype=float)
+    u = np.asarray(u, dtype=float)
+    P = skew(u)
+    Q = np.outer(u, u)
+    c = np.cos(theta)[..., None, None]
+    s = np.sin(theta)[..., None, None]
+    return -(P @ P) * c + P * s + Q
+
+
+def W(thetadot, u) -> np.ndarray:
+    """[W_{thetadot,u}] = thetadot [P_u], Eq. (6-91): W @ r == (thetadot u) x r."""
+    return np.asarray(thetadot, dtype=float)[..., None, None] * skew(u)
+
+
+def Wdot(thetadot, thetaddot, u) -> np.ndarray:
+    """Angular-acceleration matrix for a fixed axis, Eq. (6-92) / 002 (4-28):
+    thetaddot [P_u] + thetadot^2 [P_u]^2, so that r_ddot = Wdot @ r for r fixed in the body."""
+    P = skew(u)
+    return (np.asarray(thetaddot, dtype=float)[..., None, None] * P
+            + np.asarray(thetadot, dtype=float)[..., None, None] ** 2 * (P @ P))
+
+
+def wrap(a):
+    """Angle(s) wrapped to (-pi, pi]."""
+    a = np.asarray(a, dtype=float)
+    w = np.mod(a + np.pi, 2 * np.pi) - np.pi
+    w = np.where(w == -np.pi, np.pi, w)
+    return float(w) if w.ndim == 0 else w
+
+
+def out(x):
+    """Scalars as Python floats/bools/str, arrays unchanged."""
+    a = np.asarray(x)
+    if a.ndim == 0:
+        return a.item()
+    return a
+
+
+# 8th-order central finite-difference stencils (offsets 1..4)
+_D1 = np.array([4 / 5, -1 / 5, 4 / 105, -1 / 280])
+_D2 = np.array([8 / 5, -1 / 5, 8 / 315, -1 / 560])
+_D2_0 = -205 / 72
+
+
+def fd_rates(f, h: float = 1e-2, angular: bool = False):
+    """First and second derivative at t = 0 of ``f(t)`` (array-valued) by 8th-order central
+    differences.  ``angular=True`` wraps differences to (-pi, pi] (for angle outputs).
+
+    Used as the *mathematical* oracle of the mechanism rates: for smooth outputs with
+    derivatives of order one, h = 1e-2 gives errors ~1e-12 (truncation h^8, round-off eps/h^2)."""
+    f0 = np.asarray(f(0.0), dtype=float)
+    d1 = np.zeros_like(f0)
+    d2 = _D2_0 * np.zeros_like(f0)
+    for k in range(1, 5):
+        fp = np.asarray(f(k * h), dtype=float) - f0
+        fm = np.asarray(f(-k * h), dtype=float) - f0
+        if angular:
+            fp, fm = np.asarray(wrap(fp)), np.asarray(wrap(fm))
+        d1 = d1 + _D1[k - 1] * (fp - fm)
+        d2 = d2 + _D2[k - 1] * (fp + fm)
+    return d1 / h, d2 / (h * h)
