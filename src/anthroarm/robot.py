@@ -50,8 +50,11 @@ class Robot:
         self.name = name or info.robot_name
         self.spec = spec
         self.description = description
+        # Mimic joints: Pinocchio models them (mimic=True) as yourdfpy does, as joints driven by
+        # the joint they mimic, so both libraries describe the same mechanism.
+        self.has_mimic = any(j["mimic"] is not None for j in info.joints.values())
         try:
-            full = pin.buildModelFromXML(info.text)
+            full = pin.buildModelFromXML(info.text, mimic=self.has_mimic)
         except Exception as exc:  # pin raises RuntimeError/ValueError from C++
             raise URDFStructureError(info.path, f"Pinocchio cannot build the model: {exc}") from None
         for j in full.joints[1:]:
@@ -96,7 +99,9 @@ class Robot:
 
     @cached_property
     def joint_names(self) -> list[str]:
-        return [self.model.names[i] for i in range(1, self.model.njoints)]
+        """Names of the joints that carry configuration variables, in q order (mimic joints,
+        which have none, are left out)."""
+        return [self.model.names[i] for i in range(1, self.model.njoints) if self.model.joints[i].nq > 0]
 
     @cached_property
     def lower(self) -> np.ndarray:
@@ -234,10 +239,9 @@ class Robot:
     def yourdfpy_cfg(self, q) -> dict:
         """Map a configuration to yourdfpy's actuated-joint configuration by joint name.
 
-        Locked joints get their locked value; mimic joints are left to yourdfpy, which
-        computes them from the joint they mimic (Pinocchio built without ``mimic`` treats them
-        as fixed at zero; the cross-check compares only links whose pose both agree to model,
-        see :mod:`anthroarm.crosscheck`)."""
+        Locked joints get their locked value; mimic joints are not actuated in yourdfpy, which
+        computes them from the joint they mimic, as Pinocchio does (the model is built with
+        ``mimic=True`` when the URDF has mimic joints)."""
         q = self.check_q(q)
         u = self.urdf
         values = dict(self.locked)

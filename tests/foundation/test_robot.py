@@ -81,3 +81,27 @@ def test_random_q_inside_limits(arm):
     Q = arm.random_q(1000, 0)
     assert arm.within_limits(Q).all()
     assert not arm.within_limits(arm.upper + 0.1)
+
+
+MIMIC_URDF = """<robot name="m"><link name="base"/><link name="l1"/><link name="l2"/>
+<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.1"/>
+ <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.2 0 0"/>
+ <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+ <mimic joint="j1" multiplier="2" offset="0.1"/></joint></robot>"""
+
+
+def test_mimic_joint_is_modelled_like_yourdfpy(tmp_path):
+    """A mimic joint is driven by the joint it mimics in Pinocchio and in yourdfpy alike."""
+    p = tmp_path / "mimic.urdf"
+    p.write_text(MIMIC_URDF)
+    r = aa.load(str(p))
+    assert r.has_mimic and r.nq == 1 and r.joint_names == ["j1"]
+    q = np.array([0.3])
+    # l2 turns by q + (2 q + 0.1) about z (mathematics)
+    ang = q[0] + 2 * q[0] + 0.1
+    T = r.fk(q, frame="l2")
+    np.testing.assert_allclose(T[:2, :2], [[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]], atol=1e-15)
+    u = r.urdf
+    u.update_cfg(r.yourdfpy_cfg(q))
+    np.testing.assert_allclose(u.get_transform("l2", u.base_link), T, atol=1e-15)

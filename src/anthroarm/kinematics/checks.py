@@ -72,22 +72,6 @@ def _yourdfpy_rows(robot, Q, scale) -> CheckRow:
     u = robot.urdf
     model, data = robot.model, robot.data
     names = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name in u.link_map]
-    # mimic joints: Pinocchio (built without mimic) holds them fixed at zero; compare a link
-    # below a mimic joint only where yourdfpy puts that joint at zero too.
-    skipped = set()
-    for jn, j in u.joint_map.items():
-        if j.mimic is not None:
-            master = robot.locked.get(j.mimic.joint, None)
-            if master is None and j.mimic.joint in robot.joint_names:
-                master = np.nan  # moves with q
-            val = (j.mimic.multiplier or 1.0) * (master if master is not None else 0.0) + (j.mimic.offset or 0.0)
-            if not (np.isfinite(val) and val == 0.0):
-                stack = [j.child]
-                while stack:
-                    ln = stack.pop()
-                    skipped.add(ln)
-                    stack += [c.child for c in u.joint_map.values() if c.parent == ln]
-    names = [n for n in names if n not in skipped]
     fids = [model.getFrameId(n) for n in names]
     err = 0.0
     for q in Q:
@@ -95,7 +79,7 @@ def _yourdfpy_rows(robot, Q, scale) -> CheckRow:
         pin.framesForwardKinematics(model, data, q)
         for n, fid in zip(names, fids):
             err = max(err, _pose_err(u.get_transform(n, u.base_link), data.oMf[fid].homogeneous, scale))
-    note = f"{len(names)} links" + (f"; {len(skipped)} below mimic joints skipped" if skipped else "")
+    note = f"{len(names)} links" + ("; mimic joints modelled by both" if robot.has_mimic else "")
     return CheckRow(robot.name, "fk yourdfpy (all links)", err, TOL, len(Q), "pinocchio", note)
 
 
