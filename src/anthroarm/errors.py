@@ -69,3 +69,8 @@ class ViewerError(AnthroarmError):
 
 class ViewerPortInUseError(ViewerError, OSError):
     """The requested viewer port on 127.0.0.1 is already taken."""
+
+
+class InertiaError(UnsupportedModelError, ValueError):
+    """A link inertia cannot be used for dynamics: negative or non-finite mass, an indefinite
+    or non-symmetric inertia tensor, or a chain without mass (M(q) singular)."""
