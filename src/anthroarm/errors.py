@@ -74,3 +74,7 @@ class ViewerPortInUseError(ViewerError, OSError):
 class InertiaError(UnsupportedModelError, ValueError):
     """A link inertia cannot be used for dynamics: negative or non-finite mass, an indefinite
     or non-symmetric inertia tensor, or a chain without mass (M(q) singular)."""
+
+
+class SolverNotAvailableError(AnthroarmError, ValueError):
+    """A QP solver name that is unknown or not installed.  The message lists the installed ones."""
