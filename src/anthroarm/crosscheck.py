@@ -23,6 +23,7 @@ import numpy as np
 PROVIDERS: list[str] = [
     "anthroarm.kinematics.checks:rows",
     "anthroarm.design.structure:reach_rows",
+    "anthroarm.dynamics.checks:rows",
 ]
 
 
