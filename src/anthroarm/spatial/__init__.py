@@ -13,6 +13,9 @@ One concept per module:
 * :mod:`~anthroarm.spatial.dual` — dual numbers, lines, dual angles, dual orthogonal matrices;
 * :mod:`~anthroarm.spatial.polar` — complex polar vectors (5-1)–(5-11), (5-23)/(5-24).
 
+The names ``rotation_tensor`` and ``hand_angles`` are the *modules*; call
+``spatial.rotation_tensor.rotation_tensor(w, θ)`` and ``spatial.hand_direction_angles(C)``.
+
 Conventions: §5-4/§5-5 rotations are active (new → old, Pinocchio's ``oMi.rotation``); §5-6
 dual matrices are passive (old → new).  SI units, radians.
 """
@@ -22,7 +25,7 @@ from .dual import Dual, Line
 from .euler import EulerAngles, euler_xyx, euler_xyx_inverse, euler_zxz, euler_zxz_inverse
 from .hand_angles import hand_angles as hand_direction_angles
 from .hand_angles import hand_matrix
-from .rotation_tensor import J1, J2, J3, rotate, rotated_vector_motion, rotation_tensor
+from .rotation_tensor import J1, J2, J3, rotate, rotated_vector_motion
 from .rotations import axis_angle, check_rotation, check_unit_axis, rot_axis, rot_x, rot_y, rot_z, skew, unit_axis, unskew
 from .screw import acceleration_matrix, rotation_matrix, screw_matrix, screw_twist, velocity_matrix
 
@@ -30,7 +33,7 @@ __all__ = [
     "dual", "euler", "hand_angles", "polar", "rotation_tensor", "rotations", "screw",
     "Dual", "Line", "EulerAngles", "euler_xyx", "euler_xyx_inverse", "euler_zxz", "euler_zxz_inverse",
     "hand_direction_angles", "hand_matrix", "J1", "J2", "J3", "rotate", "rotated_vector_motion",
-    "rotation_tensor", "axis_angle", "check_rotation", "check_unit_axis", "rot_axis", "rot_x", "rot_y",
+    "axis_angle", "check_rotation", "check_unit_axis", "rot_axis", "rot_x", "rot_y",
     "rot_z", "skew", "unit_axis", "unskew", "acceleration_matrix", "rotation_matrix", "screw_matrix",
     "screw_twist", "velocity_matrix",
 ]
