@@ -1,1 +1,25 @@
-"""meshcat browser viewer."""
+"""meshcat browser viewer.
+
+>>> import anthroarm as aa
+>>> v = aa.viewer.Viewer("human_arm7")                  # scene in memory
+>>> v.show_workspace(); v.show_limits(); v.export_html("arm.html")
+>>> live = aa.viewer.Viewer("human_arm7", live=True)     # server on 127.0.0.1, browser tab
+>>> live.open()
+
+:class:`Viewer` — poses (one message per update), overlays (frames, IK target, workspace
+coloured by manipulability, joint-limit colours, trace), animation playback, static HTML
+export, Jupyter cells.  :mod:`~anthroarm.viewer.server` runs the 127.0.0.1-only server process;
+:mod:`~anthroarm.viewer.browser` takes headless-Chromium screenshots (tests, docs).
+"""
+
+from .viewer import Viewer, limit_color, limit_proximity, manipulability
+
+__all__ = ["Viewer", "limit_color", "limit_proximity", "manipulability", "show"]
+
+
+def show(robot, q=None, **kwargs) -> Viewer:
+    """One-liner: a :class:`Viewer` of ``robot`` (name or Robot) at ``q``."""
+    v = Viewer(robot, **kwargs)
+    if q is not None:
+        v.display(q)
+    return v

@@ -1,0 +1,93 @@
+"""Headless Chromium screenshots of viewer pages, and a pixel test that something is drawn.
+
+Used by the real-browser tests and to make ``docs/human_arm_viewer.png``.  Needs Debian's
+``chromium`` (or ``chromium-browser`` / ``google-chrome``) on PATH; WebGL runs on SwiftShader
+(software), so no GPU or display is needed.
+
+>>> png = screenshot("file:///tmp/arm.html", "/tmp/arm.png")
+>>> drawn_fraction(png, baseline_png, region=(0.2, 0.1, 0.8, 0.9))   # share of changed pixels
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+#: Flags that make headless Chromium render WebGL in software, offline and quietly.
+CHROMIUM_FLAGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--hide-scrollbars",
+    "--disable-default-apps", "--disable-extensions", "--mute-audio",
+]
+
+
+def find_chromium() -> str | None:
+    """Path of a Chromium/Chrome executable, or None."""
+    for name in ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable"):
+        p = shutil.which(name)
+        if p:
+            return p
+    return None
+
+
+def screenshot(url, png, size=(800, 600), budget_ms: int = 6000, timeout: float = 120.0) -> Path:
+    """Load ``url`` (http://, file://, or a local path) in headless Chromium and save a PNG.
+
+    ``budget_ms`` is Chromium's virtual-time budget: how long the page may run (scripts,
+    animation frames) before the picture is taken.  Raises RuntimeError if Chromium is
+    missing or fails, naming the reason."""
+    exe = find_chromium()
+    if exe is None:
+        raise RuntimeError("no chromium on PATH (Debian: apt-get install chromium)")
+    url = str(url)
+    if "://" not in url:
+        url = Path(url).resolve().as_uri()
+    png = Path(png)
+    png.unlink(missing_ok=True)
+    with tempfile.TemporaryDirectory(prefix="anthroarm-chromium-") as prof:
+        cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}", f"--screenshot={png}",
+               f"--window-size={int(size[0])},{int(size[1])}", f"--virtual-time-budget={int(budget_ms)}", url]
+        try:
+            res = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            raise RuntimeError(f"chromium did not finish within {timeout} s on {url}") from None
+    if not png.is_file():
+        tail = res.stderr.decode("utf-8", "replace").strip().splitlines()[-3:]
+        raise RuntimeError(f"chromium wrote no screenshot (exit {res.returncode}): {' | '.join(tail)}")
+    return png
+
+
+def load_rgb(png) -> np.ndarray:
+    from PIL import Image
+
+    with Image.open(png) as im:
+        return np.asarray(im.convert("RGB")).astype(np.int16)
+
+
+def changed_mask(png, baseline_png, tol: int = 40) -> np.ndarray:
+    """Boolean image: pixels whose colour differs from the baseline by more than ``tol``
+    (sum of |ΔR|+|ΔG|+|ΔB|)."""
+    a, b = load_rgb(png), load_rgb(baseline_png)
+    if a.shape != b.shape:
+        raise ValueError(f"screenshots differ in size: {a.shape} vs {b.shape}")
+    return np.abs(a - b).sum(axis=2) > tol
+
+
+def region_slice(shape, region) -> tuple[slice, slice]:
+    """``region`` = (x0, y0, x1, y1) as fractions of the width and height."""
+    h, w = shape[:2]
+    x0, y0, x1, y1 = region
+    return slice(int(y0 * h), int(y1 * h)), slice(int(x0 * w), int(x1 * w))
+
+
+def drawn_fraction(png, baseline_png, region=(0.0, 0.0, 1.0, 1.0), tol: int = 40) -> float:
+    """Share of the pixels inside ``region`` that differ from the baseline screenshot (the same
+    page without the robot)."""
+    m = changed_mask(png, baseline_png, tol)
+    ys, xs = region_slice(m.shape, region)
+    return float(m[ys, xs].mean())

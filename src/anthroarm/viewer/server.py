@@ -1,0 +1,212 @@
+"""Start, talk to and stop the viewer's meshcat server subprocess (``_server.py``).
+
+>>> srv = ServerProcess(port=7000)       # raises ViewerPortInUseError if 7000 is taken
+>>> srv.web_url
+'http://127.0.0.1:7000/static/'
+>>> srv.send_many([cmd1, cmd2])          # one ZeroMQ message, one websocket message
+>>> srv.close()                          # also done at interpreter exit
+
+The server listens on 127.0.0.1 only; it exits on its own when this process dies.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import weakref
+
+import umsgpack
+import zmq
+
+from ..errors import ViewerError, ViewerPortInUseError
+
+_SERVER_SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_server.py")
+HOST = "127.0.0.1"
+
+
+def port_is_free(port: int) -> bool:
+    """True if a TCP server could bind 127.0.0.1:``port`` right now."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        s.bind((HOST, port))
+        return True
+    except OSError:
+        return False
+    finally:
+        s.close()
+
+
+def _check_port(port) -> int | None:
+    if port is None:
+        return None
+    try:
+        p = int(port)
+    except (TypeError, ValueError):
+        raise ValueError(f"port must be an integer in 1..65535, got {port!r}") from None
+    if not 1 <= p <= 65535 or p != port:
+        raise ValueError(f"port must be an integer in 1..65535, got {port!r}")
+    return p
+
+
+def _stop(proc: subprocess.Popen, log) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=3)
+        except subprocess.TimeoutExpired:  # pragma: no cover - terminate is enough on Linux
+            proc.kill()
+            proc.wait()
+    try:
+        log.close()
+    except Exception:  # pragma: no cover
+        pass
+
+
+class ServerProcess:
+    """A meshcat-compatible server on 127.0.0.1 in a subprocess, and a ZeroMQ client to it.
+
+    Parameters
+    ----------
+    port : int, optional
+        HTTP/websocket port.  ``None``: the first free port from 7000.  A given port that is
+        taken raises :class:`~anthroarm.errors.ViewerPortInUseError` (no silent fallback).
+    timeout : float
+        Seconds to wait for the server to start, and for each reply.
+    """
+
+    context = zmq.Context.instance()
+
+    def __init__(self, port: int | None = None, timeout: float = 20.0):
+        port = _check_port(port)
+        if port is not None and not port_is_free(port):
+            raise ViewerPortInUseError(_in_use_message(port))
+        self._log = tempfile.TemporaryFile(mode="w+")
+        args = [sys.executable, "-u", _SERVER_SCRIPT, "--parent-pid", str(os.getpid())]
+        if port is not None:
+            args += ["--port", str(port)]
+        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.DEVNULL,
+                                     start_new_session=True)
+        self._finalizer = weakref.finalize(self, _stop, self.proc, self._log)
+        atexit.register(self._finalizer)
+        line = self._read_line(timeout)
+        if line.startswith("error port_in_use"):
+            self._finalizer()
+            raise ViewerPortInUseError(_in_use_message(port))
+        if not line.startswith("ready "):
+            self._finalizer()
+            raise ViewerError(f"the viewer server did not start: {line or self._stderr_tail()}")
+        fields = dict(kv.split("=", 1) for kv in line.split()[1:])
+        self.zmq_url = fields["zmq_url"]
+        self.web_url = fields["web_url"]
+        self.port = int(self.web_url.rsplit(":", 1)[1].split("/")[0])
+        self.timeout_ms = int(timeout * 1000)
+        self._connect()
+
+    # ------------------------------------------------------------------ plumbing
+    def _read_line(self, timeout: float) -> str:
+        import selectors
+
+        sel = selectors.DefaultSelector()
+        sel.register(self.proc.stdout, selectors.EVENT_READ)
+        try:
+            if not sel.select(timeout):
+                return f"no answer within {timeout} s"
+            return self.proc.stdout.readline().decode("utf-8", "replace").strip()
+        finally:
+            sel.close()
+
+    def _stderr_tail(self) -> str:
+        try:
+            self._log.seek(0)
+            lines = [ln for ln in self._log.read().splitlines() if ln.strip()]
+            return lines[-1] if lines else "no output"
+        except Exception:  # pragma: no cover
+            return "no output"
+
+    def _connect(self) -> None:
+        self.sock = self.context.socket(zmq.REQ)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.setsockopt(zmq.RCVTIMEO, self.timeout_ms)
+        self.sock.connect(self.zmq_url)
+
+    def _request(self, frames: list[bytes]) -> bytes:
+        if not self.alive:
+            raise ViewerError("the viewer server is not running (closed, or it exited)")
+        self.sock.send_multipart(frames)
+        try:
+            reply = self.sock.recv()
+        except zmq.Again:
+            self.sock.close()
+            self._connect()
+            raise ViewerError("the viewer server did not answer") from None
+        if reply.startswith(b"error"):
+            raise ViewerError(f"the viewer server refused a command: {reply.decode()}")
+        return reply
+
+    # ------------------------------------------------------------------ API
+    @property
+    def alive(self) -> bool:
+        return self.proc.poll() is None
+
+    def send(self, cmd: dict) -> None:
+        """Send one lowered meshcat command (``SetObject(...).lower()`` etc.)."""
+        self._request([cmd["type"].encode(), cmd.get("path", "").encode(), umsgpack.packb(cmd)])
+
+    def send_many(self, cmds: list[dict]) -> None:
+        """Send several commands as ONE message; the browser applies them together."""
+        if not cmds:
+            return
+        if len(cmds) == 1:
+            return self.send(cmds[0])
+        batch = {"type": "anthroarm_batch", "path": "", "commands": cmds}
+        self._request([b"anthroarm_batch", b"", umsgpack.packb(batch)])
+
+    def clients(self) -> int:
+        """Number of browser tabs connected."""
+        return int(self._request([b"clients"]))
+
+    def wait(self, n: int = 1, timeout: float = 30.0) -> None:
+        """Block until ``n`` browser tabs are connected (ViewerError after ``timeout`` s)."""
+        self.sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000))
+        try:
+            self._request([b"wait", str(n).encode()])
+        finally:
+            if not self.sock.closed:
+                self.sock.setsockopt(zmq.RCVTIMEO, self.timeout_ms)
+
+    def static_html(self) -> str:
+        return self._request([b"get_scene"]).decode("utf-8")
+
+    def close(self) -> None:
+        """Stop the server process (idempotent)."""
+        try:
+            if self.alive:
+                self.sock.setsockopt(zmq.RCVTIMEO, 1000)
+                self.sock.send_multipart([b"shutdown"])
+                self.sock.recv()
+        except Exception:
+            pass
+        try:
+            self.sock.close()
+        except Exception:  # pragma: no cover
+            pass
+        self._finalizer()
+        try:
+            atexit.unregister(self._finalizer)
+        except Exception:  # pragma: no cover
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _in_use_message(port) -> str:
+    return (f"port {port} on 127.0.0.1 is already in use (another viewer or program); "
+            f"choose a free one with --port / port=, or leave it unset to pick the first free port from 7000")

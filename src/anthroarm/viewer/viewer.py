@@ -1,0 +1,506 @@
+"""The meshcat viewer of a Robot: poses, overlays, animations, static HTML, Jupyter.
+
+>>> import anthroarm as aa
+>>> v = aa.viewer.Viewer("human_arm7")              # in memory: export or show inline
+>>> v.display(q)                                     # all link transforms in ONE message
+>>> v.show_target(T); v.show_workspace(); v.show_limits()
+>>> v.play(Q, dt=0.02); v.export_html("reach.html") # self-contained file, arm moving
+>>> live = aa.viewer.Viewer("panda", live=True)      # + a server on 127.0.0.1 (browser tab)
+>>> live.url
+'http://127.0.0.1:7000/static/'
+
+Every command updates an in-process copy of the scene (so ``static_html()`` never needs the
+server) and, when ``live``, is forwarded to the server — a pose update as one
+``anthroarm_batch`` message, so the browser never draws a half-updated arm.
+
+Coordinates: overlays (targets, traces, workspace) are given in the robot's base frame (m),
+like ``robot.fk``.  The robot is shifted in the browser so that its reach is centred on
+meshcat's orbit target; that shift is invisible to the API.
+"""
+
+from __future__ import annotations
+
+import html as _html
+import math
+import re
+from pathlib import Path
+
+import meshcat.geometry as mg
+import numpy as np
+import pinocchio as pin
+from meshcat.commands import SetObject
+
+from ._store import SceneStore
+from .visuals import LINK_RGB, Body, Piece, _tf, _y_to, cylinder_between, rgb_hex, robot_bodies
+
+ROOT = "/meshcat/anthroarm"
+#: Colour of a joint at its limit (joint-limit proximity).
+LIMIT_RGB = (0.92, 0.12, 0.10)
+#: Proximity above which a link starts to turn red: the last 15 % of the range on each side.
+LIMIT_WARN = 0.7
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.\-]", "_", str(name)) or "_"
+
+
+def _set_transform(path: str, T: np.ndarray) -> dict:
+    return {"type": "set_transform", "path": path, "matrix": np.asarray(T, float).T.ravel().tolist()}
+
+
+def _set_object(path: str, geometry, rgb=(0.7, 0.7, 0.7), opacity: float = 1.0, material=None) -> dict:
+    if material is None:
+        kw = {"color": rgb_hex(rgb)}
+        if opacity < 1.0:
+            kw.update(opacity=float(opacity), transparent=True)
+        material = mg.MeshPhongMaterial(**kw)
+    if isinstance(geometry, mg.Object):
+        cmd = SetObject(geometry)
+    else:
+        cmd = SetObject(geometry, material)
+    d = cmd.lower()
+    d["path"] = path
+    return d
+
+
+def _set_property(path: str, key: str, value) -> dict:
+    return {"type": "set_property", "path": path, "property": key, "value": value}
+
+
+def _delete(path: str) -> dict:
+    return {"type": "delete", "path": path}
+
+
+def limit_proximity(q, lower, upper) -> np.ndarray:
+    """0 at the middle of each joint's range, 1 at (or beyond) a limit; 0 for unbounded joints."""
+    q, lo, hi = (np.asarray(x, float) for x in (q, lower, upper))
+    out = np.zeros_like(q)
+    fin = np.isfinite(lo) & np.isfinite(hi) & (hi > lo)
+    half = 0.5 * (hi[fin] - lo[fin])
+    mid = 0.5 * (hi[fin] + lo[fin])
+    out[fin] = np.clip(np.abs(q[fin] - mid) / half, 0.0, 1.0)
+    return out
+
+
+def limit_color(p: float, base=LINK_RGB) -> tuple[float, float, float]:
+    """Link colour for proximity ``p``: the base colour up to :data:`LIMIT_WARN`, then a blend
+    to :data:`LIMIT_RGB` at the limit."""
+    w = float(np.clip((p - LIMIT_WARN) / (1.0 - LIMIT_WARN), 0.0, 1.0))
+    return tuple((1 - w) * b + w * r for b, r in zip(base, LIMIT_RGB))
+
+
+def manipulability(robot, Q, frame=None) -> np.ndarray:
+    """Translational manipulability (Yoshikawa) of ``frame`` at each row of ``Q``: the product
+    of the singular values of the 3 × nv linear block of the LOCAL_WORLD_ALIGNED Jacobian
+    (= sqrt(det(Jv Jvᵀ)) when nv ≥ 3).  Units m^min(3, nv)."""
+    Q = robot.check_q(Q)
+    J = robot.jacobian(np.atleast_2d(Q), frame)[:, :3, :]
+    s = np.linalg.svd(J, compute_uv=False)
+    k = min(3, robot.nv)
+    w = np.prod(s[:, :k], axis=1)
+    return w if Q.ndim == 2 else w[0]
+
+
+def viridis(x: np.ndarray) -> np.ndarray:
+    """RGB (N, 3) in [0, 1] of the viridis colour map at ``x`` in [0, 1]."""
+    from matplotlib import colormaps
+
+    return np.asarray(colormaps["viridis"](np.clip(x, 0, 1)))[:, :3]
+
+
+class Viewer:
+    """A meshcat scene showing one Robot.
+
+    Parameters
+    ----------
+    robot : Robot or str
+        A loaded robot or a catalog name.
+    live : bool
+        Start a server on 127.0.0.1 (see :class:`~anthroarm.viewer.server.ServerProcess`) so a
+        browser tab or a Jupyter iframe shows the scene as it changes.  ``False``: the scene
+        lives in memory only (``export_html``, ``jupyter_cell``).
+    port : int, optional
+        Server port (``live=True``); a port in use raises ViewerPortInUseError.
+    style : {"auto", "generated", "urdf"}
+        Visuals: generated capsules/cylinders/spheres (book models) or the URDF's meshes.
+    background : ((r, g, b), (r, g, b)), optional
+        meshcat's gradient (top, bottom; 0..255).  Default: meshcat's background hidden, the
+        page's own light CSS gradient shows through (identical in every browser, including
+        headless software WebGL, where meshcat's gradient texture comes out inverted).
+    q : array, optional
+        Initial configuration (default ``robot.neutral()``).
+    """
+
+    def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
+                 q=None, name: str | None = None, background=None, grid: bool = False):
+        if isinstance(robot, (str, Path)):
+            from ..robot import load
+
+            robot = load(robot)
+        self.robot = robot
+        self.store = SceneStore()
+        self.server = None
+        if live:
+            from .server import ServerProcess
+
+            self.server = ServerProcess(port=port)
+        self.root = f"{ROOT}/{_safe(name or robot.name)}"
+        self.bodies: list[Body] = robot_bodies(robot, style)
+        self._overlay_bodies: dict[str, list[Body]] = {}
+        self._limits_on = False
+        self._colors: dict[str, tuple] = {}
+        self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
+        self._frame_scene(background, grid)
+        self._send(self._body_objects(self.bodies))
+        self.display(self.q)
+
+    # ------------------------------------------------------------------ plumbing
+    def _send(self, cmds: list[dict]) -> None:
+        if not cmds:
+            return
+        for c in cmds:
+            self.store.apply(c)
+        if self.server is not None:
+            self.server.send_many(cmds)
+
+    def _bpath(self, body: Body, prefix: str = "bodies") -> str:
+        return f"{self.root}/{prefix}/{_safe(body.name)}"
+
+    def _body_objects(self, bodies, prefix="bodies") -> list[dict]:
+        cmds = []
+        for b in bodies:
+            bp = self._bpath(b, prefix)
+            for k, p in enumerate(b.pieces):
+                path = f"{bp}/{p.group}/{k}"
+                cmds.append(_set_object(path, p.geometry, p.rgb, p.opacity))
+                if not np.allclose(p.offset, np.eye(4)):
+                    cmds.append(_set_transform(path, p.offset))
+        return cmds
+
+    def _frame_scene(self, background, grid: bool) -> None:
+        """Centre the reach on meshcat's orbit target, place the camera and the grid."""
+        robot = self.robot
+        Q = robot.random_q(128, rng=0)
+        pts = []
+        model, data = robot.model, robot.data
+        for qi in Q:
+            pin.framesForwardKinematics(model, data, qi)
+            pts.extend(np.array(data.oMi[j].translation) for j in range(1, model.njoints))
+            pts.append(np.array(data.oMf[robot.tool_id].translation))
+        pts = np.asarray(pts + [np.zeros(3)])
+        lo, hi = pts.min(0), pts.max(0)
+        self.center = 0.5 * (lo + hi)
+        self.radius = float(max(np.linalg.norm(pts - self.center, axis=1).max(), 0.1))
+        cmds = [_set_transform(self.root, _tf(p=-self.center))]
+        floor = min(0.0, float(lo[2])) - 0.01  # base frame
+        cmds.append(_set_transform("/Grid", _tf(p=[0, 0, floor - self.center[2]])))
+        if not grid:
+            cmds.append(_set_property("/Grid", "visible", False))
+        # a translucent floor disc under the reach (always drawn; robust in software WebGL,
+        # where meshcat's line grid is drawn wrongly at oblique angles)
+        rf = 1.1 * self.radius
+        disc = mg.Cylinder(0.004 * rf, rf)
+        cmds.append(_set_object(f"{self.root}/floor", disc, (0.78, 0.81, 0.86), 0.6))
+        cmds.append(_set_transform(f"{self.root}/floor", _tf(_y_to([0, 0, 1]), [self.center[0], self.center[1], floor])))
+        cmds.append(_set_property("/Axes", "visible", False))
+        if background is None:
+            cmds.append(_set_property("/Background", "visible", False))
+        else:
+            top, bottom = background
+            cmds.append(_set_property("/Background", "top_color", [int(c) for c in top]))
+            cmds.append(_set_property("/Background", "bottom_color", [int(c) for c in bottom]))
+        self._send(cmds)
+        self.set_camera()
+
+    # ------------------------------------------------------------------ scene settings
+    def set_camera(self, direction=(0.6, 0.9, 0.5), distance: float | None = None) -> None:
+        """Look at the centre of the reach from ``direction`` (base-frame axes) at ``distance``
+        (default: the whole reach fits the 75° field of view)."""
+        d = np.asarray(direction, float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) < 1e-9:
+            raise ValueError(f"direction must be a non-zero finite 3-vector, got {direction!r}")
+        d = d / np.linalg.norm(d)
+        dist = float(distance) if distance is not None else 1.08 * self.radius / math.sin(math.radians(37.5))
+        if not (dist > 0 and math.isfinite(dist)):
+            raise ValueError(f"distance must be positive and finite, got {distance!r}")
+        x, y, z = dist * d
+        # the camera lives in meshcat's y-up "rotated" frame: world (x, y, z) -> (x, z, -y)
+        self._send([_set_property("/Cameras/default/rotated/<object>", "position", [x, z, -y])])
+
+    def set_background(self, top=None, bottom=None, visible: bool = True) -> None:
+        """Background gradient colours (0..255 RGB); ``visible=False`` for a transparent page."""
+        cmds = []
+        if top is not None:
+            cmds.append(_set_property("/Background", "top_color", [int(c) for c in top]))
+        if bottom is not None:
+            cmds.append(_set_property("/Background", "bottom_color", [int(c) for c in bottom]))
+        cmds.append(_set_property("/Background", "visible", bool(visible)))
+        self._send(cmds)
+
+    def set_grid(self, visible: bool) -> None:
+        self._send([_set_property("/Grid", "visible", bool(visible))])
+
+    # ------------------------------------------------------------------ poses
+    def _all_bodies(self):
+        for b in self.bodies:
+            yield b, "bodies"
+        for name, bs in self._overlay_bodies.items():
+            for b in bs:
+                yield b, f"overlays/{name}"
+
+    def _pose_commands(self, q) -> list[dict]:
+        model, data = self.robot.model, self.robot.data
+        pin.framesForwardKinematics(model, data, q)
+        cmds = []
+        for b, prefix in self._all_bodies():
+            if b.joint is not None:
+                T = data.oMi[b.joint].homogeneous
+            elif b.frame is not None:
+                T = data.oMf[b.frame].homogeneous
+            else:
+                continue
+            cmds.append({"type": "set_transform", "path": self._bpath(b, prefix), "matrix": T.T.ravel().tolist()})
+        return cmds
+
+    def _color_commands(self, q) -> list[dict]:
+        cmds = []
+        if self._limits_on:
+            prox = limit_proximity(q, self.robot.lower, self.robot.upper)
+        for b in self.bodies:
+            if b.dof is None:
+                continue
+            group = "links" if any(p.group == "links" for p in b.pieces) else "mesh"
+            path = f"{self._bpath(b)}/{group}"
+            if self._limits_on:
+                base = next((p.rgb for p in b.pieces if p.group == group), LINK_RGB)
+                rgb = tuple(round(c, 3) for c in limit_color(float(prox[b.dof]), base))
+            else:
+                rgb = None
+            if self._colors.get(path) != rgb:
+                self._colors[path] = rgb
+                if rgb is None:  # restore the original colours
+                    cmds += [_set_object(f"{path}/{k}", p.geometry, p.rgb, p.opacity)
+                             for k, p in enumerate(b.pieces) if p.group == group]
+                    cmds += [_set_transform(f"{path}/{k}", p.offset)
+                             for k, p in enumerate(b.pieces) if p.group == group and not np.allclose(p.offset, np.eye(4))]
+                else:
+                    cmds.append({"type": "anthroarm_color", "path": path, "color": list(rgb)})
+        return cmds
+
+    def display(self, q) -> None:
+        """Show configuration ``q``: every link transform (and, with :meth:`show_limits`,
+        every changed link colour) in one message."""
+        q = self.robot.check_q(q, "q")
+        if q.ndim != 1:
+            raise ValueError(f"{self.robot.name}: display takes one configuration ({self.robot.nq},), got {q.shape}; use play() for a trajectory")
+        self.q = q.copy()
+        self._send(self._pose_commands(q) + self._color_commands(q))
+
+    def show_limits(self, on: bool = True) -> None:
+        """Colour each link by how close its joint is to a limit (red within the last 15 %)."""
+        self._limits_on = bool(on)
+        self._send(self._color_commands(self.q))
+
+    # ------------------------------------------------------------------ overlays
+    def _overlay_path(self, name: str) -> str:
+        return f"{self.root}/overlays/{_safe(name)}"
+
+    def clear(self, name: str | None = None) -> None:
+        """Remove one overlay by name, or every overlay."""
+        if name is None:
+            self._overlay_bodies.clear()
+            self._send([_delete(f"{self.root}/overlays")])
+        else:
+            self._overlay_bodies.pop(_safe(name), None)
+            self._send([_delete(self._overlay_path(name))])
+
+    @staticmethod
+    def _triad(size: float, radius: float | None = None, opacity: float = 1.0) -> list[Piece]:
+        r = radius if radius is not None else 0.06 * size
+        cols = [(0.9, 0.1, 0.1), (0.1, 0.75, 0.1), (0.1, 0.25, 0.95)]
+        out = []
+        for i, c in enumerate(cols):
+            e = np.zeros(3)
+            e[i] = size
+            out += cylinder_between(np.zeros(3), e, r, c, "triad", opacity)
+        return out
+
+    def show_frames(self, frames=None, size: float | None = None, name: str = "frames") -> None:
+        """Coordinate triads (x red, y green, z blue) that follow the robot: ``frames`` is a
+        list of frame names, ``None`` for the tool, or ``"joints"`` for every joint frame."""
+        size = size if size is not None else 0.12 * self.radius
+        robot = self.robot
+        bodies = []
+        if frames == "joints":
+            for j in range(1, robot.model.njoints):
+                bodies.append(Body(robot.model.names[j], self._triad(size), joint=j))
+        else:
+            names = [robot.tool] if frames is None else ([frames] if isinstance(frames, str) else list(frames))
+            for f in names:
+                bodies.append(Body(str(f), self._triad(size), frame=robot.frame_id(f)))
+        key = _safe(name)
+        self.clear(key)
+        self._overlay_bodies[key] = bodies
+        self._send(self._body_objects(bodies, f"overlays/{key}"))
+        self.display(self.q)
+
+    def show_target(self, T, name: str = "target", size: float | None = None, rgb=(0.95, 0.55, 0.05)) -> None:
+        """An IK target: a translucent ball and a triad at ``T`` (4×4 pose, or a 3-vector
+        position), in the robot's base frame, metres."""
+        T = np.asarray(T, float)
+        if T.shape == (3,):
+            T = _tf(p=T)
+        if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+            raise ValueError(f"target must be a finite 4x4 pose or a 3-vector, got shape {T.shape}")
+        size = size if size is not None else 0.1 * self.radius
+        path = self._overlay_path(name)
+        cmds = [_delete(path), _set_transform(path, T),
+                _set_object(f"{path}/ball", mg.Sphere(0.35 * size), rgb, 0.45)]
+        for k, p in enumerate(self._triad(size, 0.05 * size)):
+            cmds += [_set_object(f"{path}/triad/{k}", p.geometry, p.rgb), _set_transform(f"{path}/triad/{k}", p.offset)]
+        self._send(cmds)
+
+    def show_trace(self, points, name: str = "trace", rgb=(0.85, 0.1, 0.55), radius: float | None = None,
+                   configurations: bool | None = None) -> np.ndarray:
+        """A polyline through ``points`` (N, 3) in the base frame, or through the tool positions
+        of a joint trajectory (N, nq) (``configurations=True``; guessed from the shape when
+        None).  Drawn as thin cylinders so it is visible at any zoom.  Returns the (N, 3) points."""
+        P = np.asarray(points, float)
+        if configurations is None:
+            configurations = P.ndim == 2 and P.shape[1] == self.robot.nq and P.shape[1] != 3
+        if configurations:
+            P = self.robot.fk(self.robot.check_q(P, "trajectory"))[:, :3, 3]
+        if P.ndim != 2 or P.shape[1] != 3 or len(P) < 2:
+            raise ValueError(f"trace needs (N>=2, 3) points or (N, {self.robot.nq}) configurations, got shape {P.shape}")
+        if not np.all(np.isfinite(P)):
+            raise ValueError("trace points contain NaN or inf")
+        r = radius if radius is not None else 0.012 * self.radius
+        path = self._overlay_path(name)
+        cmds = [_delete(path)]
+        # thin out to at most 200 segments
+        idx = np.unique(np.linspace(0, len(P) - 1, min(len(P), 201)).round().astype(int))
+        Pk = P[idx]
+        for k in range(len(Pk) - 1):
+            for p in cylinder_between(Pk[k], Pk[k + 1], r, rgb, "trace"):
+                cmds += [_set_object(f"{path}/{k}", p.geometry, p.rgb), _set_transform(f"{path}/{k}", p.offset)]
+        self._send(cmds)
+        return P
+
+    def show_workspace(self, n: int = 4000, rng=0, frame=None, name: str = "workspace",
+                       point_size: float | None = None) -> dict:
+        """The reachable workspace of ``frame`` (default tool) as a point cloud of ``n`` random
+        configurations inside the limits, coloured by translational manipulability
+        (:func:`manipulability`; viridis, yellow = most dexterous).  Returns
+        ``{"points": (n, 3), "manipulability": (n,)}``."""
+        if int(n) < 1:
+            raise ValueError(f"n must be >= 1, got {n}")
+        Q = self.robot.random_q(int(n), rng=rng)
+        P = self.robot.fk(Q, frame)[:, :3, 3]
+        w = manipulability(self.robot, Q, frame)
+        top = float(w.max()) if w.size and w.max() > 0 else 1.0
+        colors = viridis(w / top)
+        size = point_size if point_size is not None else 0.02 * self.radius
+        cloud = mg.PointCloud(P.T.astype(np.float32), colors.T.astype(np.float32), size=size)
+        path = self._overlay_path(name)
+        self._send([_delete(path), _set_object(path, cloud)])
+        return {"points": P, "manipulability": w}
+
+    # ------------------------------------------------------------------ animation
+    def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
+        """Play the joint trajectory ``Q`` (N, nq), one row every ``dt`` seconds, as a meshcat
+        animation (also stored in :meth:`static_html`).  ``trace`` draws the tool path."""
+        Q = self.robot.check_q(Q, "Q")
+        if Q.ndim != 2 or len(Q) < 2:
+            raise ValueError(f"play needs a trajectory of shape (N>=2, {self.robot.nq}), got {Q.shape}")
+        if not (dt > 0 and math.isfinite(dt)):
+            raise ValueError(f"dt must be positive and finite, got {dt}")
+        if trace:
+            self.show_trace(Q, configurations=True)
+        fps = 1.0 / dt
+        tracks: dict[str, tuple[list, list]] = {}
+        for k, q in enumerate(Q):
+            for cmd in self._pose_commands(q):
+                M = np.asarray(cmd["matrix"]).reshape(4, 4).T
+                quat = pin.Quaternion(M[:3, :3]).coeffs()  # x, y, z, w as three.js
+                pos, rot = tracks.setdefault(cmd["path"], ([], []))
+                pos.append({"time": k, "value": M[:3, 3].tolist()})
+                rot.append({"time": k, "value": [float(c) for c in quat]})
+        anims = [{"path": path, "clip": {"fps": fps, "name": "default", "tracks": [
+            {"name": ".position", "type": "vector3", "keys": pos},
+            {"name": ".quaternion", "type": "quaternion", "keys": rot}]}}
+            for path, (pos, rot) in tracks.items()]
+        cmd = {"type": "set_animation", "path": "", "animations": anims,
+               "options": {"play": True, "repetitions": float("inf") if loop else 1}}
+        self.display(Q[0])
+        self._send([cmd])
+        self.trajectory = Q
+
+    # ------------------------------------------------------------------ output
+    def static_html(self, title: str | None = None) -> str:
+        """A self-contained HTML page (meshcat's JavaScript inlined) with the current scene and
+        animation; opens offline in any browser."""
+        return self.store.static_html(title or f"anthroarm — {self.robot.name}")
+
+    def export_html(self, path) -> Path:
+        """Write :meth:`static_html` to ``path`` (its folder must exist); returns the path."""
+        path = Path(path)
+        if not path.parent.is_dir():
+            raise FileNotFoundError(f"folder {path.parent} does not exist (cannot write {path.name})")
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(self.static_html(), encoding="utf-8")
+        tmp.replace(path)
+        return path
+
+    @property
+    def url(self) -> str | None:
+        """Browser URL of the live server (None when not live)."""
+        return self.server.web_url if self.server is not None else None
+
+    def open(self) -> "Viewer":
+        """Open the live scene in the default web browser."""
+        if self.server is None:
+            raise RuntimeError("this viewer is not live; create it with live=True, or use export_html()")
+        import webbrowser
+
+        webbrowser.open(self.url, new=2)
+        return self
+
+    def wait(self, n: int = 1, timeout: float = 30.0) -> None:
+        """Block until ``n`` browser tabs are connected to the live server."""
+        if self.server is None:
+            raise RuntimeError("this viewer is not live")
+        self.server.wait(n, timeout)
+
+    def _iframe(self, height: int) -> str:
+        if self.server is not None:
+            src = f'src="{self.url}"'
+        else:
+            src = f'srcdoc="{_html.escape(self.static_html(), quote=True)}"'
+        return (f'<div style="height: {int(height)}px; width: 100%; overflow: hidden; resize: both">'
+                f'<iframe {src} style="width: 100%; height: 100%; border: none"></iframe></div>')
+
+    def jupyter_cell(self, height: int = 420):
+        """Inline view for Jupyter: the live page when live, else a static snapshot that works
+        without any server (and in exported notebooks)."""
+        from IPython.display import HTML
+
+        return HTML(self._iframe(height))
+
+    def _repr_html_(self) -> str:
+        return self._iframe(420)
+
+    def close(self) -> None:
+        """Stop the server (if live).  The in-memory scene stays usable for export."""
+        if self.server is not None:
+            self.server.close()
+            self.server = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __repr__(self) -> str:
+        where = self.url if self.server is not None else "in memory"
+        return f"Viewer({self.robot.name!r}, {where})"
