@@ -1,0 +1,31 @@
+"""QP differential inverse kinematics on Pinocchio (one concept per module, as pink does it).
+
+>>> import anthroarm as aa
+>>> from anthroarm.ik import qp
+>>> robot = aa.load("panda")
+>>> conf = qp.IKConfiguration(robot)
+>>> ee = qp.FrameTask(robot, position_cost=1.0, orientation_cost=1.0, lm_damping=1e-3)
+>>> ee.set_target(robot.fk(robot.random_q(rng=0)))
+>>> v = qp.step(conf, None, [ee, qp.PostureTask(robot, cost=1e-3)], dt=0.01)   # OSQP, default limits
+>>> conf.integrate_inplace(v, 0.01)
+
+Tasks (``qp.tasks``): FrameTask, PositionTask, OrientationTask, RelativeFrameTask, PostureTask,
+DampingTask, JointCouplingTask (mimic), SwivelTask.  Limits (``qp.limits``): ConfigurationLimit,
+VelocityLimit, AccelerationLimit.  Backends (``qp.backends``): persistent OSQP, daqp, quadprog,
+proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
+"""
+
+from . import backends, limits, tasks
+from .backends import available_solvers, make_backend
+from .configuration import IKConfiguration
+from .limits import AccelerationLimit, ConfigurationLimit, Limit, VelocityLimit
+from .step import StepResult, default_limits, step
+from .tasks import (DampingTask, FrameTask, JointCouplingTask, OrientationTask, PositionTask, PostureTask,
+                    RelativeFrameTask, SwivelTask, Task, comfortable_posture, mimic_tasks, swivel_angle)
+
+__all__ = [
+    "step", "StepResult", "IKConfiguration", "default_limits", "available_solvers", "make_backend",
+    "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask", "DampingTask",
+    "JointCouplingTask", "SwivelTask", "mimic_tasks", "comfortable_posture", "swivel_angle",
+    "Limit", "ConfigurationLimit", "VelocityLimit", "AccelerationLimit", "backends", "limits", "tasks",
+]

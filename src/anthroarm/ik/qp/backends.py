@@ -1,0 +1,339 @@
+"""QP backends of the differential IK: persistent workspaces for OSQP, daqp, proxqp, quadprog,
+and a generic qpsolvers path for any other installed solver.
+
+Every backend solves
+
+    min ½ xᵀ H x + cᵀ x   s.t.   lo ≤ x ≤ hi   (box, ±inf allowed),   A x = b   (optional)
+
+and returns ``(x, status)`` with status ``"optimal"``, ``"infeasible"`` or ``"failed"``.  The
+returned x is clipped into [lo, hi] (a no-op up to the solver tolerance), so joint limits
+encoded as the box are never violated.
+
+Why persistent workspaces (peers.md §4.2): through ``qpsolvers.solve_qp`` OSQP costs ~1 ms per
+7-variable QP because the dense→CSC conversion (``csc_matrix``, ``sp.triu``) dominates, and at its
+default tolerance it deviates 1.7e-4 from a dense solver (pink#163).  :class:`OSQPBackend`
+builds the sparse structure once (full upper-triangular pattern of H, identity plus a dense
+equality block for A), then per step only calls ``update(Px=…, q=…, l=…, u=…)`` and solves
+warm-started, with eps 1e-10 and solution polishing so the answer matches a dense solver.
+daqp, quadprog and proxqp are called directly (no qpsolvers conversion layer); ``"qpsolvers:NAME"``
+goes through ``qpsolvers.solve_qp`` for solvers without a direct path.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from ...errors import SolverNotAvailableError
+
+BIG = 1e20  # finite stand-in for an infinite bound (solvers differ in how they read inf)
+
+
+def _module_available(name: str) -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec(name) is not None
+
+
+DIRECT = {"osqp": "osqp", "daqp": "daqp", "quadprog": "quadprog", "proxqp": "proxsuite"}
+
+
+def available_solvers() -> list[str]:
+    """Names accepted by :func:`make_backend` on this machine: the direct backends whose module
+    is installed, then ``"qpsolvers:NAME"`` for every solver qpsolvers can run (the slow, rebuild-per-call path)."""
+    names = [n for n, mod in DIRECT.items() if _module_available(mod)]
+    try:
+        import qpsolvers
+
+        names += [f"qpsolvers:{s}" for s in qpsolvers.available_solvers]
+    except ImportError:  # pragma: no cover - qpsolvers is a dependency
+        pass
+    return names
+
+
+def _finite(x: np.ndarray) -> np.ndarray:
+    return np.minimum(np.maximum(x, -BIG), BIG)
+
+
+class Backend:
+    """Base class: ``solve(H, c, lo, hi, A=None, b=None) -> (x, status)``."""
+
+    name = "base"
+
+    def __init__(self, n: int, n_eq: int = 0):
+        self.n = int(n)
+        self.n_eq = int(n_eq)
+        self.last_info: dict = {}
+
+    def solve(self, H, c, lo, hi, A=None, b=None):  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def _finish(self, x, lo, hi, A, b, status):
+        """Clip into the box and check the equality residual; map failures to a status."""
+        if x is None or not np.isfinite(x).all():
+            return None, status if status != "optimal" else "failed"
+        x = np.minimum(np.maximum(x, lo), hi)
+        if A is not None and len(b):
+            res = float(np.abs(A @ x - b).max())
+            self.last_info["eq_residual"] = res
+            if res > 1e-6 * max(1.0, float(np.abs(b).max())):
+                return None, "infeasible"
+        return x, status
+
+
+class OSQPBackend(Backend):
+    """OSQP with a persistent workspace (sparse structure built once, ``update`` + warm start)."""
+
+    name = "osqp"
+    # OSQP's own polishing prints to stdout even with verbose=False (osqp 1.1.3), so we polish
+    # ourselves (:meth:`_polish`): same idea, reduced KKT on the active set read from the duals.
+    SETTINGS = dict(verbose=False, eps_abs=1e-9, eps_rel=1e-9, eps_prim_inf=1e-9, eps_dual_inf=1e-9,
+                    polishing=False, max_iter=20000, warm_starting=True, adaptive_rho=True,
+                    check_termination=5)
+
+    def __init__(self, n: int, n_eq: int = 0, **settings):
+        super().__init__(n, n_eq)
+        import osqp
+        import scipy.sparse as sp
+
+        self._osqp = osqp
+        # upper-triangular pattern of H in CSC order (column by column, rows 0..j)
+        cols = np.concatenate([np.full(j + 1, j) for j in range(n)])
+        rows = np.concatenate([np.arange(j + 1) for j in range(n)])
+        self._tri = (rows, cols)
+        P = sp.csc_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+        # A = [I; Aeq] with a dense pattern for the equality block; Ax in CSC order is
+        # vstack([1, Aeq[:, j]]) column by column
+        arows = np.concatenate([np.concatenate([[j], n + np.arange(n_eq)]) for j in range(n)])
+        acols = np.repeat(np.arange(n), 1 + n_eq)
+        A = sp.csc_matrix((np.ones(len(arows)), (arows, acols)), shape=(n + n_eq, n))
+        assert P.nnz == len(rows) and A.nnz == len(arows)
+        self._ones = np.ones((1, n))
+        self.settings = {**self.SETTINGS, **settings}
+        self.solver = osqp.OSQP()
+        self.solver.setup(P, np.zeros(n), A, -np.full(n + n_eq, BIG), np.full(n + n_eq, BIG), **self.settings)
+
+    def solve(self, H, c, lo, hi, A=None, b=None):
+        n_eq = 0 if A is None else len(A)
+        if n_eq != self.n_eq:
+            raise ValueError(f"OSQPBackend built for {self.n_eq} equality rows, got {n_eq}")
+        lo_f, hi_f = _finite(lo), _finite(hi)
+        if n_eq:
+            l = np.concatenate([lo_f, b])
+            u = np.concatenate([hi_f, b])
+            self.solver.update(Px=H[self._tri], q=c, l=l, u=u,
+                               Ax=np.vstack([self._ones, A]).ravel(order="F"))
+        else:
+            self.solver.update(Px=H[self._tri], q=c, l=lo_f, u=hi_f)
+        res = self.solver.solve(raise_error=False)
+        info = res.info
+        self.last_info = {"status": info.status, "iter": info.iter, "polish": info.status_polish}
+        st = info.status_val
+        S = self._osqp.SolverStatus
+        if st == S.OSQP_SOLVED:
+            status = "optimal"
+        elif st in (S.OSQP_PRIMAL_INFEASIBLE, S.OSQP_PRIMAL_INFEASIBLE_INACCURATE):
+            self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
+            return None, "infeasible"
+        elif st == S.OSQP_SOLVED_INACCURATE:
+            status = "optimal"
+            self.last_info["inaccurate"] = True
+        else:
+            self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
+            return None, "failed"
+        x = np.array(res.x)
+        xp = self._polish(H, c, lo, hi, A, b, x, np.array(res.y))
+        self.last_info["polished"] = xp is not None
+        return self._finish(x if xp is None else xp, lo, hi, A, b, status)
+
+    def _polish(self, H, c, lo, hi, A, b, x, y):
+        """Exact solution on the active set guessed from OSQP's duals (OSQP's polish rule:
+        lower bound active if x − lo < −y, upper if hi − x < y), accepted only if it is
+        primal feasible and the multipliers have the right signs; else ``None``."""
+        n = self.n
+        yb = y[:n]
+        act_lo = (x - lo) < -yb
+        act_hi = (hi - x) < yb
+        act = act_lo | act_hi
+        xa = np.where(act_lo, lo, np.where(act_hi, hi, 0.0))
+        free = ~act
+        nf = int(free.sum())
+        rhs = -(c + H[:, act] @ xa[act])[free]
+        try:
+            if A is None or not len(A):
+                xf = np.linalg.solve(H[np.ix_(free, free)], rhs) if nf else np.zeros(0)
+                lam = None
+            else:
+                m = len(A)
+                K = np.zeros((nf + m, nf + m))
+                K[:nf, :nf] = H[np.ix_(free, free)]
+                K[:nf, nf:] = A[:, free].T
+                K[nf:, :nf] = A[:, free]
+                sol = np.linalg.solve(K, np.concatenate([rhs, b - A[:, act] @ xa[act]]))
+                xf, lam = sol[:nf], sol[nf:]
+        except np.linalg.LinAlgError:
+            return None
+        xp = xa.copy()
+        xp[free] = xf
+        tol = 1e-9
+        if np.any(xp < lo - tol) or np.any(xp > hi + tol):
+            return None
+        g = H @ xp + c
+        if lam is not None:
+            g = g + A.T @ lam
+        if np.any(g[act_lo] < -1e-8) or np.any(g[act_hi] > 1e-8):
+            return None
+        return xp
+
+
+class DaqpBackend(Backend):
+    """daqp (dual active set), called directly; box rows as simple bounds."""
+
+    name = "daqp"
+
+    def __init__(self, n: int, n_eq: int = 0):
+        super().__init__(n, n_eq)
+        import daqp
+
+        self._daqp = daqp
+        self._sense = np.zeros(n + n_eq, dtype=ctypes.c_int)
+        self._sense[n:] = 5  # equality rows: active + immutable
+        self._A0 = np.zeros((0, n))
+
+    def solve(self, H, c, lo, hi, A=None, b=None):
+        if A is None or not len(A):
+            bu, bl, Am = _finite(hi), _finite(lo), self._A0
+        else:
+            bu = np.concatenate([_finite(hi), b])
+            bl = np.concatenate([_finite(lo), b])
+            Am = np.ascontiguousarray(A)
+        x, _, flag, info = self._daqp.solve(H, c, Am, bu, bl, self._sense)
+        self.last_info = {"exitflag": int(flag), "iter": info.get("iterations")}
+        if flag > 0:
+            return self._finish(np.array(x), lo, hi, A, b, "optimal")
+        return None, "infeasible" if flag == -1 else "failed"
+
+
+class QuadprogBackend(Backend):
+    """quadprog (Goldfarb–Idnani), called directly.  The box becomes the constant inequality
+    block [I; −I] (infinite bounds replaced by ±1e20, never active), built once."""
+
+    name = "quadprog"
+
+    def __init__(self, n: int, n_eq: int = 0):
+        super().__init__(n, n_eq)
+        import quadprog
+
+        self._qp = quadprog
+        self._eye = np.eye(n)
+        self._C = np.hstack([np.zeros((n, n_eq)), self._eye, -self._eye])
+
+    def solve(self, H, c, lo, hi, A=None, b=None):
+        meq = 0 if A is None else len(A)
+        if meq:
+            self._C[:, :meq] = A.T
+            bb = np.concatenate([b, _finite(lo), -_finite(hi)])
+        else:
+            bb = np.concatenate([_finite(lo), -_finite(hi)])
+        try:
+            x = self._qp.solve_qp(H, -c, self._C, bb, meq)[0]
+        except ValueError as exc:
+            msg = str(exc)
+            self.last_info = {"error": msg}
+            if "inconsistent" in msg:
+                return None, "infeasible"
+            if "positive definite" not in msg:
+                return None, "failed"
+            # singular H: retry once with a tiny Tikhonov term
+            eps = 1e-10 * max(1.0, float(np.trace(H)) / self.n)
+            try:
+                x = self._qp.solve_qp(H + eps * self._eye, -c, self._C, bb, meq)[0]
+            except ValueError:
+                return None, "failed"
+        else:
+            self.last_info = {}
+        return self._finish(x, lo, hi, A, b, "optimal")
+
+
+class ProxqpBackend(Backend):
+    """proxsuite ProxQP dense with a persistent workspace (``init`` once, then ``update``)."""
+
+    name = "proxqp"
+
+    def __init__(self, n: int, n_eq: int = 0):
+        super().__init__(n, n_eq)
+        from proxsuite import proxqp
+
+        self._proxqp = proxqp
+        self.qp = proxqp.dense.QP(n, n_eq, n)
+        self.qp.settings.eps_abs = 1e-10
+        self.qp.settings.eps_rel = 0.0
+        self.qp.settings.verbose = False
+        self.qp.settings.initial_guess = proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+        self._eye = np.eye(n)
+        self._initialised = False
+
+    def solve(self, H, c, lo, hi, A=None, b=None):
+        Aeq = np.zeros((0, self.n)) if A is None else A
+        beq = np.zeros(0) if b is None else b
+        args = (H, c, Aeq, beq, self._eye, _finite(lo), _finite(hi))
+        if not self._initialised:
+            self.qp.init(*args)
+            self._initialised = True
+        else:
+            self.qp.update(*args)
+        self.qp.solve()
+        st = self.qp.results.info.status
+        S = self._proxqp.QPSolverOutput
+        self.last_info = {"status": str(st), "iter": self.qp.results.info.iter}
+        if st == S.PROXQP_SOLVED:
+            return self._finish(np.array(self.qp.results.x), lo, hi, A, b, "optimal")
+        if st == S.PROXQP_PRIMAL_INFEASIBLE:
+            return None, "infeasible"
+        return None, "failed"
+
+
+class QpsolversBackend(Backend):
+    """Any solver qpsolvers can run (``"qpsolvers:clarabel"``, ...); rebuilds per call."""
+
+    def __init__(self, n: int, n_eq: int = 0, solver: str = "osqp"):
+        super().__init__(n, n_eq)
+        self.solver = solver
+        self.name = f"qpsolvers:{solver}"
+
+    def solve(self, H, c, lo, hi, A=None, b=None):
+        import qpsolvers
+
+        kw = {}
+        if A is not None and len(A):
+            kw = {"A": A, "b": b}
+        try:
+            x = qpsolvers.solve_qp(H, c, lb=_finite(lo), ub=_finite(hi), solver=self.solver, **kw)
+        except Exception as exc:  # solver-specific exception types
+            self.last_info = {"error": repr(exc)}
+            return None, "failed"
+        if x is None:
+            return None, "infeasible" if A is not None and len(A) else "failed"
+        return self._finish(np.array(x), lo, hi, A, b, "optimal")
+
+
+_DIRECT_CLASSES = {"osqp": OSQPBackend, "daqp": DaqpBackend, "quadprog": QuadprogBackend, "proxqp": ProxqpBackend}
+
+
+def make_backend(solver: str, n: int, n_eq: int = 0) -> Backend:
+    """A fresh backend for ``n`` variables and ``n_eq`` equality rows.
+
+    ``solver``: ``"osqp"`` (default of :func:`~anthroarm.ik.qp.step`), ``"daqp"``,
+    ``"quadprog"``, ``"proxqp"``, or ``"qpsolvers:NAME"``.  A bare name that only qpsolvers knows
+    is accepted too.  An unknown or uninstalled solver raises
+    :class:`~anthroarm.errors.SolverNotAvailableError` listing the installed ones."""
+    if not isinstance(solver, str):
+        raise SolverNotAvailableError(f"solver must be a string, got {solver!r}; installed: {', '.join(available_solvers())}")
+    avail = available_solvers()
+    if solver in _DIRECT_CLASSES and solver in avail:
+        return _DIRECT_CLASSES[solver](n, n_eq)
+    name = solver.split(":", 1)[1] if solver.startswith("qpsolvers:") else solver
+    if f"qpsolvers:{name}" in avail:
+        return QpsolversBackend(n, n_eq, name)
+    raise SolverNotAvailableError(f"QP solver {solver!r} is not installed; installed solvers: {', '.join(avail)}")

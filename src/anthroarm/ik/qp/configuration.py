@@ -1,0 +1,107 @@
+"""IKConfiguration: a robot at a configuration q, with cached kinematics for the QP tasks.
+
+One ``update(q)`` runs ``pin.computeJointJacobians`` (forward kinematics + every joint Jacobian,
+one pass); frame placements and frame Jacobians are then read lazily and cached until the next
+update.  ``integrate(v, dt)`` maps a tangent velocity back onto the configuration space with
+``pin.integrate`` (exact on Lie groups, plain ``q + v dt`` for revolute/prismatic joints).
+
+Frames and units: placements are world poses (SE(3), m); Jacobians are 6 × nv with rows
+(v; ω) in the requested reference frame (``LOCAL`` by default, the body Jacobian that the book
+writes in the hand frame, Eq. (7-94)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+LOCAL = pin.ReferenceFrame.LOCAL
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+WORLD = pin.ReferenceFrame.WORLD
+
+
+class IKConfiguration:
+    """A configuration ``q`` of ``robot`` plus the kinematic quantities tasks need.
+
+    Parameters
+    ----------
+    robot : anthroarm.Robot
+        The arm (its ``model`` is shared; this object owns a fresh ``pin.Data``).
+    q : array (nq,), optional
+        Initial configuration (default ``robot.neutral()``).  It may lie outside the joint
+        limits: the limits of :func:`anthroarm.ik.qp.step` then pull it back inside.
+    """
+
+    def __init__(self, robot, q=None):
+        self.robot = robot
+        self.model: pin.Model = robot.model
+        self.data: pin.Data = robot.model.createData()
+        self.nq = robot.model.nq
+        self.nv = robot.model.nv
+        self.lower = np.array(robot.model.lowerPositionLimit, dtype=float)
+        self.upper = np.array(robot.model.upperPositionLimit, dtype=float)
+        self.q = np.zeros(self.nq)
+        self._placements: dict = {}
+        self._jacobians: dict = {}
+        self.update(robot.neutral() if q is None else q)
+
+    def __repr__(self) -> str:
+        return f"IKConfiguration({self.robot.name!r}, q={np.array2string(self.q, precision=4)})"
+
+    # ------------------------------------------------------------------ state
+    def update(self, q=None) -> None:
+        """Set ``q`` (a copy is kept) and recompute the kinematics.  ``ValueError`` for a wrong
+        shape or a non-finite entry (naming the joint)."""
+        if q is not None:
+            q = np.asarray(q, dtype=float)
+            if q.shape != (self.nq,) or not np.isfinite(q).all():
+                self.robot.check_q(q if q.ndim == 1 else q, name="q")  # raises with the joint name
+                if q.shape != (self.nq,):
+                    raise ValueError(f"{self.robot.name}: q must have shape ({self.nq},), got {q.shape}")
+            self.q = q.copy()
+        pin.computeJointJacobians(self.model, self.data, self.q)
+        self._placements.clear()
+        self._jacobians.clear()
+
+    def frame_placement(self, frame_id: int) -> pin.SE3:
+        """World pose of frame ``frame_id`` (SE(3), m)."""
+        M = self._placements.get(frame_id)
+        if M is None:
+            M = pin.SE3(pin.updateFramePlacement(self.model, self.data, frame_id))
+            self._placements[frame_id] = M
+        return M
+
+    def frame_jacobian(self, frame_id: int, reference=LOCAL) -> np.ndarray:
+        """Frame Jacobian 6 × nv, rows (v; ω), in ``reference`` (default LOCAL)."""
+        key = (frame_id, reference)
+        J = self._jacobians.get(key)
+        if J is None:
+            self.frame_placement(frame_id)
+            J = pin.getFrameJacobian(self.model, self.data, frame_id, reference)
+            self._jacobians[key] = J
+        return J
+
+    def transform(self, frame_id: int, root_id: int) -> pin.SE3:
+        """Pose of ``frame_id`` relative to ``root_id``: T_root⁻¹ T_frame."""
+        return self.frame_placement(root_id).actInv(self.frame_placement(frame_id))
+
+    # ------------------------------------------------------------------ motion
+    def integrate(self, v, dt: float) -> np.ndarray:
+        """Configuration reached by moving at tangent velocity ``v`` (nv,) for ``dt`` seconds."""
+        return pin.integrate(self.model, self.q, np.asarray(v, dtype=float) * dt)
+
+    def integrate_inplace(self, v, dt: float) -> None:
+        """``update(integrate(v, dt))``."""
+        self.update(self.integrate(v, dt))
+
+    def within_limits(self, tol: float = 0.0) -> bool:
+        """True when every joint lies within [lower − tol, upper + tol]."""
+        return bool(np.all(self.q >= self.lower - tol) and np.all(self.q <= self.upper + tol))
+
+    def limit_violations(self, tol: float = 0.0) -> list[str]:
+        """Names of the joints outside their limits (with the value and the range)."""
+        out = []
+        for name, v, lo, hi in zip(self.robot.joint_names, self.q, self.lower, self.upper):
+            if v < lo - tol or v > hi + tol:
+                out.append(f"{name}={v:.6g} not in [{lo:.6g}, {hi:.6g}]")
+        return out

@@ -1,0 +1,53 @@
+"""ConfigurationLimit: joint position limits as a box on the step (pink's formulation).
+
+    gain · (q_min ⊖ q) ≤ Δq ≤ gain · (q_max ⊖ q)
+
+with ⊖ the joint-space difference (m or rad).  A gain < 1 lets a joint approach its limit
+geometrically instead of hitting it in one step (pink's default 0.5).  This is the book's joint
+range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step as hard inequalities
+instead of the exterior penalty (7-85).  Joints with an infinite limit are unbounded.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Limit
+
+
+class ConfigurationLimit(Limit):
+    priority = 1
+
+    def __init__(self, robot, gain: float = 0.5, lower=None, upper=None):
+        if not 0.0 < gain <= 1.0:
+            raise ValueError(f"configuration limit gain must be in (0, 1], got {gain}")
+        self.model = robot.model
+        self.gain = float(gain)
+        self.lower = np.array(robot.model.lowerPositionLimit if lower is None else lower, dtype=float)
+        self.upper = np.array(robot.model.upperPositionLimit if upper is None else upper, dtype=float)
+        if self.lower.shape != (robot.nq,) or self.upper.shape != (robot.nq,):
+            raise ValueError(f"lower/upper must have shape ({robot.nq},)")
+        if np.any(self.lower > self.upper):
+            raise ValueError("lower limit above upper limit for joints "
+                             f"{[n for n, a, b in zip(robot.joint_names, self.lower, self.upper) if a > b]}")
+        # map every velocity index to its configuration index (1-DOF joints); joints with
+        # nq != nv (continuous, spherical ...) have no position limit here
+        qidx = np.full(robot.nv, -1)
+        for j in robot.model.joints[1:]:
+            if j.nq == 1 and j.nv == 1:
+                qidx[j.idx_v] = j.idx_q
+        ok = qidx >= 0
+        self._qidx = np.where(ok, qidx, 0)
+        self._fin_lo = ok & np.isfinite(self.lower[self._qidx])
+        self._fin_hi = ok & np.isfinite(self.upper[self._qidx])
+        self._lo = np.where(self._fin_lo, self.lower[self._qidx], -np.inf)
+        self._hi = np.where(self._fin_hi, self.upper[self._qidx], np.inf)
+        self._identity = bool(np.all(self._qidx == np.arange(robot.nv))) and robot.nq == robot.nv
+
+    def box(self, conf, dt):
+        q = conf.q if self._identity else conf.q[self._qidx]
+        # inf - q stays inf: unbounded joints give an unbounded side
+        return self.gain * (self._lo - q), self.gain * (self._hi - q)
+
+    def __repr__(self) -> str:
+        return f"ConfigurationLimit(gain={self.gain})"

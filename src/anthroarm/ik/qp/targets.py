@@ -1,0 +1,60 @@
+"""Validation of IK targets: rigid 4×4 transforms, rotations and positions (SI units).
+
+Every function raises ``ValueError`` naming the value at fault: wrong shape, NaN/inf, a
+rotation block that is not orthonormal with det +1 (tolerance 1e-6), or a bottom row that is
+not (0, 0, 0, 1).  A rotation within the tolerance is re-orthonormalised (nearest rotation,
+SVD) so that log(R) is well defined.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+RIGID_TOL = 1e-6
+
+
+def _check_finite(a: np.ndarray, name: str) -> None:
+    if not np.isfinite(a).all():
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise ValueError(f"{name}{list(idx)} is {a[idx]} (targets must be finite)")
+
+
+def as_rotation(R, name: str = "R") -> np.ndarray:
+    """A proper rotation matrix (3, 3) or ``ValueError``."""
+    R = np.asarray(R, dtype=float)
+    if R.shape != (3, 3):
+        raise ValueError(f"{name} must be a 3x3 rotation matrix, got shape {R.shape}")
+    _check_finite(R, name)
+    err = float(np.abs(R.T @ R - np.eye(3)).max())
+    det = float(np.linalg.det(R))
+    if err > RIGID_TOL or det < 0:
+        raise ValueError(f"{name} is not a rotation: max|RᵀR − I| = {err:.3g}, det = {det:.6g} "
+                         f"(need orthonormal with det +1 within {RIGID_TOL:g})")
+    if err > 1e-12:
+        U, _, Vt = np.linalg.svd(R)
+        R = U @ Vt
+    return R
+
+
+def as_position(p, name: str = "p") -> np.ndarray:
+    """A position (3,) in m, or ``ValueError``."""
+    p = np.asarray(p, dtype=float)
+    if p.shape != (3,):
+        raise ValueError(f"{name} must be a position of shape (3,), got shape {p.shape}")
+    _check_finite(p, name)
+    return p
+
+
+def as_se3(T, name: str = "T") -> pin.SE3:
+    """A ``pin.SE3`` from a rigid 4×4 homogeneous matrix (or a ``pin.SE3``), or ``ValueError``."""
+    if isinstance(T, pin.SE3):
+        T = T.homogeneous
+    T = np.asarray(T, dtype=float)
+    if T.shape != (4, 4):
+        raise ValueError(f"{name} must be a 4x4 homogeneous transform, got shape {T.shape}")
+    _check_finite(T, name)
+    if np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
+        raise ValueError(f"{name} is not rigid: bottom row {T[3].tolist()} is not [0, 0, 0, 1]")
+    R = as_rotation(T[:3, :3], f"{name}[:3, :3]")
+    return pin.SE3(R, T[:3, 3].copy())

@@ -1,0 +1,17 @@
+"""Tasks of the QP differential IK (one concept per module, as in pink)."""
+
+from .base import Task
+from .coupling import JointCouplingTask, mimic_tasks
+from .damping import DampingTask
+from .frame import FrameTask
+from .orientation import OrientationTask
+from .position import PositionTask
+from .posture import HUMAN_ARM7_COMFORT, PostureTask, comfortable_posture
+from .relative_frame import RelativeFrameTask
+from .swivel import SWIVEL_FRAMES, SwivelTask, swivel_angle, swivel_from_points
+
+__all__ = [
+    "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
+    "DampingTask", "JointCouplingTask", "SwivelTask", "mimic_tasks", "comfortable_posture",
+    "HUMAN_ARM7_COMFORT", "SWIVEL_FRAMES", "swivel_angle", "swivel_from_points",
+]

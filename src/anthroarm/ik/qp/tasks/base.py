@@ -1,0 +1,77 @@
+"""Task: a residual e(q) that differential IK drives to zero, and its QP objective.
+
+Formalism (as in pink, Caron's note on task-based IK): the task asks for the displacement Δq
+to satisfy the first-order dynamics J(q) Δq = −α e(q) (gain α ∈ [0, 1]).  Its contribution to
+the QP objective is
+
+    ½ ‖W (J Δq + α e)‖² + ½ μ ‖Δq‖²,   μ = λ_LM ‖W α e‖²   (Levenberg–Marquardt damping,
+                                                           Sugihara 2011),
+
+i.e. ``H = (WJ)ᵀ(WJ) + μ I`` and ``c = α (WJ)ᵀ W e`` with W = diag(cost).  For the book this is
+the damped form of the Newton step of the feedback-compensation method: with α = 1, μ → 0 and
+a square J, Δq = −J⁻¹ e (Ch. 7 §7-5, notes §6.2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class Task:
+    """Base class.  Subclasses implement ``compute_error`` and ``compute_jacobian``.
+
+    Parameters
+    ----------
+    cost : float or array (m,)
+        Weight W = diag(cost) of the task coordinates (units: [cost] per unit of error).
+    gain : float
+        α ∈ [0, 1]; 1 is dead-beat, smaller values low-pass the task.
+    lm_damping : float
+        Unitless Levenberg–Marquardt scale λ_LM (damps the step when the error is large,
+        which keeps steps bounded near singularities and for unreachable targets).
+    """
+
+    def __init__(self, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0):
+        if not 0.0 <= float(gain) <= 1.0:
+            raise ValueError(f"task gain must be in [0, 1], got {gain}")
+        if float(lm_damping) < 0.0:
+            raise ValueError(f"lm_damping must be >= 0, got {lm_damping}")
+        c = np.asarray(cost, dtype=float)
+        if not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise ValueError(f"task cost must be finite and >= 0, got {cost}")
+        self.cost = c if c.ndim else float(c)
+        self.gain = float(gain)
+        self.lm_damping = float(lm_damping)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(cost={self.cost}, gain={self.gain}, lm_damping={self.lm_damping})"
+
+    # -- to implement ----------------------------------------------------------------------
+    def compute_error(self, conf) -> np.ndarray:
+        """Residual e(q) (m,)."""
+        raise NotImplementedError
+
+    def compute_jacobian(self, conf) -> np.ndarray:
+        """∂e/∂q in the tangent space, (m, nv)."""
+        raise NotImplementedError
+
+    # -- QP objective ----------------------------------------------------------------------
+    def compute_qp_objective(self, conf) -> tuple[np.ndarray, np.ndarray]:
+        """(H, c) of ``½ Δqᵀ H Δq + cᵀ Δq`` for this task (see the module docstring)."""
+        J = self.compute_jacobian(conf)
+        e = self.compute_error(conf)
+        return self._objective(J, e, conf.nv)
+
+    def _objective(self, J, e, nv):
+        w = self.cost
+        if isinstance(w, float):
+            WJ = w * J
+            We = (w * self.gain) * e
+        else:
+            WJ = w[:, None] * J
+            We = (w * self.gain) * e
+        H = WJ.T @ WJ
+        if self.lm_damping:
+            H.flat[:: nv + 1] += self.lm_damping * float(We @ We)
+        c = WJ.T @ We
+        return H, c

@@ -1,0 +1,79 @@
+"""JointCouplingTask: linear relations between joints (finger joints that move together,
+URDF mimic joints).
+
+    e(q) = Σ_j r_j q_j − b  (1,),   J = [r_j at the joint's velocity index]  (1 × nv)
+
+``JointCouplingTask.mimic(robot, joint, mimicked, multiplier, offset)`` encodes the URDF
+``<mimic>`` relation q_joint = multiplier · q_mimicked + offset; :func:`mimic_tasks` builds one
+task per mimic tag of the robot's URDF whose two joints are degrees of freedom of the model.
+Pass them as ``constraints=`` to :func:`~anthroarm.ik.qp.step` to hold them exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Task
+
+
+def _joint_index(robot, name: str) -> int:
+    model = robot.model
+    if not model.existJointName(name):
+        raise ValueError(f"{robot.name}: unknown joint {name!r}; joints: {', '.join(robot.joint_names)}")
+    j = model.joints[model.getJointId(name)]
+    if j.nv != 1:
+        raise ValueError(f"{robot.name}: joint {name!r} has {j.nv} DOF; coupling needs 1-DOF joints")
+    return j.idx_v
+
+
+class JointCouplingTask(Task):
+    """Σ ratios[j] q[joints[j]] = offset, as a soft task (cost) or a hard constraint."""
+
+    def __init__(self, robot, joints, ratios, offset: float = 0.0, cost=1.0, gain: float = 1.0,
+                 lm_damping: float = 0.0):
+        super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
+        joints = list(joints)
+        ratios = np.asarray(ratios, dtype=float)
+        if len(joints) != len(ratios) or len(joints) == 0:
+            raise ValueError(f"need one ratio per joint, got {len(joints)} joints and {len(ratios)} ratios")
+        if not np.isfinite(ratios).all() or not np.isfinite(offset):
+            raise ValueError("ratios and offset must be finite")
+        self.joints = joints
+        self.ratios = ratios
+        self.offset = float(offset)
+        self._row = np.zeros((1, robot.nv))
+        for name, r in zip(joints, ratios):
+            self._row[0, _joint_index(robot, name)] += r
+
+    def __repr__(self) -> str:
+        terms = " + ".join(f"{r:g}·{j}" for j, r in zip(self.joints, self.ratios))
+        return f"JointCouplingTask({terms} = {self.offset:g}, cost={self.cost})"
+
+    @classmethod
+    def mimic(cls, robot, joint: str, mimicked: str, multiplier: float = 1.0, offset: float = 0.0, **kw):
+        """q_joint = multiplier · q_mimicked + offset (URDF ``<mimic>`` semantics)."""
+        return cls(robot, [joint, mimicked], [1.0, -float(multiplier)], offset=offset, **kw)
+
+    def compute_error(self, conf) -> np.ndarray:
+        if conf.nq == conf.nv:
+            qt = conf.q
+        else:  # joint coordinates in the tangent space (1-DOF joints of a Lie-group model)
+            import pinocchio as pin
+
+            qt = pin.difference(conf.model, pin.neutral(conf.model), conf.q)
+        return np.array([self._row[0] @ qt - self.offset])
+
+    def compute_jacobian(self, conf) -> np.ndarray:
+        return self._row.copy()
+
+
+def mimic_tasks(robot, **kw) -> list[JointCouplingTask]:
+    """One :meth:`JointCouplingTask.mimic` per URDF ``<mimic>`` tag whose joints are both DOFs."""
+    tasks = []
+    dofs = set(robot.joint_names)
+    for j in robot.urdf.robot.joints:
+        m = getattr(j, "mimic", None)
+        if m is None or j.name not in dofs or m.joint not in dofs:
+            continue
+        tasks.append(JointCouplingTask.mimic(robot, j.name, m.joint, m.multiplier or 1.0, m.offset or 0.0, **kw))
+    return tasks

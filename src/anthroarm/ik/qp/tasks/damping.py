@@ -1,0 +1,25 @@
+"""DampingTask: penalise the joint displacement itself, e = 0, J = I.
+
+Adds ``cost² ‖Δq‖²`` to the objective: the Tikhonov regulariser of damped least squares
+(Ch. 7 §7-6: the λ → ∞ limit is the steepest-descent direction Jᵀe of the book's A9)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import Task
+
+
+class DampingTask(Task):
+    def __init__(self, cost=1e-3):
+        super().__init__(cost=cost, gain=0.0, lm_damping=0.0)
+
+    def compute_error(self, conf) -> np.ndarray:
+        return np.zeros(conf.nv)
+
+    def compute_jacobian(self, conf) -> np.ndarray:
+        return np.eye(conf.nv)
+
+    def compute_qp_objective(self, conf):
+        w = self.cost
+        return np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float)), np.zeros(conf.nv)

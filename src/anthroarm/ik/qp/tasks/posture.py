@@ -1,0 +1,78 @@
+"""PostureTask: pull the joints toward a reference posture, and the comfortable human posture.
+
+    e(q) = q ⊖ q_ref  (pin.difference),   J = I   (nv × nv)
+
+Used with a small cost it resolves redundancy (the book's redundancy handling by a penalty on
+the configuration, Ch. 7 §7-6 (7-84)–(7-86), becomes a QP regulariser).
+
+:func:`comfortable_posture` gives the relaxed reference posture of the human arm: upper arm
+20° flexed and 15° abducted, humerus unrotated, elbow flexed 80°, forearm mid-pronation, wrist
+straight.  These are the centres of the lowest-load ("score 1") bands of RULA (McAtamney &
+Corlett, Applied Ergonomics 24(2), 1993: upper arm −20…20°, lower arm 60…100°, wrist 0°),
+clipped into the joint limits.  Other robots get the middle of their joint ranges.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from .base import Task
+
+deg = np.pi / 180.0
+
+#: Comfortable posture of ``human_arm7`` (rad), joint name -> value.
+HUMAN_ARM7_COMFORT = {
+    "shoulder_flexion": 20 * deg,
+    "shoulder_abduction": -15 * deg,   # negative = abduction for the right arm (see models.human)
+    "shoulder_rotation": 0.0,
+    "elbow_flexion": 80 * deg,
+    "forearm_pronation": 0.0,
+    "wrist_deviation": 0.0,
+    "wrist_flexion": 0.0,
+}
+
+
+def comfortable_posture(robot) -> np.ndarray:
+    """Reference posture (nq,) of ``robot``: :data:`HUMAN_ARM7_COMFORT` for the human arm
+    (joints matched by name), the middle of the joint ranges otherwise (neutral for unbounded
+    joints); always within the limits."""
+    lo, hi = np.asarray(robot.lower, float), np.asarray(robot.upper, float)
+    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), robot.neutral())
+    names = robot.joint_names
+    if robot.nq == robot.nv and all(n in HUMAN_ARM7_COMFORT for n in names):
+        mid = np.array([HUMAN_ARM7_COMFORT[n] for n in names])
+    return np.clip(mid, lo, hi)
+
+
+class PostureTask(Task):
+    """Posture task; ``target`` defaults to :func:`comfortable_posture`."""
+
+    def __init__(self, robot, cost=1e-3, gain: float = 1.0, lm_damping: float = 0.0, target=None):
+        super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
+        self.model = robot.model
+        self.robot = robot
+        self.set_target(comfortable_posture(robot) if target is None else target)
+
+    def set_target(self, q_ref) -> None:
+        self.target = self.robot.check_q(q_ref, name="posture target").copy()
+        if self.target.ndim != 1:
+            raise ValueError(f"posture target must have shape ({self.robot.nq},)")
+
+    def set_target_from_configuration(self, conf) -> None:
+        self.target = conf.q.copy()
+
+    def compute_error(self, conf) -> np.ndarray:
+        return pin.difference(self.model, self.target, conf.q)
+
+    def compute_jacobian(self, conf) -> np.ndarray:
+        return np.eye(conf.nv)
+
+    def compute_qp_objective(self, conf):
+        # J = I: H = (w² + μ) I, c = α w² e  (same as Task._objective, without the matrix products)
+        w = self.cost
+        We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
+        H = np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float))
+        if self.lm_damping:
+            H.flat[:: conf.nv + 1] += self.lm_damping * float(We @ We)
+        return H, w * We

@@ -1,0 +1,129 @@
+"""Elbow swivel angle of a 7-DOF anthropomorphic arm and a task that holds it.
+
+With the hand pose fixed, a 7-DOF arm (3 shoulder, 1 elbow, 3 wrist joints) keeps one degree of
+freedom: the elbow E can turn on a circle about the shoulder–wrist axis S→W.  The *swivel angle*
+φ (Kreutz-Delgado, Long & Seraji, "Kinematic analysis of 7-DOF manipulators", IJRR 11(5), 1992)
+measures where E sits on that circle.  We define it, in the world frame, as the signed angle about
+u = (W − S)/|W − S| from the reference direction r (projected onto the plane ⟂ u) to the elbow
+offset p = E − S (projected too):
+
+    a = u · (r × p),   b = r · p − (r · u)(u · p),   φ = atan2(a, b).
+
+φ = 0: the elbow is as close to r as it can be (default r = −z, "elbow down", the relaxed human
+posture of :mod:`anthroarm.models.human`); φ > 0 turns it counter-clockwise about S→W.
+The gradient is analytic (tested against finite differences):
+
+    ∂a/∂p = u × r,     ∂b/∂p = r − (r·u) u,
+    ∂a/∂u = r × p,     ∂b/∂u = −(u·p) r − (r·u) p,     ∂u/∂d = (I − u uᵀ)/|d|,  d = W − S,
+    ∂φ = (b ∂a − a ∂b)/(a² + b²).
+
+Units: rad; Jacobian 1 × nv (rad per rad).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ..configuration import IKConfiguration
+from .base import Task
+
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+#: (shoulder, elbow, wrist) frame names of the catalog arms with a human layout.
+SWIVEL_FRAMES = {
+    "human_arm7": ("shoulder_flexion", "elbow_flexion", "wrist_deviation"),
+    "human_right_arm": ("right_shoulder_Z", "right_elbow_Z", "right_wrist_Z"),
+}
+
+
+def swivel_frames(robot, frames=None) -> tuple[str, str, str]:
+    """(shoulder, elbow, wrist) frame names: ``frames`` if given, else the catalog default.
+
+    Raises ``ValueError`` for a robot without a known human arm layout."""
+    if frames is not None:
+        if len(frames) != 3:
+            raise ValueError(f"swivel frames must be (shoulder, elbow, wrist), got {frames!r}")
+        for f in frames:
+            robot.frame_id(f)  # UnknownFrameError lists the valid ones
+        return tuple(frames)
+    name = getattr(robot, "name", None)
+    if name not in SWIVEL_FRAMES:
+        raise ValueError(f"{name}: no default (shoulder, elbow, wrist) frames for the swivel angle; "
+                         f"pass frames=(...). Known arms: {', '.join(SWIVEL_FRAMES)}")
+    return SWIVEL_FRAMES[name]
+
+
+def swivel_from_points(S, E, W, ref=(0.0, 0.0, -1.0)):
+    """Swivel angle φ (rad) and its gradients (dφ/dS, dφ/dE, dφ/dW), each (3,), world frame.
+
+    Raises ``ValueError`` when it is undefined: S = W, or the elbow (or ``ref``) lies on the
+    shoulder–wrist axis (straight arm)."""
+    S, E, W, r = (np.asarray(x, dtype=float) for x in (S, E, W, ref))
+    d = W - S
+    nd = float(np.linalg.norm(d))
+    if nd < 1e-12:
+        raise ValueError("swivel angle undefined: wrist coincides with shoulder")
+    u = d / nd
+    p = E - S
+    a = float(u @ np.cross(r, p))
+    b = float(r @ p - (r @ u) * (u @ p))
+    n2 = a * a + b * b
+    if n2 < 1e-24:
+        raise ValueError("swivel angle undefined: the elbow (or the reference direction) lies on the "
+                         "shoulder-wrist axis (straight arm)")
+    phi = float(np.arctan2(a, b))
+    da_dp = np.cross(u, r)
+    db_dp = r - (r @ u) * u
+    da_du = np.cross(r, p)
+    db_du = -(u @ p) * r - (r @ u) * p
+    g_p = (b * da_dp - a * db_dp) / n2
+    g_u = (b * da_du - a * db_du) / n2
+    g_d = (g_u - (g_u @ u) * u) / nd
+    return phi, (-g_p - g_d, g_p, g_d)
+
+
+def swivel_angle(robot, q, frames=None, ref=(0.0, 0.0, -1.0)) -> float:
+    """Swivel angle φ (rad) of ``robot`` at ``q`` (see the module docstring)."""
+    s, e, w = swivel_frames(robot, frames)
+    q = robot.check_q(q)
+    if q.ndim == 2:
+        return np.array([swivel_angle(robot, qi, frames, ref) for qi in q])
+    P = [robot.fk(q, f)[:3, 3] for f in (s, e, w)]
+    return swivel_from_points(*P, ref=ref)[0]
+
+
+class SwivelTask(Task):
+    """Hold the elbow swivel angle at ``target`` (rad).
+
+    Residual e = wrap(φ(q) − φ*) (1,), Jacobian ∂φ/∂q = Σ_X (∂φ/∂X) J_X(q) over the position
+    Jacobians (LOCAL_WORLD_ALIGNED, linear rows) of the shoulder, elbow and wrist frames."""
+
+    def __init__(self, robot, target: float = 0.0, cost: float = 1.0, frames=None, ref=(0.0, 0.0, -1.0),
+                 gain: float = 1.0, lm_damping: float = 0.0):
+        super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
+        names = swivel_frames(robot, frames)
+        self.frame_ids = tuple(robot.frame_id(f) for f in names)
+        self.ref = np.asarray(ref, dtype=float)
+        self.set_target(target)
+
+    def set_target(self, target: float) -> None:
+        target = float(target)
+        if not np.isfinite(target):
+            raise ValueError(f"swivel target must be finite, got {target}")
+        self.target = target
+
+    def _geometry(self, conf: IKConfiguration):
+        pts = [conf.frame_placement(f).translation for f in self.frame_ids]
+        return swivel_from_points(*pts, ref=self.ref)
+
+    def compute_error(self, conf: IKConfiguration) -> np.ndarray:
+        phi, _ = self._geometry(conf)
+        return np.array([np.arctan2(np.sin(phi - self.target), np.cos(phi - self.target))])
+
+    def compute_jacobian(self, conf: IKConfiguration) -> np.ndarray:
+        _, grads = self._geometry(conf)
+        J = np.zeros((1, conf.nv))
+        for g, f in zip(grads, self.frame_ids):
+            J[0] += g @ conf.frame_jacobian(f, LWA)[:3]
+        return J
