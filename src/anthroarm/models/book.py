@@ -72,21 +72,26 @@ def sixr_arm(s0: float = 0.5, h2: float = 0.4, s3: float = 0.35, P: float = 0.1)
     )
 
 
+def _rrprr_rows(s0: float, h2: float, stroke) -> list[DHRow]:
+    """The R-R-P-R-R H-D table shared by Fig. 6-4 and the 002 text §4-4: α01 = α12 = α34 =
+    α45 = 90°, α23 = θ3 = 0, l_AB = s0, l_BC = h2, the third joint the prismatic s2."""
+    return [
+        DHRow("R", 90 * deg, s=s0),
+        DHRow("R", 90 * deg, h=h2, lower=-90 * deg, upper=90 * deg),
+        DHRow("P", 0.0, lower=stroke[0], upper=stroke[1]),
+        DHRow("R", 90 * deg),
+        DHRow("R", 90 * deg),
+    ]
+
+
 def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0)) -> ChainSpec:
     """Unimate-type robot of Fig. 6-4 (l. 3849–3893): R-R-P-R-R with α01 = α12 = α34 = α45 = 90°,
     α23 = θ3 = 0; the third joint is the prismatic boom s2.  No numbers are printed: s0, h2, P
     and the boom stroke (0.3–1.0 m) are ours; revolute ranges are ±180° (θ2 ±90°)."""
-    rows = [
-        DHRow("R", 90 * deg, s=s0),
-        DHRow("R", 90 * deg, h=h2, lower=-90 * deg, upper=90 * deg),
-        DHRow("P", 0.0, lower=boom[0], upper=boom[1]),
-        DHRow("R", 90 * deg),
-        DHRow("R", 90 * deg),
-    ]
     return from_dh(
         "unimate5",
         "Unimate-type 5-DOF robot with a prismatic boom (book Fig. 6-4); tool = hand point P on z5.",
-        rows,
+        _rrprr_rows(s0, h2, boom),
         homogeneous(p=[0, 0, P]),
         source="book 000 l.3849-3893 (Fig. 6-4, Eq. (6-19)-(6-23)); lengths chosen by anthroarm",
         joint_names=["waist", "shoulder", "boom", "wrist_pitch", "wrist_roll"],
@@ -98,18 +103,12 @@ def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0))
 def rrprr5(s0: float = 0.4, h2: float = 0.08, p: float = 0.12, stroke=(0.2, 0.6)) -> ChainSpec:
     """R-R-P-R-R manipulator of the 002 text §4-4 (l. 355–409), Eq. (4-50)–(4-54):
     l_AB = s0, l_BC = h2, l_DP = p, α01 = α12 = α34 = α45 = 90°, α23 = θ3 = 0, s2 = l_CD is
-    the prismatic variable.  The text prints no numbers: ours are a bench-top size."""
-    rows = [
-        DHRow("R", 90 * deg, s=s0),
-        DHRow("R", 90 * deg, h=h2, lower=-90 * deg, upper=90 * deg),
-        DHRow("P", 0.0, lower=stroke[0], upper=stroke[1]),
-        DHRow("R", 90 * deg),
-        DHRow("R", 90 * deg),
-    ]
+    the prismatic variable — the same chain as the Unimate of Fig. 6-4.  The text prints no
+    numbers: ours are a bench-top size."""
     return from_dh(
         "rrprr5",
         "RRPRR 5-DOF manipulator (002 text §4-4); tool = gripper centroid P on z5.",
-        rows,
+        _rrprr_rows(s0, h2, stroke),
         homogeneous(p=[0, 0, p]),
         source="002 l.355-409 (Eq. (4-50)-(4-54)); lengths chosen by anthroarm",
         params={"s0": s0, "h2": h2, "p": p, "stroke": list(stroke)},
