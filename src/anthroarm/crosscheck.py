@@ -24,6 +24,7 @@ PROVIDERS: list[str] = [
     "anthroarm.kinematics.checks:rows",
     "anthroarm.design.structure:reach_rows",
     "anthroarm.dynamics.checks:rows",
+    "anthroarm.spatial.checks:rows",
 ]
 
 
