@@ -9,3 +9,9 @@ Part B (four-bar, RSSR, RRSS, dyads, thumb, finger, Pinocchio closed loops):
 from .fourbar import (CouplerPoint, FourBarRange, FourBarState, coupler_point, fourbar, fourbar_acceleration,
                       fourbar_cartesian, fourbar_grashof, fourbar_input_range, fourbar_points, fourbar_position,
                       fourbar_velocity, transmission_angle)
+
+# Part A: RCCC by dual-number matrices (§5-6) and relative motion (002 §4-1)
+from .rccc import (RCCCGeometry, RCCCResult, RCCCSolution, rccc_acceleration, rccc_position,  # noqa: E402
+                   rccc_velocity)
+from .relative_motion import (RelativeMotionGeometry, relative_acceleration, relative_position,  # noqa: E402
+                              relative_velocity)
