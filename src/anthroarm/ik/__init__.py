@@ -4,3 +4,7 @@
 * the book's spatial cell method and iterative methods (Ch. 7 §7-3 … §7-6);
 * QP differential IK (:mod:`anthroarm.ik.qp`) and the one-shot solver :func:`solve`.
 """
+
+from . import qp
+from .result import IKBatchResult, IKResult
+from .solver import solve

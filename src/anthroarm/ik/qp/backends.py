@@ -81,6 +81,45 @@ class Backend:
                 return None, "infeasible"
         return x, status
 
+    def _polish(self, H, c, lo, hi, A, b, x, y):
+        """Exact solution on the active set guessed from OSQP's duals (OSQP's polish rule:
+        lower bound active if x − lo < −y, upper if hi − x < y), accepted only if it is
+        primal feasible and the multipliers have the right signs; else ``None``."""
+        n = self.n
+        yb = y[:n]
+        act_lo = (x - lo) < -yb
+        act_hi = (hi - x) < yb
+        act = act_lo | act_hi
+        xa = np.where(act_lo, lo, np.where(act_hi, hi, 0.0))
+        free = ~act
+        nf = int(free.sum())
+        rhs = -(c + H[:, act] @ xa[act])[free]
+        try:
+            if A is None or not len(A):
+                xf = np.linalg.solve(H[np.ix_(free, free)], rhs) if nf else np.zeros(0)
+                lam = None
+            else:
+                m = len(A)
+                K = np.zeros((nf + m, nf + m))
+                K[:nf, :nf] = H[np.ix_(free, free)]
+                K[:nf, nf:] = A[:, free].T
+                K[nf:, :nf] = A[:, free]
+                sol = np.linalg.solve(K, np.concatenate([rhs, b - A[:, act] @ xa[act]]))
+                xf, lam = sol[:nf], sol[nf:]
+        except np.linalg.LinAlgError:
+            return None
+        xp = xa.copy()
+        xp[free] = xf
+        tol = 1e-9
+        if np.any(xp < lo - tol) or np.any(xp > hi + tol):
+            return None
+        g = H @ xp + c
+        if lam is not None:
+            g = g + A.T @ lam
+        if np.any(g[act_lo] < -1e-8) or np.any(g[act_hi] > 1e-8):
+            return None
+        return xp
+
 
 class OSQPBackend(Backend):
     """OSQP with a persistent workspace (sparse structure built once, ``update`` + warm start)."""
@@ -146,46 +185,6 @@ class OSQPBackend(Backend):
         xp = self._polish(H, c, lo, hi, A, b, x, np.array(res.y))
         self.last_info["polished"] = xp is not None
         return self._finish(x if xp is None else xp, lo, hi, A, b, status)
-
-    def _polish(self, H, c, lo, hi, A, b, x, y):
-        """Exact solution on the active set guessed from OSQP's duals (OSQP's polish rule:
-        lower bound active if x − lo < −y, upper if hi − x < y), accepted only if it is
-        primal feasible and the multipliers have the right signs; else ``None``."""
-        n = self.n
-        yb = y[:n]
-        act_lo = (x - lo) < -yb
-        act_hi = (hi - x) < yb
-        act = act_lo | act_hi
-        xa = np.where(act_lo, lo, np.where(act_hi, hi, 0.0))
-        free = ~act
-        nf = int(free.sum())
-        rhs = -(c + H[:, act] @ xa[act])[free]
-        try:
-            if A is None or not len(A):
-                xf = np.linalg.solve(H[np.ix_(free, free)], rhs) if nf else np.zeros(0)
-                lam = None
-            else:
-                m = len(A)
-                K = np.zeros((nf + m, nf + m))
-                K[:nf, :nf] = H[np.ix_(free, free)]
-                K[:nf, nf:] = A[:, free].T
-                K[nf:, :nf] = A[:, free]
-                sol = np.linalg.solve(K, np.concatenate([rhs, b - A[:, act] @ xa[act]]))
-                xf, lam = sol[:nf], sol[nf:]
-        except np.linalg.LinAlgError:
-            return None
-        xp = xa.copy()
-        xp[free] = xf
-        tol = 1e-9
-        if np.any(xp < lo - tol) or np.any(xp > hi + tol):
-            return None
-        g = H @ xp + c
-        if lam is not None:
-            g = g + A.T @ lam
-        if np.any(g[act_lo] < -1e-8) or np.any(g[act_hi] > 1e-8):
-            return None
-        return xp
-
 
 class DaqpBackend(Backend):
     """daqp (dual active set), called directly; box rows as simple bounds."""
@@ -257,7 +256,8 @@ class QuadprogBackend(Backend):
 
 
 class ProxqpBackend(Backend):
-    """proxsuite ProxQP dense with a persistent workspace (``init`` once, then ``update``)."""
+    """proxsuite ProxQP dense with a persistent workspace (``init`` once, then ``update``),
+    followed by the same active-set polish as OSQP (ProxQP's eps bounds residuals, not x)."""
 
     name = "proxqp"
 
@@ -288,7 +288,10 @@ class ProxqpBackend(Backend):
         S = self._proxqp.QPSolverOutput
         self.last_info = {"status": str(st), "iter": self.qp.results.info.iter}
         if st == S.PROXQP_SOLVED:
-            return self._finish(np.array(self.qp.results.x), lo, hi, A, b, "optimal")
+            x = np.array(self.qp.results.x)
+            xp = self._polish(H, c, lo, hi, A, b, x, np.array(self.qp.results.z))
+            self.last_info["polished"] = xp is not None
+            return self._finish(x if xp is None else xp, lo, hi, A, b, "optimal")
         if st == S.PROXQP_PRIMAL_INFEASIBLE:
             return None, "infeasible"
         return None, "failed"
