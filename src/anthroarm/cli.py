@@ -223,6 +223,17 @@ def _serve(viewer, open_browser: bool, seconds: float | None) -> int:
     return 0
 
 
+def _check_port_early(a):
+    """Fail before any long work when an explicit --port is taken (or invalid)."""
+    if getattr(a, "html", None) is None and a.port is not None:
+        from .viewer.server import _in_use_message, port_is_free
+
+        if not 1 <= a.port <= 65535:
+            raise UserError(f"--port must be in 1..65535, got {a.port}")
+        if not port_is_free(a.port):
+            raise UserError(_in_use_message(a.port))
+
+
 def _add_live_options(p):
     p.add_argument("--html", metavar="FILE", help="write a self-contained HTML file instead of starting a server")
     p.add_argument("--port", type=int, default=None, help="server port on 127.0.0.1 (default: first free from 7000)")
@@ -258,6 +269,7 @@ def cmd_view(a) -> int:
     from .viewer import Viewer
 
     out = _check_html_path(a.html)
+    _check_port_early(a)
     robot = _load_model(a.model, _parse_params(a.param))
     q = _parse_q(robot, a.q, a.deg)
     if a.workspace < 0:
@@ -300,6 +312,7 @@ def cmd_demo(a) -> int:
     from .viewer.demo import demo_viewer, reach_demo
 
     out = _check_html_path(a.html)
+    _check_port_early(a)
     robot = _load_model("human_arm7", _parse_params(a.param))
     bar = _progress(6, "reaching", not a.json)
 
@@ -337,7 +350,7 @@ def _add_ik(sub):
                     "angles (R = Rz(yaw) Ry(pitch) Rx(roll); radians unless --deg), in the model's base frame.  "
                     "Uses aa.ik.solve when available, the book's closed form (every branch) for the book arms, "
                     "else damped least squares with restarts.  Exit status 1 when no solution is found.",
-        epilog="example: anthroarm ik human_arm7 --xyz 0.15 0.26 0.12 --rpy 40 -60 70 --deg --json",
+        epilog="example (hand to mouth): anthroarm ik human_arm7 --xyz 0.151 0.193 0.141 --rpy 179.5 6.1 -71.3 --deg --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("model", help="catalog name or .urdf path")

@@ -263,26 +263,35 @@ class Viewer:
         return cmds
 
     def _color_commands(self, q) -> list[dict]:
+        """Recolour links (max proximity over ``body.link_dofs``) and joint centres (own
+        proximity); only colours that changed since the last call are sent."""
         cmds = []
-        if self._limits_on:
-            prox = limit_proximity(q, self.robot.lower, self.robot.upper)
+        prox = limit_proximity(q, self.robot.lower, self.robot.upper) if self._limits_on else None
         for b in self.bodies:
-            if b.dof is None:
+            if b.dof is None and not b.link_dofs:
                 continue
-            group = "links" if any(p.group == "links" for p in b.pieces) else "mesh"
-            path = f"{self._bpath(b)}/{group}"
-            if self._limits_on:
-                base = next((p.rgb for p in b.pieces if p.group == group), LINK_RGB)
-                rgb = tuple(round(c, 3) for c in limit_color(float(prox[b.dof]), base))
-            else:
-                rgb = None
-            if self._colors.get(path) != rgb:
+            groups = []
+            link_group = "links" if any(p.group == "links" for p in b.pieces) else "mesh"
+            if b.link_dofs and any(p.group == link_group for p in b.pieces):
+                groups.append((link_group, b.link_dofs))
+            if b.dof is not None and any(p.group == "joint" for p in b.pieces):
+                groups.append(("joint", [b.dof]))
+            for group, dofs in groups:
+                path = f"{self._bpath(b)}/{group}"
+                if prox is not None:
+                    base = next(p.rgb for p in b.pieces if p.group == group)
+                    rgb = tuple(round(c, 3) for c in limit_color(float(prox[dofs].max()), base))
+                else:
+                    rgb = None
+                if self._colors.get(path) == rgb:
+                    continue
                 self._colors[path] = rgb
                 if rgb is None:  # restore the original colours
-                    cmds += [_set_object(f"{path}/{k}", p.geometry, p.rgb, p.opacity)
-                             for k, p in enumerate(b.pieces) if p.group == group]
-                    cmds += [_set_transform(f"{path}/{k}", p.offset)
-                             for k, p in enumerate(b.pieces) if p.group == group and not np.allclose(p.offset, np.eye(4))]
+                    for k, p in enumerate(b.pieces):
+                        if p.group == group:
+                            cmds.append(_set_object(f"{path}/{k}", p.geometry, p.rgb, p.opacity))
+                            if not np.allclose(p.offset, np.eye(4)):
+                                cmds.append(_set_transform(f"{path}/{k}", p.offset))
                 else:
                     cmds.append({"type": "anthroarm_color", "path": path, "color": list(rgb)})
         return cmds

@@ -66,6 +66,10 @@ class Body:
     joint: int | None = None
     frame: int | None = None
     dof: int | None = None
+    #: configuration indices whose limit proximity colours this body's links: its own joint
+    #: and the joints that sit at the same point just before it (the shoulder's x-y-z, the
+    #: elbow and forearm rotation), so a link turns red when any joint that moves it is at a limit
+    link_dofs: list = field(default_factory=list)
 
 
 # ---------------------------------------------------------------------- primitives
@@ -164,6 +168,7 @@ def book_bodies(robot) -> list[Body]:
         base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, _tf(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
     bodies.append(Body("base", base))
 
+    pending: dict[int, list[int]] = {}
     for j in range(1, model.njoints):
         axis, kind = joint_axis(model, j)
         pieces: list[Piece] = []
@@ -182,7 +187,11 @@ def book_bodies(robot) -> list[Body]:
         if tool.parentJoint == j:
             pieces += _palm(tool, r, axis)
         dof = model.joints[j].idx_q if model.joints[j].nq == 1 else None
-        bodies.append(Body(model.names[j], pieces, joint=j, dof=dof))
+        inherited = pending.get(model.parents[j], [])
+        link_dofs = inherited + ([dof] if dof is not None else [])
+        if not any(p.group == "links" for p in pieces):
+            pending[j] = link_dofs  # nothing to colour here: hand the joint on to the next link
+        bodies.append(Body(model.names[j], pieces, joint=j, dof=dof, link_dofs=link_dofs))
         if kind == "prismatic":
             # the fixed sleeve lives on the parent body
             lo, hi = _range(robot, j)
@@ -302,7 +311,7 @@ def urdf_bodies(robot) -> list[Body]:
         if pieces:
             pj = model.frames[fid].parentJoint
             dof = model.joints[pj].idx_q if pj > 0 and model.joints[pj].nq == 1 else None
-            bodies.append(Body(name, pieces, frame=fid, dof=dof))
+            bodies.append(Body(name, pieces, frame=fid, dof=dof, link_dofs=[dof] if dof is not None else []))
     return bodies
 
 
