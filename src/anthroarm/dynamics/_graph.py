@@ -440,3 +440,42 @@ def emit_python(g: Graph, fname: str, args, outputs, shape, kinds, batched: bool
             vals = ", ".join(ref(o) for o in outputs)
             lines.append(f"    return _np.array([{vals}]).reshape({shape})")
     return "\n".join(lines)
+
+
+def emit_c(g: Graph, fname: str, args, outputs, nout: int, n: int) -> str:
+    """A C function ``void fname(long N, const double *q, [qd, qdd,] double *out)`` looping over
+    a batch (row-major ``(N, n)`` inputs, ``(N, nout)`` output); one ``const double`` per node."""
+    order = [i for i in g.cone(outputs) if g.ops[i][0] != "in"]
+    names = {i: f"x{i}" for i in order}
+    ins = used_inputs(g, outputs)
+
+    def inname(inp: Input) -> str:
+        return inp.name
+
+    params = ", ".join(f"const double *restrict {a}_" for a in args)
+    lines = [f"void {fname}(long N, {params}, double *restrict out_) {{",
+             "  for (long r = 0; r < N; ++r) {"]
+    for a in args:
+        lines.append(f"    const double *{a} = {a}_ + r * {n};")
+    lines.append(f"    double *out = out_ + r * {nout};")
+    need_q = sorted({i.k for i in ins if i.kind in ("s", "c", "q")})
+    for k in need_q:
+        lines.append(f"    const double q{k} = q[{k}];")
+    for i in ins:
+        if i.kind in ("qd", "qdd"):
+            lines.append(f"    const double {i.name} = {i.kind}[{i.k}];")
+        elif i.kind == "s":
+            lines.append(f"    const double s{i.k} = sin(q{i.k});")
+        elif i.kind == "c":
+            lines.append(f"    const double c{i.k} = cos(q{i.k});")
+    for i in order:
+        lines.append(f"    const double {names[i]} = {expr_text(g, i, names, inname, lang='c')};")
+    for k, o in enumerate(outputs):
+        if isinstance(o, float):
+            val = _c_float(o)
+        else:
+            op = g.ops[o.i]
+            val = inname(op[1]) if op[0] == "in" else names[o.i]
+        lines.append(f"    out[{k}] = {val};")
+    lines += ["  }", "}"]
+    return "\n".join(lines)

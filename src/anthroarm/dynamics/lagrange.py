@@ -58,6 +58,7 @@ ship pre-generated).
 from __future__ import annotations
 
 import hashlib
+import math
 import importlib.util
 import os
 import sys
@@ -554,6 +555,19 @@ class LagrangeDynamics:
         return a
 
     def _call(self, fname, *arrays):
+        # fast path: one state, contiguous float64 vectors of the right length
+        n = self.n
+        ok = True
+        tot = 0.0
+        for a in arrays:
+            if type(a) is not np.ndarray or a.shape != (n,) or a.dtype != np.float64:
+                ok = False
+                break
+            tot += a.sum()
+        if ok and math.isfinite(tot):
+            if self._c is not None:
+                return self._c.one(fname, arrays)
+            return getattr(self.module, fname + "_1")(*arrays)
         names = ("q", "qd", "qdd")
         arrs = [self._arr(a, names[i]) for i, a in enumerate(arrays)]
         single = all(a.ndim == 1 for a in arrs)
