@@ -266,13 +266,19 @@ class ProxqpBackend(Backend):
         from proxsuite import proxqp
 
         self._proxqp = proxqp
-        self.qp = proxqp.dense.QP(n, n_eq, n)
-        self.qp.settings.eps_abs = 1e-10
-        self.qp.settings.eps_rel = 0.0
-        self.qp.settings.verbose = False
-        self.qp.settings.initial_guess = proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+        self.qp = self._new_qp(warm=True)
         self._eye = np.eye(n)
         self._initialised = False
+
+    def _new_qp(self, warm: bool):
+        proxqp = self._proxqp
+        qp = proxqp.dense.QP(self.n, self.n_eq, self.n)
+        qp.settings.eps_abs = 1e-10
+        qp.settings.eps_rel = 0.0
+        qp.settings.verbose = False
+        qp.settings.initial_guess = (proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT if warm
+                                     else proxqp.InitialGuess.NO_INITIAL_GUESS)
+        return qp
 
     def solve(self, H, c, lo, hi, A=None, b=None):
         Aeq = np.zeros((0, self.n)) if A is None else A
@@ -286,6 +292,13 @@ class ProxqpBackend(Backend):
         self.qp.solve()
         st = self.qp.results.info.status
         S = self._proxqp.QPSolverOutput
+        if st != S.PROXQP_SOLVED:
+            # a warm start from a different problem can end in a spurious infeasibility
+            # certificate: solve once more from a cold workspace before reporting it
+            self.qp = self._new_qp(warm=True)
+            self.qp.init(*args)
+            self.qp.solve()
+            st = self.qp.results.info.status
         self.last_info = {"status": str(st), "iter": self.qp.results.info.iter}
         if st == S.PROXQP_SOLVED:
             x = np.array(self.qp.results.x)

@@ -5,7 +5,9 @@
 with ⊖ the joint-space difference (m or rad).  A gain < 1 lets a joint approach its limit
 geometrically instead of hitting it in one step (pink's default 0.5).  This is the book's joint
 range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step as hard inequalities
-instead of the exterior penalty (7-85).  Joints with an infinite limit are unbounded.
+instead of the exterior penalty (7-85).  Joints with an infinite limit are unbounded.  A joint
+that starts outside its range gets gain 1 on the violated side (back inside in one step if
+the velocity limit allows; pink's QP is infeasible there, pink#206).
 """
 
 from __future__ import annotations
@@ -47,7 +49,16 @@ class ConfigurationLimit(Limit):
     def box(self, conf, dt):
         q = conf.q if self._identity else conf.q[self._qidx]
         # inf - q stays inf: unbounded joints give an unbounded side
-        return self.gain * (self._lo - q), self.gain * (self._hi - q)
+        lo = self.gain * (self._lo - q)
+        hi = self.gain * (self._hi - q)
+        above = q > self._hi
+        below = q < self._lo
+        if above.any() or below.any():
+            # outside the range: ask for the whole way back (gain 1), landing a hair inside so
+            # that rounding in q + Δq cannot leave it outside; velocity limits cap the speed
+            hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)
+            lo = np.where(below, (self._lo - q) + 1e-12 * (1.0 + np.abs(self._lo)), lo)
+        return lo, hi
 
     def __repr__(self) -> str:
         return f"ConfigurationLimit(gain={self.gain})"
