@@ -8,3 +8,4 @@
 from . import qp
 from .result import IKBatchResult, IKResult
 from .solver import solve
+from .closed_form import AnalyticBatchResult, AnalyticIKResult, analytic, analytic_batch, has_analytic, swivel_angle

@@ -1,0 +1,752 @@
+"""Closed-form inverse kinematics of the book's arms, every branch (Ch. 7 §7-2).
+
+:func:`analytic` (exported as ``aa.ik.analytic``) returns *every* joint solution of one hand pose
+that lies inside the joint limits, each labelled by its branch and each verified by forward
+kinematics before it is returned; :func:`analytic_batch` does the same for ``N`` poses at once
+(vectorised numpy over poses × branches).
+
+Supported models (:func:`has_analytic`):
+
+``sixr_arm`` (Fig. 6-3)
+    The book's procedure (7-1)–(7-15) with the corrections of the ch7 notes §0.4 (L uses θ3;
+    N = −cos θ5, Eq. (7-12); step 6 / (7-13)–(7-14) solve θ6), written with atan2 and rotation
+    matrices: wrist centre D = p − P·a, θ1 from (7-2) (two: θ1, θ1 + π), θ2/θ3 from the planar
+    triangle B–C–D (7-4)/(7-6) (two), θ4 from z4 ⊥ z5 (7-8) (two: wrist flip), θ5 from
+    N = −cos θ5 and θ6 from (7-14).  8 branches (Fig. 7-1).
+``prosthetic_arm`` (Fig. 7-2, Table 7.1)
+    The book's order (7-17)–(7-31): wrist W = C − L3·n, elbow E on the sphere |E| = L1, the
+    sphere |E − W| = L2 and the plane (E − C)·m = 0 (7-17), θ1/θ2 from E (7-18)/(7-19), θ4 from
+    the triangle O–E–W (7-24), θ3 from (7-26), θ5/θ6 from x6 = l (7-28)–(7-31).  The elbow is
+    solved *robustly* as the intersection of the line of the two planes with the sphere, which
+    works where the book's Cramer determinant Δ of (7-20)/(7-21) is zero (Table 7.2 row 1);
+    :func:`prosthetic_book_procedure` is the book's Cramer-rule version.  Branches: the two
+    elbow roots of (7-22) × shoulder (θ1, θ2) / (θ1 + π, −θ2) × elbow flexion sign.
+``planar2r`` (Fig. 7-14)
+    Position-only by default (the mechanism has 2 DOF): the two elbow branches ±θ2.
+``human_arm7`` (§6-3)
+    Redundant (7 DOF): the elbow swivel angle φ (rotation of the elbow about the shoulder–wrist
+    axis) is the parameter of the one-parameter family.  ``swivel=`` a scalar or an array of
+    angles (rad); default: a grid of 36 angles over [−π, π).  Per swivel angle: elbow sign ×
+    shoulder Euler branch × wrist Euler branch = 8 candidates.  See :func:`swivel_angle`.
+
+Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool frame
+(``robot.tool``) in the base frame; joint values in radians.  Lengths are read from
+``robot.spec.params``, limits from ``robot.lower`` / ``robot.upper``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import UnsupportedModelError
+
+TWO_PI = 2.0 * np.pi
+HALF_PI = 0.5 * np.pi
+SUPPORTED = ("sixr_arm", "prosthetic_arm", "planar2r", "human_arm7")
+#: default swivel grid of human_arm7 (rad)
+DEFAULT_SWIVEL = np.linspace(-np.pi, np.pi, 36, endpoint=False)
+
+# failure codes of a candidate (per pose and branch); 0 = a candidate solution exists
+OK, OUTSIDE, ELBOW, DEGENERATE, OUT_OF_PLANE = 0, 1, 2, 3, 4
+_REASONS = {
+    OUTSIDE: "outside the workspace: the wrist centre is out of reach of the arm "
+             "(cos of the elbow angle outside [-1, 1])",
+    ELBOW: "no elbow position: the elbow circle (|E| = L1, |E - W| = L2) does not meet the "
+           "plane (E - C)·m = 0 of Eq. (7-17) (the hand orientation is not reachable here)",
+    DEGENERATE: "degenerate pose: the wrist centre lies along the hand y axis, the two elbow "
+                "planes of Eq. (7-17) are parallel (elbow determinant zero)",
+    OUT_OF_PLANE: "outside the workspace: the target is not in the plane x = 0 of the mechanism",
+}
+
+
+# ---------------------------------------------------------------------------- results
+@dataclass
+class AnalyticIKResult:
+    """Every closed-form solution of one pose.
+
+    ``solutions`` (K, nq) rad, each inside the joint limits and verified by FK;
+    ``branches`` K labels; ``reason`` is None when K > 0, else why there is none;
+    ``swivel`` (K,) the swivel angle of each solution (human_arm7 only, else None);
+    ``residuals`` (K,) the FK check: max |FK(q) − T| over the 3×4 pose entries (m / unitless);
+    ``singular`` names a singular configuration family if the pose is singular (a
+    representative member was returned), else None."""
+
+    solutions: np.ndarray
+    branches: list
+    reason: str | None = None
+    swivel: np.ndarray | None = None
+    residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    singular: str | None = None
+    model: str = ""
+
+    @property
+    def success(self) -> bool:
+        return len(self.branches) > 0
+
+    def __len__(self) -> int:
+        return len(self.branches)
+
+    def as_dict(self) -> dict:
+        return {
+            "model": self.model,
+            "solutions": self.solutions.tolist(),
+            "branches": list(self.branches),
+            "reason": self.reason,
+            "swivel": None if self.swivel is None else self.swivel.tolist(),
+            "residuals": self.residuals.tolist(),
+            "singular": self.singular,
+        }
+
+
+@dataclass
+class AnalyticBatchResult:
+    """Closed-form solutions of N poses, on B fixed branches.
+
+    ``solutions`` (N, B, nq): entry [i, b] is a verified solution inside the limits where
+    ``valid[i, b]``; elsewhere it is NaN (there is no solution on that branch — read ``valid``).
+    ``branches`` the B labels, ``reasons`` N entries (None where some branch is valid),
+    ``swivel`` (N, B) for human_arm7.  ``result[i]`` gives pose i as an AnalyticIKResult."""
+
+    solutions: np.ndarray
+    valid: np.ndarray
+    branches: list
+    reasons: list
+    swivel: np.ndarray | None = None
+    residuals: np.ndarray | None = None
+    singular: list | None = None
+    model: str = ""
+
+    def __len__(self) -> int:
+        return self.solutions.shape[0]
+
+    def __getitem__(self, i: int) -> AnalyticIKResult:
+        v = self.valid[i]
+        return AnalyticIKResult(
+            solutions=self.solutions[i][v].copy(),
+            branches=[b for b, ok in zip(self.branches, v) if ok],
+            reason=self.reasons[i],
+            swivel=None if self.swivel is None else self.swivel[i][v].copy(),
+            residuals=np.zeros(int(v.sum())) if self.residuals is None else self.residuals[i][v].copy(),
+            singular=None if self.singular is None else self.singular[i],
+            model=self.model,
+        )
+
+    @property
+    def n_solutions(self) -> np.ndarray:
+        return self.valid.sum(axis=1)
+
+
+# ---------------------------------------------------------------------------- model checks
+def has_analytic(robot) -> bool:
+    """True if :func:`analytic` has a closed form for this robot: a book model in
+    :data:`SUPPORTED` whose tool frame is the catalog's tool."""
+    spec = getattr(robot, "spec", None)
+    return bool(spec is not None and spec.name in SUPPORTED and robot.name == spec.name
+                and robot.tool == spec.tool_name)
+
+
+def _require(robot):
+    if not has_analytic(robot):
+        spec = getattr(robot, "spec", None)
+        if spec is not None and spec.name in SUPPORTED and robot.tool != spec.tool_name:
+            raise UnsupportedModelError(
+                f"{robot.name}: the closed form solves for the tool frame {spec.tool_name!r}, "
+                f"not {robot.tool!r}")
+        raise UnsupportedModelError(
+            f"{robot.name}: no closed-form IK; supported models: {', '.join(SUPPORTED)} "
+            "(use aa.ik.solve for a numerical solution)")
+    return robot.spec.name, robot.spec.params
+
+
+# ---------------------------------------------------------------------------- input checks
+def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False) -> tuple[np.ndarray, bool]:
+    """Return (N, 4, 4) and whether the input was a single pose.  ValueError on bad input."""
+    arr = np.asarray(T, dtype=float)
+    single = arr.ndim == 2
+    if position_only and arr.ndim in (1, 2) and arr.shape[-1] == 3 and arr.shape != (3, 3):
+        single = arr.ndim == 1
+        P = arr.reshape(-1, 3)
+        arr = np.tile(np.eye(4), (P.shape[0], 1, 1))
+        arr[:, :3, 3] = P
+    elif arr.ndim == 2 and arr.shape == (4, 4):
+        arr = arr[None]
+    elif not (arr.ndim == 3 and arr.shape[1:] == (4, 4)):
+        raise ValueError(f"{name} must be a 4x4 homogeneous pose or a batch (N, 4, 4), got shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        idx = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+        raise ValueError(f"{name}{list(idx) if not single else list(idx[1:])} is {arr[idx]} (not finite)")
+    if np.abs(arr[:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max() > 1e-12:
+        raise ValueError(f"{name}: the last row of a homogeneous pose must be [0, 0, 0, 1]")
+    R = arr[:, :3, :3]
+    err = np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(axis=(1, 2))
+    det = np.linalg.det(R) if len(R) < 64 else np.einsum("ni,ni->n", R[:, :, 0], np.cross(R[:, :, 1], R[:, :, 2]))
+    bad = (err > tol_orthonormal) | (det < 0)
+    if not position_only and bad.any():
+        i = int(np.argmax(bad))
+        where = "" if single else f"[{i}]"
+        raise ValueError(
+            f"{name}{where}: the rotation part is not a rotation matrix (max |R^T R - I| = {err[i]:.3g}, "
+            f"det = {det[i]:.6g}); orthonormalise it first (e.g. nearest rotation by SVD)")
+    return arr, single
+
+
+# ---------------------------------------------------------------------------- helpers
+def _rz(c, s):
+    z, o = np.zeros_like(c), np.ones_like(c)
+    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+
+
+_RX90 = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
+_RXM90 = _RX90.T
+
+
+def _wrap_into_limits(Q, lo, hi, tol=1e-9):
+    """Shift revolute angles by multiples of 2π into [lo, hi] where possible; returns (Q, inside).
+    Values within ``tol`` outside a limit are clipped onto it."""
+    lo_f = np.where(np.isfinite(lo), lo, -np.pi)
+    k = np.floor((Q - lo_f + tol) / TWO_PI)
+    Qw = Q - k * TWO_PI
+    inside = (Qw >= lo - tol) & (Qw <= hi + tol)
+    Qw = np.clip(Qw, lo, hi)
+    return Qw, inside.all(axis=-1)
+
+
+# ---------------------------------------------------------------------------- FK used for verification
+class _ChainFK:
+    """Vectorised FK of a ChainSpec (joint origins, unit axes along ±x/±y/±z or general,
+    tool origin), used to verify every candidate: independent of the IK formulas."""
+
+    def __init__(self, spec):
+        self.steps = []
+        for j in spec.joints:
+            ax = np.asarray(j.axis, float)
+            ax = ax / np.linalg.norm(ax)
+            self.steps.append((j.origin[:3, :3].copy(), j.origin[:3, 3].copy(), ax, j.type))
+        self.tool_R = spec.tool_origin[:3, :3].copy()
+        self.tool_p = spec.tool_origin[:3, 3].copy()
+
+    def __call__(self, Q):
+        Q = np.asarray(Q, float)
+        shape = Q.shape[:-1]
+        Q = Q.reshape(-1, Q.shape[-1])
+        n = Q.shape[0]
+        R = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        p = np.zeros((n, 3))
+        for j, (Ro, po, ax, typ) in enumerate(self.steps):
+            p = p + R @ po
+            R = R @ Ro
+            q = Q[:, j]
+            if typ == "prismatic":
+                p = p + (R @ ax) * q[:, None]
+                continue
+            c, s = np.cos(q), np.sin(q)
+            i = int(np.argmax(np.abs(ax)))
+            if abs(abs(ax[i]) - 1.0) < 1e-15:
+                s = s * np.sign(ax[i])
+                a, b = [(1, 2), (2, 0), (0, 1)][i]  # rotation about e_i mixes columns a, b
+                ca, cb = R[:, :, a].copy(), R[:, :, b].copy()
+                R[:, :, a] = c[:, None] * ca + s[:, None] * cb
+                R[:, :, b] = -s[:, None] * ca + c[:, None] * cb
+            else:
+                K = np.array([[0, -ax[2], ax[1]], [ax[2], 0, -ax[0]], [-ax[1], ax[0], 0]])
+                Rq = np.eye(3) + s[:, None, None] * K + (1 - c)[:, None, None] * (K @ K)
+                R = R @ Rq
+        p = p + R @ self.tool_p
+        R = R @ self.tool_R
+        T = np.zeros((n, 4, 4))
+        T[:, :3, :3] = R
+        T[:, :3, 3] = p
+        T[:, 3, 3] = 1.0
+        return T.reshape(*shape, 4, 4)
+
+
+_FK_CACHE: dict = {}
+
+
+def _fk_for(robot) -> _ChainFK:
+    key = id(robot.spec)
+    fk = _FK_CACHE.get(key)
+    if fk is None or fk[0] is not robot.spec:
+        fk = (robot.spec, _ChainFK(robot.spec))
+        _FK_CACHE[key] = fk
+    return fk[1]
+
+
+# ---------------------------------------------------------------------------- 6R arm (Fig. 6-3)
+SIXR_BRANCHES = [f"shoulder={s},elbow={e},wrist={w}"
+                 for s in ("front", "back") for e in ("up", "down") for w in ("noflip", "flip")]
+
+
+def _sixr(Rt, pt, s0, h2, s3, P):
+    """Candidates (N, 8, 6) of the 6R arm, Eqs. (7-1)–(7-15) corrected (ch7 notes A2)."""
+    N = Rt.shape[0]
+    a = Rt[:, :, 2]
+    d = pt - P * a - np.array([0.0, 0.0, s0])           # wrist centre D relative to B (step 0)
+    rxy = np.hypot(d[:, 0], d[:, 1])
+    shoulder_sing = rxy < 1e-12
+    th1a = np.where(shoulder_sing, 0.0, np.arctan2(d[:, 1], d[:, 0]))   # (7-2)
+    th1 = np.stack([th1a, th1a + np.pi], 1)                             # (N, 2)
+    c1, s1 = np.cos(th1), np.sin(th1)
+    X = d[:, None, 0] * c1 + d[:, None, 1] * s1                         # B of (7-3) = d·x1
+    Y = np.broadcast_to(d[:, None, 2], X.shape)                        # A of (7-3)
+    k = ((X**2 + Y**2) - h2**2 - s3**2) / (2 * h2 * s3)                # sin θ3, (7-6)
+    code = np.where(np.abs(k) > 1 + 1e-12, OUTSIDE, OK)
+    k = np.clip(k, -1.0, 1.0)
+    as_k = np.arcsin(k)
+    th3 = np.stack([as_k, np.pi - as_k], 2)                            # (N, 2, 2) elbow up/down
+    c3 = np.cos(th3)
+    # planar triangle B-C-D: θ2 = atan2(Y, X) - atan2(-s3 cos θ3, h2 + s3 sin θ3)   (7-4)
+    th2 = np.arctan2(Y, X)[:, :, None] - np.arctan2(-s3 * c3, h2 + s3 * k[:, :, None])
+    th23 = th2 + th3
+    c23, s23 = np.cos(th23), np.sin(th23)
+    # R3 = R01 R12 R23 with R01 = Rz(θ1) Rx(90°), R12 R23 = Rz(θ2+θ3) Rx(90°)
+    C1, S1 = c1[:, :, None], s1[:, :, None]
+    R3 = np.empty((N, 2, 2, 3, 3))
+    R3[..., 0, 0] = C1 * c23
+    R3[..., 0, 1] = S1
+    R3[..., 0, 2] = C1 * s23
+    R3[..., 1, 0] = S1 * c23
+    R3[..., 1, 1] = -C1
+    R3[..., 1, 2] = S1 * s23
+    R3[..., 2, 0] = s23
+    R3[..., 2, 1] = 0.0
+    R3[..., 2, 2] = -c23
+    M = np.swapaxes(R3, -1, -2) @ Rt[:, None, None]                    # C_{30} · hand rotation
+    # third column of M = (c4 s5, s4 s5, -c5): (L, M, N) of (7-8) with N = -cos θ5 (7-12 corrected)
+    L_, M_, N_ = M[..., 0, 2], M[..., 1, 2], M[..., 2, 2]
+    wrist_sing = np.hypot(L_, M_) < 1e-12
+    th4a = np.where(wrist_sing, 0.0, np.arctan2(M_, L_))               # (7-8)
+    th4 = np.stack([th4a, th4a + np.pi], -1)                           # (N, 2, 2, 2) wrist flip
+    c4, s4 = np.cos(th4), np.sin(th4)
+    th5 = np.arctan2(c4 * L_[..., None] + s4 * M_[..., None], -N_[..., None])   # (7-12) corrected
+    c5, s5 = np.cos(th5), np.sin(th5)
+    # θ6 from (R34 R45)^T M = Rz(θ6)   (7-13)/(7-14), step 6 (solves θ6, not θ5)
+    # R34 R45 = Rz(θ4) Rx(90) Rz(θ5) Rx(90): columns 0 and 1 give cos/sin of θ6
+    # G = Rz4 Rx90 Rz5 Rx90; G[:,0] = (c4 c5, s4 c5, s5), G[:,1] = (s4, -c4, 0)
+    Mx = M[..., :, 0][..., None, :]                                     # (N,2,2,1,3)
+    g0 = np.stack([c4 * c5, s4 * c5, s5], -1)
+    g1 = np.stack([s4, -c4, np.zeros_like(c4)], -1)
+    cos6 = (g0 * Mx).sum(-1)
+    sin6 = (g1 * Mx).sum(-1)
+    th6 = np.arctan2(sin6, cos6)
+    Q = np.stack([
+        np.broadcast_to(th1[:, :, None, None], th4.shape),
+        np.broadcast_to(th2[..., None], th4.shape),
+        np.broadcast_to(th3[..., None], th4.shape),
+        th4, th5, th6], -1).reshape(N, 8, 6)
+    code = np.broadcast_to(code[:, :, None, None], th4.shape).reshape(N, 8)
+    sing = np.full(N, None, dtype=object)
+    ws = wrist_sing.reshape(N, 4).any(1)
+    sing[ws] = "wrist singularity (sin θ5 = 0: only θ4 + θ6 is determined; θ4 = 0 returned)"
+    sing[shoulder_sing] = "shoulder singularity (wrist centre on the z0 axis: θ1 is free; θ1 = 0 returned)"
+    return Q, code, sing
+
+
+# ---------------------------------------------------------------------------- prosthetic arm (Fig. 7-2)
+PROSTHETIC_BRANCHES = [f"elbow_root={r},shoulder={s},flexion={f}"
+                       for r in ("+", "-") for s in ("normal", "flipped") for f in ("positive", "negative")]
+
+
+def _prosthetic(Rt, C, L1, L2, L3):
+    """Candidates (N, 8, 6) of the prosthetic arm, Eqs. (7-17)–(7-31) with the robust elbow."""
+    N = Rt.shape[0]
+    m, n = Rt[:, :, 1], Rt[:, :, 2]
+    W = C - L3 * n                                                       # step 1
+    W2 = np.einsum("ni,ni->n", W, W)
+    c4 = (W2 - L1**2 - L2**2) / (2 * L1 * L2)                           # (7-24)
+    code = np.where(np.abs(c4) > 1 + 1e-12, OUTSIDE, OK)
+    th4p = np.arccos(np.clip(c4, -1.0, 1.0))
+    # elbow E: |E| = L1, E·W = h, E·m = g (the two planes of (7-17)); line E0 + t d
+    h = 0.5 * (L1**2 + W2 - L2**2)
+    g = np.einsum("ni,ni->n", W, m)                                    # = C·m since n ⊥ m
+    dvec = np.cross(W, m)
+    dd = np.einsum("ni,ni->n", dvec, dvec)                              # = |W|²|m|² − (W·m)²
+    degen = dd < 1e-14 * np.maximum(W2, 1e-30)
+    code = np.where((code == OK) & degen, DEGENERATE, code)
+    dd_s = np.where(degen, 1.0, dd)
+    alpha = (h - g * g) / dd_s           # |m| = 1: [[W2, g],[g, 1]] [α, β] = [h, g]
+    beta = (W2 * g - g * h) / dd_s
+    E0 = alpha[:, None] * W + beta[:, None] * m
+    disc = (L1**2 - np.einsum("ni,ni->n", E0, E0)) / dd_s                # t² of (7-22)
+    code = np.where((code == OK) & (disc < -1e-12), ELBOW, code)
+    t = np.sqrt(np.clip(disc, 0.0, None))
+    E = E0[:, None, :] + np.stack([t, -t], 1)[:, :, None] * dvec[:, None, :]   # (N, 2, 3) roots
+    z2 = E / L1
+    th2a = np.arccos(np.clip(-z2[..., 2], -1.0, 1.0))                  # (7-19)
+    sh_sing = np.hypot(z2[..., 0], z2[..., 1]) < 1e-12
+    th1a = np.where(sh_sing, -HALF_PI, np.arctan2(z2[..., 1], z2[..., 0]))   # (7-18) with atan2
+    th1 = np.stack([th1a, th1a + np.pi], 2)                             # shoulder normal / flipped
+    th2 = np.stack([th2a, -th2a], 2)                                    # (N, 2, 2)
+    c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
+    # R2 = Rz(θ1) Rx90 Rz(θ2) Rx90
+    z, o = np.zeros_like(c1), np.ones_like(c1)
+    R01 = np.stack([np.stack([c1, z, s1], -1), np.stack([s1, z, -c1], -1), np.stack([z, o, z], -1)], -2)
+    R12 = np.stack([np.stack([c2, z, s2], -1), np.stack([s2, z, -c2], -1), np.stack([z, o, z], -1)], -2)
+    R2 = R01 @ R12
+    v = np.einsum("nrsji,nrj->nrsi", R2, (W[:, None, :] - E) / L2)      # = (s4 s3, -s4 c3, c4), (7-26)
+    th4 = np.stack([th4p, -th4p], 1)                                    # flexion sign (N, 2)
+    s4 = np.sin(th4)
+    sg = np.where(s4 >= 0, 1.0, -1.0)[:, None, None, :]                 # (N,1,1,2)
+    el_sing = np.abs(np.sin(th4p)) < 1e-12
+    th3 = np.where(el_sing[:, None, None, None], 0.0,
+                   np.arctan2(sg * v[..., 0:1], -sg * v[..., 1:2]))     # (N, 2, 2, 2)
+    c3, s3 = np.cos(th3 + HALF_PI), np.sin(th3 + HALF_PI)               # hidden +90° of A23
+    c4b = np.broadcast_to(np.cos(th4)[:, None, None, :], th3.shape)
+    s4b = np.broadcast_to(s4[:, None, None, :], th3.shape)
+    z3, o3 = np.zeros_like(c3), np.ones_like(c3)
+    R23 = np.stack([np.stack([c3, z3, s3], -1), np.stack([s3, z3, -c3], -1), np.stack([z3, o3, z3], -1)], -2)
+    R34 = np.stack([np.stack([c4b, z3, -s4b], -1), np.stack([s4b, z3, c4b], -1), np.stack([z3, -o3, z3], -1)], -2)
+    R4 = R2[..., None, :, :] @ R23 @ R34
+    M = np.swapaxes(R4, -1, -2) @ Rt[:, None, None, None]               # Rz5 Rx90 Rz6 Rx-90, (7-28)
+    th5 = np.arctan2(-M[..., 0, 1], M[..., 1, 1])                       # y column (-s5, c5, 0)
+    c5, s5 = np.cos(th5), np.sin(th5)
+    th6 = np.arctan2(M[..., 2, 0], c5 * M[..., 0, 0] + s5 * M[..., 1, 0])   # (7-30)/(7-31): x col (c5c6, s5c6, s6)
+    sh = th3.shape
+    Q = np.stack([np.broadcast_to(th1[..., None], sh), np.broadcast_to(th2[..., None], sh), th3,
+                  np.broadcast_to(th4[:, None, None, :], sh), th5, th6], -1).reshape(N, 8, 6)
+    code = np.broadcast_to(code[:, None], (N, 8))
+    sing = np.full(N, None, dtype=object)
+    sing[el_sing] = "elbow singularity (straight arm, sin θ4 = 0: θ3 + θ5 only determined; θ3 = 0 returned)"
+    sing[sh_sing.any(1)] = "shoulder singularity (elbow on the vertical axis: θ1 is free; θ1 = -90° returned)"
+    return Q, code, sing
+
+
+# ---------------------------------------------------------------------------- planar 2R (Fig. 7-14)
+PLANAR_BRANCHES = ["elbow=positive", "elbow=negative"]
+
+
+def _planar(Rt, p, l1, l2):
+    N = p.shape[0]
+    y, z = p[:, 1], p[:, 2]
+    c2 = (y * y + z * z - l1**2 - l2**2) / (2 * l1 * l2)
+    code = np.where(np.abs(c2) > 1 + 1e-12, OUTSIDE, OK)
+    code = np.where(np.abs(p[:, 0]) > 1e-9 * max(l1 + l2, 1.0), OUT_OF_PLANE, code)
+    t2 = np.arccos(np.clip(c2, -1, 1))
+    th2 = np.stack([t2, -t2], 1)
+    th1 = np.arctan2(z, y)[:, None] - np.arctan2(l2 * np.sin(th2), l1 + l2 * np.cos(th2))
+    Q = np.stack([th1, th2], -1)
+    return Q, np.broadcast_to(code[:, None], (N, 2)), np.full(N, None, dtype=object)
+
+
+# ---------------------------------------------------------------------------- human arm 7 (§6-3)
+HUMAN_BRANCHES = [f"elbow={e},shoulder={s},wrist={w}"
+                  for e in ("flexed", "hyperextended") for s in ("a", "b") for w in ("a", "b")]
+
+
+def _swivel_basis(n):
+    """Unit vectors (u, v) ⊥ n: u = the world −z projected onto the plane ⊥ n (φ = 0: elbow
+    lowest), falling back to −y when the shoulder–wrist axis is vertical; v = n × u."""
+    ref = np.broadcast_to(np.array([0.0, 0.0, -1.0]), n.shape).copy()
+    u = ref - np.einsum("...i,...i->...", ref, n)[..., None] * n
+    nu = np.linalg.norm(u, axis=-1)
+    vert = nu < 1e-9
+    if np.any(vert):
+        ref2 = np.array([0.0, -1.0, 0.0])
+        u2 = ref2 - np.einsum("...i,i->...", n, ref2)[..., None] * n
+        u = np.where(vert[..., None], u2, u)
+        nu = np.linalg.norm(u, axis=-1)
+    u = u / nu[..., None]
+    return u, np.cross(n, u)
+
+
+def _human(Rt, H, l1, l2, l3, swivel):
+    """Candidates (N, S·8, 7) of human_arm7 for swivel angles ``swivel`` (N, S)."""
+    N, S = swivel.shape
+    W = H + l3 * Rt[:, :, 2]                                           # wrist: H = W + R (0,0,-l3)
+    Wn = np.linalg.norm(W, axis=1)
+    c4 = (Wn**2 - l1**2 - l2**2) / (2 * l1 * l2)
+    code = np.where((np.abs(c4) > 1 + 1e-12) | (Wn < 1e-12), OUTSIDE, OK)
+    q4p = np.arccos(np.clip(c4, -1, 1))
+    nvec = W / np.where(Wn > 1e-12, Wn, 1.0)[:, None]
+    u, v = _swivel_basis(nvec)
+    cc = np.where(Wn > 1e-12, (l1**2 - l2**2 + Wn**2) / (2 * np.where(Wn > 1e-12, Wn, 1.0)), 0.0)
+    dvec = np.cos(swivel)[..., None] * u[:, None] + np.sin(swivel)[..., None] * v[:, None]   # (N,S,3)
+    r = np.sqrt(np.clip(l1**2 - cc**2, 0, None))
+    E = cc[:, None, None] * nvec[:, None] + r[:, None, None] * dvec                        # elbow
+    ex0 = np.cross(dvec, np.broadcast_to(nvec[:, None], dvec.shape))                        # d × n
+    q4 = np.stack([q4p, -q4p], 1)                                     # (N, 2)
+    sg = np.array([1.0, -1.0])
+    ez = -E / l1                                                       # (N,S,3)
+    ex = sg[None, None, :, None] * ex0[:, :, None, :]                  # (N,S,2,3)
+    ezb = np.broadcast_to(ez[:, :, None, :], ex.shape)
+    ey = np.cross(ezb, ex)
+    Rsh = np.stack([ex, ey, ezb], -1)                                  # columns
+    # XYZ Euler R = Rx(q1) Ry(q2) Rz(q3), two branches (cos q2 > 0 / < 0)
+    sb = np.array([1.0, -1.0])[None, None, None, :]
+    R02, R12, R22 = Rsh[..., 0, 2][..., None], Rsh[..., 1, 2][..., None], Rsh[..., 2, 2][..., None]
+    R00, R01 = Rsh[..., 0, 0][..., None], Rsh[..., 0, 1][..., None]
+    cq2 = sb * np.hypot(R00, R01)
+    q2 = np.arctan2(np.broadcast_to(R02, cq2.shape), cq2)
+    sh_sing = (np.abs(cq2) < 1e-12)
+    q1 = np.where(sh_sing, 0.0, np.arctan2(-sb * R12, sb * R22))
+    # gimbal lock (q2 = ±90°): q1 = 0 and R = Ry(q2) Rz(q3), so q3 = atan2(R10, R11)
+    q3 = np.where(sh_sing, np.arctan2(Rsh[..., 1, 0][..., None], Rsh[..., 1, 1][..., None]),
+                  np.arctan2(-sb * R01, sb * R00))                     # (N,S,2,2)
+    # wrist: X = (Rsh Rx(q4))^T R = Rz(q5) Ry(q6) Rx(q7)
+    c4_, s4_ = np.cos(q4), np.sin(q4)                                  # (N,2)
+    z, o = np.zeros_like(c4_), np.ones_like(c4_)
+    Rx4 = np.stack([np.stack([o, z, z], -1), np.stack([z, c4_, -s4_], -1), np.stack([z, s4_, c4_], -1)], -2)
+    RW = Rsh @ Rx4[:, None]                                            # (N,S,2,3,3)
+    X = np.swapaxes(RW, -1, -2) @ Rt[:, None, None]
+    X = X[:, :, :, None]                                               # (N,S,2,1,3,3)
+    wb = np.array([1.0, -1.0])
+    c6 = wb * np.hypot(X[..., 2, 1], X[..., 2, 2])                       # (N,S,2,2) over wrist branch
+    q6 = np.arctan2(-X[..., 2, 0], c6)
+    q5 = np.arctan2(wb * X[..., 1, 0], wb * X[..., 0, 0])
+    q7 = np.arctan2(wb * X[..., 2, 1], wb * X[..., 2, 2])
+    # assemble (N, S, elbow 2, shoulder 2, wrist 2, 7)
+    shp = (N, S, 2, 2, 2)
+    Q = np.stack([
+        np.broadcast_to(q1[..., None], shp), np.broadcast_to(q2[..., None], shp),
+        np.broadcast_to(q3[..., None], shp),
+        np.broadcast_to(q4[:, None, :, None, None], shp),
+        np.broadcast_to(q5[:, :, :, None, :], shp), np.broadcast_to(q6[:, :, :, None, :], shp),
+        np.broadcast_to(q7[:, :, :, None, :], shp)], -1).reshape(N, S * 8, 7)
+    sw = np.broadcast_to(swivel[:, :, None], (N, S, 8)).reshape(N, S * 8)
+    sing = np.full(N, None, dtype=object)
+    sing[np.abs(np.sin(q4p)) < 1e-12] = "straight elbow: the swivel angle then turns the elbow axis about the arm"
+    return Q, np.broadcast_to(code[:, None], (N, S * 8)), sing, sw
+
+
+def swivel_angle(robot, q) -> np.ndarray:
+    """Swivel angle φ (rad) of human_arm7 configurations ``q`` (nq,) or (N, nq): the rotation
+    of the elbow about the shoulder–wrist axis n, measured from u (world −z projected ⊥ n, or −y
+    if n is vertical) towards v = n × u.  A straight elbow uses the elbow axis: d = σ n × x_E
+    (σ = sign sin q4).  ``analytic(robot, FK(q), swivel=swivel_angle(robot, q))`` contains q."""
+    name, prm = _require(robot)
+    if name != "human_arm7":
+        raise UnsupportedModelError(f"{robot.name}: the swivel angle is defined for human_arm7 only")
+    q = robot.check_q(q)
+    Q = np.atleast_2d(q)
+    l1, l2 = prm["l1"], prm["l2"]
+    c1, s1, c2, s2, c3, s3 = (f(Q[:, i]) for i in (0, 1, 2) for f in (np.cos, np.sin))
+    # Rsh = Rx(q1) Ry(q2) Rz(q3): x column and z column
+    ex = np.stack([c2 * c3, c1 * s3 + s1 * s2 * c3, s1 * s3 - c1 * s2 * c3], -1)
+    ez = np.stack([s2, -s1 * c2, c1 * c2], -1)
+    s4, c4 = np.sin(Q[:, 3]), np.cos(Q[:, 3])
+    ey = np.cross(ez, ex)
+    W = -l1 * ez + l2 * (s4[:, None] * ey - c4[:, None] * ez)
+    n = W / np.linalg.norm(W, axis=1)[:, None]
+    sg = np.where(s4 >= 0, 1.0, -1.0)
+    d = sg[:, None] * np.cross(n, ex)
+    u, v = _swivel_basis(n)
+    phi = np.arctan2(np.einsum("ni,ni->n", d, v), np.einsum("ni,ni->n", d, u))
+    return phi if q.ndim == 2 else float(phi[0])
+
+
+# ---------------------------------------------------------------------------- public API
+def _candidates(name, prm, Rt, pt, swivel):
+    if name == "sixr_arm":
+        Q, code, sing = _sixr(Rt, pt, prm["s0"], prm["h2"], prm["s3"], prm["P"])
+        return Q, code, sing, None, SIXR_BRANCHES
+    if name == "prosthetic_arm":
+        Q, code, sing = _prosthetic(Rt, pt, prm["L1"], prm["L2"], prm["L3"])
+        return Q, code, sing, None, PROSTHETIC_BRANCHES
+    if name == "planar2r":
+        Q, code, sing = _planar(Rt, pt, prm["l1"], prm["l2"])
+        return Q, code, sing, None, PLANAR_BRANCHES
+    if name == "human_arm7":
+        Q, code, sing, sw = _human(Rt, pt, prm["l1"], prm["l2"], prm["l3"], swivel)
+        S = swivel.shape[1]
+        labels = [f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES] if S > 1 else list(HUMAN_BRANCHES)
+        return Q, code, sing, sw, labels
+    raise AssertionError(name)
+
+
+def _swivel_array(swivel, N, grid_1d=False):
+    """(N, S) swivel angles.  Batch rule: scalar -> every pose; 1-D -> one angle per pose
+    (length N), unless ``grid_1d`` (single-pose call: a 1-D array is a grid); 2-D (N, S) or
+    (1, S) -> a grid per pose; None -> :data:`DEFAULT_SWIVEL` for every pose."""
+    if swivel is None:
+        return np.broadcast_to(DEFAULT_SWIVEL[None, :], (N, DEFAULT_SWIVEL.size)).copy()
+    sw = np.asarray(swivel, dtype=float)
+    if not np.isfinite(sw).all():
+        raise ValueError(f"swivel must be finite angles (rad), got {swivel!r}")
+    if sw.ndim == 0:
+        return np.full((N, 1), float(sw))
+    if sw.ndim == 1 and grid_1d:
+        sw = sw[None, :]
+    elif sw.ndim == 1:
+        if sw.shape[0] != N:
+            raise ValueError(f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
+                             f"got {sw.shape[0]} (pass shape (1, S) for a grid shared by all poses)")
+        return sw[:, None].copy()
+    if sw.ndim == 2 and sw.shape[0] in (1, N) and sw.shape[1] >= 1:
+        return np.broadcast_to(sw, (N, sw.shape[1])).copy()
+    raise ValueError(f"swivel must be a scalar, shape (N,), (1, S) or (N, S) with N = {N}, got {sw.shape}")
+
+
+def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
+                   tol: float = 1e-9, tol_orthonormal: float = 1e-6,
+                   _single_grid: bool = False) -> AnalyticBatchResult:
+    """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see module docstring).
+
+    Candidates are wrapped into the joint limits (multiples of 2π), rejected if outside, and
+    verified by FK: kept only if every entry of the 3×4 pose differs from ``T`` by ≤ ``tol``
+    (m for the position; the rotation entries are unitless).  ``position_only`` (default True
+    for planar2r only) compares the position alone.  human_arm7: ``swivel`` a scalar (all
+    poses), shape (N,) (one angle per pose), (1, S) (a grid shared by all poses) or (N, S);
+    default :data:`DEFAULT_SWIVEL` for every pose.
+
+    Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) and
+    :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form."""
+    name, prm = _require(robot)
+    if position_only is None:
+        position_only = name == "planar2r"
+    Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal, position_only=position_only)
+    N = Ts.shape[0]
+    Rt, pt = Ts[:, :3, :3], Ts[:, :3, 3]
+    sw = _swivel_array(swivel, N, grid_1d=_single_grid) if name == "human_arm7" else None
+    Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
+    B = Q.shape[1]
+    Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
+    Tf = _fk_for(robot)(Qw)                                             # (N, B, 4, 4)
+    if position_only:
+        res = np.abs(Tf[..., :3, 3] - pt[:, None, :]).max(-1)
+    else:
+        res = np.abs(Tf[..., :3, :] - Ts[:, None, :3, :]).max(axis=(-1, -2))
+    valid = (code == OK) & inside & (res <= tol)
+    valid &= np.isfinite(res)
+    # remove duplicate solutions (singular poses give coincident branches)
+    if B > 1:
+        for b in range(1, B):
+            diff = np.abs(Qw[:, :b, :] - Qw[:, b:b + 1, :]).max(-1)       # (N, b)
+            dup = ((diff < 1e-9) & valid[:, :b]).any(1)
+            valid[:, b] &= ~dup
+    sol = np.where(valid[..., None], Qw, np.nan)
+    reasons = [None] * N
+    fails = np.flatnonzero(~valid.any(1))
+    for i in fails:
+        reasons[i] = _reason_for(code[i], inside[i], res[i], tol, robot)
+    return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
+                               swivel=None if swv is None else np.where(valid, swv, np.nan),
+                               residuals=np.where(valid, res, np.nan), singular=list(sing), model=name)
+
+
+def _reason_for(code, inside, res, tol, robot) -> str:
+    codes = set(int(c) for c in code)
+    if OK not in codes:
+        for c in (OUT_OF_PLANE, OUTSIDE, DEGENERATE, ELBOW):
+            if c in codes:
+                return _REASONS[c]
+    ok = code == OK
+    if not (ok & inside).any():
+        return (f"all {int(ok.sum())} closed-form candidates violate the joint limits "
+                f"({', '.join(f'{n} [{lo:.4g}, {hi:.4g}]' for n, lo, hi in zip(robot.joint_names, robot.lower, robot.upper))})")
+    worst = float(np.nanmin(np.where(ok & inside, res, np.nan)))
+    return (f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); "
+            "the pose is at a singularity or not reachable with this orientation")
+
+
+def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
+             tol_orthonormal: float = 1e-6, method: str = "robust"):
+    """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
+
+    ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
+    :class:`AnalyticBatchResult` (same as :func:`analytic_batch`).  For planar2r a position (3,)
+    is accepted.  ``method="book"`` (prosthetic_arm only) runs the book's Cramer-rule procedure
+    :func:`prosthetic_book_procedure`, whose elbow determinant Δ may vanish.
+
+    Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
+    or why there is none: outside the workspace, elbow determinant, wrist singularity, joint
+    limits), ``swivel`` (human_arm7), ``residuals`` (FK check).  See the module docstring."""
+    arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
+    if method == "book":
+        name, prm = _require(robot)
+        if name != "prosthetic_arm":
+            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) exists for prosthetic_arm only")
+        Ts, single = _check_poses(arr, tol_orthonormal=tol_orthonormal)
+        if not single:
+            raise ValueError("method='book' takes one pose")
+        return _book_result(robot, Ts[0], prm, tol)
+    if method != "robust":
+        raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
+    if arr.ndim == 3:
+        return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
+                              tol_orthonormal=tol_orthonormal)
+    batch = analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
+                           tol_orthonormal=tol_orthonormal, _single_grid=True)
+    return batch[0]
+
+
+# ---------------------------------------------------------------------------- the book's procedure
+def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float = 0.130,
+                              *, det_tol: float = 1e-9):
+    """The book's prosthetic-arm IK exactly as printed (corrected), Eqs. (7-17)–(7-31), Fig. 7-3.
+
+    Elbow by Cramer's rule (7-20)/(7-21) (coefficient A with m3, not the printed m2) and the
+    quadratic (7-22); θ1 = atan2(yE, xE) (7-18), θ2 = acos(−zE/L1) (7-19), θ4 (7-24),
+    θ3 = asin(...) (7-27), θ6 = asin r3 (7-30), θ5 = atan2(r2, r1) (7-31, r2 with −cθ2cθ3).
+    Units: whatever ``T`` and the lengths use (the book: mm).  Returns (solutions, reason):
+    ``solutions`` a list of two 6-vectors (rad; the two elbow roots, not limit-filtered) or
+    empty with ``reason`` ("elbow determinant Δ = 0", "outside workspace", "s2·s4 = 0")."""
+    T = np.asarray(T, float)
+    l1_, l2_, l3_ = T[:3, 0]
+    m1, m2, m3 = T[:3, 1]
+    n1, n2, n3 = T[:3, 2]
+    x, y, z = T[:3, 3]
+    L0s = x * x + y * y + z * z
+    K0 = 0.5 * (L1**2 + L3**2 + L0s - L2**2)
+    nC = n1 * x + n2 * y + n3 * z
+    mC = m1 * x + m2 * y + m3 * z
+    Delta = m3 * x - m1 * z + L3 * (m1 * n3 - m3 * n1)
+    scale = max(1.0, abs(x) + abs(y) + abs(z))
+    if abs(Delta) <= det_tol * scale:
+        return [], (f"elbow determinant Δ = m3·x − m1·z + L3(m1·n3 − m3·n1) = {Delta:.3g} ≈ 0: "
+                    "Cramer's rule (7-20)/(7-21) cannot solve the elbow (use the robust solver)")
+    A = (m3 * K0 - L3 * m3 * nC - mC * (z - L3 * n3)) / Delta
+    B = (m2 * z - m3 * y + L3 * (m3 * n2 - m2 * n3)) / Delta
+    Cc = (mC * (x - L3 * n1) + L3 * m1 * nC - m1 * K0) / Delta
+    D = (m1 * y - m2 * x + L3 * (m2 * n1 - m1 * n2)) / Delta
+    E = B * B + D * D + 1
+    F = 2 * (A * B + Cc * D)
+    G = A * A + Cc * Cc - L1**2
+    disc = F * F - 4 * E * G
+    if disc < 0:
+        return [], "no elbow position: F² − 4EG < 0 in (7-22)"
+    xW, yW, zW = x - L3 * n1, y - L3 * n2, z - L3 * n3
+    c4 = (xW**2 + yW**2 + zW**2 - (L1**2 + L2**2)) / (2 * L1 * L2)
+    if abs(c4) > 1:
+        return [], "outside workspace: |cos θ4| > 1 in (7-24)"
+    th4 = np.arccos(c4)
+    sols = []
+    for sgn in (1.0, -1.0):
+        yE = (-F + sgn * np.sqrt(disc)) / (2 * E)
+        xE, zE = A + B * yE, Cc + D * yE
+        th1 = np.arctan2(yE, xE)
+        th2 = np.arccos(np.clip(-zE / L1, -1, 1))
+        c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
+        s4 = np.sin(th4)
+        if abs(s2 * s4) < 1e-12:
+            return [], "singular: s2·s4 = 0 in (7-27) (arm vertical or straight)"
+        th3 = np.arcsin(np.clip((zW + L2 * c2 * c4 + L1 * c2) / (L2 * s2 * s4), -1, 1))
+        c3, s3 = np.cos(th3), np.sin(th3)
+        P1 = l1_ * c1 + l2_ * s1
+        Q1 = l1_ * s1 - l2_ * c1
+        r1 = P1 * (s2 * s4 - c2 * s3 * c4) - l3_ * (s2 * s3 * c4 + c2 * s4) + c3 * c4 * Q1
+        r2 = -c2 * c3 * P1 - l3_ * s2 * c3 - s3 * Q1
+        r3 = P1 * (c2 * s3 * s4 + s2 * c4) + l3_ * (s2 * s3 * s4 - c2 * c4) - c3 * s4 * Q1
+        th6 = np.arcsin(np.clip(r3, -1, 1))
+        th5 = np.arctan2(r2, r1)
+        sols.append(np.array([th1, th2, th3, th4, th5, th6]))
+    return sols, None
+
+
+def _book_result(robot, T, prm, tol):
+    sols, reason = prosthetic_book_procedure(T, prm["L1"], prm["L2"], prm["L3"])
+    if not sols:
+        return AnalyticIKResult(np.zeros((0, robot.nq)), [], reason, model="prosthetic_arm")
+    Q = np.array(sols)
+    Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
+    Tf = _fk_for(robot)(Qw)
+    res = np.abs(Tf[:, :3, :] - T[None, :3, :]).max(axis=(1, 2))
+    ok = inside & (res <= tol)
+    labels = ["elbow_root=+", "elbow_root=-"]
+    if not ok.any():
+        why = ("the book's asin-based θ3/θ6 (7-27)/(7-30) give no FK-consistent solution inside the limits "
+               f"(residuals {', '.join(f'{r:.3g}' for r in res)}); use method='robust'")
+        return AnalyticIKResult(np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model="prosthetic_arm")
+    return AnalyticIKResult(Qw[ok], [lb for lb, k in zip(labels, ok) if k], None, residuals=res[ok],
+                            model="prosthetic_arm")
