@@ -266,9 +266,10 @@ def _solve(J: np.ndarray, rhs: np.ndarray, tol: float) -> tuple[str, np.ndarray,
     return "ok", np.linalg.solve(J, rhs), ""
 
 
-def rccc_velocity(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: float = DEAD_TOL) -> RCCCRates:
+def rccc_velocity(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: float = DEAD_TOL,
+                  _screws=None) -> RCCCRates:
     """Joint rates from Σ Jⱼ q̇ⱼ = 0 (loop closure differentiated once), input θ̇₁ (rad/s)."""
-    S = _joint_screws(g, sol)
+    S = _joint_screws(g, sol) if _screws is None else _screws
     J = np.column_stack(S[1:])
     st, x, msg = _solve(J, -S[0] * float(theta1_dot), tol)
     return RCCCRates(st, np.concatenate([[float(theta1_dot)], x]), msg)
@@ -278,10 +279,10 @@ def rccc_acceleration(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, the
                       velocity: RCCCRates | None = None, tol: float = DEAD_TOL) -> RCCCRates:
     """Joint accelerations from Σ Jⱼ q̈ⱼ + Σⱼ [Vⱼ₋, Jⱼ] q̇ⱼ = 0, where Vⱼ₋ is the base-frame
     twist of the link carrying joint j (sum of the upstream Jᵢ q̇ᵢ)."""
-    vel = velocity or rccc_velocity(g, sol, theta1_dot, tol)
+    S = _joint_screws(g, sol)
+    vel = velocity or rccc_velocity(g, sol, theta1_dot, tol, _screws=S)
     if vel.status != "ok":
         return RCCCRates(vel.status, np.zeros(7), vel.message)
-    S = _joint_screws(g, sol)
     qd = vel.rates
     bias = np.zeros(6)
     V = np.zeros(6)

@@ -21,6 +21,7 @@ Pinocchio ``SE3(R, p)`` (active pose of frame II in frame I) and Â.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,9 +36,14 @@ class Dual:
     __array_priority__ = 100  # so that ndarray * Dual defers to Dual.__rmul__
 
     def __init__(self, real, dual=0.0):
-        self.real = np.asarray(real, dtype=float) if not isinstance(real, float) else real
-        self.dual = np.asarray(dual, dtype=float) if not isinstance(dual, float) else dual
-        if not (np.all(np.isfinite(self.real)) and np.all(np.isfinite(self.dual))):
+        if isinstance(real, (float, int, np.floating, np.integer)) and isinstance(dual, (float, int, np.floating, np.integer)):
+            self.real, self.dual = float(real), float(dual)  # scalar fast path
+            ok = math.isfinite(self.real) and math.isfinite(self.dual)
+        else:
+            self.real = np.asarray(real, dtype=float)
+            self.dual = np.asarray(dual, dtype=float)
+            ok = bool(np.isfinite(self.real).all() and np.isfinite(self.dual).all())
+        if not ok:
             raise ValueError(f"dual number with a NaN or infinite part: {np.asarray(real).tolist()} + ε{np.asarray(dual).tolist()}")
 
     # -- helpers
@@ -322,17 +328,19 @@ _PZ = -skew([0, 0, 1.0])
 
 
 def _passive(axis: int, angle: Dual) -> Dual:
-    """Passive (old → new) basic dual rotation matrix about coordinate axis ``axis``."""
+    """Passive (old → new) basic dual rotation matrix about coordinate axis ``axis``:
+    real part R_kᵀ(θ), dual part θ* · d/dθ R_kᵀ(θ) (rule 5 element-wise)."""
     a = Dual.lift(angle)
-    c, s = cos(a), sin(a)
-    one, zero = Dual(1.0, 0.0), Dual(0.0, 0.0)
-    if axis == 0:
-        rows = [[one, zero, zero], [zero, c, s], [zero, -s, c]]
-    elif axis == 1:
-        rows = [[c, zero, -s], [zero, one, zero], [s, zero, c]]
-    else:
-        rows = [[c, s, zero], [-s, c, zero], [zero, zero, one]]
-    return Dual(np.array([[float(e.real) for e in r] for r in rows]), np.array([[float(e.dual) for e in r] for r in rows]))
+    t, ts = float(a.real), float(a.dual)
+    c, s = math.cos(t), math.sin(t)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]  # the rotated plane (i, j), cyclic
+    R = np.eye(3)
+    Dm = np.zeros((3, 3))
+    R[i, i] = R[j, j] = c
+    R[i, j], R[j, i] = s, -s
+    Dm[i, i] = Dm[j, j] = -s * ts
+    Dm[i, j], Dm[j, i] = c * ts, -c * ts
+    return Dual(R, Dm)
 
 
 def screw_x(phi, phi_star=None) -> Dual:
