@@ -673,7 +673,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
 
 # ---------------------------------------------------------------------------- the book's procedure
 def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float = 0.130,
-                              *, det_tol: float = 1e-9):
+                              *, det_tol: float = 1e-9, printed_m2: bool = False):
     """The book's prosthetic-arm IK exactly as printed (corrected), Eqs. (7-17)–(7-31), Fig. 7-3.
 
     Elbow by Cramer's rule (7-20)/(7-21) (coefficient A with m3, not the printed m2) and the
@@ -681,7 +681,9 @@ def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float
     θ3 = asin(...) (7-27), θ6 = asin r3 (7-30), θ5 = atan2(r2, r1) (7-31, r2 with −cθ2cθ3).
     Units: whatever ``T`` and the lengths use (the book: mm).  Returns (solutions, reason):
     ``solutions`` a list of two 6-vectors (rad; the two elbow roots, not limit-filtered) or
-    empty with ``reason`` ("elbow determinant Δ = 0", "outside workspace", "s2·s4 = 0")."""
+    empty with ``reason`` ("elbow determinant Δ = 0", "outside workspace", "s2·s4 = 0").
+    ``printed_m2=True`` uses the printed numerator "m2/2 (L1² + L3² + L0² − L2²)" of A (a
+    misprint, kept to show that it fails; docs/errata.md)."""
     T = np.asarray(T, float)
     l1_, l2_, l3_ = T[:3, 0]
     m1, m2, m3 = T[:3, 1]
@@ -696,7 +698,7 @@ def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float
     if abs(Delta) <= det_tol * scale:
         return [], (f"elbow determinant Δ = m3·x − m1·z + L3(m1·n3 − m3·n1) = {Delta:.3g} ≈ 0: "
                     "Cramer's rule (7-20)/(7-21) cannot solve the elbow (use the robust solver)")
-    A = (m3 * K0 - L3 * m3 * nC - mC * (z - L3 * n3)) / Delta
+    A = ((m2 if printed_m2 else m3) * K0 - L3 * m3 * nC - mC * (z - L3 * n3)) / Delta
     B = (m2 * z - m3 * y + L3 * (m3 * n2 - m2 * n3)) / Delta
     Cc = (mC * (x - L3 * n1) + L3 * m1 * nC - m1 * K0) / Delta
     D = (m1 * y - m2 * x + L3 * (m2 * n1 - m1 * n2)) / Delta
