@@ -62,7 +62,9 @@ MAX_ITER = 60     # iterations per attempt (before the stall test ends it earlie
 STALL = 3         # an attempt ends after STALL iterations without a 10 % error decrease
 NULL_TOL = 1e-5   # posture / swivel secondary step norm (rad) under which it has settled
 NULL_EXTRA = 60   # extra iterations allowed for the secondary objective
+NULL_STEP = 1.0   # longest null-space step (rad)
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
+HUMAN_GRID = np.linspace(-np.pi, np.pi, 12, endpoint=False)  # swivel grid of those seeds (human_arm7)
 
 _CHAINS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -226,8 +228,9 @@ def _attempt(ch, resid, q, tol_p, tol_r, deadline):
 
 def _refine(ch, resid, q, tol_p, tol_r, secondary, deadline):
     """Second phase for redundant arms: from a solution ``q``, move in the null space of the
-    primary task toward the secondary objective (posture or swivel), Gauss–Newton corrected.
-    Returns the last iterate that still meets the tolerances, and the iterations used."""
+    primary task toward the secondary objective (posture or swivel), Gauss–Newton corrected
+    (the pose error may grow in between and is driven back).  Returns the last iterate that
+    meets the tolerances (the phase-1 solution if none does), and the iterations used."""
     good = q
     it = 0
     while it < NULL_EXTRA and time.perf_counter() <= deadline:
@@ -235,8 +238,6 @@ def _refine(ch, resid, q, tol_p, tol_r, secondary, deadline):
         it += 1
         if pe <= tol_p and re <= tol_r:
             good = q
-        elif it > 1 and pe > 1e3 * tol_p + 1e-9 and re > 1e3 * tol_r + 1e-9:
-            break  # the null-space motion is leaving the solution (limits): keep the last good one
         A = J @ J.T
         A.flat[:: A.shape[0] + 1] += LAMBDA0 + K_DAMP * float(e @ e)
         cfac, x, info = dposv(A, e)
@@ -244,8 +245,11 @@ def _refine(ch, resid, q, tol_p, tol_r, secondary, deadline):
             break
         dq = J.T @ x
         dq2 = secondary(q, dq, J, cfac)
-        if pe <= tol_p and re <= tol_r and math.sqrt(dq2 @ dq2) < NULL_TOL:
+        n2 = math.sqrt(dq2 @ dq2)
+        if pe <= tol_p and re <= tol_r and n2 < NULL_TOL:
             break
+        if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
+            dq2 *= NULL_STEP / n2
         q = np.minimum(np.maximum(q + dq + dq2, ch.lo), ch.hi)
     else:
         J, e, pe, re = resid(q)
@@ -299,7 +303,7 @@ def _analytic_module():
     return closed_form if hasattr(closed_form, "analytic") and hasattr(closed_form, "has_analytic") else None
 
 
-def _analytic_seeds(robot, ch, mode, target, ref, swivel):
+def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None):
     """Closed-form solutions (K, nq) sorted by distance to ``ref``, or an empty array."""
     if mode != "pose" or ch.fid != robot.tool_id:
         return np.zeros((0, ch.n)), ""
@@ -307,7 +311,12 @@ def _analytic_seeds(robot, ch, mode, target, ref, swivel):
     if cf is None or not cf.has_analytic(robot):
         return np.zeros((0, ch.n)), ""
     try:
-        kw = {"swivel": swivel} if (swivel is not None and robot.name == "human_arm7") else {}
+        kw = {}
+        if robot.name == "human_arm7":
+            if swivel is not None:
+                kw["swivel"] = swivel
+            elif grid is not None:
+                kw["swivel"] = grid
         S = np.asarray(cf.analytic(robot, target.homogeneous, **kw).solutions, dtype=float).reshape(-1, ch.n)
     except Exception as exc:  # a seed source only: never let it break the solve
         return np.zeros((0, ch.n)), f"analytic seed failed: {exc}"
@@ -474,7 +483,7 @@ def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restar
         if out_of_reach and attempt >= 3:
             break
         if analytic == "auto" and ana is None and not out_of_reach and attempt >= ANALYTIC_AFTER:
-            ana, note = _analytic_seeds(robot, ch, mode, target, best[0], sw[1] if sw else None)
+            ana, note = _analytic_seeds(robot, ch, mode, target, best[0], sw[1] if sw else None, HUMAN_GRID)
         if time.perf_counter() > deadline:
             break
         if max_restarts is not None and restarts >= max_restarts and (ana is None or ana_i >= len(ana)):

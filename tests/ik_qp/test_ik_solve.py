@@ -1,0 +1,224 @@
+"""One-shot IK aa.ik.solve: success on reachable poses, limits, target kinds, batch, bad input,
+unreachable targets, human-arm posture and swivel, property tests."""
+
+import json
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import anthroarm as aa
+from anthroarm.errors import UnknownFrameError
+from anthroarm.ik import IKBatchResult, IKResult, qp
+
+ROBOTS = ["panda", "ur5", "talos_arm", "human_arm7", "prosthetic_arm"]
+
+
+@pytest.fixture(scope="module")
+def robots():
+    return {n: aa.load(n) for n in ROBOTS}
+
+
+def pose_error(robot, q, T, frame=None):
+    """Independent check with pin.framesForwardKinematics on a fresh Data."""
+    d = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, d, q)
+    M = d.oMf[robot.frame_id(frame)]
+    return np.linalg.norm(M.translation - T[:3, 3]), np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_reachable_poses_are_solved_within_limits(robots, name):
+    robot = robots[name]
+    qs = robot.random_q(40, rng=123)
+    for q_goal in qs:
+        T = robot.fk(q_goal)
+        res = aa.ik.solve(robot, T)
+        assert isinstance(res, IKResult)
+        assert res.success, res.message
+        assert res.status == "success"
+        assert robot.within_limits(res.q)            # exact, no tolerance
+        pe, re = pose_error(robot, res.q, T)
+        assert pe <= 1e-6 and re <= 1e-6
+        assert res.pos_err == pytest.approx(pe, abs=1e-12) and res.rot_err == pytest.approx(re, abs=1e-12)
+
+
+def test_position_and_orientation_targets(robots):
+    robot = robots["panda"]
+    for q_goal in robot.random_q(10, rng=5):
+        T = robot.fk(q_goal)
+        r1 = aa.ik.solve(robot, T[:3, 3])
+        assert r1.success and r1.mode == "position" and robot.within_limits(r1.q)
+        assert pose_error(robot, r1.q, T)[0] <= 1e-6
+        r2 = aa.ik.solve(robot, T[:3, :3])
+        assert r2.success and r2.mode == "orientation" and robot.within_limits(r2.q)
+        assert pose_error(robot, r2.q, T)[1] <= 1e-6
+        r3 = aa.ik.solve(robot, T, mode="position")
+        assert r3.success and pose_error(robot, r3.q, T)[0] <= 1e-6
+
+
+def test_batch_form_and_warm_start(robots):
+    robot = robots["ur5"]
+    qs = robot.random_q(12, rng=9)
+    Ts = robot.fk(qs)
+    out = aa.ik.solve(robot, Ts)
+    assert isinstance(out, IKBatchResult) and len(out) == 12
+    assert out.success.all() and out.q.shape == (12, 6)
+    assert robot.within_limits(out.q).all()
+    for i, r in enumerate(out):
+        assert pose_error(robot, r.q, Ts[i])[0] <= 1e-6
+    # a smooth path: warm start from the previous solution keeps consecutive solutions close
+    path = robot.fk(qs[0] + np.linspace(0, 0.3, 15)[:, None] * np.ones(6))
+    w = aa.ik.solve(robot, path, q0=None, warm_start=True)
+    assert w.success.all()
+    assert np.abs(np.diff(w.q, axis=0)).max() < 0.2
+    pos = aa.ik.solve(robot, Ts[:, :3, 3])
+    assert pos.mode == "position" and pos.success.all()
+    q0s = aa.ik.solve(robot, Ts, q0=qs)   # per-target seeds at the answer: zero restarts
+    assert q0s.success.all() and (q0s.restarts == 0).all()
+
+
+def test_out_of_reach_target(robots):
+    robot = robots["panda"]
+    T = np.eye(4)
+    T[:3, 3] = [3.0, 0.0, 0.5]
+    res = aa.ik.solve(robot, T, max_time=0.02)
+    assert not res.success and res.status == "out_of_reach"
+    assert "reaches at most" in res.message and "closest pose" in res.message
+    assert robot.within_limits(res.q)
+    # the closest pose found is stretched toward the target: nearer than the seed
+    seed_err = pose_error(robot, qp.comfortable_posture(robot), T)[0]
+    assert res.pos_err < seed_err
+    assert res.pos_err >= np.linalg.norm(T[:3, 3]) - 1.3  # panda reach is about 1.2 m
+    assert json.loads(json.dumps(res.as_dict()))["status"] == "out_of_reach"
+
+
+def test_not_converged_target_within_reach(robots):
+    """Within the reach bound but not attainable with the joint limits (prosthetic arm: the
+    shoulder only rotates in [−π, 0]): status not_converged, closest pose, within limits."""
+    robot = robots["prosthetic_arm"]
+    T = robot.fk(robot.neutral())
+    T[:3, 3] = [0.0, 0.0, 0.6]   # straight above the shoulder, hand pointing up: elbow range forbids
+    T[:3, :3] = np.eye(3)
+    res = aa.ik.solve(robot, T, max_time=0.01)
+    if res.success:  # the pose happens to be attainable: then it must be exact
+        assert pose_error(robot, res.q, T)[0] <= 1e-6
+    else:
+        assert res.status in ("not_converged", "out_of_reach")
+        assert "closest pose found" in res.message
+    assert robot.within_limits(res.q)
+
+
+def test_bad_input(robots):
+    robot = robots["panda"]
+    T = robot.fk(robot.neutral())
+    bad = T.copy()
+    bad[0, 3] = np.nan
+    with pytest.raises(ValueError, match="finite"):
+        aa.ik.solve(robot, bad)
+    sk = T.copy()
+    sk[:3, :3] *= 1.1
+    with pytest.raises(ValueError, match="not a rotation"):
+        aa.ik.solve(robot, sk)
+    br = T.copy()
+    br[3] = [0, 0, 1, 1]
+    with pytest.raises(ValueError, match="not rigid"):
+        aa.ik.solve(robot, br)
+    with pytest.raises(ValueError, match="shape"):
+        aa.ik.solve(robot, np.eye(5))
+    with pytest.raises(UnknownFrameError, match="valid frames: .*panda_hand"):
+        aa.ik.solve(robot, T, frame="hand_of_god")
+    with pytest.raises(ValueError, match="panda_joint3"):
+        aa.ik.solve(robot, T, q0=[0, 0, np.nan, -1, 0, 1, 0])
+    with pytest.raises(ValueError, match="tol_pos"):
+        aa.ik.solve(robot, T, tol_pos=-1)
+    with pytest.raises(ValueError, match="max_time"):
+        aa.ik.solve(robot, T, max_time=0)
+    with pytest.raises(ValueError, match="mode"):
+        aa.ik.solve(robot, T, mode="both")
+    with pytest.raises(ValueError, match="is a position"):
+        aa.ik.solve(robot, np.zeros(3), mode="orientation")
+
+
+def test_seed_outside_limits_returns_within_limits(robots):
+    robot = robots["panda"]
+    T = robot.fk(robot.random_q(rng=3))
+    q0 = robot.upper + 1.0
+    res = aa.ik.solve(robot, T, q0=q0)
+    assert res.success and robot.within_limits(res.q)
+
+
+def test_other_frame(robots):
+    robot = robots["panda"]
+    q = robot.random_q(rng=8)
+    T = robot.fk(q, "panda_link5")
+    res = aa.ik.solve(robot, T, frame="panda_link5")
+    assert res.success and pose_error(robot, res.q, T, "panda_link5")[0] <= 1e-6
+
+
+def test_human_arm_posture_is_comfortable(robots):
+    """With the posture objective the human arm lands closer to the comfortable posture than
+    without it, on the same targets (the null-space pull keeps the hand pose exact)."""
+    robot = robots["human_arm7"]
+    ref = qp.comfortable_posture(robot)
+    d_with, d_without = [], []
+    for q_goal in robot.random_q(15, rng=21):
+        T = robot.fk(q_goal)
+        a = aa.ik.solve(robot, T)                   # posture="auto" for human_arm7
+        b = aa.ik.solve(robot, T, posture=None)
+        assert a.success and b.success
+        assert pose_error(robot, a.q, T)[0] <= 1e-6 and robot.within_limits(a.q)
+        d_with.append(np.linalg.norm(a.q - ref))
+        d_without.append(np.linalg.norm(b.q - ref))
+    assert np.mean(d_with) < np.mean(d_without)
+    assert np.sum(np.array(d_with) <= np.array(d_without) + 1e-9) >= 12
+
+
+def test_human_arm_swivel(robots):
+    robot = robots["human_arm7"]
+    hits = 0
+    for q_goal in robot.random_q(10, rng=2):
+        if abs(np.sin(q_goal[3])) < 0.3:
+            continue
+        T = robot.fk(q_goal)
+        phi_goal = qp.swivel_angle(robot, q_goal)   # a swivel angle known to be attainable
+        res = aa.ik.solve(robot, T, swivel=phi_goal, q0=qp.comfortable_posture(robot))
+        assert res.success and robot.within_limits(res.q)
+        d = qp.swivel_angle(robot, res.q) - phi_goal
+        if abs(np.arctan2(np.sin(d), np.cos(d))) < 1e-4:
+            hits += 1
+    assert hits >= 4
+
+
+def test_analytic_seed_when_available(robots):
+    robot = robots["prosthetic_arm"]
+    cf = pytest.importorskip("anthroarm.ik.closed_form")
+    if not cf.has_analytic(robot):
+        pytest.skip("no closed form")
+    T = robot.fk(robot.random_q(rng=4))
+    res = aa.ik.solve(robot, T, analytic=True)
+    assert res.success and res.seed == "analytic" and res.restarts == 0
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), name=st.sampled_from(ROBOTS), kind=st.sampled_from(["reach", "random"]))
+def test_property_never_violates_limits(robots, seed, name, kind):
+    """Random targets (reachable, or arbitrary poses that may be unreachable) and random seeds:
+    every answer is within the limits, errors are reported honestly, no undocumented exception."""
+    robot = robots[name]
+    rng = np.random.default_rng(seed)
+    if kind == "reach":
+        T = robot.fk(robot.random_q(rng=rng))
+    else:
+        T = np.eye(4)
+        T[:3, :3] = pin.exp3(rng.normal(size=3))
+        T[:3, 3] = rng.uniform(-1.5, 1.5, 3)
+    q0 = rng.uniform(robot.lower - 0.5, robot.upper + 0.5) if rng.random() < 0.5 else None
+    res = aa.ik.solve(robot, T, q0=q0, max_time=0.01, rng=int(seed))
+    assert robot.within_limits(res.q)
+    pe, re = pose_error(robot, res.q, T)
+    assert res.pos_err == pytest.approx(pe, abs=1e-9) and res.rot_err == pytest.approx(re, abs=1e-9)
+    assert res.success == (pe <= 1e-6 and re <= 1e-6)
+    assert res.status in ("success", "out_of_reach", "not_converged")
