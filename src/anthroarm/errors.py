@@ -78,3 +78,7 @@ class InertiaError(UnsupportedModelError, ValueError):
 
 class SolverNotAvailableError(AnthroarmError, ValueError):
     """A QP solver name that is unknown or not installed.  The message lists the installed ones."""
+
+
+class EulerSingularityError(AnthroarmError, ValueError):
+    """Euler angles at a singular posture (gimbal lock), e.g. sin ψ = 0 for X–Y–X angles."""
