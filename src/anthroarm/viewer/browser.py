@@ -91,3 +91,27 @@ def drawn_fraction(png, baseline_png, region=(0.0, 0.0, 1.0, 1.0), tol: int = 40
     m = changed_mask(png, baseline_png, tol)
     ys, xs = region_slice(m.shape, region)
     return float(m[ys, xs].mean())
+
+
+def docs_screenshot(png, size=(960, 640)) -> Path:
+    """The README picture: the §6-3 human arm mid-demo (reaching forward), the demo's targets
+    and hand path, joint-limit colours on.  ``python -m anthroarm.viewer.browser docs/x.png``."""
+    import numpy as np
+
+    from .demo import REACH_POSTURES_DEG, demo_viewer, reach_demo
+
+    res = reach_demo()
+    v = demo_viewer(res)
+    v.store.animation = None  # a still picture: the pose below, not the animation's first frame
+    v.show_limits()
+    v.display(np.deg2rad(REACH_POSTURES_DEG["hand to mouth"]))
+    v.set_camera((0.55, 1.0, 0.4), distance=1.35 * v.radius)
+    with tempfile.TemporaryDirectory() as d:
+        html = v.export_html(Path(d) / "arm.html")
+        return screenshot(html, png, size=size, budget_ms=3000)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    print(docs_screenshot(sys.argv[1] if len(sys.argv) > 1 else "human_arm_viewer.png"))

@@ -30,7 +30,7 @@ import pinocchio as pin
 REACH_POSTURES_DEG = {
     "reach forward": [85, -5, 0, 15, 0, 0, 10],
     "across the body": [70, 0, 45, 60, 20, 0, 0],
-    "hand to mouth": [45, -10, -35, 125, 40, 0, 20],
+    "hand to mouth": [60, 5, 55, 135, 0, -5, 0],
     "reach to the side": [10, -80, 0, 20, -30, 0, 0],
     "overhead": [155, -10, 10, 25, 0, -10, 0],
     "back to rest": [5, -5, 0, 15, 0, 0, 0],

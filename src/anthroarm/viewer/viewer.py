@@ -198,9 +198,9 @@ class Viewer:
             cmds.append(_set_property("/Grid", "visible", False))
         # a translucent floor disc under the reach (always drawn; robust in software WebGL,
         # where meshcat's line grid is drawn wrongly at oblique angles)
-        rf = 1.1 * self.radius
+        rf = 0.9 * self.radius
         disc = mg.Cylinder(0.004 * rf, rf)
-        cmds.append(_set_object(f"{self.root}/floor", disc, (0.78, 0.81, 0.86), 0.6))
+        cmds.append(_set_object(f"{self.root}/floor", disc, (0.80, 0.83, 0.88), 0.4))
         cmds.append(_set_transform(f"{self.root}/floor", _tf(_y_to([0, 0, 1]), [self.center[0], self.center[1], floor])))
         cmds.append(_set_property("/Axes", "visible", False))
         if background is None:
@@ -213,7 +213,7 @@ class Viewer:
         self.set_camera()
 
     # ------------------------------------------------------------------ scene settings
-    def set_camera(self, direction=(0.6, 0.9, 0.5), distance: float | None = None) -> None:
+    def set_camera(self, direction=(0.9, 1.0, 0.45), distance: float | None = None) -> None:
         """Look at the centre of the reach from ``direction`` (base-frame axes) at ``distance``
         (default: the whole reach fits the 75° field of view)."""
         d = np.asarray(direction, float)
@@ -369,7 +369,7 @@ class Viewer:
             cmds += [_set_object(f"{path}/triad/{k}", p.geometry, p.rgb), _set_transform(f"{path}/triad/{k}", p.offset)]
         self._send(cmds)
 
-    def show_trace(self, points, name: str = "trace", rgb=(0.85, 0.1, 0.55), radius: float | None = None,
+    def show_trace(self, points, name: str = "trace", rgb=(0.80, 0.25, 0.60), radius: float | None = None,
                    configurations: bool | None = None) -> np.ndarray:
         """A polyline through ``points`` (N, 3) in the base frame, or through the tool positions
         of a joint trajectory (N, nq) (``configurations=True``; guessed from the shape when
@@ -383,7 +383,7 @@ class Viewer:
             raise ValueError(f"trace needs (N>=2, 3) points or (N, {self.robot.nq}) configurations, got shape {P.shape}")
         if not np.all(np.isfinite(P)):
             raise ValueError("trace points contain NaN or inf")
-        r = radius if radius is not None else 0.012 * self.radius
+        r = radius if radius is not None else 0.005 * self.radius
         path = self._overlay_path(name)
         cmds = [_delete(path)]
         # thin out to at most 200 segments

@@ -222,13 +222,15 @@ def _palm(tool_frame, r, axis) -> list[Piece]:
 
 
 def _torso(robot, r) -> list[Piece]:
-    """Context for the §6-3 human arm (shoulder at the origin, x to the right, y forward,
-    arm hanging along -z): a torso medial to the right shoulder and a head above it."""
+    """Context for the §6-3 human arm (right shoulder at the origin, x to the right, y forward,
+    arm hanging along -z): a torso medial to the shoulder, a neck and a head.  Proportions
+    scale with the arm's length L (shoulder to midline ≈ 0.3 L ≈ 0.19 m for a 1.75 m man)."""
     L = robot.length_scale
-    w = 0.55 * L  # shoulder-to-midline distance ~ 0.2 m for a 1.75 m person
-    pieces = capsule([-w, 0.0, -0.15 * L], [-w, 0.0, -0.75 * L], 0.55 * w, TORSO_RGB, "torso")
-    pieces += capsule([-0.15 * L, 0, -0.02 * L], [-2 * w + 0.15 * L, 0, -0.02 * L], 0.9 * r, TORSO_RGB, "torso")
-    pieces.append(Piece(mg.Sphere(0.3 * w * 1.1), SKIN_RGB, _tf(p=[-w, 0.0, 0.33 * L]), "torso"))
+    w = 0.3 * L
+    pieces = [Piece(mg.Ellipsoid([0.9 * w, 0.5 * w, 0.5 * L]), TORSO_RGB, _tf(p=[-w, 0.0, -0.42 * L]), "torso")]
+    pieces += capsule([-0.12 * w, 0.0, -0.03 * L], [-1.88 * w, 0.0, -0.03 * L], 0.8 * r, TORSO_RGB, "torso")
+    pieces += cylinder_between([-w, 0.0, 0.0], [-w, 0.0, 0.12 * L], 0.22 * w, SKIN_RGB, "torso")
+    pieces.append(Piece(mg.Ellipsoid([0.33 * w, 0.38 * w, 0.45 * w]), SKIN_RGB, _tf(p=[-w, 0.02 * L, 0.25 * L]), "torso"))
     return pieces
 
 
