@@ -1,0 +1,247 @@
+"""The spatial cell method (空间单元法), book §7-3, Eq. (7-32).
+
+Off-line, the workspace is cut into cubic cells of edge ``D`` for one fixed hand orientation
+and the exact IK (:func:`anthroarm.ik.analytic_batch`) is stored at every lattice point
+``M = origin + D·(i, j, k)``.  On-line, a target ``P0`` is located in its cell and the joint
+vector is interpolated from the 8 corners by repeated linear division (定比分割), Eq. (7-32):
+
+    N1 = t1 M0 + m1 M1,  N2 = t1 M2 + m1 M4,  N3 = t1 M3 + m1 M6,  N4 = t1 M5 + m1 M7,
+    N5 = t2 N1 + m2 N2,  N6 = t2 N3 + m2 N4,  P0 = t3 N5 + m3 N6,   t_i = 1 − m_i,
+
+with corner labels M0 = (0,0,0), M1 = (1,0,0), M2 = (0,1,0), M3 = (0,0,1), M4 = (1,1,0),
+M5 = (0,1,1), M6 = (1,0,1), M7 = (1,1,1) (the printed chain has sign/index misprints, see
+docs/errata.md).  Only arithmetic is needed at run time.  :meth:`CellTable.refine` adds one
+Newton step (Pinocchio Jacobian) after the lookup.
+
+Units: metres and radians (the book's D = 50 mm is ``D=0.05``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .closed_form import _require, analytic_batch
+
+#: corner offsets (i, j, k) of M0 … M7 in the book's labelling
+CORNERS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1], [1, 1, 1]])
+
+
+def trilinear_weights(m) -> np.ndarray:
+    """Weights of M0 … M7 in Eq. (7-32) for local cell coordinates ``m`` = (m1, m2, m3) ∈ [0, 1]³
+    (shape (3,) or (N, 3)); returns (8,) or (N, 8).  They are ≥ 0 and sum to 1."""
+    m = np.asarray(m, float)
+    t = 1.0 - m
+    m1, m2, m3 = m[..., 0], m[..., 1], m[..., 2]
+    t1, t2, t3 = t[..., 0], t[..., 1], t[..., 2]
+    return np.stack([t1 * t2 * t3, m1 * t2 * t3, t1 * m2 * t3, t1 * t2 * m3,
+                     m1 * m2 * t3, t1 * m2 * m3, m1 * t2 * m3, m1 * m2 * m3], -1)
+
+
+def nested_division(M, m) -> np.ndarray:
+    """Eq. (7-32) as the book computes it: the chain N1 … N6, P0 of linear divisions.
+    ``M`` (8, k) corner values in the book's order, ``m`` (3,) local coordinates."""
+    M = np.asarray(M, float)
+    m1, m2, m3 = (float(x) for x in m)
+    t1, t2, t3 = 1 - m1, 1 - m2, 1 - m3
+    N1 = t1 * M[0] + m1 * M[1]
+    N2 = t1 * M[2] + m1 * M[4]
+    N3 = t1 * M[3] + m1 * M[6]
+    N4 = t1 * M[5] + m1 * M[7]
+    N5 = t2 * N1 + m2 * N2
+    N6 = t2 * N3 + m2 * N4
+    return t3 * N5 + m3 * N6
+
+
+class OutsideCellTableError(ValueError):
+    """A query point whose cell is not covered by the table (outside the lattice, or a corner
+    outside the workspace / joint limits)."""
+
+
+@dataclass
+class CellLookup:
+    """Batch lookup result: ``q`` (N, nq), NaN where ``ok`` is False (cell not covered)."""
+
+    q: np.ndarray
+    ok: np.ndarray
+
+
+class CellTable:
+    """Joint-angle lattice of one robot for one fixed hand orientation (book §7-3).
+
+    Build with :meth:`build`, query with :meth:`lookup` / :meth:`lookup_batch`, persist with
+    :meth:`save` / :meth:`load`.  Attributes: ``origin`` (3,) m, ``D`` m, ``shape`` (nx, ny, nz),
+    ``Q`` (nx, ny, nz, nq) rad (NaN where the lattice point has no IK solution on the branch),
+    ``valid`` (nx, ny, nz), ``rotation`` (3, 3), ``model`` and ``params``."""
+
+    def __init__(self, model: str, params: dict, rotation, origin, D: float, Q, valid):
+        self.model = model
+        self.params = dict(params)
+        self.rotation = np.asarray(rotation, float)
+        self.origin = np.asarray(origin, float)
+        self.D = float(D)
+        self.Q = np.asarray(Q, float)
+        self.valid = np.asarray(valid, bool)
+        self.shape = self.valid.shape
+        self.nq = self.Q.shape[-1]
+        # per-cell usability: all 8 corners valid
+        v = self.valid
+        self.cell_ok = (v[:-1, :-1, :-1] & v[1:, :-1, :-1] & v[:-1, 1:, :-1] & v[:-1, :-1, 1:]
+                        & v[1:, 1:, :-1] & v[:-1, 1:, 1:] & v[1:, :-1, 1:] & v[1:, 1:, 1:])
+
+    # ------------------------------------------------------------------ build
+    @classmethod
+    def build(cls, robot, rotation, D: float, bounds, *, q_ref=None, branch: str | None = None,
+              progress: bool = True, swivel: float = 0.0) -> "CellTable":
+        """Exact IK at every lattice point of the box ``bounds = (lo(3), hi(3))`` (m); the
+        lattice is anchored at the base origin (points are integer multiples of ``D``).
+
+        Branch choice: the solution with label ``branch`` if given, else the valid solution
+        nearest to ``q_ref`` (default: the joint-range middle), so that the 8 corners of a cell
+        come from one consistent branch.  ``progress`` shows a tqdm bar (one step per z slice)."""
+        name, params = _require(robot)
+        R = np.asarray(rotation, float)
+        if R.shape != (3, 3) or not np.isfinite(R).all() or np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
+            raise ValueError(f"rotation must be a 3x3 rotation matrix, got {R!r}")
+        D = float(D)
+        if not (np.isfinite(D) and D > 0):
+            raise ValueError(f"cell size D must be > 0 (m), got {D}")
+        lo, hi = (np.asarray(b, float) for b in bounds)
+        if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi <= lo).any():
+            raise ValueError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
+        i0 = np.floor(lo / D + 1e-9).astype(int)
+        i1 = np.ceil(hi / D - 1e-9).astype(int)
+        shape = tuple(int(x) for x in (i1 - i0 + 1))
+        if np.prod(shape) > 5_000_000:
+            raise ValueError(f"lattice of {shape} points is too large; increase D")
+        origin = i0 * D
+        if q_ref is None:
+            lo_q = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
+            hi_q = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
+            q_ref = 0.5 * (lo_q + hi_q)
+        q_ref = robot.check_q(q_ref, "q_ref")
+        Q = np.full(shape + (robot.nq,), np.nan)
+        valid = np.zeros(shape, bool)
+        gx, gy = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
+        it = range(shape[2])
+        if progress:
+            from tqdm.auto import tqdm
+
+            it = tqdm(it, desc=f"cell table {name} D={D * 1000:g} mm", unit="slice")
+        kw = {"swivel": swivel} if name == "human_arm7" else {}
+        for k in it:
+            P = origin + D * np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, k)], -1)
+            T = np.tile(np.eye(4), (P.shape[0], 1, 1))
+            T[:, :3, :3] = R
+            T[:, :3, 3] = P
+            res = analytic_batch(robot, T, **kw)
+            if branch is not None:
+                if branch not in res.branches:
+                    raise ValueError(f"branch {branch!r} is not one of {res.branches}")
+                b = res.branches.index(branch)
+                sel = res.solutions[:, b]
+                ok = res.valid[:, b]
+            else:
+                d = np.abs(np.where(res.valid[..., None], res.solutions, np.inf) - q_ref).max(-1)
+                b = np.argmin(d, axis=1)
+                sel = res.solutions[np.arange(len(b)), b]
+                ok = res.valid[np.arange(len(b)), b]
+            Q[:, :, k] = np.where(ok[:, None], sel, np.nan).reshape(shape[0], shape[1], robot.nq)
+            valid[:, :, k] = ok.reshape(shape[0], shape[1])
+        return cls(name, params, R, origin, D, Q, valid)
+
+    # ------------------------------------------------------------------ lookup
+    def _locate(self, P):
+        rel = (P - self.origin) / self.D
+        idx = np.floor(rel).astype(np.int64)
+        # points exactly on the upper lattice face belong to the last cell
+        hi = np.array(self.shape) - 2
+        idx = np.where((idx == hi + 1) & (rel <= hi + 1 + 1e-12), hi, idx)
+        m = rel - idx
+        inside = ((idx >= 0) & (idx <= hi)).all(-1)
+        return idx, m, inside
+
+    def lookup(self, p) -> np.ndarray:
+        """Joint vector (nq,) at position ``p`` (3,) m by Eq. (7-32).  Raises
+        :class:`OutsideCellTableError` if the cell is not covered."""
+        p = np.asarray(p, float)
+        if p.shape != (3,) or not np.isfinite(p).all():
+            raise ValueError(f"p must be a finite position (3,) in metres, got {p!r}")
+        idx, m, inside = self._locate(p)
+        if not inside:
+            raise OutsideCellTableError(f"position {p} m is outside the lattice {self.bounds}")
+        i, j, k = (int(x) for x in idx)
+        if not self.cell_ok[i, j, k]:
+            raise OutsideCellTableError(f"position {p} m lies in a cell with a corner outside the workspace or the joint limits")
+        c = self.Q[i:i + 2, j:j + 2, k:k + 2]                # corners, repeated linear division
+        c = c[0] * (1 - m[0]) + c[1] * m[0]
+        c = c[0] * (1 - m[1]) + c[1] * m[1]
+        return c[0] * (1 - m[2]) + c[1] * m[2]
+
+    def lookup_batch(self, P) -> CellLookup:
+        """Vectorised Eq. (7-32) for positions ``P`` (N, 3) m."""
+        P = np.asarray(P, float)
+        if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
+            raise ValueError(f"P must be finite positions (N, 3) in metres, got shape {P.shape}")
+        idx, m, inside = self._locate(P)
+        idc = np.clip(idx, 0, np.array(self.shape) - 2)
+        ok = inside & self.cell_ok[idc[:, 0], idc[:, 1], idc[:, 2]]
+        w = trilinear_weights(m)                              # (N, 8)
+        q = np.zeros((P.shape[0], self.nq))
+        for c, (a, b, e) in enumerate(CORNERS):
+            q += w[:, c:c + 1] * self.Q[idc[:, 0] + a, idc[:, 1] + b, idc[:, 2] + e]
+        q[~ok] = np.nan
+        return CellLookup(q, ok)
+
+    def refine(self, robot, p, q, steps: int = 1) -> np.ndarray:
+        """``steps`` Newton steps on the full pose error (position ``p``, the table's rotation)
+        from ``q``: Δq = J⁺ (p − p(q); log3(R* R(q)ᵀ)), J = Pinocchio LOCAL_WORLD_ALIGNED."""
+        import pinocchio as pin
+
+        q = robot.check_q(q).copy()
+        Rt = self.rotation
+        for _ in range(steps):
+            T = robot.fk(q)
+            e = np.concatenate([np.asarray(p, float) - T[:3, 3], pin.log3(Rt @ T[:3, :3].T)])
+            J = robot.jacobian(q)
+            q = q + np.linalg.lstsq(J, e, rcond=None)[0]
+        return q
+
+    @property
+    def bounds(self):
+        return self.origin, self.origin + self.D * (np.array(self.shape) - 1)
+
+    # ------------------------------------------------------------------ persistence
+    def save(self, path) -> Path:
+        """Write the table to ``path`` (.npz) atomically (temporary file + os.replace)."""
+        path = Path(path)
+        if path.suffix != ".npz":
+            path = path.with_suffix(".npz")
+        tmp = path.with_name(path.name + ".tmp.npz")
+        meta = json.dumps({"model": self.model, "params": self.params, "D": self.D, "format": 1})
+        with open(tmp, "wb") as fh:
+            np.savez(fh, Q=self.Q, valid=self.valid, origin=self.origin, rotation=self.rotation,
+                     meta=np.array(meta))
+        os.replace(tmp, path)
+        return path
+
+    @classmethod
+    def load(cls, path) -> "CellTable":
+        """Read a table written by :meth:`save`.  ValueError if the file is not one."""
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                meta = json.loads(str(z["meta"]))
+                return cls(meta["model"], meta["params"], z["rotation"], z["origin"], meta["D"], z["Q"], z["valid"])
+        except (KeyError, json.JSONDecodeError, OSError, ValueError) as exc:
+            if isinstance(exc, FileNotFoundError):
+                raise
+            raise ValueError(f"{path}: not a cell table written by CellTable.save ({exc})") from None
+
+    def matches(self, robot) -> bool:
+        """True if ``robot`` is the model and parameters this table was built for."""
+        return robot.spec is not None and robot.spec.name == self.model and dict(robot.spec.params) == self.params
