@@ -2,7 +2,6 @@
 Fletcher-Reeves (4-26)-(4-47), the book's simplex (4-48)-(4-64), SUMT (4-65)-(4-78), the §4-3
 constrained example; cross-checked against scipy.optimize."""
 
-import math
 
 import numpy as np
 import pytest
