@@ -50,6 +50,22 @@ def project(points: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.stack([px, py], 1)
 
 
+def half_extent_corners(g) -> list[np.ndarray]:
+    """Corners of the local bounding box of a meshcat primitive (cylinders are along y)."""
+    kind = type(g).__name__
+    if kind == "Sphere":
+        e = np.full(3, g.radius)
+    elif kind == "Ellipsoid":
+        e = np.asarray(g.radii, float)
+    elif kind == "Cylinder":
+        e = np.array([max(g.radiusTop, g.radiusBottom), g.height / 2, max(g.radiusTop, g.radiusBottom)])
+    elif kind == "Box":
+        e = np.asarray(g.lengths, float) / 2
+    else:
+        raise AssertionError(f"unexpected geometry {kind}")
+    return [e * np.array([sx, sy, sz]) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+
+
 def expected_box(v: Viewer, q) -> tuple[int, int, int, int]:
     """Pixel box (x0, y0, x1, y1) around every body piece of the robot at q."""
     robot = v.robot
@@ -59,11 +75,11 @@ def expected_box(v: Viewer, q) -> tuple[int, int, int, int]:
         M = np.eye(4) if b.joint is None and b.frame is None else (
             robot.data.oMi[b.joint].homogeneous if b.joint is not None else robot.data.oMf[b.frame].homogeneous)
         for p in b.pieces:
-            pts.append((M @ p.offset)[:3, 3])
+            A = M @ p.offset
+            pts.extend(A[:3, :3] @ c + A[:3, 3] for c in half_extent_corners(p.geometry))
     world = np.asarray(pts) - v.center
     px = project(world, camera_position(v))
-    pad = 0.09 * v.radius / np.linalg.norm(camera_position(v)) * H / (2 * math.tan(math.radians(37.5)))
-    pad = max(pad * 2.5, 20)
+    pad = 6  # anti-aliasing and the (un-modelled) perspective bulge of round shapes
     x0, y0 = px.min(0) - pad
     x1, y1 = px.max(0) + pad
     return int(max(0, x0)), int(max(0, y0)), int(min(W, x1)), int(min(H, y1))
