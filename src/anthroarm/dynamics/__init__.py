@@ -1,1 +1,37 @@
-"""Dynamics (book Ch. 8): symbolic Lagrange equations, the book's formulations, simulation."""
+"""Dynamics (book Ch. 8): symbolic Lagrange equations, the book's formulations, simulation.
+
+Modules (imported lazily, e.g. ``aa.dynamics.lagrange``):
+
+* :mod:`.lagrange` — T, V -> M(q), C(q, q̇)q̇ (Christoffel), g(q), τ for any catalog arm; LaTeX;
+  generated numpy code cached on disk (optional C backend, :mod:`.ccode`);
+* :mod:`.equivalent_link` — §8-2 equivalent link J*, M* (8-19)–(8-29), energy/moment forms;
+* :mod:`.euler_chain` — §8-3 X–Y–X Euler-angle ball-joint chain (8-41)–(8-96);
+* :mod:`.hand_model` — §8-4 prosthetic-hand Lagrange model (8-97)–(8-112);
+* :mod:`.simulate` — RK4 / solve_ivp with damping and energy bookkeeping;
+* :mod:`.human` — gravity-torque maps and reaching torques of ``human_arm7``;
+* :mod:`.checks` — the rows of ``anthroarm check``.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+_SUBMODULES = {"lagrange", "equivalent_link", "euler_chain", "hand_model", "simulate", "human", "checks", "ccode"}
+
+
+def __getattr__(name):
+    if name in _SUBMODULES:
+        mod = importlib.import_module(f".{name}", __name__)
+        globals()[name] = mod
+        return mod
+    raise AttributeError(f"module 'anthroarm.dynamics' has no attribute {name!r}")
+
+
+def load(robot, **kw):
+    """Shortcut for :func:`anthroarm.dynamics.lagrange.load`."""
+    from .lagrange import load as _load
+
+    return _load(robot, **kw)
+
+
+__all__ = sorted(_SUBMODULES) + ["load"]
