@@ -25,6 +25,7 @@ PROVIDERS: list[str] = [
     "anthroarm.design.structure:reach_rows",
     "anthroarm.dynamics.checks:rows",
     "anthroarm.spatial.checks:rows",
+    "anthroarm.mechanisms.checks:rows",
 ]
 
 

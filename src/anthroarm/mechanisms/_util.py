@@ -143,3 +143,20 @@ def fd_rates(f, h: float = 1e-2, angular: bool = False):
         d1 = d1 + _D1[k - 1] * (fp - fm)
         d2 = d2 + _D2[k - 1] * (fp + fm)
     return d1 / h, d2 / (h * h)
+
+
+def fd_derivative(f, h: float = 1e-3, angular: bool = False):
+    """First derivative at t = 0 of ``f(t)`` by the 8th-order central stencil (round-off ~eps/h).
+
+    The accelerations of the mechanisms are checked as the derivative of their (closed-form,
+    itself finite-difference-checked) velocity along the trajectory: this keeps the oracle at
+    ~1e-12 where a second difference of positions is limited to ~eps/h^2."""
+    f0 = np.asarray(f(0.0), dtype=float)
+    d1 = np.zeros_like(f0)
+    for k in range(1, 5):
+        fp = np.asarray(f(k * h), dtype=float) - f0
+        fm = np.asarray(f(-k * h), dtype=float) - f0
+        if angular:
+            fp, fm = np.asarray(wrap(fp)), np.asarray(wrap(fm))
+        d1 = d1 + _D1[k - 1] * (fp - fm)
+    return d1 / h

@@ -388,15 +388,22 @@ class ClosedLoop:
 
     def track(self, input_path, q0=None, tol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
         """Continuation: solve for each row of ``input_path`` (K x n_inputs) starting from the
-        previous solution.  Returns (Q (K x nq), converged (K,))."""
+        previous solution moved along the tangent (the velocity solution).  Keep the steps small
+        compared with the distance between assembly branches.  Returns (Q (K x nq), converged (K,))."""
         P = finite_array("input_path", np.asarray(input_path, float).reshape(len(input_path), -1),
                          (None, len(self.spec.inputs)))
         Q = np.zeros((len(P), self.model.nq))
         ok = np.zeros(len(P), dtype=bool)
         q = None if q0 is None else np.asarray(q0, float)
+        x_prev = None
         for k, x in enumerate(P):
-            qk, _, _, conv = self.solve_position(x, q, tol=tol)
+            guess = q
+            if q is not None and x_prev is not None:
+                # tangent predictor: q + dq/dx (x - x_prev), from the velocity solution
+                v, _ = self.solve_velocity(q, x - x_prev)
+                guess = q + v          # revolute/prismatic trees: nq == nv, q integrates additively
+            qk, _, _, conv = self.solve_position(x, guess, tol=tol)
             Q[k], ok[k] = qk, conv
             if conv:
-                q = qk
+                q, x_prev = qk, x
         return Q, ok
