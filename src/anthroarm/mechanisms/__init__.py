@@ -9,6 +9,14 @@ Part B (four-bar, RSSR, RRSS, dyads, thumb, finger, Pinocchio closed loops):
 from .fourbar import (CouplerPoint, FourBarRange, FourBarState, coupler_point, fourbar, fourbar_acceleration,
                       fourbar_cartesian, fourbar_grashof, fourbar_input_range, fourbar_points, fourbar_position,
                       fourbar_velocity, transmission_angle)
+from .dyads import DyadState, RigidBodyPoint, dyad, rigid_body_point
+from .rssr import RSSRCrankTest, RSSRGeometry, RSSRState, rssr, rssr_branch_through, rssr_crank_test, rssr_polar, rssr_position
+from .rrss import (RRSSGeometry, RRSSPoint, RRSSState, rrss, rrss_branch_through, rrss_newton, rrss_point,
+                   rrss_position, rrss_track)
+from .thumb import ThumbGeometry, ThumbState, thumb, thumb_f2, thumb_f3, thumb_spec
+from .finger import FingerGeometry, FingerState, design_finger, finger, finger_f, finger_spec
+from .closed_loop import ClosedLoop, Closure, LoopSpec, LoopState, TreeJoint
+from .pin_models import fourbar_spec, rrss_spec, rssr_spec
 
 # Part A: RCCC by dual-number matrices (§5-6) and relative motion (002 §4-1)
 from .rccc import (RCCCGeometry, RCCCResult, RCCCSolution, rccc_acceleration, rccc_position,  # noqa: E402
