@@ -145,3 +145,12 @@ def test_bad_chain_input():
         ch.inverse([[np.nan, 1, 0]], [[0, 0, 0]], [[0, 0, 0]])
     with pytest.raises(ValueError, match="shape"):
         ch.inverse([[0, 1]], [[0, 0, 0]], [[0, 0, 0]])
+
+
+def test_printed_skew_8_78_fails():
+    """[d]× printed at l. 6446 as [[0, −d_x, d_y], [d_z, 0, −d_x], [−d_y, d_x, 0]] is not the
+    cross-product matrix; the corrected E.skew is."""
+    d, u = np.array([0.3, -0.2, 0.5]), np.array([1.0, 2.0, -0.7])
+    assert np.allclose(E.skew(d) @ u, np.cross(d, u))
+    printed = np.array([[0, -d[0], d[1]], [d[2], 0, -d[0]], [-d[1], d[0], 0]])
+    assert not np.allclose(printed @ u, np.cross(d, u), atol=1e-3)

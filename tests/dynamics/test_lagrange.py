@@ -252,3 +252,17 @@ def test_joint_moving_no_mass_is_refused():
     model.addJoint(j1, pin.JointModelRX(), pin.SE3(np.eye(3), np.array([0.5, 0, 0])), "b")  # massless link
     with pytest.raises(InertiaError, match="positive definite"):
         L.load(model, name="tipless")
+
+
+def test_printed_lagrange_equation_8_8_fails():
+    """(8-8) prints d/dt ∂T/∂q̇ − ∂T/∂q̇ = Q; the correct second term is ∂T/∂q.  With
+    τ = d/dt ∂T/∂q̇ − ∂T/∂q + ∂V/∂q (our derivation), the printed form gives τ + ∂T/∂q − p."""
+    robot = aa.load("planar2r")
+    dyn = L.load(robot)
+    q, v, a = np.array([0.4, 0.9]), np.array([1.5, -2.0]), np.array([0.3, 0.1])
+    ref = pin.rnea(robot.model, robot.model.createData(), q, v, a)
+    assert rel(dyn.tau(q, v, a), ref) < TOL
+    h = 1e-6
+    dTdq = np.array([(dyn.kinetic_energy(q + h * e, v) - dyn.kinetic_energy(q - h * e, v)) / (2 * h) for e in np.eye(2)])
+    printed = dyn.tau(q, v, a) + dTdq - dyn.momentum(q, v)
+    assert rel(printed, ref) > 1e-2
