@@ -120,7 +120,7 @@ def test_reoptimise_planar_book_method_and_slsqp():
     p = T.planar_problem(n=7)
     x0 = np.array([105.0, -19.9, 37.2, 44.8, 90.0, 90.0])
     assert np.all(p.ineq(x0) > 0)                             # strictly feasible start
-    rm = T.optimise(p, "sumt_mixed", x0, max_stages=6)
+    rm = T.optimise(p, "sumt_mixed", x0, max_stages=4)
     rs = T.optimise(p, "slsqp", x0)
     for r in (rm, rs):
         assert r.feasible and r.S <= p.objective(x0) + 1e-9

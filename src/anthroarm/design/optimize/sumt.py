@@ -77,6 +77,27 @@ def _default_inner(phi, x, scale):
     return simplex_book(phi, x, step=step, eps1=1e-20, xtol=1e-10 * (1 + np.linalg.norm(x)), maxiter=4000)
 
 
+def _barrier_inner(phi, x, scale, g):
+    """Book simplex for a barrier function: the initial simplex is kept inside the feasible region
+    (edge = half the smallest constraint value) and the search restarts from its result until it
+    stops improving — a collapsed simplex cannot follow the narrow curved valley along an active
+    constraint otherwise."""
+    def step_at(z):
+        return min(0.1 * float(np.max(np.maximum(np.abs(z), scale))), max(0.5 * float(np.min(_vec(g, z))), 1e-12))
+
+    best, nfev = None, 0
+    for _ in range(4):
+        r = simplex_book(phi, x, step=step_at(x), eps1=1e-20, xtol=1e-12 * (1 + np.linalg.norm(x)), maxiter=4000)
+        nfev += r.nfev
+        if best is not None and r.fun >= best.fun - 1e-15 * abs(best.fun):
+            if r.fun < best.fun:
+                best = r
+            break
+        best, x = r, r.x
+    best.nfev = nfev
+    return best
+
+
 def violation(x, ineq=None, eq=None) -> float:
     """Largest constraint violation Q: ``max(−g_u, |h_v|, 0)`` (4-74)."""
     g, h = _vec(ineq, x), _vec(eq, x)
@@ -122,7 +143,7 @@ def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps
                                   "no strictly feasible starting point found: the constraints may be inconsistent",
                                   info={"violation": violation(x, g)})
         x = xf
-    inner = inner or (lambda p, z: _default_inner(p, z, scale))
+    inner = inner or (lambda p, z: _barrier_inner(p, z, scale, g))
     r = float(r0)
     hist, nfev = [x.copy()], 0
     phi_prev, x_prev = None, x.copy()
@@ -215,7 +236,7 @@ def sumt_mixed(f, x0, ineq, eq=None, bounds=None, r0: float = 1.0, c: float = 0.
             return OptimizeResult(x, float(f(x)), "infeasible", "no strictly feasible starting point found",
                                   info={"violation": violation(x, g, eq)})
         x = xf
-    inner = inner or (lambda p, z: _default_inner(p, z, scale))
+    inner = inner or (lambda p, z: _barrier_inner(p, z, scale, g))
     r = float(r0)
     hist, nfev = [x.copy()], 0
     phi_prev, x_prev = None, x.copy()
