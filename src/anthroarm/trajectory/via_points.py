@@ -1,0 +1,71 @@
+"""Via-point joint trajectories (book §7-4 一, Figs. 7-7 / 7-8).
+
+The book: choose a few safe via points (start A, lift-off, set-down, end E), solve the exact IK
+at each, fit every joint with piecewise higher-order polynomials in t with zero velocity and
+acceleration at both ends and continuity at the via points, and servo the joints to the curves.
+It prints neither the degree nor the timing; we use a quintic interpolating spline per joint
+(piecewise quintic polynomials, C⁴ at the via points — more than the C² required) with the two
+end conditions q̇ = q̈ = 0 at each end (``scipy.interpolate.make_interp_spline``, k = 5).
+
+Units: s, rad (or m for prismatic joints).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class ViaPointTrajectory:
+    """q(t) through ``Q[k]`` at ``times[k]`` (strictly increasing), zero velocity and acceleration
+    at ``times[0]`` and ``times[-1]``.  Call ``traj(t, derivative=0)`` with a scalar or an array
+    of times; outside [t0, tN] the trajectory holds the end values (zero derivatives)."""
+
+    def __init__(self, times, Q):
+        from scipy.interpolate import make_interp_spline
+
+        t = np.asarray(times, float)
+        Q = np.asarray(Q, float)
+        if t.ndim != 1 or t.size < 2 or not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
+            raise ValueError(f"times must be a strictly increasing 1-D array of >= 2 finite values, got {times!r}")
+        if Q.ndim != 2 or Q.shape[0] != t.size or not np.isfinite(Q).all():
+            raise ValueError(f"Q must be finite with shape ({t.size}, nq), got shape {Q.shape}")
+        self.times, self.Q = t, Q
+        bc = ([(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))],
+              [(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))])
+        self._spl = make_interp_spline(t, Q, k=5, bc_type=bc)
+
+    @property
+    def duration(self) -> float:
+        return float(self.times[-1] - self.times[0])
+
+    def __call__(self, t, derivative: int = 0) -> np.ndarray:
+        t = np.asarray(t, float)
+        tc = np.clip(t, self.times[0], self.times[-1])
+        out = self._spl(tc, nu=derivative)
+        if derivative > 0:
+            outside = (t < self.times[0]) | (t > self.times[-1])
+            out = np.where(np.asarray(outside)[..., None], 0.0, out)
+        return out
+
+
+def joint_via_trajectory(robot, poses, times, *, q_start=None, swivel=0.0) -> tuple[ViaPointTrajectory, np.ndarray]:
+    """Solve the closed-form IK at each via pose (4×4, m) and fit :class:`ViaPointTrajectory`.
+
+    At each via point the solution nearest (max-norm) to the previous one is taken (the first is
+    nearest to ``q_start``, default the neutral configuration), so the trajectory stays on one
+    branch.  Returns (trajectory, Q).  ValueError names a via point without a solution."""
+    from ..ik.closed_form import analytic
+
+    poses = np.asarray(poses, float)
+    prev = robot.neutral() if q_start is None else robot.check_q(q_start, "q_start")
+    Q = []
+    for k, T in enumerate(poses):
+        kw = {"swivel": swivel} if robot.spec is not None and robot.spec.name == "human_arm7" else {}
+        res = analytic(robot, T, **kw)
+        if not res.success:
+            raise ValueError(f"via point {k} has no IK solution: {res.reason}")
+        i = int(np.argmin(np.abs(res.solutions - prev).max(1)))
+        prev = res.solutions[i]
+        Q.append(prev)
+    Q = np.array(Q)
+    return ViaPointTrajectory(times, Q), Q

@@ -1,0 +1,91 @@
+"""Trajectories (§7-4 一, §7-7): via-point polynomials and resolved-rate straight lines."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import anthroarm as aa
+from anthroarm.trajectory import ViaPointTrajectory, joint_via_trajectory, straight_line_move
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(3, 7), st.integers(0, 2**31 - 1))
+def test_via_points_boundary_and_continuity(k, seed):
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(rng.uniform(0.3, 2.0, k)) - 0.3
+    Q = rng.uniform(-2, 2, (k, 3))
+    tr = ViaPointTrajectory(times, Q)
+    np.testing.assert_allclose(tr(times), Q, atol=1e-9)                   # through every via point
+    for end in (times[0], times[-1]):
+        np.testing.assert_allclose(tr(end, 1), 0, atol=1e-8)              # zero velocity
+        np.testing.assert_allclose(tr(end, 2), 0, atol=1e-7)              # zero acceleration
+    h = 1e-7
+    for tk in times[1:-1]:  # C²: left and right limits of q, q̇, q̈ agree at the via points
+        for d in (0, 1, 2):
+            np.testing.assert_allclose(tr(tk - h, d), tr(tk + h, d), atol=1e-4 * (1 + np.abs(tr(tk, d)).max()))
+    # velocity is the derivative of position (finite differences)
+    tm = 0.5 * (times[0] + times[1])
+    np.testing.assert_allclose(tr(tm, 1), (tr(tm + 1e-6) - tr(tm - 1e-6)) / 2e-6, atol=1e-5)
+
+
+def test_via_points_bad_input():
+    with pytest.raises(ValueError):
+        ViaPointTrajectory([0, 0, 1], np.zeros((3, 2)))
+    with pytest.raises(ValueError):
+        ViaPointTrajectory([0, 1], np.zeros((3, 2)))
+    with pytest.raises(ValueError):
+        ViaPointTrajectory([0, 1], [[0, np.nan], [1, 1]])
+
+
+def test_joint_via_trajectory_from_poses():
+    robot = aa.load("prosthetic_arm")
+    Qv = np.radians([[-60, 80, 0, 80, 0, 0], [-50, 85, 5, 70, 10, -10], [-40, 95, 0, 60, 5, 0]])
+    poses = robot.fk(Qv)
+    tr, Q = joint_via_trajectory(robot, poses, [0.0, 1.0, 2.5])
+    np.testing.assert_allclose(robot.fk(tr(np.array([0.0, 1.0, 2.5]))), poses, atol=1e-9)
+    T = np.eye(4)
+    T[:3, 3] = [3, 0, 0]
+    with pytest.raises(ValueError, match="via point 1"):
+        joint_via_trajectory(robot, [poses[0], T], [0, 1])
+
+
+@pytest.fixture(scope="module")
+def move_setup():
+    robot = aa.load("sixr_arm")
+    q0 = np.radians([10, 30, 20, 15, 40, 10])
+    T0 = robot.fk(q0)
+    Tg = T0.copy()
+    Tg[:3, 3] += [0.08, -0.05, 0.06]
+    import pinocchio as pin
+
+    Tg[:3, :3] = T0[:3, :3] @ pin.exp3(np.array([0.1, -0.2, 0.15]))
+    return robot, q0, Tg
+
+
+def test_resolved_rate_open_loop_drift_first_order(move_setup):
+    """Open-loop Euler integration of (7-89)/(7-96): the end-pose drift shrinks ~linearly with Δt."""
+    robot, q0, Tg = move_setup
+    d1 = straight_line_move(robot, q0, Tg, 1.0, 0.02)
+    d2 = straight_line_move(robot, q0, Tg, 1.0, 0.01)
+    assert d1.final_pos_err > 1e-5  # the book's open loop drifts
+    assert 1.5 < d1.final_pos_err / d2.final_pos_err < 2.6
+    assert d2.line_deviation < d1.line_deviation
+
+
+def test_resolved_rate_closed_loop(move_setup):
+    robot, q0, Tg = move_setup
+    open_ = straight_line_move(robot, q0, Tg, 1.0, 0.01)
+    closed = straight_line_move(robot, q0, Tg, 1.0, 0.01, closed_loop=True, k=50.0)
+    assert closed.final_pos_err < open_.final_pos_err / 10
+    assert closed.line_deviation < open_.line_deviation
+    assert closed.final_rot_err < 1e-3
+
+
+def test_resolved_rate_book_jacobian_equals_pinocchio(move_setup):
+    robot, q0, Tg = move_setup
+    a = straight_line_move(robot, q0, Tg, 0.5, 0.05, jacobian="book")
+    b = straight_line_move(robot, q0, Tg, 0.5, 0.05, jacobian="pinocchio")
+    np.testing.assert_allclose(a.q, b.q, atol=1e-10)
+    with pytest.raises(ValueError):
+        straight_line_move(robot, q0, Tg, 0.5, 1.0)
