@@ -228,38 +228,92 @@ class _ChainFK:
         self.tool_p = spec.tool_origin[:3, 3].copy()
 
     def __call__(self, Q):
+        """FK of configurations Q (..., nq) -> (..., 4, 4)."""
+        R, p, shape = self._fk_flat(Q)
+        n = R[0][0].shape[0]
+        T = np.zeros((n, 4, 4))
+        for i in range(3):
+            for j in range(3):
+                T[:, i, j] = R[i][j]
+            T[:, i, 3] = p[i]
+        T[:, 3, 3] = 1.0
+        return T.reshape(*shape, 4, 4)
+
+    def residual(self, Q, T, position_only=False):
+        """max |FK(Q) − T| over the 3×4 pose entries (or the position only); Q (..., nq), T
+        broadcastable to (..., 4, 4).  Returns (...)."""
+        R, p, shape = self._fk_flat(Q)
+        Tb = np.broadcast_to(T, shape + (4, 4)).reshape(-1, 4, 4)
+        res = np.zeros(R[0][0].shape[0])
+        for i in range(3):
+            np.maximum(res, np.abs(p[i] - Tb[:, i, 3]), out=res)
+            if not position_only:
+                for j in range(3):
+                    np.maximum(res, np.abs(R[i][j] - Tb[:, i, j]), out=res)
+        return res.reshape(shape)
+
+    def _fk_flat(self, Q):
+        """Rotation entries R[i][j] and position p[i] as flat (M,) arrays (fast elementwise)."""
         Q = np.asarray(Q, float)
         shape = Q.shape[:-1]
         Q = Q.reshape(-1, Q.shape[-1])
         n = Q.shape[0]
-        R = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-        p = np.zeros((n, 3))
+        one, zero = np.ones(n), np.zeros(n)
+        R = [[one if i == j else zero for j in range(3)] for i in range(3)]
+        p = [zero, zero, zero]
+
+        def mul_const(R, C):  # R @ C, C constant 3x3 (skip zero entries)
+            out = [[None] * 3 for _ in range(3)]
+            for i in range(3):
+                for j in range(3):
+                    acc = None
+                    for k in range(3):
+                        c = C[k, j]
+                        if c == 0.0:
+                            continue
+                        term = R[i][k] if c == 1.0 else (-R[i][k] if c == -1.0 else c * R[i][k])
+                        acc = term if acc is None else acc + term
+                    out[i][j] = zero if acc is None else acc
+            return out
+
         for j, (Ro, po, ax, typ) in enumerate(self.steps):
-            p = p + R @ po
-            R = R @ Ro
+            for i in range(3):
+                acc = p[i]
+                for k in range(3):
+                    if po[k] != 0.0:
+                        acc = acc + R[i][k] * po[k]
+                p[i] = acc
+            R = mul_const(R, np.where(np.abs(Ro) < 1e-15, 0.0, Ro))
             q = Q[:, j]
             if typ == "prismatic":
-                p = p + (R @ ax) * q[:, None]
+                for i in range(3):
+                    p[i] = p[i] + (R[i][0] * ax[0] + R[i][1] * ax[1] + R[i][2] * ax[2]) * q
                 continue
             c, s = np.cos(q), np.sin(q)
-            i = int(np.argmax(np.abs(ax)))
-            if abs(abs(ax[i]) - 1.0) < 1e-15:
-                s = s * np.sign(ax[i])
-                a, b = [(1, 2), (2, 0), (0, 1)][i]  # rotation about e_i mixes columns a, b
-                ca, cb = R[:, :, a].copy(), R[:, :, b].copy()
-                R[:, :, a] = c[:, None] * ca + s[:, None] * cb
-                R[:, :, b] = -s[:, None] * ca + c[:, None] * cb
+            k = int(np.argmax(np.abs(ax)))
+            if abs(abs(ax[k]) - 1.0) < 1e-15:
+                if ax[k] < 0:
+                    s = -s
+                a, b = [(1, 2), (2, 0), (0, 1)][k]  # rotation about e_k mixes columns a, b
+                for i in range(3):
+                    ca, cb = R[i][a], R[i][b]
+                    R[i][a] = c * ca + s * cb
+                    R[i][b] = c * cb - s * ca
             else:
                 K = np.array([[0, -ax[2], ax[1]], [ax[2], 0, -ax[0]], [-ax[1], ax[0], 0]])
-                Rq = np.eye(3) + s[:, None, None] * K + (1 - c)[:, None, None] * (K @ K)
-                R = R @ Rq
-        p = p + R @ self.tool_p
-        R = R @ self.tool_R
-        T = np.zeros((n, 4, 4))
-        T[:, :3, :3] = R
-        T[:, :3, 3] = p
-        T[:, 3, 3] = 1.0
-        return T.reshape(*shape, 4, 4)
+                K2 = K @ K
+                Rq = [[(1.0 if i == jj else 0.0) + s * K[i, jj] + (1 - c) * K2[i, jj] for jj in range(3)] for i in range(3)]
+                R = [[R[i][0] * Rq[0][jj] + R[i][1] * Rq[1][jj] + R[i][2] * Rq[2][jj] for jj in range(3)] for i in range(3)]
+        for i in range(3):
+            acc = p[i]
+            for k in range(3):
+                if self.tool_p[k] != 0.0:
+                    acc = acc + R[i][k] * self.tool_p[k]
+            p[i] = acc
+        R = mul_const(R, np.where(np.abs(self.tool_R) < 1e-15, 0.0, self.tool_R))
+        R = [[np.broadcast_to(R[i][j], (n,)) for j in range(3)] for i in range(3)]
+        p = [np.broadcast_to(p[i], (n,)) for i in range(3)]
+        return R, p, shape
 
 
 _FK_CACHE: dict = {}
@@ -602,11 +656,7 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
     B = Q.shape[1]
     Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
-    Tf = _fk_for(robot)(Qw)                                             # (N, B, 4, 4)
-    if position_only:
-        res = np.abs(Tf[..., :3, 3] - pt[:, None, :]).max(-1)
-    else:
-        res = np.abs(Tf[..., :3, :] - Ts[:, None, :3, :]).max(axis=(-1, -2))
+    res = _fk_for(robot).residual(Qw, Ts[:, None], position_only=position_only)   # FK check (N, B)
     valid = (code == OK) & inside & (res <= tol)
     valid &= np.isfinite(res)
     # remove duplicate solutions (singular poses give coincident branches)

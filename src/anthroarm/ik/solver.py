@@ -99,6 +99,7 @@ class _Chain:
                 reach += float(max(abs(self.lo_s[i]), abs(self.hi_s[i])))
         self.reach = reach
         self.path = [model.joints[j].idx_q for j in model.supports[jid][1:]]
+        self.default_ref = comfortable_posture(robot)
 
     def clip(self, q):
         return np.minimum(np.maximum(q, self.lo), self.hi)
@@ -378,7 +379,7 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     if analytic not in ("auto", True, False):
         raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
     # seeds
-    default_ref = comfortable_posture(robot)
+    default_ref = ch.default_ref
     if q0 is None:
         Q0 = None
     else:

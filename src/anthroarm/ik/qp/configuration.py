@@ -67,8 +67,7 @@ class IKConfiguration:
         """World pose of frame ``frame_id`` (SE(3), m)."""
         M = self._placements.get(frame_id)
         if M is None:
-            M = pin.SE3(pin.updateFramePlacement(self.model, self.data, frame_id))
-            self._placements[frame_id] = M
+            M = self._placements[frame_id] = pin.updateFramePlacement(self.model, self.data, frame_id)
         return M
 
     def frame_jacobian(self, frame_id: int, reference=LOCAL) -> np.ndarray:
@@ -92,7 +91,13 @@ class IKConfiguration:
 
     def integrate_inplace(self, v, dt: float) -> None:
         """``update(integrate(v, dt))``."""
-        self.update(self.integrate(v, dt))
+        v = np.asarray(v, dtype=float)
+        if v.shape != (self.nv,) or not np.isfinite(v).all():
+            raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
+        self.q = pin.integrate(self.model, self.q, v * dt)   # finite q + finite step: no re-check
+        pin.computeJointJacobians(self.model, self.data, self.q)
+        self._placements.clear()
+        self._jacobians.clear()
 
     def within_limits(self, tol: float = 0.0) -> bool:
         """True when every joint lies within [lower − tol, upper + tol]."""

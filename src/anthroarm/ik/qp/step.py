@@ -96,19 +96,19 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     if isinstance(robot, IKConfiguration):
         conf = robot
         rb = conf.robot
+        st = _state(robot, rb)
         if q is not None:
             conf.update(q)
     else:
         rb = robot
-        st0 = _state(robot, robot)
-        conf = st0.get("conf")
+        st = _state(robot, robot)
+        conf = st.get("conf")
         if conf is None:
-            conf = st0["conf"] = IKConfiguration(robot, q)
+            conf = st["conf"] = IKConfiguration(robot, q)
         else:
             conf.update(q)
     if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
-    st = _state(robot, rb)
     nv = conf.nv
     if isinstance(limits, str):
         if limits != "default":
@@ -119,17 +119,22 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     elif limits is None:
         limits = ()
 
+    # Σ tasks (tasks may return cached arrays: never modify them in place)
     H = c = None
+    own = False
     for t in tasks:
         Ht, ct = t.compute_qp_objective(conf)
         if H is None:
-            H, c = Ht.copy(), ct.copy()
+            H, c = Ht, ct
         else:
-            H += Ht
-            c += ct
+            H = H + Ht
+            c = c + ct
+            own = True
     if H is None:
-        H, c = np.zeros((nv, nv)), np.zeros(nv)
+        H, c, own = np.zeros((nv, nv)), np.zeros(nv), True
     if damping:
+        if not own:
+            H = H.copy()
         H.flat[:: nv + 1] += float(damping)
     lo, hi = combine(limits, conf, dt)
 
@@ -138,11 +143,11 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
         A = np.vstack([t.compute_jacobian(conf) for t in constraints])
         b = np.concatenate([-t.gain * t.compute_error(conf) for t in constraints])
     n_eq = 0 if A is None else len(A)
-    key = (solver, nv, n_eq)
-    backend = st["backends"].get(key)
+    backends = st["backends"]
+    backend = backends.get((solver, nv, n_eq))
     if backend is None:
-        backend = st["backends"][key] = make_backend(solver, nv, n_eq)
-    if not (np.isfinite(H).all() and np.isfinite(c).all()):
+        backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
+    if not math.isfinite(H.sum() + c.sum()):
         x, status = None, "failed"
         backend.last_info = {"error": "non-finite task objective"}
     else:

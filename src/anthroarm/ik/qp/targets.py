@@ -12,10 +12,11 @@ import numpy as np
 import pinocchio as pin
 
 RIGID_TOL = 1e-6
+_I3 = np.eye(3)
 
 
 def _check_finite(a: np.ndarray, name: str) -> None:
-    if not np.isfinite(a).all():
+    if not np.isfinite(a.sum()) and not np.isfinite(a).all():
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
         raise ValueError(f"{name}{list(idx)} is {a[idx]} (targets must be finite)")
 
@@ -26,8 +27,10 @@ def as_rotation(R, name: str = "R") -> np.ndarray:
     if R.shape != (3, 3):
         raise ValueError(f"{name} must be a 3x3 rotation matrix, got shape {R.shape}")
     _check_finite(R, name)
-    err = float(np.abs(R.T @ R - np.eye(3)).max())
-    det = float(np.linalg.det(R))
+    err = float(np.abs(R.T @ R - _I3).max())
+    r = R.tolist()
+    det = (r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+           + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]))
     if err > RIGID_TOL or det < 0:
         raise ValueError(f"{name} is not a rotation: max|RᵀR − I| = {err:.3g}, det = {det:.6g} "
                          f"(need orthonormal with det +1 within {RIGID_TOL:g})")

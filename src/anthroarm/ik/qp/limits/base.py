@@ -32,9 +32,13 @@ class Limit:
         return f"{type(self).__name__}()"
 
 
+def _priority(limit) -> float:
+    return limit.priority
+
+
 def combine(limits, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Intersect the limits' boxes in priority order (see the module docstring)."""
-    ordered = sorted(limits, key=lambda L: L.priority)
+    ordered = sorted(limits, key=_priority) if len(limits) > 1 else limits
     if not ordered:
         return np.full(conf.nv, -np.inf), np.full(conf.nv, np.inf)
     lo, hi = ordered[0].box(conf, dt)
@@ -42,9 +46,9 @@ def combine(limits, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
         l, h = lim.box(conf, dt)
         nl = np.maximum(lo, l)
         nh = np.minimum(hi, h)
-        empty = nl > nh
-        if empty.any():
+        if (nl > nh).any():
             # nearest point of the current box to [l, h]: lo if [l, h] lies below, hi if above
+            empty = nl > nh
             pt = np.where(h < lo, lo, hi)
             nl = np.where(empty, pt, nl)
             nh = np.where(empty, pt, nh)

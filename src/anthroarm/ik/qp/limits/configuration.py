@@ -51,9 +51,9 @@ class ConfigurationLimit(Limit):
         # inf - q stays inf: unbounded joints give an unbounded side
         lo = self.gain * (self._lo - q)
         hi = self.gain * (self._hi - q)
-        above = q > self._hi
-        below = q < self._lo
-        if above.any() or below.any():
+        if lo.max() > 0.0 or hi.min() < 0.0:  # some joint is outside its range
+            above = q > self._hi
+            below = q < self._lo
             # outside the range: ask for the whole way back (gain 1), landing a hair inside so
             # that rounding in q + Δq cannot leave it outside; velocity limits cap the speed
             hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)

@@ -20,6 +20,6 @@ class DampingTask(Task):
     def compute_jacobian(self, conf) -> np.ndarray:
         return np.eye(conf.nv)
 
-    def compute_qp_objective(self, conf):
+    def compute_qp_objective(self, conf):  # the returned H is a fresh array (may be modified)
         w = self.cost
-        return np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float)), np.zeros(conf.nv)
+        return np.diag(np.broadcast_to(np.asarray(w, float) ** 2, (conf.nv,)).astype(float)), np.zeros(conf.nv)

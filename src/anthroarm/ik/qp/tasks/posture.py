@@ -52,6 +52,8 @@ class PostureTask(Task):
         super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
         self.model = robot.model
         self.robot = robot
+        self._H = np.diag(np.broadcast_to(np.asarray(self.cost, float) ** 2, (robot.nv,)).astype(float))
+        self._H.setflags(write=False)
         self.set_target(comfortable_posture(robot) if target is None else target)
 
     def set_target(self, q_ref) -> None:
@@ -70,9 +72,12 @@ class PostureTask(Task):
 
     def compute_qp_objective(self, conf):
         # J = I: H = (w² + μ) I, c = α w² e  (same as Task._objective, without the matrix products)
+        # the returned H may be a cached array: callers must not modify it in place
         w = self.cost
         We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
-        H = np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float))
         if self.lm_damping:
+            H = np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float))
             H.flat[:: conf.nv + 1] += self.lm_damping * float(We @ We)
+        else:
+            H = self._H
         return H, w * We
