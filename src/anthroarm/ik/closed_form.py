@@ -317,6 +317,7 @@ class _ChainFK:
 
 
 _FK_CACHE: dict = {}
+_DEDUP_DIR = np.random.default_rng(12345).uniform(0.5, 1.5, 16)
 
 
 def _fk_for(robot) -> _ChainFK:
@@ -661,10 +662,17 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     valid &= np.isfinite(res)
     # remove duplicate solutions (singular poses give coincident branches)
     if B > 1:
-        for b in range(1, B):
-            diff = np.abs(Qw[:, :b, :] - Qw[:, b:b + 1, :]).max(-1)       # (N, b)
-            dup = ((diff < 1e-9) & valid[:, :b]).any(1)
-            valid[:, b] &= ~dup
+        # cheap pre-filter: a random projection of each solution; only rows with two nearly equal
+        # projections are compared in full
+        key = np.where(valid, Qw @ _DEDUP_DIR[:Qw.shape[-1]], 1e6 * np.arange(1, B + 1))
+        ks = np.sort(key, axis=1)
+        rows = np.flatnonzero((np.diff(ks, axis=1) < 1e-8).any(1))
+        for i in rows:
+            for b in range(1, B):
+                if valid[i, b]:
+                    diff = np.abs(Qw[i, :b] - Qw[i, b]).max(-1)
+                    if ((diff < 1e-9) & valid[i, :b]).any():
+                        valid[i, b] = False
     sol = np.where(valid[..., None], Qw, np.nan)
     reasons = [None] * N
     fails = np.flatnonzero(~valid.any(1))
