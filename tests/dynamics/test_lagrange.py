@@ -266,3 +266,18 @@ def test_printed_lagrange_equation_8_8_fails():
     dTdq = np.array([(dyn.kinetic_energy(q + h * e, v) - dyn.kinetic_energy(q - h * e, v)) / (2 * h) for e in np.eye(2)])
     printed = dyn.tau(q, v, a) + dTdq - dyn.momentum(q, v)
     assert rel(printed, ref) > 1e-2
+
+
+@pytest.mark.skipif(__import__("anthroarm.dynamics.ccode", fromlist=["compiler"]).compiler() is None,
+                    reason="no C compiler")
+def test_c_backend_matches_numpy_and_pin():
+    robot = aa.load("planar2r")
+    dc, dn = L.load(robot, backend="c"), L.load(robot)
+    rng = np.random.default_rng(5)
+    Q, V, A = rng.standard_normal((3, 6, 2))
+    assert np.allclose(dc.tau(Q, V, A), dn.tau(Q, V, A), atol=1e-13)
+    assert np.allclose(dc.mass_matrix(Q[0]), dn.mass_matrix(Q[0]), atol=1e-14)
+    assert abs(dc.kinetic_energy(Q[1], V[1]) - dn.kinetic_energy(Q[1], V[1])) < 1e-14
+    assert rel(dc.gravity(Q[2]), pin.computeGeneralizedGravity(robot.model, robot.data, Q[2])) < TOL
+    with pytest.raises(ValueError):
+        dc.gravity([np.nan, 0.0])
