@@ -19,6 +19,7 @@ Units: metres and radians (the book's D = 50 mm is ``D=0.05``).
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -88,6 +89,8 @@ class CellTable:
         self.valid = np.asarray(valid, bool)
         self.shape = self.valid.shape
         self.nq = self.Q.shape[-1]
+        self._origin_f = tuple(float(v) for v in self.origin)
+        self._hi = tuple(int(v) - 2 for v in self.shape)
         # per-cell usability: all 8 corners valid
         v = self.valid
         self.cell_ok = (v[:-1, :-1, :-1] & v[1:, :-1, :-1] & v[:-1, 1:, :-1] & v[:-1, :-1, 1:]
@@ -168,19 +171,29 @@ class CellTable:
     def lookup(self, p) -> np.ndarray:
         """Joint vector (nq,) at position ``p`` (3,) m by Eq. (7-32).  Raises
         :class:`OutsideCellTableError` if the cell is not covered."""
-        p = np.asarray(p, float)
-        if p.shape != (3,) or not np.isfinite(p).all():
+        try:
+            x, y, z = (float(v) for v in p)
+        except (TypeError, ValueError):
+            raise ValueError(f"p must be a finite position (3,) in metres, got {p!r}") from None
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
             raise ValueError(f"p must be a finite position (3,) in metres, got {p!r}")
-        idx, m, inside = self._locate(p)
-        if not inside:
-            raise OutsideCellTableError(f"position {p} m is outside the lattice {self.bounds}")
-        i, j, k = (int(x) for x in idx)
+        D, o, hi = self.D, self._origin_f, self._hi
+        r = ((x - o[0]) / D, (y - o[1]) / D, (z - o[2]) / D)
+        idx = [math.floor(v) for v in r]
+        for a in range(3):  # points exactly on the upper lattice face belong to the last cell
+            if idx[a] == hi[a] + 1 and r[a] <= hi[a] + 1 + 1e-12:
+                idx[a] = hi[a]
+            if not 0 <= idx[a] <= hi[a]:
+                raise OutsideCellTableError(f"position {tuple(p)} m is outside the lattice {self.bounds}")
+        i, j, k = idx
         if not self.cell_ok[i, j, k]:
-            raise OutsideCellTableError(f"position {p} m lies in a cell with a corner outside the workspace or the joint limits")
-        c = self.Q[i:i + 2, j:j + 2, k:k + 2]                # corners, repeated linear division
-        c = c[0] * (1 - m[0]) + c[1] * m[0]
-        c = c[0] * (1 - m[1]) + c[1] * m[1]
-        return c[0] * (1 - m[2]) + c[1] * m[2]
+            raise OutsideCellTableError(f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the joint limits")
+        m1, m2, m3 = r[0] - i, r[1] - j, r[2] - k
+        t1, t2, t3 = 1.0 - m1, 1.0 - m2, 1.0 - m3
+        # the 8 weights of (7-32) in the corner order of Q[i:i+2, j:j+2, k:k+2] (i slowest)
+        w = (t1 * t2 * t3, t1 * t2 * m3, t1 * m2 * t3, t1 * m2 * m3,
+             m1 * t2 * t3, m1 * t2 * m3, m1 * m2 * t3, m1 * m2 * m3)
+        return np.dot(w, self.Q[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq))
 
     def lookup_batch(self, P) -> CellLookup:
         """Vectorised Eq. (7-32) for positions ``P`` (N, 3) m."""
