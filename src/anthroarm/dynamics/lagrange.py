@@ -61,7 +61,6 @@ import hashlib
 import math
 import importlib.util
 import os
-import sys
 import tempfile
 import threading
 import time
@@ -71,7 +70,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InertiaError, UnsupportedModelError
-from ._graph import Graph, Node, emit_python, snap
+from ._graph import Graph, emit_python, snap
 
 #: bump when the generated code changes (part of the cache key)
 GENERATOR_VERSION = "1"
