@@ -12,6 +12,8 @@ writes in the hand frame, Eq. (7-94)).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -92,7 +94,7 @@ class IKConfiguration:
     def integrate_inplace(self, v, dt: float) -> None:
         """``update(integrate(v, dt))``."""
         v = np.asarray(v, dtype=float)
-        if v.shape != (self.nv,) or not np.isfinite(v).all():
+        if v.shape != (self.nv,) or not math.isfinite(v @ v):
             raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
         self.q = pin.integrate(self.model, self.q, v * dt)   # finite q + finite step: no re-check
         pin.computeJointJacobians(self.model, self.data, self.q)

@@ -147,7 +147,8 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     backend = backends.get((solver, nv, n_eq))
     if backend is None:
         backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
-    if not math.isfinite(H.sum() + c.sum()):
+    Hr = H.ravel()
+    if not math.isfinite(Hr @ Hr + c @ c):
         x, status = None, "failed"
         backend.last_info = {"error": "non-finite task objective"}
     else:

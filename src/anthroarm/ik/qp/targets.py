@@ -8,17 +8,30 @@ SVD) so that log(R) is well defined.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
 RIGID_TOL = 1e-6
-_I3 = np.eye(3)
 
 
 def _check_finite(a: np.ndarray, name: str) -> None:
-    if not np.isfinite(a.sum()) and not np.isfinite(a).all():
+    f = a.ravel()
+    if not math.isfinite(f @ f) and not np.isfinite(f).all():
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
         raise ValueError(f"{name}{list(idx)} is {a[idx]} (targets must be finite)")
+
+
+def _rotation_defect(r) -> tuple[float, float]:
+    """(max |R Rᵀ − I|, det R) of a 3×3 nested list (pure Python: cheaper than numpy at 3×3)."""
+    a, b, c = r
+    e = max(abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0), abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
+            abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0), abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
+            abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]), abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]))
+    det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+           + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    return e, det
 
 
 def as_rotation(R, name: str = "R") -> np.ndarray:
@@ -27,12 +40,9 @@ def as_rotation(R, name: str = "R") -> np.ndarray:
     if R.shape != (3, 3):
         raise ValueError(f"{name} must be a 3x3 rotation matrix, got shape {R.shape}")
     _check_finite(R, name)
-    err = float(np.abs(R.T @ R - _I3).max())
-    r = R.tolist()
-    det = (r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
-           + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]))
+    err, det = _rotation_defect(R.tolist())
     if err > RIGID_TOL or det < 0:
-        raise ValueError(f"{name} is not a rotation: max|RᵀR − I| = {err:.3g}, det = {det:.6g} "
+        raise ValueError(f"{name} is not a rotation: max|RRᵀ − I| = {err:.3g}, det = {det:.6g} "
                          f"(need orthonormal with det +1 within {RIGID_TOL:g})")
     if err > 1e-12:
         U, _, Vt = np.linalg.svd(R)
@@ -57,7 +67,8 @@ def as_se3(T, name: str = "T") -> pin.SE3:
     if T.shape != (4, 4):
         raise ValueError(f"{name} must be a 4x4 homogeneous transform, got shape {T.shape}")
     _check_finite(T, name)
-    if np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOL:
-        raise ValueError(f"{name} is not rigid: bottom row {T[3].tolist()} is not [0, 0, 0, 1]")
+    b = T[3].tolist()
+    if abs(b[0]) > RIGID_TOL or abs(b[1]) > RIGID_TOL or abs(b[2]) > RIGID_TOL or abs(b[3] - 1.0) > RIGID_TOL:
+        raise ValueError(f"{name} is not rigid: bottom row {b} is not [0, 0, 0, 1]")
     R = as_rotation(T[:3, :3], f"{name}[:3, :3]")
-    return pin.SE3(R, T[:3, 3].copy())
+    return pin.SE3(R, T[:3, 3])

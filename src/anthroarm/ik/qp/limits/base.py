@@ -46,7 +46,7 @@ def combine(limits, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
         l, h = lim.box(conf, dt)
         nl = np.maximum(lo, l)
         nh = np.minimum(hi, h)
-        if (nl > nh).any():
+        if np.maximum.reduce(nl - nh) > 0.0:
             # nearest point of the current box to [l, h]: lo if [l, h] lies below, hi if above
             empty = nl > nh
             pt = np.where(h < lo, lo, hi)

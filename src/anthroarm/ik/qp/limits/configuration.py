@@ -51,7 +51,7 @@ class ConfigurationLimit(Limit):
         # inf - q stays inf: unbounded joints give an unbounded side
         lo = self.gain * (self._lo - q)
         hi = self.gain * (self._hi - q)
-        if lo.max() > 0.0 or hi.min() < 0.0:  # some joint is outside its range
+        if np.maximum.reduce(lo) > 0.0 or np.minimum.reduce(hi) < 0.0:  # a joint is outside its range
             above = q > self._hi
             below = q < self._lo
             # outside the range: ask for the whole way back (gain 1), landing a hair inside so
