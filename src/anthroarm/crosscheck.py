@@ -26,6 +26,7 @@ PROVIDERS: list[str] = [
     "anthroarm.dynamics.checks:rows",
     "anthroarm.spatial.checks:rows",
     "anthroarm.mechanisms.checks:rows",
+    "anthroarm.ik.checks:rows",
 ]
 
 
