@@ -12,7 +12,6 @@ import textwrap
 import time
 import urllib.request
 
-import numpy as np
 import pytest
 
 import anthroarm as aa
