@@ -34,7 +34,8 @@ def test_dyad_rates_match_finite_differences(x, r1, r2, br):
     if D < 0.2:
         return
     assert abs(np.linalg.norm(s.P3 - p1(0)[0]) - r1) < 1e-12 and abs(np.linalg.norm(s.P3 - p2(0)[0]) - r2) < 1e-12
-    d1 = fd_derivative(lambda t: np.r_[at(t).P3, at(t).theta1, at(t).theta2], angular=False)
+    d1 = np.r_[fd_derivative(lambda t: at(t).P3),
+               fd_derivative(lambda t: np.array([at(t).theta1, at(t).theta2]), angular=True)]
     d2 = fd_derivative(lambda t: np.r_[at(t).P3dot, at(t).omega1, at(t).omega2])
     ref1 = np.r_[s.P3dot, s.omega1, s.omega2]
     ref2 = np.r_[s.P3ddot, s.alpha1, s.alpha2]
