@@ -222,3 +222,26 @@ def test_property_never_violates_limits(robots, seed, name, kind):
     assert res.pos_err == pytest.approx(pe, abs=1e-9) and res.rot_err == pytest.approx(re, abs=1e-9)
     assert res.success == (pe <= 1e-6 and re <= 1e-6)
     assert res.status in ("success", "out_of_reach", "not_converged")
+
+
+def test_human_posture_optimum_matches_closed_form_family(robots):
+    """Oracle: the closed form parameterises every solution of a human_arm7 pose by the swivel
+    angle; the posture objective must land on the member nearest the comfortable posture
+    (up to the 0.5° grid of the scan)."""
+    cf = pytest.importorskip("anthroarm.ik.closed_form")
+    robot = robots["human_arm7"]
+    if not cf.has_analytic(robot):
+        pytest.skip("no closed form")
+    ref = qp.comfortable_posture(robot)
+    rng = np.random.default_rng(0)
+    goals = np.clip(ref + rng.uniform(-0.6, 0.6, (6, 7)), robot.lower, robot.upper)
+    grid = np.linspace(-np.pi, np.pi, 720, endpoint=False)
+    for g in goals:
+        T = robot.fk(g)
+        res = aa.ik.solve(robot, T)
+        S = cf.analytic(robot, T, swivel=grid).solutions
+        d_min = np.min(np.linalg.norm(S - ref, axis=1))
+        d = np.linalg.norm(res.q - ref)
+        assert res.success
+        assert d <= d_min + 1e-6          # never worse than the best closed-form member found
+        assert d >= d_min - 5e-3          # and within the grid resolution of it

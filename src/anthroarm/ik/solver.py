@@ -193,6 +193,22 @@ class _Swivel:
         return nj * ((d - float(j @ dq1)) / den)
 
 
+def secondary_ref(q_ref, ch):
+    return ch.default_ref if q_ref is None else q_ref
+
+
+def _swivel_offset(ch, sw: _Swivel, q) -> float:
+    """|wrapped swivel(q) − target| (rad); inf where the swivel is undefined (straight arm)."""
+    pin.framesForwardKinematics(ch.model, ch.data, q)
+    pts = [ch.data.oMf[i].translation for i in sw.ids]
+    try:
+        phi = swivel_from_points(*pts)[0]
+    except ValueError:
+        return float("inf")
+    d = sw.target - phi
+    return abs(math.atan2(math.sin(d), math.cos(d)))
+
+
 # ------------------------------------------------------------------------------ one attempt
 def _attempt(ch, resid, q, tol_p, tol_r, deadline):
     """Damped Gauss–Newton from ``q``.  Returns (q, converged, iterations, best) with best =
@@ -478,8 +494,24 @@ def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restar
         if ok:
             _, _, pe, re = resid(qs)
             msg = f"converged from a {seeds_tag} seed"
-            if isinstance(secondary, _Swivel) and secondary.err > 1e-6:
-                msg += f"; swivel angle off by {secondary.err:.3g} rad (limits or the pose prevent it)"
+            if isinstance(secondary, _Swivel):
+                off = _swivel_offset(ch, secondary, qs)
+                tried = ""
+                if off > 1e-6 and analytic is not False:
+                    # another branch of the self-motion may hold the angle: closed form at φ*
+                    S, _ = _analytic_seeds(robot, ch, mode, target, secondary_ref(q_ref, ch), secondary.target)
+                    cf = _analytic_module()
+                    if cf is not None and ch.fid == robot.tool_id and cf.has_analytic(robot):
+                        tried = " and the closed form has no solution at that angle inside the limits"
+                    for cand in S:
+                        _, _, pe2, re2 = resid(cand)
+                        if pe2 <= tol_p and re2 <= tol_r:
+                            qs, seeds_tag, off, tried = cand, "analytic", 0.0, ""
+                            msg = "converged from an analytic seed at the requested swivel angle"
+                            break
+                if off > 1e-6:
+                    msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's "
+                            f"self-motion within the joint limits{tried} (the hand pose is exact)")
             return IKResult(qs, True, "success", pe, re, total_it, restarts, msg, mode, seeds_tag)
         if out_of_reach and attempt >= 3:
             break
