@@ -300,3 +300,15 @@ def test_jupyter_cell_is_a_static_iframe_when_not_live(human):
     h = v._repr_html_()
     assert h.count("<iframe") == 1 and "srcdoc=" in h and "&lt;!DOCTYPE html&gt;" in h
     assert v.jupyter_cell(300).data == v._iframe(300)
+
+
+def test_display_after_play_stops_the_animation(human):
+    v = Viewer(human)
+    v.play(np.linspace(human.neutral(), human.random_q(rng=12), 5))
+    assert any(c["type"] == "set_animation" for c in html_commands(v.static_html()))
+    v.server = rec = Recorder()
+    v.display(human.neutral())
+    assert rec.messages[-1][0]["type"] == "set_animation" and rec.messages[-1][0]["animations"] == []
+    assert not any(c["type"] == "set_animation" for c in html_commands(v.static_html()))
+    v.display(human.neutral())  # no animation left: nothing to stop
+    assert all(c["type"] != "set_animation" for c in rec.messages[-1])

@@ -159,7 +159,7 @@ class SceneStore:
         elif kind == "anthroarm_color":
             self._find(parts).color = packed
         elif kind == "set_animation":
-            self.animation = packed
+            self.animation = packed if cmd.get("animations") else None
         elif kind == "delete":
             if not parts:
                 self.root = _Node()

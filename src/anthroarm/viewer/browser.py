@@ -102,7 +102,7 @@ def docs_screenshot(png, size=(960, 640)) -> Path:
 
     res = reach_demo()
     v = demo_viewer(res)
-    v.store.animation = None  # a still picture: the pose below, not the animation's first frame
+    v.stop()  # a still picture: the pose below, not the animation
     v.show_limits()
     v.display(np.deg2rad(REACH_POSTURES_DEG["hand to mouth"]))
     v.set_camera((0.55, 1.0, 0.4), distance=1.35 * v.radius)

@@ -129,6 +129,9 @@ class Viewer:
         headless software WebGL, where meshcat's gradient texture comes out inverted).
     q : array, optional
         Initial configuration (default ``robot.neutral()``).
+    grid : bool
+        Show meshcat's line grid (moved to the floor of the reach).  A translucent floor disc
+        is always drawn.
     """
 
     def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
@@ -148,6 +151,7 @@ class Viewer:
         self.bodies: list[Body] = robot_bodies(robot, style)
         self._overlay_bodies: dict[str, list[Body]] = {}
         self._limits_on = False
+        self._animating = False
         self._colors: dict[str, tuple] = {}
         self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
         self._frame_scene(background, grid)
@@ -303,7 +307,17 @@ class Viewer:
         if q.ndim != 1:
             raise ValueError(f"{self.robot.name}: display takes one configuration ({self.robot.nq},), got {q.shape}; use play() for a trajectory")
         self.q = q.copy()
-        self._send(self._pose_commands(q) + self._color_commands(q))
+        stop = [self._stop_command()] if self._animating else []
+        self._animating = False
+        self._send(stop + self._pose_commands(q) + self._color_commands(q))
+
+    def _stop_command(self) -> dict:
+        return {"type": "set_animation", "path": "", "animations": [], "options": {"play": False, "repetitions": 1}}
+
+    def stop(self) -> None:
+        """Stop and forget the animation set by :meth:`play` (``display`` does this too)."""
+        self._animating = False
+        self._send([self._stop_command()])
 
     def show_limits(self, on: bool = True) -> None:
         """Colour each link by how close its joint is to a limit (red within the last 15 %)."""
@@ -442,6 +456,7 @@ class Viewer:
                "options": {"play": True, "repetitions": float("inf") if loop else 1}}
         self.display(Q[0])
         self._send([cmd])
+        self._animating = True
         self.trajectory = Q
 
     # ------------------------------------------------------------------ output
