@@ -419,7 +419,8 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         sw_frames = _swivel_frames(robot, swivel_frames)
     dim = {"pose": 6, "position": 3, "orientation": 3}[mode]
     redundant = ch.n > dim
-    gen = [np.random.default_rng(0 if rng is None else rng)] if not isinstance(rng, np.random.Generator) else [rng]
+    # the restart generator is created on first use (most solves need no restart)
+    gen = [rng] if isinstance(rng, np.random.Generator) else [None, 0 if rng is None else rng]
 
     results = []
     prev = None
@@ -479,20 +480,23 @@ def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restar
             q, seeds_tag = ana[ana_i].copy(), "analytic"
             ana_i += 1
         elif attempt > 0:
+            if gen[0] is None:
+                gen[0] = np.random.default_rng(gen[1])
             g = gen[0]
             q = ch.lo_s + (ch.hi_s - ch.lo_s) * g.random(ch.n)
             seeds_tag = "restart"
             restarts += 1
         qs, ok, it, b = _attempt(ch, resid, q, tol_p, tol_r, deadline)
         total_it += it
+        pe, re = b[1], b[2]
         if ok and secondary is not None:
             qs, it2 = _refine(ch, resid, qs, tol_p, tol_r, secondary, deadline + 0.5 * max_time)
             total_it += it2
+            _, _, pe, re = resid(qs)
         attempt += 1
         if b[1] + b[2] < best[1] + best[2]:
             best = b
         if ok:
-            _, _, pe, re = resid(qs)
             msg = f"converged from a {seeds_tag} seed"
             if isinstance(secondary, _Swivel):
                 off = _swivel_offset(ch, secondary, qs)
@@ -506,7 +510,7 @@ def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restar
                     for cand in S:
                         _, _, pe2, re2 = resid(cand)
                         if pe2 <= tol_p and re2 <= tol_r:
-                            qs, seeds_tag, off, tried = cand, "analytic", 0.0, ""
+                            qs, seeds_tag, off, tried, pe, re = cand, "analytic", 0.0, "", pe2, re2
                             msg = "converged from an analytic seed at the requested swivel angle"
                             break
                 if off > 1e-6:
