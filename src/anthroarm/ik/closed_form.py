@@ -320,6 +320,41 @@ _FK_CACHE: dict = {}
 _DEDUP_DIR = np.random.default_rng(12345).uniform(0.5, 1.5, 16)
 
 
+_PIN_DATA: dict = {}
+
+
+def _fk_residual(robot, Qw, Ts, position_only):
+    """max |FK(q) − T| (3×4 entries, or position) of candidates Qw (N, B, nq) against Ts (N, 4, 4).
+    Few candidates: Pinocchio's FK (one C++ call each); many: the vectorised chain FK."""
+    N, B = Qw.shape[:2]
+    if N * B > 64:
+        return _fk_for(robot).residual(Qw, Ts[:, None], position_only=position_only)
+    import pinocchio as pin
+
+    key = id(robot.model)
+    d = _PIN_DATA.get(key)
+    if d is None or d[0] is not robot.model:
+        d = (robot.model, robot.model.createData())
+        _PIN_DATA[key] = d
+    model, data = d
+    fid = robot.tool_id
+    res = np.empty((N, B))
+    for i in range(N):
+        Ti = Ts[i]
+        for b in range(B):
+            q = Qw[i, b]
+            if not np.isfinite(q).all():
+                res[i, b] = np.inf
+                continue
+            pin.framesForwardKinematics(model, data, q)
+            M = data.oMf[fid]
+            e = np.abs(M.translation - Ti[:3, 3]).max()
+            if not position_only:
+                e = max(e, np.abs(M.rotation - Ti[:3, :3]).max())
+            res[i, b] = e
+    return res
+
+
 def _fk_for(robot) -> _ChainFK:
     key = id(robot.spec)
     fk = _FK_CACHE.get(key)
@@ -657,7 +692,7 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
     B = Q.shape[1]
     Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
-    res = _fk_for(robot).residual(Qw, Ts[:, None], position_only=position_only)   # FK check (N, B)
+    res = _fk_residual(robot, Qw, Ts, position_only)                      # FK check (N, B)
     valid = (code == OK) & inside & (res <= tol)
     valid &= np.isfinite(res)
     # remove duplicate solutions (singular poses give coincident branches)
