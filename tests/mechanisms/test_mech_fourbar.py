@@ -202,3 +202,16 @@ def test_input_range_and_grashof():
     th = np.linspace(-np.pi, np.pi, 721)
     s = fourbar_position(3, 2, 2.5, 4, th)
     np.testing.assert_array_equal(rng.contains(th), s.assembled)
+
+
+def test_printed_section_5_3_theta2_for_theta_d_fails():
+    # §5-3 (l. 2711, 2727) prints tg th2 = (r1y - r2y)/(r1x - r2x) and th3 = th2 +/- alpha; the angle is th_d
+    r1, r2, r3, r4, th2 = R[0], R[1], R[2], R[3], TH2
+    c = fourbar_cartesian([r1, 0.0], r2, r3, r4, th2)
+    dx, dy = r1 - r2 * np.cos(th2), -r2 * np.sin(th2)
+    d = np.hypot(dx, dy)
+    alpha = np.arccos((r3 * r3 + d * d - r4 * r4) / (2 * r3 * d))
+    printed_th3 = th2 + alpha                                     # printed: th3 = th2 + alpha
+    B = r2 * np.exp(1j * th2) + r3 * np.exp(1j * printed_th3)
+    assert abs(abs(B - r1) - r4) > 1e-2                           # the rocker length is not kept
+    assert abs(abs(r2 * np.exp(1j * th2) + r3 * np.exp(1j * c.theta3) - r1) - r4) < 1e-14

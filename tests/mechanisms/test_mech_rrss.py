@@ -218,3 +218,14 @@ def test_track_reports_a_lost_branch_and_bad_input():
         RRSSGeometry(a0=[0, 0, 0], u0=[0, 0, 1.5], a1=[1, 0, 0], u1=[0, 1, 0], b0=[1, 1, 5], b1=[2, 0, 0])
     with pytest.raises(ValueError, match="theta1"):
         rrss(D2, np.nan)
+
+
+def test_printed_4_48_plus_p_for_p_dot_fails():
+    # 002 l. 314-318: a' = [W](a - p) + (p) is printed with p for p'; with the reference point p = a
+    # the printed form returns the position of a as its velocity
+    th1, w1 = 0.4, 0.9
+    s = rrss_newton(D2, th1, w1, 0.0)
+    truth = fd_derivative(lambda t: rrss_position(D2, th1 + w1 * t, rrss_branch_through(D2)).a)
+    np.testing.assert_allclose(s.adot, truth, atol=1e-12)
+    printed = np.cross(s.omega2, s.a - s.a) + s.a
+    assert np.linalg.norm(printed - truth) > 0.1
