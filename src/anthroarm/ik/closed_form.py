@@ -193,15 +193,6 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False) -> tupl
 
 
 # ---------------------------------------------------------------------------- helpers
-def _rz(c, s):
-    z, o = np.zeros_like(c), np.ones_like(c)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-
-
-_RX90 = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
-_RXM90 = _RX90.T
-
-
 def _wrap_into_limits(Q, lo, hi, tol=1e-9):
     """Shift revolute angles by multiples of 2π into [lo, hi] where possible; returns (Q, inside).
     Values within ``tol`` outside a limit are clipped onto it."""
