@@ -85,41 +85,41 @@ class Backend:
         return x, status
 
     def _polish(self, H, c, lo, hi, A, b, x, y):
-        """Exact solution on the active set guessed from OSQP's duals (OSQP's polish rule:
-        lower bound active if x − lo < −y, upper if hi − x < y), accepted only if it is
-        primal feasible and the multipliers have the right signs; else ``None``."""
+        """Exact solution on the active set guessed from the duals ``y`` (OSQP's polish rule:
+        lower bound active if x − lo < −y, upper if hi − x < y): the KKT system with the active
+        rows of H replaced by x_i = bound.  Accepted only if it is primal feasible and the
+        multipliers have the right signs; else ``None``."""
         n = self.n
         yb = y[:n]
         act_lo = (x - lo) < -yb
         act_hi = (hi - x) < yb
         act = act_lo | act_hi
-        xa = np.where(act_lo, lo, np.where(act_hi, hi, 0.0))
-        free = ~act
-        nf = int(free.sum())
-        rhs = -(c + H[:, act] @ xa[act])[free]
+        K = H.copy()
+        rhs = -c
+        has_act = bool(act.any())
+        if has_act:
+            K[act] = np.eye(n)[act]
+            rhs = rhs.copy()
+            rhs[act] = np.where(act_lo, lo, hi)[act]
         try:
             if A is None or not len(A):
-                xf = np.linalg.solve(H[np.ix_(free, free)], rhs) if nf else np.zeros(0)
-                lam = None
+                xp = np.linalg.solve(K, rhs)
+                g = H @ xp + c
             else:
                 m = len(A)
-                K = np.zeros((nf + m, nf + m))
-                K[:nf, :nf] = H[np.ix_(free, free)]
-                K[:nf, nf:] = A[:, free].T
-                K[nf:, :nf] = A[:, free]
-                sol = np.linalg.solve(K, np.concatenate([rhs, b - A[:, act] @ xa[act]]))
-                xf, lam = sol[:nf], sol[nf:]
+                At = A.T.copy()
+                At[act] = 0.0
+                KKT = np.block([[K, At], [A, np.zeros((m, m))]])
+                sol = np.linalg.solve(KKT, np.concatenate([rhs, b]))
+                xp = sol[:n]
+                g = H @ xp + c + A.T @ sol[n:]
         except np.linalg.LinAlgError:
             return None
-        xp = xa.copy()
-        xp[free] = xf
         tol = 1e-9
-        if np.any(xp < lo - tol) or np.any(xp > hi + tol):
+        if np.maximum.reduce(lo - xp) > tol or np.maximum.reduce(xp - hi) > tol:
             return None
-        g = H @ xp + c
-        if lam is not None:
-            g = g + A.T @ lam
-        if np.any(g[act_lo] < -1e-8) or np.any(g[act_hi] > 1e-8):
+        if has_act and (np.minimum.reduce(np.where(act_lo, g, 0.0)) < -1e-8
+                        or np.maximum.reduce(np.where(act_hi, g, 0.0)) > 1e-8):
             return None
         return xp
 
@@ -277,8 +277,10 @@ class QuadprogBackend(Backend):
 
 
 class ProxqpBackend(Backend):
-    """proxsuite ProxQP dense with a persistent workspace (``init`` once, then ``update``),
-    followed by the same active-set polish as OSQP (ProxQP's eps bounds residuals, not x)."""
+    """proxsuite ProxQP (dense), followed by the same active-set polish as OSQP (ProxQP's eps
+    bounds residuals, not x: without the polish it is 1e-4 off on IK QPs).  The one-shot
+    ``proxqp.dense.solve`` is used: on 7-variable QPs it measured 18 µs against 41 µs for a
+    persistent workspace with ``update`` (which re-runs the setup)."""
 
     name = "proxqp"
 
@@ -287,43 +289,19 @@ class ProxqpBackend(Backend):
         from proxsuite import proxqp
 
         self._proxqp = proxqp
-        self.qp = self._new_qp(warm=True)
         self._eye = np.eye(n)
-        self._initialised = False
-
-    def _new_qp(self, warm: bool):
-        proxqp = self._proxqp
-        qp = proxqp.dense.QP(self.n, self.n_eq, self.n)
-        qp.settings.eps_abs = 1e-10
-        qp.settings.eps_rel = 0.0
-        qp.settings.verbose = False
-        qp.settings.initial_guess = (proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT if warm
-                                     else proxqp.InitialGuess.NO_INITIAL_GUESS)
-        return qp
 
     def solve(self, H, c, lo, hi, A=None, b=None):
-        Aeq = np.zeros((0, self.n)) if A is None else A
-        beq = np.zeros(0) if b is None else b
-        args = (H, c, Aeq, beq, self._eye, _finite(lo), _finite(hi))
-        if not self._initialised:
-            self.qp.init(*args)
-            self._initialised = True
-        else:
-            self.qp.update(*args)
-        self.qp.solve()
-        st = self.qp.results.info.status
-        S = self._proxqp.QPSolverOutput
-        if st != S.PROXQP_SOLVED:
-            # a warm start from a different problem can end in a spurious infeasibility
-            # certificate: solve once more from a cold workspace before reporting it
-            self.qp = self._new_qp(warm=True)
-            self.qp.init(*args)
-            self.qp.solve()
-            st = self.qp.results.info.status
-        self.last_info = {"status": str(st), "iter": self.qp.results.info.iter}
+        proxqp = self._proxqp
+        Aeq, beq = (None, None) if A is None or not len(A) else (A, b)
+        r = proxqp.dense.solve(H, c, Aeq, beq, self._eye, _finite(lo), _finite(hi), eps_abs=1e-10, eps_rel=0.0,
+                               verbose=False)
+        st = r.info.status
+        S = proxqp.QPSolverOutput
+        self.last_info = {"status": str(st), "iter": r.info.iter}
         if st == S.PROXQP_SOLVED:
-            x = np.array(self.qp.results.x)
-            xp = self._polish(H, c, lo, hi, A, b, x, np.array(self.qp.results.z))
+            x = np.array(r.x)
+            xp = self._polish(H, c, lo, hi, A, b, x, np.array(r.z))
             self.last_info["polished"] = xp is not None
             return self._finish(x if xp is None else xp, lo, hi, A, b, "optimal")
         if st == S.PROXQP_PRIMAL_INFEASIBLE:
