@@ -193,8 +193,27 @@ class _Swivel:
         return nj * ((d - float(j @ dq1)) / den)
 
 
-def secondary_ref(q_ref, ch):
-    return ch.default_ref if q_ref is None else q_ref
+def _settle_swivel(robot, ch, mode, target, resid, sw, q_ref, qs, pe, re, tol_p, tol_r, analytic, msg):
+    """After the null-space refinement: if the swivel target is still off, try the closed form
+    at that angle (another branch of the self-motion may hold it); report what remains.
+    Returns (q, pos_err, rot_err, seed tag or "", message)."""
+    off = _swivel_offset(ch, sw, qs)
+    if off <= 1e-6:
+        return qs, pe, re, "", msg
+    tried = ""
+    if analytic is not False:
+        ref = ch.default_ref if q_ref is None else q_ref
+        S, _ = _analytic_seeds(robot, ch, mode, target, ref, sw.target)
+        cf = _analytic_module()
+        if cf is not None and ch.fid == robot.tool_id and cf.has_analytic(robot):
+            tried = " and the closed form has no solution at that angle inside the limits"
+        for cand in S:
+            _, _, pe2, re2 = resid(cand)
+            if pe2 <= tol_p and re2 <= tol_r:
+                return cand, pe2, re2, "analytic", "converged from an analytic seed at the requested swivel angle"
+    msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's self-motion within the "
+            f"joint limits{tried} (the hand pose is exact)")
+    return qs, pe, re, "", msg
 
 
 def _swivel_offset(ch, sw: _Swivel, q) -> float:
@@ -499,23 +518,9 @@ def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restar
         if ok:
             msg = f"converged from a {seeds_tag} seed"
             if isinstance(secondary, _Swivel):
-                off = _swivel_offset(ch, secondary, qs)
-                tried = ""
-                if off > 1e-6 and analytic is not False:
-                    # another branch of the self-motion may hold the angle: closed form at φ*
-                    S, _ = _analytic_seeds(robot, ch, mode, target, secondary_ref(q_ref, ch), secondary.target)
-                    cf = _analytic_module()
-                    if cf is not None and ch.fid == robot.tool_id and cf.has_analytic(robot):
-                        tried = " and the closed form has no solution at that angle inside the limits"
-                    for cand in S:
-                        _, _, pe2, re2 = resid(cand)
-                        if pe2 <= tol_p and re2 <= tol_r:
-                            qs, seeds_tag, off, tried, pe, re = cand, "analytic", 0.0, "", pe2, re2
-                            msg = "converged from an analytic seed at the requested swivel angle"
-                            break
-                if off > 1e-6:
-                    msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's "
-                            f"self-motion within the joint limits{tried} (the hand pose is exact)")
+                qs, pe, re, tag, msg = _settle_swivel(robot, ch, mode, target, resid, secondary, q_ref, qs, pe, re,
+                                                      tol_p, tol_r, analytic, msg)
+                seeds_tag = tag or seeds_tag
             return IKResult(qs, True, "success", pe, re, total_it, restarts, msg, mode, seeds_tag)
         if out_of_reach and attempt >= 3:
             break

@@ -10,6 +10,7 @@ the hand relative to the forearm, or one hand relative to the other.
 
 from __future__ import annotations
 
+import numpy as np
 import pinocchio as pin
 
 from ..configuration import LOCAL
@@ -20,8 +21,6 @@ from .base import Task
 class RelativeFrameTask(Task):
     def __init__(self, robot, frame, root, position_cost=1.0, orientation_cost=1.0, gain: float = 1.0,
                  lm_damping: float = 0.0, target=None):
-        import numpy as np
-
         pc = np.broadcast_to(np.asarray(position_cost, dtype=float), (3,))
         oc = np.broadcast_to(np.asarray(orientation_cost, dtype=float), (3,))
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
