@@ -27,6 +27,7 @@ PROVIDERS: list[str] = [
     "anthroarm.spatial.checks:rows",
     "anthroarm.mechanisms.checks:rows",
     "anthroarm.ik.checks:rows",
+    "anthroarm.ik.qp.checks:rows",
 ]
 
 
