@@ -99,7 +99,8 @@ def test_complex_equals_cartesian_and_closes(r1, r2, r3, r4, th2, w2, a2, br, g)
     s = fourbar(r1, r2, r3, r4, th2, w2, a2, branch=br)
     gv = r1 * np.array([np.cos(g), np.sin(g)])
     c = fourbar_cartesian(gv, r2, r3, r4, th2 + g, w2, a2, branch=br)
-    assert s.status == c.status or abs(np.sin(s.theta3 - s.theta4)) < 1e-8
+    # at a toggle the angles are only defined to ~sqrt(eps): the two forms may disagree on the flag there
+    assert s.status == c.status or abs(np.sin(s.theta3 - s.theta4)) < 1e-6
     for x in (s.theta3, s.theta4, s.omega3, s.alpha4, s.residual):
         assert np.isfinite(x)
     if s.status != "ok":

@@ -20,7 +20,7 @@ import numpy as np
 from ._util import finite_array, out, positive_length
 
 #: |D| / (r1 r2) below this: the two links are collinear, the dyad is at a dead point
-DEAD_POINT_TOL = 1e-9
+DEAD_POINT_TOL = 1e-7
 ASSEMBLY_TOL = 1e-12
 
 __all__ = ["RigidBodyPoint", "DyadState", "rigid_body_point", "dyad"]

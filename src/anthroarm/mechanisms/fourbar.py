@@ -40,8 +40,9 @@ import numpy as np
 
 from ._util import finite_array, finite_scalar, out, positive_length
 
-#: |sin(theta3 - theta4)| below this is a dead point (coupler and rocker collinear)
-DEAD_POINT_TOL = 1e-9
+#: |sin(theta3 - theta4)| below this is a dead point (coupler and rocker collinear); above the
+#: ~sqrt(eps) resolution of the toggle angle itself
+DEAD_POINT_TOL = 1e-7
 #: the cosine of (5-16) may exceed 1 by this much (round-off at a toggle) and still assemble
 ASSEMBLY_TOL = 1e-12
 

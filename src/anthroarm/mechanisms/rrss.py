@@ -35,7 +35,7 @@ import pinocchio as pin
 
 from ._util import Wdot, finite_array, finite_scalar, out, point3, rot, skew, unit_axis
 
-DEAD_POINT_TOL = 1e-9
+DEAD_POINT_TOL = 1e-7
 
 __all__ = ["RRSSGeometry", "RRSSState", "RRSSPoint", "rrss", "rrss_position", "rrss_efg", "rrss_branch_through",
            "rrss_point", "rrss_newton", "rrss_track", "rrss_constraints"]

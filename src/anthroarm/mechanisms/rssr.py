@@ -28,7 +28,7 @@ import numpy as np
 
 from ._util import finite_array, out, point3, positive_length, rot, skew, unit_axis
 
-DEAD_POINT_TOL = 1e-9
+DEAD_POINT_TOL = 1e-7
 
 __all__ = ["RSSRGeometry", "RSSRState", "RSSRCrankTest", "rssr_position", "rssr", "rssr_crank_test",
            "rssr_branch_through", "rssr_efg", "rssr_polar"]
