@@ -143,15 +143,15 @@ class ThumbState:
     points in the world frame (m): ``a`` (MP hinge), ``P`` (IP joint), ``S`` (fingertip) with
     velocities and accelerations; ``S_r`` the fingertip in R1's planar frame."""
 
-    theta1: float
-    theta2: float
-    theta3: float
-    theta1dot: float
-    theta2dot: float
-    theta3dot: float
-    theta1ddot: float
-    theta2ddot: float
-    theta3ddot: float
+    theta1: object
+    theta2: object
+    theta3: object
+    theta1dot: object
+    theta2dot: object
+    theta3dot: object
+    theta1ddot: object
+    theta2ddot: object
+    theta3ddot: object
     a: np.ndarray
     P: np.ndarray
     Pdot: np.ndarray
@@ -162,9 +162,9 @@ class ThumbState:
     S_r: np.ndarray
     F: np.ndarray
     rrss: RRSSState
-    status: str
+    status: object
     reason: str
-    residual: float     #: largest closure error of the two loops (m)
+    residual: object    #: largest closure error of the two loops (m)
 
 
 def _dyad_branch(geom: ThumbGeometry) -> int:
@@ -175,60 +175,66 @@ def _dyad_branch(geom: ThumbGeometry) -> int:
 
 def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branch: int | None = None,
           dyad_branch: int | None = None) -> ThumbState:
-    """Thumb kinematics for driver angle theta1 (rad) and its rates, Fig. 6-17 pipeline.
+    """Thumb kinematics for driver angle(s) theta1 (rad, scalar or array) and rates, Fig. 6-17 pipeline.
 
     Branches default to the ones through the initial pose (theta1 = 0: theta2 = theta3 = 0).
     (6-114) S = T S_r + a, S'_r = T S'_r(planar), S''_r = T S''_r(planar) with
     T = R(theta1, u0) [ex ey u1] ((6-115); the book's x'y'z' frame differs by a constant in-plane
     rotation); (6-116) S' = T S_r' + W(theta1', u0)(S - a0),
     S'' = T S_r'' + Wdot(theta1', theta1'', u0)(S - a0) + 2 W(theta1', u0) T S_r'."""
-    th1 = finite_scalar("theta1", theta1)
-    w1 = finite_scalar("theta1dot", theta1dot)
-    al1 = finite_scalar("theta1ddot", theta1ddot)
+    th1, w1, al1 = np.broadcast_arrays(finite_array("theta1", theta1), finite_array("theta1dot", theta1dot),
+                                       finite_array("theta1ddot", theta1ddot))
     g = geom.rrss
     rb = rrss_branch_through(g) if rrss_branch is None else rrss_branch
     db = _dyad_branch(geom) if dyad_branch is None else dyad_branch
     r = rrss(g, th1, w1, al1, rb)
-    z = np.zeros(2)
-    th2, w2, al2 = float(r.theta2), float(r.theta2dot), float(r.theta2ddot)
+    z = np.zeros(th1.shape + (2,))
+    C = np.broadcast_to(geom.C, z.shape)
+    th2, w2, al2 = (np.asarray(x, float) for x in (r.theta2, r.theta2dot, r.theta2ddot))
     # planar four-bar relative to R1 (Fig. 6-16): crank R2 about A (origin), a' = c' = 0
     ang0 = float(np.arctan2(geom.P0[1], geom.P0[0]))
     P = rigid_body_point(z, z, z, geom.R2, ang0 + th2, w2, al2)                    # (6-66)-(6-69)
-    dy = dyad(P.position, P.velocity, P.acceleration, geom.C, z, z, geom.R4, geom.R5, db)   # (6-70)-(6-87)
+    dy = dyad(P.position, P.velocity, P.acceleration, C, z, z, geom.R4, geom.R5, db)   # (6-70)-(6-87)
     phi0 = float(np.arctan2(*(geom.F0 - geom.P0)[::-1]))
-    S = rigid_body_point(P.position, P.velocity, P.acceleration, geom.R3, dy.theta1, dy.omega1, dy.alpha1, geom.beta)
-    th3 = float(np.angle(np.exp(1j * (dy.theta1 - phi0 - th2))))
-    w3, al3 = float(dy.omega1) - w2, float(dy.alpha1) - al2
+    t31, w31, a31 = (np.asarray(x, float) for x in (dy.theta1, dy.omega1, dy.alpha1))
+    S = rigid_body_point(P.position, P.velocity, P.acceleration, geom.R3, t31, w31, a31, geom.beta)
+    th3 = np.angle(np.exp(1j * (t31 - phi0 - th2)))
+    w3, al3 = w31 - w2, a31 - al2
     # coordinate transformation (6-114)/(6-115) and absolute motion (6-116)
     R1 = rot(th1, g.u0)
     T = R1 @ np.column_stack([geom.ex, geom.ey, g.u1])
     a = np.asarray(r.a)
+    Wm, Wd = W(w1, g.u0), Wdot(w1, al1, g.u0)
 
     def lift(v):
-        return T @ np.r_[v, 0.0]
+        return np.einsum("...ij,...j->...i", T, np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], -1))
+
+    def mv(M, v):
+        return np.einsum("...ij,...j->...i", M, v)
 
     S_w = lift(S.position) + a
     Sd_r = lift(S.velocity)
-    Sdot = Sd_r + W(w1, g.u0) @ (S_w - g.a0)
-    Sddot = lift(S.acceleration) + Wdot(w1, al1, g.u0) @ (S_w - g.a0) + 2 * W(w1, g.u0) @ Sd_r
+    Sdot = Sd_r + mv(Wm, S_w - g.a0)
+    Sddot = lift(S.acceleration) + mv(Wd, S_w - g.a0) + 2 * mv(Wm, Sd_r)
     Pw = lift(P.position) + a
-    Pdot = lift(P.velocity) + W(w1, g.u0) @ (Pw - g.a0)
-    Pddot = lift(P.acceleration) + Wdot(w1, al1, g.u0) @ (Pw - g.a0) + 2 * W(w1, g.u0) @ lift(P.velocity)
+    Pd_r = lift(P.velocity)
+    Pdot = Pd_r + mv(Wm, Pw - g.a0)
+    Pddot = lift(P.acceleration) + mv(Wd, Pw - g.a0) + 2 * mv(Wm, Pd_r)
     F_w = lift(dy.P3) + a
-    statuses = [str(r.status), str(dy.status)]
-    if "cannot_assemble" in statuses:
-        status = "cannot_assemble"
-        reason = f"RRSS: {r.reason}" if r.status == "cannot_assemble" else f"upper four-bar: {dy.reason}"
-    elif "dead_point" in statuses:
-        status = "dead_point"
-        reason = f"RRSS: {r.reason}" if r.status == "dead_point" else f"upper four-bar: {dy.reason}"
+    rs, ds = np.asarray(r.status), np.asarray(dy.status)
+    status = np.where(rs == "cannot_assemble", rs, np.where(ds == "cannot_assemble", ds,
+                      np.where(rs != "ok", rs, ds)))
+    if status.ndim == 0:
+        st = str(status)
+        reason = "ok" if st == "ok" else (f"RRSS: {r.reason}" if str(rs) == st else f"upper four-bar: {dy.reason}")
     else:
-        status, reason = "ok", "ok"
-    res = max(float(r.residual), abs(float(np.linalg.norm(dy.P3 - geom.C)) - geom.R5))
-    return ThumbState(theta1=th1, theta2=th2, theta3=th3, theta1dot=w1, theta2dot=w2, theta3dot=w3,
-                      theta1ddot=al1, theta2ddot=al2, theta3ddot=al3, a=a, P=Pw, Pdot=Pdot, Pddot=Pddot,
-                      S=S_w, Sdot=Sdot, Sddot=Sddot, S_r=S.position, F=F_w, rrss=r, status=status, reason=reason,
-                      residual=res)
+        nb = int(np.sum(status != "ok"))
+        reason = "ok" if nb == 0 else f"RRSS: {r.reason}; upper four-bar: {dy.reason}"
+    res = np.maximum(np.asarray(r.residual), np.abs(np.linalg.norm(dy.P3 - C, axis=-1) - geom.R5))
+    return ThumbState(theta1=out(th1), theta2=out(th2), theta3=out(th3), theta1dot=out(w1), theta2dot=out(w2),
+                      theta3dot=out(w3), theta1ddot=out(al1), theta2ddot=out(al2), theta3ddot=out(al3), a=a, P=Pw,
+                      Pdot=Pdot, Pddot=Pddot, S=S_w, Sdot=Sdot, Sddot=Sddot, S_r=S.position, F=F_w, rrss=r,
+                      status=out(status), reason=reason, residual=out(res))
 
 
 def thumb_spec(geom: ThumbGeometry):
