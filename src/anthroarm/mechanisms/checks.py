@@ -18,7 +18,7 @@ from ..crosscheck import CheckRow
 from ._util import fd_derivative, wrap
 from .closed_loop import ClosedLoop
 from .finger import FingerGeometry, finger, finger_spec
-from .fourbar import fourbar, fourbar_cartesian, fourbar_position
+from .fourbar import fourbar, fourbar_cartesian
 from .pin_models import fourbar_spec, rrss_spec, rssr_spec
 from .rrss import RRSSGeometry, rrss, rrss_branch_through, rrss_newton, rrss_position
 from .rssr import RSSRGeometry, rssr, rssr_branch_through, rssr_crank_test, rssr_position

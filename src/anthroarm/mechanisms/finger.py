@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._util import finite_array, finite_scalar, out
+from ._util import finite_array, out
 from .dyads import dyad, rigid_body_point
 
 MM = 1e-3

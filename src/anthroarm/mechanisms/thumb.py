@@ -36,7 +36,7 @@ import numpy as np
 
 from ._util import W, Wdot, finite_array, finite_scalar, out, point3, positive_length, rot
 from .dyads import dyad, rigid_body_point
-from .rrss import RRSSGeometry, RRSSState, rrss, rrss_branch_through, rrss_point
+from .rrss import RRSSGeometry, RRSSState, rrss, rrss_branch_through
 
 MM = 1e-3
 
