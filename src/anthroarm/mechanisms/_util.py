@@ -1,6 +1,8 @@
 """Private helpers of :mod:`anthroarm.mechanisms`: input validation and 3x3 rotation algebra.
 
-The rotation helpers are the 002 text's matrices (book notation in brackets):
+The rotation helpers are the 002 text's matrices (book notation in brackets); ``rot`` is
+:func:`anthroarm.spatial.screw.rotation_matrix`, the others are batched local versions of
+``spatial.screw`` (checked equal in ``tests/mechanisms/test_mech_util.py``):
 
 * ``skew(u)`` = [P_u], the cross-product matrix, 002 line 185 and Eq. (6-89) with the
   *standard* sign pattern (the print swaps u_x and u_z, see docs/errata.md);
@@ -81,14 +83,12 @@ def skew(u) -> np.ndarray:
 
 
 def rot(theta, u) -> np.ndarray:
-    """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in theta."""
-    theta = np.asarray(theta, dtype=float)
-    u = np.asarray(u, dtype=float)
-    P = skew(u)
-    Q = np.outer(u, u)
-    c = np.cos(theta)[..., None, None]
-    s = np.sin(theta)[..., None, None]
-    return -(P @ P) * c + P * s + Q
+    """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in theta.
+
+    Delegates to :func:`anthroarm.spatial.screw.rotation_matrix` (002 line 185)."""
+    from ..spatial.screw import rotation_matrix
+
+    return rotation_matrix(theta, u)
 
 
 def W(thetadot, u) -> np.ndarray:
