@@ -66,6 +66,14 @@ def test_catalog_vs_pinocchio(name):
         assert rel(fd, pin.aba(robot.model, robot.model.createData(), Q[i], V[i], A[i])) < 1e-9
 
 
+def christoffel(M, q):
+    """Christoffel symbols of the first kind, written here (not anthroarm's helper):
+    Γ[i][j][k] = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)."""
+    n = M.shape[0]
+    return [[[(M[i, j].diff(q[k]) + M[i, k].diff(q[j]) - M[j, k].diff(q[i])) / 2 for k in range(n)]
+             for j in range(n)] for i in range(n)]
+
+
 def _sympy_oracle(params, gravity):
     """Plain sympy: world poses by matrix products, T = Σ ½m|ċ|² + ½ωᵀIω with ω from RᵀṘ,
     M = ∂²T/∂q̇², Γ from M, g = ∂V/∂q.  No code shared with anthroarm."""
@@ -96,7 +104,7 @@ def _sympy_oracle(params, gravity):
         M += m * Jv.T * Jv + Jw.T * sp.Matrix(I) * Jw
         V += -m * (sp.Matrix(gravity).T * cw)[0]
     T = (qdv.T * M * qdv)[0] / 2
-    G = L.christoffel(M, q)
+    G = christoffel(M, q)
     Cqd = sp.Matrix([sum(G[i][j][k] * qd[j] * qd[k] for j in range(n) for k in range(n)) for i in range(n)])
     g = sp.Matrix([V.diff(q[i]) for i in range(n)])
 
@@ -126,11 +134,12 @@ def test_against_independent_sympy_christoffel(types, seed):
 
 
 def test_planar2r_symbolic_christoffel_and_latex():
-    """Symbolically: the derived C q̇ equals Σ Γ_ijk q̇_j q̇_k with Γ from the derived M."""
+    """Symbolically: the derived C q̇ equals Σ Γ_ijk q̇_j q̇_k with Γ from the derived M (Γ by the
+    test's own :func:`christoffel`; the engine computes C q̇ as Ṁ q̇ − ∂T/∂q)."""
     d = L.derive(aa.load("planar2r"))
     mats = L.sympy_matrices(d, which=("M", "Cqd", "g"))
     q, qd, _ = L.symbols(2)
-    G = L.christoffel(mats["M"], q)
+    G = christoffel(mats["M"], q)
     C2 = sp.Matrix([sum(G[i][j][k] * qd[j] * qd[k] for j in range(2) for k in range(2)) for i in range(2)])
     assert all(abs(sp.N(sp.simplify(e))) < 1e-12 for e in (mats["Cqd"] - C2))
     # the book's two-link arm (Fig. 7-14): M12 depends on cos q2 only, M22 is constant
@@ -195,11 +204,6 @@ def test_cache_roundtrip_and_generator_reproduces_cached_file(tmp_path, monkeypa
     # other body parameters -> other key
     other = L.chain_info(aa.load("human_arm7", height=1.9, mass=90.0).model, "h2")
     assert other.key() != key
-
-
-def test_derivation_is_fast():
-    d = L.derive(aa.load("panda"))
-    assert d.seconds < 5.0  # measured ~0.02 s; the benchmark reports the real number
 
 
 # ------------------------------------------------------------------ bad input
