@@ -51,10 +51,10 @@ def test_single_body_kinematics(seed):
     # l̈ = AΛë + BΛė² + CΛė×  (8-66)-(8-69)
     l = rng.standard_normal(3)
     A, B, C = E.ABC(e)
-    lddot = fd(lambda t: E.rotation(e + t * ed + 0.5 * t * t * edd) @ l, 0.0, 1.0)
-    lddot = (E.rotation(e + H * ed + 0.5 * H * H * edd) @ l - 2 * R @ l
-             + E.rotation(e - H * ed + 0.5 * H * H * edd) @ l) / H ** 2
-    assert np.allclose(A @ E.Lam(l) @ edd + B @ E.Lam(l) @ e2 + C @ E.Lam(l) @ ex, lddot, atol=1e-3)
+    h2 = 1e-4  # second central difference: truncation ~h2², rounding ~1e-16/h2²
+    lddot = (E.rotation(e + h2 * ed + 0.5 * h2 * h2 * edd) @ l - 2 * R @ l
+             + E.rotation(e - h2 * ed + 0.5 * h2 * h2 * edd) @ l) / h2 ** 2
+    assert np.allclose(A @ E.Lam(l) @ edd + B @ E.Lam(l) @ e2 + C @ E.Lam(l) @ ex, lddot, atol=1e-6)
 
 
 def test_printed_J1_J2_and_theta1_fail():
