@@ -49,5 +49,6 @@ def test_bad_input():
         S.simulate(robot, [0, 0], [0, 0], 0.1, damping=-1)
     with pytest.raises(ValueError, match="shape"):
         S.simulate(robot, [0, 0, 0], [0, 0], 0.1)
-    r = S.simulate(robot, [0, 0], [0, 0], 0.05, tau=lambda t, q, qd: np.array([np.nan, 0.0]))
-    assert r.status.startswith("diverged")
+    for method in ("rk4", "RK45"):
+        r = S.simulate(robot, [0, 0], [0, 0], 0.05, tau=lambda t, q, qd: np.array([np.nan, 0.0]), method=method)
+        assert r.status.startswith("diverged") and np.all(np.isfinite(r.q))

@@ -97,9 +97,8 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     constant (n,) torque or ``tau(t, q, qd) -> (n,)`` (N m).  ``damping`` ξ: scalar or (n,),
     N m s/rad, >= 0.  ``dt``: RK4 step and output spacing (s).  ``engine``: "lagrange" (the
     generated code) or "pin" (``pin.aba``; the model is the system's pin model or
-    ``pin_model``).  NaN/inf initial states raise ``ValueError``."""
-    from .lagrange import _as_info
-
+    ``pin_model``).  NaN/inf initial states raise ``ValueError``; a state or drive torque that
+    becomes non-finite during the run ends it with ``status = "diverged: ..."``."""
     dyn = _as_dyn(system) if engine == "lagrange" else None
     if engine == "pin":
         import pinocchio as pin
@@ -173,11 +172,16 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     else:
         from scipy.integrate import solve_ivp
 
-        sol = solve_ivp(rhs, (0.0, t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
-        if not sol.success:
-            status = f"solve_ivp failed: {sol.message}"
-        X = sol.y.T
-        t = sol.t
+        try:
+            sol = solve_ivp(rhs, (0.0, t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
+        except FloatingPointError as exc:  # solve_ivp keeps no partial output: report the start
+            X, t = x0[None], t[:1]
+            status = f"diverged: {exc}"
+        else:
+            if not sol.success:
+                status = f"solve_ivp failed: {sol.message}"
+            X = sol.y.T
+            t = sol.t
     q, qd = X[:, :n], X[:, n:2 * n]
     TV = np.array([energies(a, b) for a, b in zip(q, qd)])
     return SimResult(t=t, q=q, qd=qd, T=TV[:, 0], V=TV[:, 1], dissipated=X[:, 2 * n], work=X[:, 2 * n + 1],
