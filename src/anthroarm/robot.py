@@ -24,6 +24,16 @@ from .errors import UnknownFrameError, UnsupportedModelError, URDFStructureError
 from .urdf_io import URDFInfo, parse_urdf_bytes, read_urdf
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+_REFERENCES = ("LOCAL", "WORLD", "LOCAL_WORLD_ALIGNED")
+
+
+def _reference_frame(reference) -> pin.ReferenceFrame:
+    """``pin.ReferenceFrame`` from its name; ``ValueError`` listing the names otherwise."""
+    if isinstance(reference, pin.ReferenceFrame):
+        return reference
+    if reference not in _REFERENCES:
+        raise ValueError(f"reference must be one of {', '.join(_REFERENCES)}, got {reference!r}")
+    return getattr(pin.ReferenceFrame, reference)
 
 
 class Robot:
@@ -128,10 +138,13 @@ class Robot:
         :class:`UnknownFrameError` listing the valid ones."""
         if frame is None:
             return self.tool_id if hasattr(self, "tool_id") else self.frame_id(self.tool)
-        if isinstance(frame, (int, np.integer)):
+        if isinstance(frame, (int, np.integer)) and not isinstance(frame, bool):
             if not 0 <= frame < len(self.model.frames):
                 raise UnknownFrameError(f"{self.name}: frame index {frame} out of range 0..{len(self.model.frames) - 1}")
             return int(frame)
+        if not isinstance(frame, str):
+            raise UnknownFrameError(f"{self.name}: a frame is a name or an index, got {frame!r}; "
+                                    f"valid frames: {', '.join(self.frame_names)}")
         if not self.model.existFrame(frame):
             raise UnknownFrameError(
                 f"{self.name}: unknown frame {frame!r}; valid frames: {', '.join(self.frame_names)}"
@@ -140,11 +153,9 @@ class Robot:
 
     @property
     def length_scale(self) -> float:
-        """Largest distance from the base to any joint or the tool at q = neutral, plus the
-        summed joint offsets (m): the scale for relative position tolerances."""
-        q = self.neutral()
-        pin.forwardKinematics(self.model, self.data, q)
-        pin.updateFramePlacements(self.model, self.data)
+        """Sum of the lengths of every joint placement offset and of the tool offset (m), at
+        least 1 mm: a bound on the reach (for a serial chain), used as the scale of relative
+        position tolerances."""
         total = 0.0
         for jid in range(1, self.model.njoints):
             total += float(np.linalg.norm(self.model.jointPlacements[jid].translation))
@@ -211,7 +222,7 @@ class Robot:
         ``reference`` may be "LOCAL", "WORLD" or "LOCAL_WORLD_ALIGNED".  Batches give (N, 6, nv)."""
         q = self.check_q(q)
         fid = self.frame_id(frame)
-        ref = getattr(pin.ReferenceFrame, reference)
+        ref = _reference_frame(reference)
         if q.ndim == 1:
             return pin.computeFrameJacobian(self.model, self.data, q, fid, ref).copy()
         out = np.empty((q.shape[0], 6, self.nv))
@@ -266,7 +277,7 @@ def load(name_or_path, *, tool: str | None = None, package_dirs: dict | None = N
         text = models.to_urdf(spec)
         path = models.REPO_URDF_DIR / f"{s}.urdf"
         info = parse_urdf_bytes(text.encode(), path, package_dirs=package_dirs, check_meshes=check_meshes)
-        if params or not path.is_file() or path.read_text() != text:
+        if params or not path.is_file() or path.read_text(encoding="utf-8") != text:
             # not the committed default file: keep the text only (yourdfpy reads from memory)
             info.path = Path(f"<generated>/{s}.urdf")
         return Robot(info, name=s, tool=tool or spec.tool_name, spec=spec, description=spec.description)

@@ -57,6 +57,15 @@ def test_unknown_frame_lists_valid_frames(arm):
     with pytest.raises(UnknownFrameError) as e:
         arm.fk(arm.neutral(), frame="elbow_nope")
     assert "hand_point" in str(e.value)
+    with pytest.raises(UnknownFrameError, match="name or an index"):
+        arm.fk(arm.neutral(), frame=1.5)
+
+
+def test_unknown_jacobian_reference_is_a_value_error(arm):
+    with pytest.raises(ValueError, match="LOCAL_WORLD_ALIGNED"):
+        arm.jacobian(arm.neutral(), reference="world")
+    np.testing.assert_array_equal(arm.jacobian(arm.neutral(), reference=pin.ReferenceFrame.WORLD),
+                                  arm.jacobian(arm.neutral(), reference="WORLD"))
 
 
 @pytest.mark.parametrize("bad", [np.zeros(6), np.zeros(8), np.zeros((2, 6)), np.zeros((2, 2, 7))])
