@@ -257,7 +257,6 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
                 raise URDFStructureError(path, f"kinematic cycle through link {cur!r}")
             seen.add(cur)
             cur = parent_of[cur]
-    # every link reached from the root (a cycle elsewhere would leave links unreached)
     meshes: dict[str, Path] = {}
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename")
@@ -271,9 +270,13 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
             raise MeshNotFoundError(path, f"mesh {uri!r} not found (looked for {resolved})")
         meshes[uri] = resolved
 
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise URDFSyntaxError(path, f"not UTF-8 text ({exc.reason} at byte {exc.start}); save the URDF as UTF-8") from None
     return URDFInfo(
         path=path,
-        text=raw.decode("utf-8"),
+        text=text,
         robot_name=root.get("name", path.stem),
         links=links,
         joints=joints,
@@ -291,13 +294,14 @@ def joints_child(joints: dict, child: str) -> str:
 
 
 def atomic_write_text(path, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (temp file in the same folder, then rename)."""
+    """Write ``text`` to ``path`` as UTF-8, atomically (temp file in the same folder, then
+    rename): a reader sees the old file or the new one, never a partial one."""
     path = Path(path)
     if not path.parent.is_dir():
-        raise FileNotFoundError(f"folder {path.parent} does not exist")
+        raise FileNotFoundError(f"folder {path.parent} does not exist (cannot write {path.name})")
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        tmp.write_text(text)
+        tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
     finally:
         if tmp.exists():

@@ -42,6 +42,14 @@ def test_malformed_xml(tmp_path):
         aa.load(str(p))
 
 
+def test_not_utf8_names_the_file(tmp_path):
+    p = tmp_path / "latin1.urdf"
+    p.write_bytes('<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="café"><link name="base"/></robot>'
+                  .encode("latin-1"))
+    with pytest.raises(errors.URDFSyntaxError, match="latin1.urdf.*UTF-8"):
+        aa.load(str(p))
+
+
 def test_not_a_robot(tmp_path):
     with pytest.raises(errors.URDFSyntaxError, match="expected <robot>"):
         aa.load(str(write(tmp_path, "<sdf/>")))

@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 from meshcat.commands import SetObject
 
+from ..urdf_io import atomic_write_text
 from ._store import SceneStore
 from .visuals import LINK_RGB, Body, Piece, _tf, _y_to, cylinder_between, rgb_hex, robot_bodies
 
@@ -466,13 +467,10 @@ class Viewer:
         return self.store.static_html(title or f"anthroarm — {self.robot.name}")
 
     def export_html(self, path) -> Path:
-        """Write :meth:`static_html` to ``path`` (its folder must exist); returns the path."""
+        """Write :meth:`static_html` to ``path`` atomically, as UTF-8 (its folder must exist,
+        ``FileNotFoundError`` otherwise); returns the path."""
         path = Path(path)
-        if not path.parent.is_dir():
-            raise FileNotFoundError(f"folder {path.parent} does not exist (cannot write {path.name})")
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(self.static_html(), encoding="utf-8")
-        tmp.replace(path)
+        atomic_write_text(path, self.static_html())
         return path
 
     @property
