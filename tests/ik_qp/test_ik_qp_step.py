@@ -240,3 +240,41 @@ def test_bad_input(panda):
     v = qp.step(panda, panda.neutral(), [qp.PostureTask(panda)], 0.01)
     assert v.shape == (7,) and np.all(np.isfinite(v))
     assert "osqp" in qp.available_solvers()
+
+
+FINGER_URDF = """<?xml version="1.0"?>
+<robot name="finger">
+  <link name="base"/>
+  <link name="l1"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l2"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-1.5" upper="1.5" effort="1" velocity="2"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.05 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1.5" upper="1.5" effort="1" velocity="2"/></joint>
+  <joint name="tipj" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="0.04 0 0"/></joint>
+</robot>
+"""
+
+
+def test_coupled_finger_joints_hold_as_constraints(tmp_path):
+    """A two-joint finger whose joints move together (q2 = 0.5 q1 + 0.1, URDF <mimic> semantics):
+    the coupling, passed as a hard constraint, holds exactly while the tip follows a target.
+    (anthroarm.load freezes URDF mimic joints, see robot.py, so the coupling is declared here.)"""
+    path = tmp_path / "finger.urdf"
+    path.write_text(FINGER_URDF)
+    robot = aa.load(str(path), tool="tip")
+    assert robot.joint_names == ["j1", "j2"]
+    assert qp.mimic_tasks(robot) == []          # no <mimic> tag in this file
+    tasks = [qp.JointCouplingTask.mimic(robot, "j2", "j1", multiplier=0.5, offset=0.1)]
+    q = np.array([0.2, 0.5 * 0.2 + 0.1])
+    conf = qp.IKConfiguration(robot, q)
+    target = np.array([0.06, 0.05, 0.0])
+    pos = qp.PositionTask(robot, cost=[1.0, 1.0, 0.0], target=target)
+    for _ in range(200):
+        out = qp.step(conf, None, [pos], 0.05, constraints=tasks, full=True)
+        assert out.ok
+        conf.integrate_inplace(out.v, 0.05)
+        assert abs(conf.q[1] - (0.5 * conf.q[0] + 0.1)) < 1e-9
+    # the reachable point closest to the target on the coupled (1-DOF) curve
+    assert np.linalg.norm(pos.compute_error(conf)[:2]) < 0.02

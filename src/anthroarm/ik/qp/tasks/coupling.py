@@ -68,7 +68,10 @@ class JointCouplingTask(Task):
 
 
 def mimic_tasks(robot, **kw) -> list[JointCouplingTask]:
-    """One :meth:`JointCouplingTask.mimic` per URDF ``<mimic>`` tag whose joints are both DOFs."""
+    """One :meth:`JointCouplingTask.mimic` per URDF ``<mimic>`` tag whose joints are both DOFs
+    of the model.  Note: :func:`anthroarm.load` builds the Pinocchio model without mimic support
+    and freezes mimic joints (see :mod:`anthroarm.robot`), so for its robots this list is empty
+    and the coupling is declared with :meth:`JointCouplingTask.mimic` on free joints."""
     tasks = []
     dofs = set(robot.joint_names)
     for j in robot.urdf.robot.joints:
