@@ -91,10 +91,7 @@ def test_explicit_port_in_use_is_a_clear_error():
 
 
 def test_explicit_free_port_is_used():
-    s0 = socket.socket()
-    s0.bind(("127.0.0.1", 0))
-    port = s0.getsockname()[1]
-    s0.close()
+    port = free_ephemeral_port()
     with ServerProcess(port=port) as s:
         assert s.port == port and not port_is_free(port)
     assert port_is_free(port)
@@ -106,8 +103,18 @@ def test_bad_port_values(bad):
         ServerProcess(port=bad)
 
 
+def free_ephemeral_port() -> int:
+    """A free port from the OS's ephemeral range: other processes that take the first free
+    port from 7000 (other viewers on this machine) will not grab it between our steps."""
+    s0 = socket.socket()
+    s0.bind(("127.0.0.1", 0))
+    port = s0.getsockname()[1]
+    s0.close()
+    return port
+
+
 def test_close_stops_the_process():
-    s = ServerProcess()
+    s = ServerProcess(port=free_ephemeral_port())
     pid = s.proc.pid
     s.close()
     s.close()  # idempotent
