@@ -118,6 +118,32 @@ def test_skew_is_cross_product(a, b):
     assert np.allclose(R.unskew(R.skew(a)), a)
 
 
+@H
+@given(vec3, vec3)
+def test_rotation_between_is_the_smallest_turn(a, b):
+    if min(np.linalg.norm(a), np.linalg.norm(b)) < 1e-3:
+        return
+    C = R.rotation_between(a, b)
+    ah, bh = a / np.linalg.norm(a), b / np.linalg.norm(b)
+    R.check_rotation(C)
+    assert np.allclose(C @ ah, bh, atol=1e-12)
+    # the turn angle is the angle between the directions (log3: pin, independent)
+    angle = np.linalg.norm(pin.log3(C))
+    assert np.isclose(angle, np.arccos(np.clip(ah @ bh, -1, 1)), atol=1e-6)
+
+
+@pytest.mark.parametrize("a", [[0, 0, 1.0], [0, 1.0, 0], [1.0, 0, 0], [0.3, -0.2, 0.9]])
+def test_rotation_between_antiparallel_is_a_half_turn(a):
+    a = np.asarray(a) / np.linalg.norm(a)
+    C = R.rotation_between(a, -2 * a)
+    R.check_rotation(C)
+    assert np.allclose(C @ a, -a, atol=1e-15)
+    assert np.isclose(np.trace(C), -1.0)  # a half turn
+    assert np.allclose(R.rotation_between(a, 3 * a), np.eye(3))
+    with pytest.raises(ValueError, match="zero length"):
+        R.rotation_between(a, [0, 0, 0])
+
+
 # ----------------------------------------------------------------------------- bad input
 def test_non_orthogonal_rotation_raises_with_value():
     M = np.eye(3)

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .spec import ChainSpec, DHRow, JointSpec, from_dh, homogeneous, rod_link
+from ..spatial.rotations import homogeneous
+from .spec import ChainSpec, DHRow, JointSpec, from_dh, rod_link
 
 deg = np.pi / 180.0
 
@@ -40,7 +41,7 @@ def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> C
         "prosthetic_arm",
         "Anthropomorphic 6R prosthetic arm (book Ch.7 Fig. 7-2, Table 7.1); tool = palm centre C.",
         rows,
-        homogeneous(p=[0, 0, L3]),
+        homogeneous(r=[0, 0, L3]),
         source="book 000 l.4906-4941 (Table 7.1, Fig. 7-2); L2=260 mm per Table 7.2 (caption prints 240)",
         joint_names=names,
         params={"L1": L1, "L2": L2, "L3": L3},
@@ -65,7 +66,7 @@ def sixr_arm(s0: float = 0.5, h2: float = 0.4, s3: float = 0.35, P: float = 0.1)
         "sixr_arm",
         "6R manipulator with spherical wrist (book Fig. 6-3); tool = hand point P on z6.",
         rows,
-        homogeneous(p=[0, 0, P]),
+        homogeneous(r=[0, 0, P]),
         source="book 000 l.3769-3847 (Fig. 6-3, Eq. (6-14)-(6-17)); lengths chosen by anthroarm",
         params={"s0": s0, "h2": h2, "s3": s3, "P": P},
         tool_name="hand",
@@ -92,7 +93,7 @@ def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0))
         "unimate5",
         "Unimate-type 5-DOF robot with a prismatic boom (book Fig. 6-4); tool = hand point P on z5.",
         _rrprr_rows(s0, h2, boom),
-        homogeneous(p=[0, 0, P]),
+        homogeneous(r=[0, 0, P]),
         source="book 000 l.3849-3893 (Fig. 6-4, Eq. (6-19)-(6-23)); lengths chosen by anthroarm",
         joint_names=["waist", "shoulder", "boom", "wrist_pitch", "wrist_roll"],
         params={"s0": s0, "h2": h2, "P": P, "boom": list(boom)},
@@ -109,7 +110,7 @@ def rrprr5(s0: float = 0.4, h2: float = 0.08, p: float = 0.12, stroke=(0.2, 0.6)
         "rrprr5",
         "RRPRR 5-DOF manipulator (002 text §4-4); tool = gripper centroid P on z5.",
         _rrprr_rows(s0, h2, stroke),
-        homogeneous(p=[0, 0, p]),
+        homogeneous(r=[0, 0, p]),
         source="002 l.355-409 (Eq. (4-50)-(4-54)); lengths chosen by anthroarm",
         params={"s0": s0, "h2": h2, "p": p, "stroke": list(stroke)},
         tool_name="gripper",
@@ -121,7 +122,7 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
     links of 1 m, y = l1 cos θ1 + l2 cos(θ1+θ2), z = l1 sin θ1 + l2 sin(θ1+θ2)."""
     j1 = JointSpec("joint1", "revolute", homogeneous(), axis=(1.0, 0, 0),
                    link=rod_link("link1", [0, l1, 0]))
-    j2 = JointSpec("joint2", "revolute", homogeneous(p=[0, l1, 0]), axis=(1.0, 0, 0),
+    j2 = JointSpec("joint2", "revolute", homogeneous(r=[0, l1, 0]), axis=(1.0, 0, 0),
                    link=rod_link("link2", [0, l2, 0]))
     from .spec import DEFAULT_JOINT_MASS, DEFAULT_LINEAR_DENSITY, DEFAULT_LINK_RADIUS
 
@@ -130,7 +131,7 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
         description="Planar two-link mechanism with 1 m links (book Fig. 7-14, Table 7.3).",
         joints=[j1, j2],
         tool_name="tip",
-        tool_origin=homogeneous(p=[0, l2, 0]),
+        tool_origin=homogeneous(r=[0, l2, 0]),
         source="book 000 l.5637-5663 (Fig. 7-14, Table 7.3)",
         inertia_source=(
             f"not printed: uniform cylinders of {DEFAULT_LINEAR_DENSITY} kg/m, radius {DEFAULT_LINK_RADIUS} m, "

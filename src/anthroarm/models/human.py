@@ -47,7 +47,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .spec import ChainSpec, JointSpec, homogeneous, rod_link
+from ..spatial.rotations import homogeneous
+from .spec import ChainSpec, JointSpec, rod_link
 
 deg = np.pi / 180.0
 
@@ -124,13 +125,13 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> C
         JointSpec("shoulder_rotation", "revolute", homogeneous(), axis=Z,
                   link=anthropo("upper_arm", [0, 0, -l1], "upperarm", 0.045),
                   lower=lim["shoulder_rotation"][0], upper=lim["shoulder_rotation"][1], effort=40.0),
-        JointSpec("elbow_flexion", "revolute", homogeneous(p=[0, 0, -l1]), axis=X,
+        JointSpec("elbow_flexion", "revolute", homogeneous(r=[0, 0, -l1]), axis=X,
                   link=rod_link("elbow_link", [0, 0, 0], mass=0.0, joint_mass=tiny, radius=0.04),
                   lower=lim["elbow_flexion"][0], upper=lim["elbow_flexion"][1], effort=60.0),
         JointSpec("forearm_pronation", "revolute", homogeneous(), axis=Z,
                   link=anthropo("forearm", [0, 0, -l2], "forearm", 0.035),
                   lower=lim["forearm_pronation"][0], upper=lim["forearm_pronation"][1], effort=10.0),
-        JointSpec("wrist_deviation", "revolute", homogeneous(p=[0, 0, -l2]), axis=Y,
+        JointSpec("wrist_deviation", "revolute", homogeneous(r=[0, 0, -l2]), axis=Y,
                   link=virtual("wrist_link"),
                   lower=lim["wrist_deviation"][0], upper=lim["wrist_deviation"][1], effort=10.0),
         JointSpec("wrist_flexion", "revolute", homogeneous(), axis=X,
@@ -145,7 +146,7 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> C
         ),
         joints=joints,
         tool_name="hand_point",
-        tool_origin=homogeneous(p=[0, 0, -l3]),
+        tool_origin=homogeneous(r=[0, 0, -l3]),
         source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
         inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg",
         params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},

@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..spatial.rotations import homogeneous, rotation_between
+
 #: Default linear density (kg/m) and radius (m) of the book arms' links, which print no masses:
 #: an aluminium tube Ø50 × 3 mm with its fittings weighs about 1.5 kg/m.
 DEFAULT_LINEAR_DENSITY = 1.5
@@ -27,30 +29,6 @@ DEFAULT_LINK_RADIUS = 0.025
 #: mass (kg) of a joint housing lumped at each joint origin, so that co-located wrist joints
 #: still carry a positive-definite inertia.
 DEFAULT_JOINT_MASS = 0.1
-
-
-def rot_x(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1.0, 0], [-s, 0, c]])
-
-
-def rot_z(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
-
-
-def homogeneous(R=None, p=None) -> np.ndarray:
-    T = np.eye(4)
-    if R is not None:
-        T[:3, :3] = R
-    if p is not None:
-        T[:3, 3] = p
-    return T
 
 
 def rpy_from_matrix(R: np.ndarray) -> tuple[float, float, float]:
@@ -269,17 +247,8 @@ def _visuals(link: LinkSpec, indent: str) -> str:
     )
     L = float(np.linalg.norm(link.segment))
     if L > 1e-9:
-        u = link.segment / L
-        # rotation taking +z to u
-        z = np.array([0.0, 0.0, 1.0])
-        v = np.cross(z, u)
-        c = float(z @ u)
-        if np.linalg.norm(v) < 1e-12:
-            R = np.eye(3) if c > 0 else rot_x(np.pi)
-        else:
-            vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-            R = np.eye(3) + vx + vx @ vx * (1.0 / (1.0 + c))
-        T = homogeneous(R, link.segment / 2)
+        # the URDF cylinder is along +z: turn +z onto the segment
+        T = homogeneous(rotation_between([0.0, 0.0, 1.0], link.segment), link.segment / 2)
         out.append(
             f"{indent}<visual>\n{_origin(T, indent + '  ')}"
             f"{indent}  <geometry><cylinder radius=\"{_num(link.radius)}\" length=\"{_num(L)}\"/></geometry>\n"

@@ -26,14 +26,15 @@ from .euler import EulerAngles, euler_xyx, euler_xyx_inverse, euler_zxz, euler_z
 from .hand_angles import hand_angles as hand_direction_angles
 from .hand_angles import hand_matrix
 from .rotation_tensor import J1, J2, J3, rotate, rotated_vector_motion
-from .rotations import axis_angle, check_rotation, check_unit_axis, rot_axis, rot_x, rot_y, rot_z, skew, unit_axis, unskew
+from .rotations import (axis_angle, check_rotation, check_unit_axis, homogeneous, rot_axis, rot_x, rot_y, rot_z,
+                        rotation_between, skew, unit_axis, unskew)
 from .screw import acceleration_matrix, rotation_matrix, screw_matrix, screw_twist, velocity_matrix
 
 __all__ = [
     "dual", "euler", "hand_angles", "polar", "rotation_tensor", "rotations", "screw",
     "Dual", "Line", "EulerAngles", "euler_xyx", "euler_xyx_inverse", "euler_zxz", "euler_zxz_inverse",
     "hand_direction_angles", "hand_matrix", "J1", "J2", "J3", "rotate", "rotated_vector_motion",
-    "axis_angle", "check_rotation", "check_unit_axis", "rot_axis", "rot_x", "rot_y",
-    "rot_z", "skew", "unit_axis", "unskew", "acceleration_matrix", "rotation_matrix", "screw_matrix",
+    "axis_angle", "check_rotation", "check_unit_axis", "homogeneous", "rot_axis", "rot_x", "rot_y",
+    "rot_z", "rotation_between", "skew", "unit_axis", "unskew", "acceleration_matrix", "rotation_matrix", "screw_matrix",
     "screw_twist", "velocity_matrix",
 ]

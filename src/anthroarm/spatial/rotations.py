@@ -146,6 +146,29 @@ def rot_axis(n, phi) -> np.ndarray:
     return c * np.eye(3) + (1.0 - c) * nn + s * skew(n)
 
 
+def rotation_between(a, b) -> np.ndarray:
+    """The smallest rotation C with C â = b̂ for two nonzero directions a, b (any length): the
+    turn about v = â × b̂ by the angle between them, Rodrigues (5-84) written as
+    ``C = I + [v]× + [v]×² / (1 + c)`` with c = â·b̂.  For b̂ = −â: a half turn about the
+    coordinate axis least aligned with â, made perpendicular to â (about x for â = ±y or ±z).
+    Active; ``ValueError`` for a zero-length or non-finite direction."""
+    a = unit_axis(a, "direction a")
+    b = unit_axis(b, "direction b")
+    if a.ndim != 1 or b.ndim != 1:
+        raise ValueError(f"rotation_between takes two (3,) directions, got shapes {a.shape} and {b.shape}")
+    v = np.cross(a, b)
+    c = float(a @ b)
+    if np.linalg.norm(v) < 1e-12:
+        if c > 0:
+            return np.eye(3)
+        k = int(np.argmin(np.abs(a)))
+        n = np.eye(3)[k] - a[k] * a
+        n /= np.linalg.norm(n)
+        return 2.0 * np.outer(n, n) - np.eye(3)
+    V = skew(v)
+    return np.eye(3) + V + V @ V * (1.0 / (1.0 + c))
+
+
 def axis_angle(R) -> tuple[np.ndarray, float]:
     """Inverse of Eq. (5-84): unit axis n and angle φ ∈ [0, π] with ``rot_axis(n, φ) = R``.
 

@@ -30,9 +30,10 @@ import numpy as np
 import pinocchio as pin
 from meshcat.commands import SetObject
 
+from ..spatial.rotations import homogeneous
 from ..urdf_io import atomic_write_text
 from ._store import SceneStore
-from .visuals import LINK_RGB, Body, Piece, _tf, _y_to, cylinder_between, rgb_hex, robot_bodies
+from .visuals import LINK_RGB, Body, Piece, _y_to, cylinder_between, rgb_hex, robot_bodies
 
 ROOT = "/meshcat/anthroarm"
 #: Colour of a joint at its limit (joint-limit proximity).
@@ -196,9 +197,9 @@ class Viewer:
         lo, hi = pts.min(0), pts.max(0)
         self.center = 0.5 * (lo + hi)
         self.radius = float(max(np.linalg.norm(pts - self.center, axis=1).max(), 0.1))
-        cmds = [_set_transform(self.root, _tf(p=-self.center))]
+        cmds = [_set_transform(self.root, homogeneous(r=-self.center))]
         floor = min(0.0, float(lo[2])) - 0.01  # base frame
-        cmds.append(_set_transform("/Grid", _tf(p=[0, 0, floor - self.center[2]])))
+        cmds.append(_set_transform("/Grid", homogeneous(r=[0, 0, floor - self.center[2]])))
         if not grid:
             cmds.append(_set_property("/Grid", "visible", False))
         # a translucent floor disc under the reach (always drawn; robust in software WebGL,
@@ -206,7 +207,7 @@ class Viewer:
         rf = 0.9 * self.radius
         disc = mg.Cylinder(0.004 * rf, rf)
         cmds.append(_set_object(f"{self.root}/floor", disc, (0.80, 0.83, 0.88), 0.4))
-        cmds.append(_set_transform(f"{self.root}/floor", _tf(_y_to([0, 0, 1]), [self.center[0], self.center[1], floor])))
+        cmds.append(_set_transform(f"{self.root}/floor", homogeneous(_y_to([0, 0, 1]), [self.center[0], self.center[1], floor])))
         cmds.append(_set_property("/Axes", "visible", False))
         if background is None:
             cmds.append(_set_property("/Background", "visible", False))
@@ -372,8 +373,8 @@ class Viewer:
         """An IK target: a translucent ball and a triad at ``T`` (4×4 pose, or a 3-vector
         position), in the robot's base frame, metres."""
         T = np.asarray(T, float)
-        if T.shape == (3,):
-            T = _tf(p=T)
+        if T.shape == (3,) and np.all(np.isfinite(T)):
+            T = homogeneous(r=T)
         if T.shape != (4, 4) or not np.all(np.isfinite(T)):
             raise ValueError(f"target must be a finite 4x4 pose or a 3-vector, got shape {T.shape}")
         size = size if size is not None else 0.1 * self.radius

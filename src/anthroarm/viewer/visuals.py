@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MeshNotFoundError
+from ..spatial.rotations import homogeneous, rotation_between
 
 LINK_RGB = (0.62, 0.68, 0.78)
 JOINT_RGB = (0.90, 0.50, 0.20)
@@ -75,28 +76,7 @@ class Body:
 # ---------------------------------------------------------------------- primitives
 def _y_to(direction) -> np.ndarray:
     """Rotation taking +y (meshcat's cylinder axis) onto ``direction``."""
-    d = np.asarray(direction, float)
-    d = d / np.linalg.norm(d)
-    y = np.array([0.0, 1.0, 0.0])
-    c = float(y @ d)
-    if c > 1 - 1e-12:
-        return np.eye(3)
-    if c < -1 + 1e-12:
-        return np.diag([1.0, -1.0, -1.0])
-    v = np.cross(y, d)
-    s = np.linalg.norm(v)
-    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]) / s
-    ang = np.arctan2(s, c)
-    return np.eye(3) + np.sin(ang) * K + (1 - np.cos(ang)) * K @ K
-
-
-def _tf(R=None, p=None) -> np.ndarray:
-    T = np.eye(4)
-    if R is not None:
-        T[:3, :3] = R
-    if p is not None:
-        T[:3, 3] = p
-    return T
+    return rotation_between((0.0, 1.0, 0.0), direction)
 
 
 def cylinder_between(a, b, radius, rgb, group="links", opacity=1.0) -> list[Piece]:
@@ -104,7 +84,7 @@ def cylinder_between(a, b, radius, rgb, group="links", opacity=1.0) -> list[Piec
     L = float(np.linalg.norm(b - a))
     if L < 1e-9:
         return []
-    return [Piece(mg.Cylinder(L, radius), rgb, _tf(_y_to(b - a), (a + b) / 2), group, opacity)]
+    return [Piece(mg.Cylinder(L, radius), rgb, homogeneous(_y_to(b - a), (a + b) / 2), group, opacity)]
 
 
 def capsule(a, b, radius, rgb=LINK_RGB, group="links") -> list[Piece]:
@@ -112,7 +92,7 @@ def capsule(a, b, radius, rgb=LINK_RGB, group="links") -> list[Piece]:
     out = cylinder_between(a, b, radius, rgb, group)
     if not out:
         return []
-    return out + [Piece(mg.Sphere(radius), rgb, _tf(p=a), group), Piece(mg.Sphere(radius), rgb, _tf(p=b), group)]
+    return out + [Piece(mg.Sphere(radius), rgb, homogeneous(r=a), group), Piece(mg.Sphere(radius), rgb, homogeneous(r=b), group)]
 
 
 def joint_axis(model: pin.Model, jid: int) -> tuple[np.ndarray, str]:
@@ -165,7 +145,7 @@ def book_bodies(robot) -> list[Body]:
     if robot.name.startswith("human_arm"):
         base += _torso(robot, r)
     else:
-        base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, _tf(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
+        base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, homogeneous(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
     bodies.append(Body("base", base))
 
     pending: dict[int, list[int]] = {}
@@ -218,7 +198,7 @@ def _palm(tool_frame, r, axis) -> list[Piece]:
     t = np.asarray(tool_frame.placement.translation)
     d = t / np.linalg.norm(t) if np.linalg.norm(t) > 1e-9 else axis
     R = _y_to(d)
-    return [Piece(mg.Ellipsoid([1.6 * r, 1.6 * r, 0.7 * r]), SKIN_RGB, _tf(R, t), "palm")]
+    return [Piece(mg.Ellipsoid([1.6 * r, 1.6 * r, 0.7 * r]), SKIN_RGB, homogeneous(R, t), "palm")]
 
 
 def _torso(robot, r) -> list[Piece]:
@@ -227,10 +207,10 @@ def _torso(robot, r) -> list[Piece]:
     scale with the arm's length L (shoulder to midline ≈ 0.3 L ≈ 0.19 m for a 1.75 m man)."""
     L = robot.length_scale
     w = 0.3 * L
-    pieces = [Piece(mg.Ellipsoid([0.9 * w, 0.5 * w, 0.5 * L]), TORSO_RGB, _tf(p=[-w, 0.0, -0.42 * L]), "torso")]
+    pieces = [Piece(mg.Ellipsoid([0.9 * w, 0.5 * w, 0.5 * L]), TORSO_RGB, homogeneous(r=[-w, 0.0, -0.42 * L]), "torso")]
     pieces += capsule([-0.12 * w, 0.0, -0.03 * L], [-1.88 * w, 0.0, -0.03 * L], 0.8 * r, TORSO_RGB, "torso")
     pieces += cylinder_between([-w, 0.0, 0.0], [-w, 0.0, 0.12 * L], 0.22 * w, SKIN_RGB, "torso")
-    pieces.append(Piece(mg.Ellipsoid([0.33 * w, 0.38 * w, 0.45 * w]), SKIN_RGB, _tf(p=[-w, 0.02 * L, 0.25 * L]), "torso"))
+    pieces.append(Piece(mg.Ellipsoid([0.33 * w, 0.38 * w, 0.45 * w]), SKIN_RGB, homogeneous(r=[-w, 0.02 * L, 0.25 * L]), "torso"))
     return pieces
 
 
@@ -246,7 +226,7 @@ def _origin(el) -> np.ndarray:
     o = el.find("origin") if el is not None else None
     xyz = _floats(o.get("xyz") if o is not None else None, 3, (0, 0, 0))
     rpy = _floats(o.get("rpy") if o is not None else None, 3, (0, 0, 0))
-    return _tf(pin.rpy.rpyToMatrix(*rpy), xyz)
+    return homogeneous(pin.rpy.rpyToMatrix(*rpy), xyz)
 
 
 def urdf_bodies(robot) -> list[Body]:
@@ -304,7 +284,7 @@ def urdf_bodies(robot) -> list[Body]:
             elif shape.tag == "cylinder":
                 L = float(shape.get("length", 0.1))
                 geom = mg.Cylinder(L, float(shape.get("radius", 0.05)))
-                offset = offset @ _tf(_y_to([0, 0, 1]))  # URDF cylinders are along z
+                offset = offset @ homogeneous(_y_to([0, 0, 1]))  # URDF cylinders are along z
             elif shape.tag == "sphere":
                 geom = mg.Sphere(float(shape.get("radius", 0.05)))
             else:
