@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EulerSingularityError, InertiaError
+from ..spatial.rotations import skew  # [v]×, Eq. (8-78) corrected (the printed matrix is not v × ·)
 
 #: |sin ψ| below this is treated as gimbal lock
 SINGULAR_TOL = 1e-6
@@ -171,12 +172,6 @@ def Lam(l) -> np.ndarray:
     for k in range(3):
         out[3 * k:3 * k + 3, k:k + 1] = l
     return out
-
-
-def skew(v) -> np.ndarray:
-    """[v]× (Eq. (8-78), corrected)."""
-    x, y, z = v
-    return np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
 
 
 @dataclass
