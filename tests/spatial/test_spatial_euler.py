@@ -95,6 +95,10 @@ def test_euler_bad_input():
         E.euler_zxz(np.nan, 0, 0)
     with pytest.raises(ValueError, match="one"):
         E.euler_xyx_inverse(np.stack([np.eye(3)] * 2))
+    with pytest.raises(ValueError, match="psi must be finite"):
+        E.euler_xyx_rate_matrix(np.nan, 0.0)
+    with pytest.raises(ValueError, match="delta must be finite"):
+        E.euler_zxz_rate_matrix(0.3, np.inf)
 
 
 @H

@@ -63,6 +63,8 @@ def test_spherical_round_trip_5_23_5_24(p):
 def test_polar_bad_input():
     with pytest.raises(ValueError, match="finite"):
         P.polar(np.nan, 0.0)
+    with pytest.raises(ValueError, match="z must be finite"):
+        P.rotate(complex(np.nan, 0.0), 0.1)
     with pytest.raises(ValueError, match="shape"):
         P.from_xy([1.0, 2.0, 3.0])
     with pytest.raises(ValueError, match="shape"):

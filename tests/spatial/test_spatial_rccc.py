@@ -196,4 +196,11 @@ def test_rccc_bad_input():
         RCCCGeometry(Dual(1.0, 0), Dual(1.0, 0), Dual(1.0, 0), Dual(1.0, 0), np.nan)
     with pytest.raises(ValueError, match="theta1"):
         rccc_position(FIXTURE, np.nan)
+    with pytest.raises(ValueError, match="theta1 must be a scalar"):
+        rccc_position(FIXTURE, np.array([0.1, 0.2]))
+    sol = rccc_position(FIXTURE, 0.9).solutions[0]
+    with pytest.raises(ValueError, match="theta1_dot"):
+        rccc_velocity(FIXTURE, sol, np.nan)
+    with pytest.raises(ValueError, match="theta1_ddot"):
+        rccc_acceleration(FIXTURE, sol, 1.0, np.inf)
     assert RCCCGeometry((0.5, 1.0), (1.0, 2.5), (0.8, 1.5), (1.2, 3.0), 0.7).alpha12.isclose(Dual(0.5, 1.0))

@@ -200,3 +200,11 @@ def test_rotation_tensor_bad_input():
         T.dcm_rate(np.eye(3), [0, 0, 1], "moving")
     with pytest.raises(ValueError, match="not orthogonal"):
         T.dcm_acc(np.ones((3, 3)), [0, 0, 1], [0, 0, 0])
+    with pytest.raises(ValueError, match="theta_dot must be finite"):
+        T.rotation_tensor_rate([0, 0, 1.0], 0.1, np.nan)
+    with pytest.raises(ValueError, match="theta_ddot must be finite"):
+        T.rotation_tensor_acc([0, 0, 1.0], 0.1, 1.0, np.inf)
+    with pytest.raises(ValueError, match="C_dot"):
+        T.angular_velocity(np.eye(3), np.full((3, 3), np.nan))
+    with pytest.raises(ValueError, match="W_body"):
+        T.body_to_space_rate(np.eye(3), np.full((3, 3), np.nan))

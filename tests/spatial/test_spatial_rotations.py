@@ -171,4 +171,6 @@ def test_bad_axes_raise_with_value():
         R.rot_axis([np.nan, 0, 1], 0.3)
     with pytest.raises(ValueError, match="finite"):
         R.rot_x(np.inf)
+    with pytest.raises(ValueError, match="theta must be finite"):
+        R.planar_transform(np.nan, 0.0, 0.0)
     assert np.allclose(R.unit_axis([0, 0, 2.0]), [0, 0, 1])

@@ -90,3 +90,9 @@ def test_screw_bad_input():
         S.screw_matrix(0.1, 0, [0, 0, 1], [0, np.nan, 0])
     with pytest.raises(ValueError, match="4x4"):
         S.screw_parameters(np.eye(3))
+    with pytest.raises(ValueError, match="phi must be finite"):
+        S.screw_twist(np.nan, 0.0, [0, 0, 1.0], [0, 0, 0])
+    with pytest.raises(ValueError, match="phi_dot must be finite"):
+        S.velocity_matrix(np.nan, [0, 0, 1.0])
+    with pytest.raises(ValueError, match="phi_ddot must be finite"):
+        S.acceleration_matrix(1.0, np.inf, [0, 0, 1.0])

@@ -36,6 +36,7 @@ import pinocchio as pin
 
 from ..spatial import dual as D
 from ..spatial.dual import Dual
+from ..spatial.rotations import as_scalar
 
 #: tolerance below which the discriminant / Jacobian counts as a dead point
 DEAD_TOL = 1e-9
@@ -184,9 +185,7 @@ def rccc_position(g: RCCCGeometry, theta1: float, tol: float = DEAD_TOL) -> RCCC
 
     Returns an :class:`RCCCResult` whose status says "cannot assemble" / "dead point" /
     "degenerate" instead of raising or returning NaN."""
-    th1_real = float(theta1)
-    if not np.isfinite(th1_real):
-        raise ValueError(f"theta1 must be finite, got {theta1!r}")
+    th1_real = as_scalar(theta1, "theta1")
     th1 = Dual(th1_real, g.s1)
     a12, a23, a34, a41 = g.alpha12, g.alpha23, g.alpha34, g.alpha41
     # c33 = A cos θ4 + B sin θ4 + C  (corrected element, dual)
@@ -269,16 +268,18 @@ def _solve(J: np.ndarray, rhs: np.ndarray, tol: float) -> tuple[str, np.ndarray,
 def rccc_velocity(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: float = DEAD_TOL,
                   _screws=None) -> RCCCRates:
     """Joint rates from Σ Jⱼ q̇ⱼ = 0 (loop closure differentiated once), input θ̇₁ (rad/s)."""
+    w1 = as_scalar(theta1_dot, "theta1_dot")
     S = _joint_screws(g, sol) if _screws is None else _screws
     J = np.column_stack(S[1:])
-    st, x, msg = _solve(J, -S[0] * float(theta1_dot), tol)
-    return RCCCRates(st, np.concatenate([[float(theta1_dot)], x]), msg)
+    st, x, msg = _solve(J, -S[0] * w1, tol)
+    return RCCCRates(st, np.concatenate([[w1], x]), msg)
 
 
 def rccc_acceleration(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, theta1_ddot: float,
                       velocity: RCCCRates | None = None, tol: float = DEAD_TOL) -> RCCCRates:
     """Joint accelerations from Σ Jⱼ q̈ⱼ + Σⱼ [Vⱼ₋, Jⱼ] q̇ⱼ = 0, where Vⱼ₋ is the base-frame
     twist of the link carrying joint j (sum of the upstream Jᵢ q̇ᵢ)."""
+    a1 = as_scalar(theta1_ddot, "theta1_ddot")
     S = _joint_screws(g, sol)
     vel = velocity or rccc_velocity(g, sol, theta1_dot, tol, _screws=S)
     if vel.status != "ok":
@@ -290,8 +291,8 @@ def rccc_acceleration(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, the
         bias += pin.Motion(V).cross(pin.Motion(Sj)).vector * qdj
         V = V + Sj * qdj
     J = np.column_stack(S[1:])
-    st, x, msg = _solve(J, -bias - S[0] * float(theta1_ddot), tol)
-    return RCCCRates(st, np.concatenate([[float(theta1_ddot)], x]), msg)
+    st, x, msg = _solve(J, -bias - S[0] * a1, tol)
+    return RCCCRates(st, np.concatenate([[a1], x]), msg)
 
 
 # ----------------------------------------------------------------------------- Pinocchio model

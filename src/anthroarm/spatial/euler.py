@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rotations import as_angle, check_rotation, rot_x, rot_y, rot_z
+from .rotations import as_angle, as_scalar, check_rotation, rot_x, rot_y, rot_z
 
 #: |sin(middle angle)| below this counts as gimbal lock
 SINGULAR_TOL = 1e-9
@@ -108,6 +108,7 @@ def euler_xyx_inverse(R, tol: float = SINGULAR_TOL) -> EulerAngles:
 def euler_xyx_rate_matrix(psi, phi) -> np.ndarray:
     """Π of Eq. (8-45): body angular velocity ω = Π (θ̇, ψ̇, φ̇)ᵀ for R = R_x(θ)R_y(ψ)R_x(φ).
     det Π = −sin ψ."""
+    psi, phi = as_scalar(psi, "psi"), as_scalar(phi, "phi")
     cp, sp, cf, sf = np.cos(psi), np.sin(psi), np.cos(phi), np.sin(phi)
     return np.array([[cp, 0.0, 1.0], [sp * sf, cf, 0.0], [sp * cf, -sf, 0.0]])
 
@@ -115,5 +116,6 @@ def euler_xyx_rate_matrix(psi, phi) -> np.ndarray:
 def euler_zxz_rate_matrix(alpha, delta) -> np.ndarray:
     """Body angular velocity ω = B (θ̇, α̇, δ̇)ᵀ for C = C_z(θ)C_x(α)C_z(δ) (from Ċ = C W,
     Eq. (5-85)).  det B = −sin α: singular where the inverse is (gimbal lock)."""
+    alpha, delta = as_scalar(alpha, "alpha"), as_scalar(delta, "delta")
     ca, sa, cd, sd = np.cos(alpha), np.sin(alpha), np.cos(delta), np.sin(delta)
     return np.array([[sa * sd, cd, 0.0], [sa * cd, -sd, 0.0], [ca, 0.0, 1.0]])

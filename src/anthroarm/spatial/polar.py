@@ -36,7 +36,10 @@ def unit(theta) -> np.ndarray:
 
 def rotate(z, phi) -> np.ndarray:
     """e^{iφ}(r e^{iθ}) = r e^{i(φ+θ)}, Eq. (5-5): rotation of a planar vector by φ."""
-    return np.asarray(z, complex) * np.exp(1j * as_angle(phi, "phi"))
+    z = np.asarray(z, complex)
+    if not np.all(np.isfinite(z)):
+        raise ValueError(f"z must be finite, got {z.tolist()}")
+    return z * np.exp(1j * as_angle(phi, "phi"))
 
 
 def to_xy(z) -> np.ndarray:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rotations import as_angle, as_vector3, check_rotation, check_unit_axis, skew, unskew
+from .rotations import as_angle, as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
 
 
 # ----------------------------------------------------------------------------- component tensors
@@ -68,7 +68,7 @@ def rotation_tensor_rate(w, theta, theta_dot, w_dot=None) -> np.ndarray:
     For a fixed axis (``w_dot`` None or 0) this is (5-123) = θ̇ J₃ E, Eq. (5-125).  A moving
     axis needs ẇ ⟂ w (|w| stays 1)."""
     w = check_unit_axis(w, "axis w")
-    th, thd = float(theta), float(theta_dot)
+    th, thd = as_scalar(theta, "theta"), as_scalar(theta_dot, "theta_dot")
     c, s = np.cos(th), np.sin(th)
     j1 = np.outer(w, w)
     out = thd * (-(np.eye(3) - j1) * s + skew(w) * c)
@@ -84,7 +84,7 @@ def rotation_tensor_acc(w, theta, theta_dot, theta_ddot, w_dot=None, w_ddot=None
     second derivative of (5-122): J̈₁(1 − c) + J̈₃ s + 2θ̇(J̇₁ s + J̇₃ c) + θ̈(−J₂ s + J₃ c)
     − θ̇²(J₂ c + J₃ s), using J̇₂ = −J̇₁."""
     w = check_unit_axis(w, "axis w")
-    th, thd, thdd = float(theta), float(theta_dot), float(theta_ddot)
+    th, thd, thdd = as_scalar(theta, "theta"), as_scalar(theta_dot, "theta_dot"), as_scalar(theta_ddot, "theta_ddot")
     c, s = np.cos(th), np.sin(th)
     j1 = np.outer(w, w)
     j2, j3 = np.eye(3) - j1, skew(w)
@@ -177,16 +177,23 @@ def dcm_acc(C, omega, omega_dot, frame: str = "body") -> np.ndarray:
     raise ValueError(f"frame must be 'body' or 'space', got {frame!r}")
 
 
+def _finite_matrix(M, name: str) -> np.ndarray:
+    a = np.asarray(M, dtype=float)
+    if a.ndim < 2 or a.shape[-2:] != (3, 3) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be a finite (3, 3) or (N, 3, 3) array, got {a.tolist()}")
+    return a
+
+
 def body_to_space_rate(C, W_body) -> np.ndarray:
     """(W)_i = C (W)_j Cᵀ, Eq. (5-86): the angular-velocity matrix in the fixed axes."""
     C = check_rotation(C, "C")
-    return C @ np.asarray(W_body, float) @ np.swapaxes(C, -1, -2)
+    return C @ _finite_matrix(W_body, "W_body") @ np.swapaxes(C, -1, -2)
 
 
 def angular_velocity(C, C_dot, frame: str = "body") -> np.ndarray:
     """ω from C and Ċ: body ω = vee(Cᵀ Ċ) (5-85), space ω = vee(Ċ Cᵀ) (5-85′)."""
     C = check_rotation(C, "C")
-    Cd = np.asarray(C_dot, float)
+    Cd = _finite_matrix(C_dot, "C_dot")
     if frame == "body":
         return unskew(np.swapaxes(C, -1, -2) @ Cd)
     if frame == "space":

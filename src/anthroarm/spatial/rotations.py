@@ -37,6 +37,18 @@ def as_angle(a, name: str = "angle") -> np.ndarray:
     return arr
 
 
+def as_scalar(x, name: str = "value") -> float:
+    """``x`` as one finite float; ``ValueError`` naming the value for NaN/inf or an array of
+    more than one element."""
+    arr = np.asarray(x, dtype=float)
+    if arr.size != 1:
+        raise ValueError(f"{name} must be a scalar, got shape {arr.shape}")
+    v = float(arr.reshape(()))
+    if not np.isfinite(v):
+        raise ValueError(f"{name} must be finite, got {v}")
+    return v
+
+
 def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
     """A unit axis (shape (..., 3)).  Raises ``ValueError`` with the offending value for a
     zero-length axis or an axis whose length differs from 1 by more than ``tol``.
@@ -211,8 +223,9 @@ def translation(x=0.0, y=0.0, z=0.0) -> np.ndarray:
 
 def planar_transform(theta, x0, y0) -> np.ndarray:
     """Planar 3×3 homogeneous transform, Eq. (5-62): (x₁, y₁, 1) = T (x₂, y₂, 1); new → old."""
+    theta = as_scalar(theta, "theta")
     c, s = float(np.cos(theta)), float(np.sin(theta))
-    return np.array([[c, -s, float(x0)], [s, c, float(y0)], [0.0, 0.0, 1.0]])
+    return np.array([[c, -s, as_scalar(x0, "x0")], [s, c, as_scalar(y0, "y0")], [0.0, 0.0, 1.0]])
 
 
 def direction_cosines(a) -> np.ndarray:

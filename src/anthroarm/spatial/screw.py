@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotations import as_angle, as_vector3, check_rotation, check_unit_axis, skew, unskew
+from .rotations import as_angle, as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
 
 
 def P(u) -> np.ndarray:
@@ -63,7 +63,7 @@ def screw_twist(phi, s, u, p) -> np.ndarray:
     ω = φ u, v = s u − φ u × p = s u + p × ω."""
     u = check_unit_axis(u, "axis u")
     p = as_vector3(p, "point p")
-    phi, s = float(phi), float(s)
+    phi, s = as_scalar(phi, "phi"), as_scalar(s, "slide s")
     return np.concatenate([s * u - phi * np.cross(u, p), phi * u])
 
 
@@ -94,16 +94,17 @@ def screw_parameters(T, tol: float = 1e-10) -> tuple[float, float, np.ndarray, n
 def velocity_matrix(phi_dot, u) -> np.ndarray:
     """[W_{φ̇,u}] = φ̇ [P_u] (002 line 92): q̇ − ṗ = [W](q − p) for a point q of a body turning at
     φ̇ about the axis u through p (= Ṙ Rᵀ)."""
-    return float(phi_dot) * P(u)
+    return as_scalar(phi_dot, "phi_dot") * P(u)
 
 
 def acceleration_matrix(phi_dot, phi_ddot, u, u_dot=None) -> np.ndarray:
     """[E_{φ̇,φ̈,u}] = φ̈ [P_u] + φ̇ [Ṗ_u] + φ̇² [P_u]² (002 (4-28); = Ẇ + W²): q̈ − p̈ = [E](q − p).
     ``u_dot`` (default 0: fixed axis) gives the [Ṗ_u] term."""
     Pu = P(u)
-    E = float(phi_ddot) * Pu + float(phi_dot) ** 2 * (Pu @ Pu)
+    phi_dot, phi_ddot = as_scalar(phi_dot, "phi_dot"), as_scalar(phi_ddot, "phi_ddot")
+    E = phi_ddot * Pu + phi_dot ** 2 * (Pu @ Pu)
     if u_dot is not None:
-        E = E + float(phi_dot) * skew(as_vector3(u_dot, "u_dot"))
+        E = E + phi_dot * skew(as_vector3(u_dot, "u_dot"))
     return E
 
 
