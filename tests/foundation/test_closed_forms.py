@@ -93,6 +93,19 @@ def test_serial_chain_vs_pinocchio(name):
     np.testing.assert_allclose(J, r.jacobian(Q), atol=1e-13)
 
 
+def test_bad_numbers_raise_value_errors():
+    with pytest.raises(ValueError, match="theta must be finite"):
+        dh_transform(np.nan, 0.0, 0.1, 0.2)
+    with pytest.raises(ValueError, match="l2 must be finite"):
+        cf.human_arm7_hand_pose(np.zeros(7), 0.3, np.nan, 0.1)
+    with pytest.raises(ValueError, match="P must be finite"):
+        cf.sixr_hand_pose(np.zeros(6), 0.5, 0.4, 0.35, np.inf)
+    with pytest.raises(ValueError, match="row 2 h must be finite"):
+        dh_fk([DHRow("R", 0.0), DHRow("R", 0.0, h=np.nan)], np.zeros(2))
+    with pytest.raises(ValueError, match="tool"):
+        dh_fk([DHRow("R", 0.0)], np.zeros(1), np.full((4, 4), np.nan))
+
+
 # ---------------------------------------------------------------- printed forms that fail
 
 def _sixr_printed_uvw(q):

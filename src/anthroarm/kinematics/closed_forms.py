@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .dh import _as_batch
+from .dh import _as_batch, finite_params
 
 
 def _pose(x, y, z, l, m, n, u, v, w) -> np.ndarray:
@@ -33,6 +33,7 @@ def sixr_hand_pose(q, s0: float, h2: float, s3: float, P: float) -> np.ndarray:
     (6-16) is printed correctly; in (6-17) the printed u, v, w carry θ5 where θ6 belongs
     (errata): here u = [(C6C5C4 + S6S4)C23 + C6S5S23]C1 + (C6C5S4 − S6C4)S1, etc."""
     q2, single = _as_batch(q, 6)
+    s0, h2, s3, P = finite_params(s0=s0, h2=h2, s3=s3, P=P)
     t1, t2, t3, t4, t5, t6 = q2.T
     C1, S1, C2, S2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
     C4, S4, C5, S5, C6, S6 = np.cos(t4), np.sin(t4), np.cos(t5), np.sin(t5), np.cos(t6), np.sin(t6)
@@ -61,6 +62,7 @@ def unimate_hand_pose(q, s0: float, h2: float, P: float) -> np.ndarray:
     Corrected misprints (errata): (6-23) v ends in −C5 S4 C1 (printed S1); (4-52) x has C2
     where the 002 text prints C3; (4-54) v as (6-23)."""
     q2, single = _as_batch(q, 5)
+    s0, h2, P = finite_params(s0=s0, h2=h2, P=P)
     t1, t2, s2, t4, t5 = q2.T
     C1, S1, C2, S2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
     C4, S4, C5, S5 = np.cos(t4), np.sin(t4), np.cos(t5), np.sin(t5)
@@ -118,6 +120,7 @@ def human_arm7_rotations(q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def human_arm7_points(q, l1: float, l2: float, l3: float):
     """Elbow, wrist and hand points P_E, P_W, P_H of the §6-3 arm, Eq. (6-37)–(6-39), in the
     shoulder frame (m), and C_H.  Returns (PE, PW, PH, CH)."""
+    l1, l2, l3 = finite_params(l1=l1, l2=l2, l3=l3)
     CE, CW, CH = human_arm7_rotations(q)
     PE = -l1 * CE[..., :, 2]
     PW = PE - l2 * CW[..., :, 2]
@@ -165,6 +168,7 @@ def human_arm7_jacobian(q, l1: float, l2: float, l3: float) -> np.ndarray:
 def planar2r_tip(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
     """Fig. 7-14: tip (y, z) = (l1 cos θ1 + l2 cos(θ1+θ2), l1 sin θ1 + l2 sin(θ1+θ2)), shape (N, 2)."""
     q2, single = _as_batch(q, 2)
+    l1, l2 = finite_params(l1=l1, l2=l2)
     t1, t12 = q2[:, 0], q2[:, 0] + q2[:, 1]
     yz = np.stack([l1 * np.cos(t1) + l2 * np.cos(t12), l1 * np.sin(t1) + l2 * np.sin(t12)], -1)
     return yz[0] if single else yz
@@ -178,6 +182,7 @@ def prosthetic_arm_points(q, L1: float, L2: float, L3: float):
     from ..models.book import prosthetic_arm
     from .dh import dh_frames
 
+    L1, L2, L3 = finite_params(L1=L1, L2=L2, L3=L3)
     rows = prosthetic_arm(L1, L2, L3).dh
     F = dh_frames(rows, q)
     E = F[..., 3, :3, 3]

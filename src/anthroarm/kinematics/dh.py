@@ -23,10 +23,34 @@ def _as_batch(q, n: int) -> tuple[np.ndarray, bool]:
     return q2, single
 
 
-def dh_transform(theta, s, h, alpha) -> np.ndarray:
-    """Eq. (6-12): the 4×4 matrix A(s, h, θ, α), broadcast over array arguments.
+def finite_params(**values) -> list[float]:
+    """The named scalar parameters (link lengths in m, angles in rad) as floats; ``ValueError``
+    naming the first one that is not a finite number."""
+    out = []
+    for name, v in values.items():
+        try:
+            f = float(v)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a number, got {v!r}") from None
+        if not np.isfinite(f):
+            raise ValueError(f"{name} must be finite, got {f}")
+        out.append(f)
+    return out
 
-    Returns shape ``broadcast(theta, s, h, alpha).shape + (4, 4)``."""
+
+def dh_transform(theta, s, h, alpha) -> np.ndarray:
+    """Eq. (6-12): the 4×4 matrix A(s, h, θ, α), broadcast over array arguments (rad, m).
+
+    Returns shape ``broadcast(theta, s, h, alpha).shape + (4, 4)``; ``ValueError`` naming the
+    argument that holds a NaN/inf."""
+    args = {"theta": theta, "s": s, "h": h, "alpha": alpha}
+    for name, x in args.items():
+        if not np.all(np.isfinite(np.asarray(x, float))):
+            raise ValueError(f"dh_transform: {name} must be finite, got {np.asarray(x).tolist()}")
+    return _dh_transform(theta, s, h, alpha)
+
+
+def _dh_transform(theta, s, h, alpha) -> np.ndarray:
     theta, s, h, alpha = np.broadcast_arrays(*(np.asarray(x, float) for x in (theta, s, h, alpha)))
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     A = np.zeros(theta.shape + (4, 4))
@@ -59,15 +83,20 @@ def dh_frames(rows, q, tool=None) -> np.ndarray:
     Eq. (6-14): ``T_0k = A_01 A_12 … A_{k−1,k}``.  Shape ``(N, n+1[+1], 4, 4)``."""
     n = len(rows)
     q2, single = _as_batch(q, n)
+    for j, r in enumerate(rows):
+        finite_params(**{f"row {j + 1} {k}": getattr(r, k) for k in ("alpha", "s", "h", "theta", "offset")})
     N = q2.shape[0]
     F = np.empty((N, n + 1 + (tool is not None), 4, 4))
     F[:, 0] = np.eye(4)
     for j, r in enumerate(rows):
         theta, s = _row_values(rows, q2, j)
-        A = dh_transform(theta, s, r.h, r.alpha)
+        A = _dh_transform(theta, s, r.h, r.alpha)
         F[:, j + 1] = F[:, j] @ A
     if tool is not None:
-        F[:, n + 1] = F[:, n] @ np.asarray(tool, float)
+        tool = np.asarray(tool, float)
+        if tool.shape != (4, 4) or not np.all(np.isfinite(tool)):
+            raise ValueError(f"tool must be a finite 4x4 matrix, got {tool.tolist()}")
+        F[:, n + 1] = F[:, n] @ tool
     return F[0] if single else F
 
 
