@@ -257,6 +257,20 @@ def test_equality_constraints_exterior_and_mixed_vs_slsqp():
         np.testing.assert_allclose(r.x, ref.x, atol=2e-3)
 
 
+def test_nan_objective_is_a_status():
+    nan = lambda x: np.nan  # noqa: E731
+    assert O.quadratic_interpolation(nan, (0, 1)).status == "nan"
+    assert O.quadratic_interpolation(nan, (0, 0.5, 1)).status == "nan"
+    assert O.fletcher_reeves(nan, [1.0, 0.0]).status == "nan"
+    assert O.steepest_descent(nan, [1.0]).status == "nan"
+    g = lambda x: np.array([x[0]])  # noqa: E731
+    for fn in (O.sumt_exterior, O.sumt_interior, O.sumt_mixed):
+        r = fn(nan, [1.0], g)
+        assert r.status == "nan" and not r.success, (fn.__name__, r)
+    r = O.sumt_exterior(lambda x: x @ x, [1.0], lambda x: np.array([np.nan]))
+    assert r.status == "nan"
+
+
 def test_infeasible_problems_say_so():
     f = lambda x: x[0] ** 2  # noqa: E731
     g = lambda x: np.array([x[0] - 1, -x[0]])  # x >= 1 and x <= 0  # noqa: E731

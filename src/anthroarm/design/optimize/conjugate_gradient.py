@@ -38,6 +38,8 @@ def _run(f, grad, x0, gtol, maxiter, restart, fr: bool):
     restart = n if restart is None else int(restart)
     fx = fc(x)
     g = gr(x)
+    if fc.saw_nan or not np.all(np.isfinite(g)):
+        return OptimizeResult(x, fx, "nan", "the objective or its gradient is NaN/inf at x0", 0, fc.n, [x.copy()])
     p = -g
     hist = [x.copy()]
     scale = max(1.0, float(np.linalg.norm(g)))

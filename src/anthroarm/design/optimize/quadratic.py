@@ -81,6 +81,8 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
             a1, a2, a3, f1, f2, f3 = br
     else:
         raise ValueError("bracket must be (a, b) or (a1, a2, a3)")
+    if f.saw_nan:
+        return OptimizeResult(a2, f2, "nan", "the objective returned NaN", 0, f.n)
     if not (f2 <= f1 and f2 <= f3):
         return OptimizeResult(a2, f2, "no_minimum", "the three points do not bracket a minimum", 0, f.n)
     prev = a2

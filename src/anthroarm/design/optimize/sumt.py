@@ -98,6 +98,11 @@ def _barrier_inner(phi, x, scale, g):
     return best
 
 
+def _nan_result(x, stage, nfev, hist) -> OptimizeResult:
+    return OptimizeResult(x, float("nan"), "nan", f"the objective or a constraint returned NaN in stage {stage}",
+                          stage, nfev, hist)
+
+
 def violation(x, ineq=None, eq=None) -> float:
     """Largest constraint violation Q: ``max(−g_u, |h_v|, 0)`` (4-74)."""
     g, h = _vec(ineq, x), _vec(eq, x)
@@ -160,6 +165,8 @@ def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps
         nfev += res.nfev
         x = np.asarray(res.x, dtype=float)
         hist.append(x.copy())
+        if res.status == "nan":
+            return _nan_result(x, k, nfev, hist)
         ph = res.fun
         if phi_prev is not None:
             dx = np.linalg.norm(x - x_prev)
@@ -203,6 +210,8 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
         nfev += res.nfev
         x = np.asarray(res.x, dtype=float)
         hist.append(x.copy())
+        if res.status == "nan":
+            return _nan_result(x, k, nfev, hist)
         Q = violation(x, g, eq)
         if Q <= eps1:                                          # (4-74)
             status, msg = "converged", f"largest violation Q = {Q:.3g} <= {eps1:g} (4-74)"
@@ -253,6 +262,8 @@ def sumt_mixed(f, x0, ineq, eq=None, bounds=None, r0: float = 1.0, c: float = 0.
         nfev += res.nfev
         x = np.asarray(res.x, dtype=float)
         hist.append(x.copy())
+        if res.status == "nan":
+            return _nan_result(x, k, nfev, hist)
         ph = res.fun
         if phi_prev is not None:
             dx = np.linalg.norm(x - x_prev)
