@@ -102,6 +102,10 @@ def test_bad_input():
         G.grasp_error_single(L, TH, float("nan"), 10, 30)
     with pytest.raises(ValueError, match="2-16"):
         G.grasp_error_double(L, TH, D(10), 50.0, 10, 30)
+    with pytest.raises(ValueError, match="R must be finite"):
+        G.x_single(L, [10.0, np.nan], TH, D(80))
+    with pytest.raises(ValueError, match="l must be finite"):
+        G.double_x_min(np.nan, TH, D(80), 5.0)
 
 
 def test_plot_runs():

@@ -81,6 +81,11 @@ def test_reach_min_self_derived_values():
     for ls, deg, val in cases:
         assert S.reach_min(*ls, np.deg2rad(deg)) == pytest.approx(val, abs=1e-4)
     assert S.reach_min(1, 2, 3, 0.0) == pytest.approx(S.reach_max(1, 2, 3))
+    for bad in (np.nan, -1.0, 0.0):
+        with pytest.raises(ValueError, match="positive and finite"):
+            S.reach_min(1, bad, 3, 0.3)
+        with pytest.raises(ValueError, match="positive and finite"):
+            S.reach_max(1, 2, bad)
 
 
 @settings(max_examples=50, deadline=None)

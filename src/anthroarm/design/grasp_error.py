@@ -39,8 +39,8 @@ class GraspError:
     delta2: float = float("nan")
 
 
-def _check(l, theta, beta, rmin=None, rmax=None, a=0.0):
-    for name, v in (("l", l), ("theta", theta), ("beta", beta), ("a", a)):
+def _check(l, theta, beta, rmin=None, rmax=None, a=0.0, R=0.0):
+    for name, v in (("l", l), ("theta", theta), ("beta", beta), ("a", a), ("R", R)):
         if not np.all(np.isfinite(v)):
             raise ValueError(f"{name} must be finite, got {v!r}")
     if np.any(np.asarray(l) <= 0):
@@ -62,18 +62,20 @@ def grasp_error_translational(*_args, **_kw) -> float:
 def x_single(l, R, theta, beta):
     """Eq. (2-6): ``X = sqrt(l² + (R/sin θ)² − 2 l (R/sin θ) cos β)``, the pivot–centre distance
     of a single-pivot V finger (l_BC = R/sin θ, Eq. (2-5)).  Broadcasts over ``R``."""
-    _check(l, theta, beta)
+    _check(l, theta, beta, R=R)
     lbc = np.asarray(R, dtype=float) / np.sin(theta)
     return np.sqrt(l**2 + lbc**2 - 2 * l * lbc * np.cos(beta))
 
 
 def single_r0(l, theta, beta) -> float:
     """Eq. (2-8): radius of the hyperbola's vertex, ``R0 = l sin θ cos β``."""
+    _check(l, theta, beta)
     return float(l * np.sin(theta) * np.cos(beta))
 
 
 def single_x_min(l, theta, beta) -> float:
     """Eq. (2-8): ``X_min = l sin β`` (the centre is closest to the pivot at R = R0)."""
+    _check(l, theta, beta)
     return float(l * abs(np.sin(beta)))
 
 
@@ -115,7 +117,7 @@ def x_double(l, R, theta, beta, a):
     (pivots 2a apart), ``X = sqrt((R − l sin θ cos β)²/sin²θ + l² sin²β − a²)``, i.e.
     (2-13) with l_BC = R/sin θ.  NaN-free: raises ``ValueError`` where |AC| < a (the centre
     cannot lie between pivots closer than the finger geometry allows)."""
-    _check(l, theta, beta, a=a)
+    _check(l, theta, beta, a=a, R=R)
     R = np.asarray(R, dtype=float)
     x2 = (R - l * np.sin(theta) * np.cos(beta)) ** 2 / np.sin(theta) ** 2 + (l * np.sin(beta)) ** 2 - a**2
     if np.any(x2 < 0):
@@ -125,6 +127,7 @@ def x_double(l, R, theta, beta, a):
 
 def double_x_min(l, theta, beta, a) -> float:
     """Eq. (2-16): ``X_min = sqrt(l² sin²β − a²)``; requires l² sin²β > a²."""
+    _check(l, theta, beta, a=a)
     v = (l * np.sin(beta)) ** 2 - a**2
     if v < 0:
         raise ValueError(f"(2-16) needs l^2 sin^2(beta) >= a^2: {(l * np.sin(beta))**2:g} < {a**2:g}")

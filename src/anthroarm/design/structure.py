@@ -278,9 +278,17 @@ def enumerate_arm_layouts(n: int = 6, types: str = "RP", n_R: int | None = 3,
 
 # ---------------------------------------------------------------- reach, (2-3) (2-4)
 
+def _link_lengths(l1, l2, l3):
+    ls = tuple(np.asarray(v, dtype=float) for v in (l1, l2, l3))
+    if not all(np.all(v > 0) and np.all(np.isfinite(v)) for v in ls):  # NaN fails v > 0
+        raise ValueError(f"link lengths l1, l2, l3 must be positive and finite, got {l1!r}, {l2!r}, {l3!r}")
+    return ls
+
+
 def reach_max(l1, l2, l3):
     """Eq. (2-3): ``R_max = l1 + l2 + l3`` (arm stretched)."""
-    return np.asarray(l1) + np.asarray(l2) + np.asarray(l3)
+    l1, l2, l3 = _link_lengths(l1, l2, l3)
+    return l1 + l2 + l3
 
 
 def reach_min(l1, l2, l3, theta3):
@@ -294,11 +302,10 @@ def reach_min(l1, l2, l3, theta3):
     (``l2 + l3 cos θ3 < 0``, e.g. a short forearm and a strong bend).  We use
     ``α = atan2(l3 sin θ3, l2 + l3 cos θ3)``, equal to the printed form elsewhere.
     Broadcasts over arrays."""
-    l1, l2, l3, t = (np.asarray(v, dtype=float) for v in (l1, l2, l3, theta3))
+    l1, l2, l3 = _link_lengths(l1, l2, l3)
+    t = np.asarray(theta3, dtype=float)
     if np.any(~np.isfinite(t)):
         raise ValueError("theta3 contains NaN/inf")
-    if np.any(l1 <= 0) or np.any(l2 <= 0) or np.any(l3 <= 0):
-        raise ValueError("link lengths l1, l2, l3 must be positive")
     m2 = l2**2 + l3**2 + 2 * l2 * l3 * np.cos(t)
     m = np.sqrt(np.maximum(m2, 0.0))
     alpha = np.arctan2(l3 * np.sin(t), l2 + l3 * np.cos(t))
