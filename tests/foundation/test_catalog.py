@@ -120,6 +120,14 @@ def test_human_arm7_bad_parameters():
         aa.load("human_arm7", height=17.5)
     with pytest.raises(ValueError, match="accepted"):
         aa.load("prosthetic_arm", L4=0.1)
+    with pytest.raises(ValueError, match="L1 must be a finite length"):
+        aa.load("prosthetic_arm", L1=float("nan"))
+    with pytest.raises(ValueError, match="P must be a finite length"):
+        aa.load("sixr_arm", P=-0.1)
+    with pytest.raises(ValueError, match="boom"):
+        aa.load("unimate5", boom=(1.0, 0.3))
+    with pytest.raises(ValueError, match="height and mass must be numbers"):
+        aa.load("human_arm7", height="tall")
 
 
 def test_unknown_model_lists_catalog():

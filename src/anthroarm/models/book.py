@@ -15,6 +15,28 @@ from .spec import ChainSpec, DHRow, JointSpec, from_dh, rod_link
 deg = np.pi / 180.0
 
 
+def _lengths(model: str, **values) -> None:
+    """``ValueError`` naming the first length (m) that is not a finite number >= 0."""
+    for name, v in values.items():
+        try:
+            ok = bool(np.isfinite(float(v)) and float(v) >= 0.0)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise ValueError(f"{model}: {name} must be a finite length >= 0 (m), got {v!r}")
+
+
+def _stroke(model: str, name: str, stroke) -> tuple[float, float]:
+    """A prismatic range (lo, hi) in m with lo < hi, both finite."""
+    try:
+        lo, hi = (float(x) for x in stroke)
+    except (TypeError, ValueError):
+        raise ValueError(f"{model}: {name} must be a pair (lower, upper) in m, got {stroke!r}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise ValueError(f"{model}: {name} must be finite with lower < upper, got {stroke!r}")
+    return lo, hi
+
+
 def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> ChainSpec:
     """Anthropomorphic prosthetic arm, Ch. 7 Fig. 7-2 / Table 7.1 (6R, R-P-R-P-R-P).
 
@@ -27,6 +49,7 @@ def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> C
     260 mm: Table 7.2 reproduces only with 260 mm, the caption's 240 mm is a misprint
     (``docs/errata.md``); pass ``L2=0.240`` for the printed value.
     """
+    _lengths("prosthetic_arm", L1=L1, L2=L2, L3=L3)
     rows = [
         DHRow("R", 90 * deg, lower=-180 * deg, upper=0.0),
         DHRow("R", 90 * deg, lower=0.0, upper=180 * deg),
@@ -54,6 +77,7 @@ def sixr_arm(s0: float = 0.5, h2: float = 0.4, s3: float = 0.35, P: float = 0.1)
     l_AB = s0, l_BC = h2, l_CD = s3, l_DP = P.  The book prints no lengths or ranges: the
     defaults (0.5, 0.4, 0.35, 0.1 m) are ours, and every joint ranges over ±180° so that all
     eight IK branches of Fig. 7-1 are admissible."""
+    _lengths("sixr_arm", s0=s0, h2=h2, s3=s3, P=P)
     rows = [
         DHRow("R", 90 * deg, s=s0),
         DHRow("R", 0.0, h=h2),
@@ -89,6 +113,8 @@ def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0))
     """Unimate-type robot of Fig. 6-4 (l. 3849–3893): R-R-P-R-R with α01 = α12 = α34 = α45 = 90°,
     α23 = θ3 = 0; the third joint is the prismatic boom s2.  No numbers are printed: s0, h2, P
     and the boom stroke (0.3–1.0 m) are ours; revolute ranges are ±180° (θ2 ±90°)."""
+    _lengths("unimate5", s0=s0, h2=h2, P=P)
+    _stroke("unimate5", "boom", boom)
     return from_dh(
         "unimate5",
         "Unimate-type 5-DOF robot with a prismatic boom (book Fig. 6-4); tool = hand point P on z5.",
@@ -106,6 +132,8 @@ def rrprr5(s0: float = 0.4, h2: float = 0.08, p: float = 0.12, stroke=(0.2, 0.6)
     l_AB = s0, l_BC = h2, l_DP = p, α01 = α12 = α34 = α45 = 90°, α23 = θ3 = 0, s2 = l_CD is
     the prismatic variable — the same chain as the Unimate of Fig. 6-4.  The text prints no
     numbers: ours are a bench-top size."""
+    _lengths("rrprr5", s0=s0, h2=h2, p=p)
+    _stroke("rrprr5", "stroke", stroke)
     return from_dh(
         "rrprr5",
         "RRPRR 5-DOF manipulator (002 text §4-4); tool = gripper centroid P on z5.",
@@ -120,6 +148,7 @@ def rrprr5(s0: float = 0.4, h2: float = 0.08, p: float = 0.12, stroke=(0.2, 0.6)
 def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
     """Two-link planar mechanism of Fig. 7-14 (l. 5637/5645): two parallel hinges about x,
     links of 1 m, y = l1 cos θ1 + l2 cos(θ1+θ2), z = l1 sin θ1 + l2 sin(θ1+θ2)."""
+    _lengths("planar2r", l1=l1, l2=l2)
     j1 = JointSpec("joint1", "revolute", homogeneous(), axis=(1.0, 0, 0),
                    link=rod_link("link1", [0, l1, 0]))
     j2 = JointSpec("joint2", "revolute", homogeneous(r=[0, l1, 0]), axis=(1.0, 0, 0),

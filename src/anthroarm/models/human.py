@@ -84,6 +84,8 @@ def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "mal
     (m; sagittal, transverse, longitudinal) of upper arm, forearm and hand (de Leva 1996)."""
     if sex not in DE_LEVA_1996:
         raise ValueError(f"sex must be 'male' or 'female', got {sex!r}")
+    if not isinstance(height, (int, float, np.floating, np.integer)) or not isinstance(mass, (int, float, np.floating, np.integer)):
+        raise ValueError(f"body height and mass must be numbers (m, kg), got {height!r}, {mass!r}")
     if not (0.5 <= height <= 2.6):
         raise ValueError(f"body height {height} m is outside 0.5…2.6 m")
     if not (10.0 <= mass <= 300.0):
