@@ -126,19 +126,16 @@ def find_feasible(x0, ineq, margin: float = 1e-6, inner=None):
     return x if np.all(_vec(ineq, x) > 0) else None
 
 
-def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps1: float = 1e-7,
-                  eps2: float = 1e-7, max_stages: int = 40, inner=None, scale: float = 1.0) -> OptimizeResult:
-    """Interior penalty (barrier) method, Eq. (4-66)–(4-68).
-
-    ``ineq(x)`` returns the g_u (feasible ≥ 0).  If ``x0`` is not strictly feasible a phase-1
-    search (:func:`find_feasible`) looks for one; if none is found the status is ``"infeasible"``.
-    ``info``: the final r, the stage minima, the constraint values."""
-    prep, bad = _prepare(f, x0, ineq, None, bounds)
+def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale) -> OptimizeResult:
+    """The stage loop shared by the interior (4-66) and mixed (4-78) methods: barrier
+    ``r Σ 1/g_u`` on the inequalities, plus ``r^{−1/2} Σ h_v²`` when there are equalities;
+    r shrinks by ``c`` per stage until (4-67) and (4-68) hold."""
+    prep, bad = _prepare(f, x0, ineq, eq, bounds)
     if bad:
         return bad
     x, g = prep
     if g is None:
-        raise ValueError("sumt_interior needs inequality constraints (ineq or bounds)")
+        raise ValueError(f"{name} needs inequality constraints (ineq or bounds); use sumt_exterior")
     if not (r0 > 0 and 0 < c < 1):
         raise ValueError(f"need r0 > 0 and 0 < c < 1, got r0={r0!r}, c={c!r}")
     if not np.all(_vec(g, x) > 0):
@@ -146,7 +143,7 @@ def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps
         if xf is None:
             return OptimizeResult(x, float(f(x)), "infeasible",
                                   "no strictly feasible starting point found: the constraints may be inconsistent",
-                                  info={"violation": violation(x, g)})
+                                  info={"violation": violation(x, g, eq)})
         x = xf
     inner = inner or (lambda p, z: _barrier_inner(p, z, scale, g))
     r = float(r0)
@@ -159,7 +156,10 @@ def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps
             gz = _vec(g, z)
             if np.any(gz <= 0):
                 return np.inf
-            return float(f(z)) + r * float(np.sum(1.0 / gz))   # (4-66)
+            val = float(f(z)) + r * float(np.sum(1.0 / gz))                      # (4-66)
+            if eq is not None:
+                val += r**-0.5 * float(np.sum(_vec(eq, z) ** 2))                # (4-78)
+            return val
 
         res = inner(phi, x)
         nfev += res.nfev
@@ -171,13 +171,26 @@ def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps
         if phi_prev is not None:
             dx = np.linalg.norm(x - x_prev)
             dphi = abs((ph - phi_prev) / phi_prev) if phi_prev != 0 else abs(ph - phi_prev)
-            if dx < eps1 and dphi < eps2:                     # (4-67), (4-68)
+            if dx < eps1 and dphi < eps2:                                         # (4-67), (4-68)
                 status, msg = "converged", "(4-67) and (4-68) hold"
                 break
         phi_prev, x_prev = ph, x.copy()
         r *= c
+    Q = violation(x, g, eq)
+    if eq is not None and status == "converged" and Q > 1e-4 * (1 + np.linalg.norm(x)):
+        status, msg = "infeasible", f"equality constraints violated by {Q:.3g} at the end"
     return OptimizeResult(x, float(f(x)), status, msg, k, nfev, hist,
-                          {"r": r, "g": _vec(g, x), "violation": violation(x, g)})
+                          {"r": r, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
+
+
+def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps1: float = 1e-7,
+                  eps2: float = 1e-7, max_stages: int = 40, inner=None, scale: float = 1.0) -> OptimizeResult:
+    """Interior penalty (barrier) method, Eq. (4-66)–(4-68).
+
+    ``ineq(x)`` returns the g_u (feasible ≥ 0).  If ``x0`` is not strictly feasible a phase-1
+    search (:func:`find_feasible`) looks for one; if none is found the status is ``"infeasible"``.
+    ``info``: the final r, the constraint values and the largest violation."""
+    return _barrier_method("sumt_interior", f, x0, ineq, None, bounds, r0, c, eps1, eps2, max_stages, inner, scale)
 
 
 def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: float = 10.0,
@@ -230,51 +243,6 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
 def sumt_mixed(f, x0, ineq, eq=None, bounds=None, r0: float = 1.0, c: float = 0.1, eps1: float = 1e-7,
                eps2: float = 1e-7, max_stages: int = 40, inner=None, scale: float = 1.0) -> OptimizeResult:
     """Mixed method, Eq. (4-78): barrier on the inequalities, ``r^{−1/2}`` penalty on the
-    equalities.  X⁽⁰⁾ must satisfy the inequalities strictly (phase 1 is tried otherwise)."""
-    prep, bad = _prepare(f, x0, ineq, eq, bounds)
-    if bad:
-        return bad
-    x, g = prep
-    if g is None:
-        raise ValueError("sumt_mixed needs inequality constraints (ineq or bounds); use sumt_exterior")
-    if not (r0 > 0 and 0 < c < 1):
-        raise ValueError(f"need r0 > 0 and 0 < c < 1, got r0={r0!r}, c={c!r}")
-    if not np.all(_vec(g, x) > 0):
-        xf = find_feasible(x, g)
-        if xf is None:
-            return OptimizeResult(x, float(f(x)), "infeasible", "no strictly feasible starting point found",
-                                  info={"violation": violation(x, g, eq)})
-        x = xf
-    inner = inner or (lambda p, z: _barrier_inner(p, z, scale, g))
-    r = float(r0)
-    hist, nfev = [x.copy()], 0
-    phi_prev, x_prev = None, x.copy()
-    status, msg = "maxiter", f"no convergence in {max_stages} stages"
-    k = 0
-    for k in range(1, max_stages + 1):
-        def phi(z, r=r):
-            gz = _vec(g, z)
-            if np.any(gz <= 0):
-                return np.inf
-            return float(f(z)) + r * float(np.sum(1.0 / gz)) + r**-0.5 * float(np.sum(_vec(eq, z) ** 2))
-
-        res = inner(phi, x)
-        nfev += res.nfev
-        x = np.asarray(res.x, dtype=float)
-        hist.append(x.copy())
-        if res.status == "nan":
-            return _nan_result(x, k, nfev, hist)
-        ph = res.fun
-        if phi_prev is not None:
-            dx = np.linalg.norm(x - x_prev)
-            dphi = abs((ph - phi_prev) / phi_prev) if phi_prev != 0 else abs(ph - phi_prev)
-            if dx < eps1 and dphi < eps2:
-                status, msg = "converged", "(4-67) and (4-68) hold"
-                break
-        phi_prev, x_prev = ph, x.copy()
-        r *= c
-    Q = violation(x, g, eq)
-    if status == "converged" and Q > 1e-4 * (1 + np.linalg.norm(x)):
-        status, msg = "infeasible", f"equality constraints violated by {Q:.3g} at the end"
-    return OptimizeResult(x, float(f(x)), status, msg, k, nfev, hist,
-                          {"r": r, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
+    equalities.  X⁽⁰⁾ must satisfy the inequalities strictly (phase 1 is tried otherwise).
+    Status ``"infeasible"`` when the stages converge with the equalities still violated."""
+    return _barrier_method("sumt_mixed", f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale)
