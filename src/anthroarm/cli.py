@@ -177,8 +177,6 @@ def _parse_q(robot, values, deg: bool, what: str = "--q"):
     q = np.deg2rad(values) if deg else np.asarray(values, float)
     q = robot.check_q(q, what)
     if not robot.within_limits(q, tol=1e-9):
-        import numpy as np  # noqa: F811
-
         bad = [robot.joint_names[i] for i in np.flatnonzero((q < robot.lower - 1e-9) | (q > robot.upper + 1e-9))]
         print(f"anthroarm: warning: {what} is outside the joint limits of {', '.join(bad)}", file=sys.stderr)
     return q
@@ -221,6 +219,16 @@ def _serve(viewer, open_browser: bool, seconds: float | None) -> int:
     finally:
         viewer.close()
     return 0
+
+
+def _export_or_serve(viewer, out, a, announce: bool = True) -> int:
+    """Write the scene to ``out`` (``--html``), or serve it live until Ctrl-C / ``--seconds``."""
+    if out is not None:
+        viewer.export_html(out)
+        if announce:
+            print(f"wrote {out}")
+        return 0
+    return _serve(viewer, not a.no_browser, a.seconds)
 
 
 def _check_port_early(a):
@@ -281,11 +289,7 @@ def cmd_view(a) -> int:
         v.show_workspace(a.workspace)
     if a.limits:
         v.show_limits()
-    if out is not None:
-        v.export_html(out)
-        print(f"wrote {out}")
-        return 0
-    return _serve(v, not a.no_browser, a.seconds)
+    return _export_or_serve(v, out, a)
 
 
 # ---------------------------------------------------------------------------------- demo
@@ -333,12 +337,7 @@ def cmd_demo(a) -> int:
         for n, pe, re in res.errors:
             print(f"  {n:<18} position error {pe * 1000:8.3f} mm   orientation error {re:.2e} rad")
     v = demo_viewer(res, live=out is None, port=a.port)
-    if out is not None:
-        v.export_html(out)
-        if not a.json:
-            print(f"wrote {out}")
-        return 0
-    return _serve(v, not a.no_browser, a.seconds)
+    return _export_or_serve(v, out, a, announce=not a.json)
 
 
 # ---------------------------------------------------------------------------------- ik
