@@ -35,40 +35,28 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EulerSingularityError, InertiaError
-from ..spatial.rotations import skew  # [v]×, Eq. (8-78) corrected (the printed matrix is not v × ·)
+from ..spatial.euler import euler_xyx, euler_xyx_rate_matrix
+from ..spatial.rotations import rot_x, rot_y, skew  # skew = [v]×, Eq. (8-78) corrected
 
 #: |sin ψ| below this is treated as gimbal lock
 SINGULAR_TOL = 1e-6
 
 
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1.0, 0], [-s, 0, c]])
-
-
 def passive(e):
     """(Θ, Ψ, Φ) of Eq. (8-41) (passive rotations, body ← fixed = Φ Ψ Θ)."""
     th, ps, ph = e
-    return _rx(th).T, _ry(ps).T, _rx(ph).T
+    return rot_x(th).T, rot_y(ps).T, rot_x(ph).T
 
 
 def rotation(e) -> np.ndarray:
     """Fixed ← body rotation R = Θᵀ Ψᵀ Φᵀ = R_x(θ) R_y(ψ) R_x(φ), Eq. (8-42)."""
-    th, ps, ph = e
-    return _rx(th) @ _ry(ps) @ _rx(ph)
+    return euler_xyx(*e)
 
 
 def Pi(e) -> np.ndarray:
     """Π of Eq. (8-45): body angular velocity ω = Π ė; det Π = −sin ψ."""
     _, ps, ph = e
-    return np.array([[np.cos(ps), 0, 1.0],
-                     [np.sin(ps) * np.sin(ph), np.cos(ph), 0],
-                     [np.sin(ps) * np.cos(ph), -np.sin(ph), 0]])
+    return euler_xyx_rate_matrix(ps, ph)
 
 
 def Pi1(e) -> np.ndarray:

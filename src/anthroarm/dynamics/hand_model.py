@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InertiaError
+from ..spatial.rotations import rot
 
 #: Δ^x of (8-111): dE^{xθ}/dθ = Δ^x E^{xθ} (skew matrices of the unit axes, corrected Δ^i)
 DELTA = {
@@ -47,13 +48,7 @@ _ALIAS = {"x": "i", "y": "j", "z": "k", "i": "i", "j": "j", "k": "k"}
 
 def elementary_rotation(axis: str, theta: float) -> np.ndarray:
     """E^{xθ} of Eq. (8-99): active rotation about the unit axis i, j or k by θ (rad)."""
-    c, s = np.cos(theta), np.sin(theta)
-    a = _ALIAS[axis]
-    if a == "i":
-        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if a == "j":
-        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    return rot("xyz"["ijk".index(_ALIAS[axis])], theta)
 
 
 @dataclass
