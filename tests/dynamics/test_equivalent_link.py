@@ -82,3 +82,13 @@ def test_stops_and_bad_input():
         EL.FourBarFinger(mass=(0, 0, 0))
     with pytest.raises(ValueError, match="assemble"):
         EL.FourBarFinger(r1=0.1, r2=0.01, r3=0.02, r4=0.02).J_star(0.3)
+    with pytest.raises(ValueError, match="r3 must be a positive length"):
+        EL.FourBarFinger(r3=-0.01)
+    with pytest.raises(ValueError, match="drive"):
+        fb.M_star(0.3, drive=np.nan)
+    with pytest.raises(ValueError, match="omega0"):
+        fb.integrate_energy_form(0.0, np.nan, 1.0)
+    with pytest.raises(ValueError, match="t_end"):
+        fb.integrate_moment_form(0.0, 1.0, np.inf)
+    with pytest.raises(ValueError, match="NaN"):
+        EL.equivalent_inertia([(np.nan, [0, 0, 0], [0, 0, 1.0], np.eye(3))])

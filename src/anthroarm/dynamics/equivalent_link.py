@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InertiaError
+from ..spatial.rotations import as_scalar
 
 
 def equivalent_inertia(links) -> float:
@@ -41,6 +42,8 @@ def equivalent_inertia(links) -> float:
         w = np.atleast_1d(np.asarray(w, float))
         J = np.asarray(J, float)
         total += m * float(v @ v) + float(w @ (J @ w if J.ndim == 2 else J * w))  # (8-26)
+    if not np.isfinite(total):
+        raise ValueError(f"equivalent_inertia: a mass, velocity or inertia is NaN/inf (J* = {total})")
     return total
 
 
@@ -51,6 +54,8 @@ def equivalent_moment(loads) -> float:
     total = 0.0
     for F, v, M, w in loads:
         total += float(np.dot(F, v)) + float(np.dot(M, w))
+    if not np.isfinite(total):
+        raise ValueError(f"equivalent_moment: a force, moment or velocity is NaN/inf (M* = {total})")
     return total
 
 
@@ -73,6 +78,12 @@ class FourBarFinger:
     branch: int = 1
 
     def __post_init__(self):
+        for name in ("r1", "r2", "r3", "r4"):
+            if not as_scalar(getattr(self, name), f"FourBarFinger: {name}") > 0:
+                raise ValueError(f"FourBarFinger: {name} must be a positive length (m), got {getattr(self, name)}")
+        g = np.asarray(self.gravity, float)
+        if g.shape != (2,) or not np.all(np.isfinite(g)):
+            raise ValueError(f"FourBarFinger: gravity must be 2 finite numbers (m/s²), got {self.gravity}")
         for name in ("mass", "com", "inertia"):
             v = np.asarray(getattr(self, name), float)
             if v.shape != (3,) or not np.all(np.isfinite(v)):
@@ -127,6 +138,7 @@ class FourBarFinger:
     def M_star(self, phi, drive: float = 0.0, rocker_moment: float = 0.0) -> float:
         """Equivalent moment M*(φ), Eq. (8-20): the link weights, a drive moment on the crank
         and a moment on the rocker (e.g. a grip reaction, negative = resisting), N m."""
+        drive, rocker_moment = as_scalar(drive, "drive"), as_scalar(rocker_moment, "rocker_moment")
         lm = self.link_motion(phi)
         g = np.asarray(self.gravity, float)
         loads = [(self.mass[k] * g, lm["v"][k], 0.0, 0.0) for k in range(3)]
@@ -141,6 +153,7 @@ class FourBarFinger:
         the mechanism stops before φ₁)."""
         from scipy.integrate import cumulative_trapezoid
 
+        phi0, omega0, phi1 = as_scalar(phi0, "phi0"), as_scalar(omega0, "omega0"), as_scalar(phi1, "phi1")
         if omega0 <= 0:
             raise ValueError("the energy form needs omega0 > 0 (the mechanism must move toward phi1)")
         phi = np.linspace(phi0, phi1, samples)
@@ -160,6 +173,11 @@ class FourBarFinger:
         """Moment form (8-16) as an ODE: φ̇ = ω, ω̇ = (M* − ½ω² dJ*/dφ)/J*, with an optional
         viscous moment −damping·ω on the crank.  Returns the ``solve_ivp`` solution."""
         from scipy.integrate import solve_ivp
+
+        phi0, omega0, t_end = as_scalar(phi0, "phi0"), as_scalar(omega0, "omega0"), as_scalar(t_end, "t_end")
+        damping = as_scalar(damping, "damping")
+        if t_end <= 0 or damping < 0:
+            raise ValueError(f"need t_end > 0 and damping >= 0, got t_end={t_end}, damping={damping}")
 
         def rhs(t, x):
             phi, om = x
