@@ -36,11 +36,15 @@ Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool fra
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import UnsupportedModelError
+from . import analytic_scalar as ks
+from . import analytic_soa as _soa
+from .analytic_plan import plan_for
 
 TWO_PI = 2.0 * np.pi
 HALF_PI = 0.5 * np.pi
@@ -661,7 +665,7 @@ def _swivel_array(swivel, N, grid_1d=False):
 
 def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
                    tol: float = 1e-9, tol_orthonormal: float = 1e-6,
-                   _single_grid: bool = False) -> AnalyticBatchResult:
+                   _single_grid: bool = False, _fast: bool = True) -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see module docstring).
 
     Candidates are wrapped into the joint limits (multiples of 2π), rejected if outside, and
@@ -672,20 +676,31 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     default :data:`DEFAULT_SWIVEL` for every pose.
 
     Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) and
-    :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form."""
+    :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form.
+
+    Plainly valid (N, 4, 4) float arrays go through the structure-of-arrays kernels of
+    :mod:`.analytic_soa` (same formulas, branches and checks; FK verification by the generated
+    chain product of :mod:`.fk_codegen`); anything else through the general path below
+    (``_fast=False`` forces it)."""
     name, prm = _require(robot)
     if position_only is None:
         position_only = name == "planar2r"
-    Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal, position_only=position_only)
-    N = Ts.shape[0]
-    Rt, pt = Ts[:, :3, :3], Ts[:, :3, 3]
-    sw = _swivel_array(swivel, N, grid_1d=_single_grid) if name == "human_arm7" else None
-    Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
-    B = Q.shape[1]
-    Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
-    res = _fk_residual(robot, Qw, Ts, position_only)                      # FK check (N, B)
-    valid = (code == OK) & inside & (res <= tol)
-    valid &= np.isfinite(res)
+    fast = _soa_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal,
+                           _single_grid) if _fast else None
+    if fast is not None:
+        Qw, valid, code, inside, res, sing, swv, labels = fast
+        N, B = valid.shape
+    else:
+        Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal, position_only=position_only)
+        N = Ts.shape[0]
+        Rt, pt = Ts[:, :3, :3], Ts[:, :3, 3]
+        sw = _swivel_array(swivel, N, grid_1d=_single_grid) if name == "human_arm7" else None
+        Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
+        B = Q.shape[1]
+        Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
+        res = _fk_residual(robot, Qw, Ts, position_only)                  # FK check (N, B)
+        valid = (code == OK) & inside & (res <= tol)
+        valid &= np.isfinite(res)
     # remove duplicate solutions (singular poses give coincident branches)
     if B > 1:
         # cheap pre-filter: a random projection of each solution; only rows with two nearly equal
@@ -707,6 +722,29 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swv is None else np.where(valid, swv, np.nan),
                                residuals=np.where(valid, res, np.nan), singular=list(sing), model=name)
+
+
+def _soa_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal, single_grid):
+    """Candidates of :func:`analytic_batch` from :func:`.analytic_soa.solve`, or None where the
+    general path must answer (not a plain (N, 4, 4) float64 array, any invalid pose — the general
+    path raises the error —, N = 0)."""
+    if type(T) is not np.ndarray or T.dtype != np.float64 or T.ndim != 3 or T.shape[1:] != (4, 4) \
+            or T.shape[0] == 0:
+        return None
+    E = _soa.pose_rows(T)
+    if not _soa.poses_ok(E, tol_orthonormal, position_only):
+        return None
+    N = T.shape[0]
+    sw = _swivel_array(swivel, N, grid_1d=single_grid) if name == "human_arm7" else None
+    plan = plan_for(robot, name, prm)
+    Qw, valid, code, inside, res, sing, bshape = _soa.solve(name, plan, E, tol, position_only, sw)
+    if name == "human_arm7":
+        S = sw.shape[1]
+        labels = [f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES] if S > 1 else list(HUMAN_BRANCHES)
+        swv = np.repeat(sw, 8, axis=1)
+    else:
+        labels, swv = list(_SCALAR_BRANCHES[name]), None
+    return Qw, valid, code, inside, res, sing, swv, labels
 
 
 def _reason_for(code, inside, res, tol, robot) -> str:
@@ -747,12 +785,134 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         return _book_result(robot, Ts[0], prm, tol)
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
+    if arr.ndim == 2:
+        fast = _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal)
+        if fast is not None:
+            return fast
+    return _analytic_general(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
+                             tol_orthonormal=tol_orthonormal)
+
+
+def _analytic_general(robot, arr, *, swivel=None, position_only=None, tol=1e-9, tol_orthonormal=1e-6,
+                      _fast=True):
+    """:func:`analytic` without the scalar fast path: the vectorised batch code on one pose
+    (``_fast=False``: the general path, the reference of the fast paths' tests)."""
+    arr = np.asarray(arr, dtype=float)
     if arr.ndim == 3:
         return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                              tol_orthonormal=tol_orthonormal)
+                              tol_orthonormal=tol_orthonormal, _fast=_fast)
     batch = analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                           tol_orthonormal=tol_orthonormal, _single_grid=True)
+                           tol_orthonormal=tol_orthonormal, _single_grid=True, _fast=_fast)
     return batch[0]
+
+
+# ---------------------------------------------------------------------------- single-pose fast path
+_SCALAR_BRANCHES = {"sixr_arm": SIXR_BRANCHES, "prosthetic_arm": PROSTHETIC_BRANCHES,
+                    "planar2r": PLANAR_BRANCHES, "human_arm7": HUMAN_BRANCHES}
+
+
+def _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal):
+    """:func:`analytic` of one plainly valid pose with the scalar kernels of
+    :mod:`.analytic_scalar`; None where the vectorised path must answer (unsupported robot,
+    anything unusual in the input — it raises the error —, a swivel grid)."""
+    if not has_analytic(robot) or type(arr) is not np.ndarray or arr.dtype != np.float64:
+        return None
+    name = robot.spec.name
+    if position_only is None:
+        position_only = name == "planar2r"
+    if arr.shape == (4, 4):
+        rows = arr.tolist()
+        r3 = rows[3]
+        if not math.isfinite(sum(rows[0]) + sum(rows[1]) + sum(rows[2]) + sum(r3)):
+            return None
+        if abs(r3[0]) > 1e-12 or abs(r3[1]) > 1e-12 or abs(r3[2]) > 1e-12 or abs(r3[3] - 1.0) > 1e-12:
+            return None
+        if not position_only and not _rotation_ok(rows, tol_orthonormal):
+            return None
+    elif arr.shape == (3,) and position_only:
+        x, y, z = arr.tolist()
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            return None
+        rows = [[1.0, 0.0, 0.0, x], [0.0, 1.0, 0.0, y], [0.0, 0.0, 1.0, z]]
+    else:
+        return None
+    if not isinstance(tol, (float, int)):
+        return None
+    plan = plan_for(robot, name, robot.spec.params)
+    if name == "human_arm7":
+        if swivel is None:
+            return None                                   # a grid: the vectorised path
+        if isinstance(swivel, (float, int)):
+            sw = float(swivel)
+        else:
+            try:
+                sw = float(swivel) if np.ndim(swivel) == 0 else None
+            except (TypeError, ValueError):
+                return None
+        if sw is None or not math.isfinite(sw):
+            return None
+        cand = ks.human(rows, plan, tol, sw, position_only)
+    elif name == "sixr_arm":
+        cand = ks.sixr(rows, plan, tol, position_only)
+    elif name == "prosthetic_arm":
+        cand = ks.prosthetic(rows, plan, tol, position_only)
+    else:
+        cand = ks.planar(rows, plan, tol, position_only)
+    labels = _SCALAR_BRANCHES[name]
+    B, nq = len(labels), plan.nq
+    if cand.code != OK:
+        return AnalyticIKResult(np.zeros((0, nq)), [], _REASONS[cand.code],
+                                swivel=None if name != "human_arm7" else np.zeros(0),
+                                residuals=np.zeros(0), singular=cand.singular, model=name)
+    sols = cand.sols
+    if not sols:                                          # why: the general path's wording
+        code = np.zeros(B, dtype=int)
+        inside = np.zeros(B, dtype=bool)
+        res = np.full(B, np.inf)
+        for b, r in cand.tried:
+            inside[b] = True
+            res[b] = r
+        return AnalyticIKResult(np.zeros((0, nq)), [], _reason_for(code, inside, res, tol, robot),
+                                swivel=None if name != "human_arm7" else np.zeros(0),
+                                residuals=np.zeros(0), singular=cand.singular, model=name)
+    if len(sols) > 1:
+        sols = _dedup_scalar(sols)
+    return AnalyticIKResult(
+        solutions=np.array([s[1] for s in sols]),
+        branches=[labels[s[0]] for s in sols],
+        reason=None,
+        swivel=None if name != "human_arm7" else np.full(len(sols), sw),
+        residuals=np.array([s[2] for s in sols]),
+        singular=cand.singular, model=name)
+
+
+def _dedup_scalar(sols):
+    """Drop solutions within 1e-9 rad (every joint) of an earlier one (coincident branches at
+    singular poses), as the general path does.  Pre-filter: the sums of the joints of two
+    duplicates differ by < nq·1e-9, so only sums closer than 1e-8 get the full test."""
+    keys = sorted([sum(s[1]) for s in sols])
+    k0 = keys[0]
+    for k1 in keys[1:]:
+        if k1 - k0 < 1e-8:
+            break
+        k0 = k1
+    else:
+        return sols
+    keep = [sols[0]]
+    for s in sols[1:]:
+        q = s[1]
+        if all(max(abs(a - b) for a, b in zip(q, k[1])) >= 1e-9 for k in keep):
+            keep.append(s)
+    return keep
+
+
+def _rotation_ok(rows, tol_orthonormal) -> bool:
+    """|RᵀR − I| ≤ tol and det R ≥ 0 (the test of :func:`_check_poses`) for nested lists."""
+    (a, b, c, _), (d, e, f, _), (g, h, i, _) = rows[0], rows[1], rows[2]
+    err = max(abs(a * a + d * d + g * g - 1.0), abs(b * b + e * e + h * h - 1.0), abs(c * c + f * f + i * i - 1.0),
+              abs(a * b + d * e + g * h), abs(a * c + d * f + g * i), abs(b * c + e * f + h * i))
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    return err <= tol_orthonormal and det >= 0.0
 
 
 # ---------------------------------------------------------------------------- the book's procedure
