@@ -83,3 +83,5 @@ def test_bad_input():
         hand.inverse([0, np.nan, 0], [0, 0, 0], [0, 0, 0])
     with pytest.raises(ValueError, match="shape"):
         hand.gravity([0, 0])
+    with pytest.raises(ValueError, match="duration"):
+        H.coriolis_over_grasp(duration=0.0)

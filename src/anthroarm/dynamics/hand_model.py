@@ -229,6 +229,8 @@ def default_hand(xi: float = 0.002) -> HandModel:
 
 def minimum_jerk(q0, q1, T: float, t):
     """Minimum-jerk point-to-point motion q(t), q̇(t), q̈(t) from q0 to q1 in T seconds."""
+    if not (np.isfinite(T) and T > 0):
+        raise ValueError(f"minimum-jerk duration must be finite and > 0 s, got {T!r}")
     q0, q1 = np.asarray(q0, float), np.asarray(q1, float)
     s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)[..., None]
     p = 10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5
