@@ -121,3 +121,6 @@ def test_error_propagation_bad_input(robots):
         EP.length_jacobian(r, np.zeros(2))
     with pytest.raises(aa.errors.UnknownFrameError):
         EP.link_parameters(r, frame="nope")
+    chain = EP.PerturbedChain(r)
+    with pytest.raises(ValueError, match="dL has a NaN"):
+        chain.pose(q[None], np.full((1, len(chain.params)), np.nan))

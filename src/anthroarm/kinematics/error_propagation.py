@@ -36,6 +36,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import UnsupportedModelError
+from ..spatial.rotations import rot_axis
 
 
 # ----------------------------------------------------------------------------- parameters
@@ -237,6 +238,8 @@ class PerturbedChain:
         dL = np.zeros((N, len(self.params))) if dL is None else np.atleast_2d(np.asarray(dL, float))
         if dL.shape != (N, len(self.params)):
             raise ValueError(f"dL must have shape ({N}, {len(self.params)}), got {dL.shape}")
+        if not np.all(np.isfinite(dL)):
+            raise ValueError(f"dL has a NaN or infinite value: {dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}")
         dt = {}
         for k, p in enumerate(self.params):
             key = (p.kind, p.index)
@@ -250,9 +253,7 @@ class PerturbedChain:
             qi = q[:, self.idx_q[k]]
             a = self.axis[k]
             if self.revolute[k]:
-                K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-                c, s = np.cos(qi)[:, None, None], np.sin(qi)[:, None, None]
-                R = R @ (np.eye(3) + s * K + (1 - c) * (K @ K))
+                R = R @ rot_axis(a, qi)  # Rodrigues, Eq. (5-84)
             else:
                 x = x + np.einsum("nij,j->ni", R, a) * qi[:, None]
         t = self.tf + dt.get(("frame", self.fid), 0.0)
