@@ -209,6 +209,9 @@ def test_cache_roundtrip_and_generator_reproduces_cached_file(tmp_path, monkeypa
 # ------------------------------------------------------------------ bad input
 def test_nan_and_shape_errors():
     dyn = L.load(aa.load("planar2r"))
+    assert L.load("planar2r").n == 2  # a catalog name works too
+    with pytest.raises(UnsupportedModelError, match="pin.Model"):
+        L.load(3)
     with pytest.raises(ValueError, match="finite"):
         dyn.mass_matrix([np.nan, 0.0])
     with pytest.raises(ValueError, match="qd"):

@@ -38,8 +38,7 @@ symbolic differentiation only:
 * τ = d/dt(∂T/∂q̇) − ∂T/∂q + ∂V/∂q, the Euler–Lagrange equation itself.
 
 The explicit Christoffel symbols and fully written-out sympy matrices are available for small
-models (:meth:`LagrangeModel.sympy_matrices`, :meth:`LagrangeModel.christoffel`,
-:meth:`LagrangeModel.latex`).
+models (:func:`sympy_matrices`, :func:`christoffel`, :func:`latex`).
 
 **Generated code.**  The outputs are printed as straight-line numpy code (one line per graph
 node: common subexpressions appear once), vectorised over a batch ``(N, nq)``, plus a scalar
@@ -369,10 +368,19 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
 
 
 def _as_info(obj, name=None) -> ChainInfo:
+    """ChainInfo of a ChainInfo, a Robot, a ``pin.Model``, or a catalog name / URDF path."""
+    import pinocchio as pin
+
     if isinstance(obj, ChainInfo):
         return obj
+    if isinstance(obj, (str, os.PathLike)):
+        from ..robot import load as load_robot
+
+        obj = load_robot(obj)
     if hasattr(obj, "model") and hasattr(obj, "joint_names"):  # Robot
         return chain_info(obj.model, name or obj.name)
+    if not isinstance(obj, pin.Model):
+        raise UnsupportedModelError(f"Lagrange dynamics need a Robot, a pin.Model or a catalog name, got {type(obj).__name__}")
     return chain_info(obj, name)
 
 
