@@ -25,7 +25,8 @@ def listening_addresses(port: int) -> set[str]:
     out = set()
     for fname in ("/proc/net/tcp", "/proc/net/tcp6"):
         try:
-            lines = open(fname).read().splitlines()[1:]
+            with open(fname) as f:
+                lines = f.read().splitlines()[1:]
         except OSError:
             continue
         for ln in lines:

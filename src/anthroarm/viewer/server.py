@@ -60,10 +60,12 @@ def _stop(proc: subprocess.Popen, log) -> None:
         except subprocess.TimeoutExpired:  # pragma: no cover - terminate is enough on Linux
             proc.kill()
             proc.wait()
-    try:
-        log.close()
-    except Exception:  # pragma: no cover
-        pass
+    for f in (proc.stdout, log):  # the pipe of the ready line, the stderr log
+        try:
+            if f is not None:
+                f.close()
+        except Exception:  # pragma: no cover
+            pass
 
 
 class ServerProcess:
