@@ -115,18 +115,21 @@ class Robot:
 
     @cached_property
     def lower(self) -> np.ndarray:
+        """Lower joint limits in q order (rad for revolute, m for prismatic joints); read-only."""
         lo = np.array(self.model.lowerPositionLimit, dtype=float)
         lo.setflags(write=False)
         return lo
 
     @cached_property
     def upper(self) -> np.ndarray:
+        """Upper joint limits in q order (rad / m); read-only."""
         hi = np.array(self.model.upperPositionLimit, dtype=float)
         hi.setflags(write=False)
         return hi
 
     @cached_property
     def velocity_limit(self) -> np.ndarray:
+        """Joint velocity limits from the URDF (rad/s or m/s)."""
         return np.array(self.model.velocityLimit, dtype=float)
 
     @cached_property
@@ -187,6 +190,8 @@ class Robot:
         return arr
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
+        """True where ``lower - tol <= q <= upper + tol`` for every joint; one bool for ``(nq,)``,
+        an ``(N,)`` array for a batch."""
         q = self.check_q(q)
         ok = (q >= self.lower - tol) & (q <= self.upper + tol)
         return ok.all(axis=-1)

@@ -93,6 +93,11 @@ class DHRow:
 
 @dataclass
 class ChainSpec:
+    """A catalog arm: its joints (each carrying the link it moves), the tool frame placed by
+    ``tool_origin`` in the last link, provenance strings, and for H-D arms the table ``dh``
+    with the tool pose ``tool_dh`` in the last DH frame.  ``params`` are the builder's
+    arguments (SI units)."""
+
     name: str
     description: str
     joints: list[JointSpec]
