@@ -53,6 +53,9 @@ def test_reaching_parts_sum_and_match_rnea():
     assert np.allclose(res["q"][-1], q1) and np.allclose(res["qd"][[0, -1]], 0)
     Hu.plot_reaching(res)
     Hu.plot_gravity_map(Hu.gravity_torque_map(grid=5, robot=robot, dyn=dyn), joint="shoulder_flexion")
+    small, small_dyn = Hu.human_arm(1.55, 50.0, "female")
+    # the map reports the body it was computed for, not the keyword defaults
+    assert Hu.gravity_torque_map(grid=2, robot=small, dyn=small_dyn)["params"] == dict(height=1.55, mass=50.0, sex="female")
 
 
 def test_bad_input():

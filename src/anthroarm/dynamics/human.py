@@ -61,8 +61,11 @@ def gravity_torque_map(joints=("shoulder_flexion", "elbow_flexion"), grid: int =
     Q[:, a] = X.ravel()
     Q[:, b] = Y.ravel()
     tau = dyn.gravity(Q).reshape(grid, grid, robot.nq)
+    params = dict(height=height, mass=mass, sex=sex)
+    spec_params = robot.spec.params if robot.spec is not None else {}
+    params.update({k: spec_params[k] for k in params if k in spec_params})  # the body actually used
     return dict(x=x, y=y, names=(robot.joint_names[a], robot.joint_names[b]), joint_names=robot.joint_names,
-                tau=tau, q=Q.reshape(grid, grid, robot.nq), params=dict(height=height, mass=mass, sex=sex))
+                tau=tau, q=Q.reshape(grid, grid, robot.nq), params=params)
 
 
 def reaching_torques(q_start, q_goal, duration: float = 0.8, samples: int = 101, height: float = 1.75,
