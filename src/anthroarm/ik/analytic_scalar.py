@@ -111,7 +111,7 @@ def sixr(T, plan, tol, position_only=False):
                 th4a, c4, s4 = 0.0, 1.0, 0.0
             else:
                 th4a = _atan2(Mm, L)                               # (7-8)
-                c4, s4 = _cos(th4a), _sin(th4a)
+                c4, s4 = L / rho, Mm / rho                         # cos, sin of θ4
             if fk0 is None:
                 continue
             q2 = (th2 if fl[1] <= th2 <= fh[1] else _wrap(th2, lo[1], hi[1], lf[1]))
@@ -120,16 +120,21 @@ def sixr(T, plan, tol, position_only=False):
                 continue
             fk1 = st1(fk0, q2, q3)
             base = sh * 4 + el * 2
+            # θ5 from N = −cos θ5 (7-12 corrected), θ6 from (7-14); the wrist flip θ4 + π negates
+            # c4, s4 and hence exactly the atan2 arguments: θ5 → −θ5, (y6, x6) → (−y6, −x6)
+            a5 = c4 * L + s4 * Mm
+            th5 = _atan2(a5, -N)
+            n5 = _sqrt(a5 * a5 + N * N)
+            c5, s5 = -N / n5, a5 / n5
+            y6 = s4 * Mx0 - c4 * Mx1
+            x6 = c4 * c5 * Mx0 + s4 * c5 * Mx1 + s5 * Mx2
             for wr in (0, 1):
                 if wr == 0:
-                    th4, C4, S4 = th4a, c4, s4
+                    th4, th5w, th6 = th4a, th5, _atan2(y6, x6)
                 else:
-                    th4, C4, S4 = th4a + PI, -c4, -s4              # wrist flip
-                th5 = _atan2(C4 * L + S4 * Mm, -N)                 # (7-12) corrected: N = −cos θ5
-                c5, s5 = _cos(th5), _sin(th5)
-                th6 = _atan2(S4 * Mx0 - C4 * Mx1, C4 * c5 * Mx0 + S4 * c5 * Mx1 + s5 * Mx2)   # (7-14)
+                    th4, th5w, th6 = th4a + PI, -th5, _atan2(-y6, -x6)
                 q4 = (th4 if fl[3] <= th4 <= fh[3] else _wrap(th4, lo[3], hi[3], lf[3]))
-                q5 = (th5 if fl[4] <= th5 <= fh[4] else _wrap(th5, lo[4], hi[4], lf[4]))
+                q5 = (th5w if fl[4] <= th5w <= fh[4] else _wrap(th5w, lo[4], hi[4], lf[4]))
                 q6 = (th6 if fl[5] <= th6 <= fh[5] else _wrap(th6, lo[5], hi[5], lf[5]))
                 if q4 is None or q5 is None or q6 is None:
                     continue
@@ -191,14 +196,17 @@ def prosthetic(T, plan, tol, position_only=False):
         Ex, Ey, Ez = E0x + tr * dX, E0y + tr * dY, E0z + tr * dZ
         zx, zy, zz = Ex / L1, Ey / L1, Ez / L1
         mz = -zz
-        th2a = _acos(1.0 if mz > 1.0 else (-1.0 if mz < -1.0 else mz))   # (7-19)
-        if _sqrt(zx * zx + zy * zy) < 1e-12:
+        mz = 1.0 if mz > 1.0 else (-1.0 if mz < -1.0 else mz)
+        th2a = _acos(mz)                                           # (7-19)
+        rz = _sqrt(zx * zx + zy * zy)
+        if rz < 1e-12:
             sh_any = True
-            th1a = -HALF_PI
+            th1a, c1a, s1a = -HALF_PI, 0.0, -1.0
         else:
             th1a = _atan2(zy, zx)                                  # (7-18) with atan2
+            c1a, s1a = zx / rz, zy / rz
+        c2a, s2a = mz, _sqrt((1.0 - mz) * (1.0 + mz))              # cos, sin of acos(mz)
         ux, uy, uz = (Wx - Ex) / L2, (Wy - Ey) / L2, (Wz - Ez) / L2
-        c1a, s1a, c2a, s2a = _cos(th1a), _sin(th1a), _cos(th2a), _sin(th2a)
         for sh in (0, 1):
             if sh == 0:
                 th1, th2, c1, s1, c2, s2 = th1a, th2a, c1a, s1a, c2a, s2a
@@ -206,54 +214,64 @@ def prosthetic(T, plan, tol, position_only=False):
                 th1, th2, c1, s1, c2, s2 = th1a + PI, -th2a, -c1a, -s1a, c2a, -s2a
             q1 = (th1 if fl[0] <= th1 <= fh[0] else _wrap(th1, lo[0], hi[0], lf[0]))
             q2 = (th2 if fl[1] <= th2 <= fh[1] else _wrap(th2, lo[1], hi[1], lf[1]))
-            # R2 = Rz(θ1) Rx90 Rz(θ2) Rx90; columns
-            # R01 = [[c1,0,s1],[s1,0,-c1],[0,1,0]], R12 = [[c2,0,s2],[s2,0,-c2],[0,1,0]]
+            if q1 is None or q2 is None:                           # prune: outside the limits
+                continue
+            # R2 = Rz(θ1) Rx90 Rz(θ2) Rx90 = [[c1c2, s1, c1s2], [s1c2, −c1, s1s2], [s2, 0, −c2]]
             a00, a01, a02 = c1 * c2, s1, c1 * s2
             a10, a11, a12 = s1 * c2, -c1, s1 * s2
-            a20, a21, a22 = s2, 0.0, -c2
+            a20, a22 = s2, -c2
             # v = R2ᵀ (W − E)/L2 = (s4 s3, −s4 c3, c4)   (7-26)
             v0 = a00 * ux + a10 * uy + a20 * uz
             v1 = a01 * ux + a11 * uy
-            fk0 = st0(q1, q2) if (q1 is not None and q2 is not None) else None
+            fk0 = st0(q1, q2)
             base = root * 4 + sh * 2
             for fx in (0, 1):
+                q4 = q4s[fx]
+                if q4 is None:
+                    continue
                 th4, C4, S4 = flex[fx]
-                sg = 1.0 if S4 >= 0 else -1.0
-                th3 = 0.0 if el_sing else _atan2(sg * v0, -sg * v1)
-                # hidden +90° of A23: c3 = cos(θ3 + 90°) = −sin θ3, s3 = cos θ3
-                c3, s3 = _cos(th3 + HALF_PI), _sin(th3 + HALF_PI)
+                if el_sing:
+                    th3, c3, s3 = 0.0, 0.0, 1.0
+                else:
+                    sg = 1.0 if S4 >= 0 else -1.0
+                    y3, x3 = sg * v0, -sg * v1
+                    th3 = _atan2(y3, x3)
+                    r3 = _sqrt(x3 * x3 + y3 * y3)
+                    # hidden +90° of A23: c3 = cos(θ3 + 90°) = −sin θ3, s3 = sin(θ3 + 90°) = cos θ3
+                    c3, s3 = (-y3 / r3, x3 / r3) if r3 > 0.0 else (0.0, 1.0)
+                q3 = (th3 if fl[2] <= th3 <= fh[2] else _wrap(th3, lo[2], hi[2], lf[2]))
+                if q3 is None:
+                    continue
                 # R3 = R2 R23, R23 = [[c3,0,s3],[s3,0,-c3],[0,1,0]]
                 b00 = a00 * c3 + a01 * s3
                 b02 = a00 * s3 - a01 * c3
                 b10 = a10 * c3 + a11 * s3
                 b12 = a10 * s3 - a11 * c3
-                b20 = a20 * c3 + a21 * s3
-                b22 = a20 * s3 - a21 * c3
-                b01, b11, b21 = a02, a12, a22
-                # R4 = R3 R34, R34 = [[c4,0,-s4],[s4,0,c4],[0,-1,0]]
-                r00 = b00 * C4 + b01 * S4
-                r10 = b10 * C4 + b11 * S4
-                r20 = b20 * C4 + b21 * S4
-                r01, r11, r21 = -b02, -b12, -b22
-                r02 = b01 * C4 - b00 * S4
-                r12 = b11 * C4 - b10 * S4
-                r22 = b21 * C4 - b20 * S4
+                b20 = a20 * c3
+                b22 = a20 * s3
+                # R4 = R3 R34, R34 = [[c4,0,-s4],[s4,0,c4],[0,-1,0]]: columns
+                # (b·0 c4 + a·2 s4, −b·2, a·2 c4 − b·0 s4)
+                r00 = b00 * C4 + a02 * S4
+                r10 = b10 * C4 + a12 * S4
+                r20 = b20 * C4 + a22 * S4
+                r02 = a02 * C4 - b00 * S4
+                r12 = a12 * C4 - b10 * S4
+                r22 = a22 * C4 - b20 * S4
                 # M = R4ᵀ R (hand) = Rz5 Rx90 Rz6 Rx-90  (7-28); needed: M00, M10, M20, M01, M11
                 M01 = r00 * m1 + r10 * m2 + r20 * m3
-                M11 = r01 * m1 + r11 * m2 + r21 * m3
+                M11 = -(b02 * m1 + b12 * m2 + b22 * m3)
                 th5 = _atan2(-M01, M11)                            # y column (−s5, c5, 0)
-                c5, s5 = _cos(th5), _sin(th5)
+                q5 = (th5 if fl[4] <= th5 <= fh[4] else _wrap(th5, lo[4], hi[4], lf[4]))
+                if q5 is None:
+                    continue
+                n5 = _sqrt(M01 * M01 + M11 * M11)
+                c5, s5 = (M11 / n5, -M01 / n5) if n5 > 0.0 else (1.0, 0.0)
                 M00 = r00 * l1_ + r10 * l2_ + r20 * l3_
-                M10 = r01 * l1_ + r11 * l2_ + r21 * l3_
+                M10 = -(b02 * l1_ + b12 * l2_ + b22 * l3_)
                 M20 = r02 * l1_ + r12 * l2_ + r22 * l3_
                 th6 = _atan2(M20, c5 * M00 + s5 * M10)             # (7-30)/(7-31)
-                if fk0 is None:
-                    continue
-                q3 = (th3 if fl[2] <= th3 <= fh[2] else _wrap(th3, lo[2], hi[2], lf[2]))
-                q4 = q4s[fx]
-                q5 = (th5 if fl[4] <= th5 <= fh[4] else _wrap(th5, lo[4], hi[4], lf[4]))
                 q6 = (th6 if fl[5] <= th6 <= fh[5] else _wrap(th6, lo[5], hi[5], lf[5]))
-                if q3 is None or q4 is None or q5 is None or q6 is None:
+                if q6 is None:
                     continue
                 res = st1(fk0, q3, q4, q5, q6, Tt)
                 tried.append((base + fx, res))
@@ -339,6 +357,9 @@ def human(T, plan, tol, swivel, position_only=False):
             q4, C4, S4, xx, xy, xz = q4p, c4p, s4p, e0x, e0y, e0z
         else:
             q4, C4, S4, xx, xy, xz = -q4p, c4p, -s4p, -e0x, -e0y, -e0z
+        q4w = (q4 if fl[3] <= q4 <= fh[3] else _wrap(q4, lo[3], hi[3], lf[3]))
+        if q4w is None:                                           # prune: outside the limits
+            continue
         yx, yy, yz = zy * xz - zz * xy, zz * xx - zx * xz, zx * xy - zy * xx   # ey = ez × ex
         # Rsh columns (ex, ey, ez): R00 = xx, R01 = yx, R02 = zx, R10 = xy, R11 = yy, R12 = zy, R22 = zz
         h = _sqrt(xx * xx + yx * yx)
@@ -354,7 +375,6 @@ def human(T, plan, tol, swivel, position_only=False):
         wrists = []
         for wb in (1.0, -1.0):
             wrists.append((_atan2(wb * X10, wb * X00), _atan2(-X20, wb * h6), _atan2(wb * X21, wb * X22)))
-        q4w = (q4 if fl[3] <= q4 <= fh[3] else _wrap(q4, lo[3], hi[3], lf[3]))
         for sh, sb in ((0, 1.0), (1, -1.0)):
             cq2 = sb * h
             q2 = _atan2(zx, cq2)
@@ -362,8 +382,6 @@ def human(T, plan, tol, swivel, position_only=False):
                 q1, q3 = 0.0, _atan2(xy, yy)
             else:
                 q1, q3 = _atan2(-sb * zy, sb * zz), _atan2(-sb * yx, sb * xx)
-            if q4w is None:
-                continue
             w1 = (q1 if fl[0] <= q1 <= fh[0] else _wrap(q1, lo[0], hi[0], lf[0]))
             w2 = (q2 if fl[1] <= q2 <= fh[1] else _wrap(q2, lo[1], hi[1], lf[1]))
             w3 = (q3 if fl[2] <= q3 <= fh[2] else _wrap(q3, lo[2], hi[2], lf[2]))

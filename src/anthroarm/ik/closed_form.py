@@ -877,8 +877,11 @@ def _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal):
                                 residuals=np.zeros(0), singular=cand.singular, model=name)
     if len(sols) > 1:
         sols = _dedup_scalar(sols)
+    flat = []
+    for s in sols:
+        flat += s[1]
     return AnalyticIKResult(
-        solutions=np.array([s[1] for s in sols]),
+        solutions=np.array(flat).reshape(len(sols), nq),
         branches=[labels[s[0]] for s in sols],
         reason=None,
         swivel=None if name != "human_arm7" else np.full(len(sols), sw),

@@ -103,8 +103,8 @@ class FKStages:
         self.splits = tuple(splits)
         self.position_only = position_only
         self.n_stages = len(bounds) - 1
-        self.source = self._generate(spec, bounds, position_only, "    c{j} = cos({q})\n    s{j} = sin({q})")
-        self.source_numpy = self._generate(spec, bounds, position_only, "    c{j}, s{j} = cos_sin({q})")
+        self.source = self._generate(spec, bounds, position_only, "    c{j} = cos({q})\n    s{j} = sin({q})", False)
+        self.source_numpy = self._generate(spec, bounds, position_only, "    c{j}, s{j} = cos_sin({q})", True)
         self.scalar = self._compile(self.source, {"cos": math.cos, "sin": math.sin, "_max": max, "_abs": abs})
         self.numpy = self._compile(self.source_numpy, {"cos_sin": cos_sin, "_abs": np.abs, "_max": _np_max})
 
@@ -114,7 +114,7 @@ class FKStages:
         return [ns[f"stage{k}"] for k in range(self.n_stages)]
 
     @staticmethod
-    def _generate(spec, bounds, position_only, trig) -> str:
+    def _generate(spec, bounds, position_only, trig, vectorised) -> str:
         R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         p = [0.0, 0.0, 0.0]
         src = []
@@ -169,7 +169,13 @@ class FKStages:
                 diffs = [_diff(p[i], f"T{i}3") for i in range(3)]
                 if not position_only:
                     diffs += [_diff(R[i][j], f"T{i}{j}") for i in range(3) for j in range(3)]
-                tail = [f"    return _max({', '.join(diffs)})"]
+                if vectorised:
+                    tail = [f"    return _max({', '.join(f'_abs({d})' for d in diffs)})"]
+                else:  # plain comparisons beat 12 abs() calls and a 12-argument max() in CPython
+                    tail = [f"    r = _abs({diffs[0]})"]
+                    for d in diffs[1:]:
+                        tail += [f"    d = {d}", "    if d > r:", "        r = d", "    elif -d > r:", "        r = -d"]
+                    tail += ["    return r"]
             else:
                 state_out = []
                 for v in [v for row in R for v in row] + p:
@@ -183,10 +189,10 @@ class FKStages:
 
 
 def _diff(v, t: str) -> str:
-    """|v − t| as source text (a lazily negated v = "-x" gives |x + t|)."""
+    """±(v − t) as source text (a lazily negated v = "-x" gives x + t, of the same magnitude)."""
     if isinstance(v, str):
-        return f"_abs({v[1:]} + {t})" if v.startswith("-") else f"_abs({v} - {t})"
-    return f"_abs({v!r} - {t})"
+        return f"{v[1:]} + {t}" if v.startswith("-") else f"{v} - {t}"
+    return f"{v!r} - {t}"
 
 
 def cos_sin(q):
