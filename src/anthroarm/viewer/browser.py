@@ -10,7 +10,9 @@ Used by the real-browser tests and to make ``docs/human_arm_viewer.png``.  Needs
 
 from __future__ import annotations
 
+import os
 import shutil
+import signal
 import subprocess
 import tempfile
 from pathlib import Path
@@ -52,14 +54,30 @@ def screenshot(url, png, size=(800, 600), budget_ms: int = 6000, timeout: float 
     with tempfile.TemporaryDirectory(prefix="anthroarm-chromium-") as prof:
         cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}", f"--screenshot={png}",
                f"--window-size={int(size[0])},{int(size[1])}", f"--virtual-time-budget={int(budget_ms)}", url]
+        # own process group: on a timeout the renderer/GPU children are killed with the browser
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                                start_new_session=True)
         try:
-            res = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout)
+            _, err = proc.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
+            _kill_group(proc)
             raise RuntimeError(f"chromium did not finish within {timeout} s on {url}") from None
+        finally:
+            if proc.poll() is None:  # e.g. KeyboardInterrupt during communicate
+                _kill_group(proc)
     if not png.is_file():
-        tail = res.stderr.decode("utf-8", "replace").strip().splitlines()[-3:]
-        raise RuntimeError(f"chromium wrote no screenshot (exit {res.returncode}): {' | '.join(tail)}")
+        tail = err.decode("utf-8", "replace").strip().splitlines()[-3:]
+        raise RuntimeError(f"chromium wrote no screenshot (exit {proc.returncode}): {' | '.join(tail)}")
     return png
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    """SIGKILL the process group led by ``proc`` (its session, see ``start_new_session``)."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    proc.communicate()
 
 
 def load_rgb(png) -> np.ndarray:
@@ -96,8 +114,6 @@ def drawn_fraction(png, baseline_png, region=(0.0, 0.0, 1.0, 1.0), tol: int = 40
 def docs_screenshot(png, size=(960, 640)) -> Path:
     """The README picture: the §6-3 human arm mid-demo (reaching forward), the demo's targets
     and hand path, joint-limit colours on.  ``python -m anthroarm.viewer.browser docs/x.png``."""
-    import numpy as np
-
     from .demo import REACH_POSTURES_DEG, demo_viewer, reach_demo
 
     res = reach_demo()
