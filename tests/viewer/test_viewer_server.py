@@ -164,6 +164,14 @@ def test_pose_update_is_one_message_and_mirrors_the_scene():
         assert v.server.static_html() == v.store.static_html()
 
 
+def test_wait_timeout_leaves_the_server_usable(server):
+    from anthroarm.errors import ViewerError
+
+    with pytest.raises(ViewerError, match="0 of 1 browser tabs"):
+        server.wait(1, timeout=0.3)
+    assert server.clients() == 0  # the server still answers
+
+
 def test_repr_html_is_live_iframe():
     with Viewer("planar2r", live=True) as v:
         h = v._repr_html_()

@@ -119,11 +119,15 @@ class Bridge:
         if os.getppid() != self.parent_pid:
             self.loop.stop()
 
-    def _wait_clients(self, n):
+    def _wait_clients(self, n, deadline):
+        """Reply when ``n`` tabs are connected, or with an error at ``deadline`` (loop time):
+        the REP socket must answer every request, or it would take no further commands."""
         if len(self.clients) >= n:
             self.sock.send(b"ok")
+        elif self.loop.time() >= deadline:
+            self.sock.send(f"error: {len(self.clients)} of {n} browser tabs connected before the timeout".encode())
         else:
-            self.loop.call_later(0.05, lambda: self._wait_clients(n))
+            self.loop.call_later(0.05, lambda: self._wait_clients(n, deadline))
 
     def handle(self, frames):
         cmd = frames[0].decode("utf-8")
@@ -149,7 +153,8 @@ class Bridge:
             self.sock.send(str(len(self.clients)).encode())
         elif cmd == "wait":
             n = int(frames[1]) if len(frames) > 1 and frames[1] else 1
-            self._wait_clients(n)
+            seconds = float(frames[2]) if len(frames) > 2 and frames[2] else 30.0
+            self._wait_clients(n, self.loop.time() + seconds)
         elif cmd == "get_scene":
             self.sock.send(self.store.static_html().encode("utf-8"))
         elif cmd == "shutdown":

@@ -172,10 +172,11 @@ class ServerProcess:
         return int(self._request([b"clients"]))
 
     def wait(self, n: int = 1, timeout: float = 30.0) -> None:
-        """Block until ``n`` browser tabs are connected (ViewerError after ``timeout`` s)."""
-        self.sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000))
+        """Block until ``n`` browser tabs are connected (ViewerError after ``timeout`` s).  The
+        server answers at its own deadline, so a timed-out wait leaves it usable."""
+        self.sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000) + self.timeout_ms)
         try:
-            self._request([b"wait", str(n).encode()])
+            self._request([b"wait", str(n).encode(), repr(float(timeout)).encode()])
         finally:
             if not self.sock.closed:
                 self.sock.setsockopt(zmq.RCVTIMEO, self.timeout_ms)
