@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..spatial.rotations import as_scalar
+
 
 def _as_batch(q, n: int) -> tuple[np.ndarray, bool]:
     q = np.asarray(q, dtype=float)
@@ -26,16 +28,7 @@ def _as_batch(q, n: int) -> tuple[np.ndarray, bool]:
 def finite_params(**values) -> list[float]:
     """The named scalar parameters (link lengths in m, angles in rad) as floats; ``ValueError``
     naming the first one that is not a finite number."""
-    out = []
-    for name, v in values.items():
-        try:
-            f = float(v)
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a number, got {v!r}") from None
-        if not np.isfinite(f):
-            raise ValueError(f"{name} must be finite, got {f}")
-        out.append(f)
-    return out
+    return [as_scalar(v, name) for name, v in values.items()]
 
 
 def dh_transform(theta, s, h, alpha) -> np.ndarray:

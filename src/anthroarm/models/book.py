@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial.rotations import homogeneous
+from ..spatial.rotations import as_scalar, homogeneous
 from .spec import ChainSpec, DHRow, JointSpec, from_dh, rod_link
 
 deg = np.pi / 180.0
@@ -19,8 +19,8 @@ def _lengths(model: str, **values) -> None:
     """``ValueError`` naming the first length (m) that is not a finite number >= 0."""
     for name, v in values.items():
         try:
-            ok = bool(np.isfinite(float(v)) and float(v) >= 0.0)
-        except (TypeError, ValueError):
+            ok = as_scalar(v, name) >= 0.0
+        except ValueError:
             ok = False
         if not ok:
             raise ValueError(f"{model}: {name} must be a finite length >= 0 (m), got {v!r}")

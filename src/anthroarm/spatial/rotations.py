@@ -38,9 +38,12 @@ def as_angle(a, name: str = "angle") -> np.ndarray:
 
 
 def as_scalar(x, name: str = "value") -> float:
-    """``x`` as one finite float; ``ValueError`` naming the value for NaN/inf or an array of
-    more than one element."""
-    arr = np.asarray(x, dtype=float)
+    """``x`` as one finite float; ``ValueError`` naming the value for NaN/inf, a non-number or
+    an array of more than one element."""
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {x!r}") from None
     if arr.size != 1:
         raise ValueError(f"{name} must be a scalar, got shape {arr.shape}")
     v = float(arr.reshape(()))
