@@ -62,6 +62,17 @@ def _dh_transform(theta, s, h, alpha) -> np.ndarray:
     return A
 
 
+_ROW_FIELDS = ("alpha", "s", "h", "theta", "offset")
+
+
+def _check_rows(rows) -> None:
+    """``ValueError`` naming the first DH row parameter that is NaN/inf (one vector test)."""
+    vals = np.array([[getattr(r, k) for k in _ROW_FIELDS] for r in rows], dtype=float)
+    if not np.isfinite(vals).all():
+        j, k = np.argwhere(~np.isfinite(vals))[0]
+        raise ValueError(f"row {j + 1} {_ROW_FIELDS[k]} must be finite, got {vals[j, k]}")
+
+
 def _row_values(rows, q2: np.ndarray, j: int):
     r = rows[j]
     if r.kind == "R":
@@ -76,8 +87,7 @@ def dh_frames(rows, q, tool=None) -> np.ndarray:
     Eq. (6-14): ``T_0k = A_01 A_12 … A_{k−1,k}``.  Shape ``(N, n+1[+1], 4, 4)``."""
     n = len(rows)
     q2, single = _as_batch(q, n)
-    for j, r in enumerate(rows):
-        finite_params(**{f"row {j + 1} {k}": getattr(r, k) for k in ("alpha", "s", "h", "theta", "offset")})
+    _check_rows(rows)
     N = q2.shape[0]
     F = np.empty((N, n + 1 + (tool is not None), 4, 4))
     F[:, 0] = np.eye(4)

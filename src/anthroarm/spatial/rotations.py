@@ -10,6 +10,8 @@ Every function accepts a scalar angle or an array of angles (the result then has
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: tolerance for |u| = 1 and for R Rᵀ = I
@@ -40,6 +42,11 @@ def as_angle(a, name: str = "angle") -> np.ndarray:
 def as_scalar(x, name: str = "value") -> float:
     """``x`` as one finite float; ``ValueError`` naming the value for NaN/inf, a non-number or
     an array of more than one element."""
+    if isinstance(x, (float, int, np.floating, np.integer)):  # fast path for plain numbers
+        v = float(x)
+        if not math.isfinite(v):
+            raise ValueError(f"{name} must be finite, got {v}")
+        return v
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
