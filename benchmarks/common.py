@@ -9,6 +9,8 @@ import time
 from pathlib import Path
 from statistics import median
 
+from anthroarm.urdf_io import atomic_write_text
+
 RESULTS_DIR = Path(__file__).resolve().parent / "results"
 
 
@@ -71,9 +73,7 @@ def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[
     result = dict(result)
     result.setdefault("environment", environment())
     jp, mp = out / f"{name}.json", out / f"{name}.md"
-    tmp = jp.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(result, indent=1, default=float))
-    os.replace(tmp, jp)
+    atomic_write_text(jp, json.dumps(result, indent=1, default=float))
     md = [f"# {result.get('title', name)}", ""]
     if result.get("notes"):
         md += [result["notes"], ""]
@@ -81,7 +81,5 @@ def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[
     env = result["environment"]
     md += ["", f"Machine: {env['processor']}, {env['cpus']} CPUs, Python {env['python']}, numpy {env['numpy']}, "
            f"pinocchio {env['pinocchio']}; {env['date']}."]
-    tmp = mp.with_suffix(".md.tmp")
-    tmp.write_text("\n".join(md) + "\n")
-    os.replace(tmp, mp)
+    atomic_write_text(mp, "\n".join(md) + "\n")
     return jp, mp
