@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -293,15 +294,17 @@ def joints_child(joints: dict, child: str) -> str:
     return "?"
 
 
-def atomic_write_text(path, text: str) -> None:
-    """Write ``text`` to ``path`` as UTF-8, atomically (temp file in the same folder, then
-    rename): a reader sees the old file or the new one, never a partial one."""
+def atomic_write_text(path, text: str | bytes) -> None:
+    """Write ``text`` (str as UTF-8, or bytes) to ``path`` atomically: a temp file in the same
+    folder, then a rename, so a reader sees the old file or the new one, never a partial one;
+    the temp file is removed on failure.  The folder must exist (``FileNotFoundError``)."""
     path = Path(path)
     if not path.parent.is_dir():
         raise FileNotFoundError(f"folder {path.parent} does not exist (cannot write {path.name})")
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
     try:
-        tmp.write_text(text, encoding="utf-8")
+        tmp.write_bytes(data)
         os.replace(tmp, path)
     finally:
         if tmp.exists():

@@ -60,7 +60,6 @@ import hashlib
 import math
 import importlib.util
 import os
-import tempfile
 import threading
 import time
 from dataclasses import dataclass, field
@@ -440,19 +439,11 @@ def cache_dir() -> Path:
 
 
 def _atomic_write(path: Path, text: str | bytes) -> None:
+    """Create the cache folder if needed, then :func:`anthroarm.urdf_io.atomic_write_text`."""
+    from ..urdf_io import atomic_write_text
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    mode = "wb" if isinstance(text, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, mode) as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    atomic_write_text(path, text)
 
 
 def _import_file(path: Path, modname: str):
