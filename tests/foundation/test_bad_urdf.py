@@ -1,8 +1,5 @@
 """Hostile and malformed URDF files: each raises a typed anthroarm exception naming the file."""
 
-import os
-from pathlib import Path
-
 import pytest
 
 import anthroarm as aa

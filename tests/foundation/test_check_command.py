@@ -4,8 +4,6 @@ import json
 import subprocess
 import sys
 
-import pytest
-
 
 def run(*args):
     return subprocess.run([sys.executable, "-m", "anthroarm.cli", *args], capture_output=True, text=True, timeout=300)
