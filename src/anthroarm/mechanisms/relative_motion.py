@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..spatial.rotations import as_angle, as_vector3, check_unit_axis, skew
+from ..spatial.rotations import as_angle, as_vector3, check_unit_axis, rot_axis, skew
 from ..spatial.screw import rotation_matrix
 
 
@@ -92,10 +92,7 @@ def relative_position(g: RelativeMotionGeometry, theta, phi, s) -> RelativePosit
     q1p = _mv(R0, g.q1 - g.p0) + g.p0
     p1p = _mv(R0, g.p1 - g.p0) + g.p0
     u = _mv(R0, g.u1)
-    # [R_{φ,u}] with a batch of axes u: Rodrigues element-wise
-    c, sn = np.cos(ph)[..., None, None], np.sin(ph)[..., None, None]
-    Pu = skew(u)
-    Ru = np.eye(3) + sn * Pu + (1.0 - c) * (Pu @ Pu)
+    Ru = rot_axis(u, ph)  # [R_{φ,u}] for the (batch of) moved axes u, Rodrigues (5-84)
     p = p1p + s[..., None] * u
     q = _mv(Ru, q1p - p1p) + p
     return RelativePosition(q, p, u, q1p, p1p)
