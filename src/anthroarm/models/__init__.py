@@ -29,9 +29,9 @@ BOOK_MODELS = {
     "planar2r": planar2r,
 }
 
-#: folder of the committed URDFs (repository checkout) — package data copy lives next to this file
+#: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
+#: installed package does not need it: book models are loaded from the generator's text
 REPO_URDF_DIR = Path(__file__).resolve().parents[3] / "urdf"
-PACKAGE_URDF_DIR = Path(__file__).resolve().parent / "urdf"
 
 
 def names() -> list[str]:
@@ -66,16 +66,17 @@ def urdf_text(name: str, **params) -> str:
 
 
 def urdf_path(name: str) -> Path:
-    """Path of the committed URDF of a catalog model (default parameters)."""
+    """Path of the URDF of a catalog model (default parameters): the example-robot-data file,
+    or for a book model the committed ``urdf/NAME.urdf`` of a source checkout (write one
+    anywhere with :func:`urdf_text` / ``anthroarm urdf``)."""
     if name in ERD_ARMS:
         return ERD_ARMS[name].urdf_path()
     if name not in BOOK_MODELS:
         raise _unknown(name)
-    for d in (PACKAGE_URDF_DIR, REPO_URDF_DIR):
-        p = d / f"{name}.urdf"
-        if p.is_file():
-            return p
-    return REPO_URDF_DIR / f"{name}.urdf"
+    p = REPO_URDF_DIR / f"{name}.urdf"
+    if not p.is_file():
+        raise FileNotFoundError(f"{p} does not exist (not a source checkout); use anthroarm.models.urdf_text({name!r})")
+    return p
 
 
 def write_urdfs(out_dir=None) -> list[Path]:
