@@ -47,6 +47,7 @@ class ArmPlan:
     spec: object
     tool: str
     model_name: str
+    c_kernel: object = None  # compiled kernel (analytic_c.CKernel), False if unavailable, None untried
 
 
 _PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

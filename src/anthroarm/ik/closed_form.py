@@ -36,12 +36,14 @@ Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool fra
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import UnsupportedModelError
+from . import analytic_c as _c
 from . import analytic_scalar as ks
 from . import analytic_soa as _soa
 from .analytic_plan import plan_for
@@ -665,7 +667,7 @@ def _swivel_array(swivel, N, grid_1d=False):
 
 def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
                    tol: float = 1e-9, tol_orthonormal: float = 1e-6,
-                   _single_grid: bool = False, _fast: bool = True) -> AnalyticBatchResult:
+                   _single_grid: bool = False, _impl: str = "auto") -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see module docstring).
 
     Candidates are wrapped into the joint limits (multiples of 2π), rejected if outside, and
@@ -678,15 +680,17 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) and
     :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form.
 
-    Plainly valid (N, 4, 4) float arrays go through the structure-of-arrays kernels of
-    :mod:`.analytic_soa` (same formulas, branches and checks; FK verification by the generated
-    chain product of :mod:`.fk_codegen`); anything else through the general path below
-    (``_fast=False`` forces it)."""
+    Plainly valid (N, 4, 4) float arrays go through the compiled kernel of :mod:`.analytic_c`
+    if a C compiler is available, else through the structure-of-arrays kernels of
+    :mod:`.analytic_soa` (same formulas, branches and checks; FK verification by the chain
+    product generated from the spec, :mod:`.fk_codegen`); anything else through the general
+    path below.  ``_impl`` (private, for tests and benchmarks): "auto", "c", "python" (the numpy
+    kernels) or "general"."""
     name, prm = _require(robot)
     if position_only is None:
         position_only = name == "planar2r"
-    fast = _soa_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal,
-                           _single_grid) if _fast else None
+    fast = _fast_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal,
+                            _single_grid, _impl)
     if fast is not None:
         Qw, valid, code, inside, res, sing, swv, labels = fast
         N, B = valid.shape
@@ -717,33 +721,66 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     sol = np.where(valid[..., None], Qw, np.nan)
     reasons = [None] * N
     fails = np.flatnonzero(~valid.any(1))
+    sing = list(sing)
     for i in fails:
         reasons[i] = _reason_for(code[i], inside[i], res[i], tol, robot)
+        if not (code[i] == OK).any():
+            sing[i] = None      # outside the workspace: no configuration, nothing singular about it
     return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swv is None else np.where(valid, swv, np.nan),
-                               residuals=np.where(valid, res, np.nan), singular=list(sing), model=name)
+                               residuals=np.where(valid, res, np.nan), singular=sing, model=name)
 
 
-def _soa_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal, single_grid):
-    """Candidates of :func:`analytic_batch` from :func:`.analytic_soa.solve`, or None where the
-    general path must answer (not a plain (N, 4, 4) float64 array, any invalid pose — the general
-    path raises the error —, N = 0)."""
-    if type(T) is not np.ndarray or T.dtype != np.float64 or T.ndim != 3 or T.shape[1:] != (4, 4) \
-            or T.shape[0] == 0:
+def _kernel(plan, impl):
+    """The compiled kernel for ``impl`` "auto" (if available) or "c" (required), else None."""
+    if impl == "auto":
+        return _c.kernel_for(plan)
+    if impl == "c":
+        k = _c.kernel_for(plan)
+        if k is None:
+            raise RuntimeError(f"compiled IK kernel requested but unavailable: {_c.status()}")
+        return k
+    if impl in ("python", "general"):
         return None
-    E = _soa.pose_rows(T)
-    if not _soa.poses_ok(E, tol_orthonormal, position_only):
+    raise ValueError(f"_impl must be 'auto', 'c', 'python' or 'general', got {impl!r}")
+
+
+@functools.lru_cache(maxsize=64)
+def _labels(name: str, S: int) -> tuple:
+    if name == "human_arm7" and S > 1:
+        return tuple(f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES)
+    return tuple(_SCALAR_BRANCHES[name])
+
+
+def _fast_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal, single_grid, impl):
+    """Candidates of :func:`analytic_batch` from the compiled kernel or from
+    :func:`.analytic_soa.solve`, or None where the general path must answer (``impl`` "general",
+    not a plain (N, 4, 4) float64 array, any invalid pose — the general path raises the error —,
+    N = 0)."""
+    if impl == "general":
+        return None
+    if type(T) is not np.ndarray or T.dtype != np.float64 or T.ndim != 3 or T.shape[1:] != (4, 4) \
+            or T.shape[0] == 0 or not isinstance(tol, (float, int)) \
+            or not isinstance(tol_orthonormal, (float, int)):
         return None
     N = T.shape[0]
-    sw = _swivel_array(swivel, N, grid_1d=single_grid) if name == "human_arm7" else None
     plan = plan_for(robot, name, prm)
-    Qw, valid, code, inside, res, sing, bshape = _soa.solve(name, plan, E, tol, position_only, sw)
-    if name == "human_arm7":
-        S = sw.shape[1]
-        labels = [f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES] if S > 1 else list(HUMAN_BRANCHES)
-        swv = np.repeat(sw, 8, axis=1)
+    kern = _kernel(plan, impl)
+    sw = _swivel_array(swivel, N, grid_1d=single_grid) if name == "human_arm7" else None
+    if kern is not None:
+        out = kern.batch(T, sw, tol, int(position_only), tol_orthonormal)
+        if out is None:
+            return None
+        Qw, valid, inside, res, code, sing = out
+        code = np.broadcast_to(code[:, None], valid.shape)
+        sing = _SING_ARRAYS[name][sing]
     else:
-        labels, swv = list(_SCALAR_BRANCHES[name]), None
+        E = _soa.pose_rows(T)
+        if not _soa.poses_ok(E, tol_orthonormal, position_only):
+            return None
+        Qw, valid, code, inside, res, sing, _ = _soa.solve(name, plan, E, tol, position_only, sw)
+    labels = list(_labels(name, 1 if sw is None else sw.shape[1]))
+    swv = np.repeat(sw, 8, axis=1) if sw is not None else None
     return Qw, valid, code, inside, res, sing, swv, labels
 
 
@@ -763,7 +800,7 @@ def _reason_for(code, inside, res, tol, robot) -> str:
 
 
 def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-             tol_orthonormal: float = 1e-6, method: str = "robust"):
+             tol_orthonormal: float = 1e-6, method: str = "robust", _impl: str = "auto"):
     """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
 
     ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
@@ -785,24 +822,24 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         return _book_result(robot, Ts[0], prm, tol)
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
-    if arr.ndim == 2:
-        fast = _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal)
+    if arr.ndim == 2 and _impl != "general":
+        fast = _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, _impl)
         if fast is not None:
             return fast
     return _analytic_general(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                             tol_orthonormal=tol_orthonormal)
+                             tol_orthonormal=tol_orthonormal, _impl=_impl)
 
 
 def _analytic_general(robot, arr, *, swivel=None, position_only=None, tol=1e-9, tol_orthonormal=1e-6,
-                      _fast=True):
-    """:func:`analytic` without the scalar fast path: the vectorised batch code on one pose
-    (``_fast=False``: the general path, the reference of the fast paths' tests)."""
+                      _impl="auto"):
+    """:func:`analytic` through :func:`analytic_batch` (one pose = a batch of one; ``_impl``
+    "general": the general path, the reference of the fast paths' tests)."""
     arr = np.asarray(arr, dtype=float)
     if arr.ndim == 3:
         return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                              tol_orthonormal=tol_orthonormal, _fast=_fast)
+                              tol_orthonormal=tol_orthonormal, _impl=_impl)
     batch = analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                           tol_orthonormal=tol_orthonormal, _single_grid=True, _fast=_fast)
+                           tol_orthonormal=tol_orthonormal, _single_grid=True, _impl=_impl)
     return batch[0]
 
 
@@ -811,16 +848,22 @@ _SCALAR_BRANCHES = {"sixr_arm": SIXR_BRANCHES, "prosthetic_arm": PROSTHETIC_BRAN
                     "planar2r": PLANAR_BRANCHES, "human_arm7": HUMAN_BRANCHES}
 
 
-def _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal):
-    """:func:`analytic` of one plainly valid pose with the scalar kernels of
-    :mod:`.analytic_scalar`; None where the vectorised path must answer (unsupported robot,
-    anything unusual in the input — it raises the error —, a swivel grid)."""
-    if not has_analytic(robot) or type(arr) is not np.ndarray or arr.dtype != np.float64:
+def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, impl):
+    """:func:`analytic` of one pose by the compiled kernel (:mod:`.analytic_c`) or the scalar
+    kernels (:mod:`.analytic_scalar`); None where the vectorised path must answer (unsupported
+    robot, anything unusual in the input — it raises the error —; the scalar kernels also leave
+    swivel grids to it)."""
+    if not has_analytic(robot) or type(arr) is not np.ndarray or arr.dtype != np.float64 \
+            or not isinstance(tol, (float, int)) or not isinstance(tol_orthonormal, (float, int)):
         return None
     name = robot.spec.name
     if position_only is None:
         position_only = name == "planar2r"
+    plan = plan_for(robot, name, robot.spec.params)
     if arr.shape == (4, 4):
+        kern = _kernel(plan, impl)
+        if kern is not None:
+            return _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonormal)
         rows = arr.tolist()
         r3 = rows[3]
         if not math.isfinite(sum(rows[0]) + sum(rows[1]) + sum(rows[2]) + sum(r3)):
@@ -836,9 +879,6 @@ def _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal):
         rows = [[1.0, 0.0, 0.0, x], [0.0, 1.0, 0.0, y], [0.0, 0.0, 1.0, z]]
     else:
         return None
-    if not isinstance(tol, (float, int)):
-        return None
-    plan = plan_for(robot, name, robot.spec.params)
     if name == "human_arm7":
         if swivel is None:
             return None                                   # a grid: the vectorised path
@@ -887,6 +927,52 @@ def _analytic_scalar(robot, arr, swivel, position_only, tol, tol_orthonormal):
         swivel=None if name != "human_arm7" else np.full(len(sols), sw),
         residuals=np.array([s[2] for s in sols]),
         singular=cand.singular, model=name)
+
+
+#: singular-configuration messages by the kernels' codes (0: none)
+_SING_TEXT = {
+    "sixr_arm": (None, "wrist singularity (sin θ5 = 0: only θ4 + θ6 is determined; θ4 = 0 returned)",
+                 "shoulder singularity (wrist centre on the z0 axis: θ1 is free; θ1 = 0 returned)"),
+    "prosthetic_arm": (None, "elbow singularity (straight arm, sin θ4 = 0: θ3 + θ5 only determined; θ3 = 0 returned)",
+                       "shoulder singularity (elbow on the vertical axis: θ1 is free; θ1 = -90° returned)"),
+    "human_arm7": (None, "straight elbow: the swivel angle then turns the elbow axis about the arm"),
+    "planar2r": (None,),
+}
+_SING_ARRAYS = {k: np.array(v, dtype=object) for k, v in _SING_TEXT.items()}
+
+
+def _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonormal):
+    """One pose through the compiled kernel (validation, candidates, FK check, duplicates in C)."""
+    sw = None
+    if name == "human_arm7":
+        if isinstance(swivel, (float, int)):
+            sw = (float(swivel),)
+            if not math.isfinite(sw[0]):
+                return None
+        else:
+            sw = _swivel_array(swivel, 1, grid_1d=True)[0]           # ValueError as the general path
+            if sw.size > _c.MAX_SINGLE_S:
+                return None
+    out = kern.single(arr, sw, tol, int(position_only), tol_orthonormal)
+    if out is None:
+        return None
+    code, sing, bl, sols, res, (arrs, S) = out
+    nq = kern.nq
+    sing_text = _SING_TEXT[name][sing]
+    if code != OK or not bl:
+        if code != OK:
+            reason = _REASONS[code]
+        else:
+            B = kern.nb * S
+            reason = _reason_for(np.zeros(B, dtype=int), arrs["inside"][:B].astype(bool), arrs["res"][:B].copy(),
+                                 tol, robot)
+        return AnalyticIKResult(np.zeros((0, nq)), [], reason, swivel=None if sw is None else np.zeros(0),
+                                residuals=np.zeros(0), singular=sing_text, model=name)
+    labels = _labels(name, S)
+    return AnalyticIKResult(
+        solutions=sols, branches=[labels[b] for b in bl], reason=None,
+        swivel=None if sw is None else np.array([sw[b // 8] for b in bl], dtype=float),
+        residuals=res, singular=sing_text, model=name)
 
 
 def _dedup_scalar(sols):

@@ -26,6 +26,7 @@ position entries, a tuple); the last stage instead returns the FK residual
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -42,11 +43,12 @@ def _clean(x: float) -> float:
 
 
 class _Emitter:
-    """Builds statements; a value is a Python float (constant) or a variable name (str)."""
+    """Builds statements (name, expression); a value is a Python float (constant) or a variable
+    name (str), possibly lazily negated ("-name")."""
 
-    def __init__(self):
-        self.lines: list[str] = []
-        self.n = 0
+    def __init__(self, start: int = 0):
+        self.body: list[tuple] = []
+        self.n = start
 
     def combo(self, terms) -> float | str:
         """Σ coef · Π factors as one statement; terms: list of (coef, [factors])."""
@@ -83,7 +85,7 @@ class _Emitter:
             expr += f" + {const!r}" if const > 0 else f" - {-const!r}"
         name = f"t{self.n}"
         self.n += 1
-        self.lines.append(f"    {name} = {expr}")
+        self.body.append(("assign", name, expr))
         return name
 
 
@@ -92,100 +94,184 @@ def _mat_const(em, R, C):
     return [[em.combo([(C[k][j], [R[i][k]]) for k in range(3)]) for j in range(3)] for i in range(3)]
 
 
+def _chain_stages(spec, bounds, position_only) -> list[dict]:
+    """The symbolic chain product, stage by stage: for each stage its joints ``q`` (names), the
+    incoming state names ``state_in``, the statements ``body`` (("assign", name, expr) or
+    ("trig", j, q)), and either ``state_out`` (names) or, on the last stage, ``diffs``: the
+    12 (or 3, position only) expressions ±(FK entry − T entry)."""
+    R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    p = [0.0, 0.0, 0.0]
+    stages = []
+    state_in: list[str] = []
+    for st in range(len(bounds) - 1):
+        em = _Emitter(1000 * st)  # unique temporaries across stages
+        for j in range(bounds[st], bounds[st + 1]):
+            jt = spec.joints[j]
+            O = [[_clean(x) for x in row] for row in np.asarray(jt.origin, float)[:3, :3]]
+            po = [_clean(x) for x in np.asarray(jt.origin, float)[:3, 3]]
+            p = [em.combo([(1.0, [p[i]])] + [(po[k], [R[i][k]]) for k in range(3)]) for i in range(3)]
+            R = _mat_const(em, R, O)
+            ax = np.asarray(jt.axis, float)
+            ax = ax / np.linalg.norm(ax)
+            k = int(np.argmax(np.abs(ax)))
+            if abs(abs(ax[k]) - 1.0) > 1e-12:
+                raise NotImplementedError(f"joint {jt.name}: axis {tuple(ax)} is not ±x/±y/±z")
+            sg = 1.0 if ax[k] > 0 else -1.0
+            q = f"q{j}"
+            if jt.type == "prismatic":
+                p = [em.combo([(1.0, [p[i]]), (sg, [R[i][k], q])]) for i in range(3)]
+                continue
+            em.body.append(("trig", j, q))
+            c, s = f"c{j}", f"s{j}"
+            a, b = [(1, 2), (2, 0), (0, 1)][k]  # rotation about e_k mixes columns a, b
+            Rn = [row[:] for row in R]
+            for i in range(3):
+                Rn[i][a] = em.combo([(1.0, [R[i][a], c]), (sg, [R[i][b], s])])
+                Rn[i][b] = em.combo([(1.0, [R[i][b], c]), (-sg, [R[i][a], s])])
+            R = Rn
+        stage = {"q": [f"q{j}" for j in range(bounds[st], bounds[st + 1])], "state_in": state_in,
+                 "body": em.body}
+        if st == len(bounds) - 2:
+            tp = [_clean(x) for x in np.asarray(spec.tool_origin, float)[:3, 3]]
+            tR = [[_clean(x) for x in row] for row in np.asarray(spec.tool_origin, float)[:3, :3]]
+            p = [em.combo([(1.0, [p[i]])] + [(tp[k], [R[i][k]]) for k in range(3)]) for i in range(3)]
+            diffs = [_diff(p[i], f"T{i}3") for i in range(3)]
+            if not position_only:
+                R = _mat_const(em, R, tR)
+                diffs += [_diff(R[i][j], f"T{i}{j}") for i in range(3) for j in range(3)]
+            stage["diffs"] = diffs
+        else:
+            state_out = []
+            for v in [v for row in R for v in row] + p:
+                if isinstance(v, str) and v.lstrip("-") not in state_out:
+                    state_out.append(v.lstrip("-"))
+            stage["state_out"] = state_out
+            state_in = state_out  # names stay the same across the boundary
+        _drop_dead(stage)
+        stages.append(stage)
+    return stages
+
+
+_IDENT = re.compile(r"[A-Za-z_]\w*")
+
+
+def _drop_dead(stage: dict) -> None:
+    """Remove statements whose results are not used (e.g. the rotation in a position-only check)."""
+    needed = set()
+    for x in stage.get("diffs", ()) or stage.get("state_out", ()):
+        needed.update(_IDENT.findall(x))
+    keep = []
+    for item in reversed(stage["body"]):
+        if item[0] == "trig":
+            j = item[1]
+            if f"c{j}" in needed or f"s{j}" in needed:
+                keep.append(item)
+                needed.add(item[2])
+        elif item[1] in needed:
+            keep.append(item)
+            needed.update(_IDENT.findall(item[2]))
+    stage["body"] = keep[::-1]
+
+
+_T_NAMES = ["T00", "T01", "T02", "T03", "T10", "T11", "T12", "T13", "T20", "T21", "T22", "T23"]
+
+
+def _render_python(stages, vectorised: bool) -> str:
+    """Python source: ``stage{k}([st,] q..., [T])``; math or numpy names are bound at exec."""
+    src = []
+    for k, stg in enumerate(stages):
+        args = (["st"] if stg["state_in"] else []) + stg["q"] + (["T"] if "diffs" in stg else [])
+        lines = [f"def stage{k}({', '.join(args)}):"]
+        if stg["state_in"]:
+            lines.append(f"    {', '.join(stg['state_in'])}{',' if len(stg['state_in']) == 1 else ''} = st")
+        if "diffs" in stg:
+            lines.append(f"    {', '.join(_T_NAMES)} = T")
+        for item in stg["body"]:
+            if item[0] == "trig":
+                j, q = item[1], item[2]
+                lines.append(f"    c{j}, s{j} = cos_sin({q})" if vectorised else f"    c{j} = cos({q})\n    s{j} = sin({q})")
+            else:
+                lines.append(f"    {item[1]} = {item[2]}")
+        if "diffs" in stg:
+            d = stg["diffs"]
+            if vectorised:
+                lines.append(f"    return _max({', '.join(f'_abs({x})' for x in d)})")
+            else:  # plain comparisons beat 12 abs() calls and a 12-argument max() in CPython
+                lines.append(f"    r = _abs({d[0]})")
+                for x in d[1:]:
+                    lines += [f"    d = {x}", "    if d > r:", "        r = d", "    elif -d > r:", "        r = -d"]
+                lines.append("    return r")
+        else:
+            so = stg["state_out"]
+            lines.append(f"    return ({', '.join(so)}{',' if len(so) == 1 else ''})")
+        src += lines + [""]
+    return "\n".join(src) + "\n"
+
+
+def _render_c(stages, prefix: str) -> str:
+    """C99 source: ``void {prefix}{k}(const double *st, const double *q, double *out)`` for the
+    inner stages (``out`` = new state), ``double {prefix}{last}(const double *st, const double *q,
+    const double *T)`` (T = the 12 entries of the 3×4 pose, row-major) returning the residual."""
+    src = []
+    for k, stg in enumerate(stages):
+        last = "diffs" in stg
+        head = (f"static double {prefix}{k}(const double *st, const double *q, const double *T)" if last else
+                f"static void {prefix}{k}(const double *st, const double *q, double *out)")
+        used = set()
+        for item in stg["body"]:
+            used.update(_IDENT.findall(item[2]))
+        for x in stg.get("diffs", ()) or stg.get("state_out", ()):
+            used.update(_IDENT.findall(x))
+        lines = [head + " {", "    (void)st; (void)q;"]
+        lines += [f"    const double {n} = st[{i}];" for i, n in enumerate(stg["state_in"]) if n in used]
+        lines += [f"    const double {n} = q[{i}];" for i, n in enumerate(stg["q"]) if n in used]
+        if last:
+            lines += [f"    const double {n} = T[{i}];" for i, n in enumerate(_T_NAMES) if n in used]
+        for item in stg["body"]:
+            if item[0] == "trig":
+                j, q = item[1], item[2]
+                lines.append(f"    double c{j}, s{j};")
+                lines.append(f"    sincos({q}, &s{j}, &c{j});")
+            else:
+                lines.append(f"    const double {item[1]} = {item[2]};")
+        if last:
+            d = stg["diffs"]
+            lines.append(f"    double r = fabs({d[0]}), d;")
+            for x in d[1:]:
+                lines.append(f"    d = {x}; if (d > r) r = d; else if (-d > r) r = -d;")
+            lines.append("    return r;")
+        else:
+            lines += [f"    out[{i}] = {n};" for i, n in enumerate(stg["state_out"])]
+        src += lines + ["}", ""]
+    return "\n".join(src) + "\n"
+
+
 class FKStages:
     """Generated FK of one spec, split into stages at the given joint indices.
 
     ``splits`` lists the first joint of each stage after the first, e.g. ``(1, 3)`` for the 6R
-    arm: stage 0 = joint 0, stage 1 = joints 1–2, stage 2 = joints 3–5 (+ tool, residual)."""
+    arm: stage 0 = joint 0, stage 1 = joints 1–2, stage 2 = joints 3–5 (+ tool, residual).
+    ``scalar`` / ``numpy``: the compiled Python stage functions; :meth:`c_source` the C text."""
 
     def __init__(self, spec, splits, position_only: bool = False):
         bounds = [0, *splits, len(spec.joints)]
         self.splits = tuple(splits)
         self.position_only = position_only
         self.n_stages = len(bounds) - 1
-        self.source = self._generate(spec, bounds, position_only, "    c{j} = cos({q})\n    s{j} = sin({q})", False)
-        self.source_numpy = self._generate(spec, bounds, position_only, "    c{j}, s{j} = cos_sin({q})", True)
-        self.scalar = self._compile(self.source, {"cos": math.cos, "sin": math.sin, "_max": max, "_abs": abs})
+        self.stages = _chain_stages(spec, bounds, position_only)
+        self.state_sizes = [len(s.get("state_out", ())) for s in self.stages]
+        self.source = _render_python(self.stages, vectorised=False)
+        self.source_numpy = _render_python(self.stages, vectorised=True)
+        self.scalar = self._compile(self.source, {"cos": math.cos, "sin": math.sin, "_abs": abs})
         self.numpy = self._compile(self.source_numpy, {"cos_sin": cos_sin, "_abs": np.abs, "_max": _np_max})
+
+    def c_source(self, prefix: str) -> str:
+        return _render_c(self.stages, prefix)
 
     def _compile(self, source, ns):
         ns = dict(ns)
         exec(compile(source, "<fk_codegen>", "exec"), ns)
         return [ns[f"stage{k}"] for k in range(self.n_stages)]
-
-    @staticmethod
-    def _generate(spec, bounds, position_only, trig, vectorised) -> str:
-        R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-        p = [0.0, 0.0, 0.0]
-        src = []
-        state_in: list[str] = []
-        for st in range(len(bounds) - 1):
-            em = _Emitter()
-            em.n = 1000 * st  # unique temporaries across stages
-            qnames = [f"q{j}" for j in range(bounds[st], bounds[st + 1])]
-            for j in range(bounds[st], bounds[st + 1]):
-                jt = spec.joints[j]
-                O = [[_clean(x) for x in row] for row in np.asarray(jt.origin, float)[:3, :3]]
-                po = [_clean(x) for x in np.asarray(jt.origin, float)[:3, 3]]
-                p = [em.combo([(1.0, [p[i]])] + [(po[k], [R[i][k]]) for k in range(3)]) for i in range(3)]
-                R = _mat_const(em, R, O)
-                ax = np.asarray(jt.axis, float)
-                ax = ax / np.linalg.norm(ax)
-                k = int(np.argmax(np.abs(ax)))
-                if abs(abs(ax[k]) - 1.0) > 1e-12:
-                    raise NotImplementedError(f"joint {jt.name}: axis {tuple(ax)} is not ±x/±y/±z")
-                sg = 1.0 if ax[k] > 0 else -1.0
-                q = f"q{j}"
-                if jt.type == "prismatic":
-                    p = [em.combo([(1.0, [p[i]]), (sg, [R[i][k], q])]) for i in range(3)]
-                    continue
-                em.lines.append(trig.format(j=j, q=q))
-                c, s = f"c{j}", f"s{j}"
-                a, b = [(1, 2), (2, 0), (0, 1)][k]  # rotation about e_k mixes columns a, b
-                Rn = [row[:] for row in R]
-                for i in range(3):
-                    Rn[i][a] = em.combo([(1.0, [R[i][a], c]), (sg, [R[i][b], s])])
-                    Rn[i][b] = em.combo([(1.0, [R[i][b], c]), (-sg, [R[i][a], s])])
-                R = Rn
-            last = st == len(bounds) - 2
-            if last:
-                tp = [_clean(x) for x in np.asarray(spec.tool_origin, float)[:3, 3]]
-                tR = [[_clean(x) for x in row] for row in np.asarray(spec.tool_origin, float)[:3, :3]]
-                p = [em.combo([(1.0, [p[i]])] + [(tp[k], [R[i][k]]) for k in range(3)]) for i in range(3)]
-                if not position_only:
-                    R = _mat_const(em, R, tR)
-            # function header: previous state + this stage's joints (+ the target on the last stage)
-            args = []
-            if state_in:
-                args.append("st")
-            args += qnames
-            if last:
-                args.append("T")
-            head = [f"def stage{st}({', '.join(args)}):"]
-            if state_in:
-                head.append(f"    {', '.join(state_in)}{',' if len(state_in) == 1 else ''} = st")
-            if last:
-                head.append("    T00, T01, T02, T03, T10, T11, T12, T13, T20, T21, T22, T23 = T")
-                diffs = [_diff(p[i], f"T{i}3") for i in range(3)]
-                if not position_only:
-                    diffs += [_diff(R[i][j], f"T{i}{j}") for i in range(3) for j in range(3)]
-                if vectorised:
-                    tail = [f"    return _max({', '.join(f'_abs({d})' for d in diffs)})"]
-                else:  # plain comparisons beat 12 abs() calls and a 12-argument max() in CPython
-                    tail = [f"    r = _abs({diffs[0]})"]
-                    for d in diffs[1:]:
-                        tail += [f"    d = {d}", "    if d > r:", "        r = d", "    elif -d > r:", "        r = -d"]
-                    tail += ["    return r"]
-            else:
-                state_out = []
-                for v in [v for row in R for v in row] + p:
-                    if isinstance(v, str) and v.lstrip("-") not in state_out:
-                        state_out.append(v.lstrip("-"))
-                # keep state names stable across the boundary
-                tail = [f"    return ({', '.join(state_out)}{',' if len(state_out) == 1 else ''})"]
-                state_in = state_out
-            src += head + em.lines + tail + [""]
-        return "\n".join(src) + "\n"
 
 
 def _diff(v, t: str) -> str:
