@@ -1,37 +1,44 @@
 """One-shot inverse kinematics: ``aa.ik.solve(robot, T)`` -> :class:`~anthroarm.ik.result.IKResult`.
 
-Method: damped Gauss–Newton (Levenberg–Marquardt) on the pose error with projected (clipped)
-steps, and random restarts inside the joint limits under a time budget.  Per iteration:
+Method: damped Gauss–Newton (Levenberg–Marquardt) on the pose error with projected steps,
+seeds from a table of the arm's own poses, and restarts inside the joint limits under a time
+budget.  Per iteration (world frame, m and rad):
 
-    e = log₆(T(q)⁻¹ T*)  (body twist, m and rad),   J = ᵇJ(q)  (LOCAL frame Jacobian),
+    e = (p* − p ; log₃(R* Rᵀ)),   J = ᵂJ(q)  (LOCAL_WORLD_ALIGNED frame Jacobian, rows (v; ω)),
     Δq = Jᵀ (J Jᵀ + λ I)⁻¹ e,   λ = λ₀ + k ‖e‖²   (Chan / Sugihara damping),
     q ← clip(q + Δq, q_min, q_max).
 
 This is the book's feedback-compensation Newton step Δq = J⁻¹ e (Ch. 7 §7-5) made robust: the
 damping is the λ → ∞ blend toward the steepest-descent direction Jᵀe of §7-6 (A9) when the
 error is large or J is singular, and vanishes near the solution (quadratic convergence).
-Joint ranges, the penalty constraints g_i(Q) ≥ 0 of (7-84)–(7-85), are enforced exactly by
-the projection.  An attempt stops when the error no longer falls by 10 % in three iterations;
-the next seed is then tried.
+Joint ranges, the penalty constraints g_i(Q) ≥ 0 of (7-84)–(7-85), are enforced exactly: a
+joint whose step would cross its limit is frozen for that step and the step is recomputed
+with the other joints (an active set; plain clipping let those joints stall the attempt),
+then the result is clipped.  An attempt stops when the error no longer falls by 10 % in three
+iterations; the next seed is then tried.
 
-Seeds, in order: ``q0`` (clipped into the limits; default the comfortable posture of a human
-arm or the middle of the joint ranges), the closed-form branches of :func:`anthroarm.ik.analytic`
-when the robot has one, then uniform random configurations inside the limits until
-``max_time`` or ``max_restarts``.  ``analytic="auto"`` brings the closed-form seeds in only after
-:data:`ANALYTIC_AFTER` failed attempts: measured on 300 random poses, a closed-form call costs
-0.4 ms (prosthetic_arm, all branches) to 6 ms (human_arm7, 36-angle swivel grid) against a
-median 0.1–0.2 ms for the whole Gauss–Newton solve, so seeding with them first made the
-median 4–20× slower at the same 100 % success; ``analytic=True`` puts them first anyway.
+Seeds, in order: ``q0`` when given (clipped into the limits), otherwise the configuration of a
+seed table (:data:`SEED_TABLE` configurations drawn once per robot and frame, uniformly inside
+the limits from a fixed RNG seed, with their frame poses) whose pose is nearest the target,
+measured as ‖p − p*‖² + w²‖R − R*‖²_F (w = :data:`SEED_ROT_WEIGHT` × reach), which is linear
+in the table's entries, so the lookup is one matrix–vector product; then the next nearest
+table entries, then uniform random configurations inside the limits until ``max_time`` or
+``max_restarts``.  The closed-form branches of :func:`anthroarm.ik.analytic` join after
+:data:`ANALYTIC_AFTER` failed attempts (``analytic="auto"``; a closed-form call costs 0.4–6 ms
+against ~0.05 ms for a whole Gauss–Newton solve) or first (``analytic=True``).
 
-Targets: a 4×4 rigid pose (``mode="pose"``), a position (3,) (``"position"``: error p* − p in
-the world frame, LOCAL_WORLD_ALIGNED linear Jacobian rows) or a rotation (3, 3)
-(``"orientation"``: log₃(Rᵀ R*), LOCAL angular rows).  A leading batch axis solves N targets
-(:class:`~anthroarm.ik.result.IKBatchResult`).
+Targets: a 4×4 rigid pose (``mode="pose"``), a position (3,) (``"position"``: e = p* − p, the
+linear rows of J) or a rotation (3, 3) (``"orientation"``: e = log₃(R* Rᵀ), the angular rows).
+A leading batch axis solves N targets (:class:`~anthroarm.ik.result.IKBatchResult`).
 
-Redundant arms (human arm): ``posture`` adds a secondary objective in the null space of the
-primary task, Δq += N (q_ref − q − Δq), N = I − Jᵀ(JJᵀ + λI)⁻¹J, so the arm settles at the
-solution nearest the comfortable reference posture; ``swivel=φ*`` instead places the elbow at
-the swivel angle φ* (:mod:`anthroarm.ik.qp.tasks.swivel`).
+Redundant arms (human arm): ``posture`` adds a secondary objective ½‖q − q_ref‖² in the null
+space of the primary task: from a solution, Δq = J⁺e + N s with N = I − Jᵀ(JJᵀ + λI)⁻¹J, until
+the null-space step is below :data:`NULL_TOL`.  With a one-dimensional null space (a 7-DOF arm
+on a 6-D pose) the step along the self-motion is a secant (quasi-Newton) step on the posture
+cost, which converges superlinearly where the plain projected-gradient step s = q_ref − q
+converges linearly (slowly where the self-motion curve bends).  The table seed of such a
+problem also penalises ‖q − q_ref‖, so the first solution starts near the comfortable one.
+``swivel=φ*`` instead places the elbow at the swivel angle φ* (:mod:`anthroarm.ik.qp.tasks.swivel`).
 """
 
 from __future__ import annotations
@@ -54,15 +61,26 @@ from .result import IKBatchResult, IKResult
 
 LOCAL = pin.ReferenceFrame.LOCAL
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+_log3 = pin.log3
+_log6 = pin.log6
+_cjj = pin.computeJointJacobians
+_ufp = pin.updateFramePlacement
+_gfj = pin.getFrameJacobian
 
 #: Gauss–Newton settings (tuned on panda / ur5 / talos_arm / human_arm7 / prosthetic_arm).
 LAMBDA0 = 1e-10   # floor of the damping (keeps JJᵀ + λI positive definite at singularities)
 K_DAMP = 0.01     # λ grows with the squared error: large errors -> short, gradient-like steps
 MAX_ITER = 60     # iterations per attempt (before the stall test ends it earlier)
 STALL = 3         # an attempt ends after STALL iterations without a 10 % error decrease
+SEED_TABLE = 2048       # configurations in the per-(robot, frame) seed table
+SEED_TABLE_RNG = 20231  # its fixed RNG seed (the table, and so every answer, is reproducible)
+SEED_ROT_WEIGHT = 0.25  # w / reach in the seed distance ‖Δp‖² + w²‖ΔR‖²_F
+SEED_POSTURE_WEIGHT = 0.05  # w_q / reach: + w_q²‖q − q_ref‖² in that distance for posture problems
+TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
 NULL_TOL = 1e-4   # posture / swivel secondary step norm (rad) under which it has settled
 NULL_EXTRA = 60   # extra iterations allowed for the secondary objective
 NULL_STEP = 1.0   # longest null-space step (rad)
+SECANT_RANGE = (0.1, 10.0)  # accepted curvature estimates of the secant null-space step
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
 LOCKSTEP_MIN = 8      # batches at least this large iterate all targets together (vectorised LM)
 LOCKSTEP_ATTEMPTS = 10 # attempts per target in lockstep; the rest go to the one-target solver
@@ -76,9 +94,13 @@ _CHAINS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 #: is descheduled.
 _clock = time.thread_time
 
+_POSE, _POSITION, _ORIENTATION = 0, 1, 2
+_KIND = {"pose": _POSE, "position": _POSITION, "orientation": _ORIENTATION}
+
 
 class _Chain:
-    """Per (robot, frame) workspace: model, own data, limits, reach bound."""
+    """Per (robot, frame) workspace: model, own data, limits, reach bound, seed table and the
+    preallocated arrays of the Gauss–Newton kernel."""
 
     def __init__(self, robot, fid: int):
         model = robot.model
@@ -108,9 +130,56 @@ class _Chain:
         self.reach = reach
         self.path = [model.joints[j].idx_q for j in model.supports[jid][1:]]
         self.default_ref = comfortable_posture(robot)
+        # kernel workspace: J Jᵀ + λI is built in place (its diagonal is a view) and handed to
+        # LAPACK as its transpose (Fortran order, symmetric) so that dposv factorises in place
+        self.A = {m: np.empty((m, m)) for m in (3, 6)}
+        self.AF = {m: a.T for m, a in self.A.items()}
+        self.Ad = {m: a.reshape(-1)[:: m + 1] for m, a in self.A.items()}
+        self.e6 = np.empty(6)
+        self._table = None
+        self._penalty = {}
 
     def clip(self, q):
         return np.minimum(np.maximum(q, self.lo), self.hi)
+
+    def random(self, gen, size=None):
+        if gen[0] is None:
+            gen[0] = np.random.default_rng(gen[1])
+        return self.lo_s + (self.hi_s - self.lo_s) * gen[0].random(self.n if size is None else (size, self.n))
+
+    # ------------------------------------------------------------------ seed table
+    def table(self):
+        """(Q (K, n), F (K, 12), c (K,), P (K, 3), R (K, 9)): configurations, pose features
+        (in the layout of ``T[:3].ravel()``: rotation rows weighted 2w², translations 2) and
+        |p|², so that ‖Δp‖² + w²‖ΔR‖²_F = c − F·x + const for x = T*[:3].ravel()."""
+        if self._table is None:
+            rng = np.random.default_rng(SEED_TABLE_RNG)
+            Q = self.lo_s + (self.hi_s - self.lo_s) * rng.random((SEED_TABLE, self.n))
+            H = np.empty((SEED_TABLE, 3, 4))
+            model, data, fid = self.model, self.data, self.fid
+            for k, q in enumerate(Q):
+                pin.framesForwardKinematics(model, data, q)
+                H[k] = data.oMf[fid].homogeneous[:3]
+            w2 = (SEED_ROT_WEIGHT * max(self.reach, 1e-3)) ** 2
+            F = H.copy()
+            F[:, :, :3] *= 2.0 * w2
+            F[:, :, 3] *= 2.0
+            P = H[:, :, 3].copy()
+            self._table = (Q, F.reshape(SEED_TABLE, 12), (P * P).sum(1), P, H[:, :, :3].reshape(SEED_TABLE, 9).copy())
+        return self._table
+
+    def posture_penalty(self, q_ref):
+        """w_q²‖Q − q_ref‖² over the table (cached per q_ref)."""
+        key = q_ref.tobytes()
+        pen = self._penalty.get(key)
+        if pen is None:
+            Q = self.table()[0]
+            wq2 = (SEED_POSTURE_WEIGHT * max(self.reach, 1e-3)) ** 2
+            pen = wq2 * ((Q - q_ref) ** 2).sum(1)
+            if len(self._penalty) > 16:
+                self._penalty.clear()
+            self._penalty[key] = pen
+        return pen
 
 
 def _chain(robot, fid: int) -> _Chain:
@@ -123,54 +192,248 @@ def _chain(robot, fid: int) -> _Chain:
     return ch
 
 
-# ------------------------------------------------------------------------------ residuals
-def _res_pose(ch: _Chain, target: pin.SE3):
-    model, data, fid = ch.model, ch.data, ch.fid
+# ------------------------------------------------------------------------------ targets
+class _Target:
+    """One target: kind, T* (``pin.SE3``), p* (3,), R* (3, 3), tolerances, task dimension m,
+    and the seed-table features x = T*[:3].ravel() (12,) for a pose, p* or R* alone otherwise.
 
-    def f(q):
-        pin.computeJointJacobians(model, data, q)
-        M = pin.updateFramePlacement(model, data, fid).actInv(target)
-        e = pin.log6(M).vector
-        t = M.translation
-        w = e[3:]
-        return pin.getFrameJacobian(model, data, fid, LOCAL), e, math.sqrt(t @ t), math.sqrt(w @ w)
+    Pose errors are the body twist e = log₆(T(q)⁻¹ T*) = (v; ω) with the LOCAL Jacobian;
+    ‖ω‖ is the rotation error and the position error is ‖t‖ of T(q)⁻¹ T* (= ‖p* − p‖), while
+    v = V(ω)⁻¹ t with ‖V(ω)⁻¹‖ ≤ (1 + ‖ω‖)², so ‖e‖² ≤ tsum = tol_p²(1 + tol_r)² + tol_r² is
+    necessary for convergence: the kernel checks the errors exactly only then.  A position is
+    p* − p (world, LOCAL_WORLD_ALIGNED rows), a rotation log₃(Rᵀ R*) (LOCAL rows)."""
 
-    return f
+    __slots__ = ("kind", "mode", "m", "Ms", "ps", "Rs", "tol_p", "tol_r", "tp2", "tr2", "tsum", "x")
+
+    def __init__(self, mode, tgt, tol_p, tol_r):
+        self.mode = mode
+        self.kind = _KIND[mode]
+        self.tol_p = tol_p
+        self.tol_r = tol_r
+        self.tp2 = tol_p * tol_p
+        self.tr2 = tol_r * tol_r
+        self.tsum = (self.tp2 * (1.0 + tol_r) ** 2 + self.tr2) * (1.0 + 1e-12)
+        self.Ms = None
+        if mode == "pose":
+            self.m = 6
+            self.Ms = tgt
+            self.ps = np.array(tgt.translation)
+            self.Rs = np.array(tgt.rotation)
+            x = np.empty((3, 4))
+            x[:, :3] = self.Rs
+            x[:, 3] = self.ps
+            self.x = x.reshape(12)
+        elif mode == "position":
+            self.m = 3
+            self.ps = np.asarray(tgt, dtype=float)
+            self.Rs = None
+            self.x = self.ps
+        else:
+            self.m = 3
+            self.ps = None
+            self.Rs = np.ascontiguousarray(tgt, dtype=float)
+            self.x = self.Rs.reshape(9)
+
+    def errors(self, ch, q):
+        """(pos_err m, rot_err rad) at q (Pinocchio FK); 0.0 for the unchecked part."""
+        pin.framesForwardKinematics(ch.model, ch.data, q)
+        M = ch.data.oMf[ch.fid]
+        pe = re = 0.0
+        if self.kind != _ORIENTATION:
+            d = self.ps - M.translation
+            pe = math.sqrt(d.dot(d))
+        if self.kind != _POSITION:
+            w = _log3(M.rotation.T.dot(self.Rs))
+            re = math.sqrt(w.dot(w))
+        return pe, re
+
+    def lin(self, ch, q):
+        """(J (m, n), e (m,), pos_err², rot_err²) at q, in the kernel's frames; leaves FK and
+        the joint Jacobians in ch.data."""
+        model, data, fid = ch.model, ch.data, ch.fid
+        _cjj(model, data, q)
+        M = _ufp(model, data, fid)
+        if self.kind == _POSE:
+            Mt = M.actInv(self.Ms)
+            e = _log6(Mt).vector
+            t = Mt.translation
+            w = e[3:]
+            return _gfj(model, data, fid, LOCAL), e, t.dot(t), w.dot(w)
+        if self.kind == _POSITION:
+            ep = self.ps - M.translation
+            return _gfj(model, data, fid, LWA)[:3], ep, ep.dot(ep), 0.0
+        ew = _log3(M.rotation.T.dot(self.Rs))
+        return _gfj(model, data, fid, LOCAL)[3:], ew, 0.0, ew.dot(ew)
+
+    def scores(self, ch):
+        """Seed-table distance of every table entry to this target (up to a constant)."""
+        Q, F, c, P, R = ch.table()
+        if self.kind == _POSE:
+            return c - F.dot(self.x)
+        if self.kind == _POSITION:
+            return c - 2.0 * P.dot(self.ps)
+        return -R.dot(self.x)
 
 
-def _res_position(ch: _Chain, p: np.ndarray):
-    model, data, fid = ch.model, ch.data, ch.fid
+# ------------------------------------------------------------------------------ one attempt
+def _attempt(ch, tg, q, deadline):
+    """Damped Gauss–Newton from ``q`` (the kernel; see the module docstring).
 
-    def f(q):
-        pin.computeJointJacobians(model, data, q)
-        e = p - pin.updateFramePlacement(model, data, fid).translation
-        return pin.getFrameJacobian(model, data, fid, LWA)[:3], e, math.sqrt(e @ e), 0.0
-
-    return f
-
-
-def _res_orientation(ch: _Chain, R: np.ndarray):
-    model, data, fid = ch.model, ch.data, ch.fid
-
-    def f(q):
-        pin.computeJointJacobians(model, data, q)
-        e = pin.log3(pin.updateFramePlacement(model, data, fid).rotation.T @ R)
-        return pin.getFrameJacobian(model, data, fid, LOCAL)[3:], e, 0.0, math.sqrt(e @ e)
-
-    return f
+    Returns (q, converged, iterations, pos_err², rot_err², best_q, best_E): the last iterate
+    with its squared errors, and the iterate of least ‖e‖² seen."""
+    model, data, fid, lo, hi = ch.model, ch.data, ch.fid, ch.lo, ch.hi
+    kind, Ms, ps, Rs, tp2, tr2, tsum = tg.kind, tg.Ms, tg.ps, tg.Rs, tg.tp2, tg.tr2, tg.tsum
+    m = tg.m
+    A, AF, Ad = ch.A[m], ch.AF[m], ch.Ad[m]
+    ref_E = best_E = math.inf
+    best_q = q
+    stall = 0
+    it = 0
+    pe2 = re2 = 0.0
+    while it < MAX_ITER:
+        it += 1
+        _cjj(model, data, q)
+        if kind == _POSE:
+            Mt = _ufp(model, data, fid).actInv(Ms)
+            e = _log6(Mt).vector
+            E = e.dot(e)
+            if E <= tsum:             # necessary for convergence (see _Target): check exactly
+                t = Mt.translation
+                w = e[3:]
+                pe2 = t.dot(t)
+                re2 = w.dot(w)
+                if pe2 <= tp2 and re2 <= tr2:
+                    return q, True, it, pe2, re2, q, E
+            J = _gfj(model, data, fid, LOCAL)
+        elif kind == _POSITION:
+            e = ps - _ufp(model, data, fid).translation
+            E = pe2 = e.dot(e)
+            if pe2 <= tp2:
+                return q, True, it, pe2, 0.0, q, E
+            J = _gfj(model, data, fid, LWA)[:3]
+        else:
+            e = _log3(_ufp(model, data, fid).rotation.T.dot(Rs))
+            E = re2 = e.dot(e)
+            if re2 <= tr2:
+                return q, True, it, 0.0, re2, q, E
+            J = _gfj(model, data, fid, LOCAL)[3:]
+        if E < best_E:
+            best_E = E
+            best_q = q
+        if E < 0.9 * ref_E:
+            ref_E = E
+            stall = 0
+        else:
+            stall += 1
+            if stall >= STALL:
+                break
+        if not it & 3 and _clock() > deadline:  # every 4th iteration: the clock costs ~0.4 µs
+            break
+        lam = LAMBDA0 + K_DAMP * E
+        np.dot(J, J.T, out=A)
+        Ad += lam
+        x, info = dposv(AF, e, overwrite_a=1)[1:]
+        if info:  # not positive definite (NaN/inf): give up this attempt
+            break
+        qn = q + J.T.dot(x)
+        qc = np.minimum(np.maximum(qn, lo), hi)
+        if qc.tobytes() != qn.tobytes():      # (byte comparison: ~20× cheaper than (qc != qn).any())
+            # active set: the joints the step pushes past a limit stay where they are; the
+            # other joints take the step (recomputed without them), then it is clipped
+            J[:, qc != qn] = 0.0
+            np.dot(J, J.T, out=A)
+            Ad += lam
+            x, info = dposv(AF, e, overwrite_a=1)[1:]
+            if info:
+                break
+            qn = q + J.T.dot(x)
+            qc = np.minimum(np.maximum(qn, lo), hi)
+        q = qc
+    return q, False, it, pe2, re2, best_q, best_E
 
 
 # ------------------------------------------------------------------------------ secondary objectives
-class _Posture:
-    """Null-space pull toward q_ref (returns the projected step)."""
-
-    def __init__(self, q_ref, gain=1.0):
-        self.q_ref = q_ref
-        self.gain = gain
-
-    def __call__(self, q, dq1, J, cfac):
-        z = self.gain * (self.q_ref - q - dq1)
-        return z - J.T @ dpotrs(cfac, J @ z)[0]
+def _refine_posture(ch, tg, q, q_ref, deadline):
+    """Second phase for redundant arms: from a solution ``q``, minimise ½‖q − q_ref‖² along the
+    self-motion (null space of the task) while Gauss–Newton keeps the task error at zero.  A
+    joint at its limit that the step would push past it is frozen (its column of J and its share
+    of the posture pull are dropped) and the step recomputed: with a one-dimensional self-motion
+    the optimum then lies where that joint sits at its limit.  Other steps are clipped.
+    Returns (q, iterations): the last iterate that meets the tolerances (``q`` if none does)."""
+    lo, hi = ch.lo, ch.hi
+    one_dim = ch.n - tg.m == 1
+    lam0 = LAMBDA0
+    h_lo, h_hi = SECANT_RANGE
+    good = q
+    it = 0
+    t_prev = None
+    g_prev = s_prev = 0.0
+    h = 1.0
+    while it < NULL_EXTRA and _clock() <= deadline:
+        J, e, pe2, re2 = tg.lin(ch, q)
+        it += 1
+        ok = pe2 <= tg.tp2 and re2 <= tg.tr2
+        if ok:
+            good = q
+        lam = lam0 + K_DAMP * (pe2 + re2)
+        frozen = None
+        for _ in range(2):
+            A = J.dot(J.T)
+            A.flat[:: A.shape[0] + 1] += lam
+            cfac, x, info = dposv(A, e)
+            if info != 0:
+                return good, it
+            dq = J.T.dot(x)
+            z = q_ref - q - dq
+            if frozen is not None:
+                z[frozen] = 0.0
+            p = z - J.T.dot(dpotrs(cfac, J.dot(z))[0])   # N z: projection on the null space
+            if one_dim and frozen is None:
+                # secant step along the unit self-motion direction t: g = tᵀ(q_ref − q) is minus
+                # the derivative of the cost along t; its change per unit move estimates the curvature
+                g = math.sqrt(p.dot(p))
+                if g == 0.0:
+                    t, s = p, 0.0
+                else:
+                    t = p / g
+                    if t_prev is not None and t.dot(t_prev) < 0.0:
+                        t, g = -t, -g
+                    if t_prev is not None and abs(s_prev) > 1e-12:
+                        hk = (g_prev - g) / s_prev
+                        h = min(hk, h_hi) if hk >= h_lo else 1.0
+                    s = g / h
+                    if abs(s) > NULL_STEP:
+                        s = math.copysign(NULL_STEP, s)
+                n2 = abs(s)
+                step = t * s
+            else:
+                step = p
+                n2 = math.sqrt(p.dot(p))
+                if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
+                    step = p * (NULL_STEP / n2)
+            qn = q + dq + step
+            qc = np.minimum(np.maximum(qn, lo), hi)
+            if frozen is not None:
+                break
+            out = (qc != qn) & ((q == lo) | (q == hi))   # at a limit and pushed past it
+            if not out.any():
+                break
+            frozen = out                       # active set: freeze, recompute once
+            J = J.copy()
+            J[:, out] = 0.0
+        if ok and n2 < NULL_TOL:
+            break
+        if one_dim and frozen is None and g != 0.0:
+            s_prev = t.dot(qc - q)
+            t_prev, g_prev = t, g
+        else:
+            t_prev = None                      # the secant memory is void after a frozen step
+        q = qc
+    else:
+        pe, re = tg.errors(ch, q)
+        if pe * pe <= tg.tp2 and re * re <= tg.tr2:
+            good = q
+    return good, it
 
 
 class _Swivel:
@@ -201,7 +464,40 @@ class _Swivel:
         return nj * ((d - float(j @ dq1)) / den)
 
 
-def _settle_swivel(robot, ch, mode, target, resid, sw, q_ref, qs, pe, re, tol_p, tol_r, analytic, msg):
+def _refine(ch, tg, q, secondary, deadline):
+    """Second phase toward a general secondary objective (the swivel angle): from a solution
+    ``q``, move in the null space of the primary task, Gauss–Newton corrected (the pose error
+    may grow in between and is driven back).  Returns the last iterate that meets the
+    tolerances (the phase-1 solution if none does), and the iterations used."""
+    good = q
+    it = 0
+    while it < NULL_EXTRA and _clock() <= deadline:
+        J, e, pe2, re2 = tg.lin(ch, q)
+        it += 1
+        ok = pe2 <= tg.tp2 and re2 <= tg.tr2
+        if ok:
+            good = q
+        A = J @ J.T
+        A.flat[:: A.shape[0] + 1] += LAMBDA0 + K_DAMP * (pe2 + re2)
+        cfac, x, info = dposv(A, e)
+        if info != 0:
+            break
+        dq = J.T @ x
+        dq2 = secondary(q, dq, J, cfac)
+        n2 = math.sqrt(dq2 @ dq2)
+        if ok and n2 < NULL_TOL:
+            break
+        if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
+            dq2 *= NULL_STEP / n2
+        q = np.minimum(np.maximum(q + dq + dq2, ch.lo), ch.hi)
+    else:
+        pe, re = tg.errors(ch, q)
+        if pe * pe <= tg.tp2 and re * re <= tg.tr2:
+            good = q
+    return good, it
+
+
+def _settle_swivel(robot, ch, tg, target, sw, q_ref, qs, pe, re, analytic, msg):
     """After the null-space refinement: if the swivel target is still off, try the closed form
     at that angle (another branch of the self-motion may hold it); report what remains.
     Returns (q, pos_err, rot_err, seed tag or "", message)."""
@@ -211,13 +507,13 @@ def _settle_swivel(robot, ch, mode, target, resid, sw, q_ref, qs, pe, re, tol_p,
     tried = ""
     if analytic is not False:
         ref = ch.default_ref if q_ref is None else q_ref
-        S, _ = _analytic_seeds(robot, ch, mode, target, ref, sw.target)
+        S, _ = _analytic_seeds(robot, ch, tg.mode, target, ref, sw.target)
         cf = _analytic_module()
         if cf is not None and ch.fid == robot.tool_id and cf.has_analytic(robot):
             tried = " and the closed form has no solution at that angle inside the limits"
         for cand in S:
-            _, _, pe2, re2 = resid(cand)
-            if pe2 <= tol_p and re2 <= tol_r:
+            pe2, re2 = tg.errors(ch, cand)
+            if pe2 * pe2 <= tg.tp2 and re2 * re2 <= tg.tr2:
                 return cand, pe2, re2, "analytic", "converged from an analytic seed at the requested swivel angle"
     msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's self-motion within the "
             f"joint limits{tried} (the hand pose is exact)")
@@ -234,72 +530,6 @@ def _swivel_offset(ch, sw: _Swivel, q) -> float:
         return float("inf")
     d = sw.target - phi
     return abs(math.atan2(math.sin(d), math.cos(d)))
-
-
-# ------------------------------------------------------------------------------ one attempt
-def _attempt(ch, resid, q, tol_p, tol_r, deadline):
-    """Damped Gauss–Newton from ``q``.  Returns (q, converged, iterations, best) with best =
-    (q, pos_err, rot_err) of the closest iterate."""
-    best_E = np.inf
-    best = (q, np.inf, np.inf)
-    stall = 0
-    it = 0
-    while it < MAX_ITER:
-        J, e, pe, re = resid(q)
-        it += 1
-        if pe <= tol_p and re <= tol_r:
-            return q, True, it, (q, pe, re)
-        if pe + re < best[1] + best[2]:
-            best = (q, pe, re)
-        E = float(e @ e)
-        if E < 0.9 * best_E:
-            best_E = E
-            stall = 0
-        else:
-            stall += 1
-            if stall >= STALL:
-                break
-        if not it & 3 and _clock() > deadline:  # every 4th iteration: the clock costs ~0.4 µs
-            break
-        A = J @ J.T
-        A.flat[:: A.shape[0] + 1] += LAMBDA0 + K_DAMP * E
-        x, info = dposv(A, e)[1:]
-        if info != 0:  # not positive definite (NaN/inf): give up this attempt
-            break
-        q = np.minimum(np.maximum(q + J.T @ x, ch.lo), ch.hi)
-    return q, False, it, best
-
-
-def _refine(ch, resid, q, tol_p, tol_r, secondary, deadline):
-    """Second phase for redundant arms: from a solution ``q``, move in the null space of the
-    primary task toward the secondary objective (posture or swivel), Gauss–Newton corrected
-    (the pose error may grow in between and is driven back).  Returns the last iterate that
-    meets the tolerances (the phase-1 solution if none does), and the iterations used."""
-    good = q
-    it = 0
-    while it < NULL_EXTRA and _clock() <= deadline:
-        J, e, pe, re = resid(q)
-        it += 1
-        if pe <= tol_p and re <= tol_r:
-            good = q
-        A = J @ J.T
-        A.flat[:: A.shape[0] + 1] += LAMBDA0 + K_DAMP * float(e @ e)
-        cfac, x, info = dposv(A, e)
-        if info != 0:
-            break
-        dq = J.T @ x
-        dq2 = secondary(q, dq, J, cfac)
-        n2 = math.sqrt(dq2 @ dq2)
-        if pe <= tol_p and re <= tol_r and n2 < NULL_TOL:
-            break
-        if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
-            dq2 *= NULL_STEP / n2
-        q = np.minimum(np.maximum(q + dq + dq2, ch.lo), ch.hi)
-    else:
-        J, e, pe, re = resid(q)
-        if pe <= tol_p and re <= tol_r:
-            good = q
-    return good, it
 
 
 # ------------------------------------------------------------------------------ targets
@@ -381,8 +611,8 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     T : 4×4 pose (or ``pin.SE3``), position (3,), rotation (3, 3), or a batch with a leading axis N.
         World frame, metres.  ``ValueError`` for NaN, a wrong shape or a non-rigid transform.
     q0 : (nq,) or (N, nq), optional
-        Initial guess (clipped into the limits).  Default: :func:`comfortable_posture`
-        (human arm) or the middle of the joint ranges.
+        Initial guess (clipped into the limits).  Default: the nearest entry of the seed table
+        (for a posture problem, nearest with a penalty on the distance to the posture).
     frame : str, optional
         Frame to place (default the tool); unknown names raise
         :class:`~anthroarm.errors.UnknownFrameError` listing the valid ones.
@@ -394,9 +624,9 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     mode : None, "pose", "position", "orientation"
         Override the target kind (e.g. ``"position"`` with a 4×4 ``T`` uses its translation).
     max_restarts : int, optional
-        Cap on random restarts (default: limited by ``max_time`` only).
+        Cap on restarts, i.e. seeds after the first (default: limited by ``max_time`` only).
     rng : int or numpy Generator, optional
-        Seed of the restarts (default 0: reproducible results).
+        Seed of the random restarts (default 0: reproducible results).
     posture : "auto", None or (nq,)
         Reference posture for the null space of redundant arms; ``"auto"`` uses the comfortable
         posture for the human arm (``human_arm7``) and nothing otherwise.
@@ -423,7 +653,6 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     if analytic not in ("auto", True, False):
         raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
     # seeds
-    default_ref = ch.default_ref
     if q0 is None:
         Q0 = None
     else:
@@ -434,7 +663,7 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     if isinstance(posture, str):
         if posture != "auto":
             raise ValueError(f"posture must be 'auto', None or a configuration, got {posture!r}")
-        q_ref = default_ref if robot.name in ("human_arm7",) else None
+        q_ref = ch.default_ref if robot.name in ("human_arm7",) else None
     elif posture is None:
         q_ref = None
     else:
@@ -452,22 +681,21 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
 
     q_ref_sec = q_ref if redundant and swivel is None else None
     sw_sec = (sw_frames, swivel) if (redundant and swivel is not None) else None
-    seeds = []
-    for i in range(len(targets)):
-        if Q0 is None:
-            seeds.append(q_ref if q_ref is not None else default_ref)
-        else:
-            seeds.append(Q0[i] if Q0.ndim == 2 else Q0)
+    tgs = [_Target(mode, t, float(tol_pos), float(tol_rot)) for t in targets]
+    if Q0 is None:
+        seeds = [None] * len(targets)
+    else:
+        seeds = [Q0[i] if Q0.ndim == 2 else Q0 for i in range(len(targets))]
     if batch and not warm_start and len(targets) >= LOCKSTEP_MIN and analytic is not True:
-        results = _solve_lockstep(robot, ch, mode, targets, np.array(seeds, dtype=float), tol_pos, tol_rot,
-                                  max_time, max_restarts, gen, q_ref_sec, sw_sec, analytic)
+        results = _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen, q_ref_sec, sw_sec,
+                                  analytic)
     else:
         results = []
         prev = None
         for i, tgt in enumerate(targets):
             seed = prev if (warm_start and prev is not None and Q0 is None) else seeds[i]
-            res = _solve_one(robot, ch, mode, tgt, seed, tol_pos, tol_rot, max_time, max_restarts, gen,
-                             q_ref_sec, sw_sec, analytic)
+            res = _solve_one(robot, ch, tgs[i], tgt, seed, max_time, max_restarts, gen, q_ref_sec, sw_sec,
+                             analytic)
             results.append(res)
             prev = res.q
     if not batch:
@@ -482,22 +710,55 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         messages=[r.message for r in results], mode=mode)
 
 
-def _solve_lockstep(robot, ch, mode, targets, seeds, tol_p, tol_r, max_time, max_restarts, gen, q_ref, sw,
-                    analytic):
+def _table_order(ch, tg, q_ref):
+    """Seed-table indices, nearest first: the first :data:`TABLE_SEEDS` of them."""
+    sc = tg.scores(ch)
+    if q_ref is not None:
+        sc = sc + ch.posture_penalty(q_ref)
+    k = min(TABLE_SEEDS, len(sc) - 1)
+    idx = np.argpartition(sc, k)[: k + 1]
+    return idx[np.argsort(sc[idx])][:TABLE_SEEDS]
+
+
+def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen, q_ref, sw, analytic):
     """Batch form: every target iterates the same damped Gauss–Newton step together, the linear
     algebra vectorised over the batch (``np.linalg.solve`` on (N, m, m)); Pinocchio's FK and
     Jacobians are still one call per target.  Converged targets leave the batch; a target whose
-    attempt stalls restarts from a random configuration, up to :data:`LOCKSTEP_ATTEMPTS`
-    attempts, after which it is handed to the one-target solver (all its seeds, restarts and
-    the time budget).  Same answers' quality, ~3× less time per target."""
+    attempt stalls restarts from its next seed (the seed table's next nearest entry, then a
+    random configuration), up to :data:`LOCKSTEP_ATTEMPTS` attempts, after which it is handed to
+    the one-target solver (all its seeds, restarts and the time budget).  Same answers'
+    quality, less time per target."""
     model, data, fid = ch.model, ch.data, ch.fid
-    N, n = len(targets), ch.n
-    m = 6 if mode == "pose" else 3
-    Q = ch.clip(seeds.copy())
+    N, n = len(tgs), ch.n
+    kind = tgs[0].kind
+    m = tgs[0].m
+    tp2, tr2 = tgs[0].tp2, tgs[0].tr2
+    lo, hi = ch.lo, ch.hi
+    # first seeds: q0, else the nearest table entry (vectorised over the batch)
+    orders = [None] * N
+    Q = np.empty((N, n))
+    need = [k for k in range(N) if seeds[k] is None]
+    if need:
+        tab = ch.table()
+        X = np.array([tgs[k].x for k in need])
+        if kind == _POSE:
+            S = tab[2][:, None] - tab[1].dot(X.T)
+        elif kind == _POSITION:
+            S = tab[2][:, None] - 2.0 * tab[3].dot(X.T)
+        else:
+            S = -tab[4].dot(X.T)
+        if q_ref is not None:
+            S += ch.posture_penalty(q_ref)[:, None]
+        Q[need] = tab[0][S.argmin(axis=0)]
+    for k in range(N):
+        if seeds[k] is not None:
+            Q[k] = seeds[k]
+    Q = ch.clip(Q)
+    used = np.ones(N, dtype=int)          # table seeds used per target (the first counts)
     J = np.empty((N, m, n))
     E = np.empty((N, m))
-    PE = np.zeros(N)
-    RE = np.zeros(N)
+    PE2 = np.zeros(N)
+    RE2 = np.zeros(N)
     its = np.zeros(N, dtype=int)
     att_it = np.zeros(N, dtype=int)
     attempts = np.ones(N, dtype=int)
@@ -510,30 +771,31 @@ def _solve_lockstep(robot, ch, mode, targets, seeds, tol_p, tol_r, max_time, max
     while active.size:
         for k in active:                      # Pinocchio: one call per target
             q = Q[k]
-            pin.computeJointJacobians(model, data, q)
-            M = pin.updateFramePlacement(model, data, fid)
-            if mode == "pose":
-                Mt = M.actInv(targets[k])
-                E[k] = pin.log6(Mt).vector
+            tg = tgs[k]
+            _cjj(model, data, q)
+            M = _ufp(model, data, fid)
+            if kind == _POSE:
+                Mt = M.actInv(tg.Ms)
+                e = _log6(Mt).vector
+                E[k] = e
                 t = Mt.translation
-                PE[k] = math.sqrt(t @ t)
-                J[k] = pin.getFrameJacobian(model, data, fid, LOCAL)
-            elif mode == "position":
-                E[k] = targets[k] - M.translation
-                J[k] = pin.getFrameJacobian(model, data, fid, LWA)[:3]
+                w = e[3:]
+                PE2[k] = t.dot(t)
+                RE2[k] = w.dot(w)
+                J[k] = _gfj(model, data, fid, LOCAL)
+            elif kind == _POSITION:
+                e = tg.ps - M.translation
+                E[k] = e
+                PE2[k] = e.dot(e)
+                J[k] = _gfj(model, data, fid, LWA)[:3]
             else:
-                E[k] = pin.log3(M.rotation.T @ targets[k])
-                J[k] = pin.getFrameJacobian(model, data, fid, LOCAL)[3:]
-        Ea = E[active]
-        if mode == "pose":
-            RE[active] = np.sqrt((Ea[:, 3:] ** 2).sum(1))
-        elif mode == "position":
-            PE[active] = np.sqrt((Ea ** 2).sum(1))
-        else:
-            RE[active] = np.sqrt((Ea ** 2).sum(1))
+                e = _log3(M.rotation.T.dot(tg.Rs))
+                E[k] = e
+                RE2[k] = e.dot(e)
+                J[k] = _gfj(model, data, fid, LOCAL)[3:]
         its[active] += 1
         att_it[active] += 1
-        ok = (PE[active] <= tol_p) & (RE[active] <= tol_r)
+        ok = (PE2[active] <= tp2) & (RE2[active] <= tr2)
         converged[active[ok]] = True
         active = active[~ok]
         if not active.size:
@@ -546,123 +808,151 @@ def _solve_lockstep(robot, ch, mode, targets, seeds, tol_p, tol_r, max_time, max
         if ended.any():
             ek = active[ended]
             retry = ek[attempts[ek] < max_attempts]
-            if retry.size:
-                if gen[0] is None:
-                    gen[0] = np.random.default_rng(gen[1])
-                Q[retry] = ch.lo_s + (ch.hi_s - ch.lo_s) * gen[0].random((retry.size, n))
-                attempts[retry] += 1
-                att_it[retry] = 0
-                stall[retry] = 0
-                best[retry] = np.inf
+            for k in retry:                   # next seed: the next table entry, then random
+                if used[k] < TABLE_SEEDS:
+                    if orders[k] is None:
+                        orders[k] = _table_order(ch, tgs[k], q_ref)
+                    Q[k] = ch.table()[0][orders[k][used[k]]]
+                    used[k] += 1
+                else:
+                    Q[k] = ch.random(gen)
+            attempts[retry] += 1
+            att_it[retry] = 0
+            stall[retry] = 0
+            best[retry] = np.inf
             stepping = active[~ended]          # retried targets are evaluated first, next round
             active = np.concatenate([stepping, retry])
         else:
             stepping = active
         if stepping.size:                     # vectorised damped Gauss–Newton step
             Js = J[stepping]
-            A = Js @ Js.transpose(0, 2, 1)
-            A += (LAMBDA0 + K_DAMP * (E[stepping] ** 2).sum(1))[:, None, None] * eye
+            Es = E[stepping]
+            lam = (LAMBDA0 + K_DAMP * (Es ** 2).sum(1))[:, None, None]
+            Jt = Js.transpose(0, 2, 1)
             try:
-                x = np.linalg.solve(A, E[stepping][..., None])
+                x = np.linalg.solve(Js @ Jt + lam * eye, Es[..., None])
             except np.linalg.LinAlgError:    # a singular system: hand those targets over
                 active = np.setdiff1d(active, stepping)
                 continue
-            Q[stepping] = np.minimum(np.maximum(Q[stepping] + (Js.transpose(0, 2, 1) @ x)[..., 0], ch.lo), ch.hi)
+            Qs = Q[stepping]
+            Qn = Qs + (Jt @ x)[..., 0]
+            Qc = np.minimum(np.maximum(Qn, lo), hi)
+            out = Qc != Qn
+            rows = out.any(axis=1)
+            if rows.any():                    # active set (see _attempt), for the rows that need it
+                Jr = Js[rows] * ~out[rows][:, None, :]
+                Jrt = Jr.transpose(0, 2, 1)
+                try:
+                    xr = np.linalg.solve(Jr @ Jrt + lam[rows] * eye, Es[rows][..., None])
+                    Qr = Qs[rows] + (Jrt @ xr)[..., 0]
+                    Qc[rows] = np.minimum(np.maximum(Qr, lo), hi)
+                except np.linalg.LinAlgError:
+                    pass
+            Q[stepping] = Qc
     results = []
     for k in range(N):
         restarts = int(attempts[k] - 1)
+        tg = tgs[k]
         if converged[k] and q_ref is None and sw is None:
-            tag = "q0" if restarts == 0 else "restart"
-            results.append(IKResult(Q[k].copy(), True, "success", float(PE[k]), float(RE[k]), int(its[k]), restarts,
-                                    f"converged from a {tag} seed (batch)", mode, tag))
+            tag = ("q0" if seeds[k] is not None else "table") if restarts == 0 else "restart"
+            results.append(IKResult(Q[k].copy(), True, "success", math.sqrt(PE2[k]), math.sqrt(RE2[k]), int(its[k]),
+                                    restarts, f"converged from a {tag} seed (batch)", tg.mode, tag))
         elif converged[k]:                    # redundant arm: null-space settling, one target at a time
-            r = _solve_one(robot, ch, mode, targets[k], Q[k], tol_p, tol_r, max_time, max_restarts, gen, q_ref, sw,
-                           analytic)
+            r = _solve_one(robot, ch, tg, targets[k], Q[k], max_time, max_restarts, gen, q_ref, sw, analytic)
             r.iterations += int(its[k])
             r.restarts += restarts
             results.append(r)
         else:                                 # stalled LOCKSTEP_ATTEMPTS times: the full one-target solver
-            r = _solve_one(robot, ch, mode, targets[k], seeds[k], tol_p, tol_r, max_time, max_restarts, gen, q_ref,
-                           sw, analytic)
+            r = _solve_one(robot, ch, tg, targets[k], seeds[k], max_time, max_restarts, gen, q_ref, sw, analytic)
             r.iterations += int(its[k])
             results.append(r)
     return results
 
 
-def _solve_one(robot, ch, mode, target, seed, tol_p, tol_r, max_time, max_restarts, gen, q_ref, sw, analytic):
+def _solve_one(robot, ch, tg, target, seed, max_time, max_restarts, gen, q_ref, sw, analytic):
     t0 = _clock()
     deadline = t0 + max_time
-    resid = {"pose": _res_pose, "position": _res_position, "orientation": _res_orientation}[mode](ch, target)
-    if sw is not None:
-        secondary = _Swivel(ch, sw[0], sw[1])
-    elif q_ref is not None:
-        secondary = _Posture(q_ref)
-    else:
-        secondary = None
     # reachability (a sufficient test for "unreachable": farther than the summed link offsets)
     out_of_reach = ""
-    if mode in ("pose", "position"):
-        p = target.translation if mode == "pose" else target
-        dist = float(np.linalg.norm(p))
-        if dist > ch.reach + tol_p:
+    if tg.kind != _ORIENTATION:
+        dist = math.sqrt(tg.ps.dot(tg.ps))
+        if dist > ch.reach + tg.tol_p:
             out_of_reach = (f"target is {dist:.4g} m from the base origin but the chain reaches at most "
                             f"{ch.reach:.4g} m (sum of its link offsets)")
-    q = ch.clip(np.asarray(seed, dtype=float))
+    order = None      # seed-table order, computed when needed
+    used = 0          # table entries used
+    if seed is None:
+        order = _table_order(ch, tg, q_ref)
+        q = ch.table()[0][order[0]]
+        used = 1
+        seeds_tag = "table"
+    else:
+        q = np.minimum(np.maximum(np.asarray(seed, dtype=float), ch.lo), ch.hi)
+        seeds_tag = "q0"
     total_it = 0
-    best = (q, np.inf, np.inf)
+    best_q, best_E = q, math.inf
     note = ""
-    seeds_tag = "q0"
     restarts = 0
     ana = None
     ana_i = 0
     if analytic is True and not out_of_reach:
-        ana, note = _analytic_seeds(robot, ch, mode, target, q, sw[1] if sw else None)
+        ana, note = _analytic_seeds(robot, ch, tg.mode, target, q, sw[1] if sw else None)
     attempt = 0
+    secondary = None
     while True:
         if ana is not None and ana_i < len(ana):
             q, seeds_tag = ana[ana_i].copy(), "analytic"
             ana_i += 1
         elif attempt > 0:
-            if gen[0] is None:
-                gen[0] = np.random.default_rng(gen[1])
-            g = gen[0]
-            q = ch.lo_s + (ch.hi_s - ch.lo_s) * g.random(ch.n)
+            if order is None:
+                order = _table_order(ch, tg, q_ref)
+            if used < len(order):
+                q = ch.table()[0][order[used]]
+                used += 1
+            else:
+                q = ch.random(gen)
             seeds_tag = "restart"
             restarts += 1
-        qs, ok, it, b = _attempt(ch, resid, q, tol_p, tol_r, deadline)
+        qs, ok, it, pe2, re2, bq, bE = _attempt(ch, tg, q, deadline)
         total_it += it
-        pe, re = b[1], b[2]
-        if ok and secondary is not None:
-            qs, it2 = _refine(ch, resid, qs, tol_p, tol_r, secondary, deadline + 0.5 * max_time)
-            total_it += it2
-            _, _, pe, re = resid(qs)
         attempt += 1
-        if b[1] + b[2] < best[1] + best[2]:
-            best = b
+        if bE < best_E:
+            best_q, best_E = bq, bE
         if ok:
+            pe, re = math.sqrt(pe2), math.sqrt(re2)
             msg = f"converged from a {seeds_tag} seed"
-            if isinstance(secondary, _Swivel):
-                qs, pe, re, tag, msg = _settle_swivel(robot, ch, mode, target, resid, secondary, q_ref, qs, pe, re,
-                                                      tol_p, tol_r, analytic, msg)
+            if sw is not None:
+                secondary = _Swivel(ch, sw[0], sw[1])
+                qs, it2 = _refine(ch, tg, qs, secondary, deadline + 0.5 * max_time)
+                total_it += it2
+                pe, re = tg.errors(ch, qs)
+                qs, pe, re, tag, msg = _settle_swivel(robot, ch, tg, target, secondary, q_ref, qs, pe, re, analytic,
+                                                      msg)
                 seeds_tag = tag or seeds_tag
-            return IKResult(qs, True, "success", pe, re, total_it, restarts, msg, mode, seeds_tag)
+            elif q_ref is not None:
+                qs2, it2 = _refine_posture(ch, tg, qs, q_ref, deadline + 0.5 * max_time)
+                total_it += it2
+                if qs2 is not qs:
+                    qs = qs2
+                    pe, re = tg.errors(ch, qs)
+            return IKResult(qs, True, "success", pe, re, total_it, restarts, msg, tg.mode, seeds_tag)
         if out_of_reach and attempt >= 3:
             break
         if analytic == "auto" and ana is None and not out_of_reach and attempt >= ANALYTIC_AFTER:
-            ana, note = _analytic_seeds(robot, ch, mode, target, best[0], sw[1] if sw else None, HUMAN_GRID)
+            ana, note = _analytic_seeds(robot, ch, tg.mode, target, best_q, sw[1] if sw else None, HUMAN_GRID)
         if _clock() > deadline:
             break
         if max_restarts is not None and restarts >= max_restarts and (ana is None or ana_i >= len(ana)):
             break
-    q = best[0]
-    _, _, pe, re = resid(q)
+    q = best_q
+    pe, re = tg.errors(ch, q)
     el = (_clock() - t0) * 1e3
     if out_of_reach:
         status, why = "out_of_reach", out_of_reach
     else:
         status = "not_converged"
-        why = (f"no configuration within the joint limits reached tol_pos={tol_p:g} m / tol_rot={tol_r:g} rad "
-               f"after {total_it} iterations, {restarts} restarts, {el:.1f} ms CPU (max_time {max_time * 1e3:g} ms); "
-               f"the target is probably outside the joint-limited workspace")
+        why = (f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
+               f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, {el:.1f} ms CPU "
+               f"(max_time {max_time * 1e3:g} ms); the target is probably outside the joint-limited workspace")
     msg = f"{why}; closest pose found: pos_err {pe:.3g} m, rot_err {re:.3g} rad" + (f"; {note}" if note else "")
-    return IKResult(q, False, status, pe, re, total_it, restarts, msg, mode, seeds_tag)
+    return IKResult(q, False, status, pe, re, total_it, restarts, msg, tg.mode, seeds_tag)
