@@ -320,3 +320,32 @@ def test_compile_failure_falls_back(monkeypatch, tmp_path):
     assert res.success
     assert plan_for(robot, "planar2r", robot.spec.params).c_kernel is False
     assert "unavailable" in analytic_c.status()
+
+
+@pytest.mark.parametrize("impl", IMPLS)
+@pytest.mark.parametrize("name", ["sixr_arm", "prosthetic_arm", "human_arm7", "planar2r"])
+def test_fast_paths_options(name, impl):
+    """position_only (both values) and a tolerance that rejects some candidates: same answers."""
+    robot = aa.load(name)
+    T, sw, kind = _poses(name, robot, 13)
+    sel = np.flatnonzero(kind == REGULAR)[::10]
+    T = T[sel]
+    kw = {} if sw is None else {"swivel": sw[sel]}
+    for opts in ({"position_only": True}, {"position_only": False}, {"tol": 2e-16}):
+        tiny = "tol" in opts          # residuals at the rounding level land on either side of 2e-16
+        g = analytic_batch(robot, T, _impl="general", **opts, **kw)
+        a = analytic_batch(robot, T, _impl=impl, **opts, **kw)
+        assert a.branches == g.branches
+        if tiny:
+            assert np.nanmax(a.residuals, initial=0.0) <= 2e-16
+            fk_kind = "no candidate passed the FK check"
+            for ra, rg in zip(a.reasons, g.reasons):
+                if rg is not None and not rg.startswith(fk_kind):
+                    assert ra == rg                            # workspace / joint-limit reasons
+                assert ra is None or ra == rg or ra.startswith(fk_kind)
+            continue
+        _assert_same_batch(a, g, robot)
+        for k in range(0, len(T), 7):
+            kws = {} if sw is None else {"swivel": float(kw["swivel"][k])}
+            _assert_same_single(analytic(robot, T[k], _impl=impl, **opts, **kws),
+                                analytic(robot, T[k], _impl="general", **opts, **kws))
