@@ -72,6 +72,20 @@ class Backend:
     def solve(self, H, c, lo, hi, A=None, b=None):  # pragma: no cover - interface
         raise NotImplementedError
 
+    def solve_ws(self, ws, A=None, b=None):
+        """:meth:`solve` on the arrays of a step workspace (``ws.H``, ``ws.c``, ``ws.lo``,
+        ``ws.hi`` finite, ``ws.B`` = [lo; −hi]; see :mod:`anthroarm.ik.qp.step`).  The returned
+        x is a fresh array.  Backends override it to skip conversions."""
+        return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
+
+    @staticmethod
+    def _finish_box(x, lo, hi):
+        """``_finish`` without equality rows: x clipped into [lo, hi] (a fresh array)."""
+        if not math.isfinite(x @ x):
+            return None, "failed"
+        x = np.maximum(x, lo)
+        return np.minimum(x, hi, out=x), "optimal"
+
     def _finish(self, x, lo, hi, A, b, status):
         """Clip into the box and check the equality residual; map failures to a status."""
         if x is None or not math.isfinite(x @ x):
@@ -234,6 +248,15 @@ class DaqpBackend(Backend):
             return self._finish(x, lo, hi, A, b, "optimal")
         return None, "infeasible" if flag == -1 else "failed"
 
+    def solve_ws(self, ws, A=None, b=None):
+        if A is not None:
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
+        x, _, flag, info = self._daqp.solve(ws.H, ws.c, self._A0, ws.hi, ws.lo, self._sense)
+        self.last_info = {"exitflag": flag, "iter": info["iterations"]}
+        if flag > 0:
+            return self._finish_box(x, ws.lo, ws.hi)
+        return None, "infeasible" if flag == -1 else "failed"
+
 
 class QuadprogBackend(Backend):
     """quadprog (Goldfarb–Idnani), called directly.  The box becomes the constant inequality
@@ -274,6 +297,17 @@ class QuadprogBackend(Backend):
         else:
             self.last_info = {}
         return self._finish(x, lo, hi, A, b, "optimal")
+
+    def solve_ws(self, ws, A=None, b=None):
+        if A is not None:
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
+        # ws.B = [lo; −hi] is quadprog's b for C = [I, −I]
+        try:
+            x = self._qp.solve_qp(ws.H, np.negative(ws.c, out=ws.nc), self._C, ws.B, 0)[0]
+        except ValueError:
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)   # error handling there
+        self.last_info = {}
+        return self._finish_box(x, ws.lo, ws.hi)
 
 
 class ProxqpBackend(Backend):

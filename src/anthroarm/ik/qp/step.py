@@ -24,7 +24,8 @@ import numpy as np
 
 from .backends import make_backend
 from .configuration import IKConfiguration
-from .limits import ConfigurationLimit, VelocityLimit, combine
+from .limits import ConfigurationLimit, VelocityLimit
+from .limits.base import BIG, combine_into
 
 _ROBOT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -54,6 +55,29 @@ class StepResult:
 def default_limits(robot) -> list:
     """The model's configuration (gain 0.5) and velocity limits, as pink applies by default."""
     return [ConfigurationLimit(robot), VelocityLimit(robot)]
+
+
+class _Workspace:
+    """Preallocated arrays of one step (per IKConfiguration / robot): the tasks add their
+    objective into ``H``, ``c`` in place (``Hc`` holds both, so one dot product checks them for
+    NaN/inf), the limits write ``B = [lo; −hi]`` (the quadprog form), and ``hi``."""
+
+    __slots__ = ("n", "Hc", "H", "c", "Hd", "B", "Bm", "lo", "mhi", "hi", "box2", "tmp2", "nc")
+
+    def __init__(self, n: int):
+        self.n = n
+        self.Hc = np.zeros(n * n + n)
+        self.H = self.Hc[: n * n].reshape(n, n)
+        self.c = self.Hc[n * n:]
+        self.Hd = np.einsum("ii->i", self.H)        # writable view of diag(H)
+        self.B = np.zeros(2 * n)
+        self.Bm = self.B.reshape(2, n)
+        self.lo = self.B[:n]
+        self.mhi = self.B[n:]
+        self.hi = np.zeros(n)
+        self.box2 = np.zeros((2, n))
+        self.tmp2 = np.zeros((2, n))
+        self.nc = np.zeros(n)                        # scratch for backends (e.g. −c)
 
 
 def _state(owner, robot):
@@ -119,24 +143,21 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     elif limits is None:
         limits = ()
 
-    # Σ tasks (tasks may return cached arrays: never modify them in place)
-    H = c = None
-    own = False
+    ws = st.get("ws")
+    if ws is None:
+        ws = st["ws"] = _Workspace(nv)
+    # Σ tasks, in place: each task adds its (H, c) into the workspace and returns the scalar
+    # part of its diagonal (LM term, posture/damping weight), added once with the damping
+    first = True
+    diag = float(damping) if damping else 0.0
     for t in tasks:
-        Ht, ct = t.compute_qp_objective(conf)
-        if H is None:
-            H, c = Ht, ct
-        else:
-            H = H + Ht
-            c = c + ct
-            own = True
-    if H is None:
-        H, c, own = np.zeros((nv, nv)), np.zeros(nv), True
-    if damping:
-        if not own:
-            H = H.copy()
-        H.flat[:: nv + 1] += float(damping)
-    lo, hi = combine(limits, conf, dt)
+        diag += t._accumulate(conf, ws, first)
+        first = False
+    if first:
+        ws.Hc.fill(0.0)
+    if diag:
+        np.add(ws.Hd, diag, out=ws.Hd)
+    combine_into(limits, conf, dt, ws)
 
     A = b = None
     if constraints:
@@ -147,15 +168,20 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     backend = backends.get((solver, nv, n_eq))
     if backend is None:
         backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
-    Hr = H.ravel()
-    if not math.isfinite(Hr @ Hr + c @ c):
+    Hc = ws.Hc
+    if not math.isfinite(Hc @ Hc):
         x, status = None, "failed"
         backend.last_info = {"error": "non-finite task objective"}
     else:
-        x, status = backend.solve(H, c, lo, hi, A, b)
-    v = np.zeros(nv) if x is None else x / dt
+        x, status = backend.solve_ws(ws, A, b)
+    if x is None:
+        v = np.zeros(nv)
+    else:
+        v = np.divide(x, dt, out=x)
     for lim in limits:
         lim.after_step(v, dt)
-    if full:
+    if full:  # the box as combine() gives it (±inf where unbounded, not the solvers' ±BIG)
+        lo = np.where(ws.lo <= -BIG, -np.inf, ws.lo)
+        hi = np.where(ws.hi >= BIG, np.inf, ws.hi)
         return StepResult(v, status, backend.name, lo, hi, dict(backend.last_info))
     return v

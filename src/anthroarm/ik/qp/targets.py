@@ -24,8 +24,9 @@ def _check_finite(a: np.ndarray, name: str) -> None:
 
 
 def _rotation_defect(r) -> tuple[float, float]:
-    """(max |R Rᵀ − I|, det R) of a 3×3 nested list (pure Python: cheaper than numpy at 3×3)."""
-    a, b, c = r
+    """(max |R Rᵀ − I|, det R) of a 3×3 nested list (pure Python: cheaper than numpy at 3×3;
+    longer rows, e.g. those of a 4×4 transform, are read up to their third entry)."""
+    a, b, c = r[0], r[1], r[2]
     e = max(abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0), abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
             abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0), abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
             abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]), abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]))
@@ -61,6 +62,15 @@ def as_position(p, name: str = "p") -> np.ndarray:
 
 def as_se3(T, name: str = "T") -> pin.SE3:
     """A ``pin.SE3`` from a rigid 4×4 homogeneous matrix (or a ``pin.SE3``), or ``ValueError``."""
+    if type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4):
+        # fast path (a per-step target): finite, bottom row exactly (0, 0, 0, 1) and a rotation
+        # block orthonormal to 1e-12 with det > 0 is taken as it is; anything else goes through
+        # the full checks below (which raise or re-orthonormalise)
+        r = T.tolist()
+        if r[3] == [0.0, 0.0, 0.0, 1.0] and math.isfinite(sum(r[0]) + sum(r[1]) + sum(r[2])):
+            err, det = _rotation_defect(r)
+            if err <= 1e-12 and det > 0.0:
+                return pin.SE3(T)
     if isinstance(T, pin.SE3):
         T = T.homogeneous
     T = np.asarray(T, dtype=float)

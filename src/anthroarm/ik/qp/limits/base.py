@@ -28,6 +28,13 @@ class Limit:
     def after_step(self, v: np.ndarray, dt: float) -> None:
         pass
 
+    def _box_into(self, conf, dt: float, out: np.ndarray, tmp: np.ndarray) -> bool:
+        """Write the box as ``out = [lo; −hi]`` (2, nv) in place, without temporaries beyond
+        ``tmp`` (2, nv); return False when this limit has no in-place form (then
+        :func:`combine_into` falls back to :func:`combine`).  Must give the same numbers as
+        :meth:`box` whenever the box contains Δq = 0."""
+        return False
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
 
@@ -54,3 +61,39 @@ def combine(limits, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
             nh = np.where(empty, pt, nh)
         lo, hi = nl, nh
     return lo, hi
+
+
+BIG = 1e20  # finite stand-in for an infinite bound (the QP backends read ±1e20 as "no bound")
+
+
+def combine_into(limits, conf, dt: float, ws) -> None:
+    """:func:`combine` written into the step workspace: ``ws.B`` (2 nv,) = [lo; −hi] and
+    ``ws.hi`` (nv,) = hi, both clipped to ±:data:`BIG` (``ws.lo``, ``ws.mhi`` are the views
+    ``ws.B[:nv]``, ``ws.B[nv:]``; ``ws.Bm`` is ``ws.B`` as (2, nv)).
+
+    Fast path: every limit writes its box in place (:meth:`Limit._box_into`) and the boxes are
+    intersected with ``np.maximum``.  When the intersection contains Δq = 0 it equals what
+    :func:`combine` returns, number for number: no intermediate box was empty (the priority
+    rule never applied) and every box contains 0 (a configuration limit's start-outside branch
+    did not apply).  Otherwise, or when a limit has no in-place form, :func:`combine` runs."""
+    B, Bm = ws.B, ws.Bm
+    first = True
+    for lim in limits:
+        if first:
+            if not lim._box_into(conf, dt, Bm, ws.tmp2):
+                break
+            first = False
+        else:
+            if not lim._box_into(conf, dt, ws.box2, ws.tmp2):
+                break
+            np.maximum(Bm, ws.box2, out=Bm)
+    else:
+        if not first:
+            np.maximum(B, -BIG, out=B)
+            if np.maximum.reduce(B) <= 0.0:        # 0 inside the box (False for NaN)
+                np.negative(ws.mhi, out=ws.hi)
+                return
+    lo, hi = combine(limits, conf, dt)
+    np.clip(lo, -BIG, BIG, out=ws.lo)
+    np.clip(hi, -BIG, BIG, out=ws.hi)
+    np.negative(ws.hi, out=ws.mhi)

@@ -45,6 +45,8 @@ class ConfigurationLimit(Limit):
         self._lo = np.where(self._fin_lo, self.lower[self._qidx], -np.inf)
         self._hi = np.where(self._fin_hi, self.upper[self._qidx], np.inf)
         self._identity = bool(np.all(self._qidx == np.arange(robot.nv))) and robot.nq == robot.nv
+        self._L2 = np.stack([self._lo, -self._hi])     # [q_min; −q_max] for _box_into
+        self._sign2 = np.array([[1.0], [-1.0]])
 
     def box(self, conf, dt):
         q = conf.q if self._identity else conf.q[self._qidx]
@@ -59,6 +61,16 @@ class ConfigurationLimit(Limit):
             hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)
             lo = np.where(below, (self._lo - q) + 1e-12 * (1.0 + np.abs(self._lo)), lo)
         return lo, hi
+
+    def _box_into(self, conf, dt, out, tmp):
+        # [lo; −hi] = gain · ([q_min; −q_max] − [q; −q]): the same floating-point operations as
+        # box() (negation is exact); the start-outside branch is left to combine()
+        q = conf.q if self._identity else conf.q[self._qidx]
+        np.multiply(self._sign2, q, out=tmp)
+        np.subtract(self._L2, tmp, out=out)
+        if self.gain != 1.0:
+            np.multiply(out, self.gain, out=out)
+        return True
 
     def __repr__(self) -> str:
         return f"ConfigurationLimit(gain={self.gain})"

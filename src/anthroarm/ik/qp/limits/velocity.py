@@ -24,5 +24,9 @@ class VelocityLimit(Limit):
         d = self.v_max * dt
         return -d, d.copy()
 
+    def _box_into(self, conf, dt, out, tmp):
+        np.multiply(self.v_max, -dt, out=out)      # both rows: lo = −v dt and −hi = −v dt
+        return True
+
     def __repr__(self) -> str:
         return f"VelocityLimit(v_max={np.round(self.v_max, 3).tolist()})"

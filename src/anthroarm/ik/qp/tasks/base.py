@@ -62,6 +62,22 @@ class Task:
         e = self.compute_error(conf)
         return self._objective(J, e, conf.nv)
 
+    def _accumulate(self, conf, ws, first: bool) -> float:
+        """Add this task's objective into the step's buffers ``ws.H`` (nv, nv) and ``ws.c``
+        (nv,) in place (overwrite them when ``first``; ``ws.Hd`` is the writable diagonal of
+        ``ws.H``) and return a scalar that the caller adds to diag(H) once for all tasks.  Used by :func:`~anthroarm.ik.qp.step`; the sum is the same
+        as adding up :meth:`compute_qp_objective` (tests/ik_qp check it task by task).  This
+        general version calls :meth:`compute_qp_objective`; tasks with a cheaper in-place form
+        override it (and fall back here for subclasses, which may override the objective)."""
+        Ht, ct = self.compute_qp_objective(conf)
+        if first:
+            np.copyto(ws.H, Ht)
+            np.copyto(ws.c, ct)
+        else:
+            np.add(ws.H, Ht, out=ws.H)
+            np.add(ws.c, ct, out=ws.c)
+        return 0.0
+
     def _objective(self, J, e, nv):
         w = self.cost
         if isinstance(w, float):

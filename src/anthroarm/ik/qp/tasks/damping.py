@@ -23,3 +23,16 @@ class DampingTask(Task):
     def compute_qp_objective(self, conf):  # the returned H is a fresh array (may be modified)
         w = self.cost
         return np.diag(np.broadcast_to(np.asarray(w, float) ** 2, (conf.nv,)).astype(float)), np.zeros(conf.nv)
+
+    def _accumulate(self, conf, ws, first):
+        # H += diag(w²), c unchanged
+        if type(self) is not DampingTask:
+            return Task._accumulate(self, conf, ws, first)
+        if first:
+            ws.H.fill(0.0)
+            ws.c.fill(0.0)
+        w = self.cost
+        if isinstance(w, float):
+            return w * w
+        np.add(ws.Hd, w * w, out=ws.Hd)
+        return 0.0

@@ -30,8 +30,9 @@ class FrameTask(Task):
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
         self.frame_id = robot.frame_id(frame)
         self.frame = robot.model.frames[self.frame_id].name
-        self._wcol = self.cost[:, None].copy()
-        self._wg = self.cost * self.gain
+        self._nv = robot.nv
+        self._weights_for = None      # (cost array, gain) the cached weights below belong to
+        self._weights()
         self.target: pin.SE3 | None = None
         if target is not None:
             self.set_target(target)
@@ -69,12 +70,28 @@ class FrameTask(Task):
         T_tb = T_t.actInv(conf.frame_placement(self.frame_id))
         return -pin.Jlog6(T_tb) @ conf.frame_jacobian(self.frame_id, LOCAL)
 
+    def _weights(self):
+        """Cached W (as a column), αW, −αW and, when the six costs are equal, the scalar w
+        (re-derived when ``cost`` or ``gain`` was reassigned)."""
+        key = self._weights_for
+        if key is None or key[0] is not self.cost or key[1] != self.gain:
+            w = self.cost
+            self._wcol = w[:, None].copy()
+            self._wg = w * self.gain
+            uniform = bool(np.all(w == w[0]))
+            self._w1 = float(w[0]) if uniform else None          # scalar weight, or None
+            self._nwg1 = -float(w[0]) * self.gain if uniform else None
+            self._nwg = -self._wg
+            self._buf = (np.empty((6, self._nv)), np.empty((self._nv, self._nv)), np.empty(self._nv))
+            self._weights_for = (self.cost, self.gain)
+
     def compute_qp_objective(self, conf):
         # Task._objective written out for speed, with Jl = Jlog6 · ᵇJ = −J:
         # H = (W Jl)ᵀ(W Jl) + μ I,  c = α JᵀW²e = −(W Jl)ᵀ(α W e)
         T_t = self.target
         if T_t is None:
             self._require_target()
+        self._weights()
         T_b = conf.frame_placement(self.frame_id)
         e = pin.log6(T_b.actInv(T_t)).vector
         WJ = self._wcol * (pin.Jlog6(T_t.actInv(T_b)) @ conf.frame_jacobian(self.frame_id, LOCAL))
@@ -83,3 +100,38 @@ class FrameTask(Task):
         if self.lm_damping:
             H.flat[:: conf.nv + 1] += self.lm_damping * float(We @ We)
         return H, -(WJ.T @ We)
+
+    def _accumulate(self, conf, ws, first):
+        # compute_qp_objective in place: the same operations on preallocated buffers, the LM
+        # term returned as the diagonal scalar.  A subclass may override the objective: it
+        # takes the general path.
+        if type(self) is not FrameTask:
+            return Task._accumulate(self, conf, ws, first)
+        T_t = self.target
+        if T_t is None:
+            self._require_target()
+        if self._weights_for[0] is not self.cost or self._weights_for[1] != self.gain:
+            self._weights()
+        model, data, fid = conf.model, conf.data, self.frame_id
+        T_b = pin.updateFramePlacement(model, data, fid)   # kinematics are current (conf.update)
+        WJ, Ht, ct = self._buf
+        np.dot(pin.Jlog6(T_t.actInv(T_b)), pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
+        e = pin.log6(T_b.actInv(T_t)).vector
+        w = self._w1
+        if w is None:
+            np.multiply(WJ, self._wcol, out=WJ)
+            nWe = np.multiply(e, self._nwg, out=e)
+        else:
+            if w != 1.0:
+                np.multiply(WJ, w, out=WJ)
+            nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
+        WJt = WJ.T
+        if first:
+            np.dot(WJt, WJ, out=ws.H)
+            np.dot(WJt, nWe, out=ws.c)
+        else:
+            np.add(ws.H, np.dot(WJt, WJ, out=Ht), out=ws.H)
+            np.add(ws.c, np.dot(WJt, nWe, out=ct), out=ws.c)
+        if self.lm_damping:
+            return self.lm_damping * float(nWe @ nWe)
+        return 0.0

@@ -81,3 +81,23 @@ class PostureTask(Task):
         else:
             H = self._H
         return H, w * We
+
+    def _accumulate(self, conf, ws, first):
+        # J = I: c += α w² e, diag(H) += w² + μ (returned when the cost is a scalar)
+        if type(self) is not PostureTask:
+            return Task._accumulate(self, conf, ws, first)
+        w = self.cost
+        d = pin.difference(self.model, self.target, conf.q)
+        if first:
+            ws.H.fill(0.0)
+            np.multiply(d, w * w * self.gain, out=ws.c)
+        else:
+            np.add(ws.c, np.multiply(d, w * w * self.gain, out=d), out=ws.c)
+        mu = 0.0
+        if self.lm_damping:
+            We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
+            mu = self.lm_damping * float(We @ We)
+        if isinstance(w, float):
+            return w * w + mu
+        np.add(ws.Hd, w * w, out=ws.Hd)
+        return mu
