@@ -52,6 +52,11 @@ import numpy as np
 import pinocchio as pin
 from scipy.linalg.lapack import dposv, dpotrs
 
+try:  # the clip ufunc itself: ~0.2 µs against ~1.3 µs for np.clip's Python wrapper
+    from numpy._core.umath import clip as _uclip
+except ImportError:  # numpy < 2
+    from numpy.core.umath import clip as _uclip
+
 from ..errors import UnsupportedModelError
 from .qp.targets import as_position, as_rotation, as_se3
 from .qp.tasks.posture import comfortable_posture
@@ -84,7 +89,7 @@ SECANT_RANGE = (0.1, 10.0)  # accepted curvature estimates of the secant null-sp
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
 LOCKSTEP_MIN = 8      # batches at least this large iterate all targets together (vectorised LM)
 LOCKSTEP_ATTEMPTS = 10 # attempts per target in lockstep; the rest go to the one-target solver
-HUMAN_GRID = np.linspace(-np.pi, np.pi, 12, endpoint=False)  # swivel grid of those seeds (human_arm7)
+HUMAN_GRID = np.linspace(-np.pi, np.pi, 24, endpoint=False)  # swivel grid of those seeds (human_arm7)
 
 _CHAINS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -130,6 +135,7 @@ class _Chain:
         self.reach = reach
         self.path = [model.joints[j].idx_q for j in model.supports[jid][1:]]
         self.default_ref = comfortable_posture(robot)
+        self.analytic_first = _analytic_cheap(robot, fid)
         # kernel workspace: J Jᵀ + λI is built in place (its diagonal is a view) and handed to
         # LAPACK as its transpose (Fortran order, symmetric) so that dposv factorises in place
         self.A = {m: np.empty((m, m)) for m in (3, 6)}
@@ -182,13 +188,20 @@ class _Chain:
         return pen
 
 
+_last = [lambda: None, -1, None]   # (weakref to the last robot, fid, chain): skips the dict lookups
+
+
 def _chain(robot, fid: int) -> _Chain:
+    last = _last
+    if last[0]() is robot and last[1] == fid:
+        return last[2]
     d = _CHAINS.get(robot)
     if d is None:
         d = _CHAINS[robot] = {}
     ch = d.get(fid)
     if ch is None:
         ch = d[fid] = _Chain(robot, fid)
+    last[0], last[1], last[2] = weakref.ref(robot), fid, ch
     return ch
 
 
@@ -205,7 +218,7 @@ class _Target:
 
     __slots__ = ("kind", "mode", "m", "Ms", "ps", "Rs", "tol_p", "tol_r", "tp2", "tr2", "tsum", "x")
 
-    def __init__(self, mode, tgt, tol_p, tol_r):
+    def __init__(self, mode, tgt, tol_p, tol_r, x=None):
         self.mode = mode
         self.kind = _KIND[mode]
         self.tol_p = tol_p
@@ -217,12 +230,9 @@ class _Target:
         if mode == "pose":
             self.m = 6
             self.Ms = tgt
-            self.ps = np.array(tgt.translation)
-            self.Rs = np.array(tgt.rotation)
-            x = np.empty((3, 4))
-            x[:, :3] = self.Rs
-            x[:, 3] = self.ps
-            self.x = x.reshape(12)
+            self.ps = tgt.translation
+            self.Rs = tgt.rotation
+            self.x = tgt.homogeneous[:3].ravel() if x is None else x
         elif mode == "position":
             self.m = 3
             self.ps = np.asarray(tgt, dtype=float)
@@ -335,8 +345,8 @@ def _attempt(ch, tg, q, deadline):
         x, info = dposv(AF, e, overwrite_a=1)[1:]
         if info:  # not positive definite (NaN/inf): give up this attempt
             break
-        qn = q + J.T.dot(x)
-        qc = np.minimum(np.maximum(qn, lo), hi)
+        qn = q + x.dot(J)
+        qc = _uclip(qn, lo, hi)
         if qc.tobytes() != qn.tobytes():      # (byte comparison: ~20× cheaper than (qc != qn).any())
             # active set: the joints the step pushes past a limit stay where they are; the
             # other joints take the step (recomputed without them), then it is clipped
@@ -346,94 +356,112 @@ def _attempt(ch, tg, q, deadline):
             x, info = dposv(AF, e, overwrite_a=1)[1:]
             if info:
                 break
-            qn = q + J.T.dot(x)
-            qc = np.minimum(np.maximum(qn, lo), hi)
+            qc = _uclip(q + x.dot(J), lo, hi)
         q = qc
     return q, False, it, pe2, re2, best_q, best_E
 
 
 # ------------------------------------------------------------------------------ secondary objectives
 def _refine_posture(ch, tg, q, q_ref, deadline):
-    """Second phase for redundant arms: from a solution ``q``, minimise ½‖q − q_ref‖² along the
-    self-motion (null space of the task) while Gauss–Newton keeps the task error at zero.  A
-    joint at its limit that the step would push past it is frozen (its column of J and its share
-    of the posture pull are dropped) and the step recomputed: with a one-dimensional self-motion
-    the optimum then lies where that joint sits at its limit.  Other steps are clipped.
-    Returns (q, iterations): the last iterate that meets the tolerances (``q`` if none does)."""
+    """Second phase for redundant arms: from ``q`` (a solution, or a closed-form seed),
+    minimise ½‖q − q_ref‖² along the self-motion (null space of the task) while Gauss–Newton
+    keeps the task error at zero.  A joint at its limit that the step would push past it is
+    frozen (its column of J and its share of the posture pull are dropped) and the step
+    recomputed: with a one-dimensional self-motion the optimum then lies where that joint sits
+    at its limit.  Other steps are clipped.
+
+    Returns (q, pos_err², rot_err², iterations): the last iterate that meets the tolerances
+    and its errors, or (None, …) if no iterate did."""
     lo, hi = ch.lo, ch.hi
-    one_dim = ch.n - tg.m == 1
-    lam0 = LAMBDA0
+    m = tg.m
+    one_dim = ch.n - m == 1
+    A, AF, Ad = ch.A[m], ch.AF[m], ch.Ad[m]
+    tp2, tr2 = tg.tp2, tg.tr2
     h_lo, h_hi = SECANT_RANGE
-    good = q
+    good = None
+    gpe2 = gre2 = math.inf
     it = 0
-    t_prev = None
+    p_prev = None     # last null-space direction (unnormalised) and its g, s
     g_prev = s_prev = 0.0
     h = 1.0
-    while it < NULL_EXTRA and _clock() <= deadline:
-        J, e, pe2, re2 = tg.lin(ch, q)
+    lin = tg.lin
+    while it < NULL_EXTRA:
+        J, e, pe2, re2 = lin(ch, q)
         it += 1
-        ok = pe2 <= tg.tp2 and re2 <= tg.tr2
+        ok = pe2 <= tp2 and re2 <= tr2
         if ok:
-            good = q
-        lam = lam0 + K_DAMP * (pe2 + re2)
+            good, gpe2, gre2 = q, pe2, re2
+        elif not it & 3 and _clock() > deadline:
+            break
+        lam = LAMBDA0 + K_DAMP * (pe2 + re2)
         frozen = None
-        for _ in range(2):
-            A = J.dot(J.T)
-            A.flat[:: A.shape[0] + 1] += lam
-            cfac, x, info = dposv(A, e)
-            if info != 0:
-                return good, it
-            dq = J.T.dot(x)
-            z = q_ref - q - dq
+        while True:
+            np.dot(J, J.T, out=A)
+            Ad += lam
+            x, info = dposv(AF, e, overwrite_a=1)[1:]   # AF now holds the Cholesky factor
+            if info:
+                return good, gpe2, gre2, it
+            dq = x.dot(J)
+            z = q_ref - q
+            z -= dq
             if frozen is not None:
                 z[frozen] = 0.0
-            p = z - J.T.dot(dpotrs(cfac, J.dot(z))[0])   # N z: projection on the null space
-            if one_dim and frozen is None:
-                # secant step along the unit self-motion direction t: g = tᵀ(q_ref − q) is minus
+            p = z - dpotrs(AF, J.dot(z))[0].dot(J)     # N z: projection on the null space
+            g = math.sqrt(p.dot(p))
+            if one_dim and frozen is None and g > 0.0:
+                # secant step along the self-motion direction t = p/g: g = tᵀ(q_ref − q) is minus
                 # the derivative of the cost along t; its change per unit move estimates the curvature
-                g = math.sqrt(p.dot(p))
-                if g == 0.0:
-                    t, s = p, 0.0
-                else:
-                    t = p / g
-                    if t_prev is not None and t.dot(t_prev) < 0.0:
-                        t, g = -t, -g
-                    if t_prev is not None and abs(s_prev) > 1e-12:
+                if p_prev is not None:
+                    if p.dot(p_prev) < 0.0:
+                        g = -g
+                    if abs(s_prev) > 1e-12:
                         hk = (g_prev - g) / s_prev
                         h = min(hk, h_hi) if hk >= h_lo else 1.0
-                    s = g / h
-                    if abs(s) > NULL_STEP:
-                        s = math.copysign(NULL_STEP, s)
+                s = g / h
+                if abs(s) > NULL_STEP:
+                    s = math.copysign(NULL_STEP, s)
                 n2 = abs(s)
-                step = t * s
+                qn = q + dq + p * (s / g)
             else:
-                step = p
-                n2 = math.sqrt(p.dot(p))
-                if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
-                    step = p * (NULL_STEP / n2)
-            qn = q + dq + step
-            qc = np.minimum(np.maximum(qn, lo), hi)
-            if frozen is not None:
+                s = 0.0
+                n2 = g
+                qn = q + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))  # long moves leave the linearisation
+            qc = _uclip(qn, lo, hi)
+            if frozen is not None or qc.tobytes() == qn.tobytes():
                 break
             out = (qc != qn) & ((q == lo) | (q == hi))   # at a limit and pushed past it
             if not out.any():
+                # the null-space move crosses a limit: shorten it so that the first joint to
+                # cross stops on its limit (clipping the whole step would spoil the pose)
+                step = qn - q - dq
+                base = q + dq
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    sig = np.where(step > 0.0, (hi - base) / step, np.where(step < 0.0, (lo - base) / step, np.inf))
+                sig = min(max(float(sig.min()), 0.0), 1.0)
+                qn = base + sig * step
+                s *= sig
+                n2 *= sig
+                qc = _uclip(qn, lo, hi)
                 break
             frozen = out                       # active set: freeze, recompute once
             J = J.copy()
             J[:, out] = 0.0
         if ok and n2 < NULL_TOL:
             break
-        if one_dim and frozen is None and g != 0.0:
-            s_prev = t.dot(qc - q)
-            t_prev, g_prev = t, g
+        if s != 0.0:
+            clipped = qc.tobytes() != qn.tobytes()
+            s_prev = p.dot(qc - q) / g if clipped else s   # the move made along t = p/g
+            if ok and clipped and abs(s_prev) < 0.1 * n2:
+                break   # a joint limit blocks the self-motion: constrained optimum
+            p_prev, g_prev = (p if g > 0.0 else -p), g     # p_prev oriented like t
         else:
-            t_prev = None                      # the secant memory is void after a frozen step
+            p_prev = None                      # the secant memory is void after a frozen step
         q = qc
     else:
         pe, re = tg.errors(ch, q)
-        if pe * pe <= tg.tp2 and re * re <= tg.tr2:
-            good = q
-    return good, it
+        if pe * pe <= tp2 and re * re <= tr2:
+            good, gpe2, gre2 = q, pe * pe, re * re
+    return good, gpe2, gre2, it
 
 
 class _Swivel:
@@ -533,6 +561,25 @@ def _swivel_offset(ch, sw: _Swivel, q) -> float:
 
 
 # ------------------------------------------------------------------------------ targets
+def _rigid_se3(T):
+    """``pin.SE3`` of a float64 4×4 ``T`` that is rigid to 1e-12 (checked in plain Python, a
+    few µs cheaper than :func:`~anthroarm.ik.qp.targets.as_se3`), else None: then ``as_se3``
+    decides (re-orthonormalises within its tolerance, or raises naming the defect)."""
+    if T.dtype != np.float64:
+        return None
+    a, b, c, d = T.tolist()
+    if d != [0.0, 0.0, 0.0, 1.0] or not math.isfinite(sum(a) + sum(b) + sum(c)):
+        return None
+    err = max(abs(a[0] * a[0] + a[1] * a[1] + a[2] * a[2] - 1.0), abs(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] - 1.0),
+              abs(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - 1.0), abs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]),
+              abs(a[0] * c[0] + a[1] * c[1] + a[2] * c[2]), abs(b[0] * c[0] + b[1] * c[1] + b[2] * c[2]))
+    det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+           + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    if err > 1e-12 or det < 0.0:
+        return None
+    return pin.SE3(T)
+
+
 def _parse(robot, T, mode):
     """-> (mode, batch: bool, list of targets)."""
     if mode not in (None, "pose", "position", "orientation"):
@@ -569,12 +616,38 @@ def _parse(robot, T, mode):
                      f"with a leading axis; got shape {sh}")
 
 
-def _analytic_module():
-    if importlib.util.find_spec("anthroarm.ik.closed_form") is None:
-        return None
-    from . import closed_form
+_ANALYTIC = []   # the closed-form module (or None), looked up once
 
-    return closed_form if hasattr(closed_form, "analytic") and hasattr(closed_form, "has_analytic") else None
+
+def _analytic_module():
+    if not _ANALYTIC:
+        mod = None
+        if importlib.util.find_spec("anthroarm.ik.closed_form") is not None:
+            from . import closed_form
+
+            if hasattr(closed_form, "analytic") and hasattr(closed_form, "has_analytic"):
+                mod = closed_form
+        _ANALYTIC.append(mod)
+    return _ANALYTIC[0]
+
+
+def _analytic_cheap(robot, fid) -> bool:
+    """True when ``analytic="auto"`` puts the closed form first: the robot has one for this
+    frame and a call costs about as much as a few Gauss–Newton iterations — the scalar kernels
+    of the six-joint book arms (~10–20 µs), the human arm's swivel grid only with the compiled
+    kernel of :mod:`.analytic_c` (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and environment,
+    so the same call gives the same answer."""
+    cf = _analytic_module()
+    try:
+        if cf is None or fid != robot.tool_id or not cf.has_analytic(robot):
+            return False
+        if robot.spec.name != "human_arm7":
+            return True
+        from . import analytic_c
+
+        return bool(analytic_c.enabled() and analytic_c.compiler() is not None)
+    except Exception:  # a seed source only
+        return False
 
 
 def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None):
@@ -594,8 +667,8 @@ def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None):
         S = np.asarray(cf.analytic(robot, target.homogeneous, **kw).solutions, dtype=float).reshape(-1, ch.n)
     except Exception as exc:  # a seed source only: never let it break the solve
         return np.zeros((0, ch.n)), f"analytic seed failed: {exc}"
-    if len(S):
-        S = S[np.argsort(np.abs(S - ref).sum(axis=1))]
+    if len(S) > 1:
+        S = S[np.argsort(((S - ref) ** 2).sum(axis=1))]
     return S, ""
 
 
@@ -644,7 +717,12 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     """
     fid = robot.frame_id(frame)
     ch = _chain(robot, fid)
-    mode, batch, targets = _parse(robot, T, mode)
+    x = None
+    if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose") and (M := _rigid_se3(T)) is not None:
+        mode, batch, targets = "pose", False, [M]
+        x = T[:3].ravel()
+    else:
+        mode, batch, targets = _parse(robot, T, mode)
     for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
         if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a positive finite number, got {v!r}")
@@ -681,7 +759,7 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
 
     q_ref_sec = q_ref if redundant and swivel is None else None
     sw_sec = (sw_frames, swivel) if (redundant and swivel is not None) else None
-    tgs = [_Target(mode, t, float(tol_pos), float(tol_rot)) for t in targets]
+    tgs = [_Target(mode, t, float(tol_pos), float(tol_rot), x) for t in targets]
     if Q0 is None:
         seeds = [None] * len(targets)
     else:
@@ -710,14 +788,37 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         messages=[r.message for r in results], mode=mode)
 
 
-def _table_order(ch, tg, q_ref):
-    """Seed-table indices, nearest first: the first :data:`TABLE_SEEDS` of them."""
-    sc = tg.scores(ch)
-    if q_ref is not None:
-        sc = sc + ch.posture_penalty(q_ref)
-    k = min(TABLE_SEEDS, len(sc) - 1)
-    idx = np.argpartition(sc, k)[: k + 1]
-    return idx[np.argsort(sc[idx])][:TABLE_SEEDS]
+class _TableSeeds:
+    """The seed-table entries nearest a target, nearest first (copies): the nearest by one
+    ``argmin``, the next :data:`TABLE_SEEDS` − 1 sorted when first needed; then ``None``."""
+
+    __slots__ = ("ch", "sc", "k0", "order", "i")
+
+    def __init__(self, ch, tg, q_ref):
+        sc = tg.scores(ch)
+        if q_ref is not None:
+            sc = sc + ch.posture_penalty(q_ref)
+        self.ch = ch
+        self.sc = sc
+        self.k0 = -1
+        self.order = None
+        self.i = 0
+
+    def next(self):
+        sc = self.sc
+        if self.i == 0:
+            k = self.k0 = int(sc.argmin())
+        else:
+            if self.order is None:
+                n = min(TABLE_SEEDS, len(sc) - 1)
+                idx = np.argpartition(sc, n)[: n + 1]
+                idx = idx[np.argsort(sc[idx])]
+                self.order = [0] + [int(i) for i in idx if i != self.k0][: TABLE_SEEDS - 1]
+            if self.i >= len(self.order):
+                return None
+            k = self.order[self.i]
+        self.i += 1
+        return self.ch.table()[0][k].copy()
 
 
 def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen, q_ref, sw, analytic):
@@ -735,7 +836,7 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
     tp2, tr2 = tgs[0].tp2, tgs[0].tr2
     lo, hi = ch.lo, ch.hi
     # first seeds: q0, else the nearest table entry (vectorised over the batch)
-    orders = [None] * N
+    tseeds = [None] * N
     Q = np.empty((N, n))
     need = [k for k in range(N) if seeds[k] is None]
     if need:
@@ -754,7 +855,6 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
         if seeds[k] is not None:
             Q[k] = seeds[k]
     Q = ch.clip(Q)
-    used = np.ones(N, dtype=int)          # table seeds used per target (the first counts)
     J = np.empty((N, m, n))
     E = np.empty((N, m))
     PE2 = np.zeros(N)
@@ -809,13 +909,12 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
             ek = active[ended]
             retry = ek[attempts[ek] < max_attempts]
             for k in retry:                   # next seed: the next table entry, then random
-                if used[k] < TABLE_SEEDS:
-                    if orders[k] is None:
-                        orders[k] = _table_order(ch, tgs[k], q_ref)
-                    Q[k] = ch.table()[0][orders[k][used[k]]]
-                    used[k] += 1
-                else:
-                    Q[k] = ch.random(gen)
+                if tseeds[k] is None:
+                    tseeds[k] = _TableSeeds(ch, tgs[k], q_ref)
+                    if seeds[k] is None:
+                        tseeds[k].next()       # the nearest entry was the first seed
+                qn = tseeds[k].next()
+                Q[k] = ch.random(gen) if qn is None else qn
             attempts[retry] += 1
             att_it[retry] = 0
             stall[retry] = 0
@@ -879,40 +978,43 @@ def _solve_one(robot, ch, tg, target, seed, max_time, max_restarts, gen, q_ref, 
         if dist > ch.reach + tg.tol_p:
             out_of_reach = (f"target is {dist:.4g} m from the base origin but the chain reaches at most "
                             f"{ch.reach:.4g} m (sum of its link offsets)")
-    order = None      # seed-table order, computed when needed
-    used = 0          # table entries used
-    if seed is None:
-        order = _table_order(ch, tg, q_ref)
-        q = ch.table()[0][order[0]]
-        used = 1
-        seeds_tag = "table"
-    else:
-        q = np.minimum(np.maximum(np.asarray(seed, dtype=float), ch.lo), ch.hi)
-        seeds_tag = "q0"
-    total_it = 0
-    best_q, best_E = q, math.inf
-    note = ""
-    restarts = 0
+    # seeds: closed form (analytic=True, or "auto" where it is cheap and no q0 is given), q0,
+    # the seed table nearest first, uniform random
     ana = None
     ana_i = 0
-    if analytic is True and not out_of_reach:
-        ana, note = _analytic_seeds(robot, ch, tg.mode, target, q, sw[1] if sw else None)
+    note = ""
+    if not out_of_reach and (analytic is True or (analytic == "auto" and seed is None and ch.analytic_first)):
+        ref = q_ref if q_ref is not None else (ch.default_ref if seed is None else seed)
+        ana, note = _analytic_seeds(robot, ch, tg.mode, target, ref, sw[1] if sw else None, HUMAN_GRID)
+    table = None      # seed-table entries, nearest first (made when needed)
+    total_it = 0
+    best_q, best_E = None, math.inf
+    restarts = 0
     attempt = 0
     secondary = None
     while True:
         if ana is not None and ana_i < len(ana):
             q, seeds_tag = ana[ana_i].copy(), "analytic"
             ana_i += 1
-        elif attempt > 0:
-            if order is None:
-                order = _table_order(ch, tg, q_ref)
-            if used < len(order):
-                q = ch.table()[0][order[used]]
-                used += 1
-            else:
-                q = ch.random(gen)
-            seeds_tag = "restart"
+        elif seed is not None:
+            q, seeds_tag = np.minimum(np.maximum(np.asarray(seed, dtype=float), ch.lo), ch.hi), "q0"
+            seed = None
+        else:
+            if table is None:
+                table = _TableSeeds(ch, tg, q_ref)
+            q, seeds_tag = table.next(), "table"
+            if q is None:
+                q, seeds_tag = ch.random(gen), "restart"
+        if attempt:
             restarts += 1
+        if seeds_tag == "analytic" and q_ref is not None and sw is None:
+            # a closed-form solution: straight to the posture phase, which verifies it
+            qs, pe2, re2, it = _refine_posture(ch, tg, q, q_ref, deadline + 0.5 * max_time)
+            total_it += it
+            attempt += 1
+            if qs is not None:
+                return IKResult(qs, True, "success", math.sqrt(pe2), math.sqrt(re2), total_it, restarts,
+                                "converged from an analytic seed", tg.mode, seeds_tag)
         qs, ok, it, pe2, re2, bq, bE = _attempt(ch, tg, q, deadline)
         total_it += it
         attempt += 1
@@ -930,11 +1032,10 @@ def _solve_one(robot, ch, tg, target, seed, max_time, max_restarts, gen, q_ref, 
                                                       msg)
                 seeds_tag = tag or seeds_tag
             elif q_ref is not None:
-                qs2, it2 = _refine_posture(ch, tg, qs, q_ref, deadline + 0.5 * max_time)
+                qs2, pe2, re2, it2 = _refine_posture(ch, tg, qs, q_ref, deadline + 0.5 * max_time)
                 total_it += it2
-                if qs2 is not qs:
-                    qs = qs2
-                    pe, re = tg.errors(ch, qs)
+                if qs2 is not None:
+                    qs, pe, re = qs2, math.sqrt(pe2), math.sqrt(re2)
             return IKResult(qs, True, "success", pe, re, total_it, restarts, msg, tg.mode, seeds_tag)
         if out_of_reach and attempt >= 3:
             break
@@ -942,9 +1043,10 @@ def _solve_one(robot, ch, tg, target, seed, max_time, max_restarts, gen, q_ref, 
             ana, note = _analytic_seeds(robot, ch, tg.mode, target, best_q, sw[1] if sw else None, HUMAN_GRID)
         if _clock() > deadline:
             break
-        if max_restarts is not None and restarts >= max_restarts and (ana is None or ana_i >= len(ana)):
+        if max_restarts is not None and restarts >= max_restarts:
             break
-    q = best_q
+    if best_q is not None:
+        q = best_q
     pe, re = tg.errors(ch, q)
     el = (_clock() - t0) * 1e3
     if out_of_reach:
