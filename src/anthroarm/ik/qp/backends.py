@@ -67,7 +67,25 @@ class Backend:
     def __init__(self, n: int, n_eq: int = 0):
         self.n = int(n)
         self.n_eq = int(n_eq)
-        self.last_info: dict = {}
+        self._raw_info = None
+        self._info: dict = {}
+
+    @property
+    def last_info(self) -> dict:
+        """Solver details of the last solve (status, iterations, ...)."""
+        raw = self._raw_info
+        if raw is not None:
+            self._info = self._info_from(raw)
+            self._raw_info = None
+        return self._info
+
+    @last_info.setter
+    def last_info(self, info: dict) -> None:
+        self._info = info
+        self._raw_info = None
+
+    def _info_from(self, raw) -> dict:  # pragma: no cover - only backends that set _raw_info
+        return dict(raw)
 
     def solve(self, H, c, lo, hi, A=None, b=None):  # pragma: no cover - interface
         raise NotImplementedError
@@ -81,7 +99,7 @@ class Backend:
     @staticmethod
     def _finish_box(x, lo, hi):
         """``_finish`` without equality rows: x clipped into [lo, hi] (a fresh array)."""
-        if not math.isfinite(x @ x):
+        if not math.isfinite(x.dot(x)):
             return None, "failed"
         x = np.maximum(x, lo)
         return np.minimum(x, hi, out=x), "optimal"
@@ -235,6 +253,10 @@ class DaqpBackend(Backend):
         self._sense[n:] = 5  # equality rows: active + immutable
         self._A0 = np.zeros((0, n))
 
+    def _info_from(self, raw):
+        flag, info = raw
+        return {"exitflag": flag, "iter": info.get("iterations")}
+
     def solve(self, H, c, lo, hi, A=None, b=None):
         if A is None or not len(A):
             bu, bl, Am = _finite(hi), _finite(lo), self._A0
@@ -252,7 +274,7 @@ class DaqpBackend(Backend):
         if A is not None:
             return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
         x, _, flag, info = self._daqp.solve(ws.H, ws.c, self._A0, ws.hi, ws.lo, self._sense)
-        self.last_info = {"exitflag": flag, "iter": info["iterations"]}
+        self._raw_info = (flag, info)          # last_info is built when read
         if flag > 0:
             return self._finish_box(x, ws.lo, ws.hi)
         return None, "infeasible" if flag == -1 else "failed"
@@ -260,7 +282,12 @@ class DaqpBackend(Backend):
 
 class QuadprogBackend(Backend):
     """quadprog (Goldfarb–Idnani), called directly.  The box becomes the constant inequality
-    block [I; −I] (infinite bounds replaced by ±1e20, never active), built once."""
+    block [I; −I] (infinite bounds replaced by ±1e20, never active), built once.
+
+    Box-only QPs of :func:`~anthroarm.ik.qp.step` call quadprog's compiled ``qpgen2_`` routine
+    with preallocated arrays (:mod:`anthroarm.ik.qp._qpgen2`: the same routine and inputs as
+    ``quadprog.solve_qp``, bit-identical results, without its ~8 µs of per-call allocation);
+    where that is unavailable, and for equality rows, ``quadprog.solve_qp`` is called."""
 
     name = "quadprog"
 
@@ -268,9 +295,12 @@ class QuadprogBackend(Backend):
         super().__init__(n, n_eq)
         import quadprog
 
+        from . import _qpgen2
+
         self._qp = quadprog
         self._eye = np.eye(n)
         self._C = np.hstack([np.zeros((n, n_eq)), self._eye, -self._eye])
+        self._direct = _qpgen2.make(n) if n_eq == 0 else None
 
     def solve(self, H, c, lo, hi, A=None, b=None):
         meq = 0 if A is None else len(A)
@@ -302,6 +332,13 @@ class QuadprogBackend(Backend):
         if A is not None:
             return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
         # ws.B = [lo; −hi] is quadprog's b for C = [I, −I]
+        direct = self._direct
+        if direct is not None:
+            rc, x = direct.solve(ws.H, ws.c, ws.B)
+            if rc == 0:
+                self.last_info = {}
+                return self._finish_box(x, ws.lo, ws.hi)      # a fresh array (x is the buffer)
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)   # errors handled there
         try:
             x = self._qp.solve_qp(ws.H, np.negative(ws.c, out=ws.nc), self._C, ws.B, 0)[0]
         except ValueError:

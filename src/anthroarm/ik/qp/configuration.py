@@ -94,7 +94,7 @@ class IKConfiguration:
     def integrate_inplace(self, v, dt: float) -> None:
         """``update(integrate(v, dt))``."""
         v = np.asarray(v, dtype=float)
-        if v.shape != (self.nv,) or not math.isfinite(v @ v):
+        if v.shape != (self.nv,) or not math.isfinite(v.dot(v)):
             raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
         self.q = pin.integrate(self.model, self.q, v * dt)   # finite q + finite step: no re-check
         pin.computeJointJacobians(self.model, self.data, self.q)

@@ -120,7 +120,9 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     if isinstance(robot, IKConfiguration):
         conf = robot
         rb = conf.robot
-        st = _state(robot, rb)
+        st = conf.__dict__.get("_qp_state")
+        if st is None:
+            st = _state(conf, rb)
         if q is not None:
             conf.update(q)
     else:
@@ -131,17 +133,21 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
             conf = st["conf"] = IKConfiguration(robot, q)
         else:
             conf.update(q)
-    if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
+    if not (dt.__class__ is float and 0.0 < dt < math.inf):   # the common case in one test
+        if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     nv = conf.nv
-    if isinstance(limits, str):
+    if limits.__class__ is str:
         if limits != "default":
             raise ValueError(f"limits must be 'default', None or a list of Limit objects, got {limits!r}")
         limits = st.get("default_limits")
         if limits is None:
             limits = st["default_limits"] = default_limits(rb)
+        stateful = False               # configuration and velocity limits keep no state
     elif limits is None:
-        limits = ()
+        limits, stateful = (), False
+    else:
+        stateful = True
 
     ws = st.get("ws")
     if ws is None:
@@ -169,7 +175,7 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     if backend is None:
         backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
     Hc = ws.Hc
-    if not math.isfinite(Hc @ Hc):
+    if not math.isfinite(Hc.dot(Hc)):
         x, status = None, "failed"
         backend.last_info = {"error": "non-finite task objective"}
     else:
@@ -178,8 +184,9 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
         v = np.zeros(nv)
     else:
         v = np.divide(x, dt, out=x)
-    for lim in limits:
-        lim.after_step(v, dt)
+    if stateful:
+        for lim in limits:
+            lim.after_step(v, dt)
     if full:  # the box as combine() gives it (±inf where unbounded, not the solvers' ±BIG)
         lo = np.where(ws.lo <= -BIG, -np.inf, ws.lo)
         hi = np.where(ws.hi >= BIG, np.inf, ws.hi)

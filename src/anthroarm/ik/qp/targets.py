@@ -14,6 +14,7 @@ import numpy as np
 import pinocchio as pin
 
 RIGID_TOL = 1e-6
+_F64 = np.dtype(np.float64)
 
 
 def _check_finite(a: np.ndarray, name: str) -> None:
@@ -33,6 +34,20 @@ def _rotation_defect(r) -> tuple[float, float]:
     det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
            + a[2] * (b[0] * c[1] - b[1] * c[0]))
     return e, det
+
+
+def _clean_rigid(r) -> bool:
+    """True when the nested 4×4 list ``r`` is finite, has the bottom row (0, 0, 0, 1) exactly
+    and a rotation block orthonormal to 1e-12 with det > 0: then :func:`as_se3` takes it as it
+    is (the checks of :func:`_rotation_defect` written for one unpacked 4×4)."""
+    (a0, a1, a2, a3), (b0, b1, b2, b3), (c0, c1, c2, c3), d = r
+    if d != [0.0, 0.0, 0.0, 1.0] or not math.isfinite(a0 + a1 + a2 + a3 + b0 + b1 + b2 + b3 + c0 + c1 + c2 + c3):
+        return False
+    if max(abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0), abs(b0 * b0 + b1 * b1 + b2 * b2 - 1.0),
+           abs(c0 * c0 + c1 * c1 + c2 * c2 - 1.0), abs(a0 * b0 + a1 * b1 + a2 * b2),
+           abs(a0 * c0 + a1 * c1 + a2 * c2), abs(b0 * c0 + b1 * c1 + b2 * c2)) > 1e-12:
+        return False
+    return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0) > 0.0
 
 
 def as_rotation(R, name: str = "R") -> np.ndarray:
@@ -62,15 +77,10 @@ def as_position(p, name: str = "p") -> np.ndarray:
 
 def as_se3(T, name: str = "T") -> pin.SE3:
     """A ``pin.SE3`` from a rigid 4×4 homogeneous matrix (or a ``pin.SE3``), or ``ValueError``."""
-    if type(T) is np.ndarray and T.dtype == np.float64 and T.shape == (4, 4):
-        # fast path (a per-step target): finite, bottom row exactly (0, 0, 0, 1) and a rotation
-        # block orthonormal to 1e-12 with det > 0 is taken as it is; anything else goes through
-        # the full checks below (which raise or re-orthonormalise)
-        r = T.tolist()
-        if r[3] == [0.0, 0.0, 0.0, 1.0] and math.isfinite(sum(r[0]) + sum(r[1]) + sum(r[2])):
-            err, det = _rotation_defect(r)
-            if err <= 1e-12 and det > 0.0:
-                return pin.SE3(T)
+    if T.__class__ is np.ndarray and T.shape == (4, 4) and T.dtype == _F64 and _clean_rigid(T.tolist()):
+        # fast path (a per-step target): taken as it is; anything else goes through the full
+        # checks below (which raise or re-orthonormalise)
+        return pin.SE3(T)
     if isinstance(T, pin.SE3):
         T = T.homogeneous
     T = np.asarray(T, dtype=float)

@@ -28,12 +28,12 @@ class Limit:
     def after_step(self, v: np.ndarray, dt: float) -> None:
         pass
 
-    def _box_into(self, conf, dt: float, out: np.ndarray, tmp: np.ndarray) -> bool:
-        """Write the box as ``out = [lo; −hi]`` (2, nv) in place, without temporaries beyond
-        ``tmp`` (2, nv); return False when this limit has no in-place form (then
-        :func:`combine_into` falls back to :func:`combine`).  Must give the same numbers as
-        :meth:`box` whenever the box contains Δq = 0."""
-        return False
+    def _box_into(self, conf, dt: float, out: np.ndarray, tmp: np.ndarray):
+        """The box as [lo; −hi] (2, nv): written into ``out`` (scratch ``tmp``, both (2, nv)) and
+        ``out`` returned, or a cached read-only array returned; ``None`` when this limit has no
+        such form (then :func:`combine_into` falls back to :func:`combine`).  Must give the same
+        numbers as :meth:`box` whenever the box contains Δq = 0."""
+        return None
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
@@ -80,17 +80,21 @@ def combine_into(limits, conf, dt: float, ws) -> None:
     first = True
     for lim in limits:
         if first:
-            if not lim._box_into(conf, dt, Bm, ws.tmp2):
+            box = lim._box_into(conf, dt, Bm, ws.tmp2)
+            if box is None:
                 break
+            if box is not Bm:
+                np.copyto(Bm, box)
             first = False
         else:
-            if not lim._box_into(conf, dt, ws.box2, ws.tmp2):
+            box = lim._box_into(conf, dt, ws.box2, ws.tmp2)
+            if box is None:
                 break
-            np.maximum(Bm, ws.box2, out=Bm)
+            np.maximum(Bm, box, out=Bm)
     else:
         if not first:
             np.maximum(B, -BIG, out=B)
-            if np.maximum.reduce(B) <= 0.0:        # 0 inside the box (False for NaN)
+            if B[B.argmax()] <= 0.0:           # 0 inside the box (False for NaN: argmax finds it)
                 np.negative(ws.mhi, out=ws.hi)
                 return
     lo, hi = combine(limits, conf, dt)

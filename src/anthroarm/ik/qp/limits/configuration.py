@@ -12,6 +12,8 @@ the velocity limit allows; pink's QP is infeasible there, pink#206).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .base import Limit
@@ -47,6 +49,7 @@ class ConfigurationLimit(Limit):
         self._identity = bool(np.all(self._qidx == np.arange(robot.nv))) and robot.nq == robot.nv
         self._L2 = np.stack([self._lo, -self._hi])     # [q_min; −q_max] for _box_into
         self._sign2 = np.array([[1.0], [-1.0]])
+        self._scaled_for = None                        # gain of the cached gain·_L2, gain·_sign2
 
     def box(self, conf, dt):
         q = conf.q if self._identity else conf.q[self._qidx]
@@ -66,11 +69,22 @@ class ConfigurationLimit(Limit):
         # [lo; −hi] = gain · ([q_min; −q_max] − [q; −q]): the same floating-point operations as
         # box() (negation is exact); the start-outside branch is left to combine()
         q = conf.q if self._identity else conf.q[self._qidx]
-        np.multiply(self._sign2, q, out=tmp)
-        np.subtract(self._L2, tmp, out=out)
-        if self.gain != 1.0:
-            np.multiply(out, self.gain, out=out)
-        return True
+        g = self.gain
+        if g != self._scaled_for:
+            # a power-of-two gain (pink's 0.5) scales exactly: g·(a − b) = g·a − g·b bit for bit,
+            # so the product with the constant part is cached and one operation is saved
+            self._pow2 = math.frexp(g)[0] == 0.5
+            self._gL2 = g * self._L2
+            self._gs2 = g * self._sign2
+            self._scaled_for = g
+        if self._pow2:
+            np.multiply(self._gs2, q, out=tmp)
+            np.subtract(self._gL2, tmp, out=out)
+        else:
+            np.multiply(self._sign2, q, out=tmp)
+            np.subtract(self._L2, tmp, out=out)
+            np.multiply(out, g, out=out)
+        return out
 
     def __repr__(self) -> str:
         return f"ConfigurationLimit(gain={self.gain})"

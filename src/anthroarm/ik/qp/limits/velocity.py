@@ -1,6 +1,7 @@
 """VelocityLimit: |Δq| ≤ v_max · dt (rad/s or m/s), from the URDF ``velocity`` attribute by
 default.  A non-finite or non-positive entry means "no limit" for that joint (URDFs often
-leave it 0 when unknown)."""
+leave it 0 when unknown).  ``v_max`` is read-only: assign a new array to change it (the step's
+box is cached per ``v_max`` array and dt)."""
 
 from __future__ import annotations
 
@@ -19,14 +20,21 @@ class VelocityLimit(Limit):
         if np.isnan(v).any():
             raise ValueError("v_max contains NaN")
         self.v_max = np.where(np.isfinite(v) & (v > 0), v, np.inf)
+        self.v_max.setflags(write=False)   # replace it (lim.v_max = ...) rather than edit it
+        self._cached = (None, None, None)  # (v_max, dt, [−v dt; −v dt]) of the last _box_into
 
     def box(self, conf, dt):
         d = self.v_max * dt
         return -d, d.copy()
 
     def _box_into(self, conf, dt, out, tmp):
-        np.multiply(self.v_max, -dt, out=out)      # both rows: lo = −v dt and −hi = −v dt
-        return True
+        # both rows: lo = −v dt and −hi = −v dt; constant while v_max and dt are
+        vm, dt0, box = self._cached
+        if vm is not self.v_max or dt0 != dt:
+            box = np.multiply(self.v_max, -dt, out=np.empty_like(out))
+            box.setflags(write=False)
+            self._cached = (self.v_max, dt, box)
+        return box
 
     def __repr__(self) -> str:
         return f"VelocityLimit(v_max={np.round(self.v_max, 3).tolist()})"

@@ -31,7 +31,8 @@ class FrameTask(Task):
         self.frame_id = robot.frame_id(frame)
         self.frame = robot.model.frames[self.frame_id].name
         self._nv = robot.nv
-        self._weights_for = None      # (cost array, gain) the cached weights below belong to
+        self._w_cost = None           # the cost array and gain the cached weights belong to
+        self._w_gain = None
         self._weights()
         self.target: pin.SE3 | None = None
         if target is not None:
@@ -73,8 +74,7 @@ class FrameTask(Task):
     def _weights(self):
         """Cached W (as a column), αW, −αW and, when the six costs are equal, the scalar w
         (re-derived when ``cost`` or ``gain`` was reassigned)."""
-        key = self._weights_for
-        if key is None or key[0] is not self.cost or key[1] != self.gain:
+        if self._w_cost is not self.cost or self._w_gain != self.gain:
             w = self.cost
             self._wcol = w[:, None].copy()
             self._wg = w * self.gain
@@ -83,7 +83,7 @@ class FrameTask(Task):
             self._nwg1 = -float(w[0]) * self.gain if uniform else None
             self._nwg = -self._wg
             self._buf = (np.empty((6, self._nv)), np.empty((self._nv, self._nv)), np.empty(self._nv))
-            self._weights_for = (self.cost, self.gain)
+            self._w_cost, self._w_gain = self.cost, self.gain
 
     def compute_qp_objective(self, conf):
         # Task._objective written out for speed, with Jl = Jlog6 · ᵇJ = −J:
@@ -92,9 +92,9 @@ class FrameTask(Task):
         if T_t is None:
             self._require_target()
         self._weights()
-        T_b = conf.frame_placement(self.frame_id)
-        e = pin.log6(T_b.actInv(T_t)).vector
-        WJ = self._wcol * (pin.Jlog6(T_t.actInv(T_b)) @ conf.frame_jacobian(self.frame_id, LOCAL))
+        X = conf.frame_placement(self.frame_id).actInv(T_t)          # T_b⁻¹ T_t
+        e = pin.log6(X).vector
+        WJ = self._wcol * (pin.Jlog6(X.inverse()) @ conf.frame_jacobian(self.frame_id, LOCAL))
         We = self._wg * e
         H = WJ.T @ WJ
         if self.lm_damping:
@@ -110,13 +110,14 @@ class FrameTask(Task):
         T_t = self.target
         if T_t is None:
             self._require_target()
-        if self._weights_for[0] is not self.cost or self._weights_for[1] != self.gain:
+        if self._w_cost is not self.cost or self._w_gain != self.gain:
             self._weights()
         model, data, fid = conf.model, conf.data, self.frame_id
-        T_b = pin.updateFramePlacement(model, data, fid)   # kinematics are current (conf.update)
+        # kinematics are current (IKConfiguration.update / integrate_inplace computed them)
+        X = pin.updateFramePlacement(model, data, fid).actInv(T_t)          # T_b⁻¹ T_t
         WJ, Ht, ct = self._buf
-        np.dot(pin.Jlog6(T_t.actInv(T_b)), pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
-        e = pin.log6(T_b.actInv(T_t)).vector
+        pin.Jlog6(X.inverse()).dot(pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
+        e = pin.log6(X).vector
         w = self._w1
         if w is None:
             np.multiply(WJ, self._wcol, out=WJ)
@@ -124,14 +125,18 @@ class FrameTask(Task):
         else:
             if w != 1.0:
                 np.multiply(WJ, w, out=WJ)
-            nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
+            if self._nwg1 == -1.0:
+                nWe = np.negative(e, out=e)
+            else:
+                nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
         WJt = WJ.T
+        # ndarray.dot with out=: the BLAS product without np.dot's dispatch cost
         if first:
-            np.dot(WJt, WJ, out=ws.H)
-            np.dot(WJt, nWe, out=ws.c)
+            WJt.dot(WJ, out=ws.H)
+            WJt.dot(nWe, out=ws.c)
         else:
-            np.add(ws.H, np.dot(WJt, WJ, out=Ht), out=ws.H)
-            np.add(ws.c, np.dot(WJt, nWe, out=ct), out=ws.c)
+            np.add(ws.H, WJt.dot(WJ, out=Ht), out=ws.H)
+            np.add(ws.c, WJt.dot(nWe, out=ct), out=ws.c)
         if self.lm_damping:
-            return self.lm_damping * float(nWe @ nWe)
+            return self.lm_damping * float(nWe.dot(nWe))
         return 0.0

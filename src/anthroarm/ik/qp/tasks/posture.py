@@ -54,6 +54,7 @@ class PostureTask(Task):
         self.robot = robot
         self._H = np.diag(np.broadcast_to(np.asarray(self.cost, float) ** 2, (robot.nv,)).astype(float))
         self._H.setflags(write=False)
+        self._s_for = (None, None, None)   # (cost, gain, α w² per joint) of _accumulate
         self.set_target(comfortable_posture(robot) if target is None else target)
 
     def set_target(self, q_ref) -> None:
@@ -88,11 +89,18 @@ class PostureTask(Task):
             return Task._accumulate(self, conf, ws, first)
         w = self.cost
         d = pin.difference(self.model, self.target, conf.q)
+        key = self._s_for
+        if key[0] is not w or key[1] != self.gain:
+            # α w² as an (nv,) array: an array-array product is cheaper than one with a scalar
+            s = np.empty(conf.nv)
+            s[:] = w * w * self.gain
+            self._s_for = (w, self.gain, s)
+        s = self._s_for[2]
         if first:
             ws.H.fill(0.0)
-            np.multiply(d, w * w * self.gain, out=ws.c)
+            np.multiply(d, s, out=ws.c)
         else:
-            np.add(ws.c, np.multiply(d, w * w * self.gain, out=d), out=ws.c)
+            np.add(ws.c, np.multiply(d, s, out=d), out=ws.c)
         mu = 0.0
         if self.lm_damping:
             We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
