@@ -11,8 +11,10 @@ the joint limits, its FK residual from the generated straight-line FK of the cat
 (:mod:`anthroarm.ik.fk_codegen`, evaluated once per distinct branch prefix): an independent
 forward computation of the returned joint values.  A candidate is kept if its code is OK, it
 lies inside the limits after the 2π wrap and ``max |FK(q) − T| ≤ tol`` (3×4 pose entries, m for
-the position).  Poses with no solution (or inputs that are not plainly valid) are handed back to
-the general path by the caller, so reasons and errors are the general path's.
+the position).  Candidates outside the joint limits are pruned before their FK check; the
+kernels report the failure code and the residuals of the candidates inside the limits, from
+which the caller words the general path's reasons.  Inputs that are not plainly valid never get
+here (the caller hands them to the general path, which raises the error).
 
 Frames/units: ``T`` rows of the tool pose in the base frame (m); joint values in rad.
 """
@@ -23,7 +25,8 @@ import math
 
 from .analytic_plan import TWO_PI, WRAP_TOL
 
-_atan2, _sqrt, _cos, _sin, _asin, _acos, _floor = math.atan2, math.sqrt, math.cos, math.sin, math.asin, math.acos, math.floor
+_atan2, _sqrt, _cos, _sin = math.atan2, math.sqrt, math.cos, math.sin
+_asin, _acos, _floor = math.asin, math.acos, math.floor
 PI = math.pi
 HALF_PI = 0.5 * math.pi
 OK, OUTSIDE, ELBOW, DEGENERATE, OUT_OF_PLANE = 0, 1, 2, 3, 4
@@ -190,7 +193,8 @@ def prosthetic(T, plan, tol, position_only=False):
     tried = []
     # the flexion branches: θ4 = ±θ4p
     flex = ((th4p, c4p, s4p), (-th4p, c4p, -s4p))
-    q4s = ((th4p if fl[3] <= th4p <= fh[3] else _wrap(th4p, lo[3], hi[3], lf[3])), (-th4p if fl[3] <= -th4p <= fh[3] else _wrap(-th4p, lo[3], hi[3], lf[3])))
+    q4s = ((th4p if fl[3] <= th4p <= fh[3] else _wrap(th4p, lo[3], hi[3], lf[3])),
+           (-th4p if fl[3] <= -th4p <= fh[3] else _wrap(-th4p, lo[3], hi[3], lf[3])))
     for root in (0, 1):
         tr = t if root == 0 else -t
         Ex, Ey, Ez = E0x + tr * dX, E0y + tr * dY, E0z + tr * dZ

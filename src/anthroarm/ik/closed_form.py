@@ -690,12 +690,12 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) and
     :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form.
 
-    Plainly valid (N, 4, 4) float arrays go through the compiled kernel of :mod:`.analytic_c`
-    if a C compiler is available, else through the structure-of-arrays kernels of
+    Plainly valid (N, 4, 4) float64 arrays go through the structure-of-arrays numpy kernels of
     :mod:`.analytic_soa` (same formulas, branches and checks; FK verification by the chain
     product generated from the spec, :mod:`.fk_codegen`); anything else through the general
-    path below.  ``_impl`` (private, for tests and benchmarks): "auto", "c", "python" (the numpy
-    kernels) or "general"."""
+    path below.  ``_impl`` (private, for tests and benchmarks): "auto" (= "python" for
+    batches), "python", "c" (the compiled kernel of :mod:`.analytic_c` on the whole batch) or
+    "general"."""
     name, prm = _require(robot)
     if position_only is None:
         position_only = name == "planar2r"
@@ -823,7 +823,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
 
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, elbow determinant, wrist singularity, joint
-    limits), ``swivel`` (human_arm7), ``residuals`` (FK check).  See the module docstring."""
+    limits), ``swivel`` (human_arm7), ``residuals`` (FK check).  See the module docstring.
+
+    One pose is solved by the compiled kernel (:mod:`.analytic_c`) when a C compiler is
+    available — built once per robot parameterisation on first use (≈ 0.2 s, cached on disk;
+    ``ANTHROARM_IK_C=0`` disables it) — else by the scalar kernels of :mod:`.analytic_scalar`."""
     arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
     if method == "book":
         name, prm = _require(robot)

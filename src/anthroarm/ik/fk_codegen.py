@@ -189,7 +189,10 @@ def _render_python(stages, vectorised: bool) -> str:
         for item in stg["body"]:
             if item[0] == "trig":
                 j, q = item[1], item[2]
-                lines.append(f"    c{j}, s{j} = cos_sin({q})" if vectorised else f"    c{j} = cos({q})\n    s{j} = sin({q})")
+                if vectorised:
+                    lines.append(f"    c{j}, s{j} = cos_sin({q})")
+                else:
+                    lines += [f"    c{j} = cos({q})", f"    s{j} = sin({q})"]
             else:
                 lines.append(f"    {item[1]} = {item[2]}")
         if "diffs" in stg:
