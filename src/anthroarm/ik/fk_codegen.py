@@ -233,8 +233,7 @@ def _render_c(stages, prefix: str) -> str:
         for item in stg["body"]:
             if item[0] == "trig":
                 j, q = item[1], item[2]
-                lines.append(f"    double c{j}, s{j};")
-                lines.append(f"    sincos({q}, &s{j}, &c{j});")
+                lines.append(f"    const double c{j} = cos({q}), s{j} = sin({q});")  # gcc fuses to sincos
             else:
                 lines.append(f"    const double {item[1]} = {item[2]};")
         if last:
