@@ -194,6 +194,7 @@ class OSQPBackend(Backend):
         ext = getattr(self.solver, "_solver", None)
         self._ext = ext if all(hasattr(ext, a) for a in ("update_data_vec", "update_data_mat", "solve", "info",
                                                           "solution")) else None
+        self._solved = osqp.SolverStatus.OSQP_SOLVED
 
     def solve(self, H, c, lo, hi, A=None, b=None):
         n_eq = 0 if A is None else len(A)
@@ -220,6 +221,12 @@ class OSQPBackend(Backend):
             self.solver.update(Px=H.take(self._tri), q=c, l=l, u=u, **kw)
             res = self.solver.solve(raise_error=False)
             info, x = res.info, res.x
+            return self._status(info, x, res.y, H, c, lo, hi, A, b)
+        return self._status(info, x, ext.solution.y, H, c, lo, hi, A, b)
+
+    def _status(self, info, x, y, H, c, lo, hi, A, b):
+        """Map OSQP's status to (x, status): polish when ADMM stopped early, reset the warm
+        start after a failure."""
         st = info.status_val
         self.last_info = {"status": st, "iter": info.iter}
         S = self._osqp.SolverStatus
@@ -230,13 +237,30 @@ class OSQPBackend(Backend):
             return None, "infeasible"
         if st in (S.OSQP_SOLVED_INACCURATE, S.OSQP_MAX_ITER_REACHED):
             x = np.array(x)
-            y = np.array(ext.solution.y if ext is not None else res.y)
-            xp = self._polish(H, c, lo, hi, A, b, x, y)
+            xp = self._polish(H, c, lo, hi, A, b, x, np.array(y))
             self.last_info["polished"] = xp is not None
             if xp is not None or st == S.OSQP_SOLVED_INACCURATE:
                 return self._finish(x if xp is None else xp, lo, hi, A, b, "optimal")
         self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
         return None, "failed"
+
+
+    def solve_ws(self, ws, A=None, b=None):
+        ext = self._ext
+        if A is not None or ext is None:
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
+        # the workspace box is finite already (±BIG): no _finite, no concatenation
+        ext.update_data_vec(q=ws.c, l=ws.lo, u=ws.hi)
+        ext.update_data_mat(P_x=ws.H.take(self._tri), P_i=None, A_x=None, A_i=None)
+        ext.solve()
+        info = ext.info
+        if info.status_val == self._solved:
+            self._raw_info = info
+            return self._finish_box(ext.solution.x, ws.lo, ws.hi)     # fresh array
+        return self._status(info, ext.solution.x, ext.solution.y, ws.H, ws.c, ws.lo, ws.hi, None, None)
+
+    def _info_from(self, info):
+        return {"status": info.status_val, "iter": info.iter}
 
 
 class DaqpBackend(Backend):
@@ -348,12 +372,20 @@ class QuadprogBackend(Backend):
 
 
 class ProxqpBackend(Backend):
-    """proxsuite ProxQP (dense), followed by the same active-set polish as OSQP (ProxQP's eps
-    bounds residuals, not x: without the polish it is 1e-4 off on IK QPs).  The one-shot
-    ``proxqp.dense.solve`` is used: on 7-variable QPs it measured 18 µs against 41 µs for a
-    persistent workspace with ``update`` (which re-runs the setup)."""
+    """proxsuite ProxQP (dense), followed by an active-set polish (ProxQP's eps bounds
+    residuals, not x: on IK QPs, whose H has eigenvalues down to the posture weight², x is
+    1e-4 off without it).
+
+    Box-only QPs of :func:`~anthroarm.ik.qp.step` use one persistent ``proxqp.dense.QP``
+    (``update`` + warm start from the previous result, eps 1e-9): ProxQP identifies the active
+    bounds (its multipliers z, z < 0 at a lower and z > 0 at an upper bound) and
+    :meth:`_polish_box` solves the equality-constrained QP on that set exactly, accepting it
+    only with a KKT certificate (primal feasible, multipliers of the right sign).  Anything else
+    (equality rows, a failed certificate, a solver status other than solved) runs the one-shot
+    ``proxqp.dense.solve`` at eps 1e-10 followed by :meth:`Backend._polish`."""
 
     name = "proxqp"
+    EPS_WARM = 1e-9
 
     def __init__(self, n: int, n_eq: int = 0):
         super().__init__(n, n_eq)
@@ -361,6 +393,80 @@ class ProxqpBackend(Backend):
 
         self._proxqp = proxqp
         self._eye = np.eye(n)
+        self._Q = None          # persistent box-QP workspace (created on the first solve_ws)
+        self._sign2 = np.array([[1.0], [-1.0]])
+        self._tmp2 = np.zeros((2, n))
+        try:
+            from eigenpy import LLT
+        except ImportError:  # pragma: no cover - eigenpy comes with pinocchio
+            LLT = None
+        self._LLT = LLT
+
+    def solve_ws(self, ws, A=None, b=None):
+        if A is not None or self._LLT is None:
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
+        proxqp = self._proxqp
+        Q = self._Q
+        if Q is None:
+            Q = proxqp.dense.QP(self.n, 0, self.n, False)
+            st = Q.settings
+            st.eps_abs, st.eps_rel, st.verbose = self.EPS_WARM, 0.0, False
+            st.initial_guess = proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+            Q.init(ws.H, ws.c, None, None, self._eye, ws.lo, ws.hi)
+            self._Q = Q
+        else:
+            Q.update(ws.H, ws.c, None, None, None, ws.lo, ws.hi)
+        Q.solve()
+        r = Q.results
+        if r.info.status == proxqp.QPSolverOutput.PROXQP_SOLVED:
+            x = self._polish_box(ws, r.x, r.z)
+            if x is not None:
+                self._raw_info = r.info
+                return x, "optimal"
+        else:
+            self._Q = None      # start afresh next time
+        return self.solve(ws.H, ws.c, ws.lo, ws.hi)
+
+    def _info_from(self, info):
+        return {"status": str(info.status), "iter": info.iter, "polished": True}
+
+    def _polish_box(self, ws, xs, z):
+        """Exact solution of the box QP on the active set read from ProxQP's answer ``xs`` and
+        multipliers ``z`` (OSQP's rule: lower bound active where xs − lo < −z, upper where
+        hi − xs < z; a warm-started z keeps vanishing, e.g. 1e-26, entries of bounds that were
+        active before).  With x_u = −H⁻¹c (Cholesky of H) and the bounds b_A on the active set A,
+        x = x_u + H⁻¹E_A μ with μ = (E_Aᵀ H⁻¹ E_A)⁻¹ (b_A − x_{u,A}), so that Hx + c = E_A μ.
+        Returned (a fresh array, clipped into the box) only when x is within the box (1e-12)
+        and μ ≥ −1e-8 at lower, μ ≤ 1e-8 at upper bounds (the KKT conditions); else None."""
+        llt = self._LLT(ws.H)
+        x = llt.solve(ws.c)
+        np.negative(x, out=x)
+        act = None
+        if z.any():
+            at_lo = (xs - ws.lo) < -z
+            at_hi = (ws.hi - xs) < z
+            act = np.flatnonzero(at_lo | at_hi)
+        if act is not None and len(act):
+            lower = at_lo[act]
+            bA = np.where(lower, ws.lo[act], ws.hi[act])
+            Y = llt.solve(self._eye[:, act])              # H⁻¹ E_A, (n, k)
+            if Y.ndim == 1:                               # eigenpy returns (n,) for k = 1
+                Y = Y[:, None]
+            M = Y[act]
+            rhs = bA - x[act]
+            mu = rhs / M[0, 0] if len(act) == 1 else np.linalg.solve(M, rhs)
+            if (mu[lower] < -1e-8).any() or (mu[~lower] > 1e-8).any():
+                return None
+            x += Y @ mu
+            x[act] = bA
+        if not math.isfinite(x.dot(x)):
+            return None
+        # within the box: max([lo − x; x − hi]) ≤ 1e-12
+        d = np.subtract(ws.Bm, np.multiply(self._sign2, x, out=self._tmp2), out=self._tmp2)
+        if not d.flat[d.argmax()] <= 1e-12:
+            return None
+        x = np.maximum(x, ws.lo)
+        return np.minimum(x, ws.hi, out=x)
 
     def solve(self, H, c, lo, hi, A=None, b=None):
         proxqp = self._proxqp
