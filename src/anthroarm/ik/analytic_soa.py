@@ -91,7 +91,7 @@ def sixr(E, plan):
     code = np.where(np.abs(k) > 1.0 + 1e-12, OUTSIDE, OK)
     np.clip(k, -1.0, 1.0, out=k)
     ask = np.arcsin(k)
-    c3a = np.sqrt(1.0 - k * k)                                           # cos(asin k) ≥ 0
+    c3a = np.sqrt((1.0 - k) * (1.0 + k))                                 # cos(asin k) ≥ 0, accurate at |k| → 1
     th3 = np.stack([ask, PI - ask])[None]                                # (1, 2, N) elbow up/down
     hk = h2 + s3 * k
     phi = np.stack([np.arctan2(-s3 * c3a, hk), np.arctan2(s3 * c3a, hk)])[None]
