@@ -261,6 +261,24 @@ def test_generated_fk_matches_pinocchio():
                     assert (st < 1e-14) if small else (st > 1e-9)
 
 
+@needs_cc
+@pytest.mark.parametrize("name", ["sixr_arm", "prosthetic_arm", "human_arm7", "planar2r"])
+def test_compiled_fk_check_matches_pinocchio(name):
+    """The compiled FK check returns Pinocchio's max |FK(q) − T| for right and wrong targets."""
+    robot = aa.load(name)
+    kern = analytic_c.kernel_for(plan_for(robot, name, robot.spec.params))
+    rng = np.random.default_rng(8)
+    Q = rng.uniform(-np.pi, np.pi, (200, robot.nq))
+    T = robot.fk(Q)
+    Tw = robot.fk(Q + rng.normal(scale=1e-3, size=Q.shape))
+    for q, Tk, Tx in zip(Q, T, Tw):
+        assert kern.fk_residual(q, Tk) < 1e-14
+        assert kern.fk_residual(q, Tk, position_only=True) < 1e-14
+        np.testing.assert_allclose(kern.fk_residual(q, Tx), np.abs(Tk[:3] - Tx[:3]).max(), rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(kern.fk_residual(q, Tx, position_only=True), np.abs(Tk[:3, 3] - Tx[:3, 3]).max(),
+                                   rtol=1e-9, atol=1e-15)
+
+
 def test_cos_sin_half_angle_tangent():
     rng = np.random.default_rng(0)
     q = np.concatenate([rng.uniform(-10, 10, 200000), np.pi + rng.uniform(-1e-6, 1e-6, 1000),

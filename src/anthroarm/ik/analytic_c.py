@@ -431,7 +431,25 @@ def c_source(plan) -> str:
             arr("FLO", plan.fast_lo), arr("FHI", plan.fast_hi)]
     head += [f"static const double P_{k} = {_c_double(plan.params[k])};" for k in _PARAMS[plan.name]]
     return "\n".join([*head, _COMMON, plan.fk.c_source("fk_"), plan.fk_pos.c_source("fkp_"),
-                      _KERNELS[plan.name], _ENTRY])
+                      _KERNELS[plan.name], _ENTRY, _fk_entry(plan)])
+
+
+def _fk_entry(plan) -> str:
+    """``double aa_fk_residual(const double *q, const double *T, int po)``: the FK check of one
+    configuration through the generated stages (for the tests: the C FK against Pinocchio)."""
+    bounds = [0, *plan.fk.splits, plan.nq]
+    n = plan.fk.n_stages
+    lines = ["double aa_fk_residual(const double *q, const double *T, int po) {",
+             "    double a[64], b[64];", "    (void)a; (void)b;"]
+    src = "0"
+    for k in range(n):
+        if k == n - 1:
+            lines.append(f"    return po ? fkp_{k}({src}, q + {bounds[k]}, T) : fk_{k}({src}, q + {bounds[k]}, T);")
+        else:
+            dst = "a" if k % 2 == 0 else "b"
+            lines.append(f"    if (po) fkp_{k}({src}, q + {bounds[k]}, {dst}); else fk_{k}({src}, q + {bounds[k]}, {dst});")
+            src = dst
+    return "\n".join(lines + ["}", ""])
 
 
 # ---------------------------------------------------------------------------- loading
@@ -448,6 +466,10 @@ class CKernel:
         f.argtypes = [ctypes.c_long, _P, _P, ctypes.c_long, ctypes.c_double, ctypes.c_int, ctypes.c_double,
                       ctypes.c_int, _P, _P, _P, _P, _P, _P, _P, _P, _P]
         self.fn = f
+        g = self.lib.aa_fk_residual
+        g.restype = ctypes.c_double
+        g.argtypes = [_P, _P, ctypes.c_int]
+        self._fk = g
         self.nq = plan.nq
         self.nb = N_BRANCHES[plan.name]
         self.path = path
@@ -463,6 +485,12 @@ class CKernel:
             ptr = {k: a.ctypes.data for k, a in arrs.items()}
             b = self._local.b = (arrs, ptr)
         return b
+
+    def fk_residual(self, q, T, position_only=False) -> float:
+        """max |FK(q) − T| (3×4 entries, or the position) by the compiled FK check."""
+        q = np.ascontiguousarray(q, dtype=float)
+        T = np.ascontiguousarray(T, dtype=float)
+        return float(self._fk(q.ctypes.data, T.ctypes.data, int(position_only)))
 
     def single(self, T, swivel, tol, po, tolo):
         """One pose (4×4 float64); ``swivel`` None or a sequence of S ≤ MAX_SINGLE_S angles.
