@@ -61,8 +61,9 @@ class ConfigurationLimit(Limit):
             below = q < self._lo
             # outside the range: ask for the whole way back (gain 1), landing a hair inside so
             # that rounding in q + Δq cannot leave it outside; velocity limits cap the speed
-            hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)
-            lo = np.where(below, (self._lo - q) + 1e-12 * (1.0 + np.abs(self._lo)), lo)
+            with np.errstate(invalid="ignore"):   # inf − inf on unbounded joints, masked out
+                hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)
+                lo = np.where(below, (self._lo - q) + 1e-12 * (1.0 + np.abs(self._lo)), lo)
         return lo, hi
 
     def _box_into(self, conf, dt, out, tmp):
