@@ -82,6 +82,8 @@ SEED_TABLE_RNG = 20231  # its fixed RNG seed (the table, and so every answer, is
 SEED_ROT_WEIGHT = 0.25  # w / reach in the seed distance ‖Δp‖² + w²‖ΔR‖²_F
 SEED_POSTURE_WEIGHT = 0.05  # w_q / reach: + w_q²‖q − q_ref‖² in that distance for posture problems
 TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
+ALIGN_RANGE = 1.5 * np.pi   # first / last joints with at least this range are aligned (see _Aligned)
+ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
 NULL_TOL = 1e-4   # posture / swivel secondary step norm (rad) under which it has settled
 NULL_EXTRA = 60   # extra iterations allowed for the secondary objective
 NULL_STEP = 1.0   # longest null-space step (rad)
@@ -143,6 +145,7 @@ class _Chain:
         self.Ad = {m: a.reshape(-1)[:: m + 1] for m, a in self.A.items()}
         self.e6 = np.empty(6)
         self._table = None
+        self._aligned = None
         self._penalty = {}
 
     def clip(self, q):
@@ -155,24 +158,38 @@ class _Chain:
 
     # ------------------------------------------------------------------ seed table
     def table(self):
-        """(Q (K, n), F (K, 12), c (K,), P (K, 3), R (K, 9)): configurations, pose features
-        (in the layout of ``T[:3].ravel()``: rotation rows weighted 2w², translations 2) and
-        |p|², so that ‖Δp‖² + w²‖ΔR‖²_F = c − F·x + const for x = T*[:3].ravel()."""
+        """(Q (K, n), G_pose (16, K), G_pos (4, K), G_rot (9, K)): the configurations and, per
+        target kind, the matrix G whose product x·G with the target's features x is the seed
+        distance of every entry up to a constant: for a pose, x = T*.ravel() (16,) and
+        ‖Δp‖² + w²‖ΔR‖²_F = |p|² − 2p·p* − 2w² R:R* + const (the rows of G against T*'s bottom
+        row (0, 0, 0, 1) hold 0, 0, 0, |p|²); for a position x = (p*, 1), for a rotation x = R*
+        flattened.  Stored transposed: x·G reads G row by row (~2.5× faster than G·x here)."""
         if self._table is None:
+            K = SEED_TABLE
             rng = np.random.default_rng(SEED_TABLE_RNG)
-            Q = self.lo_s + (self.hi_s - self.lo_s) * rng.random((SEED_TABLE, self.n))
-            H = np.empty((SEED_TABLE, 3, 4))
+            Q = self.lo_s + (self.hi_s - self.lo_s) * rng.random((K, self.n))
+            H = np.empty((K, 3, 4))
             model, data, fid = self.model, self.data, self.fid
             for k, q in enumerate(Q):
                 pin.framesForwardKinematics(model, data, q)
                 H[k] = data.oMf[fid].homogeneous[:3]
             w2 = (SEED_ROT_WEIGHT * max(self.reach, 1e-3)) ** 2
-            F = H.copy()
-            F[:, :, :3] *= 2.0 * w2
-            F[:, :, 3] *= 2.0
-            P = H[:, :, 3].copy()
-            self._table = (Q, F.reshape(SEED_TABLE, 12), (P * P).sum(1), P, H[:, :, :3].reshape(SEED_TABLE, 9).copy())
+            P = H[:, :, 3]
+            c = (P * P).sum(1)
+            G = np.zeros((K, 4, 4))
+            G[:, :3, :3] = -2.0 * w2 * H[:, :, :3]
+            G[:, :3, 3] = -2.0 * P
+            G[:, 3, 3] = c
+            Gpos = np.column_stack((-2.0 * P, c))
+            self._table = (Q, np.ascontiguousarray(G.reshape(K, 16).T), np.ascontiguousarray(Gpos.T),
+                           np.ascontiguousarray(-H[:, :, :3].reshape(K, 9).T))
         return self._table
+
+    def aligned(self):
+        """The :class:`_Aligned` seed table of this chain, or None where it does not apply."""
+        if self._aligned is None:
+            self._aligned = _Aligned.make(self) or False
+        return self._aligned or None
 
     def posture_penalty(self, q_ref):
         """w_q²‖Q − q_ref‖² over the table (cached per q_ref)."""
@@ -186,6 +203,135 @@ class _Chain:
                 self._penalty.clear()
             self._penalty[key] = pen
         return pen
+
+
+class _Aligned:
+    """Seed table of a pose target aligned on the first and the last joint of the chain.
+
+    Turning the first joint by Δ turns everything after it rigidly about that joint's (fixed)
+    axis: T(q₁ + Δ, …) = Rot(a₁, c₁, Δ) T(q).  Turning the last joint spins the joint-n frame
+    W about its own axis: the point p_W and the axis direction z_W = R_W aₙ do not change.  So a
+    table entry matches a target up to these two angles when (ρ, h, z_W) agree, with ρ, h the
+    distance from and height along the first axis of p_W and z_W expressed in the half-plane
+    of p_W (the canonical frame, turned by −φ about a₁, φ the azimuth of p_W).  The nearest
+    entry in ‖Δρ‖² + ‖Δh‖² + w²‖Δz_W‖² (linear in the entry's features: one mat-vec) is then
+    turned: q₁ += φ* − φ_k, and qₙ by the angle about aₙ between the entry's and the target's
+    joint-n frames (atan2 of two dot products).  Every table entry thus stands for a
+    two-parameter family of poses: with the same 2048 entries the seed lies nearer the target
+    (measured: median 5 iterations instead of 6–7 on panda and ur5, and fewer restarts).
+
+    Applies to chains of ≥ 3 joints whose first and last joints are revolute with a range of at
+    least :data:`ALIGN_RANGE` (panda, ur5; not talos_arm, whose wrist spans 1.4 rad): an
+    alignment that falls outside a joint's range is wrapped by 2π or clipped."""
+
+    __slots__ = ("iq1", "iqn", "c1", "B", "Bc1", "an", "un", "vn", "AUV", "Fi", "G", "phi", "U", "V", "w", "lo1",
+                 "hi1", "lon", "hin")
+
+    @staticmethod
+    def _axis(model, data, jid, q):
+        """Unit axis (joint-local) of revolute joint ``jid``, or None for another joint."""
+        if model.joints[jid].nq != 1 or "Prismatic" in model.joints[jid].shortname() \
+                or model.joints[jid].shortname().endswith(("PX", "PY", "PZ")):
+            return None
+        i = model.joints[jid].idx_q
+        q2 = q.copy()
+        q2[i] += 0.5
+        pin.forwardKinematics(model, data, q)
+        M1 = data.oMi[jid].copy()
+        pin.forwardKinematics(model, data, q2)
+        M2 = data.oMi[jid]
+        if np.linalg.norm(M2.translation - M1.translation) > 1e-9:
+            return None
+        w = pin.log3(M1.rotation.T @ M2.rotation) / 0.5
+        return w / np.linalg.norm(w) if abs(np.linalg.norm(w) - 1.0) < 1e-6 else None
+
+    @classmethod
+    def make(cls, ch):
+        model, data = ch.model, ch.data
+        frame = model.frames[ch.fid]
+        path = list(model.supports[frame.parentJoint][1:])
+        if len(path) < 3:
+            return None
+        j1, jn = path[0], path[-1]
+        i1, i_n = model.joints[j1].idx_q, model.joints[jn].idx_q
+        if ch.hi[i1] - ch.lo[i1] < ALIGN_RANGE or ch.hi[i_n] - ch.lo[i_n] < ALIGN_RANGE:
+            return None
+        q0 = ch.default_ref.copy()
+        a1l, anl = cls._axis(model, data, j1, q0), cls._axis(model, data, jn, q0)
+        if a1l is None or anl is None:
+            return None
+        self = cls.__new__(cls)
+        pin.forwardKinematics(model, data, q0)
+        M1 = data.oMi[j1]
+        a1 = M1.rotation @ a1l
+        self.c1 = M1.translation.copy()
+        t = np.array([1.0, 0.0, 0.0]) if abs(a1[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        e1 = t - a1 * (a1 @ t)
+        e1 /= np.linalg.norm(e1)
+        self.B = np.array([e1, np.cross(a1, e1), a1])          # rows: world -> first-axis basis
+        t = np.array([1.0, 0.0, 0.0]) if abs(anl[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        un = t - anl * (anl @ t)
+        un /= np.linalg.norm(un)
+        self.an, self.un, self.vn = anl, un, np.cross(anl, un)
+        self.Fi = frame.placement.inverse()
+        self.iq1, self.iqn = i1, i_n
+        self.lo1, self.hi1, self.lon, self.hin = ch.lo[i1], ch.hi[i1], ch.lo[i_n], ch.hi[i_n]
+        self.w = ALIGN_WEIGHT * max(ch.reach, 1e-3)
+        self.AUV = np.column_stack((anl, un, self.vn))
+        self.Bc1 = self.B @ self.c1
+        Q = ch.table()[0]
+        K = len(Q)
+        f = np.empty((K, 6))
+        self.phi = np.empty(K)
+        self.U = []
+        self.V = []
+        for k, q in enumerate(Q):
+            pin.forwardKinematics(model, data, q)
+            W = data.oMi[jn]
+            f[k], self.phi[k], u, v = self._canon(W.translation, W.rotation)
+            self.U.append(u)
+            self.V.append(v)
+        # score = |f|² − 2 f·x (+ |x|², the same for every entry), as one product G·(x, 1)
+        f5 = f[:, :5]
+        self.G = np.ascontiguousarray(np.column_stack((-2.0 * f5, (f5 * f5).sum(1))).T)   # (6, K), see _Chain.table
+        return self
+
+    def _canon(self, p, R):
+        """Features (ρ, h, w z'), 1 of a joint-n frame (world position ``p``, rotation ``R``), its
+        azimuth φ, and its uₙ, vₙ directions in the canonical frame (plain floats: 3-vectors
+        cost less in Python than in NumPy)."""
+        (dx, dy, dh), (z, u, v) = (self.B.dot(p) - self.Bc1).tolist(), self.B.dot(R).dot(self.AUV).T.tolist()
+        phi = math.atan2(dy, dx)
+        co, si = math.cos(phi), math.sin(phi)
+        w = self.w
+        return ((math.hypot(dx, dy), dh, w * (co * z[0] + si * z[1]), w * (co * z[1] - si * z[0]), w * z[2], 1.0), phi,
+                (co * u[0] + si * u[1], co * u[1] - si * u[0], u[2]), (co * v[0] + si * v[1], co * v[1] - si * v[0], v[2]))
+
+    def query(self, Ms):
+        """(scores (K,), φ*, u*) of target ``Ms``: u* the canonical uₙ direction of its joint-n frame."""
+        W = Ms * self.Fi
+        x, phi, u, _ = self._canon(W.translation, W.rotation)
+        return np.array(x).dot(self.G), phi, u
+
+    def seed(self, q, k, phi, u):
+        """Table configuration ``q`` (entry k, a copy) turned onto the target: first joint by the
+        azimuth difference, last joint about its axis (wrapped by 2π or clipped into the range)."""
+        i = self.iq1
+        q[i] = _wrap(q[i] + phi - self.phi[k], self.lo1, self.hi1)
+        U, V = self.U[k], self.V[k]
+        d = math.atan2(V[0] * u[0] + V[1] * u[1] + V[2] * u[2], U[0] * u[0] + U[1] * u[1] + U[2] * u[2])
+        i = self.iqn
+        q[i] = _wrap(q[i] + d, self.lon, self.hin)
+        return q
+
+
+def _wrap(x, lo, hi):
+    """x moved by a multiple of 2π into [lo, hi] if possible, else clipped."""
+    if x < lo:
+        x += 2.0 * math.pi * math.ceil((lo - x) / (2.0 * math.pi))
+    elif x > hi:
+        x -= 2.0 * math.pi * math.ceil((x - hi) / (2.0 * math.pi))
+    return min(max(x, lo), hi)
 
 
 _last = [lambda: None, -1, None]   # (weakref to the last robot, fid, chain): skips the dict lookups
@@ -232,12 +378,12 @@ class _Target:
             self.Ms = tgt
             self.ps = tgt.translation
             self.Rs = tgt.rotation
-            self.x = tgt.homogeneous[:3].ravel() if x is None else x
+            self.x = tgt.homogeneous.ravel() if x is None else x
         elif mode == "position":
             self.m = 3
             self.ps = np.asarray(tgt, dtype=float)
             self.Rs = None
-            self.x = self.ps
+            self.x = np.append(self.ps, 1.0)
         else:
             self.m = 3
             self.ps = None
@@ -277,12 +423,7 @@ class _Target:
 
     def scores(self, ch):
         """Seed-table distance of every table entry to this target (up to a constant)."""
-        Q, F, c, P, R = ch.table()
-        if self.kind == _POSE:
-            return c - F.dot(self.x)
-        if self.kind == _POSITION:
-            return c - 2.0 * P.dot(self.ps)
-        return -R.dot(self.x)
+        return self.x.dot(ch.table()[1 + self.kind])
 
 
 # ------------------------------------------------------------------------------ one attempt
@@ -720,7 +861,7 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     x = None
     if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose") and (M := _rigid_se3(T)) is not None:
         mode, batch, targets = "pose", False, [M]
-        x = T[:3].ravel()
+        x = T.ravel()
     else:
         mode, batch, targets = _parse(robot, T, mode)
     for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
@@ -789,15 +930,21 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
 
 
 class _TableSeeds:
-    """The seed-table entries nearest a target, nearest first (copies): the nearest by one
+    """The seed-table entries nearest a target, nearest first (copies; for a pose target on a
+    chain with an :class:`_Aligned` table, turned onto the target): the nearest by one
     ``argmin``, the next :data:`TABLE_SEEDS` − 1 sorted when first needed; then ``None``."""
 
-    __slots__ = ("ch", "sc", "k0", "order", "i")
+    __slots__ = ("ch", "sc", "k0", "order", "i", "al", "phi", "u")
 
     def __init__(self, ch, tg, q_ref):
-        sc = tg.scores(ch)
+        al = ch.aligned() if tg.kind == _POSE else None
+        if al is not None:
+            sc, self.phi, self.u = al.query(tg.Ms)
+        else:
+            sc = tg.scores(ch)
         if q_ref is not None:
             sc = sc + ch.posture_penalty(q_ref)
+        self.al = al
         self.ch = ch
         self.sc = sc
         self.k0 = -1
@@ -818,7 +965,8 @@ class _TableSeeds:
                 return None
             k = self.order[self.i]
         self.i += 1
-        return self.ch.table()[0][k].copy()
+        q = self.ch.table()[0][k].copy()
+        return q if self.al is None else self.al.seed(q, k, self.phi, self.u)
 
 
 def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen, q_ref, sw, analytic):
@@ -840,17 +988,9 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
     Q = np.empty((N, n))
     need = [k for k in range(N) if seeds[k] is None]
     if need:
-        tab = ch.table()
-        X = np.array([tgs[k].x for k in need])
-        if kind == _POSE:
-            S = tab[2][:, None] - tab[1].dot(X.T)
-        elif kind == _POSITION:
-            S = tab[2][:, None] - 2.0 * tab[3].dot(X.T)
-        else:
-            S = -tab[4].dot(X.T)
-        if q_ref is not None:
-            S += ch.posture_penalty(q_ref)[:, None]
-        Q[need] = tab[0][S.argmin(axis=0)]
+        for k in need:
+            tseeds[k] = _TableSeeds(ch, tgs[k], q_ref)
+            Q[k] = tseeds[k].next()
     for k in range(N):
         if seeds[k] is not None:
             Q[k] = seeds[k]
@@ -911,8 +1051,6 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
             for k in retry:                   # next seed: the next table entry, then random
                 if tseeds[k] is None:
                     tseeds[k] = _TableSeeds(ch, tgs[k], q_ref)
-                    if seeds[k] is None:
-                        tseeds[k].next()       # the nearest entry was the first seed
                 qn = tseeds[k].next()
                 Q[k] = ch.random(gen) if qn is None else qn
             attempts[retry] += 1
