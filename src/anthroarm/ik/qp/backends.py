@@ -104,6 +104,13 @@ class Backend:
         x = np.maximum(x, lo)
         return np.minimum(x, hi, out=x), "optimal"
 
+    @staticmethod
+    def _clip_box(x, lo, hi):
+        """x clipped into [lo, hi] (a fresh array), for a direct solver that reported success
+        on finite data (step checked H, c and the box): its x is finite."""
+        x = np.maximum(x, lo)
+        return np.minimum(x, hi, out=x), "optimal"
+
     def _finish(self, x, lo, hi, A, b, status):
         """Clip into the box and check the equality residual; map failures to a status."""
         if x is None or not math.isfinite(x @ x):
@@ -300,7 +307,7 @@ class DaqpBackend(Backend):
         x, _, flag, info = self._daqp.solve(ws.H, ws.c, self._A0, ws.hi, ws.lo, self._sense)
         self._raw_info = (flag, info)          # last_info is built when read
         if flag > 0:
-            return self._finish_box(x, ws.lo, ws.hi)
+            return self._clip_box(x, ws.lo, ws.hi)
         return None, "infeasible" if flag == -1 else "failed"
 
 
@@ -361,7 +368,7 @@ class QuadprogBackend(Backend):
             rc, x = direct.solve(ws.H, ws.c, ws.B)
             if rc == 0:
                 self.last_info = {}
-                return self._finish_box(x, ws.lo, ws.hi)      # a fresh array (x is the buffer)
+                return self._clip_box(x, ws.lo, ws.hi)        # a fresh array (x is the buffer)
             return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)   # errors handled there
         try:
             x = self._qp.solve_qp(ws.H, np.negative(ws.c, out=ws.nc), self._C, ws.B, 0)[0]

@@ -62,7 +62,7 @@ class _Workspace:
     objective into ``H``, ``c`` in place (``Hc`` holds both, so one dot product checks them for
     NaN/inf), the limits write ``B = [lo; −hi]`` (the quadprog form), and ``hi``."""
 
-    __slots__ = ("n", "Hc", "H", "c", "Hd", "B", "Bm", "lo", "mhi", "hi", "box2", "tmp2", "nc")
+    __slots__ = ("n", "Hc", "H", "c", "Hd", "B", "Bm", "lo", "mhi", "hi", "box2", "tmp2", "nc", "dt", "dtv")
 
     def __init__(self, n: int):
         self.n = n
@@ -78,6 +78,8 @@ class _Workspace:
         self.box2 = np.zeros((2, n))
         self.tmp2 = np.zeros((2, n))
         self.nc = np.zeros(n)                        # scratch for backends (e.g. −c)
+        self.dt = None                               # dt held in dtv (nv,)
+        self.dtv = np.zeros(n)
 
 
 def _state(owner, robot):
@@ -183,7 +185,10 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     if x is None:
         v = np.zeros(nv)
     else:
-        v = np.divide(x, dt, out=x)
+        if ws.dt != dt:                 # dt as an array: x / dt array-wise costs less
+            ws.dtv.fill(dt)
+            ws.dt = dt
+        v = np.divide(x, ws.dtv, out=x)
     if stateful:
         for lim in limits:
             lim.after_step(v, dt)

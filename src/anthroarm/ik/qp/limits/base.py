@@ -21,6 +21,7 @@ class Limit:
     (acceleration) record the velocity that was applied."""
 
     priority: float = 1.5
+    _box_finite = False   # set by _box_into when the box it returned is finite everywhere
 
     def box(self, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - interface
         raise NotImplementedError
@@ -78,6 +79,7 @@ def combine_into(limits, conf, dt: float, ws) -> None:
     did not apply).  Otherwise, or when a limit has no in-place form, :func:`combine` runs."""
     B, Bm = ws.B, ws.Bm
     first = True
+    finite = False
     for lim in limits:
         if first:
             box = lim._box_into(conf, dt, Bm, ws.tmp2)
@@ -91,9 +93,11 @@ def combine_into(limits, conf, dt: float, ws) -> None:
             if box is None:
                 break
             np.maximum(Bm, box, out=Bm)
+        finite = finite or lim._box_finite
     else:
         if not first:
-            np.maximum(B, -BIG, out=B)
+            if not finite:     # a finite box in the intersection bounds B below already
+                np.maximum(B, -BIG, out=B)
             if B[B.argmax()] <= 0.0:           # 0 inside the box (False for NaN: argmax finds it)
                 np.negative(ws.mhi, out=ws.hi)
                 return

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Limit
+from .base import BIG, Limit
 
 
 class VelocityLimit(Limit):
@@ -34,6 +34,7 @@ class VelocityLimit(Limit):
             box = np.multiply(self.v_max, -dt, out=np.empty_like(out))
             box.setflags(write=False)
             self._cached = (self.v_max, dt, box)
+            self._box_finite = bool((np.abs(box) <= BIG).all())
         return box
 
     def __repr__(self) -> str:

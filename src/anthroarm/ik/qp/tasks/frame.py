@@ -117,17 +117,18 @@ class FrameTask(Task):
         X = pin.updateFramePlacement(model, data, fid).actInv(T_t)          # T_b⁻¹ T_t
         WJ, Ht, ct = self._buf
         pin.Jlog6(X.inverse()).dot(pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
-        e = pin.log6(X).vector
         w = self._w1
         if w is None:
             np.multiply(WJ, self._wcol, out=WJ)
+            e = pin.log6(X).vector
             nWe = np.multiply(e, self._nwg, out=e)
         else:
             if w != 1.0:
                 np.multiply(WJ, w, out=WJ)
             if self._nwg1 == -1.0:
-                nWe = np.negative(e, out=e)
+                nWe = (-pin.log6(X)).vector           # −αW e with αW = 1 (negation is exact)
             else:
+                e = pin.log6(X).vector
                 nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
         WJt = WJ.T
         # ndarray.dot with out=: the BLAS product without np.dot's dispatch cost
