@@ -401,6 +401,7 @@ class ProxqpBackend(Backend):
         self._proxqp = proxqp
         self._eye = np.eye(n)
         self._Q = None          # persistent box-QP workspace (created on the first solve_ws)
+        self._solved = proxqp.QPSolverOutput.PROXQP_SOLVED
         self._sign2 = np.array([[1.0], [-1.0]])
         self._tmp2 = np.zeros((2, n))
         try:
@@ -422,10 +423,10 @@ class ProxqpBackend(Backend):
             Q.init(ws.H, ws.c, None, None, self._eye, ws.lo, ws.hi)
             self._Q = Q
         else:
-            Q.update(ws.H, ws.c, None, None, None, ws.lo, ws.hi)
+            Q.update(H=ws.H, g=ws.c, l=ws.lo, u=ws.hi)
         Q.solve()
         r = Q.results
-        if r.info.status == proxqp.QPSolverOutput.PROXQP_SOLVED:
+        if r.info.status == self._solved:
             x = self._polish_box(ws, r.x, r.z)
             if x is not None:
                 self._raw_info = r.info
@@ -448,27 +449,35 @@ class ProxqpBackend(Backend):
         llt = self._LLT(ws.H)
         x = llt.solve(ws.c)
         np.negative(x, out=x)
-        act = None
-        if z.any():
-            at_lo = (xs - ws.lo) < -z
-            at_hi = (ws.hi - xs) < z
-            act = np.flatnonzero(at_lo | at_hi)
-        if act is not None and len(act):
-            lower = at_lo[act]
-            bA = np.where(lower, ws.lo[act], ws.hi[act])
-            Y = llt.solve(self._eye[:, act])              # H⁻¹ E_A, (n, k)
-            if Y.ndim == 1:                               # eigenpy returns (n,) for k = 1
-                Y = Y[:, None]
-            M = Y[act]
-            rhs = bA - x[act]
-            mu = rhs / M[0, 0] if len(act) == 1 else np.linalg.solve(M, rhs)
-            if (mu[lower] < -1e-8).any() or (mu[~lower] > 1e-8).any():
-                return None
-            x += Y @ mu
-            x[act] = bA
-        if not math.isfinite(x.dot(x)):
-            return None
-        # within the box: max([lo − x; x − hi]) ≤ 1e-12
+        if z.dot(z) != 0.0:          # some multiplier nonzero (cheaper than z.any())
+            # the rule entry by entry in Python: cheaper than six array operations at n ≈ 7
+            act, lower = [], []
+            for i, (xi, zi, li, hi_) in enumerate(zip(xs.tolist(), z.tolist(), ws.lo.tolist(), ws.hi.tolist())):
+                if xi - li < -zi:
+                    act.append(i)
+                    lower.append(li)
+                elif hi_ - xi < zi:
+                    act.append(i)
+                    lower.append(None)
+            if len(act) == 1:
+                i = act[0]
+                b = lower[0] if lower[0] is not None else float(ws.hi[i])
+                y = llt.solve(self._eye[i])                   # column i of H⁻¹
+                mu = (b - float(x[i])) / float(y[i])
+                if (mu < -1e-8) if lower[0] is not None else (mu > 1e-8):
+                    return None
+                x += y * mu
+                x[i] = b
+            elif act:
+                low = np.array([v is not None for v in lower])
+                bA = np.where(low, ws.lo[act], ws.hi[act])
+                Y = llt.solve(self._eye[:, act])              # H⁻¹ E_A, (n, k)
+                mu = np.linalg.solve(Y[act], bA - x[act])
+                if (mu[low] < -1e-8).any() or (mu[~low] > 1e-8).any():
+                    return None
+                x += Y @ mu
+                x[act] = bA
+        # within the box: max([lo − x; x − hi]) ≤ 1e-12 (False for NaN: argmax finds it)
         d = np.subtract(ws.Bm, np.multiply(self._sign2, x, out=self._tmp2), out=self._tmp2)
         if not d.flat[d.argmax()] <= 1e-12:
             return None
