@@ -251,3 +251,148 @@ def test_human_posture_optimum_matches_closed_form_family(robots):
         assert res.success
         assert d <= d_min + 1e-6          # never worse than the best closed-form member found
         assert d >= d_min - 5e-3          # and within the grid resolution of it
+
+
+# ------------------------------------------------------------------ seeds and fast paths of aa.ik.solve
+def _target(robot, T):
+    from anthroarm.ik import solver
+    return solver._Target("pose", pin.SE3(T), 1e-6, 1e-6, np.ascontiguousarray(T).ravel())
+
+
+def test_seed_table_distance_is_the_pose_distance(robots):
+    """The table lookup x·G equals ‖p − p*‖² + w²‖R − R*‖²_F up to a constant (oracle: the
+    distance computed directly from Pinocchio FK of the table's configurations)."""
+    from anthroarm.ik import solver
+    robot = robots["talos_arm"]
+    ch = solver._chain(robot, robot.tool_id)
+    Q = ch.table()[0][:200]
+    H = robot.fk(Q)
+    T = robot.fk(robot.random_q(rng=11))
+    w2 = (solver.SEED_ROT_WEIGHT * ch.reach) ** 2
+    direct = ((H[:, :3, 3] - T[:3, 3]) ** 2).sum(1) + w2 * ((H[:, :3, :3] - T[:3, :3]) ** 2).sum((1, 2))
+    sc = _target(robot, T).scores(ch)[:200]
+    np.testing.assert_allclose(sc - sc[0], direct - direct[0], atol=1e-9)
+
+
+def test_aligned_seed_table_turns_first_and_last_joint_exactly(robots):
+    """panda and ur5 (first and last joints spanning >= 1.5 pi): a target made from a table entry
+    with its first and last joints turned is matched by that entry, and the seed turned onto it
+    is the target's configuration itself (oracle: FK of the configuration the target came from).
+    talos_arm (wrist range 1.4 rad) has no aligned table."""
+    from anthroarm.ik import solver
+    for name in ("panda", "ur5"):
+        robot = robots[name]
+        ch = solver._chain(robot, robot.tool_id)
+        al = ch.aligned()
+        assert al is not None
+        Q = ch.table()[0]
+        for k, (d1, dn) in zip((5, 300, 1500), ((0.4, -0.7), (-1.1, 0.2), (0.05, 1.3))):
+            q = Q[k].copy()
+            q[al.iq1] += d1
+            q[al.iqn] += dn
+            if not robot.within_limits(q):
+                continue
+            T = robot.fk(q)
+            seeds = solver._TableSeeds(ch, _target(robot, T), None)
+            q_seed = seeds.next()
+            assert seeds.k0 == k
+            np.testing.assert_allclose(q_seed, q, atol=1e-12)
+            assert np.abs(robot.fk(q_seed) - T).max() < 1e-12
+    assert solver._chain(robots["talos_arm"], robots["talos_arm"].tool_id).aligned() is None
+
+
+def test_seed_tags_and_restart_cap(robots):
+    """Seeds are tagged; max_restarts=0 tries exactly one seed, and the answer is still the
+    closest pose found inside the limits."""
+    robot = robots["panda"]
+    from anthroarm.ik import solver
+    tags = set()
+    restarted = 0
+    for q in robot.random_q(40, rng=31):
+        r = aa.ik.solve(robot, robot.fk(q))
+        assert r.success
+        tags.add(r.seed)
+        if r.restarts == 0:
+            assert r.seed == "table"
+        if r.seed == "restart":             # uniform random seeds come after the table's
+            assert r.restarts >= solver.TABLE_SEEDS
+        restarted += r.restarts > 0
+    assert tags <= {"table", "restart"} and "table" in tags and restarted > 0
+    T = np.eye(4)
+    T[:3, 3] = [2.0, 0.0, 0.3]                       # out of reach
+    r = aa.ik.solve(robot, T, max_restarts=0)
+    assert not r.success and r.restarts == 0 and robot.within_limits(r.q)
+
+
+def test_closed_form_first_where_cheap(robots):
+    """prosthetic_arm (a six-joint book arm) takes its first seed from the closed form and
+    verifies it in one Gauss–Newton evaluation; so does human_arm7 when the compiled closed-form
+    kernel is available; the arms without a closed form never do."""
+    from anthroarm.ik import solver
+    robot = robots["prosthetic_arm"]
+    assert solver._chain(robot, robot.tool_id).analytic_first
+    for q in robot.random_q(10, rng=41):
+        T = robot.fk(q)
+        r = aa.ik.solve(robot, T)
+        assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
+        assert pose_error(robot, r.q, T)[0] <= 1e-6
+    out = aa.ik.solve(robot, robot.fk(robot.random_q(12, rng=42)))   # batch: the same path
+    assert out.success.all()
+    r = aa.ik.solve(robot, robot.fk(robot.random_q(rng=43)), analytic=False)
+    assert r.success and r.seed != "analytic"
+    for name in ("panda", "ur5", "talos_arm"):
+        assert not solver._chain(robots[name], robots[name].tool_id).analytic_first
+    human = robots["human_arm7"]
+    if solver._chain(human, human.tool_id).analytic_first:
+        r = aa.ik.solve(human, human.fk(human.random_q(rng=44)))
+        assert r.success and r.seed == "analytic"
+
+
+def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):
+    """Targets from configurations uniform inside the limits (far from the comfortable
+    posture): with the closed-form seeds (forced on, so that the test does not depend on a C
+    compiler) the posture phase lands on the member of the closed-form family nearest the
+    comfortable posture in at least 19 of 20 cases (oracle: 0.5° swivel scan of the closed
+    form; the phase moves along one branch, and a joint limit can cut it).  The solver before
+    the secant posture phase missed it in ~25 % of such targets."""
+    cf = pytest.importorskip("anthroarm.ik.closed_form")
+    from anthroarm.ik import solver
+    robot = robots["human_arm7"]
+    if not cf.has_analytic(robot):
+        pytest.skip("no closed form")
+    monkeypatch.setattr(solver._chain(robot, robot.tool_id), "analytic_first", True)
+    ref = qp.comfortable_posture(robot)
+    grid = np.linspace(-np.pi, np.pi, 720, endpoint=False)
+    worse = at_limit = 0
+    for g in robot.random_q(20, rng=1):
+        T = robot.fk(g)
+        res = aa.ik.solve(robot, T)
+        assert res.success and robot.within_limits(res.q)
+        assert pose_error(robot, res.q, T)[0] <= 1e-6
+        S = cf.analytic(robot, T, swivel=grid).solutions
+        d_min = np.min(np.linalg.norm(S - ref, axis=1))
+        worse += np.linalg.norm(res.q - ref) > d_min + 1e-6
+        at_limit += bool(((res.q == robot.lower) | (res.q == robot.upper)).any())
+    assert worse <= 1
+    assert at_limit >= 2   # the optimum on a joint limit (frozen joint, shortened null step) is exercised
+
+
+def test_rigid_fast_path_and_near_rigid_targets(robots):
+    """The plain-Python rigidity check accepts exact poses and hands anything else to
+    as_se3: a rotation 1e-9 off orthonormal is re-orthonormalised and solved, other dtypes and
+    a pin.SE3 are accepted, a non-rigid bottom row still raises."""
+    from anthroarm.ik import solver
+    robot = robots["ur5"]
+    T = robot.fk(robot.random_q(rng=61))
+    assert solver._rigid_se3(T) is not None
+    near = T.copy()
+    near[:3, :3] *= 1.0 + 1e-9
+    assert solver._rigid_se3(near) is None
+    r = aa.ik.solve(robot, near)
+    assert r.success and pose_error(robot, r.q, T)[0] <= 1e-6
+    assert aa.ik.solve(robot, pin.SE3(T)).success
+    assert solver._rigid_se3(T.astype(np.float32)) is None
+    bad = T.copy()
+    bad[3, 0] = 1e-3
+    with pytest.raises(ValueError, match="not rigid"):
+        aa.ik.solve(robot, bad)

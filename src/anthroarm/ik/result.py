@@ -42,13 +42,15 @@ class IKResult:
     iterations : int
         Gauss–Newton iterations summed over all restarts.
     restarts : int
-        Number of random restarts used (0: the first seed converged).
+        Number of seeds tried after the first (0: the first seed converged).
     message : str
         Human-readable explanation (why it failed, which seed won).
     mode : str
         ``"pose"``, ``"position"`` or ``"orientation"``.
     seed : str
-        Which seed produced ``q``: ``"q0"``, ``"analytic"``, ``"restart"``.
+        Which seed produced ``q``: ``"q0"`` (the caller's), ``"analytic"`` (a closed-form
+        solution), ``"table"`` (the solver's table of the arm's own poses, nearest first) or
+        ``"restart"`` (uniform random inside the limits).
     """
 
     q: np.ndarray

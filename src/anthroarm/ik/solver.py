@@ -905,7 +905,8 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         seeds = [None] * len(targets)
     else:
         seeds = [Q0[i] if Q0.ndim == 2 else Q0 for i in range(len(targets))]
-    if batch and not warm_start and len(targets) >= LOCKSTEP_MIN and analytic is not True:
+    closed_form_first = analytic is True or (analytic == "auto" and Q0 is None and ch.analytic_first and mode == "pose")
+    if batch and not warm_start and len(targets) >= LOCKSTEP_MIN and not closed_form_first:
         results = _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen, q_ref_sec, sw_sec,
                                   analytic)
     else:
@@ -997,6 +998,8 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
     Q = ch.clip(Q)
     J = np.empty((N, m, n))
     E = np.empty((N, m))
+    TR = np.empty((N, 3))
+    Ms = [tg.Ms for tg in tgs]
     PE2 = np.zeros(N)
     RE2 = np.zeros(N)
     its = np.zeros(N, dtype=int)
@@ -1009,30 +1012,27 @@ def _solve_lockstep(robot, ch, tgs, targets, seeds, max_time, max_restarts, gen,
     active = np.arange(N)
     eye = np.eye(m)
     while active.size:
-        for k in active:                      # Pinocchio: one call per target
-            q = Q[k]
-            tg = tgs[k]
-            _cjj(model, data, q)
-            M = _ufp(model, data, fid)
-            if kind == _POSE:
-                Mt = M.actInv(tg.Ms)
-                e = _log6(Mt).vector
-                E[k] = e
-                t = Mt.translation
-                w = e[3:]
-                PE2[k] = t.dot(t)
-                RE2[k] = w.dot(w)
+        if kind == _POSE:                     # Pinocchio: one call per target
+            for k in active:
+                _cjj(model, data, Q[k])
+                Mt = _ufp(model, data, fid).actInv(Ms[k])
+                E[k] = _log6(Mt).vector
+                TR[k] = Mt.translation
                 J[k] = _gfj(model, data, fid, LOCAL)
-            elif kind == _POSITION:
-                e = tg.ps - M.translation
-                E[k] = e
-                PE2[k] = e.dot(e)
+            PE2[active] = (TR[active] ** 2).sum(1)
+            RE2[active] = (E[active, 3:] ** 2).sum(1)
+        elif kind == _POSITION:
+            for k in active:
+                _cjj(model, data, Q[k])
+                E[k] = tgs[k].ps - _ufp(model, data, fid).translation
                 J[k] = _gfj(model, data, fid, LWA)[:3]
-            else:
-                e = _log3(M.rotation.T.dot(tg.Rs))
-                E[k] = e
-                RE2[k] = e.dot(e)
+            PE2[active] = (E[active] ** 2).sum(1)
+        else:
+            for k in active:
+                _cjj(model, data, Q[k])
+                E[k] = _log3(_ufp(model, data, fid).rotation.T.dot(tgs[k].Rs))
                 J[k] = _gfj(model, data, fid, LOCAL)[3:]
+            RE2[active] = (E[active] ** 2).sum(1)
         its[active] += 1
         att_it[active] += 1
         ok = (PE2[active] <= tp2) & (RE2[active] <= tr2)
