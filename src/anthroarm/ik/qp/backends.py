@@ -17,6 +17,12 @@ equality block for A), then per step only calls ``update(Px=…, q=…, l=…, u
 warm-started, with eps 1e-10 and solution polishing so the answer matches a dense solver.
 daqp, quadprog and proxqp are called directly (no qpsolvers conversion layer); ``"qpsolvers:NAME"``
 goes through ``qpsolvers.solve_qp`` for solvers without a direct path.
+
+:meth:`Backend.solve_ws` is the entry of :func:`~anthroarm.ik.qp.step`: it reads the step's
+preallocated arrays (finite box, ``B = [lo; −hi]``) and skips the conversions of ``solve``.  There
+quadprog's compiled routine is called with preallocated arrays (:mod:`._qpgen2`, bit-identical to
+``quadprog.solve_qp``), and ProxQP keeps a warm-started workspace whose active set is polished
+exactly (:meth:`ProxqpBackend._polish_box`).
 """
 
 from __future__ import annotations

@@ -12,6 +12,14 @@ FrameTask whose target moves along the commanded twist.
 
 A bad QP (inconsistent hard constraints, solver failure) gives ``status != "optimal"`` and the
 safe zero velocity instead of an exception; ``step(..., full=True)`` returns the status.
+
+Speed: a step allocates almost nothing.  The tasks add their (H, c) into preallocated arrays
+(``Task._accumulate``; the built-in frame, posture and damping tasks in place, any other task
+through its ``compute_qp_objective``), the limits write the box [lo; −hi] in place
+(:func:`~anthroarm.ik.qp.limits.base.combine_into`, which falls back to ``combine`` whenever the
+priority rule or the start-outside branch applies) and the backends take the arrays as they are
+(:meth:`~anthroarm.ik.qp.backends.Backend.solve_ws`).  tests/ik_qp/test_ik_qp_fast.py checks each
+of these against the general code; benchmarks/bench_qp_step.py times the step against pink.
 """
 
 from __future__ import annotations
