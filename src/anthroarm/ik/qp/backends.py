@@ -408,8 +408,6 @@ class ProxqpBackend(Backend):
         self._eye = np.eye(n)
         self._Q = None          # persistent box-QP workspace (created on the first solve_ws)
         self._solved = proxqp.QPSolverOutput.PROXQP_SOLVED
-        self._sign2 = np.array([[1.0], [-1.0]])
-        self._tmp2 = np.zeros((2, n))
         try:
             from eigenpy import LLT
         except ImportError:  # pragma: no cover - eigenpy comes with pinocchio
@@ -450,8 +448,9 @@ class ProxqpBackend(Backend):
         hi − xs < z; a warm-started z keeps vanishing, e.g. 1e-26, entries of bounds that were
         active before).  With x_u = −H⁻¹c (Cholesky of H) and the bounds b_A on the active set A,
         x = x_u + H⁻¹E_A μ with μ = (E_Aᵀ H⁻¹ E_A)⁻¹ (b_A − x_{u,A}), so that Hx + c = E_A μ.
-        Returned (a fresh array, clipped into the box) only when x is within the box (1e-12)
-        and μ ≥ −1e-8 at lower, μ ≤ 1e-8 at upper bounds (the KKT conditions); else None."""
+        Returned (a fresh array, clipped into the box) only when x is within the box (clipping
+        moves it by ≤ 1e-12) and μ ≥ −1e-8 at lower, μ ≤ 1e-8 at upper bounds (the KKT
+        conditions); else None."""
         llt = self._LLT(ws.H)
         x = llt.solve(ws.c)
         np.negative(x, out=x)
@@ -483,12 +482,13 @@ class ProxqpBackend(Backend):
                     return None
                 x += Y @ mu
                 x[act] = bA
-        # within the box: max([lo − x; x − hi]) ≤ 1e-12 (False for NaN: argmax finds it)
-        d = np.subtract(ws.Bm, np.multiply(self._sign2, x, out=self._tmp2), out=self._tmp2)
-        if not d.flat[d.argmax()] <= 1e-12:
+        # within the box: clipping into it moves x by at most 1e-12 (2-norm; False for NaN)
+        xc = np.maximum(x, ws.lo)
+        np.minimum(xc, ws.hi, out=xc)
+        d = np.subtract(xc, x, out=x)
+        if not d.dot(d) <= 1e-24:
             return None
-        x = np.maximum(x, ws.lo)
-        return np.minimum(x, ws.hi, out=x)
+        return xc
 
     def solve(self, H, c, lo, hi, A=None, b=None):
         proxqp = self._proxqp

@@ -45,6 +45,8 @@ class IKConfiguration:
         self.q = np.zeros(self.nq)
         self._placements: dict = {}
         self._jacobians: dict = {}
+        self._dt = None
+        self._dtv = None
         self.update(robot.neutral() if q is None else q)
 
     def __repr__(self) -> str:
@@ -96,7 +98,14 @@ class IKConfiguration:
         v = np.asarray(v, dtype=float)
         if v.shape != (self.nv,) or not math.isfinite(v.dot(v)):
             raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
-        self.q = pin.integrate(self.model, self.q, v * dt)   # finite q + finite step: no re-check
+        if dt.__class__ is float:             # dt as an array: v·dt array-wise costs less
+            if dt != self._dt:
+                self._dtv = np.full(self.nv, dt)
+                self._dt = dt
+            dq = v * self._dtv
+        else:
+            dq = v * dt
+        self.q = pin.integrate(self.model, self.q, dq)   # finite q + finite step: no re-check
         pin.computeJointJacobians(self.model, self.data, self.q)
         self._placements.clear()
         self._jacobians.clear()

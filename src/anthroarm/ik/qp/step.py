@@ -180,10 +180,15 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
         A = np.vstack([t.compute_jacobian(conf) for t in constraints])
         b = np.concatenate([-t.gain * t.compute_error(conf) for t in constraints])
     n_eq = 0 if A is None else len(A)
-    backends = st["backends"]
-    backend = backends.get((solver, nv, n_eq))
-    if backend is None:
-        backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
+    last = st.get("last")                  # (solver, n_eq, backend) of the previous step
+    if last is not None and last[0] is solver and last[1] == n_eq:
+        backend = last[2]
+    else:
+        backends = st["backends"]
+        backend = backends.get((solver, nv, n_eq))
+        if backend is None:
+            backend = backends[(solver, nv, n_eq)] = make_backend(solver, nv, n_eq)
+        st["last"] = (solver, n_eq, backend)
     Hc = ws.Hc
     if not math.isfinite(Hc.dot(Hc)):
         x, status = None, "failed"

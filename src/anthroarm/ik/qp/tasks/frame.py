@@ -82,7 +82,8 @@ class FrameTask(Task):
             self._w1 = float(w[0]) if uniform else None          # scalar weight, or None
             self._nwg1 = -float(w[0]) * self.gain if uniform else None
             self._nwg = -self._wg
-            self._buf = (np.empty((6, self._nv)), np.empty((self._nv, self._nv)), np.empty(self._nv))
+            WJ = np.empty((6, self._nv))
+            self._buf = (WJ, WJ.T, np.empty((self._nv, self._nv)), np.empty(self._nv))
             self._w_cost, self._w_gain = self.cost, self.gain
 
     def compute_qp_objective(self, conf):
@@ -115,7 +116,7 @@ class FrameTask(Task):
         model, data, fid = conf.model, conf.data, self.frame_id
         # kinematics are current (IKConfiguration.update / integrate_inplace computed them)
         X = pin.updateFramePlacement(model, data, fid).actInv(T_t)          # T_b⁻¹ T_t
-        WJ, Ht, ct = self._buf
+        WJ, WJt, Ht, ct = self._buf
         pin.Jlog6(X.inverse()).dot(pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
         w = self._w1
         if w is None:
@@ -130,7 +131,6 @@ class FrameTask(Task):
             else:
                 e = pin.log6(X).vector
                 nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
-        WJt = WJ.T
         # ndarray.dot with out=: the BLAS product without np.dot's dispatch cost
         if first:
             WJt.dot(WJ, out=ws.H)
