@@ -431,7 +431,7 @@ class ProxqpBackend(Backend):
         Q.solve()
         r = Q.results
         if r.info.status == self._solved:
-            x = self._polish_box(ws, r.x, r.z)
+            x = self._polish_box(ws, r)
             if x is not None:
                 self._raw_info = r.info
                 return x, "optimal"
@@ -442,9 +442,9 @@ class ProxqpBackend(Backend):
     def _info_from(self, info):
         return {"status": str(info.status), "iter": info.iter, "polished": True}
 
-    def _polish_box(self, ws, xs, z):
-        """Exact solution of the box QP on the active set read from ProxQP's answer ``xs`` and
-        multipliers ``z`` (OSQP's rule: lower bound active where xs − lo < −z, upper where
+    def _polish_box(self, ws, r):
+        """Exact solution of the box QP on the active set read from ProxQP's results ``r``:
+        answer xs and multipliers z (OSQP's rule: lower bound active where xs − lo < −z, upper where
         hi − xs < z; a warm-started z keeps vanishing, e.g. 1e-26, entries of bounds that were
         active before).  With x_u = −H⁻¹c (Cholesky of H) and the bounds b_A on the active set A,
         x = x_u + H⁻¹E_A μ with μ = (E_Aᵀ H⁻¹ E_A)⁻¹ (b_A − x_{u,A}), so that Hx + c = E_A μ.
@@ -454,10 +454,11 @@ class ProxqpBackend(Backend):
         llt = self._LLT(ws.H)
         x = llt.solve(ws.c)
         np.negative(x, out=x)
+        z = r.z
         if z.dot(z) != 0.0:          # some multiplier nonzero (cheaper than z.any())
             # the rule entry by entry in Python: cheaper than six array operations at n ≈ 7
             act, lower = [], []
-            for i, (xi, zi, li, hi_) in enumerate(zip(xs.tolist(), z.tolist(), ws.lo.tolist(), ws.hi.tolist())):
+            for i, (xi, zi, li, hi_) in enumerate(zip(r.x.tolist(), z.tolist(), ws.lo.tolist(), ws.hi.tolist())):
                 if xi - li < -zi:
                     act.append(i)
                     lower.append(li)
