@@ -103,6 +103,22 @@ def test_in_place_objectives_equal_compute_qp_objective(name):
             assert np.abs(ca - cs).max() <= 1e-14 * scale, group
 
 
+def test_duck_typed_task_still_accepted(panda):
+    """An object with compute_qp_objective only (not a Task subclass) is summed as before."""
+    rng = np.random.default_rng(12)
+    q, qt = panda.random_q(2, rng=rng)
+    post = qp.PostureTask(panda, cost=0.1, target=qt)
+
+    class Duck:
+        def compute_qp_objective(self, conf):
+            return post.compute_qp_objective(conf)
+
+    conf = qp.IKConfiguration(panda, q)
+    v1 = qp.step(conf, None, [Duck()], 0.01, solver="daqp")
+    v2 = qp.step(conf, None, [post], 0.01, solver="daqp")
+    assert np.abs(v1 - v2).max() < 1e-12
+
+
 def test_frame_task_weights_follow_reassigned_cost_and_gain(panda):
     """Oracle: Task._objective on compute_jacobian / compute_error (the unspecialised formula)."""
     rng = np.random.default_rng(2)

@@ -34,6 +34,7 @@ from .backends import make_backend
 from .configuration import IKConfiguration
 from .limits import ConfigurationLimit, VelocityLimit
 from .limits.base import BIG, combine_into
+from .tasks.base import Task
 
 _ROBOT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
@@ -167,7 +168,11 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     first = True
     diag = float(damping) if damping else 0.0
     for t in tasks:
-        diag += t._accumulate(conf, ws, first)
+        try:
+            acc = t._accumulate
+        except AttributeError:          # a duck-typed task with compute_qp_objective only
+            acc = Task._accumulate.__get__(t)
+        diag += acc(conf, ws, first)
         first = False
     if first:
         ws.Hc.fill(0.0)
