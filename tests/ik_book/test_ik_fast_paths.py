@@ -21,7 +21,8 @@ from anthroarm.ik.closed_form import analytic, analytic_batch, swivel_angle
 from anthroarm.ik.fk_codegen import FKStages, cos_sin
 
 HAS_CC = analytic_c.compiler() is not None and analytic_c.enabled()
-needs_cc = pytest.mark.skipif(not HAS_CC, reason="no C compiler: the compiled kernel is optional")
+needs_cc = pytest.mark.skipif(not HAS_CC, reason="compiled kernel unavailable (no C compiler, or ANTHROARM_IK_C=0); "
+                                                  "it is optional")
 IMPLS = ["python", pytest.param("c", marks=needs_cc)]
 
 ARMS = {
@@ -306,6 +307,7 @@ def test_fallback_without_compiler(monkeypatch):
     """No usable compiler: the pure-Python kernels answer, with the same results; _impl="c"
     then raises."""
     monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("ANTHROARM_IK_C", "1")
     robot = aa.load("prosthetic_arm", L3=0.12)               # a fresh parameterisation
     T = robot.fk(robot.random_q(50, np.random.default_rng(2)))
     g = analytic_batch(robot, T, _impl="general")
