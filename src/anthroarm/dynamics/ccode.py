@@ -12,10 +12,6 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
-import os
-import shutil
-import subprocess
-import tempfile
 import threading
 from pathlib import Path
 
@@ -41,9 +37,7 @@ def c_source(d) -> str:
     return "\n\n".join(parts) + "\n"
 
 
-def compiler() -> str | None:
-    cc = os.environ.get("CC", "cc")
-    return shutil.which(cc)
+from .._cbuild import build_shared, compiler  # noqa: E402  (re-exported: tests use ccode.compiler)
 
 
 class CFunctions:
@@ -93,7 +87,7 @@ class CFunctions:
 
 def compiled(info) -> CFunctions:
     """Compile (or load from the cache) the C code of a model."""
-    from .lagrange import _atomic_write, _outputs, cache_dir, derive
+    from .lagrange import _outputs, cache_dir, derive
 
     cc = compiler()
     if cc is None:
@@ -107,16 +101,10 @@ def compiled(info) -> CFunctions:
         shapes = {f: (a, s) for f, (a, o, s) in _outputs(d).items()}
         so = cache_dir() / f"lagrange_{key}_{fl}.so"
         if not so.is_file():
-            src = c_source(d)
-            so.parent.mkdir(parents=True, exist_ok=True)
-            with tempfile.TemporaryDirectory(dir=so.parent) as tmp:
-                cpath = Path(tmp) / "m.c"
-                cpath.write_text(src)
-                opath = Path(tmp) / "m.so"
-                r = subprocess.run([cc, *FLAGS, "-o", str(opath), str(cpath), "-lm"], capture_output=True, text=True)
-                if r.returncode != 0:
-                    raise UnsupportedModelError(f"C compilation failed: {r.stderr[:500]}")
-                _atomic_write(so, opath.read_bytes())
+            try:
+                build_shared(c_source(d), so, FLAGS)
+            except RuntimeError as exc:
+                raise UnsupportedModelError(str(exc)) from None
         lib = CFunctions(so, info, shapes)
         _LIBS[key + fl] = lib
         return lib

@@ -432,10 +432,10 @@ def generate_python(d: Derivation) -> str:
 
 # ====================================================================== cache
 def cache_dir() -> Path:
-    """``$ANTHROARM_CACHE`` or ``~/.cache/anthroarm``."""
-    env = os.environ.get("ANTHROARM_CACHE")
-    base = Path(env).expanduser() if env else Path.home() / ".cache" / "anthroarm"
-    return base / "lagrange"
+    """``$ANTHROARM_CACHE/lagrange`` or ``~/.cache/anthroarm/lagrange``."""
+    from .._cbuild import cache_dir as _cache_dir
+
+    return _cache_dir("lagrange")
 
 
 def _atomic_write(path: Path, text: str | bytes) -> None:

@@ -22,9 +22,6 @@ import ctypes
 import hashlib
 import math
 import os
-import shutil
-import subprocess
-import tempfile
 import threading
 from pathlib import Path
 
@@ -44,8 +41,7 @@ def enabled() -> bool:
     return os.environ.get("ANTHROARM_IK_C", "1").strip().lower() not in ("0", "false", "no", "off")
 
 
-def compiler() -> str | None:
-    return shutil.which(os.environ.get("CC", "cc"))
+from .._cbuild import build_shared, compiler  # noqa: E402
 
 
 def status() -> str:
@@ -58,9 +54,10 @@ def status() -> str:
 
 
 def cache_dir() -> Path:
-    env = os.environ.get("ANTHROARM_CACHE")
-    base = Path(env).expanduser() if env else Path.home() / ".cache" / "anthroarm"
-    return base / "ik"
+    """``$ANTHROARM_CACHE/ik`` or ``~/.cache/anthroarm/ik``."""
+    from .._cbuild import cache_dir as _cache_dir
+
+    return _cache_dir("ik")
 
 
 # ---------------------------------------------------------------------------- C text
@@ -535,21 +532,6 @@ class CKernel:
         return Q, valid.view(bool), inside.view(bool), res, code, sing
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
 def build(plan) -> CKernel:
     """Compile (or load from the cache) the kernel of ``plan``.  Raises RuntimeError on failure."""
     cc = compiler()
@@ -560,17 +542,7 @@ def build(plan) -> CKernel:
     with _LOCK:
         if key in _LIBS:
             return _LIBS[key]
-        so = cache_dir() / f"analytic_{plan.name}_{key}.so"
-        if not so.is_file():
-            so.parent.mkdir(parents=True, exist_ok=True)
-            with tempfile.TemporaryDirectory(dir=so.parent) as tmp:
-                cpath = Path(tmp) / "k.c"
-                cpath.write_text(src)
-                opath = Path(tmp) / "k.so"
-                r = subprocess.run([cc, *FLAGS, "-o", str(opath), str(cpath), "-lm"], capture_output=True, text=True)
-                if r.returncode != 0:
-                    raise RuntimeError(f"C compilation failed: {r.stderr[:500]}")
-                _atomic_write(so, opath.read_bytes())
+        so = build_shared(src, cache_dir() / f"analytic_{plan.name}_{key}.so", FLAGS)
         kern = CKernel(so, plan)
         _LIBS[key] = kern
         return kern
