@@ -129,7 +129,7 @@ def run(quick: bool = False) -> dict:
              "between the two trajectories. Violations = steps whose q lies outside the joint limits "
              "(exact comparison). Ours assembles H, c and the limit box in preallocated arrays and calls the "
              "solvers directly: OSQP keeps one sparse workspace (update + warm start through the compiled solver, "
-             "eps 1e-11, rho 10); daqp.solve; quadprog's compiled qpgen2_ routine through ctypes with preallocated "
+             "eps 1e-9, rho 10) and the active set it finds is solved exactly (KKT-checked polish); daqp.solve; quadprog's compiled qpgen2_ routine through ctypes with preallocated "
              "arrays (bit-identical to quadprog.solve_qp); ProxQP keeps a warm-started dense workspace (eps 1e-9) "
              "and its active set is solved exactly (KKT-checked polish). pink goes through qpsolvers (CSC conversion "
              "per call for OSQP, default tolerances). "

@@ -13,16 +13,17 @@ Why persistent workspaces (peers.md §4.2): through ``qpsolvers.solve_qp`` OSQP 
 7-variable QP because the dense→CSC conversion (``csc_matrix``, ``sp.triu``) dominates, and at its
 default tolerance it deviates 1.7e-4 from a dense solver (pink#163).  :class:`OSQPBackend`
 builds the sparse structure once (full upper-triangular pattern of H, identity plus a dense
-equality block for A), then per step only calls ``update(Px=…, q=…, l=…, u=…)`` and solves
-warm-started, with eps 1e-10 and solution polishing so the answer matches a dense solver.
+equality block for A), then per step only updates the values and solves warm-started; its answer
+is made to match a dense solver by an exact solve on the active set it found (:func:`polish_box`,
+accepted with a KKT certificate) or, with equality rows, by a tight tolerance (eps 1e-11).
 daqp, quadprog and proxqp are called directly (no qpsolvers conversion layer); ``"qpsolvers:NAME"``
 goes through ``qpsolvers.solve_qp`` for solvers without a direct path.
 
 :meth:`Backend.solve_ws` is the entry of :func:`~anthroarm.ik.qp.step`: it reads the step's
 preallocated arrays (finite box, ``B = [lo; −hi]``) and skips the conversions of ``solve``.  There
 quadprog's compiled routine is called with preallocated arrays (:mod:`._qpgen2`, bit-identical to
-``quadprog.solve_qp``), and ProxQP keeps a warm-started workspace whose active set is polished
-exactly (:meth:`ProxqpBackend._polish_box`).
+``quadprog.solve_qp``), and ProxQP keeps a warm-started workspace whose active set is solved
+exactly (:func:`polish_box`), as OSQP's is.
 """
 
 from __future__ import annotations
