@@ -1,10 +1,10 @@
 """One-shot inverse kinematics: ``aa.ik.solve(robot, T)`` -> :class:`~anthroarm.ik.result.IKResult`.
 
 Method: damped Gauss–Newton (Levenberg–Marquardt) on the pose error with projected steps,
-seeds from a table of the arm's own poses, and restarts inside the joint limits under a time
-budget.  Per iteration (world frame, m and rad):
+seeds from the closed form or from a table of the arm's own poses, and restarts inside the
+joint limits under a time budget.  Per iteration (tool frame, m and rad):
 
-    e = (p* − p ; log₃(R* Rᵀ)),   J = ᵂJ(q)  (LOCAL_WORLD_ALIGNED frame Jacobian, rows (v; ω)),
+    e = log₆(T(q)⁻¹ T*)  (body twist (v; ω)),   J = ᵇJ(q)  (LOCAL frame Jacobian),
     Δq = Jᵀ (J Jᵀ + λ I)⁻¹ e,   λ = λ₀ + k ‖e‖²   (Chan / Sugihara damping),
     q ← clip(q + Δq, q_min, q_max).
 
@@ -15,29 +15,50 @@ Joint ranges, the penalty constraints g_i(Q) ≥ 0 of (7-84)–(7-85), are enfor
 joint whose step would cross its limit is frozen for that step and the step is recomputed
 with the other joints (an active set; plain clipping let those joints stall the attempt),
 then the result is clipped.  An attempt stops when the error no longer falls by 10 % in three
-iterations; the next seed is then tried.
+iterations; the next seed is then tried.  Success is decided on the exact errors ‖p* − p‖ and
+the angle of Rᵀ R* from Pinocchio's FK of the returned q.
 
-Seeds, in order: ``q0`` when given (clipped into the limits), otherwise the configuration of a
-seed table (:data:`SEED_TABLE` configurations drawn once per robot and frame, uniformly inside
-the limits from a fixed RNG seed, with their frame poses) whose pose is nearest the target,
-measured as ‖p − p*‖² + w²‖R − R*‖²_F (w = :data:`SEED_ROT_WEIGHT` × reach), which is linear
-in the table's entries, so the lookup is one matrix–vector product; then the next nearest
-table entries, then uniform random configurations inside the limits until ``max_time`` or
-``max_restarts``.  The closed-form branches of :func:`anthroarm.ik.analytic` join after
-:data:`ANALYTIC_AFTER` failed attempts (``analytic="auto"``; a closed-form call costs 0.4–6 ms
-against ~0.05 ms for a whole Gauss–Newton solve) or first (``analytic=True``).
+The kernel is written for the cost of each call from Python (~0.1–0.5 µs per Pinocchio or
+NumPy call on these sizes, see ``benchmarks/results/ik.md``): one ``computeJointJacobians`` +
+``updateFramePlacement`` per iteration, J Jᵀ + λI built in a preallocated array and factorised
+in place by LAPACK ``dposv``, the ``clip`` ufunc, limit hits detected by comparing bytes.
 
-Targets: a 4×4 rigid pose (``mode="pose"``), a position (3,) (``"position"``: e = p* − p, the
-linear rows of J) or a rotation (3, 3) (``"orientation"``: e = log₃(R* Rᵀ), the angular rows).
-A leading batch axis solves N targets (:class:`~anthroarm.ik.result.IKBatchResult`).
+Seeds, in order:
+
+1. the closed-form solutions of :func:`anthroarm.ik.analytic` (nearest the posture first),
+   when ``analytic=True``, or with ``analytic="auto"`` and no ``q0`` where the closed form is
+   cheap (:func:`_analytic_cheap`: the six-joint book arms, ~10 µs; the human arm's 24-angle
+   swivel grid with the compiled kernel, ~20 µs); they are exact, so one evaluation verifies
+   them;
+2. ``q0`` when given (clipped into the limits);
+3. the seed table: :data:`SEED_TABLE` configurations drawn once per robot and frame,
+   uniformly inside the limits from a fixed RNG seed, with their poses.  The entry nearest the
+   target in ‖p − p*‖² + w²‖R − R*‖²_F (w = :data:`SEED_ROT_WEIGHT` × reach) comes first: the
+   distance is linear in the entry's features, so the lookup is one vector–matrix product.
+   Where the first and last joints span ≥ :data:`ALIGN_RANGE` (panda, ur5) the table is
+   :class:`_Aligned`: the nearest entry up to a turn of those two joints, turned onto the
+   target.  Then the next :data:`TABLE_SEEDS` − 1 nearest entries;
+4. uniform random configurations inside the limits, until ``max_time`` or ``max_restarts``;
+   with ``analytic="auto"`` the closed form joins after :data:`ANALYTIC_AFTER` failed attempts
+   where it was not first.
+
+Targets: a 4×4 rigid pose (``mode="pose"``), a position (3,) (``"position"``: e = p* − p with
+the LOCAL_WORLD_ALIGNED linear rows of J) or a rotation (3, 3) (``"orientation"``:
+e = log₃(Rᵀ R*) with the LOCAL angular rows).  A leading batch axis solves N targets
+(:class:`~anthroarm.ik.result.IKBatchResult`), in lockstep (:func:`_solve_lockstep`) where
+the table seeds them.
 
 Redundant arms (human arm): ``posture`` adds a secondary objective ½‖q − q_ref‖² in the null
 space of the primary task: from a solution, Δq = J⁺e + N s with N = I − Jᵀ(JJᵀ + λI)⁻¹J, until
 the null-space step is below :data:`NULL_TOL`.  With a one-dimensional null space (a 7-DOF arm
 on a 6-D pose) the step along the self-motion is a secant (quasi-Newton) step on the posture
 cost, which converges superlinearly where the plain projected-gradient step s = q_ref − q
-converges linearly (slowly where the self-motion curve bends).  The table seed of such a
-problem also penalises ‖q − q_ref‖, so the first solution starts near the comfortable one.
+converges linearly (slowly where the self-motion curve bends; it used to run out of
+iterations on a third of the human-arm targets); a null-space step that would cross a joint
+limit stops on it, and a joint at its limit that the pull pushes outward is frozen — the
+optimum of a one-dimensional self-motion is then on that limit.  The table seed of such a
+problem also penalises ‖q − q_ref‖ (:data:`SEED_POSTURE_WEIGHT`); closed-form seeds are
+sorted by ‖q − q_ref‖, so the phase starts on the branch nearest the comfortable posture.
 ``swivel=φ*`` instead places the elbow at the swivel angle φ* (:mod:`anthroarm.ik.qp.tasks.swivel`).
 """
 
@@ -543,8 +564,7 @@ def _refine_posture(ch, tg, q, q_ref, deadline):
             if info:
                 return good, gpe2, gre2, it
             dq = x.dot(J)
-            z = q_ref - q
-            z -= dq
+            z = q_ref - q          # N (q_ref − q − Δq) = N (q_ref − q) + O(λ): Δq lies in the row space
             if frozen is not None:
                 z[frozen] = 0.0
             p = z - dpotrs(AF, J.dot(z))[0].dot(J)     # N z: projection on the null space
@@ -791,8 +811,8 @@ def _analytic_cheap(robot, fid) -> bool:
         return False
 
 
-def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None):
-    """Closed-form solutions (K, nq) sorted by distance to ``ref``, or an empty array."""
+def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None, T=None):
+    """Closed-form solutions (K, nq), the one nearest ``ref`` first, or an empty array."""
     if mode != "pose" or ch.fid != robot.tool_id:
         return np.zeros((0, ch.n)), ""
     cf = _analytic_module()
@@ -805,11 +825,16 @@ def _analytic_seeds(robot, ch, mode, target, ref, swivel, grid=None):
                 kw["swivel"] = swivel
             elif grid is not None:
                 kw["swivel"] = grid
-        S = np.asarray(cf.analytic(robot, target.homogeneous, **kw).solutions, dtype=float).reshape(-1, ch.n)
+        res = cf.analytic(robot, target.homogeneous if T is None else T, **kw)
+        S = np.asarray(res.solutions, dtype=float).reshape(-1, ch.n)
     except Exception as exc:  # a seed source only: never let it break the solve
         return np.zeros((0, ch.n)), f"analytic seed failed: {exc}"
     if len(S) > 1:
-        S = S[np.argsort(((S - ref) ** 2).sum(axis=1))]
+        D = S - ref
+        c = (D * D).dot(np.ones(ch.n))
+        k = int(c.argmin())
+        if k:                                  # nearest first (the order of the others matters little)
+            S[[0, k]] = S[[k, 0]]
     return S, ""
 
 
@@ -1123,7 +1148,8 @@ def _solve_one(robot, ch, tg, target, seed, max_time, max_restarts, gen, q_ref, 
     note = ""
     if not out_of_reach and (analytic is True or (analytic == "auto" and seed is None and ch.analytic_first)):
         ref = q_ref if q_ref is not None else (ch.default_ref if seed is None else seed)
-        ana, note = _analytic_seeds(robot, ch, tg.mode, target, ref, sw[1] if sw else None, HUMAN_GRID)
+        ana, note = _analytic_seeds(robot, ch, tg.mode, target, ref, sw[1] if sw else None, HUMAN_GRID,
+                                    tg.x.reshape(4, 4) if tg.kind == _POSE else None)
     table = None      # seed-table entries, nearest first (made when needed)
     total_it = 0
     best_q, best_E = None, math.inf
