@@ -889,9 +889,11 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         x = T.ravel()
     else:
         mode, batch, targets = _parse(robot, T, mode)
-    for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
-        if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
-            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+    if not (type(tol_pos) is float and type(tol_rot) is float and type(max_time) is float   # the usual call
+            and 0.0 < tol_pos < math.inf and 0.0 < tol_rot < math.inf and 0.0 < max_time < math.inf):
+        for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
+            if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
     if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
         raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
     if analytic not in ("auto", True, False):
@@ -918,13 +920,15 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         if not math.isfinite(swivel):
             raise ValueError(f"swivel must be finite, got {swivel}")
         sw_frames = _swivel_frames(robot, swivel_frames)
-    dim = {"pose": 6, "position": 3, "orientation": 3}[mode]
-    redundant = ch.n > dim
+    redundant = ch.n > (6 if mode == "pose" else 3)
     # the restart generator is created on first use (most solves need no restart)
     gen = [rng] if isinstance(rng, np.random.Generator) else [None, 0 if rng is None else rng]
 
     q_ref_sec = q_ref if redundant and swivel is None else None
     sw_sec = (sw_frames, swivel) if (redundant and swivel is not None) else None
+    if not batch:
+        return _solve_one(robot, ch, _Target(mode, targets[0], float(tol_pos), float(tol_rot), x), targets[0], Q0,
+                          max_time, max_restarts, gen, q_ref_sec, sw_sec, analytic)
     tgs = [_Target(mode, t, float(tol_pos), float(tol_rot), x) for t in targets]
     if Q0 is None:
         seeds = [None] * len(targets)
@@ -943,8 +947,6 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
                              analytic)
             results.append(res)
             prev = res.q
-    if not batch:
-        return results[0]
     return IKBatchResult(
         q=np.array([r.q for r in results]).reshape(len(results), ch.n),
         success=np.array([r.success for r in results], dtype=bool),
