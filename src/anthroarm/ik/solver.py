@@ -701,9 +701,9 @@ def _settle_swivel(robot, ch, tg, target, sw, q_ref, qs, pe, re, analytic, msg):
         if cf is not None and ch.fid == robot.tool_id and cf.has_analytic(robot):
             tried = " and the closed form has no solution at that angle inside the limits"
         for cand in S:
-            pe2, re2 = tg.errors(ch, cand)
-            if pe2 * pe2 <= tg.tp2 and re2 * re2 <= tg.tr2:
-                return cand, pe2, re2, "analytic", "converged from an analytic seed at the requested swivel angle"
+            pe_c, re_c = tg.errors(ch, cand)
+            if pe_c * pe_c <= tg.tp2 and re_c * re_c <= tg.tr2:
+                return cand, pe_c, re_c, "analytic", "converged from an analytic seed at the requested swivel angle"
     msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's self-motion within the "
             f"joint limits{tried} (the hand pose is exact)")
     return qs, pe, re, "", msg
