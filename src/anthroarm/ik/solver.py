@@ -76,7 +76,10 @@ from scipy.linalg.lapack import dposv, dpotrs
 try:  # the clip ufunc itself: ~0.2 µs against ~1.3 µs for np.clip's Python wrapper
     from numpy._core.umath import clip as _uclip
 except ImportError:  # numpy < 2
-    from numpy.core.umath import clip as _uclip
+    try:
+        from numpy.core.umath import clip as _uclip
+    except ImportError:  # pragma: no cover - a NumPy without the ufunc: the public wrapper
+        _uclip = np.clip
 
 from ..errors import UnsupportedModelError
 from .qp.targets import as_position, as_rotation, as_se3
