@@ -8,7 +8,7 @@ import pkgutil
 import sys
 from pathlib import Path
 
-from .common import RESULTS_DIR, markdown_table, write_result
+from .common import RESULTS_DIR, markdown_table, steady_state_allocator, write_result
 
 
 def available() -> list[str]:
@@ -25,6 +25,7 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
     for n in names:
         mod = importlib.import_module(f"benchmarks.bench_{n}")
         print(f"== benchmark {n}: {mod.__doc__.strip().splitlines()[0] if mod.__doc__ else ''}", flush=True)
+        steady_state_allocator()
         result = mod.run(quick=quick)
         jp, mp = write_result(n, result, out_dir)
         print(markdown_table(result["columns"], result["rows"]))

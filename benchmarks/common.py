@@ -36,6 +36,20 @@ def time_call(fn, *, number: int = 1, repeat: int = 7, min_time: float = 0.0) ->
     return median(runs)
 
 
+def steady_state_allocator(nbytes: int = 16 * 1024 * 1024) -> None:
+    """Bring the C allocator to the state a long-running program is in.
+
+    glibc serves large allocations (> 128 kB at start) with fresh mmap pages, which page-fault
+    on first touch; after the first large block is freed it raises that threshold, and later
+    batches reuse heap memory.  Without this, whichever benchmark row runs first with N = 10 000
+    pays ~0.3 µs per configuration of page faults that no later row pays.  Allocating and
+    freeing one large block up front makes every row measure the steady state."""
+    import numpy as np
+
+    a = np.ones(nbytes // 8)
+    del a
+
+
 def environment() -> dict:
     import numpy
     import pinocchio
