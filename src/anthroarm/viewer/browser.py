@@ -112,16 +112,16 @@ def drawn_fraction(png, baseline_png, region=(0.0, 0.0, 1.0, 1.0), tol: int = 40
 
 
 def docs_screenshot(png, size=(960, 640)) -> Path:
-    """The README picture: the §6-3 human arm mid-demo (reaching forward), the demo's targets
-    and hand path, joint-limit colours on.  ``python -m anthroarm.viewer.browser docs/x.png``."""
+    """The README picture: the §6-3 human arm reaching forward, the demo's targets and the
+    hand's path, joint-limit colours on.  ``python -m anthroarm.viewer.browser docs/x.png``."""
     from .demo import REACH_POSTURES_DEG, demo_viewer, reach_demo
 
     res = reach_demo()
     v = demo_viewer(res)
     v.stop()  # a still picture: the pose below, not the animation
     v.show_limits()
-    v.display(np.deg2rad(REACH_POSTURES_DEG["hand to mouth"]))
-    v.set_camera((0.55, 1.0, 0.4), distance=1.35 * v.radius)
+    v.display(np.deg2rad(REACH_POSTURES_DEG["reach forward"]))
+    v.set_camera((1.0, 0.7, 0.45), distance=2.2 * v.radius)  # front-right, whole reach in view
     with tempfile.TemporaryDirectory() as d:
         html = v.export_html(Path(d) / "arm.html")
         return screenshot(html, png, size=size, budget_ms=3000)
