@@ -28,7 +28,7 @@ def test_helpers_equal_spatial_screw_and_pin():
 
 
 def test_unit_axis_and_wrap():
-    with pytest.raises(ValueError, match="zero-length"):
+    with pytest.raises(ValueError, match="zero length"):
         unit_axis("u", [0, 0, 0])
     with pytest.raises(ValueError, match="unit"):
         unit_axis("u", [0, 0, 1.01])

@@ -5,7 +5,8 @@ The rotation helpers are the 002 text's matrices (book notation in brackets); ``
 ``spatial.screw`` (checked equal in ``tests/mechanisms/test_mech_util.py``):
 
 * ``skew(u)`` = [P_u], the cross-product matrix, 002 line 185 and Eq. (6-89) with the
-  *standard* sign pattern (the print swaps u_x and u_z, see docs/errata.md);
+  *standard* sign pattern (the print swaps u_x and u_z, see docs/errata.md); it is
+  :func:`anthroarm.spatial.rotations.skew`, as are the scalar and unit-axis checks;
 * ``rot(theta, u)`` = [R_{theta,u}] = -[P_u]^2 cos(theta) + [P_u] sin(theta) + [Q_u], Eq. (6-89),
   equal to Rodrigues' form (6-88) and to ``pin.exp3(theta * u)``;
 * ``W(thetadot, u)`` = [W_{thetadot,u}] = thetadot [P_u], Eq. (6-91);
@@ -19,19 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 
-#: tolerance on |u| - 1 for an axis to count as a unit vector
-UNIT_TOL = 1e-9
+from ..spatial.rotations import UNIT_TOL, as_scalar, check_unit_axis, skew  # noqa: F401  (re-exported)
 
 
 def finite_scalar(name: str, x) -> float:
-    """``float(x)`` or ``ValueError`` naming ``name`` when x is not a finite real scalar."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real scalar, got {x!r}") from None
-    if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {x!r}")
-    return v
+    """``float(x)`` or ``ValueError`` naming ``name`` when x is not a finite real scalar
+    (:func:`anthroarm.spatial.rotations.as_scalar` with the name first)."""
+    return as_scalar(x, name)
 
 
 def positive_length(name: str, x) -> float:
@@ -63,23 +58,12 @@ def point3(name: str, x) -> np.ndarray:
 
 
 def unit_axis(name: str, u) -> np.ndarray:
-    """A 3-vector that must already be a unit vector (|u| = 1 within 1e-9); ``ValueError`` otherwise."""
-    a = finite_array(name, u, (3,))
-    n = float(np.linalg.norm(a))
-    if n == 0.0:
-        raise ValueError(f"{name} is a zero-length axis: {a.tolist()}")
-    if abs(n - 1.0) > UNIT_TOL:
-        raise ValueError(f"{name} must be a unit vector, |{name}| = {n!r} for {a.tolist()}")
-    return a / n
+    """A 3-vector that must already be a unit vector (|u| = 1 within 1e-9); ``ValueError`` otherwise.
 
-
-def skew(u) -> np.ndarray:
-    """[P_u]: skew(u) @ x == cross(u, x).  Batched over leading axes."""
-    u = np.asarray(u, dtype=float)
-    z = np.zeros(u.shape[:-1])
-    return np.stack([np.stack([z, -u[..., 2], u[..., 1]], -1),
-                     np.stack([u[..., 2], z, -u[..., 0]], -1),
-                     np.stack([-u[..., 1], u[..., 0], z], -1)], -2)
+    :func:`anthroarm.spatial.rotations.check_unit_axis` restricted to one axis of shape (3,),
+    then divided by its norm (so that |u| = 1 to rounding)."""
+    a = check_unit_axis(point3(name, u), name)
+    return a / float(np.linalg.norm(a))
 
 
 def rot(theta, u) -> np.ndarray:
