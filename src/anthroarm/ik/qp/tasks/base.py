@@ -91,3 +91,28 @@ class Task:
             H.flat[:: nv + 1] += self.lm_damping * float(We @ We)
         c = WJ.T @ We
         return H, c
+
+
+class FrameAxesTask(Task):
+    """Common set-up of the 3-coordinate tasks on one frame (:class:`PositionTask`,
+    :class:`OrientationTask`): the frame (default: the robot's tool; an unknown name raises
+    ``UnknownFrameError`` listing the frames), a cost that is a scalar or a 3-vector, and an
+    optional target passed to the subclass's ``set_target``."""
+
+    def __init__(self, robot, frame=None, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0, target=None):
+        super().__init__(cost=np.broadcast_to(np.asarray(cost, dtype=float), (3,)).copy(), gain=gain,
+                         lm_damping=lm_damping)
+        self.frame_id = robot.frame_id(frame)
+        self.frame = robot.model.frames[self.frame_id].name
+        self.target = None
+        if target is not None:
+            self.set_target(target)
+
+    def set_target(self, target) -> None:
+        raise NotImplementedError
+
+    def _require_target(self):
+        if self.target is None:
+            raise ValueError(f"{type(self).__name__}({self.frame!r}): no target set (call set_target)")
+        return self.target
+

@@ -11,21 +11,12 @@ import numpy as np
 
 from ..configuration import LWA
 from ..targets import as_position
-from .base import Task
+from .base import FrameAxesTask
 
 
-class PositionTask(Task):
+class PositionTask(FrameAxesTask):
     """Position task on ``frame`` (default: the robot's tool).  ``cost`` may be a 3-vector
     (world x, y, z weights, [cost]/m); 0 frees an axis (e.g. the planar 2R arm uses (0, 1, 1))."""
-
-    def __init__(self, robot, frame=None, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0, target=None):
-        super().__init__(cost=np.broadcast_to(np.asarray(cost, dtype=float), (3,)).copy(), gain=gain,
-                         lm_damping=lm_damping)
-        self.frame_id = robot.frame_id(frame)
-        self.frame = robot.model.frames[self.frame_id].name
-        self.target = None
-        if target is not None:
-            self.set_target(target)
 
     def set_target(self, p) -> None:
         """Target position (3,), m, world frame."""
@@ -35,9 +26,7 @@ class PositionTask(Task):
         self.target = conf.frame_placement(self.frame_id).translation.copy()
 
     def compute_error(self, conf) -> np.ndarray:
-        if self.target is None:
-            raise ValueError(f"PositionTask({self.frame!r}): no target set (call set_target)")
-        return conf.frame_placement(self.frame_id).translation - self.target
+        return conf.frame_placement(self.frame_id).translation - self._require_target()
 
     def compute_jacobian(self, conf) -> np.ndarray:
         return conf.frame_jacobian(self.frame_id, LWA)[:3]
