@@ -168,6 +168,11 @@ def test_task_bad_input(panda):
         qp.FrameTask(panda, gain=2.0)
     with pytest.raises(ValueError, match="cost"):
         qp.PostureTask(panda, cost=np.nan)
+    for bad in (np.nan, np.inf, -1e-3):  # a NaN damping used to be accepted and poisoned H
+        with pytest.raises(ValueError, match="lm_damping"):
+            qp.FrameTask(panda, lm_damping=bad)
+    with pytest.raises(ValueError, match="gain"):
+        qp.PositionTask(panda, gain=np.nan)
     t = qp.FrameTask(panda)
     with pytest.raises(ValueError, match="no target"):
         t.compute_error(qp.IKConfiguration(panda))

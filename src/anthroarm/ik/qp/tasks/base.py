@@ -34,8 +34,8 @@ class Task:
     def __init__(self, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0):
         if not 0.0 <= float(gain) <= 1.0:
             raise ValueError(f"task gain must be in [0, 1], got {gain}")
-        if float(lm_damping) < 0.0:
-            raise ValueError(f"lm_damping must be >= 0, got {lm_damping}")
+        if not 0.0 <= float(lm_damping) < np.inf:  # also rejects NaN
+            raise ValueError(f"lm_damping must be finite and >= 0, got {lm_damping}")
         c = np.asarray(cost, dtype=float)
         if not np.all(np.isfinite(c)) or np.any(c < 0):
             raise ValueError(f"task cost must be finite and >= 0, got {cost}")
