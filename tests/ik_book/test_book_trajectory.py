@@ -36,6 +36,12 @@ def test_via_points_bad_input():
         ViaPointTrajectory([0, 1], np.zeros((3, 2)))
     with pytest.raises(ValueError):
         ViaPointTrajectory([0, 1], [[0, np.nan], [1, 1]])
+    tr = ViaPointTrajectory([0, 1, 2], [[0, 0], [1, 2], [0, 1]])
+    with pytest.raises(ValueError, match="finite"):   # used to return NaN
+        tr([0.5, np.nan])
+    for d in (-1, 6, 1.5):
+        with pytest.raises(ValueError, match="derivative"):
+            tr(0.5, d)
 
 
 def test_joint_via_trajectory_from_poses():

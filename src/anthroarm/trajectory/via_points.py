@@ -39,7 +39,14 @@ class ViaPointTrajectory:
         return float(self.times[-1] - self.times[0])
 
     def __call__(self, t, derivative: int = 0) -> np.ndarray:
+        """q (derivative 0, rad or m), q̇ (1, per s), q̈ (2, per s²) … at time(s) ``t`` (s);
+        shape ``t.shape + (nq,)``.  ``ValueError`` for a NaN/inf time or a derivative order
+        that is not an integer in 0 … 5 (the pieces are quintic)."""
         t = np.asarray(t, float)
+        if not np.isfinite(t).all():
+            raise ValueError(f"t must be finite times (s), got {t.tolist()}")
+        if isinstance(derivative, bool) or not isinstance(derivative, (int, np.integer)) or not 0 <= derivative <= 5:
+            raise ValueError(f"derivative must be an integer in 0 ... 5, got {derivative!r}")
         tc = np.clip(t, self.times[0], self.times[-1])
         out = self._spl(tc, nu=derivative)
         if derivative > 0:
