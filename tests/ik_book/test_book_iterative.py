@@ -176,6 +176,10 @@ def test_penalty_bad_args(planar):
         penalty_minimize(task, [0, 0.5], [], method="bfgs")
     with pytest.raises(ValueError):
         newton(task, [np.nan, 0])
+    with pytest.raises(ValueError, match="t_end"):   # t_end = inf used to raise OverflowError
+        gradual_approach(task, [0, 0.5], t_end=np.inf)
+    with pytest.raises(ValueError, match="dt"):
+        feedback_compensation(task, _circle, [0, 0.5], [0, 0], dt=np.inf, num=3)
 
 
 # ---------------------------------------------------------------------------- gradual approach

@@ -173,8 +173,8 @@ def feedback_compensation(task, reference, q0, qd0, dt: float, num: int, *, eps:
     ``K="exact"`` uses J̇ (``task.jacobian_dot``); ``K="book_zero"`` the book's K ≡ 0."""
     if K not in ("exact", "book_zero"):
         raise ValueError(f"K must be 'exact' or 'book_zero', got {K!r}")
-    if not (dt > 0 and num >= 1):
-        raise ValueError(f"need dt > 0 and num >= 1, got dt={dt}, num={num}")
+    if not (0 < dt < np.inf and num >= 1):
+        raise ValueError(f"need a finite dt > 0 and num >= 1, got dt={dt}, num={num}")
     q = _check_q0(q0)
     qd = _check_q0(qd0, q.shape[0])
     n = q.shape[0]
@@ -342,8 +342,8 @@ def gradual_approach(task, q0, *, mu=None, t_end: float = 10.0, dt: float = 0.05
     mu = mu or (lambda t: 1.0 / (1.0 + t))
     if abs(mu(0.0) - 1.0) > 1e-12:
         raise ValueError(f"mu(0) must be 1 (7-39), got {mu(0.0)}")
-    if not (dt > 0 and t_end > 0):
-        raise ValueError("need dt > 0 and t_end > 0")
+    if not (0 < dt < np.inf and 0 < t_end < np.inf):
+        raise ValueError(f"need finite dt > 0 and t_end > 0, got dt={dt}, t_end={t_end}")
     q = _check_q0(q0)
     ts, Q, X, E = [0.0], [q.copy()], [task.value(q)], [task.error(q)]
     t = 0.0
