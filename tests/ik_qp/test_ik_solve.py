@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import anthroarm as aa
+from anthroarm.ik import closed_form as cf
 from anthroarm.errors import UnknownFrameError
 from anthroarm.ik import IKBatchResult, IKResult, qp
 
@@ -200,9 +201,7 @@ def test_human_arm_swivel(robots):
 
 def test_analytic_seed_when_available(robots):
     robot = robots["prosthetic_arm"]
-    cf = pytest.importorskip("anthroarm.ik.closed_form")
-    if not cf.has_analytic(robot):
-        pytest.skip("no closed form")
+    assert cf.has_analytic(robot)
     T = robot.fk(robot.random_q(rng=4))
     res = aa.ik.solve(robot, T, analytic=True)
     assert res.success and res.seed == "analytic" and res.restarts == 0
@@ -234,10 +233,8 @@ def test_human_posture_optimum_matches_closed_form_family(robots):
     """Oracle: the closed form parameterises every solution of a human_arm7 pose by the swivel
     angle; the posture objective must land on the member nearest the comfortable posture
     (up to the 0.5° grid of the scan)."""
-    cf = pytest.importorskip("anthroarm.ik.closed_form")
     robot = robots["human_arm7"]
-    if not cf.has_analytic(robot):
-        pytest.skip("no closed form")
+    assert cf.has_analytic(robot)
     ref = qp.comfortable_posture(robot)
     rng = np.random.default_rng(0)
     goals = np.clip(ref + rng.uniform(-0.6, 0.6, (6, 7)), robot.lower, robot.upper)
@@ -355,11 +352,9 @@ def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):
     comfortable posture in at least 19 of 20 cases (oracle: 0.5° swivel scan of the closed
     form; the phase moves along one branch, and a joint limit can cut it).  The solver before
     the secant posture phase missed it in ~25 % of such targets."""
-    cf = pytest.importorskip("anthroarm.ik.closed_form")
     from anthroarm.ik import solver
     robot = robots["human_arm7"]
-    if not cf.has_analytic(robot):
-        pytest.skip("no closed form")
+    assert cf.has_analytic(robot)
     monkeypatch.setattr(solver._chain(robot, robot.tool_id), "analytic_first", True)
     ref = qp.comfortable_posture(robot)
     grid = np.linspace(-np.pi, np.pi, 720, endpoint=False)
