@@ -110,12 +110,10 @@ _D2 = np.array([8 / 5, -1 / 5, 8 / 315, -1 / 560])
 _D2_0 = -205 / 72
 
 
-def fd_rates(f, h: float = 1e-2, angular: bool = False):
-    """First and second derivative at t = 0 of ``f(t)`` (array-valued) by 8th-order central
-    differences.  ``angular=True`` wraps differences to (-pi, pi] (for angle outputs).
-
-    Used as the *mathematical* oracle of the mechanism rates: for smooth outputs with
-    derivatives of order one, h = 1e-2 gives errors ~1e-12 (truncation h^8, round-off eps/h^2)."""
+def _stencil_sums(f, h: float, angular: bool):
+    """Σ_k D1_k (f(kh) − f(−kh)) and Σ_k D2_k (f(kh) + f(−kh) − 2 f(0)) over k = 1..4, the
+    numerators of the first and second derivative (values taken relative to f(0), so the centre
+    weight of the second-derivative stencil drops out; wrapped to (-pi, pi] when ``angular``)."""
     f0 = np.asarray(f(0.0), dtype=float)
     d1 = np.zeros_like(f0)
     d2 = _D2_0 * np.zeros_like(f0)
@@ -126,6 +124,16 @@ def fd_rates(f, h: float = 1e-2, angular: bool = False):
             fp, fm = np.asarray(wrap(fp)), np.asarray(wrap(fm))
         d1 = d1 + _D1[k - 1] * (fp - fm)
         d2 = d2 + _D2[k - 1] * (fp + fm)
+    return d1, d2
+
+
+def fd_rates(f, h: float = 1e-2, angular: bool = False):
+    """First and second derivative at t = 0 of ``f(t)`` (array-valued) by 8th-order central
+    differences.  ``angular=True`` wraps differences to (-pi, pi] (for angle outputs).
+
+    Used as the *mathematical* oracle of the mechanism rates: for smooth outputs with
+    derivatives of order one, h = 1e-2 gives errors ~1e-12 (truncation h^8, round-off eps/h^2)."""
+    d1, d2 = _stencil_sums(f, h, angular)
     return d1 / h, d2 / (h * h)
 
 
@@ -135,12 +143,4 @@ def fd_derivative(f, h: float = 1e-3, angular: bool = False):
     The accelerations of the mechanisms are checked as the derivative of their (closed-form,
     itself finite-difference-checked) velocity along the trajectory: this keeps the oracle at
     ~1e-12 where a second difference of positions is limited to ~eps/h^2."""
-    f0 = np.asarray(f(0.0), dtype=float)
-    d1 = np.zeros_like(f0)
-    for k in range(1, 5):
-        fp = np.asarray(f(k * h), dtype=float) - f0
-        fm = np.asarray(f(-k * h), dtype=float) - f0
-        if angular:
-            fp, fm = np.asarray(wrap(fp)), np.asarray(wrap(fm))
-        d1 = d1 + _D1[k - 1] * (fp - fm)
-    return d1 / h
+    return _stencil_sums(f, h, angular)[0] / h
