@@ -36,9 +36,7 @@ def _load(key):
 @pytest.mark.parametrize("key", list(ARMS))
 def test_round_trip_fk_ik_pinocchio(key):
     robot = _load(key)
-    # a stable seed per key (str hash() is salted per process: the poses changed from run to run,
-    # and about 2 % of 2000-pose prosthetic batches hold a nearly straight elbow, θ4 ≲ 1e-5, where
-    # the ill-conditioned θ3/θ5 land more than 1e-6 from the sampled configuration)
+    # a stable seed per key (str hash() is salted per process)
     rng = np.random.default_rng(zlib.crc32(key.encode()))
     Q = robot.random_q(N_ROUND_TRIP, rng)
     T = robot.fk(Q)  # Pinocchio
@@ -55,9 +53,17 @@ def test_round_trip_fk_ik_pinocchio(key):
     else:
         err = np.abs(Tfk[:, :3, :] - T[i, :3, :]).max()
     assert err <= 1e-10
-    # the configuration the pose came from is one of the solutions
+    # the configuration the pose came from is one of the solutions, wherever the pose determines
+    # it well: a pose error e maps to a joint error of about e / σ_min(J), so near a singularity
+    # (a straight elbow, an aligned wrist) the comparison is meaningless and is left out
+    J = robot.jacobian(Q)
+    if robot.spec.name == "planar2r":
+        J = J[:, 1:3, :]  # the printed task: tip (y, z)
+    sigma_min = np.linalg.svd(J, compute_uv=False)[:, -1]
+    well = sigma_min > 1e-3
+    assert well.mean() > 0.8  # most samples are well away from a singularity
     dist = np.where(res.valid[..., None], res.solutions, np.inf) - Q[:, None, :]
-    assert np.nanmin(np.abs(dist).max(-1), axis=1).max() < 1e-6
+    assert np.nanmin(np.abs(dist).max(-1), axis=1)[well].max() < 1e-6
 
 
 def test_sixr_eight_branches():
