@@ -140,7 +140,7 @@ class Robot:
         """Index of a frame; ``None`` means the tool.  Unknown names raise
         :class:`UnknownFrameError` listing the valid ones."""
         if frame is None:
-            return self.tool_id if hasattr(self, "tool_id") else self.frame_id(self.tool)
+            return self.tool_id
         if isinstance(frame, (int, np.integer)) and not isinstance(frame, bool):
             if not 0 <= frame < len(self.model.frames):
                 raise UnknownFrameError(f"{self.name}: frame index {frame} out of range 0..{len(self.model.frames) - 1}")
