@@ -82,3 +82,12 @@ class SolverNotAvailableError(AnthroarmError, ValueError):
 
 class EulerSingularityError(AnthroarmError, ValueError):
     """Euler angles at a singular posture (gimbal lock), e.g. sin ψ = 0 for X–Y–X angles."""
+
+
+class AmbiguousToolError(UnknownFrameError):
+    """A robot with several tips was loaded without ``tool=``; the message lists the tip frames."""
+
+
+class ParameterError(AnthroarmError, TypeError, ValueError):
+    """A keyword a loader or builder does not take, or a bad builder parameter.  A
+    :class:`TypeError` (like any unknown keyword) and, for old callers, a :class:`ValueError`."""

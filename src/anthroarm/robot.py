@@ -1,26 +1,35 @@
-"""Robot: one URDF, its Pinocchio model/data, tool frame and joint limits.
+"""Robot: a Pinocchio model, its kinematic description ``chain``, tool frame and limits.
 
 >>> import anthroarm as aa
 >>> robot = aa.load("prosthetic_arm")
 >>> T = robot.fk(robot.neutral())            # 4x4 world pose of the tool (palm centre)
 >>> J = robot.jacobian(robot.neutral())      # 6 x nv, LOCAL_WORLD_ALIGNED, rows (v; w)
+>>> T_batch = robot.fk(robot.random_q(1000, rng=0))   # (1000, 4, 4) through the batched chain
 
-The URDF text is validated by :func:`anthroarm.urdf_io.read_urdf` and then given to Pinocchio
-(``buildModelFromXML``) and, lazily, to yourdfpy, so both read exactly the same text.  Joints
-that a catalog entry does not use (the panda's fingers, the rest of the human body) are locked
-with ``pin.buildReducedModel``; ``robot.locked`` records their values.
+:func:`load` takes a catalog name, any example-robot-data robot by name, a URDF path, a
+``pin.Model`` or a ``pin.RobotWrapper``.  URDF text is validated by
+:func:`anthroarm.urdf_io.read_urdf` and then given to Pinocchio (``buildModelFromXML``) and,
+lazily, to yourdfpy, so both read exactly the same text.  Joints a user does not want (a
+gripper, the rest of a humanoid) are locked with ``pin.buildReducedModel`` (``locked=`` /
+``active=``); ``robot.locked`` records their values.
+
+Thread safety: a Robot may be used from several threads at once.  ``robot.data`` is a
+``pin.Data`` of the calling thread (one per thread, made on first use), ``robot.chain`` is
+immutable, and the batched path keeps no state between calls.
 """
 
 from __future__ import annotations
 
 import io
+import threading
 from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
-from .errors import UnknownFrameError, UnsupportedModelError, URDFStructureError
+from .chain import CONTINUOUS, Chain
+from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
 from .urdf_io import URDFInfo, parse_urdf_bytes, read_urdf
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -36,64 +45,125 @@ def _reference_frame(reference) -> pin.ReferenceFrame:
     return getattr(pin.ReferenceFrame, reference)
 
 
+def build_model(info: URDFInfo):
+    """``pin.Model`` of a validated URDF (mimic joints modelled, as yourdfpy does).  Pinocchio's
+    C++ errors become :class:`~anthroarm.errors.URDFStructureError` naming the file."""
+    has_mimic = any(j["mimic"] is not None for j in info.joints.values())
+    try:
+        return pin.buildModelFromXML(info.text, mimic=has_mimic)
+    except Exception as exc:  # pin raises RuntimeError/ValueError from C++
+        raise URDFStructureError(info.path, f"Pinocchio cannot build the model: {exc}") from None
+
+
+def reduce_model(model, name: str, active=None, locked=None):
+    """Lock joints of ``model``: every joint not in ``active`` (when given) and every joint in
+    ``locked`` (a list of names, locked at 0 / the neutral value, or a dict name → value: an
+    angle in rad or a displacement in m; for a joint with several coordinates its q slice).
+
+    Returns ``(reduced model, {name: value})``.  Unknown names raise
+    :class:`~anthroarm.errors.UnknownFrameError` listing the joints."""
+    if active is None and not locked:
+        return model, {}
+    names = [model.names[i] for i in range(1, model.njoints)]
+    if isinstance(locked, str) or (locked is not None and not hasattr(locked, "__iter__")):
+        raise TypeError(f"{name}: locked= is a list of joint names or a dict name -> value, got {locked!r}")
+    locked = dict(locked) if isinstance(locked, dict) else {n: None for n in (locked or ())}
+    if isinstance(active, str):
+        raise TypeError(f"{name}: active= is a list of joint names, got the string {active!r}")
+    active = list(active) if active is not None else None
+    for what, given in (("active", active or ()), ("locked", locked)):
+        missing = [a for a in given if a not in names]
+        if missing:
+            raise UnknownFrameError(f"{name}: {what} joints {missing} are not in the model; joints: {', '.join(names)}")
+    qref = pin.neutral(model)
+    lock_ids, values = [], {}
+    mimic_source = {int(m): int(s) for m, s in zip(getattr(model, "mimicking_joints", ()),
+                                                    getattr(model, "mimicked_joints", ()))}
+    for jid in range(1, model.njoints):
+        jname = model.names[jid]
+        if jname in locked or (active is not None and jname not in active):
+            jm = model.joints[jid]
+            v = locked.get(jname)
+            if jid in mimic_source:   # follows its source: locked with it (checked below)
+                lock_ids.append(jid)
+                continue
+            if v is not None:
+                v = np.atleast_1d(np.asarray(v, dtype=float))
+                if jm.nq == 2 and jm.nv == 1 and v.size == 1:      # a continuous joint: an angle
+                    v = np.array([np.cos(v[0]), np.sin(v[0])])
+                if v.size != jm.nq or not np.all(np.isfinite(v)):
+                    raise ValueError(f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}")
+                qref[jm.idx_q:jm.idx_q + jm.nq] = v
+            val = qref[jm.idx_q:jm.idx_q + jm.nq].copy()
+            values[jname] = float(val[0]) if val.size == 1 else val
+            lock_ids.append(jid)
+    for m, src in mimic_source.items():
+        if (m in lock_ids) != (src in lock_ids):
+            raise UnsupportedModelError(
+                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both or neither")
+        if m in lock_ids:
+            e = model.joints[m].extract()
+            values[model.names[m]] = float(e.scaling * np.atleast_1d(values[model.names[src]])[0] + e.offset)
+    if not lock_ids:
+        return model, {}
+    framed = {int(f.parentJoint) for f in model.frames if f.type == pin.FrameType.JOINT}
+    missing = [model.names[j] for j in range(1, model.njoints) if j not in framed]
+    if missing:   # buildReducedModel dereferences each joint's frame: it would crash the process
+        raise UnsupportedModelError(f"{name}: joints {missing} have no joint frame (model.addJointFrame); "
+                                    "Pinocchio cannot lock joints of such a model")
+    try:
+        return pin.buildReducedModel(model, lock_ids, qref), values
+    except Exception as exc:
+        raise UnsupportedModelError(f"{name}: Pinocchio cannot lock joints {list(values)}: {exc}") from None
+
+
 class Robot:
-    """A fixed-base kinematic tree loaded from one URDF.
+    """A fixed-base kinematic tree: a Pinocchio model and its kinematic description.
+
+    Use :func:`load`; the constructor takes an already built (and reduced) model.
 
     Parameters
     ----------
-    info : URDFInfo
-        Validated URDF (see :func:`anthroarm.urdf_io.read_urdf`).
+    model : pin.Model
+        Fixed-base model with revolute, continuous, prismatic and mimic joints only.
     name : str
-        Catalog name or file stem.
+        Catalog name, example-robot-data name or file stem.
     tool : str, optional
-        Frame used when ``frame=None``; default: the last frame of the model.
-    active : sequence of str, optional
-        Joints kept as degrees of freedom; every other joint is locked at ``locked_values``
-        (default 0).  ``None`` keeps all joints.
+        Frame used when ``frame=None``.  Default: the only tip of a serial chain; a tree with
+        several tips raises :class:`~anthroarm.errors.AmbiguousToolError` listing them.
+    info : URDFInfo, optional
+        The validated URDF the model was built from (yourdfpy and the viewer read it).
     spec : ChainSpec, optional
-        The parameter table a book model was generated from (closed forms use it).
+        The parameter table a book model was generated from.
+    locked : dict, optional
+        Joints locked out of the model and their values (record only).
+    visual_model, collision_model : pin.GeometryModel, optional
+        Geometry of a model given as a ``pin.Model`` / ``RobotWrapper``.
     """
 
-    def __init__(self, info: URDFInfo, name: str | None = None, tool: str | None = None,
-                 active=None, locked_values=None, spec=None, description: str = ""):
+    def __init__(self, model, *, name: str | None = None, tool: str | None = None, info: URDFInfo | None = None,
+                 spec=None, description: str = "", locked: dict | None = None, visual_model=None,
+                 collision_model=None):
         self.info = info
-        self.name = name or info.robot_name
+        self.name = name or (info.robot_name if info is not None else "") or model.name or "robot"
         self.spec = spec
         self.description = description
-        # Mimic joints: Pinocchio models them (mimic=True) as yourdfpy does, as joints driven by
-        # the joint they mimic, so both libraries describe the same mechanism.
-        self.has_mimic = any(j["mimic"] is not None for j in info.joints.values())
-        try:
-            full = pin.buildModelFromXML(info.text, mimic=self.has_mimic)
-        except Exception as exc:  # pin raises RuntimeError/ValueError from C++
-            raise URDFStructureError(info.path, f"Pinocchio cannot build the model: {exc}") from None
-        for j in full.joints[1:]:
-            if j.shortname() in ("JointModelFreeFlyer", "JointModelSpherical", "JointModelPlanar"):
-                raise UnsupportedModelError(f"{self.name}: joint type {j.shortname()} is not supported (fixed-base serial arms only)")
-        self.locked: dict[str, float] = {}
-        if active is not None:
-            missing = [a for a in active if not full.existJointName(a)]
-            if missing:
-                raise URDFStructureError(info.path, f"active joints {missing} are not in the model")
-            locked_values = dict(locked_values or {})
-            lock_ids = []
-            qref = pin.neutral(full)
-            for jid in range(1, full.njoints):
-                jname = full.names[jid]
-                if jname not in active:
-                    lock_ids.append(jid)
-                    v = float(locked_values.get(jname, 0.0))
-                    jm = full.joints[jid]
-                    if jm.nq == 1:
-                        qref[jm.idx_q] = v
-                    self.locked[jname] = v
-            model = pin.buildReducedModel(full, lock_ids, qref) if lock_ids else full
-        else:
-            model = full
+        self.locked: dict = dict(locked or {})
         self.model: pin.Model = model
-        self.data: pin.Data = model.createData()
-        self.tool = tool or model.frames[len(model.frames) - 1].name
-        self.tool_id = self.frame_id(self.tool)
+        self.visual_model = visual_model
+        self.collision_model = collision_model
+        self.chain: Chain = Chain.from_model(model, tool=tool, name=self.name)
+        self.tool = self.chain.tool
+        self.tool_id = self.chain.tool_frame
+        self._local = threading.local()
+
+    @property
+    def data(self) -> pin.Data:
+        """``pin.Data`` of the calling thread (one per thread, created on first use)."""
+        d = getattr(self._local, "data", None)
+        if d is None:
+            d = self._local.data = self.model.createData()
+        return d
 
     # ------------------------------------------------------------------ identity
     def __repr__(self) -> str:
@@ -107,86 +177,79 @@ class Robot:
     def nv(self) -> int:
         return self.model.nv
 
+    @property
+    def tips(self) -> tuple[str, ...]:
+        """One frame per leaf of the kinematic tree (see :func:`anthroarm.chain.leaf_frames`)."""
+        return self.chain.tips
+
+    @property
+    def has_mimic(self) -> bool:
+        return self.chain.has_mimic
+
     @cached_property
     def joint_names(self) -> list[str]:
         """Names of the joints that carry configuration variables, in q order (mimic joints,
-        which have none, are left out)."""
-        return [self.model.names[i] for i in range(1, self.model.njoints) if self.model.joints[i].nq > 0]
+        which have none, are left out; a continuous joint is named once for its two entries)."""
+        return [self.chain.joints[i].name for i in self.chain.independent]
 
-    @cached_property
+    @property
     def lower(self) -> np.ndarray:
-        """Lower joint limits in q order (rad for revolute, m for prismatic joints); read-only."""
-        lo = np.array(self.model.lowerPositionLimit, dtype=float)
-        lo.setflags(write=False)
-        return lo
+        """Lower joint limits in q order (rad for revolute, m for prismatic joints; −1 for a
+        continuous joint's (cos, sin) entries); read-only."""
+        return self.chain.lower
 
-    @cached_property
+    @property
     def upper(self) -> np.ndarray:
-        """Upper joint limits in q order (rad / m); read-only."""
-        hi = np.array(self.model.upperPositionLimit, dtype=float)
-        hi.setflags(write=False)
-        return hi
+        """Upper joint limits in q order (rad / m; +1 for (cos, sin) entries); read-only."""
+        return self.chain.upper
 
-    @cached_property
+    @property
     def velocity_limit(self) -> np.ndarray:
-        """Joint velocity limits from the URDF (rad/s or m/s)."""
-        return np.array(self.model.velocityLimit, dtype=float)
+        """Joint velocity limits (nv,) from the model (rad/s or m/s); read-only."""
+        return self.chain.velocity_limit
 
     @cached_property
     def frame_names(self) -> list[str]:
-        return [f.name for f in self.model.frames]
+        return [f.name for f in self.chain.frames]
 
     def frame_id(self, frame: str | None) -> int:
         """Index of a frame; ``None`` means the tool.  Unknown names raise
         :class:`UnknownFrameError` listing the valid ones."""
         if frame is None:
             return self.tool_id
-        if isinstance(frame, (int, np.integer)) and not isinstance(frame, bool):
-            if not 0 <= frame < len(self.model.frames):
-                raise UnknownFrameError(f"{self.name}: frame index {frame} out of range 0..{len(self.model.frames) - 1}")
-            return int(frame)
-        if not isinstance(frame, str):
-            raise UnknownFrameError(f"{self.name}: a frame is a name or an index, got {frame!r}; "
-                                    f"valid frames: {', '.join(self.frame_names)}")
-        if not self.model.existFrame(frame):
-            raise UnknownFrameError(
-                f"{self.name}: unknown frame {frame!r}; valid frames: {', '.join(self.frame_names)}"
-            )
-        return self.model.getFrameId(frame)
+        return self.chain.frame(frame).index
 
     @property
     def length_scale(self) -> float:
-        """Sum of the lengths of every joint placement offset and of the tool offset (m), at
-        least 1 mm: a bound on the reach (for a serial chain), used as the scale of relative
-        position tolerances."""
-        total = 0.0
-        for jid in range(1, self.model.njoints):
-            total += float(np.linalg.norm(self.model.jointPlacements[jid].translation))
-        total += float(np.linalg.norm(self.model.frames[self.tool_id].placement.translation))
-        return max(total, 1e-3)
+        """A bound on the reach of the tool (m, :meth:`anthroarm.chain.Chain.reach`), at least
+        1 mm: the scale of relative position tolerances."""
+        return max(self.chain.reach(), 1e-3)
 
     # ------------------------------------------------------------------ configurations
     def neutral(self) -> np.ndarray:
-        """Neutral configuration, clipped into the joint limits."""
+        """Neutral configuration (θ = 0 for every joint), clipped into the joint limits."""
         q = pin.neutral(self.model)
         return np.clip(q, self.lower, self.upper)
 
     def check_q(self, q, name: str = "q") -> np.ndarray:
         """Validate a configuration or a batch ``(N, nq)``; returns a float array.
 
-        Raises ``ValueError`` for a wrong shape or a NaN/inf value (naming the joint)."""
+        Raises ``ValueError`` for a wrong shape, a NaN/inf value (naming the joint) or a
+        continuous joint whose (cos, sin) pair is not a unit vector."""
         arr = np.asarray(q, dtype=float)
         if arr.ndim not in (1, 2) or arr.shape[-1] != self.nq:
             raise ValueError(
                 f"{self.name}: {name} must have shape ({self.nq},) or (N, {self.nq}) "
-                f"for joints {self.joint_names}, got shape {arr.shape}"
+                f"for q entries {list(self.chain.q_names)}, got shape {arr.shape}"
             )
         bad = ~np.isfinite(arr)
         if bad.any():
             idx = np.argwhere(bad)[0]
             j = int(idx[-1])
             where = f" (row {int(idx[0])})" if arr.ndim == 2 else ""
-            raise ValueError(f"{self.name}: {name}[{j}] for joint {self.joint_names[min(j, len(self.joint_names) - 1)]!r} is {arr[tuple(idx)]}{where}")
+            raise ValueError(f"{self.name}: {name}[{j}] for joint {self.chain.q_names[j]!r} is {arr[tuple(idx)]}{where}")
+        if self.chain.has_continuous:
+            self.chain.check_unit(arr, name)
         return arr
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
@@ -198,49 +261,56 @@ class Robot:
 
     def random_q(self, n: int | None = None, rng=None, margin: float = 0.0) -> np.ndarray:
         """Uniform random configurations inside the limits (``margin`` rad/m away from them).
-        Unbounded joints are drawn in [-π, π]."""
-        rng = np.random.default_rng(rng)
-        lo = np.where(np.isfinite(self.lower), self.lower, -np.pi) + margin
-        hi = np.where(np.isfinite(self.upper), self.upper, np.pi) - margin
-        shape = (self.nq,) if n is None else (n, self.nq)
-        return lo + (hi - lo) * rng.random(shape)
+        Unbounded joints are drawn in [-π, π] (a continuous joint: the angle, then its
+        (cos, sin))."""
+        return self.chain.random_q(n, rng, margin)
+
+    def angles(self, q) -> np.ndarray:
+        """Joint positions θ of every joint (rad or m), mimic joints included: see
+        :meth:`anthroarm.chain.Chain.angles`."""
+        return self.chain.angles(self.check_q(q))
 
     # ------------------------------------------------------------------ kinematics
     def fk(self, q, frame=None) -> np.ndarray:
         """World pose (4×4, SE(3) homogeneous) of ``frame`` (default: the tool) at ``q``.
 
-        Accepts ``(nq,)`` -> ``(4, 4)`` or a batch ``(N, nq)`` -> ``(N, 4, 4)``."""
+        ``(nq,)`` -> ``(4, 4)`` through Pinocchio; a batch ``(N, nq)`` -> ``(N, 4, 4)`` through
+        the batched chain (:meth:`anthroarm.chain.Chain.serial`, equal to Pinocchio to 1e-15)."""
         q = self.check_q(q)
         fid = self.frame_id(frame)
         if q.ndim == 1:
-            pin.framesForwardKinematics(self.model, self.data, q)
-            return self.data.oMf[fid].homogeneous.copy()
-        out = np.empty((q.shape[0], 4, 4))
-        for i, qi in enumerate(q):
-            pin.framesForwardKinematics(self.model, self.data, qi)
-            out[i] = self.data.oMf[fid].homogeneous
-        return out
+            data = self.data
+            pin.framesForwardKinematics(self.model, data, q)
+            return data.oMf[fid].homogeneous.copy()
+        return self.chain.serial(fid).fk(q)
 
     def jacobian(self, q, frame=None, reference: str = "LOCAL_WORLD_ALIGNED") -> np.ndarray:
         """Frame Jacobian, 6 × nv, rows (v; ω).  Default reference LOCAL_WORLD_ALIGNED: the
         velocity of the frame origin and the angular velocity, both in world axes.
-        ``reference`` may be "LOCAL", "WORLD" or "LOCAL_WORLD_ALIGNED".  Batches give (N, 6, nv)."""
+        ``reference`` may be "LOCAL", "WORLD" or "LOCAL_WORLD_ALIGNED".  Batches ``(N, nq)``
+        give ``(N, 6, nv)``; LOCAL_WORLD_ALIGNED batches go through the batched chain."""
         q = self.check_q(q)
         fid = self.frame_id(frame)
         ref = _reference_frame(reference)
         if q.ndim == 1:
             return pin.computeFrameJacobian(self.model, self.data, q, fid, ref).copy()
+        if ref == LWA:
+            return self.chain.serial(fid).jacobian(q)
+        data = self.data
         out = np.empty((q.shape[0], 6, self.nv))
         for i, qi in enumerate(q):
-            out[i] = pin.computeFrameJacobian(self.model, self.data, qi, fid, ref)
+            out[i] = pin.computeFrameJacobian(self.model, data, qi, fid, ref)
         return out
 
     # ------------------------------------------------------------------ yourdfpy
     @cached_property
     def urdf(self):
-        """The same URDF loaded with yourdfpy (lazy; meshes are not loaded)."""
+        """The same URDF loaded with yourdfpy (lazy; meshes are not loaded).  Robots loaded
+        from a ``pin.Model`` have no URDF: :class:`UnsupportedModelError`."""
         import yourdfpy
 
+        if self.info is None:
+            raise UnsupportedModelError(f"{self.name} was loaded from a pin.Model: it has no URDF for yourdfpy")
         return yourdfpy.URDF.load(
             io.StringIO(self.info.text) if not self.info.path.is_file() else str(self.info.path),
             build_scene_graph=True, load_meshes=False, build_collision_scene_graph=False,
@@ -255,28 +325,80 @@ class Robot:
     def yourdfpy_cfg(self, q) -> dict:
         """Map a configuration to yourdfpy's actuated-joint configuration by joint name.
 
-        Locked joints get their locked value; mimic joints are not actuated in yourdfpy, which
-        computes them from the joint they mimic, as Pinocchio does (the model is built with
-        ``mimic=True`` when the URDF has mimic joints)."""
+        Locked joints get their locked value; a continuous joint its angle; mimic joints are
+        not actuated in yourdfpy, which computes them from the joint they mimic, as Pinocchio
+        does (the model is built with ``mimic=True`` when the URDF has mimic joints)."""
         q = self.check_q(q)
+        theta = self.chain.angles(q)
         u = self.urdf
-        values = dict(self.locked)
-        for name, v in zip(self.joint_names, q):
-            values[name] = float(v)
+        values = {}
+        for name, v in self.locked.items():
+            v = np.atleast_1d(v)
+            values[name] = float(np.arctan2(v[1], v[0])) if v.size == 2 else float(v[0])
+        for j in self.chain.joints:
+            if not j.is_mimic:
+                values[j.name] = float(theta[j.index])
         return {jn: values.get(jn, 0.0) for jn in u.actuated_joint_names}
 
 
-def load(name_or_path, *, tool: str | None = None, package_dirs: dict | None = None,
-         check_meshes: bool = True, **params) -> Robot:
-    """Load a catalog model by name (with optional builder ``params``, e.g. ``height=1.62``)
-    or a URDF file by path.
+def _as_model_source(obj):
+    """(model, visual, collision) of a pin.Model / RobotWrapper / (model, collision, visual)
+    tuple as ``pin.buildModelsFromUrdf`` returns it, or None."""
+    if isinstance(obj, pin.Model):
+        return obj, None, None
+    if hasattr(obj, "model") and isinstance(getattr(obj, "model"), pin.Model):   # RobotWrapper
+        return obj.model, getattr(obj, "visual_model", None), getattr(obj, "collision_model", None)
+    return None
+
+
+def load(source, *, tool: str | None = None, active=None, locked=None, package_dirs=None,
+         check_meshes: bool = True, name: str | None = None, visual_model=None, collision_model=None,
+         **params) -> Robot:
+    """Load a robot.
+
+    ``source`` is one of
+
+    * a catalog name (:func:`anthroarm.models.names`); a book model takes its builder's
+      parameters as keywords (``height=1.62, sex="female"`` ...);
+    * any example-robot-data robot by name (``"ur10"``, ``"xarm7"``, ``"kinova"``, ``"baxter"``;
+      :func:`anthroarm.models.erd_names`), read offline from the installed package;
+    * a URDF path;
+    * a ``pin.Model`` (with ``visual_model=`` / ``collision_model=`` if you have them) or a
+      ``pin.RobotWrapper``.
+
+    Keywords: ``tool=`` the default frame (a tree with several tips needs it: the error lists
+    ``robot.tips``); ``active=`` joints to keep (all others locked); ``locked=`` joints to
+    freeze (a list of names, or a dict name → value in rad / m); ``package_dirs=`` where
+    ``package://`` URIs are found, a list of folders (Pinocchio's convention) or a dict
+    package name → root; ``name=`` the robot's name.  Any other keyword raises
+    :class:`TypeError` unless a book model's builder takes it.
 
     Raises :class:`~anthroarm.errors.UnknownModelError` (listing the catalog) for an unknown
-    name, and the typed URDF errors of :func:`~anthroarm.urdf_io.read_urdf` for a bad file.
+    name, the typed URDF errors of :func:`~anthroarm.urdf_io.read_urdf` for a bad file and
+    :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
+    (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
     from . import models
 
-    s = str(name_or_path)
+    def no_params(what):
+        if params:
+            raise ParameterError(f"{what} takes no parameters; unknown keyword(s): {', '.join(sorted(params))}")
+
+    common = dict(tool=tool, active=active, locked=locked)
+    src = _as_model_source(source)
+    if src is not None:
+        no_params("a pin.Model")
+        if package_dirs is not None:
+            raise ParameterError("package_dirs= applies to URDF files, not to a pin.Model")
+        model, vis, col = src
+        return _make(model, name=name or model.name or "robot", info=None, visual_model=visual_model or vis,
+                     collision_model=collision_model or col, **common)
+    if visual_model is not None or collision_model is not None:
+        raise ParameterError("visual_model= / collision_model= go with a pin.Model source")
+    if not isinstance(source, (str, Path)):
+        raise TypeError(f"load() takes a catalog or example-robot-data name, a URDF path, a pin.Model or a "
+                        f"RobotWrapper, got {type(source).__name__}")
+    s = str(source)
     if s in models.BOOK_MODELS:
         spec = models.spec(s, **params)
         text = models.to_urdf(spec)
@@ -285,16 +407,28 @@ def load(name_or_path, *, tool: str | None = None, package_dirs: dict | None = N
         if params or not path.is_file() or path.read_text(encoding="utf-8") != text:
             # not the committed default file: keep the text only (yourdfpy reads from memory)
             info.path = Path(f"<generated>/{s}.urdf")
-        return Robot(info, name=s, tool=tool or spec.tool_name, spec=spec, description=spec.description)
+        return _make(build_model(info), name=name or s, info=info, spec=spec, description=spec.description,
+                     tool=tool or spec.tool_name, active=active, locked=locked)
     if s in models.ERD_ARMS:
-        if params:
-            raise ValueError(f"{s}: example-robot-data arms take no parameters, got {params}")
+        no_params(f"{s} (example-robot-data)")
         arm = models.ERD_ARMS[s]
         info = read_urdf(arm.urdf_path(), package_dirs=package_dirs, check_meshes=check_meshes)
-        return Robot(info, name=s, tool=tool or arm.tool, active=arm.active, locked_values=arm.locked_values,
-                     description=arm.description)
+        if active is None and locked is None:
+            active, locked = arm.active, arm.locked_values
+        return _make(build_model(info), name=name or s, info=info, tool=tool or arm.tool, active=active,
+                     locked=locked, description=arm.description)
+    if s in models.erd_names():
+        no_params(f"{s} (example-robot-data)")
+        info = read_urdf(models.erd_urdf_path(s), package_dirs=package_dirs, check_meshes=check_meshes)
+        return _make(build_model(info), name=name or s, info=info, description=f"{s} (example-robot-data)", **common)
     looks_like_path = s.endswith(".urdf") or "/" in s or Path(s).exists()
     if not looks_like_path:
         raise models._unknown(s)
+    no_params(f"the URDF file {s}")
     info = read_urdf(s, package_dirs=package_dirs, check_meshes=check_meshes)
-    return Robot(info, name=Path(s).stem, tool=tool)
+    return _make(build_model(info), name=name or Path(s).stem, info=info, **common)
+
+
+def _make(model, *, name, active=None, locked=None, **kw) -> Robot:
+    model, values = reduce_model(model, name, active, locked)
+    return Robot(model, name=name, locked=values, **kw)

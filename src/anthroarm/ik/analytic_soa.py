@@ -2,7 +2,7 @@
 
 The same formulas, branches and branch order as the general path in
 :mod:`anthroarm.ik.closed_form` (its docstring lists the equations of each arm), laid out like
-:mod:`anthroarm.kinematics.chain`: every pose entry is one contiguous length-N vector, and the
+:mod:`anthroarm.kinematics.batched`: every pose entry is one contiguous length-N vector, and the
 branches are leading axes of size 2 (e.g. the 6R arm's θ1 has shape (2, 1, 1, N), (θ2, θ3)
 (2, 2, 1, N), θ4–θ6 (2, 2, 2, N)), so all branches of all poses are computed at once and
 shared quantities are computed once per distinct branch prefix.  cos/sin of a branch pair come

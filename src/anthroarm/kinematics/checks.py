@@ -6,7 +6,7 @@ For every model, on random configurations inside the joint limits:
   ``pin.framesForwardKinematics``;
 * their Jacobians ((6-24)–(6-29) in vector form) against ``pin.computeFrameJacobian``
   (LOCAL_WORLD_ALIGNED);
-* the generic batched chain (:class:`~anthroarm.kinematics.chain.SerialChain`) for every model;
+* the generic batched chain (:class:`~anthroarm.kinematics.batched.SerialChain`) for every model;
 * yourdfpy's FK of every link against Pinocchio's, joints mapped by name.
 
 Positions and the linear Jacobian rows are divided by the model's length scale (errors are
@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from ..crosscheck import CheckRow
 from . import closed_forms as cf
-from .chain import SerialChain
+from .batched import SerialChain
 from .dh import dh_fk, dh_jacobian
 
 TOL = 1e-12

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import UnknownModelError
+from ..errors import ParameterError, UnknownModelError
 from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
-from .erd import ERD_ARMS, ErdArm
+from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
 
@@ -44,7 +44,9 @@ def book_names() -> list[str]:
 
 
 def _unknown(name) -> UnknownModelError:
-    return UnknownModelError(f"unknown model {name!r}; the catalog has: {', '.join(names())}")
+    return UnknownModelError(f"unknown model {name!r}; the catalog has: {', '.join(names())}; "
+                             f"example-robot-data has: {', '.join(n for n in erd_names() if n not in ERD_ARMS)}; "
+                             "or give a URDF path")
 
 
 def spec(name: str, **params) -> ChainSpec:
@@ -57,7 +59,7 @@ def spec(name: str, **params) -> ChainSpec:
         import inspect
 
         sig = inspect.signature(BOOK_MODELS[name])
-        raise ValueError(f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})") from None
+        raise ParameterError(f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})") from None
 
 
 def urdf_text(name: str, **params) -> str:
@@ -71,6 +73,8 @@ def urdf_path(name: str) -> Path:
     anywhere with :func:`urdf_text` / ``anthroarm urdf``)."""
     if name in ERD_ARMS:
         return ERD_ARMS[name].urdf_path()
+    if name in erd_names():
+        return erd_urdf_path(name)
     if name not in BOOK_MODELS:
         raise _unknown(name)
     p = REPO_URDF_DIR / f"{name}.urdf"
@@ -96,6 +100,6 @@ def write_urdfs(out_dir=None) -> list[Path]:
 __all__ = [
     "BOOK_MODELS", "ERD_ARMS", "ErdArm", "ChainSpec", "DHRow", "JointSpec", "LinkSpec",
     "dh_matrix", "from_dh", "to_urdf", "names", "book_names", "spec", "urdf_text", "urdf_path",
-    "write_urdfs", "human_arm7", "prosthetic_arm", "sixr_arm", "unimate5", "rrprr5", "planar2r",
+    "write_urdfs", "erd_names", "erd_urdf_path", "human_arm7", "prosthetic_arm", "sixr_arm", "unimate5", "rrprr5", "planar2r",
     "segment_parameters",
 ]

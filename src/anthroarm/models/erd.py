@@ -1,13 +1,16 @@
-"""Arms from example-robot-data (the ``example-robot-data-loaders`` wheel ships the files).
+"""Robots from example-robot-data (the ``example-robot-data-loaders`` wheel ships the files).
 
-Each entry names the URDF inside the package, the joints kept active (all others are locked
-at the stated value with ``pin.buildReducedModel``) and the tool frame.  The URDF file itself
-is used unchanged, so Pinocchio and yourdfpy read the same text.
+:data:`ERD_ARMS` are the catalog's curated arms: each names the URDF inside the package, the
+joints kept active (all others are locked at the stated value with ``pin.buildReducedModel``)
+and the tool frame.  Every other robot the package ships loads by its name too
+(:func:`erd_names`, :func:`erd_urdf_path`), read offline from the same files.  The URDF file
+itself is used unchanged, so Pinocchio and yourdfpy read the same text.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 
@@ -64,3 +67,28 @@ ERD_ARMS: dict[str, ErdArm] = {
         ),
     ]
 }
+
+
+@lru_cache(maxsize=1)
+def _erd_loaders() -> dict:
+    """name -> loader class of every example-robot-data robot described by a URDF."""
+    from example_robot_data.robots_loader import ROBOTS
+
+    return {n: L for n, L in ROBOTS.items() if getattr(L, "urdf_filename", "")}
+
+
+def erd_names() -> list[str]:
+    """Every example-robot-data robot that has a URDF (sorted)."""
+    return sorted(_erd_loaders())
+
+
+def erd_urdf_path(name: str) -> Path:
+    """Path of the URDF of an example-robot-data robot (the file its loader reads); the
+    robot's own floating base, if its loader adds one, is not part of the URDF."""
+    from os.path import join
+
+    from example_robot_data import getModelPath
+
+    L = _erd_loaders()[name]
+    rel = join(L.path, L.urdf_subpath, L.urdf_filename)
+    return Path(getModelPath(rel)) / rel

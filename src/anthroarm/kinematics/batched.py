@@ -6,8 +6,9 @@ the product of exponentials
 
     T_0,tool(q) = M_1 exp(a_1 q_1) M_2 exp(a_2 q_2) … M_n exp(a_n q_n) M_tool
 
-for a whole batch of configurations at once.  Build it from a Pinocchio model
-(:meth:`SerialChain.of`, used for robots without a book formula: panda, ur5, …) or straight
+for a whole batch of configurations at once.  Build it from a robot's
+kinematic description (:meth:`SerialChain.from_chain`, i.e. ``robot.chain.serial(frame)``: any
+robot, continuous and mimic joints included) or straight
 from the book's H-D table (:meth:`SerialChain.from_dh`: joint j sits at the static part
 S_{j−1} of row j−1 of Eq. (6-12), axis z — the chain product (6-14) itself).
 
@@ -20,27 +21,8 @@ Jacobian is the geometric one, LOCAL_WORLD_ALIGNED, rows (v; ω).
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
-
-from ..errors import UnsupportedModelError
 
 _EPS = 1e-15
-
-
-def _axis_and_kind(jm) -> tuple[str, np.ndarray]:
-    name = jm.shortname()
-    table = {
-        "JointModelRX": ("R", (1, 0, 0)), "JointModelRY": ("R", (0, 1, 0)), "JointModelRZ": ("R", (0, 0, 1)),
-        "JointModelPX": ("P", (1, 0, 0)), "JointModelPY": ("P", (0, 1, 0)), "JointModelPZ": ("P", (0, 0, 1)),
-    }
-    if name in table:
-        k, a = table[name]
-        return k, np.array(a, float)
-    if name == "JointModelRevoluteUnaligned":
-        return "R", np.array(jm.extract().axis, float)
-    if name == "JointModelPrismaticUnaligned":
-        return "P", np.array(jm.extract().axis, float)
-    raise UnsupportedModelError(f"joint type {name} is not a 1-DOF revolute/prismatic joint")
 
 
 def _clean(M: np.ndarray) -> np.ndarray:
@@ -104,14 +86,26 @@ def _rotate_general(R, a, c, s):
     return [[R[i][0] * E[0][j] + R[i][1] * E[1][j] + R[i][2] * E[2][j] for j in range(3)] for i in range(3)]
 
 
-def _full(x, N):
-    return np.full(N, x) if isinstance(x, float) else x
+def _position(qT, coord):
+    """θ of one joint for the whole batch from q transposed (see :class:`SerialChain`)."""
+    if coord[0] == "q":
+        return qT[coord[1]]
+    _, i, a, b, continuous = coord
+    src = np.arctan2(qT[i + 1], qT[i]) if continuous else qT[i]
+    return a * src + b if (a, b) != (1.0, 0.0) else src
 
 
 class SerialChain:
-    """A serial chain: constant joint placements (R0, p0), joint axes and kinds, tool placement."""
+    """A serial chain: constant joint placements (R0, p0), joint axes and kinds, tool placement.
 
-    def __init__(self, R0s, p0s, axes, kinds, tool_R, tool_p, q_index=None, v_index=None, nq=None, nv=None):
+    ``coords[j]`` says where joint j's position θ_j comes from: ``("q", i)`` θ = q[i];
+    ``("cs", i)`` a continuous joint, (cos θ, sin θ) = (q[i], q[i+1]); ``("mimic", i, a, b,
+    continuous)`` θ = a·θ_src + b with the source at q[i] (its (cos, sin) pair if
+    ``continuous``).  ``v_index[j]`` is the column of J that joint j's rate adds to, with the
+    factor ``v_scale[j]`` (the mimic multiplier, else 1)."""
+
+    def __init__(self, R0s, p0s, axes, kinds, tool_R, tool_p, q_index=None, v_index=None, nq=None, nv=None,
+                 coords=None, v_scale=None):
         self.R0 = [_clean(R) for R in R0s]
         self.p0 = [np.array(p, float) for p in p0s]
         self.axes = [np.array(a, float) / np.linalg.norm(a) for a in axes]
@@ -121,6 +115,8 @@ class SerialChain:
         n = len(self.kinds)
         self.q_index = list(q_index) if q_index is not None else list(range(n))
         self.v_index = list(v_index) if v_index is not None else list(range(n))
+        self.coords = list(coords) if coords is not None else [("q", i) for i in self.q_index]
+        self.v_scale = [float(x) for x in v_scale] if v_scale is not None else [1.0] * n
         self.nq = nq if nq is not None else n
         self.nv = nv if nv is not None else n
         self._axis_index = []
@@ -130,33 +126,35 @@ class SerialChain:
 
     # ------------------------------------------------------------ constructors
     @classmethod
-    def from_model(cls, model: pin.Model, frame_id: int) -> "SerialChain":
-        f = model.frames[frame_id]
-        chain = []
-        jid = f.parentJoint
-        while jid > 0:
-            chain.append(jid)
-            jid = model.parents[jid]
-        chain.reverse()
-        R0s, p0s, axes, kinds, qi, vi = [], [], [], [], [], []
-        for jid in chain:
-            jm = model.joints[jid]
-            if jm.nq != 1 or jm.nv != 1:
-                raise UnsupportedModelError(f"joint {model.names[jid]} has nq={jm.nq}; only 1-DOF joints are supported")
-            k, a = _axis_and_kind(jm)
-            M = model.jointPlacements[jid]
-            R0s.append(M.rotation)
-            p0s.append(M.translation)
-            axes.append(a)
-            kinds.append(k)
-            qi.append(jm.idx_q)
-            vi.append(jm.idx_v)
-        return cls(R0s, p0s, axes, kinds, f.placement.rotation, f.placement.translation, qi, vi, model.nq, model.nv)
+    def from_chain(cls, chain, frame=None) -> "SerialChain":
+        """The path of a :class:`~anthroarm.chain.Chain` from the base to ``frame`` (default:
+        the tool), continuous and mimic joints included."""
+        from ..chain import CONTINUOUS, PRISMATIC
+
+        f = chain.frame(frame)
+        R0s, p0s, axes, kinds, coords, vi, vs = [], [], [], [], [], [], []
+        for i in chain.path(f.index):
+            j = chain.joints[i]
+            R0s.append(j.rotation)
+            p0s.append(j.translation)
+            axes.append(j.axis)
+            kinds.append("P" if j.kind == PRISMATIC else "R")
+            if j.is_mimic:
+                src = chain.joints[j.mimic.source]
+                coords.append(("mimic", src.idx_q, j.mimic.multiplier, j.mimic.offset, src.kind == CONTINUOUS))
+                vi.append(src.idx_v)
+                vs.append(j.mimic.multiplier)
+            else:
+                coords.append(("cs", j.idx_q) if j.kind == CONTINUOUS else ("q", j.idx_q))
+                vi.append(j.idx_v)
+                vs.append(1.0)
+        return cls(R0s, p0s, axes, kinds, f.rotation, f.translation, [c[1] for c in coords], vi,
+                   chain.nq, chain.nv, coords, vs)
 
     @classmethod
     def of(cls, robot, frame=None) -> "SerialChain":
         """The chain from the base of ``robot`` to ``frame`` (default: the tool)."""
-        return cls.from_model(robot.model, robot.frame_id(frame))
+        return robot.chain.serial(frame)
 
     @classmethod
     def from_dh(cls, rows, tool=None) -> "SerialChain":
@@ -193,16 +191,20 @@ class SerialChain:
         R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         p = [0.0, 0.0, 0.0]
         joints = []
-        for R0, p0, a, kind, iq, ax in zip(self.R0, self.p0, self.axes, self.kinds, self.q_index, self._axis_index):
+        for R0, p0, a, kind, coord, ax in zip(self.R0, self.p0, self.axes, self.kinds, self.coords, self._axis_index):
             dp = _vec_const(R, p0)
             p = [_axpy(p[i], 1.0, dp[i]) for i in range(3)]
             R = _mat_const(R, R0)
-            qj = qT[iq]
             w = _vec_const(R, a)  # joint axis in world
             if keep_joints:
                 joints.append((kind, w, p))
+            if coord[0] == "cs":
+                c, s, qj = qT[coord[1]], qT[coord[1] + 1], None
+            else:
+                qj = _position(qT, coord)
             if kind == "R":
-                c, s = np.cos(qj), np.sin(qj)
+                if qj is not None:
+                    c, s = np.cos(qj), np.sin(qj)
                 R = _rotate_axis(R, ax, c, s) if ax is not None else _rotate_general(R, a, c, s)
             else:
                 p = [_axpy(p[i], 1.0, w[i] * qj) for i in range(3)]
@@ -233,17 +235,18 @@ class SerialChain:
         N = q2.shape[0]
         R, p, joints = self._walk(q2, keep_joints=True)
         J = np.zeros((N, 6, self.nv))
-        for (kind, w, pj), col in zip(joints, self.v_index):
+        for (kind, w, pj), col, k in zip(joints, self.v_index, self.v_scale):
             if kind == "R":
                 d = [p[i] - pj[i] for i in range(3)]
-                J[:, 0, col] = _full(w[1] * d[2] - w[2] * d[1], N)
-                J[:, 1, col] = _full(w[2] * d[0] - w[0] * d[2], N)
-                J[:, 2, col] = _full(w[0] * d[1] - w[1] * d[0], N)
-                for i in range(3):
-                    J[:, 3 + i, col] = w[i]
+                cols = (w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0],
+                        w[0], w[1], w[2])
             else:
-                for i in range(3):
-                    J[:, i, col] = w[i]
+                cols = (w[0], w[1], w[2], 0.0, 0.0, 0.0)
+            for i, x in enumerate(cols):
+                if k == 1.0:
+                    J[:, i, col] += x     # += : a mimic joint adds to its source's column
+                elif not (isinstance(x, float) and x == 0.0):
+                    J[:, i, col] += k * x
         T = self._pose(R, p, N)
         return (T[0], J[0]) if single else (T, J)
 
