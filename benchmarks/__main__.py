@@ -8,7 +8,7 @@ import pkgutil
 import sys
 from pathlib import Path
 
-from .common import RESULTS_DIR, markdown_table, steady_state_allocator, write_result
+from .common import QUICK_DIR, RESULTS_DIR, markdown_table, steady_state_allocator, write_result
 
 
 def available() -> list[str]:
@@ -17,6 +17,8 @@ def available() -> list[str]:
 
 
 def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
+    """Run benchmarks and write their results: full runs to ``results/``, quick runs to
+    ``results/quick/`` (git-ignored; never to ``results/``), or both to ``out_dir``."""
     names = names or available()
     unknown = [n for n in names if n not in available()]
     if unknown:
@@ -27,6 +29,8 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
         print(f"== benchmark {n}: {mod.__doc__.strip().splitlines()[0] if mod.__doc__ else ''}", flush=True)
         steady_state_allocator()
         result = mod.run(quick=quick)
+        if quick:
+            result["quick"] = True
         jp, mp = write_result(n, result, out_dir)
         print(markdown_table(result["columns"], result["rows"]))
         print(f"-> {jp}\n-> {mp}\n", flush=True)
@@ -37,9 +41,9 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description="Run anthroarm's benchmarks.")
     ap.add_argument("names", nargs="*", help=f"benchmarks to run (default: all): {', '.join(available())}")
-    ap.add_argument("--quick", action="store_true", help="fewer samples, for smoke tests")
+    ap.add_argument("--quick", action="store_true", help=f"fewer samples, for smoke tests (written to {QUICK_DIR})")
     ap.add_argument("--list", action="store_true", help="list the benchmarks and exit")
-    ap.add_argument("--out", default=None, help=f"output folder (default {RESULTS_DIR})")
+    ap.add_argument("--out", default=None, help=f"output folder (default {RESULTS_DIR}; with --quick {QUICK_DIR}, never {RESULTS_DIR})")
     a = ap.parse_args(argv)
     if a.list:
         print("\n".join(available()))

@@ -12,6 +12,8 @@ from statistics import median
 from anthroarm.urdf_io import atomic_write_text
 
 RESULTS_DIR = Path(__file__).resolve().parent / "results"
+#: where ``--quick`` runs write (git-ignored): results/ holds committed full runs only
+QUICK_DIR = RESULTS_DIR / "quick"
 
 
 def time_call(fn, *, number: int = 1, repeat: int = 7, min_time: float = 0.0) -> float:
@@ -81,14 +83,24 @@ def markdown_table(columns: list[str], rows: list[list]) -> str:
 
 
 def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[Path, Path]:
-    """Write ``<name>.json`` and ``<name>.md``; ``result`` has title, columns, rows, notes."""
-    out = Path(out_dir) if out_dir else RESULTS_DIR
-    out.mkdir(parents=True, exist_ok=True)
+    """Write ``<name>.json`` and ``<name>.md`` (and the figures, if any); ``result`` has title,
+    columns, rows, notes, optionally ``figures`` {file name: matplotlib figure} and ``quick``.
+
+    A quick run never writes into :data:`RESULTS_DIR` (the committed full runs): it goes to
+    :data:`QUICK_DIR` unless ``out_dir`` names another folder."""
     result = dict(result)
+    quick = bool(result.get("quick"))
+    out = Path(out_dir) if out_dir else (QUICK_DIR if quick else RESULTS_DIR)
+    if quick and out.resolve() == RESULTS_DIR.resolve():
+        raise ValueError(f"a quick run does not write into {RESULTS_DIR} (committed full runs); "
+                         f"default for quick runs: {QUICK_DIR}")
+    out.mkdir(parents=True, exist_ok=True)
+    figures = result.pop("figures", None) or {}
     result.setdefault("environment", environment())
     jp, mp = out / f"{name}.json", out / f"{name}.md"
     atomic_write_text(jp, json.dumps(result, indent=1, default=float))
-    md = [f"# {result.get('title', name)}", ""]
+    title = result.get("title", name) + (" (quick run)" if quick else "")
+    md = [f"# {title}", ""]
     if result.get("notes"):
         md += [result["notes"], ""]
     md.append(markdown_table(result["columns"], result["rows"]))
@@ -96,4 +108,10 @@ def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[
     md += ["", f"Machine: {env['processor']}, {env['cpus']} CPUs, Python {env['python']}, numpy {env['numpy']}, "
            f"pinocchio {env['pinocchio']}; {env['date']}."]
     atomic_write_text(mp, "\n".join(md) + "\n")
+    for fname, fig in figures.items():
+        if fig is not None:
+            import matplotlib.pyplot as plt
+
+            fig.savefig(out / fname, dpi=110)
+            plt.close(fig)
     return jp, mp
