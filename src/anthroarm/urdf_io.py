@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,19 @@ from .errors import (
 MAX_URDF_BYTES = 32 * 1024 * 1024
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+#: A DTD or entity declaration, in any case (searched in place: no upper-cased copy of the file).
+_DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
+
+#: How many names an error message lists before it says "... and N more".
+_MAX_NAMES_IN_MESSAGE = 10
+
+
+def _name_list(names) -> str:
+    names = list(names)
+    shown = ", ".join(repr(n) for n in names[:_MAX_NAMES_IN_MESSAGE])
+    more = len(names) - _MAX_NAMES_IN_MESSAGE
+    return shown + (f", ... and {more} more" if more > 0 else "")
 
 
 @dataclass
@@ -62,6 +76,15 @@ def default_package_dirs() -> dict[str, Path]:
     return dirs
 
 
+def _first_children(el) -> dict:
+    """``{tag: first child with that tag}`` of an element: one pass over its children instead
+    of one ``find`` per tag (which walks them again each time)."""
+    first: dict = {}
+    for child in el:
+        first.setdefault(child.tag, child)
+    return first
+
+
 def _finite_floats(path, text: str | None, what: str, n: int, default: float = 0.0) -> list[float]:
     if text is None:
         return [default] * n
@@ -72,7 +95,7 @@ def _finite_floats(path, text: str | None, what: str, n: int, default: float = 0
         vals = [float(p) for p in parts]
     except ValueError:
         raise URDFStructureError(path, f"{what}: not a number in {text!r}") from None
-    if not all(math.isfinite(v) for v in vals):
+    if not all(map(math.isfinite, vals)):
         raise URDFStructureError(path, f"{what}: non-finite value in {text!r}")
     return vals
 
@@ -142,8 +165,7 @@ def read_urdf(path, package_dirs: dict | None = None, check_meshes: bool = True)
 def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_meshes: bool = True) -> URDFInfo:
     """Validate URDF text already in memory; ``path`` is used for messages and relative URIs."""
     path = Path(path)
-    head = raw.upper()
-    if b"<!DOCTYPE" in head or b"<!ENTITY" in head:
+    if _DTD_OR_ENTITY.search(raw):
         raise URDFSecurityError(path, "DTD/entity declarations are not allowed in a URDF (entity expansion or external entity)")
     parser = etree.XMLParser(
         resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, remove_comments=True
@@ -158,14 +180,16 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
     pkgs = default_package_dirs()
     pkgs.update({k: Path(v) for k, v in (package_dirs or {}).items()})
 
-    links = []
+    links: list[str] = []
+    linkset: set[str] = set()
     for el in root.findall("link"):
         name = el.get("name")
         if not name:
             raise URDFStructureError(path, f"<link> without a name (line {el.sourceline})")
-        if name in links:
+        if name in linkset:
             raise URDFStructureError(path, f"link {name!r} defined twice (line {el.sourceline})")
         links.append(name)
+        linkset.add(name)
         for inertial in el.findall("inertial"):
             m = inertial.find("mass")
             if m is not None:
@@ -182,10 +206,10 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
                     _finite_float(path, inertia.get(k, "0"), f"link {name!r} inertia {k}")
     if not links:
         raise URDFStructureError(path, "no <link> elements")
-    linkset = set(links)
 
     joints: dict[str, dict] = {}
-    parent_of: dict[str, str] = {}
+    parent_of: dict[str, str] = {}  # child link -> parent link
+    joint_of: dict[str, str] = {}  # child link -> the joint whose child it is
     for el in root.findall("joint"):
         name = el.get("name")
         jtype = el.get("type")
@@ -197,7 +221,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
             raise URDFStructureError(
                 path, f"joint {name!r} has unknown type {jtype!r} (line {el.sourceline}); known: {', '.join(JOINT_TYPES)}"
             )
-        pe, ce = el.find("parent"), el.find("child")
+        sub = _first_children(el)
+        pe, ce = sub.get("parent"), sub.get("child")
         if pe is None or ce is None:
             raise URDFStructureError(path, f"joint {name!r} needs <parent> and <child>")
         parent, child = pe.get("link"), ce.get("link")
@@ -206,19 +231,20 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
                 raise URDFStructureError(path, f"joint {name!r}: {role} link {ln!r} is not defined")
         if child in parent_of:
             raise URDFStructureError(
-                path, f"link {child!r} is the child of two joints ({joints_child(joints, child)!r} and {name!r}): a kinematic loop"
+                path, f"link {child!r} is the child of two joints ({joint_of[child]!r} and {name!r}): a kinematic loop"
             )
         parent_of[child] = parent
-        o = el.find("origin")
+        joint_of[child] = name
+        o = sub.get("origin")
         if o is not None:
             _finite_floats(path, o.get("xyz"), f"joint {name!r} origin xyz", 3)
             _finite_floats(path, o.get("rpy"), f"joint {name!r} origin rpy", 3)
-        ax = el.find("axis")
+        ax = sub.get("axis")
         if ax is not None:
             a = _finite_floats(path, ax.get("xyz"), f"joint {name!r} axis", 3, default=0.0)
-            if jtype in ("revolute", "continuous", "prismatic") and math.sqrt(sum(x * x for x in a)) < 1e-12:
+            if jtype in ("revolute", "continuous", "prismatic") and math.hypot(*a) < 1e-12:
                 raise URDFStructureError(path, f"joint {name!r}: zero-length axis")
-        lim = el.find("limit")
+        lim = sub.get("limit")
         if jtype in ("revolute", "prismatic") and lim is None:
             raise URDFStructureError(path, f"joint {name!r} ({jtype}) has no <limit>")
         if lim is not None:
@@ -230,7 +256,7 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
                 v = _finite_float(path, lim.get(k), f"joint {name!r} {k} limit")
                 if v is not None and v < 0:
                     raise URDFStructureError(path, f"joint {name!r}: negative {k} limit {v}")
-        mim = el.find("mimic")
+        mim = sub.get("mimic")
         mimic = None
         if mim is not None:
             mimic = {
@@ -243,21 +269,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
         if j["mimic"] is not None and j["mimic"]["joint"] not in joints:
             raise URDFStructureError(path, f"joint {name!r} mimics unknown joint {j['mimic']['joint']!r}")
 
-    roots = [ln for ln in links if ln not in parent_of]
-    if len(roots) != 1:
-        # every link has a parent -> cycle; several roots -> disconnected
-        if not roots:
-            raise URDFStructureError(path, "kinematic cycle: every link has a parent joint")
-        raise URDFStructureError(path, f"links are not connected into one tree: roots {roots}")
-    # cycle detection: walk up from every link
-    for ln in links:
-        seen = set()
-        cur = ln
-        while cur in parent_of:
-            if cur in seen:
-                raise URDFStructureError(path, f"kinematic cycle through link {cur!r}")
-            seen.add(cur)
-            cur = parent_of[cur]
+    root_link = _check_tree(path, links, parent_of, joint_of)
+
     meshes: dict[str, Path] = {}
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename")
@@ -266,6 +279,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
         scale = mesh.get("scale")
         if scale is not None:
             _finite_floats(path, scale, f"mesh {uri!r} scale", 3)
+        if uri in meshes:  # already resolved and checked (a mesh shared by many links)
+            continue
         resolved = resolve_uri(uri, path, pkgs)
         if check_meshes and not resolved.is_file():
             raise MeshNotFoundError(path, f"mesh {uri!r} not found (looked for {resolved})")
@@ -281,17 +296,48 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
         robot_name=root.get("name", path.stem),
         links=links,
         joints=joints,
-        root_link=roots[0],
+        root_link=root_link,
         meshes=meshes,
         package_dirs=pkgs,
     )
 
 
-def joints_child(joints: dict, child: str) -> str:
-    for n, j in joints.items():
-        if j["child"] == child:
-            return n
-    return "?"
+def _check_tree(path, links: list[str], parent_of: dict[str, str], joint_of: dict[str, str]) -> str:
+    """Check that the links form one tree and return its root link, in O(links).
+
+    Each link already has at most one parent (checked while reading the joints).  Then the
+    links form one tree exactly when there is one root and every link is reached from it;
+    a link not reached lies on, or hangs below, a kinematic cycle.  Iterative, so a chain of
+    any depth is fine.
+    """
+    roots = [ln for ln in links if ln not in parent_of]
+    if len(roots) > 1:
+        raise URDFStructureError(path, f"links are not connected into one tree: {len(roots)} roots ({_name_list(roots)})")
+    children: dict[str, list[str]] = {}
+    for child, parent in parent_of.items():
+        children.setdefault(parent, []).append(child)
+    reached: set[str] = set(roots)
+    stack = list(roots)
+    while stack:
+        for child in children.get(stack.pop(), ()):
+            if child not in reached:
+                reached.add(child)
+                stack.append(child)
+    if len(reached) == len(links):
+        return roots[0]
+    # A link not reached: walking up its parents never meets the root, so it meets a cycle.
+    cur = next(ln for ln in links if ln not in reached)
+    order: dict[str, int] = {}
+    while cur not in order:
+        order[cur] = len(order)
+        cur = parent_of[cur]
+    cycle = list(order)[order[cur] :]
+    where = "every link has a parent joint; " if not roots else ""
+    raise URDFStructureError(
+        path,
+        f"kinematic cycle through link {cur!r}: {where}links {_name_list(cycle)} "
+        f"(joints {_name_list(joint_of[ln] for ln in cycle)})",
+    )
 
 
 def atomic_write_text(path, text: str | bytes) -> None:

@@ -23,6 +23,13 @@ def robot_xml(links="<link name='base'/><link name='l1'/>", joints=GOOD_JOINT, e
     return f"<robot name='t'>{links}{joints}{extra}</robot>"
 
 
+def assert_structure_error(tmp_path, match, **robot_xml_kw):
+    """Loading ``robot_xml(**robot_xml_kw)`` raises URDFStructureError matching ``match``; returns it."""
+    with pytest.raises(errors.URDFStructureError, match=match) as exc:
+        aa.load(str(write(tmp_path, robot_xml(**robot_xml_kw))))
+    return exc.value
+
+
 def test_minimal_good_file_loads(tmp_path):
     r = aa.load(str(write(tmp_path, robot_xml())))
     assert r.nq == 1 and r.joint_names == ["j1"]
@@ -74,8 +81,7 @@ def test_kinematic_cycle(tmp_path):
     joints = GOOD_JOINT + """
   <joint name="j2" type="revolute"><parent link="l1"/><child link="base"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"""
-    with pytest.raises(errors.URDFStructureError, match="cycle|two joints"):
-        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+    assert_structure_error(tmp_path, "cycle|two joints", joints=joints)
 
 
 def test_closed_loop_child_with_two_parents(tmp_path):
@@ -83,39 +89,34 @@ def test_closed_loop_child_with_two_parents(tmp_path):
     joints = GOOD_JOINT + """
   <joint name="j2" type="fixed"><parent link="base"/><child link="l2"/></joint>
   <joint name="j3" type="fixed"><parent link="l2"/><child link="l1"/></joint>"""
-    with pytest.raises(errors.URDFStructureError, match="child of two joints"):
-        aa.load(str(write(tmp_path, robot_xml(links=links, joints=joints))))
+    assert_structure_error(tmp_path, "child of two joints", links=links, joints=joints)
 
 
 def test_unknown_joint_type(tmp_path):
     joints = GOOD_JOINT.replace('type="revolute"', 'type="ball"')
-    with pytest.raises(errors.URDFStructureError, match="unknown type 'ball'"):
-        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+    assert_structure_error(tmp_path, "unknown type 'ball'", joints=joints)
 
 
-def test_unknown_link(tmp_path):
-    joints = GOOD_JOINT.replace('child link="l1"', 'child link="l9"')
-    with pytest.raises(errors.URDFStructureError, match="'l9' is not defined"):
-        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+@pytest.mark.parametrize("role, old, new", [("child", "l1", "l9"), ("parent", "base", "nowhere")])
+def test_unknown_link(tmp_path, role, old, new):
+    joints = GOOD_JOINT.replace(f'{role} link="{old}"', f'{role} link="{new}"')
+    assert_structure_error(tmp_path, f"j1.*{role} link '{new}' is not defined", joints=joints)
 
 
 @pytest.mark.parametrize("bad", ["nan", "inf", "1e400", "abc"])
 def test_bad_numbers(tmp_path, bad):
     joints = GOOD_JOINT.replace('xyz="0 0 0.1"', f'xyz="0 0 {bad}"')
-    with pytest.raises(errors.URDFStructureError, match="j1.*origin xyz"):
-        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+    assert_structure_error(tmp_path, "j1.*origin xyz", joints=joints)
 
 
 def test_inverted_limits(tmp_path):
     joints = GOOD_JOINT.replace('lower="-1" upper="1"', 'lower="1" upper="-1"')
-    with pytest.raises(errors.URDFStructureError, match="lower limit"):
-        aa.load(str(write(tmp_path, robot_xml(joints=joints))))
+    assert_structure_error(tmp_path, "lower limit", joints=joints)
 
 
 def test_negative_mass(tmp_path):
     links = "<link name='base'/><link name='l1'><inertial><mass value='-2'/></inertial></link>"
-    with pytest.raises(errors.URDFStructureError, match="mass"):
-        aa.load(str(write(tmp_path, robot_xml(links=links))))
+    assert_structure_error(tmp_path, "mass", links=links)
 
 
 def mesh_link(uri):
@@ -176,3 +177,17 @@ def test_atomic_write_leaves_nothing_on_missing_folder(tmp_path):
     with pytest.raises(FileNotFoundError):
         atomic_write_text(tmp_path / "nope" / "x.urdf", "text")
     assert not any(tmp_path.iterdir())
+
+
+def test_two_roots(tmp_path):
+    links = "<link name='base'/><link name='l1'/><link name='loose'/>"
+    assert_structure_error(tmp_path, r"not connected into one tree: 2 roots \('base', 'loose'\)", links=links)
+
+
+def test_cycle_apart_from_the_root_names_its_links_and_joints(tmp_path):
+    links = "<link name='base'/><link name='l1'/><link name='a'/><link name='b'/>"
+    joints = GOOD_JOINT + """
+  <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint>"""
+    exc = assert_structure_error(tmp_path, "kinematic cycle through link '[ab]'", links=links, joints=joints)
+    assert all(f"'{name}'" in str(exc) for name in ("a", "b", "ab", "ba"))
