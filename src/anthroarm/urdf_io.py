@@ -15,6 +15,7 @@ import math
 import os
 import re
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -41,6 +42,72 @@ _DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 _MAX_NAMES_IN_MESSAGE = 10
 
 
+class PackageDirs(dict):
+    """Where ``package://NAME/...`` URIs are looked up: a dict ``{NAME: root}`` plus
+    ``search``, a tuple of folders each of which may hold a package as ``DIR/NAME``
+    (Pinocchio's ``package_dirs`` list).  Built by :func:`normalize_package_dirs`."""
+
+    def __init__(self, named: Mapping | None = None, search=()):
+        super().__init__(named or {})
+        self.search: tuple[Path, ...] = tuple(search)
+
+    def candidate_roots(self, pkg: str) -> list[Path]:
+        """The roots package ``pkg`` may live in, in order: the named root, then every
+        ``DIR/pkg`` of :attr:`search` that is a folder."""
+        roots = [Path(self[pkg])] if pkg in self else []
+        roots += [d / pkg for d in self.search if (d / pkg).is_dir()]
+        return roots
+
+    def __repr__(self) -> str:
+        return f"PackageDirs({dict.__repr__(self)}, search={list(map(str, self.search))!r})"
+
+
+#: What ``package_dirs`` may be (see :func:`normalize_package_dirs`).
+PackageDirsLike = Mapping | list | tuple | str | os.PathLike | None
+
+
+def _as_folder(value, what: str) -> Path:
+    if isinstance(value, (str, os.PathLike)):
+        return Path(value)
+    raise TypeError(f"package_dirs: {what} must be a folder (str or path), got {type(value).__name__} {value!r}")
+
+
+def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_defaults: bool = True) -> PackageDirs:
+    """The one place ``package_dirs`` is interpreted.  Accepted forms:
+
+    - a list (or tuple) of folders, Pinocchio's convention: ``package://NAME/rel`` is looked
+      up as ``DIR/NAME/rel`` in each folder ``DIR`` where ``DIR/NAME`` is a folder;
+    - a single folder (``str`` or path): the same as a one-element list;
+    - a dict ``{NAME: root}``: ``package://NAME/rel`` is ``root/rel``;
+    - ``None``: no folders of the user's.
+
+    With ``with_defaults`` the roots of :func:`default_package_dirs` are added (a name the
+    user gives wins).  A :class:`PackageDirs` is returned as it is.  Any other type raises
+    :class:`TypeError`.
+    """
+    if isinstance(package_dirs, PackageDirs):
+        return package_dirs
+    named: dict[str, Path] = default_package_dirs() if with_defaults else {}
+    search: list[Path] = []
+    if package_dirs is None:
+        pass
+    elif isinstance(package_dirs, (str, os.PathLike)):
+        search.append(Path(package_dirs))
+    elif isinstance(package_dirs, Mapping):
+        for name, root in package_dirs.items():
+            if not isinstance(name, str):
+                raise TypeError(f"package_dirs: package names must be str, got {type(name).__name__} {name!r}")
+            named[name] = _as_folder(root, f"the root of package {name!r}")
+    elif isinstance(package_dirs, (list, tuple)):
+        search.extend(_as_folder(d, f"entry {i}") for i, d in enumerate(package_dirs))
+    else:
+        raise TypeError(
+            "package_dirs must be a list of folders (package://NAME/... is looked up as DIR/NAME/...), "
+            f"a single folder, or a dict {{package name: root}}; got {type(package_dirs).__name__}"
+        )
+    return PackageDirs(named, search)
+
+
 def _name_list(names) -> str:
     names = list(names)
     shown = ", ".join(repr(n) for n in names[:_MAX_NAMES_IN_MESSAGE])
@@ -59,7 +126,7 @@ class URDFInfo:
     joints: dict[str, dict] = field(default_factory=dict)  # name -> {type, parent, child, mimic}
     root_link: str = ""
     meshes: dict[str, Path] = field(default_factory=dict)  # URI -> resolved path
-    package_dirs: dict[str, Path] = field(default_factory=dict)  # package name -> root
+    package_dirs: PackageDirs = field(default_factory=PackageDirs)  # package name -> root, + search folders
 
 
 def default_package_dirs() -> dict[str, Path]:
@@ -106,27 +173,31 @@ def _finite_float(path, text: str | None, what: str, default: float | None = Non
     return _finite_floats(path, text, what, 1)[0]
 
 
-def resolve_uri(uri: str, urdf_path: Path, package_dirs: dict[str, Path]) -> Path:
+def resolve_uri(uri: str, urdf_path: Path, package_dirs: PackageDirsLike) -> Path:
     """Resolve a mesh URI to a path.
 
-    ``package://pkg/rel`` is looked up in ``package_dirs`` (name -> root) and in the folders
-    above the URDF named ``pkg``; the result must stay inside the package root
-    (:class:`PackagePathError` otherwise).  ``file://`` and plain paths are taken relative to
-    the URDF's folder.
+    ``package://pkg/rel`` is looked up in ``package_dirs`` (any form
+    :func:`normalize_package_dirs` accepts: the named root of ``pkg``, then ``DIR/pkg`` for
+    each search folder ``DIR``) and in the folders above the URDF named ``pkg``; the result
+    must stay inside the package root (:class:`PackagePathError` otherwise).  ``file://`` and
+    plain paths are taken relative to the URDF's folder.
     """
     if uri.startswith("package://"):
+        dirs = normalize_package_dirs(package_dirs, with_defaults=False)
         rest = uri[len("package://") :]
         pkg, _, rel = rest.partition("/")
-        roots = []
-        if pkg in package_dirs:
-            roots.append(Path(package_dirs[pkg]))
+        if pkg in ("", ".", "..") or os.sep in pkg or (os.altsep and os.altsep in pkg):
+            raise PackagePathError(urdf_path, f"mesh {uri!r}: {pkg!r} is not a package name")
+        roots = dirs.candidate_roots(pkg)
         for parent in urdf_path.resolve().parents:
             if parent.name == pkg:
                 roots.append(parent)
         if not roots:
+            searched = f" (not found in package_dirs folders {[str(d) for d in dirs.search]})" if dirs.search else ""
             raise PackagePathError(
                 urdf_path,
-                f"mesh {uri!r}: unknown package {pkg!r}; pass package_dirs={{'{pkg}': '/path/to/{pkg}'}}",
+                f"mesh {uri!r}: unknown package {pkg!r}{searched}; pass package_dirs=['/folder/containing/{pkg}'] "
+                f"or package_dirs={{'{pkg}': '/path/to/{pkg}'}}",
             )
         for root in roots:
             root_r = root.resolve()
@@ -144,8 +215,11 @@ def resolve_uri(uri: str, urdf_path: Path, package_dirs: dict[str, Path]) -> Pat
     return p.resolve()
 
 
-def read_urdf(path, package_dirs: dict | None = None, check_meshes: bool = True) -> URDFInfo:
+def read_urdf(path, package_dirs: PackageDirsLike = None, check_meshes: bool = True) -> URDFInfo:
     """Read, parse and validate a URDF file.
+
+    ``package_dirs``: a list of folders holding packages, a single such folder, or a dict
+    ``{package name: root}`` (see :func:`normalize_package_dirs`).
 
     Raises
     ------
@@ -162,7 +236,7 @@ def read_urdf(path, package_dirs: dict | None = None, check_meshes: bool = True)
     return parse_urdf_bytes(raw, path, package_dirs=package_dirs, check_meshes=check_meshes)
 
 
-def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_meshes: bool = True) -> URDFInfo:
+def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, check_meshes: bool = True) -> URDFInfo:
     """Validate URDF text already in memory; ``path`` is used for messages and relative URIs."""
     path = Path(path)
     if _DTD_OR_ENTITY.search(raw):
@@ -177,8 +251,7 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: dict | None = None, check_m
     if root.tag != "robot":
         raise URDFSyntaxError(path, f"root element is <{root.tag}>, expected <robot>")
 
-    pkgs = default_package_dirs()
-    pkgs.update({k: Path(v) for k, v in (package_dirs or {}).items()})
+    pkgs = normalize_package_dirs(package_dirs)
 
     links: list[str] = []
     linkset: set[str] = set()

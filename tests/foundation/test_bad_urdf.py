@@ -191,3 +191,62 @@ def test_cycle_apart_from_the_root_names_its_links_and_joints(tmp_path):
   <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint>"""
     exc = assert_structure_error(tmp_path, "kinematic cycle through link '[ab]'", links=links, joints=joints)
     assert all(f"'{name}'" in str(exc) for name in ("a", "b", "ab", "ba"))
+
+
+@pytest.fixture
+def pkg_tree(tmp_path):
+    """tmp_path/my_pkg/meshes/a.stl, and a URDF outside the package using package://my_pkg."""
+    mesh = tmp_path / "my_pkg" / "meshes" / "a.stl"
+    mesh.parent.mkdir(parents=True)
+    mesh.write_text("solid x\nendsolid x\n")
+    (tmp_path / "robots").mkdir()
+    return tmp_path, write(tmp_path / "robots", robot_xml(links=mesh_link("package://my_pkg/meshes/a.stl"))), mesh
+
+
+@pytest.mark.parametrize("form", ["list", "tuple", "str", "path", "dict", "dict_path"])
+def test_package_dirs_forms(pkg_tree, form):
+    root, p, mesh = pkg_tree
+    package_dirs = {
+        "list": [str(root / "empty_or_missing"), str(root)], "tuple": (root,), "str": str(root), "path": root,
+        "dict": {"my_pkg": str(root / "my_pkg")}, "dict_path": {"my_pkg": root / "my_pkg"},
+    }[form]
+    r = aa.load(str(p), package_dirs=package_dirs)
+    assert r.info.meshes["package://my_pkg/meshes/a.stl"] == mesh.resolve()
+    # the robot keeps the folders: later look-ups (yourdfpy, viewer) resolve the same way
+    from anthroarm.urdf_io import resolve_uri
+
+    assert resolve_uri("package://my_pkg/meshes/a.stl", r.info.path, r.info.package_dirs) == mesh.resolve()
+
+
+def test_package_dirs_list_without_the_package(pkg_tree):
+    root, p, _ = pkg_tree
+    with pytest.raises(errors.PackagePathError, match="unknown package 'my_pkg'.*robots"):
+        aa.load(str(p), package_dirs=[str(root / "robots")])
+    with pytest.raises(errors.PackagePathError, match="unknown package 'my_pkg'"):
+        aa.load(str(p))
+
+
+def test_package_dirs_list_keeps_escape_protection(tmp_path):
+    (tmp_path / "my_pkg").mkdir()
+    (tmp_path / "outside.stl").write_text("solid x\nendsolid x\n")
+    (tmp_path / "robots").mkdir()
+    p = write(tmp_path / "robots", robot_xml(links=mesh_link("package://my_pkg/../outside.stl")))
+    with pytest.raises(errors.PackagePathError, match="escapes"):
+        aa.load(str(p), package_dirs=[str(tmp_path)])
+    # '..' as the package name would make the search folder's parent a package root
+    sub = tmp_path / "search"
+    sub.mkdir()
+    p = write(tmp_path / "robots", robot_xml(links=mesh_link("package://../outside.stl")), name="dots.urdf")
+    with pytest.raises(errors.PackagePathError, match="'..' is not a package name"):
+        aa.load(str(p), package_dirs=[str(sub)])
+
+
+@pytest.mark.parametrize("bad, what", [(42, "got int"), (b"/tmp", "got bytes"), ([1], "entry 0"),
+                                       ({"p": 3}, "root of package 'p'"), ({1: "/tmp"}, "package names must be str")])
+def test_package_dirs_wrong_type(tmp_path, bad, what):
+    from anthroarm.urdf_io import normalize_package_dirs
+
+    with pytest.raises(TypeError, match=what):
+        normalize_package_dirs(bad)
+    with pytest.raises(TypeError, match="package_dirs"):
+        aa.load(str(write(tmp_path, robot_xml())), package_dirs=bad)
