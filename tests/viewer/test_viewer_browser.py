@@ -78,7 +78,7 @@ def expected_box(v: Viewer, q) -> tuple[int, int, int, int]:
     pts = []
     for b in v.bodies:
         M = np.eye(4) if b.joint is None and b.frame is None else (
-            robot.data.oMi[b.joint].homogeneous if b.joint is not None else robot.data.oMf[b.frame].homogeneous)
+            robot.data.oMi[b.joint + 1].homogeneous if b.joint is not None else robot.data.oMf[b.frame].homogeneous)
         for p in b.pieces:
             A = M @ p.offset
             pts.extend(A[:3, :3] @ c + A[:3, 3] for c in half_extent_corners(p.geometry))

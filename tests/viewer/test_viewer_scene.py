@@ -17,7 +17,7 @@ import pytest
 import umsgpack
 
 import anthroarm as aa
-from anthroarm.errors import MeshNotFoundError
+from anthroarm.errors import MeshNotFoundError, ViewerError
 from anthroarm.viewer import Viewer, limit_color, limit_proximity, manipulability
 from anthroarm.viewer._store import SceneStore
 from anthroarm.viewer.viewer import LIMIT_RGB
@@ -73,7 +73,7 @@ def test_book_body_transforms_match_yourdfpy(name):
         for b in v.bodies:
             if b.joint is None:
                 continue
-            child = u.joint_map[robot.model.names[b.joint]].child
+            child = u.joint_map[robot.chain.joints[b.joint].name].child
             np.testing.assert_allclose(sent[v._bpath(b)], u.get_transform(child), atol=1e-12)
 
 
@@ -119,9 +119,10 @@ def test_generated_capsules_connect_the_joints(name):
         for p in b.pieces:
             if p.group == "links" and type(p.geometry).__name__ == "Sphere":
                 ends.append(p.offset[:3, 3])
-        targets = [model.jointPlacements[c].translation for c in range(1, model.njoints) if model.parents[c] == b.joint]
+        jid = model.getJointId(b.name)  # Pinocchio's own tables, not robot.chain
+        targets = [model.jointPlacements[c].translation for c in range(1, model.njoints) if model.parents[c] == jid]
         tool = model.frames[robot.tool_id]
-        if tool.parentJoint == b.joint:
+        if tool.parentJoint == jid:
             targets.append(tool.placement.translation)
         for t in targets:
             if np.linalg.norm(t) < 1e-9:
@@ -142,7 +143,7 @@ def test_kinds_of_generated_visuals(human):
             # the cylinder (meshcat: along y) is turned onto the joint axis
             ax = axes[0].offset[:3, 1]
             S = np.zeros(3)
-            S[["JointModelRX", "JointModelRY", "JointModelRZ"].index(human.model.joints[b.joint].shortname())] = 1
+            S[["JointModelRX", "JointModelRY", "JointModelRZ"].index(human.model.joints[human.model.getJointId(b.name)].shortname())] = 1
             assert abs(abs(ax @ S) - 1) < 1e-12
 
 
@@ -237,7 +238,7 @@ def test_animation_keyframes_follow_the_trajectory(human):
         assert [k["time"] for k in pos] == list(range(12))
         for k in (0, 5, 11):
             u.update_cfg(human.yourdfpy_cfg(Q[k]))
-            T = u.get_transform(u.joint_map[human.model.names[body.joint]].child)
+            T = u.get_transform(u.joint_map[body.name].child)
             np.testing.assert_allclose(pos[k]["value"], T[:3, 3], atol=1e-12)
             x, y, z, w = rot[k]["value"]
             R = pin.Quaternion(w, x, y, z).toRotationMatrix()
@@ -293,6 +294,8 @@ def test_bad_inputs_raise_value_errors(human):
         v.show_trace(np.zeros((1, 3)))
     with pytest.raises(ValueError, match="style"):
         Viewer(human, style="pretty")
+    with pytest.raises(ViewerError, match="visual_model"):
+        Viewer(human, style="visual_model")
 
 
 def test_jupyter_cell_is_a_static_iframe_when_not_live(human):

@@ -6,11 +6,8 @@ natural posture — reach forward, hand to mouth, reach to the side, overhead, a
 each target by differential IK: the target moves from the current hand pose to the goal along
 a minimum-jerk path (slerp for the orientation), then holds still for a moment.
 
-IK per step (dt = 20 ms):
-* QP differential IK (:mod:`anthroarm.ik.qp`: FrameTask + small PostureTask, the model's
-  configuration and velocity limits, OSQP by default) when that layer is importable;
-* otherwise a damped-least-squares step on ``robot.jacobian`` written here (``_dls_step``,
-  clearly a fallback: joint limits by clipping only).
+IK per step (dt = 20 ms): QP differential IK (:mod:`anthroarm.ik.qp`: FrameTask + small
+PostureTask, the model's configuration and velocity limits, OSQP by default).
 
 >>> res = reach_demo()                 # DemoResult(Q (N, 7), dt, targets, errors, method)
 >>> v = Viewer(res.robot); v.play(res.Q, res.dt); v.export_html("demo.html")
@@ -44,7 +41,7 @@ class DemoResult:
     dt: float                     # s between rows
     targets: list                 # [(name, 4x4 target pose)]
     errors: list = field(default_factory=list)  # [(name, position error m, rotation error rad)] at each hold end
-    method: str = ""              # "qp/osqp" or "dls (fallback)"
+    method: str = ""              # "qp/<solver>"
 
 
 @contextlib.contextmanager
@@ -88,8 +85,8 @@ def pose_error(robot, q, T) -> tuple[float, float]:
     return float(np.linalg.norm(F[:3, 3] - T[:3, 3])), float(np.linalg.norm(pin.log3(F[:3, :3].T @ T[:3, :3])))
 
 
-# ----------------------------------------------------------------------------- IK steppers
-class _QPStepper:
+# ----------------------------------------------------------------------------- IK stepper
+class QPStepper:
     """One QP differential-IK step with anthroarm.ik.qp (FrameTask + PostureTask, default limits)."""
 
     def __init__(self, robot, q0, solver="osqp", orientation_cost=0.3):
@@ -110,49 +107,11 @@ class _QPStepper:
         return np.array(self.conf.q, dtype=float)
 
 
-def _dls_step(robot, q, T, dt, damping=0.05, gain=10.0, w_rot=0.3):
-    """FALLBACK (used only when anthroarm.ik.qp is not importable): one damped-least-squares
-    step  v = Jᵀ (J Jᵀ + λ² I)⁻¹ K e  with e = (p* − p; w_rot·log3(Rᵀ R*) in world axes), the
-    LOCAL_WORLD_ALIGNED Jacobian of the tool, joint velocities clipped to the velocity limits
-    and q clipped into the position limits."""
-    F = robot.fk(q)
-    e = np.concatenate([T[:3, 3] - F[:3, 3], w_rot * (F[:3, :3] @ pin.log3(F[:3, :3].T @ T[:3, :3]))])
-    J = robot.jacobian(q).copy()
-    J[3:] *= w_rot
-    v = J.T @ np.linalg.solve(J @ J.T + damping**2 * np.eye(6), gain * e)
-    vmax = np.where(np.isfinite(robot.velocity_limit) & (robot.velocity_limit > 0), robot.velocity_limit, 3.0)
-    v = np.clip(v, -vmax, vmax)
-    return np.clip(q + v * dt, robot.lower, robot.upper)
-
-
-class _DLSStepper:
-    method = "dls (fallback)"
-
-    def __init__(self, robot):
-        self.robot = robot
-
-    def __call__(self, q, T, dt):
-        return _dls_step(self.robot, q, T, dt)
-
-
-def make_stepper(robot, q0, method: str = "auto", solver: str = "osqp"):
-    """``method``: "qp" (anthroarm.ik.qp, error if missing), "dls" (fallback), "auto" (qp if
-    importable)."""
-    if method not in ("auto", "qp", "dls"):
-        raise ValueError(f"method must be 'auto', 'qp' or 'dls', got {method!r}")
-    if method in ("auto", "qp"):
-        try:
-            return _QPStepper(robot, q0, solver=solver)
-        except (ImportError, AttributeError):
-            if method == "qp":
-                raise
-    return _DLSStepper(robot)
-
-
 # ----------------------------------------------------------------------------- the demo
 def reach_demo(robot=None, postures_deg=None, move_time: float = 1.4, hold_time: float = 0.5, dt: float = 0.02,
-               method: str = "auto", solver: str = "osqp", progress=None) -> DemoResult:
-    """Simulate the human arm reaching for each posture's hand pose in turn.
+               method: str = "qp", solver: str = "osqp", progress=None) -> DemoResult:
+    """Simulate the human arm reaching for each posture's hand pose in turn, by QP
+    differential IK (``method`` "qp"; "auto" is the same).
 
     ``progress``: an optional callable ``progress(done, total)`` called once per target.
     Returns a :class:`DemoResult`; ``errors`` holds the pose error at the end of each hold."""
@@ -160,6 +119,8 @@ def reach_demo(robot=None, postures_deg=None, move_time: float = 1.4, hold_time:
 
     robot = robot if robot is not None else load("human_arm7")
     postures = postures_deg if postures_deg is not None else REACH_POSTURES_DEG
+    if method not in ("qp", "auto"):
+        raise ValueError(f"method must be 'qp' (QP differential IK, anthroarm.ik.qp), got {method!r}")
     if not (dt > 0 and move_time > 0 and hold_time >= 0):
         raise ValueError("dt and move_time must be > 0 and hold_time >= 0")
     targets = []
@@ -167,7 +128,7 @@ def reach_demo(robot=None, postures_deg=None, move_time: float = 1.4, hold_time:
         qt = np.clip(np.deg2rad(np.asarray(deg, float)), robot.lower, robot.upper)
         targets.append((name, robot.fk(robot.check_q(qt, name))))
     q = robot.neutral()
-    step = make_stepper(robot, q, method, solver)
+    step = QPStepper(robot, q, solver=solver)
     Q = [q.copy()]
     errors = []
     n_move = max(1, int(round(move_time / dt)))

@@ -74,7 +74,8 @@ def _delete(path: str) -> dict:
 
 
 def limit_proximity(q, lower, upper) -> np.ndarray:
-    """0 at the middle of each joint's range, 1 at (or beyond) a limit; 0 for unbounded joints."""
+    """0 at the middle of each joint's range, 1 at (or beyond) a limit; 0 for unbounded joints.
+    ``q``: joint positions θ (rad or m, :meth:`anthroarm.chain.Chain.angles`), one per limit."""
     q, lo, hi = (np.asarray(x, float) for x in (q, lower, upper))
     out = np.zeros_like(q)
     fin = np.isfinite(lo) & np.isfinite(hi) & (hi > lo)
@@ -123,8 +124,10 @@ class Viewer:
         lives in memory only (``export_html``, ``jupyter_cell``).
     port : int, optional
         Server port (``live=True``); a port in use raises ViewerPortInUseError.
-    style : {"auto", "generated", "urdf"}
-        Visuals: generated capsules/cylinders/spheres (book models) or the URDF's meshes.
+    style : {"auto", "generated", "urdf", "visual_model"}
+        Visuals (:func:`~anthroarm.viewer.visuals.robot_bodies`): capsules, cylinders and spheres
+        generated from ``robot.chain`` (book models, robots without visual geometry), the URDF's
+        ``<visual>`` meshes, or ``robot.visual_model`` (a robot loaded from a ``pin.Model``).
     background : ((r, g, b), (r, g, b)), optional
         meshcat's gradient (top, bottom; 0..255).  Default: meshcat's background hidden, the
         page's own light CSS gradient shows through (identical in every browser, including
@@ -152,6 +155,10 @@ class Viewer:
         self.root = f"{ROOT}/{_safe(name or robot.name)}"
         self.bodies: list[Body] = robot_bodies(robot, style)
         self._overlay_bodies: dict[str, list[Body]] = {}
+        self._movers: list[tuple[str, int | None, int | None]] | None = None
+        joints = robot.chain.joints
+        self._joint_lower = np.array([j.lower for j in joints])
+        self._joint_upper = np.array([j.upper for j in joints])
         self._limits_on = False
         self._animating = False
         self._colors: dict[str, tuple] = {}
@@ -189,10 +196,11 @@ class Viewer:
         Q = robot.random_q(128, rng=0)
         pts = []
         model, data = robot.model, robot.data
+        tips = {robot.chain.frame(t).index for t in robot.chain.tips} | {robot.tool_id}
         for qi in Q:
             pin.framesForwardKinematics(model, data, qi)
-            pts.extend(np.array(data.oMi[j].translation) for j in range(1, model.njoints))
-            pts.append(np.array(data.oMf[robot.tool_id].translation))
+            pts.extend(np.array(data.oMi[j.index + 1].translation) for j in robot.chain.joints)
+            pts.extend(np.array(data.oMf[f].translation) for f in tips)
         pts = np.asarray(pts + [np.zeros(3)])
         lo, hi = pts.min(0), pts.max(0)
         self.center = 0.5 * (lo + hi)
@@ -254,39 +262,45 @@ class Viewer:
             for b in bs:
                 yield b, f"overlays/{name}"
 
+    def _moving(self) -> list[tuple[str, int | None, int | None]]:
+        """(path, Pinocchio joint id or None, frame id or None) of every moving body; rebuilt
+        when the overlays change."""
+        if self._movers is None:
+            self._movers = [(self._bpath(b, prefix), None if b.joint is None else b.joint + 1, b.frame)
+                            for b, prefix in self._all_bodies() if b.joint is not None or b.frame is not None]
+        return self._movers
+
     def _pose_commands(self, q) -> list[dict]:
         model, data = self.robot.model, self.robot.data
         pin.framesForwardKinematics(model, data, q)
-        cmds = []
-        for b, prefix in self._all_bodies():
-            if b.joint is not None:
-                T = data.oMi[b.joint].homogeneous
-            elif b.frame is not None:
-                T = data.oMf[b.frame].homogeneous
-            else:
-                continue
-            cmds.append({"type": "set_transform", "path": self._bpath(b, prefix), "matrix": T.T.ravel().tolist()})
-        return cmds
+        oMi, oMf = data.oMi, data.oMf
+        return [{"type": "set_transform", "path": path,
+                 "matrix": (oMi[j] if j is not None else oMf[f]).homogeneous.T.ravel().tolist()}
+                for path, j, f in self._moving()]
 
     def _color_commands(self, q) -> list[dict]:
-        """Recolour links (max proximity over ``body.link_dofs``) and joint centres (own
-        proximity); only colours that changed since the last call are sent."""
+        """Recolour links (max proximity over ``body.link_joints``) and joint centres (own
+        proximity), from the joint positions θ of ``robot.chain`` (a continuous joint's angle,
+        a mimic joint's copy); unbounded joints are never coloured.  Only colours that changed
+        since the last call are sent."""
         cmds = []
-        prox = limit_proximity(q, self.robot.lower, self.robot.upper) if self._limits_on else None
+        prox = None
+        if self._limits_on:
+            prox = limit_proximity(self.robot.chain.angles(q), self._joint_lower, self._joint_upper)
         for b in self.bodies:
-            if b.dof is None and not b.link_dofs:
+            if b.limit_joint is None and not b.link_joints:
                 continue
             groups = []
             link_group = "links" if any(p.group == "links" for p in b.pieces) else "mesh"
-            if b.link_dofs and any(p.group == link_group for p in b.pieces):
-                groups.append((link_group, b.link_dofs))
-            if b.dof is not None and any(p.group == "joint" for p in b.pieces):
-                groups.append(("joint", [b.dof]))
-            for group, dofs in groups:
+            if b.link_joints and any(p.group == link_group for p in b.pieces):
+                groups.append((link_group, b.link_joints))
+            if b.limit_joint is not None and any(p.group == "joint" for p in b.pieces):
+                groups.append(("joint", [b.limit_joint]))
+            for group, idx in groups:
                 path = f"{self._bpath(b)}/{group}"
                 if prox is not None:
                     base = next(p.rgb for p in b.pieces if p.group == group)
-                    rgb = tuple(round(c, 3) for c in limit_color(float(prox[dofs].max()), base))
+                    rgb = tuple(round(c, 3) for c in limit_color(float(prox[idx].max()), base))
                 else:
                     rgb = None
                 if self._colors.get(path) == rgb:
@@ -322,7 +336,8 @@ class Viewer:
         self._send([self._stop_command()])
 
     def show_limits(self, on: bool = True) -> None:
-        """Colour each link by how close its joint is to a limit (red within the last 15 %)."""
+        """Colour each link by how close its joint is to a limit (red within the last 15 %);
+        joints without limits (continuous joints) are skipped."""
         self._limits_on = bool(on)
         self._send(self._color_commands(self.q))
 
@@ -338,6 +353,7 @@ class Viewer:
         else:
             self._overlay_bodies.pop(_safe(name), None)
             self._send([_delete(self._overlay_path(name))])
+        self._movers = None
 
     @staticmethod
     def _triad(size: float, radius: float | None = None, opacity: float = 1.0) -> list[Piece]:
@@ -357,8 +373,8 @@ class Viewer:
         robot = self.robot
         bodies = []
         if frames == "joints":
-            for j in range(1, robot.model.njoints):
-                bodies.append(Body(robot.model.names[j], self._triad(size), joint=j))
+            for j in robot.chain.joints:
+                bodies.append(Body(j.name, self._triad(size), joint=j.index))
         else:
             names = [robot.tool] if frames is None else ([frames] if isinstance(frames, str) else list(frames))
             for f in names:
@@ -366,6 +382,7 @@ class Viewer:
         key = _safe(name)
         self.clear(key)
         self._overlay_bodies[key] = bodies
+        self._movers = None
         self._send(self._body_objects(bodies, f"overlays/{key}"))
         self.display(self.q)
 

@@ -1,14 +1,20 @@
-"""What the viewer draws for a Robot: a list of rigid *bodies*, each driven by one Pinocchio
-joint or frame placement and carrying meshcat geometry in its own frame.
+"""What the viewer draws for a Robot: a list of rigid *bodies*, each driven by one joint or
+frame of ``robot.chain`` and carrying meshcat geometry in its own frame.
 
-* Book models (``robot.spec`` is set): generated visuals — a sphere at every joint centre, a
-  cylinder along every joint axis, capsules (cylinder + two end spheres) from each joint to its
-  children and to the tool, a sleeve for prismatic joints, a small palm at the tool, and for the
-  human arm a torso for context.  Sizes scale with the arm's reach.
-* Any other URDF (example-robot-data arms): the URDF's ``<visual>`` elements — meshes resolved
-  with :func:`anthroarm.urdf_io.resolve_uri` (the same resolution the loader used), boxes,
-  cylinders and spheres — each attached to its link's frame.  A mesh that cannot be found
-  raises :class:`~anthroarm.errors.MeshNotFoundError` naming the link, the URI and the path.
+Where the geometry comes from (:func:`robot_bodies`, ``style="auto"``):
+
+* Book models (``robot.spec`` is set) and robots without any visual geometry: a skeleton
+  generated from ``robot.chain`` — a sphere at every joint centre, a cylinder along every joint
+  axis, capsules from each joint to its children and to the tip frames, a sleeve over the stroke
+  of prismatic joints, a small palm at the tool.  Sizes scale with the reach.  A book limb scaled
+  to a person (its spec has a ``height`` parameter) also gets a torso for context.
+* A robot with a URDF: the URDF's ``<visual>`` elements — meshes resolved with
+  :func:`anthroarm.urdf_io.resolve_uri` (the same resolution the loader used), boxes, cylinders
+  and spheres — each attached to its link's frame.  A mesh that cannot be found raises
+  :class:`~anthroarm.errors.MeshNotFoundError` naming the link, the URI and the path.
+* A robot loaded from a ``pin.Model`` with ``visual_model=`` (a ``pin.GeometryModel``): its
+  geometry objects — mesh files, or the loaded triangles when there is no file, and the
+  primitive shapes (box, sphere, cylinder, capsule, cone, ellipsoid) — on their parent joints.
 
 All geometry is expressed in metres in the driving frame; nothing here talks to a server.
 """
@@ -22,7 +28,8 @@ import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 
-from ..errors import MeshNotFoundError
+from ..chain import PRISMATIC
+from ..errors import MeshNotFoundError, ViewerError
 from ..spatial.rotations import homogeneous, rotation_between
 
 LINK_RGB = (0.62, 0.68, 0.78)
@@ -35,13 +42,6 @@ TORSO_RGB = (0.55, 0.60, 0.66)
 def rgb_hex(rgb) -> int:
     r, g, b = (int(round(255 * max(0.0, min(1.0, float(c))))) for c in rgb[:3])
     return (r << 16) | (g << 8) | b
-
-
-def material(rgb, opacity: float = 1.0) -> mg.MeshPhongMaterial:
-    kw = {"color": rgb_hex(rgb)}
-    if opacity < 1.0:
-        kw.update(opacity=float(opacity), transparent=True)
-    return mg.MeshPhongMaterial(**kw)
 
 
 @dataclass
@@ -58,19 +58,26 @@ class Piece:
 
 @dataclass
 class Body:
-    """Pieces moving with one placement: ``joint`` (pin joint id, pose ``data.oMi``) or
-    ``frame`` (pin frame id, pose ``data.oMf``); both None means fixed to the base.
-    ``dof`` is the configuration index whose limit proximity colours the body (or None)."""
+    """Pieces moving with one placement: ``joint`` (index in ``robot.chain.joints``, pose
+    ``data.oMi[joint + 1]``) or ``frame`` (index in ``robot.chain.frames`` = Pinocchio frame
+    id, pose ``data.oMf[frame]``); both None means fixed to the base.
+
+    ``limit_joint`` is the chain joint whose limit proximity colours the joint centre (None:
+    unbounded, never coloured); ``link_joints`` are the chain joints whose proximity colours
+    the links: its own joint and the joints that sit at the same point just before it (the
+    shoulder's x-y-z, the elbow and forearm rotation), so a link turns red when any joint that
+    moves it is at a limit."""
 
     name: str
     pieces: list[Piece]
     joint: int | None = None
     frame: int | None = None
-    dof: int | None = None
-    #: configuration indices whose limit proximity colours this body's links: its own joint
-    #: and the joints that sit at the same point just before it (the shoulder's x-y-z, the
-    #: elbow and forearm rotation), so a link turns red when any joint that moves it is at a limit
-    link_dofs: list = field(default_factory=list)
+    limit_joint: int | None = None
+    link_joints: list = field(default_factory=list)
+
+
+def _bounded(joint) -> bool:
+    return bool(np.isfinite(joint.lower) and np.isfinite(joint.upper) and joint.upper > joint.lower)
 
 
 # ---------------------------------------------------------------------- primitives
@@ -95,19 +102,7 @@ def capsule(a, b, radius, rgb=LINK_RGB, group="links") -> list[Piece]:
     return out + [Piece(mg.Sphere(radius), rgb, homogeneous(r=a), group), Piece(mg.Sphere(radius), rgb, homogeneous(r=b), group)]
 
 
-def joint_axis(model: pin.Model, jid: int) -> tuple[np.ndarray, str]:
-    """Unit axis of a 1-DoF joint in its own frame and its kind ("revolute"/"prismatic"),
-    read from the motion subspace ``S`` (rows: linear; angular)."""
-    jm = model.joints[jid]
-    jd = jm.createData()
-    jm.calc(jd, np.zeros(model.nq))
-    S = np.asarray(jd.S)[:, 0] if np.asarray(jd.S).ndim == 2 else np.asarray(jd.S)
-    if np.linalg.norm(S[3:]) > 1e-9:
-        return S[3:] / np.linalg.norm(S[3:]), "revolute"
-    return S[:3] / np.linalg.norm(S[:3]), "prismatic"
-
-
-# ---------------------------------------------------------------------- book models
+# ---------------------------------------------------------------------- generated skeleton
 def link_radius(robot) -> float:
     """Capsule radius: 6 % of the arm's reach, between 1.5 cm and 6 cm."""
     return float(np.clip(0.06 * robot.length_scale, 0.015, 0.06))
@@ -126,76 +121,69 @@ def _segments(t: np.ndarray, axis: np.ndarray) -> list[tuple[np.ndarray, np.ndar
     return [(np.zeros(3), t)]
 
 
-def book_bodies(robot) -> list[Body]:
-    """Generated visuals for a catalog book model (see the module docstring)."""
-    model = robot.model
+def skeleton_bodies(robot) -> list[Body]:
+    """Visuals generated from ``robot.chain`` (see the module docstring): one body per joint,
+    capsules to its child joints and to the tip frames on it (the tool among them)."""
+    chain = robot.chain
     r = link_radius(robot)
-    bodies: list[Body] = []
-    children: dict[int, list[int]] = {j: [] for j in range(model.njoints)}
-    for j in range(1, model.njoints):
-        children[model.parents[j]].append(j)
-    tool = model.frames[robot.tool_id]
+    tool = chain.frame(None)
+    ends: dict[int, list[np.ndarray]] = {j: [] for j in range(-1, len(chain.joints))}
+    for j in chain.joints:
+        ends[j.parent].append(np.asarray(j.translation))
+    tips = {chain.frame(t).index for t in chain.tips} | {tool.index}
+    for fid in sorted(tips):
+        f = chain.frames[fid]
+        ends[f.joint].append(np.asarray(f.translation))
 
-    # base: a pedestal (or the torso of the human arm) and the links from the base to the first joints
+    # base: a pedestal (or the torso of a human limb) and the links to the first joints
     base: list[Piece] = []
-    for c in children[0]:
-        t = np.asarray(model.jointPlacements[c].translation)
+    for t in ends[-1]:
         for a, b in _segments(t, np.array([0.0, 0.0, 1.0])):
             base += capsule(a, b, r)
-    if robot.name.startswith("human_arm"):
+    if robot.spec is not None and "height" in robot.spec.params:   # a limb scaled to a person
         base += _torso(robot, r)
     else:
         base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, homogeneous(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
-    bodies.append(Body("base", base))
+    bodies: list[Body] = [Body("base", base)]
+    by_joint: dict[int, Body] = {-1: bodies[0]}
 
     pending: dict[int, list[int]] = {}
-    for j in range(1, model.njoints):
-        axis, kind = joint_axis(model, j)
-        pieces: list[Piece] = []
-        pieces.append(Piece(mg.Sphere(1.25 * r), JOINT_RGB, np.eye(4), "joint"))
+    for j in chain.joints:
+        axis = np.asarray(j.axis)
+        pieces: list[Piece] = [Piece(mg.Sphere(1.25 * r), JOINT_RGB, np.eye(4), "joint")]
         pieces += cylinder_between(-1.7 * r * axis, 1.7 * r * axis, 0.55 * r, AXIS_RGB, "axis")
-        ends = [np.asarray(model.jointPlacements[c].translation) for c in children[j]]
-        if tool.parentJoint == j:
-            ends.append(np.asarray(tool.placement.translation))
-        for t in ends:
+        for t in ends[j.index]:
             for a, b in _segments(t, axis):
                 pieces += capsule(a, b, 0.8 * r)
-        if kind == "prismatic":
-            lo, hi = _range(robot, j)
+        if j.kind == PRISMATIC:
+            lo, hi = _stroke(robot, j)
             # the sliding member reaches back over the whole stroke so it never leaves its sleeve
             pieces += capsule(np.zeros(3), -(hi - lo) * axis, 0.7 * r)
-        if tool.parentJoint == j:
-            pieces += _palm(tool, r, axis)
-        dof = model.joints[j].idx_q if model.joints[j].nq == 1 else None
-        inherited = pending.get(model.parents[j], [])
-        link_dofs = inherited + ([dof] if dof is not None else [])
-        if not any(p.group == "links" for p in pieces):
-            pending[j] = link_dofs  # nothing to colour here: hand the joint on to the next link
-        bodies.append(Body(model.names[j], pieces, joint=j, dof=dof, link_dofs=link_dofs))
-        if kind == "prismatic":
             # the fixed sleeve lives on the parent body
-            lo, hi = _range(robot, j)
-            pj = model.parents[j]
-            M = model.jointPlacements[j]
-            a = M.translation + M.rotation @ (lo * axis)
-            b = M.translation + M.rotation @ (hi * axis)
-            sleeve = cylinder_between(a, b, 1.05 * r, TORSO_RGB, "axis", 0.55)
-            target = bodies[0] if pj == 0 else next(bb for bb in bodies if bb.joint == pj)
-            target.pieces += sleeve
+            a = j.translation + j.rotation @ (lo * axis)
+            b = j.translation + j.rotation @ (hi * axis)
+            by_joint[j.parent].pieces += cylinder_between(a, b, 1.05 * r, TORSO_RGB, "axis", 0.55)
+        if tool.joint == j.index:
+            pieces += _palm(tool, r, axis)
+        own = j.index if _bounded(j) else None
+        link_joints = pending.get(j.parent, []) + ([own] if own is not None else [])
+        if not any(p.group == "links" for p in pieces):
+            pending[j.index] = link_joints  # nothing to colour here: hand the joint on to the next link
+        body = by_joint[j.index] = Body(j.name, pieces, joint=j.index, limit_joint=own, link_joints=link_joints)
+        bodies.append(body)
     return bodies
 
 
-def _range(robot, jid: int) -> tuple[float, float]:
-    i = robot.model.joints[jid].idx_q
-    lo, hi = float(robot.lower[i]), float(robot.upper[i])
-    if not np.isfinite(lo) or not np.isfinite(hi):
-        lo, hi = -0.5 * robot.length_scale, 0.5 * robot.length_scale
-    return lo, hi
+def _stroke(robot, joint) -> tuple[float, float]:
+    """A prismatic joint's travel (m); ± half the reach where it has no limits."""
+    if _bounded(joint):
+        return float(joint.lower), float(joint.upper)
+    return -0.5 * robot.length_scale, 0.5 * robot.length_scale
 
 
 def _palm(tool_frame, r, axis) -> list[Piece]:
     """A flat palm at the tool: an ellipsoid whose long axis continues the last link."""
-    t = np.asarray(tool_frame.placement.translation)
+    t = np.asarray(tool_frame.translation)
     d = t / np.linalg.norm(t) if np.linalg.norm(t) > 1e-9 else axis
     R = _y_to(d)
     return [Piece(mg.Ellipsoid([1.6 * r, 1.6 * r, 0.7 * r]), SKIN_RGB, homogeneous(R, t), "palm")]
@@ -243,15 +231,18 @@ def urdf_bodies(robot) -> list[Body]:
         c = m.find("color")
         if c is not None and m.get("name"):
             named_colors[m.get("name")] = _floats(c.get("rgba"), 4, (0.7, 0.7, 0.7, 1))
-    model = robot.model
+    links = {}
+    for f in robot.chain.frames:          # the link's body frame (a joint may share its name)
+        if f.is_body:
+            links.setdefault(f.name, f)
     bodies: list[Body] = []
     mesh_cache: dict[Path, object] = {}
     for link in root.findall("link"):
         name = link.get("name")
         visuals = link.findall("visual")
-        if not visuals or not model.existFrame(name):
+        frame = links.get(name)
+        if not visuals or frame is None:
             continue
-        fid = model.getFrameId(name)
         pieces: list[Piece] = []
         for vis in visuals:
             geo = vis.find("geometry")
@@ -291,10 +282,83 @@ def urdf_bodies(robot) -> list[Body]:
                 continue
             pieces.append(Piece(geom, tuple(rgba[:3]), offset, "mesh", float(rgba[3]) if len(rgba) > 3 else 1.0))
         if pieces:
-            pj = model.frames[fid].parentJoint
-            dof = model.joints[pj].idx_q if pj > 0 and model.joints[pj].nq == 1 else None
-            bodies.append(Body(name, pieces, frame=fid, dof=dof, link_dofs=[dof] if dof is not None else []))
+            bodies.append(Body(name, pieces, frame=frame.index, **_limit_kw(robot.chain, frame.joint)))
     return bodies
+
+
+def _limit_kw(chain, joint: int) -> dict:
+    """Colouring of a body moved by chain joint ``joint`` (−1: the base): that joint if it has
+    limits."""
+    if joint >= 0 and _bounded(chain.joints[joint]):
+        return {"limit_joint": joint, "link_joints": [joint]}
+    return {}
+
+
+# ---------------------------------------------------------------------- pin.GeometryModel
+def geometry_bodies(robot) -> list[Body]:
+    """Bodies from ``robot.visual_model`` (a ``pin.GeometryModel``): one body per joint that
+    carries geometry, each object at its placement in the joint frame (Pinocchio's
+    ``GeometryObject.placement``)."""
+    chain = robot.chain
+    by_joint: dict[int, list[Piece]] = {}
+    mesh_cache: dict[Path, object] = {}
+    for go in robot.visual_model.geometryObjects:
+        by_joint.setdefault(int(go.parentJoint) - 1, []).extend(_geometry_pieces(go, mesh_cache))
+    bodies = []
+    for j, pieces in sorted(by_joint.items()):
+        if not pieces:
+            continue
+        if j < 0:
+            bodies.append(Body("base", pieces))
+        else:
+            bodies.append(Body(chain.joints[j].name, pieces, joint=j, **_limit_kw(chain, j)))
+    return bodies
+
+
+#: shapes of infinite extent (nothing to draw)
+_UNBOUNDED_SHAPES = ("Plane", "Halfspace")
+
+
+def _geometry_pieces(go, mesh_cache) -> list[Piece]:
+    """Pieces for one ``pin.GeometryObject``: a mesh file when ``meshPath`` names one (scaled
+    by ``meshScale``), else the primitive shape or the loaded triangles (already scaled)."""
+    g = go.geometry
+    kind = type(g).__name__
+    M = np.asarray(go.placement.homogeneous)
+    rgba = np.asarray(go.meshColor, float)
+    rgb, opacity = tuple(rgba[:3]), float(rgba[3])
+    z_to_y = homogeneous(_y_to([0, 0, 1]))   # coal's round shapes are along z, meshcat's along y
+    path = Path(go.meshPath) if go.meshPath else None
+    if path is not None and path.is_file():
+        if path not in mesh_cache:
+            mesh_cache[path] = load_mesh(path)
+        geom, offset = mesh_cache[path], M @ np.diag([*np.asarray(go.meshScale, float), 1.0])
+    elif kind == "Box":
+        geom, offset = mg.Box(2 * np.asarray(g.halfSide, float)), M
+    elif kind == "Sphere":
+        geom, offset = mg.Sphere(float(g.radius)), M
+    elif kind == "Ellipsoid":
+        geom, offset = mg.Ellipsoid(np.asarray(g.radii, float)), M
+    elif kind == "Cylinder":
+        geom, offset = mg.Cylinder(2 * g.halfLength, g.radius), M @ z_to_y
+    elif kind == "Cone":   # apex at +z
+        geom, offset = mg.Cylinder(2 * g.halfLength, radiusTop=0.0, radiusBottom=g.radius), M @ z_to_y
+    elif kind == "Capsule":
+        h = float(g.halfLength)
+        pieces = capsule([0, 0, -h], [0, 0, h], float(g.radius), rgb, "mesh") or [Piece(mg.Sphere(float(g.radius)), rgb, np.eye(4), "mesh")]
+        for pc in pieces:
+            pc.offset, pc.opacity = M @ pc.offset, opacity
+        return pieces
+    elif hasattr(g, "tri_indices") and g.num_tris > 0:
+        faces = np.array([list(g.tri_indices(i)) for i in range(g.num_tris)], dtype=np.uint32)
+        geom, offset = mg.TriangularMeshGeometry(np.asarray(g.vertices(), float), faces), M
+    elif kind in _UNBOUNDED_SHAPES:
+        return []
+    else:
+        raise ViewerError(f"visual geometry {go.name!r} is a {kind} with no mesh file ({go.meshPath!r}); "
+                          "the viewer draws mesh files, triangle meshes, boxes, spheres, ellipsoids, "
+                          "cylinders, cones and capsules")
+    return [Piece(geom, rgb, offset, "mesh", opacity)]
 
 
 def load_mesh(path: Path):
@@ -315,14 +379,25 @@ def load_mesh(path: Path):
     return mg.StlMeshGeometry.from_stream(buf)
 
 
+STYLES = ("auto", "generated", "urdf", "visual_model")
+
+
 def robot_bodies(robot, style: str = "auto") -> list[Body]:
-    """Bodies for any Robot.  ``style``: "auto" (generated for book models, URDF visuals
-    otherwise), "generated" or "urdf"."""
-    if style not in ("auto", "generated", "urdf"):
-        raise ValueError(f"style must be 'auto', 'generated' or 'urdf', got {style!r}")
+    """Bodies for any Robot.  ``style``: "generated" (the skeleton from ``robot.chain``),
+    "urdf" (the URDF's ``<visual>`` elements), "visual_model" (``robot.visual_model``), or
+    "auto": generated for book models, else the robot's own visuals (URDF, then visual
+    model), and the skeleton when it has none."""
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {', '.join(map(repr, STYLES))}, got {style!r}")
+    if style == "urdf" and robot.info is None:
+        raise ViewerError(f"{robot.name} has no URDF (it was loaded from a pin.Model): use style='auto'")
+    if style == "visual_model" and robot.visual_model is None:
+        raise ViewerError(f"{robot.name} has no visual_model: pass visual_model= to aa.load, or use style='auto'")
     if style == "generated" or (style == "auto" and robot.spec is not None):
-        return book_bodies(robot)
-    bodies = urdf_bodies(robot)
-    if not bodies:  # a URDF without visuals: fall back to the generated skeleton
-        return book_bodies(robot)
-    return bodies
+        return skeleton_bodies(robot)
+    bodies = []
+    if style in ("auto", "urdf") and robot.info is not None:
+        bodies = urdf_bodies(robot)
+    elif style in ("auto", "visual_model") and robot.visual_model is not None:
+        bodies = geometry_bodies(robot)
+    return bodies or skeleton_bodies(robot)   # no visual geometry at all: the skeleton
