@@ -13,6 +13,20 @@ Tasks (``qp.tasks``): FrameTask, PositionTask, OrientationTask, RelativeFrameTas
 DampingTask, JointCouplingTask (mimic), SwivelTask.  Limits (``qp.limits``): ConfigurationLimit,
 VelocityLimit, AccelerationLimit.  Backends (``qp.backends``): persistent OSQP, daqp, quadprog,
 proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
+
+Joints: everything reads ``robot.chain``.  Velocities, Jacobians and limits on the step live in
+the tangent space (nv); configurations are integrated on the manifold (``pin.integrate``) and
+posture errors are ``pin.difference``, so a continuous joint (q = (cos θ, sin θ), one velocity)
+turns the short way and has no position limit; a mimic joint has no q or v of its own
+(Pinocchio moves it with its source).
+
+Thread safety: a Robot may be shared by any number of threads calling :func:`step`.
+``step(robot, q, ...)`` keeps one IKConfiguration (its own ``pin.Data``), workspace and QP
+backends per Robot *and thread* (a ``threading.local`` on the Robot: freed with it).  An
+:class:`IKConfiguration`, the tasks (targets, scratch buffers) and stateful limits
+(:class:`AccelerationLimit`) belong to one thread at a time: give each thread its own.  The
+default limits and the backends of ``step(conf, ...)`` live on that IKConfiguration.  No module
+state refers to a Robot.
 """
 
 from . import backends, limits, tasks

@@ -7,6 +7,9 @@
   the QP optimum is the damped least-squares step Δq = −(Σ JᵀW²J + μI + λI)⁻¹ Σ α JᵀW²e
   (Eq. of ``tasks/base.py``), computed here with ``numpy.linalg.solve``; the row reports the
   largest difference of the OSQP answer (the default, sparse iterative backend).
+
+Both rows run on every model they are given (any robot :func:`anthroarm.load` takes; the
+catalog when ``models`` is None).
 """
 
 from __future__ import annotations
@@ -16,8 +19,6 @@ import pinocchio as pin
 
 from ...crosscheck import CheckRow
 
-MODELS = ("panda", "ur5", "talos_arm", "human_arm7", "prosthetic_arm")
-
 
 def rows(models, samples, rng) -> list[CheckRow]:
     import anthroarm as aa
@@ -25,9 +26,7 @@ def rows(models, samples, rng) -> list[CheckRow]:
 
     out = []
     n = max(3, min(int(samples), 20))
-    for name in MODELS:
-        if models is not None and name not in models:
-            continue
+    for name in (aa.models.names() if models is None else models):
         robot = aa.load(name)
         Q = robot.random_q(n, rng)
         worst = 0.0
@@ -51,7 +50,7 @@ def rows(models, samples, rng) -> list[CheckRow]:
         for q, q2 in zip(Q[:3], Q[1:4]):
             conf = qp.IKConfiguration(robot, q)
             ee = qp.FrameTask(robot, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2,
-                              target=robot.fk(q + 0.05 * (q2 - q)))
+                              target=robot.fk(pin.interpolate(robot.model, q, q2, 0.05)))
             post = qp.PostureTask(robot, cost=0.1, target=q2)
             dq = qp.step(conf, None, [ee, post], 1.0, limits=[big], solver="osqp", damping=1e-6)
             H = 1e-6 * np.eye(robot.nv)

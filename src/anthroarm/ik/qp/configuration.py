@@ -17,9 +17,18 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from ...chain import CONTINUOUS
+
 LOCAL = pin.ReferenceFrame.LOCAL
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 WORLD = pin.ReferenceFrame.WORLD
+
+
+def ranged_joints(chain) -> list:
+    """The joints of ``chain`` that have a position range of their own: the independent
+    revolute and prismatic joints (one entry of q, one of v; their limits may be infinite).
+    A continuous joint has no range and a mimic joint follows its source."""
+    return [j for j in chain.joints if not j.is_mimic and j.kind != CONTINUOUS]
 
 
 class IKConfiguration:
@@ -30,8 +39,12 @@ class IKConfiguration:
     robot : anthroarm.Robot
         The arm (its ``model`` is shared; this object owns a fresh ``pin.Data``).
     q : array (nq,), optional
-        Initial configuration (default ``robot.neutral()``).  It may lie outside the joint
-        limits: the limits of :func:`anthroarm.ik.qp.step` then pull it back inside.
+        Initial configuration (default ``robot.neutral()``), Pinocchio's layout ((cos θ, sin θ)
+        for a continuous joint).  It may lie outside the joint limits: the limits of
+        :func:`anthroarm.ik.qp.step` then pull it back inside.
+
+    ``lower``/``upper`` are the limits in q order (``robot.chain.lower``/``upper``, read-only;
+    ±1 on a continuous joint's entries, which :meth:`within_limits` does not test).
     """
 
     def __init__(self, robot, q=None):
@@ -40,8 +53,13 @@ class IKConfiguration:
         self.data: pin.Data = robot.model.createData()
         self.nq = robot.model.nq
         self.nv = robot.model.nv
-        self.lower = np.array(robot.model.lowerPositionLimit, dtype=float)
-        self.upper = np.array(robot.model.upperPositionLimit, dtype=float)
+        chain = robot.chain
+        self.lower = chain.lower
+        self.upper = chain.upper
+        # q indices of the bounded joints (continuous and mimic joints have no range of their own)
+        bounded = [j.idx_q for j in ranged_joints(chain)]
+        self._bounded = None if bounded == list(range(self.nq)) else np.array(bounded, dtype=int)
+        self._unit = chain.has_continuous
         self.q = np.zeros(self.nq)
         self._placements: dict = {}
         self._jacobians: dict = {}
@@ -55,13 +73,16 @@ class IKConfiguration:
     # ------------------------------------------------------------------ state
     def update(self, q=None) -> None:
         """Set ``q`` (a copy is kept) and recompute the kinematics.  ``ValueError`` for a wrong
-        shape or a non-finite entry (naming the joint)."""
+        shape, a non-finite entry or a continuous joint's (cos, sin) pair that is not a unit
+        vector (naming the joint)."""
         if q is not None:
             q = np.asarray(q, dtype=float)
             if q.shape != (self.nq,) or not np.isfinite(q).all():
                 self.robot.check_q(q if q.ndim == 1 else q, name="q")  # raises with the joint name
                 if q.shape != (self.nq,):
                     raise ValueError(f"{self.robot.name}: q must have shape ({self.nq},), got {q.shape}")
+            if self._unit:
+                self.robot.chain.check_unit(q)
             self.q = q.copy()
         pin.computeJointJacobians(self.model, self.data, self.q)
         self._placements.clear()
@@ -111,13 +132,20 @@ class IKConfiguration:
         self._jacobians.clear()
 
     def within_limits(self, tol: float = 0.0) -> bool:
-        """True when every joint lies within [lower − tol, upper + tol]."""
-        return bool(np.all(self.q >= self.lower - tol) and np.all(self.q <= self.upper + tol))
+        """True when every bounded joint lies within [lower − tol, upper + tol]."""
+        b = self._bounded
+        if b is None:
+            return bool(np.all(self.q >= self.lower - tol) and np.all(self.q <= self.upper + tol))
+        q = self.q[b]
+        return bool(np.all(q >= self.lower[b] - tol) and np.all(q <= self.upper[b] + tol))
 
     def limit_violations(self, tol: float = 0.0) -> list[str]:
-        """Names of the joints outside their limits (with the value and the range)."""
+        """Names of the bounded joints outside their limits (with the value and the range)."""
+        idx = range(self.nq) if self._bounded is None else self._bounded.tolist()
+        names = self.robot.chain.q_names
         out = []
-        for name, v, lo, hi in zip(self.robot.joint_names, self.q, self.lower, self.upper):
+        for i in idx:
+            v, lo, hi = self.q[i], self.lower[i], self.upper[i]
             if v < lo - tol or v > hi + tol:
-                out.append(f"{name}={v:.6g} not in [{lo:.6g}, {hi:.6g}]")
+                out.append(f"{names[i]}={v:.6g} not in [{lo:.6g}, {hi:.6g}]")
         return out

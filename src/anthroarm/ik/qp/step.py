@@ -25,7 +25,7 @@ of these against the general code; benchmarks/bench_qp_step.py times the step ag
 from __future__ import annotations
 
 import math
-import weakref
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,8 +35,6 @@ from .configuration import IKConfiguration
 from .limits import ConfigurationLimit, VelocityLimit
 from .limits.base import BIG, combine_into
 from .tasks.base import Task
-
-_ROBOT_CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass
@@ -91,29 +89,40 @@ class _Workspace:
         self.dtv = np.zeros(n)
 
 
-def _state(owner, robot):
-    """Per-robot (or per-IKConfiguration) cache of backends, default limits and a configuration."""
-    if isinstance(owner, IKConfiguration):
-        st = owner.__dict__.get("_qp_state")
-        if st is None:
-            st = owner.__dict__["_qp_state"] = {"backends": {}}
-        return st
-    st = _ROBOT_CACHE.get(robot)
+def _conf_state(conf) -> dict:
+    """The step state of an IKConfiguration: its backends, default limits and workspace."""
+    st = conf.__dict__.get("_qp_state")
     if st is None:
-        st = _ROBOT_CACHE[robot] = {"backends": {}}
+        st = conf.__dict__["_qp_state"] = {"backends": {}}
+    return st
+
+
+def _robot_state(robot) -> dict:
+    """The step state of ``step(robot, q, ...)`` for the calling thread: its own
+    IKConfiguration (hence ``pin.Data``), workspace and backends, kept in a ``threading.local``
+    on the Robot itself, so that threads never share them and nothing outlives the Robot."""
+    local = robot.__dict__.get("_qp_local")
+    if local is None:
+        local = robot.__dict__.setdefault("_qp_local", threading.local())   # atomic: one wins
+    st = getattr(local, "state", None)
+    if st is None:
+        st = local.state = {"backends": {}}
     return st
 
 
 def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", damping: float = 1e-12,
          constraints=(), full: bool = False):
-    """Joint velocity v (nv,) of one differential-IK step from ``q``.
+    """Joint velocity v (nv,) of one differential-IK step from ``q``: a tangent vector
+    (``pin.integrate(model, q, v dt)`` applies it; see :meth:`IKConfiguration.integrate_inplace`).
 
     Parameters
     ----------
     robot : Robot or IKConfiguration
-        With a Robot, a cached IKConfiguration is updated to ``q``.  With an IKConfiguration,
-        ``q`` may be ``None`` (use its current q, whose kinematics are already computed).
+        With a Robot, the calling thread's own IKConfiguration (kept on the Robot) is updated
+        to ``q``.  With an IKConfiguration, ``q`` may be ``None`` (use its current q, whose
+        kinematics are already computed).
     q : array (nq,) or None
+        Pinocchio's layout: a continuous joint takes (cos θ, sin θ).
     tasks : sequence of :class:`~anthroarm.ik.qp.tasks.Task`
     dt : float
         Step duration, s (> 0).
@@ -133,12 +142,12 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
         rb = conf.robot
         st = conf.__dict__.get("_qp_state")
         if st is None:
-            st = _state(conf, rb)
+            st = _conf_state(conf)
         if q is not None:
             conf.update(q)
     else:
         rb = robot
-        st = _state(robot, robot)
+        st = _robot_state(robot)
         conf = st.get("conf")
         if conf is None:
             conf = st["conf"] = IKConfiguration(robot, q)

@@ -2,7 +2,9 @@
 
     gain · (q_min ⊖ q) ≤ Δq ≤ gain · (q_max ⊖ q)
 
-with ⊖ the joint-space difference (m or rad).  A gain < 1 lets a joint approach its limit
+with ⊖ the joint-space difference (m or rad), on the joints that have a range
+(:func:`~anthroarm.ik.qp.configuration.ranged_joints` of ``robot.chain``): a continuous joint,
+whose q is (cos θ, sin θ), is unbounded, and a mimic joint follows its source's limits.  A gain < 1 lets a joint approach its limit
 geometrically instead of hitting it in one step (pink's default 0.5).  This is the book's joint
 range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step as hard inequalities
 instead of the exterior penalty (7-85).  Joints with an infinite limit are unbounded.  A joint
@@ -16,6 +18,7 @@ import math
 
 import numpy as np
 
+from ..configuration import ranged_joints
 from .base import Limit
 
 
@@ -25,21 +28,20 @@ class ConfigurationLimit(Limit):
     def __init__(self, robot, gain: float = 0.5, lower=None, upper=None):
         if not 0.0 < gain <= 1.0:
             raise ValueError(f"configuration limit gain must be in (0, 1], got {gain}")
-        self.model = robot.model
+        chain = robot.chain
         self.gain = float(gain)
-        self.lower = np.array(robot.model.lowerPositionLimit if lower is None else lower, dtype=float)
-        self.upper = np.array(robot.model.upperPositionLimit if upper is None else upper, dtype=float)
+        self.lower = np.array(chain.lower if lower is None else lower, dtype=float)
+        self.upper = np.array(chain.upper if upper is None else upper, dtype=float)
         if self.lower.shape != (robot.nq,) or self.upper.shape != (robot.nq,):
-            raise ValueError(f"lower/upper must have shape ({robot.nq},)")
+            raise ValueError(f"lower/upper must have shape ({robot.nq},) (q entries {list(chain.q_names)})")
         if np.any(self.lower > self.upper):
             raise ValueError("lower limit above upper limit for joints "
-                             f"{[n for n, a, b in zip(robot.joint_names, self.lower, self.upper) if a > b]}")
-        # map every velocity index to its configuration index (1-DOF joints); joints with
-        # nq != nv (continuous, spherical ...) have no position limit here
+                             f"{[n for n, a, b in zip(chain.q_names, self.lower, self.upper) if a > b]}")
+        # map every velocity index of a joint with a range to its configuration index; the
+        # others (continuous joints) have no position limit here
         qidx = np.full(robot.nv, -1)
-        for j in robot.model.joints[1:]:
-            if j.nq == 1 and j.nv == 1:
-                qidx[j.idx_v] = j.idx_q
+        for j in ranged_joints(chain):
+            qidx[j.idx_v] = j.idx_q
         ok = qidx >= 0
         self._qidx = np.where(ok, qidx, 0)
         self._fin_lo = ok & np.isfinite(self.lower[self._qidx])

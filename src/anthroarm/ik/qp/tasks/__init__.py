@@ -8,10 +8,10 @@ from .orientation import OrientationTask
 from .position import PositionTask
 from .posture import HUMAN_ARM7_COMFORT, PostureTask, comfortable_posture
 from .relative_frame import RelativeFrameTask
-from .swivel import SWIVEL_FRAMES, SwivelTask, swivel_angle, swivel_from_points
+from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swivel_from_points
 
 __all__ = [
     "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
     "DampingTask", "JointCouplingTask", "SwivelTask", "mimic_tasks", "comfortable_posture",
-    "HUMAN_ARM7_COMFORT", "SWIVEL_FRAMES", "swivel_angle", "swivel_from_points",
+    "HUMAN_ARM7_COMFORT", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]

@@ -17,12 +17,15 @@ from .base import Task
 
 
 def _joint_index(robot, name: str) -> int:
-    model = robot.model
-    if not model.existJointName(name):
-        raise ValueError(f"{robot.name}: unknown joint {name!r}; joints: {', '.join(robot.joint_names)}")
-    j = model.joints[model.getJointId(name)]
+    """Velocity index of the 1-DOF joint ``name`` (from ``robot.chain``)."""
+    chain = robot.chain
+    names = [j.name for j in chain.joints]
+    if name not in names:
+        raise ValueError(f"{robot.name}: unknown joint {name!r}; joints: {', '.join(names)}")
+    j = chain.joint(name)
     if j.nv != 1:
-        raise ValueError(f"{robot.name}: joint {name!r} has {j.nv} DOF; coupling needs 1-DOF joints")
+        raise ValueError(f"{robot.name}: joint {name!r} is a mimic joint (it has no velocity of its own: "
+                         f"Pinocchio moves it with {chain.joints[j.mimic.source].name!r}); couple that joint instead")
     return j.idx_v
 
 
@@ -69,11 +72,13 @@ class JointCouplingTask(Task):
 
 def mimic_tasks(robot, **kw) -> list[JointCouplingTask]:
     """One :meth:`JointCouplingTask.mimic` per URDF ``<mimic>`` tag whose joints are both DOFs
-    of the model.  Note: :func:`anthroarm.load` builds the Pinocchio model without mimic support
-    and freezes mimic joints (see :mod:`anthroarm.robot`), so for its robots this list is empty
-    and the coupling is declared with :meth:`JointCouplingTask.mimic` on free joints."""
+    of the model.  :func:`anthroarm.load` models ``<mimic>`` joints in Pinocchio (they carry no q
+    or v of their own and follow their source: ``robot.chain.joints[i].mimic``), so for a URDF
+    loaded with mimic support this list is empty; it serves models whose mimic joints were
+    built as free joints."""
     tasks = []
-    dofs = set(robot.joint_names)
+    chain = robot.chain
+    dofs = {chain.joints[i].name for i in chain.independent}
     for j in robot.urdf.robot.joints:
         m = getattr(j, "mimic", None)
         if m is None or j.name not in dofs or m.joint not in dofs:

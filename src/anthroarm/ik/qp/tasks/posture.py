@@ -2,6 +2,9 @@
 
     e(q) = q ⊖ q_ref  (pin.difference),   J = I   (nv × nv)
 
+so the error of a continuous joint ((cos θ, sin θ) in q) is the shortest angle to its reference,
+in (−π, π].
+
 Used with a small cost it resolves redundancy (the book's redundancy handling by a penalty on
 the configuration, Ch. 7 §7-6 (7-84)–(7-86), becomes a QP regulariser).
 
@@ -9,7 +12,8 @@ the configuration, Ch. 7 §7-6 (7-84)–(7-86), becomes a QP regulariser).
 20° flexed and 15° abducted, humerus unrotated, elbow flexed 80°, forearm mid-pronation, wrist
 straight.  These are the centres of the lowest-load ("score 1") bands of RULA (McAtamney &
 Corlett, Applied Ergonomics 24(2), 1993: upper arm −20…20°, lower arm 60…100°, wrist 0°),
-clipped into the joint limits.  Other robots get the middle of their joint ranges.
+clipped into the joint limits.  Other robots get the middle of their joint ranges (θ = 0 for
+a joint without a finite range, a continuous joint included).
 """
 
 from __future__ import annotations
@@ -34,15 +38,20 @@ HUMAN_ARM7_COMFORT = {
 
 
 def comfortable_posture(robot) -> np.ndarray:
-    """Reference posture (nq,) of ``robot``: :data:`HUMAN_ARM7_COMFORT` for the human arm
-    (joints matched by name), the middle of the joint ranges otherwise (neutral for unbounded
-    joints); always within the limits."""
-    lo, hi = np.asarray(robot.lower, float), np.asarray(robot.upper, float)
-    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), robot.neutral())
-    names = robot.joint_names
-    if robot.nq == robot.nv and all(n in HUMAN_ARM7_COMFORT for n in names):
-        mid = np.array([HUMAN_ARM7_COMFORT[n] for n in names])
-    return np.clip(mid, lo, hi)
+    """Reference posture (nq,) of ``robot`` from ``robot.chain``: :data:`HUMAN_ARM7_COMFORT`
+    when every independent joint has a value there (joints matched by name), else the middle
+    of each joint's range (θ = 0, clipped into the range, where it is not finite: a continuous
+    joint gets (cos 0, sin 0)); always within the limits."""
+    chain = robot.chain
+    joints = [chain.joints[i] for i in chain.independent]
+    lo = np.array([j.lower for j in joints])
+    hi = np.array([j.upper for j in joints])
+    if all(j.name in HUMAN_ARM7_COMFORT for j in joints):
+        theta = np.array([HUMAN_ARM7_COMFORT[j.name] for j in joints])
+    else:
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        theta = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), 0.0)
+    return chain.configuration(np.clip(theta, lo, hi))
 
 
 class PostureTask(Task):

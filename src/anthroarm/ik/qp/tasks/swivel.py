@@ -25,33 +25,63 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ....chain import REVOLUTE
 from ..configuration import IKConfiguration
 from .base import Task
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
-#: (shoulder, elbow, wrist) frame names of the catalog arms with a human layout.
-SWIVEL_FRAMES = {
-    "human_arm7": ("shoulder_flexion", "elbow_flexion", "wrist_deviation"),
-    "human_right_arm": ("right_shoulder_Z", "right_elbow_Z", "right_wrist_Z"),
-}
+def _joint_origins(chain) -> dict:
+    """World position (m) of every joint origin at θ = 0, from the chain's placements."""
+    T = {-1: np.eye(4)}
+    for j in chain.joints:                 # parents come first (Pinocchio's order)
+        T[j.index] = T[j.parent] @ j.placement
+    return {i: M[:3, 3] for i, M in T.items() if i >= 0}
+
+
+def human_layout(chain, frame=None) -> tuple[str, str, str] | None:
+    """(shoulder, elbow, wrist) joint frames of a human-like arm, read from the geometry of
+    ``chain`` (no names): the revolute joints on the path to ``frame`` (default the tool)
+    whose origins coincide form exactly three groups, the first of three joints (a spherical
+    shoulder), then the elbow, then the wrist; each group is named by its first joint.
+    ``None`` for any other layout (an offset elbow or wrist, six joints on a line ...)."""
+    origins = _joint_origins(chain)
+    path = [chain.joints[i] for i in chain.path(frame)]
+    if any(j.kind != REVOLUTE or j.is_mimic for j in path):
+        return None
+    scale = 1.0 + max((float(np.linalg.norm(p)) for p in origins.values()), default=0.0)
+    groups: list[list] = []
+    for j in path:
+        if groups and np.linalg.norm(origins[j.index] - origins[groups[-1][0].index]) <= 1e-9 * scale:
+            groups[-1].append(j)
+        else:
+            groups.append([j])
+    if len(groups) != 3 or len(groups[0]) != 3:
+        return None
+    names = tuple(g[0].name for g in groups)
+    if not all(chain.frame(n).joint == g[0].index for n, g in zip(names, groups)):
+        return None                        # a joint frame named differently from its joint
+    return names
 
 
 def swivel_frames(robot, frames=None) -> tuple[str, str, str]:
-    """(shoulder, elbow, wrist) frame names: ``frames`` if given, else the catalog default.
+    """(shoulder, elbow, wrist) frame names: ``frames`` if given, else the human-like layout
+    found in ``robot.chain`` (:func:`human_layout`).
 
-    Raises ``ValueError`` for a robot without a known human arm layout."""
+    Raises ``ValueError`` for a robot without such a layout (pass ``frames=``)."""
     if frames is not None:
         if len(frames) != 3:
             raise ValueError(f"swivel frames must be (shoulder, elbow, wrist), got {frames!r}")
         for f in frames:
             robot.frame_id(f)  # UnknownFrameError lists the valid ones
         return tuple(frames)
-    name = getattr(robot, "name", None)
-    if name not in SWIVEL_FRAMES:
-        raise ValueError(f"{name}: no default (shoulder, elbow, wrist) frames for the swivel angle; "
-                         f"pass frames=(...). Known arms: {', '.join(SWIVEL_FRAMES)}")
-    return SWIVEL_FRAMES[name]
+    names = human_layout(robot.chain)
+    if names is None:
+        raise ValueError(f"{robot.name}: no human-like (shoulder, elbow, wrist) layout on the path to "
+                         f"{robot.chain.tool!r} (three co-located shoulder joints, then elbow and wrist joints "
+                         "with common origins); pass frames=(shoulder, elbow, wrist) from "
+                         f"{', '.join(robot.frame_names)}")
+    return names
 
 
 def swivel_from_points(S, E, W, ref=(0.0, 0.0, -1.0)):
