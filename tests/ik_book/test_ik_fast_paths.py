@@ -243,7 +243,7 @@ def test_generated_fk_matches_pinocchio():
         Tq = robot.fk(Q + 1e-7)                                  # a wrong target must be detected
         bounds = [0, *splits, robot.nq]
         for po in (False, True):
-            fk = FKStages(robot.spec, splits, position_only=po)
+            fk = FKStages(robot.chain, splits, position_only=po)
             rows = tuple(T[:, i, j] for i in range(3) for j in range(4))
             st = None
             for k, f in enumerate(fk.numpy):
@@ -267,7 +267,7 @@ def test_generated_fk_matches_pinocchio():
 def test_compiled_fk_check_matches_pinocchio(name):
     """The compiled FK check returns Pinocchio's max |FK(q) − T| for right and wrong targets."""
     robot = aa.load(name)
-    kern = analytic_c.kernel_for(plan_for(robot, name, robot.spec.params))
+    kern = analytic_c.kernel_for(plan_for(robot))
     rng = np.random.default_rng(8)
     Q = rng.uniform(-np.pi, np.pi, (200, robot.nq))
     T = robot.fk(Q)
@@ -294,7 +294,7 @@ def test_cos_sin_half_angle_tangent():
 def test_compiled_kernel_is_used_and_cached(tmp_path, monkeypatch):
     monkeypatch.setenv("ANTHROARM_CACHE", str(tmp_path))
     robot = aa.load("sixr_arm", s0=0.45)                     # a fresh parameterisation
-    plan = plan_for(robot, "sixr_arm", robot.spec.params)
+    plan = plan_for(robot)
     assert plan.c_kernel is None
     T = robot.fk(robot.random_q(3, np.random.default_rng(0)))
     res = analytic(robot, T[0])
@@ -313,7 +313,7 @@ def test_fallback_without_compiler(monkeypatch):
     g = analytic_batch(robot, T, _impl="general")
     _assert_same_batch(analytic_batch(robot, T), g, robot)
     _assert_same_single(analytic(robot, T[0]), g[0])
-    assert plan_for(robot, "prosthetic_arm", robot.spec.params).c_kernel is False or analytic_c.compiler() is None
+    assert plan_for(robot).c_kernel is False or analytic_c.compiler() is None
     assert "pure-Python" in analytic_c.status()
     with pytest.raises(RuntimeError, match="unavailable"):
         analytic(robot, T[0], _impl="c")
@@ -326,7 +326,7 @@ def test_fallback_when_disabled(monkeypatch):
     T = robot.fk(q)
     res = analytic(robot, T, swivel=swivel_angle(robot, q))
     assert np.abs(res.solutions - q).max(1).min() < 1e-9
-    assert analytic_c.kernel_for(plan_for(robot, "human_arm7", robot.spec.params)) is None
+    assert analytic_c.kernel_for(plan_for(robot)) is None
     assert "disabled" in analytic_c.status()
 
 
@@ -338,7 +338,7 @@ def test_compile_failure_falls_back(monkeypatch, tmp_path):
     robot = aa.load("planar2r", l1=0.9)
     res = analytic(robot, robot.fk(np.array([0.3, 0.4])))
     assert res.success
-    assert plan_for(robot, "planar2r", robot.spec.params).c_kernel is False
+    assert plan_for(robot).c_kernel is False
     assert "unavailable" in analytic_c.status()
 
 

@@ -1,4 +1,9 @@
-"""A small exact expression graph with symbolic differentiation, used by :mod:`.lagrange`.
+"""The one code generator of anthroarm: an exact expression graph with symbolic
+differentiation and its emitters (Python/numpy and C).
+
+Used by :mod:`anthroarm.dynamics.lagrange` (M, C q̇, g, τ; compiled by
+:mod:`anthroarm.dynamics.ccode`) and by :mod:`anthroarm.ik.fk_codegen` (the chain product that
+verifies closed-form IK candidates, rendered as ``math``, numpy and C stage functions).
 
 Why not plain sympy expression trees?  The kinetic energy of a 7-DOF arm written out as one
 sympy expression has hundreds of thousands of terms, and sympy's automatic distribution of
@@ -18,8 +23,11 @@ expressions, exact differentiation — but stores them as a *graph* (a straight-
   sum and product rules node by node, so their results are again exact expressions.
 
 :meth:`Graph.to_sympy` turns any node into an ordinary sympy expression (``s_k -> sin(q_k)``)
-for display, simplification and independent checks; :func:`emit` prints a set of outputs as
-straight-line code (Python/numpy or C).
+for display, simplification and independent checks.  :func:`emit_python` / :func:`emit_c` print
+a set of outputs as straight-line functions; :func:`straight_line` is their common core for
+callers that write their own function frame (statements for the shared subexpressions,
+single-use nodes inlined as nested expressions, nodes computed by an earlier function taken as
+given).
 """
 
 from __future__ import annotations
@@ -169,8 +177,9 @@ class Graph:
         return Node(self, x) if isinstance(x, int) else x
 
     # ------------------------------------------------------------------ structure
-    def cone(self, outputs) -> list[int]:
-        """Ids of every node the outputs depend on, ascending (= a topological order)."""
+    def cone(self, outputs, stop=()) -> list[int]:
+        """Ids of every node the outputs depend on, ascending (= a topological order); the
+        search does not go below the ids in ``stop`` (values computed elsewhere)."""
         seen: set[int] = set()
         stack = [o.i for o in outputs if isinstance(o, Node)]
         while stack:
@@ -179,7 +188,7 @@ class Graph:
                 continue
             seen.add(i)
             op = self.ops[i]
-            if op[0] != "in":
+            if op[0] != "in" and i not in stop:
                 for a in op[1:]:
                     if isinstance(a, int) and a not in seen:
                         stack.append(a)
@@ -342,30 +351,82 @@ def refs(g: Graph, i: int) -> list[int]:
 
 
 def expr_text(g: Graph, i: int, names: dict[int, str], inname, lang: str = "py") -> str:
-    """One line's right-hand side."""
+    """One line's right-hand side: node ``i`` over its operands, each printed by name (an
+    input by ``inname``); an operand without a name is printed inline as a nested expression
+    (parenthesised so that the evaluation order is the graph's)."""
 
-    def ref(x):
+    def ref(x, pos):
         if isinstance(x, float):
             return repr(x) if lang == "py" else _c_float(x)
         op = g.ops[x]
         if op[0] == "in":
             return inname(op[1])
-        return names[x]
+        name = names.get(x)
+        if name is not None:
+            return name
+        t = expr_text(g, x, names, inname, lang)
+        if op[0] == "add" and pos != "add_l" or op[0] == "mul" and pos == "mul_r" \
+                or t.startswith("-") and pos in ("sub_r", "neg"):
+            return f"({t})"
+        return t
 
     op = g.ops[i]
     _, a, b = op
     if op[0] == "add":
         if isinstance(a, float):
-            return f"{ref(b)} + {ref(a)}" if a >= 0 else f"{ref(b)} - {ref(-a)}"
+            return f"{ref(b, 'add_l')} + {ref(a, 'add_r')}" if a >= 0 else f"{ref(b, 'add_l')} - {ref(-a, 'sub_r')}"
         st = _see_through(g, i, a, b)
         if st is not None:  # a - x
-            return f"{ref(st[0])} - {ref(st[1])}"
-        return f"{ref(a)} + {ref(b)}"
-    if isinstance(a, float):
-        if a == -1.0:
-            return f"-{ref(b)}"
-        return f"{ref(a)}*{ref(b)}"
-    return f"{ref(a)}*{ref(b)}"
+            return f"{ref(st[0], 'add_l')} - {ref(st[1], 'sub_r')}"
+        return f"{ref(a, 'add_l')} + {ref(b, 'add_r')}"
+    if isinstance(a, float) and a == -1.0:
+        return f"-{ref(b, 'neg')}"
+    return f"{ref(a, 'mul_l')}*{ref(b, 'mul_r')}"
+
+
+def straight_line(g: Graph, outputs, inname, *, known: dict | None = None, lang: str = "py",
+                  prefix: str = "x", name_outputs: bool = True) -> tuple[list[tuple[str, str]], object]:
+    """Statements ``(name, right-hand side)`` computing ``outputs`` in order, and ``ref(value)``:
+    the text of an output (a name, an input, a constant or a short inline expression).
+
+    Nodes used more than once (and the outputs) get a statement named ``{prefix}{id}``; nodes
+    used once are inlined into their user (``name_outputs=False``: an output used nowhere else
+    is inlined into ``ref(output)``, for the caller to place).  ``known`` maps ids of nodes
+    already computed (for example by an earlier stage function) to their names: they are read,
+    not recomputed."""
+    known = dict(known or {})
+    out_ids = [o.i for o in outputs if isinstance(o, Node)]
+    printed: set[int] = set()          # nodes whose text is needed (a negation seen through is not)
+    stack = [i for i in out_ids if g.ops[i][0] != "in" and i not in known]
+    while stack:
+        i = stack.pop()
+        if i not in printed:
+            printed.add(i)
+            stack += [a for a in refs(g, i) if g.ops[a][0] != "in" and a not in known]
+    order = sorted(printed)
+    uses: dict[int, int] = {}
+    for i in order:
+        for a in refs(g, i):
+            uses[a] = uses.get(a, 0) + 1
+    for i in out_ids:
+        uses[i] = uses.get(i, 0) + (2 if name_outputs else 1)
+    names = dict(known)
+    named = [i for i in order if uses.get(i, 0) > 1]
+    for i in named:
+        names[i] = f"{prefix}{i}"
+    stmts = [(names[i], expr_text(g, i, names, inname, lang)) for i in named]
+
+    def ref(o) -> str:
+        if isinstance(o, Node):
+            o = o.i
+        if isinstance(o, float):
+            return repr(o) if lang == "py" else _c_float(o)
+        op = g.ops[o]
+        if op[0] == "in":
+            return inname(op[1])
+        return names[o] if o in names else expr_text(g, o, names, inname, lang)
+
+    return stmts, ref
 
 
 def _c_float(x: float) -> str:

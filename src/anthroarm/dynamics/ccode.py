@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UnsupportedModelError
-from ._graph import emit_c
+from ..codegen.graph import emit_c
 
 FLAGS = ["-O2", "-fPIC", "-shared", "-fno-fast-math", "-std=c99"]
 _LOCK = threading.Lock()

@@ -68,7 +68,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InertiaError, UnsupportedModelError
-from ._graph import Graph, emit_python, snap
+from ..codegen.graph import Graph, emit_python, snap
 
 #: bump when the generated code changes (part of the cache key)
 GENERATOR_VERSION = "1"

@@ -8,7 +8,7 @@ branches are leading axes of size 2 (e.g. the 6R arm's θ1 has shape (2, 1, 1, N
 shared quantities are computed once per distinct branch prefix.  cos/sin of a branch pair come
 from symmetry (θ + π, −θ) or from the atan2 arguments rather than new transcendental calls.
 
-Verification: the generated FK of the catalog spec (:mod:`anthroarm.ik.fk_codegen`) evaluated
+Verification: the generated FK of ``robot.chain`` (:mod:`anthroarm.ik.fk_codegen`) evaluated
 on the wrapped joint values with the same broadcasting, an independent forward computation of
 every candidate; kept if the code is OK, the candidate lies inside the joint limits and
 ``max |FK(q) − T| ≤ tol`` (3×4 pose entries; the position only for planar2r).
@@ -319,7 +319,7 @@ def human(E, plan, swivel):
 CHUNK = 2048
 
 
-def solve(name, plan, E, tol, position_only, swivel=None):
+def solve(plan, E, tol, position_only, swivel=None):
     """Candidates, verification and validity of N poses (rows E (16, N)), in chunks of
     :data:`CHUNK` poses.
 
@@ -330,7 +330,7 @@ def solve(name, plan, E, tol, position_only, swivel=None):
     out = None
     for a in range(0, N, CHUNK):
         b = min(N, a + CHUNK)
-        part = _solve_chunk(name, plan, E[:, a:b] if (a, b) != (0, N) else E, tol, position_only,
+        part = _solve_chunk(plan, E[:, a:b] if (a, b) != (0, N) else E, tol, position_only,
                             None if swivel is None else swivel[a:b])
         if (a, b) == (0, N):
             return part
@@ -341,15 +341,15 @@ def solve(name, plan, E, tol, position_only, swivel=None):
     return (*out, part[6])
 
 
-def _solve_chunk(name, plan, E, tol, position_only, swivel):
-    if name == "sixr_arm":
-        qs, code, sing, bshape = sixr(E, plan)
-    elif name == "prosthetic_arm":
-        qs, code, sing, bshape = prosthetic(E, plan)
-    elif name == "planar2r":
-        qs, code, sing, bshape = planar(E, plan)
-    else:
+#: the kernel of each closed-form family (models.closed_forms names the arms of each)
+KERNELS = {"spherical_wrist_6r": sixr, "prosthetic_6r": prosthetic, "planar_2r": planar}
+
+
+def _solve_chunk(plan, E, tol, position_only, swivel):
+    if plan.form.swivel:
         qs, code, sing, bshape = human(E, plan, swivel)
+    else:
+        qs, code, sing, bshape = KERNELS[plan.family](E, plan)
     N = E.shape[1]
     full = bshape + (N,)
     wrapped, inside = [], None

@@ -106,7 +106,8 @@ class CellTable:
         Branch choice: the solution with label ``branch`` if given, else the valid solution
         nearest to ``q_ref`` (default: the joint-range middle), so that the 8 corners of a cell
         come from one consistent branch.  ``progress`` shows a tqdm bar (one step per z slice)."""
-        name, params = _require(robot)
+        form = _require(robot).form
+        name, params = robot.spec.name, dict(robot.spec.params)
         R = np.asarray(rotation, float)
         if R.shape != (3, 3) or not np.isfinite(R).all() or np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
             raise ValueError(f"rotation must be a 3x3 rotation matrix, got {R!r}")
@@ -135,7 +136,7 @@ class CellTable:
             from tqdm.auto import tqdm
 
             it = tqdm(it, desc=f"cell table {name} D={D * 1000:g} mm", unit="slice")
-        kw = {"swivel": swivel} if name == "human_arm7" else {}
+        kw = {"swivel": swivel} if form.swivel else {}
         for k in it:
             P = origin + D * np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, k)], -1)
             T = np.tile(np.eye(4), (P.shape[0], 1, 1))

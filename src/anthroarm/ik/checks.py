@@ -2,7 +2,7 @@
 
 For each book arm with a closed form: random configurations inside the limits → Pinocchio FK →
 :func:`anthroarm.ik.analytic_batch` → Pinocchio FK of every returned solution; the row reports
-the largest pose difference (3×4 entries; position only for planar2r) and whether every pose
+the largest pose difference (3×4 entries; position only where the registry says so) and whether every pose
 got at least one solution (a pose without one counts as an infinite error)."""
 
 from __future__ import annotations
@@ -10,24 +10,26 @@ from __future__ import annotations
 import numpy as np
 
 from ..crosscheck import CheckRow
-from .closed_form import SUPPORTED, analytic_batch, swivel_angle
+from ..models.closed_forms import names
+from .closed_form import analytic_batch, closed_form_info, swivel_angle
 
 
 def rows(models, samples, rng) -> list[CheckRow]:
     import anthroarm as aa
 
     out = []
-    for name in SUPPORTED:
+    for name in names():
         if models is not None and name not in models:
             continue
         robot = aa.load(name)
+        form = closed_form_info(robot)
         Q = robot.random_q(samples, rng)
         T = robot.fk(Q)
-        kw = {"swivel": swivel_angle(robot, Q)} if name == "human_arm7" else {}
+        kw = {"swivel": swivel_angle(robot, Q)} if form.swivel else {}
         res = analytic_batch(robot, T, **kw)
         i, b = np.nonzero(res.valid)
         Tf = robot.fk(res.solutions[i, b]) if len(i) else np.zeros((0, 4, 4))
-        if name == "planar2r":
+        if form.position_only:
             err = np.abs(Tf[:, :3, 3] - T[i, :3, 3]).max(1) if len(i) else np.zeros(0)
         else:
             err = np.abs(Tf[:, :3, :] - T[i, :3, :]).max(axis=(1, 2)) if len(i) else np.zeros(0)

@@ -5,15 +5,16 @@ that lies inside the joint limits, each labelled by its branch and each verified
 kinematics before it is returned; :func:`analytic_batch` does the same for ``N`` poses at once
 (vectorised numpy over poses × branches).
 
-Supported models (:func:`has_analytic`):
+Families of closed forms (which arm has which: the registry
+:mod:`anthroarm.models.closed_forms`; :func:`has_analytic` asks it for a robot):
 
-``sixr_arm`` (Fig. 6-3)
+``spherical_wrist_6r`` (the 6R arm of Fig. 6-3, ``sixr_arm``)
     The book's procedure (7-1)–(7-15) with the corrections of the ch7 notes §0.4 (L uses θ3;
     N = −cos θ5, Eq. (7-12); step 6 / (7-13)–(7-14) solve θ6), written with atan2 and rotation
     matrices: wrist centre D = p − P·a, θ1 from (7-2) (two: θ1, θ1 + π), θ2/θ3 from the planar
     triangle B–C–D (7-4)/(7-6) (two), θ4 from z4 ⊥ z5 (7-8) (two: wrist flip), θ5 from
     N = −cos θ5 and θ6 from (7-14).  8 branches (Fig. 7-1).
-``prosthetic_arm`` (Fig. 7-2, Table 7.1)
+``prosthetic_6r`` (Fig. 7-2, Table 7.1, ``prosthetic_arm``)
     The book's order (7-17)–(7-31): wrist W = C − L3·n, elbow E on the sphere |E| = L1, the
     sphere |E − W| = L2 and the plane (E − C)·m = 0 (7-17), θ1/θ2 from E (7-18)/(7-19), θ4 from
     the triangle O–E–W (7-24), θ3 from (7-26), θ5/θ6 from x6 = l (7-28)–(7-31).  The elbow is
@@ -21,9 +22,9 @@ Supported models (:func:`has_analytic`):
     works where the book's Cramer determinant Δ of (7-20)/(7-21) is zero (Table 7.2 row 1);
     :func:`prosthetic_book_procedure` is the book's Cramer-rule version.  Branches: the two
     elbow roots of (7-22) × shoulder (θ1, θ2) / (θ1 + π, −θ2) × elbow flexion sign.
-``planar2r`` (Fig. 7-14)
+``planar_2r`` (Fig. 7-14, ``planar2r``)
     Position-only by default (the mechanism has 2 DOF): the two elbow branches ±θ2.
-``human_arm7`` (§6-3)
+``srs_7r`` (§6-3, ``human_arm7``)
     Redundant (7 DOF): the elbow swivel angle φ (rotation of the elbow about the shoulder–wrist
     axis) is the parameter of the one-parameter family.  ``swivel=`` a scalar or an array of
     angles (rad); default: a grid of 36 angles over [−π, π).  Per swivel angle: elbow sign ×
@@ -31,7 +32,9 @@ Supported models (:func:`has_analytic`):
 
 Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool frame
 (``robot.tool``) in the base frame; joint values in radians.  Lengths are read from
-``robot.spec.params``, limits from ``robot.lower`` / ``robot.upper``.
+``robot.spec.params`` (the keys the registry names), limits from ``robot.lower`` /
+``robot.upper``.  A robot without a registered closed form raises
+:class:`~anthroarm.errors.UnsupportedModelError` pointing to ``aa.ik.solve``.
 
 Implementations (same formulas, branches, limit wrap, FK check, duplicate filter and reasons):
 the general vectorised path in this module (the reference of the tests); for plainly valid
@@ -39,7 +42,8 @@ float64 input the fast paths — batches: structure-of-arrays numpy kernels
 (:mod:`.analytic_soa`); single poses: the compiled kernel (:mod:`.analytic_c`, built with the
 system C compiler on first use and cached) or, without a compiler, scalar ``math`` kernels
 (:mod:`.analytic_scalar`).  The fast paths verify every candidate with a chain product generated
-from the catalog spec (:mod:`.fk_codegen`), the same model Pinocchio loads.  Per-robot
+from ``robot.chain`` (:mod:`.fk_codegen`), the same model Pinocchio holds; the general path with
+Pinocchio's FK (few candidates) or ``robot.chain.serial`` (many).  Per-robot
 constants are cached (:mod:`.analytic_plan`).  At exactly singular poses (measure zero) the paths
 may differ by a pair of nearly coincident roots or by the representative of a singular family.
 """
@@ -53,15 +57,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import UnsupportedModelError
+from ..models import closed_forms as _registry
 from . import analytic_c as _c
 from . import analytic_scalar as ks
 from . import analytic_soa as _soa
-from .analytic_plan import plan_for
+from .analytic_plan import cached_plan, plan_for
 
 TWO_PI = 2.0 * np.pi
 HALF_PI = 0.5 * np.pi
-SUPPORTED = ("sixr_arm", "prosthetic_arm", "planar2r", "human_arm7")
-#: default swivel grid of human_arm7 (rad)
+#: the closed-form families (models.closed_forms names the arms of each)
+SIXR, PROSTHETIC, PLANAR, SRS = "spherical_wrist_6r", "prosthetic_6r", "planar_2r", "srs_7r"
+#: default swivel grid of a redundant (srs_7r) arm (rad)
 DEFAULT_SWIVEL = np.linspace(-np.pi, np.pi, 36, endpoint=False)
 
 # failure codes of a candidate (per pose and branch); 0 = a candidate solution exists
@@ -155,25 +161,69 @@ class AnalyticBatchResult:
 
 
 # ---------------------------------------------------------------------------- model checks
-def has_analytic(robot) -> bool:
-    """True if :func:`analytic` has a closed form for this robot: a book model in
-    :data:`SUPPORTED` whose tool frame is the catalog's tool."""
+def _form(robot, frame=None):
+    """The registry entry of ``robot`` if its closed form solves for ``frame`` (default: the
+    tool), else None: a catalog arm with a registered closed form, all its joints present (none
+    locked away), the tool frame its formulas end at, and ``frame`` that tool."""
     spec = getattr(robot, "spec", None)
-    return bool(spec is not None and spec.name in SUPPORTED and robot.name == spec.name
-                and robot.tool == spec.tool_name)
+    form = _registry.lookup(spec)
+    if form is None or robot.nq != form.nq or robot.tool != spec.tool_name \
+            or len(robot.chain.path(robot.tool)) != form.nq:
+        return None
+    if frame is not None and robot.chain.frame(frame).name != robot.tool:
+        return None
+    return form
+
+
+def has_analytic(robot, frame=None) -> bool:
+    """True if :func:`analytic` has a closed form for ``robot`` at ``frame`` (a name or a
+    Pinocchio frame id; default the tool).  Which arms have one is the registry
+    :mod:`anthroarm.models.closed_forms`; an unknown frame raises
+    :class:`~anthroarm.errors.UnknownFrameError`."""
+    return _form(robot, frame) is not None
+
+
+def closed_form_info(robot, frame=None):
+    """The registry entry (:class:`anthroarm.models.closed_forms.ClosedForm`: family, branches,
+    swivel, position_only, cost_us) of ``robot`` at ``frame``, or None without a closed form."""
+    return _form(robot, frame)
+
+
+def analytic_cost(robot, frame=None) -> float:
+    """Cost hint of one :func:`analytic` call at ``frame`` in µs per pose (the compiled
+    kernel's benchmark time; a redundant arm's per swivel angle), ``inf`` without a closed form."""
+    form = _form(robot, frame)
+    return float("inf") if form is None else form.cost_us
+
+
+def _plan(robot):
+    """The plan of a robot with a closed form for its tool, else None (no exception)."""
+    plan = cached_plan(robot)
+    if plan is None:
+        form = _form(robot)
+        if form is not None:
+            plan = plan_for(robot, form)
+    return plan
 
 
 def _require(robot):
-    if not has_analytic(robot):
+    plan = _plan(robot)
+    if plan is None:
         spec = getattr(robot, "spec", None)
-        if spec is not None and spec.name in SUPPORTED and robot.tool != spec.tool_name:
+        form = _registry.lookup(spec)
+        if form is not None and robot.tool != spec.tool_name:
             raise UnsupportedModelError(
                 f"{robot.name}: the closed form solves for the tool frame {spec.tool_name!r}, "
                 f"not {robot.tool!r}")
+        if form is not None:
+            raise UnsupportedModelError(
+                f"{robot.name}: the closed form solves all {form.nq} joints of {spec.name}; this robot has "
+                f"{robot.nq} (joints locked or left out): use aa.ik.solve(robot, T)")
         raise UnsupportedModelError(
-            f"{robot.name}: no closed-form IK; supported models: {', '.join(SUPPORTED)} "
-            "(use aa.ik.solve for a numerical solution)")
-    return robot.spec.name, robot.spec.params
+            f"{robot.name}: no closed-form IK is registered for this robot (closed forms exist for "
+            f"{', '.join(_registry.names())}; anthroarm.models.closed_forms); "
+            "use aa.ik.solve(robot, T) for a numerical solution")
+    return plan
 
 
 # ---------------------------------------------------------------------------- input checks
@@ -221,154 +271,39 @@ def _wrap_into_limits(Q, lo, hi, tol=1e-9):
 
 
 # ---------------------------------------------------------------------------- FK used for verification
-class _ChainFK:
-    """Vectorised FK of a ChainSpec (joint origins, unit axes along ±x/±y/±z or general,
-    tool origin), used to verify every candidate: independent of the IK formulas."""
-
-    def __init__(self, spec):
-        self.steps = []
-        for j in spec.joints:
-            ax = np.asarray(j.axis, float)
-            ax = ax / np.linalg.norm(ax)
-            self.steps.append((j.origin[:3, :3].copy(), j.origin[:3, 3].copy(), ax, j.type))
-        self.tool_R = spec.tool_origin[:3, :3].copy()
-        self.tool_p = spec.tool_origin[:3, 3].copy()
-
-    def __call__(self, Q):
-        """FK of configurations Q (..., nq) -> (..., 4, 4)."""
-        R, p, shape = self._fk_flat(Q)
-        n = R[0][0].shape[0]
-        T = np.zeros((n, 4, 4))
-        for i in range(3):
-            for j in range(3):
-                T[:, i, j] = R[i][j]
-            T[:, i, 3] = p[i]
-        T[:, 3, 3] = 1.0
-        return T.reshape(*shape, 4, 4)
-
-    def residual(self, Q, T, position_only=False):
-        """max |FK(Q) − T| over the 3×4 pose entries (or the position only); Q (..., nq), T
-        broadcastable to (..., 4, 4).  Returns (...)."""
-        R, p, shape = self._fk_flat(Q)
-        Tb = np.broadcast_to(T, shape + (4, 4)).reshape(-1, 4, 4)
-        res = np.zeros(R[0][0].shape[0])
-        for i in range(3):
-            np.maximum(res, np.abs(p[i] - Tb[:, i, 3]), out=res)
-            if not position_only:
-                for j in range(3):
-                    np.maximum(res, np.abs(R[i][j] - Tb[:, i, j]), out=res)
-        return res.reshape(shape)
-
-    def _fk_flat(self, Q):
-        """Rotation entries R[i][j] and position p[i] as flat (M,) arrays (fast elementwise)."""
-        Q = np.asarray(Q, float)
-        shape = Q.shape[:-1]
-        Q = Q.reshape(-1, Q.shape[-1])
-        n = Q.shape[0]
-        one, zero = np.ones(n), np.zeros(n)
-        R = [[one if i == j else zero for j in range(3)] for i in range(3)]
-        p = [zero, zero, zero]
-
-        def mul_const(R, C):  # R @ C, C constant 3x3 (skip zero entries)
-            out = [[None] * 3 for _ in range(3)]
-            for i in range(3):
-                for j in range(3):
-                    acc = None
-                    for k in range(3):
-                        c = C[k, j]
-                        if c == 0.0:
-                            continue
-                        term = R[i][k] if c == 1.0 else (-R[i][k] if c == -1.0 else c * R[i][k])
-                        acc = term if acc is None else acc + term
-                    out[i][j] = zero if acc is None else acc
-            return out
-
-        for j, (Ro, po, ax, typ) in enumerate(self.steps):
-            for i in range(3):
-                acc = p[i]
-                for k in range(3):
-                    if po[k] != 0.0:
-                        acc = acc + R[i][k] * po[k]
-                p[i] = acc
-            R = mul_const(R, np.where(np.abs(Ro) < 1e-15, 0.0, Ro))
-            q = Q[:, j]
-            if typ == "prismatic":
-                for i in range(3):
-                    p[i] = p[i] + (R[i][0] * ax[0] + R[i][1] * ax[1] + R[i][2] * ax[2]) * q
-                continue
-            c, s = np.cos(q), np.sin(q)
-            k = int(np.argmax(np.abs(ax)))
-            if abs(abs(ax[k]) - 1.0) < 1e-15:
-                if ax[k] < 0:
-                    s = -s
-                a, b = [(1, 2), (2, 0), (0, 1)][k]  # rotation about e_k mixes columns a, b
-                for i in range(3):
-                    ca, cb = R[i][a], R[i][b]
-                    R[i][a] = c * ca + s * cb
-                    R[i][b] = c * cb - s * ca
-            else:
-                K = np.array([[0, -ax[2], ax[1]], [ax[2], 0, -ax[0]], [-ax[1], ax[0], 0]])
-                K2 = K @ K
-                Rq = [[(1.0 if i == jj else 0.0) + s * K[i, jj] + (1 - c) * K2[i, jj] for jj in range(3)] for i in range(3)]
-                R = [[R[i][0] * Rq[0][jj] + R[i][1] * Rq[1][jj] + R[i][2] * Rq[2][jj] for jj in range(3)] for i in range(3)]
-        for i in range(3):
-            acc = p[i]
-            for k in range(3):
-                if self.tool_p[k] != 0.0:
-                    acc = acc + R[i][k] * self.tool_p[k]
-            p[i] = acc
-        R = mul_const(R, np.where(np.abs(self.tool_R) < 1e-15, 0.0, self.tool_R))
-        R = [[np.broadcast_to(R[i][j], (n,)) for j in range(3)] for i in range(3)]
-        p = [np.broadcast_to(p[i], (n,)) for i in range(3)]
-        return R, p, shape
-
-
-_FK_CACHE: dict = {}
 _DEDUP_DIR = np.random.default_rng(12345).uniform(0.5, 1.5, 16)
 
 
-_PIN_DATA: dict = {}
-
-
 def _fk_residual(robot, Qw, Ts, position_only):
-    """max |FK(q) − T| (3×4 entries, or position) of candidates Qw (N, B, nq) against Ts (N, 4, 4).
-    Few candidates: Pinocchio's FK (one C++ call each); many: the vectorised chain FK."""
-    N, B = Qw.shape[:2]
-    if N * B > 64:
-        return _fk_for(robot).residual(Qw, Ts[:, None], position_only=position_only)
+    """max |FK(q) − T| (3×4 entries, or position) of candidates Qw (N, B, nq) against Ts (N, 4, 4),
+    +inf for a non-finite candidate.  Few candidates: Pinocchio's FK (one C++ call each, the
+    calling thread's ``robot.data``); many: the batched chain FK (``robot.chain.serial``)."""
     import pinocchio as pin
 
-    key = id(robot.model)
-    d = _PIN_DATA.get(key)
-    if d is None or d[0] is not robot.model:
-        d = (robot.model, robot.model.createData())
-        _PIN_DATA[key] = d
-    model, data = d
-    fid = robot.tool_id
+    N, B = Qw.shape[:2]
+    finite = np.isfinite(Qw).all(-1)
+    if N * B > 64:
+        Tf = robot.chain.serial(robot.tool).fk(np.where(finite[..., None], Qw, 0.0).reshape(N * B, -1))
+        Tf = Tf.reshape(N, B, 4, 4)
+        d = np.abs(Tf[..., :3, 3] - Ts[:, None, :3, 3]).max(-1)
+        if not position_only:
+            d = np.maximum(d, np.abs(Tf[..., :3, :3] - Ts[:, None, :3, :3]).max(axis=(-1, -2)))
+        return np.where(finite, d, np.inf)
+    model, data, fid = robot.model, robot.data, robot.tool_id
     res = np.empty((N, B))
     for i in range(N):
         Ti = Ts[i]
         for b in range(B):
-            q = Qw[i, b]
-            if not np.isfinite(q).all():
+            if not finite[i, b]:
                 res[i, b] = np.inf
                 continue
-            pin.framesForwardKinematics(model, data, q)
+            pin.framesForwardKinematics(model, data, Qw[i, b])
             M = data.oMf[fid]
             e = np.abs(M.translation - Ti[:3, 3]).max()
             if not position_only:
                 e = max(e, np.abs(M.rotation - Ti[:3, :3]).max())
             res[i, b] = e
     return res
-
-
-def _fk_for(robot) -> _ChainFK:
-    key = id(robot.spec)
-    fk = _FK_CACHE.get(key)
-    if fk is None or fk[0] is not robot.spec:
-        fk = (robot.spec, _ChainFK(robot.spec))
-        _FK_CACHE[key] = fk
-    return fk[1]
 
 
 # ---------------------------------------------------------------------------- 6R arm (Fig. 6-3)
@@ -608,13 +543,15 @@ def _human(Rt, H, l1, l2, l3, swivel):
 
 
 def swivel_angle(robot, q) -> np.ndarray:
-    """Swivel angle φ (rad) of human_arm7 configurations ``q`` (nq,) or (N, nq): the rotation
-    of the elbow about the shoulder–wrist axis n, measured from u (world −z projected ⊥ n, or −y
+    """Swivel angle φ (rad) of configurations ``q`` (nq,) or (N, nq) of a redundant arm
+    (closed-form family ``srs_7r``, e.g. human_arm7): the rotation of the elbow about the shoulder–wrist axis n, measured from u (world −z projected ⊥ n, or −y
     if n is vertical) towards v = n × u.  A straight elbow uses the elbow axis: d = σ n × x_E
     (σ = sign sin q4).  ``analytic(robot, FK(q), swivel=swivel_angle(robot, q))`` contains q."""
-    name, prm = _require(robot)
-    if name != "human_arm7":
-        raise UnsupportedModelError(f"{robot.name}: the swivel angle is defined for human_arm7 only")
+    plan = _require(robot)
+    if plan.family != SRS:
+        raise UnsupportedModelError(f"{robot.name}: the swivel angle is defined for a redundant shoulder-elbow-wrist "
+                                    f"arm (closed-form family {SRS}); this one is {plan.family}")
+    prm = plan.params
     q = robot.check_q(q)
     Q = np.atleast_2d(q)
     l1, l2 = prm["l1"], prm["l2"]
@@ -634,22 +571,22 @@ def swivel_angle(robot, q) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- public API
-def _candidates(name, prm, Rt, pt, swivel):
-    if name == "sixr_arm":
+def _candidates(family, prm, Rt, pt, swivel):
+    if family == SIXR:
         Q, code, sing = _sixr(Rt, pt, prm["s0"], prm["h2"], prm["s3"], prm["P"])
         return Q, code, sing, None, SIXR_BRANCHES
-    if name == "prosthetic_arm":
+    if family == PROSTHETIC:
         Q, code, sing = _prosthetic(Rt, pt, prm["L1"], prm["L2"], prm["L3"])
         return Q, code, sing, None, PROSTHETIC_BRANCHES
-    if name == "planar2r":
+    if family == PLANAR:
         Q, code, sing = _planar(Rt, pt, prm["l1"], prm["l2"])
         return Q, code, sing, None, PLANAR_BRANCHES
-    if name == "human_arm7":
+    if family == SRS:
         Q, code, sing, sw = _human(Rt, pt, prm["l1"], prm["l2"], prm["l3"], swivel)
         S = swivel.shape[1]
         labels = [f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES] if S > 1 else list(HUMAN_BRANCHES)
         return Q, code, sing, sw, labels
-    raise AssertionError(name)
+    raise AssertionError(family)
 
 
 def _swivel_array(swivel, N, grid_1d=False):
@@ -696,11 +633,11 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     path below.  ``_impl`` (private, for tests and benchmarks): "auto" (= "python" for
     batches), "python", "c" (the compiled kernel of :mod:`.analytic_c` on the whole batch) or
     "general"."""
-    name, prm = _require(robot)
+    plan = _require(robot)
+    family, prm = plan.family, plan.params
     if position_only is None:
-        position_only = name == "planar2r"
-    fast = _fast_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal,
-                            _single_grid, _impl)
+        position_only = plan.form.position_only
+    fast = _fast_candidates(robot, plan, T, swivel, position_only, tol, tol_orthonormal, _single_grid, _impl)
     if fast is not None:
         Qw, valid, code, inside, res, sing, swv, labels = fast
         N, B = valid.shape
@@ -708,8 +645,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
         Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal, position_only=position_only)
         N = Ts.shape[0]
         Rt, pt = Ts[:, :3, :3], Ts[:, :3, 3]
-        sw = _swivel_array(swivel, N, grid_1d=_single_grid) if name == "human_arm7" else None
-        Q, code, sing, swv, labels = _candidates(name, prm, Rt, pt, sw)
+        sw = _swivel_array(swivel, N, grid_1d=_single_grid) if family == SRS else None
+        Q, code, sing, swv, labels = _candidates(family, prm, Rt, pt, sw)
         B = Q.shape[1]
         Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
         res = _fk_residual(robot, Qw, Ts, position_only)                  # FK check (N, B)
@@ -738,7 +675,7 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
             sing[i] = None      # outside the workspace: no configuration, nothing singular about it
     return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swv is None else np.where(valid, swv, np.nan),
-                               residuals=np.where(valid, res, np.nan), singular=sing, model=name)
+                               residuals=np.where(valid, res, np.nan), singular=sing, model=robot.name)
 
 
 def _kernel(plan, impl, single=True):
@@ -759,13 +696,13 @@ def _kernel(plan, impl, single=True):
 
 
 @functools.lru_cache(maxsize=64)
-def _labels(name: str, S: int) -> tuple:
-    if name == "human_arm7" and S > 1:
+def _labels(family: str, S: int) -> tuple:
+    if family == SRS and S > 1:
         return tuple(f"{b},swivel#{k}" for k in range(S) for b in HUMAN_BRANCHES)
-    return tuple(_SCALAR_BRANCHES[name])
+    return tuple(_SCALAR_BRANCHES[family])
 
 
-def _fast_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthonormal, single_grid, impl):
+def _fast_candidates(robot, plan, T, swivel, position_only, tol, tol_orthonormal, single_grid, impl):
     """Candidates of :func:`analytic_batch` from the compiled kernel or from
     :func:`.analytic_soa.solve`, or None where the general path must answer (``impl`` "general",
     not a plain (N, 4, 4) float64 array, any invalid pose — the general path raises the error —,
@@ -777,22 +714,22 @@ def _fast_candidates(robot, name, prm, T, swivel, position_only, tol, tol_orthon
             or not isinstance(tol_orthonormal, (float, int)):
         return None
     N = T.shape[0]
-    plan = plan_for(robot, name, prm)
+    family = plan.family
     kern = _kernel(plan, impl, single=False)
-    sw = _swivel_array(swivel, N, grid_1d=single_grid) if name == "human_arm7" else None
+    sw = _swivel_array(swivel, N, grid_1d=single_grid) if family == SRS else None
     if kern is not None:
         out = kern.batch(T, sw, tol, int(position_only), tol_orthonormal)
         if out is None:
             return None
         Qw, valid, inside, res, code, sing = out
         code = np.broadcast_to(code[:, None], valid.shape)
-        sing = _SING_ARRAYS[name][sing]
+        sing = _SING_ARRAYS[family][sing]
     else:
         E = _soa.pose_rows(T)
         if not _soa.poses_ok(E, tol_orthonormal, position_only):
             return None
-        Qw, valid, code, inside, res, sing, _ = _soa.solve(name, plan, E, tol, position_only, sw)
-    labels = list(_labels(name, 1 if sw is None else sw.shape[1]))
+        Qw, valid, code, inside, res, sing, _ = _soa.solve(plan, E, tol, position_only, sw)
+    labels = list(_labels(family, 1 if sw is None else sw.shape[1]))
     swv = np.repeat(sw, 8, axis=1) if sw is not None else None
     return Qw, valid, code, inside, res, sing, swv, labels
 
@@ -830,13 +767,14 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     ``ANTHROARM_IK_C=0`` disables it) — else by the scalar kernels of :mod:`.analytic_scalar`."""
     arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
     if method == "book":
-        name, prm = _require(robot)
-        if name != "prosthetic_arm":
-            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) exists for prosthetic_arm only")
+        plan = _require(robot)
+        if plan.family != PROSTHETIC:
+            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) exists for the prosthetic arm "
+                             f"(closed-form family {PROSTHETIC}) only")
         Ts, single = _check_poses(arr, tol_orthonormal=tol_orthonormal)
         if not single:
             raise ValueError("method='book' takes one pose")
-        return _book_result(robot, Ts[0], prm, tol)
+        return _book_result(robot, Ts[0], plan.params, tol)
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     if arr.ndim == 2 and _impl != "general":
@@ -861,8 +799,9 @@ def _analytic_general(robot, arr, *, swivel=None, position_only=None, tol=1e-9, 
 
 
 # ---------------------------------------------------------------------------- single-pose fast path
-_SCALAR_BRANCHES = {"sixr_arm": SIXR_BRANCHES, "prosthetic_arm": PROSTHETIC_BRANCHES,
-                    "planar2r": PLANAR_BRANCHES, "human_arm7": HUMAN_BRANCHES}
+_SCALAR_BRANCHES = {SIXR: SIXR_BRANCHES, PROSTHETIC: PROSTHETIC_BRANCHES, PLANAR: PLANAR_BRANCHES,
+                    SRS: HUMAN_BRANCHES}
+_SCALAR_KERNELS = {SIXR: ks.sixr, PROSTHETIC: ks.prosthetic, PLANAR: ks.planar}
 
 
 def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, impl):
@@ -870,17 +809,19 @@ def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonorma
     kernels (:mod:`.analytic_scalar`); None where the vectorised path must answer (unsupported
     robot, anything unusual in the input — it raises the error —; the scalar kernels also leave
     swivel grids to it)."""
-    if not has_analytic(robot) or type(arr) is not np.ndarray or arr.dtype != np.float64 \
+    if type(arr) is not np.ndarray or arr.dtype != np.float64 \
             or not isinstance(tol, (float, int)) or not isinstance(tol_orthonormal, (float, int)):
         return None
-    name = robot.spec.name
+    plan = _plan(robot)
+    if plan is None:
+        return None
+    family = plan.family
     if position_only is None:
-        position_only = name == "planar2r"
-    plan = plan_for(robot, name, robot.spec.params)
+        position_only = plan.form.position_only
     if arr.shape == (4, 4):
         kern = _kernel(plan, impl)
         if kern is not None:
-            return _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonormal)
+            return _single_c(kern, robot, family, arr, swivel, position_only, tol, tol_orthonormal)
         rows = arr.tolist()
         r3 = rows[3]
         if not math.isfinite(sum(rows[0]) + sum(rows[1]) + sum(rows[2]) + sum(r3)):
@@ -896,7 +837,7 @@ def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonorma
         rows = [[1.0, 0.0, 0.0, x], [0.0, 1.0, 0.0, y], [0.0, 0.0, 1.0, z]]
     else:
         return None
-    if name == "human_arm7":
+    if family == SRS:
         if swivel is None:
             return None                                   # a grid: the vectorised path
         if isinstance(swivel, (float, int)):
@@ -909,18 +850,14 @@ def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonorma
         if sw is None or not math.isfinite(sw):
             return None
         cand = ks.human(rows, plan, tol, sw, position_only)
-    elif name == "sixr_arm":
-        cand = ks.sixr(rows, plan, tol, position_only)
-    elif name == "prosthetic_arm":
-        cand = ks.prosthetic(rows, plan, tol, position_only)
     else:
-        cand = ks.planar(rows, plan, tol, position_only)
-    labels = _SCALAR_BRANCHES[name]
+        cand = _SCALAR_KERNELS[family](rows, plan, tol, position_only)
+    labels = _SCALAR_BRANCHES[family]
     B, nq = len(labels), plan.nq
     if cand.code != OK:
         return AnalyticIKResult(np.zeros((0, nq)), [], _REASONS[cand.code],
-                                swivel=None if name != "human_arm7" else np.zeros(0),
-                                residuals=np.zeros(0), singular=cand.singular, model=name)
+                                swivel=None if family != SRS else np.zeros(0),
+                                residuals=np.zeros(0), singular=cand.singular, model=robot.name)
     sols = cand.sols
     if not sols:                                          # why: the general path's wording
         code = np.zeros(B, dtype=int)
@@ -930,8 +867,8 @@ def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonorma
             inside[b] = True
             res[b] = r
         return AnalyticIKResult(np.zeros((0, nq)), [], _reason_for(code, inside, res, tol, robot),
-                                swivel=None if name != "human_arm7" else np.zeros(0),
-                                residuals=np.zeros(0), singular=cand.singular, model=name)
+                                swivel=None if family != SRS else np.zeros(0),
+                                residuals=np.zeros(0), singular=cand.singular, model=robot.name)
     if len(sols) > 1:
         sols = _dedup_scalar(sols)
     flat = []
@@ -941,27 +878,27 @@ def _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonorma
         solutions=np.array(flat).reshape(len(sols), nq),
         branches=[labels[s[0]] for s in sols],
         reason=None,
-        swivel=None if name != "human_arm7" else np.full(len(sols), sw),
+        swivel=None if family != SRS else np.full(len(sols), sw),
         residuals=np.array([s[2] for s in sols]),
-        singular=cand.singular, model=name)
+        singular=cand.singular, model=robot.name)
 
 
 #: singular-configuration messages by the kernels' codes (0: none)
 _SING_TEXT = {
-    "sixr_arm": (None, "wrist singularity (sin θ5 = 0: only θ4 + θ6 is determined; θ4 = 0 returned)",
+    SIXR: (None, "wrist singularity (sin θ5 = 0: only θ4 + θ6 is determined; θ4 = 0 returned)",
                  "shoulder singularity (wrist centre on the z0 axis: θ1 is free; θ1 = 0 returned)"),
-    "prosthetic_arm": (None, "elbow singularity (straight arm, sin θ4 = 0: θ3 + θ5 only determined; θ3 = 0 returned)",
+    PROSTHETIC: (None, "elbow singularity (straight arm, sin θ4 = 0: θ3 + θ5 only determined; θ3 = 0 returned)",
                        "shoulder singularity (elbow on the vertical axis: θ1 is free; θ1 = -90° returned)"),
-    "human_arm7": (None, "straight elbow: the swivel angle then turns the elbow axis about the arm"),
-    "planar2r": (None,),
+    SRS: (None, "straight elbow: the swivel angle then turns the elbow axis about the arm"),
+    PLANAR: (None,),
 }
 _SING_ARRAYS = {k: np.array(v, dtype=object) for k, v in _SING_TEXT.items()}
 
 
-def _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonormal):
+def _single_c(kern, robot, family, arr, swivel, position_only, tol, tol_orthonormal):
     """One pose through the compiled kernel (validation, candidates, FK check, duplicates in C)."""
     sw = None
-    if name == "human_arm7":
+    if family == SRS:
         if isinstance(swivel, (float, int)):
             sw = (float(swivel),)
             if not math.isfinite(sw[0]):
@@ -975,7 +912,7 @@ def _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonorma
         return None
     code, sing, bl, sols, res, (arrs, S) = out
     nq = kern.nq
-    sing_text = _SING_TEXT[name][sing]
+    sing_text = _SING_TEXT[family][sing]
     if code != OK or not bl:
         if code != OK:
             reason = _REASONS[code]
@@ -984,12 +921,12 @@ def _single_c(kern, robot, name, arr, swivel, position_only, tol, tol_orthonorma
             reason = _reason_for(np.zeros(B, dtype=int), arrs["inside"][:B].astype(bool), arrs["res"][:B].copy(),
                                  tol, robot)
         return AnalyticIKResult(np.zeros((0, nq)), [], reason, swivel=None if sw is None else np.zeros(0),
-                                residuals=np.zeros(0), singular=sing_text, model=name)
-    labels = _labels(name, S)
+                                residuals=np.zeros(0), singular=sing_text, model=robot.name)
+    labels = _labels(family, S)
     return AnalyticIKResult(
         solutions=sols, branches=[labels[b] for b in bl], reason=None,
         swivel=None if sw is None else np.array([sw[b // 8] for b in bl], dtype=float),
-        residuals=res, singular=sing_text, model=name)
+        residuals=res, singular=sing_text, model=robot.name)
 
 
 def _dedup_scalar(sols):
@@ -1089,16 +1026,15 @@ def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float
 def _book_result(robot, T, prm, tol):
     sols, reason = prosthetic_book_procedure(T, prm["L1"], prm["L2"], prm["L3"])
     if not sols:
-        return AnalyticIKResult(np.zeros((0, robot.nq)), [], reason, model="prosthetic_arm")
+        return AnalyticIKResult(np.zeros((0, robot.nq)), [], reason, model=robot.name)
     Q = np.array(sols)
     Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
-    Tf = _fk_for(robot)(Qw)
-    res = np.abs(Tf[:, :3, :] - T[None, :3, :]).max(axis=(1, 2))
+    res = _fk_residual(robot, Qw[None], T[None], False)[0]
     ok = inside & (res <= tol)
     labels = ["elbow_root=+", "elbow_root=-"]
     if not ok.any():
         why = ("the book's asin-based θ3/θ6 (7-27)/(7-30) give no FK-consistent solution inside the limits "
                f"(residuals {', '.join(f'{r:.3g}' for r in res)}); use method='robust'")
-        return AnalyticIKResult(np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model="prosthetic_arm")
+        return AnalyticIKResult(np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model=robot.name)
     return AnalyticIKResult(Qw[ok], [lb for lb, k in zip(labels, ok) if k], None, residuals=res[ok],
-                            model="prosthetic_arm")
+                            model=robot.name)
