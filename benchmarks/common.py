@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from anthroarm.urdf_io import atomic_write_text
+from anthroarm._io import atomic_write_text
 
 RESULTS_DIR = Path(__file__).resolve().parent / "results"
 #: where ``--quick`` runs write (git-ignored): results/ holds committed full runs only

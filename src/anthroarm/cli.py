@@ -103,7 +103,7 @@ def _parse_params(items) -> dict:
 
 def cmd_urdf(a) -> int:
     from . import models
-    from .urdf_io import atomic_write_text
+    from ._io import atomic_write_text
 
     if a.model not in models.BOOK_MODELS:
         if a.model in models.ERD_ARMS:
@@ -484,6 +484,40 @@ def _dls_restarts(robot, T, q0, frame, tol, restarts=20, iters=200):
     return _IKOutcome(best, ok, "success" if ok else "not_converged", *best_err, total, "damped least squares")
 
 
+# ---------------------------------------------------------------------------------- cache
+def _add_cache(sub):
+    p = sub.add_parser(
+        "cache",
+        help="show or empty the cache of generated code",
+        description="The disk cache of generated Lagrange code and compiled C kernels "
+                    "($ANTHROARM_CACHE, else $XDG_CACHE_HOME/anthroarm, else the user cache folder).",
+        epilog="examples: anthroarm cache info --json; anthroarm cache clear",
+    )
+    p.add_argument("action", choices=["info", "clear"], help="info: folder, entries and size; clear: delete them")
+    p.add_argument("--json", action="store_true", help="print as JSON")
+    p.set_defaults(func=cmd_cache)
+
+
+def cmd_cache(a) -> int:
+    from . import cache
+
+    if a.action == "clear":
+        where = str(cache.root())
+        n = cache.clear()
+        print(json.dumps({"folder": where, "removed": n}) if a.json else f"removed {n} entries from {where}")
+        return 0
+    i = cache.info()
+    if a.json:
+        print(json.dumps(i, indent=1))
+    else:
+        print(f"folder  {i['folder']}")
+        print(f"entries {i['entries']} ({i['bytes'] / 1e6:.2f} MB)")
+        for sub, (n, size) in i["by_folder"].items():
+            print(f"  {sub:<9} {n:4d} entries {size / 1e6:8.2f} MB")
+        print(f"status  {i['status']}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
         prog="anthroarm",
@@ -491,7 +525,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="run 'anthroarm COMMAND --help' for the options and an example of each command",
     )
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
-    for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench):
+    for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache):
         add(sub)
     return ap
 

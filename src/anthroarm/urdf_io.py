@@ -14,13 +14,13 @@ from __future__ import annotations
 import math
 import os
 import re
-import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from lxml import etree
 
+from ._io import atomic_write_text  # noqa: F401  (moved to _io; viewer.py still imports it from here)
 from .errors import (
     MeshNotFoundError,
     PackagePathError,
@@ -411,20 +411,3 @@ def _check_tree(path, links: list[str], parent_of: dict[str, str], joint_of: dic
         f"kinematic cycle through link {cur!r}: {where}links {_name_list(cycle)} "
         f"(joints {_name_list(joint_of[ln] for ln in cycle)})",
     )
-
-
-def atomic_write_text(path, text: str | bytes) -> None:
-    """Write ``text`` (str as UTF-8, or bytes) to ``path`` atomically: a temp file in the same
-    folder, then a rename, so a reader sees the old file or the new one, never a partial one;
-    the temp file is removed on failure.  The folder must exist (``FileNotFoundError``)."""
-    path = Path(path)
-    if not path.parent.is_dir():
-        raise FileNotFoundError(f"folder {path.parent} does not exist (cannot write {path.name})")
-    data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-    try:
-        tmp.write_bytes(data)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()

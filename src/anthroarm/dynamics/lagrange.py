@@ -13,9 +13,14 @@ with :math:`T=\tfrac12\dot q^T M(q)\dot q` give
            \Gamma_{ijk}=\tfrac12\Big(\frac{\partial M_{ij}}{\partial q_k}+\frac{\partial M_{ik}}{\partial q_j}-\frac{\partial M_{jk}}{\partial q_i}\Big),
            \quad g=\frac{\partial V}{\partial q}.
 
-**Derivation.**  :func:`derive` reads a Pinocchio model (joint placements, joint axes, link
-inertias, gravity) and writes T and V as exact expressions of ``s_k = sin q_k``,
-``c_k = cos q_k`` (prismatic: ``q_k``) and ``qd_k``, following the recursive link velocities
+**Derivation.**  :func:`derive` reads ``robot.chain`` (:mod:`anthroarm.chain`: joint placements,
+axes, link inertias, gravity, mimic relations) and writes T and V as exact expressions of
+``s_k = sin θ_k``, ``c_k = cos θ_k`` (prismatic: ``θ_k``) of every joint and of the generalized
+velocities ``q̇``.  A continuous (unbounded revolute) joint is a revolute joint without limits:
+one angle θ, one velocity.  A mimic joint θ_j = a θ_i + b has no coordinate of its own: it
+moves with θ̇_j = a q̇_i inside T and V and ∂/∂θ_i reaches it by the chain rule, so M, C q̇, g
+and τ are in the independent (nv) coordinates, as Pinocchio's ``crba``/``rnea`` return them.
+The derivation following the recursive link velocities
 (each link's twist in its own frame, the form of Eq. (8-27)):
 
     ω_i = Rᵢᵀ ω_λ + a_i q̇_i,   v_i = Rᵢᵀ (v_λ + ω_λ × p_i) (+ a_i q̇_i for a prismatic joint),
@@ -24,7 +29,7 @@ inertias, gravity) and writes T and V as exact expressions of ``s_k = sin q_k``,
 
 where ``R_i, p_i`` is the placement of joint i in its parent's frame times the joint motion,
 ``c_i`` the centre of mass and ``I_i`` the rotational inertia about it (link frame, SI).  The
-expressions live in a hash-consed graph (:mod:`._graph`): exact symbolic algebra in which
+expressions live in a hash-consed graph (:mod:`anthroarm.codegen.graph`): exact symbolic algebra in which
 equal subexpressions are shared, so the derivation of a 7-DOF arm takes well under a second
 instead of the minutes a fully expanded sympy expression needs.  From T and V, by exact
 symbolic differentiation only:
@@ -41,12 +46,14 @@ The explicit Christoffel symbols and fully written-out sympy matrices are availa
 models (:func:`sympy_matrices`, :func:`christoffel`, :func:`latex`).
 
 **Generated code.**  The outputs are printed as straight-line numpy code (one line per graph
-node: common subexpressions appear once), vectorised over a batch ``(N, nq)``, plus a scalar
-variant for single calls; optionally C compiled with the system compiler
-(``backend="c"``).  The code is cached on disk under ``$ANTHROARM_CACHE`` (default
-``~/.cache/anthroarm``) keyed by a hash of the model's dynamic parameters, written
-atomically (deriving and generating the code of a 7-DOF arm takes ~0.1 s, so nothing needs to
-ship pre-generated).
+node: common subexpressions appear once), vectorised over a batch, plus a scalar variant for
+single calls; optionally C compiled with the system compiler (``backend="c"``, :mod:`.ccode`).
+The generated functions take the joint positions θ of every joint (``chain.angles(q)``);
+:class:`LagrangeDynamics` takes q in the robot's layout (nq: a continuous joint's (cos, sin)
+pair) and converts.  The code lives in the one disk cache (:mod:`anthroarm.cache`: the user
+cache folder or ``$ANTHROARM_CACHE``), keyed by ``chain.key()`` and the generator version,
+verified before it is executed, written atomically (deriving and generating the code of a
+7-DOF arm takes ~0.1 s, so nothing needs to ship pre-generated).
 
 >>> import anthroarm as aa
 >>> from anthroarm.dynamics import lagrange
@@ -56,131 +63,122 @@ ship pre-generated).
 
 from __future__ import annotations
 
-import hashlib
 import math
-import importlib.util
 import os
 import threading
 import time
+import types
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
+from .. import cache
+from ..chain import CONTINUOUS, PRISMATIC, REVOLUTE
 from ..errors import InertiaError, UnsupportedModelError
 from ..codegen.graph import Graph, emit_python, snap
 
 #: bump when the generated code changes (part of the cache key)
-GENERATOR_VERSION = "1"
+GENERATOR_VERSION = "2"
 
-
-_AXES = {"x": 0, "y": 1, "z": 2}
 
 
 # ====================================================================== model description
-@dataclass
-class JointInfo:
-    """One 1-DOF joint of the chain, read from the Pinocchio model (SI units).
-
-    ``R0, p0``: placement of the joint frame in the parent joint's frame (at q = 0);
-    ``axis``: unit joint axis in the joint frame; ``kind``: "R" revolute or "P" prismatic;
-    ``mass, com, inertia``: link inertia in the joint frame (inertia about the CoM)."""
-
-    name: str
-    parent: int  # index into the joint list, -1 = base
-    kind: str
-    axis: np.ndarray
-    R0: np.ndarray
-    p0: np.ndarray
-    mass: float
-    com: np.ndarray
-    inertia: np.ndarray
-
-
-@dataclass
+@dataclass(frozen=True, eq=False)
 class ChainInfo:
+    """The Lagrange view of a :class:`~anthroarm.chain.Chain` (``robot.chain``), inertias validated.
+
+    Generalized coordinates are the independent joints' positions θ (rad or m) in velocity
+    order (``chain.nv`` of them: a continuous joint is one angle, a mimic joint none).  Joint k
+    (every joint of ``chain.joints``, mimic ones included) moves with θ̇_k = ``factor[k]`` ·
+    v[``coord[k]``]: factor 1 for an independent joint, the multiplier for a mimic joint
+    (θ_k = a θ_i + b)."""
+
     name: str
-    joints: list[JointInfo]
-    gravity: np.ndarray
+    chain: object
+    coord: tuple      # per joint: index of its generalized coordinate (0..n-1)
+    factor: tuple     # per joint: dθ_k / dv_coord
+    source: tuple     # per joint: joint index whose velocity input drives it (itself or its mimic source)
+
+    @property
+    def joints(self):
+        return self.chain.joints
+
+    @property
+    def gravity(self) -> np.ndarray:
+        return self.chain.gravity
 
     @property
     def n(self) -> int:
-        return len(self.joints)
+        """Number of generalized coordinates (= ``chain.nv``)."""
+        return self.chain.nv
+
+    @property
+    def njoints(self) -> int:
+        return len(self.chain.joints)
 
     def key(self) -> str:
-        """Hash of everything the equations depend on (exact float bits)."""
-        h = hashlib.sha256()
-        h.update(f"lagrange-v{GENERATOR_VERSION}|".encode())
-        h.update(np.asarray(self.gravity, float).tobytes())
-        for j in self.joints:
-            h.update(f"|{j.parent}|{j.kind}|".encode())
-            for a in (j.axis, j.R0, j.p0, np.array([j.mass]), j.com, j.inertia):
-                h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-        return h.hexdigest()[:20]
+        """Cache key of the generated code: the generator version and ``chain.key()``."""
+        return cache.key("lagrange", GENERATOR_VERSION, self.chain.key(), length=20)
 
 
-def chain_info(model, name: str | None = None) -> ChainInfo:
-    """Extract joints, axes, placements and inertias from a ``pin.Model``.
-
-    Raises :class:`UnsupportedModelError` for joints that are not 1-DOF revolute/prismatic
-    (free-flyer, spherical, planar, unbounded revolute with nq = 2, helical...) and
-    :class:`InertiaError` for negative masses, non-symmetric or indefinite inertia tensors and
-    massless chains."""
-    import pinocchio as pin
-
-    name = name or getattr(model, "name", "model")
-    data = model.createData()
-    q0 = pin.neutral(model)
-    pin.forwardKinematics(model, data, q0)
-    joints: list[JointInfo] = []
-    for jid in range(1, model.njoints):
-        jm = model.joints[jid]
-        jname = model.names[jid]
-        short = jm.shortname()
-        if jm.nq != 1 or jm.nv != 1:
-            raise UnsupportedModelError(
-                f"{name}: joint {jname!r} is {short} (nq={jm.nq}, nv={jm.nv}); the symbolic Lagrange "
-                "engine supports 1-DOF revolute and prismatic joints only (no free-flyer, spherical, "
-                "planar or unbounded joints)")
-        if "Mimic" in short or "Helical" in short or "Universal" in short:
-            raise UnsupportedModelError(f"{name}: joint {jname!r} of type {short} is not supported")
-        S = np.asarray(data.joints[jid].S).reshape(6)
-        lin, ang = S[:3], S[3:]
-        if np.linalg.norm(ang) > 1e-12 and np.linalg.norm(lin) < 1e-12:
-            kind, axis = "R", ang
-        elif np.linalg.norm(lin) > 1e-12 and np.linalg.norm(ang) < 1e-12:
-            kind, axis = "P", lin
-        else:
-            raise UnsupportedModelError(f"{name}: joint {jname!r} ({short}) is neither revolute nor prismatic")
-        axis = np.array([snap(a) for a in axis / np.linalg.norm(axis)])
-        pl = model.jointPlacements[jid]
-        Y = model.inertias[jid]
-        m = float(Y.mass)
-        c = np.array(Y.lever, dtype=float)
-        Ic = np.array(Y.inertia, dtype=float)
-        label = f"{name}: link of joint {jname!r}"
+def _check_inertias(chain) -> None:
+    """:class:`InertiaError` for negative or non-finite masses, non-finite centres of mass,
+    inertia tensors that are not positive semidefinite and massless chains."""
+    name = chain.name
+    for j in chain.joints:
+        m, c, Ic = j.mass, j.com, j.inertia
+        label = f"{name}: link of joint {j.name!r}"
         if not np.isfinite(m) or m < 0:
             raise InertiaError(f"{label} has mass {m}; masses must be finite and >= 0 kg")
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(Ic))):
             raise InertiaError(f"{label} has a non-finite centre of mass or inertia")
-        if np.max(np.abs(Ic - Ic.T)) > 1e-9 * max(1.0, np.max(np.abs(Ic))):
-            raise InertiaError(f"{label} has a non-symmetric inertia tensor {Ic.tolist()}")
-        ev = np.linalg.eigvalsh(0.5 * (Ic + Ic.T))
+        ev = np.linalg.eigvalsh(Ic)
         scale = max(float(np.max(np.abs(ev))), 1e-300)
         if ev[0] < -1e-9 * scale:
             raise InertiaError(
                 f"{label} has an inertia tensor that is not positive (semi)definite: eigenvalues {ev.tolist()} kg m^2")
         if m == 0 and np.max(np.abs(Ic)) > 0:
             raise InertiaError(f"{label} has zero mass but a non-zero rotational inertia")
-        joints.append(JointInfo(
-            name=jname, parent=int(model.parents[jid]) - 1, kind=kind, axis=axis,
-            R0=np.array(pl.rotation, dtype=float), p0=np.array(pl.translation, dtype=float),
-            mass=m, com=c, inertia=0.5 * (Ic + Ic.T)))
-    if not joints:
+    if not chain.joints:
         raise UnsupportedModelError(f"{name}: the model has no joints")
-    if all(j.mass == 0 for j in joints):
+    if all(j.mass == 0 for j in chain.joints):
         raise InertiaError(f"{name}: massless chain (every link has zero mass); M(q) would be zero")
-    return ChainInfo(name=name, joints=joints, gravity=np.array(model.gravity.linear, dtype=float))
+
+
+def chain_info(obj, name: str | None = None) -> ChainInfo:
+    """:class:`ChainInfo` of a Robot (its ``robot.chain``), a :class:`~anthroarm.chain.Chain`,
+    a ``pin.Model``, a catalog / example-robot-data name or a URDF path.
+
+    Raises :class:`UnsupportedModelError` for joints the chain does not handle (free-flyer,
+    spherical, planar, helical...) and :class:`InertiaError` for negative masses, indefinite
+    inertia tensors and massless chains."""
+    import pinocchio as pin
+
+    from ..chain import Chain
+
+    if isinstance(obj, ChainInfo):
+        return obj
+    if isinstance(obj, (str, os.PathLike)):
+        from ..robot import load as load_robot
+
+        obj = load_robot(obj)
+    chain = getattr(obj, "chain", None) if not isinstance(obj, Chain) else obj
+    if chain is None:
+        if not isinstance(obj, pin.Model):
+            raise UnsupportedModelError(f"Lagrange dynamics need a Robot, a Chain, a pin.Model or a catalog name, "
+                                        f"got {type(obj).__name__}")
+        # the tool frame does not matter to dynamics: the base frame keeps trees unambiguous
+        chain = Chain.from_model(obj, tool=obj.frames[0].name, name=name or getattr(obj, "name", "") or "model")
+    _check_inertias(chain)
+    coord, factor, source = [], [], []
+    vindex = {i: chain.joints[i].idx_v for i in chain.independent}
+    for j in chain.joints:
+        src = j.mimic.source if j.is_mimic else j.index
+        coord.append(vindex[src])
+        factor.append(j.mimic.multiplier if j.is_mimic else 1.0)
+        source.append(src)
+    return ChainInfo(name=name or chain.name, chain=chain, coord=tuple(coord), factor=tuple(factor),
+                     source=tuple(source))
 
 
 # ====================================================================== symbolic derivation
@@ -248,38 +246,43 @@ class Derivation:
 def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True) -> Derivation:
     """Derive T, V, M(q), C(q,q̇)q̇, g(q) and τ symbolically (see the module docstring).
 
-    ``model_or_robot``: an :class:`anthroarm.Robot`, a ``pin.Model`` or a :class:`ChainInfo`.
+    ``model_or_robot``: anything :func:`chain_info` takes.  The graph's inputs are, per joint
+    k (mimic joints included), ``s_k, c_k`` = sin, cos θ_k (revolute and continuous joints) or
+    ``q_k`` = θ_k (prismatic), and ``qd_k, qdd_k`` for the independent joints; a mimic joint
+    moves with θ̇_k = a θ̇_source.  Outputs are in the generalized coordinates (v order).
     """
     t0 = time.perf_counter()
-    info = _as_info(model_or_robot, name)
-    n = info.n
+    info = chain_info(model_or_robot, name)
+    n, nj = info.n, info.njoints
     g = Graph()
-    s = [None] * n
-    c = [None] * n
-    qv = [None] * n
-    for k, j in enumerate(info.joints):
-        if j.kind == "R":
+    s, c, qv = [None] * nj, [None] * nj, [None] * nj
+    rot = [j.kind != PRISMATIC for j in info.joints]
+    for k in range(nj):
+        if rot[k]:
             s[k], c[k] = g.input("s", k), g.input("c", k)
         else:
             qv[k] = g.input("q", k)
-    qd = [g.input("qd", k) for k in range(n)]
-    qdd = [g.input("qdd", k) for k in range(n)]
+    ind = [k for k in range(nj) if info.source[k] == k]          # independent joints, v order
+    qd = [g.input("qd", k) for k in ind]                          # qd[i]: generalized velocity i
+    qdd = [g.input("qdd", k) for k in ind]
+    thd = [g.mul(info.factor[k], qd[info.coord[k]]) for k in range(nj)]   # θ̇_k
     grav = [snap(x) for x in info.gravity]
 
-    w = [None] * n  # angular velocity of link k, link frame
-    v = [None] * n  # linear velocity of the link-frame origin, link frame
-    gam = [None] * n  # gravity vector in link frame
-    h = [None] * n  # gᵀ p_k (world), the "height" of the link origin times |g|
+    w = [None] * nj  # angular velocity of link k, link frame
+    v = [None] * nj  # linear velocity of the link-frame origin, link frame
+    gam = [None] * nj  # gravity vector in link frame
+    h = [None] * nj  # gᵀ p_k (world), the "height" of the link origin times |g|
     T_terms, V_terms = [], []
     for k, j in enumerate(info.joints):
         if j.parent >= 0:
             wl, vl, gl, hl = w[j.parent], v[j.parent], gam[j.parent], h[j.parent]
         else:
             wl, vl, gl, hl = [0.0] * 3, [0.0] * 3, grav, 0.0
-        p0 = [snap(x) for x in j.p0]
-        R0 = j.R0
+        axis = [snap(x) for x in j.axis]
+        p0 = [snap(x) for x in j.translation]
+        R0 = j.rotation
         # position of the joint origin in the parent frame (prismatic joints move it)
-        if j.kind == "P":
+        if not rot[k]:
             ax0 = [snap(x) for x in R0 @ j.axis]
             p = [g.add(p0[i], g.mul(ax0[i], qv[k])) for i in range(3)]
         else:
@@ -289,13 +292,13 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
         wk = _matT_vec(R0, wl, g)
         vk = _matT_vec(R0, vt, g)
         gk = _matT_vec(R0, gl, g)
-        if j.kind == "R":
-            wk = _rot_T(j.axis, s[k], c[k], wk, g)
-            vk = _rot_T(j.axis, s[k], c[k], vk, g)
-            gk = _rot_T(j.axis, s[k], c[k], gk, g)
-            wk = [g.add(wk[i], g.mul(snap(j.axis[i]), qd[k])) for i in range(3)]
+        if rot[k]:
+            wk = _rot_T(axis, s[k], c[k], wk, g)
+            vk = _rot_T(axis, s[k], c[k], vk, g)
+            gk = _rot_T(axis, s[k], c[k], gk, g)
+            wk = [g.add(wk[i], g.mul(axis[i], thd[k])) for i in range(3)]
         else:
-            vk = [g.add(vk[i], g.mul(snap(j.axis[i]), qd[k])) for i in range(3)]
+            vk = [g.add(vk[i], g.mul(axis[i], thd[k])) for i in range(3)]
         w[k], v[k], gam[k], h[k] = wk, vk, gk, hk
         if j.mass > 0:
             m = j.mass
@@ -311,19 +314,35 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
     T = g.sum(T_terms)
     V = g.sum(V_terms)
 
+    def coord_seed(i):
+        """∂/∂(generalized coordinate i) of the joint inputs: θ_k = a_k θ_i + b_k for every
+        joint k driven by coordinate i (sin: a c_k, cos: −a s_k, position: a)."""
+        seed = {}
+        for k in range(nj):
+            if info.coord[k] == i:
+                a = info.factor[k]
+                if rot[k]:
+                    seed[s[k]] = g.mul(a, c[k])
+                    seed[c[k]] = g.mul(-a, s[k])
+                else:
+                    seed[qv[k]] = a
+        return seed
+
     def grad_q(adj):
-        out = []
-        for k, j in enumerate(info.joints):
-            if j.kind == "R":
+        # d/dθ f(sin θ, cos θ) = f_s cos θ − f_c sin θ, times dθ/dq_i, summed over the joints q_i drives
+        out = [[] for _ in range(n)]
+        for k in range(nj):
+            a = info.factor[k]
+            if rot[k]:
                 a_s, a_c = adj.get(s[k].i, 0.0), adj.get(c[k].i, 0.0)
-                # d/dq f(sin q, cos q) = f_s cos q - f_c sin q
-                out.append(g.add(g.mul(a_s, c[k]), g.mul(-1.0, g.mul(a_c, s[k]))))
+                d = g.add(g.mul(a_s, c[k]), g.mul(-1.0, g.mul(a_c, s[k])))
             else:
-                out.append(adj.get(qv[k].i, 0.0))
-        return out
+                d = adj.get(qv[k].i, 0.0)
+            out[info.coord[k]].append(g.mul(a, d))
+        return [g.sum(t) for t in out]
 
     adjT = g.reverse(T)
-    p = [adjT.get(qd[k].i, 0.0) for k in range(n)]
+    p = [adjT.get(qd[i].i, 0.0) for i in range(n)]
     dTdq = grad_q(adjT)
     gvec = grad_q(g.reverse(V))
     # M = ∂p/∂q̇ (column by column, keep j <= k and mirror)
@@ -333,31 +352,25 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
         for jj in range(k + 1):
             M[jj][k] = col[jj]
             M[k][jj] = col[jj]
-    # time derivative along q only (q̈ = 0): d/dt s = c q̇, d/dt c = -s q̇
+    # time derivative along q only (q̈ = 0): d/dt s_k = c_k θ̇_k, d/dt c_k = −s_k θ̇_k
     qseed = {}
-    for k, j in enumerate(info.joints):
-        if j.kind == "R":
-            qseed[s[k]] = g.mul(c[k], qd[k])
-            qseed[c[k]] = g.mul(-1.0, g.mul(s[k], qd[k]))
+    for k in range(nj):
+        if rot[k]:
+            qseed[s[k]] = g.mul(c[k], thd[k])
+            qseed[c[k]] = g.mul(-1.0, g.mul(s[k], thd[k]))
         else:
-            qseed[qv[k]] = qd[k]
+            qseed[qv[k]] = thd[k]
     Mdot_qd = g.forward(p, qseed)  # Ṁ q̇
     Cqd = [g.add(Mdot_qd[i], g.mul(-1.0, dTdq[i])) for i in range(n)]
     full = dict(qseed)
-    full.update({qd[k]: qdd[k] for k in range(n)})
+    full.update({qd[i]: qdd[i] for i in range(n)})
     dpdt = g.forward(p, full)  # d/dt ∂T/∂q̇ = M q̈ + Ṁ q̇
     tau = [g.sum([dpdt[i], g.mul(-1.0, dTdq[i]), gvec[i]]) for i in range(n)]  # (8-13) with V
     Cmat = None
     if coriolis_matrix:
         Mflat = [M[a][b] for a in range(n) for b in range(n)]
         Mdot = g.forward(Mflat, qseed)
-        dp = []  # dp[j][i] = ∂p_i/∂q_j
-        for k, j in enumerate(info.joints):
-            if j.kind == "R":
-                seed = {s[k]: c[k], c[k]: g.mul(-1.0, s[k])}
-            else:
-                seed = {qv[k]: 1.0}
-            dp.append(g.forward(p, seed))
+        dp = [g.forward(p, coord_seed(i)) for i in range(n)]  # dp[j][i] = ∂p_i/∂q_j
         Cmat = [[g.mul(0.5, g.sum([Mdot[a * n + b], dp[b][a], g.mul(-1.0, dp[a][b])])) for b in range(n)]
                 for a in range(n)]
     d = Derivation(info=info, graph=g, T=T, V=V, p=p, dTdq=dTdq, g=gvec, M=M, Cqd=Cqd, tau=tau, Cmat=Cmat,
@@ -366,30 +379,9 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
     return d
 
 
-def _as_info(obj, name=None) -> ChainInfo:
-    """ChainInfo of a ChainInfo, a Robot, a ``pin.Model``, or a catalog name / URDF path."""
-    import pinocchio as pin
-
-    if isinstance(obj, ChainInfo):
-        return obj
-    if isinstance(obj, (str, os.PathLike)):
-        from ..robot import load as load_robot
-
-        obj = load_robot(obj)
-    if hasattr(obj, "model") and hasattr(obj, "joint_names"):  # Robot
-        return chain_info(obj.model, name or obj.name)
-    if not isinstance(obj, pin.Model):
-        raise UnsupportedModelError(f"Lagrange dynamics need a Robot, a pin.Model or a catalog name, got {type(obj).__name__}")
-    return chain_info(obj, name)
-
-
 # ====================================================================== code generation
-#: function name -> (arguments, outputs attribute, output shape kind)
-FUNCTIONS = ("mass_matrix", "coriolis", "gravity", "tau", "kinetic_energy", "potential_energy",
-             "momentum", "coriolis_matrix")
-
-
 def _outputs(d: Derivation) -> dict:
+    """function name -> (arguments, output nodes (row-major), output shape)."""
     n = d.n
     out = {
         "mass_matrix": (("q",), [d.M[a][b] for a in range(n) for b in range(n)], (n, n)),
@@ -405,21 +397,33 @@ def _outputs(d: Derivation) -> dict:
     return out
 
 
+def _kinds(info: ChainInfo) -> str:
+    """One letter per joint: R revolute, C continuous, P prismatic; lower case for a mimic joint."""
+    letters = {REVOLUTE: "R", CONTINUOUS: "C", PRISMATIC: "P"}
+    return "".join(letters[j.kind].lower() if j.is_mimic else letters[j.kind] for j in info.joints)
+
+
 def generate_python(d: Derivation) -> str:
-    """Python module text with numpy (batched) and scalar versions of every function."""
-    kinds = [j.kind for j in d.info.joints]
+    """Python module text with numpy (batched) and scalar versions of every function.
+
+    Every function takes the joint positions θ of all joints (``q``, mimic joints included,
+    as :meth:`~anthroarm.chain.Chain.angles` returns them) and their velocities and
+    accelerations (``qd``, ``qdd``, one entry per joint; a mimic joint's entry is not read:
+    it moves with its source), and returns quantities in the generalized coordinates."""
+    kinds = _kinds(d.info)
     head = [
         f'"""Generated by anthroarm.dynamics.lagrange (generator v{GENERATOR_VERSION}); do not edit.',
         "",
-        f"Model {d.info.name!r}, key {d.info.key()}, {d.n} joints ({''.join(kinds)}).",
+        f"Key {d.info.key()}: {d.info.njoints} joints ({kinds}), {d.n} generalized coordinates.",
         "Lagrange equations tau = M(q) qdd + C(q, qd) qd + g(q) in SI units; see lagrange.py.",
         '"""',
         "from math import sin as _ssin, cos as _scos",
         "import numpy as _np",
         "",
         f"NQ = {d.n}",
+        f"NJ = {d.info.njoints}",
         f"KEY = {d.info.key()!r}",
-        f"KINDS = {''.join(kinds)!r}",
+        f"KINDS = {kinds!r}",
         f"GENERATOR_VERSION = {GENERATOR_VERSION!r}",
         "",
     ]
@@ -431,149 +435,136 @@ def generate_python(d: Derivation) -> str:
 
 
 # ====================================================================== cache
-def cache_dir() -> Path:
-    """``$ANTHROARM_CACHE/lagrange`` or ``~/.cache/anthroarm/lagrange``."""
-    from .._cbuild import cache_dir as _cache_dir
-
-    return _cache_dir("lagrange")
-
-
-def _atomic_write(path: Path, text: str | bytes) -> None:
-    """Create the cache folder if needed, then :func:`anthroarm.urdf_io.atomic_write_text`."""
-    from ..urdf_io import atomic_write_text
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(path, text)
-
-
-def _import_file(path: Path, modname: str):
-    spec = importlib.util.spec_from_file_location(modname, path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 _LOCK = threading.Lock()
-_MEMO: dict[str, object] = {}
+_MEMO: dict[str, object] = {}   # key -> generated module (holds no Robot)
 
 
 def generated_module(model_or_robot, name: str | None = None, use_cache: bool = True):
-    """The generated Python module of a model: from memory, the disk
-    cache, or a fresh derivation (written to the cache).  Returns ``(module, source)`` where
-    source is "memory", "cache" or "derived".  Raises :class:`InertiaError` if M(q) is not
-    positive definite (a joint that moves no mass)."""
-    info = _as_info(model_or_robot, name)
+    """The generated Python module of a model: from memory, the disk cache
+    (:mod:`anthroarm.cache`, ``lagrange/lagrange_<key>.py``, verified before it is executed) or
+    a fresh derivation (then stored).  Returns ``(module, origin)`` with origin "memory",
+    "cache" or "derived".  Raises :class:`InertiaError` if M(q) is not positive definite (a
+    joint that moves no mass)."""
+    info = chain_info(model_or_robot, name)
     key = info.key()
     with _LOCK:
         if key in _MEMO:
             return _MEMO[key], "memory"
         modname = f"anthroarm_lagrange_{key}"
-        cached = cache_dir() / f"lagrange_{key}.py"
-        mod = None
-        if use_cache and cached.is_file():
-            try:
-                mod, src = _import_file(cached, modname), "cache"
-                if getattr(mod, "KEY", None) != key or getattr(mod, "GENERATOR_VERSION", None) != GENERATOR_VERSION:
-                    mod = None
-            except Exception:  # a corrupt or foreign file: derive again and overwrite it
-                mod = None
-        if mod is None:
-            mod, src = _derive_and_store(info, cached, modname, use_cache), "derived"
+        make = lambda: generate_python(derive(info))  # noqa: E731
+        if use_cache:
+            mod, origin = cache.python_module("lagrange", f"lagrange_{key}.py", make, modname)
+        else:
+            mod, origin = types.ModuleType(modname), "derived"
+            exec(compile(make(), f"<{modname}>", "exec"), mod.__dict__)
         _check_pd(mod, info)
         _MEMO[key] = mod
-        return mod, src
+        return mod, origin
 
 
 def _check_pd(mod, info: ChainInfo) -> None:
-    """M(q) must be positive definite: at q = 0 and at two random configurations."""
+    """M(q) must be positive definite: at θ = 0 and at two random configurations."""
+    chain = info.chain
     rng = np.random.default_rng(12345)
-    Q = np.vstack([np.zeros(info.n), rng.uniform(-np.pi, np.pi, (2, info.n))])
-    for q in Q:
-        M = mod.mass_matrix_1(q)
+    Q = chain.angles(chain.configuration(np.vstack([np.zeros(info.n), rng.uniform(-np.pi, np.pi, (2, info.n))])))
+    for th in Q:
+        M = mod.mass_matrix_1(th)
         ev = np.linalg.eigvalsh(M)
         if not ev[0] > 1e-12 * max(ev[-1], 1e-300):
-            weak = int(np.argmin(np.diag(M)))
+            weak = info.chain.independent[int(np.argmin(np.diag(M)))]
             raise InertiaError(
-                f"{info.name}: the mass matrix is not positive definite at q = {np.round(q, 3).tolist()} "
+                f"{info.name}: the mass matrix is not positive definite at θ = {np.round(th, 3).tolist()} "
                 f"(eigenvalues {ev.tolist()}); joint {info.joints[weak].name!r} moves (almost) no mass or "
                 "inertia — a massless chain or zero inertia has no forward dynamics")
-
-
-def _derive_and_store(info, path: Path, modname: str, write: bool):
-    text = generate_python(derive(info))
-    if write:
-        try:
-            _atomic_write(path, text)
-            return _import_file(path, modname)
-        except OSError:
-            pass
-    ns: dict = {"__name__": modname}
-    exec(compile(text, f"<{modname}>", "exec"), ns)
-    import types
-
-    mod = types.ModuleType(modname)
-    mod.__dict__.update(ns)
-    return mod
 
 
 # ====================================================================== user-facing object
 class LagrangeDynamics:
     """Numeric Lagrange dynamics of one model, from generated code.
 
-    Every method accepts one state ``(nq,)`` or a batch ``(N, nq)`` (then returns a leading
-    ``N`` axis).  SI units: q in rad (m for prismatic joints), torques in N m (N)."""
+    States are in the robot's layout: q ``(nq,)`` as Pinocchio has it (a continuous joint's
+    (cos θ, sin θ) pair, no entry for a mimic joint), q̇ and q̈ ``(nv,)``; or batches
+    ``(N, nq)``/``(N, nv)`` (then results have a leading ``N`` axis).  Results are in the nv
+    generalized coordinates, so they compare with ``pin.crba``/``rnea``/``aba`` directly.  SI
+    units: rad (m for prismatic joints), N m (N).  Thread-safe."""
 
     def __init__(self, model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy"):
-        self.info = _as_info(model_or_robot, name)
-        self.n = self.info.n
-        self.joint_names = [j.name for j in self.info.joints]
+        self.info = chain_info(model_or_robot, name)
+        chain = self.chain = self.info.chain
+        self.n, self.nq = self.info.n, chain.nq
+        self.joint_names = [chain.joints[i].name for i in chain.independent]
         self.module, self.source = generated_module(self.info, use_cache=use_cache)
+        # θ = q and θ̇ = q̇ when every joint is a plain revolute / prismatic joint in q order
+        self._plain_q = all(j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints)
+        self._plain_v = not chain.has_mimic
+        self._vsel = np.array(self.info.coord)
+        self._vscale = np.array(self.info.factor)
         self.backend = backend
         self._c = None
         if backend == "c":
             from .ccode import compiled
 
-            self._c = compiled(self.info)
+            self._c = compiled(self.info.key(), self._c_inputs)
         elif backend != "numpy":
             raise ValueError(f"backend must be 'numpy' or 'c', got {backend!r}")
 
+    def _c_inputs(self):
+        d = derive(self.info)
+        return d.graph, _outputs(d), self.info.njoints
+
     def __repr__(self) -> str:
-        return f"LagrangeDynamics({self.info.name!r}, n={self.n}, backend={self.backend!r}, from {self.source})"
+        return (f"LagrangeDynamics({self.info.name!r}, nq={self.nq}, nv={self.n}, backend={self.backend!r}, "
+                f"from {self.source})")
+
+    # -- robot layout -> the generated code's joint positions and rates
+    def _theta(self, q):
+        if self._plain_q:
+            return q
+        if self.chain.has_continuous:
+            self.chain.check_unit(q)
+        return self.chain.angles(q)
+
+    def _rates(self, v):
+        return v if self._plain_v else v[..., self._vsel] * self._vscale
 
     # -- input checking
     def _arr(self, x, what: str):
         a = np.asarray(x, dtype=float)
-        if a.ndim not in (1, 2) or a.shape[-1] != self.n:
-            raise ValueError(f"{self.info.name}: {what} must have shape ({self.n},) or (N, {self.n}), got {a.shape}")
+        size, names = (self.nq, self.chain.q_names) if what == "q" else (self.n, self.joint_names)
+        if a.ndim not in (1, 2) or a.shape[-1] != size:
+            raise ValueError(f"{self.info.name}: {what} must have shape ({size},) or (N, {size}), got {a.shape}")
         if not np.all(np.isfinite(a)):
             bad = np.argwhere(~np.isfinite(a))[0]
             j = int(bad[-1])
-            raise ValueError(f"{self.info.name}: {what}[{j}] (joint {self.joint_names[j]!r}) is {a[tuple(bad)]}; "
+            raise ValueError(f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]}; "
                              "states must be finite")
         return a
 
-    def _call(self, fname, *arrays):
-        # fast path: one state, contiguous float64 vectors of the right length
-        n = self.n
-        ok = True
+    def _call(self, fname, q, *rates):
+        # fast path: one state, contiguous float64 vectors of the right lengths
         tot = 0.0
-        for a in arrays:
-            if type(a) is not np.ndarray or a.shape != (n,) or a.dtype != np.float64:
-                ok = False
-                break
-            tot += a.sum()
+        ok = type(q) is np.ndarray and q.shape == (self.nq,) and q.dtype == np.float64
+        if ok:
+            tot = q.sum()
+            for a in rates:
+                if type(a) is not np.ndarray or a.shape != (self.n,) or a.dtype != np.float64:
+                    ok = False
+                    break
+                tot += a.sum()
         if ok and math.isfinite(tot):
+            arrs = (self._theta(q), *(self._rates(a) for a in rates))
             if self._c is not None:
-                return self._c.one(fname, arrays)
-            return getattr(self.module, fname + "_1")(*arrays)
+                return self._c.one(fname, arrs)
+            return getattr(self.module, fname + "_1")(*arrs)
         names = ("q", "qd", "qdd")
-        arrs = [self._arr(a, names[i]) for i, a in enumerate(arrays)]
+        arrs = [self._arr(a, names[i]) for i, a in enumerate((q, *rates))]
         single = all(a.ndim == 1 for a in arrs)
         if not single:
             N = max(a.shape[0] if a.ndim == 2 else 1 for a in arrs)
-            arrs = [np.broadcast_to(a, (N, self.n)) if a.ndim == 1 else a for a in arrs]
+            arrs = [np.broadcast_to(a, (N, a.shape[-1])) if a.ndim == 1 else a for a in arrs]
             if any(a.shape[0] != N for a in arrs):
                 raise ValueError(f"{self.info.name}: batch sizes differ: {[a.shape for a in arrs]}")
+        arrs = [self._theta(arrs[0]), *(self._rates(a) for a in arrs[1:])]
         if self._c is not None:
             return self._c(fname, arrs, single)
         if single:
@@ -581,7 +572,7 @@ class LagrangeDynamics:
         return getattr(self.module, fname)(*[np.ascontiguousarray(a) for a in arrs])
 
     def mass_matrix(self, q):
-        """M(q), Eq. (8-105): (n, n) or (N, n, n), kg m² (kg for prismatic rows)."""
+        """M(q), Eq. (8-105): (nv, nv) or (N, nv, nv), kg m² (kg for prismatic rows)."""
         return self._call("mass_matrix", q)
 
     def coriolis(self, q, qd):
@@ -625,7 +616,8 @@ class LagrangeDynamics:
 
 
 def load(model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy") -> LagrangeDynamics:
-    """:class:`LagrangeDynamics` of a Robot / pin.Model (derivation cached on disk)."""
+    """:class:`LagrangeDynamics` of a Robot / Chain / pin.Model / catalog name / URDF path
+    (generated code cached on disk, :mod:`anthroarm.cache`)."""
     return LagrangeDynamics(model_or_robot, name=name, use_cache=use_cache, backend=backend)
 
 

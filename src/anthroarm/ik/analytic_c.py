@@ -8,8 +8,9 @@ tolerances; the equations are cited there), plus the FK check generated from ``r
 the general path.  One shared library per robot parameterisation (lengths, limits and joint
 placements are compile-time constants) is compiled with the system C compiler (``$CC``, default
 ``cc``; ``-O2 -fno-fast-math -ffp-contract=off``, so IEEE results equal the Python kernels' up
-to the libm) on first use and cached as ``$ANTHROARM_CACHE/ik/analytic_<model>_<hash>.so``
-(default ``~/.cache/anthroarm``), written atomically; it is called through :mod:`ctypes`.
+to the libm) on first use and kept in the one disk cache (:func:`anthroarm.cache.shared_library`:
+``ik/analytic_<model>_<hash>.so`` keyed by the source, compiler and flags, verified before it is
+loaded, written atomically); it is called through :mod:`ctypes`.
 
 Nothing here is required: without a compiler, if compilation fails, or with the environment
 variable ``ANTHROARM_IK_C=0``, :func:`kernel_for` returns None and ``closed_form`` uses the
@@ -19,7 +20,6 @@ pure-Python kernels.  :func:`status` says which applies.
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import math
 import os
 import threading
@@ -39,7 +39,8 @@ def enabled() -> bool:
     return os.environ.get("ANTHROARM_IK_C", "1").strip().lower() not in ("0", "false", "no", "off")
 
 
-from .._cbuild import build_shared, compiler  # noqa: E402
+from .. import cache  # noqa: E402
+from ..cache import compiler  # noqa: E402
 
 
 def status() -> str:
@@ -49,13 +50,6 @@ def status() -> str:
     if compiler() is None:
         return "no C compiler ($CC or cc) found: pure-Python kernels"
     return _STATUS["reason"] or "available (compiled on first use per robot)"
-
-
-def cache_dir() -> Path:
-    """``$ANTHROARM_CACHE/ik`` or ``~/.cache/anthroarm/ik``."""
-    from .._cbuild import cache_dir as _cache_dir
-
-    return _cache_dir("ik")
 
 
 # ---------------------------------------------------------------------------- C text
@@ -535,11 +529,11 @@ def build(plan) -> CKernel:
     if cc is None:
         raise RuntimeError("no C compiler ($CC or cc)")
     src = c_source(plan)
-    key = hashlib.sha256((src + " ".join(FLAGS) + cc).encode()).hexdigest()[:16]
+    key = cache.key(src, cache.compiler_id(cc), " ".join(FLAGS))
     with _LOCK:
         if key in _LIBS:
             return _LIBS[key]
-        so = build_shared(src, cache_dir() / f"analytic_{plan.name}_{key}.so", FLAGS)
+        so, _ = cache.shared_library("ik", f"analytic_{plan.name}", src, FLAGS)   # CompileError is a RuntimeError
         kern = CKernel(so, plan)
         _LIBS[key] = kern
         return kern

@@ -85,7 +85,7 @@ def urdf_path(name: str) -> Path:
 
 def write_urdfs(out_dir=None) -> list[Path]:
     """(Re)generate the URDFs of all book models with default parameters into ``out_dir``."""
-    from ..urdf_io import atomic_write_text
+    from .._io import atomic_write_text
 
     out = Path(out_dir) if out_dir is not None else REPO_URDF_DIR
     out.mkdir(parents=True, exist_ok=True)
