@@ -13,6 +13,7 @@ import anthroarm as aa
 from anthroarm.ik import closed_form as cf
 from anthroarm.errors import UnknownFrameError
 from anthroarm.ik import IKBatchResult, IKResult, qp
+from anthroarm.ik.solve import seeds, targets, workspace
 
 ROBOTS = ["panda", "ur5", "talos_arm", "human_arm7", "prosthetic_arm"]
 
@@ -252,22 +253,24 @@ def test_human_posture_optimum_matches_closed_form_family(robots):
 
 # ------------------------------------------------------------------ seeds and fast paths of aa.ik.solve
 def _target(robot, T):
-    from anthroarm.ik import solver
-    return solver._Target("pose", pin.SE3(T), 1e-6, 1e-6, np.ascontiguousarray(T).ravel())
+    return targets.Target("pose", pin.SE3(T), 1e-6, 1e-6)
+
+
+def _ws(robot):
+    return workspace.workspace(robot, robot.tool_id)
 
 
 def test_seed_table_distance_is_the_pose_distance(robots):
     """The table lookup x·G equals ‖p − p*‖² + w²‖R − R*‖²_F up to a constant (oracle: the
     distance computed directly from Pinocchio FK of the table's configurations)."""
-    from anthroarm.ik import solver
     robot = robots["talos_arm"]
-    ch = solver._chain(robot, robot.tool_id)
-    Q = ch.table()[0][:200]
+    ws = _ws(robot)
+    Q = ws.table()[0][:200]
     H = robot.fk(Q)
     T = robot.fk(robot.random_q(rng=11))
-    w2 = (solver.SEED_ROT_WEIGHT * ch.reach) ** 2
+    w2 = (seeds.SEED_ROT_WEIGHT * robot.chain.reach()) ** 2
     direct = ((H[:, :3, 3] - T[:3, 3]) ** 2).sum(1) + w2 * ((H[:, :3, :3] - T[:3, :3]) ** 2).sum((1, 2))
-    sc = _target(robot, T).scores(ch)[:200]
+    sc = T.ravel().dot(ws.table()[1])[:200]
     np.testing.assert_allclose(sc - sc[0], direct - direct[0], atol=1e-9)
 
 
@@ -276,13 +279,12 @@ def test_aligned_seed_table_turns_first_and_last_joint_exactly(robots):
     with its first and last joints turned is matched by that entry, and the seed turned onto it
     is the target's configuration itself (oracle: FK of the configuration the target came from).
     talos_arm (wrist range 1.4 rad) has no aligned table."""
-    from anthroarm.ik import solver
     for name in ("panda", "ur5"):
         robot = robots[name]
-        ch = solver._chain(robot, robot.tool_id)
-        al = ch.aligned()
+        ws = _ws(robot)
+        al = ws.aligned()
         assert al is not None
-        Q = ch.table()[0]
+        Q = ws.table()[0]
         for k, (d1, dn) in zip((5, 300, 1500), ((0.4, -0.7), (-1.1, 0.2), (0.05, 1.3))):
             q = Q[k].copy()
             q[al.iq1] += d1
@@ -290,19 +292,18 @@ def test_aligned_seed_table_turns_first_and_last_joint_exactly(robots):
             if not robot.within_limits(q):
                 continue
             T = robot.fk(q)
-            seeds = solver._TableSeeds(ch, _target(robot, T), None)
-            q_seed = seeds.next()
-            assert seeds.k0 == k
+            table = seeds.TableSeeds(ws, _target(robot, T), None)
+            q_seed = table.next()
+            assert table.k0 == k
             np.testing.assert_allclose(q_seed, q, atol=1e-12)
             assert np.abs(robot.fk(q_seed) - T).max() < 1e-12
-    assert solver._chain(robots["talos_arm"], robots["talos_arm"].tool_id).aligned() is None
+    assert _ws(robots["talos_arm"]).aligned() is None
 
 
 def test_seed_tags_and_restart_cap(robots):
     """Seeds are tagged; max_restarts=0 tries exactly one seed, and the answer is still the
     closest pose found inside the limits."""
     robot = robots["panda"]
-    from anthroarm.ik import solver
     tags = set()
     restarted = 0
     for q in robot.random_q(40, rng=31):
@@ -312,7 +313,7 @@ def test_seed_tags_and_restart_cap(robots):
         if r.restarts == 0:
             assert r.seed == "table"
         if r.seed == "restart":             # uniform random seeds come after the table's
-            assert r.restarts >= solver.TABLE_SEEDS
+            assert r.restarts >= seeds.TABLE_SEEDS
         restarted += r.restarts > 0
     assert tags <= {"table", "restart"} and "table" in tags and restarted > 0
     T = np.eye(4)
@@ -325,9 +326,8 @@ def test_closed_form_first_where_cheap(robots):
     """prosthetic_arm (a six-joint book arm) takes its first seed from the closed form and
     verifies it in one Gauss–Newton evaluation; so does human_arm7 when the compiled closed-form
     kernel is available; the arms without a closed form never do."""
-    from anthroarm.ik import solver
     robot = robots["prosthetic_arm"]
-    assert solver._chain(robot, robot.tool_id).analytic_first
+    assert _ws(robot).sh.closed_form_first
     for q in robot.random_q(10, rng=41):
         T = robot.fk(q)
         r = aa.ik.solve(robot, T)
@@ -338,9 +338,9 @@ def test_closed_form_first_where_cheap(robots):
     r = aa.ik.solve(robot, robot.fk(robot.random_q(rng=43)), analytic=False)
     assert r.success and r.seed != "analytic"
     for name in ("panda", "ur5", "talos_arm"):
-        assert not solver._chain(robots[name], robots[name].tool_id).analytic_first
+        assert not _ws(robots[name]).sh.closed_form_first
     human = robots["human_arm7"]
-    if solver._chain(human, human.tool_id).analytic_first:
+    if _ws(human).sh.closed_form_first:
         r = aa.ik.solve(human, human.fk(human.random_q(rng=44)))
         assert r.success and r.seed == "analytic"
 
@@ -352,10 +352,9 @@ def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):
     comfortable posture in at least 19 of 20 cases (oracle: 0.5° swivel scan of the closed
     form; the phase moves along one branch, and a joint limit can cut it).  The solver before
     the secant posture phase missed it in ~25 % of such targets."""
-    from anthroarm.ik import solver
     robot = robots["human_arm7"]
     assert cf.has_analytic(robot)
-    monkeypatch.setattr(solver._chain(robot, robot.tool_id), "analytic_first", True)
+    monkeypatch.setattr(_ws(robot).sh, "closed_form_first", True)
     ref = qp.comfortable_posture(robot)
     grid = np.linspace(-np.pi, np.pi, 720, endpoint=False)
     worse = at_limit = 0
@@ -373,20 +372,17 @@ def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):
 
 
 def test_rigid_fast_path_and_near_rigid_targets(robots):
-    """The plain-Python rigidity check accepts exact poses and hands anything else to
-    as_se3: a rotation 1e-9 off orthonormal is re-orthonormalised and solved, other dtypes and
-    a pin.SE3 are accepted, a non-rigid bottom row still raises."""
-    from anthroarm.ik import solver
+    """Exact poses, a rotation 1e-9 off orthonormal (re-orthonormalised), other dtypes and a
+    pin.SE3 are solved; a non-rigid bottom row raises."""
     robot = robots["ur5"]
     T = robot.fk(robot.random_q(rng=61))
-    assert solver._rigid_se3(T) is not None
     near = T.copy()
     near[:3, :3] *= 1.0 + 1e-9
-    assert solver._rigid_se3(near) is None
     r = aa.ik.solve(robot, near)
     assert r.success and pose_error(robot, r.q, T)[0] <= 1e-6
     assert aa.ik.solve(robot, pin.SE3(T)).success
-    assert solver._rigid_se3(T.astype(np.float32)) is None
+    r = aa.ik.solve(robot, T.astype(np.float32), tol_pos=1e-5, tol_rot=1e-5)
+    assert r.success and pose_error(robot, r.q, T)[0] <= 1e-5
     bad = T.copy()
     bad[3, 0] = 1e-3
     with pytest.raises(ValueError, match="not rigid"):

@@ -7,5 +7,5 @@
 
 from . import qp
 from .result import IKBatchResult, IKResult
-from .solver import solve
+from .solve import solve
 from .closed_form import AnalyticBatchResult, AnalyticIKResult, analytic, analytic_batch, has_analytic, swivel_angle
