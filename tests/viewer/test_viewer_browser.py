@@ -14,6 +14,7 @@ import math
 
 import os
 
+import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -66,6 +67,15 @@ def half_extent_corners(g) -> list[np.ndarray]:
         e = np.array([max(g.radiusTop, g.radiusBottom), g.height / 2, max(g.radiusTop, g.radiusBottom)])
     elif kind == "Box":
         e = np.asarray(g.lengths, float) / 2
+    elif isinstance(g, mg.MeshGeometry):   # a mesh file: its own bounds
+        import io
+
+        import trimesh
+
+        data = g.contents if isinstance(g.contents, bytes) else g.contents.encode()
+        lo, hi = trimesh.load(io.BytesIO(data), file_type=g.mesh_format, force="mesh").bounds
+        return [np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
+                for sx in (0, 1) for sy in (0, 1) for sz in (0, 1)]
     else:
         raise AssertionError(f"unexpected geometry {kind}")
     return [e * np.array([sx, sy, sz]) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
@@ -149,6 +159,33 @@ def test_live_server_page_draws_and_follows_the_arm(human, base_png, tmp_path):
         v._send([{"type": "delete", "path": f"{v.root}/bodies"}])
         s0 = browser.screenshot(v.url, tmp_path / "live0.png", size=(W, H), budget_ms=2000)
         assert sum(robot_pixels(s0, base_png, box1)) < 50
+
+
+def test_kinova_html_draws_the_arm_and_turns_its_continuous_joints(tmp_path):
+    """kinova (three continuous joints, nq = 9, its URDF's meshes): the exported page draws
+    the arm inside the projected bounds of its meshes, and turning the continuous base joint
+    by 90° (a new (cos, sin) pair) moves it there."""
+    robot = aa.load("kinova")
+    chain = robot.chain
+    theta = np.array([0.0, 2.4, 1.2, 0.5, 1.0, 0.3])   # base, shoulder, elbow, wrists (rad)
+    base = [j for j in chain.joints if j.kind == "continuous"][0]
+    pics = []
+    for k, turn in enumerate((0.0, np.pi / 2)):
+        th = theta.copy()
+        th[base.index] += turn
+        q = chain.configuration(th[list(chain.independent)])
+        v = Viewer(robot, q=q)
+        html = v.export_html(tmp_path / f"kinova{k}.html")
+        shot = browser.screenshot(html, tmp_path / f"kinova{k}.png", size=(W, H), budget_ms=2000)
+        if k == 0:
+            base_png = baseline(v, tmp_path, "kinova_base")
+        box = expected_box(v, q)
+        inside, outside = robot_pixels(shot, base_png, box)
+        area = (box[2] - box[0]) * (box[3] - box[1])
+        assert inside > 0.10 * area, (k, inside, area, box)
+        assert outside < 0.02 * inside, (k, outside, inside)
+        pics.append(shot)
+    assert browser.changed_mask(pics[0], pics[1]).mean() > 0.005  # the arm turned
 
 
 def test_demo_html_shows_the_arm_moving(tmp_path):
