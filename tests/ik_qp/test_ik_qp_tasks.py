@@ -80,6 +80,35 @@ def test_swivel_jacobian_matches_finite_differences(human):
     assert n_checked >= 3
 
 
+@pytest.mark.parametrize("name, expected", [
+    ("human_arm7", ("shoulder_flexion", "elbow_flexion", "wrist_deviation")),
+    ("human_right_arm", ("right_shoulder_Z", "right_elbow_Z", "right_wrist_Z")),
+])
+def test_swivel_frames_from_the_chain_geometry(name, expected):
+    """The (shoulder, elbow, wrist) frames are found from the joint origins (Pinocchio's joint
+    placements at q = 0: three co-located shoulder joints, then the elbow and wrist groups),
+    not from the arm's name: a copy of the model under another name gives the same frames."""
+    robot = aa.load(name)
+    assert qp.tasks.swivel_frames(robot) == expected
+    renamed = aa.load(robot.model.copy(), name="someone_else", tool=robot.tool)
+    assert qp.tasks.swivel_frames(renamed) == expected
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, pin.neutral(robot.model))
+    origin = {robot.model.names[i]: data.oMi[i].translation for i in range(1, robot.model.njoints)}
+    S, E, W = (origin[n] for n in expected)
+    assert min(np.linalg.norm(S - E), np.linalg.norm(E - W)) > 0.1
+
+
+def test_swivel_frames_without_a_human_layout():
+    """An offset elbow (panda) has no default: ValueError asking for frames=; explicit frames
+    are accepted and checked."""
+    panda = aa.load("panda")
+    with pytest.raises(ValueError, match="frames="):
+        qp.SwivelTask(panda)
+    task = qp.SwivelTask(panda, frames=("panda_link1", "panda_link4", "panda_link7"))
+    assert task.frame_ids == tuple(panda.frame_id(f) for f in ("panda_link1", "panda_link4", "panda_link7"))
+
+
 def test_swivel_angle_geometry():
     """Rotating the elbow about the shoulder-wrist axis by a known angle changes φ by that angle
     (Rodrigues rotation as the oracle); φ = 0 when the elbow is straight below the axis."""

@@ -51,9 +51,9 @@ class IKConfiguration:
         self.robot = robot
         self.model: pin.Model = robot.model
         self.data: pin.Data = robot.model.createData()
-        self.nq = robot.model.nq
-        self.nv = robot.model.nv
         chain = robot.chain
+        self.nq = chain.nq
+        self.nv = chain.nv
         self.lower = chain.lower
         self.upper = chain.upper
         # q indices of the bounded joints (continuous and mimic joints have no range of their own)

@@ -103,7 +103,7 @@ class FrameAxesTask(Task):
         super().__init__(cost=np.broadcast_to(np.asarray(cost, dtype=float), (3,)).copy(), gain=gain,
                          lm_damping=lm_damping)
         self.frame_id = robot.frame_id(frame)
-        self.frame = robot.model.frames[self.frame_id].name
+        self.frame = robot.chain.frame(self.frame_id).name
         self.target = None
         if target is not None:
             self.set_target(target)

@@ -29,7 +29,7 @@ class FrameTask(Task):
         oc = np.broadcast_to(np.asarray(orientation_cost, dtype=float), (3,))
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
         self.frame_id = robot.frame_id(frame)
-        self.frame = robot.model.frames[self.frame_id].name
+        self.frame = robot.chain.frame(self.frame_id).name
         self._nv = robot.nv
         self._w_cost = None           # the cost array and gain the cached weights belong to
         self._w_gain = None

@@ -26,8 +26,8 @@ class RelativeFrameTask(Task):
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
         self.frame_id = robot.frame_id(frame)
         self.root_id = robot.frame_id(root)
-        self.frame = robot.model.frames[self.frame_id].name
-        self.root = robot.model.frames[self.root_id].name
+        self.frame = robot.chain.frame(self.frame_id).name
+        self.root = robot.chain.frame(self.root_id).name
         self.target = None
         if target is not None:
             self.set_target(target)
