@@ -7,7 +7,7 @@ human_arm7 at one swivel angle), written with the ``math`` module for one pose: 
 temporaries, cos/sin of a branch pair obtained by symmetry (θ + π, −θ) instead of new calls.
 
 Each kernel returns the candidates as a tree of nested branches and, for every candidate inside
-the joint limits, its FK residual from the generated straight-line FK of the catalog spec
+the joint limits, its FK residual from the generated straight-line FK of ``robot.chain``
 (:mod:`anthroarm.ik.fk_codegen`, evaluated once per distinct branch prefix): an independent
 forward computation of the returned joint values.  A candidate is kept if its code is OK, it
 lies inside the limits after the 2π wrap and ``max |FK(q) − T| ≤ tol`` (3×4 pose entries, m for
