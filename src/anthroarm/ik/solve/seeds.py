@@ -224,30 +224,27 @@ class TableSeeds:
 
 
 # ------------------------------------------------------------------------------ closed form
-def has_closed_form(robot, fid) -> bool:
-    """:func:`anthroarm.ik.analytic` solves for frame ``fid`` of this robot."""
-    return fid == robot.tool_id and closed_form.has_analytic(robot)
-
-
-def closed_form_cheap(sh) -> bool:
-    """True when ``analytic="auto"`` puts the closed form first (where it exists): a call costs
-    about as much as a few Gauss–Newton iterations — at most six joints on the path (the scalar
-    kernels, ~10–20 µs), a redundant arm's swivel grid only with the compiled kernel of
-    :mod:`anthroarm.ik.analytic_c` (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and
-    environment, so the same call gives the same answer."""
-    return sh.dof <= 6 or bool(analytic_c.enabled() and analytic_c.compiler() is not None)
+def closed_form_cheap(robot, fid) -> bool:
+    """True when ``analytic="auto"`` puts the closed form first (where it exists,
+    :func:`anthroarm.ik.closed_form.closed_form_info`): a call costs about as much as a few
+    Gauss–Newton iterations — a non-redundant arm (~10 µs), a redundant arm's swivel grid
+    (:data:`HUMAN_GRID`) only with the compiled kernel of :mod:`anthroarm.ik.analytic_c`
+    (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and environment, so the same call gives the
+    same answer."""
+    info = closed_form.closed_form_info(robot, fid)
+    return info is not None and (not info.swivel or bool(analytic_c.enabled() and analytic_c.compiler() is not None))
 
 
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, and a note ("" or
-    why the closed form failed).  A redundant arm (more than six joints on the path) is solved
+    why the closed form failed).  A redundant arm (a swivel family of solutions) is solved
     at ``swivel`` (rad) if given, else on ``grid``."""
     sh = ws.sh
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
         return none, ""
     kw = {}
-    if sh.dof > 6:
+    if sh.swivel_family:
         if swivel is not None:
             kw["swivel"] = swivel
         elif grid is not None:

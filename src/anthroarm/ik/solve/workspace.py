@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from ...chain import CONTINUOUS, PRISMATIC
 from ..qp.tasks.posture import HUMAN_ARM7_COMFORT, comfortable_posture
+from .. import closed_form
 from . import seeds
 
 _SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # Robot -> {frame id: Shared}
@@ -69,8 +70,10 @@ class Shared:
         lo_s, hi_s = (np.array(b) for b in chain.sampling_box)
         self.lo_s = np.where(self.on_path, lo_s, self.ref)
         self.hi_s = np.where(self.on_path, hi_s, self.ref)
-        self.has_closed_form = seeds.has_closed_form(robot, fid)
-        self.closed_form_first = self.has_closed_form and seeds.closed_form_cheap(self)
+        info = closed_form.closed_form_info(robot, fid)
+        self.has_closed_form = info is not None
+        self.swivel_family = bool(info is not None and info.swivel)
+        self.closed_form_first = seeds.closed_form_cheap(robot, fid)
         self.all_on_path = bool(self.on_path.all())
         self.local = threading.local()
         self._lock = threading.Lock()
