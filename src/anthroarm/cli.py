@@ -18,15 +18,56 @@ class UserError(Exception):
     """A mistake in the command line; printed as one line, exit status 2."""
 
 
+def _add_robot_options(p, what: str = "the model"):
+    """--tool and --locked: how to load a robot that is a tree or has joints to freeze."""
+    p.add_argument("--tool", default=None, metavar="FRAME",
+                   help=f"tool frame of {what} (a tree with several tips needs one; the error lists them)")
+    p.add_argument("--locked", default=None, metavar="J1,J2=V",
+                   help="comma-separated joints to freeze: NAME (at its neutral value) or NAME=VALUE (rad or m)")
+
+
+def _add_model_arguments(p, robot_options: bool = True):
+    """The model a command works on, given the same way everywhere (see :func:`_load_model`)."""
+    p.add_argument("model", help="catalog name, example-robot-data name (see 'anthroarm models --all') or URDF path")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="book-model parameter, e.g. height=1.62 (repeatable)")
+    if robot_options:
+        _add_robot_options(p)
+
+
+def _parse_locked(text):
+    """``"a,b=0.5"`` -> {"a": None, "b": 0.5} (None: the neutral value)."""
+    if text is None:
+        return None
+    out = {}
+    for item in filter(None, (t.strip() for t in text.split(","))):
+        name, eq, value = item.partition("=")
+        try:
+            out[name.strip()] = float(value) if eq else None
+        except ValueError:
+            raise UserError(f"--locked expects NAME or NAME=VALUE (a number), got {item!r}") from None
+    if not out:
+        raise UserError("--locked expects at least one joint name")
+    return out
+
+
 def _add_check(sub):
     p = sub.add_parser(
         "check",
-        help="cross-check the book's closed forms against Pinocchio",
-        description="Cross-check every closed form against Pinocchio on random configurations inside the limits.",
-        epilog="example: anthroarm check --models prosthetic_arm human_arm7 --samples 500 --json",
+        help="cross-check the closed forms, kinematics, dynamics and IK against Pinocchio",
+        description="Cross-check every closed form against Pinocchio (and yourdfpy) on random configurations "
+                    "inside the limits.  Any robot gets the generic rows (FK and Jacobians, error propagation, "
+                    "Lagrange dynamics, aa.ik.solve round trips); the book models also get the book's rows.  "
+                    "Without a model: the whole catalog.  Exit status 1 unless every row passes.",
+        epilog="examples:\n  anthroarm check\n  anthroarm check ur10\n  anthroarm check my_arm.urdf --tool tool0\n"
+               "  anthroarm check --models prosthetic_arm,human_arm7,kinova --samples 500 --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--models", nargs="*", default=None, help="restrict to these catalog models")
+    p.add_argument("model", nargs="*", metavar="MODEL_OR_URDF",
+                   help="catalog name, example-robot-data name (see 'anthroarm models --all') or URDF path")
+    p.add_argument("--models", nargs="*", default=None, metavar="A,B,C",
+                   help="more models, comma- or space-separated (same kinds as MODEL_OR_URDF)")
+    _add_robot_options(p, "every model given")
     p.add_argument("--samples", type=int, default=200, help="random configurations per model (default 200)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
@@ -38,7 +79,11 @@ def cmd_check(a) -> int:
 
     if a.samples < 1:
         raise UserError("--samples must be >= 1")
-    rows = crosscheck.run(a.models, samples=a.samples, seed=a.seed, progress=not a.json and sys.stderr.isatty())
+    names = [n for item in [*a.model, *(a.models or [])] for n in item.split(",") if n]
+    if (a.tool is not None or a.locked is not None) and not names:
+        raise UserError("--tool and --locked apply to the models given: name one (e.g. anthroarm check ur10 --tool tool0)")
+    rows = crosscheck.run(names or None, samples=a.samples, seed=a.seed, progress=not a.json and sys.stderr.isatty(),
+                          tool=a.tool, locked=_parse_locked(a.locked))
     print(crosscheck.to_json(rows) if a.json else crosscheck.format_table(rows))
     return 0 if all(r.ok for r in rows) else 1
 
@@ -46,12 +91,41 @@ def cmd_check(a) -> int:
 def _add_models(sub):
     p = sub.add_parser(
         "models",
-        help="list the model catalog",
-        description="List the catalog: the book's models and the example-robot-data arms.",
-        epilog="example: anthroarm models --json",
+        help="list the model catalog (and every example-robot-data robot with --all)",
+        description="List the catalog (the book's models and the curated example-robot-data arms) with nq, nv and "
+                    "the joint kinds; --all adds every robot example-robot-data ships, loadable by name.",
+        epilog="examples:\n  anthroarm models\n  anthroarm models --all --json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    p.add_argument("--all", action="store_true", help="also list every example-robot-data robot")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_models)
+
+
+def _describe(name, source: str, description: str = "") -> dict:
+    """One entry of ``anthroarm models``: nq, nv, joint kinds and tool of a robot loaded by
+    name, or what it needs (tool=, with its tips) or why it does not load."""
+    from . import load
+    from .errors import AmbiguousToolError, AnthroarmError
+
+    out = {"name": name, "source": source, "description": description, "nq": None, "nv": None, "kinds": {},
+           "tool": None, "tips": [], "needs_tool": False, "error": None}
+    try:
+        try:
+            r = load(name)
+        except AmbiguousToolError:
+            out["needs_tool"] = True
+            r = load(name, tool="universe")   # the base frame: every model has it; only to count and list tips
+        out.update(nq=r.nq, nv=r.nv, kinds={k: n for k, n in r.chain.kind_counts().items() if n},
+                   tool=None if out["needs_tool"] else r.tool, tips=list(r.tips),
+                   description=description or r.description)
+    except AnthroarmError as exc:
+        out["error"] = " ".join(str(exc).split())
+    return out
+
+
+def _kinds_text(kinds: dict) -> str:
+    return " + ".join(f"{n} {k}" for k, n in kinds.items()) or "no joints"
 
 
 def cmd_models(a) -> int:
@@ -61,30 +135,44 @@ def cmd_models(a) -> int:
     for n in models.names():
         if n in models.BOOK_MODELS:
             s = models.spec(n)
-            out.append({"name": n, "nq": s.nq, "tool": s.tool_name, "source": s.source, "description": s.description})
+            out.append(_describe(n, s.source or "book", s.description))
         else:
             arm = models.ERD_ARMS[n]
-            out.append({"name": n, "nq": len(arm.active) if arm.active else None, "tool": arm.tool,
-                        "source": f"example-robot-data {arm.subpath}", "description": arm.description})
+            out.append(_describe(n, f"example-robot-data {arm.subpath}", arm.description))
+    if a.all:
+        out += [_describe(n, "example-robot-data") for n in models.erd_names() if n not in models.names()]
     if a.json:
         print(json.dumps(out, indent=1))
-    else:
-        w = max(len(o["name"]) for o in out)
-        for o in out:
-            print(f"{o['name']:<{w}}  nq={o['nq'] if o['nq'] is not None else '?':<2}  {o['description']}")
+        return 0
+    w = max(len(o["name"]) for o in out)
+    wk = max(len(_kinds_text(o["kinds"])) for o in out)
+    catalog = set(models.names())
+    for i, o in enumerate(out):
+        if i == len(catalog):
+            print("\nexample-robot-data (anthroarm.load(NAME); a tree needs tool=):")
+        if o["error"] is not None:
+            print(f"{o['name']:<{w}}  not loadable: {o['error']}")
+            continue
+        head = f"{o['name']:<{w}}  nq={o['nq']:<3} nv={o['nv']:<3} {_kinds_text(o['kinds']):<{wk}}"
+        if o["needs_tool"]:
+            print(f"{head}  needs tool=, one of: {', '.join(o['tips'])}")
+        else:
+            print(f"{head}  {o['description'] if o['name'] in catalog else 'tool ' + o['tool']}")
     return 0
 
 
 def _add_urdf(sub):
     p = sub.add_parser(
         "urdf",
-        help="write a catalog URDF with chosen parameters",
-        description="Write the URDF of a book model; parameters are the model builder's keyword arguments.",
-        epilog="example: anthroarm urdf human_arm7 -o arm.urdf --param height=1.62 --param mass=55 --param sex=female",
+        help="write the URDF of a model (a book model with chosen parameters)",
+        description="Write the URDF of a model: a book model generated with the builder's keyword arguments "
+                    "(--param), or the validated text of an example-robot-data robot or a URDF file.",
+        epilog="examples:\n  anthroarm urdf human_arm7 -o arm.urdf --param height=1.62 --param mass=55 --param sex=female\n"
+               "  anthroarm urdf ur10 -o ur10.urdf",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("model")
+    _add_model_arguments(p, robot_options=False)
     p.add_argument("-o", "--output", required=True, help="output .urdf file")
-    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE", help="builder parameter (repeatable)")
     p.set_defaults(func=cmd_urdf)
 
 
@@ -102,18 +190,13 @@ def _parse_params(items) -> dict:
 
 
 def cmd_urdf(a) -> int:
-    from . import models
     from ._io import atomic_write_text
 
-    if a.model not in models.BOOK_MODELS:
-        if a.model in models.ERD_ARMS:
-            raise UserError(f"{a.model} comes from example-robot-data; its URDF is {models.urdf_path(a.model)}")
-        raise UserError(f"unknown model {a.model!r}; the book models are: {', '.join(models.book_names())}")
     out = Path(a.output)
     if not out.parent.is_dir():
         raise UserError(f"folder {out.parent} does not exist")
-    text = models.urdf_text(a.model, **_parse_params(a.param))
-    atomic_write_text(out, text)
+    robot = _load_model(a.model, _parse_params(a.param), tool="universe")  # any frame: only the text is written
+    atomic_write_text(out, robot.info.text)
     print(f"wrote {out}")
     return 0
 
@@ -155,31 +238,38 @@ def cmd_bench(a) -> int:
 
 
 # ---------------------------------------------------------------------------------- shared helpers
-def _load_model(name, params=None):
-    """Load a catalog model or URDF path; user mistakes become one-line UserErrors."""
-    from . import load, models
-    from .errors import UnknownModelError
+def _load_model(name, params=None, tool=None, locked=None):
+    """Load a catalog model, an example-robot-data robot or a URDF path (:func:`anthroarm.load`);
+    its typed errors (unknown name, a tree without a tool, bad keywords) print as one line."""
+    from . import load
 
-    try:
-        return load(name, **(params or {}))
-    except UnknownModelError:
-        raise UserError(f"unknown model {name!r}; the catalog has: {', '.join(models.names())}") from None
+    kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
+    return load(name, **kw, **(params or {}))
 
 
 def _parse_q(robot, values, deg: bool, what: str = "--q"):
+    """A configuration from one value per joint (rad or m; degrees with --deg; a continuous
+    joint takes its angle).  Values outside the limits are kept, with a warning."""
     import numpy as np
 
     if values is None:
         return robot.neutral()
-    if len(values) != robot.nq:
-        raise UserError(f"{what} needs {robot.nq} values for {robot.name} (joints: {', '.join(robot.joint_names)}), "
+    names = robot.joint_names
+    if len(values) != len(names):
+        raise UserError(f"{what} needs {len(names)} values for {robot.name} (joints: {', '.join(names)}), "
                         f"got {len(values)}")
-    q = np.deg2rad(values) if deg else np.asarray(values, float)
-    q = robot.check_q(q, what)
-    if not robot.within_limits(q, tol=1e-9):
-        bad = [robot.joint_names[i] for i in np.flatnonzero((q < robot.lower - 1e-9) | (q > robot.upper + 1e-9))]
+    theta = np.deg2rad(values) if deg else np.asarray(values, float)
+    q = robot.check_q(robot.chain.configuration(theta), what)
+    joints = [robot.chain.joints[i] for i in robot.chain.independent]
+    bad = [j.name for j, t in zip(joints, theta) if not j.lower - 1e-9 <= t <= j.upper + 1e-9]
+    if bad:
         print(f"anthroarm: warning: {what} is outside the joint limits of {', '.join(bad)}", file=sys.stderr)
     return q
+
+
+def _joint_values(robot, q):
+    """One value per joint of ``robot.joint_names`` (a continuous joint: its angle)."""
+    return robot.angles(q)[list(robot.chain.independent)]
 
 
 def _check_html_path(path):
@@ -254,17 +344,15 @@ def _add_view(sub):
     p = sub.add_parser(
         "view",
         help="show a model in the browser (meshcat) or write it to HTML",
-        description="Show a catalog model (or a URDF file) in a meshcat viewer on 127.0.0.1, or write a "
-                    "self-contained HTML file.  Angles are radians unless --deg.",
+        description="Show a catalog model, an example-robot-data robot or a URDF file in a meshcat viewer on "
+                    "127.0.0.1, or write a self-contained HTML file.  Angles are radians unless --deg.",
         epilog="examples:\n  anthroarm view human_arm7 --q 40 -20 10 70 0 0 10 --deg --limits\n"
                "  anthroarm view panda --html panda.html --workspace 3000",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("model", help="catalog name (see 'anthroarm models') or a .urdf path")
+    _add_model_arguments(p)
     p.add_argument("--q", nargs="+", type=float, metavar="Q", help="joint values, one per joint")
     p.add_argument("--deg", action="store_true", help="--q is in degrees")
-    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                   help="book-model parameter, e.g. height=1.62 (repeatable)")
     p.add_argument("--limits", action="store_true", help="colour links by joint-limit proximity")
     p.add_argument("--frames", action="store_true", help="draw the joint frames")
     p.add_argument("--workspace", type=int, default=0, metavar="N", help="draw N workspace points coloured by manipulability")
@@ -278,7 +366,7 @@ def cmd_view(a) -> int:
 
     out = _check_html_path(a.html)
     _check_port_early(a)
-    robot = _load_model(a.model, _parse_params(a.param))
+    robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
     q = _parse_q(robot, a.q, a.deg)
     if a.workspace < 0:
         raise UserError("--workspace must be >= 0")
@@ -346,20 +434,19 @@ def _add_ik(sub):
         "ik",
         help="inverse kinematics of a tool pose",
         description="Joint values that put the tool frame at a pose given by a position (m) and roll-pitch-yaw "
-                    "angles (R = Rz(yaw) Ry(pitch) Rx(roll); radians unless --deg), in the model's base frame.  "
-                    "Uses aa.ik.solve when available, the book's closed form (every branch) for the book arms, "
-                    "else damped least squares with restarts.  Exit status 1 when no solution is found.",
+                    "angles (R = Rz(yaw) Ry(pitch) Rx(roll); radians unless --deg), in the model's base frame, "
+                    "by aa.ik.solve; arms with a closed form also list every branch inside the limits "
+                    "(aa.ik.analytic).  Exit status 1 when no solution is found.",
         epilog="example (hand to mouth): anthroarm ik human_arm7 --xyz 0.151 0.193 0.141 --rpy 179.5 6.1 -71.3 --deg --json",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("model", help="catalog name or .urdf path")
+    _add_model_arguments(p)
     p.add_argument("--xyz", nargs=3, type=float, required=True, metavar=("X", "Y", "Z"), help="position, m")
     p.add_argument("--rpy", nargs=3, type=float, default=[0.0, 0.0, 0.0], metavar=("R", "P", "Y"),
                    help="roll pitch yaw (default 0 0 0)")
     p.add_argument("--deg", action="store_true", help="--rpy, --q0 and the printed q are in degrees")
     p.add_argument("--q0", nargs="+", type=float, metavar="Q", help="initial guess (one value per joint)")
     p.add_argument("--frame", default=None, help="frame to place (default: the model's tool)")
-    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE", help="book-model parameter")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=cmd_ik)
 
@@ -370,7 +457,7 @@ def cmd_ik(a) -> int:
     import numpy as np
     import pinocchio as pin
 
-    robot = _load_model(a.model, _parse_params(a.param))
+    robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
     if not all(math.isfinite(x) for x in [*a.xyz, *a.rpy]):
         raise UserError("--xyz and --rpy must be finite numbers")
     rpy = np.deg2rad(a.rpy) if a.deg else np.asarray(a.rpy, float)
@@ -385,7 +472,7 @@ def cmd_ik(a) -> int:
         res = solve_pose(robot, T, q0=q0, frame=a.frame)
     finally:
         bar.close()
-    conv = (lambda x: np.rad2deg(x)) if a.deg else (lambda x: np.asarray(x))
+    conv = (lambda x: np.rad2deg(_joint_values(robot, x))) if a.deg else (lambda x: _joint_values(robot, x))
     if a.json:
         out = {"model": robot.name, "frame": a.frame or robot.tool, "xyz": list(a.xyz), "rpy": list(a.rpy),
                "units": "deg" if a.deg else "rad", **res.to_dict(conv, robot.joint_names)}
@@ -427,61 +514,20 @@ def _pose_err(robot, q, T, frame):
     return float(np.linalg.norm(F[:3, 3] - T[:3, 3])), float(np.linalg.norm(pin.log3(F[:3, :3].T @ T[:3, :3])))
 
 
-def solve_pose(robot, T, q0=None, frame=None, tol=1e-6) -> _IKOutcome:
-    """IK for the CLI: ``aa.ik.solve`` when it exists; else the closed form (all branches) of a
-    book arm; else damped least squares with random restarts.  Errors are recomputed here
-    from ``robot.fk`` whatever the solver says."""
+def solve_pose(robot, T, q0=None, frame=None) -> _IKOutcome:
+    """IK for the CLI: ``aa.ik.solve``, plus every closed-form branch inside the limits
+    (``aa.ik.analytic``) for an arm that has one at the tool.  Errors are recomputed here from
+    ``robot.fk`` whatever the solver says."""
     import numpy as np
 
     from . import ik
 
     sols = []
-    if frame is None and hasattr(ik, "has_analytic") and ik.has_analytic(robot):
-        ana = ik.analytic(robot, T)
-        sols = list(np.atleast_2d(ana.solutions)) if len(ana.solutions) else []
-    solve = getattr(ik, "solve", None)
-    if callable(solve):
-        r = solve(robot, T, q0=q0, frame=frame)
-        pe, re = _pose_err(robot, r.q, T, frame)
-        return _IKOutcome(r.q, r.success, r.status, pe, re, r.iterations, "aa.ik.solve", sols)
-    if sols:
-        ref = robot.neutral() if q0 is None else q0
-        q = min(sols, key=lambda s: float(np.linalg.norm(s - ref)))
-        pe, re = _pose_err(robot, q, T, frame)
-        ok = pe <= tol and re <= tol
-        return _IKOutcome(q, ok, "success" if ok else "not_converged", pe, re, 0, "closed form", sols)
-    if frame is None and hasattr(ik, "has_analytic") and ik.has_analytic(robot):
-        return _IKOutcome(None, False, f"no closed-form solution: {ana.reason}", float("nan"), float("nan"), 0,
-                          "closed form")
-    return _dls_restarts(robot, T, q0, frame, tol)
-
-
-def _dls_restarts(robot, T, q0, frame, tol, restarts=20, iters=200):
-    """Damped least squares (λ = 1e-3 m) on the LOCAL_WORLD_ALIGNED Jacobian, q clipped into
-    the limits, from q0 / neutral and then random seeds (fixed RNG)."""
-    import numpy as np
-    import pinocchio as pin
-
-    rng = np.random.default_rng(0)
-    seeds = [q0 if q0 is not None else robot.neutral()] + list(robot.random_q(restarts, rng=rng))
-    best, best_err, total = None, (np.inf, np.inf), 0
-    for q in seeds:
-        q = np.array(q, float)
-        for _ in range(iters):
-            total += 1
-            F = robot.fk(q, frame)
-            e = np.concatenate([T[:3, 3] - F[:3, 3], F[:3, :3] @ pin.log3(F[:3, :3].T @ T[:3, :3])])
-            if np.linalg.norm(e[:3]) <= tol and np.linalg.norm(e[3:]) <= tol:
-                break
-            J = robot.jacobian(q, frame)
-            q = np.clip(q + J.T @ np.linalg.solve(J @ J.T + 1e-6 * np.eye(6), e), robot.lower, robot.upper)
-        err = _pose_err(robot, q, T, frame)
-        if sum(err) < sum(best_err):
-            best, best_err = q, err
-        if err[0] <= tol and err[1] <= tol:
-            break
-    ok = best_err[0] <= tol and best_err[1] <= tol
-    return _IKOutcome(best, ok, "success" if ok else "not_converged", *best_err, total, "damped least squares")
+    if frame is None and ik.has_analytic(robot):
+        sols = list(np.reshape(ik.analytic(robot, T).solutions, (-1, robot.nq)))
+    r = ik.solve(robot, T, q0=q0, frame=frame)
+    pe, re = _pose_err(robot, r.q, T, frame)
+    return _IKOutcome(r.q, r.success, r.status, pe, re, r.iterations, "aa.ik.solve", sols)
 
 
 # ---------------------------------------------------------------------------------- cache

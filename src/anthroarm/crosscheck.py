@@ -1,13 +1,22 @@
-"""The book-vs-Pinocchio cross-check: every closed form against an independent oracle.
+"""``anthroarm check``: every closed form against an independent oracle, on any robot.
 
-:func:`run` collects :class:`CheckRow` s from the *providers* listed in :data:`PROVIDERS`.
-A provider is a function ``rows(models, samples, rng) -> list[CheckRow]`` in some module; each
-row compares one quantity of one model over ``samples`` random configurations inside the
-limits and records the largest error seen.  ``anthroarm check`` prints the rows and exits
-non-zero if any fails.
+:func:`run` loads the robots asked for (catalog names, example-robot-data names, URDF paths or
+:class:`~anthroarm.robot.Robot` objects) and collects :class:`CheckRow` s from two kinds of
+providers; each row compares one quantity over random samples and records the largest error.
 
-To add checks, write a provider next to the code it checks and append its dotted name
-``"package.module:function"`` to :data:`PROVIDERS`.
+* :data:`ROBOT_PROVIDERS` run on every robot: ``rows(robot, samples, rng) -> list[CheckRow]``
+  (FK and Jacobians vs Pinocchio and yourdfpy, §6-6 error propagation, the Lagrange equations
+  vs crba/rnea/aba, ``aa.ik.solve`` round trips).  A robot a provider cannot handle
+  (:class:`~anthroarm.errors.UnsupportedModelError`) gets one row noting
+  ``unsupported: <reason>``; a provider that raises anything else gets one row noting
+  ``error: <exception>``.  Neither passes.
+* :data:`PROVIDERS` are the book's rows: ``rows(names, samples, rng)`` with the catalog names
+  among the models asked for (the book models' closed forms, IK and reach; the spatial
+  mathematics and mechanisms, which need no model, always run).
+
+``anthroarm check`` prints the rows and exits non-zero unless every row passes.  To add checks,
+write a provider next to the code it checks and append ``"package.module:function"`` to the
+list of its kind.
 """
 
 from __future__ import annotations
@@ -16,19 +25,32 @@ import importlib
 import json
 import math
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import numpy as np
 
-#: dotted names of row providers, run in this order
+from .errors import UnsupportedModelError
+
+#: providers run on every robot, ``rows(robot, samples, rng)``: dotted name -> what it checks
+ROBOT_PROVIDERS: dict[str, str] = {
+    "anthroarm.kinematics.checks:rows": "kinematics",
+    "anthroarm.kinematics.checks:error_rows": "error propagation (6-118)",
+    "anthroarm.dynamics.checks:model_rows": "dyn Lagrange equations",
+    "anthroarm.crosscheck:ik_rows": "aa.ik.solve round trip",
+}
+
+#: providers of the book's rows, ``rows(catalog_names, samples, rng)``, run in this order
 PROVIDERS: list[str] = [
-    "anthroarm.kinematics.checks:rows",
     "anthroarm.design.structure:reach_rows",
-    "anthroarm.dynamics.checks:rows",
     "anthroarm.spatial.checks:rows",
     "anthroarm.mechanisms.checks:rows",
     "anthroarm.ik.checks:rows",
     "anthroarm.ik.qp.checks:rows",
 ]
+
+
+UNSUPPORTED = "unsupported"
+ERROR = "error"
 
 
 @dataclass
@@ -46,13 +68,26 @@ class CheckRow:
     oracle: str = "pinocchio"
     note: str = ""
 
+    @classmethod
+    def unsupported(cls, model: str, quantity: str, reason: str) -> "CheckRow":
+        """A row for a check that cannot run on ``model``: it compares nothing and does not pass."""
+        return cls(model, quantity, math.nan, 0.0, 0, "-", f"{UNSUPPORTED}: {' '.join(reason.split())}")
+
     @property
     def ok(self) -> bool:
         return bool(math.isfinite(self.max_abs_err) and self.max_abs_err <= self.tol)
 
+    @property
+    def status(self) -> str:
+        """"ok", "FAIL" or "unsupported"."""
+        if self.ok:
+            return "ok"
+        return UNSUPPORTED if self.note.startswith(UNSUPPORTED + ":") else "FAIL"
+
     def as_dict(self) -> dict:
         d = asdict(self)
         d["ok"] = self.ok
+        d["status"] = self.status
         return d
 
 
@@ -61,40 +96,101 @@ def _load_provider(dotted: str):
     return getattr(importlib.import_module(mod), fn)
 
 
-def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress: bool = False) -> list[CheckRow]:
-    """Run every provider; ``models`` restricts the model-specific rows to those names."""
+def load_robots(models=None, tool: str | None = None, locked=None) -> list:
+    """The robots of a check: ``models`` entries are catalog names, example-robot-data names,
+    URDF paths or Robots (default: the catalog); ``tool=``/``locked=`` go to
+    :func:`anthroarm.load` for every entry given by name or path."""
+    from . import models as catalog
+    from .robot import Robot, load
+
+    entries = list(models) if models else catalog.names()
+    kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
+    return [e if isinstance(e, Robot) else load(e, **kw) for e in entries]
+
+
+def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress: bool = False,
+        tool: str | None = None, locked=None) -> list[CheckRow]:
+    """Run the checks (see the module docstring) and return the rows.
+
+    ``models``: names, URDF paths or Robots (default: the whole catalog); ``providers``: dotted
+    names to run instead of all (robot providers are those in :data:`ROBOT_PROVIDERS`);
+    ``tool``/``locked``: passed to :func:`anthroarm.load` for every named model."""
     from . import models as catalog
 
-    names = list(models) if models else catalog.names()
-    for n in names:
-        if n not in catalog.names():
-            raise catalog._unknown(n)
-    rows: list[CheckRow] = []
-    provs = providers or PROVIDERS
-    it = provs
+    robots = load_robots(models, tool, locked)
+    names = catalog.names() if not models else [str(m) for m in models
+                                                      if isinstance(m, (str, Path)) and str(m) in catalog.names()]
+    provs = list(providers) if providers is not None else [*ROBOT_PROVIDERS, *PROVIDERS]
+    jobs = [(p, r) for p in provs if p in ROBOT_PROVIDERS for r in robots]
+    jobs += [(p, None) for p in provs if p not in ROBOT_PROVIDERS]
+    it = jobs
     if progress:
         from tqdm.auto import tqdm
 
-        it = tqdm(provs, desc="cross-check", unit="provider", leave=False)
-    for dotted in it:
+        it = tqdm(jobs, desc="cross-check", unit="check", leave=False)
+    rows: list[CheckRow] = []
+    for dotted, robot in it:
         rng = np.random.default_rng(seed)
-        rows.extend(_load_provider(dotted)(names, samples, rng))
+        if robot is None:
+            rows.extend(_load_provider(dotted)(names, samples, rng))
+            continue
+        try:
+            rows.extend(_load_provider(dotted)(robot, samples, rng))
+        except UnsupportedModelError as exc:
+            rows.append(CheckRow.unsupported(robot.name, ROBOT_PROVIDERS[dotted], str(exc)))
+        except Exception as exc:  # noqa: BLE001 - a check that crashes on a user's robot is a failed row, not a traceback
+            rows.append(CheckRow(robot.name, ROBOT_PROVIDERS[dotted], math.nan, 0.0, 0, "-",
+                                 f"{ERROR}: {type(exc).__name__}: {' '.join(str(exc).split())}"))
     return rows
 
 
+def ik_rows(robot, samples: int, rng) -> list[CheckRow]:
+    """``aa.ik.solve`` round trip on any robot: random configurations inside the limits →
+    Pinocchio FK of the tool → solve → Pinocchio FK of the answer.  The row reports the largest
+    position (m) or rotation (rad) error; a failure or an answer outside the limits counts as
+    an infinite error."""
+    import pinocchio as pin
+
+    from . import ik
+
+    n = max(3, min(int(samples), 20))
+    model, data, fid = robot.model, robot.model.createData(), robot.tool_id
+    worst, solved = 0.0, 0
+    for q in robot.random_q(n, rng):
+        pin.framesForwardKinematics(model, data, q)
+        T = data.oMf[fid].homogeneous.copy()
+        res = ik.solve(robot, T, max_time=1.0)  # correctness, not speed (the benchmarks time it): a
+        # first call also builds the robot's seed table
+        if not (res.success and robot.within_limits(res.q)):
+            worst = math.inf
+            continue
+        solved += 1
+        pin.framesForwardKinematics(model, data, res.q)
+        M = data.oMf[fid]
+        worst = max(worst, float(np.linalg.norm(M.translation - T[:3, 3])),
+                    float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))))
+    return [CheckRow(robot.name, "aa.ik.solve: FK(solve(T)) = T within limits", worst, 1e-6, n, "pinocchio FK",
+                     f"{solved}/{n} solved; pos (m) / rot (rad), worst of both")]
+
+
 def format_table(rows: list[CheckRow]) -> str:
-    """Plain-text table: model, quantity, max abs err, tol, samples, ok."""
+    """Plain-text table: model, quantity, max abs err, tol, samples, oracle, status; then the
+    reasons of unsupported rows and a summary line."""
     head = ("model", "quantity", "max_abs_err", "tol", "samples", "oracle", "ok")
     body = [
-        (r.model, r.quantity, f"{r.max_abs_err:.3e}", f"{r.tol:.0e}", str(r.samples), r.oracle, "ok" if r.ok else "FAIL")
+        (r.model, r.quantity, f"{r.max_abs_err:.3e}", f"{r.tol:.0e}", str(r.samples), r.oracle, r.status)
         for r in rows
     ]
     widths = [max(len(h), *(len(b[i]) for b in body)) if body else len(h) for i, h in enumerate(head)]
     fmt = "  ".join(f"{{:<{w}}}" for w in widths)
-    lines = [fmt.format(*head), fmt.format(*("-" * w for w in widths))]
-    lines += [fmt.format(*b) for b in body]
-    n_bad = sum(not r.ok for r in rows)
-    lines.append(f"{len(rows) - n_bad} passed, {n_bad} failed")
+    lines = [fmt.format(*head).rstrip(), fmt.format(*("-" * w for w in widths))]
+    lines += [fmt.format(*b).rstrip() for b in body]
+    unsupported = [r for r in rows if r.status == UNSUPPORTED]
+    for r in rows:
+        if r.note.startswith((UNSUPPORTED + ":", ERROR + ":")):
+            lines.append(f"{r.model}: {r.quantity}: {r.note}")
+    n_ok = sum(r.ok for r in rows)
+    lines.append(f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} unsupported")
     return "\n".join(lines)
 
 

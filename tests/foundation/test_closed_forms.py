@@ -7,7 +7,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm import crosscheck
-from anthroarm.kinematics import closed_forms as cf
+from anthroarm.kinematics import book_fk as cf
 from anthroarm.kinematics.batched import SerialChain
 from anthroarm.kinematics.dh import dh_fk, dh_jacobian, dh_transform
 from anthroarm.models.spec import DHRow, dh_matrix

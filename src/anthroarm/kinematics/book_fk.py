@@ -5,9 +5,16 @@ Every function takes joint values ``q`` of shape ``(n,)`` or ``(N, n)`` (rad; m 
 joints) and link lengths in m, and returns the hand pose as a 4×4 homogeneous matrix (or a
 batch) in the book's base frame 0.  In the book's notation the hand frame has its x axis
 b = (u, v, w), its z axis a = (l, m, n) and its origin at the hand point (x, y, z); y = a × b.
+
+:data:`PRINTED` is the one registry that says which book model each printed form belongs to
+(``anthroarm check`` compares them with Pinocchio through :func:`printed_forms`).  This module
+is forward kinematics; the closed-form *inverse* kinematics is :mod:`anthroarm.ik.closed_form`.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -189,3 +196,64 @@ def prosthetic_arm_points(q, L1: float, L2: float, L3: float):
     W = F[..., 5, :3, 3]
     C = W + L3 * F[..., 6, :3, 2]
     return E, W, C
+
+
+def planar2r_tip_pose(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
+    """Fig. 7-14 as a pose, (N, 4, 4): the printed tip (y, z) of :func:`planar2r_tip`; both
+    hinges turn about x, so the tip frame is Rx(θ1 + θ2)."""
+    q2, _ = _as_batch(q, 2)
+    yz = np.atleast_2d(planar2r_tip(q2, l1, l2))
+    t = q2.sum(axis=-1)
+    T = np.zeros(t.shape + (4, 4))
+    T[:, 0, 0] = T[:, 3, 3] = 1.0
+    T[:, 1, 1] = T[:, 2, 2] = np.cos(t)
+    T[:, 2, 1], T[:, 1, 2] = np.sin(t), -np.sin(t)
+    T[:, 1, 3], T[:, 2, 3] = yz[:, 0], yz[:, 1]
+    return T
+
+
+@dataclass(frozen=True)
+class PrintedForm:
+    """One printed closed form of a book model: ``pose(q, params)`` → (N, 4, 4) of the tool,
+    ``jacobian(q, params)`` → (N, 6, n) LOCAL_WORLD_ALIGNED or None, ``length_jacobian(q,
+    params)`` → (N, 3, 3) the §6-6 coefficients ∂P/∂l or None; ``params`` is the model's
+    ``spec.params`` (SI units)."""
+
+    equations: str
+    pose: Callable
+    jacobian: Callable | None = None
+    length_jacobian: Callable | None = None
+
+
+def _human_arm7_length_jacobian(q, p):
+    from .error_propagation import human_arm7_length_jacobian
+
+    return human_arm7_length_jacobian(q)
+
+
+#: book model name -> its printed forms (functions are looked up when called)
+PRINTED: dict[str, tuple[PrintedForm, ...]] = {
+    "sixr_arm": (PrintedForm("(6-16)/(6-17)", lambda q, p: sixr_hand_pose(q, p["s0"], p["h2"], p["s3"], p["P"])),),
+    "unimate5": (PrintedForm("(6-21)-(6-23)", lambda q, p: unimate_hand_pose(q, p["s0"], p["h2"], p["P"])),),
+    "rrprr5": (PrintedForm("002 (4-52)-(4-54)", lambda q, p: rrprr_hand_pose(q, p["s0"], p["h2"], p["p"])),),
+    "human_arm7": (PrintedForm("(6-34)-(6-39)", lambda q, p: human_arm7_hand_pose(q, p["l1"], p["l2"], p["l3"]),
+                               lambda q, p: human_arm7_jacobian(q, p["l1"], p["l2"], p["l3"]),
+                               _human_arm7_length_jacobian),),
+    "planar2r": (PrintedForm("Fig. 7-14 (y, z)", lambda q, p: planar2r_tip_pose(q, p["l1"], p["l2"])),),
+}
+
+
+def book_spec(robot):
+    """The parameter table of ``robot`` when it is a book model as generated (any parameters),
+    with its own tool frame and every joint (the chain the closed forms describe); else None."""
+    spec = getattr(robot, "spec", None)
+    if spec is None or robot.tool != spec.tool_name or robot.locked or robot.nq != spec.nq:
+        return None
+    return spec
+
+
+def printed_forms(robot) -> tuple[PrintedForm, ...]:
+    """The printed forms that apply to ``robot`` (see :func:`book_spec`); call them with
+    ``book_spec(robot).params``."""
+    spec = book_spec(robot)
+    return PRINTED.get(spec.name, ()) if spec is not None else ()

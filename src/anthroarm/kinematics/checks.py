@@ -1,15 +1,21 @@
-"""Cross-check rows of the kinematics (a provider of :mod:`anthroarm.crosscheck`).
+"""Cross-check rows of the kinematics (robot providers of :mod:`anthroarm.crosscheck`).
 
-For every model, on random configurations inside the joint limits:
-* the book's closed forms (H-D chain Eq. (6-12)–(6-14); the printed hand poses (6-16)/(6-17),
-  (6-21)–(6-23), 002 (4-52)–(4-54), the human arm (6-34)–(6-39); Fig. 7-14) against
-  ``pin.framesForwardKinematics``;
-* their Jacobians ((6-24)–(6-29) in vector form) against ``pin.computeFrameJacobian``
-  (LOCAL_WORLD_ALIGNED);
-* the generic batched chain (:class:`~anthroarm.kinematics.batched.SerialChain`) for every model;
-* yourdfpy's FK of every link against Pinocchio's, joints mapped by name.
+:func:`rows`, for any robot, on random configurations inside the limits:
 
-Positions and the linear Jacobian rows are divided by the model's length scale (errors are
+* the batched chain (``robot.fk(Q)`` / ``robot.jacobian(Q)`` with Q of shape (N, nq), i.e.
+  :class:`~anthroarm.kinematics.batched.SerialChain`) against Pinocchio one configuration at a
+  time (``pin.framesForwardKinematics``, ``pin.computeFrameJacobian`` LOCAL_WORLD_ALIGNED);
+* yourdfpy's FK of every link against Pinocchio's, joints mapped by name (robots with a URDF);
+* for a book model as generated: the H-D chain Eq. (6-12)–(6-14) and the printed forms of
+  :data:`anthroarm.kinematics.book_fk.PRINTED` ((6-16)/(6-17), (6-21)–(6-23), 002
+  (4-52)–(4-54), the human arm (6-34)–(6-39) with its Jacobian, Fig. 7-14).
+
+:func:`error_rows`, for any robot: §6-6 J_L (6-118) against finite differences over
+Pinocchio models with perturbed placements, the batched perturbed FK
+(:class:`~anthroarm.kinematics.error_propagation.PerturbedChain`) against Pinocchio on a
+perturbed model, and (6-119) where the book prints it.
+
+Positions and the linear Jacobian rows are divided by the robot's length scale (errors are
 relative to arm length); rotations and angular rows are absolute.
 """
 
@@ -19,11 +25,12 @@ import numpy as np
 import pinocchio as pin
 
 from ..crosscheck import CheckRow
-from . import closed_forms as cf
-from .batched import SerialChain
+from . import error_propagation as ep
+from .book_fk import book_spec, printed_forms
 from .dh import dh_fk, dh_jacobian
 
 TOL = 1e-12
+LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 def _pose_err(Ta, Tb, scale) -> float:
@@ -36,41 +43,39 @@ def _jac_err(Ja, Jb, scale) -> float:
     return float(max(np.abs(Ja[..., :3, :] - Jb[..., :3, :]).max() / scale, np.abs(Ja[..., 3:, :] - Jb[..., 3:, :]).max()))
 
 
-def _closed_forms(robot):
-    """(quantity, fk(q) -> T batch, jac(q) -> J batch or None) of the book's closed forms."""
-    p = robot.spec.params if robot.spec is not None else {}
-    name = robot.name
+def _pinocchio(robot, Q):
+    """Tool poses (N, 4, 4) and LWA Jacobians (N, 6, nv), one Pinocchio call per configuration."""
+    model, data, fid = robot.model, robot.model.createData(), robot.tool_id
+    T = np.empty((len(Q), 4, 4))
+    J = np.empty((len(Q), 6, robot.nv))
+    for i, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        T[i] = data.oMf[fid].homogeneous
+        J[i] = pin.computeFrameJacobian(model, data, q, fid, LWA)
+    return T, J
+
+
+def _book_forms(robot):
+    """(quantity, fk(Q) -> T batch, jac(Q) -> J batch or None) of the book's closed forms."""
+    spec = book_spec(robot)
+    if spec is None:
+        return []
     out = []
-    if robot.spec is not None and robot.spec.dh is not None:
-        rows, tool = robot.spec.dh, robot.spec.tool_dh
-        out.append(("fk H-D chain (6-12)-(6-14)", lambda q: dh_fk(rows, q, tool), lambda q: dh_jacobian(rows, q, tool)))
-    if name == "sixr_arm":
-        out.append(("fk printed (6-16)/(6-17)", lambda q: cf.sixr_hand_pose(q, p["s0"], p["h2"], p["s3"], p["P"]), None))
-    if name == "unimate5":
-        out.append(("fk printed (6-21)-(6-23)", lambda q: cf.unimate_hand_pose(q, p["s0"], p["h2"], p["P"]), None))
-    if name == "rrprr5":
-        out.append(("fk printed 002 (4-52)-(4-54)", lambda q: cf.rrprr_hand_pose(q, p["s0"], p["h2"], p["p"]), None))
-    if name == "human_arm7":
-        L = (p["l1"], p["l2"], p["l3"])
-        out.append(("fk printed (6-34)-(6-39)", lambda q: cf.human_arm7_hand_pose(q, *L), lambda q: cf.human_arm7_jacobian(q, *L)))
-    if name == "planar2r":
-        def tip(q):
-            # printed position (y, z); both hinges are about x, so the tip frame is Rx(θ1+θ2)
-            yz = cf.planar2r_tip(q, p["l1"], p["l2"])
-            t = np.atleast_2d(q).sum(axis=-1)
-            T = np.zeros(t.shape + (4, 4))
-            T[..., 0, 0] = T[..., 3, 3] = 1.0
-            T[..., 1, 1] = T[..., 2, 2] = np.cos(t)
-            T[..., 2, 1], T[..., 1, 2] = np.sin(t), -np.sin(t)
-            T[..., 1, 3], T[..., 2, 3] = np.atleast_2d(yz)[..., 0], np.atleast_2d(yz)[..., 1]
-            return T
-        out.append(("fk printed Fig. 7-14 (y, z)", tip, None))
+    if spec.dh is not None:
+        dh, tool = spec.dh, spec.tool_dh
+        out.append(("fk H-D chain (6-12)-(6-14)", lambda q: dh_fk(dh, q, tool), lambda q: dh_jacobian(dh, q, tool)))
+    p = spec.params
+    for f in printed_forms(robot):
+        jac = (lambda q, f=f: f.jacobian(q, p)) if f.jacobian is not None else None
+        out.append((f"fk printed {f.equations}", lambda q, f=f: f.pose(q, p), jac))
     return out
 
 
-def _yourdfpy_rows(robot, Q, scale) -> CheckRow:
+def _yourdfpy_row(robot, Q, scale) -> CheckRow:
+    if robot.info is None:
+        return CheckRow.unsupported(robot.name, "fk yourdfpy (all links)", "loaded from a pin.Model: no URDF")
     u = robot.urdf
-    model, data = robot.model, robot.data
+    model, data = robot.model, robot.model.createData()
     names = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name in u.link_map]
     fids = [model.getFrameId(n) for n in names]
     err = 0.0
@@ -83,23 +88,47 @@ def _yourdfpy_rows(robot, Q, scale) -> CheckRow:
     return CheckRow(robot.name, "fk yourdfpy (all links)", err, TOL, len(Q), "pinocchio", note)
 
 
-def rows(models, samples, rng) -> list[CheckRow]:
-    import anthroarm as aa
-
+def rows(robot, samples, rng) -> list[CheckRow]:
+    """FK and Jacobian rows of one robot (see the module docstring)."""
+    name, scale = robot.name, robot.length_scale
+    Q = robot.random_q(samples, rng)
+    T_pin, J_pin = _pinocchio(robot, Q)
     out = []
-    for name in models:
-        robot = aa.load(name)
-        scale = robot.length_scale
-        Q = robot.random_q(samples, rng)
-        T_pin = robot.fk(Q)
-        J_pin = robot.jacobian(Q)
-        for quantity, fk, jac in _closed_forms(robot):
-            out.append(CheckRow(name, quantity, _pose_err(fk(Q), T_pin, scale), TOL, samples))
-            if jac is not None:
-                out.append(CheckRow(name, quantity.replace("fk", "jacobian", 1) + " LWA", _jac_err(jac(Q), J_pin, scale), TOL, samples))
-        chain = SerialChain.of(robot)
-        T_c, J_c = chain.fk_jacobian(Q)
-        out.append(CheckRow(name, "fk serial chain (batched)", _pose_err(T_c, T_pin, scale), TOL, samples))
-        out.append(CheckRow(name, "jacobian serial chain LWA", _jac_err(J_c, J_pin, scale), TOL, samples))
-        out.append(_yourdfpy_rows(robot, Q, scale))
+    for quantity, fk, jac in _book_forms(robot):
+        out.append(CheckRow(name, quantity, _pose_err(fk(Q), T_pin, scale), TOL, samples))
+        if jac is not None:
+            out.append(CheckRow(name, quantity.replace("fk", "jacobian", 1) + " LWA", _jac_err(jac(Q), J_pin, scale),
+                                TOL, samples))
+    out.append(CheckRow(name, "fk batched chain robot.fk(Q)", _pose_err(robot.fk(Q), T_pin, scale), TOL, samples))
+    out.append(CheckRow(name, "jacobian batched chain LWA", _jac_err(robot.jacobian(Q), J_pin, scale), TOL, samples))
+    out.append(_yourdfpy_row(robot, Q, scale))
+    return out
+
+
+def error_rows(robot, samples, rng) -> list[CheckRow]:
+    """§6-6 error-propagation rows of one robot (see the module docstring)."""
+    n = max(1, min(int(samples), 5))
+    name, scale = robot.name, robot.length_scale
+    Q = robot.random_q(n, rng)
+    e_jl = max(np.abs(ep.length_jacobian(robot, q, mode="components")
+                      - ep.length_jacobian_fd(robot, q, mode="components")).max() for q in Q)
+    out = [CheckRow(name, "J_L (6-118) vs FD of perturbed placements", float(e_jl), 1e-10, n)]
+    chain = ep.PerturbedChain(robot, mode="components")
+    dL = 0.01 * scale * rng.standard_normal((n, len(chain.params)))
+    R, x = chain.pose(Q, dL)
+    err = 0.0
+    for i, q in enumerate(Q):
+        m = robot.model
+        for p, d in zip(chain.params, dL[i]):
+            m = ep._perturbed_model(m, p, d)
+        d_ = m.createData()
+        pin.framesForwardKinematics(m, d_, q)
+        M = d_.oMf[robot.tool_id]
+        err = max(err, np.abs(x[i] - M.translation).max() / scale, np.abs(R[i] - M.rotation).max())
+    out.append(CheckRow(name, "perturbed FK T(q, L+dL) vs pin on the perturbed model", float(err), TOL, n))
+    for f in printed_forms(robot):
+        p = book_spec(robot).params
+        if f.length_jacobian is not None:
+            e = max(np.abs(f.length_jacobian(q, p) - ep.length_jacobian_fd(robot, q)[:3]).max() for q in Q)
+            out.append(CheckRow(name, "(6-119) vs FD of perturbed placements", float(e), 1e-10, n))
     return out

@@ -7,9 +7,9 @@ The hand position is x = F(q₁…qₙ, L₁…L_k) (6-117); to first order (6-1
 the "error transfer coefficients" (误差的传递系数).  Δq are joint-variable errors (rad or m),
 ΔL manufacturing errors of the link dimensions (m).
 
-Link parameters of any catalog arm: every constant translation of the kinematic tree on the
-path from the base to the frame — the joint placements ``model.jointPlacements[i]`` and the
-frame placement — is a *link*; its parameters are
+Link parameters of any robot: every constant translation of the kinematic tree on the path
+from the base to the frame — the joint placements of ``robot.chain`` and the frame placement —
+is a *link*; its parameters are
 
 * ``mode="length"``: its length L = |t| along its own direction t/|t| (the book's ΔL), or
 * ``mode="components"``: its three components along the parent joint's axes (x, y, z), which
@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..errors import UnsupportedModelError
 from ..spatial.rotations import rot_axis
 
 
@@ -54,27 +53,21 @@ class LinkParameter:
     nominal: float
 
 
-def _support_joints(model: pin.Model, fid: int) -> list[int]:
-    j = model.frames[fid].parentJoint
-    out = []
-    while j > 0:
-        out.append(j)
-        j = model.parents[j]
-    return out[::-1]
-
-
 def link_parameters(robot, frame=None, mode: str = "length", tol: float = 1e-12) -> list[LinkParameter]:
-    """The link dimensions that move ``frame`` (default: the tool), in base-to-tip order.
+    """The link dimensions that move ``frame`` (default: the tool), in base-to-tip order, read
+    from ``robot.chain``: the placement of every joint on the path (mimic joints included) and
+    the frame's placement in its joint.
 
     ``mode="length"``: one parameter per nonzero placement translation (its length);
     ``mode="components"``: three per placement on the path (x, y, z in the parent frame),
-    including zero ones."""
+    including zero ones.  ``LinkParameter.index`` is the Pinocchio joint id (chain index + 1)
+    or frame id."""
     if mode not in ("length", "components"):
         raise ValueError(f"mode must be 'length' or 'components', got {mode!r}")
-    model = robot.model
-    fid = robot.frame_id(frame)
-    items = [("joint", j, model.names[j], model.jointPlacements[j].translation) for j in _support_joints(model, fid)]
-    items.append(("frame", fid, model.frames[fid].name, model.frames[fid].placement.translation))
+    chain = robot.chain
+    f = chain.frame(robot.frame_id(frame))
+    items = [("joint", i + 1, chain.joints[i].name, chain.joints[i].translation) for i in chain.path(f.index)]
+    items.append(("frame", f.index, f.name, f.translation))
     out = []
     for kind, idx, name, t in items:
         t = np.array(t, float)
@@ -92,8 +85,9 @@ def _params(robot, frame, params, mode):
     return link_parameters(robot, frame, mode) if params is None else list(params)
 
 
-def _parent_joint(model, p: LinkParameter) -> int:
-    return model.parents[p.index] if p.kind == "joint" else model.frames[p.index].parentJoint
+def _parent_joint(chain, p: LinkParameter) -> int:
+    """Pinocchio id of the joint whose frame ``p`` is expressed in (0: the base)."""
+    return chain.joints[p.index - 1].parent + 1 if p.kind == "joint" else chain.frames[p.index].joint + 1
 
 
 # ----------------------------------------------------------------------------- Jacobians
@@ -104,11 +98,11 @@ def length_jacobian(robot, q, frame=None, params=None, mode: str = "length") -> 
     if q.ndim != 1:
         raise ValueError(f"length_jacobian takes one configuration, got shape {q.shape}")
     ps = _params(robot, frame, params, mode)
-    model, data = robot.model, robot.data
-    pin.forwardKinematics(model, data, q)
+    data = robot.data
+    pin.forwardKinematics(robot.model, data, q)
     J = np.zeros((6, len(ps)))
     for k, p in enumerate(ps):
-        J[:3, k] = data.oMi[_parent_joint(model, p)].rotation @ p.direction
+        J[:3, k] = data.oMi[_parent_joint(robot.chain, p)].rotation @ p.direction
     return J
 
 
@@ -152,7 +146,7 @@ def length_jacobian_fd(robot, q, frame=None, params=None, mode: str = "length", 
 def human_arm7_length_jacobian(q) -> np.ndarray:
     """The book's Eq. (6-119) for the §6-3 arm: the 3 × 3 matrix [−e_{·3}, −w_{·3}, −h_{·3}]
     mapping (Δl₁, Δl₂, Δl₃) to (Δx_H, Δy_H, Δz_H), with C_E, C_W, C_H of (6-34)–(6-36)."""
-    from .closed_forms import human_arm7_rotations
+    from .book_fk import human_arm7_rotations
 
     CE, CW, CH = human_arm7_rotations(np.asarray(q, float))
     return -np.stack([CE[..., :, 2], CW[..., :, 2], CH[..., :, 2]], axis=-1)
@@ -196,43 +190,25 @@ def propagate(robot, q, dq=None, dL=None, frame=None, params=None, mode: str = "
 
 # ----------------------------------------------------------------------------- batched FK with perturbed dimensions
 class PerturbedChain:
-    """Batched forward kinematics of a serial arm whose link parameters are perturbed per
-    sample: T(q, L + ΔL) for N samples at once (numpy; the oracle is Pinocchio on perturbed
-    model copies).  Needs 1-DOF revolute / prismatic joints."""
+    """Batched forward kinematics of the path to ``frame`` whose link parameters are perturbed
+    per sample: T(q, L + ΔL) for N samples at once (numpy, read from ``robot.chain``: revolute,
+    continuous, prismatic and mimic joints; the oracle is Pinocchio on perturbed model copies)."""
 
     def __init__(self, robot, frame=None, params=None, mode: str = "length"):
         self.robot = robot
-        model = robot.model
+        chain = robot.chain
         self.fid = robot.frame_id(frame)
         self.params = _params(robot, frame, params, mode)
-        self.joints = _support_joints(model, self.fid)
-        self.idx_q, self.axis, self.revolute, self.R0, self.t0 = [], [], [], [], []
-        for j in self.joints:
-            jm = model.joints[j]
-            if jm.nq != 1 or jm.nv != 1:
-                raise UnsupportedModelError(f"{robot.name}: joint {model.names[j]} ({jm.shortname()}) is not a 1-DOF joint")
-            jd = jm.createData()
-            jm.calc(jd, pin.neutral(model))  # S is constant for 1-DOF joints
-            S = np.array(jd.S.matrix() if hasattr(jd.S, "matrix") else jd.S, float).reshape(6)
-            w, v = S[3:], S[:3]
-            if np.linalg.norm(w) > 1e-12:
-                if np.linalg.norm(v) > 1e-12:
-                    raise UnsupportedModelError(f"{robot.name}: joint {model.names[j]} is helical")
-                self.revolute.append(True)
-                self.axis.append(w / np.linalg.norm(w))
-            else:
-                self.revolute.append(False)
-                self.axis.append(v / np.linalg.norm(v))
-            self.idx_q.append(jm.idx_q)
-            self.R0.append(np.array(model.jointPlacements[j].rotation))
-            self.t0.append(np.array(model.jointPlacements[j].translation))
-        fM = model.frames[self.fid].placement
-        self.Rf, self.tf = np.array(fM.rotation), np.array(fM.translation)
-        self.pos_of = {j: k for k, j in enumerate(self.joints)}
+        self.path = chain.path(self.fid)
+        self.joints = [chain.joints[i] for i in self.path]
+        f = chain.frames[self.fid]
+        self.Rf, self.tf = f.rotation, f.translation
 
-    def pose(self, q, dL=None) -> tuple[np.ndarray, np.ndarray]:
+    def pose(self, q, dL=None, dq=None) -> tuple[np.ndarray, np.ndarray]:
         """World rotation (N, 3, 3) and position (N, 3) of the frame for configurations ``q``
-        (N, nq) and parameter perturbations ``dL`` (N, n_L) (m)."""
+        (N, nq), parameter perturbations ``dL`` (N, n_L) (m) and optional joint errors ``dq``
+        (N, nv) (rad or m, added to the joint angles: on the circle for a continuous joint;
+        a mimic joint follows its source)."""
         q = np.atleast_2d(self.robot.check_q(q))
         N = q.shape[0]
         dL = np.zeros((N, len(self.params))) if dL is None else np.atleast_2d(np.asarray(dL, float))
@@ -240,22 +216,29 @@ class PerturbedChain:
             raise ValueError(f"dL must have shape ({N}, {len(self.params)}), got {dL.shape}")
         if not np.all(np.isfinite(dL)):
             raise ValueError(f"dL has a NaN or infinite value: {dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}")
+        chain = self.robot.chain
+        theta = chain.angles(q)
+        if dq is not None:
+            dq = np.broadcast_to(np.asarray(dq, float), (N, self.robot.nv))
+            for j in chain.joints:
+                src = chain.joints[j.mimic.source] if j.is_mimic else j
+                gain = j.mimic.multiplier if j.is_mimic else 1.0
+                theta[:, j.index] += gain * dq[:, src.idx_v]
         dt = {}
         for k, p in enumerate(self.params):
             key = (p.kind, p.index)
             dt[key] = dt.get(key, 0.0) + dL[:, k:k + 1] * p.direction
         R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
         x = np.zeros((N, 3))
-        for k, j in enumerate(self.joints):
-            t = self.t0[k] + dt.get(("joint", j), 0.0)
+        for j in self.joints:
+            t = j.translation + dt.get(("joint", j.index + 1), 0.0)
             x = x + np.einsum("nij,nj->ni", R, np.broadcast_to(t, (N, 3)))
-            R = R @ self.R0[k]
-            qi = q[:, self.idx_q[k]]
-            a = self.axis[k]
-            if self.revolute[k]:
-                R = R @ rot_axis(a, qi)  # Rodrigues, Eq. (5-84)
+            R = R @ j.rotation
+            th = theta[:, j.index]
+            if j.kind == "prismatic":
+                x = x + np.einsum("nij,j->ni", R, j.axis) * th[:, None]
             else:
-                x = x + np.einsum("nij,j->ni", R, a) * qi[:, None]
+                R = R @ rot_axis(j.axis, th)  # Rodrigues, Eq. (5-84)
         t = self.tf + dt.get(("frame", self.fid), 0.0)
         x = x + np.einsum("nij,nj->ni", R, np.broadcast_to(t, (N, 3)))
         return R @ self.Rf, x
@@ -330,7 +313,7 @@ def monte_carlo(robot, q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, rng=None, fr
         m = min(batch, n - a)
         dq = _draw(rng, distribution, sq, m)
         dL = _draw(rng, distribution, sL, m)
-        R, x = chain.pose(q[None] + dq, dL)
+        R, x = chain.pose(np.broadcast_to(q, (m, q.size)), dL, dq)
         out[a:a + m, :3] = x - x0
         out[a:a + m, 3:] = _log3_batch(R @ R0[0].T)
     var_factor = 1.0 if distribution == "normal" else 1.0 / 3.0

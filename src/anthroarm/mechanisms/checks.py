@@ -1,6 +1,6 @@
 """Cross-check rows of the mechanisms for ``anthroarm check`` (provider ``rows``).
 
-For every mechanism: loop-closure residual of the closed form, and position, velocity and
+Four-bar, RSSR, RRSS, thumb and finger (``mech:<mechanism>``): loop-closure residual of the closed form, and position, velocity and
 acceleration against (a) Pinocchio — the spanning tree + closures solved by
 :class:`~anthroarm.mechanisms.closed_loop.ClosedLoop` — and (b) 8th-order central finite
 differences of the closed-form position along a trajectory input(t) = x0 + w t + a t^2 / 2.
@@ -8,11 +8,16 @@ Errors are made dimensionless: angles in rad, points divided by the mechanism's 
 rates relative (divided by max(input rate scale, |reference|), points first divided by the
 length scale).  Random geometry per sample (seeded by ``rng``); the
 number of samples per mechanism is capped so the whole provider runs in a few seconds.
+
+Relative motion 002 (4-6)/(4-11)/(4-17) against a Pinocchio chain (frame position, velocity,
+classical acceleration), and the RCCC loop (5-152): closure (log6), zero velocity and classical
+acceleration of the cut frame of the Pinocchio open chain, joint rates vs finite differences.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from ..crosscheck import CheckRow
 from ._util import fd_derivative, wrap
@@ -26,6 +31,7 @@ from .thumb import ThumbGeometry, thumb, thumb_spec
 
 TOL = 1e-10
 MAX_SAMPLES = 6
+LWA = pin.LOCAL_WORLD_ALIGNED
 
 
 class _Acc:
@@ -235,6 +241,90 @@ def _finger_rows(acc, n, rng):
         acc.add(m, "fingertip acceleration (classical)", _rel(d2, s.accelerations["P8"] / L, w**2 + abs(a)), "finite-diff")
 
 
+# ---------------------------------------------------------------------------------------------
+# relative motion (002 §4-1) and the RCCC mechanism (§5-6): rows of their own, checked against
+# Pinocchio chains; ``n`` samples each (capped separately, these are cheap)
+def _relative_rows(n, rng):
+    from .relative_motion import (RelativeMotionGeometry, pinocchio_model, relative_acceleration,
+                                              relative_position, relative_velocity)
+
+    e = np.zeros(3)
+    for _ in range(n):
+        u0, u1 = _rand_unit(rng), _rand_unit(rng)
+        g = RelativeMotionGeometry(u0, rng.normal(size=3), u1, rng.normal(size=3), rng.normal(size=3))
+        x = rng.normal(size=9)
+        th, thd, thdd, ph, phd, phdd, s, sd, sdd = x
+        model, fid = pinocchio_model(g)
+        data = model.createData()
+        pin.forwardKinematics(model, data, np.array([th, s, ph]), np.array([thd, sd, phd]), np.array([thdd, sdd, phdd]))
+        pin.updateFramePlacements(model, data)
+        scale = max(1.0, np.abs(np.r_[g.p0, g.p1, g.q1]).max())
+        e[0] = max(e[0], np.abs(relative_position(g, th, ph, s).q - data.oMf[fid].translation).max() / scale)
+        e[1] = max(e[1], np.abs(relative_velocity(g, th, thd, ph, phd, s, sd).total
+                                - pin.getFrameVelocity(model, data, fid, LWA).linear).max() / scale)
+        e[2] = max(e[2], np.abs(relative_acceleration(g, th, thd, thdd, ph, phd, phdd, s, sd, sdd).total
+                                - pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear).max() / scale)
+    return [
+        CheckRow("relative_motion", "position 002 (4-6) vs pin FK (rel.)", float(e[0]), 1e-10, n),
+        CheckRow("relative_motion", "velocity 002 (4-11) vs frame velocity (rel.)", float(e[1]), 1e-10, n),
+        CheckRow("relative_motion", "acceleration 002 (4-17) vs classical acc (rel.)", float(e[2]), 1e-10, n),
+    ]
+
+
+def _rccc_rows(n, rng):
+    from .rccc import RCCCGeometry, pinocchio_chain, rccc_acceleration, rccc_position, rccc_velocity
+    from ..spatial.dual import Dual
+
+    e = np.zeros(4)
+    count = checked = fd_checked = 0  # assembled geometries, branches with rates, FD comparisons
+    tries = 0
+    while (count < n or not fd_checked) and tries < 20 * n + 20:
+        tries += 1
+        tw = rng.uniform(0.2, np.pi - 0.2, 4)
+        ln = rng.uniform(-2, 2, 5)
+        g = RCCCGeometry(*(Dual(a, b) for a, b in zip(tw, ln[:4])), s1=ln[4])
+        th1, w1, a1 = rng.uniform(-np.pi, np.pi), rng.normal(), rng.normal()
+        r = rccc_position(g, th1)
+        if not r.ok:
+            continue
+        model, fid = pinocchio_chain(g)
+        data = model.createData()
+        for sol in r.solutions:
+            v = rccc_velocity(g, sol, w1)
+            a = rccc_acceleration(g, sol, w1, a1, v)
+            if v.status != "ok":
+                continue
+            checked += 1
+            pin.forwardKinematics(model, data, sol.q, v.rates, a.rates)
+            pin.updateFramePlacements(model, data)
+            err6 = pin.log6(data.oMf[fid]).vector
+            vmag = max(1.0, np.abs(v.rates).max())  # rates grow without bound near a dead point
+            amag = max(1.0, np.abs(v.rates).max() ** 2, np.abs(a.rates).max())
+            V = pin.getFrameVelocity(model, data, fid, LWA).vector
+            A = pin.getFrameClassicalAcceleration(model, data, fid, LWA).vector
+            e[0] = max(e[0], np.abs(err6[:3]).max() / g.scale, np.abs(err6[3:]).max())
+            e[1] = max(e[1], np.abs(V[:3]).max() / (g.scale * vmag), np.abs(V[3:]).max() / vmag)
+            e[2] = max(e[2], np.abs(A[:3]).max() / (g.scale * amag), np.abs(A[3:]).max() / amag)
+            h = 1e-6
+            rp, rm = rccc_position(g, th1 + h), rccc_position(g, th1 - h)
+            v1 = rccc_velocity(g, sol, 1.0).rates
+            if rp.ok and rm.ok and np.abs(v1).max() < 100.0:  # away from dead points (FD is meaningless there)
+                dq = (rp.solutions[sol.branch].q - rm.solutions[sol.branch].q) / (2 * h)
+                e[3] = max(e[3], np.abs(dq - v1).max() / max(1.0, np.abs(v1).max()))
+                fd_checked += 1
+        count += 1
+    # a row that compared nothing must not pass: NaN fails the check
+    e[:3] = e[:3] if checked else np.nan
+    e[3] = e[3] if fd_checked else np.nan
+    note = f"{checked} branches of {count} assembled geometries"
+    return [
+        CheckRow("rccc", "loop closure (5-152) log6 (rel.)", float(e[0]), 1e-10, checked, note=note),
+        CheckRow("rccc", "cut-frame velocity = 0 (rel.)", float(e[1]), 1e-10, checked, note=note),
+        CheckRow("rccc", "cut-frame classical acc = 0 (rel.)", float(e[2]), 1e-10, checked, note=note),
+        CheckRow("rccc", "joint rates vs finite differences (rel.)", float(e[3]), 1e-6, fd_checked, "finite differences"),
+    ]
+
+
 def rows(models, samples, rng) -> list[CheckRow]:
     """Provider for :func:`anthroarm.crosscheck.run` (mechanisms are not catalog models: the rows
     are always produced, named ``mech:<mechanism>``)."""
@@ -242,4 +332,5 @@ def rows(models, samples, rng) -> list[CheckRow]:
     acc = _Acc()
     for f in (_fourbar_rows, _rssr_rows, _rrss_rows, _thumb_rows, _finger_rows):
         f(acc, n, rng)
-    return acc.out()
+    k = max(1, min(int(samples), 50))
+    return acc.out() + _relative_rows(k, rng) + _rccc_rows(max(1, k // 2), rng)
