@@ -274,3 +274,25 @@ def test_viewer_does_not_keep_a_robot_alive():
     del v, robot
     gc.collect()
     assert ref() is None
+
+
+def test_joint_triads_follow_every_joint(user_robot):
+    robot = user_robot
+    v = Viewer(robot)
+    v.show_frames("joints")
+    q = robot.random_q(rng=10)
+    sent = sent_transforms(v, q)
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    triads = {p: T for p, T in sent.items() if "/overlays/frames/" in p}
+    assert len(triads) == robot.model.njoints - 1
+    for j in range(1, robot.model.njoints):
+        np.testing.assert_allclose(triads[f"{v.root}/overlays/frames/{robot.model.names[j]}"], data.oMi[j].homogeneous,
+                                   atol=1e-12)
+
+
+def test_demo_has_no_ik_fallback():
+    from anthroarm.viewer.demo import reach_demo
+
+    with pytest.raises(ValueError, match="qp"):
+        reach_demo(method="dls")
