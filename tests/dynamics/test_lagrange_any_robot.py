@@ -199,3 +199,15 @@ def test_c_backend_on_continuous_and_mimic(user_path):
     np.testing.assert_allclose(dc.tau(Q, V, A), dn.tau(Q, V, A), atol=1e-13)
     np.testing.assert_allclose(dc.mass_matrix(Q[0]), dn.mass_matrix(Q[0]), atol=1e-14)
     np.testing.assert_allclose(dc.coriolis(Q[1], V[1]), dn.coriolis(Q[1], V[1]), atol=1e-13)
+
+
+@pytest.mark.parametrize("which", ["kinova", "user", "baxter_left"])
+def test_check_rows_on_any_robot(which, user_path):
+    """The rows of ``anthroarm check`` (dynamics.checks) run on continuous and mimic models."""
+    from anthroarm.dynamics import checks
+
+    robot = aa.load("kinova") if which == "kinova" else mimic_robots(user_path)[which][0]
+    rows = checks.model_rows(robot, 4, np.random.default_rng(5))
+    assert len(rows) == 8 and all(r.ok for r in rows), [(r.quantity, r.max_abs_err) for r in rows if not r.ok]
+    if robot.chain.has_mimic:
+        assert any("mimic" in r.oracle for r in rows)

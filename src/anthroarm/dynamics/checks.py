@@ -6,6 +6,14 @@ the Christoffel matrix vs ``computeCoriolisMatrix``, g vs ``computeGeneralizedGr
 τ = M q̈ + C q̇ + g vs ``rnea``, forward dynamics vs ``aba``, T and V vs
 ``computeKineticEnergy`` / ``computePotentialEnergy``.  Errors are relative:
 max |ours − pin| / max(1, max |pin|) over the samples; tolerance 1e-10.
+
+Any robot: q in the robot's layout (continuous joints' (cos, sin) pairs).  With mimic joints
+Pinocchio 4's ``crba``, ``rnea``, ``computeGeneralizedGravity`` and ``nonLinearEffects`` are the
+reduced quantities (tests/dynamics/test_lagrange_any_robot.py checks them against Gᵀ(·)G of the
+model without mimic joints), but its ``computeCoriolisMatrix`` is not consistent with them and
+``aba`` and the energy functions refuse mimic joints: there C q̇ and the Christoffel matrix
+times q̇ are checked against ``nonLinearEffects − g``, forward dynamics against
+``crba⁻¹ (τ − nonLinearEffects)``, T against ½ q̇ᵀ crba q̇ and V against −m gᵀ ``centerOfMass``.
 """
 
 from __future__ import annotations
@@ -39,17 +47,32 @@ def model_rows(robot, samples: int, rng) -> list:
     T, V = dyn.kinetic_energy(Q, Qd), dyn.potential_energy(Q)
     fd = dyn.forward(Q, Qd, tau_in)
     ref = {k: [] for k in ("M", "Cqd", "C", "g", "tau", "fd", "T", "V")}
+    mimic = robot.chain.has_mimic
+    if mimic:
+        Cm = np.einsum("nij,nj->ni", Cm, Qd)
     for q, qd, qdd, ti in zip(Q, Qd, Qdd, tau_in):
         Mp = pin.crba(m, d, q)
-        ref["M"].append(np.triu(Mp) + np.triu(Mp, 1).T)
-        Cp = pin.computeCoriolisMatrix(m, d, q, qd)
-        ref["C"].append(Cp.copy())
-        ref["Cqd"].append(Cp @ qd)
-        ref["g"].append(pin.computeGeneralizedGravity(m, d, q).copy())
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        ref["M"].append(Mp)
+        gp = pin.computeGeneralizedGravity(m, d, q).copy()
+        ref["g"].append(gp)
+        if mimic:
+            nle = pin.nonLinearEffects(m, d, q, qd).copy()
+            ref["Cqd"].append(nle - gp)
+            ref["C"].append(nle - gp)
+            ref["fd"].append(np.linalg.solve(Mp, ti - nle))
+        else:
+            Cp = pin.computeCoriolisMatrix(m, d, q, qd)
+            ref["C"].append(Cp.copy())
+            ref["Cqd"].append(Cp @ qd)
+            ref["fd"].append(pin.aba(m, d, q, qd, ti).copy())
         ref["tau"].append(pin.rnea(m, d, q, qd, qdd).copy())
-        ref["fd"].append(pin.aba(m, d, q, qd, ti).copy())
-        ref["T"].append(pin.computeKineticEnergy(m, d, q, qd))
-        ref["V"].append(pin.computePotentialEnergy(m, d, q))
+        if mimic:   # computeKineticEnergy / computePotentialEnergy refuse mimic joints
+            ref["T"].append(0.5 * qd @ Mp @ qd)
+            ref["V"].append(-pin.computeTotalMass(m) * float(m.gravity.linear @ pin.centerOfMass(m, d, q)))
+        else:
+            ref["T"].append(pin.computeKineticEnergy(m, d, q, qd))
+            ref["V"].append(pin.computePotentialEnergy(m, d, q))
     ours = {"M": M, "Cqd": Cqd, "C": Cm, "g": g, "tau": tau, "fd": fd, "T": T, "V": V}
     label = {
         "M": ("dyn M(q) Lagrange", "pin.crba"),
@@ -61,6 +84,12 @@ def model_rows(robot, samples: int, rng) -> list:
         "T": ("dyn kinetic energy T", "pin.computeKineticEnergy"),
         "V": ("dyn potential energy V", "pin.computePotentialEnergy"),
     }
+    if mimic:
+        label["C"] = ("dyn C(q,qd) Christoffel matrix @ qd", "pin.nonLinearEffects - g (mimic)")
+        label["Cqd"] = (label["Cqd"][0], "pin.nonLinearEffects - g (mimic)")
+        label["fd"] = (label["fd"][0], "solve(pin.crba, tau - nonLinearEffects) (mimic)")
+        label["T"] = (label["T"][0], "qd' pin.crba qd / 2 (mimic)")
+        label["V"] = (label["V"][0], "-mass g'pin.centerOfMass (mimic)")
     rows = []
     for k, (q_name, oracle) in label.items():
         rows.append(CheckRow(robot.name, q_name, _rel(ours[k], ref[k]), TOL, samples, oracle,

@@ -98,7 +98,12 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     N m s/rad, >= 0.  ``dt``: RK4 step and output spacing (s).  ``engine``: "lagrange" (the
     generated code) or "pin" (``pin.aba``; the model is the system's pin model or
     ``pin_model``).  NaN/inf initial states raise ``ValueError``; a state or drive torque that
-    becomes non-finite during the run ends it with ``status = "diverged: ..."``."""
+    becomes non-finite during the run ends it with ``status = "diverged: ..."``.
+
+    q0 and the returned q are in the robot's layout (nq); q̇ has nv entries.  With continuous
+    joints (nq > nv: (cos θ, sin θ) pairs) the integrator runs on the joint angles θ, which
+    q̇ integrates directly, and maps them back with ``chain.configuration`` (q stays on the
+    circle); ``tau(t, q, qd)`` receives q in the robot's layout."""
     dyn = _as_dyn(system) if engine == "lagrange" else None
     if engine == "pin":
         import pinocchio as pin
@@ -110,13 +115,25 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
         n = dyn.n
     else:
         raise ValueError(f"engine must be 'lagrange' or 'pin', got {engine!r}")
+    chain = dyn.chain if dyn is not None else getattr(system, "chain", None)
+    nq = chain.nq if chain is not None else n
+    if chain is None and engine == "pin" and model.nq != model.nv:
+        raise ValueError(f"engine='pin' with nq = {model.nq} != nv = {model.nv} needs a Robot (its chain maps "
+                         "continuous joints' angles to (cos, sin)), not a bare pin.Model")
     q0 = np.asarray(q0, dtype=float)
     qd0 = np.asarray(qd0, dtype=float)
-    for name, a in (("q0", q0), ("qd0", qd0)):
-        if a.shape != (n,):
-            raise ValueError(f"{name} must have shape ({n},), got {a.shape}")
+    for name, a, size in (("q0", q0, nq), ("qd0", qd0, n)):
+        if a.shape != (size,):
+            raise ValueError(f"{name} must have shape ({size},), got {a.shape}")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"{name} contains NaN/inf: {a.tolist()}")
+    if nq != n:   # continuous joints: integrate the independent joints' angles
+        chain.check_unit(q0, "q0")
+        to_q = chain.configuration
+        x_q0 = chain.angles(q0)[list(chain.independent)]
+    else:
+        to_q = lambda x: x  # noqa: E731
+        x_q0 = q0
     if not (np.isfinite(t_end) and t_end > 0 and np.isfinite(dt) and dt > 0):
         raise ValueError(f"t_end and dt must be finite and > 0, got {t_end}, {dt}")
     xi = np.broadcast_to(np.asarray(damping, dtype=float), (n,)).copy()
@@ -140,7 +157,7 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
 
     def rhs(t, x):
         nfev[0] += 1
-        q, qd = x[:n], x[n:2 * n]
+        q, qd = to_q(x[:n]), x[n:2 * n]
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"the state became non-finite at t = {t:.6g} s")
         u = np.asarray(taufn(t, q, qd), dtype=float)
@@ -149,7 +166,7 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
         qdd = accel(q, qd, u - xi * qd)
         return np.concatenate([qd, qdd, [qd @ (xi * qd), u @ qd]])
 
-    x0 = np.concatenate([q0, qd0, [0.0, 0.0]])
+    x0 = np.concatenate([x_q0, qd0, [0.0, 0.0]])
     nsteps = int(round(t_end / dt))
     t = np.linspace(0.0, nsteps * dt, nsteps + 1)
     status = "ok"
@@ -182,7 +199,7 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
                 status = f"solve_ivp failed: {sol.message}"
             X = sol.y.T
             t = sol.t
-    q, qd = X[:, :n], X[:, n:2 * n]
+    q, qd = to_q(X[:, :n]), X[:, n:2 * n]
     TV = np.array([energies(a, b) for a, b in zip(q, qd)])
     return SimResult(t=t, q=q, qd=qd, T=TV[:, 0], V=TV[:, 1], dissipated=X[:, 2 * n], work=X[:, 2 * n + 1],
                      method=method, engine=engine, nfev=nfev[0], status=status)
