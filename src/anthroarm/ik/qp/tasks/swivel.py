@@ -127,7 +127,9 @@ class SwivelTask(Task):
     """Hold the elbow swivel angle at ``target`` (rad).
 
     Residual e = wrap(φ(q) − φ*) (1,), Jacobian ∂φ/∂q = Σ_X (∂φ/∂X) J_X(q) over the position
-    Jacobians (LOCAL_WORLD_ALIGNED, linear rows) of the shoulder, elbow and wrist frames."""
+    Jacobians (LOCAL_WORLD_ALIGNED, linear rows) of the shoulder, elbow and wrist frames:
+    ``frames=(shoulder, elbow, wrist)``, by default the human-like layout found in
+    ``robot.chain`` (:func:`swivel_frames`)."""
 
     def __init__(self, robot, target: float = 0.0, cost: float = 1.0, frames=None, ref=(0.0, 0.0, -1.0),
                  gain: float = 1.0, lm_damping: float = 0.0):
