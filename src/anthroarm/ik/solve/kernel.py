@@ -4,7 +4,7 @@ One step (:func:`damped_step`), shared by the one-target attempt (:func:`attempt
 lockstep batch (a leading batch axis) and the null-space phases
 (:mod:`anthroarm.ik.solve.nullspace`, which reuse its factorisation :func:`solve_damped`)::
 
-    Δθ = Jᵀ (J Jᵀ + λ I)⁻¹ e,   λ = λ₀ + k ‖e‖²   (Chan & Lawrence 1988 / Sugihara 2011 damping),
+    Δθ = Jᵀ (J Jᵀ + λ I)⁻¹ e = (JᵀJ + λ I)⁻¹ Jᵀe,   λ = λ₀ + k ‖e‖²   (Sugihara 2011 damping),
     θ ← clip(θ + Δθ, θ_min, θ_max).
 
 This is the book's feedback-compensation Newton step Δq = J⁻¹ e (Ch. 7 §7-5) made robust: the
@@ -78,23 +78,47 @@ def _jtx(J, x):
     return x.dot(J) if J.ndim == 2 else np.matmul(x[:, None, :], J)[:, 0]
 
 
+def dls(ws, J, e, lam):
+    """The damped least-squares step Δθ = Jᵀ(JJᵀ + λI)⁻¹e = (JᵀJ + λI)⁻¹Jᵀe (the two are
+    equal: push-through identity): the m × m form where m ≤ n, the n × n form where the arm
+    has fewer joints than the task (n < m: JJᵀ is singular there and its form would lose
+    digits).  None where the system is not positive definite.  Single or batch like
+    :func:`solve_damped`."""
+    m, n = J.shape[-2:]
+    if m <= n:
+        x = solve_damped(ws, J, e, lam)
+        return None if x is None else (x.dot(J) if J.ndim == 2 else _jtx(J, x))
+    g = _jtx(J, e)                                 # Jᵀe
+    if J.ndim == 2:
+        A, AF, Ad = ws.lin[n]
+        np.dot(J.T, J, out=A)
+        Ad += lam
+        dq, info = dposv(AF, g, overwrite_a=1)[1:]
+        return None if info else dq
+    A = np.matmul(J.transpose(0, 2, 1), J)
+    A.reshape(len(A), -1)[:, :: n + 1] += lam[:, None]
+    try:
+        return np.linalg.solve(A, g[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return None
+
+
 def damped_step(ws, th, J, e, lam):
     """θ after one damped step with the joint limits (see the module docstring); θ (n,) with
     J (m, n), e (m,), λ float — or a batch with a leading axis N.  None where the system is not
     positive definite."""
-    x = solve_damped(ws, J, e, lam)
-    if x is None:
+    dq = dls(ws, J, e, lam)
+    if dq is None:
         return None
     lo, hi = ws.lo, ws.hi
-    tn = th + (x.dot(J) if J.ndim == 2 else _jtx(J, x))
+    tn = th + dq
     tc = uclip(tn, lo, hi)
     if tc.tobytes() != tn.tobytes():   # (byte comparison: ~20× cheaper than (tc != tn).any())
         # active set: the joints the step pushes past a limit stay where they are, the others
         # take the step recomputed without them, then it is clipped
-        Jr = J * (tc == tn)[..., None, :]
-        x = solve_damped(ws, Jr, e, lam)
-        if x is not None:
-            tc = uclip(th + _jtx(Jr, x), lo, hi)
+        dq = dls(ws, J * (tc == tn)[..., None, :], e, lam)
+        if dq is not None:
+            tc = uclip(th + dq, lo, hi)
     return tc
 
 

@@ -116,7 +116,7 @@ class Aligned:
         f = chain.frame(sh.fid)
         self.Fi = pin.SE3(f.rotation, f.translation).inverse()
         self.iq1, self.iqn = i1, i_n
-        self.lo1, self.hi1, self.lon, self.hin = sh.lo[i1], sh.hi[i1], sh.lo[i_n], sh.hi[i_n]
+        self.lo1, self.hi1, self.lon, self.hin = (float(x) for x in (sh.lo[i1], sh.hi[i1], sh.lo[i_n], sh.hi[i_n]))
         self.w = ALIGN_WEIGHT * max(sh.reach, 1e-3)
         self.AUV = np.column_stack((anl, un, vn))
         self.Bc1 = self.B @ self.c1
@@ -135,6 +135,7 @@ class Aligned:
         # score = |f|² − 2 f·x (+ |x|², the same for every entry), as one product G·(x, 1)
         f5 = feats[:, :5]
         self.G = np.ascontiguousarray(np.column_stack((-2.0 * f5, (f5 * f5).sum(1))).T)   # (6, K)
+        self.phi = self.phi.tolist()   # plain floats: scalar arithmetic in seed() is cheaper
         return self
 
     def _canon(self, p, R):
@@ -158,11 +159,11 @@ class Aligned:
         """Table configuration θ (entry k, a copy) turned onto the target: first joint by the
         azimuth difference, last joint about its axis (wrapped by 2π or clipped into the range)."""
         i = self.iq1
-        th[i] = _wrap(th[i] + phi - self.phi[k], self.lo1, self.hi1)
+        th[i] = _wrap(float(th[i]) + phi - self.phi[k], self.lo1, self.hi1)
         U, V = self.U[k], self.V[k]
         d = math.atan2(V[0] * u[0] + V[1] * u[1] + V[2] * u[2], U[0] * u[0] + U[1] * u[1] + U[2] * u[2])
         i = self.iqn
-        th[i] = _wrap(th[i] + d, self.lon, self.hin)
+        th[i] = _wrap(float(th[i]) + d, self.lon, self.hin)
         return th
 
 

@@ -55,7 +55,7 @@ class Shared:
         self.hi = np.array([j.upper for j in ind])
         self.continuous = np.array([j.kind == CONTINUOUS for j in ind])
         self.prismatic = np.array([j.kind == PRISMATIC for j in ind])
-        self.to_q = chain.configuration if self.continuous.any() else None
+        self.to_q = _Configuration(chain) if self.continuous.any() else None
         v_of = {j.index: k for k, j in enumerate(ind)}
         self.on_path = np.zeros(self.n, dtype=bool)
         for i in chain.path(fid):
@@ -121,6 +121,33 @@ class Shared:
         return pen
 
 
+class _Configuration:
+    """q of θ for a chain with continuous joints: :meth:`anthroarm.chain.Chain.configuration`
+    with the index arrays precomputed (~2 µs instead of a loop over the joints; tested equal to
+    it); batches (N, n) go to the chain."""
+
+    __slots__ = ("chain", "nq", "lin_q", "lin_v", "cos_q", "sin_q", "cont_v")
+
+    def __init__(self, chain):
+        self.chain, self.nq = chain, chain.nq
+        ind = [chain.joints[i] for i in chain.independent]
+        lin = [(j.idx_q, v) for v, j in enumerate(ind) if j.kind != CONTINUOUS]
+        cont = [(j.idx_q, v) for v, j in enumerate(ind) if j.kind == CONTINUOUS]
+        self.lin_q, self.lin_v = (np.array(a, dtype=int) for a in zip(*lin)) if lin else (np.zeros(0, int),) * 2
+        self.cos_q, self.cont_v = (np.array(a, dtype=int) for a in zip(*cont))
+        self.sin_q = self.cos_q + 1
+
+    def __call__(self, th):
+        if th.ndim != 1:
+            return self.chain.configuration(th)
+        q = np.empty(self.nq)
+        q[self.lin_q] = th[self.lin_v]
+        c = th[self.cont_v]
+        q[self.cos_q] = np.cos(c)
+        q[self.sin_q] = np.sin(c)
+        return q
+
+
 class Workspace:
     """The calling thread's view of a :class:`Shared`: its own ``pin.Data`` and the kernel's
     preallocated arrays (J Jᵀ + λI built in place, handed to LAPACK as its transpose: Fortran
@@ -132,8 +159,8 @@ class Workspace:
         self.sh = sh
         self.model, self.fid, self.n, self.lo, self.hi, self.to_q = sh.model, sh.fid, sh.n, sh.lo, sh.hi, sh.to_q
         self.data = sh.model.createData()
-        self.lin = {}   # task dimension m -> (A (m, m), its transpose (Fortran order), its diagonal)
-        for m in (3, 6):
+        self.lin = {}   # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.dls
+        for m in {3, 6, min(sh.n, 6)}:      # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
             self.lin[m] = (A, A.T, A.reshape(-1)[:: m + 1])
 
