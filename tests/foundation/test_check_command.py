@@ -1,12 +1,43 @@
-"""`anthroarm check` and `anthroarm models` end to end (a real subprocess)."""
+"""`anthroarm check`, `anthroarm models` and `anthroarm urdf` end to end: any robot in (catalog,
+example-robot-data names, URDF paths), real rows out, non-zero exit when a row fails."""
 
 import json
 import subprocess
 import sys
 
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import anthroarm as aa
+from anthroarm import cli, crosscheck
+from anthroarm.kinematics import book_fk
+from test_chain import USER_URDF
+
+#: the rows every robot gets (book models get more)
+GENERIC = {
+    "fk batched chain robot.fk(Q)", "jacobian batched chain LWA", "fk yourdfpy (all links)",
+    "J_L (6-118) vs FD of perturbed placements", "perturbed FK T(q, L+dL) vs pin on the perturbed model",
+    "dyn M(q) Lagrange", "dyn C(q,qd)qd Christoffel", "dyn g(q) = dV/dq", "dyn tau = M qdd + C qd + g",
+    "dyn forward dynamics", "aa.ik.solve: FK(solve(T)) = T within limits",
+}
+
 
 def run(*args):
     return subprocess.run([sys.executable, "-m", "anthroarm.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def check_json(argv, capsys):
+    rc = cli.main(["check", *argv, "--json"])
+    out, err = capsys.readouterr()
+    return rc, json.loads(out) if out.strip() else None, err
+
+
+@pytest.fixture(scope="module")
+def user_urdf(tmp_path_factory):
+    p = tmp_path_factory.mktemp("user") / "user_arm.urdf"
+    p.write_text(USER_URDF)
+    return p
 
 
 def test_check_json_rows():
@@ -15,8 +46,55 @@ def test_check_json_rows():
     rows = json.loads(p.stdout)
     assert {r["model"] for r in rows} >= {"prosthetic_arm", "planar2r"}
     ours = [r for r in rows if r["model"] in ("prosthetic_arm", "planar2r")]
-    assert ours and all(r["ok"] for r in ours)
+    assert ours and all(r["ok"] and r["status"] == "ok" for r in ours)
     assert all(r["samples"] == 30 for r in ours if r["quantity"].startswith(("fk", "jacobian")))
+    assert GENERIC <= {r["quantity"] for r in ours if r["model"] == "planar2r"}
+    assert "fk printed Fig. 7-14 (y, z)" in {r["quantity"] for r in ours if r["model"] == "planar2r"}
+
+
+def test_check_example_robot_data_name(capsys):
+    rc, rows, err = check_json(["ur10", "--samples", "20"], capsys)
+    assert rc == 0, err
+    ur10 = [r for r in rows if r["model"] == "ur10"]
+    assert {r["quantity"] for r in ur10} == GENERIC | {"dyn C(q,qd) Christoffel matrix", "dyn kinetic energy T",
+                                                       "dyn potential energy V"}
+    assert all(r["ok"] for r in rows)
+    assert all(r["max_abs_err"] <= r["tol"] for r in ur10)
+    # no book rows for an arm that is not a book model
+    assert not [r for r in ur10 if "printed" in r["quantity"] or "H-D" in r["quantity"]]
+
+
+def test_check_user_urdf_with_continuous_and_mimic_joints(user_urdf, capsys):
+    rc, rows, err = check_json([str(user_urdf), "--tool", "tool", "--samples", "20"], capsys)
+    assert rc == 0, err
+    ours = [r for r in rows if r["model"] == "user_arm"]
+    assert GENERIC <= {r["quantity"] for r in ours}
+    assert all(r["ok"] for r in rows), [r for r in rows if not r["ok"]]
+    assert any("mimic" in r["note"] for r in ours if r["quantity"] == "fk yourdfpy (all links)")
+    # --tool applies to every model given: a model without that frame is a one-line error
+    rc2 = cli.main(["check", f"--models={user_urdf},kinova", "--tool", "tool", "--samples", "5"])
+    out, err = capsys.readouterr()
+    assert rc2 == 2 and "kinova" in err and "unknown tool frame 'tool'" in err
+
+
+def test_check_comma_separated_models_and_locked(capsys):
+    rc, rows, err = check_json(["--models", "z1,planar2r", "--samples", "10"], capsys)
+    assert rc == 0, err
+    assert {"z1", "planar2r"} <= {r["model"] for r in rows}
+    rc, rows, err = check_json(["so101", "--tool", "gripper_frame_link", "--locked", "gripper", "--samples", "10"],
+                               capsys)
+    assert rc == 0, err
+    assert GENERIC <= {r["quantity"] for r in rows if r["model"] == "so101"}
+
+
+def test_check_tree_without_tool_lists_the_tips(capsys):
+    rc = cli.main(["check", "baxter"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "l_gripper_r_finger_tip" in err and "tool=" in err
+    rc = cli.main(["check", "--tool", "tool0"])
+    assert rc == 2 and "name one" in capsys.readouterr().err
+    rc = cli.main(["check", "ur10", "--locked", "shoulder_pan_joint=abc"])
+    assert rc == 2 and "NAME=VALUE" in capsys.readouterr().err
 
 
 def test_check_unknown_model_is_one_line_error():
@@ -26,19 +104,89 @@ def test_check_unknown_model_is_one_line_error():
     assert "Traceback" not in p.stderr
 
 
-def test_models_json():
-    p = run("models", "--json")
-    assert p.returncode == 0
-    names = [m["name"] for m in json.loads(p.stdout)]
-    assert "human_arm7" in names and "panda" in names
+def test_check_fails_loudly(monkeypatch, capsys):
+    real = book_fk.sixr_hand_pose
+
+    def wrong(q, *a):   # a planted 1 mm error in the hand height
+        T = real(q, *a)
+        T[..., 2, 3] += 1e-3
+        return T
+
+    monkeypatch.setattr(book_fk, "sixr_hand_pose", wrong)
+    rc = cli.main(["check", "sixr_arm", "--samples", "5"])
+    out = capsys.readouterr().out
+    assert rc == 1
+    bad = [ln for ln in out.splitlines() if ln.rstrip().endswith("FAIL")]
+    assert len(bad) == 1 and "fk printed (6-16)/(6-17)" in bad[0]
+    assert "1 failed, 0 unsupported" in out
+
+
+def test_unsupported_row_does_not_pass():
+    """A robot loaded from a pin.Model has no URDF: the yourdfpy row says so and does not pass;
+    every other row still runs."""
+    model = pin.buildModelFromUrdf(str(aa.models.erd_urdf_path("ur10")))
+    robot = aa.load(model, name="ur10_model")
+    rows = crosscheck.run([robot], samples=5, providers=list(crosscheck.ROBOT_PROVIDERS))
+    bad = [r for r in rows if not r.ok]
+    assert [(r.quantity, r.status) for r in bad] == [("fk yourdfpy (all links)", "unsupported")]
+    assert "no URDF" in bad[0].note and np.isnan(bad[0].max_abs_err)
+    table = crosscheck.format_table(rows)
+    assert f"{len(rows) - 1} passed, 0 failed, 1 unsupported" in table
+    assert "ur10_model: fk yourdfpy (all links): unsupported: loaded from a pin.Model" in table
+
+
+def test_models_prints_nq_nv_and_kinds_for_every_entry(capsys):
+    assert cli.main(["models", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [o["name"] for o in out] == aa.models.names()
+    for o in out:   # oracle: Pinocchio on the URDF text, minus the joints the catalog locks
+        if o["name"] in aa.models.BOOK_MODELS:
+            m = pin.buildModelFromXML(aa.models.urdf_text(o["name"]))
+            assert (o["nq"], o["nv"]) == (m.nq, m.nv)
+        else:
+            arm = aa.models.ERD_ARMS[o["name"]]
+            m = pin.buildModelFromUrdf(str(arm.urdf_path()))
+            n = len(arm.active) if arm.active else m.nq
+            assert (o["nq"], o["nv"]) == (n, n)
+        assert sum(o["kinds"].values()) == o["nq"] and o["error"] is None and not o["needs_tool"]
+    assert cli.main(["models"]) == 0
+    text = capsys.readouterr().out
+    assert "nq=?" not in text
+    assert "ur5" in text and "nq=6" in text.split("ur5", 1)[1].splitlines()[0]
+
+
+def test_models_all_lists_every_example_robot_data_robot(capsys):
+    assert cli.main(["models", "--all", "--json"]) == 0
+    out = {o["name"]: o for o in json.loads(capsys.readouterr().out)}
+    assert set(aa.models.erd_names()) <= set(out)
+    k = out["kinova"]
+    m = pin.buildModelFromUrdf(str(aa.models.erd_urdf_path("kinova")))
+    assert (k["nq"], k["nv"], k["kinds"].get("continuous")) == (m.nq, m.nv, 3)
+    assert out["so101"]["needs_tool"] and "gripper_frame_link" in out["so101"]["tips"]
+    assert out["baxter"]["needs_tool"] and out["baxter"]["kinds"]["mimic"] == 2
+    assert out["ur10"]["tool"] == "tool0" and not out["ur10"]["needs_tool"]
+    assert cli.main(["models", "--all"]) == 0
+    text = capsys.readouterr().out
+    line = next(ln for ln in text.splitlines() if ln.startswith("so101 "))
+    assert "needs tool=" in line and "gripper_frame_link" in line
 
 
 def test_urdf_command_writes_parameterised_file(tmp_path):
     out = tmp_path / "arm.urdf"
     p = run("urdf", "human_arm7", "-o", str(out), "--param", "height=1.62", "--param", "sex=female")
     assert p.returncode == 0, p.stderr
-    import anthroarm as aa
-
     assert out.read_text() == aa.models.urdf_text("human_arm7", height=1.62, sex="female")
     p = run("urdf", "human_arm7", "-o", str(tmp_path / "missing" / "a.urdf"))
     assert p.returncode == 2 and "does not exist" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_urdf_command_takes_example_robot_data_names_and_paths(tmp_path, user_urdf, capsys):
+    out = tmp_path / "xarm7.urdf"
+    assert cli.main(["urdf", "xarm7", "-o", str(out)]) == 0
+    assert out.read_text() == aa.models.erd_urdf_path("xarm7").read_text()
+    copy = tmp_path / "copy.urdf"
+    assert cli.main(["urdf", str(user_urdf), "-o", str(copy)]) == 0
+    assert copy.read_text() == USER_URDF
+    capsys.readouterr()
+    assert cli.main(["urdf", "xarm7", "-o", str(out), "--param", "height=2"]) == 2
+    assert "takes no parameters" in capsys.readouterr().err

@@ -2,12 +2,18 @@
 differences over perturbed Pinocchio placements, (6-119) for the 7-DOF arm, first-order
 accuracy, batched perturbed FK vs Pinocchio, Monte Carlo vs the linear covariance."""
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
 import anthroarm as aa
 from anthroarm.kinematics import error_propagation as EP
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "foundation"))
+from test_chain import USER_URDF  # noqa: E402
 
 MODELS = aa.models.names()
 
@@ -124,3 +130,52 @@ def test_error_propagation_bad_input(robots):
     chain = EP.PerturbedChain(r)
     with pytest.raises(ValueError, match="dL has a NaN"):
         chain.pose(q[None], np.full((1, len(chain.params)), np.nan))
+
+
+@pytest.fixture(scope="module")
+def user_urdf(tmp_path_factory):
+    p = tmp_path_factory.mktemp("user") / "user_arm.urdf"
+    p.write_text(USER_URDF)
+    return p
+
+
+@pytest.mark.parametrize("name,kw", [("kinova", {}), ("user", {"tool": "tool"}),
+                                     ("baxter", {"tool": "l_gripper_r_finger_tip"})])
+def test_perturbed_chain_continuous_and_mimic_joints(name, kw, user_urdf):
+    """PerturbedChain reads robot.chain: continuous joints ((cos, sin) in q), mimic joints (baxter's
+    finger, the user arm's grip_mimic) and joint errors dq (on the circle: pin.integrate) equal
+    Pinocchio on the perturbed model at pin.integrate(q, dq); J_L equals its finite differences."""
+    r = aa.load(str(user_urdf) if name == "user" else name, **kw)
+    rng = np.random.default_rng(5)
+    chain = EP.PerturbedChain(r, mode="components")
+    assert [j.name for j in chain.joints] == [r.model.names[i] for i in _support(r.model, r.tool_id)]
+    Q = r.random_q(4, rng)
+    dL = 0.01 * rng.normal(size=(4, len(chain.params)))
+    dq = 0.05 * rng.normal(size=(4, r.nv))
+    R, x = chain.pose(Q, dL, dq)
+    for i in range(4):
+        m = r.model
+        for p, d in zip(chain.params, dL[i]):
+            m = EP._perturbed_model(m, p, d)
+        dd = m.createData()
+        pin.framesForwardKinematics(m, dd, pin.integrate(r.model, Q[i], dq[i]))
+        assert np.allclose(x[i], dd.oMf[r.tool_id].translation, atol=1e-12)
+        assert np.allclose(R[i], dd.oMf[r.tool_id].rotation, atol=1e-12)
+        J = EP.length_jacobian(r, Q[i], mode="components")
+        assert np.abs(J - EP.length_jacobian_fd(r, Q[i], mode="components")).max() < 1e-10
+
+
+def test_monte_carlo_on_continuous_joints_matches_linear_covariance():
+    r = aa.load("kinova")
+    q = r.random_q(rng=2)
+    res = EP.monte_carlo(r, q, sigma_q=1e-3, sigma_L=1e-3, n=20000, rng=0, progress=False)
+    assert np.allclose(np.sqrt(np.diag(res.cov)), np.sqrt(np.diag(res.linear_cov)), rtol=0.05)
+
+
+def _support(model, fid):
+    """Pinocchio joint ids from the base to frame ``fid`` (the oracle of the chain's path)."""
+    j, out = model.frames[fid].parentJoint, []
+    while j > 0:
+        out.append(j)
+        j = model.parents[j]
+    return out[::-1]

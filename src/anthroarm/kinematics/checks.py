@@ -76,13 +76,16 @@ def _yourdfpy_row(robot, Q, scale) -> CheckRow:
         return CheckRow.unsupported(robot.name, "fk yourdfpy (all links)", "loaded from a pin.Model: no URDF")
     u = robot.urdf
     model, data = robot.model, robot.model.createData()
-    names = [f.name for f in model.frames if f.type == pin.FrameType.BODY and f.name in u.link_map]
-    fids = [model.getFrameId(n) for n in names]
+    links = {}   # link name -> its body frame (a joint frame may share the name: z1)
+    for fid, f in enumerate(model.frames):
+        if f.type == pin.FrameType.BODY and f.name in u.link_map:
+            links.setdefault(f.name, fid)
+    names = list(links)
     err = 0.0
     for q in Q:
         u.update_cfg(robot.yourdfpy_cfg(q))
         pin.framesForwardKinematics(model, data, q)
-        for n, fid in zip(names, fids):
+        for n, fid in links.items():
             err = max(err, _pose_err(u.get_transform(n, u.base_link), data.oMf[fid].homogeneous, scale))
     note = f"{len(names)} links" + ("; mimic joints modelled by both" if robot.has_mimic else "")
     return CheckRow(robot.name, "fk yourdfpy (all links)", err, TOL, len(Q), "pinocchio", note)
