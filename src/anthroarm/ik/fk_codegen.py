@@ -135,7 +135,6 @@ class FKStages:
         self.n_stages = len(bounds) - 1
         g, states, diffs = chain_product(chain, frame, bounds, position_only)
         self.stages = _stages(g, states, diffs, bounds)
-        self.state_sizes = [len(s["state_out"]) for s in self.stages[:-1]] + [0]
         self.source = _render_python(self.stages, vectorised=False)
         self.source_numpy = _render_python(self.stages, vectorised=True)
         self.scalar = self._compile(self.source, {"cos": math.cos, "sin": math.sin, "_abs": abs})
