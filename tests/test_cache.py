@@ -216,3 +216,16 @@ def test_cli_cache_info_and_clear(cdir, capsys):
     assert cli_main(["cache", "info"]) == 0
     out = capsys.readouterr().out
     assert "entries 0" in out and str(cdir) in out
+
+
+def test_damaged_bytecode_entry_is_recompiled(cdir):
+    robot = aa.load("planar2r", l1=0.83)
+    L.load(robot)
+    (code,) = (cdir / "lagrange").glob("*.code")
+    damage(code, code.read_bytes()[:50])
+    L._MEMO.clear()
+    dyn = L.load(robot)
+    assert dyn.source == "cache"                               # the verified source, compiled again
+    q, v, a = np.array([0.2, 0.5]), np.array([0.3, -1.0]), np.array([1.0, 2.0])
+    assert np.allclose(dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12)
+    assert cache.read("lagrange", code.name) is not None

@@ -15,7 +15,8 @@ and ``--version``) and the flags (:func:`key`).
 
 **Integrity.**  Every entry ``NAME`` has a sidecar ``NAME.sha256`` with the SHA-256 and size
 of its bytes, written after it.  :func:`read` returns the bytes only if they match; a
-generated module is executed from exactly those verified bytes (:func:`python_module`), and a
+generated module is executed from exactly those verified bytes, or from its bytecode entry
+(keyed by the verified source's hash, itself verified; :func:`python_module`), and a
 shared library is loaded only after its file has been verified (:func:`shared_library`).  A
 truncated, edited or half-copied entry is deleted and rebuilt, never run.  Both files are
 written atomically (temp file + ``os.replace``, :func:`anthroarm._io.atomic_write_text`), so
@@ -34,6 +35,7 @@ from __future__ import annotations
 
 import atexit
 import hashlib
+import marshal
 import os
 import shutil
 import subprocess
@@ -194,7 +196,16 @@ def python_module(sub: str, name: str, make_source, modname: str):
         origin = "derived"
     mod = types.ModuleType(modname)
     mod.__file__ = str(root() / sub / name)
-    exec(compile(data, mod.__file__, "exec"), mod.__dict__)
+    # its bytecode is an entry too (compiling a large generated module costs more than deriving
+    # it), keyed by the verified source's hash and the interpreter's bytecode tag
+    cname = f"{name}.{key(data, length=16)}.{sys.implementation.cache_tag}.code"
+    code = read(sub, cname)
+    if code is not None:
+        code = marshal.loads(code)
+    else:
+        code = compile(data, mod.__file__, "exec")
+        write(sub, cname, marshal.dumps(code))
+    exec(code, mod.__dict__)
     return mod, origin
 
 

@@ -497,6 +497,7 @@ class LagrangeDynamics:
         # θ = q and θ̇ = q̇ when every joint is a plain revolute / prismatic joint in q order
         self._plain_q = all(j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints)
         self._plain_v = not chain.has_mimic
+        self._cos = np.array([j.idx_q for j in chain.joints if j.kind == CONTINUOUS and not j.is_mimic], dtype=int)
         self._vsel = np.array(self.info.coord)
         self._vscale = np.array(self.info.factor)
         self.backend = backend
@@ -520,8 +521,10 @@ class LagrangeDynamics:
     def _theta(self, q):
         if self._plain_q:
             return q
-        if self.chain.has_continuous:
-            self.chain.check_unit(q)
+        if self._cos.size:
+            c, s = q[..., self._cos], q[..., self._cos + 1]
+            if np.any(np.abs(c * c + s * s - 1.0) > 2e-6):
+                self.chain.check_unit(q)      # raises, naming the joint
         return self.chain.angles(q)
 
     def _rates(self, v):
@@ -552,7 +555,7 @@ class LagrangeDynamics:
                     break
                 tot += a.sum()
         if ok and math.isfinite(tot):
-            arrs = (self._theta(q), *(self._rates(a) for a in rates))
+            arrs = (self._theta(q),) + (rates if self._plain_v else tuple(self._rates(a) for a in rates))
             if self._c is not None:
                 return self._c.one(fname, arrs)
             return getattr(self.module, fname + "_1")(*arrs)
