@@ -41,6 +41,9 @@ from .errors import AmbiguousToolError, UnknownFrameError, UnsupportedModelError
 
 REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 
+#: a joint limit this large (rad or m) means none (Pinocchio's default is ±DBL_MAX)
+NO_LIMIT = 1e100
+
 #: what to tell the user of a joint that no algorithm here handles
 _UNSUPPORTED_ADVICE = ("lock it with locked={{{name!r}: value}} or pick the sub-chain you need with "
                        "active=[...] (aa.load(..., locked=..., active=...))")
@@ -202,6 +205,9 @@ class Chain:
                 lo, hi = -np.inf, np.inf
             elif nq == 1:
                 lo, hi = float(lower[idx_q]), float(upper[idx_q])
+                # a model built in code keeps Pinocchio's default ±DBL_MAX: no limit at all
+                lo = -np.inf if lo <= -NO_LIMIT else lo
+                hi = np.inf if hi >= NO_LIMIT else hi
             else:
                 lo, hi = -np.inf, np.inf   # set below from the source's limits
             axis = np.where(np.abs(axis) < 1e-15, 0.0, axis)

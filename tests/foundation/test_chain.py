@@ -245,3 +245,18 @@ def test_joint_kinds_from_pinocchio_types():
             assert j.kind == PRISMATIC and j.axis[ord(short[-1]) - ord("X")] == 1.0
         if short in ("JointModelRX", "JointModelRY", "JointModelRZ"):
             assert j.kind == REVOLUTE and j.axis[ord(short[-1]) - ord("X")] == 1.0
+
+
+def test_default_pinocchio_limits_mean_unbounded():
+    """A pin.Model built in code keeps ±DBL_MAX limits: sampling must not overflow."""
+    m = pin.Model()
+    j = m.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "hinge")
+    f = m.addJointFrame(j, 0)
+    m.appendBodyToJoint(j, pin.Inertia.FromSphere(1.0, 0.1), pin.SE3.Identity())
+    m.addBodyFrame("tip", j, pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.5])), f)
+    assert m.upperPositionLimit[0] > 1e300
+    r = aa.load(m)
+    assert r.chain.joint("hinge").upper == np.inf and r.tool == "tip"
+    Q = r.random_q(1000, rng=0)
+    assert np.all(np.isfinite(Q)) and np.all(np.abs(Q) <= np.pi)
+    np.testing.assert_allclose(r.fk(Q)[:, 2, 3], 0.5 * np.cos(Q[:, 0]), atol=1e-15)   # Ry(θ) e_z · 0.5
