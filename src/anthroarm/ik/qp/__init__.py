@@ -35,11 +35,11 @@ from .configuration import IKConfiguration
 from .limits import AccelerationLimit, ConfigurationLimit, Limit, VelocityLimit
 from .step import StepResult, default_limits, step
 from .tasks import (DampingTask, FrameTask, JointCouplingTask, OrientationTask, PositionTask, PostureTask,
-                    RelativeFrameTask, SwivelTask, Task, comfortable_posture, mimic_tasks, swivel_angle)
+                    RelativeFrameTask, SwivelTask, Task, comfortable_posture, swivel_angle)
 
 __all__ = [
     "step", "StepResult", "IKConfiguration", "default_limits", "available_solvers", "make_backend",
     "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask", "DampingTask",
-    "JointCouplingTask", "SwivelTask", "mimic_tasks", "comfortable_posture", "swivel_angle",
+    "JointCouplingTask", "SwivelTask", "comfortable_posture", "swivel_angle",
     "Limit", "ConfigurationLimit", "VelocityLimit", "AccelerationLimit", "backends", "limits", "tasks",
 ]

@@ -1,7 +1,7 @@
 """Tasks of the QP differential IK (one concept per module, as in pink)."""
 
 from .base import Task
-from .coupling import JointCouplingTask, mimic_tasks
+from .coupling import JointCouplingTask
 from .damping import DampingTask
 from .frame import FrameTask
 from .orientation import OrientationTask
@@ -12,6 +12,6 @@ from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swive
 
 __all__ = [
     "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
-    "DampingTask", "JointCouplingTask", "SwivelTask", "mimic_tasks", "comfortable_posture",
+    "DampingTask", "JointCouplingTask", "SwivelTask", "comfortable_posture",
     "HUMAN_ARM7_COMFORT", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]

@@ -4,9 +4,11 @@ URDF mimic joints).
     e(q) = Σ_j r_j q_j − b  (1,),   J = [r_j at the joint's velocity index]  (1 × nv)
 
 ``JointCouplingTask.mimic(robot, joint, mimicked, multiplier, offset)`` encodes the URDF
-``<mimic>`` relation q_joint = multiplier · q_mimicked + offset; :func:`mimic_tasks` builds one
-task per mimic tag of the robot's URDF whose two joints are degrees of freedom of the model.
-Pass them as ``constraints=`` to :func:`~anthroarm.ik.qp.step` to hold them exactly.
+``<mimic>`` relation q_joint = multiplier · q_mimicked + offset between two joints that are
+both degrees of freedom of the model (a coupling the URDF does not declare: joints with a
+``<mimic>`` tag are modelled by Pinocchio as followers, ``robot.chain.joints[i].mimic``, and
+need no task).  Pass them as ``constraints=`` to :func:`~anthroarm.ik.qp.step` to hold them
+exactly.
 """
 
 from __future__ import annotations
@@ -68,20 +70,3 @@ class JointCouplingTask(Task):
 
     def compute_jacobian(self, conf) -> np.ndarray:
         return self._row.copy()
-
-
-def mimic_tasks(robot, **kw) -> list[JointCouplingTask]:
-    """One :meth:`JointCouplingTask.mimic` per URDF ``<mimic>`` tag whose joints are both DOFs
-    of the model.  :func:`anthroarm.load` models ``<mimic>`` joints in Pinocchio (they carry no q
-    or v of their own and follow their source: ``robot.chain.joints[i].mimic``), so for a URDF
-    loaded with mimic support this list is empty; it serves models whose mimic joints were
-    built as free joints."""
-    tasks = []
-    chain = robot.chain
-    dofs = {chain.joints[i].name for i in chain.independent}
-    for j in robot.urdf.robot.joints:
-        m = getattr(j, "mimic", None)
-        if m is None or j.name not in dofs or m.joint not in dofs:
-            continue
-        tasks.append(JointCouplingTask.mimic(robot, j.name, m.joint, m.multiplier or 1.0, m.offset or 0.0, **kw))
-    return tasks
