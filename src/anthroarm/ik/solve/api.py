@@ -12,7 +12,7 @@ from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
 from .kernel import MAX_ITER, STALL, attempt, clock, damped_step, damping
 from .nullspace import Swivel, posture, swivel as swivel_phase
-from .seeds import HUMAN_GRID, TableSeeds, analytic_seeds
+from .seeds import SWIVEL_GRID, TableSeeds, analytic_seeds
 from .targets import ORIENTATION, POSE, Target, parse
 from .workspace import workspace
 
@@ -189,7 +189,7 @@ def solve_one(pb: Problem, tg: Target, seed):
     ana, ana_i, note = None, 0, ""
     if not out_of_reach and pb.closed_form_first(seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
-        ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, HUMAN_GRID)
+        ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
     table = None      # seed-table entries, nearest first (made when needed)
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
@@ -239,7 +239,7 @@ def solve_one(pb: Problem, tg: Target, seed):
         if out_of_reach and attempts >= 3:
             break
         if pb.analytic == "auto" and ana is None and not out_of_reach and attempts >= ANALYTIC_AFTER:
-            ana, note = analytic_seeds(pb.robot, ws, tg, best_q, sw.target if sw else None, HUMAN_GRID)
+            ana, note = analytic_seeds(pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID)
         if clock() > deadline or (pb.max_restarts is not None and restarts >= pb.max_restarts):
             break
     th = best_q if best_q is not None else th

@@ -30,7 +30,7 @@ SEED_POSTURE_WEIGHT = 0.05  # w_q / reach: + w_q²‖θ − θ_ref‖² in that 
 TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
 ALIGN_RANGE = 1.5 * np.pi   # first / last joints with at least this range are aligned (see Aligned)
 ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
-HUMAN_GRID = np.linspace(-np.pi, np.pi, 24, endpoint=False)  # swivel grid of closed-form seeds (7-DOF arms)
+SWIVEL_GRID = np.linspace(-np.pi, np.pi, 24, endpoint=False)  # swivel angles (rad) of a redundant arm's closed-form seeds
 
 
 def build_table(sh, data):
@@ -229,7 +229,7 @@ def closed_form_cheap(robot, fid) -> bool:
     """True when ``analytic="auto"`` puts the closed form first (where it exists,
     :func:`anthroarm.ik.closed_form.closed_form_info`): a call costs about as much as a few
     Gauss–Newton iterations — a non-redundant arm (~10 µs), a redundant arm's swivel grid
-    (:data:`HUMAN_GRID`) only with the compiled kernel of :mod:`anthroarm.ik.analytic_c`
+    (:data:`SWIVEL_GRID`) only with the compiled kernel of :mod:`anthroarm.ik.analytic_c`
     (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and environment, so the same call gives the
     same answer."""
     info = closed_form.closed_form_info(robot, fid)
