@@ -61,7 +61,7 @@ def solve_damped(ws, J, e, lam):
     call.  A batch (J (N, m, n), e (N, m), λ (N,)): ``np.linalg.solve``."""
     if J.ndim == 2:
         A, AF, Ad = ws.lin[len(J)]
-        np.dot(J, J.T, out=A)
+        J.dot(J.T, out=A)             # the method: np.dot goes through a Python dispatcher
         Ad += lam                     # the diagonal of A (a view)
         x, info = dposv(AF, e, overwrite_a=1)[1:]
         return None if info else x
@@ -91,7 +91,7 @@ def dls(ws, J, e, lam):
     g = _jtx(J, e)                                 # Jᵀe
     if J.ndim == 2:
         A, AF, Ad = ws.lin[n]
-        np.dot(J.T, J, out=A)
+        J.T.dot(J, out=A)
         Ad += lam
         dq, info = dposv(AF, g, overwrite_a=1)[1:]
         return None if info else dq
