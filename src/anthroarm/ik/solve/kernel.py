@@ -1,8 +1,8 @@
 """The damped Gauss–Newton (Levenberg–Marquardt) kernel of :func:`anthroarm.ik.solve`.
 
-One step (:func:`damped_step`), shared by the one-target attempt (:func:`attempt`), the
-lockstep batch (a leading batch axis) and the null-space phases
-(:mod:`anthroarm.ik.solve.nullspace`, which reuse its factorisation :func:`solve_damped`)::
+One step (:func:`damped_step`, its linear algebra :func:`solve_damped`), shared by the
+one-target attempt (:func:`attempt`), the lockstep batch (a leading batch axis) and the
+null-space phases (:mod:`anthroarm.ik.solve.nullspace`, which reuse the factorisation)::
 
     Δθ = Jᵀ (J Jᵀ + λ I)⁻¹ e = (JᵀJ + λ I)⁻¹ Jᵀe,   λ = λ₀ + k ‖e‖²   (Sugihara 2011 damping),
     θ ← clip(θ + Δθ, θ_min, θ_max).
@@ -53,61 +53,50 @@ def damping(E):
     return LAMBDA0 + K_DAMP * E
 
 
-def solve_damped(ws, J, e, lam):
-    """x = (J Jᵀ + λI)⁻¹ e, or None where J Jᵀ + λI is not positive definite (NaN/inf).
+def solve_damped(ws, J, e, lam, step=True):
+    """The damped least-squares step Δθ = Jᵀ(JJᵀ + λI)⁻¹e = (JᵀJ + λI)⁻¹Jᵀe (equal by the
+    push-through identity), or with ``step=False`` x = (JJᵀ + λI)⁻¹e itself; None where the
+    system is not positive definite (NaN/inf).
 
-    One target (J (m, n)): built in ``ws.lin[m]`` and factorised in place by ``dposv``; the
-    Cholesky factor stays in ``ws.lin[m][1]`` for null-space projections (``dpotrs``) until the next
-    call.  A batch (J (N, m, n), e (N, m), λ (N,)): ``np.linalg.solve``."""
+    One target (J (m, n), e (m,), λ float): the m × m system is built in ``ws.lin[m]`` and
+    factorised in place by LAPACK ``dposv``; its Cholesky factor stays in ``ws.lin[m][1]`` for
+    null-space projections (``dpotrs``) until the next call.  Where the arm has fewer joints
+    than the task (n < m: JJᵀ is singular and its form would lose digits) the step is solved in
+    the n × n form.  A batch (J (N, m, n), e (N, m), λ (N,)): ``np.linalg.solve``."""
     if J.ndim == 2:
-        A, AF, Ad = ws.lin[len(J)]
-        J.dot(J.T, out=A)             # the method: np.dot goes through a Python dispatcher
-        Ad += lam                     # the diagonal of A (a view)
-        x, info = dposv(AF, e, overwrite_a=1)[1:]
-        return None if info else x
-    A = np.matmul(J, J.transpose(0, 2, 1))
-    A.reshape(len(A), -1)[:, :: J.shape[1] + 1] += lam[:, None]
-    try:
-        return np.linalg.solve(A, e[..., None])[..., 0]
-    except np.linalg.LinAlgError:
-        return None
-
-
-def _jtx(J, x):
-    """Jᵀx for J (m, n) or a batch (N, m, n)."""
-    return x.dot(J) if J.ndim == 2 else np.matmul(x[:, None, :], J)[:, 0]
-
-
-def dls(ws, J, e, lam):
-    """The damped least-squares step Δθ = Jᵀ(JJᵀ + λI)⁻¹e = (JᵀJ + λI)⁻¹Jᵀe (the two are
-    equal: push-through identity): the m × m form where m ≤ n, the n × n form where the arm
-    has fewer joints than the task (n < m: JJᵀ is singular there and its form would lose
-    digits).  None where the system is not positive definite.  Single or batch like
-    :func:`solve_damped`."""
-    m, n = J.shape[-2:]
-    if m <= n:
-        x = solve_damped(ws, J, e, lam)
-        return None if x is None else (x.dot(J) if J.ndim == 2 else _jtx(J, x))
-    g = _jtx(J, e)                                 # Jᵀe
-    if J.ndim == 2:
-        A, AF, Ad = ws.lin[n]
+        m = len(J)
+        if m <= ws.n or not step:
+            A, AF, Ad = ws.lin[m]
+            J.dot(J.T, out=A)             # the method: np.dot goes through a Python dispatcher
+            Ad += lam                     # the diagonal of A (a view)
+            x, info = dposv(AF, e, overwrite_a=1)[1:]
+            return None if info else (x.dot(J) if step else x)
+        A, AF, Ad = ws.lin[ws.n]
         J.T.dot(J, out=A)
         Ad += lam
-        dq, info = dposv(AF, g, overwrite_a=1)[1:]
+        dq, info = dposv(AF, e.dot(J), overwrite_a=1)[1:]
         return None if info else dq
-    A = np.matmul(J.transpose(0, 2, 1), J)
-    A.reshape(len(A), -1)[:, :: n + 1] += lam[:, None]
+    N, m, n = J.shape
+    Jt = J.transpose(0, 2, 1)
+    rhs = e
+    if m <= n:
+        A = np.matmul(J, Jt)
+    else:
+        A = np.matmul(Jt, J)
+        rhs = np.matmul(e[:, None, :], J)[:, 0]
+    A.reshape(N, -1)[:, :: A.shape[1] + 1] += lam[:, None]
     try:
-        return np.linalg.solve(A, g[..., None])[..., 0]
+        x = np.linalg.solve(A, rhs[..., None])[..., 0]
     except np.linalg.LinAlgError:
         return None
+    return np.matmul(x[:, None, :], J)[:, 0] if m <= n else x
 
 
 def damped_step(ws, th, J, e, lam):
     """θ after one damped step with the joint limits (see the module docstring); θ (n,) with
     J (m, n), e (m,), λ float — or a batch with a leading axis N.  None where the system is not
     positive definite."""
-    dq = dls(ws, J, e, lam)
+    dq = solve_damped(ws, J, e, lam)
     if dq is None:
         return None
     lo, hi = ws.lo, ws.hi
@@ -116,7 +105,7 @@ def damped_step(ws, th, J, e, lam):
     if tc.tobytes() != tn.tobytes():   # (byte comparison: ~20× cheaper than (tc != tn).any())
         # active set: the joints the step pushes past a limit stay where they are, the others
         # take the step recomputed without them, then it is clipped
-        dq = dls(ws, J * (tc == tn)[..., None, :], e, lam)
+        dq = solve_damped(ws, J * (tc == tn)[..., None, :], e, lam)
         if dq is not None:
             tc = uclip(th + dq, lo, hi)
     return tc

@@ -68,7 +68,7 @@ def posture(ws, tg, th, th_ref, deadline):
         lam = damping(E)
         frozen = None
         while True:
-            x = solve_damped(ws, J, e, lam)     # AF now holds the Cholesky factor
+            x = solve_damped(ws, J, e, lam, step=False)     # AF now holds the Cholesky factor
             if x is None:
                 return good, gpe2, gre2, it
             dq = x.dot(J)
@@ -187,7 +187,7 @@ def swivel(ws, tg, th, sw: Swivel, deadline):
         ok = tg.ok(pe2, re2)
         if ok:
             good = th
-        x = solve_damped(ws, J, e, damping(E))
+        x = solve_damped(ws, J, e, damping(E), step=False)
         if x is None:
             break
         dq = x.dot(J)

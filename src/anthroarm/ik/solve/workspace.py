@@ -159,7 +159,7 @@ class Workspace:
         self.sh = sh
         self.model, self.fid, self.n, self.lo, self.hi, self.to_q = sh.model, sh.fid, sh.n, sh.lo, sh.hi, sh.to_q
         self.data = sh.model.createData()
-        self.lin = {}   # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.dls
+        self.lin = {}   # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
         for m in {3, 6, min(sh.n, 6)}:      # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
             self.lin[m] = (A, A.T, A.reshape(-1)[:: m + 1])
