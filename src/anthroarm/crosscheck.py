@@ -11,8 +11,8 @@ providers; each row compares one quantity over random samples and records the la
   ``unsupported: <reason>``; a provider that raises anything else gets one row noting
   ``error: <exception>``.  Neither passes.
 * :data:`PROVIDERS` are the book's rows: ``rows(names, samples, rng)`` with the catalog names
-  among the models asked for (the book models' closed forms, IK and reach; the spatial
-  mathematics and mechanisms, which need no model, always run).
+  among the models asked for, unless ``tool``/``locked`` change them (the book models' closed
+  forms, IK and reach; the spatial mathematics and mechanisms, which need no model, always run).
 
 ``anthroarm check`` prints the rows and exits non-zero unless every row passes.  To add checks,
 write a provider next to the code it checks and append ``"package.module:function"`` to the
@@ -118,8 +118,12 @@ def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress
     from . import models as catalog
 
     robots = load_robots(models, tool, locked)
-    names = catalog.names() if not models else [str(m) for m in models
-                                                      if isinstance(m, (str, Path)) and str(m) in catalog.names()]
+    if not models:
+        names = catalog.names()
+    elif tool is None and locked is None:   # the book rows are about the catalog models as they are
+        names = [str(m) for m in models if isinstance(m, (str, Path)) and str(m) in catalog.names()]
+    else:
+        names = []
     provs = list(providers) if providers is not None else [*ROBOT_PROVIDERS, *PROVIDERS]
     jobs = [(p, r) for p in provs if p in ROBOT_PROVIDERS for r in robots]
     jobs += [(p, None) for p in provs if p not in ROBOT_PROVIDERS]

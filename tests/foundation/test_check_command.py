@@ -190,3 +190,15 @@ def test_urdf_command_takes_example_robot_data_names_and_paths(tmp_path, user_ur
     capsys.readouterr()
     assert cli.main(["urdf", "xarm7", "-o", str(out), "--param", "height=2"]) == 2
     assert "takes no parameters" in capsys.readouterr().err
+
+
+def test_book_rows_only_for_the_book_model_as_catalogued():
+    """human_arm7 with another tool is not the chain the printed forms describe: generic rows
+    only (and they pass on the elbow frame), no printed FK, no closed-form IK rows."""
+    provs = [*crosscheck.ROBOT_PROVIDERS, "anthroarm.ik.checks:rows"]
+    rows = crosscheck.run(["human_arm7"], samples=10, providers=provs, tool="elbow_flexion")
+    assert {r.quantity for r in rows} >= GENERIC and all(r.ok for r in rows)
+    assert not [r for r in rows if "printed" in r.quantity or "analytic" in r.quantity]
+    rows = crosscheck.run(["human_arm7"], samples=10, providers=provs)
+    assert {"fk printed (6-34)-(6-39)", "(6-119) vs FD of perturbed placements"} <= {r.quantity for r in rows}
+    assert any("analytic IK" in r.quantity for r in rows) and all(r.ok for r in rows)
