@@ -275,7 +275,7 @@ def test_seed_table_distance_is_the_pose_distance(robots):
 
 
 def test_aligned_seed_table_turns_first_and_last_joint_exactly(robots):
-    """panda and ur5 (first and last joints spanning >= 1.5 pi): a target made from a table entry
+    """panda and ur5 (first and last joints spanning at least a half turn): a target made from a table entry
     with its first and last joints turned is matched by that entry, and the seed turned onto it
     is the target's configuration itself (oracle: FK of the configuration the target came from).
     talos_arm (wrist range 1.4 rad) has no aligned table."""
