@@ -178,7 +178,7 @@ def test_dropped_robots_are_freed():
 
 
 def test_theta_to_q_equals_the_chain(user_urdf):
-    """The solver's θ → q map (index arrays) equals Chain.configuration, the one source of the
+    """The solver's θ → q map (plain floats) equals Chain.configuration, the one source of the
     (cos θ, sin θ) layout, on kinova and the user URDF; Chain.angles inverts it."""
     from anthroarm.ik.solve.workspace import workspace
 
@@ -187,6 +187,6 @@ def test_theta_to_q_equals_the_chain(user_urdf):
         sh = workspace(robot, robot.tool_id).sh
         Th = np.random.default_rng(8).uniform(-7.0, 7.0, (50, len(ch.independent)))
         for th in Th:
-            np.testing.assert_array_equal(sh.to_q(th), ch.configuration(th))
+            np.testing.assert_allclose(sh.to_q(th), ch.configuration(th), rtol=0, atol=2e-16)
             back = sh.theta(sh.to_q(th))
             np.testing.assert_allclose(np.cos(back - th), 1.0, atol=1e-12)   # same angle up to turns
