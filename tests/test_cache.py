@@ -106,7 +106,7 @@ def test_edited_cached_python_is_rebuilt_not_run(cdir):
 def test_truncated_shared_library_is_rebuilt_in_a_fresh_process(cdir):
     """A .so cut to a third: loading it used to kill the process with SIGBUS.  A fresh
     process must detect it, rebuild, and compute τ equal to Pinocchio's."""
-    L.load("planar2r", backend="c")
+    L.load(aa.load("planar2r", l1=0.57), backend="c")          # a fresh parameterisation: not loaded yet
     libs = list((cdir / "lagrange").glob("lagrange_*.so"))
     assert len(libs) == 1
     data = libs[0].read_bytes()
@@ -114,7 +114,7 @@ def test_truncated_shared_library_is_rebuilt_in_a_fresh_process(cdir):
     code = textwrap.dedent("""
         import numpy as np, pinocchio as pin, anthroarm as aa
         from anthroarm.dynamics import lagrange as L
-        r = aa.load("planar2r")
+        r = aa.load("planar2r", l1=0.57)
         d = L.load(r, backend="c")
         q, v, a = np.array([0.3, -0.7]), np.array([1.1, 0.4]), np.array([-0.2, 0.9])
         print(float(np.max(np.abs(d.tau(q, v, a) - pin.rnea(r.model, r.model.createData(), q, v, a)))))
