@@ -20,7 +20,6 @@ from pathlib import Path
 
 from lxml import etree
 
-from ._io import atomic_write_text  # noqa: F401  (moved to _io; viewer.py still imports it from here)
 from .errors import (
     MeshNotFoundError,
     PackagePathError,

@@ -171,14 +171,6 @@ def test_errors_are_anthroarm_errors():
         assert issubclass(cls, errors.AnthroarmError)
 
 
-def test_atomic_write_leaves_nothing_on_missing_folder(tmp_path):
-    from anthroarm.urdf_io import atomic_write_text
-
-    with pytest.raises(FileNotFoundError):
-        atomic_write_text(tmp_path / "nope" / "x.urdf", "text")
-    assert not any(tmp_path.iterdir())
-
-
 def test_two_roots(tmp_path):
     links = "<link name='base'/><link name='l1'/><link name='loose'/>"
     assert_structure_error(tmp_path, r"not connected into one tree: 2 roots \('base', 'loose'\)", links=links)

@@ -31,7 +31,7 @@ import pinocchio as pin
 from meshcat.commands import SetObject
 
 from ..spatial.rotations import homogeneous
-from ..urdf_io import atomic_write_text
+from .._io import atomic_write_text
 from ._store import SceneStore
 from .visuals import LINK_RGB, Body, Piece, _y_to, cylinder_between, rgb_hex, robot_bodies
 
