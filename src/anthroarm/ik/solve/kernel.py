@@ -35,7 +35,10 @@ from scipy.linalg.lapack import dposv
 try:  # the clip ufunc itself: ~0.2 µs against ~1.3 µs for np.clip's Python wrapper
     from numpy._core.umath import clip as uclip
 except ImportError:  # numpy < 2
-    from numpy.core.umath import clip as uclip
+    try:
+        from numpy.core.umath import clip as uclip
+    except ImportError:  # pragma: no cover - a NumPy without the ufunc: the public wrapper
+        uclip = np.clip
 
 LAMBDA0 = 1e-10   # floor of the damping (keeps JJᵀ + λI positive definite at singularities)
 K_DAMP = 0.01     # λ grows with the squared error: large errors -> short, gradient-like steps
