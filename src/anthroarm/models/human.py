@@ -100,6 +100,21 @@ def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "mal
     return out
 
 
+#: Comfortable posture of the §6-3 arm (rad): upper arm 20° flexed and 15° abducted, humerus
+#: unrotated, elbow flexed 80°, forearm mid-pronation, wrist straight — the centres of the
+#: lowest-load ("score 1") bands of RULA (McAtamney & Corlett, Applied Ergonomics 24(2), 1993:
+#: upper arm −20…20°, lower arm 60…100°, wrist 0°).
+HUMAN_ARM7_COMFORT = {
+    "shoulder_flexion": 20 * deg,
+    "shoulder_abduction": -15 * deg,   # negative = abduction for this right arm
+    "shoulder_rotation": 0.0,
+    "elbow_flexion": 80 * deg,
+    "forearm_pronation": 0.0,
+    "wrist_deviation": 0.0,
+    "wrist_flexion": 0.0,
+}
+
+
 def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> ChainSpec:
     """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg."""
     seg = segment_parameters(height, mass, sex)
@@ -152,4 +167,6 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> C
         source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
         inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg",
         params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},
+        person=True,
+        comfort=dict(HUMAN_ARM7_COMFORT),
     )

@@ -96,7 +96,9 @@ class ChainSpec:
     """A catalog arm: its joints (each carrying the link it moves), the tool frame placed by
     ``tool_origin`` in the last link, provenance strings, and for H-D arms the table ``dh``
     with the tool pose ``tool_dh`` in the last DH frame.  ``params`` are the builder's
-    arguments (SI units)."""
+    arguments (SI units).  ``person``: the limb of a person (the viewer draws a torso around
+    its shoulder); ``comfort``: its comfortable posture, joint name -> rad (the default
+    reference of posture objectives, see :func:`anthroarm.ik.qp.comfortable_posture`)."""
 
     name: str
     description: str
@@ -109,6 +111,8 @@ class ChainSpec:
     dh: list[DHRow] | None = None
     tool_dh: np.ndarray | None = None  # tool pose in the last DH frame (for closed forms)
     params: dict = field(default_factory=dict)
+    person: bool = False
+    comfort: dict | None = None
 
     @property
     def nq(self) -> int:

@@ -7,7 +7,7 @@ Where the geometry comes from (:func:`robot_bodies`, ``style="auto"``):
   generated from ``robot.chain`` — a sphere at every joint centre, a cylinder along every joint
   axis, capsules from each joint to its children and to the tip frames, a sleeve over the stroke
   of prismatic joints, a small palm at the tool.  Sizes scale with the reach.  A book limb scaled
-  to a person (its spec has a ``height`` parameter) also gets a torso for context.
+  to a person (its spec says ``person=True``) also gets a torso for context.
 * A robot with a URDF: the URDF's ``<visual>`` elements — meshes resolved with
   :func:`anthroarm.urdf_io.resolve_uri` (the same resolution the loader used), boxes, cylinders
   and spheres — each attached to its link's frame.  A mesh that cannot be found raises
@@ -140,7 +140,7 @@ def skeleton_bodies(robot) -> list[Body]:
     for t in ends[-1]:
         for a, b in _segments(t, np.array([0.0, 0.0, 1.0])):
             base += capsule(a, b, r)
-    if robot.spec is not None and "height" in robot.spec.params:   # a limb scaled to a person
+    if robot.spec is not None and robot.spec.person:   # the limb of a person
         base += _torso(robot, r)
     else:
         base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, homogeneous(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
