@@ -178,6 +178,11 @@ def test_comfortable_posture(human, panda):
     assert p[1] > 0.1 and p[2] < -0.1
     mid = qp.comfortable_posture(panda)
     assert np.allclose(mid, 0.5 * (panda.lower + panda.upper))
+    # the posture comes from the model (spec.comfort), not from the robot's name
+    assert qp.tasks.has_comfortable_posture(human) and not qp.tasks.has_comfortable_posture(panda)
+    renamed = aa.load(aa.models.urdf_path("human_arm7"))          # same joints, no spec
+    assert not qp.tasks.has_comfortable_posture(renamed)
+    np.testing.assert_allclose(qp.comfortable_posture(renamed), 0.5 * (renamed.lower + renamed.upper))
 
 
 def test_mimic_coupling_task(panda):

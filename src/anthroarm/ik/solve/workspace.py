@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...chain import CONTINUOUS, PRISMATIC
-from ..qp.tasks.posture import HUMAN_ARM7_COMFORT, comfortable_posture
+from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from .. import closed_form
 from . import seeds
 
@@ -66,8 +66,7 @@ class Shared:
         self.reach = chain.reach(fid)
         self.ref = self.theta(comfortable_posture(robot))
         self.ref.setflags(write=False)
-        human = self.n == len(HUMAN_ARM7_COMFORT) and set(robot.joint_names) == set(HUMAN_ARM7_COMFORT)
-        self.posture_auto = self.ref if human else None
+        self.posture_auto = self.ref if has_comfortable_posture(robot) else None
         lo_s, hi_s = (np.array(b) for b in chain.sampling_box)
         self.lo_s = np.where(self.on_path, lo_s, self.ref)
         self.hi_s = np.where(self.on_path, hi_s, self.ref)

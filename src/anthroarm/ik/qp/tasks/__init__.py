@@ -6,12 +6,12 @@ from .damping import DampingTask
 from .frame import FrameTask
 from .orientation import OrientationTask
 from .position import PositionTask
-from .posture import HUMAN_ARM7_COMFORT, PostureTask, comfortable_posture
+from .posture import PostureTask, comfortable_posture, has_comfortable_posture
 from .relative_frame import RelativeFrameTask
 from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swivel_from_points
 
 __all__ = [
     "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
     "DampingTask", "JointCouplingTask", "SwivelTask", "comfortable_posture",
-    "HUMAN_ARM7_COMFORT", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
+    "has_comfortable_posture", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]

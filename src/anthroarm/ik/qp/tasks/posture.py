@@ -8,12 +8,11 @@ in (−π, π].
 Used with a small cost it resolves redundancy (the book's redundancy handling by a penalty on
 the configuration, Ch. 7 §7-6 (7-84)–(7-86), becomes a QP regulariser).
 
-:func:`comfortable_posture` gives the relaxed reference posture of the human arm: upper arm
-20° flexed and 15° abducted, humerus unrotated, elbow flexed 80°, forearm mid-pronation, wrist
-straight.  These are the centres of the lowest-load ("score 1") bands of RULA (McAtamney &
-Corlett, Applied Ergonomics 24(2), 1993: upper arm −20…20°, lower arm 60…100°, wrist 0°),
-clipped into the joint limits.  Other robots get the middle of their joint ranges (θ = 0 for
-a joint without a finite range, a continuous joint included).
+:func:`comfortable_posture` gives the relaxed reference posture a model carries
+(``robot.spec.comfort``: for the human arm the centres of RULA's lowest-load bands, see
+:data:`anthroarm.models.human.HUMAN_ARM7_COMFORT`), clipped into the joint limits.  Other
+robots get the middle of their joint ranges (θ = 0 for a joint without a finite range, a
+continuous joint included).
 """
 
 from __future__ import annotations
@@ -23,31 +22,24 @@ import pinocchio as pin
 
 from .base import Task
 
-deg = np.pi / 180.0
-
-#: Comfortable posture of ``human_arm7`` (rad), joint name -> value.
-HUMAN_ARM7_COMFORT = {
-    "shoulder_flexion": 20 * deg,
-    "shoulder_abduction": -15 * deg,   # negative = abduction for the right arm (see models.human)
-    "shoulder_rotation": 0.0,
-    "elbow_flexion": 80 * deg,
-    "forearm_pronation": 0.0,
-    "wrist_deviation": 0.0,
-    "wrist_flexion": 0.0,
-}
+def has_comfortable_posture(robot) -> bool:
+    """True when the robot's model carries a comfortable posture for every joint
+    (``robot.spec.comfort``, e.g. the §6-3 human arm; see :mod:`anthroarm.models.human`)."""
+    comfort = getattr(robot.spec, "comfort", None)
+    return bool(comfort) and all(robot.chain.joints[i].name in comfort for i in robot.chain.independent)
 
 
 def comfortable_posture(robot) -> np.ndarray:
-    """Reference posture (nq,) of ``robot`` from ``robot.chain``: :data:`HUMAN_ARM7_COMFORT`
-    when every independent joint has a value there (joints matched by name), else the middle
-    of each joint's range (θ = 0, clipped into the range, where it is not finite: a continuous
-    joint gets (cos 0, sin 0)); always within the limits."""
+    """Reference posture (nq,) of ``robot`` from ``robot.chain``: the model's comfortable
+    posture where it has one (:func:`has_comfortable_posture`), else the middle of each joint's
+    range (θ = 0, clipped into the range, where it is not finite: a continuous joint gets
+    (cos 0, sin 0)); always within the limits."""
     chain = robot.chain
     joints = [chain.joints[i] for i in chain.independent]
     lo = np.array([j.lower for j in joints])
     hi = np.array([j.upper for j in joints])
-    if all(j.name in HUMAN_ARM7_COMFORT for j in joints):
-        theta = np.array([HUMAN_ARM7_COMFORT[j.name] for j in joints])
+    if has_comfortable_posture(robot):
+        theta = np.array([robot.spec.comfort[j.name] for j in joints])
     else:
         finite = np.isfinite(lo) & np.isfinite(hi)
         theta = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), 0.0)
