@@ -71,7 +71,8 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         Success tolerances, m and rad.
     max_time : float
         Time budget per target, s of CPU time of the calling thread (restarts stop when it is
-        spent; a CPU-time budget makes the answer independent of the machine's load).
+        spent; a CPU-time budget makes the answer independent of the machine's load).  The
+        seed table, built once per (robot, frame) on the first call, is not charged to it.
     mode : None, "pose", "position", "orientation"
         Override the target kind (e.g. ``"position"`` with a 4×4 ``T`` uses its translation).
     max_restarts : int, optional
@@ -134,6 +135,9 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     pb = Problem(robot, ws, float(max_time), max_restarts, rng, th_ref if redundant and sw is None else None,
                  sw if redundant else None, analytic)
     tp, tr = float(tol_pos), float(tol_rot)
+    ws.table()      # the one-time seed tables: built here, before any clock starts, so the first
+    if mode == "pose":                                   # call is not charged for them
+        ws.aligned()
     if not batch:
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr, x), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
