@@ -23,7 +23,8 @@ import numpy as np
 import anthroarm as aa
 from anthroarm.ik import analytic_c
 from anthroarm.ik.cells import CellTable
-from anthroarm.ik.closed_form import analytic, analytic_batch, swivel_angle
+from anthroarm.ik import swivel_angle
+from anthroarm.ik.closed_form import analytic, analytic_batch
 
 from .common import time_call
 from .ik_peers import PinCLIK, pose_errors

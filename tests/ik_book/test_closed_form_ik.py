@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 
 import anthroarm as aa
 from anthroarm.errors import UnsupportedModelError
-from anthroarm.ik.closed_form import analytic_batch, swivel_angle
+from anthroarm.ik import swivel_angle
+from anthroarm.ik.closed_form import analytic_batch
 
 N_ROUND_TRIP = 2000
 ARMS = {

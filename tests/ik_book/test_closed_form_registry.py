@@ -48,7 +48,7 @@ def test_registry_entries_solve_their_arm(name):
     assert form.nq == robot.nq
     q = robot.random_q(None, np.random.default_rng(3), margin=0.05)
     T = robot.fk(q)
-    kw = {"swivel": cf.swivel_angle(robot, q)} if form.swivel else {}
+    kw = {"swivel": aa.ik.swivel_angle(robot, q)} if form.swivel else {}
     res = aa.ik.analytic(robot, T, **kw)
     assert res.model == robot.name
     batch = aa.ik.analytic_batch(robot, T[None], **kw)

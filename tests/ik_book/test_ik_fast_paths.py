@@ -17,7 +17,8 @@ import pytest
 import anthroarm as aa
 from anthroarm.ik import analytic_c
 from anthroarm.ik.analytic_plan import plan_for
-from anthroarm.ik.closed_form import analytic, analytic_batch, swivel_angle
+from anthroarm.ik import swivel_angle
+from anthroarm.ik.closed_form import analytic, analytic_batch
 from anthroarm.ik.fk_codegen import FKStages, cos_sin
 
 HAS_CC = analytic_c.compiler() is not None and analytic_c.enabled()

@@ -5,7 +5,6 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.ik import closed_form as cf
 from anthroarm.ik import qp
 from anthroarm.ik.qp.tasks.swivel import swivel_from_points
 
@@ -139,12 +138,24 @@ def test_swivel_angle_geometry():
         swivel_from_points(S, S + 0.5 * (W - S), W)
 
 
-def test_swivel_agrees_with_closed_form_definition(human):
-    for q in human.random_q(20, rng=5):
-        if abs(np.sin(q[3])) < 0.05:
-            continue
-        d = qp.swivel_angle(human, q) - cf.swivel_angle(human, q)
-        assert abs(np.arctan2(np.sin(d), np.cos(d))) < 1e-9
+def test_swivel_angle_batch_and_straight_elbow(human):
+    """The batched call equals the one-configuration call, which equals swivel_from_points of
+    Pinocchio's frame positions; a straight elbow (undefined by the points) gets the elbow-axis
+    convention of the closed form: analytic(FK(q), swivel=φ(q)) contains q (round trip)."""
+    Q = human.random_q(20, rng=5)
+    phis = qp.swivel_angle(human, Q)
+    frames = qp.tasks.swivel_frames(human)
+    for q, phi in zip(Q, phis):
+        P = [human.fk(q, f)[:3, 3] for f in frames]
+        assert abs(np.angle(np.exp(1j * (phi - swivel_from_points(*P)[0])))) < 1e-12
+        assert qp.swivel_angle(human, q) == pytest.approx(phi, abs=1e-12)
+    q = human.random_q(rng=3)
+    q[human.joint_names.index("elbow_flexion")] = 0.0          # straight elbow
+    with pytest.raises(ValueError, match="straight arm"):
+        swivel_from_points(*[human.fk(q, f)[:3, 3] for f in frames])
+    phi = qp.swivel_angle(human, q)
+    sols = aa.ik.analytic(human, human.fk(q), swivel=phi).solutions
+    assert np.min(np.abs(np.angle(np.exp(1j * (sols - q)))).max(axis=1)) < 1e-9
 
 
 def test_frame_and_posture_objectives_match_pink(panda):

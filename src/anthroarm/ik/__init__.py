@@ -8,4 +8,5 @@
 from . import qp
 from .result import IKBatchResult, IKResult
 from .solve import solve
-from .closed_form import AnalyticBatchResult, AnalyticIKResult, analytic, analytic_batch, has_analytic, swivel_angle
+from .closed_form import AnalyticBatchResult, AnalyticIKResult, analytic, analytic_batch, has_analytic
+from .qp.tasks.swivel import swivel_angle

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..crosscheck import CheckRow
 from ..models.closed_forms import names
-from .closed_form import analytic_batch, closed_form_info, swivel_angle
+from .closed_form import analytic_batch, closed_form_info
+from .qp.tasks.swivel import swivel_angle
 
 
 def rows(models, samples, rng) -> list[CheckRow]:

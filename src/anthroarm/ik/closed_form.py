@@ -28,7 +28,7 @@ Families of closed forms (which arm has which: the registry
     Redundant (7 DOF): the elbow swivel angle φ (rotation of the elbow about the shoulder–wrist
     axis) is the parameter of the one-parameter family.  ``swivel=`` a scalar or an array of
     angles (rad); default: a grid of 36 angles over [−π, π).  Per swivel angle: elbow sign ×
-    shoulder Euler branch × wrist Euler branch = 8 candidates.  See :func:`swivel_angle`.
+    shoulder Euler branch × wrist Euler branch = 8 candidates.  See :func:`anthroarm.ik.qp.tasks.swivel.swivel_angle`.
 
 Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool frame
 (``robot.tool``) in the base frame; joint values in radians.  Lengths are read from
@@ -62,6 +62,7 @@ from . import analytic_c as _c
 from . import analytic_scalar as ks
 from . import analytic_soa as _soa
 from .analytic_plan import cached_plan, plan_for
+from .qp.tasks.swivel import swivel_basis
 
 TWO_PI = 2.0 * np.pi
 HALF_PI = 0.5 * np.pi
@@ -467,22 +468,6 @@ HUMAN_BRANCHES = [f"elbow={e},shoulder={s},wrist={w}"
                   for e in ("flexed", "hyperextended") for s in ("a", "b") for w in ("a", "b")]
 
 
-def _swivel_basis(n):
-    """Unit vectors (u, v) ⊥ n: u = the world −z projected onto the plane ⊥ n (φ = 0: elbow
-    lowest), falling back to −y when the shoulder–wrist axis is vertical; v = n × u."""
-    ref = np.broadcast_to(np.array([0.0, 0.0, -1.0]), n.shape).copy()
-    u = ref - np.einsum("...i,...i->...", ref, n)[..., None] * n
-    nu = np.linalg.norm(u, axis=-1)
-    vert = nu < 1e-9
-    if np.any(vert):
-        ref2 = np.array([0.0, -1.0, 0.0])
-        u2 = ref2 - np.einsum("...i,i->...", n, ref2)[..., None] * n
-        u = np.where(vert[..., None], u2, u)
-        nu = np.linalg.norm(u, axis=-1)
-    u = u / nu[..., None]
-    return u, np.cross(n, u)
-
-
 def _human(Rt, H, l1, l2, l3, swivel):
     """Candidates (N, S·8, 7) of human_arm7 for swivel angles ``swivel`` (N, S)."""
     N, S = swivel.shape
@@ -492,7 +477,7 @@ def _human(Rt, H, l1, l2, l3, swivel):
     code = np.where((np.abs(c4) > 1 + 1e-12) | (Wn < 1e-12), OUTSIDE, OK)
     q4p = np.arccos(np.clip(c4, -1, 1))
     nvec = W / np.where(Wn > 1e-12, Wn, 1.0)[:, None]
-    u, v = _swivel_basis(nvec)
+    u, v = swivel_basis(nvec)
     cc = np.where(Wn > 1e-12, (l1**2 - l2**2 + Wn**2) / (2 * np.where(Wn > 1e-12, Wn, 1.0)), 0.0)
     dvec = np.cos(swivel)[..., None] * u[:, None] + np.sin(swivel)[..., None] * v[:, None]   # (N,S,3)
     r = np.sqrt(np.clip(l1**2 - cc**2, 0, None))
@@ -540,34 +525,6 @@ def _human(Rt, H, l1, l2, l3, swivel):
     sing = np.full(N, None, dtype=object)
     sing[np.abs(np.sin(q4p)) < 1e-12] = "straight elbow: the swivel angle then turns the elbow axis about the arm"
     return Q, np.broadcast_to(code[:, None], (N, S * 8)), sing, sw
-
-
-def swivel_angle(robot, q) -> np.ndarray:
-    """Swivel angle φ (rad) of configurations ``q`` (nq,) or (N, nq) of a redundant arm
-    (closed-form family ``srs_7r``, e.g. human_arm7): the rotation of the elbow about the shoulder–wrist axis n, measured from u (world −z projected ⊥ n, or −y
-    if n is vertical) towards v = n × u.  A straight elbow uses the elbow axis: d = σ n × x_E
-    (σ = sign sin q4).  ``analytic(robot, FK(q), swivel=swivel_angle(robot, q))`` contains q."""
-    plan = _require(robot)
-    if plan.family != SRS:
-        raise UnsupportedModelError(f"{robot.name}: the swivel angle is defined for a redundant shoulder-elbow-wrist "
-                                    f"arm (closed-form family {SRS}); this one is {plan.family}")
-    prm = plan.params
-    q = robot.check_q(q)
-    Q = np.atleast_2d(q)
-    l1, l2 = prm["l1"], prm["l2"]
-    c1, s1, c2, s2, c3, s3 = (f(Q[:, i]) for i in (0, 1, 2) for f in (np.cos, np.sin))
-    # Rsh = Rx(q1) Ry(q2) Rz(q3): x column and z column
-    ex = np.stack([c2 * c3, c1 * s3 + s1 * s2 * c3, s1 * s3 - c1 * s2 * c3], -1)
-    ez = np.stack([s2, -s1 * c2, c1 * c2], -1)
-    s4, c4 = np.sin(Q[:, 3]), np.cos(Q[:, 3])
-    ey = np.cross(ez, ex)
-    W = -l1 * ez + l2 * (s4[:, None] * ey - c4[:, None] * ez)
-    n = W / np.linalg.norm(W, axis=1)[:, None]
-    sg = np.where(s4 >= 0, 1.0, -1.0)
-    d = sg[:, None] * np.cross(n, ex)
-    u, v = _swivel_basis(n)
-    phi = np.arctan2(np.einsum("ni,ni->n", d, v), np.einsum("ni,ni->n", d, u))
-    return phi if q.ndim == 2 else float(phi[0])
 
 
 # ---------------------------------------------------------------------------- public API

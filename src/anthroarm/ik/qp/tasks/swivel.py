@@ -113,14 +113,49 @@ def swivel_from_points(S, E, W, ref=(0.0, 0.0, -1.0)):
     return phi, (-g_p - g_d, g_p, g_d)
 
 
-def swivel_angle(robot, q, frames=None, ref=(0.0, 0.0, -1.0)) -> float:
-    """Swivel angle φ (rad) of ``robot`` at ``q`` (see the module docstring)."""
-    s, e, w = swivel_frames(robot, frames)
+def swivel_basis(n, ref=(0.0, 0.0, -1.0)):
+    """Unit vectors (u, v) ⊥ the shoulder–wrist axis n (..., 3): u = ``ref`` projected onto the
+    plane ⊥ n (φ = 0), falling back to −y where n is parallel to ``ref`` (a vertical arm with
+    the default ``ref``); v = n × u.  The closed form (:mod:`anthroarm.ik.closed_form`) places
+    the elbow at d = cos φ u + sin φ v, so it and :func:`swivel_angle` share one definition."""
+    n = np.asarray(n, dtype=float)
+    r = np.broadcast_to(np.asarray(ref, dtype=float), n.shape)
+    u = r - np.einsum("...i,...i->...", r, n)[..., None] * n
+    nu = np.linalg.norm(u, axis=-1)
+    vert = nu < 1e-9
+    if np.any(vert):
+        r2 = np.array([0.0, -1.0, 0.0])
+        u2 = r2 - np.einsum("...i,i->...", n, r2)[..., None] * n
+        u = np.where(vert[..., None], u2, u)
+        nu = np.linalg.norm(u, axis=-1)
+    u = u / nu[..., None]
+    return u, np.cross(n, u)
+
+
+def swivel_angle(robot, q, frames=None, ref=(0.0, 0.0, -1.0)):
+    """Swivel angle φ (rad) of ``robot`` at ``q`` (nq,) -> float or (N, nq) -> (N,): the angle of
+    the elbow offset d about the shoulder–wrist axis n, from u towards v (:func:`swivel_basis`;
+    φ = atan2(d·v, d·u), the definition of the module docstring).  d is the elbow's offset from
+    the axis, E − S projected ⊥ n; for a straight elbow (E on the axis) d = n × a_E with a_E
+    the elbow joint's axis, so that φ stays defined (the closed form's convention).
+    ``frames`` = (shoulder, elbow, wrist), default :func:`swivel_frames`."""
+    names = swivel_frames(robot, frames)
     q = robot.check_q(q)
-    if q.ndim == 2:
-        return np.array([swivel_angle(robot, qi, frames, ref) for qi in q])
-    P = [robot.fk(q, f)[:3, 3] for f in (s, e, w)]
-    return swivel_from_points(*P, ref=ref)[0]
+    Q = np.atleast_2d(q)
+    T = [robot.fk(Q, f) if len(Q) > 1 else robot.fk(Q[0], f)[None] for f in names]
+    S, E, W = (t[:, :3, 3] for t in T)
+    n = W - S
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    p = E - S
+    d = p - np.einsum("ni,ni->n", p, n)[:, None] * n
+    straight = np.linalg.norm(d, axis=1) <= 1e-9 * (1.0 + np.linalg.norm(p, axis=1))
+    if np.any(straight):
+        axis = robot.chain.joints[robot.chain.frame(names[1]).joint].axis
+        aE = np.einsum("nij,j->ni", T[1][:, :3, :3], axis)
+        d = np.where(straight[:, None], np.cross(n, aE), d)
+    u, v = swivel_basis(n, ref)
+    phi = np.arctan2(np.einsum("ni,ni->n", d, v), np.einsum("ni,ni->n", d, u))
+    return phi if q.ndim == 2 else float(phi[0])
 
 
 class SwivelTask(Task):
