@@ -21,16 +21,18 @@ from anthroarm.kinematics.batched import SerialChain
 
 from .common import time_call
 
-MODELS = ["human_arm7", "prosthetic_arm", "sixr_arm", "panda", "ur5"]
+MODELS = ["human_arm7", "prosthetic_arm", "sixr_arm", "panda", "ur5", "ur10", "kinova"]
 
 
 def _ours(robot):
-    """A function Q -> (T, J): the book's chain product where there is a table, else the PoE chain."""
+    """A function Q -> (T, J): the book's chain product where there is an H-D table, the
+    tabulated joint origins and axes of a catalog spec (for the §6-3 arm Eq. (6-31)-(6-33)),
+    else the product of exponentials of robot.chain (continuous joints included)."""
     if robot.spec is not None and robot.spec.dh is not None:
         return "H-D chain (6-12)-(6-14)", SerialChain.from_dh(robot.spec.dh, robot.spec.tool_dh).fk_jacobian
-    if robot.name == "human_arm7":
+    if robot.spec is not None:
         return "chain (6-31)-(6-33)", SerialChain.from_spec(robot.spec).fk_jacobian
-    return "serial chain (PoE)", SerialChain.of(robot).fk_jacobian
+    return "serial chain (PoE)", robot.chain.serial().fk_jacobian
 
 
 def _pin_loop(robot, jacobian: bool = True):
