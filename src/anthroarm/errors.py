@@ -91,3 +91,17 @@ class AmbiguousToolError(UnknownFrameError):
 class ParameterError(AnthroarmError, TypeError, ValueError):
     """A keyword a loader or builder does not take, or a bad builder parameter.  A
     :class:`TypeError` (like any unknown keyword) and, for old callers, a :class:`ValueError`."""
+
+
+class MeshError(AnthroarmError, ValueError):
+    """A mesh file a robot's visuals name is not a usable mesh: not a mesh at all (a text file,
+    random bytes), empty, truncated, non-finite, beyond the size bound, or a format the viewer
+    does not read.  ``path`` names the mesh file, ``link`` the link (or geometry object) that
+    uses it."""
+
+    def __init__(self, path, problem: str, link: str | None = None):
+        self.path = str(path)
+        self.link = link
+        self.problem = problem
+        where = f" (mesh of link {link!r})" if link is not None else ""
+        super().__init__(f"{self.path}{where}: {problem}")

@@ -21,6 +21,8 @@ All geometry is expressed in metres in the driving frame; nothing here talks to 
 
 from __future__ import annotations
 
+import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..chain import PRISMATIC
-from ..errors import MeshNotFoundError, ViewerError
+from ..errors import MeshError, MeshNotFoundError, ViewerError
 from ..spatial.rotations import homogeneous, rotation_between
 
 LINK_RGB = (0.62, 0.68, 0.78)
@@ -267,7 +269,7 @@ def urdf_bodies(robot) -> list[Body]:
                                                        f"exist; pass package_dirs={{...}} to aa.load")
                 scale = _floats(shape.get("scale"), 3, (1, 1, 1))
                 if path not in mesh_cache:
-                    mesh_cache[path] = load_mesh(path)
+                    mesh_cache[path] = load_mesh(path, link=name)
                 geom = mesh_cache[path]
                 offset = offset @ np.diag([*scale, 1.0])
             elif shape.tag == "box":
@@ -331,7 +333,7 @@ def _geometry_pieces(go, mesh_cache) -> list[Piece]:
     path = Path(go.meshPath) if go.meshPath else None
     if path is not None and path.is_file():
         if path not in mesh_cache:
-            mesh_cache[path] = load_mesh(path)
+            mesh_cache[path] = load_mesh(path, link=go.name)
         geom, offset = mesh_cache[path], M @ np.diag([*np.asarray(go.meshScale, float), 1.0])
     elif kind == "Box":
         geom, offset = mg.Box(2 * np.asarray(g.halfSide, float)), M
@@ -361,22 +363,211 @@ def _geometry_pieces(go, mesh_cache) -> list[Piece]:
     return [Piece(geom, rgb, offset, "mesh", opacity)]
 
 
-def load_mesh(path: Path):
-    """A meshcat mesh geometry from an .stl / .dae / .obj file (others via trimesh -> STL)."""
+#: Largest mesh file the viewer reads (bytes).  Its contents go to the browser in one message.
+MAX_MESH_BYTES = 256 * 2**20
+#: The mesh formats read directly (checked here, parsed by three.js in the browser); any other
+#: extension goes through trimesh and is sent as a binary STL.
+DIRECT_FORMATS = (".stl", ".obj", ".dae")
+
+_STL_RECORD = np.dtype([("normal", "<f4", 3), ("v", "<f4", 9), ("attr", "<u2")])
+
+
+def load_mesh(path, link: str | None = None):
+    """A meshcat mesh geometry from a mesh file: .stl (binary or ASCII), .obj, .dae, or any
+    format trimesh reads (sent as STL).
+
+    The file is read once, checked, and only the checked bytes are sent: a file that is not a
+    mesh (a text file, random bytes), empty, truncated, with non-finite coordinates, larger than
+    :data:`MAX_MESH_BYTES`, or a .dae with a DTD raises :class:`~anthroarm.errors.MeshError`
+    naming the file and ``link`` (the link or geometry object that uses it)."""
+    path = Path(path)
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise MeshError(path, f"cannot be read ({exc.strerror or exc})", link) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise MeshError(path, "is not a regular file", link)
+    if st.st_size > MAX_MESH_BYTES:
+        raise MeshError(path, f"is {st.st_size} bytes, larger than the viewer's bound of {MAX_MESH_BYTES} bytes "
+                              f"(anthroarm.viewer.visuals.MAX_MESH_BYTES); decimate the mesh", link)
+    try:
+        with open(path, "rb") as f:
+            data = f.read(MAX_MESH_BYTES + 1)
+    except OSError as exc:
+        raise MeshError(path, f"cannot be read ({exc.strerror or exc})", link) from None
+    if len(data) > MAX_MESH_BYTES:  # grew since stat
+        raise MeshError(path, f"is larger than the viewer's bound of {MAX_MESH_BYTES} bytes", link)
+    if not data:
+        raise MeshError(path, "is empty", link)
     ext = path.suffix.lower()
-    if ext == ".stl":
-        return mg.StlMeshGeometry.from_file(str(path))
-    if ext == ".dae":
-        return mg.DaeMeshGeometry.from_file(str(path))
-    if ext == ".obj":
-        return mg.ObjMeshGeometry.from_file(str(path))
+    try:
+        if ext == ".stl":
+            _check_stl(data)
+            return _stl_geometry(data)
+        if ext == ".obj":
+            return mg.MeshGeometry(_check_obj(data), "obj")
+        if ext == ".dae":
+            return mg.MeshGeometry(_check_dae(data), "dae")
+        return _stl_geometry(_via_trimesh(data, ext))
+    except _NotAMesh as exc:
+        raise MeshError(path, str(exc), link) from None
+
+
+class _NotAMesh(Exception):
+    """What is wrong with the bytes (turned into a MeshError naming the file and the link)."""
+
+
+def _stl_geometry(data: bytes):
+    from meshcat.geometry import threejs_type
+    import umsgpack
+
+    _, extcode = threejs_type(np.uint8)
+    return mg.MeshGeometry(umsgpack.Ext(extcode, bytes(data)), "stl")
+
+
+def _check_stl(data: bytes) -> None:
+    """A binary STL whose size matches its triangle count, or an ASCII STL of complete facets
+    ending in 'endsolid'; every coordinate finite.  A well-formed STL without triangles (an
+    empty solid) is accepted: it draws nothing."""
+    n = len(data)
+    if n >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        expected = 84 + 50 * count
+        if expected <= n and not (expected < n and data[:5].lower() == b"solid"):
+            rec = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
+            bad = ~np.isfinite(rec["v"]).all(axis=1)
+            if bad.any():
+                raise _NotAMesh(f"is a binary STL with non-finite vertex coordinates (triangle {int(np.argmax(bad))})")
+            return
+    if data.lstrip()[:5].lower() == b"solid":
+        _check_ascii_stl(data)
+        return
+    if n >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        raise _NotAMesh(f"is not an STL file: as a binary STL its header promises {count} triangles "
+                        f"({84 + 50 * count} bytes) but the file has {n} bytes (truncated, or not a mesh), "
+                        "and it is not an ASCII STL ('solid ... endsolid')")
+    raise _NotAMesh(f"is not an STL file ({n} bytes: shorter than a binary STL header, and not an ASCII STL)")
+
+
+def _check_ascii_stl(data: bytes) -> None:
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise _NotAMesh(f"starts like an ASCII STL but has a non-ASCII byte at offset {exc.start}") from None
+    facets = 0
+    in_loop = 0
+    for lineno, line in enumerate(text.splitlines(), 1):
+        parts = line.split()
+        if not parts:
+            continue
+        key = parts[0].lower()
+        if key == "vertex":
+            try:
+                xyz = [float(x) for x in parts[1:]]
+            except ValueError:
+                xyz = []
+            if len(xyz) != 3 or not all(map(np.isfinite, xyz)):
+                raise _NotAMesh(f"is an ASCII STL with a bad vertex at line {lineno}: {line.strip()[:60]!r}")
+            in_loop += 1
+        elif key == "outer":
+            in_loop = 0
+        elif key == "endloop":
+            if in_loop != 3:
+                raise _NotAMesh(f"is an ASCII STL with a facet of {in_loop} vertices at line {lineno} (3 expected)")
+            facets += 1
+    if not re.search(r"^\s*endsolid\b", text, re.MULTILINE | re.IGNORECASE):
+        raise _NotAMesh("is an ASCII STL without 'endsolid' (truncated)")
+
+
+def _utf8(data: bytes, what: str) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise _NotAMesh(f"is not UTF-8 text (a {what} file is text): byte {data[exc.start]:#04x} at offset "
+                        f"{exc.start}") from None
+
+
+def _check_obj(data: bytes) -> str:
+    """Wavefront OBJ text: finite vertices, faces of >= 3 vertices that refer to vertices
+    defined before them; at least one face."""
+    text = _utf8(data, "Wavefront .obj")
+    nv = faces = 0
+    for lineno, line in enumerate(text.splitlines(), 1):
+        parts = line.split()
+        if not parts or parts[0].startswith("#"):
+            continue
+        if parts[0] == "v":
+            try:
+                xyz = [float(x) for x in parts[1:4]]
+            except ValueError:
+                xyz = []
+            if len(xyz) != 3 or not all(map(np.isfinite, xyz)):
+                raise _NotAMesh(f"is an OBJ with a bad vertex at line {lineno}: {line.strip()[:60]!r}")
+            nv += 1
+        elif parts[0] == "f":
+            if len(parts) < 4:
+                raise _NotAMesh(f"is an OBJ with a face of fewer than 3 vertices at line {lineno}")
+            for tok in parts[1:]:
+                try:
+                    i = int(tok.split("/")[0])
+                except ValueError:
+                    raise _NotAMesh(f"is an OBJ with a bad face at line {lineno}: {line.strip()[:60]!r}") from None
+                if not (1 <= i <= nv or -nv <= i <= -1):
+                    raise _NotAMesh(f"is an OBJ whose face at line {lineno} refers to vertex {i}, but {nv} "
+                                    "vertices are defined before it (truncated, or not a mesh)")
+            faces += 1
+    if faces == 0:
+        raise _NotAMesh(f"is not an OBJ mesh: no faces ({nv} vertices)")
+    return text
+
+
+def _check_dae(data: bytes) -> str:
+    """COLLADA XML without a DTD, with at least one <geometry>; returned as text."""
+    from lxml import etree
+
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        raise _NotAMesh(f"is not well-formed XML (a COLLADA .dae file is XML): {exc}") from None
+    tree = root.getroottree()
+    if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
+        raise _NotAMesh("declares a DTD (<!DOCTYPE ...>); refused: entity declarations can expand without bound "
+                        "or pull in other files")
+    name = etree.QName(root).localname if isinstance(root.tag, str) else str(root.tag)
+    if name != "COLLADA":
+        raise _NotAMesh(f"is XML but not COLLADA (root element <{name}>)")
+    if next(root.iter("{*}geometry", "geometry"), None) is None:
+        raise _NotAMesh("is a COLLADA file without any <geometry>")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:  # another declared encoding: send lxml's Unicode text
+        return etree.tostring(root, encoding="unicode")
+
+
+def _via_trimesh(data: bytes, ext: str) -> bytes:
+    """Any other format trimesh reads, as a binary STL."""
+    if not ext:
+        raise _NotAMesh("has no file extension; the viewer reads .stl, .obj, .dae and the formats trimesh "
+                        "reads (.ply, .glb, .off, ...)")
     import io
 
     import trimesh
 
-    mesh = trimesh.load(str(path), force="mesh")
-    buf = io.BytesIO(mesh.export(file_type="stl"))
-    return mg.StlMeshGeometry.from_stream(buf)
+    try:
+        mesh = trimesh.load(io.BytesIO(data), file_type=ext[1:], force="mesh")
+        faces = len(mesh.faces)
+        finite = bool(np.isfinite(np.asarray(mesh.vertices)).all())
+        out = mesh.export(file_type="stl") if faces and finite else b""
+    except Exception as exc:  # noqa: BLE001 - trimesh raises anything (NotImplementedError, KeyError, ...)
+        raise _NotAMesh(f"cannot be read as a {ext} mesh ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+    if not faces:
+        raise _NotAMesh(f"is a {ext} file without triangles")
+    if not finite:
+        raise _NotAMesh(f"is a {ext} mesh with non-finite vertex coordinates")
+    _check_stl(out)
+    return out
 
 
 STYLES = ("auto", "generated", "urdf", "visual_model")
