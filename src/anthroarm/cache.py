@@ -49,7 +49,7 @@ from ._io import atomic_write_text
 
 ENV = "ANTHROARM_CACHE"
 #: subfolders this module manages (``cache clear`` empties only these)
-SUBFOLDERS = ("lagrange", "ik")
+SUBFOLDERS = ("lagrange", "ik", "urdf")
 _SIDECAR = ".sha256"
 _LOCK = threading.Lock()
 _CC_IDS: dict[str, str] = {}

@@ -570,6 +570,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="anthroarm: the book's arms, kinematics, IK and dynamics, proven against Pinocchio.",
         epilog="run 'anthroarm COMMAND --help' for the options and an example of each command",
     )
+    from . import __version__
+
+    ap.add_argument("--version", action="version", version=f"anthroarm {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
     for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache):
         add(sub)

@@ -69,8 +69,10 @@ def urdf_text(name: str, **params) -> str:
 
 def urdf_path(name: str) -> Path:
     """Path of the URDF of a catalog model (default parameters): the example-robot-data file,
-    or for a book model the committed ``urdf/NAME.urdf`` of a source checkout (write one
-    anywhere with :func:`urdf_text` / ``anthroarm urdf``)."""
+    or for a book model the committed ``urdf/NAME.urdf`` of a source checkout; in an installed
+    package, the generator's text (the same file, tested) written into the cache's ``urdf``
+    folder and rewritten whenever it differs.  Write one anywhere with :func:`urdf_text` /
+    ``anthroarm urdf``."""
     if name in ERD_ARMS:
         return ERD_ARMS[name].urdf_path()
     if name in erd_names():
@@ -78,8 +80,18 @@ def urdf_path(name: str) -> Path:
     if name not in BOOK_MODELS:
         raise _unknown(name)
     p = REPO_URDF_DIR / f"{name}.urdf"
-    if not p.is_file():
-        raise FileNotFoundError(f"{p} does not exist (not a source checkout); use anthroarm.models.urdf_text({name!r})")
+    if p.is_file():
+        return p
+    from .. import cache
+    from .._io import atomic_write_text
+
+    folder = cache.folder("urdf")
+    if folder is None:
+        raise FileNotFoundError(f"{p} does not exist (not a source checkout) and {cache.status()}; "
+                                f"use anthroarm.models.urdf_text({name!r})")
+    p, text = folder / f"{name}.urdf", urdf_text(name)
+    if not p.is_file() or p.read_text(encoding="utf-8") != text:
+        atomic_write_text(p, text)
     return p
 
 
