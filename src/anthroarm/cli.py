@@ -564,6 +564,96 @@ def cmd_cache(a) -> int:
     return 0
 
 
+# ---------------------------------------------------------------------------- batch (anthroarm.batch)
+def _batch_parser(sub):
+    p = sub.add_parser(
+        "batch", help="batch jobs, locally or on a Dask cluster (reach, comfort, population, tolerance, ik, cells)",
+        description="Run a batch job of anthroarm.batch in this process (default), on a LocalCluster "
+                    "(--scheduler local --workers N) or on a running Dask scheduler (--scheduler tcp://HOST:8786); "
+                    "the same numbers either way. The result is written atomically when the job has finished.",
+        epilog="example: anthroarm batch reach --model human_arm7 --param height=1.62 --n 1000000 "
+               "--scheduler local --workers 2 --out reach.npz --plot reach.png")
+    p.add_argument("job", choices=["reach", "comfort", "population", "tolerance", "ik", "cells"])
+    p.add_argument("--model", default="human_arm7", help="catalog name, example-robot-data name or URDF path")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="book-model parameter, e.g. height=1.62 (repeatable)")
+    _add_robot_options(p)
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS|local",
+                   help="Dask scheduler address, or 'local' for a LocalCluster (default: this process)")
+    p.add_argument("--workers", type=int, default=None, help="worker processes of --scheduler local")
+    p.add_argument("--timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)")
+    p.add_argument("--n", type=int, default=None,
+                   help="configurations (reach, comfort, population: per person), samples (tolerance), targets (ik)")
+    p.add_argument("--voxel", type=float, default=0.02, help="voxel side, m (default 0.02)")
+    p.add_argument("--chunk-size", type=int, default=None, help="work items per task (default: the job's)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--heights", default="1.55,1.65,1.75,1.85", help="population: heights, m (comma-separated)")
+    p.add_argument("--masses", default="60,75", help="population: masses, kg")
+    p.add_argument("--sexes", default="female,male", help="population: sexes")
+    p.add_argument("--configs", type=int, default=10, help="tolerance: random configurations (default 10)")
+    p.add_argument("--sigma-q", type=float, default=1e-3, help="tolerance: joint error, rad (default 1e-3)")
+    p.add_argument("--sigma-l", type=float, default=1e-4, help="tolerance: link length error, m (default 1e-4)")
+    p.add_argument("--D", type=float, default=0.05, help="cells: lattice spacing, m (default 0.05)")
+    p.add_argument("--out", default=None, metavar="FILE.npz", help="write the result here (atomically)")
+    p.add_argument("--plot", default=None, metavar="FILE.png", help="reach/comfort: a slice; population: volumes")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_batch)
+
+
+def _cmd_batch(a) -> int:
+    import numpy as np
+
+    from . import batch
+
+    def floats(text, what):
+        try:
+            return [float(x) for x in text.split(",") if x.strip()]
+        except ValueError:
+            raise UserError(f"--{what} expects comma-separated numbers, got {text!r}") from None
+
+    if a.workers is not None and a.scheduler != "local":
+        raise UserError("--workers goes with --scheduler local (a running scheduler has its own workers)")
+    params = _parse_params(a.param)
+    kw = dict(progress=not a.no_progress, seed=a.seed)
+    if a.chunk_size is not None:
+        kw["chunk_size"] = a.chunk_size
+    if a.n is not None:
+        kw["n"] = a.n
+    args = ()
+    if a.job == "population":
+        kw.update(model=a.model, heights=floats(a.heights, "heights"), masses=floats(a.masses, "masses"),
+                  sexes=[s.strip() for s in a.sexes.split(",") if s.strip()], voxel=a.voxel)
+    else:
+        robot = _load_model(a.model, params, a.tool, _parse_locked(a.locked))
+        args = (robot,)
+        if a.job in ("reach", "comfort"):
+            kw["voxel"] = a.voxel
+        elif a.job == "tolerance":
+            args += (robot.random_q(a.configs, rng=a.seed, margin=0.05),)
+            kw.update(sigma_q=a.sigma_q, sigma_L=a.sigma_l)
+        elif a.job == "ik":
+            n = kw.pop("n", 1000)
+            args += (robot.fk(robot.random_q(n, rng=a.seed, margin=0.05)),)   # reachable targets
+        elif a.job == "cells":
+            kw.pop("seed")
+            kw.pop("n", None)
+            kw["D"] = a.D
+    res = batch.run_job(a.job, *args, out=a.out, plot=a.plot, scheduler=a.scheduler, workers=a.workers,
+                        timeout=a.timeout, **kw)
+    summary = {"job": res.job, **{k: list(v.shape) for k, (_, v) in res.variables.items()}}
+    for k in ("volume", "n", "outside"):
+        if k in res.attrs:
+            summary[k] = res.attrs[k]
+    if a.job == "ik":
+        summary["success_rate"] = float(np.mean(res["success"]))
+    if a.job == "population":
+        summary["volume_m3"] = [round(float(v), 6) for v in res["volume"].ravel()]
+    if a.out:
+        summary["out"] = a.out
+    print(json.dumps(summary))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
         prog="anthroarm",
@@ -574,7 +664,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     ap.add_argument("--version", action="version", version=f"anthroarm {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
-    for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache):
+    for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache,
+                _batch_parser):
         add(sub)
     return ap
 

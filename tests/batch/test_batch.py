@@ -251,3 +251,25 @@ def test_tasks_are_chunked_never_one_giant_array(arm, monkeypatch):
     monkeypatch.setattr(jobs, "_positions_blocks", spy)
     batch.reachability_map(arm, n=3 * jobs.BLOCK + 5, voxel=0.1, progress=False)
     assert max(seen) == jobs.BLOCK and sum(seen) == 3 * jobs.BLOCK + 5
+
+
+# ----------------------------------------------------------------------------- command line
+def test_cli_batch_on_the_cluster_equals_in_process(client, tmp_path, capsys):
+    from anthroarm.cli import main
+
+    common = ["batch", "reach", "--param", "height=1.62", "--n", "20000", "--voxel", "0.06", "--chunk-size", "5000",
+              "--no-progress"]
+    assert main(common + ["--out", str(tmp_path / "a.npz")]) == 0
+    assert main(common + ["--scheduler", client.scheduler.address, "--out", str(tmp_path / "b.npz")]) == 0
+    assert '"n": 20000' in capsys.readouterr().out
+    assert batch.load(tmp_path / "a.npz").equals(batch.load(tmp_path / "b.npz"))
+
+
+def test_cli_batch_unreachable_scheduler_is_one_line_exit_2(capsys):
+    from anthroarm.cli import main
+
+    t0 = time.monotonic()
+    rc = main(["batch", "reach", "--n", "100", "--scheduler", f"tcp://127.0.0.1:{_free_port()}", "--timeout", "2"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "no Dask scheduler answered" in err and err.count("\n") == 1
+    assert time.monotonic() - t0 < 15
