@@ -37,7 +37,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .errors import AmbiguousToolError, UnknownFrameError, UnsupportedModelError
+from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, UnsupportedModelError
 
 REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 
@@ -155,6 +155,13 @@ class Chain:
         import pinocchio as pin
 
         name = name or getattr(model, "name", "") or "model"
+        from .urdf_io import MAX_MOVABLE_JOINTS
+
+        if model.njoints - 1 > MAX_MOVABLE_JOINTS:   # before createData: pin.Data grows as n³
+            raise UnsupportedModelError(
+                f"{name}: {model.njoints - 1} joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model "
+                "(Pinocchio's data grows as the cube of the joint count); lock joints with "
+                "pin.buildReducedModel first or split the model")
         data = model.createData()
         pin.forwardKinematics(model, data, pin.neutral(model))
         mimic_of = {}
@@ -411,11 +418,21 @@ class Chain:
     def random_q(self, n: int | None = None, rng=None, margin: float = 0.0) -> np.ndarray:
         """Uniform random configurations: each independent joint's θ uniform in its range
         (``margin`` rad/m inside the limits), a continuous joint's θ uniform in [−π, π) and
-        then (cos θ, sin θ)."""
+        then (cos θ, sin θ).
+
+        ``n``: None (one configuration, shape ``(nq,)``) or a count >= 0 (``(n, nq)``);
+        ``margin``: finite, >= 0 and at most half of every joint's range.  Anything else raises
+        :class:`~anthroarm.errors.ParameterError`."""
+        n, margin = _check_sampling(self.name, n, margin)
         rng = np.random.default_rng(rng)
         lo, hi = self.sampling_box
+        if margin:
+            tight = [self.joints[i].name for i, a, b in zip(self.independent, lo, hi) if b - a < 2 * margin]
+            if tight:
+                raise ParameterError(f"{self.name}: margin={margin} is more than half the range of joints "
+                                     f"{tight}: no configuration is that far inside their limits")
         lo, hi = lo + margin, hi - margin
-        shape = (len(lo),) if n is None else (int(n), len(lo))
+        shape = (len(lo),) if n is None else (n, len(lo))
         return self.configuration(lo + (hi - lo) * rng.random(shape))
 
     def check_unit(self, q, name: str = "q") -> None:
@@ -476,6 +493,23 @@ class Chain:
 
 #: names preferred for the tip among several leaf links on the same joint
 _TOOL_NAME = re.compile(r"tool|tcp|end_?effector|eef|ee_link|hand|gripper_frame", re.IGNORECASE)
+
+
+def _check_sampling(name: str, n, margin) -> tuple[int | None, float]:
+    """``(n, margin)`` of :meth:`Chain.random_q`, checked (bools are not counts)."""
+    if n is not None:
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+            raise ParameterError(f"{name}: random_q(n) takes None or a whole number >= 0, got {n!r}")
+        if n < 0:
+            raise ParameterError(f"{name}: random_q(n) takes a count >= 0, got {n}")
+        n = int(n)
+    try:
+        margin = float(margin)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: random_q margin= is a number (rad or m), got {margin!r}") from None
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError(f"{name}: random_q margin= must be finite and >= 0 (rad or m), got {margin}")
+    return n, margin
 
 
 def leaf_frames(joints, frames) -> tuple[str, ...]:

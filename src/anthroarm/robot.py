@@ -30,7 +30,7 @@ import pinocchio as pin
 
 from .chain import CONTINUOUS, Chain
 from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
-from .urdf_io import URDFInfo, parse_urdf_bytes, read_urdf
+from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _REFERENCES = ("LOCAL", "WORLD", "LOCAL_WORLD_ALIGNED")
@@ -47,7 +47,9 @@ def _reference_frame(reference) -> pin.ReferenceFrame:
 
 def build_model(info: URDFInfo):
     """``pin.Model`` of a validated URDF (mimic joints modelled, as yourdfpy does).  Pinocchio's
-    C++ errors become :class:`~anthroarm.errors.URDFStructureError` naming the file."""
+    C++ errors become :class:`~anthroarm.errors.URDFStructureError` naming the file, as does a
+    model too large for Pinocchio's data (:func:`~anthroarm.urdf_io.check_size`)."""
+    check_size(info)
     has_mimic = any(j["mimic"] is not None for j in info.joints.values())
     try:
         return pin.buildModelFromXML(info.text, mimic=has_mimic)
@@ -65,12 +67,16 @@ def reduce_model(model, name: str, active=None, locked=None):
     if active is None and not locked:
         return model, {}
     names = [model.names[i] for i in range(1, model.njoints)]
-    if isinstance(locked, str) or (locked is not None and not hasattr(locked, "__iter__")):
-        raise TypeError(f"{name}: locked= is a list of joint names or a dict name -> value, got {locked!r}")
+    if isinstance(locked, (str, bytes)) or (locked is not None and not hasattr(locked, "__iter__")):
+        raise ParameterError(f"{name}: locked= is a list of joint names or a dict name -> value, got {locked!r}")
     locked = dict(locked) if isinstance(locked, dict) else {n: None for n in (locked or ())}
-    if isinstance(active, str):
-        raise TypeError(f"{name}: active= is a list of joint names, got the string {active!r}")
+    if isinstance(active, (str, bytes)) or (active is not None and not hasattr(active, "__iter__")):
+        raise ParameterError(f"{name}: active= is a list of joint names, got {active!r}")
     active = list(active) if active is not None else None
+    for what, given in (("active", active or ()), ("locked", locked)):
+        bad = [a for a in given if not isinstance(a, str)]
+        if bad:
+            raise ParameterError(f"{name}: {what}= takes joint names (str), got {bad!r}")
     for what, given in (("active", active or ()), ("locked", locked)):
         missing = [a for a in given if a not in names]
         if missing:
@@ -88,11 +94,15 @@ def reduce_model(model, name: str, active=None, locked=None):
                 lock_ids.append(jid)
                 continue
             if v is not None:
-                v = np.atleast_1d(np.asarray(v, dtype=float))
+                try:
+                    v = np.atleast_1d(np.asarray(v, dtype=float))
+                except (TypeError, ValueError):
+                    raise ParameterError(f"{name}: locked value of joint {jname!r} must be a number (rad or m), "
+                                         f"got {v!r}") from None
                 if jm.nq == 2 and jm.nv == 1 and v.size == 1:      # a continuous joint: an angle
                     v = np.array([np.cos(v[0]), np.sin(v[0])])
                 if v.size != jm.nq or not np.all(np.isfinite(v)):
-                    raise ValueError(f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}")
+                    raise ParameterError(f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}")
                 qref[jm.idx_q:jm.idx_q + jm.nq] = v
             val = qref[jm.idx_q:jm.idx_q + jm.nq].copy()
             values[jname] = float(val[0]) if val.size == 1 else val
@@ -311,10 +321,11 @@ class Robot:
 
         if self.info is None:
             raise UnsupportedModelError(f"{self.name} was loaded from a pin.Model: it has no URDF for yourdfpy")
+        # the validated text, never the file again (it may have changed since it was validated);
+        # mesh URIs go through the same resolution as the loader's (filename_handler)
         return yourdfpy.URDF.load(
-            io.StringIO(self.info.text) if not self.info.path.is_file() else str(self.info.path),
-            build_scene_graph=True, load_meshes=False, build_collision_scene_graph=False,
-            load_collision_meshes=False, filename_handler=self._filename_handler,
+            io.BytesIO(self.info.text.encode("utf-8")), build_scene_graph=True, load_meshes=False,
+            build_collision_scene_graph=False, load_collision_meshes=False, filename_handler=self._filename_handler,
         )
 
     def _filename_handler(self, fname: str) -> str:
@@ -384,6 +395,12 @@ def load(source, *, tool: str | None = None, active=None, locked=None, package_d
         if params:
             raise ParameterError(f"{what} takes no parameters; unknown keyword(s): {', '.join(sorted(params))}")
 
+    if tool is not None and not isinstance(tool, str):
+        raise ParameterError(f"tool= is a frame name (str), got {type(tool).__name__} {tool!r}")
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"name= is a str, got {type(name).__name__} {name!r}")
+    if not isinstance(check_meshes, bool):
+        raise ParameterError(f"check_meshes= is True or False, got {check_meshes!r}")
     common = dict(tool=tool, active=active, locked=locked)
     src = _as_model_source(source)
     if src is not None:

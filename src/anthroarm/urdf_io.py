@@ -7,6 +7,30 @@ quickly, and raises a typed :mod:`anthroarm.errors` exception naming the file an
 
 Only after a file passes is its text handed to Pinocchio (``buildModelFromXML``) and yourdfpy,
 so neither ever reads the file itself.
+
+**Physical bounds.**  A number that is finite but absurd (an origin of 1e308 m makes forward
+kinematics return inf) is refused at load time with :class:`~anthroarm.errors.URDFStructureError`
+naming the link or joint and the value.  The bounds, chosen far beyond any arm, hand or humanoid:
+
+- lengths (every ``<origin xyz>``: joints, inertials, visuals, collisions; box sizes, cylinder
+  and sphere dimensions, mesh scale factors): ``|x| <= MAX_LENGTH`` = 1e4 (m, or a factor);
+  box, cylinder and sphere dimensions must also be >= 0;
+- angles (``rpy``) and mimic multipliers / offsets: finite;
+- masses: ``0 <= m <= MAX_MASS`` = 1e6 kg; inertia entries: finite, ``|I| <= MAX_INERTIA`` =
+  1e12 kg m² (a non-physical, indefinite inertia is kept for kinematics; dynamics refuses it
+  with :class:`~anthroarm.errors.InertiaError`);
+- joint limits of revolute and prismatic joints: ``|limit| <= MAX_LENGTH`` (rad or m), or
+  ``|limit| >= NO_LIMIT`` = 1e100, which means *no limit* (as Pinocchio's ±DBL_MAX defaults;
+  :mod:`anthroarm.chain` treats it so); effort and velocity limits finite and >= 0;
+- at most ``MAX_MOVABLE_JOINTS`` = 200 movable joints per model, checked before Pinocchio builds it
+  (:func:`check_size`): Pinocchio's ``pin.Data`` grows as n³ (0.6 GB at 200 joints, 1.8 GB
+  at 300, an out-of-memory kill at 1000).
+
+**Where mesh files may be.**  ``package://NAME/rel`` must name a package (not empty, ``.``,
+``..`` or a path) and resolve, after following symlinks, inside that package's root
+(:class:`~anthroarm.errors.PackagePathError` otherwise).  ``file://`` URIs and plain paths are
+taken as written: relative ones from the URDF's folder, absolute ones anywhere (the policy is
+documented in SECURITY.md).
 """
 
 from __future__ import annotations
@@ -23,6 +47,7 @@ from lxml import etree
 from .errors import (
     MeshNotFoundError,
     PackagePathError,
+    ParameterError,
     URDFNotFoundError,
     URDFSecurityError,
     URDFStructureError,
@@ -33,6 +58,16 @@ from .errors import (
 MAX_URDF_BYTES = 32 * 1024 * 1024
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+#: Physical bounds (see the module docstring): lengths in m (and scale factors), masses in kg,
+#: inertias in kg m²; a joint limit at least NO_LIMIT in magnitude means no limit.
+MAX_LENGTH = 1e4
+MAX_MASS = 1e6
+MAX_INERTIA = 1e12
+NO_LIMIT = 1e100
+#: Movable joints a model may have (Pinocchio's ``pin.Data`` grows as n³).
+MAX_MOVABLE_JOINTS = 200
+MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
 
 #: A DTD or entity declaration, in any case (searched in place: no upper-cased copy of the file).
 _DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
@@ -68,7 +103,7 @@ PackageDirsLike = Mapping | list | tuple | str | os.PathLike | None
 def _as_folder(value, what: str) -> Path:
     if isinstance(value, (str, os.PathLike)):
         return Path(value)
-    raise TypeError(f"package_dirs: {what} must be a folder (str or path), got {type(value).__name__} {value!r}")
+    raise ParameterError(f"package_dirs: {what} must be a folder (str or path), got {type(value).__name__} {value!r}")
 
 
 def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_defaults: bool = True) -> PackageDirs:
@@ -82,7 +117,8 @@ def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_default
 
     With ``with_defaults`` the roots of :func:`default_package_dirs` are added (a name the
     user gives wins).  A :class:`PackageDirs` is returned as it is.  Any other type raises
-    :class:`TypeError`.
+    :class:`~anthroarm.errors.ParameterError` (a :class:`TypeError`), as does a package name
+    that is empty, ``.``, ``..`` or contains a path separator.
     """
     if isinstance(package_dirs, PackageDirs):
         return package_dirs
@@ -95,16 +131,23 @@ def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_default
     elif isinstance(package_dirs, Mapping):
         for name, root in package_dirs.items():
             if not isinstance(name, str):
-                raise TypeError(f"package_dirs: package names must be str, got {type(name).__name__} {name!r}")
+                raise ParameterError(f"package_dirs: package names must be str, got {type(name).__name__} {name!r}")
+            if not _is_package_name(name):
+                raise ParameterError(f"package_dirs: {name!r} is not a package name (package://NAME/... needs a "
+                                     "name that is not empty, '.', '..' or a path)")
             named[name] = _as_folder(root, f"the root of package {name!r}")
     elif isinstance(package_dirs, (list, tuple)):
         search.extend(_as_folder(d, f"entry {i}") for i, d in enumerate(package_dirs))
     else:
-        raise TypeError(
+        raise ParameterError(
             "package_dirs must be a list of folders (package://NAME/... is looked up as DIR/NAME/...), "
             f"a single folder, or a dict {{package name: root}}; got {type(package_dirs).__name__}"
         )
     return PackageDirs(named, search)
+
+
+def _is_package_name(pkg: str) -> bool:
+    return pkg not in ("", ".", "..") and os.sep not in pkg and not (os.altsep and os.altsep in pkg) and "\0" not in pkg
 
 
 def _name_list(names) -> str:
@@ -166,6 +209,66 @@ def _finite_floats(path, text: str | None, what: str, n: int, default: float = 0
     return vals
 
 
+def _bounded(path, vals: list[float], what: str, bound: float = MAX_LENGTH, unit: str = "m",
+             nonnegative: bool = False) -> list[float]:
+    """``vals`` unchanged if every ``|v| <= bound`` (and ``v >= 0`` when asked); else
+    :class:`URDFStructureError` naming ``what`` and the value."""
+    for v in vals:
+        if abs(v) > bound:
+            raise URDFStructureError(path, f"{what}: {v:g} is beyond the physical bound of {bound:.0e} {unit} "
+                                           "(see anthroarm.urdf_io)")
+        if nonnegative and v < 0:
+            raise URDFStructureError(path, f"{what}: {v:g} is negative")
+    return vals
+
+
+def _check_origin(path, o, what: str) -> None:
+    if o is not None:
+        _bounded(path, _finite_floats(path, o.get("xyz"), f"{what} origin xyz", 3), f"{what} origin xyz")
+        _finite_floats(path, o.get("rpy"), f"{what} origin rpy", 3)
+
+
+#: geometry element -> (attribute, count, nonnegative) checked by :func:`_check_geometry`
+_SHAPES = {"box": (("size", 3, True),), "cylinder": (("radius", 1, True), ("length", 1, True)),
+           "sphere": (("radius", 1, True),), "capsule": (("radius", 1, True), ("length", 1, True)),
+           "mesh": (("scale", 3, False),)}
+
+
+def _check_geometry(path, link: str, el) -> None:
+    """Origins and shape dimensions of a link's visuals and collisions."""
+    for kind in ("visual", "collision"):
+        for v in el.findall(kind):
+            _check_origin(path, v.find("origin"), f"link {link!r} {kind}")
+            g = v.find("geometry")
+            for shape in (g if g is not None else ()):
+                for attr, n, nonneg in _SHAPES.get(shape.tag, ()):
+                    text = shape.get(attr)
+                    if text is None:
+                        continue
+                    what = f"link {link!r} {kind} {shape.tag} {attr} (line {shape.sourceline})"
+                    _bounded(path, _finite_floats(path, text, what, n), what, unit="m" if nonneg else "",
+                             nonnegative=nonneg)
+
+
+def _check_limit(path, joint: str, jtype: str, which: str, value: float) -> None:
+    if jtype in ("revolute", "prismatic") and MAX_LENGTH < abs(value) < NO_LIMIT:
+        unit = "m" if jtype == "prismatic" else "rad"
+        raise URDFStructureError(
+            path, f"joint {joint!r} {which} limit {value:g} {unit} is beyond the physical bound of {MAX_LENGTH:.0e} "
+                  f"{unit}; write a magnitude of at least {NO_LIMIT:.0e} for no limit"
+                  + (" (or make it a continuous joint)" if jtype == "revolute" else ""))
+
+
+def check_size(info: "URDFInfo") -> None:
+    """:class:`URDFStructureError` if the model has more than :data:`MAX_MOVABLE_JOINTS`
+    movable joints (checked before Pinocchio allocates its data, which grows as n³)."""
+    n = sum(j["type"] in MOVABLE for j in info.joints.values())
+    if n > MAX_MOVABLE_JOINTS:
+        raise URDFStructureError(
+            info.path, f"{n} movable joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model (Pinocchio's data "
+                       "grows as the cube of the joint count: 0.6 GB at 200); split the model or make joints fixed")
+
+
 def _finite_float(path, text: str | None, what: str, default: float | None = None) -> float | None:
     if text is None:
         return default
@@ -185,7 +288,7 @@ def resolve_uri(uri: str, urdf_path: Path, package_dirs: PackageDirsLike) -> Pat
         dirs = normalize_package_dirs(package_dirs, with_defaults=False)
         rest = uri[len("package://") :]
         pkg, _, rel = rest.partition("/")
-        if pkg in ("", ".", "..") or os.sep in pkg or (os.altsep and os.altsep in pkg):
+        if not _is_package_name(pkg):
             raise PackagePathError(urdf_path, f"mesh {uri!r}: {pkg!r} is not a package name")
         roots = dirs.candidate_roots(pkg)
         for parent in urdf_path.resolve().parents:
@@ -268,14 +371,15 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
                 mass = _finite_float(path, m.get("value"), f"link {name!r} mass")
                 if mass is None or mass < 0:
                     raise URDFStructureError(path, f"link {name!r}: mass must be >= 0, got {m.get('value')!r}")
-            o = inertial.find("origin")
-            if o is not None:
-                _finite_floats(path, o.get("xyz"), f"link {name!r} inertial origin xyz", 3)
-                _finite_floats(path, o.get("rpy"), f"link {name!r} inertial origin rpy", 3)
+                _bounded(path, [mass], f"link {name!r}: mass", MAX_MASS, "kg")
+            _check_origin(path, inertial.find("origin"), f"link {name!r} inertial")
             inertia = inertial.find("inertia")
             if inertia is not None:
                 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
-                    _finite_float(path, inertia.get(k, "0"), f"link {name!r} inertia {k}")
+                    what = f"link {name!r} inertia {k}"
+                    _bounded(path, [_finite_float(path, inertia.get(k, "0"), what)], what, MAX_INERTIA, "kg m^2")
+        if len(el):
+            _check_geometry(path, name, el)
     if not links:
         raise URDFStructureError(path, "no <link> elements")
 
@@ -307,10 +411,7 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             )
         parent_of[child] = parent
         joint_of[child] = name
-        o = sub.get("origin")
-        if o is not None:
-            _finite_floats(path, o.get("xyz"), f"joint {name!r} origin xyz", 3)
-            _finite_floats(path, o.get("rpy"), f"joint {name!r} origin rpy", 3)
+        _check_origin(path, sub.get("origin"), f"joint {name!r}")
         ax = sub.get("axis")
         if ax is not None:
             a = _finite_floats(path, ax.get("xyz"), f"joint {name!r} axis", 3, default=0.0)
@@ -324,6 +425,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             hi = _finite_float(path, lim.get("upper"), f"joint {name!r} upper limit", 0.0)
             if jtype in ("revolute", "prismatic") and lo > hi:
                 raise URDFStructureError(path, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+            _check_limit(path, name, jtype, "lower", lo)
+            _check_limit(path, name, jtype, "upper", hi)
             for k in ("effort", "velocity"):
                 v = _finite_float(path, lim.get(k), f"joint {name!r} {k} limit")
                 if v is not None and v < 0:
@@ -350,7 +453,7 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             raise URDFStructureError(path, f"<mesh> without filename (line {mesh.sourceline})")
         scale = mesh.get("scale")
         if scale is not None:
-            _finite_floats(path, scale, f"mesh {uri!r} scale", 3)
+            _bounded(path, _finite_floats(path, scale, f"mesh {uri!r} scale", 3), f"mesh {uri!r} scale", unit="")
         if uri in meshes:  # already resolved and checked (a mesh shared by many links)
             continue
         resolved = resolve_uri(uri, path, pkgs)
