@@ -241,6 +241,8 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False) -> tupl
         arr = arr[None]
     elif not (arr.ndim == 3 and arr.shape[1:] == (4, 4)):
         raise ValueError(f"{name} must be a 4x4 homogeneous pose or a batch (N, 4, 4), got shape {arr.shape}")
+    if arr.shape[0] == 0:
+        return arr, single                   # an empty batch: an empty result
     if not np.isfinite(arr).all():
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
         raise ValueError(f"{name}{list(idx) if not single else list(idx[1:])} is {arr[idx]} (not finite)")
@@ -590,6 +592,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     path below.  ``_impl`` (private, for tests and benchmarks): "auto" (= "python" for
     batches), "python", "c" (the compiled kernel of :mod:`.analytic_c` on the whole batch) or
     "general"."""
+    _check_tol("tol", tol)
+    _check_tol("tol_orthonormal", tol_orthonormal)
     plan = _require(robot)
     family, prm = plan.family, plan.params
     if position_only is None:
@@ -609,6 +613,18 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
         res = _fk_residual(robot, Qw, Ts, position_only)                  # FK check (N, B)
         valid = (code == OK) & inside & (res <= tol)
         valid &= np.isfinite(res)
+    # poses without a solution whose candidates lie on (or, by rounding, just beyond) a limit, or
+    # whose singular family has members inside the limits: _rescue_pose
+    if family != SRS and N:
+        c_ = np.asarray(code)
+        todo = np.flatnonzero(~valid.any(1) & ((c_ == OK) | (c_ == ELBOW)).any(1))
+        if todo.size:
+            Tall, _ = _check_poses(T, tol_orthonormal=tol_orthonormal, position_only=position_only)
+            Qw, valid, res = np.array(Qw), np.array(valid), np.array(res, dtype=float)
+            inside = np.array(inside)
+            for i in todo:
+                for b, q, r in _rescue_pose(robot, plan, Tall[i], tol, position_only):
+                    Qw[i, b], valid[i, b], res[i, b], inside[i, b] = q, True, r, True
     # remove duplicate solutions (singular poses give coincident branches)
     if B > 1:
         # cheap pre-filter: a random projection of each solution; only rows with two nearly equal
@@ -722,6 +738,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     One pose is solved by the compiled kernel (:mod:`.analytic_c`) when a C compiler is
     available — built once per robot parameterisation on first use (≈ 0.2 s, cached on disk;
     ``ANTHROARM_IK_C=0`` disables it) — else by the scalar kernels of :mod:`.analytic_scalar`."""
+    _check_tol("tol", tol)
+    _check_tol("tol_orthonormal", tol_orthonormal)
     arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
     if method == "book":
         plan = _require(robot)
@@ -737,7 +755,9 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if arr.ndim == 2 and _impl != "general":
         fast = _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, _impl)
         if fast is not None:
-            return fast
+            plan = _plan(robot)
+            po = plan.form.position_only if position_only is None else position_only
+            return _rescued_single(robot, plan, arr, po, tol, fast)
     return _analytic_general(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
                              tol_orthonormal=tol_orthonormal, _impl=_impl)
 
@@ -995,3 +1015,161 @@ def _book_result(robot, T, prm, tol):
         return AnalyticIKResult(np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model=robot.name)
     return AnalyticIKResult(Qw[ok], [lb for lb, k in zip(labels, ok) if k], None, residuals=res[ok],
                             model=robot.name)
+
+
+# ---------------------------------------------------------------------------- poses on the limits
+#: how far (rad) a closed-form candidate may lie outside a joint limit and still be kept, clipped
+#: onto the limit and polished (see :func:`_rescue_pose`).  The closed forms lose precision at
+#: double roots and singular configurations — an arccos near ±1, a square root of a discriminant
+#: near 0 — where a joint is determined by the pose only to ≈ √ε ≈ 1.5e-8 rad; a configuration with
+#: a joint exactly on its limit then yields a candidate up to a few 1e-8 rad beyond it.  1e-6 rad
+#: covers that with margin; every kept candidate still passes the FK check (``tol``).
+LIMIT_SLACK = 1e-6
+
+
+def _check_tol(name, value):
+    """``tol`` / ``tol_orthonormal``: a finite positive number, else ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise TypeError(f"{name} must be a positive number, got {type(value).__name__} {value!r}")
+    if not (math.isfinite(float(value)) and float(value) > 0.0):
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+
+
+def _slide_into_limits(q, J, lo, hi):
+    """Move ``q`` along its exact self-motions into the limits, or return None.
+
+    Two revolute joints i, j whose axes are the same line at ``q`` (columns J[:, i] = s·J[:, j]
+    of the tool Jacobian, s = ±1: the shoulder at θ2 = 0/π, a straight elbow, a wrist at
+    sin θ5 = 0) leave the tool pose unchanged under q_i += t, q_j −= s·t for every t (the links
+    between them turn about the common axis, which that turn maps onto itself).  The smallest |t|
+    (with 2π shifts of either joint) that brings both inside their limits is chosen."""
+    q = q.copy()
+    nq = q.size
+    scale = max(float(np.abs(J).max()), 1e-300)
+
+    def outside(v):
+        return float(np.maximum(lo - v, v - hi).clip(0.0).max())
+
+    for _ in range(2):                         # at most two families (shoulder and elbow) at once
+        if outside(q) <= LIMIT_SLACK:
+            return q
+        moved = False
+        for i in range(nq):
+            for j in range(i + 1, nq):
+                bad_ij = max(lo[i] - q[i], q[i] - hi[i], lo[j] - q[j], q[j] - hi[j]) > LIMIT_SLACK
+                if not bad_ij:
+                    continue
+                for s in (1.0, -1.0):
+                    if np.abs(J[:, i] - s * J[:, j]).max() > 1e-6 * scale:
+                        continue
+                    best = None
+                    for ki in (-1, 0, 1):
+                        for kj in (-1, 0, 1):
+                            a, b = lo[i] + TWO_PI * ki - q[i], hi[i] + TWO_PI * ki - q[i]
+                            c, d = q[j] - hi[j] - TWO_PI * kj, q[j] - lo[j] - TWO_PI * kj
+                            if s < 0:
+                                c, d = -d, -c
+                            a, b = max(a, c), min(b, d)
+                            if a <= b:
+                                t = min(max(0.0, a), b)
+                                if best is None or abs(t) < abs(best[0]):
+                                    best = (t, ki, kj)
+                    if best is not None:
+                        t, ki, kj = best
+                        q[i] += t - TWO_PI * ki
+                        q[j] -= s * t + TWO_PI * kj
+                        moved = True
+                        break
+        if not moved:
+            break
+    return q if outside(q) <= LIMIT_SLACK else None
+
+
+def _refine(robot, q, T, lo, hi, position_only, polish=True):
+    """(q, max |FK(q) − T| over the 3×4 entries or the position) after polishing ``q`` inside
+    the limits by bounded least squares on the FK error (scipy's trust-region reflective
+    method, which copes with the rank-deficient Jacobian at the singular poses where the closed
+    forms lose precision).  FK: Pinocchio, ``robot.data`` of the calling thread."""
+    import pinocchio as pin
+
+    model, data, fid = robot.model, robot.data, robot.tool_id
+    Rt, pt = T[:3, :3], T[:3, 3]
+
+    def err(x):
+        pin.framesForwardKinematics(model, data, x)
+        M = data.oMf[fid]
+        e = M.translation - pt
+        return e if position_only else np.concatenate([e, (M.rotation - Rt).ravel()])
+
+    if polish and bool((hi > lo).all()):
+        from scipy.optimize import least_squares
+
+        sol = least_squares(err, q, bounds=(lo, hi), method="trf", xtol=1e-15, ftol=1e-15,
+                            gtol=1e-15, max_nfev=60)
+        if np.isfinite(sol.x).all():
+            q = np.clip(sol.x, lo, hi)
+    return q, float(np.abs(err(q)).max())
+
+
+def _rescue_pose(robot, plan, T, tol, position_only):
+    """Solutions of one pose (4×4) whose closed-form candidates lie on or just beyond a limit.
+
+    Run where a pose got no solution.  Each candidate of the reference formulas
+    (:func:`_candidates`) is shifted by 2π into the limits, moved along its exact self-motions
+    (:func:`_slide_into_limits`: a straight elbow, the shoulder or the wrist at a singularity,
+    where the formulas return one representative of a one-parameter family) and, if it is then
+    within :data:`LIMIT_SLACK` of the limits, clipped onto them and polished by a few
+    Gauss–Newton steps (the candidates at such poses carry ≈ √ε errors).  Kept if it passes the
+    FK check ``tol``.  Returns ``[(branch, q, residual)]``; not for the redundant ``srs_7r``
+    family (its limits are handled by the swivel angle)."""
+    family = plan.family
+    if family == SRS:
+        return []
+    Ts = T[None]
+    Q, code, _s, _w, _l = _candidates(family, plan.params, Ts[:, :3, :3], Ts[:, :3, 3], None)
+    Q = Q[0]
+    # ELBOW: the discriminant of (7-22) is below its rounding threshold; at a double root (the
+    # elbow circle tangent to the plane) the candidate with t = 0 is the solution — the FK decides
+    ok = ((code[0] == OK) | (code[0] == ELBOW)) & np.isfinite(Q).all(-1)
+    if not ok.any():
+        return []
+    lo, hi = np.asarray(robot.lower, float), np.asarray(robot.upper, float)
+    lo_f = np.where(np.isfinite(lo), lo, -np.pi)
+    Qs = Q - np.floor((Q - lo_f + LIMIT_SLACK) / TWO_PI) * TWO_PI
+    Js = np.asarray(robot.jacobian(np.where(ok[:, None], Qs, 0.0)))
+    rows = slice(0, 3) if position_only else slice(None)
+    out = []
+    for b in np.flatnonzero(ok):
+        q = _slide_into_limits(Qs[b], Js[b][rows], lo, hi)
+        if q is None:
+            continue
+        q, res = _refine(robot, np.clip(q, lo, hi), T, lo, hi, position_only, polish=False)
+        if res > 1e-6:                     # not a near-solution: skip the polish
+            continue
+        q, res = _refine(robot, q, T, lo, hi, position_only)
+        if res <= tol and all(np.abs(q - k[1]).max() >= 1e-9 for k in out):
+            out.append((int(b), q, res))
+    return out
+
+
+def _pose4(arr):
+    """A 4×4 pose from a 4×4 array or (planar2r, position only) a position (3,)."""
+    if arr.shape == (3,):
+        T = np.eye(4)
+        T[:3, 3] = arr
+        return T
+    return np.asarray(arr, dtype=float)
+
+
+def _rescued_single(robot, plan, arr, position_only, tol, result):
+    """``result`` of one pose, with :func:`_rescue_pose`'s solutions where it had none."""
+    if len(result) or plan.family == SRS or result.reason in (_REASONS[OUTSIDE], _REASONS[DEGENERATE],
+                                                               _REASONS[OUT_OF_PLANE]):
+        return result
+    found = _rescue_pose(robot, plan, _pose4(arr), tol, position_only)
+    if not found:
+        return result
+    labels = _SCALAR_BRANCHES[plan.family]
+    return AnalyticIKResult(solutions=np.array([f[1] for f in found]), branches=[labels[f[0]] for f in found],
+                            reason=None, swivel=None, residuals=np.array([f[2] for f in found]),
+                            singular=result.singular, model=robot.name)
