@@ -38,3 +38,25 @@ def test_analytic_batch_of_zero_poses_is_empty(name, impl):
     assert len(b) == 0
     assert b.solutions.shape[0] == 0 and b.valid.shape[0] == 0
     assert b.n_solutions.shape == (0,)
+
+
+@pytest.mark.parametrize("damping", [-10.0, -1e-12, math.nan, math.inf])
+@pytest.mark.parametrize("solver", ["osqp", "proxqp"])
+def test_qp_step_rejects_negative_or_non_finite_damping(arm, damping, solver):
+    from anthroarm.ik import qp
+
+    q0 = arm.random_q(rng=5, margin=0.2)
+    conf = qp.IKConfiguration(arm, q0)
+    ee = qp.FrameTask(arm, position_cost=1.0, orientation_cost=0.5)
+    ee.set_target(arm.fk(arm.random_q(rng=6, margin=0.2)))
+    with pytest.raises(ValueError, match="damping"):
+        qp.step(conf, None, [ee], 0.01, solver=solver, damping=damping)
+
+
+@pytest.mark.parametrize("samples", [0, -3, 2, 2.5, True])
+def test_rssr_crank_test_rejects_bad_sample_counts(samples):
+    from anthroarm.mechanisms.rssr import RSSRGeometry, rssr_crank_test
+
+    g = RSSRGeometry(a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3])
+    with pytest.raises(ValueError, match="samples"):
+        rssr_crank_test(g, samples=samples)

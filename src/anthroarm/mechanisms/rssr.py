@@ -226,6 +226,8 @@ def rssr_crank_test(geom: RSSRGeometry, samples: int = 3600) -> RSSRCrankTest:
     search.  Intervals where the linkage assembles are returned (rad, in [-pi, pi])."""
     from scipy.optimize import minimize_scalar
 
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 8:
+        raise ValueError(f"samples must be an integer >= 8 (points over the turn of the input), got {samples!r}")
     al = np.linspace(-np.pi, np.pi, int(samples), endpoint=False)
     E, F, G, _ = rssr_efg(geom, al)
     disc = E * E + F * F - G * G

@@ -176,6 +176,9 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     # part of its diagonal (LM term, posture/damping weight), added once with the damping
     first = True
     diag = float(damping) if damping else 0.0
+    if not (math.isfinite(diag) and diag >= 0.0):
+        raise ValueError(f"damping must be a finite number >= 0 (a negative damping makes the QP "
+                         f"non-convex), got {damping!r}")
     for t in tasks:
         try:
             acc = t._accumulate
