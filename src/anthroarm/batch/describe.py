@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import inspect
 import threading
+import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -25,6 +26,8 @@ CACHE_SIZE = 16
 
 _cache: "OrderedDict[tuple, object]" = OrderedDict()
 _lock = threading.Lock()
+#: Robot -> its description (weak keys; a description holds strings and numbers, not the Robot)
+_described: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -92,6 +95,19 @@ def describe(robot, **params) -> RobotDescription:
         robot = load(robot, **params)
     elif params:
         raise TypeError(f"builder parameters {sorted(params)} go with a catalog name, not a Robot")
+    try:
+        return _described[robot]
+    except (KeyError, TypeError):
+        pass
+    d = _describe(robot)
+    try:
+        _described[robot] = d
+    except TypeError:
+        pass
+    return d
+
+
+def _describe(robot) -> RobotDescription:
     from .. import models
 
     locked = tuple(sorted((str(k), float(v)) for k, v in robot.locked.items()))

@@ -31,8 +31,10 @@ from .result import BatchResult
 
 #: configurations per task of the map jobs (~0.1 s of work per task: scheduler overhead ≲ 2 %)
 MAP_CHUNK = 1 << 18
-#: configurations per vectorised block inside a task (fits the CPU cache: ~0.2 µs/config FK)
-BLOCK = 1 << 14
+#: configurations per vectorised block inside a task: each (B,) float temporary is 64 KiB, under
+#: glibc's 128 KiB mmap threshold.  Dask's nanny sets MALLOC_TRIM_THRESHOLD_, which pins that
+#: threshold, so 128 KiB blocks would be fresh page-faulting mmaps: 4x slower on a worker.
+BLOCK = 1 << 13
 #: Monte Carlo samples per task
 MC_CHUNK = 1 << 15
 #: IK targets per task
