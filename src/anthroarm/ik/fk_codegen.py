@@ -59,7 +59,6 @@ def chain_product(chain, frame=None, bounds=None, position_only=False):
     k (for the stage boundaries ``bounds``: joint positions along the path), ``diffs`` the 12
     (or 3) values ±(FK entry − T entry) of the last stage, of magnitude |FK − T|."""
     path = chain.path(frame)
-    fr = chain.frame(frame)
     for i in path:
         j = chain.joints[i]
         if j.is_mimic or j.kind == "continuous":
@@ -67,6 +66,42 @@ def chain_product(chain, frame=None, bounds=None, position_only=False):
                                       "the generated FK takes revolute and prismatic joints only")
     bounds = bounds or [0, len(path)]
     g = Graph()
+    states = []
+    R, p = _product(g, chain, frame, path, bounds, states)
+    T = [g.input("T", k) for k in range(12)]
+    vals = p + ([] if position_only else [v for row in R for v in row])
+    idx = [3, 7, 11, 0, 1, 2, 4, 5, 6, 8, 9, 10]
+    diffs = []
+    for v, k in zip(vals, idx):
+        x = _negated(g, v)
+        if x is not None:
+            diffs.append(g.add(x, T[k]))              # −(−x − T) = x + T: the same magnitude
+        else:
+            diffs.append(g.add(v, g.mul(-1.0, T[k])))
+    return g, states, diffs
+
+
+def frame_product(chain, frame=None):
+    """The pose of ``frame`` and the joints' frames along its path, in a new :class:`Graph`:
+    ``(g, R, p, joints)`` with R (3 × 3 nested lists) and p (3,) the frame's rotation and
+    position in the base frame, and ``joints[k]`` = (R_k, p_k) the frame of the k-th joint of
+    ``chain.path(frame)`` after its placement (before its own motion: its axis in the base frame
+    is R_k · axis, its origin p_k).  Inputs ``c{k}, s{k}`` (cos, sin of the k-th joint's angle)
+    or ``q{k}`` (a prismatic joint's displacement), k the position along the path; a continuous
+    joint is a revolute one here (its angle θ, not its (cos, sin) pair), a mimic joint reads its
+    own angle θ_j = a θ_source + b (the caller supplies it)."""
+    path = chain.path(frame)
+    g = Graph()
+    joints = []
+    R, p = _product(g, chain, frame, path, [0, len(path)], [], joints)
+    return g, R, p, joints
+
+
+def _product(g, chain, frame, path, bounds, states, joints=None):
+    """(R, p) of the chain product O_1 Rot(a_1, q_1) … O_n Rot(a_n, q_n) O_frame built in ``g``;
+    appends the stage states to ``states`` and, if given, each joint's frame after its
+    placement to ``joints``."""
+    fr = chain.frame(frame)
     R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
     p = [0.0, 0.0, 0.0]
 
@@ -77,10 +112,11 @@ def chain_product(chain, frame=None, bounds=None, position_only=False):
         R = [[g.sum([g.mul(rot[k][c], R[i][k]) for k in range(3)]) for c in range(3)] for i in range(3)]
         return R, p
 
-    states = []
     for pos, i in enumerate(path):
         j = chain.joints[i]
         R, p = place(R, p, j.rotation, j.translation)
+        if joints is not None:
+            joints.append((R, p))
         ax = [snap(x) for x in j.axis]
         if j.kind == "prismatic":
             q = g.input("q", pos)
@@ -105,18 +141,7 @@ def chain_product(chain, frame=None, bounds=None, position_only=False):
                 R = [[g.sum([g.mul(R[r][k], Rq[k][cc]) for k in range(3)]) for cc in range(3)] for r in range(3)]
         if pos + 1 in bounds[1:-1]:
             states.append([v for row in R for v in row] + p)
-    R, p = place(R, p, fr.rotation, fr.translation)
-    T = [g.input("T", k) for k in range(12)]
-    vals = p + ([] if position_only else [v for row in R for v in row])
-    idx = [3, 7, 11, 0, 1, 2, 4, 5, 6, 8, 9, 10]
-    diffs = []
-    for v, k in zip(vals, idx):
-        x = _negated(g, v)
-        if x is not None:
-            diffs.append(g.add(x, T[k]))              # −(−x − T) = x + T: the same magnitude
-        else:
-            diffs.append(g.add(v, g.mul(-1.0, T[k])))
-    return g, states, diffs
+    return place(R, p, fr.rotation, fr.translation)
 
 
 class FKStages:

@@ -10,7 +10,8 @@ import numpy as np
 from ..qp.targets import as_se3
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
-from .kernel import MAX_ITER, STALL, attempt, clock, damped_step, damping
+from . import ckernel
+from .kernel import MAX_ITER, STALL, attempt as py_attempt, clock, damped_step, damping
 from .nullspace import Swivel, posture, swivel as swivel_phase
 from .seeds import SWIVEL_GRID, TableSeeds, analytic_seeds
 from .targets import ORIENTATION, POSE, Target, parse
@@ -25,15 +26,16 @@ class Problem:
     """The settings of one call, shared by its targets: the robot (for the closed form only),
     the calling thread's workspace, the time budget (s of thread CPU time), the restart cap and
     generator, the posture reference θ_ref (None: no posture phase), the swivel objective
-    (None: none), the closed-form policy, and the caller's q0 in θ (off-path joints are
-    returned at its values)."""
+    (None: none), the closed-form policy, and the attempt kernel (:func:`.kernel.attempt` or
+    its compiled form :func:`.ckernel.attempt`)."""
 
-    __slots__ = ("robot", "ws", "max_time", "max_restarts", "rng", "_gen", "th_ref", "swivel", "analytic")
+    __slots__ = ("robot", "ws", "max_time", "max_restarts", "rng", "_gen", "th_ref", "swivel", "analytic", "attempt")
 
     def __init__(self, robot, ws, max_time, max_restarts, rng, th_ref, swivel, analytic):
         self.robot, self.ws, self.max_time, self.max_restarts = robot, ws, max_time, max_restarts
         self.rng, self._gen = rng, None
         self.th_ref, self.swivel, self.analytic = th_ref, swivel, analytic
+        self.attempt = py_attempt   # kernel.attempt or its compiled form (ckernel.attempt)
 
     def random(self):
         """A uniform random θ in the sampling box (the generator made on first use: most
@@ -135,9 +137,10 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     pb = Problem(robot, ws, float(max_time), max_restarts, rng, th_ref if redundant and sw is None else None,
                  sw if redundant else None, analytic)
     tp, tr = float(tol_pos), float(tol_rot)
-    ws.table()      # the one-time seed tables: built here, before any clock starts, so the first
-    if mode == "pose":                                   # call is not charged for them
+    ws.table()      # the one-time seed tables and compiled kernel: built here, before any clock
+    if mode == "pose":                         # starts, so the first call is not charged for them
         ws.aligned()
+    pb.attempt = ckernel.attempt if ckernel.ready(ws) else py_attempt    # compiled where available
     if not batch:
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr, x), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
@@ -195,6 +198,7 @@ def solve_one(pb: Problem, tg: Target, seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
         ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
     table = None      # seed-table entries, nearest first (made when needed)
+    attempt = pb.attempt
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
     while True:

@@ -80,6 +80,7 @@ class Shared:
         self._table = None
         self._aligned = None
         self._penalty = {}
+        self.ckernel = None   # the compiled attempt kernel (ckernel.kernel_for), False if unavailable
 
     def theta(self, q) -> np.ndarray:
         """θ (n,) or (N, n) of a configuration q in Pinocchio's layout (a copy)."""
@@ -152,12 +153,13 @@ class Workspace:
     preallocated arrays (J Jᵀ + λI built in place, handed to LAPACK as its transpose: Fortran
     order, symmetric), plus the shared fields the kernel reads, copied for fast access."""
 
-    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin")
+    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "cbuf")
 
     def __init__(self, sh: Shared):
         self.sh = sh
         self.model, self.fid, self.n, self.lo, self.hi, self.to_q = sh.model, sh.fid, sh.n, sh.lo, sh.hi, sh.to_q
         self.data = sh.model.createData()
+        self.cbuf = None    # the compiled kernel's buffers (ckernel.ready)
         self.lin = {}   # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
         for m in {3, 6, min(sh.n, 6)}:      # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
