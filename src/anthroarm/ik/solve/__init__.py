@@ -42,6 +42,11 @@ Redundant arms (human arm): ``posture`` adds ½‖θ − θ_ref‖² in the null
 along a one-dimensional self-motion; :func:`.nullspace.posture`); ``swivel=φ*`` places the
 elbow at the swivel angle φ* (:func:`.nullspace.swivel`).
 
+Speed (:mod:`.ckernel`): where a C compiler is available, each attempt runs as one compiled
+call (the FK and Jacobian of the frame generated from ``robot.chain``, the same iteration as
+:func:`.kernel.attempt`, tested equal to it); ``ANTHROARM_IK_C=0`` or no compiler: the Python
+kernel.
+
 Threads and memory (:mod:`.workspace`): one Robot may be used from several threads at once
 (per-thread ``pin.Data`` and kernel arrays); the per-robot cache holds the Robot weakly and
 nothing that refers to it.

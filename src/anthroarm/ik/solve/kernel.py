@@ -22,6 +22,10 @@ off the frame's path are zero: those joints keep their seed values.
 Written for the cost of each call from Python (~0.1–0.5 µs per NumPy or Pinocchio call at these
 sizes): J Jᵀ + λI is built in a preallocated array of the calling thread's workspace and
 factorised in place by LAPACK ``dposv``; limit hits are detected by comparing bytes.
+
+:func:`attempt` is the reference of its compiled form (:mod:`.ckernel`, which reads the
+constants below), used by :func:`~anthroarm.ik.solve.api.solve_one` where a C compiler is
+available.
 """
 
 from __future__ import annotations
