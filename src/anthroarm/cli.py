@@ -1,7 +1,10 @@
 """The ``anthroarm`` command line.
 
-User mistakes (unknown model, bad arguments, missing folders) print one line to stderr and
-exit with status 2; failed checks exit with status 1.  No tracebacks for user mistakes.
+User mistakes (unknown model, bad arguments, missing folders) and file errors (a folder or a
+device as the output, a read-only or full disk, a permission denied) print one line to stderr
+and exit with status 2, leaving the target untouched (every write is atomic:
+:func:`anthroarm._io.atomic_write_text`); failed checks exit with status 1.  No tracebacks for
+user mistakes (tested in ``tests/adversarial/test_cli_garbage.py`` and ``test_file_faults.py``).
 """
 
 from __future__ import annotations
@@ -16,6 +19,18 @@ from .errors import AnthroarmError
 
 class UserError(Exception):
     """A mistake in the command line; printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line error (the usage is one ``--help`` away); subcommand parsers
+    are of the same class."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see '{self.prog} --help')\n")
+
+
+#: Largest --samples / --workspace counts (beyond them the arrays alone need gigabytes).
+MAX_SAMPLES = 1_000_000
 
 
 def _add_robot_options(p, what: str = "the model"):
@@ -77,8 +92,8 @@ def _add_check(sub):
 def cmd_check(a) -> int:
     from . import crosscheck
 
-    if a.samples < 1:
-        raise UserError("--samples must be >= 1")
+    if not 1 <= a.samples <= MAX_SAMPLES:
+        raise UserError(f"--samples must be in 1..{MAX_SAMPLES}, got {a.samples}")
     names = [n for item in [*a.model, *(a.models or [])] for n in item.split(",") if n]
     if (a.tool is not None or a.locked is not None) and not names:
         raise UserError("--tool and --locked apply to the models given: name one (e.g. anthroarm check ur10 --tool tool0)")
@@ -195,6 +210,8 @@ def cmd_urdf(a) -> int:
     out = Path(a.output)
     if not out.parent.is_dir():
         raise UserError(f"folder {out.parent} does not exist")
+    if out.is_dir():
+        raise UserError(f"-o {a.output} is a folder; give a file name such as {out / 'robot.urdf'}")
     robot = _load_model(a.model, _parse_params(a.param), tool="universe")  # any frame: only the text is written
     atomic_write_text(out, robot.info.text)
     print(f"wrote {out}")
@@ -322,7 +339,12 @@ def _export_or_serve(viewer, out, a, announce: bool = True) -> int:
 
 
 def _check_port_early(a):
-    """Fail before any long work when an explicit --port is taken (or invalid)."""
+    """Fail before any long work (and before a server or a browser starts) when an explicit
+    --port is taken or invalid, or --seconds is not a finite number >= 0."""
+    import math
+
+    if a.seconds is not None and not (math.isfinite(a.seconds) and a.seconds >= 0):
+        raise UserError(f"--seconds must be a finite number >= 0, got {a.seconds}")
     if getattr(a, "html", None) is None and a.port is not None:
         from .viewer.server import _in_use_message, port_is_free
 
@@ -367,9 +389,9 @@ def cmd_view(a) -> int:
     out = _check_html_path(a.html)
     _check_port_early(a)
     robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
+    if not 0 <= a.workspace <= MAX_SAMPLES:
+        raise UserError(f"--workspace must be in 0..{MAX_SAMPLES}, got {a.workspace}")
     q = _parse_q(robot, a.q, a.deg)
-    if a.workspace < 0:
-        raise UserError("--workspace must be >= 0")
     v = Viewer(robot, live=out is None, port=a.port, style=a.style, q=q)
     if a.frames:
         v.show_frames("joints")
@@ -460,6 +482,10 @@ def cmd_ik(a) -> int:
     robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
     if not all(math.isfinite(x) for x in [*a.xyz, *a.rpy]):
         raise UserError("--xyz and --rpy must be finite numbers")
+    from .urdf_io import MAX_LENGTH
+
+    if max(map(abs, a.xyz)) > MAX_LENGTH:
+        raise UserError(f"--xyz {' '.join(map(str, a.xyz))} is beyond the physical bound of {MAX_LENGTH:g} m")
     rpy = np.deg2rad(a.rpy) if a.deg else np.asarray(a.rpy, float)
     T = np.eye(4)
     T[:3, :3] = pin.rpy.rpyToMatrix(*rpy)
@@ -655,7 +681,7 @@ def _cmd_batch(a) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
+    ap = _Parser(
         prog="anthroarm",
         description="anthroarm: the book's arms, kinematics, IK and dynamics, proven against Pinocchio.",
         epilog="run 'anthroarm COMMAND --help' for the options and an example of each command",
@@ -679,9 +705,7 @@ def main(argv=None) -> int:
     try:
         return int(a.func(a) or 0)
     except (UserError, AnthroarmError, ValueError, FileNotFoundError) as exc:
-        msg = " ".join(str(exc).split())  # one line
-        print(f"anthroarm {a.command}: error: {msg}", file=sys.stderr)
-        return 2
+        return _one_line_error(a.command, str(exc))
     except KeyboardInterrupt:
         print(f"anthroarm {a.command}: interrupted", file=sys.stderr)
         return 130
@@ -690,6 +714,16 @@ def main(argv=None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:   # a folder or device as the target, read-only or full disk, no permission
+        where = f"{exc.filename}: " if exc.filename else ""
+        return _one_line_error(a.command, f"{where}{exc.strerror or exc}")
+    except MemoryError:
+        return _one_line_error(a.command, "out of memory (ask for fewer samples or points)")
+
+
+def _one_line_error(command: str, message: str) -> int:
+    print(f"anthroarm {command}: error: {' '.join(message.split())}", file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":

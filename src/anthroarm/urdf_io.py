@@ -330,7 +330,9 @@ def read_urdf(path, package_dirs: PackageDirsLike = None, check_meshes: bool = T
     """
     path = Path(path)
     if not path.is_file():
-        raise URDFNotFoundError(path, "file does not exist")
+        what = ("is a folder, not a URDF file" if path.is_dir() else
+                "is not a regular file (a device, FIFO or socket)" if path.exists() else "file does not exist")
+        raise URDFNotFoundError(path, what)
     size = path.stat().st_size
     if size > MAX_URDF_BYTES:
         raise URDFSecurityError(path, f"file is {size} bytes, larger than the {MAX_URDF_BYTES} accepted")
