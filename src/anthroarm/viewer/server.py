@@ -6,13 +6,19 @@
 >>> srv.send_many([cmd1, cmd2])          # one ZeroMQ message, one websocket message
 >>> srv.close()                          # also done at interpreter exit
 
-The server listens on 127.0.0.1 only; it exits on its own when this process dies.
+The server listens on 127.0.0.1 only; it exits on its own when this process dies.  Only this
+process can drive it: the server gets a random secret through its stdin (not its command line
+or environment), and every request carries that secret as its first frame.  The web page and
+websocket answer only loopback ``Host`` names (no DNS rebinding).
 """
 
 from __future__ import annotations
 
 import atexit
+import math
+import numbers
 import os
+import secrets
 import socket
 import subprocess
 import sys
@@ -22,10 +28,14 @@ import weakref
 import umsgpack
 import zmq
 
-from ..errors import ViewerError, ViewerPortInUseError
+from ..errors import ParameterError, ViewerError, ViewerPortInUseError
 
 _SERVER_SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_server.py")
 HOST = "127.0.0.1"
+#: Longest wait (s) for a reply, for the server to start, or for browser tabs (the server's
+#: own bound, ``_server.MAX_WAIT``); the most tabs :meth:`ServerProcess.wait` can wait for.
+MAX_WAIT = 3600.0
+MAX_TABS = 1024
 
 
 def port_is_free(port: int) -> bool:
@@ -41,15 +51,33 @@ def port_is_free(port: int) -> bool:
 
 
 def _check_port(port) -> int | None:
+    """``None`` or an integer 1..65535 (a bool or a float is a TypeError, not port 1)."""
     if port is None:
         return None
-    try:
-        p = int(port)
-    except (TypeError, ValueError):
-        raise ValueError(f"port must be an integer in 1..65535, got {port!r}") from None
-    if not 1 <= p <= 65535 or p != port:
-        raise ValueError(f"port must be an integer in 1..65535, got {port!r}")
-    return p
+    if isinstance(port, bool) or not isinstance(port, numbers.Integral):
+        raise ParameterError(f"port must be an integer in 1..65535 (or None for the first free port from 7000), "
+                             f"got {port!r} of type {type(port).__name__}")
+    if not 1 <= int(port) <= 65535:
+        raise ParameterError(f"port must be an integer in 1..65535, got {port!r}")
+    return int(port)
+
+
+def _check_seconds(value, name: str = "timeout") -> float:
+    """A finite number of seconds in (0, MAX_WAIT]; ParameterError (TypeError/ValueError) otherwise."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError(f"{name} must be a number of seconds, got {value!r} of type {type(value).__name__}")
+    v = float(value)
+    if not (math.isfinite(v) and 0 < v <= MAX_WAIT):
+        raise ParameterError(f"{name} must be finite, > 0 and <= {MAX_WAIT:g} s, got {value!r}")
+    return v
+
+
+def _check_tabs(n) -> int:
+    if isinstance(n, bool) or not isinstance(n, numbers.Integral):
+        raise ParameterError(f"n (browser tabs) must be an integer in 1..{MAX_TABS}, got {n!r} of type {type(n).__name__}")
+    if not 1 <= int(n) <= MAX_TABS:
+        raise ParameterError(f"n (browser tabs) must be an integer in 1..{MAX_TABS}, got {n!r}")
+    return int(n)
 
 
 def _stop(proc: subprocess.Popen, log) -> None:
@@ -77,23 +105,33 @@ class ServerProcess:
         HTTP/websocket port.  ``None``: the first free port from 7000.  A given port that is
         taken raises :class:`~anthroarm.errors.ViewerPortInUseError` (no silent fallback).
     timeout : float
-        Seconds to wait for the server to start, and for each reply.
+        Seconds to wait for the server to start, and for each reply (finite, at most
+        :data:`MAX_WAIT`).
+
+    ``secret`` (bytes) is the per-server token every request starts with.
     """
 
     context = zmq.Context.instance()
 
     def __init__(self, port: int | None = None, timeout: float = 20.0):
         port = _check_port(port)
+        timeout = _check_seconds(timeout)
         if port is not None and not port_is_free(port):
             raise ViewerPortInUseError(_in_use_message(port))
         self._log = tempfile.TemporaryFile(mode="w+")
         args = [sys.executable, "-u", _SERVER_SCRIPT, "--parent-pid", str(os.getpid())]
         if port is not None:
             args += ["--port", str(port)]
-        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.DEVNULL,
+        self.secret = secrets.token_hex(32).encode("ascii")
+        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.PIPE,
                                      start_new_session=True)
         self._finalizer = weakref.finalize(self, _stop, self.proc, self._log)
         atexit.register(self._finalizer)
+        try:  # the secret travels through the pipe: not in argv or the environment (ps, /proc)
+            self.proc.stdin.write(self.secret + b"\n")
+            self.proc.stdin.close()
+        except OSError:  # the child died at once; its first line (or stderr) says why
+            pass
         line = self._read_line(timeout)
         if line.startswith("error port_in_use"):
             self._finalizer()
@@ -138,7 +176,7 @@ class ServerProcess:
     def _request(self, frames: list[bytes]) -> bytes:
         if not self.alive:
             raise ViewerError("the viewer server is not running (closed, or it exited)")
-        self.sock.send_multipart(frames)
+        self.sock.send_multipart([self.secret, *frames])
         try:
             reply = self.sock.recv()
         except zmq.Again:
@@ -173,7 +211,11 @@ class ServerProcess:
 
     def wait(self, n: int = 1, timeout: float = 30.0) -> None:
         """Block until ``n`` browser tabs are connected (ViewerError after ``timeout`` s).  The
-        server answers at its own deadline, so a timed-out wait leaves it usable."""
+        server answers at its own deadline, so a timed-out wait leaves it usable.  ``n`` is an
+        integer in 1..:data:`MAX_TABS`, ``timeout`` finite in (0, :data:`MAX_WAIT`] s
+        (:class:`~anthroarm.errors.ParameterError`, a TypeError/ValueError, otherwise)."""
+        n = _check_tabs(n)
+        timeout = _check_seconds(timeout)
         self.sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000) + self.timeout_ms)
         try:
             self._request([b"wait", str(n).encode(), repr(float(timeout)).encode()])
@@ -189,7 +231,7 @@ class ServerProcess:
         try:
             if self.alive:
                 self.sock.setsockopt(zmq.RCVTIMEO, 1000)
-                self.sock.send_multipart([b"shutdown"])
+                self.sock.send_multipart([self.secret, b"shutdown"])
                 self.sock.recv()
         except Exception:
             pass

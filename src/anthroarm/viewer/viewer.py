@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 from meshcat.commands import SetObject
 
+from ..errors import ParameterError
 from ..spatial.rotations import homogeneous
 from .._io import atomic_write_text
 from ._store import SceneStore
@@ -71,6 +72,25 @@ def _set_property(path: str, key: str, value) -> dict:
 
 def _delete(path: str) -> dict:
     return {"type": "delete", "path": path}
+
+
+def _rgb255(value, what: str) -> list[int]:
+    try:
+        c = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        c = np.array([np.nan])
+    if c.shape != (3,) or not np.all(np.isfinite(c)) or np.any((c < 0) | (c > 255)):
+        raise ParameterError(f"{what} must be three numbers (r, g, b) in 0..255, got {value!r}")
+    return [int(round(x)) for x in c]
+
+
+def _check_background(background):
+    """``None`` or ((r, g, b), (r, g, b)) with 0..255 components -> two lists of ints."""
+    if background is None:
+        return None
+    if isinstance(background, (str, bytes)) or not hasattr(background, "__len__") or len(background) != 2:
+        raise ParameterError(f"background must be ((r, g, b), (r, g, b)) in 0..255 (top, bottom), got {background!r}")
+    return _rgb255(background[0], "background top colour"), _rgb255(background[1], "background bottom colour")
 
 
 def limit_proximity(q, lower, upper) -> np.ndarray:
@@ -123,7 +143,8 @@ class Viewer:
         browser tab or a Jupyter iframe shows the scene as it changes.  ``False``: the scene
         lives in memory only (``export_html``, ``jupyter_cell``).
     port : int, optional
-        Server port (``live=True``); a port in use raises ViewerPortInUseError.
+        Server port (``live=True``): an integer in 1..65535 (a bool or float is a TypeError); a
+        port in use raises ViewerPortInUseError.
     style : {"auto", "generated", "urdf", "visual_model"}
         Visuals (:func:`~anthroarm.viewer.visuals.robot_bodies`): capsules, cylinders and spheres
         generated from ``robot.chain`` (book models, robots without visual geometry), the URDF's
@@ -141,19 +162,26 @@ class Viewer:
 
     def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
                  q=None, name: str | None = None, background=None, grid: bool = False):
-        if isinstance(robot, (str, Path)):
-            from ..robot import load
+        from ..robot import Robot, load
 
+        if isinstance(robot, (str, Path)):
             robot = load(robot)
+        if not isinstance(robot, Robot):
+            raise ParameterError(f"Viewer takes a Robot (aa.load(...)) or a model name / URDF path, got {type(robot).__name__}")
+        background = _check_background(background)
         self.robot = robot
         self.store = SceneStore()
         self.server = None
         if live:
+            from .server import _check_port
+
+            port = _check_port(port)  # a bad port is a ParameterError before any work
+        self.root = f"{ROOT}/{_safe(name or robot.name)}"
+        self.bodies: list[Body] = robot_bodies(robot, style)   # MeshError etc. before a server starts
+        if live:
             from .server import ServerProcess
 
             self.server = ServerProcess(port=port)
-        self.root = f"{ROOT}/{_safe(name or robot.name)}"
-        self.bodies: list[Body] = robot_bodies(robot, style)
         self._overlay_bodies: dict[str, list[Body]] = {}
         self._movers: list[tuple[str, int | None, int | None]] | None = None
         joints = robot.chain.joints
@@ -245,9 +273,9 @@ class Viewer:
         """Background gradient colours (0..255 RGB); ``visible=False`` for a transparent page."""
         cmds = []
         if top is not None:
-            cmds.append(_set_property("/Background", "top_color", [int(c) for c in top]))
+            cmds.append(_set_property("/Background", "top_color", _rgb255(top, "top")))
         if bottom is not None:
-            cmds.append(_set_property("/Background", "bottom_color", [int(c) for c in bottom]))
+            cmds.append(_set_property("/Background", "bottom_color", _rgb255(bottom, "bottom")))
         cmds.append(_set_property("/Background", "visible", bool(visible)))
         self._send(cmds)
 
@@ -506,7 +534,9 @@ class Viewer:
         return self
 
     def wait(self, n: int = 1, timeout: float = 30.0) -> None:
-        """Block until ``n`` browser tabs are connected to the live server."""
+        """Block until ``n`` browser tabs are connected to the live server; ViewerError after
+        ``timeout`` seconds.  ``n`` in 1..1024 and a finite ``timeout`` in (0, 3600] s
+        (:class:`~anthroarm.errors.ParameterError`, a TypeError/ValueError, otherwise)."""
         if self.server is None:
             raise RuntimeError("this viewer is not live")
         self.server.wait(n, timeout)
