@@ -16,12 +16,11 @@ of 5 runs of N consecutive frames.  Target (issue 7): >= 60 fps for human_arm7.
 
 from __future__ import annotations
 
-import subprocess
-import tempfile
 import time
 from statistics import median
 
 import anthroarm as aa
+from anthroarm.errors import ViewerError
 from anthroarm.viewer import Viewer, browser
 
 MODELS = ["human_arm7", "panda"]
@@ -46,22 +45,20 @@ def _per_link(v: Viewer):
     return f
 
 
-def _with_browser(v: Viewer):
-    exe = browser.find_chromium()
-    if exe is None:
+def _browser_frame_time(v: Viewer, Q) -> float | None:
+    """Per-frame time with a headless Chromium tab connected and rendering; None without
+    Chromium or when the tab does not connect within 30 s.  The browser and all its helper
+    processes are stopped and waited for before its profile is removed (browser.live_tab), so
+    the measurement is never lost to cleanup."""
+    if browser.find_chromium() is None:
         return None
-    prof = tempfile.TemporaryDirectory(prefix="anthroarm-bench-")
-    proc = subprocess.Popen([exe, *browser.CHROMIUM_FLAGS, f"--user-data-dir={prof.name}", "--window-size=800,600",
-                             "--remote-debugging-port=0", v.url], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    t0 = time.time()
-    while v.server.clients() < 1 and time.time() - t0 < 30:
-        time.sleep(0.1)
-    if v.server.clients() < 1:
-        proc.kill()
-        proc.wait()
-        prof.cleanup()
-        return None
-    return proc, prof
+    with browser.live_tab(v.url):
+        try:
+            v.wait(1, timeout=30)
+        except ViewerError:
+            return None
+        time.sleep(1.0)  # let the page finish loading the scene
+        return _per_frame(v.display, Q)
 
 
 def run(quick: bool = False) -> dict:
@@ -76,21 +73,7 @@ def run(quick: bool = False) -> dict:
             t_mem = _per_frame(mem.display, Q)
             t_batch = _per_frame(v.display, Q)
             t_link = _per_frame(_per_link(v), Q[: max(20, n // 4)])
-            t_browser = None
-            started = _with_browser(v)
-            if started is not None:
-                proc, prof = started
-                try:
-                    time.sleep(1.0)  # let the page finish loading the scene
-                    t_browser = _per_frame(v.display, Q)
-                finally:
-                    proc.terminate()
-                    try:
-                        proc.wait(10)
-                    except subprocess.TimeoutExpired:
-                        proc.kill()
-                        proc.wait()
-                    prof.cleanup()
+            t_browser = _browser_frame_time(v, Q)
         for label, t, msgs in (("batched (anthroarm)", t_batch, 1),
                                ("batched + headless Chromium tab", t_browser, 1),
                                ("one message per link (meshcat-python style)", t_link, nb),

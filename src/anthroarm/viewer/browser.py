@@ -6,15 +6,27 @@ Used by the real-browser tests and to make ``docs/human_arm_viewer.png``.  Needs
 
 >>> png = screenshot("file:///tmp/arm.html", "/tmp/arm.png")
 >>> drawn_fraction(png, baseline_png, region=(0.2, 0.1, 0.8, 0.9))   # share of changed pixels
+>>> with live_tab(viewer.url) as tab:     # a tab connected to a live viewer (benchmarks)
+...     viewer.wait(1, timeout=30)
+
+Every browser runs in its own process group with a private profile folder; when it is done,
+the whole group is stopped and *waited for* before the folder is removed (Chromium's helper
+processes keep writing into the profile after the main process has exited, and removing it
+under them failed with ``OSError: [Errno 39] Directory not empty``).  Removing the profile
+never raises.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
+import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -51,33 +63,124 @@ def screenshot(url, png, size=(800, 600), budget_ms: int = 6000, timeout: float 
         url = Path(url).resolve().as_uri()
     png = Path(png)
     png.unlink(missing_ok=True)
-    with tempfile.TemporaryDirectory(prefix="anthroarm-chromium-") as prof:
-        cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}", f"--screenshot={png}",
-               f"--window-size={int(size[0])},{int(size[1])}", f"--virtual-time-budget={int(budget_ms)}", url]
-        # own process group: on a timeout the renderer/GPU children are killed with the browser
-        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
-                                start_new_session=True)
-        try:
-            _, err = proc.communicate(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            _kill_group(proc)
-            raise RuntimeError(f"chromium did not finish within {timeout} s on {url}") from None
-        finally:
-            if proc.poll() is None:  # e.g. KeyboardInterrupt during communicate
-                _kill_group(proc)
+    prof = tempfile.mkdtemp(prefix="anthroarm-chromium-")
+    cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}", f"--screenshot={png}",
+           f"--window-size={int(size[0])},{int(size[1])}", f"--virtual-time-budget={int(budget_ms)}", url]
+    # own process group: the renderer/GPU children are stopped with the browser
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                            start_new_session=True)
+    err = b""
+    try:
+        _, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise RuntimeError(f"chromium did not finish within {timeout} s on {url}") from None
+    finally:
+        stop_browser(proc)
+        remove_profile(prof)
     if not png.is_file():
-        tail = err.decode("utf-8", "replace").strip().splitlines()[-3:]
+        tail = (err or b"").decode("utf-8", "replace").strip().splitlines()[-3:]
         raise RuntimeError(f"chromium wrote no screenshot (exit {proc.returncode}): {' | '.join(tail)}")
     return png
 
 
-def _kill_group(proc: subprocess.Popen) -> None:
-    """SIGKILL the process group led by ``proc`` (its session, see ``start_new_session``)."""
+@dataclass
+class Tab:
+    """A headless Chromium showing one page: ``proc`` (the browser, leader of its own process
+    group) and ``profile`` (its private profile folder)."""
+
+    proc: subprocess.Popen
+    profile: str
+
+
+@contextlib.contextmanager
+def live_tab(url, size=(800, 600)):
+    """A headless Chromium tab on ``url`` (e.g. a live viewer's page) for the duration of the
+    ``with`` block.  On exit the browser and every process it started are stopped and waited
+    for (bounded), then the profile folder is removed (never raises).  RuntimeError if there
+    is no Chromium."""
+    exe = find_chromium()
+    if exe is None:
+        raise RuntimeError("no chromium on PATH (Debian: apt-get install chromium)")
+    prof = tempfile.mkdtemp(prefix="anthroarm-chromium-")
     try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except ProcessLookupError:
+        proc = subprocess.Popen([exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}",
+                                 f"--window-size={int(size[0])},{int(size[1])}", "--remote-debugging-port=0", str(url)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+                                start_new_session=True)
+    except BaseException:
+        remove_profile(prof)
+        raise
+    try:
+        yield Tab(proc, prof)
+    finally:
+        stop_browser(proc)
+        remove_profile(prof)
+
+
+def group_members(pgid: int) -> list[int]:
+    """Live (not zombie) processes of process group ``pgid`` (Linux: from /proc; elsewhere
+    ``[pgid]`` while the group exists)."""
+    if not os.path.isdir("/proc/self"):
+        try:
+            os.killpg(pgid, 0)
+            return [pgid]
+        except (ProcessLookupError, PermissionError):
+            return []
+    out = []
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat", "rb") as f:
+                fields = f.read().rsplit(b")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if len(fields) > 2 and int(fields[2]) == pgid and fields[0] not in (b"Z", b"X"):
+            out.append(int(d))
+    return out
+
+
+def stop_browser(proc: subprocess.Popen, grace: float = 5.0, timeout: float = 10.0) -> None:
+    """Stop a browser started with ``start_new_session=True`` and every process of its group,
+    and wait until none is left (at most ``grace + timeout`` seconds): SIGTERM, ``grace`` s for
+    a clean exit, then SIGKILL for whatever is left (helpers still writing, a stopped child)."""
+    pgid = proc.pid
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(pgid, signal.SIGTERM)
+    try:
+        proc.wait(grace)
+    except subprocess.TimeoutExpired:
         pass
-    proc.communicate()
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(pgid, signal.SIGKILL)
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        proc.wait(timeout)
+    deadline = time.monotonic() + timeout
+    while group_members(pgid) and time.monotonic() < deadline:  # bounded
+        time.sleep(0.05)
+    for f in (proc.stdout, proc.stderr):
+        with contextlib.suppress(Exception):
+            if f is not None:
+                f.close()
+
+
+def remove_profile(path, attempts: int = 5) -> bool:
+    """Remove a browser profile folder; a few attempts, then what can be removed.  Never
+    raises (a benchmark or a screenshot must not lose its result to cleanup); returns True if
+    the folder is gone, else prints one line to stderr."""
+    for k in range(attempts):
+        try:
+            shutil.rmtree(path)
+            return True
+        except FileNotFoundError:
+            return True
+        except OSError:
+            time.sleep(0.1 * (k + 1))
+    shutil.rmtree(path, ignore_errors=True)
+    if os.path.exists(path):
+        print(f"anthroarm: warning: could not remove the browser profile {path}", file=sys.stderr)
+        return False
+    return True
 
 
 def load_rgb(png) -> np.ndarray:
