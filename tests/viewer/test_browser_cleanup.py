@@ -26,20 +26,7 @@ if browser.find_chromium() is None:  # pragma: no cover - CI installs chromium (
 
 def processes_mentioning(text: str) -> list[int]:
     """Live processes whose command line contains ``text``."""
-    out = []
-    for d in os.listdir("/proc"):
-        if not d.isdigit():
-            continue
-        try:
-            with open(f"/proc/{d}/cmdline", "rb") as f:
-                cmd = f.read()
-            with open(f"/proc/{d}/stat", "rb") as f:
-                state = f.read().rsplit(b")", 1)[1].split()[0]
-        except (OSError, IndexError):
-            continue
-        if text.encode() in cmd and state not in (b"Z", b"X"):
-            out.append(int(d))
-    return out
+    return [pid for pid, _, cmd in browser.live_processes() if text.encode() in cmd]
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc")

@@ -117,6 +117,22 @@ def live_tab(url, size=(800, 600)):
         remove_profile(prof)
 
 
+def live_processes():
+    """(pid, process group, command line) of every live (not zombie) process; Linux /proc."""
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat", "rb") as f:
+                fields = f.read().rsplit(b")", 1)[1].split()
+            with open(f"/proc/{d}/cmdline", "rb") as f:
+                cmdline = f.read().replace(b"\0", b" ")
+        except (OSError, IndexError):
+            continue
+        if len(fields) > 2 and fields[0] not in (b"Z", b"X"):
+            yield int(d), int(fields[2]), cmdline
+
+
 def group_members(pgid: int) -> list[int]:
     """Live (not zombie) processes of process group ``pgid`` (Linux: from /proc; elsewhere
     ``[pgid]`` while the group exists)."""
@@ -126,18 +142,7 @@ def group_members(pgid: int) -> list[int]:
             return [pgid]
         except (ProcessLookupError, PermissionError):
             return []
-    out = []
-    for d in os.listdir("/proc"):
-        if not d.isdigit():
-            continue
-        try:
-            with open(f"/proc/{d}/stat", "rb") as f:
-                fields = f.read().rsplit(b")", 1)[1].split()
-        except (OSError, IndexError):
-            continue
-        if len(fields) > 2 and int(fields[2]) == pgid and fields[0] not in (b"Z", b"X"):
-            out.append(int(d))
-    return out
+    return [pid for pid, group, _ in live_processes() if group == pgid]
 
 
 def stop_browser(proc: subprocess.Popen, grace: float = 5.0, timeout: float = 10.0) -> None:
