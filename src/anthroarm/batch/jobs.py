@@ -3,12 +3,12 @@
 Every job takes the robot (a :class:`~anthroarm.robot.Robot`, a catalog name or a
 :class:`~anthroarm.batch.describe.RobotDescription`), its own parameters, and the keywords
 
-``client``      ``None`` (vectorised numpy in this process, chunked, with a tqdm bar) or a
-                :class:`distributed.Client` (:func:`anthroarm.batch.connect`);
-``chunk_size``  work items per task (configurations, samples, targets, lattice slices);
-                the result depends on it for random jobs, never on the number of workers;
-``seed``        root of the per-task :class:`numpy.random.SeedSequence` children (random jobs);
-``progress``    a tqdm bar; ``callback(done, total)`` after each task (raise to cancel);
+* ``client``: ``None`` (vectorised numpy in this process, chunked, with a tqdm bar) or a
+  :class:`distributed.Client` (:func:`anthroarm.batch.connect`);
+* ``chunk_size``: work items per task (configurations, samples, targets, lattice slices);
+  the result depends on it for random jobs, never on the number of workers;
+* ``seed``: root of the per-task :class:`numpy.random.SeedSequence` children (random jobs);
+* ``progress``: a tqdm bar; ``callback(done, total)`` after each task (raise to cancel);
 
 and returns a :class:`~anthroarm.batch.result.BatchResult`.  The local and the Dask run of
 the same call return bitwise identical results (see :mod:`anthroarm.batch.engine`).  Jobs
@@ -32,7 +32,7 @@ from .result import BatchResult
 #: configurations per task of the map jobs (~0.1 s of work per task: scheduler overhead ≲ 2 %)
 MAP_CHUNK = 1 << 18
 #: configurations per vectorised block inside a task: each (B,) float temporary is 64 KiB, under
-#: glibc's 128 KiB mmap threshold.  Dask's nanny sets MALLOC_TRIM_THRESHOLD_, which pins that
+#: glibc's 128 KiB mmap threshold.  Dask's nanny sets ``MALLOC_TRIM_THRESHOLD_``, which pins that
 #: threshold, so 128 KiB blocks would be fresh page-faulting mmaps: 4x slower on a worker.
 BLOCK = 1 << 13
 #: Monte Carlo samples per task

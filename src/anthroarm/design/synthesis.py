@@ -5,12 +5,12 @@ Geometry (Fig. 3-10 is missing; reconstruction of ch3-4 notes §7, consistent wi
 ``C = O + r e^{iδ}``.  The crank O→A has length r1 and the prescribed angle α; the coupler
 carries C at distance r2 from A (angle ψ) and the rocker joint B at distance r5 from C in the
 direction ``C→B = −e^{iφ}`` with ``φ = ψ + γ`` (γ = 0: B on line AC, the book's case); the
-rocker D→B has length r4; the second ground pivot is ``D = O + r3 e^{iβ}``:
+rocker D→B has length r4; the second ground pivot is ``D = O + r3 e^{iβ}``::
 
     (3-9)   r e^{iδ} = r1 e^{iα} + r2 e^{iψ}
     (3-10)  r e^{iδ} = r3 e^{iβ} + r4 e^{iθ} + r5 e^{iφ}
 
-Eliminating ψ and θ gives the linear-in-parameters equations
+Eliminating ψ and θ gives the linear-in-parameters equations::
 
     (3-11/13)  K1·[2r cos(δ − α)] + K2 = r²,   K1 = r1, K2 = r2² − r1²
     (3-12/14)  k1·[2r cos(β − δ)] + k2·[2r cos(φ − δ)] + k3 = r² + k4·[2 cos(β − φ)],

@@ -31,7 +31,7 @@ THETA[2, 0, 1], THETA[2, 1, 0] = -1.0, 1.0
 THETA[3, 0, 3] = 1.0
 THETA[4, 1, 3] = 1.0
 THETA[5, 2, 3] = 1.0
-#: δ_j of Eq. (7-60): tr(Θ_j Θ_kᵀ) = δ_jk / δ_j
+#: the factors δ_j of Eq. (7-60), j = 1…6: tr(Θ_j Θ_kᵀ) = δ_jk / δ_j
 DELTA = np.array([0.5, 0.5, 0.5, 1.0, 1.0, 1.0])
 
 

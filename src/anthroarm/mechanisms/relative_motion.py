@@ -5,13 +5,19 @@ is joined to link 2 by a cylindrical pair, turning φ about and sliding s along 
 (initially u₁ through p₁).  q₁ is the initial position of a point of link 3
 (θ = φ = s = 0).  All vectors in the fixed frame (link 1), m and rad.
 
-Position (4-1)–(4-6):
+Position (4-1)–(4-6)::
+
     q₁′ = [R_{θ,u₀}](q₁ − p₀) + p₀,  p₁′ = [R_{θ,u₀}](p₁ − p₀) + p₀,  u = [R_{θ,u₀}] u₁,
     p = p₁′ + s u,  q = [R_{φ,u}](q₁′ − p₁′) + p₁′ + s u   (screw matrix [S_{φ,s,u,p₁′}]).
-Velocity (4-7)–(4-11) (transport + relative):
+
+Velocity (4-7)–(4-11) (transport + relative)::
+
     q̇ = ṗ₀ + [W_{θ̇,u₀}](q − p₀)  +  [W_{φ̇,u}](q − p) + ṡ u.
-Acceleration (4-12)–(4-17) (transport + relative + Coriolis):
+
+Acceleration (4-12)–(4-17) (transport + relative + Coriolis)::
+
     q̈ = p̈₀ + [E_{θ̇,θ̈,u₀}](q − p₀) + [E_{φ̇,φ̈,u}](q − p) + s̈ u + 2[W_{θ̇,u₀}]([W_{φ̇,u}](q − p) + ṡ u),
+
 where [E_{φ̇,φ̈,u}] has no [Ṗ_u] term (the relative motion is taken in link 2, where u is
 fixed).  The printed (4-9) has u₀ for u and s for ṡ, (4-14) ṡ for s̈, and (4-16) a misplaced
 bracket; (4-17) is printed correctly (docs/errata.md, "002 text").

@@ -10,33 +10,33 @@ Segment lengths, masses, centres of mass and radii of gyration come from de Leva
 "Adjustments to Zatsiorsky–Seluyanov's segment inertia parameters", J. Biomech. 29(9),
 Table 4, scaled by body height (lengths, linearly) and body mass (masses, linearly):
 
-======== ===== ======= ======= ====== =========================
-segment  sex   length  mass %  CoM %  radii of gyration % (sag, trans, long)
-======== ===== ======= ======= ====== =========================
-upperarm male  281.7   2.71    57.72  28.5, 26.9, 15.8
-forearm  male  268.9   1.62    45.74  27.6, 26.5, 12.1
-hand     male   86.2   0.61    79.00  62.8, 51.3, 40.1
-upperarm female 275.1  2.55    57.54  27.8, 26.0, 14.8
-forearm  female 264.3  1.38    45.59  26.1, 25.7,  9.4
-hand     female  78.0  0.56    74.74  53.1, 45.4, 33.5
-======== ===== ======= ======= ====== =========================
+======== ====== ======= ======= ====== =========================================
+segment  sex    length  mass %  CoM %  radii of gyration % (sag, trans, long)
+======== ====== ======= ======= ====== =========================================
+upperarm male   281.7   2.71    57.72  28.5, 26.9, 15.8
+forearm  male   268.9   1.62    45.74  27.6, 26.5, 12.1
+hand     male   86.2    0.61    79.00  62.8, 51.3, 40.1
+upperarm female 275.1   2.55    57.54  27.8, 26.0, 14.8
+forearm  female 264.3   1.38    45.59  26.1, 25.7, 9.4
+hand     female 78.0    0.56    74.74  53.1, 45.4, 33.5
+======== ====== ======= ======= ====== =========================================
 
 Lengths in mm for the reference statures 1741 mm (male) and 1735 mm (female); the hand segment
 runs from the wrist joint centre to the 3rd metacarpale, and H is placed at its end.
 
 Joint ranges (degrees), from the book's Table 2.2 (l. 527–534) where it has a row:
 
-========================= ====== =========== ===================================================
-joint                     axis   range       source
-========================= ====== =========== ===================================================
-shoulder_flexion          x      −50 … 180   Table 2.2 θ2 (+180, −(40…60): mid value −50)
-shoulder_abduction        y     −180 … 30    not in Table 2.2: AAOS abduction 180, adduction 30
-shoulder_rotation         z      −90 … 90    Table 2.2 θ3 (upper-arm rotation ±90)
-elbow_flexion             x       −5 … 145   Table 2.2 θ4
-forearm_pronation         z      −90 … 90    Table 2.2 θ5
-wrist_deviation           y      −30 … 20    not in Table 2.2 (book notes: missing row); AAOS
-wrist_flexion             x      −70 … 55    Table 2.2 θ6 (+(50…60): mid value 55, −70)
-========================= ====== =========== ===================================================
+================== ==== ========= ==================================================
+joint              axis range     source
+================== ==== ========= ==================================================
+shoulder_flexion   x    −50 … 180 Table 2.2 θ2 (+180, −(40…60): mid value −50)
+shoulder_abduction y    −180 … 30 not in Table 2.2: AAOS abduction 180, adduction 30
+shoulder_rotation  z    −90 … 90  Table 2.2 θ3 (upper-arm rotation ±90)
+elbow_flexion      x    −5 … 145  Table 2.2 θ4
+forearm_pronation  z    −90 … 90  Table 2.2 θ5
+wrist_deviation    y    −30 … 20  not in Table 2.2 (book notes: missing row); AAOS
+wrist_flexion      x    −70 … 55  Table 2.2 θ6 (+(50…60): mid value 55, −70)
+================== ==== ========= ==================================================
 
 For a right arm, abduction (hand moving to +x) is a negative rotation about +y; flexion moves
 the hand forward (+y).  Table 2.2's θ1 (internal/external rotation +45/−90) overlaps its θ3;

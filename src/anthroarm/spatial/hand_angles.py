@@ -8,7 +8,7 @@ horizontal plane, pitched down by β and rolled about its own axis by γ:
 (the book's text labels the last two factors C_z(−β)C_x(−γ), but its printed matrices are
 C_x(−β)C_z(−γ)).  The hand points along −z_H = (cos α cos β, sin α cos β, −sin β): α is the
 azimuth from +x toward +y, β > 0 pitches downward, γ is the roll.  The product has
-element (1,3) = **−**cos α cos β; the book prints +cos α cos β (non-orthogonal), and its
+element (1,3) = −cos α cos β (minus); the book prints +cos α cos β (non-orthogonal), and its
 inverse (6-47) α = tan⁻¹(−c₂₃/c₁₃) then returns −α.  Corrected inverse (cos β > 0):
 
     α = atan2(−c₂₃, −c₁₃),   β = asin c₃₃,   γ = atan2(−c₃₁, c₃₂).

@@ -5,7 +5,7 @@ Step 1: values S_i at the n+1 vertices; best X_L, worst X_H, second worst X_G (4
 Step 2: centroid without X_H, ``X_F = (Σ X_i − X_H)/n`` (4-55); reflection ``X_R = 2X_F − X_H``.
 Step 3: if S_R ≥ S_G compress: ``X_S = (1 − λ)X_H + λX_R``, 0 < λ < 1, λ ≠ ½ (4-59)/(4-60).
 Step 4: if S_R < S_G expand: ``X_B = (1 − μ)X_H + μX_R``, μ > 1 (4-61); X_S = X_B if S_B < S_R
-        else X_R (the stricter test S_R < S_L is an option).
+else X_R (the stricter test S_R < S_L is an option).
 Step 5: if S_S < S_G replace X_H by X_S, else step 6: shrink towards X_L, ``X_i = (X_i + X_L)/2``.
 Step 7: stop when ``Σ (S_i − S_L)² < ε1`` (4-63) or ``|(S_H − S_L)/S_L| < ε2`` (4-64).
 

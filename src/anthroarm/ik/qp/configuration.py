@@ -43,6 +43,8 @@ class IKConfiguration:
         for a continuous joint).  It may lie outside the joint limits: the limits of
         :func:`anthroarm.ik.qp.step` then pull it back inside.
 
+    Notes
+    -----
     ``lower``/``upper`` are the limits in q order (``robot.chain.lower``/``upper``, read-only;
     ±1 on a continuous joint's entries, which :meth:`within_limits` does not test).
     """

@@ -1,4 +1,4 @@
-"""One step of QP differential IK: the joint velocity that best achieves the tasks within limits.
+"""One step of QP differential IK: the joint velocity that best achieves the tasks within limits::
 
     min_Δq  Σ_tasks ½‖W(J Δq + α e)‖² + ½ μ‖Δq‖² + ½ λ‖Δq‖²
     s.t.    lo(q, dt) ≤ Δq ≤ hi(q, dt)        (limits, combined by priority: always feasible)
@@ -41,10 +41,15 @@ from .tasks.base import Task
 class StepResult:
     """Output of :func:`step` with ``full=True``.
 
-    v : (nv,) joint velocity (rad/s, m/s); zero when ``status`` is not ``"optimal"``.
-    status : ``"optimal"``, ``"infeasible"`` (hard constraints cannot hold inside the limits)
+    Attributes
+    ----------
+    v : (nv,) array
+        Joint velocity (rad/s, m/s); zero when ``status`` is not ``"optimal"``.
+    status : str
+        ``"optimal"``, ``"infeasible"`` (hard constraints cannot hold inside the limits)
         or ``"failed"`` (solver error).
-    lo, hi : the combined box on Δq that the step respected.
+    lo, hi : (nv,) arrays
+        The combined box on Δq that the step respected.
     """
 
     v: np.ndarray
