@@ -260,3 +260,15 @@ def test_default_pinocchio_limits_mean_unbounded():
     Q = r.random_q(1000, rng=0)
     assert np.all(np.isfinite(Q)) and np.all(np.abs(Q) <= np.pi)
     np.testing.assert_allclose(r.fk(Q)[:, 2, 3], 0.5 * np.cos(Q[:, 0]), atol=1e-15)   # Ry(θ) e_z · 0.5
+
+
+def test_batched_positions_equal_pinocchio():
+    r = aa.load("kinova")
+    Q = r.random_q(50, rng=4)
+    d = r.model.createData()
+    P = r.chain.serial().positions(Q)
+    for q, p in zip(Q, P):
+        pin.framesForwardKinematics(r.model, d, q)
+        np.testing.assert_allclose(p, d.oMf[r.tool_id].translation, atol=1e-12)
+    assert r.chain.serial().positions(Q[0]).shape == (3,)
+    assert aa.batch.reachability_map is not None        # aa.batch is a lazy attribute

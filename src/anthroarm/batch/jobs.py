@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from ..ik.cells import MAX_LATTICE, lattice
 from . import engine
 from .describe import RobotDescription, describe, robot_from
 from .errors import JobTooLargeError
@@ -110,15 +111,14 @@ def _voxel_coords(lo, shape, voxel):
 def _positions_blocks(robot, p):
     """The task's random configurations in cache-sized blocks: yields (Q (B, nq), [x, y, z])
     with x, y, z (B,) the positions (m, base frame) of ``p["frame"]`` by the batched FK
-    (:class:`~anthroarm.kinematics.batched.SerialChain`: the translation part of its ``fk``,
-    without assembling the 4×4 matrices)."""
+    (:meth:`~anthroarm.kinematics.batched.SerialChain.positions`: no 4×4 matrices)."""
     rng = np.random.default_rng(p["seed"])
     ser = robot.chain.serial(p["frame"])
     n = p["n"]
     for a in range(0, n, BLOCK):
         Q = robot.chain.random_q(min(BLOCK, n - a), rng=rng)
-        _, xyz, _ = ser._walk(Q, False)   # noqa: SLF001  the fk's own walk, positions only
-        yield Q, [np.broadcast_to(np.asarray(c, float), (Q.shape[0],)) for c in xyz]
+        xyz = ser.positions(Q)
+        yield Q, [xyz[:, 0], xyz[:, 1], xyz[:, 2]]
 
 
 def _flat_index(xyz, lo, voxel, shape):
@@ -498,10 +498,8 @@ def cell_table(robot, rotation=None, D: float = 0.05, bounds=None, *, q_ref=None
         raise ValueError(f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, bounds={bounds!r}")
     if robot.spec is None:
         raise ValueError(f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is None)")
-    # the lattice of CellTable.build: integer multiples of D from the base origin
-    i0, i1 = np.floor(lo / D + 1e-9).astype(int), np.ceil(hi / D - 1e-9).astype(int)
-    shape = tuple(int(x) for x in (i1 - i0 + 1))
-    if np.prod(shape) > 5_000_000:
+    i0, shape = lattice(lo, hi, D)      # the lattice of CellTable.build
+    if np.prod(shape) > MAX_LATTICE:
         raise JobTooLargeError(f"lattice of {shape} points is too large. Remedy: increase D or shrink bounds")
     chunk_size = _positive_int(chunk_size, "chunk_size")
     payloads = []

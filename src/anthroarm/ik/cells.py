@@ -71,6 +71,19 @@ class CellLookup:
     ok: np.ndarray
 
 
+#: the most lattice points a cell table may have
+MAX_LATTICE = 5_000_000
+
+
+def lattice(lo, hi, D: float) -> tuple[np.ndarray, tuple[int, int, int]]:
+    """The §7-3 lattice covering the box [lo, hi] (m, base frame): points at integer multiples
+    of the cell size ``D`` (m) from the base origin.  Returns (i0, shape): the integer index of
+    the first point per axis (its position is i0·D) and the number of points per axis."""
+    i0 = np.floor(np.asarray(lo, float) / D + 1e-9).astype(int)
+    i1 = np.ceil(np.asarray(hi, float) / D - 1e-9).astype(int)
+    return i0, tuple(int(x) for x in (i1 - i0 + 1))
+
+
 class CellTable:
     """Joint-angle lattice of one robot for one fixed hand orientation (book §7-3).
 
@@ -117,10 +130,8 @@ class CellTable:
         lo, hi = (np.asarray(b, float) for b in bounds)
         if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi <= lo).any():
             raise ValueError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
-        i0 = np.floor(lo / D + 1e-9).astype(int)
-        i1 = np.ceil(hi / D - 1e-9).astype(int)
-        shape = tuple(int(x) for x in (i1 - i0 + 1))
-        if np.prod(shape) > 5_000_000:
+        i0, shape = lattice(lo, hi, D)
+        if np.prod(shape) > MAX_LATTICE:
             raise ValueError(f"lattice of {shape} points is too large; increase D")
         origin = i0 * D
         if q_ref is None:

@@ -229,6 +229,14 @@ class SerialChain:
         T = self._pose(R, p, q2.shape[0])
         return T[0] if single else T
 
+    def positions(self, q) -> np.ndarray:
+        """Tool position only (m, base frame), (3,) or (N, 3): the translation of :meth:`fk`
+        without assembling the rotations into 4×4 matrices."""
+        q2, single = self._batch(q)
+        _, p, _ = self._walk(q2, keep_joints=False)
+        xyz = np.column_stack([np.broadcast_to(np.asarray(c, float), (q2.shape[0],)) for c in p])
+        return xyz[0] if single else xyz
+
     def fk_jacobian(self, q) -> tuple[np.ndarray, np.ndarray]:
         """Tool pose and its LOCAL_WORLD_ALIGNED Jacobian (6 × nv, rows (v; ω)) in one pass."""
         q2, single = self._batch(q)
