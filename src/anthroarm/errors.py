@@ -105,3 +105,18 @@ class MeshError(AnthroarmError, ValueError):
         self.problem = problem
         where = f" (mesh of link {link!r})" if link is not None else ""
         super().__init__(f"{self.path}{where}: {problem}")
+
+
+class SingularMassMatrixError(InertiaError):
+    """M(q) is singular or too ill-conditioned for forward dynamics at this configuration: a
+    joint moves (almost) no mass or inertia there (e.g. a point mass on the axis of the joint
+    above it).  ``q`` is the configuration (robot layout), ``cond`` the condition number of
+    M(q) (``inf`` when it is exactly singular), ``joint`` the joint that moves least.  Forward
+    dynamics has no unique answer there; Pinocchio's ``aba`` returns accelerations of ~1e30
+    without a warning."""
+
+    def __init__(self, message: str, q=None, cond: float = float("inf"), joint: str | None = None):
+        self.q = q
+        self.cond = cond
+        self.joint = joint
+        super().__init__(message)

@@ -79,6 +79,9 @@ from ..codegen.graph import Graph, emit_python, snap
 
 #: bump when the generated code changes (part of the cache key)
 GENERATOR_VERSION = "2"
+#: forward dynamics refuses M(q) whose reciprocal condition number (estimated from the Cholesky
+#: pivots) is below this: :class:`~anthroarm.errors.SingularMassMatrixError`
+SINGULAR_RCOND = 1e-12
 
 
 
@@ -607,15 +610,65 @@ class LagrangeDynamics:
         return self._call("momentum", q, qd)
 
     def forward(self, q, qd, tau):
-        """Forward dynamics q̈ = M⁻¹(τ − C q̇ − g) (Cholesky solve), rad/s²."""
+        """Forward dynamics q̈ = M⁻¹(τ − C q̇ − g) (Cholesky solve), rad/s².
+
+        Raises :class:`~anthroarm.errors.SingularMassMatrixError` (an :class:`InertiaError`,
+        so a :class:`ValueError`) naming q, the condition number and the joint that moves least
+        when M(q) is singular or its estimated condition number exceeds ``1 / SINGULAR_RCOND``
+        (= 1e12: fewer than ~4 significant digits would be left in q̈) — e.g. a point mass on
+        the axis of the joint above it.  No regularised answer is returned: there the
+        acceleration of that joint is not determined by the model (Pinocchio's ``aba`` returns
+        ~1e30 rad/s² without a warning on the same model).  A ``ValueError`` when finite inputs
+        give accelerations beyond the float range."""
         M = self.mass_matrix(q)
         rhs = self._arr(tau, "tau") - self.coriolis(q, qd) - self.gravity(q)
-        if M.ndim == 2:
-            L = np.linalg.cholesky(M)
-            return np.linalg.solve(L.T, np.linalg.solve(L, rhs))
-        if rhs.ndim == 1:
+        if M.ndim == 3 and rhs.ndim == 1:
             rhs = np.broadcast_to(rhs, (M.shape[0], self.n))
-        return np.linalg.solve(M, rhs[..., None])[..., 0]
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            L = None
+        if L is None or not self._well_conditioned(L):
+            self._raise_singular(q, M, L)
+        if M.ndim == 2:
+            a = _tri_solve(L, rhs)
+        else:
+            a = np.linalg.solve(M, rhs[..., None])[..., 0]
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"{self.info.name}: forward dynamics overflows for tau = {np.asarray(tau).tolist()} "
+                             "(accelerations beyond the float range); use torques of a physical size")
+        return a
+
+    @staticmethod
+    def _well_conditioned(L) -> bool:
+        # cond(M) >= (max L_ii / min L_ii)^2: the pivots of the Cholesky factor give a cheap
+        # lower bound; the exact value is computed only for the message
+        d = np.diagonal(L, axis1=-2, axis2=-1)
+        lo, hi = d.min(axis=-1), d.max(axis=-1)
+        return bool(np.all(lo * lo > SINGULAR_RCOND * hi * hi))
+
+    def _raise_singular(self, q, M, L):
+        from ..errors import SingularMassMatrixError
+
+        q = np.asarray(q, dtype=float)
+        Ms, Qs = (M[None], q[None]) if M.ndim == 2 else (M, np.broadcast_to(q, (M.shape[0], self.nq)))
+        ev_all = np.linalg.eigvalsh(Ms)
+        rc = ev_all[:, 0] / np.maximum(ev_all[:, -1], 1e-300)
+        k = int(np.argmin(rc))
+        w, V = np.linalg.eigh(Ms[k])
+        cond = float("inf") if w[0] <= 0 else float(w[-1] / w[0])
+        joint = self.joint_names[int(np.argmax(np.abs(V[:, 0])))]
+        where = "" if M.ndim == 2 else f" (batch item {k})"
+        raise SingularMassMatrixError(
+            f"{self.info.name}: the mass matrix is singular at q = {Qs[k].tolist()}{where}: condition number "
+            f"{cond:.3g} (limit {1 / SINGULAR_RCOND:.0e}); joint {joint!r} moves (almost) no mass or inertia "
+            "there, so its acceleration is not determined. Give the links beyond it mass or rotational inertia "
+            "about that joint's axis, or avoid this configuration", q=Qs[k].copy(), cond=cond, joint=joint)
+
+
+def _tri_solve(L, b):
+    """x with L Lᵀ x = b (the two solves on the Cholesky factor)."""
+    return np.linalg.solve(L.T, np.linalg.solve(L, b))
 
 
 def load(model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy") -> LagrangeDynamics:

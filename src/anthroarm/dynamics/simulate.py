@@ -21,6 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import SingularMassMatrixError
+
 
 @dataclass
 class SimResult:
@@ -98,7 +100,11 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     N m s/rad, >= 0.  ``dt``: RK4 step and output spacing (s).  ``engine``: "lagrange" (the
     generated code) or "pin" (``pin.aba``; the model is the system's pin model or
     ``pin_model``).  NaN/inf initial states raise ``ValueError``; a state or drive torque that
-    becomes non-finite during the run ends it with ``status = "diverged: ..."``.
+    becomes non-finite during the run ends it with ``status = "diverged: ..."``; a configuration
+    where M(q) is singular (:class:`~anthroarm.errors.SingularMassMatrixError` from
+    :meth:`~.lagrange.LagrangeDynamics.forward`) ends it with ``status = "singular: ..."`` (the
+    trajectory up to the last step before it is kept).  ``engine="pin"`` integrates whatever
+    ``pin.aba`` returns there (~1e30 rad/s², then ``"diverged"``).
 
     q0 and the returned q are in the robot's layout (nq); q̇ has nv entries.  With continuous
     joints (nq > nv: (cos θ, sin θ) pairs) the integrator runs on the joint angles θ, which
@@ -186,14 +192,18 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
             X = X[: k + 1]
             t = t[: k + 1]
             status = f"diverged: {exc}"
+        except SingularMassMatrixError as exc:
+            X = X[: k + 1]
+            t = t[: k + 1]
+            status = f"singular: {exc}"
     else:
         from scipy.integrate import solve_ivp
 
         try:
             sol = solve_ivp(rhs, (0.0, t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
-        except FloatingPointError as exc:  # solve_ivp keeps no partial output: report the start
+        except (FloatingPointError, SingularMassMatrixError) as exc:  # solve_ivp keeps no partial output
             X, t = x0[None], t[:1]
-            status = f"diverged: {exc}"
+            status = f"{'diverged' if isinstance(exc, FloatingPointError) else 'singular'}: {exc}"
         else:
             if not sol.success:
                 status = f"solve_ivp failed: {sol.message}"
