@@ -60,3 +60,75 @@ def test_rssr_crank_test_rejects_bad_sample_counts(samples):
     g = RSSRGeometry(a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3])
     with pytest.raises(ValueError, match="samples"):
         rssr_crank_test(g, samples=samples)
+
+
+# ----------------------------------------------------------------- fourbar at extreme scales
+FOURBAR = (4.0, 1.5, 3.5, 3.0)   # the module docstring's crank-rocker
+
+
+@pytest.mark.parametrize("scale", [1e-155, 1e-100, 1e100, 1e155, 1e300])
+@pytest.mark.parametrize("kind", ["complex", "cartesian"])
+def test_fourbar_angles_do_not_depend_on_the_length_unit(scale, kind):
+    """Mathematics: angles and angular rates of a linkage are invariant under scaling its lengths."""
+    import warnings
+
+    from anthroarm.mechanisms.fourbar import fourbar, fourbar_cartesian
+
+    def run(s):
+        r1, r2, r3, r4 = (s * x for x in FOURBAR)
+        if kind == "complex":
+            return fourbar(r1, r2, r3, r4, 0.7, omega2=2.0, alpha2=-1.0)
+        return fourbar_cartesian((r1, 0.0), r2, r3, r4, 0.7, omega2=2.0, alpha2=-1.0)
+
+    ref = run(1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        got = run(scale)
+    assert got.status == "ok"
+    for k in ("theta3", "theta4", "omega3", "omega4", "alpha3", "alpha4"):
+        assert math.isclose(getattr(got, k), getattr(ref, k), rel_tol=1e-12, abs_tol=1e-12), k
+    assert math.isclose(got.d, scale * ref.d, rel_tol=1e-12)
+    assert got.residual <= 1e-12 * scale
+
+
+@pytest.mark.parametrize("scale", [1e-155, 1.0, 1e155])
+def test_fourbar_range_and_grashof_at_extreme_scales(scale):
+    from anthroarm.mechanisms.fourbar import fourbar_grashof, fourbar_input_range
+
+    L = [scale * x for x in FOURBAR]
+    assert fourbar_grashof(*L) == "crank-rocker"
+    assert fourbar_input_range(*L).full_turn
+
+
+@pytest.mark.parametrize("omega2, alpha2", [(1e300, 0.0), (-1e300, 0.0), (1e160, 0.0)])
+def test_fourbar_unrepresentable_rates_are_a_value_error(omega2, alpha2):
+    import warnings
+
+    from anthroarm.mechanisms.fourbar import fourbar, fourbar_cartesian
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(ValueError, match="beyond the float range"):
+            fourbar(*FOURBAR, 0.7, omega2=omega2, alpha2=alpha2)
+        with pytest.raises(ValueError, match="beyond the float range"):
+            fourbar_cartesian((FOURBAR[0], 0.0), *FOURBAR[1:], 0.7, omega2=omega2, alpha2=alpha2)
+
+
+def test_fourbar_large_but_representable_rates():
+    """th2' = 1e150 rad/s: accelerations ~1e300 are representable; they scale as th2'^2."""
+    from anthroarm.mechanisms.fourbar import fourbar
+
+    ref = fourbar(*FOURBAR, 0.7, omega2=1.0)
+    got = fourbar(*FOURBAR, 0.7, omega2=1e150)
+    assert math.isclose(got.omega4, 1e150 * ref.omega4, rel_tol=1e-12)
+    assert math.isclose(got.alpha4, 1e300 * ref.alpha4, rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("lengths", [(1e-160, 1.0, 1.0, 1.0), (1.0, 1.0, 1e160, 1.0), (1e-320, 1.0, 1.0, 1.0)])
+def test_fourbar_length_ratio_beyond_the_float_range(lengths):
+    from anthroarm.mechanisms.fourbar import fourbar, fourbar_input_range
+
+    with pytest.raises(ValueError, match="differ by a factor"):
+        fourbar(*lengths, 0.3)
+    with pytest.raises(ValueError, match="differ by a factor"):
+        fourbar_input_range(*lengths)

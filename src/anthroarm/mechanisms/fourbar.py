@@ -16,6 +16,13 @@ angles from +x, counter-clockwise positive, rad; lengths in m (any consistent un
 r2 = crank O2-A, r3 = coupler A-B, r4 = rocker O4-B.  The loop is
 ``r2 e^{i th2} + r3 e^{i th3} = r1 + r4 e^{i th4}`` (5-18).
 
+Scale: lengths may have any magnitude the float range holds, but the longest link may be at
+most ``MAX_LENGTH_RATIO`` (1e150) times the shortest (``ValueError`` otherwise).  Every formula runs on lengths divided by the longest link and on rates divided by a
+rate scale (the largest of |th2'|, |th3'|, |th4'|, sqrt|th2''|), so angles do not depend on
+the unit of length (1e-155 m and 1e155 m give the same angles) and no intermediate square
+overflows.  A result that is itself beyond the float range (e.g. th2' = 1e300 rad/s, whose
+accelerations are ~1e600) is a ``ValueError`` naming the quantity.
+
 Branches: ``branch=+1`` is the book's (5-16) ``th3 = th_d + arccos(...)``; ``branch=-1`` is the
 other assembly mode ``th_d - arccos(...)``.
 
@@ -45,6 +52,8 @@ from ._util import finite_array, finite_scalar, out, positive_length
 DEAD_POINT_TOL = 1e-7
 #: the cosine of (5-16) may exceed 1 by this much (round-off at a toggle) and still assemble
 ASSEMBLY_TOL = 1e-12
+#: longest / shortest link above this is a ValueError (squares of the ratio must stay in range)
+MAX_LENGTH_RATIO = 1e150
 
 __all__ = [
     "FourBarState", "CouplerPoint", "FourBarRange",
@@ -127,8 +136,11 @@ class FourBarRange:
 
 
 def _lengths(r1, r2, r3, r4):
-    return (positive_length("r1", r1), positive_length("r2", r2),
-            positive_length("r3", r3), positive_length("r4", r4))
+    r = (positive_length("r1", r1), positive_length("r2", r2), positive_length("r3", r3), positive_length("r4", r4))
+    if max(r) > MAX_LENGTH_RATIO * min(r):
+        raise ValueError(f"link lengths {list(r)} differ by a factor above {MAX_LENGTH_RATIO:.0e}: the squares of "
+                         "their ratios are not representable; such a linkage cannot be computed in floating point")
+    return r
 
 
 def _branch(branch) -> int:
@@ -166,9 +178,10 @@ def _finish(r1, r2, r3, r4, branch, th2, th3, th4, d, thd, k, ground_angle, gx, 
     s34 = np.sin(th3 - th4)
     dead = assembled & (np.abs(s34) < DEAD_POINT_TOL)
     # loop residual r2 + r3 - r1 - r4 (vector), Eq. (5-18)
-    rx = r2 * np.cos(th2) + r3 * np.cos(th3) - gx - r4 * np.cos(th4)
-    ry = r2 * np.sin(th2) + r3 * np.sin(th3) - gy - r4 * np.sin(th4)
-    res = np.hypot(rx, ry)
+    L = max(r1, r2, r3, r4)
+    rx = (r2 / L) * np.cos(th2) + (r3 / L) * np.cos(th3) - gx / L - (r4 / L) * np.cos(th4)
+    ry = (r2 / L) * np.sin(th2) + (r3 / L) * np.sin(th3) - gy / L - (r4 / L) * np.sin(th4)
+    res = L * np.hypot(rx, ry)
     return FourBarState(
         r1=r1, r2=r2, r3=r3, r4=r4, branch=branch,
         theta2=out(th2), theta3=out(th3), theta4=out(th4), d=out(d), theta_d=out(thd),
@@ -177,6 +190,20 @@ def _finish(r1, r2, r3, r4, branch, th2, th3, th4, d, thd, k, ground_angle, gx, 
         omega2=out(np.zeros_like(th2)), omega3=out(np.zeros_like(th2)), omega4=out(np.zeros_like(th2)),
         alpha2=out(np.zeros_like(th2)), alpha3=out(np.zeros_like(th2)), alpha4=out(np.zeros_like(th2)),
     )
+
+
+def _representable(name: str, x, why: str):
+    """``x`` (computed with overflow warnings off) or ``ValueError`` when it holds inf/NaN."""
+    x = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"{name} is beyond the float range ({why}); use smaller rates or other units")
+    return x
+
+
+def _rate_scale(*rates):
+    """Elementwise max(|w2|, |w3|, |w4|, sqrt|a2|) (1 where all are 0): rates / scale are <= 1."""
+    om = np.maximum.reduce([np.abs(np.asarray(r, dtype=float)) for r in rates[:-1]] + [np.sqrt(np.abs(rates[-1]))])
+    return np.where(om > 0, om, 1.0)
 
 
 def _cosine(r3, r4, d, scale):
@@ -201,13 +228,15 @@ def fourbar_position(r1, r2, r3, r4, theta2, branch: int = 1) -> FourBarState:
     r1, r2, r3, r4 = _lengths(r1, r2, r3, r4)
     branch = _branch(branch)
     th2 = finite_array("theta2", theta2)
-    zd = r1 - r2 * np.exp(1j * th2)                        # d e^{i th_d} = r1 - r2 e^{i th2}  (5-12)
-    d = np.abs(zd)                                          # (5-13)
+    L = max(r1, r2, r3, r4)                                 # lengths / L: no square overflows
+    n1, n2, n3, n4 = r1 / L, r2 / L, r3 / L, r4 / L
+    zd = n1 - n2 * np.exp(1j * th2)                         # d e^{i th_d} = r1 - r2 e^{i th2}  (5-12)
+    dn = np.abs(zd)                                         # (5-13), d / L
     thd = np.angle(zd)                                      # (5-14) with atan2
-    k = _cosine(r3, r4, d, r1 + r2 + r3 + r4)
+    k = _cosine(n3, n4, dn, n1 + n2 + n3 + n4)
     th3 = thd + branch * np.arccos(np.clip(k, -1.0, 1.0))   # (5-16), both branches
-    th4 = np.arctan2(r3 * np.sin(th3) - d * np.sin(thd), r3 * np.cos(th3) - d * np.cos(thd))  # (5-17) corr.
-    return _finish(r1, r2, r3, r4, branch, th2, th3, th4, d, thd, k, 0.0, r1, 0.0)
+    th4 = np.arctan2(n3 * np.sin(th3) - dn * np.sin(thd), n3 * np.cos(th3) - dn * np.cos(thd))  # (5-17) corr.
+    return _finish(r1, r2, r3, r4, branch, th2, th3, th4, dn * L, thd, k, 0.0, r1, 0.0)
 
 
 def _rates_mask(state):
@@ -225,8 +254,11 @@ def fourbar_velocity(state: FourBarState, omega2) -> FourBarState:
     th2, th3, th4 = (np.asarray(x, dtype=float) for x in (state.theta2, state.theta3, state.theta4))
     good = _rates_mask(state)
     den = np.where(good, np.sin(th3 - th4), 1.0)
-    w3 = np.where(good, w2 * state.r2 * np.sin(th4 - th2) / (state.r3 * den), 0.0)
-    w4 = np.where(good, w2 * state.r2 * np.sin(th3 - th2) / (state.r4 * den), 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        w3 = np.where(good, w2 * ((state.r2 / state.r3) * np.sin(th4 - th2) / den), 0.0)
+        w4 = np.where(good, w2 * ((state.r2 / state.r4) * np.sin(th3 - th2) / den), 0.0)
+    w3 = _representable("omega3", w3, f"omega2 = {np.max(np.abs(w2)):.3g} rad/s near a dead point")
+    w4 = _representable("omega4", w4, f"omega2 = {np.max(np.abs(w2)):.3g} rad/s near a dead point")
     return replace(state, omega2=out(w2), omega3=out(w3), omega4=out(w4))
 
 
@@ -243,16 +275,22 @@ def fourbar_acceleration(state: FourBarState, alpha2=0.0) -> FourBarState:
     a2 = np.broadcast_to(finite_array("alpha2", alpha2), np.shape(state.theta2)).astype(float)
     th2, th3, th4 = (np.asarray(x, dtype=float) for x in (state.theta2, state.theta3, state.theta4))
     w2, w3, w4 = (np.asarray(x, dtype=float) for x in (state.omega2, state.omega3, state.omega4))
-    r2, r3, r4 = state.r2, state.r3, state.r4
+    L = max(state.r1, state.r2, state.r3, state.r4)
+    r2, r3, r4 = state.r2 / L, state.r3 / L, state.r4 / L     # lengths / L and rates / om (<= 1)
+    om = _rate_scale(w2, w3, w4, a2)
+    w2, w3, w4, a2n = w2 / om, w3 / om, w4 / om, (a2 / om) / om
     # the complex method works in the ground frame (r1 on +x): rotate absolute angles back
     g = state.ground_angle
     t2, t3, t4 = th2 - g, th3 - g, th4 - g
-    A = r2 * a2 * np.sin(t2) + r2 * w2**2 * np.cos(t2) + r3 * w3**2 * np.cos(t3) - r4 * w4**2 * np.cos(t4)
-    B = -r2 * a2 * np.cos(t2) + r2 * w2**2 * np.sin(t2) + r3 * w3**2 * np.sin(t3) - r4 * w4**2 * np.sin(t4)
+    A = r2 * a2n * np.sin(t2) + r2 * w2**2 * np.cos(t2) + r3 * w3**2 * np.cos(t3) - r4 * w4**2 * np.cos(t4)
+    B = -r2 * a2n * np.cos(t2) + r2 * w2**2 * np.sin(t2) + r3 * w3**2 * np.sin(t3) - r4 * w4**2 * np.sin(t4)
     good = _rates_mask(state)
     den = np.where(good, np.sin(th3 - th4), 1.0)
-    a3 = np.where(good, -(A * np.cos(t4) + B * np.sin(t4)) / (r3 * den), 0.0)
-    a4 = np.where(good, -(A * np.cos(t3) + B * np.sin(t3)) / (r4 * den), 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        a3 = np.where(good, om * (om * (-(A * np.cos(t4) + B * np.sin(t4)) / (r3 * den))), 0.0)
+        a4 = np.where(good, om * (om * (-(A * np.cos(t3) + B * np.sin(t3)) / (r4 * den))), 0.0)
+    why = f"rates up to {np.max(om):.3g} rad/s give accelerations of order their square"
+    a3, a4 = _representable("alpha3", a3, why), _representable("alpha4", a4, why)
     return replace(state, alpha2=out(a2), alpha3=out(a3), alpha4=out(a4))
 
 
@@ -288,26 +326,36 @@ def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch
     branch = _branch(branch)
     th2, w2, a2 = np.broadcast_arrays(finite_array("theta2", theta2), finite_array("omega2", omega2),
                                       finite_array("alpha2", alpha2))
-    r2x, r2y = r2 * np.cos(th2), r2 * np.sin(th2)
-    dx, dy = g[0] - r2x, g[1] - r2y
-    d = np.hypot(dx, dy)
+    L = max(r1, r2, r3, r4)                     # every vector / L: no product overflows
+    gn, n2, n3, n4 = g / L, r2 / L, r3 / L, r4 / L
+    r2x, r2y = n2 * np.cos(th2), n2 * np.sin(th2)
+    dx, dy = gn[0] - r2x, gn[1] - r2y
+    dn = np.hypot(dx, dy)
     thd = np.arctan2(dy, dx)
-    k = _cosine(r3, r4, d, r1 + r2 + r3 + r4)
+    k = _cosine(n3, n4, dn, n2 + n3 + n4 + r1 / L)
     th3 = thd + branch * np.arccos(np.clip(k, -1.0, 1.0))
-    r3x, r3y = r3 * np.cos(th3), r3 * np.sin(th3)
+    r3x, r3y = n3 * np.cos(th3), n3 * np.sin(th3)
     r4x, r4y = r3x - dx, r3y - dy
     th4 = np.arctan2(r4y, r4x)
-    s = _finish(r1, r2, r3, r4, branch, th2, th3, th4, d, thd, k, np.arctan2(g[1], g[0]), g[0], g[1])
+    s = _finish(r1, r2, r3, r4, branch, th2, th3, th4, dn * L, thd, k, np.arctan2(g[1], g[0]), g[0], g[1])
     # r4 from the closed form has length r4 only when assembled; use the unit direction times r4
-    r4x, r4y = r4 * np.cos(th4), r4 * np.sin(th4)
+    r4x, r4y = n4 * np.cos(th4), n4 * np.sin(th4)
     good = _rates_mask(s)
     den = np.where(good, r4x * r3y - r3x * r4y, 1.0)
-    w3 = np.where(good, w2 * (r2x * r4y - r2y * r4x) / den, 0.0)
-    w4 = np.where(good, w2 * (r2x * r3y - r3x * r2y) / den, 0.0)
-    A = r2y * a2 + r2x * w2**2 + r3x * w3**2 - r4x * w4**2
-    B = -r2x * a2 + r2y * w2**2 + r3y * w3**2 - r4y * w4**2
-    a3 = np.where(good, -(A * r4x + B * r4y) / den, 0.0)
-    a4 = np.where(good, -(A * r3x + B * r3y) / den, 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        w3 = np.where(good, w2 * ((r2x * r4y - r2y * r4x) / den), 0.0)
+        w4 = np.where(good, w2 * ((r2x * r3y - r3x * r2y) / den), 0.0)
+    why = f"omega2 = {np.max(np.abs(w2)):.3g} rad/s near a dead point"
+    w3, w4 = _representable("omega3", w3, why), _representable("omega4", w4, why)
+    om = _rate_scale(w2, w3, w4, a2)             # rates / om <= 1: no square overflows
+    v2, v3, v4, a2n = w2 / om, w3 / om, w4 / om, (a2 / om) / om
+    A = r2y * a2n + r2x * v2**2 + r3x * v3**2 - r4x * v4**2
+    B = -r2x * a2n + r2y * v2**2 + r3y * v3**2 - r4y * v4**2
+    with np.errstate(over="ignore", invalid="ignore"):
+        a3 = np.where(good, om * (om * (-(A * r4x + B * r4y) / den)), 0.0)
+        a4 = np.where(good, om * (om * (-(A * r3x + B * r3y) / den)), 0.0)
+    why = f"rates up to {np.max(om):.3g} rad/s give accelerations of order their square"
+    a3, a4 = _representable("alpha3", a3, why), _representable("alpha4", a4, why)
     return replace(s, omega2=out(w2), omega3=out(w3), omega4=out(w4),
                    alpha2=out(a2), alpha3=out(a3), alpha4=out(a4))
 
@@ -325,14 +373,15 @@ def coupler_point(state: FourBarState, p, gamma=0.0) -> CouplerPoint:
     w2, w3 = np.asarray(state.omega2, float), np.asarray(state.omega3, float)
     a2, a3 = np.asarray(state.alpha2, float), np.asarray(state.alpha3, float)
     e2, e3 = np.exp(1j * th2), np.exp(1j * (th3 + gamma))
-    z = state.r2 * e2 + p * e3
-    zd = 1j * state.r2 * w2 * e2 + 1j * p * w3 * e3
-    zdd = state.r2 * (1j * a2 - w2**2) * e2 + p * (1j * a3 - w3**2) * e3
+    with np.errstate(over="ignore", invalid="ignore"):
+        z = state.r2 * e2 + p * e3
+        zd = 1j * state.r2 * w2 * e2 + 1j * p * w3 * e3
+        zdd = state.r2 * (1j * a2 - w2**2) * e2 + p * (1j * a3 - w3**2) * e3
 
-    def xy(c):
-        return np.stack([c.real, c.imag], -1)
+    def xy(name, c):
+        return _representable(name, np.stack([c.real, c.imag], -1), "lengths times rates squared")
 
-    return CouplerPoint(xy(z), xy(zd), xy(zdd))
+    return CouplerPoint(xy("coupler point", z), xy("coupler point velocity", zd), xy("coupler point acceleration", zdd))
 
 
 def fourbar_points(state: FourBarState) -> dict:
@@ -357,6 +406,8 @@ def fourbar_input_range(r1, r2, r3, r4) -> FourBarRange:
     cos th2 in [(r1^2 + r2^2 - (r3 + r4)^2)/(2 r1 r2), (r1^2 + r2^2 - (r3 - r4)^2)/(2 r1 r2)].
     The input is a crank (``full_turn``) when that interval contains [-1, 1]."""
     r1, r2, r3, r4 = _lengths(r1, r2, r3, r4)
+    L = max(r1, r2, r3, r4)                     # scale-free: lengths / L
+    r1, r2, r3, r4 = r1 / L, r2 / L, r3 / L, r4 / L
     cmin = (r1 * r1 + r2 * r2 - (r3 + r4) ** 2) / (2 * r1 * r2)
     cmax = (r1 * r1 + r2 * r2 - (r3 - r4) ** 2) / (2 * r1 * r2)
     if cmin <= -1.0 and cmax >= 1.0:
@@ -376,6 +427,7 @@ def fourbar_grashof(r1, r2, r3, r4) -> str:
     """Grashof class: "crank-rocker", "double-crank", "double-rocker", "rocker-crank",
     "change-point" (s + l = p + q) or "triple-rocker" (non-Grashof)."""
     r = _lengths(r1, r2, r3, r4)
+    r = tuple(x / max(r) for x in r)            # scale-free (no overflow of the sums)
     s, l_ = min(r), max(r)
     pq = sum(r) - s - l_
     tol = 1e-12 * sum(r)
