@@ -132,3 +132,50 @@ def test_fourbar_length_ratio_beyond_the_float_range(lengths):
         fourbar(*lengths, 0.3)
     with pytest.raises(ValueError, match="differ by a factor"):
         fourbar_input_range(*lengths)
+
+
+# ------------------------------------------------------------- ik.qp limits and integration
+@pytest.mark.parametrize("v_max", [-1.0, -1e-12, [1, 1, 1, 1, 1, -2.0]])
+def test_qp_velocity_limit_rejects_negative_bounds(arm, v_max):
+    """A negative speed bound used to be silently replaced by "no limit"."""
+    from anthroarm.ik import qp
+
+    with pytest.raises(ValueError, match="v_max"):
+        qp.VelocityLimit(arm, v_max=v_max)
+
+
+def test_qp_configuration_limit_rejects_nan_bounds(arm):
+    from anthroarm.ik import qp
+
+    with pytest.raises(ValueError, match="NaN"):
+        qp.ConfigurationLimit(arm, lower=np.full(6, math.nan))
+    with pytest.raises(ValueError, match="NaN"):
+        qp.ConfigurationLimit(arm, upper=np.r_[np.ones(5), math.nan])
+
+
+@pytest.mark.parametrize("dt", [math.nan, math.inf, np.array(math.nan)])
+def test_qp_integrate_rejects_non_finite_dt(arm, dt):
+    from anthroarm.ik import qp
+
+    conf = qp.IKConfiguration(arm, arm.random_q(rng=3, margin=0.1))
+    q0 = conf.q.copy()
+    with pytest.raises(ValueError, match="dt"):
+        conf.integrate_inplace(np.zeros(6), dt)
+    assert np.array_equal(conf.q, q0)
+
+
+# ------------------------------------------------------------------------ Lagrange magnitudes
+@pytest.mark.parametrize("what", ["q", "qd", "tau"])
+def test_lagrange_rejects_states_beyond_the_bound(what):
+    """|x| > 1e100: squares times inertias leave the float range (was NaN/inf with a warning)."""
+    import warnings
+
+    from anthroarm.dynamics import lagrange
+
+    d = lagrange.load(aa.load("planar2r"))
+    args = {"q": np.zeros(2), "qd": np.zeros(2), "tau": np.zeros(2)}
+    args[what] = np.array([0.0, 1e200])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(ValueError, match=what):
+            d.forward(args["q"], args["qd"], args["tau"])

@@ -82,6 +82,10 @@ GENERATOR_VERSION = "2"
 #: forward dynamics refuses M(q) whose reciprocal condition number (estimated from the Cholesky
 #: pivots) is below this: :class:`~anthroarm.errors.SingularMassMatrixError`
 SINGULAR_RCOND = 1e-12
+#: |q|, |q̇|, |q̈|, |τ| above this are a ValueError (their squares times masses and lengths
+#: within the loader's physical bounds stay in the float range)
+STATE_BOUND = 1e100
+_FAST_BOUND = (STATE_BOUND * 1e-160) ** 2
 
 
 
@@ -544,6 +548,12 @@ class LagrangeDynamics:
             j = int(bad[-1])
             raise ValueError(f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]}; "
                              "states must be finite")
+        if a.size and np.max(np.abs(a)) > STATE_BOUND:
+            bad = np.argwhere(np.abs(a) > STATE_BOUND)[0]
+            j = int(bad[-1])
+            raise ValueError(f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]:.3g}; states and "
+                             f"torques must be within +-{STATE_BOUND:.0e} (their squares and products with the "
+                             "inertias must stay in the float range)")
         return a
 
     def _call(self, fname, q, *rates):
@@ -551,13 +561,15 @@ class LagrangeDynamics:
         tot = 0.0
         ok = type(q) is np.ndarray and q.shape == (self.nq,) and q.dtype == np.float64
         if ok:
-            tot = q.sum()
+            s = q * 1e-160                    # squares of the scaled entries cannot overflow
+            tot = s.dot(s)
             for a in rates:
                 if type(a) is not np.ndarray or a.shape != (self.n,) or a.dtype != np.float64:
                     ok = False
                     break
-                tot += a.sum()
-        if ok and math.isfinite(tot):
+                s = a * 1e-160
+                tot += s.dot(s)
+        if ok and tot < _FAST_BOUND:          # finite (NaN compares False) and every entry within the bound
             arrs = (self._theta(q),) + (rates if self._plain_v else tuple(self._rates(a) for a in rates))
             if self._c is not None:
                 return self._c.one(fname, arrs)

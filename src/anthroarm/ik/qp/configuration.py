@@ -123,10 +123,14 @@ class IKConfiguration:
             raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
         if dt.__class__ is float:             # dt as an array: v·dt array-wise costs less
             if dt != self._dt:
+                if not math.isfinite(dt):
+                    raise ValueError(f"dt must be a finite time step (s), got {dt}")
                 self._dtv = np.full(self.nv, dt)
                 self._dt = dt
             dq = v * self._dtv
         else:
+            if not np.all(np.isfinite(dt)):
+                raise ValueError(f"dt must be a finite time step (s), got {dt!r}")
             dq = v * dt
         self.q = pin.integrate(self.model, self.q, dq)   # finite q + finite step: no re-check
         pin.computeJointJacobians(self.model, self.data, self.q)

@@ -34,6 +34,8 @@ class ConfigurationLimit(Limit):
         self.upper = np.array(chain.upper if upper is None else upper, dtype=float)
         if self.lower.shape != (robot.nq,) or self.upper.shape != (robot.nq,):
             raise ValueError(f"lower/upper must have shape ({robot.nq},) (q entries {list(chain.q_names)})")
+        if np.isnan(self.lower).any() or np.isnan(self.upper).any():
+            raise ValueError("lower/upper limits contain NaN (use inf for a side without a limit)")
         if np.any(self.lower > self.upper):
             raise ValueError("lower limit above upper limit for joints "
                              f"{[n for n, a, b in zip(chain.q_names, self.lower, self.upper) if a > b]}")
