@@ -120,3 +120,7 @@ class SingularMassMatrixError(InertiaError):
         self.cond = cond
         self.joint = joint
         super().__init__(message)
+
+
+class DualDivisionError(AnthroarmError, ValueError):
+    """Division by a dual number whose real part is zero (a + ε b with a = 0 has no inverse)."""

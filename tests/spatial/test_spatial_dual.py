@@ -66,7 +66,9 @@ def test_dual_bad_input():
         D.sqrt(Dual(-1.0, 0.0))
     with pytest.raises(ValueError, match="not a dual number"):
         D.sqrt(Dual(0.0, 1.0))
-    with pytest.raises(ZeroDivisionError):
+    from anthroarm.errors import DualDivisionError
+
+    with pytest.raises(DualDivisionError, match="zero real part"):   # a ValueError, not ZeroDivisionError
         Dual(1.0, 1.0) / Dual(0.0, 1.0)
     with pytest.raises(ValueError, match="NaN"):
         Dual(np.nan, 0.0)

@@ -106,7 +106,10 @@ class Dual:
     def __truediv__(self, o):
         o = Dual.lift(o)
         if np.any(np.asarray(o.real) == 0):
-            raise ZeroDivisionError(f"division by a dual number with zero real part: {o!r}")
+            from ..errors import DualDivisionError
+
+            raise DualDivisionError(f"division by a dual number with zero real part: {o!r} (a pure dual "
+                                    "number a = 0 + eps b has no inverse)")
         return Dual(self.real / o.real, self.dual / o.real - self.real * o.dual / o.real**2)
 
     def __rtruediv__(self, o):

@@ -66,7 +66,8 @@ def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
     The book's rotation tensor E^{wθ} and screw matrices need |w| = 1 (Eq. (5-101), 002 (4-6));
     use :func:`unit_axis` to normalise a direction explicitly."""
     a = as_vector3(u, name)
-    n = np.linalg.norm(a, axis=-1)
+    # a component above 2 cannot belong to a unit vector (and its square might overflow)
+    n = np.where(np.max(np.abs(a), axis=-1) > 2.0, np.inf, np.linalg.norm(np.clip(a, -2.0, 2.0), axis=-1))
     if np.any(n < 1e-12):
         raise ValueError(f"{name} has zero length: {a.tolist()}")
     if np.any(np.abs(n - 1.0) > tol):
@@ -81,9 +82,13 @@ def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
 def unit_axis(u, name: str = "axis") -> np.ndarray:
     """Normalise a direction (shape (..., 3)); ``ValueError`` for a zero-length one."""
     a = as_vector3(u, name)
-    n = np.linalg.norm(a, axis=-1, keepdims=True)
-    if np.any(n < 1e-12):
+    m = np.max(np.abs(a), axis=-1, keepdims=True)     # divide by the largest component first:
+    if np.any(m < 1e-300):                            # no square overflows or underflows
         raise ValueError(f"{name} has zero length: {a.tolist()}")
+    a = a / m
+    n = np.linalg.norm(a, axis=-1, keepdims=True)
+    if np.any(m * n < 1e-12):
+        raise ValueError(f"{name} has zero length: {(a * m).tolist()}")
     return a / n
 
 
@@ -123,6 +128,8 @@ def skew(v) -> np.ndarray:
 def unskew(W) -> np.ndarray:
     """Vector w of a skew matrix W = [w]× (the antisymmetric part is used)."""
     W = np.asarray(W, dtype=float)
+    if W.shape[-2:] != (3, 3) or not np.all(np.isfinite(W)):
+        raise ValueError(f"W must be a finite (..., 3, 3) matrix, got shape {W.shape}: {W.tolist()}")
     return 0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1)
 
 
