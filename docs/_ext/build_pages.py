@@ -60,6 +60,33 @@ def copy_notebooks(src: Path, dst: Path) -> list[Path]:
 
 
 # ------------------------------------------------------------------------------- benchmarks
+TABLE_DELIMITER = re.compile(r"^\|(?:\s*:?-+:?\s*\|)+\s*$")
+
+
+def escape_cell_bars(text: str) -> str:
+    """Escape each "|" written inside a table cell (``| max |x - x*| |``) as ``\\|``.
+
+    Markdown splits such a row into more cells than the delimiter row has columns, and the table
+    is then not a table at all (the benchmark tables name ``|q diff|`` and ``|x - x*|``).  A
+    column separator is written `` | `` (space or another "|" on both sides, or at either end of
+    the row); any other "|" of a table row is text."""
+    out = []
+    for line in text.split("\n"):
+        row = line.rstrip()
+        if row.startswith("|") and row.endswith("|") and len(row) > 1 and not TABLE_DELIMITER.match(row):
+            cells = []
+            for i, ch in enumerate(row):
+                inner = 0 < i < len(row) - 1
+                prev, nxt = row[i - 1] if i else " ", row[i + 1] if i + 1 < len(row) else " "
+                if ch == "|" and inner and prev != "\\" and (prev not in " |" or nxt not in " |"):
+                    cells.append("\\|")
+                else:
+                    cells.append(ch)
+            line = "".join(cells)
+        out.append(line)
+    return "\n".join(out)
+
+
 def benchmark_pages(results: Path, dst: Path) -> list[str]:
     """One page per committed ``benchmarks/results/NAME.md``, with the plots ``NAME*.png``."""
     if dst.exists():
@@ -71,6 +98,7 @@ def benchmark_pages(results: Path, dst: Path) -> list[str]:
         text = md.read_text(encoding="utf-8").rstrip() + "\n"
         # the tables' own relative mentions of results/ files are plain text on the site
         text = text.replace("](results/", "](")
+        text = escape_cell_bars(text)
         plots = sorted(p for p in results.glob(f"{name}*.png"))
         if plots:
             text += "\n## Plots\n\n"
