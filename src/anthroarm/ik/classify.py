@@ -25,18 +25,18 @@ with the measured quantity kept so the user sees how close a call was:
 6R classes (1-based joint numbers as in the paper; first match in this order wins, all matches
 are listed in ``compatible``):
 
-==================================  ===========================================  ============
-class                               condition                                    solution
-==================================  ===========================================  ============
-``spherical_two_parallel``          4-5-6 spherical, 2 ∥ 3                       closed form
-``spherical_two_intersecting``      4-5-6 spherical, 1 and 2 intersect           closed form
-``three_parallel_two_intersecting`` 2 ∥ 3 ∥ 4, 5 and 6 intersect                 closed form
-``spherical``                       4-5-6 spherical                              quartic
-``three_parallel``                  2 ∥ 3 ∥ 4                                    quartic
-``two_parallel``                    2 ∥ 3                                        1-D search
-``two_intersecting``                5 and 6 intersect                            1-D search
-``gen_six_dof``                     none of the above                            2-D search
-==================================  ===========================================  ============
+===================================  ==================================  ===========
+class                                condition                           solution
+===================================  ==================================  ===========
+``spherical_two_parallel``           4-5-6 spherical, 2 ∥ 3              closed form
+``spherical_two_intersecting``       4-5-6 spherical, 1 and 2 intersect  closed form
+``three_parallel_two_intersecting``  2 ∥ 3 ∥ 4, 5 and 6 intersect        closed form
+``spherical``                        4-5-6 spherical                     quartic
+``three_parallel``                   2 ∥ 3 ∥ 4                           quartic
+``two_parallel``                     2 ∥ 3                               1-D search
+``two_intersecting``                 5 and 6 intersect                   1-D search
+``gen_six_dof``                      none of the above                   2-D search
+===================================  ==================================  ===========
 
 The same tests on the reversed chain (tool to base: a spherical *shoulder* is a spherical wrist
 of the reversed arm) are made too; the class of the reversed chain is used when it ranks
