@@ -200,3 +200,12 @@ def test_first_call_is_not_charged_for_the_seed_table():
     res = aa.ik.solve(robot, T, max_time=1e-3)
     assert res.success, res.message
     np.testing.assert_allclose(robot.fk(res.q), T, atol=1e-6)
+
+
+@pytest.mark.parametrize("rng", ["abc", -1, 2.5, True, [1, 2]])
+def test_bad_rng_is_refused_before_solving(rng):
+    """A restart generator that cannot be built is a TypeError at the call, not later (or
+    never, when the first seed converges)."""
+    robot = aa.load("ur5")
+    with pytest.raises(TypeError, match="rng"):
+        aa.ik.solve(robot, robot.fk(robot.neutral()), rng=rng)

@@ -111,6 +111,9 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
                 raise ValueError(f"{name} must be a positive finite number, got {v!r}")
     if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
         raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+    if not (rng is None or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
+            or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)):
+        raise TypeError(f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}")
     if analytic not in ("auto", True, False):
         raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
     Q0 = None
