@@ -375,7 +375,6 @@ def test_rssr_rrss_bad_numbers(bad, which):
     typed_or_finite(RRSSGeometry, a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=[bad, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
 
 
-@pytest.mark.xfail(strict=True, reason="left (issue 12): dyads: lengths/points of 1e308 overflow (RuntimeWarning) instead of a ValueError")
 @SETTINGS
 @given(bad=bad_float, which=st.integers(0, 8))
 def test_dyad_bad_numbers(bad, which):

@@ -144,3 +144,44 @@ def fd_derivative(f, h: float = 1e-3, angular: bool = False):
     itself finite-difference-checked) velocity along the trajectory: this keeps the oracle at
     ~1e-12 where a second difference of positions is limited to ~eps/h^2."""
     return _stencil_sums(f, h, angular)[0] / h
+
+
+def pow2_scale(*xs) -> float:
+    """The largest power of two not above max |x| over ``xs`` (1.0 when all are 0).
+
+    Dividing by a power of two is exact (for normal numbers), so formulas evaluated on
+    ``x / pow2_scale(...)`` and scaled back give the same bits as the unscaled ones wherever those
+    do not overflow, and finite answers where the squares of the raw lengths would overflow."""
+    m = max((float(np.max(np.abs(np.asarray(x, dtype=float)), initial=0.0)) for x in xs), default=0.0)
+    if not np.isfinite(m):
+        raise ValueError(f"a length or coordinate is beyond the float range ({m})")
+    if m == 0.0:
+        return 1.0
+    return float(np.ldexp(1.0, np.frexp(m)[1] - 1))
+
+
+def norm(name: str, v, axis=-1):
+    """|v| along ``axis`` without overflow or underflow of the squares (v / 2^k first);
+    ``ValueError`` naming ``name`` when a difference of coordinates already overflowed."""
+    v = np.asarray(v, dtype=float)
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} is beyond the float range: the coordinates are too far apart")
+    s = pow2_scale(v)
+    return s * np.linalg.norm(v / s, axis=axis)
+
+
+def representable(name: str, x, why: str):
+    """``x`` (computed under ``np.errstate(over='ignore', invalid='ignore')``) as a float array,
+    or ``ValueError`` naming ``name`` when it holds inf/NaN: the true value exists but is beyond
+    the float range (``why`` says which inputs make it so)."""
+    x = np.asarray(x, dtype=float)
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"{name} is beyond the float range ({why}); use smaller inputs or other units")
+    return x
+
+
+def difference(name: str, a, b):
+    """``a - b`` or ``ValueError`` naming ``name`` when the difference overflows."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    return representable(name, d, "the points are too far apart")

@@ -9,6 +9,11 @@ Corrections to the print (``docs/errata.md``, Chapter 6): (6-73)/(6-77) use arct
 which loses the quadrant -> atan2; the acceleration formulas (6-86)/(6-87) are printed as
 *velocities* (single dot) but give the angular *accelerations*; the tag of (6-75) is printed
 "(6-25)".
+
+Any length scale: the dyad works on lengths divided by a power of two near the largest one (an
+exact scaling), so points and lengths up to the float range give finite angles; a result that
+cannot be represented (points too far apart for their difference, rates whose squares overflow)
+is a ``ValueError`` naming the quantity.
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._util import finite_array, out, positive_length
+from ._util import difference, finite_array, out, positive_length, pow2_scale, representable
 
 #: |D| / (r1 r2) below this: the two links are collinear, the dyad is at a dead point
 DEAD_POINT_TOL = 1e-7
@@ -87,10 +92,13 @@ def rigid_body_point(P1, P1dot, P1ddot, length, theta, thetadot=0.0, thetaddot=0
     ph = finite_array("phi", phi)
     ang = th + ph
     r = L * np.stack([np.cos(ang), np.sin(ang)], -1)
-    P = P1 + r                                                        # (6-66)/(6-67)
-    V = P1dot + _cross_k(w, r)                                         # (6-68)
-    A = P1ddot + _cross_k(al, r) - (w**2)[..., None] * r               # (6-69)
-    return RigidBodyPoint(P, V, A)
+    with np.errstate(over="ignore", invalid="ignore"):
+        P = P1 + r                                                    # (6-66)/(6-67)
+        V = P1dot + _cross_k(w, r)                                     # (6-68)
+        A = P1ddot + _cross_k(al, r) - (w**2)[..., None] * r           # (6-69)
+    why = f"length {L:.3g} m, thetadot up to {np.max(np.abs(w)):.3g} rad/s"
+    return RigidBodyPoint(representable("position", P, why), representable("velocity", V, why),
+                          representable("acceleration", A, why))
 
 
 def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadState:
@@ -112,33 +120,44 @@ def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadS
     if branch not in (1, -1):
         raise ValueError(f"branch must be +1 or -1, got {branch!r}")
     P1, P2, P1dot, P2dot, P1ddot, P2ddot = np.broadcast_arrays(P1, P2, P1dot, P2dot, P1ddot, P2ddot)
-    dv = P2 - P1
-    dist = np.hypot(dv[..., 0], dv[..., 1])                           # (6-70)
+    dv = difference("P2 - P1", P2, P1)
+    # every length / L (a power of two: exact), so no square overflows or underflows
+    L = pow2_scale(r1, r2, dv)
+    n1, n2, dvn = r1 / L, r2 / L, dv / L
+    distn = np.hypot(dvn[..., 0], dvn[..., 1])                         # (6-70), d / L
+    dist = distn * L
     phi = np.arctan2(dv[..., 1], dv[..., 0])                           # (6-73)
-    tiny = 1e-14 * (r1 + r2)
-    safe = np.where(dist > tiny, dist, 1.0)
-    k = np.where(dist > tiny, (r1 * r1 + dist * dist - r2 * r2) / (2 * r1 * safe),
-                 np.where(abs(r1 - r2) <= tiny, 1.0, 2.0))
+    tiny = 1e-14 * (n1 + n2)
+    safe = np.where(distn > tiny, distn, 1.0)
+    k = np.where(distn > tiny, (n1 * n1 + distn * distn - n2 * n2) / (2 * n1 * safe),
+                 np.where(abs(n1 - n2) <= tiny, 1.0, 2.0))
     assembled = np.abs(k) <= 1 + ASSEMBLY_TOL                          # (6-71)/(6-72)
     th1 = phi + branch * np.arccos(np.clip(k, -1.0, 1.0))              # (6-74)/(6-75)
-    P3 = P1 + r1 * np.stack([np.cos(th1), np.sin(th1)], -1)            # (6-76)
-    th2 = np.arctan2(P3[..., 1] - P2[..., 1], P3[..., 0] - P2[..., 0])  # (6-77)
-    a, b = P3[..., 0] - P1[..., 0], P3[..., 1] - P1[..., 1]
-    c, dd = P3[..., 0] - P2[..., 0], P3[..., 1] - P2[..., 1]
-    D = b * c - a * dd
-    dead = assembled & (np.abs(D) < DEAD_POINT_TOL * r1 * r2)
+    r = r1 * np.stack([np.cos(th1), np.sin(th1)], -1)
+    P3 = representable("P3", P1 + r, "the points are too far apart")  # (6-76)
+    rn = n1 * np.stack([np.cos(th1), np.sin(th1)], -1)                 # (P3 - P1) / L
+    qn = rn - dvn                                                      # (P3 - P2) / L
+    th2 = np.arctan2(qn[..., 1], qn[..., 0])                           # (6-77)
+    a, b = rn[..., 0], rn[..., 1]                                      # a, b, c, d of (6-83) / L
+    c, dd = qn[..., 0], qn[..., 1]
+    D = b * c - a * dd                                                 # D / L^2
+    dead = assembled & (np.abs(D) < DEAD_POINT_TOL * n1 * n2)
     good = assembled & ~dead
-    Ds = np.where(good, D, 1.0)
-    X, Y = P2dot[..., 0] - P1dot[..., 0], P2dot[..., 1] - P1dot[..., 1]
-    w1 = np.where(good, -(X * c + Y * dd) / Ds, 0.0)                  # (6-83)
-    w2 = np.where(good, -(X * a + Y * b) / Ds, 0.0)                   # (6-84)
-    E = (P2ddot[..., 0] - P1ddot[..., 0]) + w1**2 * a - w2**2 * c
-    F = (P2ddot[..., 1] - P1ddot[..., 1]) + w1**2 * b - w2**2 * dd
-    a1 = np.where(good, -(E * c + F * dd) / Ds, 0.0)                  # (6-86), corrected to theta''
-    a2 = np.where(good, -(E * a + F * b) / Ds, 0.0)                   # (6-87), corrected to theta''
-    r = P3 - P1
-    V = P1dot + _cross_k(w1, r)                                        # (6-78)
-    A = P1ddot + _cross_k(a1, r) - (w1**2)[..., None] * r              # (6-85)
+    Ds = np.where(good, D, 1.0) * L
+    with np.errstate(over="ignore", invalid="ignore"):
+        X, Y = P2dot[..., 0] - P1dot[..., 0], P2dot[..., 1] - P1dot[..., 1]
+        w1 = np.where(good, -(X * c + Y * dd) / Ds, 0.0)              # (6-83)
+        w2 = np.where(good, -(X * a + Y * b) / Ds, 0.0)               # (6-84)
+        E = (P2ddot[..., 0] - P1ddot[..., 0]) + L * (w1**2 * a - w2**2 * c)
+        F = (P2ddot[..., 1] - P1ddot[..., 1]) + L * (w1**2 * b - w2**2 * dd)
+        a1 = np.where(good, -(E * c + F * dd) / Ds, 0.0)              # (6-86), corrected to theta''
+        a2 = np.where(good, -(E * a + F * b) / Ds, 0.0)               # (6-87), corrected to theta''
+        V = P1dot + _cross_k(w1, r)                                    # (6-78)
+        A = P1ddot + _cross_k(a1, r) - (w1**2)[..., None] * r          # (6-85)
+    why = "rates of the points too large for these lengths"
+    w1, w2 = representable("omega1", w1, why), representable("omega2", w2, why)
+    a1, a2 = representable("alpha1", a1, why), representable("alpha2", a2, why)
+    V, A = representable("P3dot", V, why), representable("P3ddot", A, why)
     st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
     if np.ndim(dist) == 0:
         if not assembled:
