@@ -351,7 +351,6 @@ def test_fourbar_bad_numbers(bad, which, L):
         must_raise(fourbar, *a)
 
 
-@pytest.mark.xfail(strict=True, reason="left (issue 12): RSSRGeometry: points of 1e308 overflow in the radius computation (RuntimeWarning)")
 @SETTINGS
 @given(bad=bad_float, which=st.integers(0, 5))
 def test_rssr_rrss_bad_numbers(bad, which):
@@ -373,6 +372,31 @@ def test_rssr_rrss_bad_numbers(bad, which):
     typed_or_finite(rrss, h, bad)
     typed_or_finite(rrss, h, 0.3, bad)
     typed_or_finite(RRSSGeometry, a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=[bad, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
+
+
+@SETTINGS
+@given(e=st.integers(-300, 308), alpha=st.floats(-np.pi, np.pi), w=st.sampled_from([0.0, 1.0, 1e200]))
+def test_rssr_rrss_extreme_scales_are_finite_or_value_error(e, alpha, w):
+    """Geometry scaled by 10^e: the geometry is accepted or refused with a ValueError; the
+    closed forms return finite states (the same angles, by scale invariance, where the length
+    scale is moderate) or a ValueError naming the unrepresentable quantity (E^2 + F^2 - G^2
+    grows as the fourth power of the lengths)."""
+    from anthroarm.mechanisms.rrss import RRSSGeometry, rrss
+    from anthroarm.mechanisms.rssr import RSSRGeometry, rssr
+
+    s = 10.0 ** e
+    P = dict(a0=[0, 0, 0], a1=[1, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
+    sc = {k: [s * x for x in v] for k, v in P.items()}
+    g = typed_or_finite(RSSRGeometry, ua=[0, 0, 1], ub=[0, 1, 0], **sc)
+    if g is not None:
+        got = typed_or_finite(rssr, g, alpha, w)
+        if got is not None and abs(e) <= 60 and w == 0.0:
+            ref = rssr(RSSRGeometry(ua=[0, 0, 1], ub=[0, 1, 0], **P), alpha)
+            assert got.status == ref.status
+            assert abs(math.remainder(got.beta - ref.beta, 2 * math.pi)) <= 1e-9
+    h = typed_or_finite(RRSSGeometry, u0=[0, 0, 1], u1=[1, 0, 0], **sc)
+    if h is not None:
+        typed_or_finite(rrss, h, alpha, w)
 
 
 @SETTINGS

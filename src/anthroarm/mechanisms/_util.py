@@ -176,7 +176,7 @@ def representable(name: str, x, why: str):
     the float range (``why`` says which inputs make it so)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"{name} is beyond the float range ({why}); use smaller inputs or other units")
+        raise ValueError(f"{name} cannot be represented in floating point ({why}); use other units or smaller rates")
     return x
 
 
@@ -185,3 +185,19 @@ def difference(name: str, a, b):
     with np.errstate(over="ignore", invalid="ignore"):
         d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
     return representable(name, d, "the points are too far apart")
+
+
+def representable_fields(state, why: str):
+    """``state`` (a dataclass computed under ``np.errstate(over='ignore', invalid='ignore')``)
+    unchanged, or ``ValueError`` naming the first numeric field that holds inf/NaN (its true
+    value is beyond the float range; ``why`` names the inputs that make it so)."""
+    from dataclasses import fields
+
+    for f in fields(state):
+        v = getattr(state, f.name)
+        if isinstance(v, (str, bool, np.bool_)) or v is None:
+            continue
+        a = np.asarray(v)
+        if a.dtype.kind in "fc":
+            representable(f.name, a, why)
+    return state

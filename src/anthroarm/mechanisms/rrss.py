@@ -24,6 +24,10 @@ text's unknowns (u, phi) make the Jacobian rank-deficient at phi = 0 (u drops ou
 vector with Pinocchio's right Jacobian ``pin.Jexp3`` is regular there, so the march can start at
 the reference configuration.  Velocities solve the linear form of (4-48)/(4-49) in (p', omega),
 accelerations its time derivative.
+
+A closed-form state whose numbers cannot be represented (lengths near the float range: E^2 + F^2
+- G^2 grows as their fourth power; rates whose squares overflow) is a ``ValueError`` naming the
+quantity, never inf or NaN.
 """
 
 from __future__ import annotations
@@ -33,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._util import Wdot, finite_array, finite_scalar, out, point3, rot, skew, unit_axis
+from ._util import Wdot, difference, finite_array, finite_scalar, norm, out, point3, pow2_scale, representable_fields, rot, skew, unit_axis
 
 DEAD_POINT_TOL = 1e-7
 
@@ -60,17 +64,19 @@ class RRSSGeometry:
         object.__setattr__(self, "u1", unit_axis("u1", self.u1))
         if self.bar_length == 0.0:
             raise ValueError(f"b1 and b0 coincide ({self.b1.tolist()}): zero-length S-S bar")
-        d = self.b1 - self.a1
+        d = difference("b1 - a1", self.b1, self.a1)
+        d = d / pow2_scale(d)                  # exact; no overflow of the projection
         if np.linalg.norm(d - self.u1 * (self.u1 @ d)) == 0.0:
             raise ValueError(f"b1 = {self.b1.tolist()} lies on the hinge axis u1: theta2 cannot move it")
 
     @property
     def bar_length(self) -> float:
-        return float(np.linalg.norm(self.b1 - self.b0))
+        return float(norm("b1 - b0", difference("b1 - b0", self.b1, self.b0)))
 
     @property
     def length_scale(self) -> float:
-        return float(np.linalg.norm(self.a1 - self.a0) + np.linalg.norm(self.b1 - self.a1) + self.bar_length)
+        return float(norm("a1 - a0", difference("a1 - a0", self.a1, self.a0))
+                     + norm("b1 - a1", difference("b1 - a1", self.b1, self.a1)) + self.bar_length)
 
 
 @dataclass(frozen=True)
@@ -137,7 +143,7 @@ def rrss_efg(geom: RRSSGeometry, theta1):
     ue = _dot(ua, e)
     E = _dot(c, e - ua * ue[..., None])
     F = _dot(c, np.cross(ua, e))
-    G = _dot(c, ua) * ue + 0.5 * (_dot(e, e) + _dot(c, c) - geom.bar_length ** 2)
+    G = _dot(c, ua) * ue + 0.5 * (_dot(e, e) + _dot(c, c) - np.float64(geom.bar_length) ** 2)
     return E, F, G, a, bp, ua
 
 
@@ -164,50 +170,53 @@ def rrss(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, branch: int 
         raise ValueError(f"branch must be +1 or -1, got {branch!r}")
     th1, w1, al1 = np.broadcast_arrays(finite_array("theta1", theta1), finite_array("theta1dot", theta1dot),
                                        finite_array("theta1ddot", theta1ddot))
-    E, F, G, a, bp, ua = rrss_efg(geom, th1)
-    disc = E * E + F * F - G * G
-    L = geom.length_scale
-    assembled = disc >= -1e-12 * L**4
-    th2 = _half_angle(E, F, G, branch, np.sqrt(np.clip(disc, 0.0, None)))   # (6-99)
-    R2rel = _rot_batch(th2, ua)
-    b = _vec(R2rel, bp - a) + a                                               # (6-96)
-    R1 = rot(th1, geom.u0)
-    u0 = geom.u0
-    rb0, rba, rba0 = b - geom.b0, b - a, b - geom.a0
-    den = _dot(rb0, np.cross(ua, rba))
-    dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.bar_length * np.linalg.norm(geom.b1 - geom.a1))
-    good = assembled & ~dead
-    dens = np.where(good, den, 1.0)
-    w2 = np.where(good, -w1 * _dot(rb0, np.cross(u0, rba0)) / dens, 0.0)      # (6-105)
-    om1 = w1[..., None] * u0
-    adot = np.cross(om1, a - geom.a0)                                         # (6-106)
-    bdot = np.cross(om1, rba0) + w2[..., None] * np.cross(ua, rba)            # (6-103)/(6-104)
-    b_e = _vec(Wdot(w1, al1, u0), rba0)                                       # transport
-    b_c = 2 * np.cross(om1, w2[..., None] * np.cross(ua, rba))                # Coriolis
-    cen = (w2**2)[..., None] * np.cross(ua, np.cross(ua, rba))
-    al2 = np.where(good, -(_dot(rb0, b_e + cen + b_c) + _dot(bdot, bdot)) / dens, 0.0)   # (6-111)
-    addot = _vec(Wdot(w1, al1, u0), a - geom.a0)                              # (6-112)
-    bddot = b_e + al2[..., None] * np.cross(ua, rba) + cen + b_c              # (6-110)
-    om2 = om1 + w2[..., None] * ua
-    uadot = np.cross(om1, ua)
-    omd2 = al1[..., None] * u0 + al2[..., None] * ua + w2[..., None] * uadot
-    st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
-    if not np.all(good):
-        z = ~good[..., None]
-        bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
-        om2, omd2 = np.where(z, 0.0, om2), np.where(z, 0.0, omd2)
-    if np.ndim(th1) == 0:
-        reason = {"ok": "ok",
-                  "dead_point": "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0",
-                  "cannot_assemble": f"cannot assemble at theta1 = {float(th1):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0"}[str(st)]
-    else:
-        na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-        reason = "ok" if na == nd == 0 else f"{na} of {th1.size} cannot assemble, {nd} at a branch point"
-    res = np.abs(np.linalg.norm(rb0, axis=-1) - geom.bar_length)
-    return RRSSState(theta1=out(th1), theta2=out(th2), theta1dot=out(w1), theta2dot=out(w2), theta1ddot=out(al1),
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        E, F, G, a, bp, ua = rrss_efg(geom, th1)
+        disc = E * E + F * F - G * G
+        L = np.float64(geom.length_scale)     # numpy: overflow is inf (checked below), not OverflowError
+        assembled = disc >= -1e-12 * L**4
+        th2 = _half_angle(E, F, G, branch, np.sqrt(np.clip(disc, 0.0, None)))   # (6-99)
+        R2rel = _rot_batch(th2, ua)
+        b = _vec(R2rel, bp - a) + a                                               # (6-96)
+        R1 = rot(th1, geom.u0)
+        u0 = geom.u0
+        rb0, rba, rba0 = b - geom.b0, b - a, b - geom.a0
+        den = _dot(rb0, np.cross(ua, rba))
+        dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.bar_length * np.linalg.norm(geom.b1 - geom.a1))
+        good = assembled & ~dead
+        dens = np.where(good, den, 1.0)
+        w2 = np.where(good, -w1 * _dot(rb0, np.cross(u0, rba0)) / dens, 0.0)      # (6-105)
+        om1 = w1[..., None] * u0
+        adot = np.cross(om1, a - geom.a0)                                         # (6-106)
+        bdot = np.cross(om1, rba0) + w2[..., None] * np.cross(ua, rba)            # (6-103)/(6-104)
+        b_e = _vec(Wdot(w1, al1, u0), rba0)                                       # transport
+        b_c = 2 * np.cross(om1, w2[..., None] * np.cross(ua, rba))                # Coriolis
+        cen = (w2**2)[..., None] * np.cross(ua, np.cross(ua, rba))
+        al2 = np.where(good, -(_dot(rb0, b_e + cen + b_c) + _dot(bdot, bdot)) / dens, 0.0)   # (6-111)
+        addot = _vec(Wdot(w1, al1, u0), a - geom.a0)                              # (6-112)
+        bddot = b_e + al2[..., None] * np.cross(ua, rba) + cen + b_c              # (6-110)
+        om2 = om1 + w2[..., None] * ua
+        uadot = np.cross(om1, ua)
+        omd2 = al1[..., None] * u0 + al2[..., None] * ua + w2[..., None] * uadot
+        st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
+        if not np.all(good):
+            z = ~good[..., None]
+            bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
+            om2, omd2 = np.where(z, 0.0, om2), np.where(z, 0.0, omd2)
+        if np.ndim(th1) == 0:
+            reason = {"ok": "ok",
+                      "dead_point": "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0",
+                      "cannot_assemble": f"cannot assemble at theta1 = {float(th1):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0"}[str(st)]
+        else:
+            na, nd = int(np.sum(~assembled)), int(np.sum(dead))
+            reason = "ok" if na == nd == 0 else f"{na} of {th1.size} cannot assemble, {nd} at a branch point"
+        res = np.abs(np.linalg.norm(rb0, axis=-1) - geom.bar_length)
+    st_ = RRSSState(theta1=out(th1), theta2=out(th2), theta1dot=out(w1), theta2dot=out(w2), theta1ddot=out(al1),
                      theta2ddot=out(al2), a=a, u_a=ua, b=b, adot=adot, bdot=bdot, addot=addot, bddot=bddot,
                      R2=R2rel @ R1, omega2=om2, omegadot2=omd2, branch=int(branch), assembled=out(assembled),
                      dead_point=out(dead), status=out(st), reason=reason, residual=out(res))
+    return representable_fields(st_, f"length scale {geom.length_scale:.3g} m, theta1dot up to "
+                                f"{np.max(np.abs(w1)):.3g} rad/s, theta1ddot up to {np.max(np.abs(al1)):.3g} rad/s^2")
 
 
 def _rot_batch(theta, u):

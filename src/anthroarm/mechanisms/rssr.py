@@ -18,6 +18,11 @@ is a crank when this holds over a full turn (:func:`rssr_crank_test`).
 No NaN: outside the assembly range a state has ``assembled=False`` and beta is the nearest
 configuration (the discriminant clipped to 0); at a branch point (discriminant 0, the coupler in
 the plane of the output's motion) ``dead_point=True`` and the rates are reported as 0.
+
+Numbers at the float range: the radii of the geometry are computed without overflow (vectors
+divided by a power of two first); a state whose numbers cannot be represented (E^2 + F^2 - G^2
+grows as the fourth power of the lengths, the accelerations as the square of the rates) is a
+``ValueError`` naming the quantity, never inf or NaN.
 """
 
 from __future__ import annotations
@@ -26,12 +31,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._util import finite_array, out, point3, positive_length, rot, skew, unit_axis
+from ._util import finite_array, norm, out, point3, positive_length, representable_fields, rot, skew, unit_axis
 
 DEAD_POINT_TOL = 1e-7
 
 __all__ = ["RSSRGeometry", "RSSRState", "RSSRCrankTest", "rssr_position", "rssr", "rssr_crank_test",
            "rssr_branch_through", "rssr_efg", "rssr_polar"]
+
+
+def _diff(p, q):
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return p - q
+
+
+def _pow2(d):
+    from ._util import pow2_scale
+
+    return pow2_scale(norm("a difference of the points", d))
 
 
 @dataclass(frozen=True)
@@ -60,17 +76,19 @@ class RSSRGeometry:
 
     @property
     def coupler_length(self) -> float:
-        return float(np.linalg.norm(self.a1 - self.b1))
+        return float(norm("a1 - b1", _diff(self.a1, self.b1)))
 
     @property
     def crank_radius(self) -> float:
-        d = self.a1 - self.a0
-        return float(np.linalg.norm(d - self.ua * (self.ua @ d)))
+        d = _diff(self.a1, self.a0)
+        s = _pow2(d)       # d / 2^k: no overflow of the projection
+        return float(s * norm("crank radius", d / s - self.ua * (self.ua @ (d / s))))
 
     @property
     def rocker_radius(self) -> float:
-        d = self.b1 - self.b0
-        return float(np.linalg.norm(d - self.ub * (self.ub @ d)))
+        d = _diff(self.b1, self.b0)
+        s = _pow2(d)
+        return float(s * norm("rocker radius", d / s - self.ub * (self.ub @ (d / s))))
 
     @property
     def length_scale(self) -> float:
@@ -139,7 +157,7 @@ def rssr_efg(geom: RSSRGeometry, alpha):
     Q = np.outer(geom.ub, geom.ub)
     E = c @ ((np.eye(3) - Q) @ d)
     F = c @ (P @ d)
-    L2 = geom.coupler_length ** 2
+    L2 = np.float64(geom.coupler_length) ** 2        # numpy: inf on overflow, not OverflowError
     G = c @ (Q @ d) + 0.5 * (L2 - np.einsum("...i,...i", c, c) - d @ d)
     return E, F, G, a
 
@@ -169,45 +187,48 @@ def rssr(geom: RSSRGeometry, alpha, alphadot=0.0, alphaddot=0.0, branch: int = 1
     s = _check_branch(branch)
     al, ad, add = np.broadcast_arrays(finite_array("alpha", alpha), finite_array("alphadot", alphadot),
                                       finite_array("alphaddot", alphaddot))
-    E, F, G, a = rssr_efg(geom, al)
-    disc = E * E + F * F - G * G
-    scale2 = (geom.rocker_radius * (geom.coupler_length + geom.crank_radius + geom.rocker_radius)) ** 2
-    assembled = disc >= -1e-12 * scale2
-    root = np.sqrt(np.clip(disc, 0.0, None))
-    beta = _beta(E, F, G, s, root)
-    Rb = rot(beta, geom.ub)
-    b = np.einsum("...ij,j->...i", Rb, geom.b1 - geom.b0) + geom.b0            # (4-20)
-    Pa, Pb = skew(geom.ua), skew(geom.ub)
-    ra, rb = a - geom.a0, b - geom.b0
-    ab = a - b
-    adot = ad[..., None] * (ra @ Pa.T)                                          # (4-24)
-    addot = add[..., None] * (ra @ Pa.T) + (ad**2)[..., None] * (ra @ (Pa @ Pa).T)   # (4-28)
-    den = np.einsum("...i,...i", ab, rb @ Pb.T)
-    dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.coupler_length * geom.rocker_radius)
-    good = assembled & ~dead
-    dens = np.where(good, den, 1.0)
-    bd = np.where(good, np.einsum("...i,...i", adot, ab) / dens, 0.0)           # (4-26)
-    bdot = bd[..., None] * (rb @ Pb.T)                                          # (4-25)
-    rel = adot - bdot
-    num = np.einsum("...i,...i", ab, addot - (bd**2)[..., None] * (rb @ (Pb @ Pb).T)) + np.einsum("...i,...i", rel, rel)
-    bdd = np.where(good, num / dens, 0.0)                                       # (4-30)
-    bddot = bdd[..., None] * (rb @ Pb.T) + (bd**2)[..., None] * (rb @ (Pb @ Pb).T)   # (4-29)
-    res = np.abs(np.linalg.norm(ab, axis=-1) - geom.coupler_length)
-    st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
-    if np.ndim(al) == 0:
-        reason = {"ok": "ok",
-                  "dead_point": "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0",
-                  "cannot_assemble": f"cannot assemble at alpha = {float(al):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0 (4-31)"}[str(st)]
-    else:
-        na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-        reason = "ok" if na == nd == 0 else f"{na} of {al.size} cannot assemble (4-31), {nd} at a branch point"
-    if not np.all(good):   # keep the rates of bad entries exactly zero
-        z = ~good[..., None]
-        bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
-    return RSSRState(alpha=out(al), beta=out(beta), alphadot=out(ad), betadot=out(bd), alphaddot=out(add),
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        E, F, G, a = rssr_efg(geom, al)
+        disc = E * E + F * F - G * G
+        scale2 = np.float64(geom.rocker_radius * (geom.coupler_length + geom.crank_radius + geom.rocker_radius)) ** 2
+        assembled = disc >= -1e-12 * scale2
+        root = np.sqrt(np.clip(disc, 0.0, None))
+        beta = _beta(E, F, G, s, root)
+        Rb = rot(beta, geom.ub)
+        b = np.einsum("...ij,j->...i", Rb, geom.b1 - geom.b0) + geom.b0            # (4-20)
+        Pa, Pb = skew(geom.ua), skew(geom.ub)
+        ra, rb = a - geom.a0, b - geom.b0
+        ab = a - b
+        adot = ad[..., None] * (ra @ Pa.T)                                          # (4-24)
+        addot = add[..., None] * (ra @ Pa.T) + (ad**2)[..., None] * (ra @ (Pa @ Pa).T)   # (4-28)
+        den = np.einsum("...i,...i", ab, rb @ Pb.T)
+        dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.coupler_length * geom.rocker_radius)
+        good = assembled & ~dead
+        dens = np.where(good, den, 1.0)
+        bd = np.where(good, np.einsum("...i,...i", adot, ab) / dens, 0.0)           # (4-26)
+        bdot = bd[..., None] * (rb @ Pb.T)                                          # (4-25)
+        rel = adot - bdot
+        num = np.einsum("...i,...i", ab, addot - (bd**2)[..., None] * (rb @ (Pb @ Pb).T)) + np.einsum("...i,...i", rel, rel)
+        bdd = np.where(good, num / dens, 0.0)                                       # (4-30)
+        bddot = bdd[..., None] * (rb @ Pb.T) + (bd**2)[..., None] * (rb @ (Pb @ Pb).T)   # (4-29)
+        res = np.abs(np.linalg.norm(ab, axis=-1) - geom.coupler_length)
+        st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
+        if np.ndim(al) == 0:
+            reason = {"ok": "ok",
+                      "dead_point": "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0",
+                      "cannot_assemble": f"cannot assemble at alpha = {float(al):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0 (4-31)"}[str(st)]
+        else:
+            na, nd = int(np.sum(~assembled)), int(np.sum(dead))
+            reason = "ok" if na == nd == 0 else f"{na} of {al.size} cannot assemble (4-31), {nd} at a branch point"
+        if not np.all(good):   # keep the rates of bad entries exactly zero
+            z = ~good[..., None]
+            bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
+    st_ = RSSRState(alpha=out(al), beta=out(beta), alphadot=out(ad), betadot=out(bd), alphaddot=out(add),
                      betaddot=out(bdd), a=a, b=b, adot=adot, bdot=bdot, addot=addot, bddot=bddot,
                      E=out(E), F=out(F), G=out(G), discriminant=out(disc), branch=s, assembled=out(assembled),
                      dead_point=out(dead), status=out(st), reason=reason, residual=out(res))
+    return representable_fields(st_, f"length scale {geom.length_scale:.3g} m, alphadot up to "
+                                f"{np.max(np.abs(ad)):.3g} rad/s, alphaddot up to {np.max(np.abs(add)):.3g} rad/s^2")
 
 
 def rssr_branch_through(geom: RSSRGeometry, alpha0: float = 0.0, beta0: float = 0.0) -> int:
