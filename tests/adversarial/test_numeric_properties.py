@@ -414,7 +414,6 @@ def test_dyad_bad_numbers(bad, which):
     typed_or_finite(rigid_body_point, (0.0, 0.0), (0.0, 0.0), (0.0, 0.0), 1.0, bad, bad)
 
 
-@pytest.mark.xfail(strict=True, reason="left (issue 12): spatial: dual exp(1000) overflows to inf; euler_*_inverse of a 1e308 matrix overflows in check_rotation")
 @SETTINGS
 @given(bad=bad_float, shape=st.sampled_from([(2,), (4,), (3, 3), ()]))
 def test_spatial_bad_inputs(bad, shape):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rotations import as_vector3, check_rotation, check_unit_axis, skew, unskew
+from .rotations import as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
 
 
 class Dual:
@@ -143,9 +143,17 @@ class Dual:
 
 
 # ----------------------------------------------------------------------------- functions f(â) = f(a) + ε a* f′(a)
-def _f(x, f, df):
+def _f(x, f, df, name: str = "f"):
+    """f(â) = f(a) + ε a* f'(a); ``ValueError`` naming ``name`` when a part of the result cannot
+    be represented (e.g. exp of a real part above ~709.78 overflows)."""
     x = Dual.lift(x)
-    return Dual(f(x.real), x.dual * df(x.real))
+    with np.errstate(over="ignore", invalid="ignore"):
+        re, du = f(x.real), x.dual * df(x.real)
+    for part, v in (("real", re), ("dual", du)):
+        if not np.all(np.isfinite(v)):
+            raise ValueError(f"{name}({x!r}): the {part} part is beyond the float range "
+                             f"(largest float {np.finfo(float).max:.6g})")
+    return Dual(re, du)
 
 
 def sin(x) -> Dual:
@@ -163,7 +171,7 @@ def tan(x) -> Dual:
 
 
 def exp(x) -> Dual:
-    return _f(x, np.exp, np.exp)
+    return _f(x, np.exp, np.exp, "exp")
 
 
 def log(x) -> Dual:
@@ -369,6 +377,7 @@ def P_matrix(axis: str) -> np.ndarray:
 
 def translation_dual(px: float, py: float, pz: float) -> Dual:
     """Pure translation (φ*, θ*, ψ*) as a dual matrix, Eq. (5-150): I + ε(φ*P_x + θ*P_y + ψ*P_z)."""
+    px, py, pz = as_scalar(px, "px"), as_scalar(py, "py"), as_scalar(pz, "pz")
     return Dual(np.eye(3), px * _PX + py * _PY + pz * _PZ)
 
 

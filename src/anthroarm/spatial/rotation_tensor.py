@@ -16,7 +16,7 @@ skew matrix of the angular velocity and ε that of the angular acceleration.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -133,16 +133,23 @@ def rotated_vector_motion(w, theta, theta_dot, theta_ddot, R, R_dot=(0.0, 0.0, 0
     def EE(v):
         return np.einsum("...ij,...j->...i", E, v)
 
-    j3R = np.cross(w, R)
-    j2R = R - (R @ w)[..., None] * w if R.ndim > 1 else R - (R @ w) * w
-    rot_v = EE(thd * j3R)
-    str_v = EE(np.broadcast_to(Rd, rot_v.shape))
-    tang = EE(thdd * j3R)
-    cent = EE(-(thd**2) * j2R)
-    cor = EE(2.0 * thd * np.cross(w, Rd))
-    rel = EE(np.broadcast_to(Rdd, tang.shape))
-    return RotatedVectorMotion(EE(np.broadcast_to(R, rot_v.shape)), rot_v + str_v, rot_v, str_v,
-                               tang + cent + cor + rel, tang, cent, cor, rel)
+    with np.errstate(over="ignore", invalid="ignore"):
+        j3R = np.cross(w, R)
+        j2R = R - (R @ w)[..., None] * w if R.ndim > 1 else R - (R @ w) * w
+        rot_v = EE(thd * j3R)
+        str_v = EE(np.broadcast_to(Rd, rot_v.shape))
+        tang = EE(thdd * j3R)
+        cent = EE(-(thd**2) * j2R)
+        cor = EE(2.0 * thd * np.cross(w, Rd))
+        rel = EE(np.broadcast_to(Rdd, tang.shape))
+        res = RotatedVectorMotion(EE(np.broadcast_to(R, rot_v.shape)), rot_v + str_v, rot_v, str_v,
+                                  tang + cent + cor + rel, tang, cent, cor, rel)
+    for f in fields(res):   # a rate whose square overflows: a ValueError naming the term
+        if not np.all(np.isfinite(getattr(res, f.name))):
+            raise ValueError(f"{f.name} of the rotated vector cannot be represented in floating point "
+                             f"(theta_dot = {np.max(np.abs(thd)):.3g}, theta_ddot = {np.max(np.abs(thdd)):.3g}, "
+                             f"|R| = {np.max(np.abs(R)):.3g}); use smaller rates or other units")
+    return res
 
 
 def component_products(w) -> dict:

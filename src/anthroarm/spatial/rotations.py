@@ -103,6 +103,10 @@ def check_rotation(R, name: str = "rotation", tol: float = ORTHO_TOL) -> np.ndar
         raise ValueError(f"{name} must have shape (3, 3) or (N, 3, 3), got shape {a.shape}")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} has a NaN or infinite element: {a.tolist()}")
+    big = np.abs(a).max(axis=(-2, -1))
+    if np.any(big > 2.0):   # entries of a rotation lie in [-1, 1]; R R^T would overflow at ~1e154
+        raise ValueError(f"{name} is not orthogonal: it has an element of magnitude {float(np.max(big)):.6g} "
+                         f"(the entries of a rotation lie in [-1, 1])")
     err = np.abs(a @ np.swapaxes(a, -1, -2) - np.eye(3)).max(axis=(-2, -1))
     if np.any(err > tol):
         i = int(np.argmax(err)) if a.ndim > 2 else 0
