@@ -25,9 +25,9 @@ vector with Pinocchio's right Jacobian ``pin.Jexp3`` is regular there, so the ma
 the reference configuration.  Velocities solve the linear form of (4-48)/(4-49) in (p', omega),
 accelerations its time derivative.
 
-A closed-form state whose numbers cannot be represented (lengths near the float range: E^2 + F^2
-- G^2 grows as their fourth power; rates whose squares overflow) is a ``ValueError`` naming the
-quantity, never inf or NaN.
+A closed-form state whose numbers cannot be represented (lengths near the float range, where
+E^2 + F^2 - G^2 grows as their fourth power; rates whose squares overflow) is a ``ValueError``
+naming the quantity, never inf or NaN.
 """
 
 from __future__ import annotations
