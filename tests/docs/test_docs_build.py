@@ -39,9 +39,8 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 #: the build, notebooks included, took 1.5-2.5 min on the shared 2-core machine
 BUILD_TIMEOUT = 900
-#: notebooks whose pages must show a plot (an <img> in a cell output).  book_ik, dynamics and
-#: qp_ik call matplotlib.use("Agg") before plotting, so their plt.show() displays nothing.
-NOTEBOOKS_WITH_PLOTS = {"book_tour", "mechanisms", "design"}
+#: notebooks whose pages must show a plot (an <img> in a cell output)
+NOTEBOOKS_WITH_PLOTS = {"book_tour", "mechanisms", "design", "book_ik", "dynamics", "qp_ik"}
 
 pytestmark = pytest.mark.slow
 
