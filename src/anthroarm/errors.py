@@ -124,3 +124,15 @@ class SingularMassMatrixError(InertiaError):
 
 class DualDivisionError(AnthroarmError, ValueError):
     """Division by a dual number whose real part is zero (a + ε b with a = 0 has no inverse)."""
+
+
+class ObjectiveError(AnthroarmError, ValueError):
+    """An optimiser's objective never returned a finite value: NaN or ±inf at every point it
+    was evaluated, so there is no best point to report.  ``x`` is the last point evaluated,
+    ``value`` the value there (NaN or ±inf), ``nfev`` the number of evaluations."""
+
+    def __init__(self, message: str, x=None, value: float = float("nan"), nfev: int = 0):
+        self.x = x
+        self.value = value
+        self.nfev = nfev
+        super().__init__(message)

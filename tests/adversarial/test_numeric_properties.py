@@ -472,7 +472,6 @@ def _quad(x):
     return float(np.sum((x - 1.0) ** 2))
 
 
-@pytest.mark.xfail(strict=True, reason="left (issue 12): optimisers: an objective that is inf/NaN everywhere returns fun=inf (no typed error yet)")
 @SETTINGS
 @given(bad=bad_float, count=st.sampled_from([0, -1, -100]), tol=st.sampled_from([0.0, -1e-6, math.nan, math.inf]))
 def test_design_optimisers_bad_inputs(bad, count, tol):

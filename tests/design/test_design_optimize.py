@@ -9,6 +9,7 @@ import scipy.optimize as so
 from hypothesis import given, settings, strategies as st
 
 from anthroarm.design import optimize as O
+from anthroarm.errors import ObjectiveError
 
 # ----------------------------------------------------------------------------- golden section
 
@@ -60,7 +61,17 @@ def test_golden_bad_input():
         O.golden_section(lambda x: x, 0, np.inf)
     with pytest.raises(ValueError, match="eps"):
         O.golden_points_needed(0, 1, -1)
-    assert O.golden_section(lambda x: np.nan, 0, 1).status == "nan"
+    with pytest.raises(ObjectiveError, match="never returned a finite value"):
+        O.golden_section(lambda x: np.nan, 0, 1)
+    for kw in ({"eps": 0.0}, {"eps": -1e-6}, {"eps": np.nan}, {"n": 0}, {"n": -1}, {"scan": -1}):
+        with pytest.raises(ValueError, match=next(iter(kw))):
+            O.golden_section(lambda x: x * x, 0, 1, **kw)
+    with pytest.raises(ValueError, match="within"):
+        O.golden_section(lambda x: x * x, -1e308, 1)
+    # a partly-NaN objective: status "nan", the best finite sample
+    r = O.golden_section(lambda x: np.nan if x > 0.5 else (x - 0.3) ** 2, 0, 1)
+    assert r.status == "nan" and not r.success
+    assert np.isfinite(r.fun) and 0 <= r.x <= 0.5 and r.fun == pytest.approx((r.x - 0.3) ** 2)
 
 
 # ----------------------------------------------------------------------------- quadratic interpolation
@@ -183,7 +194,7 @@ def test_simplex_variants_and_bad_input():
         O.simplex_book(so.rosen, None, initial_simplex=[[0, 0], [1, 1], [2, 2]])
     with pytest.raises(ValueError, match="NaN"):
         O.simplex_book(so.rosen, [np.nan, 0])
-    assert O.simplex_book(lambda x: 1.0, [0, 0], maxiter=5, eps1=-1).status == "maxiter"
+    assert O.simplex_book(lambda x: 1.0, [0, 0], maxiter=5, eps1=0).status == "maxiter"
 
 
 # ----------------------------------------------------------------------------- SUMT and the §4-3 example
@@ -259,16 +270,60 @@ def test_equality_constraints_exterior_and_mixed_vs_slsqp():
 
 def test_nan_objective_is_a_status():
     nan = lambda x: np.nan  # noqa: E731
-    assert O.quadratic_interpolation(nan, (0, 1)).status == "nan"
-    assert O.quadratic_interpolation(nan, (0, 0.5, 1)).status == "nan"
-    assert O.fletcher_reeves(nan, [1.0, 0.0]).status == "nan"
-    assert O.steepest_descent(nan, [1.0]).status == "nan"
+    inf = lambda x: np.inf  # noqa: E731
     g = lambda x: np.array([x[0]])  # noqa: E731
-    for fn in (O.sumt_exterior, O.sumt_interior, O.sumt_mixed):
-        r = fn(nan, [1.0], g)
-        assert r.status == "nan" and not r.success, (fn.__name__, r)
-    r = O.sumt_exterior(lambda x: x @ x, [1.0], lambda x: np.array([np.nan]))
-    assert r.status == "nan"
+    # an objective that is never finite has no best point: a typed error carrying x and the value
+    for bad in (nan, inf):
+        for call in (lambda: O.quadratic_interpolation(bad, (0, 1)),
+                     lambda: O.quadratic_interpolation(bad, (0, 0.5, 1)),
+                     lambda: O.fletcher_reeves(bad, [1.0, 0.0]), lambda: O.steepest_descent(bad, [1.0]),
+                     lambda: O.simplex_book(bad, [1.0, 0.0]), lambda: O.sumt_exterior(bad, [1.0], g),
+                     lambda: O.sumt_interior(bad, [1.0], g), lambda: O.sumt_mixed(bad, [1.0], g),
+                     lambda: O.bracket_minimum(bad, 0.0), lambda: O.line_minimize(bad)):
+            with pytest.raises(ObjectiveError) as e:
+                call()
+            assert isinstance(e.value, ValueError) and not np.isfinite(e.value.value)
+    # a constraint that is NaN everywhere makes the penalty function NaN everywhere
+    with pytest.raises(ObjectiveError):
+        O.sumt_exterior(lambda x: x @ x, [1.0], lambda x: np.array([np.nan]))
+    # partly NaN: status "nan" with the best point where f was finite
+    part = lambda x: np.nan if np.atleast_1d(x)[0] > 1.5 else float(np.sum((np.atleast_1d(x) - 1.0) ** 2))  # noqa: E731
+    r = O.quadratic_interpolation(part, (0.0, 1.0, 3.0))
+    assert r.status == "nan" and not r.success, r
+    assert np.isfinite(r.x) and r.fun == part(r.x) and r.x <= 1.5
+    # the simplex treats NaN like inf (a point to move away from) and still converges
+    r = O.simplex_book(part, [1.2, 0.0], step=1.0)
+    assert r.success and r.fun == pytest.approx(part(r.x)) and np.all(np.isfinite(r.x)) and r.x[0] <= 1.5
+
+
+def test_optimiser_arguments_are_checked():
+    q = lambda x: float(np.sum((np.atleast_1d(x) - 1.0) ** 2))  # noqa: E731
+    for bad in (0.0, -1e-6, np.nan, np.inf):
+        for call in (lambda: O.quadratic_interpolation(q, (0, 1, 2), eps=bad),
+                     lambda: O.fletcher_reeves(q, [0.5], gtol=bad),
+                     lambda: O.sumt_exterior(q, [0.5], eps1=bad),
+                     lambda: O.sumt_exterior(q, [0.5], c=bad),
+                     lambda: O.sumt_interior(q, [0.5], lambda x: 2 - x, r0=bad),
+                     lambda: O.numerical_gradient(q, [0.5], h=bad), lambda: O.bracket_minimum(q, 0.0, h=bad),
+                     lambda: O.line_minimize(q, h0=bad)):
+            with pytest.raises(ValueError):
+                call()
+    for bad in (-1e-6, np.nan, np.inf):          # eps1 = 0 switches (4-63) off
+        with pytest.raises(ValueError, match="eps1"):
+            O.simplex_book(q, [0.5], eps1=bad)
+    for n in (0, -1):
+        for call in (lambda: O.quadratic_interpolation(q, (0, 1, 2), maxiter=n),
+                     lambda: O.fletcher_reeves(q, [0.5], maxiter=n),
+                     lambda: O.steepest_descent(q, [0.5], maxiter=n), lambda: O.simplex_book(q, [0.5], maxiter=n),
+                     lambda: O.bracket_minimum(q, 0.0, maxiter=n), lambda: O.sumt_exterior(q, [0.5], max_stages=n)):
+            with pytest.raises(ValueError, match="maxiter|max_stages"):
+                call()
+    with pytest.raises(TypeError, match="integer"):
+        O.simplex_book(q, [0.5], maxiter=2.5)
+    for call in (lambda: O.fletcher_reeves(q, [1e308, 0.5]), lambda: O.simplex_book(q, [1e308]),
+                 lambda: O.simplex_book(q, [0.5], step=1e308)):
+        with pytest.raises(ValueError, match="x0|step"):
+            call()
 
 
 def test_infeasible_problems_say_so():
@@ -280,7 +335,11 @@ def test_infeasible_problems_say_so():
     assert O.sumt_mixed(f, [0.5], g).status == "infeasible"
     rb = O.sumt_interior(f, [0.5], None, bounds=[(2.0, 1.0)])
     assert rb.status == "infeasible_bounds" and "bound 0" in rb.message
-    assert O.sumt_exterior(f, [0.5], bounds=[(0.0, np.nan)]).status == "infeasible_bounds"
+    assert rb.fun == f([0.5])                 # the value at x0, finite
+    for bad in (np.nan, -1e308, 1e308):
+        with pytest.raises(ValueError, match="bound 0"):
+            O.sumt_exterior(f, [0.5], bounds=[(0.0, bad)])
+    assert O.sumt_exterior(f, [0.5], bounds=[(0.0, -np.inf)]).status == "infeasible_bounds"
     with pytest.raises(ValueError, match="entries"):
         O.sumt_exterior(f, [0.5], bounds=[(0, 1), (0, 1)])
 

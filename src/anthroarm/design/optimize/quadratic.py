@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .golden import bracket_minimum
-from .result import Counted, OptimizeResult
+from .result import Counted, OptimizeResult, count, positive
 
 
 def quadratic_coefficients(a1, a2, a3, f1, f2, f3):
@@ -45,11 +47,15 @@ def quadratic_step(a1, a2, a3, f1, f2, f3) -> float:
 def quadratic_step_equal(h, f1, f2, f3) -> float:
     """Equal spacing 0, h, 2h: Eq. (4-23) ``α* = (4f2 − 3f1 − f3)/(4f2 − 2f3 − 2f1)·h``;
     requires (4-24) ``f1 + f3 > 2 f2``."""
-    if not h > 0:
-        raise ValueError(f"trial step h must be positive, got {h!r}")
+    h = positive("trial step h", h)
+    if not all(math.isfinite(v) for v in (f1, f2, f3)):
+        raise ValueError(f"the three values must be finite, got {f1!r}, {f2!r}, {f3!r}")
     if not f1 + f3 > 2 * f2:
         raise ValueError("(4-24) f1 + f3 > 2 f2 fails: the three values have no parabolic minimum")
-    return (4 * f2 - 3 * f1 - f3) / (4 * f2 - 2 * f3 - 2 * f1) * h
+    a = (4 * f2 - 3 * f1 - f3) / (4 * f2 - 2 * f3 - 2 * f1) * h
+    if not math.isfinite(a):
+        raise ValueError(f"alpha* = ... * h is beyond the float range (h = {h!r}, values {f1!r}, {f2!r}, {f3!r})")
+    return a
 
 
 def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -> OptimizeResult:
@@ -60,7 +66,13 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
     searches from a.  Each step keeps the three points that bracket the lowest value (the book's
     flowchart Fig. 4-5 is missing; this is the standard rule) and stops when successive vertices
     differ by less than ``eps`` (relative to |α| + 1).  Status ``"no_minimum"`` when no bracket
-    exists (monotone or concave data)."""
+    exists (monotone or concave data).  If ``f`` was NaN somewhere the status is ``"nan"`` with the
+    best finite point; an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`.
+    ``eps`` must be finite and > 0, ``maxiter`` an integer >= 1, the bracket finite (``ValueError``)."""
+    eps = positive("eps", eps)
+    maxiter = count("maxiter", maxiter)
+    if any(not math.isfinite(float(v)) for v in bracket):
+        raise ValueError(f"bracket must be finite, got {bracket}")
     f = Counted(f)
     if len(bracket) == 3:
         a1, a2, a3 = (float(v) for v in bracket)
@@ -76,22 +88,22 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
         if not (f2 <= f1 and f2 <= f3):
             br = bracket_minimum(f, a, (b - a) / 10)
             if br is None:
-                return OptimizeResult(a1 if f1 < f3 else a3, min(f1, f3), "no_minimum",
-                                      "f keeps decreasing: no bracket of a minimum", 0, f.n)
+                return f.result(a1 if f1 < f3 else a3, min(f1, f3), "no_minimum",
+                                "f keeps decreasing: no bracket of a minimum", 0, f.n)
             a1, a2, a3, f1, f2, f3 = br
     else:
         raise ValueError("bracket must be (a, b) or (a1, a2, a3)")
     if f.saw_nan:
-        return OptimizeResult(a2, f2, "nan", "the objective returned NaN", 0, f.n)
+        return f.result(a2, np.inf, "nan", "the objective returned NaN (x, fun: the best finite point)", 0, f.n)
     if not (f2 <= f1 and f2 <= f3):
-        return OptimizeResult(a2, f2, "no_minimum", "the three points do not bracket a minimum", 0, f.n)
+        return f.result(a2, f2, "no_minimum", "the three points do not bracket a minimum", 0, f.n)
     prev = a2
     hist = [a2]
     for it in range(1, maxiter + 1):
         try:
             x = quadratic_step(a1, a2, a3, f1, f2, f3)
         except ValueError:                          # flat / collinear values: the middle point is the answer
-            return OptimizeResult(a2, f2, "converged", "the three values are equal: flat bracket", it, f.n, hist)
+            return f.result(a2, f2, "converged", "the three values are equal: flat bracket", it, f.n, hist)
         if not a1 <= x <= a3:
             x = a2
         if x == a2:                                 # vertex on the middle point: nudge to keep three distinct points
@@ -109,19 +121,22 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
                 a1, f1 = x, fx
         hist.append(a2)
         if f.saw_nan:
-            return OptimizeResult(a2, f2, "nan", "the objective returned NaN", it, f.n, hist)
+            return f.result(a2, np.inf, "nan", "the objective returned NaN (x, fun: the best finite point)",
+                            it, f.n, hist)
         if abs(x - prev) < eps * (abs(x) + 1.0) or (a3 - a1) < eps * (abs(a2) + 1.0):
-            return OptimizeResult(a2, f2, "converged", f"|alpha* - previous| < {eps:g}", it, f.n, hist,
-                                  {"bracket": (a1, a2, a3)})
+            return f.result(a2, f2, "converged", f"|alpha* - previous| < {eps:g}", it, f.n, hist,
+                            {"bracket": (a1, a2, a3)})
         prev = x
-    return OptimizeResult(a2, f2, "maxiter", f"no convergence in {maxiter} steps", maxiter, f.n, hist,
-                          {"bracket": (a1, a2, a3)})
+    return f.result(a2, f2, "maxiter", f"no convergence in {maxiter} steps", maxiter, f.n, hist,
+                    {"bracket": (a1, a2, a3)})
 
 
 def line_minimize(phi, h0: float = 1e-2, eps: float = 1e-10):
     """1-D minimisation used by the multi-dimensional methods: advance-retreat bracket from 0,
     then quadratic interpolation (exact in one step on a quadratic).  Returns ``(h, phi(h))``,
-    or ``(0, phi(0))`` when no decrease exists."""
+    or ``(0, phi(0))`` when no decrease exists.  ``h0`` and ``eps`` must be finite and > 0."""
+    h0 = positive("h0", h0)
+    eps = positive("eps", eps)
     br = bracket_minimum(phi, 0.0, h0)
     if br is None:
         return math.nan, -math.inf

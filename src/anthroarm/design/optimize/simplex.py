@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .result import Counted, OptimizeResult, as_vector
+from .result import MAX_COORD, Counted, OptimizeResult, as_vector, count, positive
 
 
 def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: float = 1e-14,
@@ -31,8 +31,16 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
     ``initial_simplex`` ((n+1, n)) is given; its edges must be linearly independent.
     ``expand_if="G"`` expands when S_R < S_G (book step 4), ``"L"`` when S_R < S_L.
     ``eps2=None`` disables (4-64) (it is ill-posed when S_L ≈ 0).  ``xtol`` > 0 also stops when
-    the simplex diameter falls below it.  ``f`` may return ``inf`` (e.g. an infeasible point
-    for a barrier function)."""
+    the simplex diameter falls below it; ``eps1=0`` leaves the stop to ``eps2``/``xtol``/``maxiter``.
+    ``f`` may return ``inf`` (e.g. an infeasible point for a barrier function).  ``eps1`` and ``xtol`` must be finite and >= 0, ``eps2`` (when given)
+    finite and > 0, ``maxiter`` an integer >= 1, ``x0``, ``step`` and ``initial_simplex`` finite
+    within ±1e150 (``ValueError``).  If ``f`` was NaN somewhere the status is ``"nan"`` with the
+    best finite point; an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`."""
+    eps1 = positive("eps1", eps1, allow_zero=True)
+    if eps2 is not None:
+        eps2 = positive("eps2", eps2)
+    xtol = positive("xtol", xtol, allow_zero=True)
+    maxiter = count("maxiter", maxiter)
     if not (0 < lam < 1) or lam == 0.5:
         raise ValueError(f"compression factor must satisfy 0 < lam < 1, lam != 0.5 (4-60); got {lam!r}")
     if not mu > 1:
@@ -41,17 +49,18 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
         raise ValueError("expand_if must be 'G' or 'L'")
     fc = Counted(f)
     if initial_simplex is None:
-        x0 = as_vector("x0", x0)
+        x0 = as_vector("x0", x0, limit=MAX_COORD)
         n = x0.size
         st = np.broadcast_to(np.asarray(step, dtype=float), (n,))
-        if np.any(st == 0) or not np.all(np.isfinite(st)):
-            raise ValueError(f"simplex step must be finite and non-zero, got {step!r}")
+        if np.any(st == 0) or not np.all(np.isfinite(st)) or np.any(np.abs(st) > MAX_COORD):
+            raise ValueError(f"simplex step must be finite, non-zero and within +-{MAX_COORD:g}, got {step!r}")
         X = np.vstack([x0] + [x0 + st[i] * np.eye(n)[i] for i in range(n)])
     else:
         X = np.array(initial_simplex, dtype=float)
         n = X.shape[1]
-        if X.shape != (n + 1, n) or not np.all(np.isfinite(X)):
-            raise ValueError(f"initial_simplex must be a finite (n+1, n) array, got shape {X.shape}")
+        if X.shape != (n + 1, n) or not np.all(np.isfinite(X)) or np.any(np.abs(X) > MAX_COORD):
+            raise ValueError(f"initial_simplex must be a finite (n+1, n) array within +-{MAX_COORD:g}, "
+                             f"got shape {X.shape}")
     if np.linalg.matrix_rank(X[1:] - X[0]) < n:
         raise ValueError("simplex edges X_i - X_0 are linearly dependent: the search would stay in a subspace")
     S = np.array([fc(x) for x in X])
@@ -95,5 +104,5 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
     order = np.argsort(S, kind="stable")
     X, S = X[order], S[order]
     if fc.saw_nan and not np.isfinite(S[0]):
-        status, msg = "nan", "the objective returned NaN"
-    return OptimizeResult(X[0].copy(), float(S[0]), status, msg, it, fc.n, hist, {"simplex": X, "values": S})
+        status, msg = "nan", "the objective returned NaN (x, fun: the best finite point)"
+    return fc.result(X[0].copy(), float(S[0]), status, msg, it, fc.n, hist, {"simplex": X, "values": S})

@@ -15,13 +15,21 @@ Constraints follow §4-3 and SciPy: inequalities are feasible when ``g_u(X) ≥ 
 The unconstrained minimiser is the book's simplex (:func:`simplex_book`) by default; any
 ``inner(phi, x0) -> OptimizeResult`` can be passed.  The book gives no values for r⁽⁰⁾, C, ε:
 r⁽⁰⁾ = 1 ("many programs", l. 2013), C = 0.1 (interior/mixed) and 10 (exterior) are ours.
+
+Arguments are checked (``ValueError``): r⁽⁰⁾, M⁽⁰⁾, R, ε1, ε2 and ``scale`` finite and > 0,
+``max_stages`` an integer ≥ 1, ``x0`` finite within ±1e150, a bound NaN or beyond ±1e150 (±inf
+means no bound).  An empty bound (lo ≥ hi) gives status ``"infeasible_bounds"`` with f(x0); an
+objective (or penalty function) that is never finite raises
+:class:`~anthroarm.errors.ObjectiveError`; one that is NaN somewhere gives status ``"nan"`` with
+the best finite point.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .result import OptimizeResult, as_vector
+from ...errors import ObjectiveError
+from .result import MAX_COORD, OptimizeResult, as_vector, count, positive
 from .simplex import simplex_book
 
 
@@ -31,13 +39,41 @@ def _vec(fn, x):
     return np.atleast_1d(np.asarray(fn(x), dtype=float)).ravel()
 
 
+def _check_bounds(bounds):
+    """``[(lo, hi), …]`` as floats (None → ∓inf).  Raises ``ValueError`` naming a bound that is
+    NaN or beyond ±1e150 (±inf means "no bound")."""
+    out = []
+    for i, b in enumerate(bounds):
+        try:
+            lo, hi = b
+        except (TypeError, ValueError):
+            raise ValueError(f"bound {i} must be a pair (lo, hi), got {b!r}") from None
+        lo = -np.inf if lo is None else float(lo)
+        hi = np.inf if hi is None else float(hi)
+        for name, v in (("lower", lo), ("upper", hi)):
+            if np.isnan(v) or (np.isfinite(v) and abs(v) > MAX_COORD):
+                raise ValueError(f"bound {i}: the {name} bound must be a number within +-{MAX_COORD:g} "
+                                 f"or +-inf (no bound), got {v!r}")
+        out.append((lo, hi))
+    return out
+
+
+def _empty_bound(bounds):
+    """Message naming the first bound with lo >= hi, or None."""
+    for i, (lo, hi) in enumerate(bounds):
+        if lo >= hi:
+            return f"bound {i} is empty: lower {lo:g} >= upper {hi:g}"
+    return None
+
+
 def bounds_to_ineq(bounds):
     """``[(lo, hi), …]`` -> function ``x -> [x_i − lo_i, hi_i − x_i, …]`` (≥ 0 when feasible).
-    ``None`` or ±inf ends are skipped.  Raises ``ValueError`` on a bound with lo ≥ hi, naming it."""
-    bounds = [(-np.inf if lo is None else float(lo), np.inf if hi is None else float(hi)) for lo, hi in bounds]
-    for i, (lo, hi) in enumerate(bounds):
-        if np.isnan(lo) or np.isnan(hi) or lo >= hi:
-            raise ValueError(f"bound {i} is empty: lower {lo:g} >= upper {hi:g}")
+    ``None`` or ±inf ends are skipped.  Raises ``ValueError`` on a bound with lo ≥ hi, or one
+    that is NaN or beyond ±1e150, naming it."""
+    bounds = _check_bounds(bounds)
+    empty = _empty_bound(bounds)
+    if empty:
+        raise ValueError(empty)
 
     def g(x):
         out = []
@@ -60,15 +96,28 @@ def _combine(ineq, bounds):
     return lambda x: np.concatenate([_vec(ineq, x), gb(x)])
 
 
+def _finite_f(f, x, what: str) -> float:
+    """``f(x)`` for a result; an objective that is not finite there raises ObjectiveError."""
+    v = float(f(x))
+    if not np.isfinite(v):
+        raise ObjectiveError(f"the objective is {v} at {what} x = {np.asarray(x)}", x, v, 1)
+    return v
+
+
+def _check_params(max_stages, eps1, eps2, scale, **factors):
+    for name, v in factors.items():
+        positive(name, v)
+    return count("max_stages", max_stages), positive("eps1", eps1), positive("eps2", eps2), positive("scale", scale)
+
+
 def _prepare(f, x0, ineq, eq, bounds):
-    x0 = as_vector("x0", x0)
+    x0 = as_vector("x0", x0, limit=MAX_COORD)
     if bounds is not None:
         if len(bounds) != x0.size:
             raise ValueError(f"bounds has {len(bounds)} entries for {x0.size} variables")
-        try:
-            bounds_to_ineq(bounds)
-        except ValueError as e:
-            return None, OptimizeResult(x0, float("nan"), "infeasible_bounds", str(e))
+        empty = _empty_bound(_check_bounds(bounds))
+        if empty:
+            return None, OptimizeResult(x0, _finite_f(f, x0, "the starting point"), "infeasible_bounds", empty, nfev=1)
     return (x0, _combine(ineq, bounds)), None
 
 
@@ -98,9 +147,10 @@ def _barrier_inner(phi, x, scale, g):
     return best
 
 
-def _nan_result(x, stage, nfev, hist) -> OptimizeResult:
-    return OptimizeResult(x, float("nan"), "nan", f"the objective or a constraint returned NaN in stage {stage}",
-                          stage, nfev, hist)
+def _nan_result(f, x, stage, nfev, hist) -> OptimizeResult:
+    return OptimizeResult(x, _finite_f(f, x, f"the best finite point of stage {stage}"), "nan",
+                          f"the objective or a constraint returned NaN in stage {stage} "
+                          "(x, fun: the best finite point)", stage, nfev, hist)
 
 
 def violation(x, ineq=None, eq=None) -> float:
@@ -130,18 +180,19 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
     """The stage loop shared by the interior (4-66) and mixed (4-78) methods: barrier
     ``r Σ 1/g_u`` on the inequalities, plus ``r^{−1/2} Σ h_v²`` when there are equalities;
     r shrinks by ``c`` per stage until (4-67) and (4-68) hold."""
+    max_stages, eps1, eps2, scale = _check_params(max_stages, eps1, eps2, scale, r0=r0, c=c)
+    if not c < 1:
+        raise ValueError(f"need r0 > 0 and 0 < c < 1, got r0={r0!r}, c={c!r}")
     prep, bad = _prepare(f, x0, ineq, eq, bounds)
     if bad:
         return bad
     x, g = prep
     if g is None:
         raise ValueError(f"{name} needs inequality constraints (ineq or bounds); use sumt_exterior")
-    if not (r0 > 0 and 0 < c < 1):
-        raise ValueError(f"need r0 > 0 and 0 < c < 1, got r0={r0!r}, c={c!r}")
     if not np.all(_vec(g, x) > 0):
         xf = find_feasible(x, g)
         if xf is None:
-            return OptimizeResult(x, float(f(x)), "infeasible",
+            return OptimizeResult(x, _finite_f(f, x, "the starting point"), "infeasible",
                                   "no strictly feasible starting point found: the constraints may be inconsistent",
                                   info={"violation": violation(x, g, eq)})
         x = xf
@@ -166,7 +217,7 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
         x = np.asarray(res.x, dtype=float)
         hist.append(x.copy())
         if res.status == "nan":
-            return _nan_result(x, k, nfev, hist)
+            return _nan_result(f, x, k, nfev, hist)
         ph = res.fun
         if phi_prev is not None:
             dx = np.linalg.norm(x - x_prev)
@@ -179,7 +230,7 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
     Q = violation(x, g, eq)
     if eq is not None and status == "converged" and Q > 1e-4 * (1 + np.linalg.norm(x)):
         status, msg = "infeasible", f"equality constraints violated by {Q:.3g} at the end"
-    return OptimizeResult(x, float(f(x)), status, msg, k, nfev, hist,
+    return OptimizeResult(x, _finite_f(f, x, "the result"), status, msg, k, nfev, hist,
                           {"r": r, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
 
 
@@ -201,12 +252,13 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
     Converged when the largest violation Q ≤ ``eps1`` (4-74).  When M exceeds the control value
     ``R`` and X* stops moving (4-75) while Q is still above ``eps1``, the constraints cannot be
     met: status ``"infeasible"`` with the remaining violation in ``info``."""
+    max_stages, eps1, eps2, scale = _check_params(max_stages, eps1, eps2, scale, M0=M0, c=c, R=R)
+    if not c > 1:
+        raise ValueError(f"need M0 > 0 and c > 1, got M0={M0!r}, c={c!r}")
     prep, bad = _prepare(f, x0, ineq, eq, bounds)
     if bad:
         return bad
     x, g = prep
-    if not (M0 > 0 and c > 1):
-        raise ValueError(f"need M0 > 0 and c > 1, got M0={M0!r}, c={c!r}")
     inner = inner or (lambda p, z: _default_inner(p, z, scale))
     M = float(M0)
     hist, nfev = [x.copy()], 0
@@ -224,7 +276,7 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
         x = np.asarray(res.x, dtype=float)
         hist.append(x.copy())
         if res.status == "nan":
-            return _nan_result(x, k, nfev, hist)
+            return _nan_result(f, x, k, nfev, hist)
         Q = violation(x, g, eq)
         if Q <= eps1:                                          # (4-74)
             status, msg = "converged", f"largest violation Q = {Q:.3g} <= {eps1:g} (4-74)"
@@ -236,7 +288,7 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
             break
         x_prev = x.copy()
         M *= c
-    return OptimizeResult(x, float(f(x)), status, msg, k, nfev, hist,
+    return OptimizeResult(x, _finite_f(f, x, "the result"), status, msg, k, nfev, hist,
                           {"M": M, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
 
 
