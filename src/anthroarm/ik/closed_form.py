@@ -738,8 +738,10 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     One pose is solved by the compiled kernel (:mod:`.analytic_c`) when a C compiler is
     available — built once per robot parameterisation on first use (≈ 0.2 s, cached on disk;
     ``ANTHROARM_IK_C=0`` disables it) — else by the scalar kernels of :mod:`.analytic_scalar`."""
-    _check_tol("tol", tol)
-    _check_tol("tol_orthonormal", tol_orthonormal)
+    if not (type(tol) is float and type(tol_orthonormal) is float        # the usual call: one test
+            and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
+        _check_tol("tol", tol)
+        _check_tol("tol_orthonormal", tol_orthonormal)
     arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
     if method == "book":
         plan = _require(robot)
@@ -754,6 +756,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     if arr.ndim == 2 and _impl != "general":
         fast = _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, _impl)
+        if fast is not None and len(fast):       # solutions found: nothing to rescue
+            return fast
         if fast is not None:
             plan = _plan(robot)
             po = plan.form.position_only if position_only is None else position_only
