@@ -35,7 +35,10 @@ def _noop(_robot, payload):
 
 
 def run(quick: bool = False) -> dict:
+    import dask
     from distributed import Client, LocalCluster
+
+    from anthroarm.batch import engine
 
     robot = aa.load("human_arm7")
     n_local = 10**5 if quick else 10**6
@@ -55,7 +58,8 @@ def run(quick: bool = False) -> dict:
     times = {}
     per_noop = None
     for workers in (1, 2):
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cl, \
+        with dask.config.set(engine.LOCAL_WORKER_CONFIG), \
+                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0") as cl, \
                 Client(cl, set_as_default=False) as client:
             warm = batch.reachability_map(robot, n=n_big // 10, client=client, **kw)   # robot rebuilt per worker
             assert warm.equals(ref), "Dask result differs from the local one"
@@ -64,8 +68,6 @@ def run(quick: bool = False) -> dict:
             rows.append([f"Dask LocalCluster, {workers} worker(s)", f"{n_big:.0e} configs", f"{workers} x 1 thread",
                          times[workers], n_big / times[workers], ""])
             if workers == 1:
-                from anthroarm.batch import engine
-
                 m = 200
                 t = _best(lambda: engine.run([(_noop, None, i) for i in range(m)], lambda i, p: None, client=client,
                                              progress=False), repeat=2)
@@ -100,9 +102,10 @@ def run(quick: bool = False) -> dict:
         "per_task_overhead_s": per_task_overhead,
         "per_person_s": per_person,
         "model_100_workers_s": t_model,
-        "notes": ("Measured on the project's shared 2-core machine while other engineers' test suites were "
-                  "running on it: absolute times are noisy and the 2-worker speed-up in particular is "
-                  "limited by the other load (two busy cores are not two free cores). The local path uses "
+        "notes": ("Measured on the project's 2-core machine with no other job running. The local path uses "
                   "one core. Overhead = (1-worker Dask wall time - local time) / local time, same job, "
-                  "default chunk size."),
+                  "default chunk size. Workers run with glibc's malloc trim threshold raised to 64 MiB "
+                  "(Dask's nanny sets 64 KiB: a task ran 1.4-1.5x slower) and, on the local cluster, "
+                  "without Dask's statistical profiler (12 % slower with it); the remaining ~10 % per-task "
+                  "slowdown on a worker is not explained yet."),
     }

@@ -38,6 +38,12 @@ from .errors import SchedulerUnreachableError
 CONNECT_TIMEOUT = 10.0
 
 
+#: Dask settings of the workers of a local cluster: no statistical profiler (it samples every
+#: thread's stack every 10 ms under the GIL; a reachability task ran 12 % slower with it).  A
+#: cluster you start yourself keeps its own settings (docs/batch.md says how to set this one).
+LOCAL_WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
+
+
 def connect(scheduler="local", workers: int | None = None, timeout: float = CONNECT_TIMEOUT,
             threads_per_worker: int = 1):
     """A :class:`distributed.Client`: ``"local"`` starts a ``LocalCluster`` of ``workers``
@@ -47,11 +53,13 @@ def connect(scheduler="local", workers: int | None = None, timeout: float = CONN
 
     An address that does not answer within ``timeout`` seconds raises
     :class:`~anthroarm.batch.errors.SchedulerUnreachableError` naming the address and the remedy."""
+    from dask import config as dask_config
     from distributed import Client
 
     if scheduler in (None, "local"):   # the client owns the cluster: closing it stops the workers
-        return Client(n_workers=workers, threads_per_worker=threads_per_worker, processes=True,
-                      dashboard_address=":0", set_as_default=False)
+        with dask_config.set(LOCAL_WORKER_CONFIG):
+            return Client(n_workers=workers, threads_per_worker=threads_per_worker, processes=True,
+                          dashboard_address=":0", set_as_default=False)
     try:
         return Client(scheduler, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError) as exc:
@@ -90,9 +98,39 @@ def window(client) -> int:
     return max(8, 4 * threads)
 
 
+#: glibc's M_TRIM_THRESHOLD set on a worker (bytes), see :func:`_relax_malloc_trim`
+WORKER_TRIM_THRESHOLD = 64 << 20
+_trim_relaxed = [False]
+
+
+def _relax_malloc_trim() -> None:
+    """Once per worker process: raise glibc's malloc trim threshold to
+    :data:`WORKER_TRIM_THRESHOLD`.  Dask's nanny starts workers with
+    ``MALLOC_TRIM_THRESHOLD_=65536`` so that they hand freed memory back to the OS at once; with
+    the megabyte-sized temporaries of the batched FK that makes every free a trim and every
+    allocation fresh page faults: a reachability task ran 1.4-1.5x slower on a worker than in the
+    client's process.  64 MiB keeps the worker's footprint bounded while its arrays are reused.
+    A no-op where glibc's ``mallopt`` is not available."""
+    if _trim_relaxed[0]:
+        return
+    _trim_relaxed[0] = True
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").mallopt(-1, WORKER_TRIM_THRESHOLD)   # M_TRIM_THRESHOLD = -1
+    except (OSError, AttributeError):
+        pass
+
+
 def _execute(fn, desc, payload):
-    """Worker side of one task: the cached robot, then ``fn``."""
+    """One task: the cached robot, then ``fn``."""
     return fn(robot_from(desc) if desc is not None else None, payload)
+
+
+def _execute_on_worker(fn, desc, payload):
+    """Worker side of one task (:func:`_relax_malloc_trim`, then :func:`_execute`)."""
+    _relax_malloc_trim()
+    return _execute(fn, desc, payload)
 
 
 def run(tasks, consume, *, client=None, progress: bool = True, desc: str = "batch", callback=None) -> int:
@@ -133,7 +171,7 @@ def _run_dask(client, tasks, consume, bar, callback, desc):
 
     def submit(i, task):
         fn, d, payload = task
-        f = client.submit(_execute, fn, d, payload, key=f"anthroarm-{desc}-{token}-{i}", pure=False)
+        f = client.submit(_execute_on_worker, fn, d, payload, key=f"anthroarm-{desc}-{token}-{i}", pure=False)
         index[f.key] = i
         return f
 
