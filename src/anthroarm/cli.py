@@ -50,6 +50,100 @@ def _add_model_arguments(p, robot_options: bool = True):
         _add_robot_options(p)
 
 
+#: commands whose model (positional, or fixed) may be a book model with builder parameters
+_MODEL_COMMANDS = {"urdf": None, "view": None, "ik": None, "demo": "human_arm7"}
+
+
+def _model_params(model) -> list[tuple[str, object, str, str]] | None:
+    """The builder parameters of a book model, ``[(name, default, kind, unit)]`` (kind: ``float``,
+    ``pair`` (two numbers, e.g. a stroke) or ``str``); None for any other model.  Units follow the
+    catalog's convention: lengths in m, mass in kg."""
+    import inspect
+
+    from . import models
+
+    if not isinstance(model, str) or model not in models.BOOK_MODELS:
+        return None
+    out = []
+    for p in inspect.signature(models.BOOK_MODELS[model]).parameters.values():
+        d = p.default
+        kind = "pair" if isinstance(d, tuple) else "str" if isinstance(d, str) else "float"
+        unit = "" if kind == "str" else "kg" if p.name == "mass" else "m"
+        out.append((p.name, d, kind, unit))
+    return out
+
+
+def _param_names(model) -> str:
+    return ", ".join(f"--{n}" for n, *_ in _model_params(model) or [])
+
+
+def _convert_param(model, name, kind, unit, text):
+    """The builder value of ``--NAME TEXT`` / ``--param NAME=TEXT``."""
+    import math
+
+    if kind == "str":
+        return text
+    want = "two numbers MIN,MAX" if kind == "pair" else "a number"
+    try:
+        vals = [float(x) for x in str(text).split(",")]
+    except ValueError:
+        vals = []
+    if len(vals) != (2 if kind == "pair" else 1) or not all(math.isfinite(v) for v in vals):
+        raise UserError(f"{model} parameter {name} expects {want} ({unit}), got {text!r}")
+    return tuple(vals) if kind == "pair" else vals[0]
+
+
+def _add_model_param_options(p, model):
+    """``--NAME VALUE`` for every builder parameter of a book model (shown by ``--help`` with its
+    unit and default); an option the command already has stays reachable through --param."""
+    from . import models
+
+    params = _model_params(model)
+    if not params:
+        return
+    doc = (models.BOOK_MODELS[model].__doc__ or "").strip().splitlines()
+    g = p.add_argument_group(f"parameters of {model}",
+                             f"{doc[0] if doc else ''} Also accepted as --param NAME=VALUE.".strip())
+    for name, default, kind, unit in params:
+        if f"--{name}" in p._option_string_actions:
+            continue
+        shown = ",".join(f"{x:g}" for x in default) if kind == "pair" else default
+        metavar = "MIN,MAX" if kind == "pair" else name.upper()
+        help_ = f"{unit + ', ' if unit else ''}{'min,max, ' if kind == 'pair' else ''}default {shown}"
+        g.add_argument(f"--{name}", dest=f"model_param:{name}", default=None, metavar=metavar, help=help_)
+    p.set_defaults(_model=model)
+
+
+class _PrescanError(Exception):
+    pass
+
+
+class _Prescan(argparse.ArgumentParser):
+    def error(self, message):
+        raise _PrescanError(message)
+
+
+def _prescan_model(sp, rest):
+    """The model named in ``rest`` (the arguments after the command) as ``sp`` would parse it,
+    with its required options not yet enforced and unknown options (a model's parameters) let
+    through; None if there is none."""
+    pre = _Prescan(add_help=False, prog=sp.prog)
+    for act in sp._actions:
+        if not act.option_strings:
+            if act.dest == "model" and act.nargs is None:
+                pre.add_argument("model", nargs="?")
+            continue
+        if act.nargs == 0:
+            pre.add_argument(*act.option_strings, dest=act.dest, action="store_true")
+        else:
+            pre.add_argument(*act.option_strings, dest=act.dest, nargs=act.nargs)
+    try:
+        ns, _ = pre.parse_known_args(rest)
+    except _PrescanError:
+        return None
+    return getattr(ns, "model", None)
+
+
 def _parse_locked(text):
     """``"a,b=0.5"`` -> {"a": None, "b": 0.5} (None: the neutral value)."""
     if text is None:
@@ -181,8 +275,10 @@ def _add_urdf(sub):
         "urdf",
         help="write the URDF of a model (a book model with chosen parameters)",
         description="Write the URDF of a model: a book model generated with the builder's keyword arguments "
-                    "(--param), or the validated text of an example-robot-data robot or a URDF file.",
-        epilog="examples:\n  anthroarm urdf human_arm7 -o arm.urdf --param height=1.62 --param mass=55 --param sex=female\n"
+                    "(--NAME VALUE or --param NAME=VALUE; 'anthroarm urdf MODEL --help' lists them with units and defaults), "
+                    "or the validated text of an example-robot-data robot or a URDF file.",
+        epilog="examples:\n  anthroarm urdf human_arm7 -o arm.urdf --height 1.62 --mass 55 --sex female\n"
+               "  anthroarm urdf prosthetic_arm -o arm.urdf --param L2=0.240\n"
                "  anthroarm urdf ur10 -o ur10.urdf",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -191,17 +287,37 @@ def _add_urdf(sub):
     p.set_defaults(func=cmd_urdf)
 
 
-def _parse_params(items) -> dict:
+def _parse_params(items, model=None, a=None) -> dict:
+    """Builder keyword arguments from ``--param KEY=VALUE`` items and, for a book model, its
+    ``--NAME VALUE`` options (in ``a``); a book model's names are checked against its builder
+    and the values converted to the builder's kinds."""
     params = {}
     for it in items:
         if "=" not in it:
             raise UserError(f"--param expects KEY=VALUE, got {it!r}")
         k, v = it.split("=", 1)
-        try:
-            params[k] = float(v)
-        except ValueError:
-            params[k] = v
-    return params
+        params[k.strip()] = v
+    spec = _model_params(model)
+    if spec is None:       # not a book model: numbers as floats; load() rejects any parameter
+        out = {}
+        for k, v in params.items():
+            try:
+                out[k] = float(v)
+            except ValueError:
+                out[k] = v
+        return out
+    kinds = {n: (kind, unit) for n, _, kind, unit in spec}
+    unknown = [k for k in params if k not in kinds]
+    if unknown:
+        raise UserError(f"unknown parameter {unknown[0]!r} of {model}; its parameters: "
+                        f"{', '.join(kinds)} (e.g. --param {spec[0][0]}=VALUE or --{spec[0][0]} VALUE)")
+    for n in kinds:
+        v = getattr(a, f"model_param:{n}", None) if a is not None else None
+        if v is not None:
+            if n in params and params[n] != v:
+                raise UserError(f"{model} parameter {n} given twice (--{n} {v} and --param {n}={params[n]})")
+            params[n] = v
+    return {k: _convert_param(model, k, *kinds[k], v) for k, v in params.items()}
 
 
 def cmd_urdf(a) -> int:
@@ -212,7 +328,7 @@ def cmd_urdf(a) -> int:
         raise UserError(f"folder {out.parent} does not exist")
     if out.is_dir():
         raise UserError(f"-o {a.output} is a folder; give a file name such as {out / 'robot.urdf'}")
-    robot = _load_model(a.model, _parse_params(a.param), tool="universe")  # any frame: only the text is written
+    robot = _load_model(a.model, _parse_params(a.param, a.model, a), tool="universe")  # any frame: only the text is written
     atomic_write_text(out, robot.info.text)
     print(f"wrote {out}")
     return 0
@@ -221,14 +337,39 @@ def cmd_urdf(a) -> int:
 def _add_bench(sub):
     p = sub.add_parser(
         "bench",
-        help="run benchmarks (JSON + markdown in benchmarks/results)",
-        description="Run the benchmark suite side by side with the peers.",
-        epilog="example: anthroarm bench fk --quick",
+        help="run benchmarks (JSON + markdown in a user folder, or --out)",
+        description="Run the benchmark suite side by side with the peers and write JSON + markdown tables "
+                    f"(and figures) to --out; default: {_bench_user_dir()} ($XDG_DATA_HOME honoured), "
+                    "its 'quick' subfolder with --quick.  The committed benchmarks/results/ of a source "
+                    "checkout is written only with --update-results (full runs).",
+        epilog="examples:\n  anthroarm bench fk --quick\n  anthroarm bench ik --out ./my_results\n"
+               "  anthroarm bench --update-results        # maintainers: refresh benchmarks/results/",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
-    p.add_argument("--quick", action="store_true", help="fewer samples")
+    p.add_argument("--quick", action="store_true", help="fewer samples (never written to benchmarks/results/)")
     p.add_argument("--list", action="store_true", help="list the benchmarks")
+    p.add_argument("--out", default=None, metavar="FOLDER", help="output folder (created if missing)")
+    p.add_argument("--update-results", action="store_true",
+                   help="write into the committed benchmarks/results/ (full runs only)")
     p.set_defaults(func=cmd_bench)
+
+
+def _bench_user_dir() -> Path:
+    """Default folder of ``anthroarm bench``: the platform's user data folder
+    (``$XDG_DATA_HOME/anthroarm/benchmarks``, else ``~/.local/share/anthroarm/benchmarks`` on
+    Linux and other Unix; ``~/Library/Application Support`` on macOS; ``%LOCALAPPDATA%`` on
+    Windows)."""
+    import os
+
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        xdg = os.environ.get("XDG_DATA_HOME", "")
+        base = Path(xdg) if xdg and Path(xdg).is_absolute() else Path.home() / ".local" / "share"
+    return base / "anthroarm" / "benchmarks"
 
 
 def _benchmarks_module():
@@ -242,6 +383,29 @@ def _benchmarks_module():
     return bm
 
 
+def _bench_out(a, results_dir: Path) -> Path:
+    """The folder ``anthroarm bench`` writes to, created and proven writable before any run."""
+    import tempfile
+
+    if a.update_results and a.out is not None:
+        raise UserError("--update-results writes benchmarks/results/; it does not go with --out")
+    if a.update_results and a.quick:
+        raise UserError("--update-results takes full runs only; a --quick run never replaces the committed results")
+    if a.update_results:
+        out = results_dir
+    elif a.out is not None:
+        out = Path(a.out).expanduser()
+    else:
+        out = _bench_user_dir() / ("quick" if a.quick else "")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as exc:
+        raise UserError(f"cannot write benchmark results to {out}: {exc.strerror or exc}") from None
+    return out
+
+
 def cmd_bench(a) -> int:
     bm = _benchmarks_module()
     if a.list:
@@ -250,7 +414,8 @@ def cmd_bench(a) -> int:
     unknown = [n for n in a.names if n not in bm.available()]
     if unknown:
         raise UserError(f"unknown benchmark(s) {unknown}; available: {', '.join(bm.available())}")
-    bm.run(a.names or None, quick=a.quick)
+    out = _bench_out(a, bm.RESULTS_DIR)
+    bm.run(a.names or None, quick=a.quick, out_dir=out)
     return 0
 
 
@@ -388,7 +553,7 @@ def cmd_view(a) -> int:
 
     out = _check_html_path(a.html)
     _check_port_early(a)
-    robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
+    robot = _load_model(a.model, _parse_params(a.param, a.model, a), a.tool, _parse_locked(a.locked))
     if not 0 <= a.workspace <= MAX_SAMPLES:
         raise UserError(f"--workspace must be in 0..{MAX_SAMPLES}, got {a.workspace}")
     q = _parse_q(robot, a.q, a.deg)
@@ -427,7 +592,7 @@ def cmd_demo(a) -> int:
 
     out = _check_html_path(a.html)
     _check_port_early(a)
-    robot = _load_model("human_arm7", _parse_params(a.param))
+    robot = _load_model("human_arm7", _parse_params(a.param, "human_arm7", a))
     bar = _progress(6, "reaching", not a.json)
 
     def tick(done, total):
@@ -479,7 +644,7 @@ def cmd_ik(a) -> int:
     import numpy as np
     import pinocchio as pin
 
-    robot = _load_model(a.model, _parse_params(a.param), a.tool, _parse_locked(a.locked))
+    robot = _load_model(a.model, _parse_params(a.param, a.model, a), a.tool, _parse_locked(a.locked))
     if not all(math.isfinite(x) for x in [*a.xyz, *a.rpy]):
         raise UserError("--xyz and --rpy must be finite numbers")
     from .urdf_io import MAX_LENGTH
@@ -639,7 +804,7 @@ def _cmd_batch(a) -> int:
 
     if a.workers is not None and a.scheduler != "local":
         raise UserError("--workers goes with --scheduler local (a running scheduler has its own workers)")
-    params = _parse_params(a.param)
+    params = _parse_params(a.param, a.model)
     kw = dict(progress=not a.no_progress, seed=a.seed)
     if a.chunk_size is not None:
         kw["chunk_size"] = a.chunk_size
@@ -680,7 +845,10 @@ def _cmd_batch(a) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv=None) -> argparse.ArgumentParser:
+    """The parser; given the command line, a book model's builder parameters become options of
+    the commands that take a model (``anthroarm urdf human_arm7 --height 1.62``, listed by
+    ``--help``)."""
     ap = _Parser(
         prog="anthroarm",
         description="anthroarm: the book's arms, kinematics, IK and dynamics, proven against Pinocchio.",
@@ -693,15 +861,42 @@ def build_parser() -> argparse.ArgumentParser:
     for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache,
                 _batch_parser):
         add(sub)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    cmd = next((i for i, t in enumerate(argv) if not t.startswith("-")), None)
+    if cmd is not None and argv[cmd] in _MODEL_COMMANDS:
+        sp = sub.choices[argv[cmd]]
+        model = _MODEL_COMMANDS[argv[cmd]] or _prescan_model(sp, argv[cmd + 1:])
+        _add_model_param_options(sp, model)
     return ap
 
 
+def _unknown_options_error(a, extras) -> int:
+    """One line for arguments no option takes: for a command that takes a model, name the
+    model's parameters (or say it has none)."""
+    model = getattr(a, "_model", None) or getattr(a, "model", None)
+    if a.command in _MODEL_COMMANDS and isinstance(model, str) and any(e.startswith("--") for e in extras):
+        names = _param_names(model)
+        if names:
+            msg = f"unknown option(s) {' '.join(extras)} for {model}; its parameters: {names} (or --param NAME=VALUE)"
+        else:
+            from . import models
+
+            msg = (f"unrecognized arguments: {' '.join(extras)} ({model} has no builder parameters; "
+                   f"the book models have: {', '.join(models.book_names())})")
+        return _one_line_error(a.command, msg + f" (see 'anthroarm {a.command} {model} --help')")
+    return _one_line_error(a.command or "", f"unrecognized arguments: {' '.join(extras)} (see 'anthroarm --help')")
+
+
 def main(argv=None) -> int:
-    ap = build_parser()
-    a = ap.parse_args(argv)
+    ap = build_parser(argv)
+    a, extras = ap.parse_known_args(argv)
     if not getattr(a, "command", None):
+        if extras:
+            ap.error(f"unrecognized arguments: {' '.join(extras)}")
         ap.print_help()
         return 2
+    if extras:
+        return _unknown_options_error(a, extras)
     try:
         return int(a.func(a) or 0)
     except (UserError, AnthroarmError, ValueError, FileNotFoundError) as exc:
