@@ -1,7 +1,8 @@
 """Subproblem IK (anthroarm.ik.classify._solve_spherical_two_parallel, all 8 branches, no limit
 filter or FK check) vs PyPI ik-geo (Rust, class spherical_two_parallel) on sixr_arm.
 
-Run: .venv/bin/python benchmarks/bench_ik_subproblems.py [--poses 300]
+Run: .venv/bin/python benchmarks/timing_ik_subproblems.py [--poses 300]  (a development script, not one of
+the benchmarks `python -m benchmarks` runs: those are the bench_*.py modules with a run())
 Prints medians (µs per pose) and agreement; writes nothing."""
 
 from __future__ import annotations
