@@ -102,6 +102,46 @@ def compiler() -> str | None:
     return shutil.which(os.environ.get("CC", "cc"))
 
 
+class CompiledOnce:
+    """One family of compiled kernels, each built on first use and kept on its owner.
+
+    :meth:`get` builds ``owner.<attr>`` once (``False`` after a failed build, so it is not
+    retried) and keeps the last failure for :meth:`status`; the environment variable ``switch``
+    set to 0/false/no/off disables the family, and callers then use ``fallback`` (named in the
+    status)."""
+
+    def __init__(self, switch: str, fallback: str, available: str):
+        self.switch, self.fallback, self.available = switch, fallback, available
+        self.reason: str | None = None
+
+    def enabled(self) -> bool:
+        return os.environ.get(self.switch, "1").strip().lower() not in ("0", "false", "no", "off")
+
+    def status(self) -> str:
+        """Why the compiled kernels are (not) in use (the last build failure, if any)."""
+        if not self.enabled():
+            return f"disabled by {self.switch}=0"
+        if compiler() is None:
+            return f"no C compiler ($CC or cc) found: {self.fallback}"
+        return self.reason or self.available
+
+    def get(self, owner, attr: str, build, what: str):
+        """``owner.<attr>``, built by ``build(owner)`` the first time; None where the family is
+        disabled or the build failed (``what`` names the kernel in the status)."""
+        if not self.enabled():
+            return None
+        k = getattr(owner, attr)
+        if k is None:
+            try:
+                k = build(owner)
+                self.reason = None
+            except (RuntimeError, OSError) as exc:
+                self.reason = f"compiled {what} unavailable ({exc}); {self.fallback}"
+                k = False
+            setattr(owner, attr, k)
+        return k or None
+
+
 def compiler_id(cc: str) -> str:
     """The compiler's path and the first line of its ``--version`` (memoised per path)."""
     with _LOCK:

@@ -32,24 +32,14 @@ FLAGS = ["-O2", "-fPIC", "-shared", "-std=c99", "-fno-fast-math", "-ffp-contract
 MAX_SINGLE_S = 64
 _LOCK = threading.Lock()
 _LIBS: dict[str, "CKernel"] = {}
-_STATUS = {"reason": None}
-
-
-def enabled() -> bool:
-    return os.environ.get("ANTHROARM_IK_C", "1").strip().lower() not in ("0", "false", "no", "off")
-
 
 from .. import cache  # noqa: E402
 from ..cache import compiler  # noqa: E402
 
-
-def status() -> str:
-    """Why the compiled kernel is (not) in use (the last build failure, if any)."""
-    if not enabled():
-        return "disabled by ANTHROARM_IK_C=0"
-    if compiler() is None:
-        return "no C compiler ($CC or cc) found: pure-Python kernels"
-    return _STATUS["reason"] or "available (compiled on first use per robot)"
+#: the closed-form kernels: one per plan, switched off by ANTHROARM_IK_C=0
+KERNELS = cache.CompiledOnce("ANTHROARM_IK_C", "pure-Python kernels", "available (compiled on first use per robot)")
+enabled = KERNELS.enabled
+status = KERNELS.status
 
 
 # ---------------------------------------------------------------------------- C text
@@ -542,17 +532,4 @@ def build(plan) -> CKernel:
 def kernel_for(plan) -> CKernel | None:
     """The compiled kernel of ``plan`` (cached on the plan), or None (disabled, no compiler,
     compilation failed — see :func:`status`)."""
-    k = plan.c_kernel
-    if k is None:
-        if not enabled():
-            return None
-        try:
-            k = build(plan)
-            _STATUS["reason"] = None
-        except (RuntimeError, OSError) as exc:
-            _STATUS["reason"] = f"compiled kernel unavailable for {plan.name} ({exc}); pure-Python kernels"
-            k = False
-        plan.c_kernel = k
-    if k is False or not enabled():
-        return None
-    return k
+    return KERNELS.get(plan, "c_kernel", build, f"kernel for {plan.name}")

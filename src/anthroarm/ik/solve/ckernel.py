@@ -42,7 +42,7 @@ import numpy as np
 
 from ... import cache
 from ...chain import PRISMATIC
-from ..analytic_c import FLAGS, enabled
+from ..analytic_c import FLAGS
 from ..fk_codegen import frame_product
 from ...codegen.graph import straight_line
 from . import kernel
@@ -50,16 +50,11 @@ from .targets import ORIENTATION, POSE, POSITION
 
 _LOCK = threading.Lock()
 _LIBS: dict[str, "CKernel"] = {}      # source key -> loaded library (no Robot referenced)
-_STATUS = {"reason": None}
-
-
-def status() -> str:
-    """Why the compiled attempt kernel is (not) in use."""
-    if not enabled():
-        return "disabled by ANTHROARM_IK_C=0"
-    if cache.compiler() is None:
-        return "no C compiler ($CC or cc) found: Python kernel"
-    return _STATUS["reason"] or "available (compiled on first use per robot and frame)"
+#: the attempt kernels: one per (robot, frame), switched off by ANTHROARM_IK_C=0 like the
+#: closed-form kernels (:data:`anthroarm.ik.analytic_c.KERNELS`)
+KERNELS = cache.CompiledOnce("ANTHROARM_IK_C", "Python kernel", "available (compiled on first use per robot and frame)")
+enabled = KERNELS.enabled
+status = KERNELS.status
 
 
 def _c(x: float) -> str:
@@ -469,18 +464,7 @@ def build(sh) -> CKernel:
 def kernel_for(sh) -> CKernel | None:
     """The compiled kernel of the Shared ``sh`` (built once, kept on it), or None (disabled,
     no compiler, compilation failed: :func:`status` says which)."""
-    if not enabled():
-        return None
-    k = sh.ckernel
-    if k is None:
-        try:
-            k = build(sh)
-            _STATUS["reason"] = None
-        except (RuntimeError, OSError) as exc:
-            _STATUS["reason"] = f"compiled attempt kernel unavailable ({exc}); Python kernel"
-            k = False
-        sh.ckernel = k
-    return k or None
+    return KERNELS.get(sh, "ckernel", build, "attempt kernel")
 
 
 class Buffers:
