@@ -61,13 +61,14 @@ def joint_via_trajectory(robot, poses, times, *, q_start=None, swivel=0.0) -> tu
     At each via point the solution nearest (max-norm) to the previous one is taken (the first is
     nearest to ``q_start``, default the neutral configuration), so the trajectory stays on one
     branch.  Returns (trajectory, Q).  ValueError names a via point without a solution."""
-    from ..ik.closed_form import analytic
+    from ..ik.closed_form import analytic, closed_form_info
 
     poses = np.asarray(poses, float)
     prev = robot.neutral() if q_start is None else robot.check_q(q_start, "q_start")
+    form = closed_form_info(robot)
+    kw = {"swivel": swivel} if form is not None and form.swivel else {}   # redundant arm: one swivel
     Q = []
     for k, T in enumerate(poses):
-        kw = {"swivel": swivel} if robot.spec is not None and robot.spec.name == "human_arm7" else {}
         res = analytic(robot, T, **kw)
         if not res.success:
             raise ValueError(f"via point {k} has no IK solution: {res.reason}")
