@@ -110,6 +110,22 @@ _D2 = np.array([8 / 5, -1 / 5, 8 / 315, -1 / 560])
 _D2_0 = -205 / 72
 
 
+def assembly_status(assembled, dead, x, disc, x_name: str, dead_reason: str, eq: str = ""):
+    """Status array ("ok", "dead_point", "cannot_assemble") of a closure with discriminant
+    E² + F² − G² (``disc``) at input ``x``, and one reason string: for a scalar input the
+    reason of its state (``dead_reason`` at a branch point), for a batch the counts.  ``eq``
+    names the book's equation of the assembly condition, e.g. " (4-31)"."""
+    st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
+    if np.ndim(x) == 0:
+        reason = {"ok": "ok", "dead_point": dead_reason,
+                  "cannot_assemble": f"cannot assemble at {x_name} = {float(x):.6g}: "
+                                     f"E^2 + F^2 - G^2 = {float(disc):.6g} < 0{eq}"}[str(st)]
+    else:
+        na, nd = int(np.sum(~assembled)), int(np.sum(dead))
+        reason = "ok" if na == nd == 0 else f"{na} of {np.size(x)} cannot assemble{eq}, {nd} at a branch point"
+    return st, reason
+
+
 def _stencil_sums(f, h: float, angular: bool):
     """Σ_k D1_k (f(kh) − f(−kh)) and Σ_k D2_k (f(kh) + f(−kh) − 2 f(0)) over k = 1..4, the
     numerators of the first and second derivative (values taken relative to f(0), so the centre

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._util import Wdot, difference, finite_array, finite_scalar, norm, out, point3, pow2_scale, representable_fields, rot, skew, unit_axis
+from ._util import Wdot, assembly_status, difference, finite_array, finite_scalar, norm, out, point3, pow2_scale, representable_fields, rot, skew, unit_axis
 
 DEAD_POINT_TOL = 1e-7
 
@@ -198,18 +198,13 @@ def rrss(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, branch: int 
         om2 = om1 + w2[..., None] * ua
         uadot = np.cross(om1, ua)
         omd2 = al1[..., None] * u0 + al2[..., None] * ua + w2[..., None] * uadot
-        st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
+        st, reason = assembly_status(
+            assembled, dead, th1, disc, "theta1",
+            "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0")
         if not np.all(good):
             z = ~good[..., None]
             bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
             om2, omd2 = np.where(z, 0.0, om2), np.where(z, 0.0, omd2)
-        if np.ndim(th1) == 0:
-            reason = {"ok": "ok",
-                      "dead_point": "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0",
-                      "cannot_assemble": f"cannot assemble at theta1 = {float(th1):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0"}[str(st)]
-        else:
-            na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-            reason = "ok" if na == nd == 0 else f"{na} of {th1.size} cannot assemble, {nd} at a branch point"
         res = np.abs(np.linalg.norm(rb0, axis=-1) - geom.bar_length)
     st_ = RRSSState(theta1=out(th1), theta2=out(th2), theta1dot=out(w1), theta2dot=out(w2), theta1ddot=out(al1),
                      theta2ddot=out(al2), a=a, u_a=ua, b=b, adot=adot, bdot=bdot, addot=addot, bddot=bddot,

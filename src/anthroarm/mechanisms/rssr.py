@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._util import finite_array, norm, out, point3, positive_length, representable_fields, rot, skew, unit_axis
+from ._util import assembly_status, finite_array, norm, out, point3, positive_length, representable_fields, rot, skew, unit_axis
 
 DEAD_POINT_TOL = 1e-7
 
@@ -212,14 +212,9 @@ def rssr(geom: RSSRGeometry, alpha, alphadot=0.0, alphaddot=0.0, branch: int = 1
         bdd = np.where(good, num / dens, 0.0)                                       # (4-30)
         bddot = bdd[..., None] * (rb @ Pb.T) + (bd**2)[..., None] * (rb @ (Pb @ Pb).T)   # (4-29)
         res = np.abs(np.linalg.norm(ab, axis=-1) - geom.coupler_length)
-        st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
-        if np.ndim(al) == 0:
-            reason = {"ok": "ok",
-                      "dead_point": "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0",
-                      "cannot_assemble": f"cannot assemble at alpha = {float(al):.6g}: E^2 + F^2 - G^2 = {float(disc):.6g} < 0 (4-31)"}[str(st)]
-        else:
-            na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-            reason = "ok" if na == nd == 0 else f"{na} of {al.size} cannot assemble (4-31), {nd} at a branch point"
+        st, reason = assembly_status(
+            assembled, dead, al, disc, "alpha",
+            "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0", " (4-31)")
         if not np.all(good):   # keep the rates of bad entries exactly zero
             z = ~good[..., None]
             bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
