@@ -7,14 +7,15 @@
 >>> live.open()
 
 :class:`Viewer` — poses (one message per update), overlays (frames, IK target, workspace
-coloured by manipulability, joint-limit colours, trace), animation playback, static HTML
-export, Jupyter cells.  :mod:`~anthroarm.viewer.server` runs the 127.0.0.1-only server process;
+coloured by manipulability, joint-limit colours, trace, point clouds, arrows), animation
+playback, static HTML export, Jupyter cells; ``Viewer.scene`` is the underlying meshcat scene
+(a meshcat ``Visualizer``, :class:`Scene`) for anything else.  :mod:`~anthroarm.viewer.server` runs the 127.0.0.1-only server process;
 :mod:`~anthroarm.viewer.browser` takes headless-Chromium screenshots (tests, docs).
 """
 
-from .viewer import Viewer, limit_color, limit_proximity, manipulability
+from .viewer import Scene, Viewer, arrow_mesh, colormap_rgb, limit_color, limit_proximity, manipulability
 
-__all__ = ["Viewer", "limit_color", "limit_proximity", "manipulability", "show"]
+__all__ = ["Scene", "Viewer", "arrow_mesh", "colormap_rgb", "limit_color", "limit_proximity", "manipulability", "show"]
 
 
 def show(robot, q=None, **kwargs) -> Viewer:

@@ -28,12 +28,15 @@ from pathlib import Path
 import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
-from meshcat.commands import SetObject
+from meshcat.commands import SetObject, SetProperty
+from meshcat.path import Path as MeshcatPath
+from meshcat.visualizer import Visualizer
 
-from ..errors import ParameterError
-from ..spatial.rotations import homogeneous
+from ..errors import ParameterError, ViewerError
+from ..spatial.rotations import homogeneous, rotation_between
 from .._io import atomic_write_text
 from ._store import SceneStore
+
 from .visuals import LINK_RGB, Body, Piece, _y_to, cylinder_between, rgb_hex, robot_bodies
 
 ROOT = "/meshcat/anthroarm"
@@ -129,6 +132,179 @@ def viridis(x: np.ndarray) -> np.ndarray:
     from matplotlib import colormaps
 
     return np.asarray(colormaps["viridis"](np.clip(x, 0, 1)))[:, :3]
+
+
+def colormap_rgb(values, colormap: str = "viridis", vmin=None, vmax=None):
+    """RGB (N, 3) in [0, 1] of ``values`` (N,) through the matplotlib colour map ``colormap``,
+    scaled from ``vmin`` (default: the smallest finite value) to ``vmax`` (the largest).
+    Returns ``(rgb, vmin, vmax)``.  NaN or inf values, an unknown map or ``vmax < vmin`` raise
+    :class:`~anthroarm.errors.ParameterError`."""
+    from matplotlib import colormaps
+
+    v = np.asarray(values, dtype=float)
+    if v.ndim != 1 or not np.all(np.isfinite(v)):
+        raise ParameterError(f"values must be a 1-D array of finite numbers, got shape {v.shape}"
+                             + ("" if v.ndim != 1 else " with NaN or inf"))
+    if not isinstance(colormap, str) or colormap not in colormaps:
+        raise ParameterError(f"colormap must be a matplotlib colour map name (viridis, viridis_r, plasma, "
+                             f"coolwarm, ...), got {colormap!r}")
+    lo = float(v.min()) if vmin is None and v.size else (0.0 if vmin is None else float(vmin))
+    hi = float(v.max()) if vmax is None and v.size else (1.0 if vmax is None else float(vmax))
+    if not (math.isfinite(lo) and math.isfinite(hi) and hi >= lo):
+        raise ParameterError(f"vmin, vmax must be finite with vmin <= vmax, got {lo}, {hi}")
+    x = (v - lo) / (hi - lo) if hi > lo else np.full_like(v, 0.5)
+    return np.asarray(colormaps[colormap](np.clip(x, 0.0, 1.0)))[:, :3], lo, hi
+
+
+def _rgb01(value, n: int, what: str) -> np.ndarray:
+    """One colour (3,) or one per item (n, 3), components in [0, 1] -> (n, 3) float."""
+    try:
+        c = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        c = np.array([np.nan])
+    if c.shape == (3,):
+        c = np.tile(c, (n, 1))
+    if c.shape != (n, 3) or not np.all(np.isfinite(c)) or np.any((c < 0) | (c > 1)):
+        raise ParameterError(f"{what} must be one colour (r, g, b) or ({n}, 3) colours, components in 0..1, "
+                             f"got shape {np.shape(value)}")
+    return c
+
+
+def _points3(points, what: str, min_rows: int = 1) -> np.ndarray:
+    try:
+        P = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{what} must be an (N, 3) array of numbers (m, base frame), got {type(points).__name__}") from None
+    if P.shape == (3,):
+        P = P[None]
+    if P.ndim != 2 or P.shape[1] != 3 or len(P) < min_rows:
+        raise ParameterError(f"{what} must be an (N>={min_rows}, 3) array (m, base frame), got shape {P.shape}")
+    if not np.all(np.isfinite(P)):
+        bad = int(np.argmax(~np.isfinite(P).all(axis=1)))
+        raise ParameterError(f"{what} contain NaN or inf (row {bad})")
+    return P
+
+
+class _ShadedMesh(mg.TriangularMeshGeometry):
+    """A triangle mesh with per-vertex normals (meshcat's own sends none, so Phong shading
+    would leave it flat black) and per-vertex colours."""
+
+    def __init__(self, vertices, faces, normals, color):
+        super().__init__(vertices, faces, color)
+        self.normals = np.asarray(normals, dtype=np.float32)
+
+    def lower(self, object_data):
+        d = super().lower(object_data)
+        d["data"]["attributes"]["normal"] = mg.pack_numpy_array(self.normals.T)
+        return d
+
+
+def arrow_mesh(origins, vectors, radius, colors, head_length=None, segments: int = 10):
+    """One shaded triangle mesh of arrows: a shaft (cylinder) of ``radius`` and a cone head from
+    each origin along its vector (both (N, 3), m).  ``colors`` (N, 3) in [0, 1].  The head is
+    ``head_length`` long (default 3.5 radii, at most half the arrow) and 2.2 radii wide.
+    Zero-length vectors draw nothing."""
+    O, V = np.asarray(origins, float), np.asarray(vectors, float)
+    verts, norms, cols, faces = [], [], [], []
+    ang = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
+    ring = np.stack([np.cos(ang), np.sin(ang)], 1)
+    count = 0
+    for o, v, c in zip(O, V, np.asarray(colors, float)):
+        L = float(np.linalg.norm(v))
+        if L < 1e-12:
+            continue
+        d = v / L
+        R = rotation_between((0.0, 0.0, 1.0), d)
+        ex, ey = R[:, 0], R[:, 1]
+        hl = min(head_length if head_length is not None else 3.5 * radius, 0.5 * L)
+        rim = ring[:, :1] * ex + ring[:, 1:] * ey          # (s, 3) unit radial directions
+        a, b = o, o + (L - hl) * d                          # shaft
+        tip = o + v
+        # shaft: 2s vertices with radial normals
+        vs = np.concatenate([a + radius * rim, b + radius * rim])
+        ns = np.concatenate([rim, rim])
+        # cone: rim at b (2.2 r) and the tip, normals tilted by the cone's half-angle
+        rc = 2.2 * radius
+        slope = rc / hl
+        nc = (rim + slope * d) / math.sqrt(1 + slope * slope)
+        vc = np.concatenate([b + rc * rim, np.repeat(tip[None], segments, 0)])
+        ncs = np.concatenate([nc, nc])
+        # the cone's base disc (facing back)
+        vb = np.concatenate([b + rc * rim, b[None]])
+        nb = np.tile(-d, (segments + 1, 1))
+        base = count
+        k = np.arange(segments)
+        k1 = (k + 1) % segments
+        f_shaft = np.concatenate([np.stack([k, k1, segments + k1], 1), np.stack([k, segments + k1, segments + k], 1)])
+        f_cone = np.stack([k, k1, segments + k], 1) + 2 * segments
+        f_base = np.stack([np.full(segments, segments), k1, k], 1) + 4 * segments
+        faces.append(np.concatenate([f_shaft, f_cone, f_base]) + base)
+        vv = np.concatenate([vs, vc, vb])
+        verts.append(vv)
+        norms.append(np.concatenate([ns, ncs, nb]))
+        cols.append(np.tile(c, (len(vv), 1)))
+        count += len(vv)
+    if not verts:
+        return None
+    return _ShadedMesh(np.concatenate(verts), np.concatenate(faces), np.concatenate(norms), np.concatenate(cols))
+
+
+class _SceneWindow:
+    """What a meshcat :class:`~meshcat.visualizer.Visualizer` sends its commands through: here
+    the Viewer's own channel (its in-memory scene and, when live, its server)."""
+
+    def __init__(self, viewer: "Viewer"):
+        self._viewer = viewer
+
+    @property
+    def web_url(self):
+        return self._viewer.url
+
+    def send(self, command) -> None:
+        self._viewer._send([command.lower()])
+
+    def open(self):
+        self._viewer.open()
+        return self
+
+    def wait(self):
+        self._viewer.wait()
+
+    def get_scene(self) -> str:
+        return self._viewer.static_html()
+
+    def get_image(self):
+        raise ViewerError("image capture is not supported by the anthroarm viewer; use "
+                          "anthroarm.viewer.browser.screenshot on export_html()")
+
+    def close(self) -> None:
+        self._viewer.close()
+
+
+class Scene(Visualizer):
+    """meshcat's :class:`~meshcat.visualizer.Visualizer` API on the scene of a
+    :class:`Viewer` (:attr:`Viewer.scene`): ``scene["name"].set_object(geometry, material)``,
+    ``set_transform``, ``set_property``, ``delete``, plus :meth:`set_cam_pos`.  Paths start at ``/meshcat`` (absolute paths such as
+    ``"/Grid"`` or ``"/Cameras/default"`` address meshcat's own nodes).  Everything sent
+    through it is kept in the static HTML export and reaches a live browser."""
+
+    __slots__ = ()
+
+    def __getitem__(self, path):
+        vis = Scene(window=self.window)
+        vis.path = self.path.append(path)
+        return vis
+
+    def set_cam_pos(self, position) -> None:
+        """Place the camera at ``position`` (3-vector, m) in meshcat's world frame (z up); it
+        keeps looking at the orbit target, the world origin (where the Viewer puts the centre
+        of the robot's reach)."""
+        x, y, z = (float(c) for c in _points3(position, "camera position")[0])
+        self.window.send(SetProperty("position", [x, z, -y], MeshcatPath(("Cameras", "default", "rotated", "<object>"))))
+
+    def __repr__(self) -> str:
+        return f"<anthroarm Scene at {self.path.lower()} of {self.window._viewer!r}>"
+
 
 
 class Viewer:
@@ -475,6 +651,119 @@ class Viewer:
         self._send([_delete(path), _set_object(path, cloud)])
         return {"points": P, "manipulability": w}
 
+    def show_points(self, points, colors=None, *, values=None, colormap: str = "viridis", vmin=None, vmax=None,
+                    size: float | None = None, name: str = "points", label: str | None = None) -> dict:
+        """A 3-D point cloud (reachability and comfort maps, markers, sampled positions).
+
+        Parameters
+        ----------
+        points : array_like, shape (N, 3)
+            Positions in the robot's base frame, metres.
+        colors : array_like, optional
+            One colour ``(r, g, b)`` or one per point ``(N, 3)``, components in 0..1.  Default:
+            a single orange, or the colour map of ``values``.
+        values : array_like, shape (N,), optional
+            A scalar per point, coloured through ``colormap`` from ``vmin`` to ``vmax`` (default:
+            their range).  Not together with ``colors``.
+        colormap : str
+            A matplotlib colour map name (``"viridis"``, ``"viridis_r"``, ``"plasma"``, ...).
+        size : float, optional
+            Point size in metres (default 2 % of the reach).
+        name : str
+            Overlay name (:meth:`clear` removes it; a second call with the same name replaces it).
+        label : str, optional
+            Title of the colour legend drawn for ``values`` (default ``name``).
+
+        Returns
+        -------
+        dict
+            ``{"points": (N, 3), "colors": (N, 3), "vmin", "vmax"}`` (``vmin``/``vmax`` None
+            without ``values``).
+
+        Raises
+        ------
+        ParameterError
+            Points not (N, 3) or not finite, colours outside 0..1, values of the wrong length
+            or not finite, an unknown colour map, both ``colors`` and ``values``, or a size that
+            is not positive.
+        """
+        P = _points3(points, "points")
+        lo = hi = None
+        if values is not None:
+            if colors is not None:
+                raise ParameterError("give colors or values (with a colormap), not both")
+            v = np.asarray(values, dtype=float) if np.ndim(values) else np.array([np.nan])
+            if v.shape != (len(P),):
+                raise ParameterError(f"values must have one number per point ({len(P)}), got shape {np.shape(values)}")
+            C, lo, hi = colormap_rgb(v, colormap, vmin, vmax)
+        else:
+            C = _rgb01((0.95, 0.55, 0.05) if colors is None else colors, len(P), "colors")
+        size = self._length(size, 0.02 * self.radius, "size")
+        cloud = mg.PointCloud(P.T.astype(np.float32), C.T.astype(np.float32), size=size)
+        path = self._overlay_path(name)
+        self._send([_delete(path), _set_object(path, cloud)])
+        if values is not None and hasattr(self, "_legend_commands"):
+            self._send(self._legend_commands(_safe(name), label or name, colormap, lo, hi))
+        return {"points": P, "colors": C, "vmin": lo, "vmax": hi}
+
+    def show_arrows(self, origins, directions, colors=None, *, scale: float = 1.0, radius: float | None = None,
+                    name: str = "arrows") -> np.ndarray:
+        """Arrows (contact normals, forces, velocities) from ``origins`` along ``directions``.
+
+        Parameters
+        ----------
+        origins : array_like, shape (N, 3)
+            Tails in the robot's base frame, metres.
+        directions : array_like, shape (N, 3)
+            Arrow vectors; each is drawn ``scale`` times its length (a force in N with
+            ``scale=0.01`` is 1 cm per newton).  A zero vector draws nothing.
+        colors : array_like, optional
+            One colour ``(r, g, b)`` or one per arrow ``(N, 3)``, 0..1 (default red).
+        scale : float
+            Metres of arrow per unit of ``directions`` (positive).
+        radius : float, optional
+            Shaft radius in metres (default 0.6 % of the reach); the head is 2.2 radii wide.
+        name : str
+            Overlay name (:meth:`clear` removes it).
+
+        Returns
+        -------
+        numpy.ndarray
+            The (N, 3) tips, base frame, metres.
+
+        Raises
+        ------
+        ParameterError
+            Shapes that differ or are not (N, 3), NaN or inf, bad colours, a scale or radius
+            that is not positive and finite.
+        """
+        O = _points3(origins, "origins")
+        D = _points3(directions, "directions")
+        if D.shape != O.shape:
+            raise ParameterError(f"origins and directions must have the same shape, got {O.shape} and {D.shape}")
+        scale = self._length(scale, 1.0, "scale")
+        r = self._length(radius, 0.006 * self.radius, "radius")
+        C = _rgb01((0.85, 0.10, 0.10) if colors is None else colors, len(O), "colors")
+        V = scale * D
+        mesh = arrow_mesh(O, V, r, C)
+        path = self._overlay_path(name)
+        cmds = [_delete(path)]
+        if mesh is not None:
+            cmds.append(_set_object(path, mesh, material=mg.MeshPhongMaterial(vertexColors=True)))
+        self._send(cmds)
+        return O + V
+
+    @staticmethod
+    def _length(value, default: float, what: str) -> float:
+        if value is None:
+            return float(default)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ParameterError(f"{what} must be a positive number, got {value!r}")
+        v = float(value)
+        if not (math.isfinite(v) and v > 0):
+            raise ParameterError(f"{what} must be positive and finite, got {value!r}")
+        return v
+
     # ------------------------------------------------------------------ animation
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
         """Play the joint trajectory ``Q`` (N, nq), one row every ``dt`` seconds, as a meshcat
@@ -518,6 +807,22 @@ class Viewer:
         path = Path(path)
         atomic_write_text(path, self.static_html())
         return path
+
+    @property
+    def scene(self) -> Scene:
+        """The underlying meshcat scene, as a meshcat :class:`~meshcat.visualizer.Visualizer`
+        (:class:`Scene`): the escape hatch for anything the Viewer has no method for.
+
+        >>> import meshcat.geometry as mg
+        >>> v.scene["mine/box"].set_object(mg.Box([0.1, 0.1, 0.1]))   # /meshcat/mine/box
+        >>> v.scene["/Grid"].set_property("visible", True)
+        >>> v.scene.set_cam_pos([1.5, 1.0, 0.8])
+
+        Its commands go through the Viewer: they are kept in :meth:`static_html` and sent to
+        the live server.  Coordinates are meshcat's world frame; the robot's base frame is
+        shifted by ``-viewer.center`` in it (draw under ``viewer.root`` to use base-frame
+        coordinates: ``v.scene[v.root + "/mine"]``)."""
+        return Scene(window=_SceneWindow(self))
 
     @property
     def url(self) -> str | None:
