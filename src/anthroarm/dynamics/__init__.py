@@ -9,6 +9,7 @@ Modules (imported lazily, e.g. ``aa.dynamics.lagrange``):
 * :mod:`.hand_model` — §8-4 prosthetic-hand Lagrange model (8-97)–(8-112);
 * :mod:`.simulate` — RK4 / solve_ivp with damping and energy bookkeeping;
 * :mod:`.human` — gravity-torque maps and reaching torques of ``human_arm7``;
+* :mod:`.loads` — external wrenches and held objects as generalised forces (8-5), τ = rnea − Jᵀw;
 * :mod:`.checks` — the rows of ``anthroarm check``.
 """
 
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 import importlib
 
-_SUBMODULES = {"lagrange", "equivalent_link", "euler_chain", "hand_model", "simulate", "human", "checks", "ccode"}
+_SUBMODULES = {"lagrange", "equivalent_link", "euler_chain", "hand_model", "simulate", "human", "checks", "ccode", "loads"}
 
 
 def __getattr__(name):
