@@ -136,3 +136,11 @@ class ObjectiveError(AnthroarmError, ValueError):
         self.value = value
         self.nfev = nfev
         super().__init__(message)
+
+
+class UnknownCodeError(AnthroarmError, KeyError):
+    """A code or key that a book table does not hold (e.g. a display code of Table 9.6); the
+    message lists the valid ones."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""

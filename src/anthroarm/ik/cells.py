@@ -13,7 +13,15 @@ M5 = (0,1,1), M6 = (1,0,1), M7 = (1,1,1) (the printed chain has sign/index mispr
 docs/errata.md).  Only arithmetic is needed at run time.  :meth:`CellTable.refine` adds one
 Newton step (Pinocchio Jacobian) after the lookup.
 
-Units: metres and radians (the book's D = 50 mm is ``D=0.05``).
+Motor pulses (§9-3, l. 7589): the care robot of Chapter 9 stores, for every lattice point, the
+motor pulse counts from the origin (all joints at zero) instead of joint angles, and reaches a
+commanded point by the *relative* pulses between two table entries (its position registers).
+:meth:`CellTable.with_pulses` attaches the integer table ``pulses = round(q · pulses_per_rad)``;
+:meth:`CellTable.lookup_pulses` interpolates it by Eq. (7-32) and rounds to whole pulses;
+:meth:`CellTable.relative_pulses` is the register difference.  The lattice may be of any point
+fixed in the tool frame (``point=``, e.g. the wrist centre of §9-3, "手腕的位置坐标").
+
+Units: metres and radians (the book's D = 50 mm is ``D=0.05``); pulses are integers.
 """
 
 from __future__ import annotations
@@ -58,6 +66,17 @@ def nested_division(M, m) -> np.ndarray:
     return t3 * N5 + m3 * N6
 
 
+def _finite_vector(v, name: str, n: int) -> np.ndarray:
+    """``v`` as a finite float vector of length ``n``; ValueError naming ``name`` otherwise."""
+    try:
+        a = np.array(v, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {n} finite numbers, got {v!r}") from None
+    if a.shape != (n,) or not np.isfinite(a).all():
+        raise ValueError(f"{name} must be {n} finite numbers, got {v!r}")
+    return a
+
+
 class OutsideCellTableError(ValueError):
     """A query point whose cell is not covered by the table (outside the lattice, or a corner
     outside the workspace / joint limits)."""
@@ -92,8 +111,14 @@ class CellTable:
     ``Q`` (nx, ny, nz, nq) rad (NaN where the lattice point has no IK solution on the branch),
     ``valid`` (nx, ny, nz), ``rotation`` (3, 3), ``model`` and ``params``."""
 
-    def __init__(self, model: str, params: dict, rotation, origin, D: float, Q, valid):
+    def __init__(self, model: str, params: dict, rotation, origin, D: float, Q, valid, *, point=None,
+                 pulses_per_rad=None):
         self.model = model
+        #: the point (m, tool frame) whose position the lattice holds; zero = the tool origin
+        self.point = np.zeros(3) if point is None else _finite_vector(point, "point", 3)
+        #: motor pulses per joint radian (nq,), or None for a table of joint angles only
+        self.pulses_per_rad = None
+        self.pulses = None
         self.params = dict(params)
         self.rotation = np.asarray(rotation, float)
         self.origin = np.asarray(origin, float)
@@ -108,17 +133,22 @@ class CellTable:
         v = self.valid
         self.cell_ok = (v[:-1, :-1, :-1] & v[1:, :-1, :-1] & v[:-1, 1:, :-1] & v[:-1, :-1, 1:]
                         & v[1:, 1:, :-1] & v[:-1, 1:, 1:] & v[1:, :-1, 1:] & v[1:, 1:, 1:])
+        if pulses_per_rad is not None:
+            self._set_pulses(pulses_per_rad)
 
     # ------------------------------------------------------------------ build
     @classmethod
     def build(cls, robot, rotation, D: float, bounds, *, q_ref=None, branch: str | None = None,
-              progress: bool = True, swivel: float = 0.0) -> "CellTable":
+              progress: bool = True, swivel: float = 0.0, point=None) -> "CellTable":
         """Exact IK at every lattice point of the box ``bounds = (lo(3), hi(3))`` (m); the
         lattice is anchored at the base origin (points are integer multiples of ``D``).
 
         Branch choice: the solution with label ``branch`` if given, else the valid solution
         nearest to ``q_ref`` (default: the joint-range middle), so that the 8 corners of a cell
-        come from one consistent branch.  ``progress`` shows a tqdm bar (one step per z slice)."""
+        come from one consistent branch.  ``progress`` shows a tqdm bar (one step per z slice).
+        ``point`` (3,) m in the tool frame: the lattice holds the positions of this point (the
+        tool pose at lattice point M is the table's rotation R at ``M − R·point``); default the
+        tool origin."""
         form = _require(robot).form
         name, params = robot.spec.name, dict(robot.spec.params)
         R = np.asarray(rotation, float)
@@ -130,6 +160,7 @@ class CellTable:
         lo, hi = (np.asarray(b, float) for b in bounds)
         if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi <= lo).any():
             raise ValueError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
+        point = np.zeros(3) if point is None else _finite_vector(point, "point", 3)
         i0, shape = lattice(lo, hi, D)
         if np.prod(shape) > MAX_LATTICE:
             raise ValueError(f"lattice of {shape} points is too large; increase D")
@@ -152,7 +183,7 @@ class CellTable:
             P = origin + D * np.stack([gx.ravel(), gy.ravel(), np.full(gx.size, k)], -1)
             T = np.tile(np.eye(4), (P.shape[0], 1, 1))
             T[:, :3, :3] = R
-            T[:, :3, 3] = P
+            T[:, :3, 3] = P - R @ point
             res = analytic_batch(robot, T, **kw)
             if branch is not None:
                 if branch not in res.branches:
@@ -167,7 +198,7 @@ class CellTable:
                 ok = res.valid[np.arange(len(b)), b]
             Q[:, :, k] = np.where(ok[:, None], sel, np.nan).reshape(shape[0], shape[1], robot.nq)
             valid[:, :, k] = ok.reshape(shape[0], shape[1])
-        return cls(name, params, R, origin, D, Q, valid)
+        return cls(name, params, R, origin, D, Q, valid, point=point)
 
     # ------------------------------------------------------------------ lookup
     def _locate(self, P):
@@ -229,12 +260,64 @@ class CellTable:
 
         q = robot.check_q(q).copy()
         Rt = self.rotation
+        target = np.asarray(p, float) - Rt @ self.point       # the tool origin's position
         for _ in range(steps):
             T = robot.fk(q)
-            e = np.concatenate([np.asarray(p, float) - T[:3, 3], pin.log3(Rt @ T[:3, :3].T)])
+            e = np.concatenate([target - T[:3, 3], pin.log3(Rt @ T[:3, :3].T)])
             J = robot.jacobian(q)
             q = q + np.linalg.lstsq(J, e, rcond=None)[0]
         return q
+
+    # ------------------------------------------------------------------ motor pulses (§9-3)
+    def _set_pulses(self, pulses_per_rad) -> None:
+        k = _finite_vector(np.broadcast_to(np.asarray(pulses_per_rad, float), (self.nq,)) if np.ndim(pulses_per_rad) == 0
+                           else pulses_per_rad, "pulses_per_rad", self.nq)
+        if (k <= 0).any():
+            raise ValueError(f"pulses_per_rad must be > 0 (pulses per joint radian), got {k}")
+        Q = np.where(self.valid[..., None], self.Q, 0.0) * k
+        if np.abs(Q).max(initial=0.0) >= 2.0**62:
+            raise ValueError("pulses_per_rad too large: the pulse counts overflow int64")
+        self.pulses_per_rad = k
+        #: integer motor pulses from the origin (q = 0) to every lattice point, (nx, ny, nz, nq);
+        #: 0 where ``valid`` is False
+        self.pulses = np.rint(Q).astype(np.int64)
+
+    def with_pulses(self, pulses_per_rad) -> "CellTable":
+        """A copy of the table that also stores motor pulses (§9-3, l. 7589): the integer
+        ``round(q · pulses_per_rad)`` at every lattice point.  ``pulses_per_rad``: a scalar or
+        (nq,) motor pulses per joint radian (encoder counts per motor turn × gear ratio / 2π),
+        finite and > 0; ValueError otherwise."""
+        return type(self)(self.model, self.params, self.rotation, self.origin, self.D, self.Q, self.valid,
+                          point=self.point, pulses_per_rad=pulses_per_rad)
+
+    def _require_pulses(self):
+        if self.pulses is None:
+            raise ValueError("this cell table stores no motor pulses: use table.with_pulses(pulses_per_rad)")
+
+    def lookup_pulses(self, p) -> np.ndarray:
+        """Motor pulses (nq,) int64 from the origin to position ``p`` (3,) m: Eq. (7-32) on the
+        stored integer pulses of the 8 corners, rounded to whole pulses.  Raises
+        :class:`OutsideCellTableError` if the cell is not covered, ValueError without pulses."""
+        self._require_pulses()
+        q = self.lookup(p)
+        del q  # the same cell checks; the pulses are interpolated from the integer table
+        r = (np.asarray(p, float) - self.origin) / self.D
+        idx = np.minimum(np.floor(r).astype(int), np.array(self.shape) - 2)
+        m = r - idx
+        i, j, k = idx
+        corners = self.pulses[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq).astype(float)
+        w = trilinear_weights(m)[[0, 3, 2, 5, 1, 6, 4, 7]]    # (7-32) weights in the order of ``corners``
+        return np.rint(w @ corners).astype(np.int64)
+
+    def relative_pulses(self, p_from, p_to) -> np.ndarray:
+        """Pulses (nq,) int64 each motor turns to move from ``p_from`` to ``p_to`` (m): the
+        difference of the two table lookups, as the position registers of §9-3 compute it."""
+        return self.lookup_pulses(p_to) - self.lookup_pulses(p_from)
+
+    def pulses_to_q(self, pulses) -> np.ndarray:
+        """Joint values (rad) of motor pulses counted from the origin."""
+        self._require_pulses()
+        return np.asarray(pulses, float) / self.pulses_per_rad
 
     @property
     def bounds(self):
@@ -247,7 +330,10 @@ class CellTable:
         if path.suffix != ".npz":
             path = path.with_suffix(".npz")
         tmp = path.with_name(path.name + ".tmp.npz")
-        meta = json.dumps({"model": self.model, "params": self.params, "D": self.D, "format": 1})
+        extra = {"point": [float(v) for v in self.point]}
+        if self.pulses_per_rad is not None:
+            extra["pulses_per_rad"] = [float(v) for v in self.pulses_per_rad]
+        meta = json.dumps({"model": self.model, "params": self.params, "D": self.D, "format": 1, **extra})
         with open(tmp, "wb") as fh:
             np.savez(fh, Q=self.Q, valid=self.valid, origin=self.origin, rotation=self.rotation,
                      meta=np.array(meta))
@@ -261,7 +347,8 @@ class CellTable:
         try:
             with np.load(path, allow_pickle=False) as z:
                 meta = json.loads(str(z["meta"]))
-                return cls(meta["model"], meta["params"], z["rotation"], z["origin"], meta["D"], z["Q"], z["valid"])
+                return cls(meta["model"], meta["params"], z["rotation"], z["origin"], meta["D"], z["Q"], z["valid"],
+                           point=meta.get("point"), pulses_per_rad=meta.get("pulses_per_rad"))
         except (KeyError, json.JSONDecodeError, OSError, ValueError) as exc:
             if isinstance(exc, FileNotFoundError):
                 raise

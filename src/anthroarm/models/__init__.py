@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..errors import ParameterError, UnknownModelError
 from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
+from .care_robot import care_robot
 from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
@@ -27,6 +28,7 @@ BOOK_MODELS = {
     "unimate5": unimate5,
     "rrprr5": rrprr5,
     "planar2r": planar2r,
+    "care_robot": care_robot,
 }
 
 #: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
@@ -113,5 +115,5 @@ __all__ = [
     "BOOK_MODELS", "ERD_ARMS", "ErdArm", "ChainSpec", "DHRow", "JointSpec", "LinkSpec",
     "dh_matrix", "from_dh", "to_urdf", "names", "book_names", "spec", "urdf_text", "urdf_path",
     "write_urdfs", "erd_names", "erd_urdf_path", "human_arm7", "prosthetic_arm", "sixr_arm", "unimate5", "rrprr5", "planar2r",
-    "segment_parameters",
+    "segment_parameters", "care_robot",
 ]

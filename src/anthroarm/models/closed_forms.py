@@ -50,6 +50,8 @@ class ClosedForm:
 REGISTRY: dict[str, ClosedForm] = {
     # θ1 (shoulder) | θ2, θ3 (elbow) | θ4–θ6 (wrist flip)
     "sixr_arm": ClosedForm("spherical_wrist_6r", ("s0", "h2", "s3", "P"), 6, (1, 3), 8, cost_us=8.0),
+    # the care robot of §9-3 on the assumed layout of Fig. 6-3 (models/care_robot.py)
+    "care_robot": ClosedForm("spherical_wrist_6r", ("s0", "h2", "s3", "P"), 6, (1, 3), 8, cost_us=8.0),
     # θ1, θ2 (elbow root × shoulder) | θ3–θ6 (flexion sign)
     "prosthetic_arm": ClosedForm("prosthetic_6r", ("L1", "L2", "L3"), 6, (2,), 8, cost_us=7.0),
     # one stage: the two elbow branches differ in both joints
