@@ -17,7 +17,7 @@ from .robot import Robot, load
 
 __version__ = "0.1.0"
 
-_LAZY = {"batch", "cache", "crosscheck", "kinematics", "ik", "dynamics", "spatial", "mechanisms", "design",
+_LAZY = {"batch", "cache", "control", "crosscheck", "kinematics", "ik", "dynamics", "spatial", "mechanisms", "design",
          "viewer", "trajectory", "urdf_io"}
 
 

@@ -138,6 +138,20 @@ class ObjectiveError(AnthroarmError, ValueError):
         super().__init__(message)
 
 
+class ControlError(AnthroarmError, ValueError):
+    """A bad input to :mod:`anthroarm.control` (servo, motor, teach/playback, DDA, gripper): a
+    non-finite or out-of-range parameter, a malformed program.  The message names the value."""
+
+
+class PlaybackError(ControlError):
+    """A teach/playback program that cannot run: a jump or call to a label, subroutine or address
+    that does not exist (the message lists the valid ones), or a duplicate label."""
+
+
+class DegenerateArcError(ControlError):
+    """A circular arc through three points that are collinear or coincident (no unique circle)."""
+
+
 class UnknownCodeError(AnthroarmError, KeyError):
     """A code or key that a book table does not hold (e.g. a display code of Table 9.6); the
     message lists the valid ones."""
