@@ -138,6 +138,48 @@ class ObjectiveError(AnthroarmError, ValueError):
         super().__init__(message)
 
 
+class MotionDataError(AnthroarmError, ValueError):
+    """Recorded motion that cannot be used as given (:mod:`anthroarm.motion`): a C3D or CSV file
+    that is missing, unreadable or malformed, unknown units, marker trajectories of the wrong
+    shape.  ``path`` names the file (``None`` for arrays)."""
+
+    def __init__(self, problem: str, path=None):
+        self.path = None if path is None else str(path)
+        self.problem = problem
+        super().__init__(problem if path is None else f"{self.path}: {problem}")
+
+
+class C3DError(MotionDataError):
+    """A C3D file ezc3d cannot read or write, or one without usable POINT data (labels, rate,
+    units)."""
+
+
+class MarkerSetError(AnthroarmError, ValueError):
+    """A marker set that does not fit the robot: an unknown body frame (the message lists the
+    frames), duplicate marker names, a non-finite position or weight, or no marker of the set in
+    a trial."""
+
+
+class UnconstrainedJointError(MarkerSetError):
+    """The markers cannot determine some joints: no marker on a body downstream of the joint,
+    or a marker Jacobian whose rank is below the number of joints.  ``joints`` lists them."""
+
+    def __init__(self, message: str, joints=()):
+        self.joints = tuple(joints)
+        super().__init__(message)
+
+
+class ActivityError(AnthroarmError, ValueError):
+    """A daily-living activity that cannot be built: a bad parameter (duration, mass, a target
+    that is not finite), or, with ``strict=True``, a target outside the arm's reach
+    (``keyframe`` names it, ``distance`` is the remaining hand error in m)."""
+
+    def __init__(self, message: str, keyframe: str | None = None, distance: float = 0.0):
+        self.keyframe = keyframe
+        self.distance = distance
+        super().__init__(message)
+
+
 class ControlError(AnthroarmError, ValueError):
     """A bad input to :mod:`anthroarm.control` (servo, motor, teach/playback, DDA, gripper): a
     non-finite or out-of-range parameter, a malformed program.  The message names the value."""

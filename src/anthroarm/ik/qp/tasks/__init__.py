@@ -4,6 +4,7 @@ from .base import Task
 from .coupling import JointCouplingTask
 from .damping import DampingTask
 from .frame import FrameTask
+from .marker import MarkerTask
 from .orientation import OrientationTask
 from .position import PositionTask
 from .posture import PostureTask, comfortable_posture, has_comfortable_posture
@@ -11,7 +12,7 @@ from .relative_frame import RelativeFrameTask
 from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swivel_from_points
 
 __all__ = [
-    "Task", "FrameTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
+    "Task", "FrameTask", "MarkerTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
     "DampingTask", "JointCouplingTask", "SwivelTask", "comfortable_posture",
     "has_comfortable_posture", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]

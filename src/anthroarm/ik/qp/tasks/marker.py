@@ -1,0 +1,115 @@
+"""MarkerTask: drive body-fixed points (skin markers) to measured positions (world frame, m).
+
+For markers k = 1 … M, each fixed in the frame of joint j(k) at l_k (m):
+
+    e_k(q) = p_k(q) − m_k,   p_k = ⁰R_j l_k + ⁰o_j,
+    J_k(q) = J_v,j + J_ω,j × (p_k − ⁰o_j)     (LOCAL_WORLD_ALIGNED: the point's velocity in
+                                               world axes, from Pinocchio's joint Jacobian)
+
+and the cost of marker k's three rows is √w_k, so that the task's objective is the marker-IK
+residual ½ Σ w_k ‖J_k Δq + e_k‖² (OpenSim's IK tool minimises the same weighted sum of squared
+marker errors, Delp et al. 2007, IEEE TBME 54(11), 1940–1950).  A marker that is missing in a
+frame gets weight 0 (its rows drop out), which is how gaps are handled.
+
+Unlike :class:`~anthroarm.ik.qp.tasks.PositionTask` (the origin of one frame), this task takes
+any number of points at offsets in their bodies and evaluates them in one pass over the bodies
+that carry them (one ``getJointJacobian`` per body).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from .base import Task
+
+_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+class MarkerTask(Task):
+    """Position task on M body-fixed points.
+
+    Parameters
+    ----------
+    robot : anthroarm.Robot
+    joints : (M,) int
+        Index in ``robot.chain.joints`` of the joint whose body carries each marker (−1: fixed
+        to the base; such a marker has a zero Jacobian).
+    local : (M, 3)
+        Marker positions in those joint frames, m.
+    weights : (M,) optional
+        w_k ≥ 0 (default 1); the rows of marker k get cost √w_k.
+    """
+
+    def __init__(self, robot, joints, local, weights=None, gain: float = 1.0, lm_damping: float = 0.0):
+        joints = np.asarray(joints, dtype=int)
+        local = np.asarray(local, dtype=float)
+        M = joints.shape[0]
+        if local.shape != (M, 3) or not np.isfinite(local).all():
+            raise ValueError(f"local must be a finite ({M}, 3) array (m), got shape {local.shape}")
+        w = np.ones(M) if weights is None else np.asarray(weights, dtype=float)
+        if w.shape != (M,) or not np.isfinite(w).all() or np.any(w < 0):
+            raise ValueError(f"weights must be {M} finite numbers >= 0")
+        super().__init__(cost=np.repeat(np.sqrt(w), 3), gain=gain, lm_damping=lm_damping)
+        self.model = robot.model
+        self.nv = robot.nv
+        self.joints = joints
+        self.local = local
+        self.base_weights = w
+        self.target = np.zeros((M, 3))
+        self.visible = np.ones(M, dtype=bool)
+        self._groups = [(int(b), np.flatnonzero(joints == b)) for b in np.unique(joints) if b >= 0]
+        self._fixed = np.flatnonzero(joints < 0)
+        self._p = np.zeros((M, 3))
+        self._J = np.zeros((M, 3, self.nv))
+        self._q_for = None
+
+    def set_target(self, positions, visible=None) -> None:
+        """Measured positions (M, 3), m, world frame.  Rows that are NaN, or False in
+        ``visible``, are missing: weight 0 in this frame."""
+        P = np.asarray(positions, dtype=float)
+        if P.shape != self.target.shape:
+            raise ValueError(f"marker targets must have shape {self.target.shape}, got {P.shape}")
+        vis = np.isfinite(P).all(axis=1)
+        if visible is not None:
+            vis &= np.asarray(visible, dtype=bool)
+        self.visible = vis
+        self.target = np.where(vis[:, None], P, 0.0)
+        self.cost = np.repeat(np.sqrt(self.base_weights * vis), 3)
+
+    def _update(self, conf) -> None:
+        if self._q_for is conf.q:
+            return
+        data = conf.data
+        p, J = self._p, self._J
+        for b, idx in self._groups:
+            Mi = data.oMi[b + 1]
+            R = Mi.rotation
+            r = self.local[idx] @ R.T                      # (m, 3) lever arms, world axes
+            p[idx] = r + Mi.translation
+            Jb = pin.getJointJacobian(self.model, data, b + 1, _LWA)
+            Jv, Jw = Jb[:3], Jb[3:]
+            rx, ry, rz = r[:, 0:1], r[:, 1:2], r[:, 2:3]
+            # J_ω × r, column by column
+            J[idx, 0] = Jv[0] + Jw[1] * rz - Jw[2] * ry
+            J[idx, 1] = Jv[1] + Jw[2] * rx - Jw[0] * rz
+            J[idx, 2] = Jv[2] + Jw[0] * ry - Jw[1] * rx
+        if self._fixed.size:
+            p[self._fixed] = self.local[self._fixed]
+            J[self._fixed] = 0.0
+        self._q_for = conf.q
+
+    def positions(self, conf) -> np.ndarray:
+        """(M, 3) world positions of the markers at ``conf`` (m)."""
+        self._update(conf)
+        return self._p.copy()
+
+    def compute_error(self, conf) -> np.ndarray:
+        """(3M,) p(q) − m, m (zero rows where a marker is missing)."""
+        self._update(conf)
+        return np.where(self.visible[:, None], self._p - self.target, 0.0).ravel()
+
+    def compute_jacobian(self, conf) -> np.ndarray:
+        """(3M, nv), LOCAL_WORLD_ALIGNED point Jacobians stacked marker by marker."""
+        self._update(conf)
+        return self._J.reshape(-1, self.nv)

@@ -1,0 +1,33 @@
+"""From a person's recorded motion to joint trajectories (issue 17, items 1–4).
+
+>>> import anthroarm as aa
+>>> from anthroarm import motion
+>>> robot = aa.load("human_arm7", height=1.62, mass=55, sex="female")
+>>> markers = motion.default_marker_set(robot)            # ISB landmarks, scaled to the person
+>>> trial = motion.read_c3d("trial.c3d")                   # doctest: +SKIP
+>>> res = motion.marker_ik(robot, trial, markers)          # doctest: +SKIP
+>>> res.q, res.rms, res.status                             # doctest: +SKIP
+
+Modules: :mod:`~anthroarm.motion.trial` (marker trajectories in m), :mod:`~anthroarm.motion.c3d`
+(C3D through ezc3d, units converted), :mod:`~anthroarm.motion.csv_io` (joint-angle CSV),
+:mod:`~anthroarm.motion.markers` (marker sets and the default human-arm set),
+:mod:`~anthroarm.motion.marker_ik` (frame-by-frame marker IK on the QP layer),
+:mod:`~anthroarm.motion.scaling` (a person's arm from measured lengths or a static trial),
+:mod:`~anthroarm.motion.activities` (the daily-living activity library).
+
+Algorithms here take arrays and a Robot; reading files is in ``c3d`` / ``csv_io`` and progress
+bars are the CLI's (``anthroarm ik-markers``).
+"""
+
+from .c3d import read_c3d, write_c3d
+from .marker_ik import STATUSES, MarkerIK, MarkerIKResult, marker_ik, match_markers
+from .markers import (HUMAN_ARM_LANDMARKS, BoundMarkers, Marker, MarkerSet, default_marker_set, human_arm_markers,
+                      segment_length)
+from .trial import MarkerTrajectories
+
+__all__ = [
+    "MarkerTrajectories", "read_c3d", "write_c3d",
+    "Marker", "MarkerSet", "BoundMarkers", "HUMAN_ARM_LANDMARKS", "default_marker_set", "human_arm_markers",
+    "segment_length",
+    "MarkerIK", "MarkerIKResult", "marker_ik", "match_markers", "STATUSES",
+]

@@ -1,0 +1,128 @@
+"""C3D marker files (the biomechanics standard, https://www.c3d.org) through ``ezc3d``.
+
+:func:`read_c3d` returns :class:`~anthroarm.motion.trial.MarkerTrajectories` in metres: the
+file's ``POINT:UNITS`` (mm, cm, m) is read and converted; the labels come from ``POINT:LABELS``
+(and ``LABELS2``, ``LABELS3`` ... for files with more than 255 points), the rate from
+``POINT:RATE``.  A sample is missing when its residual is negative (the C3D convention for an
+invalid point), when a coordinate is not finite, or, with ``zero_is_missing`` (default), when
+it is exactly (0, 0, 0), which several capture systems write for gaps.
+
+:func:`write_c3d` writes a trial (in mm by default) to a temporary file in the target's folder
+and renames it into place, so a reader never sees half a file.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import C3DError
+from .trial import MarkerTrajectories
+
+#: metres per unit of the C3D POINT:UNITS values anthroarm understands
+UNITS = {"mm": 1e-3, "millimeter": 1e-3, "millimeters": 1e-3, "millimetre": 1e-3, "millimetres": 1e-3,
+         "cm": 1e-2, "m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0}
+
+
+def _param(c, group: str, name: str, default=None):
+    try:
+        return c["parameters"][group][name]["value"]
+    except (KeyError, TypeError):
+        return default
+
+
+def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
+    """Marker trajectories of a C3D file, in metres (world = the lab frame of the file).
+
+    Raises
+    ------
+    C3DError
+        No such file, not a C3D file ezc3d can read, no POINT data, unknown ``POINT:UNITS``
+        (the message lists the known ones), a non-positive rate, duplicate labels.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise C3DError("C3D file not found" if not p.exists() else "not a file", p)
+    try:
+        import ezc3d
+
+        c = ezc3d.c3d(str(p))
+    except Exception as exc:  # ezc3d raises RuntimeError/IOError from C++
+        raise C3DError(f"ezc3d cannot read this file as C3D ({exc})", p) from None
+    pts = np.asarray(c["data"]["points"], dtype=float)
+    if pts.ndim != 3 or pts.shape[0] < 3:
+        raise C3DError(f"no POINT data (points array of shape {pts.shape})", p)
+    labels = list(_param(c, "POINT", "LABELS", []) or [])
+    k = 2
+    while len(labels) < pts.shape[1] and _param(c, "POINT", f"LABELS{k}") is not None:
+        labels += list(_param(c, "POINT", f"LABELS{k}"))
+        k += 1
+    labels = [str(s).strip() for s in labels[:pts.shape[1]]]
+    if len(labels) < pts.shape[1]:
+        labels += [f"point{i + 1}" for i in range(len(labels), pts.shape[1])]
+    units = _param(c, "POINT", "UNITS", ["mm"])
+    unit = str(units[0] if len(units) else "mm").strip().lower()
+    if unit not in UNITS:
+        raise C3DError(f"POINT:UNITS is {unit!r}; known units: {', '.join(sorted(set(UNITS)))}", p)
+    rate = _param(c, "POINT", "RATE", [0.0])
+    rate = float(np.asarray(rate, dtype=float).ravel()[0]) if np.size(rate) else 0.0
+    if not (np.isfinite(rate) and rate > 0):
+        raise C3DError(f"POINT:RATE is {rate!r}: the frame rate must be positive (Hz)", p)
+    P = np.moveaxis(pts[:3], 0, -1).transpose(1, 0, 2) * UNITS[unit]      # (N, M, 3)
+    missing = ~np.isfinite(P).all(axis=2)
+    res = c["data"].get("meta_points", {}).get("residuals") if isinstance(c["data"], dict) else None
+    if res is not None:
+        res = np.asarray(res, dtype=float)
+        if res.shape == (1, pts.shape[1], pts.shape[2]):
+            missing |= (res[0] < 0).T
+    if zero_is_missing:
+        missing |= np.all(P == 0.0, axis=2)
+    P[missing] = np.nan
+    dup = sorted({s for s in labels if labels.count(s) > 1})
+    if dup:
+        raise C3DError(f"duplicate marker labels {dup}: rename them in the capture software", p)
+    return MarkerTrajectories(tuple(labels), P, rate=rate, source=str(p), meta={"units": unit})
+
+
+def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
+    """Write ``trial`` to ``path`` as a C3D file with ``POINT:UNITS = units`` (``"mm"`` or
+    ``"m"``); missing samples are written as NaN with residual −1.  Atomic: a temporary
+    file in the same folder, then ``os.replace``."""
+    if units not in ("mm", "m"):
+        raise C3DError(f"units must be 'mm' or 'm', got {units!r}", path)
+    if not isinstance(trial, MarkerTrajectories):
+        raise C3DError(f"write_c3d takes MarkerTrajectories, got {type(trial).__name__}", path)
+    import ezc3d
+
+    p = Path(path)
+    if not p.parent.is_dir():
+        raise C3DError(f"folder {p.parent} does not exist", p)
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [trial.rate]
+    c["parameters"]["POINT"]["LABELS"]["value"] = list(trial.names)
+    c["parameters"]["POINT"]["UNITS"]["value"] = [units]
+    N, M, _ = trial.positions.shape
+    pts = np.ones((4, M, N))
+    pts[:3] = trial.positions.transpose(2, 1, 0) / UNITS[units]
+    missing = ~trial.visible.T                              # (M, N)
+    pts[:3, missing] = np.nan
+    c["data"]["points"] = pts
+    res = np.zeros((1, M, N))
+    res[0, missing] = -1.0
+    c["data"]["meta_points"] = {"residuals": res, "camera_masks": np.zeros((7, M, N), dtype=bool)}
+    tmp = p.with_name(f".{p.stem}.{os.getpid()}.{secrets.token_hex(4)}.tmp.c3d")
+    try:
+        c.write(str(tmp))
+        os.replace(tmp, p)
+    except Exception as exc:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        if isinstance(exc, OSError):
+            raise
+        raise C3DError(f"ezc3d cannot write the file ({exc})", p) from None
+    return p
