@@ -200,3 +200,18 @@ class UnknownCodeError(AnthroarmError, KeyError):
 
     def __str__(self) -> str:
         return str(self.args[0]) if self.args else ""
+
+
+class CatalogueError(AnthroarmError, ValueError):
+    """A motor or gearbox catalogue (CSV, :mod:`anthroarm.prosthesis.catalogue`) that cannot be
+    used: a missing column, a value that is not a number, a negative or zero constant, a
+    duplicate name.  ``path`` names the file, ``line`` the line (1-based) and ``column`` the
+    column at fault (``None`` when the whole file is at fault)."""
+
+    def __init__(self, problem: str, path=None, line: int | None = None, column: str | None = None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.column = column
+        self.problem = problem
+        where = "" if path is None else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
+        super().__init__(where + problem)
