@@ -93,6 +93,17 @@ class ParameterError(AnthroarmError, TypeError, ValueError):
     :class:`TypeError` (like any unknown keyword) and, for old callers, a :class:`ValueError`."""
 
 
+class AnthropometryError(AnthroarmError, ValueError):
+    """Body or hand measurements outside human ranges (:mod:`anthroarm.models.hand`): a hand
+    longer than the forearm, a negative or implausible breadth, a hand length out of
+    proportion to the stature.  ``name`` is the parameter, ``value`` its value (SI)."""
+
+    def __init__(self, message: str, name: str | None = None, value=None):
+        self.name = name
+        self.value = value
+        super().__init__(message)
+
+
 class MeshError(AnthroarmError, ValueError):
     """A mesh file a robot's visuals name is not a usable mesh: not a mesh at all (a text file,
     random bytes), empty, truncated, non-finite, beyond the size bound, or a format the viewer
@@ -215,3 +226,8 @@ class CatalogueError(AnthroarmError, ValueError):
         self.problem = problem
         where = "" if path is None else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
         super().__init__(where + problem)
+
+
+class CouplingError(AnthroarmError, ValueError):
+    """Coupled joints given inconsistent values: a mimic joint's value that is not
+    multiplier · source + offset, or a start configuration that breaks a hard coupling."""

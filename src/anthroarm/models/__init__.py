@@ -19,6 +19,7 @@ from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
 from .care_robot import care_robot
 from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
+from .human_upper_limb import human_upper_limb
 from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
 
 BOOK_MODELS = {
@@ -28,6 +29,7 @@ BOOK_MODELS = {
     "unimate5": unimate5,
     "rrprr5": rrprr5,
     "planar2r": planar2r,
+    "human_upper_limb": human_upper_limb,
     "care_robot": care_robot,
 }
 

@@ -56,6 +56,38 @@ class LinkSpec:
     #: vector from the link origin to the next joint (or tool); drawn as a capsule
     segment: np.ndarray = field(default_factory=lambda: np.zeros(3))
     radius: float = DEFAULT_LINK_RADIUS
+    #: visual geometry that replaces the default (a sphere at the origin and a cylinder along
+    #: ``segment``): a tuple of :class:`Shape` (e.g. a palm box, phalanx capsules); ``None``
+    #: keeps the default
+    shapes: tuple | None = None
+
+
+@dataclass
+class Shape:
+    """One URDF visual of a link: ``kind`` "box" (``size`` = x, y, z extents), "cylinder"
+    (``size`` = radius, length; along the local z of ``origin``) or "sphere" (``size`` =
+    (radius,)); ``origin`` is its 4×4 pose in the link frame (m); ``material`` and ``rgba``
+    name and colour it."""
+
+    kind: str
+    size: tuple
+    origin: np.ndarray = field(default_factory=lambda: np.eye(4))
+    material: str = "link"
+    rgba: tuple = (0.75, 0.78, 0.82, 1.0)
+
+
+def capsule(p0, p1, radius: float, material: str = "link", rgba=(0.75, 0.78, 0.82, 1.0)) -> tuple:
+    """A capsule from ``p0`` to ``p1`` (link frame, m) of ``radius`` (m), as URDF 1.0 visuals
+    can draw it: a cylinder between the points and a sphere at each end."""
+    p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
+    d = p1 - p0
+    L = float(np.linalg.norm(d))
+    out = [Shape("sphere", (radius,), homogeneous(r=p0), material, rgba)]
+    if L > 1e-12:
+        T = homogeneous(rotation_between([0.0, 0.0, 1.0], d), (p0 + p1) / 2)
+        out.append(Shape("cylinder", (radius, L), T, material, rgba))
+        out.append(Shape("sphere", (radius,), homogeneous(r=p1), material, rgba))
+    return tuple(out)
 
 
 @dataclass
@@ -71,6 +103,11 @@ class JointSpec:
     effort: float = 100.0
     velocity: float = 3.0
     link: LinkSpec | None = None
+    #: name of the parent link (a tree); ``None``: the link of the joint before (a serial chain)
+    parent: str | None = None
+    #: ``(joint, multiplier, offset)``: this joint copies θ = multiplier · θ_joint + offset
+    #: (URDF ``<mimic>``); it has no variable of its own
+    mimic: tuple | None = None
 
 
 @dataclass
@@ -113,10 +150,15 @@ class ChainSpec:
     params: dict = field(default_factory=dict)
     person: bool = False
     comfort: dict | None = None
+    #: link that carries the tool frame; ``None``: the link of the last joint
+    tool_parent: str | None = None
+    #: extra fixed frames ``(name, parent link, 4×4 origin)``, e.g. the fingertips of a hand
+    frames: tuple = ()
 
     @property
     def nq(self) -> int:
-        return len(self.joints)
+        """Number of configuration variables: the joints that do not mimic another."""
+        return sum(1 for j in self.joints if j.mimic is None)
 
 
 def dh_matrix(row: DHRow, q: float) -> np.ndarray:
@@ -246,7 +288,23 @@ def _origin(T: np.ndarray, indent: str) -> str:
     return f'{indent}<origin xyz="{_vec(T[:3, 3])}" rpy="{_vec((r, p, y))}"/>\n'
 
 
+def _shape(s: Shape, indent: str) -> str:
+    if s.kind == "box":
+        geom = f'<box size="{_vec(s.size)}"/>'
+    elif s.kind == "cylinder":
+        geom = f'<cylinder radius="{_num(s.size[0])}" length="{_num(s.size[1])}"/>'
+    elif s.kind == "sphere":
+        geom = f'<sphere radius="{_num(s.size[0])}"/>'
+    else:
+        raise ValueError(f"shape kind must be box, cylinder or sphere, got {s.kind!r}")
+    return (f"{indent}<visual>\n{_origin(np.asarray(s.origin, float), indent + '  ')}"
+            f"{indent}  <geometry>{geom}</geometry>\n"
+            f"{indent}  <material name=\"{s.material}\"><color rgba=\"{_vec(s.rgba)}\"/></material>\n{indent}</visual>\n")
+
+
 def _visuals(link: LinkSpec, indent: str) -> str:
+    if link.shapes is not None:
+        return "".join(_shape(s, indent) for s in link.shapes)
     out = []
     # sphere at the joint centre
     out.append(
@@ -291,6 +349,8 @@ def to_urdf(spec: ChainSpec) -> str:
     parent = spec.base_link
     for j in spec.joints:
         link = j.link or LinkSpec(name=f"{j.name}_link")
+        if j.parent is not None:
+            parent = j.parent
         lines.append(f'  <joint name="{j.name}" type="{j.type}">\n')
         lines.append(f'    <parent link="{parent}"/>\n    <child link="{link.name}"/>\n')
         lines.append(_origin(j.origin, "    "))
@@ -298,6 +358,9 @@ def to_urdf(spec: ChainSpec) -> str:
         lines.append(
             f'    <limit lower="{_num(j.lower)}" upper="{_num(j.upper)}" effort="{_num(j.effort)}" velocity="{_num(j.velocity)}"/>\n'
         )
+        if j.mimic is not None:
+            src, mult, off = j.mimic
+            lines.append(f'    <mimic joint="{src}" multiplier="{_num(mult)}" offset="{_num(off)}"/>\n')
         lines.append("  </joint>\n")
         lines.append(f'  <link name="{link.name}">\n')
         lines.append(_inertial(link, "    "))
@@ -305,9 +368,15 @@ def to_urdf(spec: ChainSpec) -> str:
         lines.append("  </link>\n")
         parent = link.name
     lines.append(f'  <joint name="{spec.tool_name}_joint" type="fixed">\n')
-    lines.append(f'    <parent link="{parent}"/>\n    <child link="{spec.tool_name}"/>\n')
+    lines.append(f'    <parent link="{spec.tool_parent or parent}"/>\n    <child link="{spec.tool_name}"/>\n')
     lines.append(_origin(spec.tool_origin, "    "))
     lines.append("  </joint>\n")
     lines.append(f'  <link name="{spec.tool_name}"/>\n')
+    for name, frame_parent, T in spec.frames:
+        lines.append(f'  <joint name="{name}_joint" type="fixed">\n')
+        lines.append(f'    <parent link="{frame_parent}"/>\n    <child link="{name}"/>\n')
+        lines.append(_origin(np.asarray(T, float), "    "))
+        lines.append("  </joint>\n")
+        lines.append(f'  <link name="{name}"/>\n')
     lines.append("</robot>\n")
     return "".join(lines)
