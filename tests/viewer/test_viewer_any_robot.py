@@ -19,6 +19,7 @@ import umsgpack
 import anthroarm as aa
 from anthroarm.errors import ViewerError
 from anthroarm.viewer import Viewer
+from anthroarm.viewer.visuals import PackedMesh, _placement
 
 
 
@@ -190,7 +191,7 @@ def piece_poses_match_omg(robot, v: Viewer, q):
     poses = []
     for b in v.bodies:
         M = sent[v._bpath(b)] if b.joint is not None else np.eye(4)
-        poses += [M @ p.offset for p in b.pieces]
+        poses += [M @ p.offset @ np.linalg.inv(_placement(p.geometry)) for p in b.pieces]
     assert len(poses) == len(gm.geometryObjects)
     for k, go in enumerate(gm.geometryObjects):
         scale = np.diag([*go.meshScale, 1.0])
@@ -202,7 +203,7 @@ def test_pin_model_with_visual_model_draws_its_meshes():
     model = pin.buildModelFromUrdf(str(path))
     visual = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=[str(path.parents[4])])
     robot = aa.load(model, visual_model=visual, name="ur5_model")
-    v = Viewer(robot)
+    v = Viewer(robot, mesh_triangles=None)   # the mesh files as they are
     assert sum(len(b.pieces) for b in v.bodies) == len(visual.geometryObjects)
     objs = [umsgpack.unpackb(c) for c in v.store.commands()]
     files = [o for o in objs if o["type"] == "set_object" and o["object"]["geometries"]
@@ -211,6 +212,9 @@ def test_pin_model_with_visual_model_draws_its_meshes():
     for q in robot.random_q(2, rng=8):
         check_against_pinocchio(robot, v, q)
         piece_poses_match_omg(robot, v, q)
+    packed = Viewer(robot)   # default: compact meshes, placed by their own grid-to-metres placement
+    assert all(isinstance(p.geometry, PackedMesh) for b in packed.bodies for p in b.pieces)
+    piece_poses_match_omg(robot, packed, robot.random_q(rng=9))
 
 
 def test_pin_model_with_primitive_visuals():

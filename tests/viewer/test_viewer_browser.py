@@ -21,6 +21,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.viewer import Viewer, browser
+from anthroarm.viewer.visuals import PackedMesh
 
 pytestmark = pytest.mark.browser
 
@@ -67,6 +68,10 @@ def half_extent_corners(g) -> list[np.ndarray]:
         e = np.array([max(g.radiusTop, g.radiusBottom), g.height / 2, max(g.radiusTop, g.radiusBottom)])
     elif kind == "Box":
         e = np.asarray(g.lengths, float) / 2
+    elif isinstance(g, PackedMesh):        # a packed mesh: its grid's bounds (the offset places the grid)
+        lo, hi = g.grid.min(0).astype(float), g.grid.max(0).astype(float)
+        return [np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
+                for sx in (0, 1) for sy in (0, 1) for sz in (0, 1)]
     elif isinstance(g, mg.MeshGeometry):   # a mesh file: its own bounds
         import io
 

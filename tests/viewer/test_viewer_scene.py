@@ -97,13 +97,53 @@ def test_urdf_mesh_bodies_match_yourdfpy():
 
 def test_panda_meshes_are_the_package_files():
     robot = aa.load("panda")
-    v = Viewer(robot)
+    v = Viewer(robot, mesh_triangles=None)   # the files as they are
     objs = [umsgpack.unpackb(c) for c in v.store.commands()]
     meshes = [o for o in objs if o["type"] == "set_object" and o["object"]["geometries"]
               and o["object"]["geometries"][0].get("type") == "_meshfile"]
     assert len(meshes) >= 8
     first = robot.info.meshes[next(iter(robot.info.meshes))]
     assert first.is_file()
+
+
+def test_packed_panda_meshes_approximate_the_files_and_fit_a_jupyter_cell():
+    """Default mesh budget: each mesh file becomes a PackedMesh of at most MESH_TRIANGLES
+    triangles whose vertices lie within one clustering cell of the file's own vertices (trimesh
+    reads the file: the oracle), with the same bounding box to 2 % of its size; the Jupyter
+    cell of the whole arm embeds at most 2 MB (15 MB with the raw files)."""
+    import io
+
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    from anthroarm.viewer.visuals import MESH_TRIANGLES, PackedMesh
+
+    robot = aa.load("panda")
+    v = Viewer(robot)
+    packed = {}
+    for b in v.bodies:
+        for piece in b.pieces:
+            if isinstance(piece.geometry, PackedMesh):
+                packed[id(piece.geometry)] = piece.geometry
+    assert len(packed) >= 8
+    files = {p for p in robot.info.meshes.values() if "/visual/" in str(p)}
+    by_count = {}
+    for f in files:
+        m = trimesh.load(io.BytesIO(f.read_bytes()), file_type=f.suffix[1:], force="mesh")
+        by_count[f] = m
+    for g in packed.values():
+        assert len(g.faces) <= MESH_TRIANGLES and g.faces.max() < len(g.grid)
+        W = g.vertices
+        # the file this mesh came from: the one whose bounding box matches
+        best = min(by_count.values(), key=lambda m: np.abs(m.bounds - np.array([W.min(0), W.max(0)])).max())
+        side = float(np.ptp(best.vertices, axis=0).max())
+        np.testing.assert_allclose([W.min(0), W.max(0)], best.bounds, atol=0.02 * side)
+        cell = side / 8  # coarsest grid the budget could need for these meshes is far finer
+        d, _ = cKDTree(best.vertices).query(W)
+        assert d.max() < cell, (d.max(), side)
+        assert np.median(d) < 0.01 * side
+    assert len(v._repr_html_().encode()) <= 2 * 2**20
+    assert len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()) > 10 * 2**20   # what it was
 
 
 @pytest.mark.parametrize("name", BOOK)

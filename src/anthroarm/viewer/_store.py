@@ -13,6 +13,9 @@ Two commands are added to meshcat's protocol (handled by the page's JavaScript p
                      message and is never drawn half-applied.
 ``anthroarm_color``  ``{"type", "path", "color": [r, g, b(, a)]}`` — recolour every mesh under
                      ``path`` (used for joint-limit proximity), without resending geometry.
+
+and after every ``set_object`` it computes smooth vertex normals for the meshes that came
+without any (:class:`~anthroarm.viewer.visuals.PackedMesh`, meshcat's ``TriangularMeshGeometry``).
 """
 
 from __future__ import annotations
@@ -49,6 +52,13 @@ JS_PATCH = r"""
       return;
     }
     base(cmd);
+    if (cmd.type === "set_object") {   // meshes sent without normals (PackedMesh): smooth normals here
+      var made = viewer.scene_tree.find(split(cmd.path));
+      made.object.traverse(function (o) {
+        var g = o.isMesh && o.geometry;
+        if (g && g.getAttribute && g.getAttribute("position") && !g.getAttribute("normal")) { g.computeVertexNormals(); }
+      });
+    }
   };
   window.anthroarm_ready = true;
 })();

@@ -219,8 +219,9 @@ def _origin(el) -> np.ndarray:
     return homogeneous(pin.rpy.rpyToMatrix(*rpy), xyz)
 
 
-def urdf_bodies(robot) -> list[Body]:
-    """Bodies from the URDF's ``<visual>`` elements (meshes resolved like the loader did)."""
+def urdf_bodies(robot, max_triangles: int | None = None) -> list[Body]:
+    """Bodies from the URDF's ``<visual>`` elements (meshes resolved like the loader did);
+    ``max_triangles``: see :func:`load_mesh`."""
     from lxml import etree
 
     from ..urdf_io import resolve_uri
@@ -269,9 +270,9 @@ def urdf_bodies(robot) -> list[Body]:
                                                        f"exist; pass package_dirs={{...}} to aa.load")
                 scale = _floats(shape.get("scale"), 3, (1, 1, 1))
                 if path not in mesh_cache:
-                    mesh_cache[path] = load_mesh(path, link=name)
+                    mesh_cache[path] = load_mesh(path, link=name, max_triangles=max_triangles)
                 geom = mesh_cache[path]
-                offset = offset @ np.diag([*scale, 1.0])
+                offset = offset @ np.diag([*scale, 1.0]) @ _placement(geom)
             elif shape.tag == "box":
                 geom = mg.Box(_floats(shape.get("size"), 3, (0.1, 0.1, 0.1)))
             elif shape.tag == "cylinder":
@@ -288,6 +289,11 @@ def urdf_bodies(robot) -> list[Body]:
     return bodies
 
 
+def _placement(geom) -> np.ndarray:
+    """Where a mesh geometry's own coordinates sit in the mesh file's frame (a PackedMesh's grid)."""
+    return geom.placement if isinstance(geom, PackedMesh) else np.eye(4)
+
+
 def _limit_kw(chain, joint: int) -> dict:
     """Colouring of a body moved by chain joint ``joint`` (−1: the base): that joint if it has
     limits."""
@@ -297,7 +303,7 @@ def _limit_kw(chain, joint: int) -> dict:
 
 
 # ---------------------------------------------------------------------- pin.GeometryModel
-def geometry_bodies(robot) -> list[Body]:
+def geometry_bodies(robot, max_triangles: int | None = None) -> list[Body]:
     """Bodies from ``robot.visual_model`` (a ``pin.GeometryModel``): one body per joint that
     carries geometry, each object at its placement in the joint frame (Pinocchio's
     ``GeometryObject.placement``)."""
@@ -305,7 +311,7 @@ def geometry_bodies(robot) -> list[Body]:
     by_joint: dict[int, list[Piece]] = {}
     mesh_cache: dict[Path, object] = {}
     for go in robot.visual_model.geometryObjects:
-        by_joint.setdefault(int(go.parentJoint) - 1, []).extend(_geometry_pieces(go, mesh_cache))
+        by_joint.setdefault(int(go.parentJoint) - 1, []).extend(_geometry_pieces(go, mesh_cache, max_triangles))
     bodies = []
     for j, pieces in sorted(by_joint.items()):
         if not pieces:
@@ -321,7 +327,7 @@ def geometry_bodies(robot) -> list[Body]:
 _UNBOUNDED_SHAPES = ("Plane", "Halfspace")
 
 
-def _geometry_pieces(go, mesh_cache) -> list[Piece]:
+def _geometry_pieces(go, mesh_cache, max_triangles=None) -> list[Piece]:
     """Pieces for one ``pin.GeometryObject``: a mesh file when ``meshPath`` names one (scaled
     by ``meshScale``), else the primitive shape or the loaded triangles (already scaled)."""
     g = go.geometry
@@ -333,8 +339,9 @@ def _geometry_pieces(go, mesh_cache) -> list[Piece]:
     path = Path(go.meshPath) if go.meshPath else None
     if path is not None and path.is_file():
         if path not in mesh_cache:
-            mesh_cache[path] = load_mesh(path, link=go.name)
-        geom, offset = mesh_cache[path], M @ np.diag([*np.asarray(go.meshScale, float), 1.0])
+            mesh_cache[path] = load_mesh(path, link=go.name, max_triangles=max_triangles)
+        geom = mesh_cache[path]
+        offset = M @ np.diag([*np.asarray(go.meshScale, float), 1.0]) @ _placement(geom)
     elif kind == "Box":
         geom, offset = mg.Box(2 * np.asarray(g.halfSide, float)), M
     elif kind == "Sphere":
@@ -372,9 +379,10 @@ DIRECT_FORMATS = (".stl", ".obj", ".dae")
 _STL_RECORD = np.dtype([("normal", "<f4", 3), ("v", "<f4", 9), ("attr", "<u2")])
 
 
-def load_mesh(path, link: str | None = None):
+def load_mesh(path, link: str | None = None, max_triangles: int | None = None):
     """A meshcat mesh geometry from a mesh file: .stl (binary or ASCII), .obj, .dae, or any
-    format trimesh reads (sent as STL).
+    format trimesh reads (sent as STL).  With ``max_triangles`` the file is parsed here and
+    sent as a :class:`PackedMesh` of at most that many triangles (:func:`pack_mesh`) instead.
 
     The file is read once, checked, and only the checked bytes are sent: a file that is not a
     mesh (a text file, random bytes), empty, truncated, with non-finite coordinates, larger than
@@ -403,14 +411,147 @@ def load_mesh(path, link: str | None = None):
     try:
         if ext == ".stl":
             _check_stl(data)
-            return _stl_geometry(data)
-        if ext == ".obj":
-            return mg.MeshGeometry(_check_obj(data), "obj")
-        if ext == ".dae":
-            return mg.MeshGeometry(_check_dae(data), "dae")
-        return _stl_geometry(_via_trimesh(data, ext))
+            geom, fmt, body = _stl_geometry(data), "stl", data
+        elif ext == ".obj":
+            body = _check_obj(data)
+            geom, fmt = mg.MeshGeometry(body, "obj"), "obj"
+        elif ext == ".dae":
+            body = _check_dae(data)
+            geom, fmt = mg.MeshGeometry(body, "dae"), "dae"
+        else:
+            body = _via_trimesh(data, ext)
+            geom, fmt = _stl_geometry(body), "stl"
+        if max_triangles is None:
+            return geom
+        return _packed(body, fmt, _check_budget(max_triangles), (str(path), st.st_mtime_ns, st.st_size))
     except _NotAMesh as exc:
         raise MeshError(path, str(exc), link) from None
+
+
+#: Default triangle budget of one mesh file in the viewer (``Viewer(mesh_triangles=...)``): the
+#: Franka Panda's 11 visual meshes (148 000 triangles, 10.6 MB of COLLADA text) become 55 000
+#: triangles in about 0.4 MB, so a Jupyter cell embeds well under 2 MB.
+MESH_TRIANGLES = 5000
+
+
+class PackedMesh(mg.Geometry):
+    """An indexed triangle mesh in a compact form: vertex positions on a 16-bit grid over the
+    mesh's bounding cube (``placement`` maps grid units to the mesh file's metres), indices as
+    16-bit integers below 65 536 vertices.  No normals are sent: the page computes smooth
+    vertex normals (``anthroarm_normals`` in :data:`~anthroarm.viewer._store.JS_PATCH`)."""
+
+    def __init__(self, grid: np.ndarray, faces: np.ndarray, placement: np.ndarray):
+        super().__init__()
+        self.grid = np.ascontiguousarray(grid, dtype=np.uint16)
+        self.faces = np.ascontiguousarray(faces, dtype=np.uint16 if len(self.grid) <= 65536 else np.uint32)
+        self.placement = np.asarray(placement, float)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(N, 3) vertex positions in the mesh file's frame (m)."""
+        return self.grid.astype(float) @ self.placement[:3, :3].T + self.placement[:3, 3]
+
+    def lower(self, object_data):
+        import umsgpack
+
+        def attr(a, size):
+            code, name = (20, "Uint16Array") if a.dtype == np.uint16 else (22, "Uint32Array")
+            return {"itemSize": size, "type": name, "array": umsgpack.Ext(code, a.tobytes()), "normalized": False}
+
+        return {"uuid": self.uuid, "type": "BufferGeometry",
+                "data": {"attributes": {"position": attr(self.grid, 3)}, "index": attr(self.faces.ravel(), 1)}}
+
+
+def _check_budget(max_triangles) -> int:
+    import numbers
+
+    if isinstance(max_triangles, bool) or not isinstance(max_triangles, numbers.Integral) or int(max_triangles) < 12:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"max_triangles (mesh_triangles) must be an integer >= 12 or None (the mesh files "
+                             f"as they are), got {max_triangles!r}")
+    return int(max_triangles)
+
+
+def _cluster(V: np.ndarray, F: np.ndarray, n: int, count_only: bool = False):
+    """Vertex clustering on a grid of ``n`` cells along the bounding cube's side: the vertices
+    of a cell merge into their mean; triangles that collapse, or repeat, are dropped.
+    ``count_only``: just the number of triangles that do not collapse (an upper bound)."""
+    lo = V.min(0)
+    side = float((V.max(0) - lo).max()) or 1.0
+    key = np.minimum(np.floor((V - lo) / side * n).astype(np.int64), n - 1)
+    flat = (key[:, 0] * n + key[:, 1]) * n + key[:, 2]
+    if count_only:
+        G = flat[F]
+        return int(np.count_nonzero((G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2])))
+    _, inv = np.unique(flat, return_inverse=True)
+    inv = inv.ravel()
+    cnt = np.bincount(inv)
+    W = np.stack([np.bincount(inv, V[:, k]) for k in range(3)], 1) / cnt[:, None]
+    G = inv[F]
+    G = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2])]
+    if len(G):
+        r = np.argmin(G, 1)   # rotate each triangle to start at its smallest index: repeats become equal rows
+        G = np.unique(np.stack([G[np.arange(len(G)), (r + k) % 3] for k in range(3)], 1), axis=0)
+    used = np.unique(G)
+    remap = np.full(len(W), -1, np.int64)
+    remap[used] = np.arange(len(used))
+    return W[used], remap[G]
+
+
+def pack_mesh(vertices, faces, max_triangles: int = MESH_TRIANGLES) -> PackedMesh:
+    """A :class:`PackedMesh` of at most ``max_triangles`` triangles: coincident vertices merged
+    (a 16-bit grid: 1/65535 of the bounding cube), then, above the budget, vertex clustering on
+    the finest grid that meets it (Rossignac & Borrel 1993, "Multi-resolution 3D approximations
+    for rendering complex scenes")."""
+    V = np.asarray(vertices, float)
+    F = np.asarray(faces, np.int64).reshape(-1, 3)
+    W, G = _cluster(V, F, 65535)
+    if len(G) > max_triangles:
+        lo, hi = 2, 4096
+        while lo < hi:           # the finest grid whose surviving triangles fit (they grow with n)
+            mid = (lo + hi + 1) // 2
+            if _cluster(V, F, mid, count_only=True) <= max_triangles:
+                lo = mid
+            else:
+                hi = mid - 1
+        W, G = _cluster(V, F, lo)
+    if len(W) == 0:
+        W, G = np.zeros((1, 3)), np.zeros((0, 3), np.int64)
+    lo = W.min(0)
+    step = max(float((W.max(0) - lo).max()), 1e-12) / 65535.0
+    grid = np.clip(np.round((W - lo) / step), 0, 65535)
+    placement = np.diag([step, step, step, 1.0])
+    placement[:3, 3] = lo
+    return PackedMesh(grid, G, placement)
+
+
+_PACKED: dict = {}
+
+
+def _packed(body, fmt: str, max_triangles: int, key) -> PackedMesh:
+    """The checked mesh bytes/text parsed with trimesh and packed; the last 64 results are kept
+    (key: file, modification time, size, budget), so a second Viewer of a robot is quick."""
+    import io
+
+    import trimesh
+
+    k = (*key, max_triangles)
+    if k in _PACKED:
+        return _PACKED[k]
+    data = body.encode("utf-8") if isinstance(body, str) else body
+    try:
+        m = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh")
+        V, F = np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
+    except Exception as exc:  # noqa: BLE001 - trimesh/pycollada raise anything
+        raise _NotAMesh(f"cannot be parsed for the viewer ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+    if len(F) and not np.all(np.isfinite(V)):
+        raise _NotAMesh("has non-finite vertex coordinates")
+    packed = pack_mesh(V, F, max_triangles) if len(F) else PackedMesh(np.zeros((1, 3)), np.zeros((0, 3)), np.eye(4))
+    if len(_PACKED) >= 64:
+        _PACKED.pop(next(iter(_PACKED)))
+    _PACKED[k] = packed
+    return packed
 
 
 class _NotAMesh(Exception):
@@ -573,11 +714,12 @@ def _via_trimesh(data: bytes, ext: str) -> bytes:
 STYLES = ("auto", "generated", "urdf", "visual_model")
 
 
-def robot_bodies(robot, style: str = "auto") -> list[Body]:
+def robot_bodies(robot, style: str = "auto", max_triangles: int | None = None) -> list[Body]:
     """Bodies for any Robot.  ``style``: "generated" (the skeleton from ``robot.chain``),
     "urdf" (the URDF's ``<visual>`` elements), "visual_model" (``robot.visual_model``), or
     "auto": generated for book models, else the robot's own visuals (URDF, then visual
-    model), and the skeleton when it has none."""
+    model), and the skeleton when it has none.  ``max_triangles``: each mesh file as a
+    :class:`PackedMesh` of at most that many triangles (None: the files as they are)."""
     if style not in STYLES:
         raise ValueError(f"style must be one of {', '.join(map(repr, STYLES))}, got {style!r}")
     if style == "urdf" and robot.info is None:
@@ -588,7 +730,7 @@ def robot_bodies(robot, style: str = "auto") -> list[Body]:
         return skeleton_bodies(robot)
     bodies = []
     if style in ("auto", "urdf") and robot.info is not None:
-        bodies = urdf_bodies(robot)
+        bodies = urdf_bodies(robot, max_triangles)
     elif style in ("auto", "visual_model") and robot.visual_model is not None:
-        bodies = geometry_bodies(robot)
+        bodies = geometry_bodies(robot, max_triangles)
     return bodies or skeleton_bodies(robot)   # no visual geometry at all: the skeleton
