@@ -17,6 +17,7 @@ from pathlib import Path
 from ..errors import ParameterError, UnknownModelError
 from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
 from .care_robot import care_robot
+from .templates import TEMPLATES
 from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .human_upper_limb import human_upper_limb
@@ -31,6 +32,7 @@ BOOK_MODELS = {
     "planar2r": planar2r,
     "human_upper_limb": human_upper_limb,
     "care_robot": care_robot,
+    **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
 }
 
 #: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
