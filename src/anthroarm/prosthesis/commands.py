@@ -1,0 +1,138 @@
+"""The ``anthroarm size`` command: a person → activities → joint demands → motors → an HTML report.
+
+    anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 --out report.html
+
+``--activities`` is ``adl`` (the daily-living activity library of :mod:`anthroarm.motion`, turned
+into joint trajectories for this person) or a comma-separated list of joint-trajectory files:
+``.npz`` with arrays ``t`` (N,) s and ``q`` (N, nq) rad, or ``.csv`` with a header ``t`` and the
+arm's joint names (rad; ``#`` lines are comments).  Progress bars (stderr, on a terminal) follow
+the activities and the joints; the last line printed is a JSON summary.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+
+def add_parser(sub):
+    """Register ``size`` on the CLI's subparsers (``anthroarm.cli.build_parser``)."""
+    p = sub.add_parser(
+        "size", help="size a prosthesis's motors for a person's activities and write an HTML report",
+        description="From a person (height, mass, sex) and a set of activities to joint torques with a held "
+                    "object (Eq. (8-5)), their envelope, the lightest catalogue motor + gearbox per joint (servo "
+                    "model of Eq. (9-1)), the book's weight rules, and a self-contained HTML report.",
+        epilog="example: anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 "
+               "--out report.html")
+    p.add_argument("--model", default="human_arm7", help="arm model (default human_arm7, scaled to the person)")
+    p.add_argument("--height", type=float, default=1.75, help="body height, m (default 1.75)")
+    p.add_argument("--mass", type=float, default=70.0, help="body mass, kg (default 70)")
+    p.add_argument("--sex", default="male", choices=["male", "female"])
+    p.add_argument("--activities", default="adl", metavar="adl|FILE[,FILE...]",
+                   help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
+                        "and joint-name columns, rad)")
+    p.add_argument("--payload", type=float, default=0.5, help="mass held in the hand, kg (default 0.5)")
+    p.add_argument("--margin", type=float, default=0.2, help="demand margin, fraction (default 0.2 = 20 %%)")
+    p.add_argument("--motors", default=None, metavar="CSV", help="motor catalogue (default: the shipped example)")
+    p.add_argument("--gearboxes", default=None, metavar="CSV", help="gearbox catalogue (default: the shipped example)")
+    p.add_argument("--out", default="report.html", metavar="FILE.html", help="the report (written atomically)")
+    p.add_argument("--no-viewer", action="store_true", help="leave the 3-D animation out of the report (smaller file)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.set_defaults(func=cmd_size)
+    return p
+
+
+def _read_trajectory(path: Path, robot) -> dict:
+    import numpy as np
+
+    from ..errors import ActivityError
+
+    if not path.is_file():
+        raise ActivityError(f"{path}: no such trajectory file")
+    if path.suffix.lower() == ".npz":
+        with np.load(path) as z:
+            if "t" not in z or "q" not in z:
+                raise ActivityError(f"{path}: an .npz trajectory needs arrays 't' (N,) and 'q' (N, {robot.nq}); "
+                                    f"it has {sorted(z.files)}")
+            return dict(name=path.stem, t=np.asarray(z["t"], float), q=np.asarray(z["q"], float))
+    if path.suffix.lower() == ".csv":
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.startswith("#")]
+        if not lines:
+            raise ActivityError(f"{path}: empty trajectory file")
+        header = [h.strip() for h in lines[0].split(",")]
+        need = ["t", *robot.joint_names]
+        missing = [c for c in need if c not in header]
+        if missing:
+            raise ActivityError(f"{path}: missing column(s) {missing}; need {need}")
+        try:
+            data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]], dtype=float)
+        except ValueError as exc:
+            raise ActivityError(f"{path}: a value is not a number ({exc})") from None
+        if data.ndim != 2 or data.shape[1] != len(header):
+            raise ActivityError(f"{path}: every row needs {len(header)} values")
+        cols = [header.index(c) for c in need]
+        return dict(name=path.stem, t=data[:, cols[0]], q=data[:, cols[1:]])
+    raise ActivityError(f"{path}: a trajectory file is .npz or .csv, got {path.suffix!r}")
+
+
+def activities_from(spec: str, robot, payload: float) -> list[dict]:
+    """The activity dicts of :func:`.study.run` for ``--activities`` (module docstring)."""
+    if spec.strip().lower() == "adl":
+        return adl_activities(robot, payload)
+    return [_read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
+
+
+def adl_activities(robot, payload: float) -> list[dict]:
+    """The daily-living library's activities for ``robot`` as activity dicts; an activity the
+    library cannot build for this arm (a target out of reach) is kept with its status."""
+    try:
+        from ..motion import activities as adl
+    except ImportError:
+        from ..errors import ActivityError
+
+        raise ActivityError("the daily-living activity library (anthroarm.motion.activities) is not available in "
+                            "this installation; give joint trajectories as files (--activities a.npz,b.csv)") from None
+    return adl.for_sizing(robot, payload=payload)
+
+
+def cmd_size(a) -> int:
+    import numpy as np
+
+    from ..cli import UserError, _load_model, _progress
+    from . import catalogue, report, study
+
+    out = Path(a.out)
+    if out.suffix.lower() not in (".html", ".htm"):
+        raise UserError(f"--out {a.out}: the report is an HTML file (.html)")
+    if out.is_dir():
+        raise UserError(f"--out {a.out} is a folder; give a file name such as {out / 'report.html'}")
+    if not out.parent.is_dir():
+        raise UserError(f"--out {a.out}: folder {out.parent} does not exist")
+    for what, v, lo, hi in (("height", a.height, 0.5, 2.5), ("mass", a.mass, 10.0, 300.0),
+                            ("payload", a.payload, 0.0, 50.0), ("margin", a.margin, 0.0, 10.0)):
+        if not (np.isfinite(v) and lo <= v <= hi):
+            raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
+    cat = catalogue.load(a.motors, a.gearboxes)
+    robot = _load_model(a.model, dict(height=a.height, mass=a.mass, sex=a.sex))
+    acts = activities_from(a.activities, robot, a.payload)
+    bar = _progress(len(acts) + robot.nv, "size", not a.no_progress)
+
+    def progress(stage, name):
+        bar.set_postfix_str(f"{stage} {name}")
+        bar.update(1)
+
+    try:
+        st = study.run(robot, acts, payload=a.payload, catalogue=cat, margin=a.margin,
+                       person=dict(height=a.height, mass=a.mass, sex=a.sex), progress=progress)
+        bar.set_postfix_str("report")
+        report.write(st, out, viewer=not a.no_viewer)
+    finally:
+        bar.close()
+    summary = dict(out=str(out), drive_mass_kg=round(st.sizing.drive_mass, 4),
+                   joints={r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
+                           for r in st.sizing.rows()},
+                   unfit=st.sizing.unfit, skipped=[x.name for x in st.envelope.skipped],
+                   rules={r.source: r.ok for r in st.rules})
+    print(json.dumps(summary), file=sys.stdout)
+    return 0
