@@ -19,10 +19,13 @@ Algorithms here take arrays and a Robot; reading files is in ``c3d`` / ``csv_io`
 bars are the CLI's (``anthroarm ik-markers``).
 """
 
+from . import activities
+from .activities import Activity, ActivityTrajectory, Keyframe, activity, activity_trajectory
 from .c3d import read_c3d, write_c3d
 from .marker_ik import STATUSES, MarkerIK, MarkerIKResult, marker_ik, match_markers
 from .markers import (HUMAN_ARM_LANDMARKS, BoundMarkers, Marker, MarkerSet, default_marker_set, human_arm_markers,
                       segment_length)
+from .timing import keyframe_trajectory, minimum_jerk
 from .trial import MarkerTrajectories
 
 __all__ = [
@@ -30,4 +33,6 @@ __all__ = [
     "Marker", "MarkerSet", "BoundMarkers", "HUMAN_ARM_LANDMARKS", "default_marker_set", "human_arm_markers",
     "segment_length",
     "MarkerIK", "MarkerIKResult", "marker_ik", "match_markers", "STATUSES",
+    "activities", "Activity", "ActivityTrajectory", "Keyframe", "activity", "activity_trajectory",
+    "minimum_jerk", "keyframe_trajectory",
 ]
