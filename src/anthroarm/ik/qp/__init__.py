@@ -10,7 +10,8 @@
 >>> conf.integrate_inplace(v, 0.01)
 
 Tasks (``qp.tasks``): FrameTask, PositionTask, OrientationTask, RelativeFrameTask, PostureTask,
-DampingTask, JointCouplingTask (mimic), SwivelTask, MarkerTask (body-fixed points).  Limits (``qp.limits``): ConfigurationLimit,
+DampingTask, JointCouplingTask (mimic), SwivelTask, MarkerTask (body-fixed points),
+ContactNormalTask, SurfaceContactTask (fingertip contacts, :mod:`anthroarm.hand`).  Limits (``qp.limits``): ConfigurationLimit,
 VelocityLimit, AccelerationLimit.  Backends (``qp.backends``): persistent OSQP, daqp, quadprog,
 proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
 
@@ -34,12 +35,13 @@ from .backends import available_solvers, make_backend
 from .configuration import IKConfiguration
 from .limits import AccelerationLimit, ConfigurationLimit, Limit, VelocityLimit
 from .step import StepResult, default_limits, step
+from .tasks import (ContactNormalTask, SurfaceContactTask)
 from .tasks import (DampingTask, FrameTask, JointCouplingTask, MarkerTask, OrientationTask, PositionTask, PostureTask,
                     RelativeFrameTask, SwivelTask, Task, comfortable_posture, swivel_angle)
 
 __all__ = [
     "step", "StepResult", "IKConfiguration", "default_limits", "available_solvers", "make_backend",
     "Task", "FrameTask", "MarkerTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask", "DampingTask",
-    "JointCouplingTask", "SwivelTask", "comfortable_posture", "swivel_angle",
+    "JointCouplingTask", "SwivelTask", "ContactNormalTask", "SurfaceContactTask", "comfortable_posture", "swivel_angle",
     "Limit", "ConfigurationLimit", "VelocityLimit", "AccelerationLimit", "backends", "limits", "tasks",
 ]

@@ -1,6 +1,7 @@
 """Tasks of the QP differential IK (one concept per module, as in pink)."""
 
 from .base import Task
+from .contact_normal import ContactNormalTask
 from .coupling import JointCouplingTask
 from .damping import DampingTask
 from .frame import FrameTask
@@ -9,10 +10,11 @@ from .orientation import OrientationTask
 from .position import PositionTask
 from .posture import PostureTask, comfortable_posture, has_comfortable_posture
 from .relative_frame import RelativeFrameTask
+from .surface_contact import SurfaceContactTask
 from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swivel_from_points
 
 __all__ = [
     "Task", "FrameTask", "MarkerTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
     "DampingTask", "JointCouplingTask", "SwivelTask", "comfortable_posture",
-    "has_comfortable_posture", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
+    "has_comfortable_posture", "ContactNormalTask", "SurfaceContactTask", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]
