@@ -109,3 +109,26 @@ def test_weight_rules_with_the_book_numbers():
     assert "L7298" not in {r.source for r in W.check(1.0, None, 7)}
     with pytest.raises(ValueError):
         W.check(-1.0, 70.0, 7)
+
+
+def test_payload_per_sample_equals_rnea_with_the_object_on_the_hand(robot):
+    """An object picked up half-way: samples without it equal pin.rnea of the arm, samples with it
+    pin.rnea of the arm whose hand body carries the cylinder's inertia."""
+    t, q, qd, qdd = _poly_traj(robot, n=41)
+    mass = np.where(t > 0.7, 0.8, 0.0)
+    act = E.activity_torques(robot, "pick", t, q, qd, qdd, payload=mass)
+    obj = E.held_object(0.8)
+    heavy = robot.model.copy()
+    fr = heavy.frames[robot.tool_id]
+    heavy.inertias[fr.parentJoint] = heavy.inertias[fr.parentJoint] + fr.placement.act(
+        pin.Inertia(0.8, obj.com, obj.inertia))
+    d0, d1 = robot.model.createData(), heavy.createData()
+    for k in range(len(t)):
+        ref = (pin.rnea(heavy, d1, q[k], qd[k], qdd[k]) if mass[k] > 0
+               else pin.rnea(robot.model, d0, q[k], qd[k], qdd[k]))
+        np.testing.assert_allclose(act.tau[k], ref, atol=1e-9)
+    assert act.payload == 0.8 and act.mass_in_hand.shape == (41,)
+    with pytest.raises(ActivityError, match="payload"):
+        E.activity_torques(robot, "pick", t, q, qd, qdd, payload=np.ones(5))
+    with pytest.raises(ActivityError, match="payload"):
+        E.activity_torques(robot, "pick", t, q, qd, qdd, payload=-1.0)

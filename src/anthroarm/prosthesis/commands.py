@@ -32,7 +32,9 @@ def add_parser(sub):
     p.add_argument("--activities", default="adl", metavar="adl|FILE[,FILE...]",
                    help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
                         "and joint-name columns, rad)")
-    p.add_argument("--payload", type=float, default=0.5, help="mass held in the hand, kg (default 0.5)")
+    p.add_argument("--payload", type=float, default=None,
+                   help="mass held in the hand all the time, kg (adl: at least this, the library's objects while "
+                        "they are held; default: the library's objects only; files: default 0)")
     p.add_argument("--margin", type=float, default=0.2, help="demand margin, fraction (default 0.2 = 20 %%)")
     p.add_argument("--motors", default=None, metavar="CSV", help="motor catalogue (default: the shipped example)")
     p.add_argument("--gearboxes", default=None, metavar="CSV", help="gearbox catalogue (default: the shipped example)")
@@ -79,21 +81,10 @@ def _read_trajectory(path: Path, robot) -> dict:
 def activities_from(spec: str, robot, payload: float) -> list[dict]:
     """The activity dicts of :func:`.study.run` for ``--activities`` (module docstring)."""
     if spec.strip().lower() == "adl":
+        from .study import adl_activities
+
         return adl_activities(robot, payload)
     return [_read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
-
-
-def adl_activities(robot, payload: float) -> list[dict]:
-    """The daily-living library's activities for ``robot`` as activity dicts; an activity the
-    library cannot build for this arm (a target out of reach) is kept with its status."""
-    try:
-        from ..motion import activities as adl
-    except ImportError:
-        from ..errors import ActivityError
-
-        raise ActivityError("the daily-living activity library (anthroarm.motion.activities) is not available in "
-                            "this installation; give joint trajectories as files (--activities a.npz,b.csv)") from None
-    return adl.for_sizing(robot, payload=payload)
 
 
 def cmd_size(a) -> int:
@@ -110,7 +101,8 @@ def cmd_size(a) -> int:
     if not out.parent.is_dir():
         raise UserError(f"--out {a.out}: folder {out.parent} does not exist")
     for what, v, lo, hi in (("height", a.height, 0.5, 2.5), ("mass", a.mass, 10.0, 300.0),
-                            ("payload", a.payload, 0.0, 50.0), ("margin", a.margin, 0.0, 10.0)):
+                            ("payload", 0.0 if a.payload is None else a.payload, 0.0, 50.0),
+                            ("margin", a.margin, 0.0, 10.0)):
         if not (np.isfinite(v) and lo <= v <= hi):
             raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
     cat = catalogue.load(a.motors, a.gearboxes)
@@ -123,7 +115,7 @@ def cmd_size(a) -> int:
         bar.update(1)
 
     try:
-        st = study.run(robot, acts, payload=a.payload, catalogue=cat, margin=a.margin,
+        st = study.run(robot, acts, payload=a.payload or 0.0, catalogue=cat, margin=a.margin,
                        person=dict(height=a.height, mass=a.mass, sex=a.sex), progress=progress)
         bar.set_postfix_str("report")
         report.write(st, out, viewer=not a.no_viewer)

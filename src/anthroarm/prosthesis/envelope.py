@@ -30,8 +30,9 @@ class ActivityTorques:
     """One activity's trajectory and its joint demands (rows: samples; columns: joints, nv order).
 
     ``t`` s, ``q`` rad, ``qd`` rad/s, ``qdd`` rad/s², ``tau`` N·m the joint torques with the
-    loads, ``tau_free`` without them, ``power`` = τ q̇ W.  ``status`` "ok" or
-    "outside_limits" (then ``reason`` says where)."""
+    loads, ``tau_free`` without them, ``power`` = τ q̇ W, ``mass_in_hand`` (N,) kg and
+    ``payload`` its largest value.  ``status`` "ok", "outside_limits" or a status given by
+    whoever made the trajectory (e.g. "unreachable"); then ``reason`` says why."""
 
     name: str
     t: np.ndarray
@@ -45,6 +46,7 @@ class ActivityTorques:
     status: str = "ok"
     reason: str = ""
     payload: float = 0.0
+    mass_in_hand: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -75,8 +77,21 @@ def _check_time(t, n: int, name: str) -> np.ndarray:
     return t
 
 
-def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, dynamics=None,
-                     limit_tol: float = 1e-6, payload: float = 0.0) -> ActivityTorques:
+#: the held object's shape: a solid cylinder (a full cup or jug), axis along the hand frame's z,
+#: centred on the hand point (m)
+CUP_RADIUS, CUP_HEIGHT = 0.04, 0.10
+
+
+def held_object(mass: float = 1.0, frame: str | None = None):
+    """The held object of the reports: :data:`CUP_RADIUS`/:data:`CUP_HEIGHT` solid cylinder of
+    ``mass`` kg at ``frame`` (default the tool), as :class:`anthroarm.dynamics.loads.HeldObject`."""
+    from ..dynamics.loads import HeldObject
+
+    return HeldObject.cylinder(mass, CUP_RADIUS, CUP_HEIGHT, frame=frame)
+
+
+def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, payload=0.0, dynamics=None,
+                     limit_tol: float = 1e-6) -> ActivityTorques:
     """Joint torques, speeds and powers of one activity.
 
     Parameters
@@ -92,20 +107,23 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, d
     qd, qdd : array, (N, nv), optional
         Joint velocities and accelerations; default: :func:`derivatives` of ``q``.
     loads : Wrench, HeldObject or sequence, optional
-        Loads on the arm (:mod:`anthroarm.dynamics.loads`).
+        Other loads on the arm (:mod:`anthroarm.dynamics.loads`).
+    payload : float or array (N,)
+        Mass in the hand, kg, constant or per sample (an object picked up and put down): the
+        :func:`held_object` cylinder of that mass.  Its generalised forces are linear in the
+        mass (the cylinder's inertia scales with it), so they are computed once for 1 kg and
+        scaled per sample.
     dynamics : LagrangeDynamics, optional
         Reused generated Lagrange code of ``robot``.
     limit_tol : float
         Tolerance (rad) on the joint limits.
-    payload : float
-        Held mass recorded with the result (kg; for reports).
 
     Raises
     ------
     anthroarm.errors.ActivityError
         Malformed times or samples.
     """
-    from ..dynamics.loads import inverse_dynamics
+    from ..dynamics.loads import generalized_forces, inverse_dynamics
 
     try:
         q = robot.check_q(q, f"q of activity {name!r}")
@@ -120,8 +138,16 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, d
         d1, d2 = derivatives(t, q)
         qd = d1 if qd is None else qd
         qdd = d2 if qdd is None else qdd
+    mass = np.asarray(payload, dtype=float)
+    mass = np.full(len(t), float(mass)) if mass.ndim == 0 else mass
+    if mass.shape != (len(t),) or not np.all(np.isfinite(mass)) or np.any(mass < 0):
+        raise ActivityError(f"activity {name!r}: payload must be a mass >= 0 kg, one or one per sample ({len(t)})")
     try:
         res = inverse_dynamics(robot, q, qd, qdd, loads, dynamics=dynamics)
+        tau = res.tau
+        if np.any(mass > 0):
+            unit = generalized_forces(robot, q, held_object(1.0), res.qd, qdd)     # Eq. (8-5), 1 kg
+            tau = tau - mass[:, None] * unit
     except ValueError as exc:
         raise ActivityError(f"activity {name!r}: {exc}") from None
     status, reason = "ok", ""
@@ -133,9 +159,9 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, d
         status = "outside_limits"
         reason = (f"sample {k} (t = {t[k]:.3f} s): joint {robot.chain.q_names[j]!r} at {np.degrees(q[k, j]):.1f} deg is "
                   f"outside [{np.degrees(robot.lower[j]):.1f}, {np.degrees(robot.upper[j]):.1f}] deg")
-    return ActivityTorques(name=name, t=t, q=q, qd=res.qd, qdd=np.asarray(qdd, float), tau=res.tau,
-                           tau_free=res.tau_free, power=res.power, joint_names=list(robot.joint_names),
-                           status=status, reason=reason, payload=payload)
+    return ActivityTorques(name=name, t=t, q=q, qd=res.qd, qdd=np.asarray(qdd, float), tau=tau,
+                           tau_free=res.tau_free, power=tau * res.qd, joint_names=list(robot.joint_names),
+                           status=status, reason=reason, payload=float(np.max(mass)), mass_in_hand=np.array(mass))
 
 
 def _rms(t, x):

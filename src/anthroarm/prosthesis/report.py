@@ -87,8 +87,8 @@ def joint_figure(study, j: int):
         a1.plot(w, dc.joint_torque(w), "k-", lw=1.5, label=f"torque-speed line {dc.V_nom:g} V")
         a1.axhline(dc.continuous_torque, color="tab:red", ls="--", lw=1, label="continuous torque")
         a1.axhline(cand.gearbox.tau_max, color="tab:purple", ls=":", lw=1, label="gearbox intermittent")
-        a1.set_xlim(0, max(w0, wmax * scale) * 1.05)
-        a1.set_ylim(0, max(float(dc.stall_torque()), env.peak_torque[j] * scale) * 1.05)
+        a1.set_xlim(0, max(min(w0, 3.0 * wmax * scale), wmax * scale, 1e-3) * 1.05)
+        a1.set_ylim(0, max(cand.gearbox.tau_max, env.peak_torque[j] * scale, dc.continuous_torque) * 1.15)
         a1.set_title(("" if js.choice else "closest, does not fit: ") + cand.name, fontsize=8)
     a1.set_xlabel(f"|{name} speed| [rad/s]")
     a1.set_ylabel("|torque| [N m]")
@@ -128,8 +128,9 @@ def _person_section(study) -> str:
                      f"{np.degrees(j.lower):.0f}", f"{np.degrees(j.upper):.0f}"))
     who = ", ".join(f"{k} {v}" + (" m" if k == "height" else " kg" if k == "mass" else "") for k, v in p.items())
     return (f"<h2>The person's arm model</h2><p>{_e(robot.name)} ({robot.nv} joints) for {_e(who)}; "
-            f"held object {study.payload:g} kg (a solid cylinder r = 4 cm, h = 10 cm at the hand point).</p>"
-            + _table(["joint", "mass moved [kg]", "offset from parent [m]", "lower [deg]", "upper [deg]"], rows))
+            f"held object: a solid cylinder (r = 4 cm, h = 10 cm) at the hand point, at least {study.payload:g} kg; "
+            "its largest mass in each activity is in the activities' table.</p>"
+            + _table(["joint", "link mass [kg]", "offset from parent [m]", "lower [deg]", "upper [deg]"], rows))
 
 
 def _fmt_ok(ok):
@@ -154,7 +155,7 @@ def render(study, *, viewer: bool = True, title: str | None = None) -> str:
         ok = a.status == "ok"
         arows.append((a.name, f"{a.duration:.2f}" if len(a.t) else "", len(a.t), f"{a.payload:g}",
                       (a.status, "ok" if ok else "bad"), a.reason))
-    parts.append("<h2>Activities</h2>" + _table(["activity", "duration [s]", "samples", "payload [kg]", "status",
+    parts.append("<h2>Activities</h2>" + _table(["activity", "duration [s]", "samples", "max payload [kg]", "status",
                                                   "reason"], arows, left=(0, 4, 5)))
     if viewer:
         parts.append(_viewer_html(study))

@@ -3,8 +3,9 @@ motors and gearboxes → the book's weight rules.  :func:`run` returns a :class:
 :mod:`.report` turns into HTML.
 
 An activity is given as a dict ``{"name", "t", "q"}`` (optionally ``"qd"``, ``"qdd"``,
-``"payload"`` kg, ``"status"`` / ``"reason"`` when whoever made it already knows it is unusable,
-e.g. a target outside the arm's reach), in SI units (s, rad).
+``"payload"`` kg — one mass or one per sample —, ``"status"`` / ``"reason"`` when whoever made
+it already knows it is unusable, e.g. a target outside the arm's reach), in SI units (s, rad).
+:func:`adl_activities` makes them from the daily-living library of :mod:`anthroarm.motion`.
 """
 
 from __future__ import annotations
@@ -34,15 +35,6 @@ class Study:
     timings: dict = field(default_factory=dict)
 
 
-def _held(payload: float, robot):
-    from ..dynamics.loads import HeldObject
-
-    if payload == 0:
-        return None
-    # a cup: solid cylinder, r 4 cm, h 10 cm, centred on the hand point, axis along the frame's z
-    return HeldObject.cylinder(payload, 0.04, 0.10, com=(0.0, 0.0, 0.0))
-
-
 def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: float = 0.2, person=None,
         progress=None) -> Study:
     """Run the loop (module docstring) on ``robot`` (the person's arm model).
@@ -53,8 +45,9 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     activities : sequence of dict
         See the module docstring.
     payload : float
-        Mass held in the hand during every activity, kg (a solid cylinder r = 4 cm, h = 10 cm
-        centred on the tool frame; 0: none).  An activity's own ``"payload"`` overrides it.
+        Mass held in the hand during every activity that does not give its own ``"payload"``,
+        kg (:func:`.envelope.held_object`: a solid cylinder r = 4 cm, h = 10 cm centred on the
+        tool frame; 0: none).
     catalogue : Catalogue, optional
         Default: the shipped example (:func:`.catalogue.load`).
     margin : float
@@ -88,17 +81,17 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
         name = str(spec.get("name", f"activity {len(acts) + 1}"))
         if progress is not None:
             progress("activity", name)
-        m = float(spec.get("payload", payload))
+        m = spec.get("payload", payload)
         status = spec.get("status", "ok")
         if status != "ok":
             t = np.asarray(spec.get("t", np.zeros(0)), float)
             q = np.asarray(spec.get("q", np.zeros((0, robot.nq))), float)
             z = np.zeros((len(q), robot.nv))
             acts.append(env_mod.ActivityTorques(name, t, q, z, z, z, z, z, list(robot.joint_names), status,
-                                                str(spec.get("reason", "")), m))
+                                                str(spec.get("reason", "")), float(np.max(m, initial=0.0))))
             continue
         acts.append(env_mod.activity_torques(robot, name, spec["t"], spec["q"], spec.get("qd"), spec.get("qdd"),
-                                             _held(m, robot), dynamics=dyn, payload=m))
+                                             payload=m, dynamics=dyn))
     timings["dynamics"] = time.perf_counter() - t0
     env = env_mod.envelope(acts)
     t0 = time.perf_counter()
@@ -106,3 +99,28 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     timings["sizing"] = time.perf_counter() - t0
     rules = weight_rules.check(res.drive_mass, person.get("mass"), robot.nv, len(res.unfit))
     return Study(robot, person, acts, env, res, rules, payload, cat, timings)
+
+
+def adl_activities(robot, payload: float | None = None, names=None, *, rate: float = 100.0) -> list[dict]:
+    """The daily-living activities of :mod:`anthroarm.motion.activities` (all of them, or
+    ``names``) for ``robot``, as activity dicts for :func:`run`.
+
+    The mass in the hand per sample is the library's object (``object_mass`` while the
+    activity holds it); with ``payload`` (kg) the hand carries at least ``payload`` all the
+    time: ``max(payload, object mass while holding)``.  An activity with a keyframe out of the
+    arm's reach gets status "unreachable" and a reason naming the keyframe and the distance."""
+    from ..motion import activities as adl
+
+    if payload is not None and not (np.isfinite(payload) and 0.0 <= payload <= 50.0):
+        raise ActivityError(f"payload must be in [0, 50] kg, got {payload}")
+    out = []
+    for name in (adl.names() if names is None else list(names)):
+        tr = adl.activity_trajectory(robot, name, rate=rate)
+        mass = tr.payload if payload is None else np.maximum(tr.payload, payload)
+        spec = dict(name=name, t=tr.t, q=tr.q, qd=tr.qd, qdd=tr.qdd, payload=mass, title=tr.activity.title)
+        if not tr.reachable:
+            bad = [(n, e) for n, s, e in zip(tr.keyframe_names, tr.keyframe_status, tr.keyframe_error) if s != "ok"]
+            spec["status"] = "unreachable"
+            spec["reason"] = "; ".join(f"keyframe {n!r} out of reach ({e * 1000:.0f} mm short)" for n, e in bad)
+        out.append(spec)
+    return out

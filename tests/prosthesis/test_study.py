@@ -1,0 +1,75 @@
+"""The whole loop on the daily-living library and the report: statuses for unusable activities,
+the report's numbers equal to the study's, the CLI end to end."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+import anthroarm as aa
+from anthroarm.cli import main
+from anthroarm.dynamics.hand_model import minimum_jerk
+from anthroarm.errors import ActivityError
+from anthroarm.prosthesis import report, study
+
+
+@pytest.fixture(scope="module")
+def person():
+    return aa.load("human_arm7", height=1.75, mass=70.0, sex="male")
+
+
+def test_adl_activities_carry_the_library_objects(person):
+    acts = study.adl_activities(person, payload=0.5, names=["lift_to_table", "reach_shelf"])
+    lift = acts[0]
+    assert lift["name"] == "lift_to_table" and "status" not in lift
+    assert np.max(lift["payload"]) == 1.0 and np.min(lift["payload"]) == 0.5       # 1 kg while held
+    assert np.all(acts[1]["payload"] == 0.5)
+    with pytest.raises(ActivityError, match="payload"):
+        study.adl_activities(person, payload=-1.0, names=["reach_shelf"])
+
+
+def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
+    t = np.linspace(0, 1.0, 51)
+    q0 = person.neutral()
+    q, qd, qdd = minimum_jerk(q0, q0 + np.array([1.0, 0, 0, 1.0, 0, 0, 0]), 1.0, t)
+    acts = [dict(name="reach", t=t, q=q, qd=qd, qdd=qdd),
+            dict(name="far shelf", t=t, q=q, status="unreachable", reason="keyframe 'shelf' out of reach (120 mm short)")]
+    st = study.run(person, acts, payload=0.5)
+    assert [a.status for a in st.activities] == ["ok", "unreachable"]
+    assert [a.name for a in st.envelope.activities] == ["reach"]
+    out = report.write(st, tmp_path / "r.html", viewer=False)
+    text = out.read_text()
+    assert "far shelf" in text and "120 mm short" in text
+    # the report's drive mass is the study's
+    m = re.search(r"Drive mass \(motors \+ gearboxes\): ([0-9.]+) kg", text)
+    assert float(m.group(1)) == pytest.approx(st.sizing.drive_mass, abs=5e-4)
+    assert text.count("data:image/png;base64,") == person.nv
+    with pytest.raises(ActivityError, match="payload"):
+        study.run(person, acts, payload=float("nan"))
+
+
+def test_cli_size_end_to_end(tmp_path, capsys):
+    out = tmp_path / "report.html"
+    rc = main(["size", "--height", "1.75", "--mass", "70", "--sex", "male", "--activities", "adl", "--payload",
+               "0.5", "--no-viewer", "--no-progress", "--out", str(out)])
+    assert rc == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["out"] == str(out) and out.stat().st_size > 10_000
+    assert set(summary["joints"]) == set(aa.load("human_arm7").joint_names)
+    assert summary["rules"]["L7441"] is True
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--out", "x.txt"], "HTML"),
+    (["--payload", "-1"], "payload"),
+    (["--activities", "nope.npz"], "no such"),
+    (["--motors", "missing.csv"], "not found"),
+])
+def test_cli_size_bad_input(tmp_path, capsys, args, words, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc = main(["size", "--no-progress", "--no-viewer", *args])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "report.html").exists()
