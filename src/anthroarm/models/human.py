@@ -115,9 +115,41 @@ HUMAN_ARM7_COMFORT = {
 }
 
 
-def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> ChainSpec:
-    """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg."""
+#: the segments of :data:`DE_LEVA_1996` and the links of :func:`human_arm7` that carry them
+SEGMENT_LINKS = {"upperarm": "upper_arm", "forearm": "forearm", "hand": "hand"}
+
+
+def _measured_lengths(seg: dict, segment_lengths) -> dict:
+    """``seg`` with the lengths of ``segment_lengths`` (segment name -> m; the centre of mass and
+    the radii of gyration keep their de Leva fractions of the length, the masses stay)."""
+    if not isinstance(segment_lengths, dict):
+        raise ValueError(f"segment_lengths is a dict segment -> length (m) with keys {list(SEGMENT_LINKS)}, "
+                         f"got {segment_lengths!r}")
+    unknown = sorted(set(segment_lengths) - set(SEGMENT_LINKS))
+    if unknown:
+        raise ValueError(f"segment_lengths: unknown segments {unknown}; known: {list(SEGMENT_LINKS)}")
+    out = {k: dict(v) for k, v in seg.items()}
+    for key, L in segment_lengths.items():
+        if isinstance(L, bool) or not isinstance(L, (int, float, np.floating, np.integer)) or not (0.02 <= L <= 1.0):
+            raise ValueError(f"segment_lengths[{key!r}] must be a length in 0.02 ... 1.0 m, got {L!r}")
+        k = float(L) / out[key]["length"]
+        out[key]["length"] = float(L)
+        out[key]["com"] *= k
+        out[key]["radii"] = tuple(r * k for r in out[key]["radii"])
+    return out
+
+
+def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segment_lengths: dict | None = None) -> ChainSpec:
+    """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg.
+
+    ``segment_lengths`` (optional): measured lengths in m of ``"upperarm"`` (shoulder to elbow
+    joint centre), ``"forearm"`` (elbow to wrist) and ``"hand"`` (wrist to the 3rd metacarpale),
+    any subset; they replace de Leva's height-scaled lengths (centres of mass and radii of
+    gyration keep their fractions of the length, masses stay those of the body mass).  From a
+    static marker trial: :func:`anthroarm.motion.scaling.scale_from_static`."""
     seg = segment_parameters(height, mass, sex)
+    if segment_lengths is not None:
+        seg = _measured_lengths(seg, segment_lengths)
     l1, l2, l3 = (seg[s]["length"] for s in ("upperarm", "forearm", "hand"))
     X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
     lim = {k: (a * deg, b * deg) for k, (a, b) in HUMAN_ARM7_LIMITS_DEG.items()}
@@ -165,7 +197,8 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> C
         tool_name="hand_point",
         tool_origin=homogeneous(r=[0, 0, -l3]),
         source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
-        inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg",
+        inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg"
+        + ("" if segment_lengths is None else f"; measured segment lengths {sorted(segment_lengths)}"),
         params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},
         person=True,
         comfort=dict(HUMAN_ARM7_COMFORT),

@@ -26,6 +26,7 @@ from .marker_ik import STATUSES, MarkerIK, MarkerIKResult, marker_ik, match_mark
 from .markers import (HUMAN_ARM_LANDMARKS, BoundMarkers, Marker, MarkerSet, default_marker_set, human_arm_markers,
                       segment_length)
 from .timing import keyframe_trajectory, minimum_jerk
+from .scaling import ScalingResult, scale_from_static
 from .trial import MarkerTrajectories
 
 __all__ = [
@@ -34,5 +35,5 @@ __all__ = [
     "segment_length",
     "MarkerIK", "MarkerIKResult", "marker_ik", "match_markers", "STATUSES",
     "activities", "Activity", "ActivityTrajectory", "Keyframe", "activity", "activity_trajectory",
-    "minimum_jerk", "keyframe_trajectory",
+    "minimum_jerk", "keyframe_trajectory", "ScalingResult", "scale_from_static",
 ]
