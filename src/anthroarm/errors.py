@@ -231,3 +231,24 @@ class CatalogueError(AnthroarmError, ValueError):
 class CouplingError(AnthroarmError, ValueError):
     """Coupled joints given inconsistent values: a mimic joint's value that is not
     multiplier · source + offset, or a start configuration that breaks a hard coupling."""
+
+
+class EMGError(AnthroarmError, ValueError):
+    """An EMG recording or signal-chain setting that cannot be processed: NaN/inf samples, the
+    wrong array shape or channel count, a bad window or gain (:mod:`anthroarm.emg`)."""
+
+
+class SamplingRateError(EMGError):
+    """The sampling rate cannot represent a filter band: it must exceed twice the highest band
+    edge (Nyquist).  ``fs`` is the rate (Hz), ``required`` the smallest usable rate (Hz)."""
+
+    def __init__(self, message: str, fs: float = float("nan"), required: float = float("nan")):
+        self.fs = fs
+        self.required = required
+        super().__init__(message)
+
+
+class ThresholdError(EMGError):
+    """EMG amplitude thresholds that can never switch: not finite or not > 0, an off-threshold
+    above the on-threshold, an on-threshold no input reaches (beyond the amplifier's rail) or
+    an off-threshold at or below the noise floor (never switches off)."""

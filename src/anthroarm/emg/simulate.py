@@ -1,0 +1,377 @@
+r"""Closed-loop simulation of the book's 3-DOF EMG upper-arm hand (§9-2 三 2, Fig. 9-25).
+
+EMG (2 channels, flexor and extensor) → :class:`~anthroarm.emg.processor.EMGProcessor`
+(envelopes, thresholds, codes 00/01/10/11) → :class:`~anthroarm.emg.codes.CodeMachine`
+(modes, commands, vibrators) → **set-points** → one analog **position servo** per joint
+(:class:`anthroarm.control.servo.PositionServo`, Eqs. (9-1)–(9-8)) → the joints of an arm
+(Pinocchio's ``aba`` with the motors' reflected inertia as armature, integrated by
+:func:`anthroarm.dynamics.simulate.simulate`) and a one-DOF hand that can close on an object.
+
+How a command moves a joint (assumptions; the book prints the codes, not the drive law):
+
+* a command ±1 moves the selected joint's **set-point** at ``speed`` rad/s (default 1.5)
+  inside the joint's limits; 0 holds it.  The servo tracks the set-point; its loop is closed
+  by the potentiometer and tachogenerator of Eq. (9-4), its torque limited by the amplifier
+  limit ``V_max`` (the battery);
+* the servo of each arm joint is tuned critically damped (ζ = 1) for the joint's inertia at
+  the start, ``M(q0)[j, j]``, with ω_n the larger of 20 rad/s and what the motor's own
+  back-EMF damping allows (:meth:`~anthroarm.control.servo.PositionServo.tuned`); the motor is a
+  16 mm coreless DC micromotor (:func:`prosthesis_motor`, illustrative values: no-load speed
+  ≈ 9550 r/min, inside the 4700–13550 r/min of the book's coreless motors, §9-3);
+* the joints of the arm that are not driven are **locked** where ``q0`` puts them (the
+  wearer's own shoulder holds the socket still);
+* the hand ("fingers") is a one-DOF servo joint with its own inertia
+  (:class:`HandModel`) when the arm has no finger joint: closing on an object at
+  ``object_angle`` meets a Kelvin–Voigt contact (stiffness and damping, assumptions).  Its
+  set-point stops ``max_lead`` rad ahead of the measured angle (anti-windup), so the hand opens
+  at once when told to.  **Grasp** (the middle vibrator, book §9-2) is the book's other
+  servo idea: at rest (|θ̇| small) the servo error reveals the load torque, Eq. (9-8)
+  (:meth:`~anthroarm.control.servo.PositionServo.estimate_load_torque`); above
+  ``grasp_torque`` the hand holds an object; fully closed counts as "gripped tight" too.
+
+The algorithm reads joints by the names given in ``joints`` (mode → joint name of
+``robot.chain``, or ``None`` for the built-in hand); it never looks at the arm's name.  SI
+units: V, s, rad, N·m.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import EMGError, ParameterError, UnsupportedModelError
+from .codes import VIBRATORS, CodeMachine, CodeTrace, vibrators_with_grasp
+from .processor import EMGProcessor, ProcessedEMG
+
+#: default speed of a commanded set-point, rad/s (assumption)
+DEFAULT_SPEED = 1.5
+#: gear ratio per mode of the default motors (assumption)
+DEFAULT_RATIOS = {"elbow": 500.0, "wrist": 100.0, "fingers": 200.0}
+
+
+def prosthesis_motor(i: float = 200.0, eta: float = 0.7):
+    """A 16 mm coreless DC micromotor behind a gearbox of ratio ``i`` and efficiency ``eta``
+    (:class:`anthroarm.control.motor.DCMotor`): R = 5 Ω, k_m = 6 mN·m/A, J_m = 0.6 g·cm²,
+    6 V (a prosthesis battery).  Illustrative values in the range of such motors' data
+    sheets, an assumption; no-load speed V/k_m = 1000 rad/s ≈ 9550 r/min."""
+    from ..control.motor import DCMotor
+
+    return DCMotor(R=5.0, k_m=6e-3, J_m=6e-8, i=float(i), eta=float(eta), V_nom=6.0, name="16 mm coreless")
+
+
+def joint_servo(motor, J_L: float, omega_n_min: float = 20.0):
+    """A critically damped :class:`~anthroarm.control.servo.PositionServo` of ``motor`` for a
+    load inertia ``J_L`` (kg·m²), amplifier limited to ``motor.V_nom``: ω_n is the larger of
+    ``omega_n_min`` and 1.05 × the motor's own damping limit (below it no tachogenerator gain
+    gives ζ = 1)."""
+    from ..control.servo import PositionServo
+
+    bare = PositionServo.from_motor(motor, J_L, k_a=1.0, k_p=1.0)      # k_s = 0: the motor's damping only
+    omega_n = max(float(omega_n_min), 1.05 * bare.Kv / (2.0 * bare.J0))
+    return PositionServo.tuned(motor, J_L, omega_n=omega_n, zeta=1.0, V_max=motor.V_nom)
+
+
+@dataclass(frozen=True)
+class HandModel:
+    """The one-DOF hand used when the arm has no finger joint (assumptions, SI units).
+
+    ``J_L`` hand-mechanism inertia at the output (kg·m²); ``lower``/``upper`` open and
+    closed angles (rad); ``object_angle`` where the fingers touch an object (rad, ``None``:
+    nothing to grasp); ``contact_stiffness`` (N·m/rad) and ``contact_damping`` (N·m·s/rad) of
+    the object; ``max_lead`` the set-point's largest lead on the measured angle (rad);
+    ``grasp_torque`` (N·m) the estimated load that counts as a grasp; ``still`` (rad/s) the
+    speed below which the servo error is read as a load."""
+
+    J_L: float = 1e-4
+    lower: float = 0.0
+    upper: float = 1.4
+    object_angle: float | None = 0.9
+    contact_stiffness: float = 5.0
+    contact_damping: float = 0.02
+    max_lead: float = 0.3
+    grasp_torque: float = 0.1
+    still: float = 0.05
+
+    def contact_torque(self, theta, omega):
+        """Load torque of the object on the closing fingers (N·m, ≥ 0)."""
+        if self.object_angle is None:
+            return np.zeros_like(np.asarray(theta, dtype=float))
+        pen = np.asarray(theta, dtype=float) - self.object_angle
+        return np.where(pen > 0, np.maximum(self.contact_stiffness * pen + self.contact_damping * omega, 0.0), 0.0)
+
+
+@dataclass
+class PoweredHandResult:
+    """Everything of one run, per control frame (``t`` s) unless said otherwise.
+
+    ``processed`` (:class:`~anthroarm.emg.processor.ProcessedEMG`) and ``trace``
+    (:class:`~anthroarm.emg.codes.CodeTrace`) are the signal chain; ``modes`` the mode names,
+    ``joint_names`` the driven joint of each (``"hand"`` for the built-in hand);
+    ``setpoint``/``angle`` (frames, n_modes) rad; ``q`` (frames, robot.nq) the whole arm's
+    configuration; ``grasped`` (frames,) bool; ``load_estimate`` (frames,) N·m the hand
+    servo's load estimate (Eq. (9-8)); ``vibrators`` (frames, 3) left/right/middle;
+    ``emg`` (channels, samples) and ``t_emg`` the input; ``status`` "ok" or what went wrong
+    (the dynamics' status)."""
+
+    t: np.ndarray
+    processed: ProcessedEMG
+    trace: CodeTrace
+    modes: tuple
+    joint_names: tuple
+    setpoint: np.ndarray
+    angle: np.ndarray
+    q: np.ndarray
+    grasped: np.ndarray
+    load_estimate: np.ndarray
+    vibrators: np.ndarray
+    emg: np.ndarray
+    t_emg: np.ndarray
+    robot: object = field(repr=False, default=None)
+    status: str = "ok"
+
+    def plot(self, fig=None):
+        """EMG, envelopes with thresholds, codes, mode and commands, joint angles (set-point
+        dashed) and vibrators on one time axis; returns the matplotlib figure."""
+        import matplotlib.pyplot as plt
+
+        if fig is None:
+            fig = plt.figure(figsize=(9, 9.5))
+        ax = fig.subplots(5, 1, sharex=True, gridspec_kw=dict(height_ratios=[1.2, 1.2, 0.7, 0.8, 1.5]))
+        names = ("flexor", "extensor")
+        for c in range(self.emg.shape[0]):
+            ax[0].plot(self.t_emg, self.emg[c] * 1e6, lw=0.4, alpha=0.8,
+                       label=names[c] if c < 2 else f"ch {c}")
+        ax[0].set_ylabel("EMG [µV]")
+        ax[0].legend(fontsize=7, loc="upper right")
+        p = self.processed
+        for c in range(p.envelope_pp.shape[0]):
+            line, = ax[1].plot(self.t, p.envelope_pp[c] * 1e6, label=f"{names[c] if c < 2 else c} envelope")
+            ax[1].axhline(p.on_pp[c] * 1e6, color=line.get_color(), ls="--", lw=0.8)
+            ax[1].axhline(p.off_pp[c] * 1e6, color=line.get_color(), ls=":", lw=0.8)
+        ax[1].set_ylabel("p-p [µV]")
+        ax[1].legend(fontsize=7, loc="upper right", title="-- on, ··· off threshold", title_fontsize=7)
+        ax[2].step(self.t, p.code, where="post", color="0.6", lw=0.8, label="raw")
+        ax[2].step(self.t, self.trace.code, where="post", color="k", label="debounced")
+        ax[2].set_yticks([0, 1, 2, 3], ["00", "01", "10", "11"])
+        ax[2].set_ylabel("code")
+        ax[2].legend(fontsize=7, loc="upper right")
+        ax[3].step(self.t, self.trace.mode, where="post", label="mode")
+        ax[3].step(self.t, self.trace.command, where="post", label="command")
+        ax[3].set_yticks(range(-1, len(self.modes)), ["−1"] + [f"{i}: {m}" if i else f"0: {m}"
+                                                               for i, m in enumerate(self.modes)])
+        for k, col in enumerate(VIBRATORS):
+            on = self.vibrators[:, k]
+            if on.any():
+                ax[3].fill_between(self.t, -1, len(self.modes) - 1, where=on, step="post", alpha=0.15,
+                                   label=f"{col} vibrator")
+        ax[3].legend(fontsize=7, loc="upper right", ncol=2)
+        for j, m in enumerate(self.modes):
+            line, = ax[4].plot(self.t, self.angle[:, j], label=f"{m} ({self.joint_names[j]})")
+            ax[4].plot(self.t, self.setpoint[:, j], ls="--", lw=0.8, color=line.get_color())
+        ax[4].set_ylabel("angle [rad]")
+        ax[4].set_xlabel("t [s]")
+        ax[4].legend(fontsize=7, loc="upper right")
+        fig.suptitle(f"EMG-driven hand: {self.status}", fontsize=10)
+        fig.tight_layout()
+        return fig
+
+    def viewer(self, every: int = 4):
+        """A :class:`anthroarm.viewer.Viewer` of the arm playing the motion (every ``every``-th
+        frame); ``viewer.static_html()`` is a self-contained page."""
+        from ..viewer import Viewer
+
+        v = Viewer(self.robot)
+        Q = self.q[::max(1, int(every))]
+        v.play(Q, dt=self.trace.frame_s * max(1, int(every)), loop=True, trace=False)
+        return v
+
+
+def _setpoints(trace: CodeTrace, j: int, speed: float, lo: float, hi: float, start: float) -> np.ndarray:
+    """The set-point of mode ``j`` per frame: it moves at ``speed`` while ``trace`` commands
+    this mode, clipped to [lo, hi]."""
+    step = speed * trace.frame_s * trace.command * (trace.mode == j)
+    out = np.empty(step.size)
+    s, last = start, 0
+    for k in np.flatnonzero(step):            # only frames that move; the rest hold
+        out[last:k] = s
+        s = min(max(s + step[k], lo), hi)
+        last = k
+    out[last:] = s
+    return out
+
+
+def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, processor: EMGProcessor | None = None,
+                          machine: CodeMachine | None = None, servos: dict | None = None, speeds: dict | None = None,
+                          hand: HandModel | None = None, dt: float = 1e-3) -> PoweredHandResult:
+    """Run EMG → codes → servos → arm and hand (see the module text).
+
+    Parameters
+    ----------
+    robot
+        An :class:`~anthroarm.robot.Robot` (or anything :func:`anthroarm.load` takes).
+    emg
+        (2, samples) volts at the electrodes: channel 0 flexor, channel 1 extensor.
+    fs
+        Sampling rate, Hz.
+    joints
+        Mode name → joint name of ``robot.chain`` (or ``None``: the built-in hand), in the
+        mode cycle order, e.g. ``{"elbow": "elbow_flexion", "wrist": "forearm_rotation",
+        "fingers": None}``.
+    q0
+        Initial configuration (robot.nq); non-driven joints stay locked there.  Default: the
+        driven joints at the middle of [max(lower, 0), upper] clipped to their limits, the
+        others at 0 clipped to their limits.
+    processor, machine
+        The signal chain and state machine (defaults: ``EMGProcessor(fs)``,
+        ``CodeMachine(frame_s, modes=tuple(joints))``).
+    servos
+        Mode → :class:`~anthroarm.control.servo.PositionServo` (default :func:`joint_servo`
+        of :func:`prosthesis_motor`).  A given servo's ``J_L`` is only used for its gains; the
+        arm's inertia is the dynamics'.
+    speeds
+        Mode → set-point speed, rad/s (default :data:`DEFAULT_SPEED`).
+    hand
+        :class:`HandModel` of the built-in hand.
+    dt
+        Integration step of the arm (s).
+
+    Returns
+    -------
+    PoweredHandResult
+    """
+    import pinocchio as pin
+    from scipy.integrate import solve_ivp
+
+    from ..dynamics.simulate import simulate
+    from ..robot import Robot, load
+
+    robot = robot if isinstance(robot, Robot) else load(robot)
+    if not isinstance(joints, dict) or not joints:
+        raise ParameterError("joints maps each mode name to a joint name of the robot or None, e.g. "
+                             "{'elbow': 'elbow_flexion', 'wrist': 'forearm_rotation', 'fingers': None}")
+    modes = tuple(joints)
+    if sum(v is None for v in joints.values()) > 1:
+        raise ParameterError("at most one mode can be the built-in hand (None)")
+    processor = processor if processor is not None else EMGProcessor(fs, 2)
+    if processor.n_channels != 2 or abs(processor.fs - float(fs)) > 1e-9 * float(fs):
+        raise EMGError(f"the processor must take 2 channels at fs = {fs} Hz (has {processor.n_channels} at "
+                       f"{processor.fs} Hz)")
+    machine = machine if machine is not None else CodeMachine(processor.frame_s, modes=modes)
+    if machine.modes != modes:
+        raise ParameterError(f"the machine's modes {machine.modes} differ from the joints' modes {modes}")
+    hand = hand if hand is not None else HandModel()
+    speeds = {m: DEFAULT_SPEED for m in modes} | dict(speeds or {})
+    for m, v in speeds.items():
+        if m not in modes or not (np.isfinite(v) and v > 0):
+            raise ParameterError(f"speeds: mode {m!r} must be one of {modes} with a finite speed > 0 rad/s, got {v!r}")
+
+    chain = robot.chain
+    arm = {m: chain.joint(n) for m, n in joints.items() if n is not None}
+    for m, jt in arm.items():
+        if jt.kind == "continuous" or jt.is_mimic:
+            raise UnsupportedModelError(f"joint {jt.name!r} ({m}) is {jt.kind}{' mimic' if jt.is_mimic else ''}; "
+                                        "a driven joint must be a revolute or prismatic joint with its own q")
+    if q0 is None:
+        q0 = np.zeros(robot.nq)
+        for jt in chain.joints:
+            if jt.nq == 1:
+                q0[jt.idx_q] = np.clip(0.0, jt.lower, jt.upper)
+        for jt in arm.values():
+            lo = max(jt.lower, 0.0) if np.isfinite(jt.lower) else 0.0
+            hi = jt.upper if np.isfinite(jt.upper) else lo + 1.0
+            q0[jt.idx_q] = 0.5 * (lo + hi)
+    q0 = robot.check_q(q0, "q0")
+    if q0.ndim != 1:
+        raise ParameterError(f"q0 must be one configuration ({robot.nq},), got {q0.shape}")
+
+    # ---- signal chain
+    x = np.asarray(emg, dtype=float)
+    proc = processor.process(x)
+    trace = machine.run(proc.code)
+    t = proc.t_frames
+    n_f = t.size
+    if n_f < 2:
+        raise EMGError(f"the EMG is shorter than two control frames ({processor.frame_s} s each)")
+
+    # ---- the arm: driven joints free, the others locked at q0
+    locked = {jt.name: float(q0[jt.idx_q]) for jt in chain.joints
+              if jt.nq == 1 and jt.name not in {a.name for a in arm.values()}}
+    setpoint = np.zeros((n_f, len(modes)))
+    angle = np.zeros((n_f, len(modes)))
+    q_out = np.repeat(q0[None, :], n_f, axis=0)
+    status = "ok"
+    if arm:
+        red = load(robot.model, locked=locked, tool=robot.tool) if locked else robot
+        rq0 = np.array([q0[chain.joint(red.chain.joints[k].name).idx_q] for k in range(red.nq)])
+        M0 = pin.crba(red.model, red.model.createData(), rq0)
+        col = {m: red.chain.joint(jt.name).idx_v for m, jt in arm.items()}
+        srv = {}
+        for m, jt in arm.items():
+            J_L = float(M0[col[m], col[m]])
+            srv[m] = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), J_L)
+        model = red.model.copy()
+        for m in arm:
+            model.armature[col[m]] += srv[m].J0 - srv[m].J_L       # reflected motor inertia, eta i^2 J_m
+        sp = {}
+        for m, jt in arm.items():
+            j = modes.index(m)
+            sp[m] = _setpoints(trace, j, speeds[m], jt.lower, jt.upper, float(q0[jt.idx_q]))
+            setpoint[:, j] = sp[m]
+
+        def tau(tt, q, qd):
+            k = min(max(int(np.searchsorted(t, tt, side="right")) - 1, -1), n_f - 1)
+            out = np.zeros(red.nv)
+            for m in arm:
+                c = col[m]
+                ti = sp[m][k] if k >= 0 else float(q0[arm[m].idx_q])
+                # the servo's output torque eta i M_m of Eqs. (9-1)-(9-4): J_0 * theta_ddot at zero load
+                out[c] = srv[m].J0 * srv[m].rhs(np.array([q[c], qd[c]]), ti, 0.0)[1]
+            return out
+
+        sim = simulate(red, rq0, np.zeros(red.nv), float(t[-1]), dt=dt, tau=tau, engine="pin", pin_model=model)
+        status = sim.status
+        for m, jt in arm.items():
+            j = modes.index(m)
+            a = np.interp(t, sim.t, sim.q[:, col[m]])
+            angle[:, j] = a
+            q_out[:, jt.idx_q] = a
+
+    # ---- the built-in hand
+    grasped = np.zeros(n_f, dtype=bool)
+    load_est = np.zeros(n_f)
+    hand_modes = [m for m, n in joints.items() if n is None]
+    if hand_modes:
+        m = hand_modes[0]
+        j = modes.index(m)
+        hs = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), hand.J_L)
+        cmd = trace.command * (trace.mode == j)
+        v = speeds[m]
+
+        def rhs(tt, s):
+            th, om, ti = s
+            k = int(np.searchsorted(t, tt, side="right")) - 1
+            c = cmd[k] if k >= 0 else 0
+            rate = 0.0
+            if c > 0 and ti < hand.upper and ti - th < hand.max_lead:
+                rate = v
+            elif c < 0 and ti > hand.lower and th - ti < hand.max_lead:
+                rate = -v
+            d = hs.rhs(np.array([th, om]), ti, float(hand.contact_torque(th, om)))
+            return [d[0], d[1], rate]
+
+        th0 = float(hand.lower)
+        sol = solve_ivp(rhs, (0.0, float(t[-1])), [th0, 0.0, th0], t_eval=t, max_step=processor.frame_s,
+                        rtol=1e-6, atol=1e-9)
+        if not sol.success:
+            status = f"hand: {sol.message}"
+        th, om, ti = sol.y
+        angle[:, j], setpoint[:, j] = th, np.clip(ti, hand.lower, hand.upper)
+        load_est = hs.estimate_load_torque(hs.k_p * (ti - th))
+        grasped = ((load_est >= hand.grasp_torque) & (np.abs(om) < hand.still)) | (th >= hand.upper - 0.02)
+    vib = vibrators_with_grasp(trace, grasped)
+    return PoweredHandResult(t=t, processed=proc, trace=trace, modes=modes,
+                             joint_names=tuple(n if n is not None else "hand" for n in joints.values()),
+                             setpoint=setpoint, angle=angle, q=q_out, grasped=grasped, load_estimate=load_est,
+                             vibrators=vib, emg=x, t_emg=np.arange(x.shape[1]) / fs,
+                             robot=robot, status=status)

@@ -1,0 +1,139 @@
+"""Filters and the differential front end of the EMG chain (book §9-2, Table 9.1).
+
+Oracles: Butterworth mathematics (unit gain at the centre, 1/sqrt(2) at the -3 dB edges, from
+``scipy.signal.sosfreqz`` of the designed sections), the steady-state response of an LTI filter
+to a sine (amplitude times |H(f)|), the Wiener-Khinchin relation for white noise, and the
+linear amplifier equation for the CMRR."""
+
+import numpy as np
+import pytest
+from scipy import signal as sps
+
+from anthroarm.emg import (BOOK_BANK_2CH, BOOK_BANK_3CH, CONDITIONING_BAND, DifferentialAmplifier, FilterBank,
+                           bandpass_sos, band_edges, electrode_potentials, notch_sos)
+from anthroarm.errors import EMGError, SamplingRateError
+
+
+def test_book_centre_frequencies_are_the_printed_ones():
+    assert BOOK_BANK_2CH == (40.0, 100.0, 160.0, 360.0)      # Table 9.1, 方式1
+    assert BOOK_BANK_3CH == (70.0, 160.0, 360.0)             # Table 9.1, 方式2
+
+
+@pytest.mark.parametrize("fs", [1000.0, 2000.0, 4000.0])
+@pytest.mark.parametrize("centres", [BOOK_BANK_2CH, BOOK_BANK_3CH])
+def test_bank_unit_gain_at_centre_and_minus_3db_at_edges(fs, centres):
+    bank = FilterBank(centres, fs)
+    for k, fc in enumerate(centres):
+        lo, hi = bank.edges[k]
+        g = bank.gains([fc, lo, hi])[k]
+        assert g[0] == pytest.approx(1.0, abs=1e-9)
+        assert g[1] == pytest.approx(1 / np.sqrt(2), abs=1e-9)
+        assert g[2] == pytest.approx(1 / np.sqrt(2), abs=1e-9)
+        # half an octave apart in the pre-warped axis, symmetric about fc there
+        w = np.tan(np.pi * np.array([lo, fc, hi]) / fs)
+        assert np.log2(w[2] / w[0]) == pytest.approx(0.5, abs=1e-12)
+        assert w[1] ** 2 == pytest.approx(w[0] * w[2], rel=1e-12)
+        assert lo < fc < hi
+
+
+def test_bank_bands_do_not_overlap_and_are_the_documented_ones():
+    bank = FilterBank(BOOK_BANK_2CH, 2000.0)
+    assert np.all(bank.edges[1:, 0] > bank.edges[:-1, 1])
+    # module docstring: 40 -> 33.6-47.6, 360 -> 303-428 Hz (nominal fc * 2**(+-1/4))
+    np.testing.assert_allclose(bank.edges[0], [40 * 2 ** -0.25, 40 * 2 ** 0.25], rtol=2e-3)
+    np.testing.assert_allclose(bank.edges[3], [312.1, 411.6], atol=0.05)   # documented values at 2 kHz
+
+
+def test_conditioning_band_edges_minus_3db():
+    sos = bandpass_sos(*CONDITIONING_BAND, 2000.0)
+    _, h = sps.sosfreqz(sos, worN=np.array(CONDITIONING_BAND), fs=2000.0)
+    np.testing.assert_allclose(np.abs(h), 1 / np.sqrt(2), atol=1e-9)
+
+
+def test_bank_separates_tones_with_the_gain_of_its_frequency_response():
+    fs = 2000.0
+    bank = FilterBank(BOOK_BANK_2CH, fs)
+    t = np.arange(int(2 * fs)) / fs
+    for f in BOOK_BANK_2CH:
+        x = np.sin(2 * np.pi * f * t)
+        y = bank.apply(x)[0]                       # (bands, samples)
+        amp = np.sqrt(2) * np.sqrt(np.mean(y[:, int(fs):] ** 2, axis=1))   # steady second half
+        np.testing.assert_allclose(amp, bank.gains([f])[:, 0], rtol=2e-3)
+        assert BOOK_BANK_2CH[int(np.argmax(amp))] == f
+
+
+def test_white_noise_through_a_band_has_the_wiener_khinchin_variance():
+    fs = 2000.0
+    bank = FilterBank(BOOK_BANK_3CH, fs)
+    x = np.random.default_rng(3).standard_normal(200_000)
+    y = bank.apply(x)[0][:, 2000:]
+    f = np.linspace(0, fs / 2, 200_001)
+    h2 = bank.gains(f) ** 2
+    expected = np.trapezoid(h2, f, axis=1) * 2 / fs       # sigma^2 = 1: one-sided PSD 2/fs
+    np.testing.assert_allclose(y.var(axis=1), expected, rtol=0.03)
+
+
+def test_notch_removes_mains():
+    sos = notch_sos(50.0, 2000.0)
+    _, h = sps.sosfreqz(sos, worN=np.array([50.0, 150.0]), fs=2000.0)
+    assert abs(h[0]) < 1e-9 and abs(h[1]) > 0.95
+
+
+@pytest.mark.parametrize("fs", [800.0, 856.0, 100.0])
+def test_sampling_rate_below_twice_the_highest_band_is_refused(fs):
+    with pytest.raises(SamplingRateError) as e:
+        FilterBank(BOOK_BANK_2CH, fs)
+    assert e.value.required == pytest.approx(2 * 360 * 2 ** 0.25)
+    assert "360" in str(e.value) and "fs >" in str(e.value)
+    FilterBank(BOOK_BANK_2CH, 860.0)                     # just above: fine
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), 0.0, -2000.0, "fast"])
+def test_bad_sampling_rates(bad):
+    with pytest.raises(EMGError):
+        bandpass_sos(20.0, 450.0, bad)
+
+
+def test_bad_bands():
+    with pytest.raises(EMGError):
+        bandpass_sos(450.0, 20.0, 2000.0)
+    with pytest.raises(EMGError):
+        band_edges(-40.0, 2000.0)
+    with pytest.raises(EMGError):
+        FilterBank([], 2000.0)
+
+
+def test_cmrr_of_the_differential_amplifier():
+    fs, amp = 2000.0, DifferentialAmplifier(gain=5000.0, cmrr_db=100.0, rail=None)
+    t = np.arange(2000) / fs
+    emg = 100e-6 * np.sin(2 * np.pi * 120 * t)                  # 200 µV p-p differential
+    vp, vm = electrode_potentials(emg, fs, mains_pp=1.0, mains_hz=50.0, offset_v=0.2)
+    out = amp.amplify(vp, vm)
+    assert out.status == "ok"
+    gc = 5000.0 * 10 ** (-100 / 20)
+    cm = 0.5 * np.sin(2 * np.pi * 50 * t) + 0.2
+    np.testing.assert_allclose(out.signal[0], 5000.0 * emg + gc * cm, rtol=0, atol=1e-12)
+    # the common-mode hum (1 V p-p, 74 dB above the EMG) leaves 0.05 V p-p beside 1 V p-p of EMG
+    assert amp.common_mode_gain == pytest.approx(0.05)
+    np.testing.assert_allclose(amp.input_referred(out.signal), (emg + gc / 5000.0 * cm)[None], atol=1e-15)
+
+
+def test_amplifier_saturation_is_reported():
+    amp = DifferentialAmplifier(gain=10_000.0, rail=5.0)
+    assert amp.max_input_pp == pytest.approx(1e-3)
+    x = np.array([[0.0, 4e-4, 6e-4, -7e-4]])
+    out = amp.amplify(x / 2, -x / 2)
+    np.testing.assert_allclose(out.signal[0], [0.0, 4.0, 5.0, -5.0])
+    assert out.saturated.tolist() == [2] and out.status.startswith("saturated")
+
+
+def test_amplifier_bad_input():
+    with pytest.raises(EMGError):
+        DifferentialAmplifier(gain=-1)
+    with pytest.raises(EMGError):
+        DifferentialAmplifier(cmrr_db=float("nan"))
+    amp = DifferentialAmplifier()
+    with pytest.raises(EMGError, match="same shape"):
+        amp.amplify(np.zeros((2, 10)), np.zeros((2, 11)))
+    with pytest.raises(EMGError, match="NaN"):
+        amp.amplify(np.array([[0.0, np.nan]]), np.zeros((1, 2)))
