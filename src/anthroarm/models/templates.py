@@ -156,6 +156,55 @@ def articulated_robot(h0: float = 0.5, l2: float = 0.5, l3: float = 0.5, base=BA
                  {"h0": h0, "l2": l2, "l3": l3, "base": list(b), "shoulder": list(s), "elbow": list(e)})
 
 
+# ------------------------------------------------------------------ §6-4 vector-loop arms
+
+
+def unimate2600_loop(c1: float = 0.5, c2: float = 0.3, boom=(0.3, 1.0), c4: float = 0.15, c5: float = 0.1,
+                     g6: float = 0.12):
+    """The Unimate 2600 of Fig. 6-10 (a spherical-form robot, Table 2.3) in vector-loop form,
+    characteristic equation (6-50): ``P = C₁ + E^{kθ₁}(C₂ + E^{jθ₂}(L₃ + E^{iθ₃}(C₄ + E^{jθ₄}(C₅
+    + E^{iθ₅}(G₆*)))))``, joints θ₁ (k), θ₂ (j), the boom L (slide along i), θ₃ (i), θ₄ (j),
+    θ₅ (i).  Directions (Fig. 6-10 is lost; read from the grouping of (6-51), ch6 notes §2.5):
+    C₁, C₂ ∥ k; L₃, C₄ ∥ i; C₅, G₆ ∥ k (assumed).  Attitude vectors a₀ ∥ G₆ (k, the hand axis)
+    and b₀ ∥ i (assumed).  No numbers are printed: the lengths (m) and the boom stroke are ours.
+
+    Returns
+    -------
+    tuple
+        ``(VectorLoop, limits)``: the loop and the joint ranges for
+        :func:`anthroarm.kinematics.vector_loop.loop_spec`.
+    """
+    from ..kinematics.vector_loop import I, J, K, VectorLoop
+
+    m = "unimate2600"
+    c1, c2, c4, c5, g6 = (_length(m, n, v) for n, v in (("c1", c1), ("c2", c2), ("c4", c4), ("c5", c5), ("g6", g6)))
+    stroke = _range(m, "boom", boom, 0.0)
+    k, i = np.array(K), np.array(I)
+    loop = VectorLoop((("C", c1 * k), ("R", K), ("C", c2 * k), ("R", J), ("L", I), ("R", I), ("C", c4 * i),
+                       ("R", J), ("C", c5 * k), ("R", I)), G=g6 * k, a0=K, b0=I, name="unimate2600")
+    rng = (-np.pi, np.pi)
+    return loop, [rng, (-np.pi / 2, np.pi / 2), stroke, rng, rng, rng]
+
+
+def tensor6r_loop(c1: float = 0.3, c2: float = 0.2, c3: float = 0.05, c4: float = 0.4, c5: float = 0.2,
+                  c6: float = 0.15, c7: float = 0.05, G8: float = 0.1):
+    """The 6R arm of Fig. 6-11 (an articulated-form robot) in vector-loop form, Eqs. (6-62)–(6-65)
+    as reconstructed in the ch6 notes §2.6: ``P = C₁ᵏ + E^{kθ₁}(C₂ᵏ + C₃ⁱ + E^{jθ₂}(C₄ⁱ +
+    E^{jθ₃}(C₅ⁱ + E^{iθ₄}(C₆ⁱ + E^{jθ₅}(C₇ⁱ + E^{iθ₆}(G₈ⁱ))))))``; attitude vectors a₀ ∥ i (the
+    hand axis) and b₀ ∥ k (6-65).  In the initial state the arm is horizontal along +i.  No
+    numbers are printed: the lengths (m) are ours.  Returns ``(VectorLoop, limits)``."""
+    from ..kinematics.vector_loop import I, J, K, VectorLoop
+
+    m = "tensor6r"
+    c = [_length(m, n, v) for n, v in (("c1", c1), ("c2", c2), ("c3", c3), ("c4", c4), ("c5", c5), ("c6", c6),
+                                         ("c7", c7), ("G8", G8))]
+    k, i = np.array(K), np.array(I)
+    loop = VectorLoop((("C", c[0] * k), ("R", K), ("C", c[1] * k + c[2] * i), ("R", J), ("C", c[3] * i), ("R", J),
+                       ("C", c[4] * i), ("R", I), ("C", c[5] * i), ("R", J), ("C", c[6] * i), ("R", I)),
+                      G=c[7] * i, a0=I, b0=K, name="tensor6r")
+    return loop, [(-np.pi, np.pi)] * 6
+
+
 #: catalog name -> generator, in the order of Table 2.3
 TEMPLATES = {
     "cartesian_robot": cartesian_robot,
@@ -164,5 +213,5 @@ TEMPLATES = {
     "articulated_robot": articulated_robot,
 }
 
-__all__ = ["TEMPLATES", "cartesian_robot", "cylindrical_robot", "spherical_robot", "articulated_robot",
+__all__ = ["TEMPLATES", "unimate2600_loop", "tensor6r_loop", "cartesian_robot", "cylindrical_robot", "spherical_robot", "articulated_robot",
            "MAX_LINEAR_SPEED", "MAX_ANGULAR_SPEED", "BASE_RANGE", "REACH", "LIFT"]

@@ -1,0 +1,179 @@
+r"""The rotation-tensor (vector-loop) method of pose analysis, book §6-4, Eqs. (6-48)–(6-65).
+
+An **orthogonal manipulator** (正交系机械手) has, in its initial state, every joint axis and
+slide direction parallel to one of the ground axes i, j, k (k up, i forward).  Its grip point is
+a vector loop (6-48) ``P = R₁ + R₂ + … + G*``, written as the nested **characteristic
+equation** (6-50)/(6-59)
+
+    P = C₁ + E^{w₁θ₁}(C₂ + E^{w₂θ₂}( … (C_m + E^{w_mθ_m}(G*)) … )),
+
+with constant vectors C, variable-length (prismatic) vectors L = s·u, and the rotation tensors
+E^{wθ} of §5-5 (:func:`anthroarm.spatial.rotation_tensor.rotation_tensor`) about the
+*initial-state* axes w.  An attitude vector a* (6-49) turns with the hand: ``a = E(a₀)`` (6-53);
+the pose is the product of 4×4 matrices ``M_i = [[E^{w_iθ_i}, C_i], [0, 1]]`` applied to
+``[[G, a₀, b₀], [1, 0, 0]]`` (6-57), (6-60), (6-61).
+
+A loop is a tuple of items, base to tip:
+
+* ``("C", v)`` — a constant vector v (m), initial-state ground frame;
+* ``("R", w)`` — a revolute joint: E^{wθ} acts on everything after it;
+* ``("L", u)`` — a prismatic joint: the variable vector s·u (s the joint value, m);
+
+then the grip vector G and the attitude vectors a₀, b₀ (unit).  :func:`nested_pose` evaluates
+(6-59) from the inside out; :func:`product_pose` the matrix product (6-60); :func:`loop_spec`
+writes the same arm as a :class:`~anthroarm.models.spec.ChainSpec` (joint origins = the
+accumulated C vectors, axes = w, rpy = 0) for Pinocchio.  The two arms of the book are in
+:mod:`anthroarm.models.templates` (``unimate2600_loop``, ``tensor6r_loop``).
+
+Frames and units: the ground frame, m and rad; joint values in loop order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..spatial.rotation_tensor import rotation_tensor
+
+I, J, K = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
+
+__all__ = ["VectorLoop", "nested_pose", "product_pose", "pose_matrices", "loop_spec", "I", "J", "K"]
+
+
+def _vec3(v, what: str, unit: bool = False) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,) or not np.isfinite(a).all():
+        raise ValueError(f"{what} must be 3 finite numbers, got {v!r}")
+    if unit:
+        n = np.linalg.norm(a)
+        if abs(n - 1.0) > 1e-9:
+            raise ValueError(f"{what} must be a unit vector, got {v!r} (norm {n:.6g})")
+    return a
+
+
+@dataclass(frozen=True)
+class VectorLoop:
+    """An orthogonal manipulator in vector-loop form (see the module docstring)."""
+
+    items: tuple
+    G: np.ndarray
+    a0: tuple = I
+    b0: tuple = K
+    name: str = "vector_loop"
+
+    def __post_init__(self):
+        items = []
+        for n, it in enumerate(self.items):
+            try:
+                kind, v = it
+            except (TypeError, ValueError):
+                raise ValueError(f"loop item {n} must be (kind, vector), got {it!r}") from None
+            if kind not in ("C", "R", "L"):
+                raise ValueError(f"loop item {n}: kind must be 'C', 'R' or 'L', got {kind!r}")
+            items.append((kind, _vec3(v, f"loop item {n} ({kind})", unit=kind != "C")))
+        object.__setattr__(self, "items", tuple(items))
+        object.__setattr__(self, "G", _vec3(self.G, "G"))
+        object.__setattr__(self, "a0", _vec3(self.a0, "a0", unit=True))
+        object.__setattr__(self, "b0", _vec3(self.b0, "b0", unit=True))
+
+    @property
+    def joints(self) -> tuple:
+        """The joint items ("R" or "L", axis), base to tip."""
+        return tuple(it for it in self.items if it[0] != "C")
+
+    @property
+    def nq(self) -> int:
+        return len(self.joints)
+
+
+def _q(loop: VectorLoop, q) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.shape != (loop.nq,) or not np.isfinite(q).all():
+        raise ValueError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}")
+    return q
+
+
+def nested_pose(loop: VectorLoop, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Grip point P and attitude vectors a, b by the nested characteristic equation (6-59)
+    (Unimate form (6-50), (6-52), (6-53)), evaluated from the tip inwards:
+    ``v ← C + v``, ``v ← s u + v`` or ``v ← E^{wθ}(v)`` for P; a and b only turn."""
+    q = _q(loop, q)
+    P, a, b = loop.G.copy(), loop.a0.copy(), loop.b0.copy()
+    k = loop.nq
+    for kind, v in reversed(loop.items):
+        if kind == "C":
+            P = v + P
+        elif kind == "L":
+            k -= 1
+            P = q[k] * v + P
+        else:
+            k -= 1
+            E = rotation_tensor(v, q[k])
+            P, a, b = E @ P, E @ a, E @ b
+    return P, a, b
+
+
+def pose_matrices(loop: VectorLoop, q) -> list[np.ndarray]:
+    """The 4×4 matrices M_i = [[E^{w_iθ_i}, ΔP_i], [0, 1]] of (6-55)/(6-60), one per joint,
+    ΔP_i the constant vectors (and the slide s·u of a prismatic joint) before joint i; the last
+    matrix carries the vectors after the last joint (rotation I)."""
+    q = _q(loop, q)
+    out, acc, k = [], np.zeros(3), 0
+    for kind, v in loop.items:
+        if kind == "C":
+            acc = acc + v
+        elif kind == "L":
+            acc = acc + q[k] * v
+            k += 1
+        else:
+            M = np.eye(4)
+            M[:3, :3], M[:3, 3] = rotation_tensor(v, q[k]), acc
+            out.append(M)
+            acc, k = np.zeros(3), k + 1
+    M = np.eye(4)
+    M[:3, 3] = acc
+    out.append(M)
+    return out
+
+
+def product_pose(loop: VectorLoop, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """P, a, b by the matrix product (6-60)/(6-61): ``[[P, a, b], [1, 0, 0]] = M₁ M₂ ⋯ M_m
+    [[G, a₀, b₀], [1, 0, 0]]``."""
+    T = np.eye(4)
+    for M in pose_matrices(loop, q):
+        T = T @ M
+    X = np.zeros((4, 3))
+    X[:3, 0], X[3, 0] = loop.G, 1.0
+    X[:3, 1], X[:3, 2] = loop.a0, loop.b0
+    Y = T @ X
+    return Y[:3, 0], Y[:3, 1], Y[:3, 2]
+
+
+def loop_spec(loop: VectorLoop, limits=None):
+    """The loop as a :class:`~anthroarm.models.spec.ChainSpec` (URDF for Pinocchio): joint n
+    sits at the sum of the constant vectors since joint n−1, rpy = 0, axis w (or u for a
+    slide); the tool frame ``grip`` at G with the ground axes (so a = R_tool a₀).  ``limits``:
+    optional (lower, upper) per joint (default ±π, slides 0–1 m)."""
+    from ..spatial.rotations import homogeneous
+    from ..models.spec import ChainSpec, JointSpec, rod_link
+
+    joints, acc, n = [], np.zeros(3), 0
+    lim = list(limits) if limits is not None else None
+    for kind, v in loop.items:
+        if kind == "C":
+            acc = acc + v
+            continue
+        lo, hi = lim[n] if lim is not None else ((-np.pi, np.pi) if kind == "R" else (0.0, 1.0))
+        if joints:
+            joints[-1].link = rod_link(joints[-1].link.name, acc)
+        joints.append(JointSpec(f"joint{n + 1}", "revolute" if kind == "R" else "prismatic",
+                                homogeneous(r=acc), axis=tuple(v), lower=lo, upper=hi,
+                                link=rod_link(f"link{n + 1}", np.zeros(3))))
+        acc, n = np.zeros(3), n + 1
+    tool = acc + loop.G
+    joints[-1].link = rod_link(joints[-1].link.name, tool)
+    return ChainSpec(name=loop.name, description=f"{loop.name}: orthogonal manipulator in vector-loop form (book §6-4)",
+                     joints=joints, tool_name="grip", tool_origin=homogeneous(r=tool),
+                     source="book 000 l.4047-4209 (§6-4, Eqs. (6-48)-(6-65))",
+                     inertia_source="not printed: default rods (models.spec.rod_link)")
