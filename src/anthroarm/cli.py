@@ -858,10 +858,11 @@ def build_parser(argv=None) -> argparse.ArgumentParser:
 
     ap.add_argument("--version", action="version", version=f"anthroarm {__version__}")
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
+    from .motion.commands import add_parser as _ik_markers_parser
     from .prosthesis.commands import add_parser as _size_parser
 
     for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache,
-                _batch_parser, _size_parser):
+                _batch_parser, _size_parser, _ik_markers_parser):
         add(sub)
     argv = list(sys.argv[1:] if argv is None else argv)
     cmd = next((i for i, t in enumerate(argv) if not t.startswith("-")), None)

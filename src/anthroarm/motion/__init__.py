@@ -22,6 +22,7 @@ bars are the CLI's (``anthroarm ik-markers``).
 from . import activities
 from .activities import Activity, ActivityTrajectory, Keyframe, activity, activity_trajectory
 from .c3d import read_c3d, write_c3d
+from .csv_io import JointTrajectory, read_joint_csv, write_joint_csv
 from .marker_ik import STATUSES, MarkerIK, MarkerIKResult, marker_ik, match_markers
 from .markers import (HUMAN_ARM_LANDMARKS, BoundMarkers, Marker, MarkerSet, default_marker_set, human_arm_markers,
                       segment_length)
@@ -30,7 +31,7 @@ from .scaling import ScalingResult, scale_from_static
 from .trial import MarkerTrajectories
 
 __all__ = [
-    "MarkerTrajectories", "read_c3d", "write_c3d",
+    "MarkerTrajectories", "read_c3d", "write_c3d", "JointTrajectory", "read_joint_csv", "write_joint_csv",
     "Marker", "MarkerSet", "BoundMarkers", "HUMAN_ARM_LANDMARKS", "default_marker_set", "human_arm_markers",
     "segment_length",
     "MarkerIK", "MarkerIKResult", "marker_ik", "match_markers", "STATUSES",

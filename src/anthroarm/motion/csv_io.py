@@ -1,0 +1,150 @@
+"""Joint-angle trajectories as CSV.
+
+Format (what :func:`write_joint_csv` writes and ``anthroarm size --activities FILE.csv`` reads):
+``#`` lines are comments (units, source, the legend of the status codes); the header is ``t``
+(s) and one column per joint named as the joint (rad, or m for a prismatic joint); a marker-IK
+result adds ``rms_m``, ``max_error_m`` (m; ``nan`` for a skipped frame), ``n_markers`` and
+``status`` (a code: 0 ok, 1 too_few_markers, 2 not_converged, 3 skipped).  Every value is a
+number, so any CSV reader takes it.
+
+:func:`read_joint_csv` also accepts ``time`` / ``time_s`` for the time column and joint columns
+with a unit suffix (``_rad``, ``_deg``; degrees are converted), so spreadsheets from other tools
+load too.  A row whose joint values are not finite is a gap: it is marked invalid and holds the
+previous valid row (the next one before the first), never NaN.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._io import atomic_write_text
+from ..errors import MotionDataError
+from .marker_ik import STATUSES, MarkerIKResult
+
+TIME_COLUMNS = ("t", "time", "time_s")
+
+
+@dataclass
+class JointTrajectory:
+    """Joint trajectory read from CSV: ``t`` (N,) s, ``q`` (N, n) rad (or m), the joint
+    ``names`` of the columns, and ``valid`` (N,) False for rows that had a missing value."""
+
+    t: np.ndarray
+    q: np.ndarray
+    names: tuple
+    valid: np.ndarray
+    source: str = ""
+
+
+def write_joint_csv(path, t, q=None, names=None, *, comment: str = "") -> Path:
+    """Write a joint trajectory: ``write_joint_csv(path, result)`` for a
+    :class:`~anthroarm.motion.marker_ik.MarkerIKResult` (with its per-frame errors and status),
+    an object with ``t``/``time``, ``q`` and ``joint_names`` (an activity trajectory), or
+    ``write_joint_csv(path, t, q, names)``.  Atomic (:func:`anthroarm._io.atomic_write_text`)."""
+    extra = None
+    if q is None:
+        res = t
+        t = getattr(res, "time", None) if getattr(res, "t", None) is None else res.t
+        q, names = res.q, res.joint_names
+        if isinstance(res, MarkerIKResult):
+            code = np.array([STATUSES.index(s) for s in res.status])
+            extra = (("rms_m", "max_error_m", "n_markers", "status"),
+                     np.column_stack([res.rms, res.max_error, res.n_markers, code]))
+    t = np.asarray(t, float)
+    q = np.asarray(q, float)
+    names = tuple(names or ())
+    if q.ndim != 2 or t.shape != (q.shape[0],) or len(names) != q.shape[1]:
+        raise MotionDataError(f"write_joint_csv: t (N,), q (N, n) and n names, got {t.shape}, {q.shape}, {len(names)}")
+    if not (np.isfinite(t).all() and np.isfinite(q).all()):
+        raise MotionDataError("write_joint_csv: t and q must be finite", path)
+    buf = io.StringIO()
+    buf.write("# anthroarm joint trajectory: t in s, joint angles in rad (prismatic joints in m)\n")
+    if extra is not None:
+        buf.write("# rms_m, max_error_m: marker errors in m (nan: skipped frame); status: "
+                  + ", ".join(f"{i} {s}" for i, s in enumerate(STATUSES)) + "\n")
+    for line in comment.splitlines():
+        buf.write(f"# {line}\n")
+    header = ["t", *names] + (list(extra[0]) if extra is not None else [])
+    buf.write(",".join(header) + "\n")
+    cols = [t[:, None], q] + ([extra[1]] if extra is not None else [])
+    data = np.hstack(cols)
+    nint = 2 if extra is not None else 0
+    for row in data:
+        vals = [repr(float(x)) for x in row[:len(row) - nint]]
+        vals += [str(int(x)) for x in row[len(row) - nint:]]
+        buf.write(",".join(vals) + "\n")
+    p = Path(path)
+    atomic_write_text(p, buf.getvalue())
+    return p
+
+
+def read_joint_csv(path, robot=None) -> JointTrajectory:
+    """Read a joint trajectory (see the module docstring).  With ``robot``, every joint of
+    ``robot.chain.q_names`` must have a column (returned in the robot's order); without, every
+    column except the time and the marker-IK extras is a joint.
+
+    Raises :class:`~anthroarm.errors.MotionDataError` naming the file and the line: no such
+    file, no header, no time column, a missing joint, a value that is not a number, a row of the
+    wrong length, times that do not increase, no valid row."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MotionDataError("joint-trajectory CSV not found", p) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MotionDataError(f"cannot read the file as text ({exc})", p) from None
+    rows = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows:
+        raise MotionDataError("no header line", p)
+    header = [h.strip() for h in rows[0][1].split(",")]
+    tcol = next((header.index(c) for c in TIME_COLUMNS if c in header), None)
+    if tcol is None:
+        raise MotionDataError(f"no time column (one of {list(TIME_COLUMNS)}); header: {header}", p)
+    joints = {}
+    for i, h in enumerate(header):
+        if i == tcol or h in ("rms_m", "max_error_m", "n_markers", "status"):
+            continue
+        if h.endswith("_deg"):
+            joints[h[:-4]] = (i, np.pi / 180.0)
+        elif h.endswith("_rad"):
+            joints[h[:-4]] = (i, 1.0)
+        else:
+            joints[h] = (i, 1.0)
+    names = tuple(joints) if robot is None else tuple(robot.chain.q_names)
+    missing = [n for n in names if n not in joints]
+    if missing:
+        raise MotionDataError(f"missing joint column(s) {missing}; header: {header}", p)
+    if not names:
+        raise MotionDataError("no joint columns", p)
+    vals = np.empty((len(rows) - 1, len(header)))
+    for r, (lineno, ln) in enumerate(rows[1:]):
+        cells = ln.split(",")
+        if len(cells) != len(header):
+            raise MotionDataError(f"line {lineno}: {len(cells)} values, the header has {len(header)}", p)
+        for c, cell in enumerate(cells):
+            s = cell.strip()
+            try:
+                vals[r, c] = float(s) if s else np.nan
+            except ValueError:
+                raise MotionDataError(f"line {lineno}, column {header[c]!r}: {s!r} is not a number", p) from None
+    t = vals[:, tcol]
+    if not np.isfinite(t).all():
+        bad = rows[1 + int(np.flatnonzero(~np.isfinite(t))[0])][0]
+        raise MotionDataError(f"line {bad}: the time is missing or not finite", p)
+    if np.any(np.diff(t) <= 0):
+        bad = rows[2 + int(np.flatnonzero(np.diff(t) <= 0)[0])][0]
+        raise MotionDataError(f"line {bad}: times must increase", p)
+    q = np.column_stack([vals[:, joints[n][0]] * joints[n][1] for n in names]) if len(t) else np.zeros((0, len(names)))
+    valid = np.isfinite(q).all(axis=1)
+    if not valid.any():
+        raise MotionDataError("no row with every joint value", p)
+    first = int(np.argmax(valid))
+    q[:first] = q[first]
+    for n in range(first + 1, len(q)):
+        if not valid[n]:
+            q[n] = q[n - 1]
+    return JointTrajectory(t, q, names, valid, str(p))

@@ -1,0 +1,135 @@
+"""C3D edge cases (units, missing, garbage), joint-angle CSV round trips and errors, and the
+``anthroarm ik-markers`` command on a real C3D file."""
+
+import json
+
+import numpy as np
+import pytest
+
+import anthroarm as aa
+from anthroarm.cli import main
+from anthroarm.errors import C3DError, MotionDataError
+from anthroarm.motion import MarkerTrajectories, marker_ik, read_c3d, write_c3d
+from anthroarm.motion.csv_io import read_joint_csv, write_joint_csv
+from motion_synthetic import known_motion, pin_marker_positions
+
+
+def _write_with_units(path, P, names, unit, scale):
+    """A C3D written directly with ezc3d (not through write_c3d) in any POINT:UNITS."""
+    import ezc3d
+
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [50.0]
+    c["parameters"]["POINT"]["LABELS"]["value"] = list(names)
+    c["parameters"]["POINT"]["UNITS"]["value"] = [unit]
+    pts = np.ones((4, P.shape[1], P.shape[0]))
+    pts[:3] = P.transpose(2, 1, 0) * scale
+    c["data"]["points"] = pts
+    c.write(str(path))
+
+
+def test_c3d_units_are_converted(tmp_path, arm, markers):
+    _, Q = known_motion(arm, n=5)
+    P = pin_marker_positions(arm, markers, Q)
+    for unit, scale in (("mm", 1000.0), ("cm", 100.0), ("m", 1.0)):
+        _write_with_units(tmp_path / f"u_{unit}.c3d", P, markers.names, unit, scale)
+        tr = read_c3d(tmp_path / f"u_{unit}.c3d")
+        assert tr.rate == 50.0 and tr.names == markers.names
+        np.testing.assert_allclose(tr.positions, P, atol=1e-6)
+    _write_with_units(tmp_path / "u_in.c3d", P, markers.names, "in", 39.37)
+    with pytest.raises(C3DError, match="POINT:UNITS is 'in'"):
+        read_c3d(tmp_path / "u_in.c3d")
+
+
+def test_c3d_bad_files(tmp_path):
+    with pytest.raises(C3DError, match="not found"):
+        read_c3d(tmp_path / "nope.c3d")
+    (tmp_path / "garbage.c3d").write_bytes(b"this is not a c3d file" * 50)
+    with pytest.raises(C3DError, match="ezc3d"):
+        read_c3d(tmp_path / "garbage.c3d")
+    with pytest.raises(MotionDataError, match="duplicate"):
+        MarkerTrajectories(["A", "A"], np.zeros((2, 2, 3)))
+    with pytest.raises(MotionDataError, match="shape"):
+        MarkerTrajectories(["A"], np.zeros((2, 2, 3)))
+    with pytest.raises(C3DError, match="folder"):
+        write_c3d(tmp_path / "no" / "x.c3d", MarkerTrajectories(["A"], np.ones((3, 1, 3))))
+    # a zero sample is a gap (old capture systems write (0, 0, 0) for missing markers)
+    P = np.ones((4, 2, 3))
+    P[1, 0] = 0.0
+    write_c3d(tmp_path / "z.c3d", MarkerTrajectories(["A", "B"], P))
+    assert read_c3d(tmp_path / "z.c3d").visible.tolist() == [[True, True], [False, True], [True, True], [True, True]]
+    assert read_c3d(tmp_path / "z.c3d", zero_is_missing=False).visible.all()
+    # no half-written file: a failing write leaves the old file and no temp file
+    before = (tmp_path / "z.c3d").read_bytes()
+    with pytest.raises(C3DError):
+        write_c3d(tmp_path / "z.c3d", "not a trial")
+    assert (tmp_path / "z.c3d").read_bytes() == before and not list(tmp_path.glob(".*tmp*"))
+
+
+def test_csv_round_trip_of_a_marker_ik_result(tmp_path, arm, markers):
+    _, Q = known_motion(arm, n=30)
+    P = pin_marker_positions(arm, markers, Q)
+    P[10:12] = np.nan
+    res = marker_ik(arm, MarkerTrajectories(markers.names, P, rate=100.0), markers)
+    write_joint_csv(tmp_path / "a.csv", res)
+    back = read_joint_csv(tmp_path / "a.csv", arm)
+    np.testing.assert_array_equal(back.q, res.q)                 # repr() of floats: exact
+    np.testing.assert_array_equal(back.t, res.time)
+    assert back.names == tuple(arm.joint_names) and back.valid.all()
+    text = (tmp_path / "a.csv").read_text()
+    assert "3 skipped" in text and text.splitlines()[2].startswith("t,shoulder_flexion")
+    rows = [ln.split(",") for ln in text.splitlines() if ln and not ln.startswith("#")]
+    assert rows[11][-1] == "3" and rows[11][-4] == "nan"          # frame 10: skipped
+
+
+def test_csv_degrees_gaps_and_errors(tmp_path, arm):
+    names = arm.joint_names
+    lines = ["# a spreadsheet in degrees", "time_s," + ",".join(f"{n}_deg" for n in names)]
+    lines.append("0.0," + ",".join(["10"] * 7))
+    lines.append("0.1," + ",".join(["20"] * 6 + [""]))           # a gap in one joint
+    lines.append("0.2," + ",".join(["30"] * 7))
+    (tmp_path / "d.csv").write_text("\n".join(lines) + "\n")
+    tr = read_joint_csv(tmp_path / "d.csv", arm)
+    np.testing.assert_allclose(tr.q[0], np.deg2rad(10)) and np.testing.assert_allclose(tr.q[2], np.deg2rad(30))
+    assert tr.valid.tolist() == [True, False, True]
+    np.testing.assert_allclose(tr.q[1], tr.q[0])                  # held, not NaN
+    bad = {"nohead.csv": "# only a comment\n", "notime.csv": "a,b\n1,2\n",
+           "word.csv": "t," + ",".join(names) + "\n0," + ",".join(["x"] * 7) + "\n",
+           "short.csv": "t," + ",".join(names) + "\n0,1\n",
+           "back.csv": "t," + ",".join(names) + "\n1," + ",".join(["0"] * 7) + "\n0," + ",".join(["0"] * 7) + "\n",
+           "joint.csv": "t,shoulder_flexion\n0,1\n"}
+    msgs = {"nohead.csv": "header", "notime.csv": "time column", "word.csv": "line 2", "short.csv": "line 2",
+            "back.csv": "increase", "joint.csv": "missing joint"}
+    for f, body in bad.items():
+        (tmp_path / f).write_text(body)
+        with pytest.raises(MotionDataError, match=msgs[f]):
+            read_joint_csv(tmp_path / f, arm)
+    with pytest.raises(MotionDataError, match="not found"):
+        read_joint_csv(tmp_path / "missing.csv")
+
+
+def test_cli_ik_markers(tmp_path, capsys):
+    person = aa.load("human_arm7", height=1.62, mass=55, sex="female")
+    from anthroarm.motion import default_marker_set
+
+    ms = default_marker_set(person)
+    _, Q = known_motion(person, n=120, seed=9)
+    P = pin_marker_positions(person, ms, Q)
+    P[50:52] = np.nan
+    write_c3d(tmp_path / "trial.c3d", MarkerTrajectories([f"S1:{n}" for n in ms.names], P, rate=100.0))
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "angles.csv"),
+               "--height", "1.62", "--mass", "55", "--sex", "female", "--no-progress"])
+    out = capsys.readouterr().out.strip().splitlines()[-1]
+    assert rc == 0
+    summary = json.loads(out)
+    assert summary["frames"] == 120 and summary["ok"] == 118 and summary["skipped"] == 2
+    back = read_joint_csv(tmp_path / "angles.csv", person)
+    ok = np.ones(120, bool)
+    ok[50:52] = False
+    assert np.max(np.abs(back.q[ok] - Q[ok])) < 1e-4
+    # bad input: one line on stderr, exit 2, no output file
+    rc = main(["ik-markers", str(tmp_path / "nope.c3d"), "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "C3D file not found" in err and err.count("\n") == 1 and not (tmp_path / "x.csv").exists()
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "no" / "x.csv")])
+    assert rc == 2 and "existing folder" in capsys.readouterr().err
