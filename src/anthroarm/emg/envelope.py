@@ -74,13 +74,18 @@ def lowpass_envelope(x, fs: float, cutoff_hz: float = 5.0, order: int = 2) -> np
     """Linear envelope (V, mean rectified value): :math:`|x|` through a causal Butterworth
     low-pass at ``cutoff_hz`` (default 5 Hz, an assumption: 3–10 Hz is the usual range,
     De Luca 1997).  ``fs`` must exceed twice the cutoff."""
+    a = signal(x, "emg")
+    return sps.sosfilt(lowpass_sos(fs, cutoff_hz, order), np.abs(a), axis=-1)
+
+
+def lowpass_sos(fs: float, cutoff_hz: float, order: int = 2) -> np.ndarray:
+    """The Butterworth low-pass of the linear envelope as second-order sections; ``fs`` (Hz)
+    must exceed twice ``cutoff_hz``."""
     from .filters import check_sampling_rate
 
-    a = signal(x, "emg")
     fc = positive(cutoff_hz, "envelope cutoff", "Hz")
     fs = check_sampling_rate(fs, fc, f"the {fc:g} Hz envelope low-pass")
-    sos = sps.butter(int(order), fc, btype="lowpass", fs=fs, output="sos")
-    return sps.sosfilt(sos, np.abs(a), axis=-1)
+    return sps.butter(int(order), fc, btype="lowpass", fs=fs, output="sos")
 
 
 def rms(x) -> np.ndarray:

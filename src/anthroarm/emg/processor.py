@@ -35,7 +35,7 @@ from scipy import signal as sps
 
 from ..errors import EMGError, ThresholdError
 from ._checks import positive, signal
-from .envelope import PP_PER_MAV, PP_PER_RMS, running_rms, window_samples
+from .envelope import PP_PER_MAV, PP_PER_RMS, lowpass_sos, running_rms, window_samples
 from .filters import CONDITIONING_BAND, bandpass_sos, check_sampling_rate, notch_sos
 
 #: code values of an antagonist pair (flexor bit first, as printed: "10" = flexor)
@@ -157,9 +157,7 @@ class EMGProcessor:
             self.window = window_samples(window_s, self.fs)
             self._pp = PP_PER_RMS
         else:
-            fc = positive(cutoff_hz, "envelope cutoff", "Hz")
-            check_sampling_rate(self.fs, fc, f"the {fc:g} Hz envelope low-pass")
-            self.env_sos = sps.butter(2, fc, btype="lowpass", fs=self.fs, output="sos")
+            self.env_sos = lowpass_sos(self.fs, cutoff_hz)
             self._pp = PP_PER_MAV
         self.hop = window_samples(frame_s, self.fs)
         self.frame_s = self.hop / self.fs

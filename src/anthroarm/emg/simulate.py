@@ -19,7 +19,9 @@ How a command moves a joint (assumptions; the book prints the codes, not the dri
   16 mm coreless DC micromotor (:func:`prosthesis_motor`, illustrative values: no-load speed
   ≈ 9550 r/min, inside the 4700–13550 r/min of the book's coreless motors, §9-3);
 * the joints of the arm that are not driven are **locked** where ``q0`` puts them (the
-  wearer's own shoulder holds the socket still);
+  wearer's own shoulder holds the socket still); the driven joints start at rest at ``q0``,
+  their servos settled there (set-point ``q0 + g(q0)/K_s``, Eq. (9-8), with Pinocchio's gravity
+  torque ``g``);
 * the hand ("fingers") is a one-DOF servo joint with its own inertia
   (:class:`HandModel`) when the arm has no finger joint: closing on an object at
   ``object_angle`` meets a Kelvin–Voigt contact (stiffness and damping, assumptions).  Its
@@ -111,8 +113,10 @@ class PoweredHandResult:
     ``setpoint``/``angle`` (frames, n_modes) rad; ``q`` (frames, robot.nq) the whole arm's
     configuration; ``grasped`` (frames,) bool; ``load_estimate`` (frames,) N·m the hand
     servo's load estimate (Eq. (9-8)); ``vibrators`` (frames, 3) left/right/middle;
-    ``emg`` (channels, samples) and ``t_emg`` the input; ``status`` "ok" or what went wrong
-    (the dynamics' status)."""
+    ``emg`` (channels, samples) and ``t_emg`` the input; ``servos`` mode →
+    :class:`~anthroarm.control.servo.PositionServo` used; ``hand`` the :class:`HandModel`
+    (``None`` without a built-in hand); ``status`` "ok" or what went wrong (the dynamics' or
+    the hand integrator's status)."""
 
     t: np.ndarray
     processed: ProcessedEMG
@@ -128,6 +132,8 @@ class PoweredHandResult:
     emg: np.ndarray
     t_emg: np.ndarray
     robot: object = field(repr=False, default=None)
+    servos: dict = field(default_factory=dict)
+    hand: HandModel | None = None
     status: str = "ok"
 
     def plot(self, fig=None):
@@ -301,6 +307,7 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
     angle = np.zeros((n_f, len(modes)))
     q_out = np.repeat(q0[None, :], n_f, axis=0)
     status = "ok"
+    used = {}
     if arm:
         red = load(robot.model, locked=locked, tool=robot.tool) if locked else robot
         rq0 = np.array([q0[chain.joint(red.chain.joints[k].name).idx_q] for k in range(red.nq)])
@@ -310,13 +317,18 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         for m, jt in arm.items():
             J_L = float(M0[col[m], col[m]])
             srv[m] = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), J_L)
+        used.update(srv)
         model = red.model.copy()
         for m in arm:
             model.armature[col[m]] += srv[m].J0 - srv[m].J_L       # reflected motor inertia, eta i^2 J_m
-        sp = {}
+        # the servos have settled at q0: each set-point starts at q0 + M_L / K_s, Eq. (9-8),
+        # with M_L the gravity torque Pinocchio gives there
+        g0 = pin.computeGeneralizedGravity(red.model, red.model.createData(), rq0)
+        sp, start = {}, {}
         for m, jt in arm.items():
             j = modes.index(m)
-            sp[m] = _setpoints(trace, j, speeds[m], jt.lower, jt.upper, float(q0[jt.idx_q]))
+            start[m] = float(q0[jt.idx_q]) + float(g0[col[m]]) / srv[m].Ks
+            sp[m] = _setpoints(trace, j, speeds[m], jt.lower, jt.upper, start[m])
             setpoint[:, j] = sp[m]
 
         def tau(tt, q, qd):
@@ -324,7 +336,7 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
             out = np.zeros(red.nv)
             for m in arm:
                 c = col[m]
-                ti = sp[m][k] if k >= 0 else float(q0[arm[m].idx_q])
+                ti = sp[m][k] if k >= 0 else start[m]
                 # the servo's output torque eta i M_m of Eqs. (9-1)-(9-4): J_0 * theta_ddot at zero load
                 out[c] = srv[m].J0 * srv[m].rhs(np.array([q[c], qd[c]]), ti, 0.0)[1]
             return out
@@ -345,6 +357,7 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         m = hand_modes[0]
         j = modes.index(m)
         hs = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), hand.J_L)
+        used[m] = hs
         cmd = trace.command * (trace.mode == j)
         v = speeds[m]
 
@@ -374,4 +387,4 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
                              joint_names=tuple(n if n is not None else "hand" for n in joints.values()),
                              setpoint=setpoint, angle=angle, q=q_out, grasped=grasped, load_estimate=load_est,
                              vibrators=vib, emg=x, t_emg=np.arange(x.shape[1]) / fs,
-                             robot=robot, status=status)
+                             robot=robot, servos=used, hand=hand if hand_modes else None, status=status)
