@@ -134,7 +134,8 @@ def base_png(human, tmp_path_factory):
 
 def test_static_html_draws_the_arm(human, base_png, tmp_path):
     q = np.deg2rad([60, -30, 10, 80, 0, 0, 10])
-    v = Viewer(human, q=q)
+    v = Viewer(human)   # the camera frames the first pose: the same as the baseline's
+    v.display(q)
     html = v.export_html(tmp_path / "arm.html")
     shot = browser.screenshot(html, tmp_path / "arm.png", size=(W, H), budget_ms=2000)
     box = expected_box(v, q)
@@ -147,7 +148,8 @@ def test_static_html_draws_the_arm(human, base_png, tmp_path):
 def test_live_server_page_draws_and_follows_the_arm(human, base_png, tmp_path):
     q1 = np.deg2rad([20, -10, 0, 30, 0, 0, 0])
     q2 = np.deg2rad([150, -20, 30, 40, 0, 0, 0])
-    with Viewer(human, live=True, q=q1) as v:
+    with Viewer(human, live=True) as v:
+        v.display(q1)
         s1 = browser.screenshot(v.url, tmp_path / "live1.png", size=(W, H), budget_ms=2000)
         box1 = expected_box(v, q1)
         inside, outside = robot_pixels(s1, base_png, box1)
@@ -175,15 +177,16 @@ def test_kinova_html_draws_the_arm_and_turns_its_continuous_joints(tmp_path):
     theta = np.array([0.0, 2.4, 1.2, 0.5, 1.0, 0.3])   # base, shoulder, elbow, wrists (rad)
     base = [j for j in chain.joints if j.kind == "continuous"][0]
     pics = []
+    v = Viewer(robot)
     for k, turn in enumerate((0.0, np.pi / 2)):
         th = theta.copy()
         th[base.index] += turn
         q = chain.configuration(th[list(chain.independent)])
-        v = Viewer(robot, q=q)
+        v.display(q)
         html = v.export_html(tmp_path / f"kinova{k}.html")
         shot = browser.screenshot(html, tmp_path / f"kinova{k}.png", size=(W, H), budget_ms=2000)
         if k == 0:
-            base_png = baseline(v, tmp_path, "kinova_base")
+            base_png = baseline(Viewer(robot), tmp_path, "kinova_base")
         box = expected_box(v, q)
         inside, outside = robot_pixels(shot, base_png, box)
         area = (box[2] - box[0]) * (box[3] - box[1])

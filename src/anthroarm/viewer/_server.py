@@ -45,7 +45,9 @@ from _store import MESHCAT_DIST, SceneStore, page_html  # noqa: E402
 
 HOST = "127.0.0.1"
 MESHCAT_COMMANDS = {"set_transform", "set_object", "delete", "set_property", "set_animation",
-                    "anthroarm_batch", "anthroarm_color"}
+                    "anthroarm_batch", "anthroarm_color", "anthroarm_ui"}
+#: the kinds of HTML overlay the page builds (``anthroarm_ui``)
+UI_KINDS = {"legend", "note", "teach"}
 #: Longest ``wait`` (s) and most browser tabs a ``wait`` may ask for.
 MAX_WAIT = 3600.0
 MAX_TABS = 1024
@@ -294,6 +296,10 @@ def _check_command(cmd, top: bool) -> None:
     elif kind == "set_object":
         if not isinstance(cmd.get("object"), dict):
             raise ValueError("set_object: object must be a map")
+    elif kind == "anthroarm_ui":
+        spec = cmd.get("spec")
+        if not (isinstance(spec, dict) and spec.get("kind") in UI_KINDS):
+            raise ValueError(f"anthroarm_ui: spec must be a map with kind in {sorted(UI_KINDS)}")
     elif kind == "anthroarm_color":
         c = cmd.get("color")
         if not (isinstance(c, list) and len(c) in (3, 4) and all(isinstance(x, (int, float)) for x in c)):

@@ -14,6 +14,11 @@ Two commands are added to meshcat's protocol (handled by the page's JavaScript p
 ``anthroarm_color``  ``{"type", "path", "color": [r, g, b(, a)]}`` — recolour every mesh under
                      ``path`` (used for joint-limit proximity), without resending geometry.
 
+``anthroarm_ui``     ``{"type", "path", "spec": {"kind": "legend" | "note" | "teach", ...}}`` — an
+                     HTML overlay on the page (a colour legend, a line of text, the joint
+                     sliders of ``Viewer.teach`` with their forward kinematics), built with
+                     ``textContent`` only; deleting ``path`` or a parent removes it.
+
 and after every ``set_object`` it computes smooth vertex normals for the meshes that came
 without any (:class:`~anthroarm.viewer.visuals.PackedMesh`, meshcat's ``TriangularMeshGeometry``).
 """
@@ -34,6 +39,111 @@ JS_PATCH = r"""
 (function () {
   var base = viewer.handle_command.bind(viewer);
   function split(p) { return p.split("/").filter(function (x) { return x.length > 0; }); }
+  // ---- HTML overlays (legends, notes, teach sliders): built with textContent only
+  var uiNodes = {};
+  function el(tag, css, text) {
+    var e = document.createElement(tag);
+    if (css) { e.style.cssText = css; }
+    if (text !== undefined) { e.textContent = String(text); }
+    return e;
+  }
+  function panel(id, css) {
+    var p = document.getElementById(id);
+    if (!p) { p = el("div", css); p.id = id; document.body.appendChild(p); }
+    return p;
+  }
+  var BOX = "background:rgba(255,255,255,0.88);border:1px solid #9aa5b4;border-radius:4px;padding:5px 8px;" +
+            "margin-top:6px;font:12px/1.35 sans-serif;color:#1d2430;";
+  function css(c) { return "rgb(" + [0, 1, 2].map(function (k) { return Math.round(255 * c[k]); }).join(",") + ")"; }
+  function dropUi(path) {
+    var pre = split(path).join("/");
+    Object.keys(uiNodes).forEach(function (k) {
+      if (k === pre || k.indexOf(pre + "/") === 0 || pre === "") { uiNodes[k].remove(); delete uiNodes[k]; }
+    });
+  }
+  function legend(spec) {
+    var box = el("div", BOX);
+    box.className = "anthroarm-legend";
+    box.appendChild(el("div", "font-weight:600", spec.title));
+    if (spec.stops) {
+      box.appendChild(el("div", "height:10px;width:180px;border:1px solid #555;margin-top:2px;background:linear-gradient(to right," +
+                                spec.stops.map(css).join(",") + ")"));
+      var ticks = el("div", "display:flex;justify-content:space-between;width:182px");
+      (spec.ticks || []).forEach(function (t) { ticks.appendChild(el("span", "", t)); });
+      box.appendChild(ticks);
+    }
+    (spec.entries || []).forEach(function (e) {
+      var row = el("div", "display:flex;align-items:center;gap:6px");
+      row.appendChild(el("span", "display:inline-block;width:22px;height:10px;border:1px solid #555;background:" + css(e[0])));
+      row.appendChild(el("span", "", e[1]));
+      box.appendChild(row);
+    });
+    return box;
+  }
+  // row-major 4x4 helpers for the teach panel's forward kinematics
+  function mul(A, B) {
+    var C = new Array(16);
+    for (var i = 0; i < 4; i++) { for (var j = 0; j < 4; j++) {
+      var s = 0; for (var k = 0; k < 4; k++) { s += A[4 * i + k] * B[4 * k + j]; } C[4 * i + j] = s; } }
+    return C;
+  }
+  var EYE = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
+  function motion(kind, a, t) {
+    if (kind === "prismatic") { return [1, 0, 0, a[0] * t, 0, 1, 0, a[1] * t, 0, 0, 1, a[2] * t, 0, 0, 0, 1]; }
+    var c = Math.cos(t), s = Math.sin(t), v = 1 - c, x = a[0], y = a[1], z = a[2];
+    return [c + x * x * v, x * y * v - z * s, x * z * v + y * s, 0,
+            y * x * v + z * s, c + y * y * v, y * z * v - x * s, 0,
+            z * x * v - y * s, z * y * v + x * s, c + z * z * v, 0, 0, 0, 0, 1];
+  }
+  function colMajor(M) { var o = []; for (var j = 0; j < 4; j++) { for (var i = 0; i < 4; i++) { o.push(M[4 * i + j]); } } return o; }
+  function teach(spec) {
+    var theta = spec.theta.slice();
+    function pose() {
+      var T = [];
+      for (var j = 0; j < spec.joints.length; j++) {
+        var J = spec.joints[j];
+        if (J.src >= 0) { theta[j] = J.mult * theta[J.src] + J.off; }
+        T.push(mul(mul(J.parent >= 0 ? T[J.parent] : EYE, J.placement), motion(J.kind, J.axis, theta[j])));
+      }
+      var cmds = spec.movers.map(function (m) {
+        var M = m.joint >= 0 ? T[m.joint] : EYE;
+        return {type: "set_transform", path: m.path, matrix: colMajor(m.offset ? mul(M, m.offset) : M)};
+      });
+      viewer.handle_command({type: "anthroarm_batch", path: "", commands: cmds});
+      window.anthroarm_teach = {theta: theta.slice(), poses: T};
+    }
+    var box = el("div", BOX + "max-height:85vh;overflow-y:auto;");
+    box.className = "anthroarm-teach";
+    box.appendChild(el("div", "font-weight:600;margin-bottom:2px", spec.title));
+    spec.sliders.forEach(function (s) {
+      var row = el("div", "display:grid;grid-template-columns:110px 150px 62px;align-items:center;gap:4px");
+      row.appendChild(el("span", "overflow:hidden;text-overflow:ellipsis;white-space:nowrap", s.name));
+      var input = el("input", "width:150px");
+      input.type = "range"; input.min = s.min; input.max = s.max; input.step = s.step; input.value = s.value;
+      input.dataset.joint = s.name;
+      var out = el("span", "text-align:right;font-variant-numeric:tabular-nums", s.value + " " + s.unit);
+      input.addEventListener("input", function () {
+        theta[s.joint] = parseFloat(input.value) * s.scale;
+        out.textContent = Number(input.value).toFixed(s.digits) + " " + s.unit;
+        pose();
+      });
+      row.appendChild(input); row.appendChild(out); box.appendChild(row);
+    });
+    return box;
+  }
+  function ui(path, spec) {
+    var key = split(path).join("/");
+    if (uiNodes[key]) { uiNodes[key].remove(); delete uiNodes[key]; }
+    var node = null;
+    if (spec.kind === "legend") { node = legend(spec); }
+    else if (spec.kind === "note") { node = el("div", BOX, spec.text); node.className = "anthroarm-note"; }
+    else if (spec.kind === "teach") { node = teach(spec); }
+    if (node === null) { return; }
+    var where = spec.kind === "teach" ? panel("anthroarm-teach", "position:absolute;left:8px;top:2px;z-index:10")
+                                      : panel("anthroarm-legends", "position:absolute;left:8px;bottom:8px;z-index:10");
+    where.appendChild(node);
+    uiNodes[key] = node;
+  }
   viewer.handle_command = function (cmd) {
     if (cmd.type === "anthroarm_batch") {
       for (var i = 0; i < cmd.commands.length; i++) { viewer.handle_command(cmd.commands[i]); }
@@ -51,6 +161,8 @@ JS_PATCH = r"""
       viewer.set_dirty();
       return;
     }
+    if (cmd.type === "anthroarm_ui") { ui(cmd.path, cmd.spec); return; }
+    if (cmd.type === "delete") { dropUi(cmd.path); }
     base(cmd);
     if (cmd.type === "set_object") {   // meshes sent without normals (PackedMesh): smooth normals here
       var made = viewer.scene_tree.find(split(cmd.path));
@@ -120,7 +232,7 @@ def split_path(path: str) -> tuple[str, ...]:
 
 
 class _Node:
-    __slots__ = ("children", "object", "transform", "properties", "color")
+    __slots__ = ("children", "object", "transform", "properties", "color", "ui")
 
     def __init__(self):
         self.children: dict[str, _Node] = {}
@@ -128,6 +240,7 @@ class _Node:
         self.transform: bytes | None = None
         self.properties: dict[str, bytes] = {}
         self.color: bytes | None = None
+        self.ui: bytes | None = None
 
 
 class SceneStore:
@@ -168,6 +281,8 @@ class SceneStore:
             self._find(parts).properties[cmd["property"]] = packed
         elif kind == "anthroarm_color":
             self._find(parts).color = packed
+        elif kind == "anthroarm_ui":
+            self._find(parts).ui = packed
         elif kind == "set_animation":
             self.animation = packed if cmd.get("animations") else None
         elif kind == "delete":
@@ -193,6 +308,8 @@ class SceneStore:
                 walk(child)
             if node.color is not None:  # after the children: colours every mesh below
                 out.append(node.color)
+            if node.ui is not None:
+                out.append(node.ui)
 
         walk(self.root)
         if self.animation is not None:

@@ -307,6 +307,79 @@ class Scene(Visualizer):
 
 
 
+def _box_corners(lo, hi) -> np.ndarray:
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])], float)
+
+
+def local_corners(g) -> np.ndarray | None:
+    """The 8 corners of a meshcat geometry's bounding box in its own frame (cylinders along y),
+    or None for geometry without known bounds (a mesh file sent as it is)."""
+    from .visuals import PackedMesh
+
+    kind = type(g).__name__
+    if isinstance(g, PackedMesh):
+        return _box_corners(g.grid.min(0), g.grid.max(0)) if len(g.faces) else None
+    if kind == "Sphere":
+        e = np.full(3, float(g.radius))
+    elif kind == "Ellipsoid":
+        e = np.asarray(g.radii, float)
+    elif kind == "Cylinder":
+        rr = max(float(g.radiusTop), float(g.radiusBottom))
+        e = np.array([rr, g.height / 2, rr])
+    elif kind == "Box":
+        e = np.asarray(g.lengths, float) / 2
+    else:
+        return None
+    return _box_corners(-e, e)
+
+
+def colormap_legend(title: str, colormap: str, vmin: float, vmax: float, n: int = 9) -> dict:
+    """The ``anthroarm_ui`` spec of a colour-bar legend: ``n`` colours of ``colormap`` from
+    ``vmin`` to ``vmax`` and three tick labels (min, middle, max)."""
+    from matplotlib import colormaps
+
+    stops = np.asarray(colormaps[colormap](np.linspace(0.0, 1.0, n)))[:, :3]
+    ticks = [f"{v:.3g}" for v in (vmin, 0.5 * (vmin + vmax), vmax)]
+    return {"kind": "legend", "title": str(title), "stops": [[round(float(c), 4) for c in rgb] for rgb in stops],
+            "ticks": ticks}
+
+
+def nice_length(x: float) -> float:
+    """The largest of 1, 2, 5 × 10^k metres not above ``x`` (> 0): grid spacings, scale bars."""
+    k = math.floor(math.log10(x))
+    for m in (5.0, 2.0, 1.0):
+        if m * 10.0 ** k <= x * (1 + 1e-9):
+            return m * 10.0 ** k
+    return 10.0 ** k  # pragma: no cover - unreachable
+
+
+def format_length(x: float) -> str:
+    """``0.05`` -> ``'5 cm'``, ``0.002`` -> ``'2 mm'``, ``2.0`` -> ``'2 m'``."""
+    for unit, f in (("m", 1.0), ("cm", 100.0), ("mm", 1000.0)):
+        if x * f >= 1 - 1e-9:
+            return f"{x * f:.3g} {unit}"
+    return f"{x * 1000:.3g} mm"
+
+
+def framing_distance(corners, direction, fill: float = 0.85, fov_deg: float = 75.0, aspect: float = 4 / 3) -> float:
+    """Camera distance from the orbit target (the origin) along the unit ``direction`` at which
+    every point of ``corners`` (K, 3; relative to the target) projects inside ``fill`` of the
+    vertical field of view ``fov_deg`` and of the horizontal one (width / height = ``aspect``);
+    z is up.  A point at depth D - c·d and offset (c·r, c·u) in the camera frame is inside when
+    D >= c·d + |c·u| / (fill tan(fov/2)) (and the same with r and the horizontal half-angle)."""
+    C = np.asarray(corners, float)
+    d = np.asarray(direction, float)
+    f = -d
+    r = np.cross(f, [0.0, 0.0, 1.0])
+    r = r / np.linalg.norm(r) if np.linalg.norm(r) > 1e-9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(r, f)
+    tv = fill * math.tan(math.radians(fov_deg) / 2)
+    th = fill * math.tan(math.radians(fov_deg) / 2) * aspect
+    depth = C @ d
+    need = np.maximum(depth + np.abs(C @ u) / tv, depth + np.abs(C @ r) / th)
+    return float(max(need.max(), 1e-3))
+
+
 class Viewer:
     """A meshcat scene showing one Robot.
 
@@ -331,9 +404,11 @@ class Viewer:
         headless software WebGL, where meshcat's gradient texture comes out inverted).
     q : array, optional
         Initial configuration (default ``robot.neutral()``).
-    grid : bool
-        Show meshcat's line grid (moved to the floor of the reach).  A translucent floor disc
-        is always drawn.
+    grid, axes, scale_bar : bool
+        Guides (each also switchable later: :meth:`set_grid`, :meth:`set_axes`,
+        :meth:`set_scale_bar`): a floor grid of :attr:`spacing` m squares through the base
+        origin, the world axes at the base origin, and a scale bar one grid square long with
+        a note giving its length.  A translucent floor disc is always drawn.
     mesh_triangles : int or None
         Most triangles each mesh file is drawn with
         (:data:`~anthroarm.viewer.visuals.MESH_TRIANGLES` by default): meshes are parsed,
@@ -343,8 +418,8 @@ class Viewer:
     """
 
     def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
-                 q=None, name: str | None = None, background=None, grid: bool = False,
-                 mesh_triangles: int | None = MESH_TRIANGLES):
+                 q=None, name: str | None = None, background=None, grid: bool = True, axes: bool = True,
+                 scale_bar: bool = True, mesh_triangles: int | None = MESH_TRIANGLES):
         from ..robot import Robot, load
 
         if isinstance(robot, (str, Path)):
@@ -374,7 +449,7 @@ class Viewer:
         self._animating = False
         self._colors: dict[str, tuple] = {}
         self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
-        self._frame_scene(background, grid)
+        self._frame_scene(background, grid, axes, scale_bar)
         self._send(self._body_objects(self.bodies))
         self.display(self.q)
 
@@ -401,33 +476,40 @@ class Viewer:
                     cmds.append(_set_transform(path, p.offset))
         return cmds
 
-    def _frame_scene(self, background, grid: bool) -> None:
-        """Centre the reach on meshcat's orbit target, place the camera and the grid."""
+    def _frame_scene(self, background, grid: bool, axes: bool, scale_bar: bool) -> None:
+        """Centre the robot on meshcat's orbit target, place the camera, the floor and the
+        guides (grid, world axes, scale bar)."""
         robot = self.robot
-        Q = robot.random_q(128, rng=0)
-        pts = []
         model, data = robot.model, robot.data
         tips = {robot.chain.frame(t).index for t in robot.chain.tips} | {robot.tool_id}
-        for qi in Q:
-            pin.framesForwardKinematics(model, data, qi)
-            pts.extend(np.array(data.oMi[j.index + 1].translation) for j in robot.chain.joints)
-            pts.extend(np.array(data.oMf[f].translation) for f in tips)
-        pts = np.asarray(pts + [np.zeros(3)])
-        lo, hi = pts.min(0), pts.max(0)
-        self.center = 0.5 * (lo + hi)
-        self.radius = float(max(np.linalg.norm(pts - self.center, axis=1).max(), 0.1))
+
+        def points(Q):
+            pts = []
+            for qi in Q:
+                pin.framesForwardKinematics(model, data, qi)
+                pts.extend(np.array(data.oMi[j.index + 1].translation) for j in robot.chain.joints)
+                pts.extend(np.array(data.oMf[f].translation) for f in tips)
+            return np.asarray(pts + [np.zeros(3)])
+
+        reach = points(robot.random_q(128, rng=0))        # the workspace: sizes and the floor
+        lo, hi = reach.min(0), reach.max(0)
+        mid = 0.5 * (lo + hi)
+        self.radius = float(max(np.linalg.norm(reach - mid, axis=1).max(), 0.1 * robot.length_scale, 1e-3))
+        # the framing: the robot as first displayed (its drawn pieces, joints and tips)
+        pose = np.vstack([points(self.q[None]), self._piece_corners(self.q)])
+        blo, bhi = pose.min(0), pose.max(0)
+        self.center = 0.5 * (blo + bhi)
+        self._reach_box = _box_corners(lo, hi) - self.center
+        self._frame_box = _box_corners(blo, bhi) - self.center
         cmds = [_set_transform(self.root, homogeneous(r=-self.center))]
-        floor = min(0.0, float(lo[2])) - 0.01  # base frame
-        cmds.append(_set_transform("/Grid", homogeneous(r=[0, 0, floor - self.center[2]])))
-        if not grid:
-            cmds.append(_set_property("/Grid", "visible", False))
-        # a translucent floor disc under the reach (always drawn; robust in software WebGL,
-        # where meshcat's line grid is drawn wrongly at oblique angles)
+        self.floor = floor = min(0.0, float(lo[2])) - 0.01  # base frame
+        cmds.append(_set_property("/Grid", "visible", False))     # meshcat's 20 m grid: ours fits the robot
+        cmds.append(_set_property("/Axes", "visible", False))
+        # a translucent floor disc under the reach (always drawn; robust in software WebGL)
         rf = 0.9 * self.radius
         disc = mg.Cylinder(0.004 * rf, rf)
         cmds.append(_set_object(f"{self.root}/floor", disc, (0.80, 0.83, 0.88), 0.4))
-        cmds.append(_set_transform(f"{self.root}/floor", homogeneous(_y_to([0, 0, 1]), [self.center[0], self.center[1], floor])))
-        cmds.append(_set_property("/Axes", "visible", False))
+        cmds.append(_set_transform(f"{self.root}/floor", homogeneous(_y_to([0, 0, 1]), [mid[0], mid[1], floor])))
         if background is None:
             cmds.append(_set_property("/Background", "visible", False))
         else:
@@ -435,17 +517,99 @@ class Viewer:
             cmds.append(_set_property("/Background", "top_color", [int(c) for c in top]))
             cmds.append(_set_property("/Background", "bottom_color", [int(c) for c in bottom]))
         self._send(cmds)
+        self._guides(mid, rf)
+        self.set_grid(grid)
+        self.set_axes(axes)
+        self.set_scale_bar(scale_bar)
         self.set_camera()
 
+    def _piece_corners(self, q) -> np.ndarray:
+        """Corners (K, 3), base frame, of the local bounding boxes of every drawn piece at ``q``
+        (mesh files sent as they are have no bounds here and are skipped)."""
+        model, data = self.robot.model, self.robot.data
+        pin.framesForwardKinematics(model, data, q)
+        out = [np.zeros((0, 3))]
+        for b in self.bodies:
+            M = np.eye(4) if b.joint is None and b.frame is None else (
+                data.oMi[b.joint + 1].homogeneous if b.joint is not None else data.oMf[b.frame].homogeneous)
+            for pc in b.pieces:
+                c = local_corners(pc.geometry)
+                if c is not None:
+                    A = M @ pc.offset
+                    out.append(c @ A[:3, :3].T + A[:3, 3])
+        return np.vstack(out)
+
+    def _guides(self, mid, rf: float) -> None:
+        """Grid lines on the floor (``spacing`` m apart, through the base origin), a world-axes
+        triad at the base origin, a scale bar ``spacing`` long on the floor in front of the robot
+        (the default camera's side)."""
+        self.spacing = sp = nice_length(2 * rf / 10)
+        n0 = np.floor((mid[:2] - rf) / sp).astype(int)
+        n1 = np.ceil((mid[:2] + rf) / sp).astype(int)
+        xs, ys = sp * np.arange(n0[0], n1[0] + 1), sp * np.arange(n0[1], n1[1] + 1)
+        z = self.floor + 0.002 * rf
+        segs = [[(x, ys[0], z), (x, ys[-1], z)] for x in xs] + [[(xs[0], y, z), (xs[-1], y, z)] for y in ys]
+        P = np.asarray(segs, np.float32).reshape(-1, 3)
+        grid = mg.LineSegments(mg.PointsGeometry(P.T), mg.LineBasicMaterial(color=0x7d8899, opacity=0.6, transparent=True))
+        cmds = [_set_object(f"{self.root}/grid", grid)]
+        size = 0.15 * self.radius
+        for k, piece in enumerate(self._triad(size, 0.04 * size)):
+            path = f"{self.root}/axes/{k}"
+            cmds += [_set_object(path, piece.geometry, piece.rgb), _set_transform(path, piece.offset)]
+        # the scale bar: `spacing` long, alternating dark and light fifths, at the grid's front-left
+        corner = self._frame_box.max(0)[:2] + self.center[:2]    # on the camera's side of the robot, on grid lines
+        a = np.array([sp * (np.floor(corner[0] / sp) - 1), sp * np.floor(corner[1] / sp), z + 0.006 * rf])
+        for k in range(5):
+            p0, p1 = a + [k * sp / 5, 0, 0], a + [(k + 1) * sp / 5, 0, 0]
+            for piece in cylinder_between(p0, p1, 0.012 * rf, (0.1, 0.1, 0.12) if k % 2 == 0 else (0.97, 0.97, 0.97)):
+                path = f"{self.root}/scale/{k}"
+                cmds += [_set_object(path, piece.geometry, piece.rgb), _set_transform(path, piece.offset)]
+        self._send(cmds)
+
+    def _ui(self, path: str, spec: dict) -> dict:
+        return {"type": "anthroarm_ui", "path": path, "spec": spec}
+
+    def set_grid(self, visible: bool = True) -> None:
+        """Show or hide the floor grid (lines :attr:`spacing` m apart through the base origin)."""
+        self._send([_set_property(f"{self.root}/grid", "visible", bool(visible))])
+
+    def set_axes(self, visible: bool = True) -> None:
+        """Show or hide the world axes at the robot's base origin (x red, y green, z blue)."""
+        self._send([_set_property(f"{self.root}/axes", "visible", bool(visible))])
+
+    def set_scale_bar(self, visible: bool = True) -> None:
+        """Show or hide the scale bar on the floor and its note (its length = the grid spacing)."""
+        cmds = [_set_property(f"{self.root}/scale", "visible", bool(visible))]
+        note = f"{self.root}/ui/scale"
+        if visible:
+            cmds.append(self._ui(note, {"kind": "note", "text": f"scale bar and grid squares: {format_length(self.spacing)}"}))
+        else:
+            cmds.append(_delete(note))
+        self._send(cmds)
+
     # ------------------------------------------------------------------ scene settings
-    def set_camera(self, direction=(0.9, 1.0, 0.45), distance: float | None = None) -> None:
-        """Look at the centre of the reach from ``direction`` (base-frame axes) at ``distance``
-        (default: the whole reach fits the 75° field of view)."""
+    def set_camera(self, direction=(0.9, 1.0, 0.45), distance: float | None = None, fill: float = 0.85,
+                   fit: str = "pose") -> None:
+        """Look at the robot from ``direction`` (base-frame axes) at ``distance`` m.
+
+        The default distance frames ``fit``: ``"pose"``, the box around the robot as displayed
+        now (every drawn piece), or ``"reach"``, the box around its workspace; the box
+        fills ``fill`` of meshcat's 75° vertical field of view (and of the horizontal one of a
+        4:3 view), seen from ``direction``."""
+        if fit not in ("pose", "reach"):
+            raise ValueError(f"fit must be 'pose' or 'reach', got {fit!r}")
         d = np.asarray(direction, float)
         if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) < 1e-9:
             raise ValueError(f"direction must be a non-zero finite 3-vector, got {direction!r}")
         d = d / np.linalg.norm(d)
-        dist = float(distance) if distance is not None else 1.08 * self.radius / math.sin(math.radians(37.5))
+        if not (0.1 <= float(fill) <= 1.0):
+            raise ValueError(f"fill must be in [0.1, 1], got {fill!r}")
+        if fit == "pose":   # the robot as displayed now, about the fixed orbit target
+            c = self._piece_corners(self.q)
+            box = _box_corners(c.min(0), c.max(0)) - self.center if len(c) else self._frame_box
+        else:
+            box = self._reach_box
+        dist = float(distance) if distance is not None else framing_distance(box, d, float(fill))
         if not (dist > 0 and math.isfinite(dist)):
             raise ValueError(f"distance must be positive and finite, got {distance!r}")
         x, y, z = dist * d
@@ -461,9 +625,6 @@ class Viewer:
             cmds.append(_set_property("/Background", "bottom_color", _rgb255(bottom, "bottom")))
         cmds.append(_set_property("/Background", "visible", bool(visible)))
         self._send(cmds)
-
-    def set_grid(self, visible: bool) -> None:
-        self._send([_set_property("/Grid", "visible", bool(visible))])
 
     # ------------------------------------------------------------------ poses
     def _all_bodies(self):
@@ -547,10 +708,19 @@ class Viewer:
         self._send([self._stop_command()])
 
     def show_limits(self, on: bool = True) -> None:
-        """Colour each link by how close its joint is to a limit (red within the last 15 %);
-        joints without limits (continuous joints) are skipped."""
+        """Colour each link by how close its joint is to a limit (red within the last 15 %),
+        with a colour legend; joints without limits (continuous joints) are skipped.
+        ``on=False`` restores the colours and removes the legend."""
         self._limits_on = bool(on)
-        self._send(self._color_commands(self.q))
+        legend = f"{self.root}/ui/limits"
+        if self._limits_on:
+            x = np.linspace(0.0, 1.0, 11)
+            spec = {"kind": "legend", "title": "joint-limit proximity (0: mid-range, 1: at a limit)",
+                    "stops": [list(limit_color(v)) for v in x], "ticks": ["0", "0.5", "1"]}
+            cmds = [self._ui(legend, spec)]
+        else:
+            cmds = [_delete(legend)]
+        self._send(self._color_commands(self.q) + cmds)
 
     # ------------------------------------------------------------------ overlays
     def _overlay_path(self, name: str) -> str:
@@ -643,19 +813,17 @@ class Viewer:
                        point_size: float | None = None) -> dict:
         """The reachable workspace of ``frame`` (default tool) as a point cloud of ``n`` random
         configurations inside the limits, coloured by translational manipulability
-        (:func:`manipulability`; viridis, yellow = most dexterous).  Returns
-        ``{"points": (n, 3), "manipulability": (n,)}``."""
+        (:func:`manipulability`; viridis, yellow = most dexterous), with its colour legend.
+        Returns ``{"points": (n, 3), "manipulability": (n,)}``."""
         if int(n) < 1:
             raise ValueError(f"n must be >= 1, got {n}")
         Q = self.robot.random_q(int(n), rng=rng)
         P = self.robot.fk(Q, frame)[:, :3, 3]
         w = manipulability(self.robot, Q, frame)
         top = float(w.max()) if w.size and w.max() > 0 else 1.0
-        colors = viridis(w / top)
-        size = point_size if point_size is not None else 0.02 * self.radius
-        cloud = mg.PointCloud(P.T.astype(np.float32), colors.T.astype(np.float32), size=size)
-        path = self._overlay_path(name)
-        self._send([_delete(path), _set_object(path, cloud)])
+        unit = f"m{'²³'[min(3, self.robot.nv) - 2]}" if self.robot.nv >= 2 else "m"
+        self.show_points(P, values=w, colormap="viridis", vmin=0.0, vmax=top, size=point_size, name=name,
+                         label=f"manipulability ({unit}; yellow = most dexterous)")
         return {"points": P, "manipulability": w}
 
     def show_points(self, points, colors=None, *, values=None, colormap: str = "viridis", vmin=None, vmax=None,
@@ -709,8 +877,8 @@ class Viewer:
         cloud = mg.PointCloud(P.T.astype(np.float32), C.T.astype(np.float32), size=size)
         path = self._overlay_path(name)
         self._send([_delete(path), _set_object(path, cloud)])
-        if values is not None and hasattr(self, "_legend_commands"):
-            self._send(self._legend_commands(_safe(name), label or name, colormap, lo, hi))
+        if values is not None:
+            self._send([self._ui(f"{path}/legend", colormap_legend(label or name, colormap, lo, hi))])
         return {"points": P, "colors": C, "vmin": lo, "vmax": hi}
 
     def show_arrows(self, origins, directions, colors=None, *, scale: float = 1.0, radius: float | None = None,
