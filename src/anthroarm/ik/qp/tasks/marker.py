@@ -4,7 +4,8 @@ For markers k = 1 … M, each fixed in the frame of joint j(k) at l_k (m):
 
     e_k(q) = p_k(q) − m_k,   p_k = ⁰R_j l_k + ⁰o_j,
     J_k(q) = J_v,j + J_ω,j × (p_k − ⁰o_j)     (LOCAL_WORLD_ALIGNED: the point's velocity in
-                                               world axes, from Pinocchio's joint Jacobian)
+                                               world axes; computed as the WORLD-frame columns
+                                               v_O + ω × p_k of the joints above the body)
 
 and the cost of marker k's three rows is √w_k, so that the task's objective is the marker-IK
 residual ½ Σ w_k ‖J_k Δq + e_k‖² (OpenSim's IK tool minimises the same weighted sum of squared
@@ -13,17 +14,14 @@ frame gets weight 0 (its rows drop out), which is how gaps are handled.
 
 Unlike :class:`~anthroarm.ik.qp.tasks.PositionTask` (the origin of one frame), this task takes
 any number of points at offsets in their bodies and evaluates them in one pass over the bodies
-that carry them (one ``getJointJacobian`` per body).
+that carry them and one read of the world-frame joint Jacobian (``data.J``).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from .base import Task
-
-_LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 class MarkerTask(Task):
@@ -58,8 +56,22 @@ class MarkerTask(Task):
         self.base_weights = w
         self.target = np.zeros((M, 3))
         self.visible = np.ones(M, dtype=bool)
-        self._groups = [(int(b), np.flatnonzero(joints == b)) for b in np.unique(joints) if b >= 0]
+        self._bodies = [int(b) for b in np.unique(joints) if b >= 0]
+        self._gidx = np.array([self._bodies.index(int(j)) if j >= 0 else 0 for j in joints], dtype=int)
         self._fixed = np.flatnonzero(joints < 0)
+        # mask[k, v]: velocity v moves marker k (v's joint is on the path from the base to k's body)
+        chain = robot.chain
+        mask = np.zeros((M, self.nv))
+        for k, j in enumerate(joints):
+            i = int(j)
+            while i >= 0:
+                jt = chain.joints[i]
+                src = chain.joints[jt.mimic.source] if jt.is_mimic else jt
+                mask[k, src.idx_v:src.idx_v + src.nv] = 1.0
+                i = jt.parent
+        self._mask = mask
+        self._R = np.zeros((len(self._bodies), 3, 3))
+        self._o = np.zeros((len(self._bodies), 3))
         self._p = np.zeros((M, 3))
         self._J = np.zeros((M, 3, self.nv))
         self._q_for = None
@@ -78,25 +90,29 @@ class MarkerTask(Task):
         self.cost = np.repeat(np.sqrt(self.base_weights * vis), 3)
 
     def _update(self, conf) -> None:
+        # one pass: the bodies' placements, then every marker at once from the world-frame joint
+        # Jacobian of computeJointJacobians (data.J: column v = (v_O; ω) of joint v's motion, v_O
+        # the velocity of the point at the world origin), J_k = mask_k · (v_O + ω × p_k)
         if self._q_for is conf.q:
             return
         data = conf.data
-        p, J = self._p, self._J
-        for b, idx in self._groups:
+        R, o = self._R, self._o
+        for i, b in enumerate(self._bodies):
             Mi = data.oMi[b + 1]
-            R = Mi.rotation
-            r = self.local[idx] @ R.T                      # (m, 3) lever arms, world axes
-            p[idx] = r + Mi.translation
-            Jb = pin.getJointJacobian(self.model, data, b + 1, _LWA)
-            Jv, Jw = Jb[:3], Jb[3:]
-            rx, ry, rz = r[:, 0:1], r[:, 1:2], r[:, 2:3]
-            # J_ω × r, column by column
-            J[idx, 0] = Jv[0] + Jw[1] * rz - Jw[2] * ry
-            J[idx, 1] = Jv[1] + Jw[2] * rx - Jw[0] * rz
-            J[idx, 2] = Jv[2] + Jw[0] * ry - Jw[1] * rx
+            R[i] = Mi.rotation
+            o[i] = Mi.translation
+        g = self._gidx
+        p = np.einsum("mij,mj->mi", R[g], self.local) + o[g]
+        Jw = data.J
+        lin, ang = Jw[:3], Jw[3:]
+        px, py, pz = p[:, 0:1], p[:, 1:2], p[:, 2:3]
+        J, mask = self._J, self._mask
+        np.multiply(lin[0] + ang[1] * pz - ang[2] * py, mask, out=J[:, 0])
+        np.multiply(lin[1] + ang[2] * px - ang[0] * pz, mask, out=J[:, 1])
+        np.multiply(lin[2] + ang[0] * py - ang[1] * px, mask, out=J[:, 2])
         if self._fixed.size:
             p[self._fixed] = self.local[self._fixed]
-            J[self._fixed] = 0.0
+        self._p = p
         self._q_for = conf.q
 
     def positions(self, conf) -> np.ndarray:
