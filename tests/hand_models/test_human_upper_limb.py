@@ -31,10 +31,6 @@ def limb():
     return aa.load("human_upper_limb")
 
 
-def _fk(robot, q, frame):
-    return robot.fk(q, frame=frame)
-
-
 def test_mobility_is_the_books_27_and_20():
     spec = aa.models.spec("human_upper_limb")
     m = mechanism_of(spec)

@@ -25,8 +25,6 @@ Load a fingertip as the tool with ``aa.load("human_upper_limb", tool="index_tip"
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..spatial.rotations import homogeneous
 from .hand import (BREADTH_RATIO, BUCHHOLZ_1992, hand_chain, hand_dimensions, palm_link,
                    parse_coupling)

@@ -157,8 +157,8 @@ class ChainSpec:
 
     @property
     def nq(self) -> int:
-        """Number of configuration variables: the joints that do not mimic another."""
-        return sum(1 for j in self.joints if j.mimic is None)
+        """Number of configuration variables: the joints that are not fixed and do not mimic another."""
+        return sum(1 for j in self.joints if j.mimic is None and j.type != "fixed")
 
 
 def dh_matrix(row: DHRow, q: float) -> np.ndarray:
