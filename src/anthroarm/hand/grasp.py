@@ -53,6 +53,8 @@ from .objects import Cylinder, Sphere
 #: success criteria of the issue: every fingertip within 1 mm, its normal within 5°
 POSITION_TOL = 1e-3
 NORMAL_TOL = math.radians(5.0)
+#: iterations without a 1 % improvement of the best error after which an attempt has stalled
+STALL_WINDOW = 25
 
 
 @dataclass
@@ -378,7 +380,7 @@ def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iter
             break
         score = max(pe.max() / position_tol, ne.max() / normal_tol)
         history.append(score)
-        if len(history) > 25 and score > 0.99 * history[-26]:
+        if len(history) > STALL_WINDOW and score > 0.99 * min(history[:-STALL_WINDOW]):
             status = "stalled"
             break
         if it >= max_iterations:

@@ -2,11 +2,15 @@
 
 :func:`reachable_grasps` draws grasp problems that are solvable by construction:
 
-1. an object (cylinder or sphere) of random radius is placed in the **palm frame** in front of
-   the palm (on the side the pads face, from :mod:`anthroarm.hand.fingers`), and the fingers
+1. an object (cylinder or sphere) of random radius r is placed in the **palm frame** in front of
+   the palm (:func:`palm_axes`: r + 5..25 mm along the mean pad normal of the open hand,
+   10..40 % of the fingers' length along them, ±1 cm across; a cylinder's axis across the
+   palm, tilted at random), and the fingers
    alone (arm held, :func:`~anthroarm.hand.grasp.solve_grasp` with ``move_arm=False``, sliding
-   contacts) are closed on it from the open hand; draws where that fails are discarded;
-2. the arm is drawn uniformly inside its limits (``margin`` rad); the witness is that arm
+   contacts, to 0.2 mm and 1°) are closed on it from the open hand; draws where that fails are
+   discarded;
+2. the arm is drawn uniformly inside its limits (``arm_margin`` rad), ``per_hand`` times per
+   hand grasp of step 1 (each a different problem: the arm is what a solver must find); the witness is that arm
    configuration with the finger configuration of step 1, and the object is carried with the
    palm (its pose relative to the palm is what step 1 solved);
 3. the contact points are the fingertips of the witness (Pinocchio FK).
@@ -85,9 +89,29 @@ def open_hand(robot, hand: Hand, q=None) -> np.ndarray:
     return q
 
 
+def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
+    """(T_palm_obj, object in the world) of radius ``r`` fitted to the pads at ``q``: the centres
+    p_i + r n_i (fingertip p_i, pad normal n_i, palm frame), their mean as the centre and, for a
+    cylinder, their principal direction as the axis (a sphere's frame takes ``across`` as z); the
+    fingertips weighted by ``weights`` (default equal)."""
+    pin.framesForwardKinematics(model, data, q)
+    Mp = data.oMf[hand.palm_id]
+    centres = np.array([Mp.actInv(data.oMf[f.tip_id]).act(r * f.pad_axis) for f in hand.fingers])
+    w = np.ones(len(centres)) if weights is None else np.asarray(weights, dtype=float)
+    w = w / w.sum()
+    c = w @ centres
+    axis = np.linalg.svd((centres - c) * np.sqrt(w)[:, None])[2][0] if kind == "cylinder" else across
+    T_palm_obj = np.eye(4)
+    T_palm_obj[:3, :3] = _frame(axis)
+    T_palm_obj[:3, 3] = c
+    Tw = Mp0.homogeneous @ T_palm_obj
+    obj = Cylinder(Tw[:3, 3], Tw[:3, 2], r) if kind == "cylinder" else Sphere(Tw[:3, 3], r)
+    return T_palm_obj, obj
+
+
 def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand | None = None,
                      radius=(0.015, 0.04), arm_margin: float = 0.2, max_draws: int | None = None,
-                     solver: str = "daqp") -> list[GraspProblem]:
+                     solver: str = "daqp", per_hand: int = 1, rounds: int = 6) -> list[GraspProblem]:
     """``n`` reachable grasp problems (see the module docstring).
 
     Parameters
@@ -105,6 +129,10 @@ def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand
         Give up after this many objects (default 20 n); fewer problems are returned then.
     solver : str
         QP backend of step 1.
+    per_hand : int
+        Arm configurations drawn per hand grasp of step 1 (a hand without arm joints: 1).
+    rounds : int
+        Fit-and-close rounds of step 1 per draw.
     """
     if kind not in ("cylinder", "sphere"):
         raise ValueError(f"kind must be 'cylinder' or 'sphere', got {kind!r}")
@@ -116,8 +144,10 @@ def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand
     pin.framesForwardKinematics(model, data, q_open)
     Mp0 = pin.SE3(data.oMf[hand.palm_id])
     nrm, fdir, across = palm_axes(hand, q_open)
-    tips0 = np.array([Mp0.actInv(data.oMf[f.tip_id]).translation for f in hand.fingers])
-    depth = float(np.mean(tips0 @ fdir))          # how far the fingers reach along the hand
+    fq = hand.finger_q_indices
+    lo_f, hi_f = robot.chain.lower[fq], robot.chain.upper[fq]
+    lo_f = np.where(np.isfinite(lo_f), lo_f, -np.pi)
+    hi_f = np.where(np.isfinite(hi_f), hi_f, np.pi)
     arm_q = []
     for i in hand.arm_joints:
         j = robot.chain.joints[i]
@@ -131,26 +161,34 @@ def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand
     while len(out) < n and draws < max_draws:
         draws += 1
         r = float(rng.uniform(*radius))
-        c = (nrm * (r + rng.uniform(0.005, 0.025)) + fdir * depth * rng.uniform(0.1, 0.4)
-             + across * rng.uniform(-0.01, 0.01))
-        axis = across + 0.3 * rng.uniform(-1, 1, 3)
-        R = _frame(axis)
-        T_palm_obj = np.eye(4)
-        T_palm_obj[:3, :3] = R
-        T_palm_obj[:3, 3] = c
-        Tw = Mp0.homogeneous @ T_palm_obj
-        obj = Cylinder(Tw[:3, 3], Tw[:3, 2], r) if kind == "cylinder" else Sphere(Tw[:3, 3], r)
-        res = solve_grasp(robot, obj, hand=hand, q0=q_open, move_arm=False, solver=solver, restarts=0,
-                          max_iterations=100,
-                          position_tol=2e-4, normal_tol=np.radians(1.0))
-        if not res.success:
+        # a random half-closed hand; the object fitted to where its pads point, then the fingers
+        # closed on it and the object fitted again (alternation: the pair becomes consistent)
+        q_h = q_open.copy()
+        q_h[fq] = lo_f + (hi_f - lo_f) * rng.uniform(0.2, 0.8, len(fq))
+        res = None
+        w = None
+        for _ in range(rounds):
+            T_palm_obj, obj = _fit_object(hand, model, data, q_h, Mp0, r, kind, across, w)
+            if obj.size > hand.span:
+                break
+            res = solve_grasp(robot, obj, hand=hand, q0=q_h, move_arm=False, solver=solver, restarts=0,
+                              max_iterations=40, position_tol=2e-4, normal_tol=np.radians(1.0))
+            if res.success:
+                break
+            q_h = res.q
+            # the fingers that did not reach pull the next fit toward them
+            w = 1.0 + res.position_errors / 1e-3 + res.normal_errors / np.radians(5.0)
+        if res is None or not res.success:
             continue
-        q = res.q.copy()
-        if arm_q:
-            q[arm_q] = robot.random_q(rng=rng, margin=margin)[arm_q]
-        pin.framesForwardKinematics(model, data, q)
-        Tw = data.oMf[hand.palm_id].homogeneous @ T_palm_obj
-        obj = Cylinder(Tw[:3, 3], Tw[:3, 2], r) if kind == "cylinder" else Sphere(Tw[:3, 3], r)
-        contacts = np.array([data.oMf[f.tip_id].translation for f in hand.fingers])
-        out.append(GraspProblem(obj, contacts, q, T_palm_obj))
+        for _ in range(int(per_hand) if arm_q else 1):
+            if len(out) >= n:
+                break
+            q = res.q.copy()
+            if arm_q:
+                q[arm_q] = robot.random_q(rng=rng, margin=margin)[arm_q]
+            pin.framesForwardKinematics(model, data, q)
+            Tw = data.oMf[hand.palm_id].homogeneous @ T_palm_obj
+            obj = Cylinder(Tw[:3, 3], Tw[:3, 2], r) if kind == "cylinder" else Sphere(Tw[:3, 3], r)
+            contacts = np.array([data.oMf[f.tip_id].translation for f in hand.fingers])
+            out.append(GraspProblem(obj, contacts, q, T_palm_obj))
     return out
