@@ -8,11 +8,11 @@ covers the joint when all five utilisations are ≤ 1:
 
 ``voltage``
     max |V(τ, ω, α)| / V_nom, with V = R I + k_m i ω and I = (J_m i α + τ_gear)/k_m
-    (:meth:`DCMotor.voltage`): every (torque, speed) point lies under the torque–speed line at
-    the nominal voltage, the rotor's inertia included;
+    (:meth:`anthroarm.control.motor.DCMotor.voltage`): every (torque, speed) point lies under
+    the torque–speed line at the nominal voltage, the rotor's inertia included;
 ``thermal``
     RMS of the motor torque over each activity / the rated continuous torque
-    (:meth:`DCMotor.thermal_check`), the largest over the activities;
+    (:meth:`anthroarm.control.motor.DCMotor.thermal_check`), the largest over the activities;
 ``gear_peak``
     max |τ| / the gearbox's intermittent output torque;
 ``gear_rms``
