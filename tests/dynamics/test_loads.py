@@ -219,3 +219,20 @@ def test_bad_wrenches_and_trajectories(person):
         L.inverse_dynamics(person, q, qd, qdd, [object()])
     with pytest.raises(ValueError, match="engine"):
         L.inverse_dynamics(person, q, qd, qdd, engine="newton")
+
+
+def test_lagrange_with_the_load_term_equals_lagrange_of_the_arm_carrying_the_object(person):
+    """The Lagrange path: τ from the generated Lagrange code minus Jᵀw (Eq. (8-5)) equals the
+    generated Lagrange code of a second arm whose hand body carries the object (its T and V
+    include the object), i.e. the external wrench enters the Lagrange equations (8-8) as Q."""
+    from anthroarm.dynamics import lagrange
+
+    cup = L.HeldObject(0.7, com=[0.01, 0.02, 0.06], inertia=np.diag([6e-4, 6e-4, 4e-4]))
+    model = person.model.copy()
+    fr = model.frames[person.tool_id]
+    model.inertias[fr.parentJoint] = model.inertias[fr.parentJoint] + fr.placement.act(
+        pin.Inertia(cup.mass, cup.com, cup.inertia))
+    heavy = aa.load(model, tool=person.tool)
+    q, qd, qdd = _traj(person, 10, 9)
+    res = L.inverse_dynamics(person, q, qd, qdd, cup, engine="lagrange")
+    np.testing.assert_allclose(res.tau, lagrange.load(heavy).tau(q, qd, qdd), atol=1e-9, rtol=1e-10)
