@@ -67,33 +67,32 @@ def joint_figure(study, j: int):
 
     env, js = study.envelope, study.sizing.joints[j]
     name = env.joint_names[j]
-    fig = Figure(figsize=(10, 3.2))
-    a0, a1 = fig.subplots(1, 2)
+    fig = Figure(figsize=(12, 3.4))
+    a0, a1 = fig.subplots(1, 2, gridspec_kw=dict(wspace=0.6))
     scale = 1.0 + study.sizing.margin
     wmax = 0.0
     for act in env.activities:
         a0.plot(act.t - act.t[0], act.tau[:, j], lw=1.2, label=act.name)
-        a1.plot(np.abs(act.qd[:, j]), np.abs(act.tau[:, j]), ".", ms=2.5, label=act.name)
+        a1.plot(np.abs(act.qd[:, j]), np.abs(act.tau[:, j]), ".", ms=2.5)
         wmax = max(wmax, float(np.max(np.abs(act.qd[:, j]))))
     a0.set_xlabel("t [s]")
     a0.set_ylabel(f"{name} torque [N m]")
     a0.axhline(0, color="k", lw=0.5)
-    a0.legend(fontsize=6, ncol=2)
+    a0.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     cand = js.choice or js.closest
     if cand is not None:
         dc = cand.dc_motor()
         w0 = float(dc.no_load_speed())
         w = np.linspace(0.0, w0, 100)
-        a1.plot(w, dc.joint_torque(w), "k-", lw=1.5, label=f"torque-speed line {dc.V_nom:g} V")
-        a1.axhline(dc.continuous_torque, color="tab:red", ls="--", lw=1, label="continuous torque")
+        a1.plot(w, dc.joint_torque(w), "k-", lw=1.5, label=f"torque-speed line at {dc.V_nom:g} V (9-1)")
+        a1.axhline(dc.continuous_torque, color="tab:red", ls="--", lw=1, label="motor continuous torque")
         a1.axhline(cand.gearbox.tau_max, color="tab:purple", ls=":", lw=1, label="gearbox intermittent")
         a1.set_xlim(0, max(min(w0, 3.0 * wmax * scale), wmax * scale, 1e-3) * 1.05)
         a1.set_ylim(0, max(cand.gearbox.tau_max, env.peak_torque[j] * scale, dc.continuous_torque) * 1.15)
         a1.set_title(("" if js.choice else "closest, does not fit: ") + cand.name, fontsize=8)
     a1.set_xlabel(f"|{name} speed| [rad/s]")
     a1.set_ylabel("|torque| [N m]")
-    a1.legend(fontsize=6)
-    fig.tight_layout()
+    a1.legend(fontsize=6, loc="upper right")
     return fig
 
 
