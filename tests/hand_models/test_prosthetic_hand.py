@@ -130,6 +130,10 @@ def test_solve_returns_tips_and_statuses(hand, loop):
         ph.solve(loop, {"index_mcp": float("nan")}, hand)
     with pytest.raises(ParameterError):
         ph.solve(loop, [0.1, 0.2], hand)
+    with pytest.raises(ParameterError):
+        ph.solve(loop, ["a", "b", "c", "d", "e"], hand)
+    with pytest.raises(ParameterError):
+        ph.solve(loop, {"thumb_r1": "wide"}, hand)
 
 
 def test_inconsistent_passive_joints_are_reported(hand, loop):

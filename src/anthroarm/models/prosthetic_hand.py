@@ -239,13 +239,13 @@ def _drivers(loop: ClosedLoop, drivers) -> np.ndarray:
             raise ParameterError(f"prosthetic_hand: unknown driver(s) {unknown}; drivers: {', '.join(names)}")
         vals = [drivers.get(n, 0.0) for n in names]
     else:
-        vals = list(np.atleast_1d(np.asarray(drivers, dtype=float)))
-        if len(vals) != len(names):
-            raise ParameterError(f"prosthetic_hand: {len(names)} drivers ({', '.join(names)}), got {len(vals)}")
+        vals = drivers
     try:
-        x = np.array(vals, dtype=float)
+        x = np.atleast_1d(np.array(vals, dtype=float))
     except (TypeError, ValueError):
         raise ParameterError(f"prosthetic_hand: drivers must be numbers (rad), got {drivers!r}") from None
+    if x.shape != (len(names),):
+        raise ParameterError(f"prosthetic_hand: {len(names)} drivers ({', '.join(names)}), got shape {x.shape}")
     if not np.all(np.isfinite(x)):
         raise ParameterError(f"prosthetic_hand: drivers must be finite (rad), got {x.tolist()}")
     return x
