@@ -29,6 +29,18 @@ def test_adl_activities_carry_the_library_objects(person):
         study.adl_activities(person, payload=-1.0, names=["reach_shelf"])
 
 
+def test_adl_activity_out_of_reach_is_a_status(person):
+    """Targets placed for a 2.4 m person: the 1.75 m arm cannot reach the door handle; the
+    activity keeps status "unreachable", the keyframe and the distance, and stays out of the
+    envelope."""
+    acts = study.adl_activities(person, payload=0.5, names=["open_door", "reach_shelf"], height=2.4)
+    door = acts[0]
+    assert door["status"] == "unreachable" and "'handle' out of reach" in door["reason"]
+    st = study.run(person, acts, payload=0.5)
+    assert [a.name for a in st.envelope.skipped] == ["open_door"]
+    assert [a.name for a in st.envelope.activities] == ["reach_shelf"]
+
+
 def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
     t = np.linspace(0, 1.0, 51)
     q0 = person.neutral()

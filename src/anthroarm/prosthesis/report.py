@@ -127,8 +127,9 @@ def _person_section(study) -> str:
                      f"{np.degrees(j.lower):.0f}", f"{np.degrees(j.upper):.0f}"))
     who = ", ".join(f"{k} {v}" + (" m" if k == "height" else " kg" if k == "mass" else "") for k, v in p.items())
     return (f"<h2>The person's arm model</h2><p>{_e(robot.name)} ({robot.nv} joints) for {_e(who)}; "
-            f"held object: a solid cylinder (r = 4 cm, h = 10 cm) at the hand point, at least {study.payload:g} kg; "
-            "its largest mass in each activity is in the activities' table.</p>"
+            "held object: a solid cylinder (r = 4 cm, h = 10 cm) at the hand point"
+            + (f", at least {study.payload:g} kg" if study.payload > 0 else "")
+            + "; its largest mass in each activity is in the activities' table.</p>"
             + _table(["joint", "link mass [kg]", "offset from parent [m]", "lower [deg]", "upper [deg]"], rows))
 
 

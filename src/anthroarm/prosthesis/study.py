@@ -101,21 +101,23 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     return Study(robot, person, acts, env, res, rules, payload, cat, timings)
 
 
-def adl_activities(robot, payload: float | None = None, names=None, *, rate: float = 100.0) -> list[dict]:
+def adl_activities(robot, payload: float | None = None, names=None, *, rate: float = 100.0,
+                   height: float | None = None) -> list[dict]:
     """The daily-living activities of :mod:`anthroarm.motion.activities` (all of them, or
     ``names``) for ``robot``, as activity dicts for :func:`run`.
 
     The mass in the hand per sample is the library's object (``object_mass`` while the
     activity holds it); with ``payload`` (kg) the hand carries at least ``payload`` all the
     time: ``max(payload, object mass while holding)``.  An activity with a keyframe out of the
-    arm's reach gets status "unreachable" and a reason naming the keyframe and the distance."""
+    arm's reach gets status "unreachable" and a reason naming the keyframe and the distance.
+    ``height`` (m): place the targets for a person of this stature (default: the model's)."""
     from ..motion import activities as adl
 
     if payload is not None and not (np.isfinite(payload) and 0.0 <= payload <= 50.0):
         raise ActivityError(f"payload must be in [0, 50] kg, got {payload}")
     out = []
     for name in (adl.names() if names is None else list(names)):
-        tr = adl.activity_trajectory(robot, name, rate=rate)
+        tr = adl.activity_trajectory(robot, name, rate=rate, height=height)
         mass = tr.payload if payload is None else np.maximum(tr.payload, payload)
         spec = dict(name=name, t=tr.t, q=tr.q, qd=tr.qd, qdd=tr.qdd, payload=mass, title=tr.activity.title)
         if not tr.reachable:
