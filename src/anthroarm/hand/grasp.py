@@ -189,7 +189,7 @@ def _fit_palm(hand: Hand, data, points, obj) -> np.ndarray:
 
 
 def palm_approach(hand: Hand, points, obj, q, rng=None, seed_arm: bool = False, rounds: int = 3,
-                  solver: str = "daqp") -> np.ndarray:
+                  solver: str = "daqp", step_fn=None) -> np.ndarray:
     """A start for a grasp with given contact ``points``: the arm joints of ``q`` moved so that the
     palm sits where a hand shape fits the contacts, the finger joints shaped for them.
 
@@ -219,7 +219,7 @@ def palm_approach(hand: Hand, points, obj, q, rng=None, seed_arm: bool = False, 
         X = data.oMf[hand.palm_id].homogeneous @ np.linalg.inv(T)     # world → current palm placement
         pts = points @ X[:3, :3].T + X[:3, 3]
         res = solve_grasp(robot, obj.transformed(X), pts, hand=hand, q0=cur, move_arm=False, restarts=0,
-                          max_iterations=30, solver=solver)
+                          max_iterations=30, solver=solver, step_fn=step_fn)
         cur[fq] = res.q[fq]
     q_start = cur
     if seed_arm:
@@ -237,7 +237,7 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
                 max_iterations: int = 300, max_step: float = 0.2, position_cost: float = 1.0,
                 normal_cost: float = 0.1, lm_damping: float = 1e-3, posture_cost: float = 0.0,
                 position_tol: float = POSITION_TOL, normal_tol: float = NORMAL_TOL, solver: str = "daqp",
-                tasks=(), restarts: int = 10, seed=0, move_arm: bool = True) -> GraspResult:
+                tasks=(), restarts: int = 10, seed=0, move_arm: bool = True, step_fn=None) -> GraspResult:
     """Grasp ``obj`` (a :class:`~anthroarm.hand.objects.Sphere` or
     :class:`~anthroarm.hand.objects.Cylinder`, world frame) with the fingertips of ``robot``.
 
@@ -284,6 +284,10 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     move_arm : bool
         False holds the arm's joints (those all fingertips share, :attr:`Hand.arm_joints`) at
         their values in ``q0``: a grasp with the palm where it is.
+    step_fn : callable, optional
+        Replaces :func:`anthroarm.ik.qp.step` in the iterations: ``step_fn(conf, tasks, limits,
+        couplings, solver)`` returns an object with ``v`` (nv,), ``ok`` and ``status``, ``info``
+        (benchmarks/bench_hand.py runs the same loop on pink's ``solve_ik`` this way).
 
     Returns
     -------
@@ -344,16 +348,17 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
         if attempt:
             start = best[0].copy()               # arm where the best attempt left it, fingers anew
             if approach and attempt % 2 == 1:    # or, every other time, a new arm branch
-                start = palm_approach(hand, points, obj, start, rng=rng, seed_arm=True, solver=solver)
+                start = palm_approach(hand, points, obj, start, rng=rng, seed_arm=True, solver=solver,
+                                      step_fn=step_fn)
             else:
                 start[fq] = robot.random_q(rng=rng)[fq]
             conf.update(start)
             if posture_cost:
                 all_tasks[-1].set_target(conf.q)
         elif approach:
-            conf.update(palm_approach(hand, points, obj, conf.q, rng=rng, solver=solver))
+            conf.update(palm_approach(hand, points, obj, conf.q, rng=rng, solver=solver, step_fn=step_fn))
         out = _descend(conf, hand, obj, points, all_tasks, limits, couplings, solver, max_iterations,
-                       position_tol, normal_tol)
+                       position_tol, normal_tol, step_fn)
         total += out[2]
         score = max(out[3].max() / position_tol, out[4].max() / normal_tol)
         if best is None or out[1] == "success" or score < best[-1]:
@@ -365,7 +370,8 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
                        within, dict(info, attempts=attempt + 1))
 
 
-def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iterations, position_tol, normal_tol):
+def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iterations, position_tol, normal_tol,
+             step_fn=None):
     """QP iterations from ``conf`` until the criteria hold, the step vanishes, the error stops
     improving (by 1 % over 25 iterations: ``"stalled"``) or ``max_iterations``."""
     status = "max_iterations"
@@ -385,8 +391,11 @@ def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iter
             break
         if it >= max_iterations:
             break
-        res = qp.step(conf, None, tasks, 1.0, limits=limits, solver=solver, damping=1e-9,
-                      constraints=couplings, full=True)
+        if step_fn is None:
+            res = qp.step(conf, None, tasks, 1.0, limits=limits, solver=solver, damping=1e-9,
+                          constraints=couplings, full=True)
+        else:
+            res = step_fn(conf, tasks, limits, couplings, solver)
         if not res.ok:
             status = f"qp_{res.status}"
             info = res.info
