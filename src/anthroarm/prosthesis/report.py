@@ -120,17 +120,24 @@ def _viewer_html(study, max_frames: int = 600) -> str:
 
 def _person_section(study) -> str:
     robot = study.robot
+    chain = robot.chain
     p = study.person
     rows = []
-    for j in robot.chain.joints:
-        rows.append((j.name, f"{j.mass:.3f}", f"{np.linalg.norm(j.translation):.3f}",
-                     f"{np.degrees(j.lower):.0f}", f"{np.degrees(j.upper):.0f}"))
+    for j in chain.joints:
+        rows.append((j.name, j.kind, np.array2string(np.round(j.axis, 3), separator=", "), f"{j.mass:.3f}",
+                     f"{np.linalg.norm(j.translation):.3f}", f"{np.degrees(j.lower):.0f}", f"{np.degrees(j.upper):.0f}"))
     who = ", ".join(f"{k} {v}" + (" m" if k == "height" else " kg" if k == "mass" else "") for k, v in p.items())
-    return (f"<h2>The person's arm model</h2><p>{_e(robot.name)} ({robot.nv} joints) for {_e(who)}; "
+    spec = dict(robot.spec.params) if robot.spec is not None else {}
+    extra = ", ".join(f"{k} = {v:.3f} m" for k, v in spec.items() if k not in p and isinstance(v, float))
+    total = sum(j.mass for j in chain.joints)
+    return (f"<h2>The person's arm model</h2><p>{_e(robot.name)} ({robot.nv} joints) for {_e(who)}"
+            + (f" ({_e(extra)})" if extra else "")
+            + f"; arm mass {total:.2f} kg, reach {chain.reach():.3f} m; "
             "held object: a solid cylinder (r = 4 cm, h = 10 cm) at the hand point"
             + (f", at least {study.payload:g} kg" if study.payload > 0 else "")
             + "; its largest mass in each activity is in the activities' table.</p>"
-            + _table(["joint", "link mass [kg]", "offset from parent [m]", "lower [deg]", "upper [deg]"], rows))
+            + _table(["joint", "kind", "axis (joint frame)", "its link's mass [kg]", "offset from parent [m]",
+                      "lower [deg]", "upper [deg]"], rows, left=(0, 1, 2)))
 
 
 def _fmt_ok(ok):
