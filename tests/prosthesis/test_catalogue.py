@@ -91,3 +91,14 @@ def test_missing_file_and_no_mounting_pair(tmp_path):
         C.load(m, g)
     g2 = _write(tmp_path, "g2.csv", f"{GEAR_HEADER}\n{GOOD_GEAR}\n")
     assert len(C.load(m, g2).combinations()) == 1
+
+
+def test_a_spreadsheet_bom_is_read(tmp_path):
+    m = tmp_path / "m.csv"
+    m.write_bytes(("\ufeff" + f"{MOTOR_HEADER}\n{GOOD_MOTOR}\n").encode("utf-8"))
+    (motor,) = C.load_motors(m)
+    assert motor.name == "M1" and motor.k_m == pytest.approx(0.020)
+    bad = tmp_path / "bin.csv"
+    bad.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(CatalogueError, match="UTF-8"):
+        C.load_motors(bad)

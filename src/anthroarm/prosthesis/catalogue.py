@@ -123,7 +123,7 @@ def _rows(path, columns):
     """(line number, dict) per data row; checks the header."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")      # a spreadsheet may write a BOM
     except FileNotFoundError:
         raise CatalogueError("file not found", path) from None
     except IsADirectoryError:
@@ -239,7 +239,7 @@ def load(motors=None, gearboxes=None) -> Catalogue:
 def source_note(path) -> str:
     """The ``#`` comment lines at the top of a catalogue file (its source), joined."""
     lines = []
-    for line in Path(path).read_text(encoding="utf-8").splitlines():
+    for line in Path(path).read_text(encoding="utf-8-sig").splitlines():
         if not line.lstrip().startswith("#"):
             break
         lines.append(line.lstrip()[1:].strip())
