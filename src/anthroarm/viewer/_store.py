@@ -121,7 +121,7 @@ JS_PATCH = r"""
       var input = el("input", "width:150px");
       input.type = "range"; input.min = s.min; input.max = s.max; input.step = s.step; input.value = s.value;
       input.dataset.joint = s.name;
-      var out = el("span", "text-align:right;font-variant-numeric:tabular-nums", s.value + " " + s.unit);
+      var out = el("span", "text-align:right;font-variant-numeric:tabular-nums", Number(s.value).toFixed(s.digits) + " " + s.unit);
       input.addEventListener("input", function () {
         theta[s.joint] = parseFloat(input.value) * s.scale;
         out.textContent = Number(input.value).toFixed(s.digits) + " " + s.unit;

@@ -97,14 +97,18 @@ def live_tab(url, size=(800, 600)):
     """A headless Chromium tab on ``url`` (e.g. a live viewer's page) for the duration of the
     ``with`` block.  On exit the browser and every process it started are stopped and waited
     for (bounded), then the profile folder is removed (never raises).  RuntimeError if there
-    is no Chromium."""
+    is no Chromium.  :class:`DevTools` ``(tab)`` drives the page (scripts, mouse events)."""
     exe = find_chromium()
     if exe is None:
         raise RuntimeError("no chromium on PATH (Debian: apt-get install chromium)")
+    url = str(url)
+    if "://" not in url:
+        url = Path(url).resolve().as_uri()
     prof = tempfile.mkdtemp(prefix="anthroarm-chromium-")
     try:
         proc = subprocess.Popen([exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}",
-                                 f"--window-size={int(size[0])},{int(size[1])}", "--remote-debugging-port=0", str(url)],
+                                 f"--window-size={int(size[0])},{int(size[1])}", "--remote-debugging-port=0",
+                                 "--remote-debugging-address=127.0.0.1", url],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
                                 start_new_session=True)
     except BaseException:
@@ -115,6 +119,113 @@ def live_tab(url, size=(800, 600)):
     finally:
         stop_browser(proc)
         remove_profile(prof)
+
+
+class DevTools:
+    """A Chrome DevTools Protocol connection (over a websocket on 127.0.0.1) to the page of a
+    :func:`live_tab`: run JavaScript in it (:meth:`evaluate`) and send it real input events
+    (:meth:`drag`), as a person's mouse would.  Used by the viewer's teach-slider tests.
+
+    >>> with live_tab(url) as tab, DevTools(tab) as page:
+    ...     page.wait_for("window.anthroarm_ready === true")
+    ...     page.drag((x0, y), (x1, y))
+    """
+
+    def __init__(self, tab: Tab, timeout: float = 60.0):
+        import asyncio
+        import json
+        import urllib.request
+
+        from tornado.websocket import websocket_connect
+
+        self.timeout = float(timeout)
+        deadline = time.monotonic() + self.timeout
+        port_file = Path(tab.profile) / "DevToolsActivePort"
+        while not port_file.is_file() or not port_file.read_text().strip():
+            if tab.proc.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError("chromium did not open its DevTools port")
+            time.sleep(0.05)
+        port = int(port_file.read_text().split()[0])
+        page = None
+        while page is None:
+            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
+                targets = json.loads(r.read().decode())
+            page = next((t for t in targets if t.get("type") == "page" and t.get("webSocketDebuggerUrl")), None)
+            if page is None:
+                if time.monotonic() > deadline:
+                    raise RuntimeError("chromium shows no page to drive")
+                time.sleep(0.05)
+        self._json = json
+        self._loop = asyncio.new_event_loop()
+
+        async def connect():
+            return await websocket_connect(page["webSocketDebuggerUrl"], max_message_size=64 * 2**20)
+
+        self._conn = self._loop.run_until_complete(asyncio.wait_for(connect(), self.timeout))
+        self._id = 0
+
+    def call(self, method: str, **params):
+        """One DevTools command; its ``result`` (RuntimeError with the protocol's message on an error)."""
+        import asyncio
+
+        self._id += 1
+        mid = self._id
+        async def read():
+            return await self._conn.read_message()
+
+        self._conn.write_message(self._json.dumps({"id": mid, "method": method, "params": params}))
+        while True:
+            msg = self._loop.run_until_complete(asyncio.wait_for(read(), self.timeout))
+            if msg is None:
+                raise RuntimeError("the DevTools connection closed")
+            data = self._json.loads(msg)
+            if data.get("id") == mid:
+                if "error" in data:
+                    raise RuntimeError(f"{method}: {data['error']}")
+                return data.get("result", {})
+
+    def evaluate(self, expression: str):
+        """The JSON value of a JavaScript expression in the page (RuntimeError if it throws)."""
+        r = self.call("Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True)
+        if "exceptionDetails" in r:
+            raise RuntimeError(f"the page threw: {r['exceptionDetails'].get('exception', {}).get('description', r['exceptionDetails'])}")
+        return r.get("result", {}).get("value")
+
+    def wait_for(self, expression: str, timeout: float = 30.0):
+        """Poll ``expression`` until it is truthy (RuntimeError after ``timeout`` s); its value."""
+        deadline = time.monotonic() + timeout
+        while True:
+            v = self.evaluate(expression)
+            if v:
+                return v
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"timed out waiting for {expression!r}")
+            time.sleep(0.05)
+
+    def drag(self, start, end, steps: int = 8) -> None:
+        """Press the left mouse button at ``start`` (x, y CSS pixels), move to ``end`` in
+        ``steps`` moves, release: Chromium's own input pipeline, like a person's drag."""
+        x0, y0 = (float(c) for c in start)
+        x1, y1 = (float(c) for c in end)
+        self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x0, y=y0)
+        self.call("Input.dispatchMouseEvent", type="mousePressed", x=x0, y=y0, button="left", buttons=1, clickCount=1)
+        for k in range(1, steps + 1):
+            t = k / steps
+            self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x0 + t * (x1 - x0), y=y0 + t * (y1 - y0),
+                      button="left", buttons=1)
+        self.call("Input.dispatchMouseEvent", type="mouseReleased", x=x1, y=y1, button="left", buttons=1, clickCount=1)
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self._conn.close()
+        with contextlib.suppress(Exception):
+            self._loop.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
 def live_processes():

@@ -939,6 +939,64 @@ class Viewer:
             raise ParameterError(f"{what} must be positive and finite, got {value!r}")
         return v
 
+    # ------------------------------------------------------------------ teach
+    def teach(self, on: bool = True, q=None) -> "Viewer":
+        """Joint sliders on the page (like Robotics Toolbox's ``teach``): one per independent
+        joint, in degrees (mm for a prismatic joint) within its limits (continuous or unbounded
+        revolute joints ±180°); mimic joints follow their source.  Dragging a slider moves the
+        robot at once, in a live tab, a Jupyter cell or an exported HTML file alike: the page
+        computes the forward kinematics of ``robot.chain`` itself (the joint placements, axes
+        and mimic relations sent with the sliders; tested against Pinocchio in a real browser).
+
+        The sliders start at ``q`` (default: the configuration displayed now).  ``on=False``
+        removes them.  The Python side is not told of the page's slider positions: call
+        :meth:`display` to show a configuration from Python.  Returns the viewer."""
+        path = f"{self.root}/ui/teach"
+        if not on:
+            self._send([_delete(path)])
+            return self
+        if q is not None or self._animating:
+            self.display(self.q if q is None else q)
+        self._send([self._ui(path, self._teach_spec())])
+        return self
+
+    def _teach_spec(self) -> dict:
+        chain = self.robot.chain
+        theta = chain.angles(self.q)
+        joints, sliders = [], []
+        for j in chain.joints:
+            m = j.mimic
+            joints.append({"parent": int(j.parent), "kind": j.kind, "axis": [float(a) for a in j.axis],
+                           "placement": [float(x) for x in j.placement.ravel()],
+                           "src": -1 if m is None else int(m.source),
+                           "mult": 1.0 if m is None else float(m.multiplier), "off": 0.0 if m is None else float(m.offset)})
+            if m is not None:
+                continue
+            if j.kind == "prismatic":
+                lo, hi = (j.lower, j.upper) if np.isfinite(j.lower) and np.isfinite(j.upper) else (
+                    -0.5 * self.robot.length_scale, 0.5 * self.robot.length_scale)
+                scale, unit, lo, hi, value = 1e-3, "mm", 1e3 * lo, 1e3 * hi, 1e3 * theta[j.index]
+            else:
+                lo, hi = (j.lower, j.upper) if (j.kind != "continuous" and np.isfinite(j.lower)
+                                                and np.isfinite(j.upper) and j.upper - j.lower <= 2 * math.pi + 1e-9) \
+                    else (-math.pi, math.pi)
+                scale, unit, lo, hi, value = math.pi / 180, "°", math.degrees(lo), math.degrees(hi), math.degrees(theta[j.index])
+            # on the slider's own grid (min + k·step, step 0.1): the browser snaps a value to it
+            lo, hi = math.ceil(lo * 10 - 1e-6) / 10, math.floor(hi * 10 + 1e-6) / 10
+            value = min(max(round(value * 10) / 10, lo), hi)
+            sliders.append({"joint": int(j.index), "name": j.name, "min": lo, "max": hi,
+                            "step": 0.1, "value": value, "unit": unit, "scale": scale, "digits": 1})
+            theta[j.index] = value * scale   # the page starts where its sliders are
+        movers = []
+        for path, jid, fid in self._moving():
+            if jid is not None:
+                movers.append({"path": path, "joint": jid - 1})
+            else:
+                f = chain.frames[fid]
+                movers.append({"path": path, "joint": int(f.joint), "offset": [float(x) for x in f.placement.ravel()]})
+        return {"kind": "teach", "title": f"{self.robot.name}: joints", "theta": [float(t) for t in theta],
+                "joints": joints, "sliders": sliders, "movers": movers}
+
     # ------------------------------------------------------------------ animation
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
         """Play the joint trajectory ``Q`` (N, nq), one row every ``dt`` seconds, as a meshcat

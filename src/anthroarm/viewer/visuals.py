@@ -3,12 +3,14 @@ frame of ``robot.chain`` and carrying meshcat geometry in its own frame.
 
 Where the geometry comes from (:func:`robot_bodies`, ``style="auto"``):
 
-* Book models (``robot.spec`` is set) and robots without any visual geometry: a skeleton
+* Book models (``robot.spec`` is set) whose links are plain segments, and robots without any
+  visual geometry: a skeleton
   generated from ``robot.chain`` — a sphere at every joint centre, a cylinder along every joint
   axis, capsules from each joint to its children and to the tip frames, a sleeve over the stroke
   of prismatic joints, a small palm at the tool.  Sizes scale with the reach.  A book limb scaled
   to a person (its spec says ``person=True``) also gets a torso for context.
-* A robot with a URDF: the URDF's ``<visual>`` elements — meshes resolved with
+* A book model that designs its links' shapes (``LinkSpec.shapes``: the palm and phalanges of
+  ``human_upper_limb``), and a robot with a URDF: the URDF's ``<visual>`` elements — meshes resolved with
   :func:`anthroarm.urdf_io.resolve_uri` (the same resolution the loader used), boxes, cylinders
   and spheres — each attached to its link's frame.  A mesh that cannot be found raises
   :class:`~anthroarm.errors.MeshNotFoundError` naming the link, the URI and the path.
@@ -717,8 +719,10 @@ STYLES = ("auto", "generated", "urdf", "visual_model")
 def robot_bodies(robot, style: str = "auto", max_triangles: int | None = None) -> list[Body]:
     """Bodies for any Robot.  ``style``: "generated" (the skeleton from ``robot.chain``),
     "urdf" (the URDF's ``<visual>`` elements), "visual_model" (``robot.visual_model``), or
-    "auto": generated for book models, else the robot's own visuals (URDF, then visual
-    model), and the skeleton when it has none.  ``max_triangles``: each mesh file as a
+    "auto": generated for book models whose links are plain segments, the URDF's visuals for
+    book models that design their links' shapes (``LinkSpec.shapes``: a hand's palm and
+    phalanges; a person's limb keeps its torso), else the robot's own visuals (URDF, then
+    visual model), and the skeleton when it has none.  ``max_triangles``: each mesh file as a
     :class:`PackedMesh` of at most that many triangles (None: the files as they are)."""
     if style not in STYLES:
         raise ValueError(f"style must be one of {', '.join(map(repr, STYLES))}, got {style!r}")
@@ -726,11 +730,14 @@ def robot_bodies(robot, style: str = "auto", max_triangles: int | None = None) -
         raise ViewerError(f"{robot.name} has no URDF (it was loaded from a pin.Model): use style='auto'")
     if style == "visual_model" and robot.visual_model is None:
         raise ViewerError(f"{robot.name} has no visual_model: pass visual_model= to aa.load, or use style='auto'")
-    if style == "generated" or (style == "auto" and robot.spec is not None):
+    designed = robot.spec is not None and any(j.link is not None and j.link.shapes is not None for j in robot.spec.joints)
+    if style == "generated" or (style == "auto" and robot.spec is not None and not designed):
         return skeleton_bodies(robot)
     bodies = []
     if style in ("auto", "urdf") and robot.info is not None:
         bodies = urdf_bodies(robot, max_triangles)
+        if bodies and designed and robot.spec.person:   # the limb of a person: the torso for context
+            bodies.insert(0, Body("torso", _torso(robot, link_radius(robot))))
     elif style in ("auto", "visual_model") and robot.visual_model is not None:
         bodies = geometry_bodies(robot, max_triangles)
     return bodies or skeleton_bodies(robot)   # no visual geometry at all: the skeleton
