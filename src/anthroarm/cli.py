@@ -51,7 +51,7 @@ def _add_model_arguments(p, robot_options: bool = True):
 
 
 #: commands whose model (positional, or fixed) may be a book model with builder parameters
-_MODEL_COMMANDS = {"urdf": None, "view": None, "ik": None, "demo": "human_arm7"}
+_MODEL_COMMANDS = {"urdf": None, "view": None, "teach": None, "ik": None, "demo": "human_arm7"}
 
 
 def _model_params(model) -> list[tuple[str, object, str, str]] | None:
@@ -860,8 +860,9 @@ def build_parser(argv=None) -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", metavar="COMMAND")
     from .motion.commands import add_parser as _ik_markers_parser
     from .prosthesis.commands import add_parser as _size_parser
+    from .viewer.commands import add_parser as _teach_parser
 
-    for add in (_add_check, _add_models, _add_ik, _add_view, _add_demo, _add_urdf, _add_bench, _add_cache,
+    for add in (_add_check, _add_models, _add_ik, _add_view, _teach_parser, _add_demo, _add_urdf, _add_bench, _add_cache,
                 _batch_parser, _size_parser, _ik_markers_parser):
         add(sub)
     argv = list(sys.argv[1:] if argv is None else argv)

@@ -169,3 +169,22 @@ def test_mimic_joint_follows_in_an_exported_page(page, user_robot, tmp_path):
     b = [p for p in want if p.endswith("/grip_mimic")][0]
     rel = np.linalg.inv(got[a]) @ got[b]
     assert not np.allclose(rel[:3, :3], np.eye(3), atol=1e-3)
+
+
+def test_cli_teach_writes_a_page_with_sliders_at_the_given_pose(tmp_path, capsys):
+    from anthroarm.cli import main
+
+    out = tmp_path / "teach.html"
+    deg = [40.0, -20.0, 10.0, 70.0, 0.0, 0.0, 10.0]
+    assert main(["teach", "human_arm7", "--q", *map(str, deg), "--deg", "--html", str(out)]) == 0
+    import base64
+    import json
+    import re
+
+    m = re.search(r"var cmds = (\[.*?\]);", out.read_text(encoding="utf-8"), re.S)
+    cmds = [umsgpack.unpackb(base64.b64decode(c)) for c in json.loads(m.group(1))]
+    (spec,) = [c["spec"] for c in cmds if c["type"] == "anthroarm_ui" and c["spec"]["kind"] == "teach"]
+    assert [s["value"] for s in spec["sliders"]] == pytest.approx(deg)
+    assert main(["teach", "human_arm7", "--q", "1", "2", "--html", str(tmp_path / "bad.html")]) == 2
+    assert "needs 7 values" in capsys.readouterr().err
+    assert not (tmp_path / "bad.html").exists()
