@@ -11,7 +11,8 @@
 
 Tasks (``qp.tasks``): FrameTask, PositionTask, OrientationTask, RelativeFrameTask, PostureTask,
 DampingTask, JointCouplingTask (mimic), SwivelTask, MarkerTask (body-fixed points),
-ContactNormalTask, SurfaceContactTask (fingertip contacts, :mod:`anthroarm.hand`).  Limits (``qp.limits``): ConfigurationLimit,
+ContactNormalTask, SurfaceContactTask (fingertip contacts, :mod:`anthroarm.hand`),
+MultiFrameTask and JointCouplingsTask (several frames / relations in one objective).  Limits (``qp.limits``): ConfigurationLimit,
 VelocityLimit, AccelerationLimit.  Backends (``qp.backends``): persistent OSQP, daqp, quadprog,
 proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
 
@@ -35,13 +36,13 @@ from .backends import available_solvers, make_backend
 from .configuration import IKConfiguration
 from .limits import AccelerationLimit, ConfigurationLimit, Limit, VelocityLimit
 from .step import StepResult, default_limits, step
-from .tasks import (ContactNormalTask, SurfaceContactTask)
+from .tasks import ContactNormalTask, JointCouplingsTask, MultiFrameTask, SurfaceContactTask
 from .tasks import (DampingTask, FrameTask, JointCouplingTask, MarkerTask, OrientationTask, PositionTask, PostureTask,
                     RelativeFrameTask, SwivelTask, Task, comfortable_posture, swivel_angle)
 
 __all__ = [
     "step", "StepResult", "IKConfiguration", "default_limits", "available_solvers", "make_backend",
     "Task", "FrameTask", "MarkerTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask", "DampingTask",
-    "JointCouplingTask", "SwivelTask", "ContactNormalTask", "SurfaceContactTask", "comfortable_posture", "swivel_angle",
+    "JointCouplingTask", "SwivelTask", "ContactNormalTask", "SurfaceContactTask", "MultiFrameTask", "JointCouplingsTask", "comfortable_posture", "swivel_angle",
     "Limit", "ConfigurationLimit", "VelocityLimit", "AccelerationLimit", "backends", "limits", "tasks",
 ]

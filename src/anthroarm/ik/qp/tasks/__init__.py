@@ -2,6 +2,8 @@
 
 from .base import Task
 from .contact_normal import ContactNormalTask
+from .joint_couplings import JointCouplingsTask
+from .multi_frame import MultiFrameTask
 from .coupling import JointCouplingTask
 from .damping import DampingTask
 from .frame import FrameTask
@@ -16,5 +18,5 @@ from .swivel import SwivelTask, human_layout, swivel_angle, swivel_frames, swive
 __all__ = [
     "Task", "FrameTask", "MarkerTask", "PositionTask", "OrientationTask", "RelativeFrameTask", "PostureTask",
     "DampingTask", "JointCouplingTask", "SwivelTask", "comfortable_posture",
-    "has_comfortable_posture", "ContactNormalTask", "SurfaceContactTask", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
+    "has_comfortable_posture", "ContactNormalTask", "SurfaceContactTask", "MultiFrameTask", "JointCouplingsTask", "human_layout", "swivel_angle", "swivel_frames", "swivel_from_points",
 ]
