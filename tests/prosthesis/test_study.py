@@ -59,6 +59,12 @@ def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
     assert text.count("data:image/png;base64,") == person.nv
     with pytest.raises(ActivityError, match="payload"):
         study.run(person, acts, payload=float("nan"))
+    with pytest.raises(ActivityError, match="no 'q'"):
+        study.run(person, [dict(name="x", t=t)])
+    with pytest.raises(ActivityError, match="dict"):
+        study.run(person, [(t, q)])
+    with pytest.raises(ActivityError, match="payload"):
+        study.run(person, [dict(name="x", t=t, q=q, payload="heavy")])
 
 
 def test_cli_size_end_to_end(tmp_path, capsys):

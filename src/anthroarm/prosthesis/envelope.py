@@ -138,7 +138,10 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, p
         d1, d2 = derivatives(t, q)
         qd = d1 if qd is None else qd
         qdd = d2 if qdd is None else qdd
-    mass = np.asarray(payload, dtype=float)
+    try:
+        mass = np.asarray(payload, dtype=float)
+    except (TypeError, ValueError):
+        raise ActivityError(f"activity {name!r}: payload must be a mass in kg, got {payload!r}") from None
     mass = np.full(len(t), float(mass)) if mass.ndim == 0 else mass
     if mass.shape != (len(t),) or not np.all(np.isfinite(mass)) or np.any(mass < 0):
         raise ActivityError(f"activity {name!r}: payload must be a mass >= 0 kg, one or one per sample ({len(t)})")

@@ -78,6 +78,8 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     t0 = time.perf_counter()
     acts = []
     for spec in activities:
+        if not isinstance(spec, dict):
+            raise ActivityError(f"an activity is a dict with 't' (s) and 'q' (rad), got {type(spec).__name__}")
         name = str(spec.get("name", f"activity {len(acts) + 1}"))
         if progress is not None:
             progress("activity", name)
@@ -90,6 +92,10 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
             acts.append(env_mod.ActivityTorques(name, t, q, z, z, z, z, z, list(robot.joint_names), status,
                                                 str(spec.get("reason", "")), float(np.max(m, initial=0.0))))
             continue
+        missing = [k for k in ("t", "q") if k not in spec]
+        if missing:
+            raise ActivityError(f"activity {name!r} has no {' and no '.join(repr(k) for k in missing)} "
+                                "(times in s, joint positions in rad)")
         acts.append(env_mod.activity_torques(robot, name, spec["t"], spec["q"], spec.get("qd"), spec.get("qdd"),
                                              payload=m, dynamics=dyn))
     timings["dynamics"] = time.perf_counter() - t0
