@@ -206,3 +206,17 @@ def test_demo_html_shows_the_arm_moving(tmp_path):
     b = browser.screenshot(html, tmp_path / "t1.png", size=(W, H), budget_ms=1500)
     # only the arm moves (targets and the traced path are fixed): the pictures differ
     assert browser.changed_mask(a, b).mean() > 0.005
+
+
+def test_first_display_frames_the_robot(human, base_png, tmp_path):
+    """The default camera: the robot as first displayed fills most of the frame's height and
+    is not cut off (meshcat's default view had it fill about a third)."""
+    v = Viewer(human)
+    html = v.export_html(tmp_path / "framed.html")
+    shot = browser.screenshot(html, tmp_path / "framed.png", size=(W, H), budget_ms=2000)
+    m = browser.changed_mask(shot, base_png)
+    m[:40, W - 260:] = False
+    ys, xs = np.nonzero(m)
+    height = (ys.max() - ys.min()) / H
+    assert height > 0.6, height
+    assert ys.min() > 2 and ys.max() < H - 3 and xs.min() > 2 and xs.max() < W - 3

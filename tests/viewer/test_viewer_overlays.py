@@ -139,3 +139,121 @@ def test_arrows_end_where_they_should(viewer):
         viewer.show_arrows(O, D, scale=0.0)
     with pytest.raises(ParameterError, match="NaN"):
         viewer.show_arrows(O, D * np.nan)
+
+
+def test_batch_voxel_maps_as_point_clouds_with_legends():
+    """reachability_map / comfort_map of anthroarm.batch: one point per reached voxel at its
+    centre (recomputed here from the result's arrays), coloured through the colour map, with
+    the legend in the page."""
+    from anthroarm.batch import jobs
+
+    robot = aa.load("human_arm7")
+    v = Viewer(robot)
+    res = jobs.reachability_map(robot, n=3000, voxel=0.08, seed=0, progress=False)
+    out = v.show_map(res)
+    counts = res["counts"]
+    i, j, k = np.nonzero(counts)
+    centres = np.stack([res.coords["x"][i], res.coords["y"][j], res.coords["z"][k]], 1)
+    assert counts.sum() == 3000 and len(out["points"]) == len(centres)
+    np.testing.assert_allclose(np.sort(out["points"], axis=0), np.sort(centres, axis=0))
+    (obj,) = objects_at(v, f"{v.root}/overlays/reachability_map")
+    assert obj["object"]["materials"][0]["size"] == pytest.approx(0.08)
+    c = counts[i, j, k].astype(float)
+    order = np.lexsort(centres.T)
+    got = attribute(obj, "color")[np.lexsort(out["points"].T)]
+    np.testing.assert_allclose(got, colormaps["viridis"]((c[order] - c.min()) / (c.max() - c.min()))[:, :3], atol=1e-6)
+    legends = [x["spec"] for x in page_commands(v) if x["type"] == "anthroarm_ui" and x["spec"]["kind"] == "legend"]
+    assert any(sp["title"].startswith("reachability_map: counts") and sp["ticks"][-1] == f"{c.max():.3g}" for sp in legends)
+    comfort = jobs.comfort_map(robot, n=3000, voxel=0.08, seed=0, progress=False)
+    out = v.show_map(comfort)
+    assert len(out["points"]) == np.isfinite(comfort["discomfort"]).sum() == (comfort["counts"] > 0).sum()
+    with pytest.raises(ParameterError, match="voxel map"):
+        v.show_map(comfort, "nope")
+    with pytest.raises(ParameterError, match="batch result"):
+        v.show_map({"counts": 1})
+
+
+def test_legends_for_manipulability_and_limits_are_in_the_page_and_go_away():
+    v = Viewer(aa.load("planar2r"))
+    res = v.show_workspace(200)
+    specs = lambda: {x["path"]: x["spec"] for x in page_commands(v) if x["type"] == "anthroarm_ui"}
+    man = specs()[f"{v.root}/overlays/workspace/legend"]
+    assert man["title"].startswith("manipulability (m²")
+    assert man["ticks"] == ["0", f"{res['manipulability'].max() / 2:.3g}", f"{res['manipulability'].max():.3g}"]
+    assert man["stops"][0] == pytest.approx(list(colormaps["viridis"](0.0)[:3]), abs=1e-4)
+    v.show_limits()
+    lim = specs()[f"{v.root}/ui/limits"]
+    assert lim["stops"][0] == pytest.approx(list(aa.viewer.limit_color(0.0))) and lim["stops"][-1] == pytest.approx(
+        list(aa.viewer.viewer.LIMIT_RGB))
+    v.show_limits(False)
+    v.clear("workspace")
+    assert set(specs()) == {f"{v.root}/ui/scale"}    # only the scale-bar note is left
+    v.set_scale_bar(False)
+    assert not specs()
+
+
+def test_grid_axes_and_scale_bar_are_drawn_to_scale_and_switch_off():
+    v = Viewer(aa.load("human_arm7"))
+    sp = v.spacing
+    assert sp in {m * 10.0 ** k for m in (1, 2, 5) for k in range(-3, 2)}
+    (grid,) = objects_at(v, f"{v.root}/grid")
+    assert grid["object"]["object"]["type"] == "LineSegments"
+    X = attribute(grid, "position").astype(float)
+    # lines on the floor, every one on a multiple of the spacing (so through the base origin)
+    assert np.ptp(X[:, 2]) < 1e-6 and X[0, 2] < 0
+    along_y = X[0::2][np.isclose(X[0::2, 0], X[1::2, 0])]
+    np.testing.assert_allclose(along_y[:, 0] / sp, np.round(along_y[:, 0] / sp), atol=1e-4)
+    # the scale bar is one grid square long: its five pieces add up to the spacing
+    bar = [c for c in page_commands(v) if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/scale/")]
+    assert len(bar) == 5
+    assert sum(c["object"]["geometries"][0]["height"] for c in bar) == pytest.approx(sp)
+    notes = [c["spec"]["text"] for c in page_commands(v) if c["type"] == "anthroarm_ui" and c["spec"]["kind"] == "note"]
+    assert notes == [f"scale bar and grid squares: {aa.viewer.viewer.format_length(sp)}"]
+    axes = [c for c in page_commands(v) if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/axes/")]
+    assert len(axes) == 3
+
+    def visible(path):
+        vals = [c["value"] for c in page_commands(v) if c["type"] == "set_property" and c["path"] == path
+                and c["property"] == "visible"]
+        return vals[-1]
+
+    assert visible(f"{v.root}/grid") and visible(f"{v.root}/axes") and visible(f"{v.root}/scale")
+    v.set_grid(False)
+    v.set_axes(False)
+    v.set_scale_bar(False)
+    assert not (visible(f"{v.root}/grid") or visible(f"{v.root}/axes") or visible(f"{v.root}/scale"))
+    v2 = Viewer(aa.load("planar2r"), grid=False, axes=False, scale_bar=False)
+    cmds = page_commands(v2)
+    assert [c["value"] for c in cmds if c["type"] == "set_property" and c["path"] == f"{v2.root}/grid"] == [False]
+
+
+def test_nice_lengths_and_framing_distance():
+    from anthroarm.viewer.viewer import framing_distance, nice_length
+
+    assert [nice_length(x) for x in (0.013, 0.02, 0.049, 0.7, 3.0)] == pytest.approx([0.01, 0.02, 0.02, 0.5, 2.0])
+    # a unit cube seen along x: its near face (depth 0.5) must fit fill · tan(37.5°) (vertical and 4:3)
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    D = framing_distance(corners, np.array([1.0, 0.0, 0.0]), fill=0.8)
+    assert D == pytest.approx(0.5 + 0.5 / (0.8 * np.tan(np.radians(37.5))))
+
+
+def test_hands_are_drawn_from_their_own_visual_geometry():
+    """allegro (URDF meshes) and human_upper_limb (designed phalanx and palm shapes): every
+    finger link carries its URDF visuals; no generated 'palm' paddle; the person's torso stays."""
+    from anthroarm.viewer.visuals import robot_bodies
+
+    for name, tool in (("allegro_right_hand", "link_3.0_tip"), ("human_upper_limb", None)):
+        robot = aa.load(name, tool=tool) if tool else aa.load(name)
+        bodies = robot_bodies(robot)
+        groups = {p.group for b in bodies for p in b.pieces}
+        assert "palm" not in groups and "mesh" in groups, (name, groups)
+        with_visuals = {b.name for b in bodies if any(p.group == "mesh" for p in b.pieces)}
+        from lxml import etree
+
+        root = etree.fromstring(robot.info.text.encode())
+        urdf_links = {l.get("name") for l in root.findall("link") if l.find("visual") is not None}
+        assert with_visuals == urdf_links, (name, urdf_links ^ with_visuals)
+        assert len(with_visuals) >= 16
+    assert bodies[0].name == "torso"
+    assert {p.group for p in robot_bodies(robot, "generated")[-1].pieces} >= {"links"}   # the skeleton is still there on request
+    assert any(p.group == "palm" for b in robot_bodies(robot, "generated") for p in b.pieces)

@@ -881,6 +881,58 @@ class Viewer:
             self._send([self._ui(f"{path}/legend", colormap_legend(label or name, colormap, lo, hi))])
         return {"points": P, "colors": C, "vmin": lo, "vmax": hi}
 
+    def show_map(self, result, var: str | None = None, *, colormap: str | None = None, size: float | None = None,
+                 name: str | None = None) -> dict:
+        """A voxel map of :mod:`anthroarm.batch` as a 3-D point cloud with its colour legend: one
+        point at the centre of every reached voxel, coloured by its value.
+
+        Parameters
+        ----------
+        result : anthroarm.batch.result.BatchResult
+            A ``reachability_map`` (``counts``: configurations per voxel) or ``comfort_map``
+            (``discomfort``: 0 = comfortable) result, computed for this robot (the voxel
+            centres are in its base frame, m).
+        var : str, optional
+            The variable to draw (default: ``counts`` or ``discomfort`` by the job).
+        colormap : str, optional
+            Default ``viridis`` (``viridis_r`` for discomfort: yellow = comfortable).
+        size : float, optional
+            Point size, m (default: the voxel side).
+        name : str, optional
+            Overlay name (default: the job's name).
+
+        Returns
+        -------
+        dict
+            As :meth:`show_points`, plus ``"values"`` (K,).
+
+        Raises
+        ------
+        ParameterError
+            A result without a voxel map, or an unknown ``var``.
+        """
+        from ..batch.plot import _MAPS, occupied_points
+
+        job = getattr(result, "job", None)
+        variables = getattr(result, "variables", None)
+        if not isinstance(variables, dict):
+            raise ParameterError(f"show_map takes an anthroarm.batch result (reachability_map, comfort_map), "
+                                 f"got {type(result).__name__}")
+        var = var or _MAPS.get(job)
+        if var is None or var not in variables or tuple(result.dims(var)) != ("x", "y", "z"):
+            raise ParameterError(f"{job}: no voxel map {var!r} to draw; voxel maps: "
+                                 f"{[k for k in variables if tuple(result.dims(k)) == ('x', 'y', 'z')]}")
+        P, vals = occupied_points(result, var)
+        if len(P) == 0:
+            raise ParameterError(f"{job}: the map {var!r} has no reached voxel to draw")
+        voxel = float(result.attrs.get("voxel", 0.0)) or None
+        cmap = colormap or ("viridis_r" if var == "discomfort" else "viridis")
+        note = " (configurations per voxel)" if var == "counts" else " (0 = comfortable)" if var == "discomfort" else ""
+        out = self.show_points(P, values=np.asarray(vals, float), colormap=cmap, size=size or voxel,
+                               name=name or job or var, label=f"{job}: {var}{note}")
+        out["values"] = np.asarray(vals, float)
+        return out
+
     def show_arrows(self, origins, directions, colors=None, *, scale: float = 1.0, radius: float | None = None,
                     name: str = "arrows") -> np.ndarray:
         """Arrows (contact normals, forces, velocities) from ``origins`` along ``directions``.
