@@ -276,8 +276,8 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     restarts : int
         Further attempts after one that fails (not after a QP failure): the arm joints where the
         best attempt left them, the finger joints uniform in their ranges (``seed``), and with
-        given contacts on an arm every other attempt a new arm branch (:func:`palm_approach`
-        from a random arm configuration).  The best attempt is returned; ``iterations`` and
+        given contacts on an arm every other attempt a finer :func:`palm_approach` (6 rounds;
+        from the third attempt on from a random arm configuration: a new arm branch).  The best attempt is returned; ``iterations`` and
         ``time`` count all of them.
     seed : int or numpy Generator
         Random source of the restarts (deterministic by default).
@@ -347,9 +347,9 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     for attempt in range(int(restarts) + 1):
         if attempt:
             start = best[0].copy()               # arm where the best attempt left it, fingers anew
-            if approach and attempt % 2 == 1:    # or, every other time, a new arm branch
-                start = palm_approach(hand, points, obj, start, rng=rng, seed_arm=True, solver=solver,
-                                      step_fn=step_fn)
+            if approach and attempt % 2 == 1:    # or, every other time, a finer approach (a new arm branch
+                start = palm_approach(hand, points, obj, start, rng=rng, seed_arm=attempt > 1, solver=solver,
+                                      rounds=6, step_fn=step_fn)     # after the first restart)
             else:
                 start[fq] = robot.random_q(rng=rng)[fq]
             conf.update(start)
