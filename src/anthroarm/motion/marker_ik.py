@@ -1,6 +1,6 @@
 """Marker-based inverse kinematics, frame by frame (OpenSim's IK tool, on anthroarm's QP layer).
 
-For every frame n the joint angles minimise the weighted sum of squared marker errors
+For every frame n the joint angles minimise the weighted sum of squared marker errors::
 
     min_q  Σ_k w_k v_nk ‖p_k(q) − m_nk‖²    subject to  q_min ≤ q ≤ q_max,
 

@@ -13,7 +13,7 @@ squares problem instead of marker-pair distances): the person stands still for a
 each marker's position is the median of its visible samples.  Every body b that carries markers
 and has a length (:func:`~anthroarm.motion.markers.segment_length`) gets a factor s_b that
 scales everything fixed in it: the offset to the next joint (or to the tool) and its markers'
-positions.  The unknowns (q, log s) minimise
+positions.  The unknowns (q, log s) minimise::
 
     Σ_k w_k ‖p_k(q, s) − m̄_k‖²,   q within the joint limits, 0.5 ≤ s_b ≤ 2,
 

@@ -2,12 +2,12 @@
 
 Flash & Hogan, "The coordination of arm movements: an experimentally confirmed mathematical
 model", J. Neurosci. 5(7), 1688–1703 (1985): the motion from rest to rest in time T that
-minimises the integrated squared jerk ∫ (d³x/dt³)² dt is, for each coordinate,
+minimises the integrated squared jerk ∫ (d³x/dt³)² dt is, for each coordinate::
 
     x(t) = x0 + (x1 − x0) s(τ),   s(τ) = 10 τ³ − 15 τ⁴ + 6 τ⁵,   τ = t / T,
 
-the quintic with zero velocity and acceleration at both ends (their Eq. (3) for a straight
-reach).  :func:`keyframe_trajectory` chains such segments through keyframes with optional holds:
+the quintic with zero velocity and acceleration at both ends (their solution for a
+point-to-point movement).  :func:`keyframe_trajectory` chains such segments through keyframes with optional holds:
 q, q̇ and q̈ are continuous (every segment starts and ends at rest), q⃛ jumps at the keyframes.
 
 Units: s, and the coordinates' own units (rad, m).

@@ -1,6 +1,6 @@
 """MarkerTask: drive body-fixed points (skin markers) to measured positions (world frame, m).
 
-For markers k = 1 … M, each fixed in the frame of joint j(k) at l_k (m):
+For markers k = 1 … M, each fixed in the frame of joint j(k) at l_k (m)::
 
     e_k(q) = p_k(q) − m_k,   p_k = ⁰R_j l_k + ⁰o_j,
     J_k(q) = J_v,j + J_ω,j × (p_k − ⁰o_j)     (LOCAL_WORLD_ALIGNED: the point's velocity in
