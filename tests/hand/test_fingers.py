@@ -23,13 +23,21 @@ def limb():
     return aa.load("human_upper_limb")
 
 
+@pytest.fixture(scope="module")
+def linkage():
+    """The book's linkage hand as a plain URDF: passive joints are mimic joints, bars are leaves."""
+    from anthroarm.models.prosthetic_hand import robot
+
+    return robot()
+
+
 def _moving_columns(robot, q, frame_id):
     d = robot.model.createData()
     J = pin.computeFrameJacobian(robot.model, d, q, frame_id, pin.LOCAL_WORLD_ALIGNED)
     return set(np.flatnonzero(np.abs(J).max(axis=0) > 1e-12).tolist())
 
 
-@pytest.mark.parametrize("name", ["allegro", "limb"])
+@pytest.mark.parametrize("name", ["allegro", "limb", "linkage"])
 def test_fingers_are_the_joints_that_move_one_tip_only(name, request):
     robot = request.getfixturevalue(name)
     hand = Hand(robot)
@@ -41,6 +49,9 @@ def test_fingers_are_the_joints_that_move_one_tip_only(name, request):
         assert set(hand.arm_v_indices) == cols[f.tip] & others
     if name == "allegro":
         assert len(hand.fingers) == 4 and hand.arm_joints == () and hand.palm == "palm_link"
+    elif name == "linkage":   # one driver per digit; of each digit's leaves (bars too) the fingertip
+        assert sorted(hand.tips) == ["index_tip", "little_tip", "middle_tip", "ring_tip", "thumb_tip"]
+        assert all(len(f.v_indices) == 1 for f in hand.fingers) and hand.arm_joints == ()
     else:   # hand_point is a tip of the tree but no joint of its own moves it: not a finger
         assert sorted(hand.tips) == ["index_tip", "little_tip", "middle_tip", "ring_tip", "thumb_tip"]
         assert len(hand.arm_joints) == 7 and hand.palm == "palm"
@@ -65,7 +76,7 @@ def test_pad_normal_is_the_direction_of_distal_flexion(name, request):
             assert n_world @ v / np.linalg.norm(v) == pytest.approx(1.0, abs=1e-12)
 
 
-@pytest.mark.parametrize("name", ["allegro", "limb"])
+@pytest.mark.parametrize("name", ["allegro", "limb", "linkage"])
 def test_span_bounds_fingertip_distances(name, request):
     robot = request.getfixturevalue(name)
     hand = Hand(robot)

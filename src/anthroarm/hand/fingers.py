@@ -2,6 +2,9 @@
 fingertip, the palm, the pad normal of each fingertip and the hand's span.
 
 A **fingertip** is a tip of the tree (:attr:`anthroarm.robot.Robot.tips`, one frame per leaf).
+By default every tip is one, except tips that no joint of their own moves (a hand point on the
+palm) and, of the tips moved by the same independent joints (the bars of a linkage finger
+whose passive joints are mimic joints), all but the one at the end of the longest path.
 The joints on the path from the base to a tip that no other tip shares are that **finger's
 joints**; the joints every tip shares are the **arm** (the shoulder-to-wrist chain of a human
 upper limb; none on a hand with a fixed palm such as ``allegro_right_hand``).  The **palm** is a
@@ -118,10 +121,24 @@ class Hand:
         default = tips is all_tips
         paths = [chain.path(t) for t in tips]
         common = _common(paths)
-        if default:   # tips that no joint of their own moves (a hand point, the palm) are no fingertips
+        if default:
+            # tips that no joint of their own moves (a hand point, the palm) are no fingertips
             keep = [k for k, p in enumerate(paths) if len(p) > common]
             tips = tuple(tips[k] for k in keep)
             paths = [paths[k] for k in keep]
+            common = _common(paths)
+            # a linkage's bars are leaves too: of the tips moved by the same independent joints
+            # (one finger; a bar moved by mimic joints only counts their sources) keep the one
+            # at the end of the longest path: the fingertip
+            best: dict = {}
+            for t, p in zip(tips, paths):
+                own = frozenset(chain.joints[i].idx_v for i in p[common:] if not chain.joints[i].is_mimic)
+                drivers = own or frozenset(chain.joints[chain.joints[i].mimic.source].idx_v
+                                           for i in p[common:] if chain.joints[i].is_mimic)
+                if drivers not in best or len(p) > len(best[drivers][1]):
+                    best[drivers] = (t, p)
+            tips = tuple(t for t, _ in best.values())
+            paths = [p for _, p in best.values()]
             if len(tips) < 2:
                 raise FingertipError(f"{robot.name}: fewer than two tips move on joints of their own "
                                      f"({', '.join(all_tips)}): not a hand")
