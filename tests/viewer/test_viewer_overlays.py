@@ -257,3 +257,44 @@ def test_hands_are_drawn_from_their_own_visual_geometry():
     assert bodies[0].name == "torso"
     assert {p.group for p in robot_bodies(robot, "generated")[-1].pieces} >= {"links"}   # the skeleton is still there on request
     assert any(p.group == "palm" for b in robot_bodies(robot, "generated") for p in b.pieces)
+
+
+def test_joint_values_colour_each_link_by_its_joint_with_a_legend():
+    """Gravity torques of the §6-3 arm (Pinocchio's computeGeneralizedGravity) colour the
+    links: the body moved by joint j gets plasma(|τ_j| scaled to the range); show_limits and
+    this colouring replace each other; None restores the colours."""
+    import pinocchio as pin
+
+    robot = aa.load("human_arm7")
+    v = Viewer(robot)
+    q = np.deg2rad([30, -20, 10, 60, 0, 0, 0])
+    v.display(q)
+    tau = pin.computeGeneralizedGravity(robot.model, robot.model.createData(), q)
+
+    class Rec:
+        def __init__(self):
+            self.messages = []
+
+        def send_many(self, cmds):
+            self.messages.append(list(cmds))
+
+    v.server = rec = Rec()
+    out = v.show_joint_values(tau, "gravity torque |τ| (N·m)")
+    colors = {c["path"]: c["color"] for c in rec.messages[-1] if c["type"] == "anthroarm_color"}
+    a = np.abs(tau)
+    expect = colormaps["plasma"]((a - a.min()) / (a.max() - a.min()))[:, :3]
+    coloured = [b for b in v.bodies if b.joint is not None and any(p.group == "links" for p in b.pieces)]
+    assert len(coloured) >= 3 and len(colors) == len(coloured)   # joints at one point share the next link
+    for b in coloured:
+        np.testing.assert_allclose(colors[f"{v.root}/bodies/{b.name}/links"], expect[b.joint], atol=2e-3)
+    np.testing.assert_allclose(out["values"], a)
+    legend = [c["spec"] for c in rec.messages[-1] if c["type"] == "anthroarm_ui"]
+    assert legend[0]["title"] == "gravity torque |τ| (N·m)" and legend[0]["ticks"][-1] == f"{a.max():.3g}"
+    n = len(rec.messages)
+    v.show_limits()                                   # replaces the torque colours and legend
+    assert any(c["type"] == "delete" and c["path"].endswith("/ui/joint_values") for m in rec.messages[n:] for c in m)
+    v.show_limits(False)
+    restored = [c for c in rec.messages[-1] if c["type"] == "set_object"]
+    assert restored and not [c for c in rec.messages[-1] if c["type"] == "anthroarm_color"]
+    with pytest.raises(ParameterError, match="one number per joint"):
+        v.show_joint_values(np.ones(3))

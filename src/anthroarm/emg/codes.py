@@ -43,11 +43,11 @@ from ..errors import EMGError
 from ._checks import positive
 from .processor import BOTH, EXTENSOR, FLEXOR, REST
 
-#: mode cycle (assumption: the order in which the book lists the vibrators)
+#: mode cycle (an assumption, the order in which the book lists the vibrators)
 MODES = ("elbow", "wrist", "fingers")
-#: book §9-2: the chest vibrator that signals a switch to each mode (None: no vibrator)
+#: the chest vibrator that signals a switch to each mode, book §9-2 (None means no vibrator)
 VIBRATOR_OF_MODE = {"elbow": "left", "wrist": "right", "fingers": None}
-#: columns of :attr:`CodeTrace.vibrators`
+#: the columns of ``CodeTrace.vibrators``
 VIBRATORS = ("left", "right", "middle")
 
 

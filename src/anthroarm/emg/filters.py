@@ -39,11 +39,11 @@ from scipy import signal as sps
 from ..errors import EMGError, SamplingRateError
 from ._checks import positive
 
-#: Table 9.1, 方式1 (2 EMG channels): band-pass centre frequencies, Hz
+#: band-pass centre frequencies of Table 9.1, 方式1 (2 EMG channels), Hz
 BOOK_BANK_2CH = (40.0, 100.0, 160.0, 360.0)
-#: Table 9.1, 方式2 (3 EMG channels): band-pass centre frequencies, Hz
+#: band-pass centre frequencies of Table 9.1, 方式2 (3 EMG channels), Hz
 BOOK_BANK_3CH = (70.0, 160.0, 360.0)
-#: conditioning band of the chain, Hz (assumption: De Luca et al. 2010; SENIAM)
+#: conditioning band of the chain, Hz (an assumption after De Luca et al. 2010 and SENIAM)
 CONDITIONING_BAND = (20.0, 450.0)
 #: default bank bandwidth, octaves between the −3 dB edges (assumption, see the module text)
 BANK_BANDWIDTH_OCTAVES = 0.5

@@ -38,7 +38,7 @@ from ._checks import positive, signal
 from .envelope import PP_PER_MAV, PP_PER_RMS, lowpass_sos, running_rms, window_samples
 from .filters import CONDITIONING_BAND, bandpass_sos, check_sampling_rate, notch_sos
 
-#: code values of an antagonist pair (flexor bit first, as printed: "10" = flexor)
+#: code values of an antagonist pair, flexor bit first as printed ("10" is the flexor)
 REST, EXTENSOR, FLEXOR, BOTH = 0, 1, 2, 3
 CODE_NAMES = ("00", "01", "10", "11")
 

@@ -30,6 +30,8 @@ How a command moves a joint (assumptions; the book prints the codes, not the dri
   servo idea: at rest (|θ̇| small) the servo error reveals the load torque, Eq. (9-8)
   (:meth:`~anthroarm.control.servo.PositionServo.estimate_load_torque`); above
   ``grasp_torque`` the hand holds an object; fully closed counts as "gripped tight" too.
+  While the amplifier is saturated (squeezing at the battery voltage) the linear estimate
+  overstates the load; a threshold is all the vibrator needs.
 
 The algorithm reads joints by the names given in ``joints`` (mode → joint name of
 ``robot.chain``, or ``None`` for the built-in hand); it never looks at the arm's name.  SI
@@ -171,6 +173,7 @@ class PoweredHandResult:
             if on.any():
                 ax[3].fill_between(self.t, -1, len(self.modes) - 1, where=on, step="post", alpha=0.15,
                                    label=f"{col} vibrator")
+        ax[3].set_ylabel("mode / command")
         ax[3].legend(fontsize=7, loc="upper right", ncol=2)
         for j, m in enumerate(self.modes):
             line, = ax[4].plot(self.t, self.angle[:, j], label=f"{m} ({self.joint_names[j]})")

@@ -29,14 +29,14 @@ from ..errors import EMGError
 from ._checks import positive, signal
 from .envelope import PP_PER_RMS
 
-#: book §9-2: healthy EMG 1–3 mV peak-to-peak (V)
+#: healthy EMG, 1–3 mV peak-to-peak (V), book §9-2
 HEALTHY_PP = (1e-3, 3e-3)
-#: book §9-2: typical moderate contraction of a healthy muscle, 100 µV (V)
+#: a typical moderate contraction of a healthy muscle, 100 µV (V), book §9-2
 TYPICAL_PP = 100e-6
-#: book §9-2: amputee EMG, at least 50 µV untrained, 100 µV trained (V, p-p)
+#: amputee EMG, at least 50 µV untrained, 100 µV trained (V, p-p), book §9-2
 AMPUTEE_PP = 50e-6
 AMPUTEE_TRAINED_PP = 100e-6
-#: book §9-2: the band of the main spectral power (Hz)
+#: the band of the main spectral power (Hz), book §9-2
 EMG_BAND = (30.0, 300.0)
 
 

@@ -109,10 +109,12 @@ def cell_table(robot=None, *, rotation=R_FORWARD, bounds=CELL_BOUNDS, D: float =
     ----------
     robot : Robot, optional
         A loaded ``care_robot`` (default: ``anthroarm.load("care_robot")``).
-    rotation : array_like (3, 3)
-        Hand orientation of the table (default :data:`R_FORWARD`, assumed).
-    bounds : (lo(3), hi(3))
-        Box of wrist positions, m (default :data:`CELL_BOUNDS`, assumed).
+    rotation : array_like
+        Hand orientation of the table, a 3×3 rotation matrix (default :data:`R_FORWARD`,
+        assumed).
+    bounds : tuple
+        Box of wrist positions ``(lo, hi)``, two corners of 3 coordinates each, m (default
+        :data:`CELL_BOUNDS`, assumed).
     D : float
         Cell size, m (printed: 0.10).
     branch, encoder_counts, gear_ratio

@@ -446,6 +446,7 @@ class Viewer:
         self._joint_lower = np.array([j.lower for j in joints])
         self._joint_upper = np.array([j.upper for j in joints])
         self._limits_on = False
+        self._joint_rgb: list | None = None   # show_joint_values: one colour per chain joint
         self._animating = False
         self._colors: dict[str, tuple] = {}
         self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
@@ -651,41 +652,53 @@ class Viewer:
                 for path, j, f in self._moving()]
 
     def _color_commands(self, q) -> list[dict]:
-        """Recolour links (max proximity over ``body.link_joints``) and joint centres (own
-        proximity), from the joint positions θ of ``robot.chain`` (a continuous joint's angle,
-        a mimic joint's copy); unbounded joints are never coloured.  Only colours that changed
-        since the last call are sent."""
-        cmds = []
+        """Recolour links and joint centres: with :meth:`show_limits`, links by the largest
+        proximity over ``body.link_joints`` and joint centres by their own (from the joint
+        positions θ of ``robot.chain``: a continuous joint's angle, a mimic joint's copy;
+        unbounded joints are never coloured); with :meth:`show_joint_values`, each body's links
+        by the value of the joint that moves it.  Only colours that changed since the last call
+        are sent (None: the original colours)."""
         prox = None
         if self._limits_on:
             prox = limit_proximity(self.robot.chain.angles(q), self._joint_lower, self._joint_upper)
+        frames = self.robot.chain.frames
+        want: dict[str, tuple | None] = {}
+        where: dict[str, tuple] = {}
         for b in self.bodies:
-            if b.limit_joint is None and not b.link_joints:
-                continue
-            groups = []
-            link_group = "links" if any(p.group == "links" for p in b.pieces) else "mesh"
-            if b.link_joints and any(p.group == link_group for p in b.pieces):
-                groups.append((link_group, b.link_joints))
-            if b.limit_joint is not None and any(p.group == "joint" for p in b.pieces):
-                groups.append(("joint", [b.limit_joint]))
-            for group, idx in groups:
-                path = f"{self._bpath(b)}/{group}"
-                if prox is not None:
+            has = {p.group for p in b.pieces}
+            link_group = "links" if "links" in has else "mesh"
+            bp = self._bpath(b)
+            if link_group in has:
+                where[f"{bp}/{link_group}"] = (b, link_group)
+            if "joint" in has:
+                where[f"{bp}/joint"] = (b, "joint")
+            if prox is not None:
+                groups = []
+                if b.link_joints and link_group in has:
+                    groups.append((link_group, b.link_joints))
+                if b.limit_joint is not None and "joint" in has:
+                    groups.append(("joint", [b.limit_joint]))
+                for group, idx in groups:
                     base = next(p.rgb for p in b.pieces if p.group == group)
-                    rgb = tuple(round(c, 3) for c in limit_color(float(prox[idx].max()), base))
-                else:
-                    rgb = None
-                if self._colors.get(path) == rgb:
-                    continue
-                self._colors[path] = rgb
-                if rgb is None:  # restore the original colours
-                    for k, p in enumerate(b.pieces):
-                        if p.group == group:
-                            cmds.append(_set_object(f"{path}/{k}", p.geometry, p.rgb, p.opacity))
-                            if not np.allclose(p.offset, np.eye(4)):
-                                cmds.append(_set_transform(f"{path}/{k}", p.offset))
-                else:
-                    cmds.append({"type": "anthroarm_color", "path": path, "color": list(rgb)})
+                    want[f"{bp}/{group}"] = tuple(round(c, 3) for c in limit_color(float(prox[idx].max()), base))
+            elif self._joint_rgb is not None and link_group in has:
+                j = b.joint if b.joint is not None else (frames[b.frame].joint if b.frame is not None else -1)
+                if j >= 0:
+                    want[f"{bp}/{link_group}"] = self._joint_rgb[j]
+        cmds = []
+        for path, (b, group) in where.items():
+            rgb = want.get(path)
+            if self._colors.get(path) == rgb:
+                continue
+            self._colors[path] = rgb
+            if rgb is None:  # restore the original colours
+                for k, p in enumerate(b.pieces):
+                    if p.group == group:
+                        cmds.append(_set_object(f"{path}/{k}", p.geometry, p.rgb, p.opacity))
+                        if not np.allclose(p.offset, np.eye(4)):
+                            cmds.append(_set_transform(f"{path}/{k}", p.offset))
+            else:
+                cmds.append({"type": "anthroarm_color", "path": path, "color": list(rgb)})
         return cmds
 
     def display(self, q) -> None:
@@ -712,6 +725,9 @@ class Viewer:
         with a colour legend; joints without limits (continuous joints) are skipped.
         ``on=False`` restores the colours and removes the legend."""
         self._limits_on = bool(on)
+        if self._limits_on and self._joint_rgb is not None:   # one colouring at a time
+            self._joint_rgb = None
+            self._send([_delete(f"{self.root}/ui/joint_values")])
         legend = f"{self.root}/ui/limits"
         if self._limits_on:
             x = np.linspace(0.0, 1.0, 11)
@@ -721,6 +737,58 @@ class Viewer:
         else:
             cmds = [_delete(legend)]
         self._send(self._color_commands(self.q) + cmds)
+
+    def show_joint_values(self, values, label: str = "joint torque |τ| (N·m)", *, colormap: str = "plasma",
+                          vmin=None, vmax=None, absolute: bool = True) -> dict:
+        """Colour each body's links by a value of the joint that moves it (joint torques from
+        :mod:`anthroarm.dynamics`, loads, effort ratios ...), with a colour legend.
+
+        Parameters
+        ----------
+        values : array_like
+            One number per joint of ``robot.chain`` (mimic joints included), or one per
+            velocity (``robot.nv``: a mimic joint then takes its source's value), e.g. τ.
+        label : str
+            Legend title, with the unit.
+        colormap : str
+            A matplotlib colour map name.
+        vmin, vmax : float, optional
+            Colour range (default: the values' range).
+        absolute : bool
+            Colour by ``|values|`` (a torque's size, either sign).
+
+        Returns
+        -------
+        dict
+            ``{"values": (njoints,), "colors": (njoints, 3), "vmin", "vmax"}``.
+
+        Raises
+        ------
+        ParameterError
+            Values of another length, NaN or inf, or a bad colour map or range.
+
+        ``values=None`` removes the colouring and its legend.  :meth:`show_limits` and this
+        colouring replace each other.
+        """
+        legend = f"{self.root}/ui/joint_values"
+        if values is None:
+            self._joint_rgb = None
+            self._send(self._color_commands(self.q) + [_delete(legend)])
+            return {}
+        chain = self.robot.chain
+        v = np.asarray(values, dtype=float) if np.ndim(values) else np.array([np.nan])
+        if v.ndim == 1 and len(v) == self.robot.nv and len(v) != len(chain.joints):
+            v = np.array([v[(chain.joints[j.mimic.source] if j.mimic else j).idx_v] for j in chain.joints])
+        if v.shape != (len(chain.joints),):
+            raise ParameterError(f"values must have one number per joint ({len(chain.joints)}) or per velocity "
+                                 f"({self.robot.nv}), got shape {np.shape(values)}")
+        v = np.abs(v) if absolute else v
+        rgb, lo, hi = colormap_rgb(v, colormap, vmin, vmax)
+        self._limits_on = False
+        self._joint_rgb = [tuple(round(float(c), 3) for c in row) for row in rgb]
+        self._send(self._color_commands(self.q) + [_delete(f"{self.root}/ui/limits"),
+                                                  self._ui(legend, colormap_legend(label, colormap, lo, hi))])
+        return {"values": v, "colors": rgb, "vmin": lo, "vmax": hi}
 
     # ------------------------------------------------------------------ overlays
     def _overlay_path(self, name: str) -> str:
