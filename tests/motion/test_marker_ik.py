@@ -172,3 +172,25 @@ def test_array_input_checks(arm, markers):
     P[0, 2] = np.inf                                            # an inf sample is a missing one
     res = marker_ik(arm, P, markers)
     assert res.n_markers[0] == len(markers) - 1 and np.isfinite(res.q).all()
+
+
+def test_first_frame_far_from_the_comfortable_posture(arm, markers):
+    """Marker IK is non-convex: a first frame anywhere in the joint range is found by the
+    multi-start (a single Gauss–Newton start from the comfortable posture fails on some)."""
+    Q = arm.random_q(25, rng=11, margin=0.05)
+    P = pin_marker_positions(arm, markers, Q)
+    single = [marker_ik(arm, P[i:i + 1], markers, seeds=0) for i in range(25)]
+    multi = [marker_ik(arm, P[i:i + 1], markers) for i in range(25)]
+    assert sum(np.abs(r.q[0] - Q[i]).max() > 1e-3 for i, r in enumerate(single)) >= 2
+    for i, r in enumerate(multi):
+        assert np.abs(r.q[0] - Q[i]).max() < 1e-4 and r.status[0] == "ok"
+
+
+def test_swapped_labels_give_large_error_frames(arm, markers):
+    _, Q = known_motion(arm, n=30, seed=12)
+    P = pin_marker_positions(arm, markers, Q)
+    el, rs = markers.names.index("EL"), markers.names.index("RS")
+    P[10:13, [el, rs]] = P[10:13, [rs, el]]                    # mislabelled for three frames
+    res = marker_ik(arm, P, markers)
+    assert (res.status[10:13] == "large_error").all() and (res.rms[10:13] > 0.02).all()
+    assert (res.status[13:] == "ok").all() and np.abs(res.q[13:] - Q[13:]).max() < 1e-4

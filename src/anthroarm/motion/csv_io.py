@@ -4,7 +4,7 @@ Format (what :func:`write_joint_csv` writes and ``anthroarm size --activities FI
 ``#`` lines are comments (units, source, the legend of the status codes); the header is ``t``
 (s) and one column per joint named as the joint (rad, or m for a prismatic joint); a marker-IK
 result adds ``rms_m``, ``max_error_m`` (m; ``nan`` for a skipped frame), ``n_markers`` and
-``status`` (a code: 0 ok, 1 too_few_markers, 2 not_converged, 3 skipped).  Every value is a
+``status`` (a code: 0 ok, 1 too_few_markers, 2 not_converged, 3 skipped, 4 large_error).  Every value is a
 number, so any CSV reader takes it.
 
 :func:`read_joint_csv` also accepts ``time`` / ``time_s`` for the time column and joint columns

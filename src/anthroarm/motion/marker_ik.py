@@ -16,9 +16,9 @@ Method: Gauss–Newton with box limits through anthroarm's QP layer.  Each itera
 ``regularization``, 1e-4 by default: a joint no visible marker determines keeps its last value
 instead of drifting) and a :class:`~anthroarm.ik.qp.ConfigurationLimit` of gain 1 (the step is
 the Gauss–Newton step projected into the limits by the QP; each iterate is inside the limits).
-The first frame starts from ``q0`` (default: the comfortable posture); every later frame is
-warm-started from the previous one, so it usually converges in 2–4 iterations.  The iteration
-stops when the largest joint change is below ``tol`` (rad).
+The first frame starts from ``q0`` (default: the comfortable posture) and other seeds (see
+below); every later frame is warm-started from the previous one, so it usually converges in
+2–4 iterations.  The iteration stops when the largest joint change is below ``tol`` (rad).
 
 Per frame the result holds q, the RMS and largest marker error of the visible markers (m), the
 number of visible markers, the iterations and a status:
@@ -30,7 +30,14 @@ number of visible markers, the iterations and a status:
 * ``"not_converged"``: ``max_iter`` iterations without the step falling below ``tol``; q is the
   last iterate (inside the limits);
 * ``"skipped"``: no visible marker (a NaN frame): q repeats the previous frame (the seed for the
-  first), and the frame's errors are NaN (there is nothing to measure them on).
+  first), and the frame's errors are NaN (there is nothing to measure them on);
+* ``"large_error"``: the RMS marker error is above ``max_rms`` (2 cm by default): a wrong local
+  minimum or a mislabelled marker; the next frame starts afresh.
+
+A frame without a previous solution (the first, and the one after a skipped or large-error
+frame) is started from ``q0`` and from ``seeds`` uniform postures inside the limits (a few
+Gauss–Newton iterations each, the best continued): marker IK is a non-convex problem and a
+single start from the comfortable posture can end in a wrong local minimum.
 
 The marker set is checked once before solving: a joint that no marker is downstream of, or a
 marker Jacobian whose rank is below nv at the comfortable posture, raises
@@ -50,7 +57,7 @@ from ..ik.qp.tasks.marker import MarkerTask
 from .markers import BoundMarkers, MarkerSet, default_marker_set
 from .trial import MarkerTrajectories
 
-STATUSES = ("ok", "too_few_markers", "not_converged", "skipped")
+STATUSES = ("ok", "too_few_markers", "not_converged", "skipped", "large_error")
 
 
 @dataclass
@@ -147,6 +154,13 @@ class MarkerIK:
     max_iter, first_iter : int
         Gauss–Newton iterations per frame (``first_iter`` for the first frame and after a
         skipped one, which may start far from the answer).
+    seeds : int
+        Extra starting postures for such a fresh frame (deterministic uniform samples inside
+        the limits, :meth:`~anthroarm.chain.Chain.random_q`), each given ``seed_iter``
+        iterations; the one with the smallest marker error is iterated to convergence.
+    max_rms : float
+        A frame whose RMS marker error exceeds ``max_rms`` (m) gets status ``"large_error"`` and
+        the next frame is started afresh (a wrong local minimum, a mislabelled marker).
     tol : float
         Stop when the largest joint change of an iteration is below ``tol`` (rad).
     regularization : float
@@ -156,7 +170,8 @@ class MarkerIK:
     """
 
     def __init__(self, robot, marker_set: MarkerSet | None = None, *, solver: str = "daqp", max_iter: int = 20,
-                 first_iter: int = 200, tol: float = 1e-6, regularization: float = 1e-4, check: bool = True):
+                 first_iter: int = 200, tol: float = 1e-6, regularization: float = 1e-4, check: bool = True,
+                 seeds: int = 24, seed_iter: int = 25, max_rms: float = 0.02):
         self.robot = robot
         self.marker_set = default_marker_set(robot) if marker_set is None else marker_set
         if not isinstance(self.marker_set, MarkerSet):
@@ -164,18 +179,51 @@ class MarkerIK:
         self.bound = BoundMarkers(robot, self.marker_set)
         if check:
             self.bound.check_constrains()
-        for nm, v in (("max_iter", max_iter), ("first_iter", first_iter)):
+        for nm, v in (("max_iter", max_iter), ("first_iter", first_iter), ("seed_iter", seed_iter), ("seeds", seeds + 1)):
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise ValueError(f"{nm} must be a whole number >= 1, got {v!r}")
-        for nm, v in (("tol", tol), ("regularization", regularization)):
+        for nm, v in (("tol", tol), ("regularization", regularization), ("max_rms", max_rms)):
             if not (isinstance(v, (int, float, np.floating)) and np.isfinite(v) and v > 0):
                 raise ValueError(f"{nm} must be a finite number > 0, got {v!r}")
         self.solver, self.max_iter, self.first_iter = solver, int(max_iter), int(first_iter)
         self.tol, self.regularization = float(tol), float(regularization)
+        self.seed_iter, self.max_rms = int(seed_iter), float(max_rms)
+        self.seed_q = robot.random_q(int(seeds), rng=0, margin=0.05) if seeds else np.zeros((0, robot.nq))
         qp.make_backend(solver, robot.nv, 0)      # SolverNotAvailableError now, not mid-trial
         self._rank_cache: dict = {}
 
     # ------------------------------------------------------------------ one frame
+    def _iterate(self, conf, tasks, limits, it_max: int) -> tuple[bool, int]:
+        """Gauss–Newton steps (QP steps with dt = 1) until the largest joint change is below
+        ``tol``: (converged, iterations)."""
+        it = 0
+        for it in range(1, it_max + 1):
+            v = qp.step(conf, None, tasks, 1.0, limits=limits, solver=self.solver)
+            conf.integrate_inplace(v, 1.0)
+            if np.max(np.abs(v)) < self.tol:
+                return True, it
+        return False, it
+
+    def _best_start(self, conf, task, reg, tasks, limits, vis, q_first) -> int:
+        """Multi-start for a frame without a previous solution: ``q_first`` and the seed
+        postures, ``seed_iter`` iterations each; leaves ``conf`` at the best.  Returns the
+        iterations spent."""
+        best_q, best_cost, spent = None, np.inf, 0
+        w = self.marker_set.weights
+        for q in (q_first, *self.seed_q):
+            conf.update(q)
+            reg.target = conf.q.copy()
+            _, it = self._iterate(conf, tasks, limits, self.seed_iter)
+            spent += it
+            d = np.linalg.norm(task.positions(conf) - task.target, axis=1)
+            cost = float(np.sum(w[vis] * d[vis] ** 2))
+            if cost < best_cost:
+                best_q, best_cost = conf.q.copy(), cost
+            if np.sqrt(np.mean(d[vis] ** 2)) < 0.1 * self.max_rms:
+                break
+        conf.update(best_q)
+        return spent
+
     def _determined(self, task: MarkerTask, visible: np.ndarray, conf) -> bool:
         """The visible markers determine every joint at ``conf``: each joint has one downstream
         (cached per visibility pattern) and J (weighted) has full column rank."""
@@ -262,28 +310,28 @@ class MarkerIK:
                 fresh = True
                 continue
             task.set_target(P[n], vis)
+            extra = 0
+            if fresh:
+                extra = self._best_start(conf, task, reg, tasks, limits, vis, q_seed if n == 0 else conf.q)
             reg.target = conf.q.copy()
             it_max = self.first_iter if fresh else self.max_iter
-            converged = False
-            for it in range(1, it_max + 1):
-                v = qp.step(conf, None, tasks, 1.0, limits=limits, solver=self.solver)
-                conf.integrate_inplace(v, 1.0)
-                if np.max(np.abs(v)) < self.tol:
-                    converged = True
-                    break
-            iters[n] = it
+            converged, it = self._iterate(conf, tasks, limits, it_max)
+            iters[n] = it + extra
             d = np.linalg.norm(task.positions(conf) - task.target, axis=1)
             merr[n, vis] = d[vis]
             rms[n] = float(np.sqrt(np.mean(d[vis] ** 2)))
             mx[n] = float(d[vis].max())
             Q[n] = conf.q
+            fresh = False
             if not self._determined(task, vis, conf):
                 status[n] = "too_few_markers"
+            elif rms[n] > self.max_rms:
+                status[n] = "large_error"
+                fresh = True
             elif not converged:
                 status[n] = "not_converged"
             else:
                 status[n] = "ok"
-            fresh = False
             if progress is not None and (n + 1) % 50 == 0:
                 progress(n + 1, N)
         seconds = _time.process_time() - t0
