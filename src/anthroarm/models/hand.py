@@ -79,7 +79,7 @@ FINGERS = DIGITS[1:]
 #: the order of their names, so the spec lists them that way and spec order = q order
 Q_ORDER = tuple(sorted(DIGITS))
 
-#: Buchholz, Armstrong & Goldstein (1992): segment length / hand length (see the module table)
+#: segment length / hand length, per digit, of Buchholz, Armstrong & Goldstein 1992 (the module table)
 BUCHHOLZ_1992 = {
     "thumb": (0.118, 0.251, 0.196, 0.158),
     "index": (0.463, 0.245, 0.143, 0.097),
@@ -101,7 +101,7 @@ FINGER_ROM_DEG = {"mcp_abduction": (-20.0, 20.0), "mcp_flexion": (-45.0, 90.0), 
 THUMB_ROM_DEG = {"cmc_abduction": (0.0, 70.0), "cmc_flexion": (-20.0, 15.0), "mcp": (0.0, 50.0),
                  "ip": (-20.0, 80.0)}
 
-#: Rijpkema & Girard (1991): θ_DIP = 2/3 θ_PIP
+#: θ_DIP / θ_PIP of the physiological coupling, 2/3 after Rijpkema & Girard 1991
 DIP_PIP_RATIO = 2.0 / 3.0
 
 #: rest direction of the thumb metacarpal in the hand frame (distal, radial, palmar; unit)

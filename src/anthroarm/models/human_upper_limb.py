@@ -97,5 +97,5 @@ def human_upper_limb(height: float = 1.75, mass: float = 75.0, sex: str = "male"
                         "cylinders of 1160 kg/m3 (Dempster 1955); palm: de Leva hand mass minus the phalanges, as a box"),
         params=params,
         person=True,
-        comfort={**arm.comfort, **comfort},
+        comfort={**(arm.comfort or {}), **comfort},
     )

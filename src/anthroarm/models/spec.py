@@ -157,7 +157,7 @@ class ChainSpec:
 
     @property
     def nq(self) -> int:
-        """Number of configuration variables: the joints that are not fixed and do not mimic another."""
+        """How many configuration variables the chain has (its joints that are neither fixed nor mimic joints)."""
         return sum(1 for j in self.joints if j.mimic is None and j.type != "fixed")
 
 
