@@ -133,3 +133,29 @@ def test_cli_ik_markers(tmp_path, capsys):
     assert rc == 2 and "C3D file not found" in err and err.count("\n") == 1 and not (tmp_path / "x.csv").exists()
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "no" / "x.csv")])
     assert rc == 2 and "existing folder" in capsys.readouterr().err
+
+
+def test_own_marker_set_as_json(tmp_path, arm, markers, capsys):
+    """A lab's own set: written, read back equal, used by the CLI; bad files are typed errors."""
+    from anthroarm.errors import MarkerSetError
+    from anthroarm.motion import MarkerSet
+
+    own = markers.subset(["UA", "EL", "EM", "RS", "US", "MC2", "MC5"])
+    own.write_json(tmp_path / "own.json")
+    back = MarkerSet.read_json(tmp_path / "own.json")
+    assert back.names == own.names and np.array_equal(back.positions, own.positions)
+    _, Q = known_motion(arm, n=20, seed=13)
+    P = pin_marker_positions(arm, own, Q)
+    write_c3d(tmp_path / "t.c3d", MarkerTrajectories(own.names, P, rate=100.0))
+    rc = main(["ik-markers", str(tmp_path / "t.c3d"), "--out", str(tmp_path / "a.csv"), "--markers",
+               str(tmp_path / "own.json"), "--no-progress"])
+    assert rc == 0 and json.loads(capsys.readouterr().out.strip().splitlines()[-1])["ok"] == 20
+    assert np.abs(read_joint_csv(tmp_path / "a.csv", arm).q - Q).max() < 1e-4
+    (tmp_path / "bad.json").write_text("{not json")
+    with pytest.raises(MarkerSetError, match="not a JSON"):
+        MarkerSet.read_json(tmp_path / "bad.json")
+    (tmp_path / "bad2.json").write_text('{"markers": {"A": ["hand"]}}')
+    with pytest.raises(MarkerSetError, match="expected"):
+        MarkerSet.read_json(tmp_path / "bad2.json")
+    with pytest.raises(MarkerSetError, match="not found"):
+        MarkerSet.read_json(tmp_path / "none.json")
