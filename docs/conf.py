@@ -46,7 +46,7 @@ build_pages.benchmark_pages(ROOT / "benchmarks" / "results", DOCS / "benchmarks"
 build_pages.equation_table(DOCS / "book_map_equations.md")
 build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
-GUIDE = ["load", "kinematics", "ik", "dynamics", "mechanisms", "hand", "design", "book_systems", "prosthesis", "emg", "viewer",
+GUIDE = ["load", "kinematics", "ik", "dynamics", "mechanisms", "hand", "design", "book_systems", "motion", "prosthesis", "emg", "viewer",
          *(["/batch"] if (DOCS / "batch.md").is_file() else []), "benchmarks"]
 build_pages.write_if_changed(DOCS / "guide" / "_toc.md",
                              "```{toctree}\n:maxdepth: 1\n\n" + "\n".join(GUIDE) + "\n```\n")
@@ -64,7 +64,7 @@ nitpick_ignore_regex = [
                r"|yourdfpy|lxml|qpsolvers|osqp|tornado|zmq|pathlib|os|typing|collections|concurrent"
                r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes)(\..*)?"),
     # prose in numpydoc type fields ("array (N, 3)", "float, rad") is not a Python name
-    (r"py:class", r"[a-z_][a-z0-9_]*|.*[^\w.].*|True|False|[A-Z]|Eq\.?|\."),
+    (r"py:class", r"[a-z_][a-z0-9_]*|.*[^\w.].*|True|False|[A-Z]|\d+|Eq\.?|\."),
     # module constants without a doc comment are not in the reference (names in prose)
     (r"py:data", r"(.*\.)?[A-Z][A-Z0-9_]*"),
     # private objects are not part of the API reference
