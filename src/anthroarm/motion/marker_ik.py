@@ -239,9 +239,10 @@ class MarkerIK:
         ev = np.linalg.eigvalsh(WJ.T @ WJ)
         return bool(ev[0] > 1e-10 * max(ev[-1], 1e-300))
 
-    def solve(self, trial, *, q0=None, rename: dict | None = None, progress=None) -> MarkerIKResult:
+    def solve(self, trial, *, q0=None, rename: dict | None = None, progress=None,
+              rate: float = 100.0) -> MarkerIKResult:
         """Solve every frame of ``trial`` (:class:`~anthroarm.motion.trial.MarkerTrajectories`,
-        or an ``(N, M, 3)`` array in the marker set's order, m).  ``q0`` seeds the first frame
+        or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0`` seeds the first frame
         (default: the comfortable posture).  ``progress(n_done, n_total)`` is called every 50
         frames (the CLI's progress bar).
 
@@ -272,7 +273,9 @@ class MarkerIK:
             P[~np.isfinite(P).all(axis=2)] = np.nan
             N = P.shape[0]
             cols = np.where(np.isfinite(P).all(axis=2).any(axis=0), np.arange(len(names)), -1)
-            t = np.arange(N) / 100.0
+            if not (isinstance(rate, (int, float, np.floating)) and np.isfinite(rate) and rate > 0):
+                raise MotionDataError(f"rate must be a positive number (Hz), got {rate!r}")
+            t = np.arange(N) / float(rate)
         missing = tuple(n for n, c in zip(names, cols) if c < 0)
         if missing:
             free = self.bound.unconstrained_joints(cols >= 0)
@@ -344,7 +347,7 @@ class MarkerIK:
 
 
 def marker_ik(robot, trial, marker_set: MarkerSet | None = None, *, q0=None, rename: dict | None = None,
-              progress=None, **options) -> MarkerIKResult:
+              progress=None, rate: float = 100.0, **options) -> MarkerIKResult:
     """Marker IK of a whole trial: ``MarkerIK(robot, marker_set, **options).solve(trial, ...)``
     (see :class:`MarkerIK` for the options and the module docstring for the method)."""
-    return MarkerIK(robot, marker_set, **options).solve(trial, q0=q0, rename=rename, progress=progress)
+    return MarkerIK(robot, marker_set, **options).solve(trial, q0=q0, rename=rename, progress=progress, rate=rate)
