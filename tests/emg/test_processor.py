@@ -116,6 +116,10 @@ def test_bad_signals_and_rates():
         EMGProcessor(FS, envelope="hilbert")
     with pytest.raises(EMGError):
         EMGProcessor(FS, frame_s=0.0)
+    with pytest.raises(EMGError, match="band"):
+        EMGProcessor(FS, band=(20.0,))
+    with pytest.raises(EMGError, match="low < high"):
+        EMGProcessor(FS, band=(450.0, 20.0))
 
 
 def test_envelope_and_onsets_against_neurokit2():

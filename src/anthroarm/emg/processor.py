@@ -145,8 +145,12 @@ class EMGProcessor:
         if not (isinstance(n_channels, (int, np.integer)) and n_channels >= 1):
             raise EMGError(f"n_channels must be an integer >= 1, got {n_channels!r}")
         self.n_channels = int(n_channels)
-        self.fs = check_sampling_rate(fs, float(band[1]), f"the conditioning band {band[0]:g}–{band[1]:g} Hz")
-        sos = [bandpass_sos(band[0], band[1], self.fs)]
+        try:
+            lo, hi = (float(b) for b in band)
+        except (TypeError, ValueError):
+            raise EMGError(f"band must be (low, high) in Hz, got {band!r}") from None
+        self.fs = check_sampling_rate(fs, hi, f"the conditioning band {lo:g}–{hi:g} Hz")
+        sos = [bandpass_sos(lo, hi, self.fs)]
         if notch_hz is not None:
             sos.append(notch_sos(notch_hz, self.fs))
         self.sos = np.vstack(sos)
