@@ -91,3 +91,14 @@ def test_cli_size_bad_input(tmp_path, capsys, args, words, monkeypatch):
     err = capsys.readouterr().err
     assert words in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "report.html").exists()
+
+
+def test_report_embeds_one_viewer_page_with_the_activities(person, tmp_path):
+    t = np.linspace(0, 0.5, 26)
+    q0 = person.neutral()
+    q, qd, qdd = minimum_jerk(q0, q0 + np.array([0.8, 0, 0, 0.9, 0, 0, 0]), 0.5, t)
+    st = study.run(person, [dict(name="a", t=t, q=q, qd=qd, qdd=qdd), dict(name="b", t=t, q=q[::-1])], payload=0.2)
+    text = report.render(st, viewer=True)
+    assert text.count("<iframe srcdoc=") == 1 and "set_animation" not in text[:200]
+    assert "a at 0.0 s; b at 0.5 s" in text
+    assert text.count("MeshCat.Viewer(") == 1            # meshcat's page once, escaped in srcdoc
