@@ -45,6 +45,12 @@ def test_mobility_is_the_books_27_and_20():
     assert spec.nq == 27 == aa.load("human_upper_limb").nq
 
 
+def test_mobility_of_the_arm_alone_is_seven():
+    # ch. 2 (l. 544): the arm without the fingers, shoulder 3 + elbow/forearm 2 + wrist 2 = 7
+    m = mechanism_of(aa.models.spec("human_arm7"))
+    assert m.mobility() == 7 and m.pair_counts() == {1: 0, 2: 0, 3: 1, 4: 2, 5: 0}
+
+
 def test_mimic_coupling_keeps_the_graph_and_drops_four_variables():
     spec = aa.models.spec("human_upper_limb", dip_coupling="2/3")
     assert mechanism_of(spec).mobility() == 27          # the pairs are the same
@@ -228,6 +234,12 @@ def test_cli_writes_the_model(tmp_path):
     res = subprocess.run([sys.executable, "-c", CLI, "urdf", "human_upper_limb", "--param", "hand_length=0.5",
                           "-o", str(tmp_path / "bad.urdf")], capture_output=True, text=True, timeout=120)
     assert res.returncode != 0 and "forearm" in res.stderr and "Traceback" not in res.stderr
+    from anthroarm import cli
+
+    out2 = tmp_path / "coupled.urdf"
+    assert cli.main(["urdf", "human_upper_limb", "--dip_coupling", "2/3", "-o", str(out2)]) == 0
+    text = out2.read_text()
+    assert text.count("<mimic ") == 4 and 'multiplier="0.6666666666666666"' in text
 
 
 def test_crosscheck_rows_pass():

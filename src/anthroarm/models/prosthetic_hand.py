@@ -42,7 +42,7 @@ fingertips (P8 of the six-bar, S of the thumb).  Units: m, rad, kg.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -107,7 +107,6 @@ class ProstheticHand:
     palm_size: tuple
     scale: float = 1.0
     thumb_range: tuple = THUMB_RANGE
-    extra: dict = field(default_factory=dict)
 
     def driver_range(self, digit: str) -> tuple[float, float]:
         """(lower, upper) of the digit's driver variable (rad, tree convention, see module doc)."""
