@@ -4,7 +4,8 @@ The signal: :func:`anthroarm.emg.synthesize`, a flexor and an extensor burst at 
 (a) ours: :meth:`anthroarm.emg.EMGProcessor.process` (built once: conditioning band-pass,
 100 ms moving RMS or linear envelope, 5 ms frames, Schmitt thresholds, codes), alone and
 followed by :meth:`anthroarm.emg.CodeMachine.run`; the Table 9.1 filter bank
-(:class:`anthroarm.emg.FilterBank`, 4 bands) on the same signal; (b) neurokit2: ``emg_process``
+(:class:`anthroarm.emg.FilterBank`, 4 bands) on the same signal; the chain fed in 50 blocks of
+20 ms as a real-time controller would (filter states kept between blocks); (b) neurokit2: ``emg_process``
 (clean, amplitude, activation) once per channel, and its ``emg_clean`` + ``emg_amplitude``
 alone (the part that matches ours).  Goal (issue 16): 1 s of 2-channel EMG in at most 1 ms,
 i.e. faster than 1000× real time.  Ratios > 1 mean ours is faster.
@@ -40,17 +41,29 @@ def run(quick: bool = False) -> dict:
         machine.reset()
         return machine.run(proc.process(x).code)
 
+    blocks = np.split(x, 50, axis=1)                       # 20 ms blocks, as a real-time controller gets them
+
+    def streaming():
+        proc.reset()
+        machine.reset()
+        for b in blocks:
+            machine.run(proc.process(b, reset=False).code)
+
     ours = {
         "ours: EMGProcessor (RMS envelope, thresholds, codes)": lambda: proc.process(x),
         "ours: EMGProcessor (linear envelope)": lambda: lp.process(x),
         "ours: EMGProcessor + CodeMachine": chain_codes,
+        "ours: streaming, 50 blocks of 20 ms + CodeMachine": streaming,
         "ours: FilterBank, 4 bands (Table 9.1)": lambda: bank.apply(x),
     }
     t_ours = {}
     for name, fn in ours.items():
         t = time_call(fn, repeat=repeat, min_time=min_time)
         t_ours[name] = t
-        rows.append([name, t * 1e3, 1.0 / t, "met" if t <= GOAL_S else "NOT met", float("nan")])
+        goal = "met" if t <= GOAL_S else "NOT met"
+        if fn is streaming:       # the goal is for one call on the whole second; say the per-block cost
+            goal = f"n/a ({t / len(blocks) * 1e6:.0f} µs per 20 ms block)"
+        rows.append([name, t * 1e3, 1.0 / t, goal, float("nan")])
 
     try:
         import neurokit2 as nk

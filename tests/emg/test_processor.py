@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from anthroarm.emg import (AMPUTEE_PP, BOTH, EXTENSOR, FLEXOR, REST, DifferentialAmplifier, EMGProcessor, Thresholds,
-                           synthesize)
+                           electrode_potentials, synthesize)
 from anthroarm.errors import EMGError, SamplingRateError, ThresholdError
 
 FS = 2000.0
@@ -140,3 +140,18 @@ def test_envelope_and_onsets_against_neurokit2():
     assert np.all((off >= truth_on + 1.0) & (off <= truth_on + 1.1))
     np.testing.assert_allclose(on, np.asarray(info["EMG_Onsets"]) / 1000.0, atol=0.1)
     np.testing.assert_allclose(off, np.asarray(info["EMG_Offsets"]) / 1000.0, atol=0.1)
+
+
+@pytest.mark.parametrize("cmrr_db, notch, switches", [(100.0, None, False), (60.0, None, True), (60.0, 50.0, False)])
+def test_mains_hum_and_the_cmrr(cmrr_db, notch, switches):
+    """1 V p-p of 50 Hz common-mode hum, no EMG: the differential front end leaves
+    1 V * 10**(-CMRR/20) at its input (10 µV p-p at 100 dB, under the 25 µV off-threshold;
+    1 mV at 60 dB, which would move the hand); a 50 Hz notch removes it again."""
+    amp = DifferentialAmplifier(gain=1000.0, cmrr_db=cmrr_db, rail=None)
+    vp, vm = electrode_potentials(np.zeros((2, int(2 * FS))), FS, mains_pp=1.0)
+    out = amp.amplify(vp, vm)
+    res = EMGProcessor(FS, gain=amp.gain, notch_hz=notch).process(out.signal)
+    residual = 1.0 * 10 ** (-cmrr_db / 20)
+    if notch is None:
+        assert res.envelope_pp[0, -1] == pytest.approx(residual, rel=0.02)   # 50 Hz: gain ~1 in 20-450 Hz
+    assert res.active[:, -1].tolist() == [switches, switches]
