@@ -20,7 +20,8 @@ over more than 180° (here ±135°), radial extension 500–1000 mm, vertical st
 elevation and elbow ranges) is our choice, said in each docstring.  Inertias: the default rods
 of :func:`anthroarm.models.spec.rod_link` (not printed).
 
-Units: metres, radians.  A parameter out of range raises
+Units: metres, radians (the angular ranges ``base``, ``elevation``, ``shoulder``, ``elbow``
+are in rad, the strokes and lengths in m).  A parameter out of range raises
 :class:`~anthroarm.errors.ParameterError` naming it.
 """
 
@@ -90,8 +91,9 @@ def _spec(name: str, form: str, joints: list[JointSpec], tool, params: dict) -> 
 
 def cartesian_robot(h0: float = 0.5, x0: float = 0.3, x_stroke=(0.0, 1.0), y_stroke=(-0.5, 0.5),
                     z_stroke=LIFT) -> ChainSpec:
-    """Cartesian (直角坐标式) P-P-P template: slides along x, y, z; tool at
-    ``(x0 + q1, q2, h0 + q3)`` (m).  Workspace: the box of the three strokes (Table 2.3: cube).
+    """Cartesian (直角坐标式) P-P-P template of Table 2.3.
+
+    Slides along x, y, z; tool at ``(x0 + q1, q2, h0 + q3)`` (m).  Workspace: the box of the three strokes (Table 2.3: cube).
     Defaults (ours): gantry height h0 = 0.5 m, x offset 0.3 m, strokes 1 m."""
     m = "cartesian_robot"
     h0, x0 = _length(m, "h0", h0), _length(m, "x0", x0)
@@ -104,8 +106,9 @@ def cartesian_robot(h0: float = 0.5, x0: float = 0.3, x_stroke=(0.0, 1.0), y_str
 
 
 def cylindrical_robot(h0: float = 0.3, base=BASE_RANGE, lift=LIFT, reach=REACH) -> ChainSpec:
-    """Cylindrical (圆柱坐标式) R-P-P template (the Versatran, Fig. 2-11): azimuth q1 about z,
-    height ``h0 + q2``, radius q3 (m).  Workspace: a hollow cylinder sector (Table 2.3).
+    """Cylindrical (圆柱坐标式) R-P-P template of Table 2.3 (the Versatran, Fig. 2-11).
+
+    Azimuth q1 (rad) about z, height ``h0 + q2``, radius q3 (m).  Workspace: a hollow cylinder sector (Table 2.3).
     Defaults: base ±135°, lift 0–1 m, reach 0.5–1 m (§2-4); h0 = 0.3 m (ours)."""
     m = "cylindrical_robot"
     h0 = _length(m, "h0", h0)
@@ -120,8 +123,9 @@ def cylindrical_robot(h0: float = 0.3, base=BASE_RANGE, lift=LIFT, reach=REACH) 
 
 
 def spherical_robot(h0: float = 0.8, base=BASE_RANGE, elevation=(-45 * deg, 60 * deg), reach=REACH) -> ChainSpec:
-    """Spherical (球坐标式) R-R-P template (the Unimate, Fig. 2-11): azimuth q1 about z, elevation
-    q2 of the boom about the shoulder at height h0 (positive up), boom length q3 (m) from the
+    """Spherical (球坐标式) R-R-P template of Table 2.3 (the Unimate, Fig. 2-11).
+
+    Azimuth q1 about z, elevation q2 (rad) of the boom about the shoulder at height h0 (positive up), boom length q3 (m) from the
     shoulder.  Workspace: a spherical shell sector (Table 2.3: 球体; "can pick objects off the
     floor").  Defaults: base ±135°, reach 0.5–1 m (§2-4); h0 = 0.8 m, elevation −45°…60° (ours)."""
     m = "spherical_robot"
@@ -138,8 +142,10 @@ def spherical_robot(h0: float = 0.8, base=BASE_RANGE, elevation=(-45 * deg, 60 *
 
 def articulated_robot(h0: float = 0.5, l2: float = 0.5, l3: float = 0.5, base=BASE_RANGE,
                       shoulder=(-45 * deg, 90 * deg), elbow=(-150 * deg, 0.0)) -> ChainSpec:
-    """Articulated (多关节式) R-R-R template: azimuth q1 about z, shoulder q2 and elbow q3
-    (relative; both positive up, about −y) in the vertical plane; upper arm l2, forearm l3 (m),
+    """Articulated (多关节式) R-R-R template of Table 2.3.
+
+    Azimuth q1 about z, shoulder q2 and elbow q3 (rad; the elbow relative, both positive up,
+    about −y) in the vertical plane; upper arm l2, forearm l3 (m),
     shoulder at height h0.  Tool: ``r = l2 cos q2 + l3 cos(q2+q3)``, ``z = h0 + l2 sin q2 +
     l3 sin(q2+q3)`` at azimuth q1.  Defaults: base ±135° (§2-4); lengths 0.5 m, shoulder
     −45°…90°, elbow −150°…0 (ours)."""
