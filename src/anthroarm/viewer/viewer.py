@@ -406,7 +406,7 @@ class Viewer:
         Initial configuration (default ``robot.neutral()``).
     grid, axes, scale_bar : bool
         Guides (each also switchable later: :meth:`set_grid`, :meth:`set_axes`,
-        :meth:`set_scale_bar`): a floor grid of :attr:`spacing` m squares through the base
+        :meth:`set_scale_bar`): a floor grid of ``viewer.spacing`` m squares through the base
         origin, the world axes at the base origin, and a scale bar one grid square long with
         a note giving its length.  A translucent floor disc is always drawn.
     mesh_triangles : int or None
@@ -571,7 +571,7 @@ class Viewer:
         return {"type": "anthroarm_ui", "path": path, "spec": spec}
 
     def set_grid(self, visible: bool = True) -> None:
-        """Show or hide the floor grid (lines :attr:`spacing` m apart through the base origin)."""
+        """Show or hide the floor grid (lines ``viewer.spacing`` m apart through the base origin)."""
         self._send([_set_property(f"{self.root}/grid", "visible", bool(visible))])
 
     def set_axes(self, visible: bool = True) -> None:
@@ -767,6 +767,8 @@ class Viewer:
         ParameterError
             Values of another length, NaN or inf, or a bad colour map or range.
 
+        Notes
+        -----
         ``values=None`` removes the colouring and its legend.  :meth:`show_limits` and this
         colouring replace each other.
         """
