@@ -35,8 +35,8 @@ distal wrist crease; the MCP joints of fingers 2–5 lie on a line across the pa
 the middle finger on the hand's long axis (index radial of it); the thumb CMC sits 0.118 HL
 distal of the wrist, 0.22 HB radial and 0.12 HB palmar of the axis, and the thumb's rest
 direction points distally, radially and palmar (:data:`THUMB_REST_DIRECTION`).  Each
-phalanx is a solid cylinder of radius HB/8 (finger breadth HB/4; thumb 1.15×, distal
-phalanges tapered to 0.85×) and density 1160 kg/m³ (hand density of Dempster (1955), as
+phalanx is a solid cylinder of radius HB/8 (finger breadth HB/4; thumb 1.15×; middle
+phalanges 0.925×, distal 0.85×) and density 1160 kg/m³ (hand density of Dempster (1955), as
 tabulated by Winter, *Biomechanics and Motor Control of Human Movement*, 4th ed. 2009,
 Table 4.1); the palm carries the rest of de Leva's hand mass as a box HB wide, l_hand long
 and 0.3 HB thick.
