@@ -59,9 +59,8 @@ def test_model_mass_is_the_printed_total(robot):
 
 
 def test_model_segment_lengths_are_the_printed_ones(robot):
-    # q = 0 of the 6R layout of Fig. 6-3: shoulder at height s0, elbow at h2 along x,
-    # forearm s3 and finger-palm P along the same line: tool at (h2, 0, s0 - s3 - P)... read off
-    # the joint placements instead of assuming the posture
+    # distances between the joint origins (Pinocchio FK at q = 0): waist -> shoulder = base,
+    # shoulder -> elbow = upper arm, elbow -> wrist centre = forearm, wrist centre -> grip = finger-palm
     data = robot.model.createData()
     pin.forwardKinematics(robot.model, data, robot.neutral())
     pin.updateFramePlacements(robot.model, data)
@@ -139,6 +138,7 @@ def test_interpolated_wrist_within_the_printed_1_cm(robot, table):
     assert np.median(err) < CELL_ACCURACY
     assert (err <= CELL_ACCURACY).mean() >= 0.9
     assert err.max() < 3 * CELL_ACCURACY
+    assert err.max() > CELL_ACCURACY         # ... but it is not a bound everywhere (docs/guide/book_systems.md)
     assert err.max() > 1e-3          # interpolation is not exact between lattice points
 
 
