@@ -137,3 +137,18 @@ def test_amplifier_bad_input():
         amp.amplify(np.zeros((2, 10)), np.zeros((2, 11)))
     with pytest.raises(EMGError, match="NaN"):
         amp.amplify(np.array([[0.0, np.nan]]), np.zeros((1, 2)))
+
+
+def test_numbers_beyond_any_voltage_are_refused_not_overflowed():
+    from anthroarm.emg import EMGProcessor, moving_rms, spectrum
+
+    huge = np.full((2, 400), 1e200)
+    for call in (lambda: EMGProcessor(2000.0).process(huge), lambda: moving_rms(huge, 2000.0),
+                 lambda: spectrum(huge, 2000.0)):
+        with pytest.raises(EMGError, match="not a voltage"):
+            call()
+    with pytest.raises(EMGError, match="overflows"):
+        DifferentialAmplifier(gain=1e308, rail=None).amplify(np.full((1, 4), 1e5), np.zeros((1, 4)))
+    # the largest accepted voltage goes through without inf/NaN
+    out = EMGProcessor(2000.0).process(np.full((2, 400), 1e6) * np.sign(np.sin(np.arange(400)))[None])
+    assert np.all(np.isfinite(out.envelope_pp)) and np.all(np.isfinite(out.filtered))

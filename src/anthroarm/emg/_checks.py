@@ -8,6 +8,9 @@ import numpy as np
 
 from ..errors import EMGError
 
+#: the largest magnitude accepted as a voltage (V); squares and sums of it stay far from overflow
+MAX_VOLTS = 1e6
+
 
 def positive(value, name: str, unit: str = "") -> float:
     """``value`` as a finite float > 0, else :class:`~anthroarm.errors.EMGError` naming it."""
@@ -22,8 +25,8 @@ def positive(value, name: str, unit: str = "") -> float:
 
 def signal(x, name: str = "emg", n_channels: int | None = None, min_samples: int = 1) -> np.ndarray:
     """``x`` as a float array of shape (n_channels, n_samples) (a 1-D array is one channel when
-    ``n_channels`` is None or 1); NaN/inf, other ranks or a wrong channel count raise
-    :class:`~anthroarm.errors.EMGError`."""
+    ``n_channels`` is None or 1); NaN/inf, magnitudes beyond :data:`MAX_VOLTS`, other ranks or a
+    wrong channel count raise :class:`~anthroarm.errors.EMGError`."""
     try:
         a = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
@@ -42,4 +45,7 @@ def signal(x, name: str = "emg", n_channels: int | None = None, min_samples: int
         bad = np.argwhere(~np.isfinite(a))[0]
         raise EMGError(f"{name} contains NaN/inf (first at channel {bad[0]}, sample {bad[1]}): "
                        "fill or cut the gap before processing")
+    if a.size and np.max(np.abs(a)) > MAX_VOLTS:
+        raise EMGError(f"{name} has values up to {np.max(np.abs(a)):.3g}, beyond {MAX_VOLTS:.0e} V: "
+                       "not a voltage (wrong units?)")
     return a
