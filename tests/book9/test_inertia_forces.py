@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.dynamics.inertia_forces import (angular_momentum, axis_projections, dalembert_torques,
+from anthroarm.dynamics.inertia_forces import (angular_momentum, joint_frame_from_links, axis_projections, dalembert_torques,
                                                inertia_couple, inertia_couple_expanded, inertia_couple_fixed,
                                                inertia_force, inertia_force_body, joint_frame, link_inertia_loads,
                                                oblique_components, oblique_components_printed, torque_terms)
@@ -209,3 +209,18 @@ def test_printed_8_33_angular_momentum_fails():
     Hy_printed = -w[0] * Jyz + w[1] * Jy - w[2] * Jxy          # J_yx = J_xy
     assert abs(Hx_printed - H_true[0]) > 1e-3 or abs(Hy_printed - H_true[1]) > 1e-3
     del Jx
+
+
+def test_8_84_row_vectors_with_the_passive_matrices_are_the_rotated_axes():
+    """(8-84): (l, m, n)(Φ Ψ Θ) of a link with X–Y–X angles e is R(e) (l, m, n)ᵀ, R = R_x(θ)
+    R_y(ψ) R_x(φ) (scipy's intrinsic 'XYX' as the independent oracle)."""
+    from scipy.spatial.transform import Rotation
+
+    e1, e2 = RNG.uniform(-1, 1, 3), RNG.uniform(-1, 1, 3)
+    l1, l2 = np.array([0.0, 0.6, 0.8]), np.array([1.0, 0.0, 0.0])
+    A = joint_frame_from_links(l1, e1, l2, e2)
+    R1, R2 = (Rotation.from_euler("XYX", e).as_matrix() for e in (e1, e2))
+    np.testing.assert_allclose(A[:, 0], R1 @ l1, atol=1e-14)
+    np.testing.assert_allclose(A[:, 1], R2 @ l2, atol=1e-14)
+    c = np.cross(R1 @ l1, R2 @ l2)
+    np.testing.assert_allclose(A[:, 2], c / np.linalg.norm(c), atol=1e-14)          # (8-85)

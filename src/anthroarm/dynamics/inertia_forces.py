@@ -45,7 +45,7 @@ from ..spatial.rotations import rot_axis
 
 __all__ = ["inertia_force", "inertia_force_body", "angular_momentum", "inertia_couple", "inertia_couple_expanded",
            "inertia_couple_fixed", "LinkMotion", "link_motion", "LinkInertiaLoads", "link_inertia_loads",
-           "dalembert_torques", "torque_terms", "joint_frame", "oblique_components", "oblique_components_printed",
+           "dalembert_torques", "torque_terms", "joint_frame", "joint_frame_from_links", "oblique_components", "oblique_components_printed",
            "axis_projections"]
 
 
@@ -267,6 +267,21 @@ def joint_frame(p1, p2) -> np.ndarray:
     if s < 1e-9:
         raise ValueError(f"joint axes p1 and p2 are parallel (|p1 × p2| = {s:.3g}): (8-85) has no third axis")
     return np.column_stack([u1, u2, c / s])
+
+
+def joint_frame_from_links(l1, e1, l2, e2) -> np.ndarray:
+    """The joint frame of Eq. (8-84) from the book's data: the direction cosines ``l1`` of axis
+    1 in the frame of link β(p, 1), whose X–Y–X Euler angles are ``e1`` = (θ, ψ, φ), and ``l2``
+    of axis 2 in link β(p, 2) with ``e2``.  As printed, each fixed-frame axis is the row vector
+    ``(l, m, n)(Φ Ψ Θ)`` with the passive matrices of Eq. (8-41)
+    (:func:`anthroarm.dynamics.euler_chain.passive`); then :func:`joint_frame` adds p3 (8-85)."""
+    from .euler_chain import passive
+
+    rows = []
+    for name, lmn, e in (("l1", l1, e1), ("l2", l2, e2)):
+        Th, Ps, Ph = passive(_vec(e, f"Euler angles of {name}'s link"))
+        rows.append(_vec(lmn, name) @ (Ph @ Ps @ Th))
+    return joint_frame(rows[0], rows[1])
 
 
 def oblique_components(M, axes) -> np.ndarray:
