@@ -119,6 +119,25 @@ def test_flexion_moves_fingers_palmar_and_abduction_toward_thumb(limb):
     assert d[0] < -1e-3                                  # thumb flexion sweeps across the palm (ulnar)
 
 
+def test_thumb_reaches_the_index_tip_within_the_ranges(limb):
+    """Opposition (tip pinch) is possible inside the joint ranges: a bounded local minimisation
+    (scipy, independent of the model code) brings the thumb tip onto the index tip."""
+    from scipy.optimize import minimize
+
+    names = list(limb.model.names)[1:]
+    idx = [i for i, n in enumerate(names) if n.startswith(("thumb", "index"))]
+
+    def gap(x):
+        q = np.zeros(limb.nq)
+        q[idx] = x
+        return np.linalg.norm(limb.fk(q, frame="thumb_tip")[:3, 3] - limb.fk(q, frame="index_tip")[:3, 3])
+
+    lo, hi = limb.lower[idx], limb.upper[idx]
+    res = minimize(gap, (lo + hi) / 2, bounds=list(zip(lo, hi)))
+    assert res.fun < 1e-6
+    assert np.all(res.x >= lo - 1e-12) and np.all(res.x <= hi + 1e-12)
+
+
 def test_finger_ranges_are_aaos(limb):
     names = list(limb.model.names)[1:]
     lo, hi = np.rad2deg(limb.lower), np.rad2deg(limb.upper)
