@@ -152,3 +152,15 @@ def test_numbers_beyond_any_voltage_are_refused_not_overflowed():
     # the largest accepted voltage goes through without inf/NaN
     out = EMGProcessor(2000.0).process(np.full((2, 400), 1e6) * np.sign(np.sin(np.arange(400)))[None])
     assert np.all(np.isfinite(out.envelope_pp)) and np.all(np.isfinite(out.filtered))
+
+
+def test_sizes_that_would_exhaust_memory_or_never_switch_are_refused():
+    from anthroarm.emg import EMGProcessor, Thresholds, synthesize
+    from anthroarm.errors import ThresholdError
+
+    with pytest.raises(EMGError, match="not an envelope window"):
+        EMGProcessor(2000.0, window_s=1e9)
+    with pytest.raises(EMGError, match="samples"):
+        synthesize(1e9, 2000.0, [[(0.0, 1.0, 1.0)]])
+    with pytest.raises(ThresholdError, match="never switch on"):          # no voltage reaches 1e300 V p-p
+        EMGProcessor(2000.0, thresholds=Thresholds(1e300, 1e-6))

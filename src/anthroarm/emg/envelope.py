@@ -33,12 +33,16 @@ from ._checks import positive, signal
 PP_PER_RMS = 2.0 * math.sqrt(2.0)
 #: sine-equivalent peak-to-peak per volt of mean rectified value
 PP_PER_MAV = math.pi
+#: the longest envelope window or control frame accepted (s)
+MAX_WINDOW_S = 10.0
 
 
 def window_samples(window_s: float, fs: float) -> int:
     """The number of samples of a ``window_s`` (s) window at ``fs`` (Hz), at least 1."""
     w = positive(window_s, "envelope window", "s")
     f = positive(fs, "sampling rate fs", "Hz")
+    if w > MAX_WINDOW_S:
+        raise EMGError(f"window {w:g} s is longer than {MAX_WINDOW_S:g} s: not an envelope window")
     n = int(round(w * f))
     if n < 1:
         raise EMGError(f"envelope window {w:g} s is shorter than one sample at {f:g} Hz")

@@ -34,7 +34,7 @@ import numpy as np
 from scipy import signal as sps
 
 from ..errors import EMGError, ThresholdError
-from ._checks import positive, signal
+from ._checks import MAX_VOLTS, positive, signal
 from .envelope import PP_PER_MAV, PP_PER_RMS, lowpass_sos, running_rms, window_samples
 from .filters import CONDITIONING_BAND, bandpass_sos, check_sampling_rate, notch_sos
 
@@ -168,7 +168,9 @@ class EMGProcessor:
         self.gain = positive(gain, "gain", "V/V")
         self.thresholds = thresholds if thresholds is not None else Thresholds()
         noise_pp = 0.0 if noise_rms is None else PP_PER_RMS * float(noise_rms)
-        self.thresholds.check(self.n_channels, float(max_input_pp), noise_pp)
+        # no accepted signal exceeds MAX_VOLTS at the processor, 2 MAX_VOLTS / gain p-p at the electrodes
+        reach = min(float(max_input_pp), 2.0 * MAX_VOLTS / self.gain)
+        self.thresholds.check(self.n_channels, reach, noise_pp)
         self.on, self.off = self.thresholds.arrays(self.n_channels)
         # thresholds in the units of the envelope before the p-p factor and the gain
         self._on_raw = self.on / self._pp * self.gain

@@ -38,6 +38,8 @@ AMPUTEE_PP = 50e-6
 AMPUTEE_TRAINED_PP = 100e-6
 #: the band of the main spectral power (Hz), book §9-2
 EMG_BAND = (30.0, 300.0)
+#: the most samples per channel the generator makes (a guard against a mistyped duration)
+MAX_SAMPLES = 100_000_000
 
 
 def band_limited_noise(n_samples: int, fs: float, band=EMG_BAND, n_channels: int = 1, rng=None) -> np.ndarray:
@@ -48,8 +50,8 @@ def band_limited_noise(n_samples: int, fs: float, band=EMG_BAND, n_channels: int
     lo, hi = float(band[0]), float(band[1])
     if not (0 <= lo < hi < fs / 2):
         raise EMGError(f"band must satisfy 0 <= low < high < fs/2 = {fs / 2:g} Hz, got ({lo:g}, {hi:g})")
-    if not (isinstance(n_samples, (int, np.integer)) and n_samples >= 16):
-        raise EMGError(f"n_samples must be an integer >= 16, got {n_samples!r}")
+    if not (isinstance(n_samples, (int, np.integer)) and 16 <= n_samples <= MAX_SAMPLES):
+        raise EMGError(f"n_samples must be an integer in 16..{MAX_SAMPLES:.0e}, got {n_samples!r}")
     rng = np.random.default_rng(rng)
     spec = np.fft.rfft(rng.standard_normal((n_channels, int(n_samples))), axis=-1)
     f = np.fft.rfftfreq(int(n_samples), 1.0 / fs)
@@ -111,6 +113,8 @@ def synthesize(duration_s: float, fs: float, bursts, pp=TYPICAL_PP, band=EMG_BAN
     if not bursts or not all(isinstance(b, (list, tuple)) for b in bursts):
         raise EMGError("bursts is a list with one list of (onset_s, duration_s, level) per channel")
     n_ch, n = len(bursts), int(round(dur * fs))
+    if not 16 <= n <= MAX_SAMPLES:
+        raise EMGError(f"duration_s * fs = {dur * fs:.3g} samples; the generator makes 16..{MAX_SAMPLES:.0e}")
     p = np.broadcast_to(np.asarray(pp, dtype=float), (n_ch,)).copy()
     if not np.all(np.isfinite(p)) or np.any(p <= 0):
         raise EMGError(f"pp must be finite and > 0 (V peak-to-peak), got {p.tolist()}")
