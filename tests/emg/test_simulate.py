@@ -116,3 +116,10 @@ def test_bad_input(arm):
     with pytest.raises(EMGError, match="two control frames"):
         simulate_powered_hand(arm, np.zeros((2, 5)), FS, JOINTS)
     assert HandModel().contact_torque(0.5, 0.0) == 0.0
+
+
+@pytest.mark.parametrize("kw", [dict(J_L=0.0), dict(upper=-1.0), dict(object_angle=2.0), dict(contact_stiffness=-1.0),
+                                dict(max_lead=float("nan")), dict(J_L="heavy")])
+def test_bad_hand_models(kw):
+    with pytest.raises(ParameterError):
+        HandModel(**kw)

@@ -97,6 +97,25 @@ class HandModel:
     grasp_torque: float = 0.1
     still: float = 0.05
 
+    def __post_init__(self):
+        vals = {k: getattr(self, k) for k in ("J_L", "lower", "upper", "contact_stiffness", "contact_damping",
+                                              "max_lead", "grasp_torque", "still")}
+        for k, v in vals.items():
+            if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v)):
+                raise ParameterError(f"HandModel.{k} must be a finite number, got {v!r}")
+        for k in ("J_L", "max_lead", "grasp_torque", "still"):
+            if vals[k] <= 0:
+                raise ParameterError(f"HandModel.{k} must be > 0, got {vals[k]!r}")
+        for k in ("contact_stiffness", "contact_damping"):
+            if vals[k] < 0:
+                raise ParameterError(f"HandModel.{k} must be >= 0, got {vals[k]!r}")
+        if not self.lower < self.upper:
+            raise ParameterError(f"HandModel: lower ({self.lower}) must be below upper ({self.upper}) rad")
+        oa = self.object_angle
+        if oa is not None and not (isinstance(oa, (int, float, np.floating)) and self.lower <= oa <= self.upper):
+            raise ParameterError(f"HandModel.object_angle must be None or in [lower, upper] = "
+                                 f"[{self.lower}, {self.upper}] rad, got {oa!r}")
+
     def contact_torque(self, theta, omega):
         """Load torque of the object on the closing fingers (N·m, ≥ 0)."""
         if self.object_angle is None:
