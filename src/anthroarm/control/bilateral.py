@@ -36,7 +36,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
+import scipy.linalg
 
 from ..errors import ControlError
 from . import _check
@@ -147,10 +147,16 @@ class Bilateral:
         s(self, "K_master", self.K if self.K_master is None else _check.positive(self.K_master, "K_master"))
         s(self, "D_master", self.D if self.D_master is None else _check.nonnegative(self.D_master, "D_master"))
 
-    def _torques(self, kind, th, wh, x, load, wall):
+    def _torques(self, kind, th, wh, x, load, wall, contact=None):
+        """(τ_h, τ_e, τ_1, τ_2); ``contact`` True/False forces the wall's linear law on/off."""
         t1, w1, t2, w2 = x
         tau_h = self.K_h * (th - t1) + self.B_h * (wh - w1)
-        tau_e = load + (0.0 if wall is None else wall.torque(t2, w2))
+        if wall is None or contact is False:
+            tau_e = load + 0.0 * t2
+        elif contact is None:
+            tau_e = load + wall.torque(t2, w2)
+        else:
+            tau_e = load + wall.K * (t2 - wall.theta) + wall.B * w2
         e, de = t1 - t2, w1 - w2
         tau_2 = self.K * e + self.D * de
         if kind == "symmetric":
@@ -161,9 +167,28 @@ class Bilateral:
             tau_1 = self.G * (tau_h - self.k_f * tau_e)
         return tau_h, tau_e, tau_1, tau_2
 
+    def _affine(self, kind, load, wall, contact):
+        """(A, B, c) with ``ẋ = A x + B (θ_h, θ̇_h) + c`` for one contact state: the equations
+        are affine in the state and the operator's input while the wall is on or off."""
+        def f(x, u):
+            tau_h, tau_e, tau_1, tau_2 = self._torques(kind, u[0], u[1], x, load, wall, contact)
+            return np.array([x[1], (tau_h + tau_1 - self.B1 * x[1]) / self.J1,
+                             x[3], (tau_2 - tau_e - self.B2 * x[3]) / self.J2])
+
+        z4, z2 = np.zeros(4), np.zeros(2)
+        c = f(z4, z2)
+        A = np.column_stack([f(e, z2) - c for e in np.eye(4)])
+        B = np.column_stack([f(z4, e) - c for e in np.eye(2)])
+        return A, B, c
+
     def simulate(self, kind: str, t, theta_h, load: float = 0.0, wall: Wall | None = None,
-                 rtol: float = 1e-8) -> BilateralResult:
+                 max_step: float = 1e-3) -> BilateralResult:
         """Simulate one type of Fig. 9-17 from rest at the operator's first position.
+
+        The equations are linear while the wall is in contact or not, so each step is exact
+        (matrix exponential) for the operator's input interpolated linearly over the step
+        (first-order hold); the contact state is decided at the start of each step (steps of at
+        most ``max_step``).
 
         Parameters
         ----------
@@ -178,8 +203,8 @@ class Bilateral:
             Constant load torque on the slave, N·m.
         wall : Wall, optional
             A stiff environment.
-        rtol : float
-            Relative tolerance of the integrator (``scipy.integrate.solve_ivp``, LSODA).
+        max_step : float
+            Longest integration step, s.
 
         Returns
         -------
@@ -189,6 +214,7 @@ class Bilateral:
             raise ControlError(f"kind must be one of {KINDS}, got {kind!r}")
         t = _check.time_grid(t)
         load = _check.scalar(load, "load (N m)")
+        max_step = _check.positive(max_step, "max_step (s)")
         if wall is not None and not isinstance(wall, Wall):
             raise ControlError(f"wall must be a Wall, got {type(wall).__name__}")
         if callable(theta_h):
@@ -199,27 +225,48 @@ class Bilateral:
 
             def path(tt):
                 return np.interp(tt, t, samples), np.interp(tt, t, rate)
-        th0 = float(path(t[0])[0])
-        if not np.isfinite(th0):
+        th_t, wh_t = (np.broadcast_to(np.asarray(v, dtype=float), t.shape) for v in path(t))
+        if not (np.all(np.isfinite(th_t)) and np.all(np.isfinite(wh_t))):
             raise ControlError("theta_h must be finite")
+        modes = {c: self._affine(kind, load, wall, c) for c in ((False, True) if wall is not None else (False,))}
+        cache: dict = {}
 
-        def f(tt, x):
-            th, wh = path(tt)
-            tau_h, tau_e, tau_1, tau_2 = self._torques(kind, th, wh, x, load, wall)
-            return [x[1], (tau_h + tau_1 - self.B1 * x[1]) / self.J1,
-                    x[3], (tau_2 - tau_e - self.B2 * x[3]) / self.J2]
+        def discrete(c, h):
+            """First-order hold: ẋ = A x + B u + k with u linear over the step (z = (x, u, u̇))."""
+            key = (c, h)
+            if key not in cache:
+                A, B, k = modes[c]
+                M = np.zeros((9, 9))
+                M[:4, :4], M[:4, 4:6], M[:4, 6] = A * h, B * h, k * h
+                M[4:6, 7:9] = np.eye(2) * h
+                E = scipy.linalg.expm(M)
+                cache[key] = (E[:4, :4], E[:4, 4:6], E[:4, 6], E[:4, 7:9])
+            return cache[key]
 
-        sol = solve_ivp(f, (t[0], t[-1]), [th0, 0.0, th0, 0.0], t_eval=t, method="LSODA", rtol=rtol,
-                        atol=1e-10, max_step=(t[-1] - t[0]) / 200.0)
-        if not sol.success or not np.all(np.isfinite(sol.y)):
-            raise ControlError(f"the {kind} simulation failed: {sol.message}")
-        X = sol.y
-        th, wh = path(t)
-        th, wh = np.broadcast_to(th, t.shape).astype(float), np.broadcast_to(wh, t.shape).astype(float)
-        tau_h, tau_e, tau_1, tau_2 = self._torques(kind, th, wh, X, load, wall)
+        X = np.empty((t.size, 4))
+        x = np.array([th_t[0], 0.0, th_t[0], 0.0])
+        X[0] = x
+        for k in range(t.size - 1):
+            n = max(1, int(np.ceil((t[k + 1] - t[k]) / max_step - 1e-9)))
+            h = (t[k + 1] - t[k]) / n
+            hk = float(np.round(h, 15))
+            u0 = np.array([th_t[k], wh_t[k]])
+            for j in range(n):
+                u1 = np.asarray(path(t[k] + (j + 1) * h), dtype=float) if j < n - 1 else np.array([th_t[k + 1],
+                                                                                                  wh_t[k + 1]])
+                contact = wall is not None and bool(wall.torque(x[2], x[3]) > 0.0)
+                Ad, Bd, cd, Dd = discrete(contact, hk)
+                x = Ad @ x + Bd @ u0 + cd + Dd @ ((u1 - u0) / h)
+                u0 = u1
+            if not np.all(np.isfinite(x)):
+                raise ControlError(f"the {kind} simulation diverged at t = {t[k + 1]:g} s")
+            X[k + 1] = x
+        X = X.T
+        tau_h, tau_e, tau_1, tau_2 = self._torques(kind, th_t, wh_t, X, load, wall)
         bc = np.broadcast_to
-        return BilateralResult(kind=kind, t=t, theta_h=th, theta_m=X[0], theta_s=X[2], omega_m=X[1], omega_s=X[3],
-                               felt=np.asarray(tau_h, dtype=float), tau_env=bc(np.asarray(tau_e, float), t.shape).copy(),
+        return BilateralResult(kind=kind, t=t, theta_h=th_t.copy(), theta_m=X[0], theta_s=X[2], omega_m=X[1],
+                               omega_s=X[3], felt=np.asarray(tau_h, dtype=float),
+                               tau_env=bc(np.asarray(tau_e, float), t.shape).copy(),
                                tau_master=bc(np.asarray(tau_1, float), t.shape).copy(),
                                tau_slave=np.asarray(tau_2, dtype=float))
 

@@ -25,7 +25,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..errors import ControlError
 from . import _check
@@ -242,22 +241,30 @@ class GraspResult:
 
 
 def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: float, duration: float,
-          approach_speed: float = 0.02, set_force: float = 5.0, jaw_mass: float = 0.05, k_v: float = 50.0,
-          k_p: float = 0.5, k_i: float = 20.0, n: int = 2001) -> GraspResult:
-    """Grip-force control of Fig. 9-13: approach at constant speed, then a force loop.
+          approach_speed: float = 0.01, set_force: float = 5.0, jaw_mass: float = 0.05, k_v: float = 100.0,
+          k_p: float = 2.0, k_i: float = 10.0, k_x: float = 2000.0, n: int = 2001) -> GraspResult:
+    """Grip-force control of Fig. 9-13: approach at constant speed, then, from the contact on,
+    a force loop ("once it touches the object, the grip-force feedback loop closes").
 
     Model (assumed): one jaw of mass ``jaw_mass`` driven by ``motor`` (torque–speed line of
-    Eq. (9-1) through its gearbox) via a lead of ``lead`` metres of jaw travel per joint radian,
-    so the jaw force is ``τ_joint / lead`` and the equivalent mass
+    Eq. (9-1) through its gearbox, efficiency η taken in both directions) via a lead of ``lead``
+    metres of jaw travel per joint radian, so the jaw force is ``η i τ_m / lead`` and the
+    equivalent mass
     ``jaw_mass + i² J_m / lead²``.  The object is a spring of ``stiffness`` (N/m) whose surface
     is ``gap`` ahead of the jaw.
 
-    * before contact: a speed loop, ``V = k_v (approach_speed − ẋ) · lead`` (clipped to ±V_nom);
+    * before contact: a speed loop with feed-forward, ``V = V_0 + k_v (approach_speed − ẋ)``
+      with ``V_0`` the steady voltage of the free jaw at that speed;
     * hard grasp: from contact ``V = V_nom``: the jaw squeezes with the motor's full force,
       at rest the stall force ``η i k_m V_nom / (R lead)``;
-    * soft grasp: a PI force loop, ``V = k_p (F_set − F) + k_i ∫(F_set − F) dt`` (clipped),
-      at rest ``F = F_set``;
-    * zero grasp: the same loop with ``F_set = 0``: the jaw holds the object without force.
+    * soft grasp: a PI force loop, ``V = k_p (F_set − F) + k_i ∫(F_set − F) dt``, at rest
+      ``F = F_set``;
+    * zero grasp: the jaw is held where it touched, ``V = k_x (x_c − x) − k_v ẋ``: it holds the
+      object without force (to feel its position or shape).
+
+    V is clipped to ``±V_nom`` throughout.  The phases switch once, at the first contact
+    (latched).  Integration: classical Runge–Kutta with a fixed step that resolves the fastest
+    linearised mode at the contact.
 
     Parameters
     ----------
@@ -273,9 +280,10 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
         Jaw travel per joint radian, m/rad (> 0).
     duration : float
         Simulated time, s.
-    approach_speed, set_force, jaw_mass, k_v, k_p, k_i : float
-        Approach speed (m/s), soft-grasp force (N), jaw mass (kg), speed-loop gain (V·s/m per
-        m/rad), force-loop gains (V/N, V/(N·s)).
+    approach_speed, set_force, jaw_mass : float
+        Approach speed (m/s), soft-grasp force (N), jaw mass (kg).
+    k_v, k_p, k_i, k_x : float
+        Speed-loop gain (V·s/m), force-loop gains (V/N, V/(N·s)), position-hold gain (V/m).
     n : int
         Number of output samples.
 
@@ -292,39 +300,71 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
     lead = _check.positive(lead, "lead (m/rad)")
     duration = _check.positive(duration, "duration (s)")
     v0 = _check.positive(approach_speed, "approach_speed (m/s)")
-    F_set = 0.0 if mode == "zero" else _check.nonnegative(set_force, "set_force (N)")
+    F_set = _check.nonnegative(set_force, "set_force (N)")
     m_eq = _check.positive(jaw_mass, "jaw_mass (kg)") + motor.reflected_inertia / lead**2
-    k_v, k_p, k_i = (_check.nonnegative(v, nm) for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i")))
+    k_v, k_p, k_i, k_x = (_check.nonnegative(v, nm) for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i"),
+                                                                    (k_x, "k_x")))
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ControlError(f"n must be an integer >= 2, got {n!r}")
     Vmax = motor.V_nom
+    V0 = float(motor.voltage(0.0, v0 / lead))
+    if abs(V0) > Vmax:
+        raise ControlError(f"approach_speed {v0} m/s needs {V0:.3g} V, above V_nom = {Vmax} V")
 
-    def force(x, v):
+    def force(x):
         return np.where(x > gap, K * (x - gap), 0.0)
 
-    def volts(x, v, z):
-        touching = x >= gap
-        V_app = k_v * (v0 - v) * lead
-        if mode == "hard":
-            V_cnt = Vmax
+    def volts(x, v, z, touching):
+        if not touching:
+            V = V0 + k_v * (v0 - v)
+        elif mode == "hard":
+            V = np.full(np.shape(x), Vmax)
+        elif mode == "soft":
+            V = k_p * (F_set - force(x)) + k_i * z
         else:
-            V_cnt = k_p * (F_set - force(x, v)) + k_i * z
-        return np.clip(np.where(touching, V_cnt, V_app), -Vmax, Vmax)
+            V = k_x * (gap - x) - k_v * v
+        return np.clip(V, -Vmax, Vmax)
 
-    def f(t, s):
+    def f(s, touching):
         x, v, z = s
-        V = volts(x, v, z)
-        F_m = motor.joint_torque(v / lead, V) / lead
-        touching = x >= gap
-        dz = (F_set - float(force(x, v))) if touching else 0.0
-        return [v, (float(F_m) - float(force(x, v))) / m_eq, dz]
+        # motoring efficiency in both directions: a smooth model (the power-flow switch of
+        # DCMotor.joint_torque is discontinuous at zero speed, where a grasp comes to rest)
+        F_m = motor.eta * motor.i * float(motor.motor_torque(volts(x, v, z, touching), motor.i * v / lead)) / lead
+        Fo = float(force(x))
+        return np.array([v, (F_m - Fo) / m_eq, (F_set - Fo) if touching else 0.0])
 
+    # fixed-step classical Runge-Kutta; the step resolves the fastest linearised mode at contact
+    s_c = np.array([gap * (1 + 1e-3), 0.0, 0.0])
+    eps = np.array([gap * 1e-6, v0 * 1e-6, 1e-6])
+    J = np.column_stack([(f(s_c + e, True) - f(s_c - e, True)) / (2 * e.sum()) for e in np.diag(eps)])
+    J0 = np.column_stack([(f(s_c + e, False) - f(s_c - e, False)) / (2 * e.sum()) for e in np.diag(eps)])
+    lam = max(np.max(np.abs(np.linalg.eigvals(J))), np.max(np.abs(np.linalg.eigvals(J0))), 1e-9)
     t = np.linspace(0.0, duration, int(n))
-    sol = solve_ivp(f, (0.0, duration), [0.0, 0.0, 0.0], t_eval=t, method="LSODA", rtol=1e-8, atol=1e-12,
-                    max_step=duration / 500.0)
-    if not sol.success:
-        raise ControlError(f"grasp simulation failed: {sol.message}")
-    x, v, z = sol.y
-    touch = np.nonzero(x >= gap)[0]
-    return GraspResult(mode, t, x, force(x, v), volts(x, v, z), float(t[touch[0]]) if touch.size else float("nan"))
+    sub = max(1, int(np.ceil((t[1] - t[0]) * lam / 0.2)))
+    if (n - 1) * sub > 5_000_000:
+        raise ControlError(f"the grasp needs {(n - 1) * sub} integration steps (stiff object or motor); "
+                           "shorten the duration or soften the gains")
+    h = (t[1] - t[0]) / sub
+    X = np.empty((3, t.size))
+    touching = np.zeros(t.size, dtype=bool)
+    st, on, tc = np.zeros(3), False, float("nan")
+    X[:, 0] = st
+    for k in range(1, t.size):
+        for j in range(sub):
+            k1 = f(st, on)
+            k2 = f(st + 0.5 * h * k1, on)
+            k3 = f(st + 0.5 * h * k2, on)
+            k4 = f(st + h * k3, on)
+            st = st + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+            if not on and st[0] >= gap:       # the contact closes the force loop (latched)
+                on, tc = True, float(t[k - 1] + (j + 1) * h)
+        if not np.all(np.isfinite(st)):
+            raise ControlError(f"the {mode} grasp simulation diverged at t = {t[k]:g} s")
+        X[:, k] = st
+        touching[k] = on
+    x, v, z = X
+    V = np.where(touching, volts(x, v, z, True), volts(x, v, z, False))
+    return GraspResult(mode, t, x, force(x), V, tc)
 
 
 # ---------------------------------------------------------------------------- slip control
