@@ -174,3 +174,20 @@ def test_bad_axes_raise_with_value():
     with pytest.raises(ValueError, match="theta must be finite"):
         R.planar_transform(np.nan, 0.0, 0.0)
     assert np.allclose(R.unit_axis([0, 0, 2.0]), [0, 0, 1])
+
+
+@pytest.mark.parametrize("gap", [1e-3, 1e-6, 1e-9, 1e-11])
+def test_rotation_between_nearly_antiparallel_stays_orthogonal(gap):
+    """Beyond a quarter turn the (1 + c) denominator of the compact Rodrigues form loses
+    orthogonality (a hand trace pointing along -y broke the viewer); the result must be a
+    rotation to rounding and still map a onto b as well as the geometry allows (the axis of a
+    near half turn is determined only to eps / gap)."""
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        a = rng.normal(size=3)
+        a /= np.linalg.norm(a)
+        b = -a + gap * rng.normal(size=3)
+        C = R.rotation_between(a, b)
+        assert np.abs(C.T @ C - np.eye(3)).max() < 1e-14
+        assert np.isclose(np.linalg.det(C), 1.0, atol=1e-14)
+        assert np.linalg.norm(C @ a - b / np.linalg.norm(b)) < 1e-15 / gap + 1e-12

@@ -107,7 +107,7 @@ def _viewer_html(study, max_frames: int = 600) -> str:
     Q = np.concatenate([a.q[::step] for a in acts])
     dt = float(np.median(np.concatenate([np.diff(a.t) for a in acts]))) * step
     v = Viewer(study.robot)
-    v.play(Q, dt=dt, loop=True, trace=False)   # trace=True: spatial.rotation_between fails near -y (see report)
+    v.play(Q, dt=dt, loop=True, trace=True)
     page = v.static_html(title=f"anthroarm — {study.robot.name} activities")
     starts, t = [], 0.0
     for a in acts:

@@ -199,7 +199,14 @@ def rotation_between(a, b) -> np.ndarray:
         n /= np.linalg.norm(n)
         return 2.0 * np.outer(n, n) - np.eye(3)
     V = skew(v)
-    return np.eye(3) + V + V @ V * (1.0 / (1.0 + c))
+    if c >= 0.0:
+        return np.eye(3) + V + V @ V * (1.0 / (1.0 + c))
+    # beyond a quarter turn 1/(1 + c) amplifies the rounding of V @ V (orthogonality lost as
+    # eps/(1 + c)): Rodrigues with the unit axis and (sin, cos) of the angle, orthogonal to eps
+    s = float(np.linalg.norm(v))
+    K = V / s
+    r = float(np.hypot(s, c))
+    return np.eye(3) + K * (s / r) + K @ K * (1.0 - c / r)
 
 
 def axis_angle(R) -> tuple[np.ndarray, float]:
