@@ -10,6 +10,9 @@ Variants, each on a live server on 127.0.0.1 (a separate process, as in use):
   measured the latter at 3.9 ms per frame on the panda, 11 geometries);
 * **in memory** — no server: FK and command building only (the floor of the cost).
 
+The notes give the size of the panda's Jupyter cell (a static page: meshcat's JavaScript and
+the scene), with packed meshes and with the mesh files as they are.
+
 Frames are random configurations inside the limits (fixed seed); per-frame time is the median
 of 5 runs of N consecutive frames.  Target (issue 7): >= 60 fps for human_arm7.
 """
@@ -61,8 +64,16 @@ def _browser_frame_time(v: Viewer, Q) -> float | None:
         return _per_frame(v.display, Q)
 
 
+def page_sizes(name: str = "panda") -> tuple[int, int]:
+    """Bytes of the Jupyter cell (static page in an iframe) of ``Viewer(name)``: meshes packed
+    (default ``mesh_triangles``) and sent as the files are (``mesh_triangles=None``)."""
+    robot = aa.load(name)
+    return (len(Viewer(robot)._repr_html_().encode()), len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()))
+
+
 def run(quick: bool = False) -> dict:
     n = 100 if quick else 600
+    packed, raw = page_sizes("panda")
     rows = []
     for name in MODELS:
         robot = aa.load(name)
@@ -90,5 +101,7 @@ def run(quick: bool = False) -> dict:
                   "(ZeroMQ REQ/REP round trip) which forwards it to every connected tab.  The browser draws at "
                   "its own requestAnimationFrame rate; these numbers are the rate at which complete poses "
                   "reach it.  Target: >= 60 fps for human_arm7.  Peer: Pinocchio MeshcatVisualizer.display "
-                  "3.9 ms/frame on the panda (peers.md §4.4)."),
+                  "3.9 ms/frame on the panda (peers.md §4.4).  Jupyter cell of Viewer('panda') (static page): "
+                  f"{packed / 2**20:.2f} MB with the meshes packed (mesh_triangles=5000), {raw / 2**20:.1f} MB with "
+                  "the mesh files as they are (mesh_triangles=None)."),
     }

@@ -414,7 +414,7 @@ class Viewer:
         (:data:`~anthroarm.viewer.visuals.MESH_TRIANGLES` by default): meshes are parsed,
         merged and, above the budget, decimated into compact 16-bit
         :class:`~anthroarm.viewer.visuals.PackedMesh` geometry, so a Jupyter cell or an HTML
-        file stays small (Franka Panda: 15 MB → 1.5 MB).  ``None`` sends the files as they are.
+        file stays small (Franka Panda: 15.0 MB → 1.49 MB).  ``None`` sends the files as they are.
     """
 
     def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
