@@ -53,9 +53,10 @@ def test_spherical_coordinates_about_the_shoulder():
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), Q[:, 2], atol=1e-12)
     np.testing.assert_allclose(np.arcsin(d[:, 2] / Q[:, 2]), Q[:, 1], atol=1e-12)
     np.testing.assert_allclose(np.arctan2(d[:, 1], d[:, 0]), Q[:, 0], atol=1e-12)
-    # Table 2.3 remark "能提取地面上的物体" (can pick objects off the floor): the lowest point
-    # 0.8 - 1.0 sin 45° = 0.093 m, and with a longer boom below the floor
-    assert 0.8 - 1.0 * np.sin(np.pi / 4) < 0.1
+    # Table 2.3 remark "能提取地面上的物体" (can pick objects off the floor): boom down 45° at full
+    # reach puts the tool 0.8 - 1.0 sin 45° = 0.093 m above the base plane
+    low = r.fk(np.array([0.0, r.lower[1], r.upper[2]]))[:3, 3]
+    assert low[2] == pytest.approx(0.8 - np.sin(np.pi / 4), abs=1e-12) and low[2] < 0.1
 
 
 def test_articulated_two_link_formula():
