@@ -123,3 +123,35 @@ def test_bad_input(arm):
 def test_bad_hand_models(kw):
     with pytest.raises(ParameterError):
         HandModel(**kw)
+
+
+def test_a_hand_model_of_the_catalog_moves_its_fingers_together():
+    """human_upper_limb: the elbow (gear raised for its heavier forearm) and twelve finger joints
+    driven by the fingers mode; every other joint stays where q0 put it."""
+    r = aa.load("human_upper_limb", tool="index_tip")
+    fingers = [f"{f}_{j}" for f in ("index", "middle", "ring", "little") for j in ("mcp_flexion", "pip", "dip")]
+    q0 = np.zeros(r.nq)
+    for jt in r.chain.joints:
+        q0[jt.idx_q] = np.clip(0.0, jt.lower, jt.upper)
+    q0[r.chain.joint("elbow_flexion").idx_q] = 1.2
+    bursts = [[(0.2, 0.25, 1), (0.9, 0.25, 1), (1.4, 0.25, 1), (1.9, 0.5, 1)], [(0.91, 0.25, 1), (1.41, 0.25, 1)]]
+    rec = synthesize(2.6, FS, bursts, pp=100e-6, rng=3)
+    res = simulate_powered_hand(r, rec.emg, FS, {"elbow": "elbow_flexion", "wrist": "forearm_pronation",
+                                                 "fingers": fingers}, q0=q0)
+    assert res.status == "ok" and res.hand is None
+    assert sorted(res.joint_servos) == sorted(["elbow_flexion", "forearm_pronation", *fingers])
+    e = res.angle[:, 0]
+    assert e[-1] > 1.2 + 0.15                                         # flexed against its gravity load
+    k = int(np.searchsorted(res.t, 1.85))                             # at rest, before the fingers move
+    g = pin.computeGeneralizedGravity(r.model, r.data, res.q[k])[r.chain.joint("elbow_flexion").idx_v]
+    assert res.servos["elbow"].Ks * (res.setpoint[k, 0] - e[k]) == pytest.approx(g, rel=2e-3)   # Eq. (9-8)
+    fq = np.array([res.q[:, r.chain.joint(n).idx_q] for n in fingers])
+    assert np.all(fq[:, res.t < 1.9] < 1e-3) and np.all(fq[:, -1] > 0.5)   # closed together, after their turn
+    assert np.ptp(fq[:, -1]) < 0.05
+    driven = {"elbow_flexion", "forearm_pronation", *fingers}
+    still = [r.chain.joint(j.name).idx_q for j in r.chain.joints if j.name not in driven]
+    np.testing.assert_array_equal(res.q[:, still], np.repeat(q0[None, still], len(res.q), axis=0))
+    with pytest.raises(ParameterError, match="two modes"):
+        simulate_powered_hand(r, rec.emg, FS, {"elbow": "elbow_flexion", "fingers": ["elbow_flexion"]}, q0=q0)
+    with pytest.raises(ParameterError):
+        simulate_powered_hand(r, rec.emg, FS, {"elbow": "elbow_flexion", "fingers": []}, q0=q0)

@@ -17,7 +17,9 @@ How a command moves a joint (assumptions; the book prints the codes, not the dri
   the start, ``M(q0)[j, j]``, with ω_n the larger of 20 rad/s and what the motor's own
   back-EMF damping allows (:meth:`~anthroarm.control.servo.PositionServo.tuned`); the motor is a
   16 mm coreless DC micromotor (:func:`prosthesis_motor`, illustrative values: no-load speed
-  ≈ 9550 r/min, inside the 4700–13550 r/min of the book's coreless motors, §9-3);
+  ≈ 9550 r/min, inside the 4700–13550 r/min of the book's coreless motors, §9-3) behind a
+  gearbox of :data:`DEFAULT_RATIOS`, raised where needed so that the stall torque is at least
+  twice the joint's gravity load at ``q0`` (a sizing margin);
 * the joints of the arm that are not driven are **locked** where ``q0`` puts them (the
   wearer's own shoulder holds the socket still); the driven joints start at rest at ``q0``,
   their servos settled there (set-point ``q0 + g(q0)/K_s``, Eq. (9-8), with Pinocchio's gravity
@@ -33,8 +35,9 @@ How a command moves a joint (assumptions; the book prints the codes, not the dri
   While the amplifier is saturated (squeezing at the battery voltage) the linear estimate
   overstates the load; a threshold is all the vibrator needs.
 
-The algorithm reads joints by the names given in ``joints`` (mode → joint name of
-``robot.chain``, or ``None`` for the built-in hand); it never looks at the arm's name.  SI
+The algorithm reads joints by the names given in ``joints`` (mode → a joint name of
+``robot.chain``, several names that move together — the finger joints of a hand model — or
+``None`` for the built-in hand); it never looks at the arm's name.  SI
 units: V, s, rad, N·m.
 """
 
@@ -131,11 +134,12 @@ class PoweredHandResult:
     ``processed`` (:class:`~anthroarm.emg.processor.ProcessedEMG`) and ``trace``
     (:class:`~anthroarm.emg.codes.CodeTrace`) are the signal chain; ``modes`` the mode names,
     ``joint_names`` the driven joint of each (``"hand"`` for the built-in hand);
-    ``setpoint``/``angle`` (frames, n_modes) rad; ``q`` (frames, robot.nq) the whole arm's
-    configuration; ``grasped`` (frames,) bool; ``load_estimate`` (frames,) N·m the hand
+    ``setpoint``/``angle`` (frames, n_modes) rad (of each mode's first joint); ``q`` (frames,
+    robot.nq) the whole arm's configuration; ``grasped`` (frames,) bool; ``load_estimate`` (frames,) N·m the hand
     servo's load estimate (Eq. (9-8)); ``vibrators`` (frames, 3) left/right/middle;
     ``emg`` (channels, samples) and ``t_emg`` the input; ``servos`` mode →
-    :class:`~anthroarm.control.servo.PositionServo` used; ``hand`` the :class:`HandModel`
+    :class:`~anthroarm.control.servo.PositionServo` of its (first) joint, ``joint_servos`` joint
+    name → servo for every driven joint of the arm; ``hand`` the :class:`HandModel`
     (``None`` without a built-in hand); ``status`` "ok" or what went wrong (the dynamics' or
     the hand integrator's status)."""
 
@@ -154,6 +158,7 @@ class PoweredHandResult:
     t_emg: np.ndarray
     robot: object = field(repr=False, default=None)
     servos: dict = field(default_factory=dict)
+    joint_servos: dict = field(default_factory=dict)
     hand: HandModel | None = None
     status: str = "ok"
 
@@ -243,7 +248,8 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
     fs
         Sampling rate, Hz.
     joints
-        Mode name → joint name of ``robot.chain`` (or ``None``: the built-in hand), in the
+        Mode name → joint name of ``robot.chain``, a list of joint names that move together
+        (e.g. the finger flexion joints of a hand model) or ``None`` (the built-in hand), in the
         mode cycle order, e.g. ``{"elbow": "elbow_flexion", "wrist": "forearm_rotation",
         "fingers": None}``.
     q0
@@ -254,8 +260,8 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         The signal chain and state machine (defaults: ``EMGProcessor(fs)``,
         ``CodeMachine(frame_s, modes=tuple(joints))``).
     servos
-        Mode → :class:`~anthroarm.control.servo.PositionServo` (default :func:`joint_servo`
-        of :func:`prosthesis_motor`).  A given servo's ``J_L`` is only used for its gains; the
+        Mode → :class:`~anthroarm.control.servo.PositionServo` for each joint of the mode
+        (default: :func:`joint_servo` of :func:`prosthesis_motor` per joint).  A given servo's ``J_L`` is only used for its gains; the
         arm's inertia is the dynamics'.
     speeds
         Mode → set-point speed, rad/s (default :data:`DEFAULT_SPEED`).
@@ -295,8 +301,17 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
             raise ParameterError(f"speeds: mode {m!r} must be one of {modes} with a finite speed > 0 rad/s, got {v!r}")
 
     chain = robot.chain
-    arm = {m: chain.joint(n) for m, n in joints.items() if n is not None}
-    for m, jt in arm.items():
+    names = {}
+    for m, v in joints.items():
+        seq = () if v is None else ((v,) if isinstance(v, str) else tuple(v))
+        if v is not None and (not seq or not all(isinstance(n, str) for n in seq)):
+            raise ParameterError(f"joints[{m!r}] must be a joint name, a list of joint names or None, got {v!r}")
+        names[m] = seq
+    drives = [(m, chain.joint(n)) for m in modes for n in names[m]]      # (mode, joint), mode order
+    seen = [jt.name for _, jt in drives]
+    if len(set(seen)) != len(seen):
+        raise ParameterError(f"a joint is driven by two modes: {sorted(n for n in set(seen) if seen.count(n) > 1)}")
+    for m, jt in drives:
         if jt.kind == "continuous" or jt.is_mimic:
             raise UnsupportedModelError(f"joint {jt.name!r} ({m}) is {jt.kind}{' mimic' if jt.is_mimic else ''}; "
                                         "a driven joint must be a revolute or prismatic joint with its own q")
@@ -305,7 +320,7 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         for jt in chain.joints:
             if jt.nq == 1:
                 q0[jt.idx_q] = np.clip(0.0, jt.lower, jt.upper)
-        for jt in arm.values():
+        for _, jt in drives:
             lo = max(jt.lower, 0.0) if np.isfinite(jt.lower) else 0.0
             hi = jt.upper if np.isfinite(jt.upper) else lo + 1.0
             q0[jt.idx_q] = 0.5 * (lo + hi)
@@ -323,58 +338,61 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         raise EMGError(f"the EMG is shorter than two control frames ({processor.frame_s} s each)")
 
     # ---- the arm: driven joints free, the others locked at q0
-    locked = {jt.name: float(q0[jt.idx_q]) for jt in chain.joints
-              if jt.nq == 1 and jt.name not in {a.name for a in arm.values()}}
+    locked = {jt.name: float(q0[jt.idx_q]) for jt in chain.joints if jt.nq == 1 and jt.name not in seen}
     setpoint = np.zeros((n_f, len(modes)))
     angle = np.zeros((n_f, len(modes)))
     q_out = np.repeat(q0[None, :], n_f, axis=0)
     status = "ok"
-    used = {}
-    if arm:
+    used, per_joint = {}, {}
+    if drives:
         red = load(robot.model, locked=locked, tool=robot.tool) if locked else robot
         rq0 = np.array([q0[chain.joint(red.chain.joints[k].name).idx_q] for k in range(red.nq)])
         M0 = pin.crba(red.model, red.model.createData(), rq0)
-        col = {m: red.chain.joint(jt.name).idx_v for m, jt in arm.items()}
-        srv = {}
-        for m, jt in arm.items():
-            J_L = float(M0[col[m], col[m]])
-            srv[m] = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), J_L)
-        used.update(srv)
+        col = [red.chain.joint(jt.name).idx_v for _, jt in drives]
+        g0 = pin.computeGeneralizedGravity(red.model, red.model.createData(), rq0)
+        per_ratio = prosthesis_motor(1.0).stall_torque()             # N m of stall torque per unit of i
+        srv = []
+        for (m, jt), c in zip(drives, col):
+            given = (servos or {}).get(m)
+            # the gearbox: the mode's default ratio, raised (in steps of 50) until the stall torque is
+            # at least twice the gravity load at q0 (a sizing margin, an assumption)
+            i = max(DEFAULT_RATIOS.get(m, 200.0), 50.0 * np.ceil(2.0 * abs(float(g0[c])) / per_ratio / 50.0))
+            srv.append(given or joint_servo(prosthesis_motor(i), float(M0[c, c])))
+            per_joint[jt.name] = srv[-1]
+            used.setdefault(m, srv[-1])                              # a mode's first joint
         model = red.model.copy()
-        for m in arm:
-            model.armature[col[m]] += srv[m].J0 - srv[m].J_L       # reflected motor inertia, eta i^2 J_m
+        for c, sv in zip(col, srv):
+            model.armature[c] += sv.J0 - sv.J_L                      # reflected motor inertia, eta i^2 J_m
         # the servos have settled at q0: each set-point starts at q0 + M_L / K_s, Eq. (9-8),
         # with M_L the gravity torque Pinocchio gives there
-        g0 = pin.computeGeneralizedGravity(red.model, red.model.createData(), rq0)
-        sp, start = {}, {}
-        for m, jt in arm.items():
-            j = modes.index(m)
-            start[m] = float(q0[jt.idx_q]) + float(g0[col[m]]) / srv[m].Ks
-            sp[m] = _setpoints(trace, j, speeds[m], jt.lower, jt.upper, start[m])
-            setpoint[:, j] = sp[m]
+        start = [float(q0[jt.idx_q]) + float(g0[c]) / sv.Ks for (_, jt), c, sv in zip(drives, col, srv)]
+        sp = [_setpoints(trace, modes.index(m), speeds[m], jt.lower, jt.upper, s0)
+              for (m, jt), s0 in zip(drives, start)]
 
         def tau(tt, q, qd):
             k = min(max(int(np.searchsorted(t, tt, side="right")) - 1, -1), n_f - 1)
             out = np.zeros(red.nv)
-            for m in arm:
-                c = col[m]
-                ti = sp[m][k] if k >= 0 else start[m]
+            for c, sv, spi, s0 in zip(col, srv, sp, start):
+                ti = spi[k] if k >= 0 else s0
                 # the servo's output torque eta i M_m of Eqs. (9-1)-(9-4): J_0 * theta_ddot at zero load
-                out[c] = srv[m].J0 * srv[m].rhs(np.array([q[c], qd[c]]), ti, 0.0)[1]
+                out[c] = sv.J0 * sv.rhs(np.array([q[c], qd[c]]), ti, 0.0)[1]
             return out
 
         sim = simulate(red, rq0, np.zeros(red.nv), float(t[-1]), dt=dt, tau=tau, engine="pin", pin_model=model)
         status = sim.status
-        for m, jt in arm.items():
-            j = modes.index(m)
-            a = np.interp(t, sim.t, sim.q[:, col[m]])
-            angle[:, j] = a
+        first = set()
+        for (m, jt), c, spi in zip(drives, col, sp):
+            a = np.interp(t, sim.t, sim.q[:, c])
             q_out[:, jt.idx_q] = a
+            if m not in first:                                       # the mode's columns: its first joint
+                first.add(m)
+                j = modes.index(m)
+                angle[:, j], setpoint[:, j] = a, spi
 
     # ---- the built-in hand
     grasped = np.zeros(n_f, dtype=bool)
     load_est = np.zeros(n_f)
-    hand_modes = [m for m, n in joints.items() if n is None]
+    hand_modes = [m for m in modes if not names[m]]
     if hand_modes:
         m = hand_modes[0]
         j = modes.index(m)
@@ -409,4 +427,5 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
                              joint_names=tuple(n if n is not None else "hand" for n in joints.values()),
                              setpoint=setpoint, angle=angle, q=q_out, grasped=grasped, load_estimate=load_est,
                              vibrators=vib, emg=x, t_emg=np.arange(x.shape[1]) / fs,
-                             robot=robot, servos=used, hand=hand if hand_modes else None, status=status)
+                             robot=robot, servos=used, joint_servos=per_joint, hand=hand if hand_modes else None,
+                             status=status)
