@@ -93,12 +93,12 @@ def test_moving_centrode_maps_back_to_the_fixed_one():
 
 def test_radcliffe_stability_margin():
     """TKA line vertical through x0: the margin is x0 - x_ICR (exact); stable (> 0) with the hip
-    above the ankle, unstable when the hip is aligned 3 cm posterior."""
+    above the ankle, unstable when the hip is aligned 6 cm posterior."""
     icr = knee_flexion(K, 0.0).icr[0]
     assert icr[1] > 0.05                                       # a high (proximal) ICR at extension
     assert stability_margin(K, (0.0, 0.45)) == pytest.approx(0.0 - icr[0], abs=1e-12)
     assert stability_margin(K, (0.0, 0.45)) > 0
-    # hip 3 cm posterior: the TKA line passes behind... its x at the ICR height
+    # hip 6 cm posterior: at the height of the ICR the TKA line passes behind it
     hip = np.array([-0.06, 0.45])
     x_line = hip[0] + (K.ankle[0] - hip[0]) * (icr[1] - hip[1]) / (K.ankle[1] - hip[1])
     assert x_line < icr[0]
