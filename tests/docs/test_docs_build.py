@@ -40,7 +40,7 @@ DOCS = ROOT / "docs"
 #: the build, notebooks included, took 1.5-2.5 min on the shared 2-core machine
 BUILD_TIMEOUT = 900
 #: notebooks whose pages must show a plot (an <img> in a cell output)
-NOTEBOOKS_WITH_PLOTS = {"book_tour", "mechanisms", "design", "book_ik", "dynamics", "qp_ik", "person_to_prosthesis",
+NOTEBOOKS_WITH_PLOTS = {"book_tour", "mechanisms", "design", "book_ik", "dynamics", "qp_ik", "person_to_prosthesis", "teach_playback",
                         "powered_hand"}
 
 pytestmark = pytest.mark.slow
