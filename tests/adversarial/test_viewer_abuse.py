@@ -124,6 +124,8 @@ MALFORMED = {
     "msgpack_deep_nesting": [b"set_object", b"", b"\x91" * 200_000 + b"\xc0"],
     "batch_commands_not_a_list": [b"anthroarm_batch", b"", umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": 5})],
     "batch_of_garbage": [b"anthroarm_batch", b"", umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": [1, "x", None]})],
+    "ui_spec_not_a_map": [b"anthroarm_ui", b"", umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": "<script>"})],
+    "ui_unknown_kind": [b"anthroarm_ui", b"", umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": {"kind": "html"}})],
     "huge_garbage_payload": [b"set_object", b"", b"\xc1" * (48 * 2**20)],
     "clients_with_arguments": [b"clients", b"x"],
     "ten_thousand_frames": [b"url"] + [b""] * 10_000,

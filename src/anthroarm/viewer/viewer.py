@@ -658,6 +658,8 @@ class Viewer:
         unbounded joints are never coloured); with :meth:`show_joint_values`, each body's links
         by the value of the joint that moves it.  Only colours that changed since the last call
         are sent (None: the original colours)."""
+        if not self._limits_on and self._joint_rgb is None and not any(c is not None for c in self._colors.values()):
+            return []          # nothing coloured, nothing to restore: the common case of display()
         prox = None
         if self._limits_on:
             prox = limit_proximity(self.robot.chain.angles(q), self._joint_lower, self._joint_upper)
