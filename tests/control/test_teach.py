@@ -91,7 +91,7 @@ def test_random_access_follows_the_addresses_chosen():
 def test_store_round_trip(tmp_path):
     T = np.eye(4)
     T[:3, 3] = [0.1, 0.0, 0.3]
-    items = (Step(np.eye(4), 0.0, label="a", grip=3.0), Step(T, 1.0, motion="line", dwell=0.5),
+    items = (Step(np.eye(4), 0.0, label="a", grip=3.0, motion="line"), Step(T, 1.0, motion="line", dwell=0.5),
              Jump("a", "again"), Call("sub"))
     p = Program("stored", items)
     path = tmp_path / "prog.json"
@@ -124,6 +124,12 @@ def test_trajectory_hits_taught_points_at_their_times_line_and_arc():
     c = circle_through(p2, via, p3)
     assert np.allclose(np.linalg.norm(P[arc] - c.center, axis=1), c.radius)
     assert np.allclose(c.center, [0, 0, 0.2], atol=1e-12)
+    # poses: the same path with the hand turning, every sample a rotation
+    T1, T2 = np.eye(4), np.eye(4)
+    T1[:3, 3], T2[:3, 3] = p1, p2
+    T2[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    t2, P2 = play_fixed(Program("poses", (Step(T1, 0.0, motion="line"), Step(T2, 1.0, motion="line")))).trajectory(0.1)
+    assert np.allclose(P2[-1], T2) and np.allclose(P2[:, :3, :3] @ np.swapaxes(P2[:, :3, :3], 1, 2), np.eye(3))
 
 
 def test_bad_steps():
@@ -131,6 +137,8 @@ def test_bad_steps():
         Step([0, 0, 0], 1.0, motion="arc")
     with pytest.raises(ControlError, match="Cartesian"):
         Step([0, 0], 1.0, motion="line")
+    with pytest.raises(ControlError, match="entry by entry"):
+        Step(np.eye(4), 1.0)
     with pytest.raises(ControlError):
         Step([0.0], -1.0)
     with pytest.raises(ControlError):

@@ -91,6 +91,8 @@ class Step:
             raise ControlError(f"motion must be one of {MOTIONS}, got {self.motion!r}")
         if self.motion in ("line", "arc") and pos.shape not in ((3,), (4, 4)):
             raise ControlError(f"{self.motion!r} motion needs a Cartesian point (3,) or pose (4, 4), got {pos.shape}")
+        if self.motion == "joint" and pos.shape == (4, 4):
+            raise ControlError("a 4x4 pose cannot be interpolated entry by entry: give motion='line' or 'arc'")
         if self.motion == "arc":
             if self.via is None:
                 raise ControlError("an 'arc' step needs its via point (via=...)")
@@ -337,24 +339,21 @@ class Playback:
             raise ControlError("nothing was played back")
         ts, ps = [np.array([0.0])], [ex[0].position[None]]
         t0 = 0.0
-        prev = ex[0]
-        if prev.dwell > 0:
-            n = max(1, int(np.ceil(prev.dwell / dt)))
-            ts.append(t0 + prev.dwell * np.arange(1, n + 1) / n)
-            ps.append(np.repeat(prev.position[None], n, axis=0))
-            t0 += prev.dwell
-        for st in ex[1:]:
-            if st.time > 0:
-                n = max(1, int(np.ceil(st.time / dt)))
-                s = np.arange(1, n + 1) / n
-                ts.append(t0 + st.time * s)
-                ps.append(_move(prev, st, s))
-                t0 += st.time
+
+        def segment(duration, positions_at):
+            nonlocal t0
+            n = max(1, int(np.ceil(duration / dt)))
+            s = np.arange(1, n + 1) / n
+            ts.append(t0 + duration * s)
+            ps.append(positions_at(s))
+            t0 += duration
+
+        prev = None
+        for st in ex:
+            if prev is not None and st.time > 0:
+                segment(st.time, lambda s, a=prev, b=st: _move(a, b, s))
             if st.dwell > 0:
-                n = max(1, int(np.ceil(st.dwell / dt)))
-                ts.append(t0 + st.dwell * np.arange(1, n + 1) / n)
-                ps.append(np.repeat(st.position[None], n, axis=0))
-                t0 += st.dwell
+                segment(st.dwell, lambda s, b=st: np.repeat(b.position[None], s.size, axis=0))
             prev = st
         return np.concatenate(ts), np.concatenate(ps)
 
