@@ -121,3 +121,14 @@ def test_slip_small_steps_grip_equals_start_plus_steps_and_holds_the_weight():
     # a hand too weak to hold: dropped
     weak = simulate_slip(m, mu, SlipController(F0, step, grip_max=2.0), u, max_slip=0.02)
     assert weak.status == "dropped" and weak.grip == 2.0
+
+
+def test_counts_are_checked():
+    with pytest.raises(ControlError, match="max_steps"):
+        tactile_search(lambda p: True, [0.0], [1.0], 0.1, max_steps=-1)
+    with pytest.raises(ControlError, match="max_corrections"):
+        correct_position(0.0, 0.03, 0.08, 0.001, 0.001, max_corrections=1.5)
+    with pytest.raises(ControlError, match="n_jaws"):
+        simulate_slip(0.1, 0.5, SlipController(1.0, 0.1), 1e-3, n_jaws=0)
+    with pytest.raises(ControlError, match="pulses"):
+        SlipController(1.0, 0.1).update(True)

@@ -62,3 +62,10 @@ def on_grid(x, t: np.ndarray, name: str) -> np.ndarray:
     if a.shape != t.shape:
         raise ControlError(f"{name} must be a scalar or have one value per time sample {t.shape}, got {a.shape}")
     return a
+
+
+def count(x, name: str, minimum: int = 0) -> int:
+    """An integer (not a bool) >= ``minimum``."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < minimum:
+        raise ControlError(f"{name} must be an integer >= {minimum}, got {x!r}")
+    return int(x)

@@ -85,7 +85,8 @@ def tactile_search(contact: Callable, start, direction, step: float, max_steps: 
         raise ControlError(f"direction must be a nonzero vector of the shape of start {p.shape}, got {d.shape}")
     d = d / np.linalg.norm(d)
     step = _check.positive(step, "step (m)")
-    for k in range(int(max_steps) + 1):
+    max_steps = _check.count(max_steps, "max_steps")
+    for k in range(max_steps + 1):
         q = p + k * step * d
         if contact(q):
             return SearchResult(True, q, k, "contact")
@@ -121,6 +122,7 @@ def _touch_index(gap, resolution):
 
 
 def _correct(error, unit, gaps, resolution, max_corrections):
+    max_corrections = _check.count(max_corrections, "max_corrections")
     hist = [error]
     for k in range(int(max_corrections) + 1):
         ga, gb = gaps(error)
@@ -304,8 +306,7 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
     m_eq = _check.positive(jaw_mass, "jaw_mass (kg)") + motor.reflected_inertia / lead**2
     k_v, k_p, k_i, k_x = (_check.nonnegative(v, nm) for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i"),
                                                                     (k_x, "k_x")))
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-        raise ControlError(f"n must be an integer >= 2, got {n!r}")
+    n = _check.count(n, "n", 2)
     Vmax = motor.V_nom
     V0 = float(motor.voltage(0.0, v0 / lead))
     if abs(V0) > Vmax:
@@ -395,9 +396,8 @@ class SlipController:
 
     def update(self, pulses: int) -> float:
         """Take ``pulses`` new roller pulses (≥ 0) and return the new grip force, N."""
-        if isinstance(pulses, bool) or not isinstance(pulses, (int, np.integer)) or pulses < 0:
-            raise ControlError(f"pulses must be an integer >= 0, got {pulses!r}")
-        self.grip = min(self.grip + int(pulses) * self.step, self.grip_max)
+        pulses = _check.count(pulses, "pulses")
+        self.grip = min(self.grip + pulses * self.step, self.grip_max)
         return self.grip
 
 
@@ -464,6 +464,7 @@ def simulate_slip(mass: float, mu: float, controller: SlipController, unit: floa
     unit = _check.positive(unit, "unit (m)")
     g = _check.positive(g, "g (m/s^2)")
     max_slip = _check.positive(max_slip, "max_slip (m)")
+    n_jaws = _check.count(n_jaws, "n_jaws", 1)
     if not isinstance(controller, SlipController):
         raise ControlError("controller must be a SlipController")
     t, s, v = 0.0, 0.0, 0.0

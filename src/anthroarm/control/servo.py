@@ -427,7 +427,6 @@ class PositionServo:
         ServoResponse
         """
         duration = _check.positive(duration, "duration (s)")
-        if not isinstance(n, (int, np.integer)) or n < 2:
-            raise ControlError(f"n must be an integer >= 2, got {n!r}")
-        t = np.linspace(0.0, duration, int(n))
+        n = _check.count(n, "n", 2)
+        t = np.linspace(0.0, duration, n)
         return self.simulate(t, theta_step, M_L_step)

@@ -397,8 +397,8 @@ def _run(program: Program, mode: str, *, library=None, sensors=None, cycles: int
          max_steps: int = 100_000) -> Playback:
     """Execute items with a call stack; jumps test sensors; stop after ``max_steps`` steps."""
     library = {} if library is None else dict(library)
-    if isinstance(cycles, bool) or not isinstance(cycles, (int, np.integer)) or cycles < 1:
-        raise ControlError(f"cycles must be an integer >= 1, got {cycles!r}")
+    cycles = _check.count(cycles, "cycles", 1)
+    max_steps = _check.count(max_steps, "max_steps", 1)
     for prog in [program, *library.values()]:
         _check_calls(prog, library)
     out: list[ExecutedStep] = []
@@ -521,6 +521,7 @@ def play_random_access(points: Mapping[str, Step], start: str, next_address: Cal
         An address that does not exist (the message lists them).
     """
     pts = dict(points)
+    max_steps = _check.count(max_steps, "max_steps", 1)
     prog_name = "random access"
     out: list[ExecutedStep] = []
     hist: list[str] = []
