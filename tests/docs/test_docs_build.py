@@ -41,7 +41,7 @@ DOCS = ROOT / "docs"
 BUILD_TIMEOUT = 900
 #: notebooks whose pages must show a plot (an <img> in a cell output)
 NOTEBOOKS_WITH_PLOTS = {"book_tour", "mechanisms", "design", "book_ik", "dynamics", "qp_ik", "person_to_prosthesis", "teach_playback",
-                        "powered_hand"}
+                        "powered_hand", "hand"}
 
 pytestmark = pytest.mark.slow
 

@@ -20,7 +20,7 @@ configuration to convergence.  Two ways to say where the fingertips go:
 The pad normal of each fingertip is :mod:`anthroarm.hand.fingers`' convention (the direction the
 distal joint's flexion moves the tip).  Each iteration is one QP step with dt = 1 (Δq = v):
 tasks with Levenberg–Marquardt damping, the configuration limit (gain 0.5) and a trust region
-|Δq| ≤ ``max_step`` (rad or m per iteration, as a velocity limit), the ``couplings``
+``|Δq| ≤ max_step`` (rad or m per iteration, as a velocity limit), the ``couplings``
 (:class:`~anthroarm.ik.qp.tasks.coupling.JointCouplingTask`, e.g. a linkage written as a linear
 relation) as hard equality constraints; mimic joints are moved by Pinocchio with their source.
 A warm start is ``q0`` (the previous grasp's answer).
@@ -282,7 +282,7 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     seed : int or numpy Generator
         Random source of the restarts (deterministic by default).
     move_arm : bool
-        False holds the arm's joints (those all fingertips share, :attr:`Hand.arm_joints`) at
+        False holds the arm's joints (those all fingertips share, ``Hand.arm_joints``) at
         their values in ``q0``: a grasp with the palm where it is.
     step_fn : callable, optional
         Replaces :func:`anthroarm.ik.qp.step` in the iterations: ``step_fn(conf, tasks, limits,

@@ -68,7 +68,7 @@ class Sphere:
 
     @property
     def size(self) -> float:
-        """Diameter, m: what the hand must span."""
+        """The diameter (m): what the hand must span."""
         return 2.0 * self.radius
 
     def _rho(self, p):
@@ -130,7 +130,7 @@ class Cylinder:
 
     @property
     def size(self) -> float:
-        """Diameter, m: what the hand must span."""
+        """The diameter (m): what the hand must span."""
         return 2.0 * self.radius
 
     def _w(self, p):
