@@ -23,6 +23,11 @@ def test_fixed_sequence_plays_in_taught_order_every_cycle():
     ch = p.channels()
     assert ch["sequence"] == ["home", "above", "grasp", "place"]
     assert np.array_equal(ch["time"], [0.0, 1.0, 0.5, 2.0]) and ch["position"].shape == (4, 2)
+    # separated storage round trip: channels -> program -> channels
+    back = Program.from_channels("pick", **{k: v for k, v in ch.items()})
+    assert back.to_json() == p.to_json()
+    with pytest.raises(ControlError, match="lengths"):
+        Program.from_channels("x", ["a"], [[0.0], [1.0]], [0.0, 1.0])
     with pytest.raises(PlaybackError, match="fixed sequence"):
         play_fixed(Program("j", (Step([0.0], 0, label="a"), Jump("a", "s"))))
 

@@ -345,13 +345,10 @@ class PositionServo:
         fastest = float(np.max(np.abs(self.poles())))
         return max(1, int(math.ceil(dt * fastest * 50.0)))
 
-    def _advance(self, x, dt, theta_i, M_L, cache):
+    def _advance(self, x, dt, theta_i, M_L, zoh=None):
+        """One step; ``zoh`` = (Ad, Bd) of this ``dt`` when the caller has them."""
         if self.V_max is None:
-            if cache is None or cache[0] != dt:
-                Ad, Bd = self._zoh(dt)
-                cache = (dt, Ad, Bd) if cache is None else cache
-            else:
-                _, Ad, Bd = cache
+            Ad, Bd = self._zoh(dt) if zoh is None else zoh
             return Ad @ x + Bd @ np.array([theta_i, M_L])
         n = self._substeps(dt)
         h = dt / n
@@ -392,13 +389,10 @@ class PositionServo:
         X[0] = x
         dts = np.diff(t)
         uniform = np.allclose(dts, dts[0], rtol=1e-9, atol=0.0)
-        cache = None
-        if self.V_max is None and uniform:
-            Ad, Bd = self._zoh(float(dts[0]))
-            cache = (float(dts[0]), Ad, Bd)
+        zoh = self._zoh(float(dts[0])) if self.V_max is None and uniform else None
         for k, dt in enumerate(dts):
             dt = float(dts[0]) if uniform else float(dt)
-            X[k + 1] = self._advance(X[k], dt, ti[k], ml[k], cache if uniform else None)
+            X[k + 1] = self._advance(X[k], dt, ti[k], ml[k], zoh)
         theta, omega = X[:, 0], X[:, 1]
         V_raw = self.k_a * self.k_p * (ti - theta) - self.k_a * self.k_s * self.i * omega
         V = self.voltage(theta, omega, ti)

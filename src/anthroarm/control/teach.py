@@ -205,6 +205,42 @@ class Program:
                 "position": np.array([s.position for s in st]),
                 "time": np.array([s.time for s in st]), "dwell": np.array([s.dwell for s in st])}
 
+    @classmethod
+    def from_channels(cls, name: str, sequence, position, time, dwell=None, **step_kwargs) -> Program:
+        """A program from separately stored channels (the book's 分离存贮): the inverse of
+        :meth:`channels` for a program of steps.
+
+        Parameters
+        ----------
+        name : str
+            Program name.
+        sequence : sequence of str
+            A label per step (``"#k"`` entries, as :meth:`channels` writes for unlabelled
+            steps, give no label).
+        position : array_like, shape (n, ...)
+            The positions.
+        time : array_like, shape (n,)
+            Move times, s.
+        dwell : array_like, shape (n,), optional
+            Dwell times, s.
+        **step_kwargs
+            Passed to every :class:`Step` (e.g. ``motion="line"``).
+
+        Returns
+        -------
+        Program
+        """
+        pos = _check.array(position, "position")
+        n = len(sequence)
+        t = _check.array(time, "time")
+        d = np.zeros(n) if dwell is None else _check.array(dwell, "dwell")
+        if pos.shape[:1] != (n,) or t.shape != (n,) or d.shape != (n,):
+            raise ControlError(f"channels of different lengths: sequence {n}, position {pos.shape}, time {t.shape}, "
+                               f"dwell {d.shape}")
+        labels = [None if (isinstance(s, str) and s.startswith("#")) else s for s in sequence]
+        return cls(name, tuple(Step(p, float(tk), label=lb, dwell=float(dk), **step_kwargs)
+                               for p, tk, lb, dk in zip(pos, t, labels, d)))
+
     # ------------------------------------------------------------------ store
     def to_json(self) -> str:
         """The program as JSON text (round trip with :meth:`from_json`)."""
