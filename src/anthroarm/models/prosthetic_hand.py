@@ -14,8 +14,7 @@ Two models of the same hand:
   and returns the fingertips.  Its fingertip paths equal the mechanism solvers' (tested to
   1e-9 m).
 * :func:`prosthetic_hand` / :func:`robot` / :func:`urdf_text` — a plain URDF
-  (``urdf/prosthetic_hand.urdf``; not a catalog entry, because Pinocchio's energy and
-  Coriolis-matrix algorithms refuse mimic joints, which the catalog-wide tests call): the same
+  (``urdf/prosthetic_hand.urdf``; not a catalog entry yet, see :func:`robot`): the same
   spanning tree (links, bars and all) with every passive joint a ``<mimic>`` of its finger's
   driver, θ_j ≈ a_j θ_driver + b_j, fitted by least squares on the exact closed-loop solution
   over the driver range (:func:`mimic_fit` reports each fit's largest joint error and the
@@ -464,9 +463,12 @@ def robot(scale: float = 1.0, tool: str = "index_tip"):
     """The plain-URDF hand as a :class:`~anthroarm.robot.Robot` (nq = 5, the drivers; passive
     joints are mimic joints), with ``tool`` as its default frame.
 
-    Not a catalog entry: Pinocchio's energy and Coriolis-matrix algorithms refuse mimic joints,
-    so the catalog-wide dynamics comparisons cannot run on it (``anthroarm.dynamics.checks``
-    handles mimic joints and passes on it: ``aa.crosscheck.run([robot()])``)."""
+    Not a catalog entry yet.  Pinocchio's energy functions and ``aba`` refuse mimic joints and
+    its ``computeCoriolisMatrix`` does not match its reduced ``crba``/``rnea`` on them; the
+    dynamics checks compare this hand with the equivalent oracles instead (½ q̇ᵀ M q̇,
+    −m gᵀ c, ``nonLinearEffects`` − g, M⁻¹(τ − ``nonLinearEffects``):
+    :mod:`anthroarm.dynamics.checks` and ``tests/dynamics/test_lagrange.py``, which runs its
+    catalog comparison on this hand too)."""
     from ..robot import _make, build_model
     from ..urdf_io import parse_urdf_bytes
 
