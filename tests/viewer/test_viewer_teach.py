@@ -143,6 +143,14 @@ def test_dragging_a_slider_moves_the_live_robot_as_pinocchio_says(page):
         assert set(got) == set(want)
         for path in want:
             np.testing.assert_allclose(got[path], want[path], atol=1e-9, err_msg=path)
+        # the tool readout under the sliders: Pinocchio's tool pose (mm, rpy in degrees)
+        text = page.evaluate("document.querySelector('#anthroarm-teach .anthroarm-tool').textContent")
+        robot = v.robot
+        theta = [math.radians(values[robot.chain.joints[i].name]) for i in robot.chain.independent]
+        T = robot.fk(robot.chain.configuration(np.array(theta)))
+        nums = [float(x) for x in text.replace("°", " ").replace("mm,", " ").split() if x.lstrip("-").replace(".", "").isdigit()]
+        np.testing.assert_allclose(nums[:3], 1000 * T[:3, 3], atol=0.051)
+        np.testing.assert_allclose(nums[3:6], np.degrees(pin.rpy.matrixToRpy(T[:3, :3])), atol=0.051)
         # the scene really changed: the forearm's body turned by the dragged elbow angle
         R = before[:3, :3].T @ got[elbow][:3, :3]
         angle = math.degrees(math.acos(np.clip((np.trace(R) - 1) / 2, -1, 1)))

@@ -110,7 +110,12 @@ JS_PATCH = r"""
         return {type: "set_transform", path: m.path, matrix: colMajor(m.offset ? mul(M, m.offset) : M)};
       });
       viewer.handle_command({type: "anthroarm_batch", path: "", commands: cmds});
-      window.anthroarm_teach = {theta: theta.slice(), poses: T};
+      var P = mul(spec.tool.joint >= 0 ? T[spec.tool.joint] : EYE, spec.tool.offset);
+      var xyz = [P[3], P[7], P[11]];
+      var rpy = [Math.atan2(P[9], P[10]), Math.asin(Math.max(-1, Math.min(1, -P[8]))), Math.atan2(P[4], P[0])];
+      readout.textContent = spec.tool.name + ": x y z " + xyz.map(function (v) { return (1000 * v).toFixed(1); }).join(" ") +
+        " mm, r p y " + rpy.map(function (v) { return (180 / Math.PI * v).toFixed(1); }).join(" ") + "°";
+      window.anthroarm_teach = {theta: theta.slice(), poses: T, tool: {xyz: xyz, rpy: rpy}};
     }
     var box = el("div", BOX + "max-height:85vh;overflow-y:auto;");
     box.className = "anthroarm-teach";
@@ -129,6 +134,10 @@ JS_PATCH = r"""
       });
       row.appendChild(input); row.appendChild(out); box.appendChild(row);
     });
+    var readout = el("div", "margin-top:3px;font-variant-numeric:tabular-nums");
+    readout.className = "anthroarm-tool";
+    box.appendChild(readout);
+    pose();
     return box;
   }
   function ui(path, spec) {

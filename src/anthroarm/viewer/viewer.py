@@ -1070,7 +1070,9 @@ class Viewer:
         revolute joints ±180°); mimic joints follow their source.  Dragging a slider moves the
         robot at once, in a live tab, a Jupyter cell or an exported HTML file alike: the page
         computes the forward kinematics of ``robot.chain`` itself (the joint placements, axes
-        and mimic relations sent with the sliders; tested against Pinocchio in a real browser).
+        and mimic relations sent with the sliders; tested against Pinocchio in a real browser),
+        and shows the tool's position (mm) and roll, pitch, yaw (°, Pinocchio's ``rpy``
+        convention) in the robot's base frame under the sliders.
 
         The sliders start at ``q`` (default: the configuration displayed now).  ``on=False``
         removes them.  The Python side is not told of the page's slider positions: call
@@ -1118,8 +1120,10 @@ class Viewer:
             else:
                 f = chain.frames[fid]
                 movers.append({"path": path, "joint": int(f.joint), "offset": [float(x) for x in f.placement.ravel()]})
+        tool = chain.frames[self.robot.tool_id]
         return {"kind": "teach", "title": f"{self.robot.name}: joints", "theta": [float(t) for t in theta],
-                "joints": joints, "sliders": sliders, "movers": movers}
+                "joints": joints, "sliders": sliders, "movers": movers,
+                "tool": {"name": tool.name, "joint": int(tool.joint), "offset": [float(x) for x in tool.placement.ravel()]}}
 
     # ------------------------------------------------------------------ animation
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
