@@ -17,7 +17,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.dynamics import loads as L
-from anthroarm.errors import InertiaError, UnknownFrameError
+from anthroarm.errors import InertiaError, ParameterError, UnknownFrameError
 
 
 @pytest.fixture(scope="module")
@@ -199,25 +199,37 @@ def test_bad_held_objects(kw, exc):
         L.HeldObject(**kw)
 
 
+@pytest.mark.parametrize("args", [("1 kg", 0.04, 0.1), (0.5, "wide", 0.1), (0.5, 0.04, -0.1), (np.nan, 0.04, 0.1)])
+def test_bad_cylinders(args):
+    with pytest.raises(InertiaError, match="held object"):
+        L.HeldObject.cylinder(*args)
+
+
 def test_bad_wrenches_and_trajectories(person):
-    with pytest.raises(ValueError, match="finite"):
+    with pytest.raises(ParameterError, match="finite"):
         L.Wrench([0, np.inf, 0])
-    with pytest.raises(ValueError, match="reference"):
+    with pytest.raises(ParameterError, match="numbers"):
+        L.Wrench(["a", "b", "c"])
+    with pytest.raises(ParameterError, match="beyond"):
+        L.Wrench([0, 0, 1e300])
+    with pytest.raises(ParameterError, match="reference"):
         L.Wrench([0, 0, 1.0], reference="WORLD_UPSIDE_DOWN")
     q, qd, qdd = _traj(person, 4, 0)
-    with pytest.raises(ValueError, match="qd"):
+    with pytest.raises(ParameterError, match="qd"):
         L.inverse_dynamics(person, q, qd[:3], qdd)
+    with pytest.raises(ParameterError, match="qd"):
+        L.inverse_dynamics(person, q, [["x"] * person.nv] * 4, qdd)
     bad = qdd.copy()
     bad[1, 2] = np.nan
-    with pytest.raises(ValueError, match="shoulder_rotation"):
+    with pytest.raises(ParameterError, match="shoulder_rotation"):
         L.inverse_dynamics(person, q, qd, bad)
-    with pytest.raises(ValueError, match="rows"):
+    with pytest.raises(ParameterError, match="rows"):
         L.inverse_dynamics(person, q, qd, qdd, L.Wrench(np.ones((3, 3))))
     with pytest.raises(UnknownFrameError):
         L.inverse_dynamics(person, q, qd, qdd, L.Wrench([0, 0, 1.0], frame="no_such_frame"))
-    with pytest.raises(TypeError):
+    with pytest.raises(ParameterError, match="Wrench or a HeldObject"):
         L.inverse_dynamics(person, q, qd, qdd, [object()])
-    with pytest.raises(ValueError, match="engine"):
+    with pytest.raises(ParameterError, match="engine"):
         L.inverse_dynamics(person, q, qd, qdd, engine="newton")
 
 

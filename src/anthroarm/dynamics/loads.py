@@ -41,7 +41,10 @@ as adding its inertia to the body of the holding frame (the second oracle of the
 Inverse dynamics without the loads comes from the generated Lagrange code
 (:mod:`anthroarm.dynamics.lagrange`, ``engine="lagrange"``, the default) or Pinocchio's ``rnea``
 (``engine="pinocchio"``); the loads' term :math:`J^T w` is added to either.  Inputs are in the
-robot's layout (q ``(N, nq)``, q̇ and q̈ ``(N, nv)``); SI units throughout.
+robot's layout (q ``(N, nq)``, q̇ and q̈ ``(N, nv)``); SI units throughout.  Bad input: a
+held object's mass or inertia raises :class:`~anthroarm.errors.InertiaError`; a wrench, rate or
+option that is not finite, not numbers, of the wrong shape or unknown raises
+:class:`~anthroarm.errors.ParameterError` (a ``ValueError``); q is checked by the robot.
 """
 
 from __future__ import annotations
@@ -51,7 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..errors import InertiaError
+from ..errors import InertiaError, ParameterError
 
 _REFERENCES = {"LOCAL": pin.LOCAL, "LOCAL_WORLD_ALIGNED": pin.LOCAL_WORLD_ALIGNED}
 #: a held object above this mass (kg) or force/moment above this magnitude is refused
@@ -59,15 +62,18 @@ LOAD_BOUND = 1e6
 
 
 def _vector3(x, what: str, n: int | None = None) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{what} must be numbers, got {x!r}") from None
     if a.shape not in ((3,),) and not (a.ndim == 2 and a.shape[1] == 3):
-        raise ValueError(f"{what} must have shape (3,) or (N, 3), got {a.shape}")
+        raise ParameterError(f"{what} must have shape (3,) or (N, 3), got {a.shape}")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"{what} must be finite, got {a[~np.isfinite(a)][0]}")
+        raise ParameterError(f"{what} must be finite, got {a[~np.isfinite(a)][0]}")
     if a.size and np.max(np.abs(a)) > LOAD_BOUND:
-        raise ValueError(f"{what} has an entry beyond +-{LOAD_BOUND:.0e} (N, N m or m): {np.max(np.abs(a)):.3g}")
+        raise ParameterError(f"{what} has an entry beyond +-{LOAD_BOUND:.0e} (N, N m or m): {np.max(np.abs(a)):.3g}")
     if n is not None and a.ndim == 2 and a.shape[0] != n:
-        raise ValueError(f"{what} has {a.shape[0]} rows but the trajectory has {n} samples")
+        raise ParameterError(f"{what} has {a.shape[0]} rows but the trajectory has {n} samples")
     return a
 
 
@@ -86,7 +92,7 @@ class Wrench:
 
     def __post_init__(self):
         if self.reference not in _REFERENCES:
-            raise ValueError(f"Wrench reference must be one of {sorted(_REFERENCES)}, got {self.reference!r}")
+            raise ParameterError(f"Wrench reference must be one of {sorted(_REFERENCES)}, got {self.reference!r}")
         object.__setattr__(self, "force", _vector3(self.force, "Wrench force (N)"))
         object.__setattr__(self, "moment", _vector3(self.moment, "Wrench moment (N m)"))
 
@@ -143,8 +149,14 @@ class HeldObject:
     def cylinder(cls, mass: float, radius: float, height: float, com=(0.0, 0.0, 0.0), frame: str | None = None):
         """A solid cylinder (a full cup) whose axis is the frame's z axis: I = diag(m(3r²+h²)/12,
         m(3r²+h²)/12, m r²/2) about its centre of mass."""
-        if not (radius >= 0 and height >= 0 and np.isfinite(radius) and np.isfinite(height)):
-            raise InertiaError(f"held object: radius and height must be finite and >= 0 m, got {radius}, {height}")
+        mass = cls(mass).mass                          # the mass checks of a point mass
+        try:
+            r, h = float(radius), float(height)
+        except (TypeError, ValueError):
+            r = h = float("nan")
+        if not (r >= 0 and h >= 0 and np.isfinite(r) and np.isfinite(h)):
+            raise InertiaError(f"held object: radius and height must be finite and >= 0 m, got {radius!r}, {height!r}")
+        radius, height = r, h
         a = mass * (3 * radius**2 + height**2) / 12.0
         return cls(mass, np.asarray(com, float), np.diag([a, a, mass * radius**2 / 2.0]), frame)
 
@@ -195,13 +207,16 @@ def _check_rates(robot, q, qd, qdd):
     q = np.atleast_2d(q)
     out = [q]
     for x, name in ((qd, "qd"), (qdd, "qdd")):
-        a = np.atleast_2d(np.asarray(x, dtype=float))
+        try:
+            a = np.atleast_2d(np.asarray(x, dtype=float))
+        except (TypeError, ValueError):
+            raise ParameterError(f"{robot.name}: {name} must be numbers (rad/s, rad/s^2), got {x!r}") from None
         if a.shape != (len(q), robot.nv):
-            raise ValueError(f"{robot.name}: {name} must have shape ({len(q)}, {robot.nv}) like q, got "
+            raise ParameterError(f"{robot.name}: {name} must have shape ({len(q)}, {robot.nv}) like q, got "
                              f"{np.shape(x)}")
         if not np.all(np.isfinite(a)):
             j = int(np.argwhere(~np.isfinite(a))[0][-1])
-            raise ValueError(f"{robot.name}: {name} for joint {robot.joint_names[j]!r} is not finite")
+            raise ParameterError(f"{robot.name}: {name} for joint {robot.joint_names[j]!r} is not finite")
         out.append(a)
     return single, out
 
@@ -227,7 +242,7 @@ def _as_loads(loads) -> tuple:
     loads = tuple(loads)
     for x in loads:
         if not isinstance(x, (Wrench, HeldObject)):
-            raise TypeError(f"a load is a Wrench or a HeldObject, got {type(x).__name__}")
+            raise ParameterError(f"a load is a Wrench or a HeldObject, got {type(x).__name__}")
     return loads
 
 
@@ -283,7 +298,7 @@ def inverse_dynamics(robot, q, qd, qdd, loads=None, *, engine: str = "lagrange",
         model, data = robot.model, robot.data
         free = np.array([pin.rnea(model, data, Q[k], V[k], A[k]) for k in range(len(Q))])
     else:
-        raise ValueError(f"engine must be 'lagrange' or 'pinocchio', got {engine!r}")
+        raise ParameterError(f"engine must be 'lagrange' or 'pinocchio', got {engine!r}")
     qext = _loads_q(robot, Q, V, A, loads)
     tau = free - qext
     res = InverseDynamicsResult(tau=tau, tau_free=free, q_ext=qext, qd=V, power=tau * V,
