@@ -117,9 +117,10 @@ JS_PATCH = r"""
         " mm, r p y " + rpy.map(function (v) { return (180 / Math.PI * v).toFixed(1); }).join(" ") + "°";
       window.anthroarm_teach = {theta: theta.slice(), poses: T, tool: {xyz: xyz, rpy: rpy}};
     }
-    var box = el("div", BOX + "max-height:85vh;overflow-y:auto;");
+    var box = el("details", BOX + "max-height:85vh;overflow-y:auto;");   // click the title to fold it away
     box.className = "anthroarm-teach";
-    box.appendChild(el("div", "font-weight:600;margin-bottom:2px", spec.title));
+    box.open = true;
+    box.appendChild(el("summary", "font-weight:600;margin-bottom:2px;cursor:pointer", spec.title));
     spec.sliders.forEach(function (s) {
       var row = el("div", "display:grid;grid-template-columns:110px 150px 62px;align-items:center;gap:4px");
       row.appendChild(el("span", "overflow:hidden;text-overflow:ellipsis;white-space:nowrap", s.name));
