@@ -254,77 +254,28 @@ __all__ = ["Classification", "Kinematics", "classify", "kinematics", "CLASSES", 
 
 
 # ----------------------------------------------------------------------------- first solver
-def _wrist_centre(kin: Kinematics, first: int) -> np.ndarray:
-    """Least-squares common point of the axes first, first+1, first+2 (base frame, m)."""
-    hs, ps = kin.H[first:first + 3], kin.points[first:first + 3]
-    M = sum(np.eye(3) - np.outer(h, h) for h in hs)
-    b = sum((np.eye(3) - np.outer(h, h)) @ p for h, p in zip(hs, ps))
-    return np.linalg.lstsq(M, b, rcond=None)[0]
-
-
 def _spherical_wrist_P(kin: Kinematics) -> np.ndarray:
     """IK-Geo's offsets ``P`` (7, 3) of a 6R arm with a spherical wrist, joints 4, 5, 6 slid
     along their axes to the wrist centre (p_45 = p_56 = 0; base frame, m, q = 0)."""
-    c = _wrist_centre(kin, 3)
-    o = kin.points
-    return np.array([o[0], o[1] - o[0], o[2] - o[1], c - o[2], np.zeros(3), np.zeros(3), kin.p_tool - c])
+    from .geometric import ik_geo_P
+
+    return ik_geo_P(SPHERICAL_TWO_PARALLEL, kin.H, kin.points, kin.p_tool)
 
 
 def _solve_spherical_two_parallel(kin: Kinematics, T) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every IK branch of a ``spherical_two_parallel`` 6R arm (internal; not yet dispatched by
-    ``aa.ik.analytic``).
-
-    IK-Geo §IV (the solver ``IK_spherical_2_parallel`` of the reference implementation): with
-    the wrist centre c (joints 4, 5, 6 slid along their axes to it), p_0c = p − R₀₆ p_6T
-    fixes q1 by SP4 (h2 ⊥ the plane of the parallel links), q3 by SP3 (the elbow triangle),
-    q2 by SP1, then the wrist: q5 by SP4, q4 and q6 by SP1.  2 × 2 × 2 = 8 branches.
+    """Every IK branch of a ``spherical_two_parallel`` 6R arm in the joint order of ``kin``
+    (the class solver of :mod:`anthroarm.ik.geometric`, kept for its callers).
 
     ``T``: (4, 4) or (N, 4, 4) pose of the tool in the base frame (m).  Returns q (N, 8, 6)
-    joint angles in (−π, π] (the joint order of ``kin``), ``valid`` (N, 8) and ``exact``
-    (N, 8) (False: a least-squares branch, the pose is out of reach).  No limit filtering and no
-    FK check here: the caller does both."""
+    joint angles in (−π, π], ``valid`` (N, 8) and ``exact`` (N, 8) (False: a least-squares
+    branch, the pose is out of reach).  No limit filtering and no FK check here."""
+    from .geometric import solve_class
+
     T = np.asarray(T, dtype=float)
     single = T.ndim == 2
     T = T[None] if single else T
-    n = len(T)
-    H = kin.H
-    p01, p12, p23, p34, _, _, p6T_base = _spherical_wrist_P(kin)
-    R06 = T[:, :3, :3] @ kin.R_tool.T                         # rot1 … rot6 = R · R_tool⁻¹
-    # p_6T at q = 0 (IK-Geo's P(:,7)) turns with R06: the wrist centre is p − R06 p_6T
-    wrist = T[:, :3, 3] - np.einsum("nij,j->ni", R06, p6T_base)          # p_0c
-    from . import subproblems as sp
-    h1, h2, h3, h4, h5, h6 = (np.broadcast_to(H[i], (n, 3)) for i in range(6))
-    s1 = sp.sp4(h2, wrist - p01, -h1, np.full(n, h2[0] @ (p12 + p23 + p34)))
-    q = np.full((n, 8, 6), np.nan)
-    valid = np.zeros((n, 8), bool)
-    exact = np.zeros((n, 8), bool)
-    for a in range(2):
-        q1 = s1.theta[:, a, 0]
-        ok1 = s1.valid[:, a]
-        q1z = np.nan_to_num(q1)
-        v = sp._rotate(-h1, q1z, wrist - p01) - p12                       # rot(−h1,q1)(p_0c − p01) − p12
-        # IK-Geo uses −p_0c … + p12 with the opposite sign; the distance is the same
-        s3 = sp.sp3(-np.broadcast_to(p34, (n, 3)), np.broadcast_to(p23, (n, 3)), h3,
-                    np.linalg.norm(v, axis=1))
-        for b in range(2):
-            q3 = np.nan_to_num(s3.theta[:, b, 0])
-            ok3 = ok1 & s3.valid[:, b]
-            s2 = sp.sp1(np.broadcast_to(p23, (n, 3)) + sp._rotate(h3, q3, np.broadcast_to(p34, (n, 3))), v, h2)
-            q2 = s2.theta[:, 0, 0]
-            R03 = sp.rot(h1, q1z) @ sp.rot(h2, q2) @ sp.rot(h3, q3)
-            R36 = np.swapaxes(R03, 1, 2) @ R06
-            s5 = sp.sp4(h4, h6, h5, np.einsum("ni,nij,nj->n", h4, R36, h6))
-            for cidx in range(2):
-                q5 = np.nan_to_num(s5.theta[:, cidx, 0])
-                ok = ok3 & s5.valid[:, cidx]
-                s4 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R36, h6), h4)
-                s6 = sp.sp1(sp._rotate(-h5, q5, h4), np.einsum("nji,nj->ni", R36, h4), -h6)
-                k = 4 * a + 2 * b + cidx
-                q[:, k] = np.stack([q1z, q2, q3, s4.theta[:, 0, 0], q5, s6.theta[:, 0, 0]], -1)
-                valid[:, k] = ok
-                exact[:, k] = ok & s1.exact[:, a] & s3.exact[:, b] & s2.exact[:, 0] & s5.exact[:, cidx] \
-                    & s4.exact[:, 0] & s6.exact[:, 0]
-    q = np.where(valid[..., None], q, np.nan)
+    q, valid, exact = solve_class(SPHERICAL_TWO_PARALLEL, kin.H, _spherical_wrist_P(kin),
+                                  T[:, :3, :3] @ kin.R_tool.T, T[:, :3, 3])
     if single:
         return q[0], valid[0], exact[0]
     return q, valid, exact

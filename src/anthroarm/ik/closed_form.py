@@ -61,6 +61,7 @@ from ..models import closed_forms as _registry
 from . import analytic_c as _c
 from . import analytic_scalar as ks
 from . import analytic_soa as _soa
+from . import geometric as _geo
 from .analytic_plan import cached_plan, plan_for
 from .qp.tasks.swivel import swivel_basis
 
@@ -176,24 +177,49 @@ def _form(robot, frame=None):
     return form
 
 
+#: the registry-like entry of an arm solved by its geometry (:mod:`.geometric`), per class;
+#: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of magnitude)
+_GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), 8, cost_us=150.0) for c in _geo.SOLVED}
+
+
+def _geo_plan(robot, frame=None):
+    """The :class:`.geometric.GeoPlan` of a robot without a registered closed form whose
+    geometry has one (IK-Geo class of ``robot.chain``), for ``frame`` = its tool; else None."""
+    if frame is not None and robot.chain.frame(frame).name != robot.tool:
+        return None
+    if _form(robot) is not None:
+        return None
+    return _geo.plan_for(robot)
+
+
+def _form_any(robot, frame=None):
+    form = _form(robot, frame)
+    if form is None:
+        gp = _geo_plan(robot, frame)
+        if gp is not None:
+            return _GEO_FORMS[gp.cls]
+    return form
+
+
 def has_analytic(robot, frame=None) -> bool:
     """True if :func:`analytic` has a closed form for ``robot`` at ``frame`` (a name or a
     Pinocchio frame id; default the tool).  Which arms have one is the registry
-    :mod:`anthroarm.models.closed_forms`; an unknown frame raises
-    :class:`~anthroarm.errors.UnknownFrameError`."""
-    return _form(robot, frame) is not None
+    :mod:`anthroarm.models.closed_forms`, then the arm's geometry (a 6R class of
+    :mod:`.geometric`); an unknown frame raises :class:`~anthroarm.errors.UnknownFrameError`."""
+    return _form_any(robot, frame) is not None
 
 
 def closed_form_info(robot, frame=None):
     """The registry entry (:class:`anthroarm.models.closed_forms.ClosedForm`: family, branches,
-    swivel, position_only, cost_us) of ``robot`` at ``frame``, or None without a closed form."""
-    return _form(robot, frame)
+    swivel, position_only, cost_us) of ``robot`` at ``frame``, or None without a closed form.
+    An arm solved by its geometry gets an entry whose ``family`` is its IK-Geo class."""
+    return _form_any(robot, frame)
 
 
 def analytic_cost(robot, frame=None) -> float:
     """Cost hint of one :func:`analytic` call at ``frame`` in µs per pose (the compiled
     kernel's benchmark time; a redundant arm's per swivel angle), ``inf`` without a closed form."""
-    form = _form(robot, frame)
+    form = _form_any(robot, frame)
     return float("inf") if form is None else form.cost_us
 
 
@@ -220,10 +246,14 @@ def _require(robot):
             raise UnsupportedModelError(
                 f"{robot.name}: the closed form solves all {form.nq} joints of {spec.name}; this robot has "
                 f"{robot.nq} (joints locked or left out): use aa.ik.solve(robot, T)")
+        c = _geo.classification(robot)
+        why = ("its chain could not be read" if c is None else
+               f"its kinematic class is {c.name}" + (f" ({c.reason})" if c.reason else ""))
         raise UnsupportedModelError(
             f"{robot.name}: no closed-form IK is registered for this robot (closed forms exist for "
-            f"{', '.join(_registry.names())}; anthroarm.models.closed_forms); "
-            "use aa.ik.solve(robot, T) for a numerical solution")
+            f"{', '.join(_registry.names())}; anthroarm.models.closed_forms) and no closed form for "
+            f"this geometry: {why}, solved in closed form are 6R arms of the classes "
+            f"{', '.join(_geo.SOLVED)}; use aa.ik.solve(robot, T) for a numerical solution")
     return plan
 
 
@@ -594,6 +624,10 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     "general"."""
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
+    if _plan(robot) is None:
+        gp = _geo.plan_for(robot)
+        if gp is not None:
+            return _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal)
     plan = _require(robot)
     family, prm = plan.family, plan.params
     if position_only is None:
@@ -649,6 +683,60 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swv is None else np.where(valid, swv, np.nan),
                                residuals=np.where(valid, res, np.nan), singular=sing, model=robot.name)
+
+
+def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal) -> AnalyticBatchResult:
+    """:func:`analytic_batch` of an arm solved by its geometry (:mod:`.geometric`): the class
+    solver's 8 branches, wrapped by 2π into the joint limits, each verified by FK (the 3×4 pose
+    to ``tol``), duplicates removed; a reason for every pose without a solution."""
+    if swivel is not None:
+        raise ValueError(f"{robot.name}: swivel= applies to a redundant arm's family of solutions; "
+                         f"this arm is a 6R arm ({gp.cls}) with finitely many solutions")
+    if position_only:
+        raise ValueError(f"{robot.name}: a 6R arm is solved for the full pose (position and rotation); "
+                         "for a position alone use aa.ik.solve(robot, p, position_only=True)")
+    Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal)
+    N, B, ch = Ts.shape[0], 8, gp.chain
+    labels = list(gp.labels)
+    if N == 0:
+        return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
+                                   residuals=np.zeros((0, B)), singular=[], model=robot.name)
+    th, cand, exact = _geo.solve(gp, Ts)
+    thw, inside = _wrap_into_limits(th, gp.lower, gp.upper)
+    finite = np.isfinite(thw).all(-1)
+    Q = ch.configuration(np.where(finite[..., None], thw, 0.0))
+    res = np.where(finite, _fk_residual(robot, Q, Ts, False), np.inf)
+    valid = cand & inside & finite & (res <= tol)
+    for i in np.flatnonzero(valid.sum(1) > 1):          # coincident branches (singular poses)
+        for b in range(1, B):
+            if valid[i, b]:
+                d = np.abs(np.angle(np.exp(1j * (thw[i, :b] - thw[i, b])))).max(-1)
+                if ((d < 1e-9) & valid[i, :b]).any():
+                    valid[i, b] = False
+    reasons = [None] * N
+    names = [ch.joints[j].name for j in ch.independent]
+    c = gp.classification
+    for i in np.flatnonzero(~valid.any(1)):
+        ex = exact[i]
+        if not ex.any():
+            best = float(np.min(res[i])) if np.isfinite(res[i]).any() else float("inf")
+            reasons[i] = (f"outside the workspace: no branch of the {gp.cls} closed form reaches this "
+                          f"pose (its subproblems have least-squares answers only; best FK residual "
+                          f"{best:.3g})")
+        elif not (ex & inside[i]).any():
+            reasons[i] = (f"all {int(ex.sum())} closed-form solutions violate the joint limits ("
+                          + ", ".join(f"{n} [{lo:.4g}, {hi:.4g}]" for n, lo, hi in zip(names, gp.lower, gp.upper))
+                          + ")")
+        else:
+            worst = float(np.min(np.where(ex & inside[i], res[i], np.inf)))
+            reasons[i] = (f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); the "
+                          f"pose is singular, or the arm is {gp.cls} only within the classification "
+                          f"tolerance (axes up to {c.worst_accepted[0]:.3g} m / sine {c.worst_accepted[1]:.3g} "
+                          f"from the exact relation; tol {c.tol:g} m, angle_tol {c.angle_tol:g})")
+    sol = np.where(valid[..., None], Q, np.nan)
+    return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
+                               residuals=np.where(valid, res, np.nan), singular=[None] * N,
+                               model=robot.name)
 
 
 def _kernel(plan, impl, single=True):
@@ -754,6 +842,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         return _book_result(robot, Ts[0], plan.params, tol)
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
+    if _plan(robot) is None:
+        gp = _geo.plan_for(robot)
+        if gp is not None:
+            res = _geometric_batch(robot, gp, arr, swivel, position_only, tol, tol_orthonormal)
+            return res[0] if np.ndim(arr) == 2 else res
     if arr.ndim == 2 and _impl != "general":
         fast = _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, _impl)
         if fast is not None and len(fast):       # solutions found: nothing to rescue

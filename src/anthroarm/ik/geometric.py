@@ -1,0 +1,292 @@
+"""Closed-form IK of any 6R arm whose geometry allows it, by IK-Geo's solver classes.
+
+Source: A. J. Elias and J. T. Wen, "IK-Geo: Unified robot inverse kinematics using subproblem
+decomposition", arXiv 2211.05737, §IV (the 6-DOF solvers); the decompositions were read from
+the reference implementation (github.com/rpiRobotics/ik-geo, ``matlab/+IK``); the code is our
+own, batched over N poses, built on the subproblems of :mod:`anthroarm.ik.subproblems`.
+
+The arm is read from ``robot.chain`` (:func:`anthroarm.ik.classify.classify`), never from its
+name.  Conventions (IK-Geo): joint i turns about the unit axis ``h_i`` (base frame, q = 0);
+``P[0]`` is the base → joint 1 offset, ``P[i]`` joint i → joint i+1, ``P[6]`` joint 6 → tool
+(m); the tool orientation at q = 0 is removed first, ``R06 = R · R_tool(0)ᵀ``.  Joints may slide
+along their own axes without changing the kinematics, which makes the offsets between
+intersecting axes zero (the form each solver needs: :func:`ik_geo_P`).
+
+========================================  =====================================  ==========
+class (:mod:`.classify`)                  decomposition                          branches
+========================================  =====================================  ==========
+``spherical_two_parallel``                q1 SP4, q3 SP3, q2 SP1; wrist q5 SP4,  2 × 2 × 2
+                                          q4, q6 SP1
+``spherical_two_intersecting``            q3 SP3, (q1, q2) SP2; wrist as above   2 × 2 × 2
+``three_parallel_two_intersecting``       q1 SP4, q5 SP4, q2 + q3 + q4 and q6    2 × 2 × 2
+                                          SP1, q3 SP3, q2 SP1, q4 by difference
+========================================  =====================================  ==========
+
+A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
+solved on the reversed arm: T = e^{ξ1 q1} ⋯ e^{ξ6 q6} M gives T⁻¹ = e^{ξ'1 q6} ⋯ e^{ξ'6 q1} M⁻¹
+with ξ'_k the twist of joint 7 − k seen from the tool at q = 0 and its axis negated
+(``h'_k = −R_toolᵀ h_{7−k}`` through ``R_toolᵀ (o_{7−k} − p_tool)``), the same angles.
+
+Every branch returned is a candidate: its ``exact`` flag is False where a subproblem had only a
+least-squares answer (the pose is out of reach on that branch).  Limits and the FK check are
+the caller's (:func:`anthroarm.ik.closed_form.analytic`).
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import classify as C
+from . import subproblems as sp
+
+#: the classes solved here in closed form (the others: use aa.ik.solve)
+SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING)
+
+_LABELS = {
+    C.SPHERICAL_TWO_PARALLEL: ("q1", "q3", "q5"),
+    C.SPHERICAL_TWO_INTERSECTING: ("q3", "q1q2", "q5"),
+    C.THREE_PARALLEL_TWO_INTERSECTING: ("q1", "q5", "q3"),
+}
+
+
+def branch_labels(cls: str) -> tuple[str, ...]:
+    """The 8 branch labels of a class: which root of each of its three two-root subproblems
+    (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …)."""
+    a, b, c = _LABELS[cls]
+    return tuple(f"{a}={i},{b}={j},{c}={k}" for i in range(2) for j in range(2) for k in range(2))
+
+
+@dataclass(frozen=True)
+class GeoPlan:
+    """What a call needs besides the pose: the class, the (possibly reversed) kinematics in
+    IK-Geo's form (``H`` (6, 3), ``P`` (7, 3), ``R_tool`` (3, 3)), the map from the solver's
+    joints to ``robot.chain.independent``, the per-joint limits (rad; ±inf for continuous
+    joints) and the classification (its tolerances and near calls)."""
+
+    cls: str
+    reversed: bool
+    H: np.ndarray
+    P: np.ndarray
+    R_tool: np.ndarray
+    order: np.ndarray          # independent joint k is solver joint order[k]
+    lower: np.ndarray
+    upper: np.ndarray
+    classification: object     # the anthroarm.ik.classify.Classification
+    chain: object
+    tool: str
+    labels: tuple
+
+
+def _common_point(H, pts):
+    """Least-squares common point of lines (h_i, o_i)."""
+    M = sum(np.eye(3) - np.outer(h, h) for h in H)
+    b = sum((np.eye(3) - np.outer(h, h)) @ p for h, p in zip(H, pts))
+    return np.linalg.lstsq(M, b, rcond=None)[0]
+
+
+def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) -> np.ndarray:
+    """IK-Geo's offsets ``P`` (7, 3) of a 6R arm of class ``cls``: the joints whose axes meet
+    slid along their axes to the common point (spherical wrist: p45 = p56 = 0; intersecting
+    1–2: p12 = 0; intersecting 5–6: p56 = 0).  ``H`` (6, 3), ``points`` (6, 3) one point of
+    each axis, ``p_tool`` (3,) the tool position at q = 0 (base frame, m)."""
+    o = np.array(points, dtype=float)
+    groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)],
+              C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
+              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)]}[cls]
+    for g in groups:
+        c = _common_point(H[list(g)], o[list(g)])
+        for i in g:
+            o[i] = c
+    return np.diff(np.vstack([np.zeros(3), o, p_tool]), axis=0)
+
+
+def _reversed(kin: C.Kinematics):
+    """(H, points, R_tool, p_tool) of the arm read from the tool at q = 0 (module docstring)."""
+    Rt, pt = kin.R_tool, kin.p_tool
+    H = -(kin.H[::-1] @ Rt)                       # rows: −R_toolᵀ h
+    pts = (kin.points[::-1] - pt) @ Rt
+    return H, pts, Rt.T, -Rt.T @ pt
+
+
+_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def plan_for(robot) -> GeoPlan | None:
+    """The cached :class:`GeoPlan` of ``robot`` for its tool, or None when its geometry has no
+    closed form here (not 6R on the path to the tool, a mimic joint, joints off that path, or
+    a class in :data:`anthroarm.ik.classify.CLASSES` other than :data:`SOLVED`)."""
+    hit = _PLANS.get(robot)
+    if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
+        return hit[2]
+    plan = _build(robot)
+    _PLANS[robot] = (robot.chain, robot.tool, plan)
+    return plan
+
+
+def classification(robot):
+    """The classification of ``robot`` at its tool (None where the chain cannot be read, e.g.
+    a mimic joint on the path)."""
+    try:
+        return C.classify(robot)
+    except Exception:            # noqa: BLE001 - UnsupportedModelError (mimic) and kin: no class
+        return None
+
+
+def _build(robot) -> GeoPlan | None:
+    c = classification(robot)
+    if c is None or not c.compatible:
+        return None
+    ch = robot.chain
+    kin = c.kinematics
+    if sorted(kin.joints) != sorted(ch.independent):
+        return None                      # joints off the tool path: a solution is not a configuration
+    pick = next(((n, r) for n, r in c.compatible if n in SOLVED), None)
+    if pick is None:
+        return None
+    cls, rev = pick
+    if rev:
+        H, pts, R_tool, p_tool = _reversed(kin)
+    else:
+        H, pts, R_tool, p_tool = kin.H, kin.points, kin.R_tool, kin.p_tool
+    path = kin.joints                    # solve() turns a reversed solution back to this order
+    P = ik_geo_P(cls, H, pts, p_tool)
+    order = np.array([path.index(j) for j in ch.independent])
+    lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in ch.independent])
+    hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in ch.independent])
+    return GeoPlan(cls, rev, np.array(H), P, np.array(R_tool), order, lo, hi, c, ch, robot.tool,
+                   branch_labels(cls))
+
+
+# ----------------------------------------------------------------------------- the solvers
+def _b(v, n):
+    return np.broadcast_to(v, (n, 3))
+
+
+def _wrist(H, R36, n):
+    """Spherical wrist: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and q6 by SP1.
+    Returns [(q4, q5, q6, valid, exact) for the two q5 roots]."""
+    h4, h5, h6 = _b(H[3], n), _b(H[4], n), _b(H[5], n)
+    s5 = sp.sp4(h4, h6, h5, np.einsum("ni,nij,nj->n", h4, R36, h6))
+    out = []
+    for c in range(2):
+        q5 = np.nan_to_num(s5.theta[:, c, 0])
+        s4 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R36, h6), h4)
+        s6 = sp.sp1(sp._rotate(-h5, q5, h4), np.einsum("nji,nj->ni", R36, h4), -h6)
+        out.append((s4.theta[:, 0, 0], q5, s6.theta[:, 0, 0], s5.valid[:, c],
+                    s5.exact[:, c] & s4.exact[:, 0] & s6.exact[:, 0]))
+    return out
+
+
+def _spherical_two_parallel(H, P, R06, p):
+    n = len(p)
+    h1, h2, h3 = _b(H[0], n), _b(H[1], n), _b(H[2], n)
+    p01, p12, p23, p34 = P[0], P[1], P[2], P[3]
+    wrist = p - R06 @ P[6] - p01                                        # p_16 (wrist centre − p01)
+    s1 = sp.sp4(h2, wrist, -h1, np.full(n, H[1] @ (p12 + p23 + p34)))
+    out = []
+    for a in range(2):
+        q1 = np.nan_to_num(s1.theta[:, a, 0])
+        v = sp._rotate(-h1, q1, wrist) - p12                              # R01ᵀ p_16 − p12
+        s3 = sp.sp3(-_b(p34, n), _b(p23, n), h3, np.linalg.norm(v, axis=1))
+        for b in range(2):
+            q3 = np.nan_to_num(s3.theta[:, b, 0])
+            s2 = sp.sp1(_b(p23, n) + sp._rotate(h3, q3, _b(p34, n)), v, h2)
+            q2 = s2.theta[:, 0, 0]
+            R03 = sp.rot(h1, q1) @ sp.rot(h2, q2) @ sp.rot(h3, q3)
+            ok = s1.valid[:, a] & s3.valid[:, b]
+            ex = s1.exact[:, a] & s3.exact[:, b] & s2.exact[:, 0]
+            for q4, q5, q6, v5, e5 in _wrist(H, np.swapaxes(R03, 1, 2) @ R06, n):
+                out.append((np.stack([q1, q2, q3, q4, q5, q6], -1), ok & v5, ex & e5))
+    return out
+
+
+def _spherical_two_intersecting(H, P, R06, p):
+    n = len(p)
+    h1, h2, h3 = _b(H[0], n), _b(H[1], n), _b(H[2], n)
+    p16 = p - R06 @ P[6] - P[0]                                         # from the 1–2 intersection
+    s3 = sp.sp3(_b(P[3], n), -_b(P[2], n), h3, np.linalg.norm(p16, axis=1))
+    out = []
+    for b in range(2):
+        q3 = np.nan_to_num(s3.theta[:, b, 0])
+        s12 = sp.sp2(p16, _b(P[2], n) + sp._rotate(h3, q3, _b(P[3], n)), -h1, h2)
+        for a in range(2):
+            q1, q2 = np.nan_to_num(s12.theta[:, a, 0]), np.nan_to_num(s12.theta[:, a, 1])
+            R03 = sp.rot(h1, q1) @ sp.rot(h2, q2) @ sp.rot(h3, q3)
+            ok = s3.valid[:, b] & s12.valid[:, a]
+            ex = s3.exact[:, b] & s12.exact[:, a]
+            for q4, q5, q6, v5, e5 in _wrist(H, np.swapaxes(R03, 1, 2) @ R06, n):
+                out.append((np.stack([q1, q2, q3, q4, q5, q6], -1), ok & v5, ex & e5))
+    return out
+
+
+def _three_parallel_two_intersecting(H, P, R06, p):
+    n = len(p)
+    h1, h2, h5, h6 = _b(H[0], n), _b(H[1], n), _b(H[4], n), _b(H[5], n)
+    # h3, h4 are ±h2: rot(h3, q3) = rot(h2, s3 q3)
+    s3n, s4n = np.sign(H[1] @ H[2]), np.sign(H[1] @ H[3])
+    p06 = p - R06 @ P[6] - P[0]
+    s1 = sp.sp4(h2, p06, -h1, np.full(n, H[1] @ P[1:5].sum(0)))
+    R06h6 = R06 @ H[5]
+    out = []
+    for a in range(2):
+        q1 = np.nan_to_num(s1.theta[:, a, 0])
+        R01 = sp.rot(h1, q1)
+        R01t = np.swapaxes(R01, 1, 2)
+        s5 = sp.sp4(h2, h6, h5, np.einsum("i,nij,nj->n", H[1], R01t, R06h6))
+        for c in range(2):
+            q5 = np.nan_to_num(s5.theta[:, c, 0])
+            s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R01t, R06h6), h2)
+            th14 = s14.theta[:, 0, 0]
+            s6 = sp.sp1(sp._rotate(-h5, q5, h2),
+                        np.einsum("nji,nj->ni", R06, R01 @ H[1]), -h6)
+            d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, _b(P[4], n))
+            s3 = sp.sp3(-_b(P[3], n), _b(P[2], n), h2, np.linalg.norm(d_in, axis=1))
+            for b in range(2):
+                t3 = np.nan_to_num(s3.theta[:, b, 0])
+                s2 = sp.sp1(_b(P[2], n) + sp._rotate(h2, t3, _b(P[3], n)), d_in, h2)
+                q2 = s2.theta[:, 0, 0]
+                t4 = np.angle(np.exp(1j * (th14 - q2 - t3)))
+                q = np.stack([q1, q2, s3n * t3, s4n * t4, q5, s6.theta[:, 0, 0]], -1)
+                ok = s1.valid[:, a] & s5.valid[:, c] & s3.valid[:, b]
+                ex = s1.exact[:, a] & s5.exact[:, c] & s14.exact[:, 0] & s6.exact[:, 0] \
+                    & s3.exact[:, b] & s2.exact[:, 0]
+                out.append((q, ok, ex))
+    # order the branches q1 × q5 × q3 as the labels say
+    return out
+
+
+_SOLVERS = {C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
+            C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
+            C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting}
+
+
+def solve_class(cls: str, H, P, R06, p):
+    """Every branch of the class solver ``cls`` in IK-Geo's form (``H`` (6, 3), ``P`` (7, 3),
+    ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions, base frame, m).
+    Returns q (N, 8, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, 8),
+    exact (N, 8) (False: least squares, out of reach)."""
+    out = _SOLVERS[cls](np.asarray(H, float), np.asarray(P, float), R06, p)
+    q = np.stack([o[0] for o in out], 1)
+    valid = np.stack([o[1] for o in out], 1)
+    exact = np.stack([o[2] for o in out], 1) & valid
+    q = np.angle(np.exp(1j * q))
+    return np.where(valid[..., None], q, np.nan), valid, exact
+
+
+def solve(plan: GeoPlan, T):
+    """Every branch for poses ``T`` (N, 4, 4) of the tool (base frame, m; valid rotations):
+    θ (N, 8, n) in the order of ``robot.chain.independent`` (rad, (−π, π]), valid, exact."""
+    T = np.asarray(T, dtype=float)
+    R, p = T[:, :3, :3], T[:, :3, 3]
+    if plan.reversed:
+        R, p = np.swapaxes(R, 1, 2), -np.einsum("nji,nj->ni", R, p)
+    q, valid, exact = solve_class(plan.cls, plan.H, plan.P, R @ plan.R_tool.T, p)
+    if plan.reversed:
+        q = q[..., ::-1]
+    return q[..., plan.order], valid, exact
+
+
+__all__ = ["GeoPlan", "SOLVED", "branch_labels", "ik_geo_P", "plan_for", "solve", "solve_class"]

@@ -1,0 +1,213 @@
+"""Closed-form IK of any 6R arm by its geometry (anthroarm.ik.geometric through aa.ik.analytic):
+the UR3/5/10 (three parallel + two intersecting), kinova and a PUMA 560 (spherical wrist + two
+parallel), the prosthetic arm (spherical shoulder: a reversed spherical_two_intersecting), and
+random user arms of each class written here as standard-DH URDFs.
+
+Oracles: Pinocchio FK of every returned branch (FK(IK(T)) = T to 1e-9) and the joint values
+the pose was made from; PyPI ik-geo (Rust) for the number of exact solutions and their values
+on the same poses (skipped when ik_geo is not installed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import anthroarm as aa
+from anthroarm.errors import UnsupportedModelError
+from anthroarm.ik import classify as C
+from anthroarm.ik import geometric as G
+
+PI = np.pi
+
+
+def dh_urdf(tmp_path, name, alpha, a, d, lim=PI):
+    """A 6R arm from standard DH parameters (T = Π Rz(θ) Tz(d) Tx(a) Rx(α), Craig/Corke), joint
+    limits ±lim, tool at the last DH frame."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(7)) + '<link name="tool"/>'
+    js = []
+    for i in range(6):
+        xyz, rpy = ("0 0 0", "0 0 0") if i == 0 else (f"{a[i-1]} 0 {d[i-1]}", f"{alpha[i-1]} 0 0")
+        js.append(f'<joint name="j{i+1}" type="revolute"><origin xyz="{xyz}" rpy="{rpy}"/>'
+                  f'<parent link="l{i}"/><child link="l{i+1}"/><axis xyz="0 0 1"/>'
+                  f'<limit lower="{-lim!r}" upper="{lim!r}" effort="10" velocity="1"/></joint>')
+    js.append(f'<joint name="jt" type="fixed"><origin xyz="{a[5]} 0 {d[5]}" rpy="{alpha[5]} 0 0"/>'
+              '<parent link="l6"/><child link="tool"/></joint>')
+    path = tmp_path / f"{name}.urdf"
+    path.write_text(f'<?xml version="1.0"?><robot name="{name}"><link name="base"/>'
+                    '<joint name="j0" type="fixed"><parent link="base"/><child link="l0"/></joint>'
+                    f'{links}{"".join(js)}</robot>')
+    return aa.load(str(path))
+
+
+def puma560(tmp_path):
+    # Corke, RTB models/DH/Puma560: d1 = 0.6718, a2 = 0.4318, d3 = 0.15005, a3 = 0.0203, d4 = 0.4318
+    return dh_urdf(tmp_path, "puma560", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
+                   [0, 0.4318, 0.0203, 0, 0, 0], [0.6718, 0, 0.15005, 0.4318, 0, 0])
+
+
+def random_arm(tmp_path, cls, seed):
+    """A random user 6R arm whose DH parameters satisfy the class constraints."""
+    r = np.random.default_rng(seed)
+    L = lambda: r.uniform(0.05, 0.5)                                   # noqa: E731
+    A = lambda: r.choice([-1, 1]) * r.uniform(0.3, 1.3)                 # a generic twist
+    if cls == C.SPHERICAL_TWO_PARALLEL:            # 2 ∥ 3 (α2 = 0), a4 = a5 = d5 = 0
+        alpha, a, d = [A(), 0, A(), A(), A(), A()], [L(), L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
+    elif cls == C.SPHERICAL_TWO_INTERSECTING:      # 1 × 2 (a1 = 0), spherical wrist
+        alpha, a, d = [A(), A(), A(), A(), A(), A()], [0, L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
+    else:                                          # 2 ∥ 3 ∥ 4 (α2 = α3 = 0), 5 × 6 (a5 = 0)
+        alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), 0, L()], [L(), L(), L(), L(), L(), L()]
+    return dh_urdf(tmp_path, f"user_{cls}_{seed}", alpha, a, d)
+
+
+def _fk(robot, q):
+    model, data = robot.model, robot.model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    return data.oMf[model.getFrameId(robot.tool)].homogeneous.copy()
+
+
+def _poses(robot, n, seed):
+    th = robot.chain.random_q(n, np.random.default_rng(seed))
+    return th, np.array([_fk(robot, q) for q in th])
+
+
+def _angles(robot, Q):
+    return robot.chain.angles(Q) if hasattr(robot.chain, "angles") else Q
+
+
+def _arms(tmp_path):
+    return [("ur3", aa.load("ur3")), ("ur5", aa.load("ur5")), ("ur10", aa.load("ur10")),
+            ("kinova", aa.load("kinova")), ("puma560", puma560(tmp_path))] + \
+        [(f"user_{c}", random_arm(tmp_path, c, s)) for s in (1, 2) for c in G.SOLVED]
+
+
+CLASS = {"ur3": C.THREE_PARALLEL_TWO_INTERSECTING, "ur5": C.THREE_PARALLEL_TWO_INTERSECTING,
+         "ur10": C.THREE_PARALLEL_TWO_INTERSECTING, "kinova": C.SPHERICAL_TWO_PARALLEL,
+         "puma560": C.SPHERICAL_TWO_PARALLEL}
+
+
+def test_every_branch_fk_verified_and_the_pose_found(tmp_path):
+    for label, robot in _arms(tmp_path):
+        gp = G.plan_for(robot)
+        assert gp is not None, label
+        assert gp.cls == CLASS.get(label, label[5:]), label
+        assert aa.ik.has_analytic(robot)
+        th, T = _poses(robot, 12, 3)
+        res = aa.ik.analytic_batch(robot, T)
+        assert res.valid.any(1).all(), (label, res.reasons)
+        for i in range(len(T)):
+            r = res[i]
+            assert len(r) <= 8 and np.isfinite(r.solutions).all()
+            for q in r.solutions:
+                assert np.abs(_fk(robot, q) - T[i]).max() < 1e-9, label
+                assert (q >= robot.lower - 1e-12).all() and (q <= robot.upper + 1e-12).all()
+            # the posture the pose was made from is among the branches (mod 2π)
+            A = _angles(robot, r.solutions)
+            d = np.abs(np.angle(np.exp(1j * (A - _angles(robot, th[i][None]))))).max(1)
+            assert d.min() < 1e-7, label
+        one = aa.ik.analytic(robot, T[0])
+        np.testing.assert_allclose(one.solutions, res[0].solutions, atol=1e-12)
+        assert one.branches == res[0].branches
+
+
+def test_reversed_class_prosthetic_arm():
+    """The prosthetic arm has a spherical shoulder: spherical_two_intersecting of the reversed
+    chain.  (aa.ik.analytic keeps the book's procedure for it; the class solver is checked here.)"""
+    robot = aa.load("prosthetic_arm")
+    gp = G.plan_for(robot)
+    assert gp.cls == C.SPHERICAL_TWO_INTERSECTING and gp.reversed
+    th, T = _poses(robot, 15, 4)
+    q, valid, exact = G.solve(gp, T)
+    assert exact.all()                                            # generic poses: 8 exact branches
+    for i in range(len(T)):
+        for k in range(8):
+            assert np.abs(_fk(robot, robot.chain.configuration(q[i, k])) - T[i]).max() < 1e-9
+        assert np.abs(np.angle(np.exp(1j * (q[i] - th[i])))).max(1).min() < 1e-7
+    # the book method (registered) and the class solver find the same solutions inside the limits
+    book = aa.ik.analytic_batch(robot, T)
+    for i in range(len(T)):
+        ours = np.array([x for x in q[i] if ((x >= robot.lower - 1e-9) & (x <= robot.upper + 1e-9)).all()])
+        assert len(ours) == len(book[i])
+
+
+def test_branch_counts_and_values_equal_ik_geo(tmp_path):
+    ik_geo = pytest.importorskip("ik_geo")
+    arms = _arms(tmp_path) + [("prosthetic_arm", aa.load("prosthetic_arm")), ("sixr_arm", aa.load("sixr_arm"))]
+    for label, robot in arms:
+        gp = G.plan_for(robot)
+        geo = getattr(ik_geo.Robot, gp.cls)(gp.H.tolist(), gp.P.tolist())
+        _, T = _poses(robot, 15, 6)
+        q, valid, exact = G.solve(gp, T)
+        counts = []
+        for i in range(len(T)):
+            R, p = T[i, :3, :3], T[i, :3, 3]
+            if gp.reversed:
+                R, p = R.T, -R.T @ p
+            theirs = np.array([s for s, ls in geo.get_ik((R @ gp.R_tool.T).T.tolist(), p.tolist()) if not ls])
+            if gp.reversed:
+                theirs = theirs[:, ::-1]
+            theirs = theirs[:, gp.order]
+            ours = q[i][exact[i]]
+            assert len(ours) == len(theirs), label
+            counts.append(len(ours))
+            dd = np.abs(np.angle(np.exp(1j * (ours[:, None] - theirs[None])))).max(-1)
+            assert dd.min(1).max() < 1e-8 and dd.min(0).max() < 1e-8, label
+        if label.startswith("ur") or label in ("kinova", "puma560", "sixr_arm"):
+            assert max(counts) == 8
+
+
+def test_unreachable_pose_says_so():
+    robot = aa.load("ur5")
+    T = np.eye(4)
+    T[:3, 3] = [3.0, 0.0, 0.0]                                     # 3 m: out of reach
+    r = aa.ik.analytic(robot, T)
+    assert not r.success and r.solutions.shape == (0, 6) and "outside the workspace" in r.reason
+    b = aa.ik.analytic_batch(robot, np.stack([T, robot.fk(robot.neutral())]))
+    assert not b.valid[0].any() and b.valid[1].any() and b.reasons[1] is None
+
+
+def test_singular_pose_ur5_home():
+    """q = 0 of the UR5 is a wrist singularity (axes 4 and 6 parallel): whatever is returned
+    is FK-exact and finite, with no duplicates."""
+    robot = aa.load("ur5")
+    T = robot.fk(robot.neutral())
+    r = aa.ik.analytic(robot, T)
+    assert r.success and np.isfinite(r.solutions).all()
+    for q in r.solutions:
+        assert np.abs(_fk(robot, q) - T).max() < 1e-9
+    D = np.abs(r.solutions[:, None] - r.solutions[None]).max(-1) + np.eye(len(r)) * 9
+    assert D.min() > 1e-9
+
+
+def test_bad_rotation_and_options():
+    robot = aa.load("ur10")
+    T = robot.fk(robot.neutral())
+    bad = T.copy()
+    bad[:3, :3] *= 1.01
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        aa.ik.analytic(robot, bad)
+    with pytest.raises(ValueError, match="swivel"):
+        aa.ik.analytic(robot, T, swivel=0.3)
+    empty = aa.ik.analytic_batch(robot, np.zeros((0, 4, 4)))
+    assert len(empty) == 0
+
+
+def test_near_intersecting_axes_within_tolerance_are_reported(tmp_path):
+    """Wrist axes 1e-7 m from a common point: classified spherical within tol = 1e-6, so the
+    closed form is approximate; the FK check rejects it and the reason names the tolerance."""
+    robot = dh_urdf(tmp_path, "puma_off", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
+                    [0, 0.4318, 0.0203, 0, 0, 0], [0.6718, 0, 0.15005, 0.4318, 1e-7, 0])
+    assert G.plan_for(robot).cls == C.SPHERICAL_TWO_PARALLEL
+    _, T = _poses(robot, 1, 8)
+    r = aa.ik.analytic(robot, T[0])
+    # the least-squares common point lies midway: each line 0.5e-7 m from it
+    assert not r.success and "classification tolerance" in r.reason and "5e-08 m" in r.reason
+
+
+def test_no_closed_form_geometry(tmp_path):
+    r = np.random.default_rng(0)
+    robot = dh_urdf(tmp_path, "gen6r", r.uniform(0.3, 1.3, 6), r.uniform(0.05, 0.4, 6), r.uniform(0.05, 0.4, 6))
+    assert C.classify(robot).name == C.GEN_SIX_DOF and G.plan_for(robot) is None
+    assert not aa.ik.has_analytic(robot)
+    with pytest.raises(UnsupportedModelError, match="no closed form for this geometry.*gen_six_dof.*aa.ik.solve"):
+        aa.ik.analytic(robot, np.eye(4))
