@@ -102,3 +102,24 @@ def test_report_embeds_one_viewer_page_with_the_activities(person, tmp_path):
     assert text.count("<iframe srcdoc=") == 1 and "set_animation" not in text[:200]
     assert "a at 0.0 s; b at 0.5 s" in text
     assert text.count("MeshCat.Viewer(") == 1            # meshcat's page once, escaped in srcdoc
+
+
+def test_cli_size_bad_trajectory_files(tmp_path, capsys, monkeypatch, person):
+    """Files that are not trajectories: one line naming the file (and the line), no report."""
+    monkeypatch.chdir(tmp_path)
+    names = ",".join(["t", *person.joint_names])
+    row = ",".join(["0.0"] * (person.nq + 1))
+    (tmp_path / "junk.npz").write_bytes(b"not a zip archive")
+    np.save(tmp_path / "one.npy", np.zeros(3))
+    (tmp_path / "one.npy").rename(tmp_path / "one.npz")
+    np.savez(tmp_path / "text.npz", t=np.array(["a"] * 5), q=np.zeros((5, person.nq)))
+    (tmp_path / "ragged.csv").write_text(f"{names}\n{row}\n1.0,2.0\n")
+    (tmp_path / "word.csv").write_text(f"{names}\n{row}\n{row.replace('0.0', 'x', 1)}\n")
+    (tmp_path / "header.csv").write_text(f"# only a header\n{names}\n")
+    for f, words in [("junk.npz", "not a NumPy .npz archive"), ("one.npz", "not a NumPy .npz archive"),
+                     ("text.npz", "must be numbers"), ("ragged.csv", "line 3: 2 values"),
+                     ("word.csv", "line 3: a value is not a number"), ("header.csv", "no samples")]:
+        rc = main(["size", "--no-progress", "--no-viewer", "--activities", f])
+        err = capsys.readouterr().err
+        assert rc == 2 and f in err and words in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "report.html").exists()

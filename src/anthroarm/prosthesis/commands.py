@@ -46,6 +46,8 @@ def add_parser(sub):
 
 
 def _read_trajectory(path: Path, robot) -> dict:
+    import zipfile
+
     import numpy as np
 
     from ..errors import ActivityError
@@ -53,26 +55,50 @@ def _read_trajectory(path: Path, robot) -> dict:
     if not path.is_file():
         raise ActivityError(f"{path}: no such trajectory file")
     if path.suffix.lower() == ".npz":
-        with np.load(path) as z:
-            if "t" not in z or "q" not in z:
+        not_npz = ActivityError(f"{path}: not a NumPy .npz archive of numeric arrays (np.savez(path, t=..., q=...))")
+        try:
+            z = np.load(path, allow_pickle=False)
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile):
+            raise not_npz from None
+        if not isinstance(z, np.lib.npyio.NpzFile):        # a single .npy array under an .npz name
+            raise not_npz
+        with z:
+            if "t" not in z.files or "q" not in z.files:
                 raise ActivityError(f"{path}: an .npz trajectory needs arrays 't' (N,) and 'q' (N, {robot.nq}); "
                                     f"it has {sorted(z.files)}")
-            return dict(name=path.stem, t=np.asarray(z["t"], float), q=np.asarray(z["q"], float))
+            try:
+                t, q = z["t"], z["q"]
+            except (OSError, ValueError, EOFError, zipfile.BadZipFile):
+                raise not_npz from None
+        try:
+            return dict(name=path.stem, t=np.asarray(t, float), q=np.asarray(q, float))
+        except (TypeError, ValueError):
+            raise ActivityError(f"{path}: 't' and 'q' must be numbers (s, rad), got {t.dtype} and {q.dtype}") from None
     if path.suffix.lower() == ".csv":
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.startswith("#")]
+        try:
+            text = path.read_text(encoding="utf-8-sig")
+        except UnicodeDecodeError:
+            raise ActivityError(f"{path}: not a UTF-8 text file") from None
+        lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines()) if ln.strip() and not ln.startswith("#")]
         if not lines:
             raise ActivityError(f"{path}: empty trajectory file")
-        header = [h.strip() for h in lines[0].split(",")]
+        header = [h.strip() for h in lines[0][1].split(",")]
         need = ["t", *robot.joint_names]
         missing = [c for c in need if c not in header]
         if missing:
             raise ActivityError(f"{path}: missing column(s) {missing}; need {need}")
-        try:
-            data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]], dtype=float)
-        except ValueError as exc:
-            raise ActivityError(f"{path}: a value is not a number ({exc})") from None
-        if data.ndim != 2 or data.shape[1] != len(header):
-            raise ActivityError(f"{path}: every row needs {len(header)} values")
+        rows = []
+        for lineno, ln in lines[1:]:
+            fields = ln.split(",")
+            if len(fields) != len(header):
+                raise ActivityError(f"{path}, line {lineno}: {len(fields)} values, the header has {len(header)}")
+            try:
+                rows.append([float(x) for x in fields])
+            except ValueError:
+                raise ActivityError(f"{path}, line {lineno}: a value is not a number: {ln.strip()!r}") from None
+        if not rows:
+            raise ActivityError(f"{path}: a header but no samples")
+        data = np.array(rows, dtype=float)
         cols = [header.index(c) for c in need]
         return dict(name=path.stem, t=data[:, cols[0]], q=data[:, cols[1:]])
     raise ActivityError(f"{path}: a trajectory file is .npz or .csv, got {path.suffix!r}")
