@@ -340,7 +340,7 @@ def docs_screenshot(png, size=(960, 640)) -> Path:
     v.stop()  # a still picture: the pose below, not the animation
     v.show_limits()
     v.display(np.deg2rad(REACH_POSTURES_DEG["reach forward"]))
-    v.set_camera((1.0, 0.7, 0.45), distance=2.2 * v.radius)  # front-right, whole reach in view
+    v.set_camera((1.0, 0.7, 0.45), fit="reach", fill=1.0)  # front-right, whole reach in view
     with tempfile.TemporaryDirectory() as d:
         html = v.export_html(Path(d) / "arm.html")
         return screenshot(html, png, size=size, budget_ms=3000)
