@@ -161,6 +161,7 @@ def test_dragging_a_slider_moves_the_live_robot_as_pinocchio_says(page):
 @pytest.mark.skipif(browser.find_chromium() is None and not os.environ.get("CI"), reason="chromium is not installed")
 def test_mimic_joint_follows_in_an_exported_page(page, user_robot, tmp_path):
     v = Viewer(user_robot)
+    v.show_limits()
     v.teach()
     html = v.export_html(tmp_path / "teach.html")
     load(page, html.resolve().as_uri())
@@ -172,6 +173,36 @@ def test_mimic_joint_follows_in_an_exported_page(page, user_robot, tmp_path):
     want = expected_poses(v, values)
     for path in want:
         np.testing.assert_allclose(got[path], want[path], atol=1e-9, err_msg=path)
+    # joint-limit colours follow the sliders: the page's colours are the ones Python's
+    # show_limits computes for the same configuration (limit_proximity, limit_color)
+    drag_slider(page, "shoulder", 0.995)
+    values = slider_values(page)
+    chain = user_robot.chain
+    q = chain.configuration(np.array([math.radians(values[chain.joints[i].name]) for i in chain.independent]))
+
+    class Rec:
+        def __init__(self):
+            self.messages = []
+
+        def send_many(self, cmds):
+            self.messages.append(list(cmds))
+
+    v._colors = {}
+    v.server = rec = Rec()
+    v.display(q)
+    v.server = None
+    colours = {c["path"]: c["color"] for c in rec.messages[-1] if c["type"] == "anthroarm_color"}
+    import json
+
+    shown = page.evaluate("(function (paths) { var out = {}; paths.forEach(function (p) { var c = null;"
+                        " viewer.scene_tree.find(p.split('/').filter(function (x) { return x; })).object.traverse("
+                        "function (o) { if (c === null && o.material && o.material.color) { c = o.material.color.toArray(); } });"
+                        f" out[p] = c; }}); return out; }})({json.dumps(list(colours))})")
+    assert len(colours) >= 3
+    red = [pth for pth, c in colours.items() if c[0] > 0.8 and c[2] < 0.3]
+    assert red, colours                   # the shoulder at 99.5 % of its range: something is red
+    for pth, c in colours.items():
+        np.testing.assert_allclose(shown[pth], c, atol=2e-3, err_msg=pth)
     # the mimic finger (grip_mimic = -grip + 0.1) really turned against the other
     a = [p for p in want if p.endswith("/grip")][0]
     b = [p for p in want if p.endswith("/grip_mimic")][0]

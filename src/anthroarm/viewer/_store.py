@@ -109,6 +109,21 @@ JS_PATCH = r"""
         var M = m.joint >= 0 ? T[m.joint] : EYE;
         return {type: "set_transform", path: m.path, matrix: colMajor(m.offset ? mul(M, m.offset) : M)};
       });
+      var L = spec.limits;
+      if (L) {   // joint-limit colours, as Viewer._color_commands: max proximity over the group's joints
+        L.groups.forEach(function (g) {
+          var p = 0;
+          g.joints.forEach(function (j) {
+            var lo = L.lower[j], hi = L.upper[j];
+            if (lo !== null && hi !== null && hi > lo) {
+              p = Math.max(p, Math.min(1, Math.abs(theta[j] - 0.5 * (lo + hi)) / (0.5 * (hi - lo))));
+            }
+          });
+          var w = Math.min(1, Math.max(0, (p - L.warn) / (1 - L.warn)));
+          cmds.push({type: "anthroarm_color", path: g.path,
+                     color: [0, 1, 2].map(function (k) { return (1 - w) * g.base[k] + w * L.red[k]; })});
+        });
+      }
       viewer.handle_command({type: "anthroarm_batch", path: "", commands: cmds});
       var P = mul(spec.tool.joint >= 0 ? T[spec.tool.joint] : EYE, spec.tool.offset);
       var xyz = [P[3], P[7], P[11]];

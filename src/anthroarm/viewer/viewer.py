@@ -447,6 +447,7 @@ class Viewer:
         self._joint_upper = np.array([j.upper for j in joints])
         self._limits_on = False
         self._joint_rgb: list | None = None   # show_joint_values: one colour per chain joint
+        self._teaching = False
         self._animating = False
         self._colors: dict[str, tuple] = {}
         self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
@@ -738,6 +739,8 @@ class Viewer:
             cmds = [self._ui(legend, spec)]
         else:
             cmds = [_delete(legend)]
+        if self._teaching:   # the sliders recolour as they move (or stop doing so)
+            cmds.append(self._ui(f"{self.root}/ui/teach", self._teach_spec()))
         self._send(self._color_commands(self.q) + cmds)
 
     def show_joint_values(self, values, label: str = "joint torque |τ| (N·m)", *, colormap: str = "plasma",
@@ -1072,12 +1075,14 @@ class Viewer:
         computes the forward kinematics of ``robot.chain`` itself (the joint placements, axes
         and mimic relations sent with the sliders; tested against Pinocchio in a real browser),
         and shows the tool's position (mm) and roll, pitch, yaw (°, Pinocchio's ``rpy``
-        convention) in the robot's base frame under the sliders.
+        convention) in the robot's base frame under the sliders.  With :meth:`show_limits` on,
+        the links turn red as the sliders approach a limit.
 
         The sliders start at ``q`` (default: the configuration displayed now).  ``on=False``
         removes them.  The Python side is not told of the page's slider positions: call
         :meth:`display` to show a configuration from Python.  Returns the viewer."""
         path = f"{self.root}/ui/teach"
+        self._teaching = bool(on)
         if not on:
             self._send([_delete(path)])
             return self
@@ -1121,9 +1126,24 @@ class Viewer:
                 f = chain.frames[fid]
                 movers.append({"path": path, "joint": int(f.joint), "offset": [float(x) for x in f.placement.ravel()]})
         tool = chain.frames[self.robot.tool_id]
+        limits = None
+        if self._limits_on:   # the page recolours like _color_commands: same groups, same blend
+            groups = []
+            for b in self.bodies:
+                has = {pc.group for pc in b.pieces}
+                link_group = "links" if "links" in has else "mesh"
+                for group, idx in ((link_group, b.link_joints), ("joint", [b.limit_joint] if b.limit_joint is not None else [])):
+                    if idx and group in has:
+                        base = next(pc.rgb for pc in b.pieces if pc.group == group)
+                        groups.append({"path": f"{self._bpath(b)}/{group}", "joints": [int(i) for i in idx],
+                                       "base": [float(c) for c in base]})
+            fin = lambda x: float(x) if np.isfinite(x) else None   # noqa: E731 - msgpack has no inf
+            limits = {"lower": [fin(x) for x in self._joint_lower], "upper": [fin(x) for x in self._joint_upper],
+                      "warn": LIMIT_WARN, "red": list(LIMIT_RGB), "groups": groups}
         return {"kind": "teach", "title": f"{self.robot.name}: joints", "theta": [float(t) for t in theta],
                 "joints": joints, "sliders": sliders, "movers": movers,
-                "tool": {"name": tool.name, "joint": int(tool.joint), "offset": [float(x) for x in tool.placement.ravel()]}}
+                "tool": {"name": tool.name, "joint": int(tool.joint), "offset": [float(x) for x in tool.placement.ravel()]},
+                "limits": limits}
 
     # ------------------------------------------------------------------ animation
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
