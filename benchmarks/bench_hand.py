@@ -22,7 +22,7 @@ the ContactNormalTask's residual and Jacobian).  Success = every fingertip withi
 contact, pad normal within 5°, inside the limits, checked on the returned configuration by
 Pinocchio FK.  Also the Allegro hand (fixed palm) with sliding contacts.
 
-mink (MuJoCo-based) is not compared: see the notes for why.
+mink (MuJoCo-based) is not compared yet: see the notes.
 """
 
 from __future__ import annotations
@@ -287,10 +287,10 @@ def run(quick: bool = False) -> dict:
              "median / ours with the same backend; runs A B A B. Grasp rows: times in ms per solve (CPU time, all "
              "attempts and the palm approach included), success % checked on the returned q by Pinocchio FK (1 mm, 5 deg, limits); "
              "ours and pink run the same solve loop (hand.solve_grasp) and differ only in the QP step "
-             "(step_fn=). mink is not compared: it needs MuJoCo and an MJCF model of each robot; the machine's "
-             "package mirror has mink 1.3.0 and mujoco, but no MJCF of the catalog's human upper limb or of "
-             "example-robot-data's Allegro exists here, and a URDF->MJCF conversion is a different model, not "
-             "the same problem." + ("" if pink is not None else " pink is not installed: ours only."))
+             "(step_fn=). mink is not compared yet: mink 1.3.0 and mujoco 4.0.0 install from the "
+             "machine's package mirror (pip --dry-run), but mink solves on MuJoCo models; the limb and the Allegro hand "
+             "would first have to be converted from URDF with the fingertip frames kept as sites and checked against "
+             "Pinocchio FK, which is left for later." + ("" if pink is not None else " pink is not installed: ours only."))
     return dict(
         title="Multi-finger IK: QP step on the 27-DOF limb and grasp solves, anthroarm vs pink",
         columns=["measure", "robot", "backend", "ours median", "ours p90", "pink median", "pink p90",

@@ -1,0 +1,100 @@
+"""The README picture: the human upper limb holding an upright glass in front of the body.
+
+:func:`cup_grasp` finds the configuration: a reachable five-fingertip cylinder grasp of the hand
+(:func:`~anthroarm.hand.problems.reachable_grasps`: the fingers closed on a cylinder of radius
+35–40 mm with the palm held), carried to an upright glass at ``center`` (base frame, m) by
+solving the palm pose with :func:`anthroarm.ik.solve` over twelve turns about the vertical (and
+the glass upside down), keeping the arm configuration nearest the comfortable posture.  The
+grasp is checked with :func:`~anthroarm.hand.grasp.grasp_errors` (1 mm, 5°, on the glass's side,
+inside the limits) before it is returned.
+
+:func:`readme_picture` draws it in the viewer (contact points, inward normals, the glass as a
+meshcat cylinder) and takes a headless-Chromium screenshot
+(:func:`anthroarm.viewer.browser.screenshot`): ``python -m anthroarm.hand.demo docs/x.png``.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .fingers import Hand
+from .grasp import NORMAL_TOL, POSITION_TOL, grasp_errors
+from .objects import Cylinder
+from .problems import reachable_grasps
+
+GLASS_HEIGHT = 0.18   # m, the drawn glass (the fingertips lie within ±9 cm of its centre)
+
+
+def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
+    """(robot, hand, q, glass) of the picture (see the module docstring).  ``RuntimeError`` if no
+    draw gives a grasp that passes the checks."""
+    import anthroarm as aa
+    from ..ik.qp import IKConfiguration
+    from ..ik.qp.tasks.posture import comfortable_posture
+
+    robot = aa.load("human_upper_limb") if robot is None else robot
+    h = Hand(robot)
+    comfort = comfortable_posture(robot)
+    aq = h.arm_q_indices
+    best = None
+    for seed in seeds:
+        pb = reachable_grasps(robot, 1, rng=seed, hand=h, radius=(0.035, 0.04))[0]
+        for yaw in np.linspace(0, 2 * np.pi, 12, endpoint=False):
+            for flip in (np.eye(3), np.diag([1.0, -1.0, -1.0])):
+                Tw = np.eye(4)
+                Tw[:3, :3] = pin.rpy.rpyToMatrix(0.0, 0.0, yaw) @ flip
+                Tw[:3, 3] = center
+                res = aa.ik.solve(robot, Tw @ np.linalg.inv(pb.T_palm_obj), frame=h.palm, q0=comfort, max_time=0.02)
+                if not (res.success and robot.within_limits(res.q)):
+                    continue
+                q = pb.witness.copy()
+                q[aq] = res.q[aq]
+                glass = Cylinder(Tw[:3, 3], Tw[:3, 2], pb.obj.radius, length=GLASS_HEIGHT)
+                pe, ne, _, on_side = grasp_errors(h, IKConfiguration(robot, q), glass)
+                if pe.max() > POSITION_TOL or ne.max() > NORMAL_TOL or not on_side:
+                    continue
+                d = float(np.linalg.norm((res.q - comfort)[aq]))
+                if best is None or d < best[0]:
+                    best = (d, q, glass)
+    if best is None:
+        raise RuntimeError("no reachable upright-glass grasp found for the picture")
+    return robot, h, best[1], best[2]
+
+
+def readme_picture(png, size=(960, 640)) -> Path:
+    """Screenshot of :func:`cup_grasp` in the viewer, written to ``png``."""
+    import meshcat.geometry as mg
+
+    from ..ik.qp import IKConfiguration
+    from ..viewer import Viewer
+    from ..viewer.browser import screenshot
+
+    robot, h, q, glass = cup_grasp()
+    _, _, contacts, _ = grasp_errors(h, IKConfiguration(robot, q), glass)
+    v = Viewer(robot, q=q)
+    v.show_points(contacts, colors=(0.1, 0.65, 0.2))
+    v.show_arrows(contacts, -0.035 * np.array([glass.normal(c) for c in contacts]), colors=(0.9, 0.2, 0.1))
+    Tw = np.eye(4)
+    Tw[:3, :3] = np.column_stack([np.cross(glass.axis, [0.0, 0.0, 1.0]) if abs(glass.axis[2]) < 0.9 else [1.0, 0, 0],
+                                  glass.axis, np.zeros(3)])
+    Tw[:3, 0] /= np.linalg.norm(Tw[:3, 0])
+    Tw[:3, 2] = np.cross(Tw[:3, 0], Tw[:3, 1])                # meshcat's cylinder runs along its y axis
+    Tw[:3, 3] = glass.center
+    node = v.scene[v.root.removeprefix("/meshcat/") + "/overlays/glass"]
+    node.set_object(mg.Cylinder(GLASS_HEIGHT, glass.radius),
+                    mg.MeshLambertMaterial(color=0xD9D2C0, opacity=0.85, transparent=True))
+    node.set_transform(Tw)
+    v.set_camera((0.5, 1.0, 0.25), distance=0.75)
+    with tempfile.TemporaryDirectory() as d:
+        html = v.export_html(Path(d) / "grasp.html")
+        return screenshot(html, png, size=size, budget_ms=3000)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    print(readme_picture(sys.argv[1] if len(sys.argv) > 1 else "hand_grasp_viewer.png"))
