@@ -51,6 +51,8 @@ GOOD_GEAR = "G1,X,20,2,20,0.8,2,3,8000,80"
     # not a number
     (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,abc,10,30,10000,100\n", 2, "torque_constant_mNm_per_A", "not a number"),
     (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,nan,10,30,10000,100\n", 2, "torque_constant_mNm_per_A", "not finite"),
+    # beyond any data sheet (a typo): 1e300 g cm^2
+    (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,20,1e300,30,10000,100\n", 2, "rotor_inertia_gcm2", "typo"),
     # duplicate name
     (f"{MOTOR_HEADER}\n{GOOD_MOTOR}\n{GOOD_MOTOR}\n", 3, "name", "duplicate"),
     # a short row
@@ -74,6 +76,8 @@ def test_bad_motor_files(tmp_path, text, line, column, words):
     ("G1,X,20;x,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "list"),
     ("G1,X,20,2.5,20,0.8,2,3,8000,80", "stages", "whole"),
     ("G1,X,20,2,-20,0.8,2,3,8000,80", "ratio", "> 0"),
+    ("G1,X,20,2,1e300,0.8,2,3,8000,80", "ratio", "typo"),             # would overflow the sizing
+    ("G1,X,20;1e9,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "> 0 mm"),
 ])
 def test_bad_gearbox_files(tmp_path, row, column, words):
     p = _write(tmp_path, "gearboxes.csv", f"{GEAR_HEADER}\n{row}\n")

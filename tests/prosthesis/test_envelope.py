@@ -7,7 +7,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.dynamics.loads import HeldObject
-from anthroarm.errors import ActivityError
+from anthroarm.errors import ActivityError, ParameterError
 from anthroarm.prosthesis import envelope as E
 from anthroarm.prosthesis import weight_rules as W
 
@@ -107,8 +107,9 @@ def test_weight_rules_with_the_book_numbers():
     heavy = {r.source: r for r in W.check(1.5, 70.0, 6, unsized_joints=1)}
     assert heavy["L7445"].ok is False and heavy["L7441"].ok is False and "lower bound" in heavy["L7445"].note
     assert "L7298" not in {r.source for r in W.check(1.0, None, 7)}
-    with pytest.raises(ValueError):
-        W.check(-1.0, 70.0, 7)
+    for bad in [(-1.0, 70.0), (np.nan, 70.0), (1.0, 0.0), ("1 kg", 70.0), (1.0, np.inf)]:
+        with pytest.raises(ParameterError, match="drive_mass >= 0 kg and body_mass > 0 kg"):
+            W.check(*bad, 7)
 
 
 def test_payload_per_sample_equals_rnea_with_the_object_on_the_hand(robot):

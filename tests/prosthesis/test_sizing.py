@@ -146,3 +146,18 @@ def test_bad_margin(person_envelope):
         S.size(person_envelope[1], C.load(), margin=-0.1)
     with pytest.raises(ActivityError, match="margin"):
         S.size(person_envelope[1], C.load(), margin=float("nan"))
+
+
+def test_a_pair_whose_equations_overflow_does_not_cover_the_joint(tmp_path):
+    """A gearbox with absurd (but positive, finite, in-bound) ratio and efficiency: η i underflows
+    to 0, so τ/(η i) is inf where τ ≠ 0 and NaN where τ = 0.  The pair must not cover the joint
+    (inf, never NaN, which max() would skip, nor a ControlError from deep inside the motor model)."""
+    cat = _catalogue(tmp_path, ["m,X,20,24,1.0,20,10,160,10000,150"], ["G,X,20,2,1e-300,1e-300,5,8,8000,50"])
+    t = np.linspace(0, 1, 11)
+    tau = np.where(t > 0.5, 2.0, 0.0)
+    env = E.envelope([_act("x", t, tau)])
+    demands = [(a.t, a.tau[:, 0], a.qd[:, 0], a.qdd[:, 0]) for a in env.activities]
+    u = S._utilisation(cat.motors[0], cat.gearboxes[0], demands, 1.0)
+    assert u["thermal"] == np.inf and u["voltage"] == np.inf and not np.isnan(list(u.values())).any()
+    js = S.size(env, cat, 0.0).joints[0]
+    assert js.status == "none" and "infx" in js.reason

@@ -152,7 +152,12 @@ def _rows(path, columns):
     return out
 
 
-def _number(row, col, path, lineno, *, positive=True, upper=None) -> float:
+#: largest value of any catalogue number, in its column's unit (rpm, g, mNm, ...): beyond it a
+#: value is a typo, and the sizing's equations would overflow
+UPPER = 1e6
+
+
+def _number(row, col, path, lineno, *, positive=True, upper=UPPER) -> float:
     text = row[col]
     try:
         v = float(text)
@@ -162,8 +167,8 @@ def _number(row, col, path, lineno, *, positive=True, upper=None) -> float:
         raise CatalogueError(f"{col} = {text!r} is not finite", path, lineno, col)
     if positive and v <= 0.0:
         raise CatalogueError(f"{col} = {v:g} must be > 0 (a physical constant)", path, lineno, col)
-    if upper is not None and v > upper:
-        raise CatalogueError(f"{col} = {v:g} must be <= {upper:g}", path, lineno, col)
+    if v > upper:
+        raise CatalogueError(f"{col} = {v:g} must be <= {upper:g} (in the column's unit; a typo?)", path, lineno, col)
     return v
 
 
@@ -206,8 +211,8 @@ def load_gearboxes(path=None) -> tuple:
             except ValueError:
                 raise CatalogueError(f"motor_diameters_mm = {r['motor_diameters_mm']!r} is not a ';'-separated list "
                                      "of numbers", path, lineno, "motor_diameters_mm") from None
-            if not (math.isfinite(d) and d > 0):
-                raise CatalogueError(f"motor_diameters_mm has {part!r}; diameters must be > 0", path, lineno,
+            if not (math.isfinite(d) and 0 < d <= UPPER):
+                raise CatalogueError(f"motor_diameters_mm has {part!r}; diameters must be > 0 mm", path, lineno,
                                      "motor_diameters_mm")
             diams.append(d * 1e-3)
         stages = n("stages")

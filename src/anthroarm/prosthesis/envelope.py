@@ -168,8 +168,10 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, p
 
 
 def _rms(t, x):
-    """RMS over the time span of each column, trapezoidal rule: sqrt(∫x² dt / T)."""
-    return np.sqrt(np.trapezoid(x * x, t, axis=0) / (t[-1] - t[0]))
+    """RMS over the time span of each column (:func:`anthroarm.control.motor.rms`)."""
+    from ..control.motor import rms
+
+    return np.array([rms(t, col) for col in np.asarray(x).T])
 
 
 @dataclass

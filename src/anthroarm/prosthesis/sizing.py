@@ -31,7 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ActivityError
+from ..control.motor import rms
+from ..errors import ActivityError, ControlError
 
 CHECKS = ("voltage", "thermal", "gear_peak", "gear_rms", "speed")
 _LIMIT_TEXT = {
@@ -110,17 +111,27 @@ class SizingResult:
 
 
 def _utilisation(motor, gearbox, demands, scale: float) -> dict:
+    """The five utilisations (module docstring) of one pair; a demand that overflows the pair's
+    equations (absurd catalogue values) counts as infinite: the pair does not cover it."""
     dc = motor.dc_motor(gearbox)
     speed_limit = min(motor.max_speed, gearbox.max_input_speed)
     u = dict.fromkeys(CHECKS, 0.0)
-    for t, tau, w, a in demands:
-        tau, w, a = scale * tau, scale * w, scale * a
-        u["voltage"] = max(u["voltage"], float(np.max(np.abs(dc.voltage(tau, w, a)))) / motor.V_nom)
-        u["thermal"] = max(u["thermal"], dc.thermal_check(t, tau, w, a).ratio)
-        u["gear_peak"] = max(u["gear_peak"], float(np.max(np.abs(tau))) / gearbox.tau_max)
-        rms = float(np.sqrt(np.trapezoid(tau * tau, t) / (t[-1] - t[0])))
-        u["gear_rms"] = max(u["gear_rms"], rms / gearbox.tau_cont)
-        u["speed"] = max(u["speed"], float(np.max(np.abs(w))) * gearbox.ratio / speed_limit)
+
+    def worse(key, value):
+        value = float(value)
+        u[key] = max(u[key], value if np.isfinite(value) else np.inf)
+
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for t, tau, w, a in demands:
+            tau, w, a = scale * tau, scale * w, scale * a
+            worse("voltage", np.max(np.abs(dc.voltage(tau, w, a))) / motor.V_nom)
+            try:
+                worse("thermal", dc.thermal_check(t, tau, w, a).ratio)
+            except ControlError:                  # the motor torque overflowed to inf/NaN
+                worse("thermal", np.inf)
+            worse("gear_peak", np.max(np.abs(tau)) / gearbox.tau_max)
+            worse("gear_rms", rms(t, tau) / gearbox.tau_cont)
+            worse("speed", np.max(np.abs(w)) * gearbox.ratio / speed_limit)
     return u
 
 

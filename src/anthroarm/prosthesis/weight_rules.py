@@ -22,6 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
+
 DRIVE_SHARE = (0.50, 0.60)        # L274
 ARMS_FRACTION = 0.126             # both arms / body mass, L7298
 MAX_FULL_ARM_MASS = 2.0           # kg, L7445
@@ -51,11 +53,16 @@ def check(drive_mass: float, body_mass: float | None, dof: int, unsized_joints: 
     """The rules of the module docstring for a drive of ``drive_mass`` kg on an arm with ``dof``
     joints, for a person of ``body_mass`` kg (``None``: unknown, the 12.6 % rule is left out).
     ``unsized_joints`` > 0 (joints without a motor) makes the masses lower bounds (said in the
-    notes)."""
-    drive_mass = float(drive_mass)
-    body = float("nan") if body_mass is None else float(body_mass)
-    if not (np.isfinite(drive_mass) and drive_mass >= 0 and (body_mass is None or (np.isfinite(body) and body > 0))):
-        raise ValueError(f"need drive_mass >= 0 and body_mass > 0 kg, got {drive_mass}, {body_mass}")
+    notes).  Bad masses raise :class:`~anthroarm.errors.ParameterError`."""
+    try:
+        drive = float(drive_mass)
+        body = float("nan") if body_mass is None else float(body_mass)
+    except (TypeError, ValueError):
+        drive = body = float("nan")
+    if not (np.isfinite(drive) and drive >= 0 and (body_mass is None or (np.isfinite(body) and body > 0))):
+        raise ParameterError(f"weight rules need drive_mass >= 0 kg and body_mass > 0 kg (or None), got "
+                             f"{drive_mass!r}, {body_mass!r}")
+    drive_mass = drive
     lo, hi = prosthesis_mass_range(drive_mass)
     partial = f" (lower bound: {unsized_joints} joint(s) without a motor)" if unsized_joints else ""
     rows = [
