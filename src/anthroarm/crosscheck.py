@@ -37,6 +37,7 @@ ROBOT_PROVIDERS: dict[str, str] = {
     "anthroarm.kinematics.checks:error_rows": "error propagation (6-118)",
     "anthroarm.dynamics.checks:model_rows": "dyn Lagrange equations",
     "anthroarm.crosscheck:ik_rows": "aa.ik.solve round trip",
+    "anthroarm.ik.geometric:check_rows": "closed form by geometry (IK-Geo class)",
 }
 
 #: providers of the book's rows, ``rows(catalog_names, samples, rng)``, run in this order

@@ -1,6 +1,7 @@
 """`anthroarm check`, `anthroarm models` and `anthroarm urdf` end to end: any robot in (catalog,
 example-robot-data names, URDF paths), real rows out, non-zero exit when a row fails."""
 
+import importlib.util
 import json
 import subprocess
 import sys
@@ -56,8 +57,11 @@ def test_check_example_robot_data_name(capsys):
     rc, rows, err = check_json(["ur10", "--samples", "20"], capsys)
     assert rc == 0, err
     ur10 = [r for r in rows if r["model"] == "ur10"]
-    assert {r["quantity"] for r in ur10} == GENERIC | {"dyn C(q,qd) Christoffel matrix", "dyn kinetic energy T",
-                                                       "dyn potential energy V"}
+    geometry = {"closed form by geometry: FK(IK(T)) = T, all branches"}          # a 6R class (ik.geometric)
+    if importlib.util.find_spec("ik_geo"):
+        geometry.add("closed form by geometry: branches = IK-Geo's")
+    assert {r["quantity"] for r in ur10} == GENERIC | geometry | {
+        "dyn C(q,qd) Christoffel matrix", "dyn kinetic energy T", "dyn potential energy V"}
     assert all(r["ok"] for r in rows)
     assert all(r["max_abs_err"] <= r["tol"] for r in ur10)
     # no book rows for an arm that is not a book model

@@ -289,4 +289,51 @@ def solve(plan: GeoPlan, T):
     return q[..., plan.order], valid, exact
 
 
-__all__ = ["GeoPlan", "SOLVED", "branch_labels", "ik_geo_P", "plan_for", "solve", "solve_class"]
+# ----------------------------------------------------------------------------- anthroarm check
+def check_rows(robot, samples: int, rng) -> list:
+    """``anthroarm check`` rows of an arm whose geometry has a class solver here (none for the
+    others): every exact branch of random reachable poses FK-checked by Pinocchio (max entry
+    of the 3×4 pose), and the number of exact branches per pose against IK-Geo's (PyPI
+    ``ik-geo``, same H and P; the row is left out when it is not installed)."""
+    import pinocchio as pin
+
+    from ..crosscheck import CheckRow
+
+    plan = plan_for(robot)
+    if plan is None:
+        return []
+    n = max(3, min(int(samples), 30))
+    model, data, fid = robot.model, robot.model.createData(), robot.tool_id
+    Q = robot.random_q(n, rng)
+    T = np.empty((n, 4, 4))
+    for i, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q)
+        T[i] = data.oMf[fid].homogeneous
+    th, valid, exact = solve(plan, T)
+    worst, nb = 0.0, int(exact.sum())
+    for i, k in zip(*np.nonzero(exact)):
+        pin.framesForwardKinematics(model, data, plan.chain.configuration(th[i, k]))
+        worst = max(worst, float(np.abs(data.oMf[fid].homogeneous[:3] - T[i, :3]).max()))
+    if not exact.any(1).all():
+        worst = float("inf")                   # a pose made by FK must have a branch
+    tag = f"{plan.cls}{' (reversed chain)' if plan.reversed else ''}"
+    rows = [CheckRow(robot.name, "closed form by geometry: FK(IK(T)) = T, all branches", worst, 1e-9, n,
+                     "pinocchio FK", f"{tag}; {nb} branches")]
+    try:
+        import ik_geo
+    except ImportError:
+        return rows
+    geo = getattr(ik_geo.Robot, plan.cls)(plan.H.tolist(), plan.P.tolist())
+    diff = 0
+    for i in range(n):
+        R, p = T[i, :3, :3], T[i, :3, 3]
+        if plan.reversed:
+            R, p = R.T, -R.T @ p
+        theirs = sum(1 for _, ls in geo.get_ik((R @ plan.R_tool.T).T.tolist(), p.tolist()) if not ls)
+        diff = max(diff, abs(theirs - int(exact[i].sum())))
+    rows.append(CheckRow(robot.name, "closed form by geometry: branches = IK-Geo's", float(diff), 0.0, n,
+                         "ik-geo (Rust)", f"{tag}; max |ours - ik-geo| exact solutions per pose"))
+    return rows
+
+
+__all__ = ["GeoPlan", "SOLVED", "branch_labels", "check_rows", "ik_geo_P", "plan_for", "solve", "solve_class"]
