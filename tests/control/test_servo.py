@@ -153,3 +153,14 @@ def test_bad_simulation_inputs():
         SERVO.simulate([0.0, 1.0], theta_i=np.inf)
     with pytest.raises(ControlError):
         SERVO.advance([0.0, 0.0], 0.0, 1.0)
+
+
+def test_book_units():
+    """kgf·cm = 9.80665 N × 0.01 m; kgf·cm·s² = 9.80665 N × 0.01 m × s² = 0.0980665 kg·m²."""
+    b = PositionServo.from_book_units(k_m=0.5, k=0.01, J_m=2e-5, J_L=0.1, i=50.0, k_a=10.0, k_p=1.0, k_s=0.01)
+    assert b.k_m == pytest.approx(0.5 * 9.80665 * 0.01) and b.J_L == pytest.approx(0.1 * 9.80665 * 0.01)
+    # the dynamics do not depend on the unit system: ω_n and ζ are those of the same servo in kgf·cm
+    wn = math.sqrt(50.0 * 0.5 * 10.0 * 1.0 / (50.0**2 * 2e-5 + 0.1))
+    assert b.natural_frequency == pytest.approx(wn, rel=1e-12)
+    # the steady error (volts) under a load of 1 kgf·cm is the same number in either system
+    assert float(b.steady_error(9.80665e-2)) == pytest.approx(1.0 / (50.0 * 0.5 * 10.0), rel=1e-12)

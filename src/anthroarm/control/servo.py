@@ -42,7 +42,11 @@ from ..errors import ControlError
 from . import _check
 from .motor import DCMotor
 
-__all__ = ["PositionServo", "ServoResponse"]
+__all__ = ["KGF_CM", "PositionServo", "ServoResponse"]
+
+#: one kilogram-force centimetre in N·m (the book's torque unit, printed "kg·cm"); also
+#: kgf·cm·s² in kg·m² (its inertia unit)
+KGF_CM = 9.80665e-2
 
 
 @dataclass(frozen=True)
@@ -168,6 +172,17 @@ class PositionServo:
             raise ControlError(f"motor must be a DCMotor, got {type(motor).__name__}")
         return cls(k_m=motor.stall_torque_coefficient, k=motor.torque_speed_slope, J_m=motor.J_m, J_L=J_L,
                    i=motor.i, k_a=k_a, k_p=k_p, k_s=k_s, eta=motor.eta, V_max=V_max)
+
+    @classmethod
+    def from_book_units(cls, k_m: float, k: float, J_m: float, J_L: float, i: float, k_a: float, k_p: float,
+                        k_s: float = 0.0, eta: float = 1.0, V_max: float | None = None) -> PositionServo:
+        """The servo from parameters in the book's gravitational units (§9-1 三.3, l. 7119–7133):
+        ``k_m`` in kgf·cm/V, ``k`` in kgf·cm·s/rad, ``J_m`` and ``J_L`` in kgf·cm·s²; ``i``,
+        ``k_a``, ``k_p`` (V/rad), ``k_s`` (V·s/rad) as they are.  1 kgf·cm = 0.0980665 N·m and
+        1 kgf·cm·s² = 0.0980665 kg·m² (standard gravity 9.80665 m/s², ISO 80000-4)."""
+        c = KGF_CM
+        return cls(k_m=_check.scalar(k_m, "k_m") * c, k=_check.scalar(k, "k") * c, J_m=_check.scalar(J_m, "J_m") * c,
+                   J_L=_check.scalar(J_L, "J_L") * c, i=i, k_a=k_a, k_p=k_p, k_s=k_s, eta=eta, V_max=V_max)
 
     @classmethod
     def tuned(cls, motor: DCMotor, J_L: float, omega_n: float, zeta: float, k_p: float = 1.0,
