@@ -49,6 +49,14 @@ def test_arc_of_a_known_circle():
     assert np.allclose(arc2.tangents(s), fd, atol=1e-8)
 
 
+@pytest.mark.parametrize("scale", [1e-150, 1e-6, 1.0, 1e6, 1e150])
+def test_arc_at_any_scale(scale):
+    p = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]) * scale + np.array([2.0, 0.0, 0.0]) * scale
+    arc = circle_through(*p)
+    assert arc.radius == pytest.approx(scale, rel=1e-12)
+    assert np.allclose(arc.center / scale, [2.0, 0.0, 0.0], atol=1e-12) and arc.sweep == pytest.approx(np.pi)
+
+
 def test_collinear_and_coincident_points_raise():
     with pytest.raises(DegenerateArcError, match="collinear"):
         circle_through([0, 0, 0], [1, 1, 1], [2, 2, 2])

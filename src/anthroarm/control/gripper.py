@@ -465,6 +465,8 @@ def simulate_slip(mass: float, mu: float, controller: SlipController, unit: floa
     g = _check.positive(g, "g (m/s^2)")
     max_slip = _check.positive(max_slip, "max_slip (m)")
     n_jaws = _check.count(n_jaws, "n_jaws", 1)
+    if max_slip / unit > 1e7:
+        raise ControlError(f"max_slip / unit = {max_slip / unit:.3g} pulses is too many to simulate (at most 1e7)")
     if not isinstance(controller, SlipController):
         raise ControlError("controller must be a SlipController")
     t, s, v = 0.0, 0.0, 0.0
