@@ -325,22 +325,27 @@ def test_seed_tags_and_restart_cap(robots):
 def test_closed_form_first_where_cheap(robots):
     """prosthetic_arm (a six-joint book arm) takes its first seed from the closed form and
     verifies it in one Gauss–Newton evaluation; so does human_arm7 when the compiled closed-form
-    kernel is available; ur5 and talos_arm by their geometry; the arms without a closed form never do."""
-    # ur5 and talos_arm: a closed form by their geometry (anthroarm.ik.geometric)
-    for name, n in (("prosthetic_arm", 10), ("ur5", 5), ("talos_arm", 5)):
-        robot = robots[name]
-        assert _ws(robot).sh.closed_form_first
-        for q in robot.random_q(n, rng=41):
-            T = robot.fk(q)
-            r = aa.ik.solve(robot, T)
-            assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
-            assert pose_error(robot, r.q, T)[0] <= 1e-6
+    kernel is available; ur5 and talos_arm (a closed form by geometry, milliseconds) only when
+    asked; the arms without a closed form never do."""
     robot = robots["prosthetic_arm"]
+    assert _ws(robot).sh.closed_form_first
+    for q in robot.random_q(10, rng=41):
+        T = robot.fk(q)
+        r = aa.ik.solve(robot, T)
+        assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
+        assert pose_error(robot, r.q, T)[0] <= 1e-6
     out = aa.ik.solve(robot, robot.fk(robot.random_q(12, rng=42)))   # batch: the same path
     assert out.success.all()
     r = aa.ik.solve(robot, robot.fk(robot.random_q(rng=43)), analytic=False)
     assert r.success and r.seed != "analytic"
-    assert not _ws(robots["panda"]).sh.closed_form_first
+    for name in ("panda", "ur5", "talos_arm"):   # ur5, talos_arm: a closed form by geometry, in ms
+        assert not _ws(robots[name]).sh.closed_form_first
+    for name in ("ur5", "talos_arm"):            # asked for, it answers in one verified step
+        arm = robots[name]
+        T = arm.fk(arm.random_q(rng=45))
+        r = aa.ik.solve(arm, T, analytic=True)
+        assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
+        assert pose_error(arm, r.q, T)[0] <= 1e-6
     human = robots["human_arm7"]
     if _ws(human).sh.closed_form_first:
         r = aa.ik.solve(human, human.fk(human.random_q(rng=44)))

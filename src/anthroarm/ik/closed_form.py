@@ -178,8 +178,9 @@ def _form(robot, frame=None):
 
 
 #: the registry-like entry of an arm solved by its geometry (:mod:`.geometric`), per class;
-#: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of magnitude)
-_GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), 8, cost_us=150.0) for c in _geo.SOLVED}
+#: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of
+#: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py)
+_GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), 8, cost_us=3000.0) for c in _geo.SOLVED}
 
 
 def _geo_plan(robot, frame=None):

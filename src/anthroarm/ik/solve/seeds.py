@@ -31,6 +31,7 @@ TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
 ALIGN_RANGE = np.pi   # first / last joints spanning at least a half turn are aligned (see Aligned; so101: median 10 % faster)
 ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
 SWIVEL_GRID = np.linspace(-np.pi, np.pi, 24, endpoint=False)  # swivel angles (rad) of a redundant arm's closed-form seeds
+CHEAP_US = 50.0   # a closed form costing at most this (µs, ClosedForm.cost_us) is tried first
 
 
 def build_table(sh, data):
@@ -228,12 +229,15 @@ class TableSeeds:
 def closed_form_cheap(robot, fid) -> bool:
     """True when ``analytic="auto"`` puts the closed form first (where it exists,
     :func:`anthroarm.ik.closed_form.closed_form_info`): a call costs about as much as a few
-    Gauss–Newton iterations — a non-redundant arm (~10 µs), a redundant arm's swivel grid
+    Gauss–Newton iterations (``cost_us`` ≤ :data:`CHEAP_US`; an arm solved by its geometry in
+    numpy, :mod:`anthroarm.ik.geometric`, costs milliseconds and joins after
+    ``ANALYTIC_AFTER`` failed attempts) — a non-redundant arm (~10 µs), a redundant arm's swivel grid
     (:data:`SWIVEL_GRID`) only with the compiled kernel of :mod:`anthroarm.ik.analytic_c`
     (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and environment, so the same call gives the
     same answer."""
     info = closed_form.closed_form_info(robot, fid)
-    return info is not None and (not info.swivel or bool(analytic_c.enabled() and analytic_c.compiler() is not None))
+    return info is not None and info.cost_us <= CHEAP_US and \
+        (not info.swivel or bool(analytic_c.enabled() and analytic_c.compiler() is not None))
 
 
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
