@@ -215,6 +215,7 @@ def test_configuration_rejects_an_inconsistent_dip():
     ({"hand_length": 0.10}, "stature"),                 # 0.057 x stature: not a human hand
     ({"hand_breadth": 0.15}, "hand length"),            # broader than 0.65 x its length
     ({"hand_length": "long"}, "finite"),
+    ({"hand_breadth": 1e300}, r"hand_breadth 1e\+300 m is 5.15e\+300 × the hand length"),   # short, readable
 ])
 def test_bad_anthropometry_raises(kw, match):
     with pytest.raises(AnthropometryError, match=match):

@@ -178,11 +178,11 @@ def hand_dimensions(hand_length: float, hand_breadth: float, forearm_length: flo
             "proportions (a hand is about 0.7 forearm lengths)", "hand_length", HL)
     if stature is not None and not (HL_PER_STATURE[0] * stature <= HL <= HL_PER_STATURE[1] * stature):
         raise AnthropometryError(
-            f"hand_length {HL:.4g} m is {HL / stature:.3f} × the stature {stature} m; human hands lie within "
+            f"hand_length {HL:.4g} m is {HL / stature:.3g} × the stature {stature} m; human hands lie within "
             f"{HL_PER_STATURE[0]}…{HL_PER_STATURE[1]} × stature", "hand_length", HL)
     if not (HB_PER_HL[0] * HL <= HB <= HB_PER_HL[1] * HL):
         raise AnthropometryError(
-            f"hand_breadth {HB:.4g} m is {HB / HL:.3f} × the hand length; human hands lie within "
+            f"hand_breadth {HB:.4g} m is {HB / HL:.3g} × the hand length; human hands lie within "
             f"{HB_PER_HL[0]}…{HB_PER_HL[1]} × hand length", "hand_breadth", HB)
     return {"hand_length": HL, "hand_breadth": HB,
             "segments": {d: tuple(c * HL for c in BUCHHOLZ_1992[d]) for d in DIGITS}}

@@ -53,7 +53,8 @@ from ..mechanisms.finger import FingerGeometry, finger, finger_spec
 from ..mechanisms.rrss import RRSSGeometry
 from ..mechanisms.thumb import ThumbGeometry, thumb, thumb_spec
 from ..spatial.rotations import homogeneous, rot_axis
-from .hand import BUCHHOLZ_1992, DIGITS, FINGERS, Q_ORDER, THUMB_REST_DIRECTION, digit_bases, hand_dimensions
+from .hand import BREADTH_RATIO, BUCHHOLZ_1992, DIGITS, FINGERS, Q_ORDER, THUMB_REST_DIRECTION, digit_bases, hand_dimensions
+from .human import segment_parameters
 from .spec import ChainSpec, JointSpec, LinkSpec, Shape, capsule
 
 DEG = np.pi / 180.0
@@ -137,8 +138,8 @@ def default_hand(scale: float = 1.0) -> ProstheticHand:
         raise ParameterError(f"prosthetic_hand: scale must be a number in 0.3…3, got {scale!r}")
     s = float(scale)
     # the palm of the default adult hand of models.hand (HL = de Leva hand / 0.446, HB = 0.45 HL)
-    HL = 0.0862 * 1.75 / 1.741 / BUCHHOLZ_1992["middle"][0]
-    dims = hand_dimensions(HL, 0.45 * HL)
+    HL = segment_parameters()["hand"]["length"] / BUCHHOLZ_1992["middle"][0]
+    dims = hand_dimensions(HL, BREADTH_RATIO * HL)
     l_palm = BUCHHOLZ_1992["middle"][0] * HL
     bases = digit_bases(dims, l_palm)
     g0 = FingerGeometry.default()
@@ -279,7 +280,10 @@ def closure_status(loop: ClosedLoop, q, tol: float = 1e-9) -> tuple[float, str]:
     closure gap (m, Pinocchio ``RigidConstraintModel``) and ``"ok"`` or ``"inconsistent"`` (the
     passive joints contradict the drivers: the loops are open by more than ``tol`` m).
     A q of the wrong size or not finite raises :class:`~anthroarm.errors.ParameterError`."""
-    q = np.asarray(q, dtype=float)
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"prosthetic_hand: q must be {loop.model.nq} joint values (rad), got {q!r}") from None
     if q.shape != (loop.model.nq,) or not np.all(np.isfinite(q)):
         raise ParameterError(f"prosthetic_hand: q must be {loop.model.nq} finite joint values (rad), got shape {q.shape}")
     gap = loop.residual_pin(q)
@@ -339,8 +343,8 @@ def mimic_fit(scale: float = 1.0, samples: int = 41) -> MimicFit:
     fingertip errors of the approximation.  Multipliers and offsets are rounded to 1e-10 so
     the URDF text is reproducible."""
     default_hand(scale)    # validates scale
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 3:
-        raise ParameterError(f"samples must be an integer >= 3, got {samples!r}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 3 <= samples <= 10_000:
+        raise ParameterError(f"samples must be an integer in 3…10000, got {samples!r}")
     return _fit(float(scale), int(samples))
 
 
