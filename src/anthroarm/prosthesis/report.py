@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write_text
+from .envelope import CUP_HEIGHT, CUP_RADIUS
 
 _CSS = """
 body { font-family: system-ui, sans-serif; margin: 1.5em auto; max-width: 1100px; color: #222; }
@@ -133,7 +134,7 @@ def _person_section(study) -> str:
     return (f"<h2>The person's arm model</h2><p>{_e(robot.name)} ({robot.nv} joints) for {_e(who)}"
             + (f" ({_e(extra)})" if extra else "")
             + f"; arm mass {total:.2f} kg, reach {chain.reach():.3f} m; "
-            "held object: a solid cylinder (r = 4 cm, h = 10 cm) at the hand point"
+            f"held object: a solid cylinder (r = {CUP_RADIUS * 100:g} cm, h = {CUP_HEIGHT * 100:g} cm) at the hand point"
             + (f", at least {study.payload:g} kg" if study.payload > 0 else "")
             + "; its largest mass in each activity is in the activities' table.</p>"
             + _table(["joint", "kind", "axis (joint frame)", "its link's mass [kg]", "offset from parent [m]",
