@@ -26,12 +26,14 @@ from .features import (SpectralFeatures, band_powers, mean_frequency, median_fre
 from .filters import (BOOK_BANK_2CH, BOOK_BANK_3CH, CONDITIONING_BAND, FilterBank, band_edges, bandpass_sos,
                       check_sampling_rate, notch_sos)
 from .frontend import AmplifierOutput, DifferentialAmplifier
-from .processor import BOTH, CODE_NAMES, EXTENSOR, FLEXOR, REST, EMGProcessor, ProcessedEMG, Thresholds
+from .processor import (BOOK_SENSITIVITY_PP, BOTH, CODE_NAMES, EXTENSOR, FLEXOR, REST, Calibration, EMGProcessor,
+                        ProcessedEMG, Thresholds, calibrate_thresholds)
 from .synth import (AMPUTEE_PP, AMPUTEE_TRAINED_PP, EMG_BAND, HEALTHY_PP, TYPICAL_PP, SyntheticEMG, activation,
                     band_limited_noise, electrode_potentials, synthesize)
 
 __all__ = [
-    "AMPUTEE_PP", "AMPUTEE_TRAINED_PP", "AmplifierOutput", "BOOK_BANK_2CH", "BOOK_BANK_3CH", "BOTH", "CODE_NAMES",
+    "AMPUTEE_PP", "AMPUTEE_TRAINED_PP", "AmplifierOutput", "BOOK_BANK_2CH", "BOOK_BANK_3CH", "BOOK_SENSITIVITY_PP",
+    "BOTH", "CODE_NAMES", "Calibration", "calibrate_thresholds",
     "CONDITIONING_BAND", "CodeMachine", "CodeTrace", "DifferentialAmplifier", "EMGProcessor", "EMG_BAND",
     "EXTENSOR", "FLEXOR", "FilterBank", "HEALTHY_PP", "MODES", "PP_PER_MAV", "PP_PER_RMS", "ProcessedEMG", "REST",
     "SpectralFeatures", "SyntheticEMG", "TYPICAL_PP", "Thresholds", "VIBRATORS", "VIBRATOR_OF_MODE", "activation",
