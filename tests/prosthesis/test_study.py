@@ -123,3 +123,15 @@ def test_cli_size_bad_trajectory_files(tmp_path, capsys, monkeypatch, person):
         err = capsys.readouterr().err
         assert rc == 2 and f in err and words in err and len(err.strip().splitlines()) == 1, err
     assert not (tmp_path / "report.html").exists()
+
+
+def test_every_submodule_is_an_attribute_of_the_package():
+    """aa.prosthesis.NAME for every module file of the package (lazy imports), study included."""
+    from pathlib import Path
+
+    import anthroarm.prosthesis as P
+
+    files = {p.stem for p in Path(P.__file__).parent.glob("*.py") if not p.stem.startswith("_")}
+    assert set(P.__all__) == files
+    for name in files:
+        assert getattr(aa.prosthesis, name).__name__ == f"anthroarm.prosthesis.{name}"
