@@ -121,3 +121,12 @@ def test_missing_ratings_raise():
         m.thermal_check([0, 1], 1.0)
     with pytest.raises(ControlError):
         rms([0.0, 0.0], [1.0, 1.0])
+
+
+def test_results_beyond_the_float_range_raise():
+    with pytest.raises(ControlError, match="floating-point"):
+        MOTOR.replace(R=1e-3).motor_torque(1e308, 0.0)      # k_m/R = 30 N m/V: 3e309 N m
+    with pytest.raises(ControlError):
+        MOTOR.joint_torque(1e307, 1e308)
+    with pytest.raises(ControlError, match="floating-point"):
+        MOTOR.copper_loss(1e300)          # R I^2 with I ~ 4e299 A

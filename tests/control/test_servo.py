@@ -164,3 +164,10 @@ def test_book_units():
     assert b.natural_frequency == pytest.approx(wn, rel=1e-12)
     # the steady error (volts) under a load of 1 kgf·cm is the same number in either system
     assert float(b.steady_error(9.80665e-2)) == pytest.approx(1.0 / (50.0 * 0.5 * 10.0), rel=1e-12)
+
+
+def test_overflowing_inputs_raise():
+    with pytest.raises(ControlError):
+        SERVO.simulate([0.0, 1.0, 2.0], theta_i=1e307)
+    with pytest.raises(ControlError, match="floating-point"):
+        SERVO.estimate_load_torque(1e308)

@@ -69,3 +69,20 @@ def count(x, name: str, minimum: int = 0) -> int:
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < minimum:
         raise ControlError(f"{name} must be an integer >= {minimum}, got {x!r}")
     return int(x)
+
+
+def finite_result(func):
+    """Decorate a method whose array result must be finite: a result beyond the float range
+    (inputs near 1e308) is a :class:`~anthroarm.errors.ControlError` naming the method, not an
+    inf or NaN handed back."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = func(*args, **kwargs)
+        if not np.all(np.isfinite(out)):
+            raise ControlError(f"{func.__name__}: the result is beyond the floating-point range for these inputs")
+        return out
+
+    return wrapper

@@ -201,6 +201,7 @@ class DCMotor:
         return _check.array(V, "V (voltage, V)")
 
     # ------------------------------------------------------------------ steady torque-speed line
+    @_check.finite_result
     def motor_torque(self, V, omega_m):
         """Steady motor shaft torque at voltage ``V`` and motor speed ``omega_m``, Eq. (9-1):
         ``τ_m = (k_m/R) V − (k_m²/R + b_m) ω_m`` (N·m, motor side; after the viscous friction).
@@ -221,6 +222,7 @@ class DCMotor:
         w = _check.array(omega_m, "omega_m (motor speed, rad/s)")
         return self.stall_torque_coefficient * V - self.torque_speed_slope * w
 
+    @_check.finite_result
     def joint_torque(self, omega, V=None):
         """Steady joint torque available at joint speed ``omega``: the torque–speed line seen
         through the gearbox, ``τ = η i [(k_m/R) V − (k_m²/R + b_m) i ω]`` where the motor drives
@@ -243,14 +245,17 @@ class DCMotor:
         motoring = tm * w >= 0.0
         return np.where(motoring, self.eta * self.i * tm, self.i / self.eta * tm)
 
+    @_check.finite_result
     def stall_torque(self, V=None):
         """Joint torque at zero speed, ``η i k_m V / R`` (N·m)."""
         return self.eta * self.i * self.stall_torque_coefficient * self._voltage(V)
 
+    @_check.finite_result
     def no_load_speed(self, V=None):
         """Joint speed at zero torque, ``k_m V / ((k_m² + b_m R) i)`` (rad/s)."""
         return self.stall_torque_coefficient * self._voltage(V) / (self.torque_speed_slope * self.i)
 
+    @_check.finite_result
     def speed_at_torque(self, tau, V=None):
         """Steady joint speed at which the motor delivers the joint torque ``tau`` at voltage
         ``V`` (the inverse of :meth:`joint_torque` in the motoring quadrant, τ ≥ 0 for V > 0).
@@ -272,6 +277,7 @@ class DCMotor:
         return (self.stall_torque_coefficient * self._voltage(V) - tm) / (self.torque_speed_slope * self.i)
 
     # ------------------------------------------------------------------ what a joint motion needs
+    @_check.finite_result
     def required_motor_torque(self, tau, omega=0.0, alpha=0.0):
         """Electromagnetic motor torque (``k_m`` × current) that makes the joint deliver torque
         ``tau`` at speed ``omega`` and acceleration ``alpha``:
@@ -296,10 +302,12 @@ class DCMotor:
         gear = np.where(tau * w >= 0.0, tau / (self.eta * self.i), self.eta * tau / self.i)
         return self.J_m * self.i * a + self.b_m * self.i * w + gear
 
+    @_check.finite_result
     def current(self, tau, omega=0.0, alpha=0.0):
         """Armature current, ``τ_em / k_m`` (A), for :meth:`required_motor_torque`."""
         return self.required_motor_torque(tau, omega, alpha) / self.k_m
 
+    @_check.finite_result
     def voltage(self, tau, omega=0.0, alpha=0.0):
         """Steady armature voltage that the motion needs, ``R I + k_m i ω`` (V; the inductive
         term ``L dI/dt`` is left out)."""
@@ -312,6 +320,7 @@ class DCMotor:
         need = self.voltage(tau, omega)
         return np.abs(need) <= np.abs(self._voltage(V)) * (1.0 + 1e-12)
 
+    @_check.finite_result
     def copper_loss(self, tau, omega=0.0, alpha=0.0):
         """Heat in the winding, ``R I²`` (W)."""
         I = self.current(tau, omega, alpha)

@@ -235,6 +235,7 @@ class PositionServo:
         return self.Kv / (2.0 * math.sqrt(self.Ks * self.J0))
 
     # ------------------------------------------------------------------ the servo error as a force sensor
+    @_check.finite_result
     def steady_error(self, M_L):
         """Steady position-error voltage under a constant load torque, Eq. (9-8) as corrected:
         ``e_ss = M_L / (η i k_m k_a)`` (V), whatever the (constant) set-point.
@@ -251,6 +252,7 @@ class PositionServo:
         """
         return _check.array(M_L, "M_L (load torque, N m)") / (self.eta * self.i * self.k_m * self.k_a)
 
+    @_check.finite_result
     def estimate_load_torque(self, e):
         """The load torque the steady servo error reveals, ``M̂_L = η i k_m k_a e`` (N·m), the
         inverse of Eq. (9-8): the servo error as a force sensor (§9-1 三.3).
@@ -408,11 +410,15 @@ class PositionServo:
         for k, dt in enumerate(dts):
             dt = float(dts[0]) if uniform else float(dt)
             X[k + 1] = self._advance(X[k], dt, ti[k], ml[k], zoh)
-        theta, omega = X[:, 0], X[:, 1]
-        V_raw = self.k_a * self.k_p * (ti - theta) - self.k_a * self.k_s * self.i * omega
-        V = self.voltage(theta, omega, ti)
-        M_m = self.k_m * V - self.k * self.i * omega
-        return ServoResponse(t=t, theta=theta, omega=omega, theta_i=ti, M_L=ml, e=self.k_p * (ti - theta), V=V,
+        with np.errstate(over="ignore", invalid="ignore"):
+            theta, omega = X[:, 0], X[:, 1]
+            V_raw = self.k_a * self.k_p * (ti - theta) - self.k_a * self.k_s * self.i * omega
+            V = self.voltage(theta, omega, ti)
+            M_m = self.k_m * V - self.k * self.i * omega
+            e = self.k_p * (ti - theta)
+        if not all(np.all(np.isfinite(a)) for a in (X, V_raw, V, M_m, e)):
+            raise ControlError("the servo's state, voltage or torque left the floating-point range (inputs too large)")
+        return ServoResponse(t=t, theta=theta, omega=omega, theta_i=ti, M_L=ml, e=e, V=V,
                              M_m=M_m, saturated=np.abs(V_raw) > np.abs(V))
 
     def step_response(self, duration: float, theta_step: float = 1.0, M_L_step: float = 0.0,
