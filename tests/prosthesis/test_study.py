@@ -25,8 +25,9 @@ def test_adl_activities_carry_the_library_objects(person):
     assert lift["name"] == "lift_to_table" and "status" not in lift
     assert np.max(lift["payload"]) == 1.0 and np.min(lift["payload"]) == 0.5       # 1 kg while held
     assert np.all(acts[1]["payload"] == 0.5)
-    with pytest.raises(ActivityError, match="payload"):
-        study.adl_activities(person, payload=-1.0, names=["reach_shelf"])
+    for bad in (-1.0, float("nan"), "heavy", [1.0]):
+        with pytest.raises(ActivityError, match="payload must be a mass"):
+            study.adl_activities(person, payload=bad, names=["reach_shelf"])
 
 
 def test_adl_activity_out_of_reach_is_a_status(person):
@@ -57,8 +58,9 @@ def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
     m = re.search(r"Drive mass \(motors \+ gearboxes\): ([0-9.]+) kg", text)
     assert float(m.group(1)) == pytest.approx(st.sizing.drive_mass, abs=5e-4)
     assert text.count("data:image/png;base64,") == person.nv
-    with pytest.raises(ActivityError, match="payload"):
-        study.run(person, acts, payload=float("nan"))
+    for bad in (float("nan"), "heavy", None, 51.0):
+        with pytest.raises(ActivityError, match="payload must be a mass"):
+            study.run(person, acts, payload=bad)
     with pytest.raises(ActivityError, match="no 'q'"):
         study.run(person, [dict(name="x", t=t)])
     with pytest.raises(ActivityError, match="dict"):

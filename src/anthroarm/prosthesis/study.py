@@ -35,6 +35,17 @@ class Study:
     timings: dict = field(default_factory=dict)
 
 
+def _payload(payload) -> float:
+    """A held mass in [0, 50] kg, or an :class:`~anthroarm.errors.ActivityError`."""
+    try:
+        m = float(payload)
+    except (TypeError, ValueError):
+        m = float("nan")
+    if not (np.isfinite(m) and 0.0 <= m <= 50.0):
+        raise ActivityError(f"payload must be a mass in [0, 50] kg, got {payload!r}")
+    return m
+
+
 def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: float = 0.2, person=None,
         progress=None) -> Study:
     """Run the loop (module docstring) on ``robot`` (the person's arm model).
@@ -64,9 +75,7 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     from . import envelope as env_mod
     from . import sizing, weight_rules
 
-    payload = float(payload)
-    if not (np.isfinite(payload) and 0.0 <= payload <= 50.0):
-        raise ActivityError(f"payload must be in [0, 50] kg, got {payload}")
+    payload = _payload(payload)
     if person is None:
         p = dict(robot.spec.params) if robot.spec is not None else {}
         person = {k: p[k] for k in ("height", "mass", "sex") if k in p}
@@ -119,8 +128,7 @@ def adl_activities(robot, payload: float | None = None, names=None, *, rate: flo
     ``height`` (m): place the targets for a person of this stature (default: the model's)."""
     from ..motion import activities as adl
 
-    if payload is not None and not (np.isfinite(payload) and 0.0 <= payload <= 50.0):
-        raise ActivityError(f"payload must be in [0, 50] kg, got {payload}")
+    payload = None if payload is None else _payload(payload)
     out = []
     for name in (adl.names() if names is None else list(names)):
         tr = adl.activity_trajectory(robot, name, rate=rate, height=height)
