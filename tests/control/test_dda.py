@@ -82,3 +82,19 @@ def test_pulse_counts_round_trip():
     assert np.array_equal(pulse_counts(q0, q1, res), c)
     with pytest.raises(ControlError):
         pulse_counts(q0, q1, 0.0)
+
+
+def test_care_robot_cell_table_move_by_dda():
+    """§9-3: the position registers give the pulses of a move (difference of two cell-table
+    lookups); the DDA hands them out so that all six motors end on the same tick, and the
+    registers then hold exactly the target's table pulses."""
+    import anthroarm as aa
+    from anthroarm.models.care_robot import cell_table
+
+    table = cell_table(aa.load("care_robot"))
+    a, b = np.array([0.30, -0.05, 0.10]), np.array([0.42, 0.12, 0.22])
+    rel = table.relative_pulses(a, b)
+    move = dda(rel)
+    last = move.last_pulse_tick()
+    assert np.all(last[rel != 0] == move.n_ticks) and move.n_ticks == np.abs(rel).max()
+    assert np.array_equal(table.lookup_pulses(a) + move.positions()[-1], table.lookup_pulses(b))
