@@ -56,8 +56,9 @@ _MODEL_COMMANDS = {"urdf": None, "view": None, "teach": None, "ik": None, "demo"
 
 def _model_params(model) -> list[tuple[str, object, str, str]] | None:
     """The builder parameters of a book model, ``[(name, default, kind, unit)]`` (kind: ``float``,
-    ``pair`` (two numbers, e.g. a stroke) or ``str``); None for any other model.  Units follow the
-    catalog's convention: lengths in m, mass in kg."""
+    ``pair`` (two numbers, e.g. a stroke), ``map`` (a dict of numbers, e.g. human_arm7's
+    ``segment_lengths``, given as ``KEY=VALUE,KEY=VALUE``) or ``str``); None for any other model.
+    Units follow the catalog's convention: lengths in m, mass in kg."""
     import inspect
 
     from . import models
@@ -67,7 +68,9 @@ def _model_params(model) -> list[tuple[str, object, str, str]] | None:
     out = []
     for p in inspect.signature(models.BOOK_MODELS[model]).parameters.values():
         d = p.default
-        kind = "pair" if isinstance(d, tuple) else "str" if isinstance(d, str) else "float"
+        ann = p.annotation if isinstance(p.annotation, str) else getattr(p.annotation, "__name__", "")
+        kind = ("pair" if isinstance(d, tuple) else "str" if isinstance(d, str)
+                else "map" if isinstance(d, dict) or ann.split("|")[0].strip() == "dict" else "float")
         unit = "" if kind == "str" else "kg" if p.name == "mass" else "m"
         out.append((p.name, d, kind, unit))
     return out
@@ -83,6 +86,20 @@ def _convert_param(model, name, kind, unit, text):
 
     if kind == "str":
         return text
+    if kind == "map":
+        out = {}
+        for item in str(text).split(","):
+            k, _, v = item.partition("=")
+            try:
+                x = float(v)
+            except ValueError:
+                x = math.nan
+            if not k.strip() or not math.isfinite(x) or k.strip() in out:
+                raise UserError(f"{model} parameter {name} expects comma-separated KEY=VALUE pairs, each value a "
+                                f"finite number ({unit}) and each KEY once; got {text!r} "
+                                f"(see 'anthroarm urdf {model} --help')")
+            out[k.strip()] = x
+        return out
     want = "two numbers MIN,MAX" if kind == "pair" else "a number"
     try:
         vals = [float(x) for x in str(text).split(",")]
@@ -107,10 +124,14 @@ def _add_model_param_options(p, model):
     for name, default, kind, unit in params:
         if f"--{name}" in p._option_string_actions:
             continue
-        shown = ",".join(f"{x:g}" for x in default) if kind == "pair" else default
-        metavar = "MIN,MAX" if kind == "pair" else name.upper()
-        help_ = f"{unit + ', ' if unit else ''}{'min,max, ' if kind == 'pair' else ''}default {shown}"
-        g.add_argument(f"--{name}", dest=f"model_param:{name}", default=None, metavar=metavar, help=help_)
+        shown = (",".join(f"{x:g}" for x in default) if kind == "pair"
+                 else "none" if kind == "map" and default is None else default)
+        metavar = "MIN,MAX" if kind == "pair" else "KEY=VALUE,..." if kind == "map" else name.upper()
+        help_ = (f"{unit + ', ' if unit else ''}{'min,max, ' if kind == 'pair' else ''}"
+                 f"{'comma-separated KEY=VALUE pairs, ' if kind == 'map' else ''}default {shown}")
+        flags = [f"--{name}"] + ([f"--{name.replace('_', '-')}"] if kind == "map" and "_" in name
+                                 and f"--{name.replace('_', '-')}" not in p._option_string_actions else [])
+        g.add_argument(*flags, dest=f"model_param:{name}", default=None, metavar=metavar, help=help_)
     p.set_defaults(_model=model)
 
 

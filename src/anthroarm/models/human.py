@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotations import homogeneous
 from .spec import ChainSpec, JointSpec, rod_link
 
@@ -119,19 +120,32 @@ HUMAN_ARM7_COMFORT = {
 SEGMENT_LINKS = {"upperarm": "upper_arm", "forearm": "forearm", "hand": "hand"}
 
 
-def _measured_lengths(seg: dict, segment_lengths) -> dict:
-    """``seg`` with the lengths of ``segment_lengths`` (segment name -> m; the centre of mass and
-    the radii of gyration keep their de Leva fractions of the length, the masses stay)."""
+def _segment_lengths(segment_lengths) -> dict:
+    """``segment_lengths`` keyed by the de Leva segment names (a link's name is accepted for its
+    segment); bad keys or values raise :class:`~anthroarm.errors.ParameterError`."""
     if not isinstance(segment_lengths, dict):
-        raise ValueError(f"segment_lengths is a dict segment -> length (m) with keys {list(SEGMENT_LINKS)}, "
-                         f"got {segment_lengths!r}")
-    unknown = sorted(set(segment_lengths) - set(SEGMENT_LINKS))
-    if unknown:
-        raise ValueError(f"segment_lengths: unknown segments {unknown}; known: {list(SEGMENT_LINKS)}")
-    out = {k: dict(v) for k, v in seg.items()}
-    for key, L in segment_lengths.items():
+        raise ParameterError(f"segment_lengths is a dict segment -> length (m) with keys {list(SEGMENT_LINKS)}, "
+                             f"got {segment_lengths!r}")
+    by_link = {link: key for key, link in SEGMENT_LINKS.items()}
+    lengths = {}
+    for name, L in segment_lengths.items():
+        key = by_link.get(name, name)
+        if key not in SEGMENT_LINKS:
+            raise ParameterError(f"segment_lengths: unknown segment {name!r}; known: {list(SEGMENT_LINKS)} "
+                                 f"(or the links {list(by_link)})")
+        if key in lengths:
+            raise ParameterError(f"segment_lengths: {key!r} given twice (as {key!r} and {SEGMENT_LINKS[key]!r})")
         if isinstance(L, bool) or not isinstance(L, (int, float, np.floating, np.integer)) or not (0.02 <= L <= 1.0):
-            raise ValueError(f"segment_lengths[{key!r}] must be a length in 0.02 ... 1.0 m, got {L!r}")
+            raise ParameterError(f"segment_lengths[{name!r}] must be a length in 0.02 ... 1.0 m, got {L!r}")
+        lengths[key] = float(L)
+    return lengths
+
+
+def _measured_lengths(seg: dict, lengths: dict) -> dict:
+    """``seg`` with the lengths of ``lengths`` (:func:`_segment_lengths`, m; the centre of mass
+    and the radii of gyration keep their de Leva fractions of the length, the masses stay)."""
+    out = {k: dict(v) for k, v in seg.items()}
+    for key, L in lengths.items():
         k = float(L) / out[key]["length"]
         out[key]["length"] = float(L)
         out[key]["com"] *= k
@@ -143,12 +157,15 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segm
     """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg.
 
     ``segment_lengths`` (optional): measured lengths in m of ``"upperarm"`` (shoulder to elbow
-    joint centre), ``"forearm"`` (elbow to wrist) and ``"hand"`` (wrist to the 3rd metacarpale),
-    any subset; they replace de Leva's height-scaled lengths (centres of mass and radii of
-    gyration keep their fractions of the length, masses stay those of the body mass).  From a
+    joint centre; also accepted as ``"upper_arm"``, the link's name), ``"forearm"`` (elbow to
+    wrist) and ``"hand"`` (wrist to the 3rd metacarpale), any subset (on the command line:
+    ``--segment-lengths upperarm=0.30,forearm=0.26``); they replace de Leva's height-scaled
+    lengths (centres of mass and radii of gyration keep their fractions of the length, masses
+    stay those of the body mass).  From a
     static marker trial: :func:`anthroarm.motion.scaling.scale_from_static`."""
     seg = segment_parameters(height, mass, sex)
     if segment_lengths is not None:
+        segment_lengths = _segment_lengths(segment_lengths)
         seg = _measured_lengths(seg, segment_lengths)
     l1, l2, l3 = (seg[s]["length"] for s in ("upperarm", "forearm", "hand"))
     X, Y, Z = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
