@@ -68,7 +68,7 @@ def test_a_closed_form_is_a_property_of_the_model_not_of_its_label():
     assert np.abs(res.solutions - q).max(1).min() < 1e-9
 
 
-@pytest.mark.parametrize("name", ["unimate5", "panda"])   # ur10, kinova: closed form by geometry
+@pytest.mark.parametrize("name", ["unimate5", "rrprr5"])   # ur10, kinova, panda: closed form by geometry
 def test_no_closed_form_is_a_typed_error(name):
     robot = aa.load(name)
     assert not aa.ik.has_analytic(robot)

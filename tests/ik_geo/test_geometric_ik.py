@@ -192,16 +192,20 @@ def test_bad_rotation_and_options():
     assert len(empty) == 0
 
 
-def test_near_intersecting_axes_within_tolerance_are_reported(tmp_path):
-    """Wrist axes 1e-7 m from a common point: classified spherical within tol = 1e-6, so the
-    closed form is approximate; the FK check rejects it and the reason names the tolerance."""
+def test_near_intersecting_axes_within_tolerance_are_polished(tmp_path):
+    """Wrist axes 1e-7 m from a common point: classified spherical within tol = 1e-6 (the
+    classification reports 5e-8 m: the least-squares common point lies midway), so the class
+    solution is off by ~1e-7; it is polished onto the pose and then FK-exact."""
     robot = dh_urdf(tmp_path, "puma_off", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
                     [0, 0.4318, 0.0203, 0, 0, 0], [0.6718, 0, 0.15005, 0.4318, 1e-7, 0])
-    assert G.plan_for(robot).cls == C.SPHERICAL_TWO_PARALLEL
-    _, T = _poses(robot, 1, 8)
+    gp = G.plan_for(robot)
+    assert gp.cls == C.SPHERICAL_TWO_PARALLEL and abs(gp.classification.worst_accepted[0] - 5e-8) < 1e-12
+    th, T = _poses(robot, 1, 8)
+    q, _, exact = G.solve(gp, T)
+    raw = max(np.abs(_fk(robot, x) - T[0]).max() for x in q[0][exact[0]])
+    assert 1e-9 < raw < 1e-6                                # the class solution alone is not exact
     r = aa.ik.analytic(robot, T[0])
-    # the least-squares common point lies midway: each line 0.5e-7 m from it
-    assert not r.success and "classification tolerance" in r.reason and "5e-08 m" in r.reason
+    assert r.success and all(np.abs(_fk(robot, x) - T[0]).max() < 1e-9 for x in r.solutions)
 
 
 def test_no_closed_form_geometry(tmp_path):
@@ -211,3 +215,29 @@ def test_no_closed_form_geometry(tmp_path):
     assert not aa.ik.has_analytic(robot)
     with pytest.raises(UnsupportedModelError, match="no closed form for this geometry.*gen_six_dof.*aa.ik.solve"):
         aa.ik.analytic(robot, np.eye(4))
+
+
+@pytest.mark.parametrize("name, polish", [("panda", 1e-12), ("xarm7", 1e-4)])
+def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
+    """panda and xarm7 with the last joint held are 6R arms with a spherical shoulder
+    (spherical_two_intersecting of the reversed chain).  xarm7's URDF rounds its angles (axes
+    ~4e-6 rad off, shoulder lines 5e-7 m apart): the class solution is polished onto the exact
+    pose, which moves the held joint by ~1e-6."""
+    robot = aa.load(name)
+    gp = G.plan_for(robot)
+    assert gp.cls == C.SPHERICAL_TWO_INTERSECTING and gp.reversed and gp.param_joint == 6
+    th, T = _poses(robot, 8, 9)
+    res = aa.ik.analytic_batch(robot, T, param=th[:, 6])
+    assert res.valid.any(1).all(), res.reasons
+    for i in range(len(T)):
+        r = res[i]
+        for q in r.solutions:
+            assert np.abs(_fk(robot, q) - T[i]).max() < 1e-9
+            assert abs(np.angle(np.exp(1j * (q[6] - th[i, 6])))) < polish      # the parameter held
+        d = np.abs(np.angle(np.exp(1j * (r.solutions - th[i])))).max(1)
+        assert d.min() < max(polish, 1e-9)
+    grid = aa.ik.analytic(robot, T[0])                        # default: a grid of the held joint
+    assert len(grid) > 0 and all(np.abs(_fk(robot, q) - T[0]).max() < 1e-9 for q in grid.solutions)
+    assert "param#" in grid.branches[0]
+    with pytest.raises(ValueError, match="param="):
+        aa.ik.analytic(aa.load("ur5"), aa.load("ur5").fk(aa.load("ur5").neutral()), param=0.3)

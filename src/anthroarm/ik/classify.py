@@ -214,7 +214,12 @@ def classify(robot, frame=None, tol: float = 1e-6, angle_tol: float = 1e-6) -> C
         if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
                 or not np.isfinite(v) or v <= 0:
             raise ParameterError(f"classify: {name} must be a finite number > 0, got {v!r}")
-    kin = kinematics(robot, frame)
+    return classify_kinematics(kinematics(robot, frame), tol, angle_tol)
+
+
+def classify_kinematics(kin: Kinematics, tol: float = 1e-6, angle_tol: float = 1e-6) -> Classification:
+    """:func:`classify` of given :class:`Kinematics` (e.g. the first six joints of a 7-joint
+    arm whose last joint is held fixed)."""
     sin, par, dist, inter, tri, sph, three = _relations(kin.H, kin.points, tol, angle_tol)
     # the closest calls: the largest value accepted and the smallest rejected, per unit
     dl = np.concatenate([dist[~np.isnan(dist)], tri[~np.isnan(tri)]])
@@ -247,7 +252,7 @@ def classify(robot, frame=None, tol: float = 1e-6, angle_tol: float = 1e-6) -> C
     return Classification(name, is_rev, compatible, **common)
 
 
-__all__ = ["Classification", "Kinematics", "classify", "kinematics", "CLASSES", "CLOSED_FORM_CLASSES",
+__all__ = ["Classification", "Kinematics", "classify", "classify_kinematics", "kinematics", "CLASSES", "CLOSED_FORM_CLASSES",
            "NOT_6R", "SPHERICAL_TWO_PARALLEL", "SPHERICAL_TWO_INTERSECTING",
            "THREE_PARALLEL_TWO_INTERSECTING", "SPHERICAL", "THREE_PARALLEL", "TWO_PARALLEL",
            "TWO_INTERSECTING", "GEN_SIX_DOF"]

@@ -181,6 +181,13 @@ def _form(robot, frame=None):
 #: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of
 #: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py)
 _GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), 8, cost_us=3000.0) for c in _geo.SOLVED}
+#: a 7-joint arm with its last joint held (the family parameter): per value of the grid
+_GEO_FORMS7 = {c: _registry.ClosedForm(c, (), 7, (), 8, cost_us=3000.0) for c in _geo.SOLVED}
+#: values of the held joint of a 7-joint arm when ``param`` is not given
+PARAM_GRID = 12
+#: FK residual (m / unitless) up to which a class solution is polished (arm of its class only
+#: within the classification tolerance)
+POLISH_MAX = 1e-4
 
 
 def _geo_plan(robot, frame=None):
@@ -198,7 +205,7 @@ def _form_any(robot, frame=None):
     if form is None:
         gp = _geo_plan(robot, frame)
         if gp is not None:
-            return _GEO_FORMS[gp.cls]
+            return (_GEO_FORMS if gp.param_joint is None else _GEO_FORMS7)[gp.cls]
     return form
 
 
@@ -603,7 +610,7 @@ def _swivel_array(swivel, N, grid_1d=False):
 
 
 def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
-                   tol: float = 1e-9, tol_orthonormal: float = 1e-6,
+                   tol: float = 1e-9, tol_orthonormal: float = 1e-6, param=None,
                    _single_grid: bool = False, _impl: str = "auto") -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see module docstring).
 
@@ -628,7 +635,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
     if _plan(robot) is None:
         gp = _geo.plan_for(robot)
         if gp is not None:
-            return _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal)
+            return _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, param)
+    _no_param(robot, param)
     plan = _require(robot)
     family, prm = plan.family, plan.params
     if position_only is None:
@@ -686,27 +694,58 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
                                residuals=np.where(valid, res, np.nan), singular=sing, model=robot.name)
 
 
-def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal) -> AnalyticBatchResult:
+def _no_param(robot, param):
+    if param is not None:
+        raise ValueError(f"{robot.name}: param= is for a 7-joint arm solved by its geometry (its last joint "
+                         "held); use swivel= for a registered redundant arm")
+
+
+def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, param=None) -> AnalyticBatchResult:
     """:func:`analytic_batch` of an arm solved by its geometry (:mod:`.geometric`): the class
-    solver's 8 branches, wrapped by 2π into the joint limits, each verified by FK (the 3×4 pose
-    to ``tol``), duplicates removed; a reason for every pose without a solution."""
+    solver's 8 branches (per value of ``param`` for a 7-joint arm: its last joint, rad; scalar,
+    (N,), (1, S) or (N, S) as ``swivel``; default :data:`PARAM_GRID` values over its range),
+    wrapped by 2π into the joint limits, each verified by FK (the 3×4 pose to ``tol``; candidates
+    within :data:`POLISH_MAX` polished first), duplicates removed; a reason for every pose
+    without a solution."""
     if swivel is not None:
         raise ValueError(f"{robot.name}: swivel= applies to a redundant arm's family of solutions; "
                          f"this arm is a 6R arm ({gp.cls}) with finitely many solutions")
     if position_only:
         raise ValueError(f"{robot.name}: a 6R arm is solved for the full pose (position and rotation); "
                          "for a position alone use aa.ik.solve(robot, p, position_only=True)")
-    Ts, _ = _check_poses(T, tol_orthonormal=tol_orthonormal)
-    N, B, ch = Ts.shape[0], 8, gp.chain
-    labels = list(gp.labels)
+    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal)
+    N, ch = Ts.shape[0], gp.chain
+    if gp.param_joint is None and param is not None:
+        raise ValueError(f"{robot.name}: param= is the value of the held joint of a 7-joint arm; this arm "
+                         f"is a 6R arm ({gp.cls}) with finitely many solutions")
+    if gp.param_joint is not None:
+        if param is None:             # a grid over the held joint's range
+            k = gp.order.tolist().index(gp.param_joint)
+            lo, hi = (max(gp.lower[k], -np.pi), min(gp.upper[k], np.pi))
+            param = np.linspace(lo, hi, PARAM_GRID + 1)[:-1] + 0.5 * (hi - lo) / PARAM_GRID
+        pv = _swivel_array(param, N, grid_1d=single)                     # (N, S), same rules as swivel
+    else:
+        pv = np.zeros((N, 1))
+    S = pv.shape[1]
+    labels = list(gp.labels) if S == 1 else [f"{b},param#{k}" for k in range(S) for b in gp.labels]
+    B = 8 * S
     if N == 0:
         return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
                                    residuals=np.zeros((0, B)), singular=[], model=robot.name)
-    th, cand, exact = _geo.solve(gp, Ts)
+    Tr = np.repeat(Ts, S, axis=0)
+    th, cand, exact = _geo.solve(gp, Tr, pv.reshape(-1) if gp.param_joint is not None else None)
+    th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in (th, cand, exact))
     thw, inside = _wrap_into_limits(th, gp.lower, gp.upper)
     finite = np.isfinite(thw).all(-1)
     Q = ch.configuration(np.where(finite[..., None], thw, 0.0))
     res = np.where(finite, _fk_residual(robot, Q, Ts, False), np.inf)
+    # an arm of its class only within the classification tolerance (e.g. rounded URDF angles):
+    # polish its near-exact candidates on the FK error (joint layout = angles only)
+    near = cand & exact & inside & finite & (res > tol) & (res <= POLISH_MAX)
+    if near.any() and robot.nq == len(ch.independent):
+        for i, b in zip(*np.nonzero(near)):
+            Q[i, b], res[i, b] = _refine(robot, Q[i, b], Ts[i], robot.lower, robot.upper, False)
+            thw[i, b] = Q[i, b]
     valid = cand & inside & finite & (res <= tol)
     for i in np.flatnonzero(valid.sum(1) > 1):          # coincident branches (singular poses)
         for b in range(1, B):
@@ -812,7 +851,7 @@ def _reason_for(code, inside, res, tol, robot) -> str:
 
 
 def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-             tol_orthonormal: float = 1e-6, method: str = "robust", _impl: str = "auto"):
+             tol_orthonormal: float = 1e-6, method: str = "robust", param=None, _impl: str = "auto"):
     """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
 
     ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
@@ -846,8 +885,9 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if _plan(robot) is None:
         gp = _geo.plan_for(robot)
         if gp is not None:
-            res = _geometric_batch(robot, gp, arr, swivel, position_only, tol, tol_orthonormal)
+            res = _geometric_batch(robot, gp, arr, swivel, position_only, tol, tol_orthonormal, param)
             return res[0] if np.ndim(arr) == 2 else res
+    _no_param(robot, param)
     if arr.ndim == 2 and _impl != "general":
         fast = _analytic_single_fast(robot, arr, swivel, position_only, tol, tol_orthonormal, _impl)
         if fast is not None and len(fast):       # solutions found: nothing to rescue

@@ -78,6 +78,12 @@ class GeoPlan:
     chain: object
     tool: str
     labels: tuple
+    #: a 7-joint arm: the last joint on the path is the family parameter (its index along the
+    #: path, its axis and point at q = 0, and the tool pose M at q = 0, 4×4); else None
+    param_joint: int | None = None
+    param_axis: np.ndarray | None = None
+    param_point: np.ndarray | None = None
+    M: np.ndarray | None = None
 
 
 def _common_point(H, pts):
@@ -137,27 +143,43 @@ def classification(robot):
 
 def _build(robot) -> GeoPlan | None:
     c = classification(robot)
-    if c is None or not c.compatible:
+    if c is None:
         return None
     ch = robot.chain
     kin = c.kinematics
     if sorted(kin.joints) != sorted(ch.independent):
         return None                      # joints off the tool path: a solution is not a configuration
-    pick = next(((n, r) for n, r in c.compatible if n in SOLVED), None)
+    param = None
+    if c.name == C.NOT_6R and kin.n == 7 and all(k in ("revolute", "continuous") for k in kin.kinds):
+        # a redundant 7R arm: hold the last joint as the family parameter; the first six joints
+        # with the tool at q = 0 are a 6R arm (their relations do not depend on the last joint)
+        param = 6
+        c6 = C.classify_kinematics(C.Kinematics(kin.H[:6], kin.points[:6], kin.P[:6], kin.R_tool, kin.p_tool,
+                                                kin.joints[:6], kin.kinds[:6], kin.names[:6]),
+                                   c.tol, c.angle_tol)
+        kin6, compatible = c6.kinematics, c6.compatible
+    else:
+        kin6, compatible = kin, c.compatible
+    pick = next(((n, r) for n, r in compatible if n in SOLVED), None)
     if pick is None:
         return None
     cls, rev = pick
     if rev:
-        H, pts, R_tool, p_tool = _reversed(kin)
+        H, pts, R_tool, p_tool = _reversed(kin6)
     else:
-        H, pts, R_tool, p_tool = kin.H, kin.points, kin.R_tool, kin.p_tool
+        H, pts, R_tool, p_tool = kin6.H, kin6.points, kin6.R_tool, kin6.p_tool
     path = kin.joints                    # solve() turns a reversed solution back to this order
     P = ik_geo_P(cls, H, pts, p_tool)
     order = np.array([path.index(j) for j in ch.independent])
     lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in ch.independent])
     hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in ch.independent])
+    extra = {}
+    if param is not None:
+        M = np.eye(4)
+        M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
+        extra = dict(param_joint=param, param_axis=kin.H[param], param_point=kin.points[param], M=M)
     return GeoPlan(cls, rev, np.array(H), P, np.array(R_tool), order, lo, hi, c, ch, robot.tool,
-                   branch_labels(cls))
+                   branch_labels(cls), **extra)
 
 
 # ----------------------------------------------------------------------------- the solvers
@@ -276,16 +298,31 @@ def solve_class(cls: str, H, P, R06, p):
     return np.where(valid[..., None], q, np.nan), valid, exact
 
 
-def solve(plan: GeoPlan, T):
+def solve(plan: GeoPlan, T, param=None):
     """Every branch for poses ``T`` (N, 4, 4) of the tool (base frame, m; valid rotations):
-    θ (N, 8, n) in the order of ``robot.chain.independent`` (rad, (−π, π]), valid, exact."""
+    θ (N, 8, n) in the order of ``robot.chain.independent`` (rad, (−π, π]), valid, exact.
+
+    A 7-joint arm (``plan.param_joint``): ``param`` (N,) the value of its last joint (rad) for
+    each pose.  With the last joint's twist ξ7 and M the tool pose at q = 0,
+    T = F6(q1…q6) e^{ξ7 v} M, so the first six joints solve the 6R arm (tool M) for the pose
+    T · M⁻¹ e^{−ξ7 v} M."""
     T = np.asarray(T, dtype=float)
+    if plan.param_joint is not None:
+        v = np.broadcast_to(np.asarray(param, dtype=float), (len(T),))
+        Rv = sp.rot(np.broadcast_to(plan.param_axis, (len(T), 3)), -v)            # e^{−ξ7 v}
+        E = np.broadcast_to(np.eye(4), (len(T), 4, 4)).copy()
+        E[:, :3, :3] = Rv
+        E[:, :3, 3] = plan.param_point - np.einsum("nij,j->ni", Rv, plan.param_point)
+        Minv = np.linalg.inv(plan.M)
+        T = T @ Minv @ E @ plan.M
     R, p = T[:, :3, :3], T[:, :3, 3]
     if plan.reversed:
         R, p = np.swapaxes(R, 1, 2), -np.einsum("nji,nj->ni", R, p)
     q, valid, exact = solve_class(plan.cls, plan.H, plan.P, R @ plan.R_tool.T, p)
     if plan.reversed:
         q = q[..., ::-1]
+    if plan.param_joint is not None:
+        q = np.concatenate([q, np.broadcast_to(np.angle(np.exp(1j * v))[:, None, None], q.shape[:2] + (1,))], -1)
     return q[..., plan.order], valid, exact
 
 
