@@ -138,3 +138,36 @@ def test_bad_grasps(allegro, limb):
     assert not res.success and res.status in ("stalled", "max_iterations")
     assert np.isfinite(res.q).all() and np.isfinite(res.position_errors).all() and res.within_limits
     assert res.position_errors.min() > 1.0          # metres away, as the geometry says
+
+
+def test_grasp_overlays(allegro):
+    """The drawn cylinder's axis (meshcat's y) is the object's axis, the frame is a rotation;
+    show_grasp puts the object, points and arrows into the viewer's scene."""
+    from anthroarm.hand.overlays import object_transform, show_grasp
+
+    cyl = Cylinder([0.1, 0.02, 0.0], [0.3, -1.0, 0.2], 0.03)
+    T = object_transform(cyl)
+    np.testing.assert_allclose(T[:3, 1], cyl.axis, atol=1e-15)
+    np.testing.assert_allclose(T[:3, :3].T @ T[:3, :3], np.eye(3), atol=1e-15)
+    assert np.linalg.det(T[:3, :3]) == pytest.approx(1.0)
+    np.testing.assert_allclose(T[:3, 3], cyl.center)
+    v = aa.viewer.Viewer(allegro)
+    contacts = np.array([cyl.point(a, 0.01) for a in (0.0, 1.0, 2.0, 3.0)])
+    show_grasp(v, cyl, contacts, name="cup")
+    import base64
+    import json
+    import re
+
+    import umsgpack
+
+    m = re.search(r"var cmds = (\[.*?\]);", v.static_html(), re.S)         # the page's replayed commands
+    cmds = [umsgpack.unpackb(base64.b64decode(c)) for c in json.loads(m.group(1))]
+    paths = {c["path"]: c for c in cmds if c["type"] in ("set_object", "set_transform")}
+    obj = f"{v.root}/overlays/cup_object"
+    assert paths[obj]["type"] in ("set_object", "set_transform")
+    assert any(p.startswith(f"{v.root}/overlays/cup_points") for p in paths)
+    assert any(p.startswith(f"{v.root}/overlays/cup_normals") for p in paths)
+    geo = [c for c in cmds if c["type"] == "set_object" and c["path"] == obj][0]["object"]["geometries"][0]
+    assert geo["type"] == "CylinderGeometry" and geo["radiusTop"] == pytest.approx(0.03)
+    with pytest.raises(TypeError):
+        show_grasp(v, "a cup", contacts)

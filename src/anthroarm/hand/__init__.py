@@ -10,12 +10,16 @@
 
 Modules: :mod:`~anthroarm.hand.fingers` (fingers, palm, pad normals, span, from
 ``robot.chain``), :mod:`~anthroarm.hand.objects` (sphere and cylinder surfaces),
-:mod:`~anthroarm.hand.grasp` (tasks, solve loop, success criteria: 1 mm, 5°, limits).
+:mod:`~anthroarm.hand.grasp` (tasks, solve loop, success criteria: 1 mm, 5°, limits),
+:mod:`~anthroarm.hand.problems` (reachable random grasps with a witness),
+:mod:`~anthroarm.hand.overlays` (object, contacts and normals in the viewer),
+:mod:`~anthroarm.hand.demo` (the README picture).
 """
 
 from .fingers import Finger, Hand
 from .grasp import NORMAL_TOL, POSITION_TOL, GraspResult, check_span, grasp_errors, grasp_tasks, solve_grasp
 from .objects import Cylinder, Sphere
+from .overlays import show_grasp
 
 __all__ = ["Hand", "Finger", "Sphere", "Cylinder", "solve_grasp", "GraspResult", "grasp_tasks", "grasp_errors",
-           "check_span", "POSITION_TOL", "NORMAL_TOL"]
+           "check_span", "show_grasp", "POSITION_TOL", "NORMAL_TOL"]

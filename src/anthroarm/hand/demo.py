@@ -8,8 +8,8 @@ the glass upside down), keeping the arm configuration nearest the comfortable po
 grasp is checked with :func:`~anthroarm.hand.grasp.grasp_errors` (1 mm, 5°, on the glass's side,
 inside the limits) before it is returned.
 
-:func:`readme_picture` draws it in the viewer (contact points, inward normals, the glass as a
-meshcat cylinder) and takes a headless-Chromium screenshot
+:func:`readme_picture` draws it in the viewer (:func:`~anthroarm.hand.overlays.show_grasp`:
+contact points, inward normals, the glass as a meshcat cylinder) and takes a headless-Chromium screenshot
 (:func:`anthroarm.viewer.browser.screenshot`): ``python -m anthroarm.hand.demo docs/x.png``.
 """
 
@@ -67,27 +67,15 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
 
 def readme_picture(png, size=(960, 640)) -> Path:
     """Screenshot of :func:`cup_grasp` in the viewer, written to ``png``."""
-    import meshcat.geometry as mg
-
     from ..ik.qp import IKConfiguration
     from ..viewer import Viewer
+    from .overlays import show_grasp
     from ..viewer.browser import screenshot
 
     robot, h, q, glass = cup_grasp()
     _, _, contacts, _ = grasp_errors(h, IKConfiguration(robot, q), glass)
     v = Viewer(robot, q=q)
-    v.show_points(contacts, colors=(0.1, 0.65, 0.2))
-    v.show_arrows(contacts, -0.035 * np.array([glass.normal(c) for c in contacts]), colors=(0.9, 0.2, 0.1))
-    Tw = np.eye(4)
-    Tw[:3, :3] = np.column_stack([np.cross(glass.axis, [0.0, 0.0, 1.0]) if abs(glass.axis[2]) < 0.9 else [1.0, 0, 0],
-                                  glass.axis, np.zeros(3)])
-    Tw[:3, 0] /= np.linalg.norm(Tw[:3, 0])
-    Tw[:3, 2] = np.cross(Tw[:3, 0], Tw[:3, 1])                # meshcat's cylinder runs along its y axis
-    Tw[:3, 3] = glass.center
-    node = v.scene[v.root.removeprefix("/meshcat/") + "/overlays/glass"]
-    node.set_object(mg.Cylinder(GLASS_HEIGHT, glass.radius),
-                    mg.MeshLambertMaterial(color=0xD9D2C0, opacity=0.85, transparent=True))
-    node.set_transform(Tw)
+    show_grasp(v, glass, contacts)
     v.set_camera((0.5, 1.0, 0.25), distance=0.75)
     with tempfile.TemporaryDirectory() as d:
         html = v.export_html(Path(d) / "grasp.html")

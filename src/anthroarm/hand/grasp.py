@@ -237,7 +237,7 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
                 max_iterations: int = 300, max_step: float = 0.2, position_cost: float = 1.0,
                 normal_cost: float = 0.1, lm_damping: float = 1e-3, posture_cost: float = 0.0,
                 position_tol: float = POSITION_TOL, normal_tol: float = NORMAL_TOL, solver: str = "daqp",
-                tasks=(), restarts: int = 10, seed=0, move_arm: bool = True, step_fn=None) -> GraspResult:
+                tasks=(), restarts: int = 25, seed=0, move_arm: bool = True, step_fn=None) -> GraspResult:
     """Grasp ``obj`` (a :class:`~anthroarm.hand.objects.Sphere` or
     :class:`~anthroarm.hand.objects.Cylinder`, world frame) with the fingertips of ``robot``.
 
