@@ -747,12 +747,10 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
             Q[i, b], res[i, b] = _refine(robot, Q[i, b], Ts[i], robot.lower, robot.upper, False)
             thw[i, b] = Q[i, b]
     valid = cand & inside & finite & (res <= tol)
-    for i in np.flatnonzero(valid.sum(1) > 1):          # coincident branches (singular poses)
-        for b in range(1, B):
-            if valid[i, b]:
-                d = np.abs(np.angle(np.exp(1j * (thw[i, :b] - thw[i, b])))).max(-1)
-                if ((d < 1e-9) & valid[i, :b]).any():
-                    valid[i, b] = False
+    # coincident branches (singular poses): drop a branch equal to an earlier valid one
+    d = np.abs(np.angle(np.exp(1j * (thw[:, :, None] - thw[:, None, :])))).max(-1)      # (N, B, B)
+    earlier = np.tril(np.ones((B, B), bool), -1)                                         # [b, a]: a < b
+    valid &= ~((d < 1e-9) & earlier & valid[:, None, :]).any(-1)
     reasons = [None] * N
     names = [ch.joints[j].name for j in ch.independent]
     c = gp.classification

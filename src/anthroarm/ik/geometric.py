@@ -183,101 +183,98 @@ def _build(robot) -> GeoPlan | None:
 
 
 # ----------------------------------------------------------------------------- the solvers
+# Each stage solves all branches of the stage before at once: M problems → 2M (a two-root
+# subproblem fans out, the root index innermost), so a pose's 8 branches come out in the order
+# of the labels (first subproblem outermost) after 3 fans, with one subproblem call per stage.
+def _fan(sol, *carry):
+    """Split the two roots of ``sol`` (M problems) into 2M rows; ``carry`` arrays (M, …) are
+    repeated to match.  Returns θ (2M,), valid (2M,), exact (2M,) and the carried arrays."""
+    th = np.nan_to_num(sol.theta[:, :, 0]).reshape(-1)
+    return (th, sol.valid.reshape(-1), sol.exact.reshape(-1), *(np.repeat(c, 2, axis=0) for c in carry))
+
+
 def _b(v, n):
     return np.broadcast_to(v, (n, 3))
 
 
-def _wrist(H, R36, n):
-    """Spherical wrist: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and q6 by SP1.
-    Returns [(q4, q5, q6, valid, exact) for the two q5 roots]."""
+def _wrist(H, R36, ok, ex, *carry):
+    """Spherical wrist: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and q6 by SP1 (M
+    problems → 2M).  Returns q4, q5, q6, valid, exact and the carried arrays."""
+    n = len(R36)
     h4, h5, h6 = _b(H[3], n), _b(H[4], n), _b(H[5], n)
     s5 = sp.sp4(h4, h6, h5, np.einsum("ni,nij,nj->n", h4, R36, h6))
-    out = []
-    for c in range(2):
-        q5 = np.nan_to_num(s5.theta[:, c, 0])
-        s4 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R36, h6), h4)
-        s6 = sp.sp1(sp._rotate(-h5, q5, h4), np.einsum("nji,nj->ni", R36, h4), -h6)
-        out.append((s4.theta[:, 0, 0], q5, s6.theta[:, 0, 0], s5.valid[:, c],
-                    s5.exact[:, c] & s4.exact[:, 0] & s6.exact[:, 0]))
-    return out
+    q5, v5, e5, R36, ok, ex, *carry = _fan(s5, R36, ok, ex, *carry)
+    n *= 2
+    h4, h5, h6 = _b(H[3], n), _b(H[4], n), _b(H[5], n)
+    s4 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R36, h6), h4)
+    s6 = sp.sp1(sp._rotate(-h5, q5, h4), np.einsum("nji,nj->ni", R36, h4), -h6)
+    return (s4.theta[:, 0, 0], q5, s6.theta[:, 0, 0], ok & v5, ex & e5 & s4.exact[:, 0] & s6.exact[:, 0],
+            *carry)
 
 
 def _spherical_two_parallel(H, P, R06, p):
     n = len(p)
-    h1, h2, h3 = _b(H[0], n), _b(H[1], n), _b(H[2], n)
     p01, p12, p23, p34 = P[0], P[1], P[2], P[3]
     wrist = p - R06 @ P[6] - p01                                        # p_16 (wrist centre − p01)
-    s1 = sp.sp4(h2, wrist, -h1, np.full(n, H[1] @ (p12 + p23 + p34)))
-    out = []
-    for a in range(2):
-        q1 = np.nan_to_num(s1.theta[:, a, 0])
-        v = sp._rotate(-h1, q1, wrist) - p12                              # R01ᵀ p_16 − p12
-        s3 = sp.sp3(-_b(p34, n), _b(p23, n), h3, np.linalg.norm(v, axis=1))
-        for b in range(2):
-            q3 = np.nan_to_num(s3.theta[:, b, 0])
-            s2 = sp.sp1(_b(p23, n) + sp._rotate(h3, q3, _b(p34, n)), v, h2)
-            q2 = s2.theta[:, 0, 0]
-            R03 = sp.rot(h1, q1) @ sp.rot(h2, q2) @ sp.rot(h3, q3)
-            ok = s1.valid[:, a] & s3.valid[:, b]
-            ex = s1.exact[:, a] & s3.exact[:, b] & s2.exact[:, 0]
-            for q4, q5, q6, v5, e5 in _wrist(H, np.swapaxes(R03, 1, 2) @ R06, n):
-                out.append((np.stack([q1, q2, q3, q4, q5, q6], -1), ok & v5, ex & e5))
-    return out
+    s1 = sp.sp4(_b(H[1], n), wrist, -_b(H[0], n), np.full(n, H[1] @ (p12 + p23 + p34)))
+    q1, ok, ex, wrist, R06 = _fan(s1, wrist, R06)
+    n *= 2
+    v = sp._rotate(-_b(H[0], n), q1, wrist) - p12                       # R01ᵀ p_16 − p12
+    s3 = sp.sp3(-_b(p34, n), _b(p23, n), _b(H[2], n), np.linalg.norm(v, axis=1))
+    q3, v3, e3, q1, ok, ex, v, R06 = _fan(s3, q1, ok, ex, v, R06)
+    n *= 2
+    s2 = sp.sp1(_b(p23, n) + sp._rotate(_b(H[2], n), q3, _b(p34, n)), v, _b(H[1], n))
+    q2 = s2.theta[:, 0, 0]
+    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
+    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok & v3, ex & e3 & s2.exact[:, 0],
+                                            q1, q2, q3)
+    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
 
 
 def _spherical_two_intersecting(H, P, R06, p):
     n = len(p)
-    h1, h2, h3 = _b(H[0], n), _b(H[1], n), _b(H[2], n)
     p16 = p - R06 @ P[6] - P[0]                                         # from the 1–2 intersection
-    s3 = sp.sp3(_b(P[3], n), -_b(P[2], n), h3, np.linalg.norm(p16, axis=1))
-    out = []
-    for b in range(2):
-        q3 = np.nan_to_num(s3.theta[:, b, 0])
-        s12 = sp.sp2(p16, _b(P[2], n) + sp._rotate(h3, q3, _b(P[3], n)), -h1, h2)
-        for a in range(2):
-            q1, q2 = np.nan_to_num(s12.theta[:, a, 0]), np.nan_to_num(s12.theta[:, a, 1])
-            R03 = sp.rot(h1, q1) @ sp.rot(h2, q2) @ sp.rot(h3, q3)
-            ok = s3.valid[:, b] & s12.valid[:, a]
-            ex = s3.exact[:, b] & s12.exact[:, a]
-            for q4, q5, q6, v5, e5 in _wrist(H, np.swapaxes(R03, 1, 2) @ R06, n):
-                out.append((np.stack([q1, q2, q3, q4, q5, q6], -1), ok & v5, ex & e5))
-    return out
+    s3 = sp.sp3(_b(P[3], n), -_b(P[2], n), _b(H[2], n), np.linalg.norm(p16, axis=1))
+    q3, ok, ex, p16, R06 = _fan(s3, p16, R06)
+    n *= 2
+    s12 = sp.sp2(p16, _b(P[2], n) + sp._rotate(_b(H[2], n), q3, _b(P[3], n)), -_b(H[0], n), _b(H[1], n))
+    q1 = np.nan_to_num(s12.theta[:, :, 0]).reshape(-1)
+    q2 = np.nan_to_num(s12.theta[:, :, 1]).reshape(-1)
+    v12, e12 = s12.valid.reshape(-1), s12.exact.reshape(-1)
+    q3, ok, ex, R06 = (np.repeat(a, 2, axis=0) for a in (q3, ok, ex, R06))
+    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
+    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok & v12, ex & e12, q1, q2, q3)
+    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
 
 
 def _three_parallel_two_intersecting(H, P, R06, p):
     n = len(p)
-    h1, h2, h5, h6 = _b(H[0], n), _b(H[1], n), _b(H[4], n), _b(H[5], n)
     # h3, h4 are ±h2: rot(h3, q3) = rot(h2, s3 q3)
     s3n, s4n = np.sign(H[1] @ H[2]), np.sign(H[1] @ H[3])
     p06 = p - R06 @ P[6] - P[0]
-    s1 = sp.sp4(h2, p06, -h1, np.full(n, H[1] @ P[1:5].sum(0)))
+    s1 = sp.sp4(_b(H[1], n), p06, -_b(H[0], n), np.full(n, H[1] @ P[1:5].sum(0)))
+    q1, ok, ex, p06, R06 = _fan(s1, p06, R06)
+    n *= 2
+    R01t = sp.rot(H[0], -q1)
     R06h6 = R06 @ H[5]
-    out = []
-    for a in range(2):
-        q1 = np.nan_to_num(s1.theta[:, a, 0])
-        R01 = sp.rot(h1, q1)
-        R01t = np.swapaxes(R01, 1, 2)
-        s5 = sp.sp4(h2, h6, h5, np.einsum("i,nij,nj->n", H[1], R01t, R06h6))
-        for c in range(2):
-            q5 = np.nan_to_num(s5.theta[:, c, 0])
-            s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R01t, R06h6), h2)
-            th14 = s14.theta[:, 0, 0]
-            s6 = sp.sp1(sp._rotate(-h5, q5, h2),
-                        np.einsum("nji,nj->ni", R06, R01 @ H[1]), -h6)
-            d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, _b(P[4], n))
-            s3 = sp.sp3(-_b(P[3], n), _b(P[2], n), h2, np.linalg.norm(d_in, axis=1))
-            for b in range(2):
-                t3 = np.nan_to_num(s3.theta[:, b, 0])
-                s2 = sp.sp1(_b(P[2], n) + sp._rotate(h2, t3, _b(P[3], n)), d_in, h2)
-                q2 = s2.theta[:, 0, 0]
-                t4 = np.angle(np.exp(1j * (th14 - q2 - t3)))
-                q = np.stack([q1, q2, s3n * t3, s4n * t4, q5, s6.theta[:, 0, 0]], -1)
-                ok = s1.valid[:, a] & s5.valid[:, c] & s3.valid[:, b]
-                ex = s1.exact[:, a] & s5.exact[:, c] & s14.exact[:, 0] & s6.exact[:, 0] \
-                    & s3.exact[:, b] & s2.exact[:, 0]
-                out.append((q, ok, ex))
-    # order the branches q1 × q5 × q3 as the labels say
-    return out
+    s5 = sp.sp4(_b(H[1], n), _b(H[5], n), _b(H[4], n), np.einsum("i,nij,nj->n", H[1], R01t, R06h6))
+    q5, v5, e5, q1, ok, ex, p06, R06, R01t, R06h6 = _fan(s5, q1, ok, ex, p06, R06, R01t, R06h6)
+    n *= 2
+    h2, h5, h6 = _b(H[1], n), _b(H[4], n), _b(H[5], n)
+    s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R01t, R06h6), h2)
+    th14 = s14.theta[:, 0, 0]
+    R01h2 = np.einsum("nji,j->ni", R01t, H[1])
+    s6 = sp.sp1(sp._rotate(-h5, q5, h2), np.einsum("nji,nj->ni", R06, R01h2), -h6)     # R06ᵀ R01 h2
+    d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, _b(P[4], n))
+    s3 = sp.sp3(-_b(P[3], n), _b(P[2], n), h2, np.linalg.norm(d_in, axis=1))
+    ok, ex = ok & v5, ex & e5 & s14.exact[:, 0] & s6.exact[:, 0]
+    t3, v3, e3, q1, q5, q6, th14, d_in, ok, ex = _fan(s3, q1, q5, s6.theta[:, 0, 0], th14, d_in, ok, ex)
+    n *= 2
+    s2 = sp.sp1(_b(P[2], n) + sp._rotate(_b(H[1], n), t3, _b(P[3], n)), d_in, _b(H[1], n))
+    q2 = s2.theta[:, 0, 0]
+    t4 = np.angle(np.exp(1j * (th14 - q2 - t3)))
+    q = np.stack([q1, q2, s3n * t3, s4n * t4, q5, q6], -1)
+    return q, ok & v3, ex & e3 & s2.exact[:, 0]
 
 
 _SOLVERS = {C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
@@ -290,10 +287,9 @@ def solve_class(cls: str, H, P, R06, p):
     ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions, base frame, m).
     Returns q (N, 8, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, 8),
     exact (N, 8) (False: least squares, out of reach)."""
-    out = _SOLVERS[cls](np.asarray(H, float), np.asarray(P, float), R06, p)
-    q = np.stack([o[0] for o in out], 1)
-    valid = np.stack([o[1] for o in out], 1)
-    exact = np.stack([o[2] for o in out], 1) & valid
+    n = len(p)
+    q, valid, exact = _SOLVERS[cls](np.asarray(H, float), np.asarray(P, float), R06, p)
+    q, valid, exact = q.reshape(n, 8, 6), valid.reshape(n, 8), exact.reshape(n, 8) & valid.reshape(n, 8)
     q = np.angle(np.exp(1j * q))
     return np.where(valid[..., None], q, np.nan), valid, exact
 
