@@ -45,8 +45,55 @@ def test_c3d_bad_files(tmp_path):
     with pytest.raises(C3DError, match="not found"):
         read_c3d(tmp_path / "nope.c3d")
     (tmp_path / "garbage.c3d").write_bytes(b"this is not a c3d file" * 50)
-    with pytest.raises(C3DError, match="ezc3d"):
+    with pytest.raises(C3DError, match="not a C3D file"):
         read_c3d(tmp_path / "garbage.c3d")
+    (tmp_path / "short.c3d").write_bytes(b"garbage")
+    with pytest.raises(C3DError, match="not a C3D file"):
+        read_c3d(tmp_path / "short.c3d")
+    with pytest.raises(C3DError, match="not a file"):
+        read_c3d(tmp_path)
+
+
+def test_c3d_truncated_and_damaged_files_are_c3d_errors(tmp_path):
+    """A file cut short is refused (ezc3d alone returns the frames it found, silently); a damaged
+    parameter section is refused before ezc3d reads it.  With ezc3d 1.7.2 alone (measured in a
+    subprocess when this test was written) "group" is a RuntimeError, "desc" never returns and
+    "sign" kills the interpreter with SIGSEGV."""
+    P = np.random.default_rng(0).uniform(-1, 1, (50, 10, 3))
+    write_c3d(tmp_path / "good.c3d", MarkerTrajectories([f"M{i}" for i in range(10)], P, rate=100.0))
+    good = (tmp_path / "good.c3d").read_bytes()
+    assert read_c3d(tmp_path / "good.c3d").n_frames == 50
+    for cut, needle in ((600, "parameter section"), (len(good) // 2, "announces 50 frames")):
+        (tmp_path / "cut.c3d").write_bytes(good[:cut])
+        with pytest.raises(C3DError, match=needle):
+            read_c3d(tmp_path / "cut.c3d")
+    # the parameter records of an ezc3d-written file: group POINT first, then its parameters
+    start = (good[0] - 1) * 512
+    assert good[start + 4:start + 6] == bytes([5, 0xFF]) and good[start + 6:start + 11] == b"POINT"
+    records, i = [], start + 4
+    while good[i]:
+        n = abs(int.from_bytes(good[i:i + 1], "little", signed=True))
+        records.append((i, good[i + 2:i + 2 + n].decode()))
+        nxt = int.from_bytes(good[i + 2 + n:i + 4 + n], "little", signed=True)
+        if nxt == 0:
+            break
+        i = i + 2 + n + nxt
+    where = dict((name, at) for at, name in records)
+    damaged = {}
+    d = bytearray(good)                         # a parameter of a group id no group has
+    d[where["USED"] + 1] = 100
+    damaged["group"] = bytes(d)
+    d = bytearray(good)                         # a parameter's group id flipped negative (read as a group)
+    d[where["FORMAT"] + 1] = 0xA7
+    damaged["sign"] = bytes(d)
+    d = bytearray(good)                         # a description length that runs into the next record
+    at = where["RATE"]
+    d[at + 2 + 4 + 2 + 2 + 4] = 200             # name length, group, "RATE", offset, type + 0 dims, float
+    damaged["desc"] = bytes(d)
+    for kind, data in damaged.items():
+        (tmp_path / f"{kind}.c3d").write_bytes(data)
+        with pytest.raises(C3DError, match="damaged C3D parameter section"):
+            read_c3d(tmp_path / f"{kind}.c3d")
     with pytest.raises(MotionDataError, match="duplicate"):
         MarkerTrajectories(["A", "A"], np.zeros((2, 2, 3)))
     with pytest.raises(MotionDataError, match="shape"):

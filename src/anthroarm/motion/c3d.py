@@ -34,18 +34,90 @@ def _param(c, group: str, name: str, default=None):
         return default
 
 
+def _check_structure(p: Path) -> int | None:
+    """Walk the header and the parameter section of a C3D file (https://www.c3d.org, "The C3D
+    File Format User Guide", ch. 2-3: 512-byte blocks; parameter records ``name length, group id,
+    name, offset to the next record, [type, dimensions, data], description``) and raise
+    :class:`~anthroarm.errors.C3DError` where it is inconsistent, before ezc3d reads it: ezc3d
+    (1.7) crashes the interpreter (SIGSEGV) or never returns on some damaged parameter sections.
+    Returns the number of frames the header announces (None when it cannot say: 65535 or more)."""
+    import struct
+
+    size = p.stat().st_size
+    with open(p, "rb") as fh:
+        head = fh.read(512)
+        if len(head) < 512 or head[1] != 0x50:
+            raise C3DError("not a C3D file (no C3D header: the second byte is not 0x50)", p)
+        start = (head[0] - 1) * 512
+        if head[0] < 2 or start + 4 > size:
+            raise C3DError(f"damaged C3D header: parameter section at block {head[0]} is outside the file", p)
+        fh.seek(start)
+        sec = fh.read(4)
+        n_blocks, proc = sec[2], sec[3]
+        if proc not in (84, 85, 86):
+            raise C3DError(f"damaged C3D parameter section: processor type {proc} (84 Intel, 85 DEC, 86 MIPS)", p)
+        if n_blocks < 1 or start + 512 * n_blocks > size:
+            raise C3DError(f"damaged or truncated C3D file: the parameter section ({n_blocks} blocks) does not fit in "
+                           f"the file ({size} bytes)", p)
+        fh.seek(start)
+        sec = fh.read(512 * n_blocks)
+    i16 = ">h" if proc == 86 else "<h"
+    u16 = ">H" if proc == 86 else "<H"
+    groups, params = set(), set()
+    i = 4
+    while i + 2 <= len(sec):
+        nchar, gid = struct.unpack("bb", sec[i:i + 2])
+        if nchar == 0:
+            break
+        off_at = i + 2 + abs(nchar)
+        if gid == 0 or off_at + 3 > len(sec):
+            raise C3DError(f"damaged C3D parameter section at byte {start + i}: group id {gid}", p)
+        nxt = struct.unpack(i16, sec[off_at:off_at + 2])[0]
+        j = off_at + 2
+        if gid < 0:
+            if -gid in groups:
+                raise C3DError(f"damaged C3D parameter section: group id {-gid} appears twice", p)
+            groups.add(-gid)
+        else:
+            params.add(gid)
+            typ, ndim = struct.unpack("bB", sec[j:j + 2])
+            dims = sec[j + 2:j + 2 + ndim]
+            if typ not in (-1, 1, 2, 4) or ndim > 7 or len(dims) < ndim:
+                raise C3DError(f"damaged C3D parameter section at byte {start + i}: data type {typ}, {ndim} "
+                               "dimensions", p)
+            j += 2 + ndim + abs(typ) * int(np.prod([int(d) for d in dims]))
+        if j >= len(sec):
+            raise C3DError(f"damaged C3D parameter section at byte {start + i}: a record runs past the section", p)
+        j += 1 + sec[j]                                  # the description
+        if j > len(sec) or (nxt != 0 and (nxt < 2 or j > off_at + nxt)):
+            raise C3DError(f"damaged C3D parameter section at byte {start + i}: a record overlaps the next one", p)
+        if nxt == 0:
+            break
+        i = off_at + nxt
+    if params - groups:
+        raise C3DError(f"damaged C3D parameter section: parameters of undeclared groups {sorted(params - groups)}", p)
+    first, last = (struct.unpack(u16, head[k:k + 2])[0] for k in (6, 8))
+    return last - first + 1 if 0 < first <= last < 65535 else None
+
+
 def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     """Marker trajectories of a C3D file, in metres (world = the lab frame of the file).
 
     Raises
     ------
     C3DError
-        No such file, not a C3D file ezc3d can read, no POINT data, unknown ``POINT:UNITS``
-        (the message lists the known ones), a non-positive rate, duplicate labels.
+        No such file, not a C3D file ezc3d can read (a damaged header or parameter section is
+        found before ezc3d reads it), a truncated file (fewer frames than its header
+        announces), no POINT data, unknown ``POINT:UNITS`` (the message lists the known ones),
+        a non-positive rate, duplicate labels.
     """
     p = Path(path)
     if not p.is_file():
         raise C3DError("C3D file not found" if not p.exists() else "not a file", p)
+    try:
+        announced = _check_structure(p)
+    except OSError as exc:
+        raise C3DError(f"cannot read the file ({exc.strerror or exc})", p) from None
     try:
         import ezc3d
 
@@ -55,6 +127,8 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     pts = np.asarray(c["data"]["points"], dtype=float)
     if pts.ndim != 3 or pts.shape[0] < 3:
         raise C3DError(f"no POINT data (points array of shape {pts.shape})", p)
+    if announced is not None and pts.shape[2] < announced:
+        raise C3DError(f"truncated file: its header announces {announced} frames, it holds {pts.shape[2]}", p)
     labels = list(_param(c, "POINT", "LABELS", []) or [])
     k = 2
     while len(labels) < pts.shape[1] and _param(c, "POINT", f"LABELS{k}") is not None:
