@@ -190,7 +190,7 @@ class DCMotor:
     def continuous_torque(self) -> float:
         """The rated continuous torque at the joint, ``η i tau_cont`` (N·m, motoring)."""
         if self.tau_cont is None:
-            raise ControlError(f"motor {self.name or ''!s} has no tau_cont (rated continuous torque)".replace("  ", " "))
+            raise ControlError(f"motor {self.name!r} has no tau_cont (rated continuous torque, N m)")
         return self.eta * self.i * self.tau_cont
 
     def _voltage(self, V):
