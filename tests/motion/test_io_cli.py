@@ -100,6 +100,16 @@ def test_c3d_truncated_and_damaged_files_are_c3d_errors(tmp_path):
         MarkerTrajectories(["A"], np.zeros((2, 2, 3)))
     with pytest.raises(C3DError, match="folder"):
         write_c3d(tmp_path / "no" / "x.c3d", MarkerTrajectories(["A"], np.ones((3, 1, 3))))
+    with pytest.raises(C3DError, match="is a folder"):
+        write_c3d(tmp_path, MarkerTrajectories(["A"], np.ones((3, 1, 3))))
+    with pytest.raises(C3DError, match="255 bytes"):            # ezc3d writes it, then cannot read it
+        write_c3d(tmp_path / "long.c3d", MarkerTrajectories(["A" * 256], np.ones((3, 1, 3))))
+    assert not (tmp_path / "long.c3d").exists()
+    # a coordinate no lab holds (wrong units, a corrupt sample): its squares would overflow to inf
+    with pytest.raises(MotionDataError, match="marker 'B' in frame 2 .* beyond 1e\\+06 m"):
+        MarkerTrajectories(["A", "B"], np.where(np.arange(12).reshape(2, 2, 3) == 9, 1e200, 1.0).repeat(2, 0))
+    with pytest.raises(MotionDataError, match="wrong units"):
+        marker_ik(aa.load("human_arm7"), np.full((2, 10, 3), 2e6))
     # a zero sample is a gap (old capture systems write (0, 0, 0) for missing markers)
     P = np.ones((4, 2, 3))
     P[1, 0] = 0.0
@@ -144,9 +154,13 @@ def test_csv_degrees_gaps_and_errors(tmp_path, arm):
            "word.csv": "t," + ",".join(names) + "\n0," + ",".join(["x"] * 7) + "\n",
            "short.csv": "t," + ",".join(names) + "\n0,1\n",
            "back.csv": "t," + ",".join(names) + "\n1," + ",".join(["0"] * 7) + "\n0," + ",".join(["0"] * 7) + "\n",
-           "joint.csv": "t,shoulder_flexion\n0,1\n"}
+           "joint.csv": "t,shoulder_flexion\n0,1\n",
+           "inf.csv": "t," + ",".join(names) + "\n0," + ",".join(["0"] * 6 + ["inf"]) + "\n",
+           "overflow.csv": "t," + ",".join(names) + "\n0," + ",".join(["1e400"] + ["0"] * 6) + "\n",
+           "huge.csv": "t," + ",".join(names) + "\n0," + ",".join(["0"] * 7) + "\n1e7," + ",".join(["0"] * 7) + "\n"}
     msgs = {"nohead.csv": "header", "notime.csv": "time column", "word.csv": "line 2", "short.csv": "line 2",
-            "back.csv": "increase", "joint.csv": "missing joint"}
+            "back.csv": "increase", "joint.csv": "missing joint", "inf.csv": "line 2, column 'wrist_flexion'",
+            "overflow.csv": "line 2, column 'shoulder_flexion'", "huge.csv": "line 3, column 't'"}
     for f, body in bad.items():
         (tmp_path / f).write_text(body)
         with pytest.raises(MotionDataError, match=msgs[f]):
@@ -180,6 +194,12 @@ def test_cli_ik_markers(tmp_path, capsys):
     assert rc == 2 and "C3D file not found" in err and err.count("\n") == 1 and not (tmp_path / "x.csv").exists()
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "no" / "x.csv")])
     assert rc == 2 and "existing folder" in capsys.readouterr().err
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path)])        # a folder
+    assert rc == 2 and "give a file name" in capsys.readouterr().err
+    (tmp_path / "garbage.c3d").write_bytes(b"garbage")
+    rc = main(["ik-markers", str(tmp_path / "garbage.c3d"), "--out", str(tmp_path / "g.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "not a C3D file" in err and err.count("\n") == 1 and not (tmp_path / "g.csv").exists()
 
 
 def test_own_marker_set_as_json(tmp_path, arm, markers, capsys):

@@ -172,8 +172,13 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
     import ezc3d
 
     p = Path(path)
+    if p.is_dir():
+        raise C3DError("is a folder: give a file name", p)
     if not p.parent.is_dir():
         raise C3DError(f"folder {p.parent} does not exist", p)
+    long = [n for n in trial.names if len(n.encode("utf-8")) > 255]
+    if long:
+        raise C3DError(f"marker labels longer than 255 bytes cannot be stored in POINT:LABELS: {long[0][:40]!r}...", p)
     c = ezc3d.c3d()
     c["parameters"]["POINT"]["RATE"]["value"] = [trial.rate]
     c["parameters"]["POINT"]["LABELS"]["value"] = list(trial.names)

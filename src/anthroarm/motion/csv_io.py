@@ -9,7 +9,8 @@ number, so any CSV reader takes it.
 
 :func:`read_joint_csv` also accepts ``time`` / ``time_s`` for the time column and joint columns
 with a unit suffix (``_rad``, ``_deg``; degrees are converted), so spreadsheets from other tools
-load too.  A row whose joint values are not finite is a gap: it is marked invalid and holds the
+load too.  An empty or ``nan`` cell is a gap; ``inf`` or a magnitude beyond 1e6 is an error.
+A row whose joint values are not finite is a gap: it is marked invalid and holds the
 previous valid row (the next one before the first), never NaN.
 """
 
@@ -26,6 +27,8 @@ from ..errors import MotionDataError
 from .marker_ik import STATUSES, MarkerIKResult
 
 TIME_COLUMNS = ("t", "time", "time_s")
+#: the largest magnitude :func:`read_joint_csv` takes in a cell (inf and beyond are errors)
+MAX_VALUE = 1e6
 
 
 @dataclass
@@ -88,8 +91,9 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     column except the time and the marker-IK extras is a joint.
 
     Raises :class:`~anthroarm.errors.MotionDataError` naming the file and the line: no such
-    file, no header, no time column, a missing joint, a value that is not a number, a row of the
-    wrong length, times that do not increase, no valid row."""
+    file, no header, no time column, a missing joint, a value that is not a number or is
+    infinite or beyond :data:`MAX_VALUE`, a row of the wrong length, times that do not increase,
+    no valid row."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
@@ -128,9 +132,13 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
         for c, cell in enumerate(cells):
             s = cell.strip()
             try:
-                vals[r, c] = float(s) if s else np.nan
+                x = float(s) if s else np.nan
             except ValueError:
                 raise MotionDataError(f"line {lineno}, column {header[c]!r}: {s!r} is not a number", p) from None
+            if abs(x) > MAX_VALUE:           # inf, or no angle (rad), length (m) or time (s)
+                raise MotionDataError(f"line {lineno}, column {header[c]!r}: {s!r} is beyond {MAX_VALUE:g} (not a "
+                                      "joint value in rad or m, nor a time in s); leave a gap empty or write nan", p)
+            vals[r, c] = x
     t = vals[:, tcol]
     if not np.isfinite(t).all():
         bad = rows[1 + int(np.flatnonzero(~np.isfinite(t))[0])][0]

@@ -55,7 +55,7 @@ from ..errors import MarkerSetError, MotionDataError
 from ..ik import qp
 from ..ik.qp.tasks.marker import MarkerTask
 from .markers import BoundMarkers, MarkerSet, default_marker_set
-from .trial import MarkerTrajectories
+from .trial import MarkerTrajectories, check_coordinates
 
 STATUSES = ("ok", "too_few_markers", "not_converged", "skipped", "large_error")
 
@@ -270,6 +270,7 @@ class MarkerIK:
             if P.ndim != 3 or P.shape[1:] != (len(names), 3):
                 raise MotionDataError(f"marker positions must have shape (frames, {len(names)}, 3) in the order "
                                       f"{list(names)}, got {P.shape}")
+            check_coordinates(P, names)
             P[~np.isfinite(P).all(axis=2)] = np.nan
             N = P.shape[0]
             cols = np.where(np.isfinite(P).all(axis=2).any(axis=0), np.arange(len(names)), -1)

@@ -15,6 +15,20 @@ import numpy as np
 
 from ..errors import MotionDataError
 
+#: the largest marker coordinate accepted, m: beyond it a value is not a position in a lab (wrong
+#: units, a corrupt sample) and its squares would overflow the marker-IK residuals to inf
+MAX_COORDINATE = 1e6
+
+
+def check_coordinates(P: np.ndarray, names, path=None) -> None:
+    """Raise :class:`~anthroarm.errors.MotionDataError` naming the first marker and frame whose
+    finite coordinate exceeds :data:`MAX_COORDINATE` in magnitude (``P`` is (N, M, 3), m)."""
+    big = np.isfinite(P) & (np.abs(np.nan_to_num(P)) > MAX_COORDINATE)
+    if big.any():
+        n, k, _ = np.argwhere(big)[0]
+        raise MotionDataError(f"marker {names[k]!r} in frame {n} is at {P[n, k].tolist()} m, beyond "
+                              f"{MAX_COORDINATE:g} m: not a position in a lab (wrong units?)", path)
+
 
 @dataclass
 class MarkerTrajectories:
@@ -25,7 +39,8 @@ class MarkerTrajectories:
     names : tuple of str
         Marker labels, one per column (unique).
     positions : (N, M, 3) array
-        World positions, m; NaN where a marker is missing.
+        World positions, m; NaN where a marker is missing.  A coordinate beyond
+        :data:`MAX_COORDINATE` (1e6 m) is a :class:`~anthroarm.errors.MotionDataError`.
     rate : float
         Frame rate, Hz (> 0).
     source : str
@@ -54,6 +69,7 @@ class MarkerTrajectories:
                 and self.rate > 0):
             raise MotionDataError(f"frame rate must be a positive number (Hz), got {self.rate!r}", self._path())
         self.rate = float(self.rate)
+        check_coordinates(P, self.names, self._path())
         bad = ~np.isfinite(P).all(axis=2)
         P[bad] = np.nan             # a marker is seen in all three coordinates or missing
         self.positions = P
