@@ -211,7 +211,9 @@ def _sp4_core(h, p, k, d, tol):
     nA = np.linalg.norm(A, axis=-1)
     ab = np.abs(b)
     margin = nA - ab                                   # > 0: two roots; residual of the LS root
-    two = margin > tol
+    # two roots wherever the plane cuts the circle (as IK-Geo's sp_4): a near-tangent pair is
+    # kept as two roots, not merged into one whose error grows like √margin in the angle
+    two = margin > 0.0
     xi = np.sqrt(np.maximum(nA * nA - b * b, 0.0))
     x_ls = A * b[:, None]                               # Aᵀb (a multiple of the LS point)
     jA = np.stack([A[:, 1], -A[:, 0]], -1)              # the null direction of A
@@ -261,8 +263,8 @@ def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
 
         x = (Aᵀ b ± √(‖A‖² − b²) · (A₂, −A₁)ᵀ) / ‖A‖²
 
-    Two solutions when ``‖A‖ − abs(b) > tol``; one (the tangent point, exact) when
-    ``abs(‖A‖ − abs(b)) ≤ tol``; otherwise one least-squares solution θ = atan2 of Aᵀb, which
+    Two solutions when ``‖A‖ > abs(b)``; one (the tangent point, exact) when
+    ``0 ≥ ‖A‖ − abs(b) ≥ −tol``; otherwise one least-squares solution θ = atan2 of Aᵀb, which
     minimises ``abs(hᵀ rot(k, θ) p − d)`` (``exact = False``).  ``singular``: h or p parallel to k
     (the height does not depend on θ; θ = 0 returned, exact when ``abs(b) ≤ tol``).
 
