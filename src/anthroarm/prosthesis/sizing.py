@@ -124,10 +124,13 @@ def _utilisation(motor, gearbox, demands, scale: float) -> dict:
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for t, tau, w, a in demands:
             tau, w, a = scale * tau, scale * w, scale * a
-            worse("voltage", np.max(np.abs(dc.voltage(tau, w, a))) / motor.V_nom)
+            try:
+                worse("voltage", np.max(np.abs(dc.voltage(tau, w, a))) / motor.V_nom)
+            except ControlError:                  # the motor model refuses a torque beyond float range
+                worse("voltage", np.inf)
             try:
                 worse("thermal", dc.thermal_check(t, tau, w, a).ratio)
-            except ControlError:                  # the motor torque overflowed to inf/NaN
+            except ControlError:
                 worse("thermal", np.inf)
             worse("gear_peak", np.max(np.abs(tau)) / gearbox.tau_max)
             worse("gear_rms", rms(t, tau) / gearbox.tau_cont)
