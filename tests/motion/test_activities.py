@@ -112,6 +112,16 @@ def test_parameters_and_payload():
         A.activity("pour", robot, move=float("nan"))
     with pytest.raises(ActivityError, match="height"):
         A.activity("pour", aa.load("prosthetic_arm"))
+    # bad keyframes and rates are refused before any IK is solved
+    for act, needle in ((A.Activity("none", "none", []), "no keyframes"),
+                        (A.Activity("text", "text", [A.Keyframe("k", "abc")]), "3 finite numbers"),
+                        (A.Activity("inf", "inf", [A.Keyframe("k", (0.0, 0.0, np.inf))]), "3 finite numbers"),
+                        (A.Activity("slow", "slow", [A.Keyframe("a", (0.0, 0.3, 0.0)),
+                                                     A.Keyframe("b", (0.0, 0.3, 0.1), move=1e300)]), "samples")):
+        with pytest.raises(ActivityError, match=needle):
+            A.activity_trajectory(robot, act)
+    with pytest.raises(ActivityError, match="rate"):
+        A.activity_trajectory(robot, "pour", rate=0.0)
 
 
 def test_table_9_2_rows_are_covered():

@@ -44,6 +44,9 @@ import numpy as np
 from ..errors import ActivityError
 from .timing import keyframe_trajectory
 
+#: the most samples :func:`activity_trajectory` makes (a bound on the memory a bad rate or duration takes)
+MAX_SAMPLES = 1e7
+
 #: stature fractions (Drillis & Contini 1966, Winter 2009 Fig. 4.1) and this module's estimates
 BODY_PROPORTIONS = {
     "shoulder_height": 0.818, "chin_height": 0.870, "mouth_height": 0.890, "eye_height": 0.936,
@@ -356,13 +359,28 @@ def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False
         raise ActivityError("parameters go with an activity name, not with a built Activity")
     if not isinstance(act, Activity):
         raise ActivityError(f"expected an Activity or a name, got {type(act).__name__}")
+    if not act.keyframes:
+        raise ActivityError(f"activity {act.name!r} has no keyframes")
+    if not (isinstance(rate, (int, float, np.floating, np.integer)) and np.isfinite(rate) and rate > 0):
+        raise ActivityError(f"rate must be a positive number of samples per second, got {rate!r}")
+    for kf in act.keyframes:
+        try:
+            ok = (np.asarray(kf.position, float).shape == (3,) and np.isfinite(kf.position).all()
+                  and np.isfinite(kf.move) and kf.move > 0 and np.isfinite(kf.hold) and kf.hold >= 0)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok:
+            raise ActivityError(f"activity {act.name!r}: keyframe {kf.name!r} needs a target of 3 finite numbers (m), "
+                                f"move > 0 s and hold >= 0 s; got {kf.position!r}, {kf.move!r}, {kf.hold!r}",
+                                keyframe=kf.name)
+    total = sum(kf.move for kf in act.keyframes[1:]) + sum(kf.hold for kf in act.keyframes)
+    if total * rate > MAX_SAMPLES:
+        raise ActivityError(f"activity {act.name!r}: {total:g} s at {rate:g} Hz is more than {MAX_SAMPLES:g} samples; "
+                            "lower the rate or the durations")
     q_prev = comfortable_posture(robot) if q_start is None else robot.check_q(q_start, name="q_start")
     Qk, status, err = [], [], []
     for kf in act.keyframes:
         p = np.asarray(kf.position, float)
-        if p.shape != (3,) or not np.isfinite(p).all():
-            raise ActivityError(f"activity {act.name!r}: keyframe {kf.name!r} target must be 3 finite numbers (m)",
-                                keyframe=kf.name)
         res = ik.solve(robot, p, q0=q_prev, mode="position", posture="auto")
         e = float(np.linalg.norm(robot.fk(res.q)[:3, 3] - p))
         ok = e <= tol
@@ -377,10 +395,6 @@ def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False
     Qk = np.array(Qk)
     durations = np.array([kf.move for kf in act.keyframes], float)
     holds = np.array([kf.hold for kf in act.keyframes], float)
-    for kf in act.keyframes:
-        if not (np.isfinite(kf.move) and kf.move > 0 and np.isfinite(kf.hold) and kf.hold >= 0):
-            raise ActivityError(f"activity {act.name!r}: keyframe {kf.name!r} needs move > 0 s and hold >= 0 s",
-                                keyframe=kf.name)
     t, q, qd, qdd, arrival = keyframe_trajectory(Qk, durations, holds, rate)
     # the object is in the hand from a keyframe flagged holding until the next keyframe not flagged
     holding = np.zeros(len(t), dtype=bool)

@@ -21,18 +21,17 @@ import numpy as np
 def minimum_jerk(x0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, velocity and acceleration of the rest-to-rest minimum-jerk motion from ``x0``
     to ``x1`` (arrays of the same shape) in ``duration`` s, at times ``t`` (clipped to
-    [0, duration]).  Returns arrays of shape ``t.shape + x0.shape``."""
+    [0, duration]).  Returns arrays of shape ``t.shape + x0.shape``.  The formula is
+    :func:`anthroarm.dynamics.hand_model.minimum_jerk` (one source); this adds scalar
+    coordinates."""
+    from ..dynamics.hand_model import minimum_jerk as _minimum_jerk
+
     x0 = np.asarray(x0, float)
-    x1 = np.asarray(x1, float)
     T = float(duration)
     if not (np.isfinite(T) and T > 0):
         raise ValueError(f"duration must be a positive number of seconds, got {duration!r}")
-    tau = np.clip(np.asarray(t, float) / T, 0.0, 1.0)[..., None] if x0.ndim else np.clip(np.asarray(t, float) / T, 0, 1)
-    s = tau ** 3 * (10 - 15 * tau + 6 * tau ** 2)
-    ds = 30 * tau ** 2 * (1 - tau) ** 2 / T
-    dds = 60 * tau * (1 - tau) * (1 - 2 * tau) / T ** 2
-    d = x1 - x0
-    return x0 + s * d, ds * d, dds * d
+    x, v, a = _minimum_jerk(x0, x1, T, t)
+    return (x[..., 0], v[..., 0], a[..., 0]) if x0.ndim == 0 else (x, v, a)
 
 
 def keyframe_trajectory(Q, durations, holds=None, rate: float = 100.0):
