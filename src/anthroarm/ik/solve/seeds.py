@@ -31,7 +31,8 @@ TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
 ALIGN_RANGE = np.pi   # first / last joints spanning at least a half turn are aligned (see Aligned; so101: median 10 % faster)
 ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
 SWIVEL_GRID = np.linspace(-np.pi, np.pi, 24, endpoint=False)  # swivel angles (rad) of a redundant arm's closed-form seeds
-CHEAP_US = 50.0   # a closed form costing at most this (µs, ClosedForm.cost_us) is tried first
+#: a closed form costing at most this (µs, ``ClosedForm.cost_us``) is tried first
+CHEAP_US = 50.0
 
 
 def build_table(sh, data):
