@@ -30,6 +30,60 @@ from .common import time_call
 from .ik_peers import PinCLIK, pose_errors
 
 ARMS = ["sixr_arm", "prosthetic_arm", "human_arm7", "planar2r"]
+#: arms solved by their geometry (ik/geometric.py; panda: its last joint held at the sampled value)
+GEO_ARMS = ["ur5", "kinova", "talos_arm", "panda"]
+
+
+def _geo_rows(name, n_batch, n_single, rng):
+    """analytic batch / single on an arm solved by its geometry, and ik-geo (Rust) on the same
+    poses (its class solver, all branches, no limits or FK check) when it is installed."""
+    from anthroarm.ik import geometric as G
+
+    robot = aa.load(name)
+    gp = G.plan_for(robot)
+    Q = robot.random_q(n_batch, rng)
+    T = robot.fk(Q)
+    kw = {"param": Q[:, 6]} if gp.param_joint is not None else {}
+    res = analytic_batch(robot, T, **kw)
+    t = time_call(lambda: analytic_batch(robot, T, **kw), repeat=3) / n_batch
+    i, b = np.nonzero(res.valid)
+    err = _fk_err(robot, res.solutions[i, b], T[i], False)
+    ok = np.zeros(n_batch, bool)
+    np.logical_or.at(ok, i, err <= 1e-10)
+    viol = 100.0 * (~robot.within_limits(res.solutions[i, b])).mean()
+    cls = gp.cls + (" (reversed)" if gp.reversed else "")
+    rows = [[name, "analytic batch (by geometry)", n_batch, 100.0 * ok.mean(), t * 1e6, float(err.max()), viol,
+             f"{cls}; {res.valid.sum(1).mean():.2f} solutions/pose"]]
+    times, errs, okc = [], [], 0
+    for k in range(n_single):
+        kk = {"param": float(Q[k, 6])} if kw else {}
+        t0 = time.perf_counter()
+        r = analytic(robot, T[k], **kk)
+        times.append(time.perf_counter() - t0)
+        if len(r):
+            e = _fk_err(robot, r.solutions, np.broadcast_to(T[k], (len(r), 4, 4)), False)
+            errs.append(e.max())
+            okc += bool((e <= 1e-10).any())
+    rows.append([name, "analytic single (by geometry)", n_single, 100.0 * okc / n_single,
+                 float(np.median(times)) * 1e6, float(max(errs)), 0.0, f"{cls}; numpy class solver + FK check"])
+    try:
+        import ik_geo
+    except ImportError:
+        return rows
+    if gp.param_joint is None:
+        geo = getattr(ik_geo.Robot, gp.cls)(gp.H.tolist(), gp.P.tolist())
+        tt = []
+        for k in range(n_single):
+            R, p = T[k, :3, :3], T[k, :3, 3]
+            if gp.reversed:
+                R, p = R.T, -R.T @ p
+            a = ((R @ gp.R_tool.T).T.tolist(), p.tolist())
+            t0 = time.perf_counter()
+            geo.get_ik(*a)
+            tt.append(time.perf_counter() - t0)
+        rows.append([name, "ik-geo single (Rust, same class)", n_single, "", float(np.median(tt)) * 1e6, "", "",
+                     "all branches, no limits, no FK check"])
+    return rows
 
 
 def _fk_err(robot, sols, T, position_only):
@@ -111,6 +165,8 @@ def run(quick: bool = False) -> dict:
                 viol_c += not bool(robot.within_limits(q))
             rows.append([name, "pin CLIK recipe", n_clik, 100.0 * succ / n_clik, float(np.median(tt)) * 1e6, "",
                          100.0 * viol_c / n_clik, "DLS damp 1e-6, DT 0.1, 1000 it, seed = comfortable posture"])
+    for name in GEO_ARMS:
+        rows.extend(_geo_rows(name, n_batch, n_single, rng))
     # cell method lookup (prosthetic arm, hand horizontal-forward, D = 50 mm)
     robot = aa.load("prosthetic_arm")
     R = np.array([[0.0, 0, 1], [-1, 0, 0], [0, -1, 0]])
