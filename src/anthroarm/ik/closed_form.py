@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import functools
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,6 +64,7 @@ from . import analytic_scalar as ks
 from . import analytic_soa as _soa
 from . import geometric as _geo
 from .analytic_plan import cached_plan, plan_for
+from .fk_codegen import FKStages
 from .qp.tasks.swivel import swivel_basis
 
 TWO_PI = 2.0 * np.pi
@@ -694,6 +696,30 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None,
                                residuals=np.where(valid, res, np.nan), singular=sing, model=robot.name)
 
 
+_GEO_FK: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _geo_fk_residual(robot, gp, th, Q, Ts):
+    """max |FK − T| over the 3×4 pose entries of candidates θ (N, B, n) (independent-joint
+    order; Q the configurations): Pinocchio for a few, else the chain product generated from
+    ``robot.chain`` (:class:`.fk_codegen.FKStages`, cached per robot)."""
+    N, B = th.shape[:2]
+    hit = _GEO_FK.get(robot)
+    if N * B > 64 and (hit is None or hit[0] is not robot.chain or hit[1] != robot.tool):
+        try:
+            fk = FKStages(robot.chain, (), frame=robot.tool)
+        except NotImplementedError:              # e.g. continuous joints: Pinocchio / chain FK
+            fk = None
+        hit = (robot.chain, robot.tool, fk)
+        _GEO_FK[robot] = hit
+    if N * B <= 64 or hit[2] is None:
+        return _fk_residual(robot, Q, Ts, False)
+    path = np.argsort(gp.order)                     # path position p holds independent joint path[p]
+    ang = [np.ascontiguousarray(np.nan_to_num(th[..., k]).T) for k in path]      # (B, N) each
+    rows = tuple(Ts[:, i, j] for i in range(3) for j in range(4))
+    return np.broadcast_to(hit[2].numpy[0](*ang, rows), (B, N)).T
+
+
 def _no_param(robot, param):
     if param is not None:
         raise ValueError(f"{robot.name}: param= is for a 7-joint arm solved by its geometry (its last joint "
@@ -738,7 +764,7 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
     thw, inside = _wrap_into_limits(th, gp.lower, gp.upper)
     finite = np.isfinite(thw).all(-1)
     Q = ch.configuration(np.where(finite[..., None], thw, 0.0))
-    res = np.where(finite, _fk_residual(robot, Q, Ts, False), np.inf)
+    res = np.where(finite, _geo_fk_residual(robot, gp, thw, Q, Ts), np.inf)
     # an arm of its class only within the classification tolerance (e.g. rounded URDF angles):
     # polish its near-exact candidates on the FK error (joint layout = angles only)
     near = cand & exact & inside & finite & (res > tol) & (res <= POLISH_MAX)
