@@ -194,3 +194,27 @@ def test_swapped_labels_give_large_error_frames(arm, markers):
     res = marker_ik(arm, P, markers)
     assert (res.status[10:13] == "large_error").all() and (res.rms[10:13] > 0.02).all()
     assert (res.status[13:] == "ok").all() and np.abs(res.q[13:] - Q[13:]).max() < 1e-4
+
+
+def test_default_set_is_the_models_table_scaled_by_chain_lengths():
+    """The landmark table lives in models.human; its fractions times the segment lengths the
+    builder used (spec.params l1, l2, l3) give the set, for human_arm7 and for human_upper_limb
+    (whose hand also carries finger joints: the hand's length ends at its hand point, the tool)."""
+    import anthroarm as aa
+    from anthroarm.models.human import HUMAN_ARM_LANDMARKS
+    from anthroarm.motion import default_marker_set, human_arm_markers, segment_length
+
+    for name in ("human_arm7", "human_upper_limb"):
+        robot = aa.load(name, height=1.62, mass=55, sex="female")
+        p = robot.spec.params
+        L = {"base_link": p["l1"], "upper_arm": p["l1"], "forearm": p["l2"], "hand": p["l3"]}
+        ms = default_marker_set(robot)
+        assert ms.names == tuple(HUMAN_ARM_LANDMARKS)
+        for m in ms:
+            body, frac, _w, _d = HUMAN_ARM_LANDMARKS[m.name]
+            np.testing.assert_allclose(m.position, np.array(frac) * L[body], atol=1e-15)
+    # with the tool on a finger the hand branches to five joints at different distances: ambiguous
+    with pytest.raises(MarkerSetError, match="ambiguous"):
+        segment_length(aa.load("human_upper_limb", tool="index_tip"), "hand")
+    with pytest.raises(MarkerSetError, match="needs the links"):
+        human_arm_markers(aa.load("prosthetic_arm"))

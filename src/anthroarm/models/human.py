@@ -116,6 +116,35 @@ HUMAN_ARM7_COMFORT = {
 }
 
 
+#: Skin markers of the human arm model at the bony landmarks the ISB recommendation names (Wu et
+#: al. 2005, "ISB recommendation on definitions of joint coordinate systems ... Part II: shoulder,
+#: elbow, wrist and hand", J. Biomech. 38(5), 981-992): acromion AC, lateral/medial epicondyle
+#: EL/EM, radial/ulnar styloid RS/US, heads of the 2nd, 3rd and 5th metacarpals MC2/MC3/MC5, plus
+#: a technical marker on the lateral upper arm (UA) and one on the dorsal forearm (FA).
+#: name -> (link, (x, y, z) as fractions of that link's segment length, weight, description), in
+#: the links' frames of :func:`human_arm7` (x lateral, y anterior, z up; at q = 0 the arm hangs
+#: along -z with the palm forward, so the styloids and metacarpal heads lie on +-x).  Markers on
+#: ``base_link`` (the trunk) scale with :data:`HUMAN_ARM_TRUNK_SCALE_LINK`.  The fractions are
+#: typical skin-surface offsets from the joint centres (epicondylar width ~70 mm, wrist width
+#: ~57 mm, metacarpal breadth ~60 mm for a 1.75 m man: segment lengths 283, 270, 87 mm), not
+#: measured on a person.  Read by :func:`anthroarm.motion.markers.default_marker_set`.
+HUMAN_ARM_LANDMARKS = {
+    "AC": ("base_link", (0.106, 0.0, 0.159), 1.0, "acromion (on the trunk: fixed, used for scaling)"),
+    "UA": ("upper_arm", (0.160, 0.0, -0.50), 1.0, "lateral upper arm, mid-shaft (technical marker)"),
+    "EL": ("upper_arm", (0.113, 0.0, -1.0), 1.0, "lateral epicondyle of the humerus"),
+    "EM": ("upper_arm", (-0.134, 0.0, -1.0), 1.0, "medial epicondyle of the humerus"),
+    "FA": ("forearm", (0.0, -0.130, -0.50), 1.0, "dorsal forearm, mid-shaft (technical marker)"),
+    "RS": ("forearm", (0.111, 0.0, -1.0), 1.0, "radial styloid"),
+    "US": ("forearm", (-0.100, 0.0, -1.0), 1.0, "ulnar styloid"),
+    "MC2": ("hand", (0.280, -0.120, -0.97), 1.0, "head of the 2nd metacarpal (dorsal)"),
+    "MC3": ("hand", (0.0, -0.120, -1.0), 1.0, "head of the 3rd metacarpal (dorsal)"),
+    "MC5": ("hand", (-0.400, -0.120, -0.88), 1.0, "head of the 5th metacarpal (dorsal)"),
+}
+
+#: the link whose segment length scales the trunk (``base_link``) markers of :data:`HUMAN_ARM_LANDMARKS`
+HUMAN_ARM_TRUNK_SCALE_LINK = "upper_arm"
+
+
 #: the segments of :data:`DE_LEVA_1996` and the links of :func:`human_arm7` that carry them
 SEGMENT_LINKS = {"upperarm": "upper_arm", "forearm": "forearm", "hand": "hand"}
 

@@ -5,22 +5,13 @@ a link, a joint frame, the tool), given by its position in that frame (m).  A
 :class:`MarkerSet` is an ordered list of markers with unique names and weights (the w_i of the
 marker IK residual Σ w_i ‖p_i(q) − m_i‖², see :mod:`anthroarm.motion.marker_ik`).
 
-:func:`human_arm_markers` is the default set of the human arm model
-(:mod:`anthroarm.models.human`, bodies ``upper_arm``, ``forearm``, ``hand``) at the bony
-landmarks the ISB recommendation names (Wu et al. 2005, "ISB recommendation on definitions of
-joint coordinate systems ... Part II: shoulder, elbow, wrist and hand", J. Biomech. 38(5),
-981–992): acromion AC, lateral/medial epicondyle EL/EM, radial/ulnar styloid RS/US, heads of
-the 2nd, 3rd and 5th metacarpals MC2/MC3/MC5, plus one technical marker on the lateral upper arm
-(UA) and one on the dorsal forearm (FA): 10 markers, 9 on moving bodies.
-
-Frames and units: the model's segment frames (x lateral, y anterior, z up; at q = 0 the arm hangs
-along −z with the palm forward, which is why wrist flexion is about x and the styloids and the
-metacarpal heads lie on ±x).  Positions are stored as fractions of the segment length (joint
-centre to next joint centre; wrist to 3rd metacarpale for the hand, de Leva 1996) so that the
-set follows the person's size; the fractions correspond to the millimetres below for a 1.75 m
-man (segment lengths 283, 270, 87 mm).  They are typical skin-surface offsets from the joint
-centres (epicondylar width ≈ 70 mm, wrist width ≈ 57 mm, metacarpal breadth ≈ 60 mm), not
-measured on a person: a lab with its own protocol supplies its own set
+:func:`human_arm_markers` is the default set of a person's arm model
+(:mod:`anthroarm.models.human`, bodies ``upper_arm``, ``forearm``, ``hand``): ten markers at the
+ISB landmarks (Wu et al. 2005, J. Biomech. 38(5), 981–992), 9 on moving bodies.  The table is
+model knowledge and lives with the model (:data:`anthroarm.models.human.HUMAN_ARM_LANDMARKS`:
+link, position as fractions of the link's segment length, weight); this module scales it to the
+robot's segment lengths read from ``robot.chain`` (:func:`segment_length`) and checks that the
+links exist as frames.  A lab with its own protocol supplies its own set
 (:meth:`MarkerSet.from_dict`, :meth:`MarkerSet.read_json`).
 """
 
@@ -34,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MarkerSetError, UnconstrainedJointError, UnknownFrameError
+from ..models.human import HUMAN_ARM_LANDMARKS, HUMAN_ARM_TRUNK_SCALE_LINK
 
 
 @dataclass(frozen=True)
@@ -47,23 +39,6 @@ class Marker:
     weight: float = 1.0
 
 
-#: The default human-arm landmarks: name -> (body, (x, y, z) as fractions of that body's
-#: segment length, weight, description).  See the module docstring for the geometry.
-HUMAN_ARM_LANDMARKS = {
-    "AC": ("base_link", (0.106, 0.0, 0.159), 1.0, "acromion (on the trunk: fixed, used for scaling)"),
-    "UA": ("upper_arm", (0.160, 0.0, -0.50), 1.0, "lateral upper arm, mid-shaft (technical marker)"),
-    "EL": ("upper_arm", (0.113, 0.0, -1.0), 1.0, "lateral epicondyle of the humerus"),
-    "EM": ("upper_arm", (-0.134, 0.0, -1.0), 1.0, "medial epicondyle of the humerus"),
-    "FA": ("forearm", (0.0, -0.130, -0.50), 1.0, "dorsal forearm, mid-shaft (technical marker)"),
-    "RS": ("forearm", (0.111, 0.0, -1.0), 1.0, "radial styloid"),
-    "US": ("forearm", (-0.100, 0.0, -1.0), 1.0, "ulnar styloid"),
-    "MC2": ("hand", (0.280, -0.120, -0.97), 1.0, "head of the 2nd metacarpal (dorsal)"),
-    "MC3": ("hand", (0.0, -0.120, -1.0), 1.0, "head of the 3rd metacarpal (dorsal)"),
-    "MC5": ("hand", (-0.400, -0.120, -0.88), 1.0, "head of the 5th metacarpal (dorsal)"),
-}
-
-#: the body whose length scales the trunk markers of :data:`HUMAN_ARM_LANDMARKS`
-_TRUNK_SCALE_BODY = "upper_arm"
 
 
 class MarkerSet:
@@ -321,53 +296,55 @@ class BoundMarkers:
 
 
 def segment_length(robot, body: str) -> float:
-    """Length (m) of the segment carried by frame ``body``: the distance from its joint to the
-    next joint on the chain, or to the tool frame when no joint follows (read from
-    ``robot.chain``)."""
+    """Length (m) of the segment carried by frame ``body``, read from ``robot.chain``: the
+    distance from its joint to the tool frame when the tool is on this segment (a hand ends at
+    its hand point even when finger joints branch off it), else to the next joint (past
+    co-located virtual joints), else to the farthest frame fixed to it.  A segment whose child
+    joints lie at different distances is ambiguous: :class:`~anthroarm.errors.MarkerSetError`."""
     chain = robot.chain
     f = chain.frame(body)
     if f.joint < 0:
         raise MarkerSetError(f"{body!r} is fixed to the base of {robot.name}: it has no segment length")
-    kids = chain.children(f.joint)
-    tr = None
-    for k in kids:
-        t = np.asarray(chain.joints[k].translation)
-        if np.linalg.norm(t) > 0:
-            tr = t
-            break
-        # a co-located virtual joint: follow it to the next offset on the chain
-        for kk in chain.children(k):
-            t = np.asarray(chain.joints[kk].translation)
-            if np.linalg.norm(t) > 0:
-                tr = t
-                break
-        if tr is not None:
-            break
-    if tr is None:
-        offs = [np.linalg.norm(g.translation) for g in chain.frames
-                if g.joint == f.joint and np.linalg.norm(g.translation) > 0]
-        if not offs:
-            raise MarkerSetError(f"{body!r} of {robot.name}: no joint or frame below it to measure a length")
-        tr = np.array([max(offs), 0.0, 0.0])
-    return float(np.linalg.norm(tr))
+    tool = chain.frame(chain.tool)
+    if tool.joint == f.joint and np.linalg.norm(tool.translation) > 0:
+        return float(np.linalg.norm(tool.translation))
+    ends = []
+    for k in chain.children(f.joint):
+        t = np.linalg.norm(chain.joints[k].translation)
+        if t == 0:      # a co-located virtual joint: follow it to the next offset on the chain
+            t = next((d for d in (np.linalg.norm(chain.joints[kk].translation) for kk in chain.children(k)) if d > 0), 0.0)
+        if t > 0:
+            ends.append((float(t), chain.joints[k].name))
+    if ends:
+        if max(e for e, _ in ends) - min(e for e, _ in ends) > 1e-9:
+            raise MarkerSetError(f"{body!r} of {robot.name} branches to joints at different distances "
+                                 f"({', '.join(f'{n} {e:.4f} m' for e, n in ends)}): its segment length is ambiguous; "
+                                 "give the marker positions in m (MarkerSet)")
+        return ends[0][0]
+    offs = [np.linalg.norm(g.translation) for g in chain.frames if g.joint == f.joint]
+    if not offs or max(offs) == 0:
+        raise MarkerSetError(f"{body!r} of {robot.name}: no joint or frame below it to measure a length")
+    return float(max(offs))
 
 
 def human_arm_markers(robot, landmarks: dict | None = None) -> MarkerSet:
-    """The default marker set of the human arm model (:data:`HUMAN_ARM_LANDMARKS`), scaled to
-    ``robot``'s segment lengths (:func:`segment_length` of ``upper_arm``, ``forearm``,
-    ``hand``; trunk markers by the upper arm's).  ``landmarks`` replaces the table (same form).
-    A robot without those bodies raises :class:`~anthroarm.errors.MarkerSetError`."""
+    """The default marker set of the human arm model
+    (:data:`anthroarm.models.human.HUMAN_ARM_LANDMARKS`), scaled to ``robot``'s segment lengths
+    (:func:`segment_length` of each link; markers on a frame fixed to the base by the length of
+    :data:`~anthroarm.models.human.HUMAN_ARM_TRUNK_SCALE_LINK`).  ``landmarks`` replaces the
+    table (same form).  A robot without those links raises
+    :class:`~anthroarm.errors.MarkerSetError`."""
     table = HUMAN_ARM_LANDMARKS if landmarks is None else landmarks
     lengths = {}
     out = []
     for name, (body, frac, w, _desc) in table.items():
-        scale_body = body if body != "base_link" else _TRUNK_SCALE_BODY
-        if scale_body not in lengths:
-            try:
+        try:
+            scale_body = HUMAN_ARM_TRUNK_SCALE_LINK if robot.chain.frame(body).joint < 0 else body
+            if scale_body not in lengths:
                 lengths[scale_body] = segment_length(robot, scale_body)
-            except UnknownFrameError:
-                raise MarkerSetError(f"the human-arm marker set needs a body {scale_body!r}; {robot.name} has frames "
-                                     f"{', '.join(robot.frame_names)}: give your own MarkerSet") from None
+        except UnknownFrameError as exc:
+            raise MarkerSetError(f"the human-arm marker set needs the links {sorted({b for b, *_ in table.values()})} "
+                                 f"({exc}): give your own MarkerSet") from None
         out.append(Marker(name, body, tuple(float(v) * lengths[scale_body] for v in frac), w))
     return MarkerSet(out, name="human_arm_isb10")
 
