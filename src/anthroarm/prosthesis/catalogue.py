@@ -152,7 +152,7 @@ def _rows(path, columns):
     return out
 
 
-#: largest value of any catalogue number, in its column's unit (rpm, g, mNm, ...): beyond it a
+#: largest value of any catalogue number in its column's own unit, e.g. rpm or g; beyond it a
 #: value is a typo, and the sizing's equations would overflow
 UPPER = 1e6
 
