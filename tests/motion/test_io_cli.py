@@ -147,7 +147,8 @@ def test_csv_degrees_gaps_and_errors(tmp_path, arm):
     lines.append("0.2," + ",".join(["30"] * 7))
     (tmp_path / "d.csv").write_text("\n".join(lines) + "\n")
     tr = read_joint_csv(tmp_path / "d.csv", arm)
-    np.testing.assert_allclose(tr.q[0], np.deg2rad(10)) and np.testing.assert_allclose(tr.q[2], np.deg2rad(30))
+    np.testing.assert_allclose(tr.q[0], np.deg2rad(10), rtol=1e-15)
+    np.testing.assert_allclose(tr.q[2], np.deg2rad(30), rtol=1e-15)
     assert tr.valid.tolist() == [True, False, True]
     np.testing.assert_allclose(tr.q[1], tr.q[0])                  # held, not NaN
     bad = {"nohead.csv": "# only a comment\n", "notime.csv": "a,b\n1,2\n",
