@@ -85,6 +85,8 @@ def test_cli_size_end_to_end(tmp_path, capsys):
     (["--payload", "-1"], "payload"),
     (["--activities", "nope.npz"], "no such"),
     (["--motors", "missing.csv"], "not found"),
+    (["--model", "prosthetic_arm"], "person models: "),          # a book arm not scaled by a person
+    (["--model", "ur5"], "person models"),
 ])
 def test_cli_size_bad_input(tmp_path, capsys, args, words, monkeypatch):
     monkeypatch.chdir(tmp_path)

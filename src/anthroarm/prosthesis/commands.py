@@ -25,7 +25,8 @@ def add_parser(sub):
                     "model of Eq. (9-1)), the book's weight rules, and a self-contained HTML report.",
         epilog="example: anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 "
                "--out report.html")
-    p.add_argument("--model", default="human_arm7", help="arm model (default human_arm7, scaled to the person)")
+    p.add_argument("--model", default="human_arm7",
+                   help="a catalog model built from a person's height, mass and sex (default human_arm7)")
     p.add_argument("--height", type=float, default=1.75, help="body height, m (default 1.75)")
     p.add_argument("--mass", type=float, default=70.0, help="body mass, kg (default 70)")
     p.add_argument("--sex", default="male", choices=["male", "female"])
@@ -113,6 +114,23 @@ def activities_from(spec: str, robot, payload: float) -> list[dict]:
     return [_read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
 
 
+def _person_params(a) -> dict:
+    """height, mass and sex for a catalog model whose builder scales a person; anything else
+    cannot be sized for a person: a one-line error naming the person models."""
+    import inspect
+
+    from .. import models
+    from ..cli import UserError
+
+    builder = models.BOOK_MODELS.get(a.model)
+    person = [n for n, b in models.BOOK_MODELS.items()
+              if {"height", "mass", "sex"} <= set(inspect.signature(b).parameters)]
+    if builder is None or a.model not in person:
+        raise UserError(f"--model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
+                        f"person models: {', '.join(sorted(person))}")
+    return dict(height=a.height, mass=a.mass, sex=a.sex)
+
+
 def cmd_size(a) -> int:
     import numpy as np
 
@@ -132,7 +150,7 @@ def cmd_size(a) -> int:
         if not (np.isfinite(v) and lo <= v <= hi):
             raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
     cat = catalogue.load(a.motors, a.gearboxes)
-    robot = _load_model(a.model, dict(height=a.height, mass=a.mass, sex=a.sex))
+    robot = _load_model(a.model, _person_params(a))
     acts = activities_from(a.activities, robot, a.payload)
     bar = _progress(len(acts) + robot.nv, "size", not a.no_progress)
 
