@@ -268,3 +268,12 @@ def test_crosscheck_rows_pass():
     assert len(rows) >= 8
     bad = [(r.quantity, r.max_abs_err, r.note) for r in rows if not r.ok]
     assert not bad, bad
+
+
+def test_a_visual_shape_urdf_cannot_draw_is_a_parameter_error():
+    from anthroarm.models.spec import Shape, to_urdf
+
+    spec = aa.models.spec("human_upper_limb")
+    spec.joints[-1].link.shapes = (Shape("cone", (0.01,)),)
+    with pytest.raises(ParameterError, match="box, cylinder or sphere"):
+        to_urdf(spec)

@@ -26,7 +26,7 @@ Load a fingertip as the tool with ``aa.load("human_upper_limb", tool="index_tip"
 from __future__ import annotations
 
 from ..spatial.rotations import homogeneous
-from .hand import (BREADTH_RATIO, BUCHHOLZ_1992, hand_chain, hand_dimensions, palm_link,
+from .hand import (BREADTH_RATIO, BUCHHOLZ_1992, _number, hand_chain, hand_dimensions, palm_link,
                    parse_coupling)
 from .human import human_arm7, segment_parameters
 from .spec import ChainSpec
@@ -65,8 +65,6 @@ def human_upper_limb(height: float = 1.75, mass: float = 75.0, sex: str = "male"
     l_forearm = seg["forearm"]["length"]
     l_hand_deleva = seg["hand"]["length"]
     HL = l_hand_deleva / BUCHHOLZ_1992["middle"][0] if hand_length is None else hand_length
-    from .hand import _number
-
     HL = _number("hand_length", HL)
     HB = BREADTH_RATIO * HL if hand_breadth is None else hand_breadth
     dims = hand_dimensions(HL, HB, forearm_length=l_forearm, stature=float(height))

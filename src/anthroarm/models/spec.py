@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotations import homogeneous, rotation_between
 
 #: Default linear density (kg/m) and radius (m) of the book arms' links, which print no masses:
@@ -296,7 +297,7 @@ def _shape(s: Shape, indent: str) -> str:
     elif s.kind == "sphere":
         geom = f'<sphere radius="{_num(s.size[0])}"/>'
     else:
-        raise ValueError(f"shape kind must be box, cylinder or sphere, got {s.kind!r}")
+        raise ParameterError(f"shape kind must be box, cylinder or sphere, got {s.kind!r}")
     return (f"{indent}<visual>\n{_origin(np.asarray(s.origin, float), indent + '  ')}"
             f"{indent}  <geometry>{geom}</geometry>\n"
             f"{indent}  <material name=\"{s.material}\"><color rgba=\"{_vec(s.rgba)}\"/></material>\n{indent}</visual>\n")
