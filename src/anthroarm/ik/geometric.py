@@ -20,6 +20,7 @@ class (:mod:`.classify`)                  decomposition                         
 ``spherical_two_intersecting``            q3 SP3, (q1, q2) SP2; wrist as above   2 × 2 × 2
 ``three_parallel_two_intersecting``       q1 SP4, q5 SP4, q2 + q3 + q4 and q6    2 × 2 × 2
                                           SP1, q3 SP3, q2 SP1, q4 by difference
+``spherical``                             (q1, q2, q3) SP5 (quartic); the wrist   4 × 2
 ========================================  =====================================  ==========
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
@@ -43,20 +44,25 @@ from . import classify as C
 from . import subproblems as sp
 
 #: the classes solved here in closed form (the others: use aa.ik.solve)
-SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING)
+SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
+          C.SPHERICAL)
 
+#: per class: (the unknowns of each branching subproblem, its number of roots), outermost first
 _LABELS = {
-    C.SPHERICAL_TWO_PARALLEL: ("q1", "q3", "q5"),
-    C.SPHERICAL_TWO_INTERSECTING: ("q3", "q1q2", "q5"),
-    C.THREE_PARALLEL_TWO_INTERSECTING: ("q1", "q5", "q3"),
+    C.SPHERICAL_TWO_PARALLEL: (("q1", 2), ("q3", 2), ("q5", 2)),
+    C.SPHERICAL_TWO_INTERSECTING: (("q3", 2), ("q1q2", 2), ("q5", 2)),
+    C.THREE_PARALLEL_TWO_INTERSECTING: (("q1", 2), ("q5", 2), ("q3", 2)),
+    C.SPHERICAL: (("q1q2q3", 4), ("q5", 2)),
 }
 
 
 def branch_labels(cls: str) -> tuple[str, ...]:
-    """The 8 branch labels of a class: which root of each of its three two-root subproblems
+    """The 8 branch labels of a class: which root of each of its branching subproblems
     (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …)."""
-    a, b, c = _LABELS[cls]
-    return tuple(f"{a}={i},{b}={j},{c}={k}" for i in range(2) for j in range(2) for k in range(2))
+    out = [""]
+    for name, k in _LABELS[cls]:
+        out = [f"{o},{name}={i}".lstrip(",") for o in out for i in range(k)]
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -99,7 +105,7 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     1–2: p12 = 0; intersecting 5–6: p56 = 0).  ``H`` (6, 3), ``points`` (6, 3) one point of
     each axis, ``p_tool`` (3,) the tool position at q = 0 (base frame, m)."""
     o = np.array(points, dtype=float)
-    groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)],
+    groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)], C.SPHERICAL: [(3, 4, 5)],
               C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
               C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)]}[cls]
     for g in groups:
@@ -277,7 +283,21 @@ def _three_parallel_two_intersecting(H, P, R06, p):
     return q, ok & v3, ex & e3 & s2.exact[:, 0]
 
 
-_SOLVERS = {C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
+def _spherical(H, P, R06, p):
+    """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
+    quartic, up to 4), then the wrist."""
+    n = len(p)
+    p16 = p - R06 @ P[6] - P[0]
+    s = sp.sp5(-_b(P[1], n), p16, _b(P[2], n), _b(P[3], n), -_b(H[0], n), _b(H[1], n), _b(H[2], n))
+    q1, q2, q3 = (np.nan_to_num(s.theta[:, :, j]).reshape(-1) for j in range(3))
+    ok, ex = s.valid.reshape(-1), s.exact.reshape(-1)
+    R06 = np.repeat(R06, 4, axis=0)
+    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
+    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok, ex, q1, q2, q3)
+    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
+
+
+_SOLVERS = {C.SPHERICAL: _spherical, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
             C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
             C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting}
 
