@@ -203,6 +203,8 @@ def test_configuration_rejects_an_inconsistent_dip():
         configuration(spec, {"index_knuckle": 0.1})
     with pytest.raises(ParameterError):
         configuration(spec, {"index_pip": float("nan")})
+    with pytest.raises(ParameterError, match="dict"):
+        configuration(spec, [0.9, 0.6])
 
 
 @pytest.mark.parametrize("kw, match", [

@@ -62,6 +62,7 @@ Units: m, kg, rad.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from fractions import Fraction
 from numbers import Real
 
@@ -299,6 +300,8 @@ def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
     order of ``spec.joints`` without the mimic joints, which is Pinocchio's for these trees."""
     from ..errors import CouplingError
 
+    if not isinstance(angles, Mapping):
+        raise ParameterError(f"{spec.name}: angles must be a dict joint name -> rad, got {type(angles).__name__}")
     by_name = {j.name: j for j in spec.joints}
     unknown = [n for n in angles if n not in by_name]
     if unknown:
