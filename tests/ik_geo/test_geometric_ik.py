@@ -57,6 +57,8 @@ def random_arm(tmp_path, cls, seed):
         alpha, a, d = [A(), A(), A(), A(), A(), A()], [0, L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
     elif cls == C.SPHERICAL:                       # a spherical wrist, nothing else (SP5 quartic)
         alpha, a, d = [A(), A(), A(), A(), A(), A()], [L(), L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
+    elif cls == C.THREE_PARALLEL:                  # 2 ∥ 3 ∥ 4 alone (SP6 quartic)
+        alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), L(), L()], [L(), L(), L(), L(), L(), L()]
     else:                                          # 2 ∥ 3 ∥ 4 (α2 = α3 = 0), 5 × 6 (a5 = 0)
         alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), 0, L()], [L(), L(), L(), L(), L(), L()]
     return dh_urdf(tmp_path, f"user_{cls}_{seed}", alpha, a, d)
@@ -153,9 +155,9 @@ def test_branch_counts_and_values_equal_ik_geo(tmp_path):
             assert len(ours) == len(theirs), label
             counts.append(len(ours))
             dd = np.abs(np.angle(np.exp(1j * (ours[:, None] - theirs[None])))).max(-1)
-            # spherical: the quartic's roots; ik-geo's are not polished (FK error up to ~1e-10,
+            # spherical, three_parallel: the quartic's roots; ik-geo's are not polished (FK error up to ~1e-10,
             # ours ~1e-15: test_every_branch_fk_verified), so they agree to ~1e-7 rad
-            atol = 1e-6 if gp.cls == C.SPHERICAL else 1e-8
+            atol = 1e-6 if gp.cls in (C.SPHERICAL, C.THREE_PARALLEL) else 1e-8
             assert dd.min(1).max() < atol and dd.min(0).max() < atol, label
         if label.startswith("ur") or label in ("kinova", "puma560", "sixr_arm"):
             assert max(counts) == 8

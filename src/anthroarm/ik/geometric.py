@@ -21,6 +21,7 @@ class (:mod:`.classify`)                  decomposition                         
 ``three_parallel_two_intersecting``       q1 SP4, q5 SP4, q2 + q3 + q4 and q6    2 × 2 × 2
                                           SP1, q3 SP3, q2 SP1, q4 by difference
 ``spherical``                             (q1, q2, q3) SP5 (quartic); the wrist   4 × 2
+``three_parallel``                        (q1, q5) SP6 (quartic); then as above   4 × 2
 ========================================  =====================================  ==========
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
@@ -45,7 +46,7 @@ from . import subproblems as sp
 
 #: the classes solved here in closed form (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
-          C.SPHERICAL)
+          C.SPHERICAL, C.THREE_PARALLEL)
 
 #: per class: (the unknowns of each branching subproblem, its number of roots), outermost first
 _LABELS = {
@@ -53,6 +54,7 @@ _LABELS = {
     C.SPHERICAL_TWO_INTERSECTING: (("q3", 2), ("q1q2", 2), ("q5", 2)),
     C.THREE_PARALLEL_TWO_INTERSECTING: (("q1", 2), ("q5", 2), ("q3", 2)),
     C.SPHERICAL: (("q1q2q3", 4), ("q5", 2)),
+    C.THREE_PARALLEL: (("q1q5", 4), ("q3", 2)),
 }
 
 
@@ -107,7 +109,7 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     o = np.array(points, dtype=float)
     groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)], C.SPHERICAL: [(3, 4, 5)],
               C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
-              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)]}[cls]
+              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)], C.THREE_PARALLEL: []}[cls]
     for g in groups:
         c = _common_point(H[list(g)], o[list(g)])
         for i in g:
@@ -253,27 +255,22 @@ def _spherical_two_intersecting(H, P, R06, p):
     return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
 
 
-def _three_parallel_two_intersecting(H, P, R06, p):
-    n = len(p)
-    # h3, h4 are ±h2: rot(h3, q3) = rot(h2, s3 q3)
+def _three_parallel_tail(H, P, R06, p06, q1, q5, ok, ex):
+    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (M problems → 2M): θ14 = q2 + q3 + q4 and q6 by
+    SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by difference.  h3, h4 may be −h2:
+    rot(h3, q3) = rot(h2, ±q3)."""
+    n = len(q1)
     s3n, s4n = np.sign(H[1] @ H[2]), np.sign(H[1] @ H[3])
-    p06 = p - R06 @ P[6] - P[0]
-    s1 = sp.sp4(_b(H[1], n), p06, -_b(H[0], n), np.full(n, H[1] @ P[1:5].sum(0)))
-    q1, ok, ex, p06, R06 = _fan(s1, p06, R06)
-    n *= 2
-    R01t = sp.rot(H[0], -q1)
-    R06h6 = R06 @ H[5]
-    s5 = sp.sp4(_b(H[1], n), _b(H[5], n), _b(H[4], n), np.einsum("i,nij,nj->n", H[1], R01t, R06h6))
-    q5, v5, e5, q1, ok, ex, p06, R06, R01t, R06h6 = _fan(s5, q1, ok, ex, p06, R06, R01t, R06h6)
-    n *= 2
     h2, h5, h6 = _b(H[1], n), _b(H[4], n), _b(H[5], n)
-    s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R01t, R06h6), h2)
+    R01t = sp.rot(H[0], -q1)
+    s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,njk,k->ni", R01t, R06, H[5]), h2)
     th14 = s14.theta[:, 0, 0]
     R01h2 = np.einsum("nji,j->ni", R01t, H[1])
     s6 = sp.sp1(sp._rotate(-h5, q5, h2), np.einsum("nji,nj->ni", R06, R01h2), -h6)     # R06ᵀ R01 h2
-    d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, _b(P[4], n))
+    # d_inner = R01ᵀ p06 − p12 − R14 (p45 + R45 p56)
+    d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, P[4] + sp._rotate(h5, q5, _b(P[5], n)))
     s3 = sp.sp3(-_b(P[3], n), _b(P[2], n), h2, np.linalg.norm(d_in, axis=1))
-    ok, ex = ok & v5, ex & e5 & s14.exact[:, 0] & s6.exact[:, 0]
+    ok, ex = ok, ex & s14.exact[:, 0] & s6.exact[:, 0]
     t3, v3, e3, q1, q5, q6, th14, d_in, ok, ex = _fan(s3, q1, q5, s6.theta[:, 0, 0], th14, d_in, ok, ex)
     n *= 2
     s2 = sp.sp1(_b(P[2], n) + sp._rotate(_b(H[1], n), t3, _b(P[3], n)), d_in, _b(H[1], n))
@@ -281,6 +278,34 @@ def _three_parallel_two_intersecting(H, P, R06, p):
     t4 = np.angle(np.exp(1j * (th14 - q2 - t3)))
     q = np.stack([q1, q2, s3n * t3, s4n * t4, q5, q6], -1)
     return q, ok & v3, ex & e3 & s2.exact[:, 0]
+
+
+def _three_parallel_two_intersecting(H, P, R06, p):
+    """2 ∥ 3 ∥ 4 and 5 × 6 (p56 = 0): q1 by SP4 (h2ᵀ R01ᵀ p16 = h2ᵀ (p12 + … + p45)), q5 by
+    SP4 (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
+    n = len(p)
+    p06 = p - R06 @ P[6] - P[0]
+    s1 = sp.sp4(_b(H[1], n), p06, -_b(H[0], n), np.full(n, H[1] @ P[1:5].sum(0)))
+    q1, ok, ex, p06, R06 = _fan(s1, p06, R06)
+    n *= 2
+    s5 = sp.sp4(_b(H[1], n), _b(H[5], n), _b(H[4], n),
+                np.einsum("i,nji,njk,k->n", H[1], sp.rot(H[0], q1), R06, H[5]))
+    q5, v5, e5, q1, ok, ex, p06, R06 = _fan(s5, q1, ok, ex, p06, R06)
+    return _three_parallel_tail(H, P, R06, p06, q1, q5, ok & v5, ex & e5)
+
+
+def _three_parallel(H, P, R06, p):
+    """2 ∥ 3 ∥ 4 alone: (q1, q5) by SP6 (the two height equations along h2, of the position
+    and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
+    n = len(p)
+    p06 = p - R06 @ P[6] - P[0]
+    h, k = np.array([H[1]] * 4), np.array([-H[0], H[4], -H[0], H[4]])
+    pp = np.stack([p06, -_b(P[5], n), R06 @ H[5], -_b(H[5], n)], 1)
+    s = sp.sp6(np.broadcast_to(h, (n, 4, 3)), np.broadcast_to(k, (n, 4, 3)), pp,
+               np.full(n, H[1] @ P[1:5].sum(0)), np.zeros(n))
+    q1, q5 = (np.nan_to_num(s.theta[:, :, j]).reshape(-1) for j in range(2))
+    ok, ex = s.valid.reshape(-1), s.exact.reshape(-1)
+    return _three_parallel_tail(H, P, np.repeat(R06, 4, axis=0), np.repeat(p06, 4, axis=0), q1, q5, ok, ex)
 
 
 def _spherical(H, P, R06, p):
@@ -297,7 +322,7 @@ def _spherical(H, P, R06, p):
     return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
 
 
-_SOLVERS = {C.SPHERICAL: _spherical, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
+_SOLVERS = {C.SPHERICAL: _spherical, C.THREE_PARALLEL: _three_parallel, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
             C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
             C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting}
 
