@@ -22,7 +22,10 @@ the ContactNormalTask's residual and Jacobian).  Success = every fingertip withi
 contact, pad normal within 5°, inside the limits, checked on the returned configuration by
 Pinocchio FK.  Also the Allegro hand (fixed palm) with sliding contacts.
 
-mink (MuJoCo-based) is not compared yet: see the notes.
+Part 3, mink (MuJoCo): the QP step of part 1 on mink 1.x with the limb's URDF loaded by MuJoCo
+(fixed links kept as bodies; FK checked against Pinocchio to 1e-9 before timing), the couplings
+as a mink Task with the same rows, mink's configuration (gain 0.5) and velocity limits.  Skipped
+when mink is not installed.
 """
 
 from __future__ import annotations
@@ -103,6 +106,92 @@ def _run_pink(pink, robot, q0, targets, backend):
         t.append(time.process_time() - t0)
         Q.append(pconf.q.copy())
     return np.array(t), np.array(Q), errors
+
+
+def _mink_model(robot):
+    """The robot's URDF as a MuJoCo model (fixed links kept as bodies, so the fingertip frames
+    exist) and the map from Pinocchio's joint order to MuJoCo's qpos; FK is checked against
+    Pinocchio before use."""
+    import re
+
+    import mujoco
+
+    txt = aa.models.to_urdf(robot.spec)          # the catalog model's URDF text
+    txt = re.sub(r"(<robot[^>]*>)", r'\1<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>', txt, count=1)
+    model = mujoco.MjModel.from_xml_string(txt)
+    names = [model.joint(i).name for i in range(model.njnt)]
+    perm = np.array([model.jnt_qposadr[names.index(j.name)] for j in robot.chain.joints])
+    q = robot.random_q(rng=5)
+    d = mujoco.MjData(model)
+    d.qpos[perm] = q
+    mujoco.mj_kinematics(model, d)
+    for f in FRAMES:
+        b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f)
+        T = robot.fk(q, frame=f)
+        assert np.abs(d.xpos[b] - T[:3, 3]).max() < 1e-9 and np.abs(d.xmat[b].reshape(3, 3) - T[:3, :3]).max() < 1e-9
+    return model, perm
+
+
+def _run_mink(mink, robot, q0, targets, backend):
+    model, perm = _mink_model(robot)
+
+    class Linear(mink.Task):     # the couplings: A q = 0 in MuJoCo's order (pink's LinearHolonomicTask)
+        def __init__(self, A):
+            super().__init__(cost=np.ones(len(A)))
+            self.A = A
+
+        def compute_error(self, configuration):
+            return self.A @ configuration.q
+
+        def compute_jacobian(self, configuration):
+            return self.A
+
+    A = np.zeros((len(COUPLED), model.nv))
+    A[:, perm] = np.vstack([qp.JointCouplingTask.mimic(robot, a, b, 2.0 / 3.0)._row for a, b in COUPLED])
+    qm = np.zeros(model.nq)
+    qm[perm] = q0
+    conf = mink.Configuration(model, qm)
+    tasks = [mink.FrameTask(f, "body", position_cost=1.0, orientation_cost=0.1, lm_damping=1e-3) for f in FRAMES]
+    post = mink.PostureTask(model, cost=1e-3)
+    post.set_target(qm)
+    tasks += [Linear(A), post]
+    vmax = {j.name: j.velocity for j in robot.chain.joints if np.isfinite(j.velocity)}
+    limits = [mink.ConfigurationLimit(model, gain=0.5), mink.VelocityLimit(model, vmax)]
+    t, Q = [], []
+    for Ts in targets:
+        t0 = time.process_time()
+        for task, T in zip(tasks, Ts):
+            task.set_target(mink.SE3.from_matrix(T))
+        v = mink.solve_ik(conf, tasks, DT, solver=backend, damping=1e-12, limits=limits)
+        conf.integrate_inplace(v, DT)
+        t.append(time.process_time() - t0)
+        Q.append(conf.q[perm].copy())
+    return np.array(t), np.array(Q)
+
+
+def _mink_rows(n_steps, backends):
+    try:
+        from importlib.metadata import version
+
+        import mink
+    except ImportError:  # mink and mujoco: the optional "bench" extra
+        return []
+    robot = aa.load("human_upper_limb")
+    q0, targets = _trajectory(robot, n_steps)
+    rows = []
+    for backend in backends:
+        to, Qo = _run_ours(robot, q0, targets, backend)
+        tm, Qm = _run_mink(mink, robot, q0, targets, backend)
+        to2, _ = _run_ours(robot, q0, targets, backend)
+        tm2, _ = _run_mink(mink, robot, q0, targets, backend)
+        t_o = np.concatenate([to[5:], to2[5:]]) * 1e6
+        t_m = np.concatenate([tm[5:], tm2[5:]]) * 1e6
+        rows.append(["qp step vs mink (6 frame tasks + 4 couplings + posture)", "human_upper_limb (27 DOF)", backend,
+                     np.median(t_o), np.percentile(t_o, 90), np.median(t_m), np.percentile(t_m, 90),
+                     np.median(t_m) / np.median(t_o), "", "", len(to),
+                     f"peer = mink {version('mink')} on MuJoCo {version('mujoco')} (URDF -> MjModel, "
+                     f"FK checked against Pinocchio); max |q diff| {float(np.abs(Qo - Qm).max()):.1e} rad"])
+    return rows
 
 
 def _step_rows(pink, n_steps, backends):
@@ -281,18 +370,17 @@ def run(quick: bool = False) -> dict:
     except ImportError:  # peers are the optional "bench" extra
         pink = None
     rows = _step_rows(pink, 40 if quick else 400, BACKENDS[:2] if quick else BACKENDS)
+    rows += _mink_rows(40 if quick else 400, ["daqp"] if quick else ["daqp", "quadprog", "osqp"])
     rows += _grasp_rows(pink, 20 if quick else 500, quick)
     logging.disable(logging.NOTSET)
-    notes = ("QP step rows: times in us (CPU time of this process, time.process_time; 2 shared cores); ratio = pink "
-             "median / ours with the same backend; runs A B A B. Grasp rows: times in ms per solve (CPU time, all "
-             "attempts and the palm approach included), success % checked on the returned q by Pinocchio FK (1 mm, 5 deg, limits); "
-             "ours and pink run the same solve loop (hand.solve_grasp) and differ only in the QP step "
-             "(step_fn=). mink is not compared yet: mink 1.3.0 and mujoco 4.0.0 install from the "
-             "machine's package mirror (pip --dry-run), but mink solves on MuJoCo models; the limb and the Allegro hand "
-             "would first have to be converted from URDF with the fingertip frames kept as sites and checked against "
-             "Pinocchio FK, which is left for later." + ("" if pink is not None else " pink is not installed: ours only."))
+    notes = ("QP step rows: times in us (CPU time of this process, time.process_time; 2 shared cores); ratio = peer "
+             "median / ours with the same backend; runs A B A B; the peer is pink, or mink in the 'vs mink' rows (the "
+             "same step on MuJoCo, model from the same URDF). Grasp rows: times in ms per solve (CPU time, all "
+             "attempts and the palm approach included), success % checked on the returned q by Pinocchio FK "
+             "(1 mm, 5 deg, limits); ours and pink run the same solve loop (hand.solve_grasp) and differ only in "
+             "the QP step (step_fn=)." + ("" if pink is not None else " pink is not installed: ours only."))
     return dict(
-        title="Multi-finger IK: QP step on the 27-DOF limb and grasp solves, anthroarm vs pink",
-        columns=["measure", "robot", "backend", "ours median", "ours p90", "pink median", "pink p90",
-                 "ratio pink/ours", "ours success %", "pink success %", "n", "note"],
+        title="Multi-finger IK: QP step on the 27-DOF limb and grasp solves, anthroarm vs pink and mink",
+        columns=["measure", "robot", "backend", "ours median", "ours p90", "peer median", "peer p90",
+                 "ratio peer/ours", "ours success %", "pink success %", "n", "note"],
         rows=rows, notes=notes)
