@@ -195,6 +195,9 @@ def test_cli_ik_markers(tmp_path, capsys):
     assert rc == 2 and "C3D file not found" in err and err.count("\n") == 1 and not (tmp_path / "x.csv").exists()
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "no" / "x.csv")])
     assert rc == 2 and "existing folder" in capsys.readouterr().err
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "p.csv"), "--model",
+               "prosthetic_arm", "--height", "1.7"])                  # the loader names what the model accepts
+    assert rc == 2 and "accepted: ['L1', 'L2', 'L3']" in capsys.readouterr().err
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path)])        # a folder
     assert rc == 2 and "give a file name" in capsys.readouterr().err
     (tmp_path / "garbage.c3d").write_bytes(b"garbage")

@@ -172,6 +172,11 @@ def test_a_set_that_does_not_constrain_a_joint_is_refused(arm):
 def test_array_input_checks(arm, markers):
     with pytest.raises(MotionDataError, match="shape"):
         marker_ik(arm, np.zeros((5, 3, 3)), markers)
+    from anthroarm.errors import ParameterError
+
+    for bad in ({"seeds": -1}, {"seeds": "24"}, {"max_iter": 2.5}, {"tol": float("nan")}):
+        with pytest.raises(ParameterError, match=next(iter(bad))):
+            MarkerIK(arm, markers, **bad)
     P = pin_marker_positions(arm, markers, comfortable_posture(arm))
     P[0, 2] = np.inf                                            # an inf sample is a missing one
     res = marker_ik(arm, P, markers)

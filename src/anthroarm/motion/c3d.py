@@ -197,11 +197,8 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
         c.write(str(tmp))
         os.replace(tmp, p)
     except Exception as exc:
-        try:
-            tmp.unlink()
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise
-        raise C3DError(f"ezc3d cannot write the file ({exc})", p) from None
+        tmp.unlink(missing_ok=True)
+        what = f"cannot write the file ({exc.strerror})" if isinstance(exc, OSError) and exc.strerror else \
+            f"ezc3d cannot write the file ({exc})"
+        raise C3DError(what, p) from None
     return p

@@ -28,8 +28,9 @@ def add_parser(sub):
     p.add_argument("trial", help="C3D file of the trial (POINT:UNITS mm, cm or m)")
     p.add_argument("--out", required=True, metavar="FILE.csv", help="joint angles, written atomically")
     p.add_argument("--model", default="human_arm7", help="arm model (default human_arm7)")
-    p.add_argument("--height", type=float, default=None, help="body height, m (human_arm7; default 1.75)")
-    p.add_argument("--mass", type=float, default=None, help="body mass, kg (human_arm7; default 75)")
+    p.add_argument("--height", type=float, default=None,
+                   help="body height, m (a person's arm model: human_arm7, human_upper_limb; default 1.75)")
+    p.add_argument("--mass", type=float, default=None, help="body mass, kg (a person's arm model; default 75)")
     p.add_argument("--sex", default=None, choices=["male", "female"])
     p.add_argument("--static", default=None, metavar="STATIC.c3d",
                    help="static trial: scale the segments to it before the IK")
@@ -61,8 +62,6 @@ def cmd_ik_markers(a) -> int:
     if out.is_dir() or not out.parent.is_dir():
         raise UserError(f"--out {a.out}: give a file name in an existing folder")
     person = {k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None}
-    if person and a.model != "human_arm7":
-        raise UserError("--height/--mass/--sex scale the human_arm7 model; drop them for --model " + a.model)
     trial = read_c3d(a.trial)
     robot = aa.load(a.model, **person)
     markers = MarkerSet.read_json(a.markers) if a.markers else None

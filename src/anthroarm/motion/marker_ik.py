@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MarkerSetError, MotionDataError
+from ..errors import MarkerSetError, MotionDataError, ParameterError
 from ..ik import qp
 from ..ik.qp.tasks.marker import MarkerTask
 from .markers import BoundMarkers, MarkerSet, default_marker_set
@@ -179,12 +179,13 @@ class MarkerIK:
         self.bound = BoundMarkers(robot, self.marker_set)
         if check:
             self.bound.check_constrains()
-        for nm, v in (("max_iter", max_iter), ("first_iter", first_iter), ("seed_iter", seed_iter), ("seeds", seeds + 1)):
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-                raise ValueError(f"{nm} must be a whole number >= 1, got {v!r}")
+        for nm, v, least in (("max_iter", max_iter, 1), ("first_iter", first_iter, 1), ("seed_iter", seed_iter, 1),
+                             ("seeds", seeds, 0)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
+                raise ParameterError(f"{nm} must be a whole number >= {least}, got {v!r}")
         for nm, v in (("tol", tol), ("regularization", regularization), ("max_rms", max_rms)):
             if not (isinstance(v, (int, float, np.floating)) and np.isfinite(v) and v > 0):
-                raise ValueError(f"{nm} must be a finite number > 0, got {v!r}")
+                raise ParameterError(f"{nm} must be a finite number > 0, got {v!r}")
         self.solver, self.max_iter, self.first_iter = solver, int(max_iter), int(first_iter)
         self.tol, self.regularization = float(tol), float(regularization)
         self.seed_iter, self.max_rms = int(seed_iter), float(max_rms)
