@@ -23,7 +23,7 @@ import pinocchio as pin
 
 import anthroarm as aa
 from anthroarm.ik.qp import comfortable_posture
-from anthroarm.motion import Marker, MarkerIK, MarkerSet, MarkerTrajectories, default_marker_set
+from anthroarm.motion import Marker, MarkerIK, MarkerSet, MarkerTrajectories, default_marker_set, segment_length
 
 SIGMA = 1e-3
 BACKENDS = ["daqp", "quadprog", "osqp"]
@@ -32,9 +32,9 @@ BACKENDS = ["daqp", "quadprog", "osqp"]
 def _sets(robot):
     full = default_marker_set(robot)
     eight = full.subset(["UA", "EL", "EM", "RS", "US", "MC2", "MC3", "MC5"])
-    L2 = 0.27
+    L1, L2 = segment_length(robot, "upper_arm"), segment_length(robot, "forearm")
     twelve = MarkerSet(list(full) + [Marker("FA2", "forearm", (0.03, -0.03, -0.3 * L2)),
-                                     Marker("UA2", "upper_arm", (0.03, 0.03, -0.3))], name="isb12")
+                                     Marker("UA2", "upper_arm", (0.03, 0.03, -0.3 * L1))], name="isb12")
     return {"8": eight, "10": full, "12": twelve}
 
 

@@ -70,8 +70,8 @@ class MarkerTask(Task):
                 mask[k, src.idx_v:src.idx_v + src.nv] = 1.0
                 i = jt.parent
         self._mask = mask
-        self._R = np.zeros((len(self._bodies), 3, 3))
-        self._o = np.zeros((len(self._bodies), 3))
+        self._R = np.zeros((max(len(self._bodies), 1), 3, 3))     # one slot when every marker is on the base
+        self._o = np.zeros((max(len(self._bodies), 1), 3))
         self._p = np.zeros((M, 3))
         self._J = np.zeros((M, 3, self.nv))
         self._q_for = None
