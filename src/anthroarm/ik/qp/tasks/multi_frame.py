@@ -59,6 +59,7 @@ class MultiFrameTask(Task):
         super().__init__(cost=np.concatenate([pc, oc], axis=1).ravel(), gain=gain, lm_damping=lm_damping)
         self.frame_ids = [robot.frame_id(f) for f in frames]
         self.frames = [robot.chain.frame(i).name for i in self.frame_ids]
+        self._target_names = [f"MultiFrameTask target of {f!r}" for f in self.frames]
         self._nv = robot.nv
         self.targets: list = [None] * K
         self._w_cost = None
@@ -78,15 +79,14 @@ class MultiFrameTask(Task):
             if k not in self.frames:
                 raise ValueError(f"MultiFrameTask: {k!r} is not one of its frames {self.frames}")
             k = self.frames.index(k)
-        self.targets[k] = as_se3(T, f"MultiFrameTask target of {self.frames[k]!r}")
+        self.targets[k] = as_se3(T, self._target_names[k])
 
     def set_targets(self, Ts) -> None:
-        """All targets, in the order of ``frames``."""
+        """All targets, in the order of ``frames`` (each as in :meth:`set_target`)."""
         Ts = list(Ts)
         if len(Ts) != len(self.frames):
             raise ValueError(f"MultiFrameTask: {len(Ts)} targets for {len(self.frames)} frames")
-        for k, T in enumerate(Ts):
-            self.set_target(k, T)
+        self.targets = [as_se3(T, name) for T, name in zip(Ts, self._target_names)]
 
     def set_targets_from_configuration(self, conf) -> None:
         self.targets = [pin.SE3(conf.frame_placement(f)) for f in self.frame_ids]
