@@ -150,3 +150,22 @@ def test_bad_steps():
         Step([np.nan], 1.0)
     with pytest.raises(ControlError, match="cycles"):
         play_fixed(pick_and_place(), cycles=0)
+
+
+def test_joint_path_on_the_care_robot_reaches_every_sample():
+    """Teach three poses by FK of known joints, play straight lines between them on the arm:
+    every sample's IK meets the pose (robot.fk, Pinocchio) and the joints move continuously."""
+    import anthroarm as aa
+
+    robot = aa.load("care_robot")
+    qs = np.array([[0.2, 0.6, -0.9, 0.1, 0.5, 0.0], [0.5, 0.5, -0.7, 0.2, 0.4, 0.2], [0.4, 0.8, -1.1, 0.0, 0.6, 0.1]])
+    prog = record("arm", [robot.fk(q) for q in qs], [0.0, 0.4, 0.4], motion="line")
+    t, q, ok = play_fixed(prog).joint_path(robot, 0.05, q0=qs[0])
+    assert ok.all() and len(t) == len(q)
+    _, P = play_fixed(prog).trajectory(0.05)
+    for k in range(len(t)):
+        F = robot.fk(q[k])
+        assert np.allclose(F[:3, 3], P[k][:3, 3], atol=1e-5) and np.allclose(F[:3, :3], P[k][:3, :3], atol=1e-5)
+    assert np.max(np.abs(np.diff(q, axis=0))) < 0.2
+    with pytest.raises(ControlError, match="4x4 poses"):
+        play_fixed(pick_and_place()).joint_path(robot, 0.1)

@@ -393,6 +393,47 @@ class Playback:
             prev = st
         return np.concatenate(ts), np.concatenate(ps)
 
+    def joint_path(self, robot, dt: float, q0=None, frame=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Play a program of 4×4 poses on an arm: :meth:`trajectory` sampled every ``dt``
+        seconds, each pose solved by :func:`anthroarm.ik.solve` warm-started from the previous
+        sample's joints (continuity along the path).
+
+        Parameters
+        ----------
+        robot : anthroarm.Robot
+            The arm; poses are of its tool frame (or ``frame``) in its base frame.
+        dt : float
+            Sample time, s.
+        q0 : array_like, optional
+            Joints to start the first solve from (default the robot's neutral configuration).
+        frame : str, optional
+            The frame the poses are of (default the robot's tool).
+
+        Returns
+        -------
+        t : numpy.ndarray, shape (N,)
+            Times, s.
+        q : numpy.ndarray, shape (N, nq)
+            Joint values (rad, m); a sample whose solve failed repeats the last good joints.
+        ok : numpy.ndarray of bool, shape (N,)
+            Whether each solve met the IK tolerances.
+        """
+        from ..ik import solve
+
+        t, P = self.trajectory(dt)
+        if P.shape[1:] != (4, 4):
+            raise ControlError(f"joint_path needs a program of 4x4 poses, this one stores positions of shape "
+                               f"{P.shape[1:]}")
+        q = robot.neutral() if q0 is None else _check.array(q0, "q0")
+        qs, ok = [], []
+        for T in P:
+            r = solve(robot, T, q0=q, frame=frame)
+            if r.success:
+                q = r.q
+            qs.append(np.array(q, dtype=float))
+            ok.append(bool(r.success))
+        return t, np.array(qs), np.array(ok)
+
 
 def _move(a: Step, b: Step, s: np.ndarray) -> np.ndarray:
     """Positions from ``a`` to ``b`` at the fractions ``s`` with ``b``'s motion."""
