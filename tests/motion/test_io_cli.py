@@ -198,6 +198,12 @@ def test_cli_ik_markers(tmp_path, capsys):
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "p.csv"), "--model",
                "prosthetic_arm", "--height", "1.7"])                  # the loader names what the model accepts
     assert rc == 2 and "accepted: ['L1', 'L2', 'L3']" in capsys.readouterr().err
+    # every frame empty: a CSV of held postures, exit 1, and the summary is still strict JSON
+    write_c3d(tmp_path / "nan.c3d", MarkerTrajectories(ms.names, np.full((5, len(ms), 3), np.nan)))
+    rc = main(["ik-markers", str(tmp_path / "nan.c3d"), "--out", str(tmp_path / "nan.csv"), "--no-progress"])
+    cap = capsys.readouterr()
+    summary = json.loads(cap.out.strip().splitlines()[-1], parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    assert rc == 1 and summary["skipped"] == 5 and summary["rms_median_m"] is None and "no frame" in cap.err
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path)])        # a folder
     assert rc == 2 and "give a file name" in capsys.readouterr().err
     (tmp_path / "garbage.c3d").write_bytes(b"garbage")

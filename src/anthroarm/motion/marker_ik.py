@@ -114,13 +114,14 @@ class MarkerIKResult:
         return {s: int(np.sum(self.status == s)) for s in STATUSES}
 
     def summary(self) -> dict:
-        """Counts, median/max RMS error (m) of the solved frames, ms per frame."""
+        """Counts, median/max RMS error (m) of the solved frames (None when every frame was
+        skipped: the dict is printed as strict JSON), ms per frame."""
         solved = self.status != "skipped"
         r = self.rms[solved]
         return {"frames": len(self), **self.counts(),
-                "rms_median_m": float(np.median(r)) if r.size else float("nan"),
-                "rms_max_m": float(np.max(r)) if r.size else float("nan"),
-                "max_error_m": float(np.max(self.max_error[solved])) if r.size else float("nan"),
+                "rms_median_m": float(np.median(r)) if r.size else None,
+                "rms_max_m": float(np.max(r)) if r.size else None,
+                "max_error_m": float(np.max(self.max_error[solved])) if r.size else None,
                 "ms_per_frame": 1e3 * self.seconds / max(len(self), 1),
                 "missing_markers": list(self.missing_markers)}
 
