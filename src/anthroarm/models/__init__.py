@@ -21,6 +21,7 @@ from .templates import TEMPLATES
 from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .human_upper_limb import human_upper_limb
+from .prosthetic_hand import prosthetic_hand
 from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
 
 BOOK_MODELS = {
@@ -32,6 +33,7 @@ BOOK_MODELS = {
     "planar2r": planar2r,
     "human_upper_limb": human_upper_limb,
     "care_robot": care_robot,
+    "prosthetic_hand": prosthetic_hand,   # Fig. 2-8/2-9 linkages; plain URDF with fitted mimic joints
     **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
 }
 
