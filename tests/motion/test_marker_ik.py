@@ -139,6 +139,8 @@ def test_renamed_and_missing_markers(arm, markers, tmp_path):
     trial = MarkerTrajectories(labels, P, rate=100.0)
     res = marker_ik(arm, trial, markers, rename={"FOREARM": "FA"})
     assert res.missing_markers == () and np.max(np.abs(res.q - Q)) < 1e-5
+    with pytest.raises(MarkerSetError, match=r"\['FX'\], which are not markers"):
+        marker_ik(arm, trial, markers, rename={"FOREARM": "FX"})       # a typo in the target
     res2 = marker_ik(arm, trial, markers)                       # FA not found: solved without it
     assert res2.missing_markers == ("FA",) and (res2.status == "ok").all()
     no_hand = MarkerTrajectories([n for n in markers.names if not n.startswith("MC")],

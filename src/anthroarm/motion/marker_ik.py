@@ -129,8 +129,14 @@ class MarkerIKResult:
 def match_markers(trial_names, marker_set: MarkerSet, rename: dict | None = None) -> np.ndarray:
     """Column of each marker of ``marker_set`` in a trial with labels ``trial_names`` (−1 if
     absent).  A label matches a marker by exact name, after ``rename`` (trial label -> marker
-    name), or after stripping a subject prefix (``"Subject1:EL"`` -> ``"EL"``) and case."""
+    name), or after stripping a subject prefix (``"Subject1:EL"`` -> ``"EL"``) and case.  A
+    ``rename`` target that is not a marker of the set is a :class:`~anthroarm.errors.MarkerSetError`
+    (a typo would otherwise leave the marker silently missing)."""
     rename = dict(rename or {})
+    unknown = sorted(str(v) for v in rename.values() if v not in marker_set.names)
+    if unknown:
+        raise MarkerSetError(f"rename maps trial labels to {unknown}, which are not markers of {marker_set.name!r} "
+                             f"({', '.join(marker_set.names)})")
     cols = {}
     for i, lab in enumerate(trial_names):
         for key in (rename.get(lab, lab), lab.split(":")[-1].strip()):
