@@ -72,3 +72,31 @@ def test_static_trial_without_hand_markers_leaves_the_hand_unscaled():
     assert abs(res.segment_lengths["upperarm"] - TRUE["upperarm"]) < 1e-6
     with pytest.raises(MarkerSetError, match="no marker"):
         scale_from_static(aa.load("human_arm7"), np.full((len(ms), 3), np.nan))
+
+
+def test_a_static_trial_that_does_not_fit_says_so(tmp_path, capsys):
+    """A static trial three times too large (other units, another subject) hits the 2x bound and
+    leaves centimetres of marker error: status large_error, and ik-markers --static refuses it."""
+    from anthroarm.cli import main
+    from anthroarm.errors import ParameterError
+
+    arm = aa.load("human_arm7")
+    ms = default_marker_set(arm)
+    P = pin_marker_positions(arm, ms, comfortable_posture(arm))[0]
+    assert scale_from_static(arm, P).status == "ok"
+    big = scale_from_static(arm, 3 * P)
+    assert big.status == "large_error" and big.rms > 0.02 and big.info["at_bound"]
+    assert all(abs(f - 2.0) < 1e-6 for f in big.scales.values())
+    near = scale_from_static(arm, 3 * P, max_rms=1e3)             # only the bound is left to say it
+    assert near.status == "at_bound"
+    for bad in ({"bounds": (1.2, 2.0)}, {"bounds": (0.5,)}, {"max_rms": -1.0}):
+        with pytest.raises(ParameterError):
+            scale_from_static(arm, P, **bad)
+    with pytest.raises(ValueError, match="numbers"):
+        scale_from_static(arm, [["a", "b", "c"]] * len(ms))
+    write_c3d(tmp_path / "static.c3d", MarkerTrajectories(ms.names, np.repeat(3 * P[None], 10, 0)))
+    write_c3d(tmp_path / "trial.c3d", MarkerTrajectories(ms.names, np.repeat(P[None], 10, 0)))
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "a.csv"), "--static",
+               str(tmp_path / "static.c3d"), "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "large_error" in err and err.count("\n") == 1 and not (tmp_path / "a.csv").exists()

@@ -68,6 +68,11 @@ def cmd_ik_markers(a) -> int:
     info = {}
     if a.static:
         sc = scale_from_static(robot, read_c3d(a.static), markers, rename=rename)
+        if sc.status != "ok":
+            raise UserError(f"--static {a.static}: the static trial does not fit {a.model} ({sc.status}: RMS marker "
+                            f"error {sc.rms * 1e3:.1f} mm, scale factors "
+                            f"{ {k: round(v, 2) for k, v in sc.scales.items()} }); check the markers' labels (--rename) "
+                            "and that it is a static trial of this person")
         robot = aa.load(a.model, **sc.load_kwargs(robot))
         markers = sc.marker_set
         info["segment_lengths_m"] = {k: round(v, 4) for k, v in sc.segment_lengths.items()}

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..errors import MarkerSetError, MotionDataError
+from ..errors import MarkerSetError, MotionDataError, ParameterError
 from .marker_ik import match_markers
 from .markers import MarkerSet, default_marker_set, segment_length
-from .trial import MarkerTrajectories
+from .trial import MarkerTrajectories, check_coordinates
 
 
 @dataclass
@@ -59,6 +59,11 @@ class ScalingResult:
     marker_set : MarkerSet
         The marker set with positions scaled with their bodies; markers fixed to the base are
         moved to where the static trial saw them.
+    status : str
+        ``"ok"``; ``"large_error"``: the RMS marker error is above ``max_rms`` (a static trial in
+        other units, mislabelled markers, another person's set); ``"at_bound"``: a scale factor
+        stopped at a bound of ``bounds`` (``info["at_bound"]`` names the bodies).  Only an
+        ``"ok"`` result is a measurement of the person.
     """
 
     scales: dict
@@ -69,6 +74,7 @@ class ScalingResult:
     max_error: float
     marker_error: dict
     marker_set: MarkerSet
+    status: str = "ok"
     info: dict = field(default_factory=dict)
 
     def load_kwargs(self, robot) -> dict:
@@ -85,11 +91,15 @@ def _static_positions(trial, marker_set, rename):
         P = np.full((trial.n_frames, len(marker_set), 3), np.nan)
         P[:, cols >= 0] = trial.positions[:, cols[cols >= 0]]
     else:
-        P = np.array(trial, dtype=float)
+        try:
+            P = np.array(trial, dtype=float)
+        except (TypeError, ValueError):
+            raise MotionDataError("static marker positions must be numbers (m)") from None
         if P.ndim == 2:
             P = P[None]
         if P.ndim != 3 or P.shape[1:] != (len(marker_set), 3):
             raise MotionDataError(f"static marker positions must have shape (frames, {len(marker_set)}, 3), got {P.shape}")
+        check_coordinates(P, marker_set.names)
     P[~np.isfinite(P).all(axis=2)] = np.nan
     seen = np.isfinite(P).all(axis=2).any(axis=0)
     m = np.full((len(marker_set), 3), np.nan)
@@ -99,15 +109,26 @@ def _static_positions(trial, marker_set, rename):
 
 
 def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=None, rename: dict | None = None,
-                      bounds=(0.5, 2.0)) -> ScalingResult:
+                      bounds=(0.5, 2.0), max_rms: float = 0.02) -> ScalingResult:
     """Segment scale factors of ``robot`` from a static trial (see the module docstring).
 
     ``trial``: :class:`~anthroarm.motion.trial.MarkerTrajectories` (a C3D read with
     :func:`~anthroarm.motion.c3d.read_c3d`) or an array ``(frames, M, 3)`` / ``(M, 3)`` in the
-    marker set's order (m).  Raises :class:`~anthroarm.errors.MarkerSetError` when a body to be
-    scaled has no visible marker at or below its distal end."""
+    marker set's order (m).  The result's ``status`` says whether the fit can be trusted
+    (RMS marker error at most ``max_rms`` m, no factor at a bound).  Raises
+    :class:`~anthroarm.errors.MarkerSetError` when a body to be scaled has no visible marker at
+    or below its distal end, :class:`~anthroarm.errors.ParameterError` for ``bounds`` that are
+    not 0 < low < 1 < high or a ``max_rms`` that is not a positive number."""
     from scipy.optimize import least_squares
 
+    try:
+        lo_b, hi_b = (float(b) for b in bounds)
+        ok = 0 < lo_b < 1 < hi_b < np.inf and 0 < float(max_rms) < np.inf
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ParameterError(f"bounds must be two numbers 0 < low < 1 < high and max_rms a positive number (m), got "
+                             f"{bounds!r}, {max_rms!r}")
     ms = default_marker_set(robot) if marker_set is None else marker_set
     bound = ms.bind(robot)
     mbar, seen = _static_positions(trial, ms, rename)
@@ -198,7 +219,10 @@ def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=N
             pos = np.asarray(m.position, float) * fac
         new_markers.append(type(m)(m.name, m.body, tuple(float(v) for v in pos), m.weight))
     err = {n: float(e) for n, e in zip(np.array(ms.names)[use], d)}
-    return ScalingResult(scales, lengths, seg, x[:nq].copy(), float(np.sqrt(np.mean(d ** 2))), float(d.max()), err,
-                         MarkerSet(new_markers, name=f"{ms.name} (scaled)"),
+    rms = float(np.sqrt(np.mean(d ** 2)))
+    at_bound = [name for name, f in scales.items() if not bounds[0] * (1 + 1e-6) < f < bounds[1] * (1 - 1e-6)]
+    status = "large_error" if not rms <= max_rms else "at_bound" if at_bound else "ok"
+    return ScalingResult(scales, lengths, seg, x[:nq].copy(), rms, float(d.max()), err,
+                         MarkerSet(new_markers, name=f"{ms.name} (scaled)"), status,
                          info={"cost": float(best.cost), "nfev": int(best.nfev), "status": int(best.status),
-                               "markers_used": [n for n, u in zip(ms.names, use) if u]})
+                               "markers_used": [n for n, u in zip(ms.names, use) if u], "at_bound": at_bound})
