@@ -25,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MarkerSetError, UnconstrainedJointError, UnknownFrameError
+from ..ik.qp.tasks.marker import moved_by
 from ..models.human import HUMAN_ARM_LANDMARKS, HUMAN_ARM_TRUNK_SCALE_LINK
 
 
@@ -207,15 +208,7 @@ class BoundMarkers:
                                      f"{', '.join(f.name for f in chain.frames)}") from None
             self.joint[k] = f.joint
             self.local[k] = f.rotation @ np.asarray(m.position, float) + f.translation
-        self.downstream = np.zeros((chain.nv, M), dtype=bool)
-        for k in range(M):
-            if self.joint[k] < 0:
-                continue
-            for i in chain.path(self._frame_of(k)):
-                j = chain.joints[i]
-                src = j.mimic.source if j.is_mimic else i
-                js = chain.joints[src]
-                self.downstream[js.idx_v:js.idx_v + js.nv, k] = True
+        self.downstream = moved_by(chain, self.joint).T
         self.bodies = np.unique(self.joint[self.joint >= 0])
 
     def _frame_of(self, k: int) -> int:

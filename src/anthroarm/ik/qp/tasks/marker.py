@@ -24,6 +24,21 @@ import numpy as np
 from .base import Task
 
 
+def moved_by(chain, joints) -> np.ndarray:
+    """(M, nv) bool: ``[k, v]`` is True when velocity v moves the body of joint ``joints[k]``
+    (index in ``chain.joints``, −1: the base, moved by none): v's joint is on the path from the
+    base to that body; a mimic joint counts as its source's velocity."""
+    out = np.zeros((len(joints), chain.nv), dtype=bool)
+    for k, j in enumerate(joints):
+        i = int(j)
+        while i >= 0:
+            jt = chain.joints[i]
+            src = chain.joints[jt.mimic.source] if jt.is_mimic else jt
+            out[k, src.idx_v:src.idx_v + src.nv] = True
+            i = jt.parent
+    return out
+
+
 class MarkerTask(Task):
     """Position task on M body-fixed points.
 
@@ -59,17 +74,7 @@ class MarkerTask(Task):
         self._bodies = [int(b) for b in np.unique(joints) if b >= 0]
         self._gidx = np.array([self._bodies.index(int(j)) if j >= 0 else 0 for j in joints], dtype=int)
         self._fixed = np.flatnonzero(joints < 0)
-        # mask[k, v]: velocity v moves marker k (v's joint is on the path from the base to k's body)
-        chain = robot.chain
-        mask = np.zeros((M, self.nv))
-        for k, j in enumerate(joints):
-            i = int(j)
-            while i >= 0:
-                jt = chain.joints[i]
-                src = chain.joints[jt.mimic.source] if jt.is_mimic else jt
-                mask[k, src.idx_v:src.idx_v + src.nv] = 1.0
-                i = jt.parent
-        self._mask = mask
+        self._mask = moved_by(robot.chain, joints).astype(float)
         self._R = np.zeros((max(len(self._bodies), 1), 3, 3))     # one slot when every marker is on the base
         self._o = np.zeros((max(len(self._bodies), 1), 3))
         self._p = np.zeros((M, 3))
