@@ -168,6 +168,10 @@ def test_csv_degrees_gaps_and_errors(tmp_path, arm):
             read_joint_csv(tmp_path / f, arm)
     with pytest.raises(MotionDataError, match="not found"):
         read_joint_csv(tmp_path / "missing.csv")
+    for name in ("b,c", "#b", ""):                             # would shift or hide a column when read back
+        with pytest.raises(MotionDataError, match="column names"):
+            write_joint_csv(tmp_path / "n.csv", np.arange(3.0), np.zeros((3, 2)), ["a", name])
+    assert not (tmp_path / "n.csv").exists()
 
 
 def test_cli_ik_markers(tmp_path, capsys):

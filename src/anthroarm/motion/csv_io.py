@@ -64,6 +64,11 @@ def write_joint_csv(path, t, q=None, names=None, *, comment: str = "") -> Path:
         raise MotionDataError(f"write_joint_csv: t (N,), q (N, n) and n names, got {t.shape}, {q.shape}, {len(names)}")
     if not (np.isfinite(t).all() and np.isfinite(q).all()):
         raise MotionDataError("write_joint_csv: t and q must be finite", path)
+    bad = [n for n in names
+           if not str(n).strip() or any(c in str(n) for c in ',\n\r"') or str(n).lstrip().startswith("#")]
+    if bad:
+        raise MotionDataError(f"write_joint_csv: joint names {bad} cannot be CSV column names (empty, a comma, a quote, "
+                              "a line break or a leading #)", path)
     buf = io.StringIO()
     buf.write("# anthroarm joint trajectory: t in s, joint angles in rad (prismatic joints in m)\n")
     if extra is not None:
