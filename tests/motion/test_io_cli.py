@@ -41,6 +41,29 @@ def test_c3d_units_are_converted(tmp_path, arm, markers):
         read_c3d(tmp_path / "u_in.c3d")
 
 
+def test_c3d_negative_residual_is_a_missing_sample(tmp_path):
+    """A capture system may leave finite coordinates in a sample it flags invalid (residual < 0,
+    the C3D convention): the sample is missing however plausible its coordinates (ezc3d reads
+    them as NaN; read_c3d relies on that)."""
+    import ezc3d
+
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [100.0]
+    c["parameters"]["POINT"]["LABELS"]["value"] = ["A", "B"]
+    c["parameters"]["POINT"]["UNITS"]["value"] = ["mm"]
+    pts = np.ones((4, 2, 3))
+    pts[:3] = 100.0
+    c["data"]["points"] = pts
+    res = np.zeros((1, 2, 3))
+    res[0, 1, 2] = -1.0                         # marker B, frame 2: invalid, coordinates left at 100 mm
+    c["data"]["meta_points"] = {"residuals": res, "camera_masks": np.zeros((7, 2, 3), dtype=bool)}
+    c.write(str(tmp_path / "r.c3d"))
+    tr = read_c3d(tmp_path / "r.c3d")
+    assert tr.visible.tolist() == [[True, True], [True, True], [True, False]]
+    np.testing.assert_allclose(tr.positions[2, 0], [0.1, 0.1, 0.1], rtol=1e-6)
+    assert np.isnan(tr.positions[2, 1]).all()
+
+
 def test_c3d_bad_files(tmp_path):
     with pytest.raises(C3DError, match="not found"):
         read_c3d(tmp_path / "nope.c3d")

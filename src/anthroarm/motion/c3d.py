@@ -4,8 +4,9 @@
 file's ``POINT:UNITS`` (mm, cm, m) is read and converted; the labels come from ``POINT:LABELS``
 (and ``LABELS2``, ``LABELS3`` ... for files with more than 255 points), the rate from
 ``POINT:RATE``.  A sample is missing when its residual is negative (the C3D convention for an
-invalid point), when a coordinate is not finite, or, with ``zero_is_missing`` (default), when
-it is exactly (0, 0, 0), which several capture systems write for gaps.
+invalid point; ezc3d reads its coordinates as NaN), when a coordinate is not finite, or, with
+``zero_is_missing`` (default), when it is exactly (0, 0, 0), which several capture systems write
+for gaps.
 
 :func:`write_c3d` writes a trial (in mm by default) to a temporary file in the target's folder
 and renames it into place, so a reader never sees half a file.
@@ -147,11 +148,6 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
         raise C3DError(f"POINT:RATE is {rate!r}: the frame rate must be positive (Hz)", p)
     P = np.moveaxis(pts[:3], 0, -1).transpose(1, 0, 2) * UNITS[unit]      # (N, M, 3)
     missing = ~np.isfinite(P).all(axis=2)
-    res = c["data"].get("meta_points", {}).get("residuals") if isinstance(c["data"], dict) else None
-    if res is not None:
-        res = np.asarray(res, dtype=float)
-        if res.shape == (1, pts.shape[1], pts.shape[2]):
-            missing |= (res[0] < 0).T
     if zero_is_missing:
         missing |= np.all(P == 0.0, axis=2)
     P[missing] = np.nan
