@@ -248,3 +248,13 @@ def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
     assert "param#" in grid.branches[0]
     with pytest.raises(ValueError, match="param="):
         aa.ik.analytic(aa.load("ur5"), aa.load("ur5").fk(aa.load("ur5").neutral()), param=0.3)
+
+
+@pytest.mark.parametrize("name", ["ur10", "panda", "prosthetic_arm"])
+def test_check_rows_pass(name):
+    """The `anthroarm check` rows (FK(IK(T)) = T; branch counts = ik-geo's when installed) on a
+    6R arm, a 7-joint arm (its sampled last joint held) and a reversed class."""
+    rows = G.check_rows(aa.load(name), 8, np.random.default_rng(0))
+    assert len(rows) >= 1 and all(r.ok for r in rows), [(r.quantity, r.max_abs_err, r.note) for r in rows]
+    assert rows[0].max_abs_err < 1e-9
+    assert G.check_rows(aa.load("unimate5"), 8, np.random.default_rng(0)) == []
