@@ -395,7 +395,7 @@ class Playback:
 
     def joint_path(self, robot, dt: float, q0=None, frame=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Play a program of 4×4 poses on an arm: :meth:`trajectory` sampled every ``dt``
-        seconds, each pose solved by :func:`anthroarm.ik.solve` warm-started from the previous
+        seconds, each pose solved by :func:`~anthroarm.ik.solve.api.solve` warm-started from the previous
         sample's joints (continuity along the path).
 
         Parameters
