@@ -205,34 +205,6 @@ class DegenerateArcError(ControlError):
     """A circular arc through three points that are collinear or coincident (no unique circle)."""
 
 
-class UnknownCodeError(AnthroarmError, KeyError):
-    """A code or key that a book table does not hold (e.g. a display code of Table 9.6); the
-    message lists the valid ones."""
-
-    def __str__(self) -> str:
-        return str(self.args[0]) if self.args else ""
-
-
-class CatalogueError(AnthroarmError, ValueError):
-    """A motor or gearbox catalogue (CSV, :mod:`anthroarm.prosthesis.catalogue`) that cannot be
-    used: a missing column, a value that is not a number, a negative or zero constant, a
-    duplicate name.  ``path`` names the file, ``line`` the line (1-based) and ``column`` the
-    column at fault (``None`` when the whole file is at fault)."""
-
-    def __init__(self, problem: str, path=None, line: int | None = None, column: str | None = None):
-        self.path = None if path is None else str(path)
-        self.line = line
-        self.column = column
-        self.problem = problem
-        where = "" if path is None else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
-        super().__init__(where + problem)
-
-
-class CouplingError(AnthroarmError, ValueError):
-    """Coupled joints given inconsistent values: a mimic joint's value that is not
-    multiplier · source + offset, or a start configuration that breaks a hard coupling."""
-
-
 class EMGError(AnthroarmError, ValueError):
     """An EMG recording or signal-chain setting that cannot be processed: NaN/inf samples, the
     wrong array shape or channel count, a bad window or gain (:mod:`anthroarm.emg`)."""
@@ -252,3 +224,41 @@ class ThresholdError(EMGError):
     """EMG amplitude thresholds that can never switch: not finite or not > 0, an off-threshold
     above the on-threshold, an on-threshold no input reaches (beyond the amplifier's rail) or
     an off-threshold at or below the noise floor (never switches off)."""
+
+
+class GraspError(AnthroarmError, ValueError):
+    """A grasp that cannot be posed: an object larger than the hand's span, a bad object
+    (non-finite centre, radius <= 0), a wrong number of contacts."""
+
+
+class FingertipError(AnthroarmError, ValueError):
+    """A fingertip task or grasp contact on a frame that is not a fingertip of the hand (not a
+    tip of ``robot.chain`` moved by finger joints).  The message lists the fingertips."""
+
+
+class CouplingError(AnthroarmError, ValueError):
+    """Coupled joints given inconsistent values: a mimic joint's value that is not
+    multiplier · source + offset, or a start configuration that breaks a hard coupling."""
+
+
+class CatalogueError(AnthroarmError, ValueError):
+    """A motor or gearbox catalogue (CSV, :mod:`anthroarm.prosthesis.catalogue`) that cannot be
+    used: a missing column, a value that is not a number, a negative or zero constant, a
+    duplicate name.  ``path`` names the file, ``line`` the line (1-based) and ``column`` the
+    column at fault (``None`` when the whole file is at fault)."""
+
+    def __init__(self, problem: str, path=None, line: int | None = None, column: str | None = None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.column = column
+        self.problem = problem
+        where = "" if path is None else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
+        super().__init__(where + problem)
+
+
+class UnknownCodeError(AnthroarmError, KeyError):
+    """A code or key that a book table does not hold (e.g. a display code of Table 9.6); the
+    message lists the valid ones."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
