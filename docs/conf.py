@@ -46,7 +46,8 @@ build_pages.benchmark_pages(ROOT / "benchmarks" / "results", DOCS / "benchmarks"
 build_pages.equation_table(DOCS / "book_map_equations.md")
 build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
-GUIDE = ["load", "kinematics", "ik", "dynamics", "mechanisms", "hand", "control", "grasp", "design", "book_systems", "motion", "prosthesis", "emg", "viewer",
+GUIDE = ["load", "kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "grasp", "motion", "prosthesis", "emg",
+         "control", "book_systems", "viewer",
          *(["/batch"] if (DOCS / "batch.md").is_file() else []), "benchmarks"]
 build_pages.write_if_changed(DOCS / "guide" / "_toc.md",
                              "```{toctree}\n:maxdepth: 1\n\n" + "\n".join(GUIDE) + "\n```\n")
