@@ -43,6 +43,11 @@ def test_marker_positions_and_jacobian_match_pinocchio(arm, markers):
         Jfd[:, i] = ((pp - pm) / (2 * h)).ravel()
     np.testing.assert_allclose(J, Jfd, atol=1e-8)
     np.testing.assert_allclose(b.jacobian(Q[2]), J, atol=1e-14)
+    # a configuration whose q is changed in place and updated: the task follows it (no stale cache)
+    conf.q[:] = Q[4]
+    conf.update()
+    np.testing.assert_allclose(task.positions(conf), pin_marker_positions(arm, markers, Q[4])[0], atol=1e-14)
+    np.testing.assert_allclose(task.compute_jacobian(conf), b.jacobian(Q[4]), atol=1e-14)
 
 
 def test_noise_free_trial_recovers_the_motion(arm, markers, tmp_path):

@@ -79,7 +79,7 @@ class MarkerTask(Task):
         self._o = np.zeros((max(len(self._bodies), 1), 3))
         self._p = np.zeros((M, 3))
         self._J = np.zeros((M, 3, self.nv))
-        self._q_for = None
+        self._for = (None, b"")          # (configuration, its q's bytes) the cache below was computed for
 
     def set_target(self, positions, visible=None) -> None:
         """Measured positions (M, 3), m, world frame.  Rows that are NaN, or False in
@@ -98,7 +98,8 @@ class MarkerTask(Task):
         # one pass: the bodies' placements, then every marker at once from the world-frame joint
         # Jacobian of computeJointJacobians (data.J: column v = (v_O; ω) of joint v's motion, v_O
         # the velocity of the point at the world origin), J_k = mask_k · (v_O + ω × p_k)
-        if self._q_for is conf.q:
+        key = conf.q.tobytes()      # by value: a q changed in place and update() must not hit the cache
+        if self._for[0] is conf and self._for[1] == key:
             return
         data = conf.data
         R, o = self._R, self._o
@@ -118,7 +119,7 @@ class MarkerTask(Task):
         if self._fixed.size:
             p[self._fixed] = self.local[self._fixed]
         self._p = p
-        self._q_for = conf.q
+        self._for = (conf, key)
 
     def positions(self, conf) -> np.ndarray:
         """(M, 3) world positions of the markers at ``conf`` (m)."""
