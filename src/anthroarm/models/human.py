@@ -190,8 +190,8 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segm
     wrist) and ``"hand"`` (wrist to the 3rd metacarpale), any subset (on the command line:
     ``--segment-lengths upperarm=0.30,forearm=0.26``); they replace de Leva's height-scaled
     lengths (centres of mass and radii of gyration keep their fractions of the length, masses
-    stay those of the body mass).  From a
-    static marker trial: :func:`anthroarm.motion.scaling.scale_from_static`."""
+    stay those of the body mass).  From a static marker trial:
+    :func:`anthroarm.motion.scaling.scale_from_static`."""
     seg = segment_parameters(height, mass, sex)
     if segment_lengths is not None:
         segment_lengths = _segment_lengths(segment_lengths)
