@@ -168,6 +168,11 @@ def test_a_set_that_does_not_constrain_a_joint_is_refused(arm):
                          Marker("W", "forearm", (0, 0, -0.27)), Marker("H", "hand", (0.0, 0.0, -0.08))])
     with pytest.raises(UnconstrainedJointError, match="rank"):
         MarkerIK(arm, on_axis)
+    # forced through (check=False), every frame of a straight-wrist motion is flagged, not "ok"
+    _, Q = known_motion(arm, n=5, seed=6)
+    Q[:, arm.joint_names.index("wrist_deviation"):] = 0.0
+    res = marker_ik(arm, pin_marker_positions(arm, on_axis, Q), on_axis, check=False)
+    assert (res.status == "too_few_markers").all() and res.rms.max() < 1e-6
     with pytest.raises(MarkerSetError, match="frames"):
         MarkerSet([Marker("A", "no_such_body", (0, 0, 0))]).bind(arm)
     with pytest.raises(MarkerSetError, match="duplicate"):

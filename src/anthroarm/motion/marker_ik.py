@@ -241,8 +241,6 @@ class MarkerIK:
             s = self._rank_cache[key] = not self.bound.unconstrained_joints(visible)
         if not s:
             return False
-        if visible.all():
-            return True
         WJ = task.cost[:, None] * task.compute_jacobian(conf)
         ev = np.linalg.eigvalsh(WJ.T @ WJ)
         return bool(ev[0] > 1e-10 * max(ev[-1], 1e-300))
