@@ -246,6 +246,11 @@ def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
     grid = aa.ik.analytic(robot, T[0])                        # default: a grid of the held joint
     assert len(grid) > 0 and all(np.abs(_fk(robot, q) - T[0]).max() < 1e-9 for q in grid.solutions)
     assert "param#" in grid.branches[0]
+    gb = aa.ik.analytic_batch(robot, T[:3])                   # the same grid for every pose of a batch
+    assert len(gb.branches) == gb.solutions.shape[1] == 8 * 12 and gb.valid.any(1).all()
+    assert gb[0].branches == grid.branches
+    with pytest.raises(ValueError, match="param: a 1-D array gives one angle per pose"):
+        aa.ik.analytic_batch(robot, T[:3], param=[0.1, 0.2])
     with pytest.raises(ValueError, match="param="):
         aa.ik.analytic(aa.load("ur5"), aa.load("ur5").fk(aa.load("ur5").neutral()), param=0.3)
 

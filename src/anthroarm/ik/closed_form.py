@@ -748,8 +748,11 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
         if param is None:             # a grid over the held joint's range
             k = gp.order.tolist().index(gp.param_joint)
             lo, hi = (max(gp.lower[k], -np.pi), min(gp.upper[k], np.pi))
-            param = np.linspace(lo, hi, PARAM_GRID + 1)[:-1] + 0.5 * (hi - lo) / PARAM_GRID
-        pv = _swivel_array(param, N, grid_1d=single)                     # (N, S), same rules as swivel
+            param = (np.linspace(lo, hi, PARAM_GRID + 1)[:-1] + 0.5 * (hi - lo) / PARAM_GRID)[None]
+        try:
+            pv = _swivel_array(param, N, grid_1d=single)                 # (N, S), same rules as swivel
+        except ValueError as exc:
+            raise ValueError(str(exc).replace("swivel", "param")) from None
     else:
         pv = np.zeros((N, 1))
     S = pv.shape[1]
@@ -774,9 +777,12 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
             thw[i, b] = Q[i, b]
     valid = cand & inside & finite & (res <= tol)
     # coincident branches (singular poses): drop a branch equal to an earlier valid one
-    d = np.abs(np.angle(np.exp(1j * (thw[:, :, None] - thw[:, None, :])))).max(-1)      # (N, B, B)
     earlier = np.tril(np.ones((B, B), bool), -1)                                         # [b, a]: a < b
-    valid &= ~((d < 1e-9) & earlier & valid[:, None, :]).any(-1)
+    step = max(1, 2_000_000 // (B * B * thw.shape[-1]))                  # bounded memory (param grids)
+    for i in range(0, N, step):
+        t, v = thw[i:i + step], valid[i:i + step]
+        d = np.abs(np.angle(np.exp(1j * (t[:, :, None] - t[:, None, :])))).max(-1)     # (n, B, B)
+        valid[i:i + step] &= ~((d < 1e-9) & earlier & v[:, None, :]).any(-1)
     reasons = [None] * N
     names = [ch.joints[j].name for j in ch.independent]
     c = gp.classification
