@@ -58,7 +58,7 @@ def _model_params(model) -> list[tuple[str, object, str, str]] | None:
     """The builder parameters of a book model, ``[(name, default, kind, unit)]`` (kind: ``float``,
     ``pair`` (two numbers, e.g. a stroke), ``map`` (a dict of numbers, e.g. human_arm7's
     ``segment_lengths``, given as ``KEY=VALUE,KEY=VALUE``) or ``str``); None for any other model.
-    Units follow the catalog's convention: lengths in m, mass in kg."""
+    Units: :func:`anthroarm.models.param_unit` (lengths in m, mass in kg, angles in rad)."""
     import inspect
 
     from . import models
@@ -71,7 +71,7 @@ def _model_params(model) -> list[tuple[str, object, str, str]] | None:
         ann = p.annotation if isinstance(p.annotation, str) else getattr(p.annotation, "__name__", "")
         kind = ("pair" if isinstance(d, tuple) else "str" if isinstance(d, str)
                 else "map" if isinstance(d, dict) or ann.split("|")[0].strip() == "dict" else "float")
-        unit = "" if kind == "str" else "kg" if p.name == "mass" else "m"
+        unit = "" if kind == "str" else models.param_unit(model, p.name)
         out.append((p.name, d, kind, unit))
     return out
 
@@ -118,9 +118,9 @@ def _add_model_param_options(p, model):
     params = _model_params(model)
     if not params:
         return
-    doc = (models.BOOK_MODELS[model].__doc__ or "").strip().splitlines()
-    g = p.add_argument_group(f"parameters of {model}",
-                             f"{doc[0] if doc else ''} Also accepted as --param NAME=VALUE.".strip())
+    paragraph = " ".join((models.BOOK_MODELS[model].__doc__ or "").strip().split("\n\n")[0].split())
+    first = paragraph.split(". ")[0].rstrip(".") + "." if paragraph else ""
+    g = p.add_argument_group(f"parameters of {model}", f"{first} Also accepted as --param NAME=VALUE.".strip())
     for name, default, kind, unit in params:
         if f"--{name}" in p._option_string_actions:
             continue

@@ -124,3 +124,23 @@ def test_bench_writes_to_out_and_by_default_to_the_user_folder(tmp_path):
         assert r.returncode == 0, r.stderr
         assert (tmp_path / "xdg" / "anthroarm" / "benchmarks" / "quick" / "tolerance.json").is_file()
     assert {p: p.stat().st_mtime_ns for p in results.glob("*.*")} == before
+
+
+def test_urdf_help_gives_angle_ranges_in_rad_and_they_are_used_as_rad(tmp_path, capsys):
+    """A template's joint ranges are angles: --help says rad, and the value given becomes the
+    revolute joint's limits in Pinocchio's model as given (no degree or metre conversion)."""
+    with pytest.raises(SystemExit) as e:
+        cli.main(["urdf", "spherical_robot", "--help"])
+    assert e.value.code == 0
+    opts = {ln.split()[0]: ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("--")}
+    assert opts["--elevation"].split()[2] == "rad," and opts["--base"].split()[2] == "rad,"
+    assert opts["--reach"].split()[2] == "m,"
+    out = tmp_path / "s.urdf"
+    assert cli.main(["urdf", "spherical_robot", "-o", str(out), "--elevation=-0.5,0.75"]) == 0
+    import pinocchio as pin
+
+    m = pin.buildModelFromUrdf(str(out))
+    revolute = [j for j in range(1, m.njoints) if m.joints[j].shortname().startswith("JointModelR")]
+    lims = sorted((float(m.lowerPositionLimit[m.joints[j].idx_q]), float(m.upperPositionLimit[m.joints[j].idx_q]))
+                  for j in revolute)
+    assert (-0.5, 0.75) in [(round(a, 12), round(b, 12)) for a, b in lims]

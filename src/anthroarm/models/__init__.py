@@ -37,6 +37,22 @@ BOOK_MODELS = {
     **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
 }
 
+#: units of the builder parameters that are not lengths in m (the catalog's convention; mass is
+#: kg everywhere): shown by ``anthroarm urdf MODEL --help``
+PARAM_UNITS: dict[str, dict[str, str]] = {
+    "cylindrical_robot": {"base": "rad"},
+    "spherical_robot": {"base": "rad", "elevation": "rad"},
+    "articulated_robot": {"base": "rad", "shoulder": "rad", "elbow": "rad"},
+    "prosthetic_hand": {"scale": "1"},
+}
+
+
+def param_unit(model: str, param: str) -> str:
+    """Unit of a builder parameter of a book model: :data:`PARAM_UNITS`, else kg for ``mass``
+    and m for the rest."""
+    return PARAM_UNITS.get(model, {}).get(param, "kg" if param == "mass" else "m")
+
+
 #: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
 #: installed package does not need it: book models are loaded from the generator's text
 REPO_URDF_DIR = Path(__file__).resolve().parents[3] / "urdf"
