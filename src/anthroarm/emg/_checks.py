@@ -12,15 +12,39 @@ from ..errors import EMGError
 MAX_VOLTS = 1e6
 
 
-def positive(value, name: str, unit: str = "") -> float:
-    """``value`` as a finite float > 0, else :class:`~anthroarm.errors.EMGError` naming it."""
+def number(value, name: str, unit: str = "") -> float:
+    """``value`` as a finite float, else :class:`~anthroarm.errors.EMGError` naming it."""
     try:
         v = float(value)
     except (TypeError, ValueError):
         raise EMGError(f"{name} must be a number{' in ' + unit if unit else ''}, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
+    if not math.isfinite(v):
+        raise EMGError(f"{name} must be finite{' (' + unit + ')' if unit else ''}, got {value!r}")
+    return v
+
+
+def positive(value, name: str, unit: str = "") -> float:
+    """``value`` as a finite float > 0, else :class:`~anthroarm.errors.EMGError` naming it."""
+    v = number(value, name, unit)
+    if not v > 0:
         raise EMGError(f"{name} must be finite and > 0{' (' + unit + ')' if unit else ''}, got {value!r}")
     return v
+
+
+def nonnegative(value, name: str, unit: str = "") -> float:
+    """``value`` as a finite float >= 0, else :class:`~anthroarm.errors.EMGError` naming it."""
+    v = number(value, name, unit)
+    if not v >= 0:
+        raise EMGError(f"{name} must be finite and >= 0{' (' + unit + ')' if unit else ''}, got {value!r}")
+    return v
+
+
+def count(value, name: str, lo: int, hi: int) -> int:
+    """``value`` as an int in ``lo..hi`` (an integer type, not a float or a string), else
+    :class:`~anthroarm.errors.EMGError` naming it."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+        raise EMGError(f"{name} must be an integer in {lo}..{hi:g}, got {value!r}")
+    return int(value)
 
 
 def signal(x, name: str = "emg", n_channels: int | None = None, min_samples: int = 1) -> np.ndarray:

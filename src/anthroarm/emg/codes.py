@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EMGError
-from ._checks import positive
+from ._checks import nonnegative, positive
 from .processor import BOTH, EXTENSOR, FLEXOR, REST
 
 #: mode cycle (an assumption, the order in which the book lists the vibrators)
@@ -97,9 +97,12 @@ class CodeMachine:
     def __init__(self, frame_s: float, debounce_s: float = 0.05, cocontraction_s: float = 0.15,
                  modes=MODES, start_mode: int = 0, vibrate_s: float = 0.3):
         self.frame_s = positive(frame_s, "frame_s", "s")
-        self.n_db = max(1, int(round(_nonneg(debounce_s, "debounce_s") / self.frame_s)))
-        self.n_cc = int(round(_nonneg(cocontraction_s, "cocontraction_s") / self.frame_s))
+        self.n_db = max(1, int(round(nonnegative(debounce_s, "debounce_s", "s") / self.frame_s)))
+        self.n_cc = int(round(nonnegative(cocontraction_s, "cocontraction_s", "s") / self.frame_s))
         self.n_vib = max(1, int(round(positive(vibrate_s, "vibrate_s", "s") / self.frame_s)))
+        if isinstance(modes, str):
+            raise EMGError(f"modes is a sequence of mode names, e.g. ('elbow', 'wrist', 'fingers'), got the "
+                           f"string {modes!r}")
         self.modes = tuple(str(m) for m in modes)
         if len(self.modes) < 1:
             raise EMGError("modes needs at least one joint name")
@@ -204,9 +207,3 @@ def vibrators_with_grasp(trace: CodeTrace, grasped) -> np.ndarray:
     v[:, VIBRATORS.index("middle")] = g
     return v
 
-
-def _nonneg(value, name):
-    v = float(value)
-    if not (np.isfinite(v) and v >= 0):
-        raise EMGError(f"{name} must be finite and >= 0 (s), got {value!r}")
-    return v

@@ -27,7 +27,7 @@ import numpy as np
 from scipy import signal as sps
 
 from ..errors import EMGError
-from ._checks import positive, signal
+from ._checks import count, positive, signal
 
 #: sine-equivalent peak-to-peak per volt RMS
 PP_PER_RMS = 2.0 * math.sqrt(2.0)
@@ -89,7 +89,8 @@ def lowpass_sos(fs: float, cutoff_hz: float, order: int = 2) -> np.ndarray:
 
     fc = positive(cutoff_hz, "envelope cutoff", "Hz")
     fs = check_sampling_rate(fs, fc, f"the {fc:g} Hz envelope low-pass")
-    return sps.butter(int(order), fc, btype="lowpass", fs=fs, output="sos")
+    order = count(order, "envelope filter order", 1, 8)
+    return sps.butter(order, fc, btype="lowpass", fs=fs, output="sos")
 
 
 def rms(x) -> np.ndarray:

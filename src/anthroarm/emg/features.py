@@ -38,13 +38,30 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     return f, p
 
 
+def _spectrum_arrays(freqs, psd) -> tuple[np.ndarray, np.ndarray]:
+    """``freqs`` (n,) Hz and ``psd`` (channels, n) as finite float arrays, else EMGError."""
+    try:
+        f = np.asarray(freqs, dtype=float)
+        p = np.atleast_2d(np.asarray(psd, dtype=float))
+    except (TypeError, ValueError):
+        raise EMGError("freqs and psd must be numeric arrays (the output of spectrum())") from None
+    if f.ndim != 1 or p.ndim != 2 or p.shape[-1] != f.size:
+        raise EMGError(f"psd (channels, n_freqs) must have one bin per entry of freqs (n_freqs,), got shapes "
+                       f"{p.shape} and {f.shape}")
+    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(p))):
+        raise EMGError("freqs or psd contains NaN/inf")
+    return f, p
+
+
 def _weights(freqs, psd, band):
-    f = np.asarray(freqs, dtype=float)
-    p = np.atleast_2d(np.asarray(psd, dtype=float))
-    if p.shape[-1] != f.size:
-        raise EMGError(f"psd has {p.shape[-1]} frequency bins but freqs has {f.size}")
+    f, p = _spectrum_arrays(freqs, psd)
     if band is not None:
-        lo, hi = float(band[0]), float(band[1])
+        try:
+            lo, hi = (float(b) for b in band)
+        except (TypeError, ValueError):
+            raise EMGError(f"band must be (low, high) in Hz, got {band!r}") from None
+        if not lo < hi:
+            raise EMGError(f"band must be (low, high) with low < high, in Hz; got {band!r}")
         keep = (f >= lo) & (f <= hi)
         f, p = f[keep], p[:, keep]
     tot = p.sum(axis=-1)
@@ -78,10 +95,12 @@ def peak_frequency(freqs, psd) -> np.ndarray:
 def band_powers(freqs, psd, bands) -> np.ndarray:
     """Power (V²) per channel and band: the PSD integrated (trapezoid) over each
     ``(low, high)`` row of ``bands`` (Hz); shape (channels, n_bands)."""
-    f = np.asarray(freqs, dtype=float)
-    p = np.atleast_2d(np.asarray(psd, dtype=float))
-    b = np.atleast_2d(np.asarray(bands, dtype=float))
-    if b.shape[-1] != 2 or not np.all(np.isfinite(b)) or np.any(b[:, 0] >= b[:, 1]):
+    f, p = _spectrum_arrays(freqs, psd)
+    try:
+        b = np.atleast_2d(np.asarray(bands, dtype=float))
+    except (TypeError, ValueError):
+        raise EMGError(f"bands must be rows (low, high) in Hz, got {bands!r}") from None
+    if b.ndim != 2 or b.shape[-1] != 2 or not np.all(np.isfinite(b)) or np.any(b[:, 0] >= b[:, 1]):
         raise EMGError(f"bands must be rows (low, high) with low < high, in Hz; got {b.tolist()}")
     out = np.empty((p.shape[0], b.shape[0]))
     for j, (lo, hi) in enumerate(b):

@@ -47,6 +47,15 @@ BOOK_BANK_3CH = (70.0, 160.0, 360.0)
 CONDITIONING_BAND = (20.0, 450.0)
 #: default bank bandwidth, octaves between the −3 dB edges (assumption, see the module text)
 BANK_BANDWIDTH_OCTAVES = 0.5
+#: the widest bank band accepted, octaves (a band-pass wider than this is not a bank band)
+MAX_BANDWIDTH_OCTAVES = 10.0
+
+
+def _bandwidth(bandwidth_octaves) -> float:
+    b = positive(bandwidth_octaves, "bandwidth_octaves", "octaves")
+    if b > MAX_BANDWIDTH_OCTAVES:
+        raise EMGError(f"bandwidth_octaves {b:g} is wider than {MAX_BANDWIDTH_OCTAVES:g} octaves: not a bank band")
+    return b
 
 
 def check_sampling_rate(fs, highest_edge_hz: float, what: str) -> float:
@@ -77,7 +86,7 @@ def band_edges(centre_hz: float, fs: float, bandwidth_octaves: float = BANK_BAND
     gain at :math:`f_c` and −3 dB at both returned edges (assumption of this module, see above).
     ``fs`` must exceed :math:`2 f_c 2^{b/2}` (:class:`~anthroarm.errors.SamplingRateError`)."""
     fc = positive(centre_hz, "band centre", "Hz")
-    b = positive(bandwidth_octaves, "bandwidth_octaves", "octaves")
+    b = _bandwidth(bandwidth_octaves)
     check_sampling_rate(fs, fc * 2.0 ** (b / 2), f"the band centred at {fc:g} Hz")
     wc = _prewarp(fc, fs)
     lo, hi = _unwarp(wc * 2.0 ** (-b / 2), fs), _unwarp(wc * 2.0 ** (b / 2), fs)
@@ -138,10 +147,14 @@ class FilterBank:
     order: int = 2
 
     def __post_init__(self):
-        c = np.atleast_1d(np.asarray(self.centres_hz, dtype=float))
-        if c.ndim != 1 or c.size == 0:
-            raise EMGError(f"centres_hz must be a non-empty list of frequencies (Hz), got {self.centres_hz!r}")
-        b = positive(self.bandwidth_octaves, "bandwidth_octaves", "octaves")
+        try:
+            c = np.atleast_1d(np.asarray(self.centres_hz, dtype=float))
+        except (TypeError, ValueError):
+            c = np.zeros((0, 0))
+        if c.ndim != 1 or c.size == 0 or not np.all(np.isfinite(c)) or np.any(c <= 0):
+            raise EMGError(f"centres_hz must be a non-empty list of finite frequencies > 0 (Hz), got "
+                           f"{self.centres_hz!r}")
+        b = _bandwidth(self.bandwidth_octaves)
         check_sampling_rate(self.fs, c.max() * 2.0 ** (b / 2), f"the band centred at {c.max():g} Hz")
         edges = np.array([band_edges(f, self.fs, b) for f in c])
         sos = np.stack([bandpass_sos(lo, hi, self.fs, self.order) for lo, hi in edges])
@@ -160,5 +173,10 @@ class FilterBank:
 
     def gains(self, freqs_hz) -> np.ndarray:
         """|H(f)| of every band at ``freqs_hz`` (Hz), shape (n_bands, n_freqs) (``sosfreqz``)."""
-        f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))
+        try:
+            f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))
+        except (TypeError, ValueError):
+            raise EMGError(f"freqs_hz must be frequencies in Hz, got {freqs_hz!r}") from None
+        if not np.all(np.isfinite(f)):
+            raise EMGError("freqs_hz contains NaN/inf")
         return np.stack([np.abs(sps.sosfreqz(s, worN=f, fs=self.fs)[1]) for s in self.sos])

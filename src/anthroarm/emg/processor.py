@@ -34,7 +34,7 @@ import numpy as np
 from scipy import signal as sps
 
 from ..errors import EMGError, ThresholdError
-from ._checks import MAX_VOLTS, positive, signal
+from ._checks import MAX_VOLTS, nonnegative, number, positive, signal
 from .envelope import PP_PER_MAV, PP_PER_RMS, lowpass_sos, running_rms, window_samples
 from .filters import CONDITIONING_BAND, bandpass_sos, check_sampling_rate, notch_sos
 
@@ -167,9 +167,12 @@ class EMGProcessor:
         self.frame_s = self.hop / self.fs
         self.gain = positive(gain, "gain", "V/V")
         self.thresholds = thresholds if thresholds is not None else Thresholds()
-        noise_pp = 0.0 if noise_rms is None else PP_PER_RMS * float(noise_rms)
+        if not isinstance(self.thresholds, Thresholds):
+            raise ThresholdError(f"thresholds must be a Thresholds(on_pp, off_pp), got {thresholds!r}")
+        noise_pp = 0.0 if noise_rms is None else PP_PER_RMS * nonnegative(noise_rms, "noise_rms", "V")
+        mx = float("inf") if max_input_pp == float("inf") else positive(max_input_pp, "max_input_pp", "V")
         # no accepted signal exceeds MAX_VOLTS at the processor, 2 MAX_VOLTS / gain p-p at the electrodes
-        reach = min(float(max_input_pp), 2.0 * MAX_VOLTS / self.gain)
+        reach = min(mx, 2.0 * MAX_VOLTS / self.gain)
         self.thresholds.check(self.n_channels, reach, noise_pp)
         self.on, self.off = self.thresholds.arrays(self.n_channels)
         # thresholds in the units of the envelope before the p-p factor and the gain
@@ -260,11 +263,10 @@ def calibrate_thresholds(rest, fs: float, *, k: float = 5.0, off_fraction: float
     compares the on-threshold with the book's sensitivity (:data:`BOOK_SENSITIVITY_PP`)."""
     x = signal(rest, "rest", processor_kw.get("n_channels"))
     kk = positive(k, "k (standard deviations)")
-    if not (0.0 <= float(off_fraction) <= 1.0):
+    frac = number(off_fraction, "off_fraction")
+    if not 0.0 <= frac <= 1.0:
         raise EMGError(f"off_fraction must be in [0, 1], got {off_fraction!r}")
-    settle = float(settle_s)
-    if not (np.isfinite(settle) and settle >= 0):
-        raise EMGError(f"settle_s must be finite and >= 0 (s), got {settle_s!r}")
+    settle = nonnegative(settle_s, "settle_s", "s")
     kw = dict(processor_kw)
     kw["n_channels"] = x.shape[0]
     out = EMGProcessor(fs, **kw).process(x)
@@ -275,7 +277,7 @@ def calibrate_thresholds(rest, fs: float, *, k: float = 5.0, off_fraction: float
     e = out.envelope_pp[:, keep]
     mean, sd = e.mean(axis=1), e.std(axis=1)
     on = mean + kk * sd
-    off = mean + float(off_fraction) * kk * sd
+    off = mean + frac * kk * sd
     off = np.where(off > 0, off, 0.5 * on)
     if not np.all(on > 0):
         raise EMGError("the rest recording is silent (envelope 0): record with the electrodes on")

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EMGError
-from ._checks import positive, signal
+from ._checks import MAX_VOLTS, count, nonnegative, number, positive, signal
 from .envelope import PP_PER_RMS
 
 #: healthy EMG, 1–3 mV peak-to-peak (V), book §9-2
@@ -38,20 +38,29 @@ AMPUTEE_PP = 50e-6
 AMPUTEE_TRAINED_PP = 100e-6
 #: the band of the main spectral power (Hz), book §9-2
 EMG_BAND = (30.0, 300.0)
-#: the most samples per channel the generator makes (a guard against a mistyped duration)
+#: the most samples (all channels together) the generator makes (a guard against a mistyped
+#: duration or channel count: 1e8 float64 samples are 0.8 GB)
 MAX_SAMPLES = 100_000_000
+
+
+def _band(band, fs: float) -> tuple[float, float]:
+    try:
+        lo, hi = (float(b) for b in band)
+    except (TypeError, ValueError):
+        raise EMGError(f"band must be (low, high) in Hz, got {band!r}") from None
+    if not (0 <= lo < hi < fs / 2):
+        raise EMGError(f"band must satisfy 0 <= low < high < fs/2 = {fs / 2:g} Hz, got ({lo:g}, {hi:g})")
+    return lo, hi
 
 
 def band_limited_noise(n_samples: int, fs: float, band=EMG_BAND, n_channels: int = 1, rng=None) -> np.ndarray:
     """Gaussian noise with a flat spectrum inside ``band`` (Hz) and none outside (FFT brick-wall),
     scaled to unit sample variance per channel; shape (n_channels, n_samples).  ``band[1]``
-    must be below fs/2."""
+    must be below fs/2; at most :data:`MAX_SAMPLES` samples in all."""
     fs = positive(fs, "sampling rate fs", "Hz")
-    lo, hi = float(band[0]), float(band[1])
-    if not (0 <= lo < hi < fs / 2):
-        raise EMGError(f"band must satisfy 0 <= low < high < fs/2 = {fs / 2:g} Hz, got ({lo:g}, {hi:g})")
-    if not (isinstance(n_samples, (int, np.integer)) and 16 <= n_samples <= MAX_SAMPLES):
-        raise EMGError(f"n_samples must be an integer in 16..{MAX_SAMPLES:.0e}, got {n_samples!r}")
+    lo, hi = _band(band, fs)
+    n_samples = count(n_samples, "n_samples", 16, MAX_SAMPLES)
+    n_channels = count(n_channels, "n_channels", 1, MAX_SAMPLES // n_samples)
     rng = np.random.default_rng(rng)
     spec = np.fft.rfft(rng.standard_normal((n_channels, int(n_samples))), axis=-1)
     f = np.fft.rfftfreq(int(n_samples), 1.0 / fs)
@@ -65,9 +74,18 @@ def activation(t, bursts, ramp_s: float = 0.05) -> np.ndarray:
     """Muscle activation :math:`a(t) \\in [0, 1]` at times ``t`` (s): a sum of bursts
     ``(onset_s, duration_s, level)`` (level in [0, 1]), each rising and falling with a
     raised-cosine ramp of ``ramp_s`` seconds inside its duration, clipped to 1."""
-    t = np.asarray(t, dtype=float)
+    try:
+        t = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise EMGError(f"t must be times in s, got {type(t).__name__}") from None
+    if not np.all(np.isfinite(t)):
+        raise EMGError("t contains NaN/inf: activation needs finite times (s)")
     a = np.zeros_like(t)
     r = positive(ramp_s, "ramp_s", "s")
+    try:
+        bursts = list(bursts)
+    except TypeError:
+        raise EMGError(f"bursts is a list of (onset_s, duration_s, level), got {bursts!r}") from None
     for b in bursts:
         try:
             t0, dur, level = (float(v) for v in b)
@@ -112,15 +130,18 @@ def synthesize(duration_s: float, fs: float, bursts, pp=TYPICAL_PP, band=EMG_BAN
     bursts = list(bursts)
     if not bursts or not all(isinstance(b, (list, tuple)) for b in bursts):
         raise EMGError("bursts is a list with one list of (onset_s, duration_s, level) per channel")
-    n_ch, n = len(bursts), int(round(dur * fs))
-    if not 16 <= n <= MAX_SAMPLES:
-        raise EMGError(f"duration_s * fs = {dur * fs:.3g} samples; the generator makes 16..{MAX_SAMPLES:.0e}")
-    p = np.broadcast_to(np.asarray(pp, dtype=float), (n_ch,)).copy()
+    n_ch = len(bursts)
+    if not 16 <= dur * fs * n_ch <= MAX_SAMPLES:
+        raise EMGError(f"duration_s * fs * channels = {dur * fs * n_ch:.3g} samples; the generator makes "
+                       f"16..{MAX_SAMPLES:.0e}")
+    n = int(round(dur * fs))
+    try:
+        p = np.broadcast_to(np.asarray(pp, dtype=float), (n_ch,)).copy()
+    except (TypeError, ValueError):
+        raise EMGError(f"pp is one amplitude (V peak-to-peak) or one per channel ({n_ch}), got {pp!r}") from None
     if not np.all(np.isfinite(p)) or np.any(p <= 0):
         raise EMGError(f"pp must be finite and > 0 (V peak-to-peak), got {p.tolist()}")
-    nr = float(noise_rms)
-    if not (np.isfinite(nr) and nr >= 0):
-        raise EMGError(f"noise_rms must be finite and >= 0 (V), got {noise_rms!r}")
+    nr = nonnegative(noise_rms, "noise_rms", "V")
     rng = np.random.default_rng(rng)
     t = np.arange(n) / fs
     act = np.stack([activation(t, b, ramp_s) for b in bursts])
@@ -140,5 +161,10 @@ def electrode_potentials(emg, fs: float, mains_pp: float = 0.0, mains_hz: float 
     x = signal(emg, "emg")
     fs = positive(fs, "sampling rate fs", "Hz")
     t = np.arange(x.shape[1]) / fs
-    cm = 0.5 * float(mains_pp) * np.sin(2 * np.pi * float(mains_hz) * t) + float(offset_v)
+    amp = nonnegative(mains_pp, "mains_pp", "V")
+    f0 = positive(mains_hz, "mains_hz", "Hz")
+    cm = 0.5 * amp * np.sin(2 * np.pi * f0 * t) + number(offset_v, "offset_v", "V")
+    if not np.all(np.isfinite(cm)) or amp + abs(float(offset_v)) > MAX_VOLTS:
+        raise EMGError(f"mains_pp {mains_pp!r} V and offset_v {offset_v!r} V are beyond {MAX_VOLTS:.0e} V: "
+                       "not a voltage (wrong units?)")
     return cm + 0.5 * x, cm - 0.5 * x
