@@ -70,13 +70,19 @@ def test_ik_on_continuous_joints_prints_one_angle_per_joint(capsys):
     out = capsys.readouterr().out
     assert rc == 0, out
 
-
     res = json.loads(out)
     assert list(res["q"]) == r.joint_names and len(res["q"]) == 6 and res["method"] == "aa.ik.solve"
     qs = r.chain.configuration(np.array(list(res["q"].values())))
     pin.framesForwardKinematics(r.model, d, qs)
     assert np.linalg.norm(d.oMf[r.tool_id].translation - M.translation) < 1e-6
-    assert res["closed_form_solutions"] == []
+    # kinova's geometry (spherical wrist + two parallel axes) has a closed form: every branch
+    # listed, as one angle per joint, reaches the pose by Pinocchio's FK
+    assert res["closed_form_solutions"]
+    for sol in res["closed_form_solutions"]:
+        assert len(sol) == 6
+        pin.framesForwardKinematics(r.model, d, r.chain.configuration(np.array(sol)))
+        assert np.linalg.norm(d.oMf[r.tool_id].translation - M.translation) < 1e-6
+        assert np.linalg.norm(pin.log3(d.oMf[r.tool_id].rotation.T @ M.rotation)) < 1e-6
 
 
 def test_ik_book_arm_lists_its_closed_form_branches(capsys):
