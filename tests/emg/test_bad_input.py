@@ -78,3 +78,25 @@ def test_band_powers_refuse_nan_psd_and_mismatched_shapes(spec):
         emg.band_powers(f[:3], p, [(30.0, 60.0)])
     with pytest.raises(EMGError, match="bands"):
         emg.band_powers(f, p, "x")
+
+
+@pytest.fixture(scope="module")
+def arm():
+    import anthroarm as aa
+
+    return aa.load("prosthetic_arm")
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(dt=np.nan), "dt"), (dict(dt=0.0), "dt"), (dict(dt="x"), "dt"), (dict(dt=10.0), "control frame"),
+    (dict(dt=1e-7), "integration steps"),             # 5e6 steps for 0.5 s: refused, not run for minutes
+    (dict(speeds={"fingers": "x"}), "speeds"), (dict(hand="x"), "HandModel"),
+    (dict(servos={"fingers": 3}), "PositionServo"),
+])
+def test_simulate_bad_parameters_are_parameter_errors(arm, kw, match):
+    from anthroarm.emg.simulate import simulate_powered_hand
+    from anthroarm.errors import ParameterError
+
+    rec = emg.synthesize(0.5, FS, [[(0.1, 0.2, 1.0)], [(0.3, 0.1, 1.0)]], pp=1e-4, rng=0)
+    with pytest.raises(ParameterError, match=match):
+        simulate_powered_hand(arm, rec.emg, FS, {"elbow": "elbow_flexion", "fingers": None}, **kw)

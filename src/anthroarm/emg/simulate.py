@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import EMGError, ParameterError, UnsupportedModelError
+from ..control.servo import PositionServo
 from .codes import VIBRATORS, CodeMachine, CodeTrace, vibrators_with_grasp
 from .processor import EMGProcessor, ProcessedEMG
 
@@ -55,6 +56,8 @@ from .processor import EMGProcessor, ProcessedEMG
 DEFAULT_SPEED = 1.5
 #: gear ratio per mode of the default motors (assumption)
 DEFAULT_RATIOS = {"elbow": 500.0, "wrist": 100.0, "fingers": 200.0}
+#: the most arm integration steps one run may take (t_end / dt)
+MAX_STEPS = 1_000_000
 
 
 def prosthesis_motor(i: float = 200.0, eta: float = 0.7):
@@ -72,8 +75,6 @@ def joint_servo(motor, J_L: float, omega_n_min: float = 20.0):
     load inertia ``J_L`` (kg·m²), amplifier limited to ``motor.V_nom``: ω_n is the larger of
     ``omega_n_min`` and 1.05 × the motor's own damping limit (below it no tachogenerator gain
     gives ζ = 1)."""
-    from ..control.servo import PositionServo
-
     bare = PositionServo.from_motor(motor, J_L, k_a=1.0, k_p=1.0)      # k_s = 0: the motor's damping only
     omega_n = max(float(omega_n_min), 1.05 * bare.Kv / (2.0 * bare.J0))
     return PositionServo.tuned(motor, J_L, omega_n=omega_n, zeta=1.0, V_max=motor.V_nom)
@@ -295,10 +296,18 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
     if machine.modes != modes:
         raise ParameterError(f"the machine's modes {machine.modes} differ from the joints' modes {modes}")
     hand = hand if hand is not None else HandModel()
+    if not isinstance(hand, HandModel):
+        raise ParameterError(f"hand must be a HandModel, got {type(hand).__name__}")
     speeds = {m: DEFAULT_SPEED for m in modes} | dict(speeds or {})
     for m, v in speeds.items():
-        if m not in modes or not (np.isfinite(v) and v > 0):
+        if m not in modes or not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v) and v > 0):
             raise ParameterError(f"speeds: mode {m!r} must be one of {modes} with a finite speed > 0 rad/s, got {v!r}")
+    for m, sv in (servos or {}).items():
+        if m not in modes or not isinstance(sv, PositionServo):
+            raise ParameterError(f"servos: mode {m!r} must be one of {modes} with a PositionServo, got {sv!r}")
+    if not (isinstance(dt, (int, float, np.integer, np.floating)) and np.isfinite(dt) and 0 < dt <= processor.frame_s):
+        raise ParameterError(f"dt must be a finite step > 0 s and at most one control frame ({processor.frame_s:g} s), "
+                             f"got {dt!r}")
 
     chain = robot.chain
     names = {}
@@ -336,6 +345,9 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
     n_f = t.size
     if n_f < 2:
         raise EMGError(f"the EMG is shorter than two control frames ({processor.frame_s} s each)")
+    if drives and t[-1] / dt > MAX_STEPS:
+        raise ParameterError(f"{t[-1]:g} s of EMG at dt = {dt:g} s is {t[-1] / dt:.3g} integration steps, more than "
+                             f"{MAX_STEPS:.0e}: raise dt or cut the recording")
 
     # ---- the arm: driven joints free, the others locked at q0
     locked = {jt.name: float(q0[jt.idx_q]) for jt in chain.joints if jt.nq == 1 and jt.name not in seen}
