@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.errors import UnknownCodeError
+from anthroarm.errors import ParameterError, UnknownCodeError
 from anthroarm.ik.cells import CellTable, OutsideCellTableError
 from anthroarm.models import book_tables
 from anthroarm.models.care_robot import (CELL_ACCURACY, CELL_D, TABLE_9_5, cell_table, pulses_per_rad,
@@ -187,13 +187,14 @@ def test_queries_outside_the_lattice_are_typed(table):
 
 
 def test_bad_pulse_scales_are_typed(table):
-    for bad in (0.0, -3.0, np.inf, [1.0, 2.0]):
-        with pytest.raises(ValueError, match="pulses_per_rad"):
+    for bad in (0.0, -3.0, np.inf, [1.0, 2.0], "x"):
+        with pytest.raises(ParameterError, match="pulses_per_rad"):
             table.with_pulses(bad)
-    with pytest.raises(ValueError):
-        pulses_per_rad(0, 200)
+    for bad in ((0, 200), (2000, np.nan), ("x", 200)):
+        with pytest.raises(ParameterError, match="encoder_counts and gear_ratio"):
+            pulses_per_rad(*bad)
     plain = CellTable(table.model, table.params, table.rotation, table.origin, table.D, table.Q, table.valid)
-    with pytest.raises(ValueError, match="no motor pulses"):
+    with pytest.raises(ParameterError, match="no motor pulses"):
         plain.lookup_pulses([0.3, 0.0, 0.1])
 
 
@@ -206,6 +207,27 @@ def test_save_and_load_keep_pulses(table, tmp_path):
 
 
 # ---------------------------------------------------------------- Table 9.6
+
+
+#: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display, output)
+TABLE_9_6_PRINT = {
+    1: ("15", "请一会儿来"), 2: ("25", "不是"), 3: ("35", "是"), 4: ("13", "请擦身"), 5: ("23", "请梳头"),
+    6: ("33", "请刷牙"), 7: ("14", "您早"), 8: ("24", "您好"), 9: ("34", "晚上好"), 10: ("5D", "是想吃什么吗?"),
+    11: ("9D", "请让吃药"), 12: ("BD", "请开窗"), 13: ("ED", "请关窗"), 14: ("57", "是想喝什么吗?"),
+    15: ("B7", "请开门"), 16: ("E7", "请关门"), 17: ("5B", "对不起"), 18: ("6B", "请开电视机"),
+    19: ("DB", "请关电视机"), 20: ("7B", "请开收音机"), 21: ("9B", "请熄灯"), 22: ("BB", "请拉开窗帘"),
+    23: ("EB", "请关窗帘"), 24: ("58", "请帮助"), 25: ("68", "像是有点冷"), 26: ("D8", "像是有点热"),
+    27: ("78", "晚安"), 28: ("98", "是想上厕所吗?"), 29: ("B8", "请点灯"), 30: ("E8", "请息灯"),
+    31: ("5A", "请拿报纸来"), 32: ("6A", "请拿书来"), 33: ("DA", "请拿杂志来"), 34: ("7A", "像是伤风了"),
+    35: ("9A", "想要翻身吗?"), 36: ("BA", "是否有点不舒服?"),
+}
+
+
+def test_table_9_6_is_the_print_row_by_row():
+    rows = book_tables.melody_codes()
+    assert {r.no: (r.display, r.output_zh) for r in rows} == TABLE_9_6_PRINT
+    for no, (display, zh) in TABLE_9_6_PRINT.items():
+        assert book_tables.melody_lookup(display.lower()).no == no
 
 
 def test_table_9_6_rows():

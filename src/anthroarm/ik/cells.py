@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import ParameterError
 from .closed_form import _require, analytic_batch
 
 #: corner offsets (i, j, k) of M0 … M7 in the book's labelling
@@ -67,13 +68,14 @@ def nested_division(M, m) -> np.ndarray:
 
 
 def _finite_vector(v, name: str, n: int) -> np.ndarray:
-    """``v`` as a finite float vector of length ``n``; ValueError naming ``name`` otherwise."""
+    """``v`` as a finite float vector of length ``n``; :class:`~anthroarm.errors.ParameterError`
+    (a ValueError) naming ``name`` otherwise."""
     try:
         a = np.array(v, dtype=float).reshape(-1)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {n} finite numbers, got {v!r}") from None
+        raise ParameterError(f"{name} must be {n} finite numbers, got {v!r}") from None
     if a.shape != (n,) or not np.isfinite(a).all():
-        raise ValueError(f"{name} must be {n} finite numbers, got {v!r}")
+        raise ParameterError(f"{name} must be {n} finite numbers, got {v!r}")
     return a
 
 
@@ -214,6 +216,12 @@ class CellTable:
     def lookup(self, p) -> np.ndarray:
         """Joint vector (nq,) at position ``p`` (3,) m by Eq. (7-32).  Raises
         :class:`OutsideCellTableError` if the cell is not covered."""
+        (i, j, k), w = self._cell(p)
+        return np.dot(w, self.Q[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq))
+
+    def _cell(self, p):
+        """The covered cell (i, j, k) of position ``p`` and the 8 weights of Eq. (7-32) in the
+        corner order of ``Q[i:i+2, j:j+2, k:k+2]`` (i slowest)."""
         try:
             x, y, z = (float(v) for v in p)
         except (TypeError, ValueError):
@@ -236,7 +244,7 @@ class CellTable:
         # the 8 weights of (7-32) in the corner order of Q[i:i+2, j:j+2, k:k+2] (i slowest)
         w = (t1 * t2 * t3, t1 * t2 * m3, t1 * m2 * t3, t1 * m2 * m3,
              m1 * t2 * t3, m1 * t2 * m3, m1 * m2 * t3, m1 * m2 * m3)
-        return np.dot(w, self.Q[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq))
+        return (i, j, k), w
 
     def lookup_batch(self, P) -> CellLookup:
         """Vectorised Eq. (7-32) for positions ``P`` (N, 3) m."""
@@ -270,13 +278,13 @@ class CellTable:
 
     # ------------------------------------------------------------------ motor pulses (§9-3)
     def _set_pulses(self, pulses_per_rad) -> None:
-        k = _finite_vector(np.broadcast_to(np.asarray(pulses_per_rad, float), (self.nq,)) if np.ndim(pulses_per_rad) == 0
-                           else pulses_per_rad, "pulses_per_rad", self.nq)
+        k = _finite_vector([pulses_per_rad] * self.nq if np.ndim(pulses_per_rad) == 0 else pulses_per_rad,
+                           "pulses_per_rad", self.nq)
         if (k <= 0).any():
-            raise ValueError(f"pulses_per_rad must be > 0 (pulses per joint radian), got {k}")
+            raise ParameterError(f"pulses_per_rad must be > 0 (pulses per joint radian), got {k}")
         Q = np.where(self.valid[..., None], self.Q, 0.0) * k
         if np.abs(Q).max(initial=0.0) >= 2.0**62:
-            raise ValueError("pulses_per_rad too large: the pulse counts overflow int64")
+            raise ParameterError("pulses_per_rad too large: the pulse counts overflow int64")
         self.pulses_per_rad = k
         #: integer motor pulses from the origin (q = 0) to every lattice point, (nx, ny, nz, nq);
         #: 0 where ``valid`` is False
@@ -292,22 +300,16 @@ class CellTable:
 
     def _require_pulses(self):
         if self.pulses is None:
-            raise ValueError("this cell table stores no motor pulses: use table.with_pulses(pulses_per_rad)")
+            raise ParameterError("this cell table stores no motor pulses: use table.with_pulses(pulses_per_rad)")
 
     def lookup_pulses(self, p) -> np.ndarray:
         """Motor pulses (nq,) int64 from the origin to position ``p`` (3,) m: Eq. (7-32) on the
         stored integer pulses of the 8 corners, rounded to whole pulses.  Raises
         :class:`OutsideCellTableError` if the cell is not covered, ValueError without pulses."""
         self._require_pulses()
-        q = self.lookup(p)
-        del q  # the same cell checks; the pulses are interpolated from the integer table
-        r = (np.asarray(p, float) - self.origin) / self.D
-        idx = np.minimum(np.floor(r).astype(int), np.array(self.shape) - 2)
-        m = r - idx
-        i, j, k = idx
+        (i, j, k), w = self._cell(p)
         corners = self.pulses[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq).astype(float)
-        w = trilinear_weights(m)[[0, 3, 2, 5, 1, 6, 4, 7]]    # (7-32) weights in the order of ``corners``
-        return np.rint(w @ corners).astype(np.int64)
+        return np.rint(np.dot(w, corners)).astype(np.int64)
 
     def relative_pulses(self, p_from, p_to) -> np.ndarray:
         """Pulses (nq,) int64 each motor turns to move from ``p_from`` to ``p_to`` (m): the

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotations import homogeneous
 from .book import _lengths, sixr_arm
 from .spec import ChainSpec, from_dh, rod_link
@@ -81,13 +82,15 @@ def table_9_5_mass_sum_kg() -> float:
 
 def pulses_per_rad(encoder_counts: float = ENCODER_COUNTS, gear_ratio: float = GEAR_RATIO) -> float:
     """Motor pulses per joint radian: ``encoder_counts · gear_ratio / 2π`` (both assumed, see
-    :data:`ENCODER_COUNTS`, :data:`GEAR_RATIO`).  ValueError unless both are finite and > 0."""
+    :data:`ENCODER_COUNTS`, :data:`GEAR_RATIO`).  :class:`~anthroarm.errors.ParameterError` unless
+    both are finite and > 0."""
     try:
         c, g = float(encoder_counts), float(gear_ratio)
     except (TypeError, ValueError):
-        raise ValueError(f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, {gear_ratio!r}") from None
+        raise ParameterError(f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, "
+                             f"{gear_ratio!r}") from None
     if not (np.isfinite(c) and np.isfinite(g) and c > 0 and g > 0):
-        raise ValueError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
+        raise ParameterError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
     return c * g / (2.0 * np.pi)
 
 
