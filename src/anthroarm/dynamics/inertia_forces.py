@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..chain import PRISMATIC
+from ..errors import ParameterError
 from ..spatial.rotations import rot_axis
 
 __all__ = ["inertia_force", "inertia_force_body", "angular_momentum", "inertia_couple", "inertia_couple_expanded",
@@ -50,9 +51,12 @@ __all__ = ["inertia_force", "inertia_force_body", "angular_momentum", "inertia_c
 
 
 def _vec(x, name: str, shape=(3,)) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be finite numbers of shape {shape}, got {x!r}") from None
     if a.shape != shape or not np.isfinite(a).all():
-        raise ValueError(f"{name} must be finite numbers of shape {shape}, got {x!r}")
+        raise ParameterError(f"{name} must be finite numbers of shape {shape}, got {x!r}")
     return a
 
 
@@ -61,8 +65,8 @@ def _vec(x, name: str, shape=(3,)) -> np.ndarray:
 
 def inertia_force(m: float, a_com) -> np.ndarray:
     """Inertia force (N), Eq. (8-30): ``F = −m a_s``, in the frame of ``a_com`` (m/s²)."""
-    if not (np.isfinite(m) and m >= 0):
-        raise ValueError(f"mass must be finite and >= 0 (kg), got {m!r}")
+    if not (isinstance(m, (int, float, np.integer, np.floating)) and np.isfinite(m) and m >= 0):
+        raise ParameterError(f"mass must be finite and >= 0 (kg), got {m!r}")
     return -float(m) * _vec(a_com, "a_com")
 
 
@@ -260,12 +264,12 @@ def joint_frame(p1, p2) -> np.ndarray:
     u1, u2 = _vec(p1, "p1"), _vec(p2, "p2")
     n1, n2 = np.linalg.norm(u1), np.linalg.norm(u2)
     if not (n1 > 0 and n2 > 0):
-        raise ValueError("joint axes p1 and p2 must be non-zero")
+        raise ParameterError("joint axes p1 and p2 must be non-zero")
     u1, u2 = u1 / n1, u2 / n2
     c = np.cross(u1, u2)
     s = np.linalg.norm(c)
     if s < 1e-9:
-        raise ValueError(f"joint axes p1 and p2 are parallel (|p1 × p2| = {s:.3g}): (8-85) has no third axis")
+        raise ParameterError(f"joint axes p1 and p2 are parallel (|p1 × p2| = {s:.3g}): (8-85) has no third axis")
     return np.column_stack([u1, u2, c / s])
 
 
@@ -284,17 +288,26 @@ def joint_frame_from_links(l1, e1, l2, e2) -> np.ndarray:
     return joint_frame(rows[0], rows[1])
 
 
+def _check_axes(axes) -> np.ndarray:
+    """``axes`` (3, 3) with three independent columns (a :func:`joint_frame`), else ParameterError."""
+    A = _vec(axes, "axes", (3, 3))
+    if abs(np.linalg.det(A)) < 1e-12 * max(1.0, float(np.abs(A).max()) ** 3):
+        raise ParameterError(f"axes are not independent (det = {np.linalg.det(A):.3g}): no decomposition of M "
+                             "along them; build them with joint_frame(p1, p2)")
+    return A
+
+
 def oblique_components(M, axes) -> np.ndarray:
     """(M1, M2, M3) with ``M = M1 p1 + M2 p2 + M3 p3``, Eq. (8-86) corrected: ``A⁻¹ M`` with A
     the :func:`joint_frame` (axes as columns).  M in the fixed frame (N·m)."""
-    A = _vec(axes, "axes", (3, 3))
+    A = _check_axes(axes)
     return np.linalg.solve(A, _vec(M, "M"))
 
 
 def oblique_components_printed(M, axes) -> np.ndarray:
     """Eq. (8-86) as printed: ``a_p⁻¹ M`` with a_p = [a_ij] holding the direction cosines of
     axis i in **row** i (8-84).  Kept to show where it fails (oblique axes)."""
-    A = _vec(axes, "axes", (3, 3))
+    A = _check_axes(axes)
     return np.linalg.solve(A.T, _vec(M, "M"))
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotation_tensor import rotation_tensor
 
 I, J, K = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
@@ -42,13 +43,16 @@ __all__ = ["VectorLoop", "nested_pose", "product_pose", "pose_matrices", "loop_s
 
 
 def _vec3(v, what: str, unit: bool = False) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{what} must be 3 finite numbers, got {v!r}") from None
     if a.shape != (3,) or not np.isfinite(a).all():
-        raise ValueError(f"{what} must be 3 finite numbers, got {v!r}")
+        raise ParameterError(f"{what} must be 3 finite numbers, got {v!r}")
     if unit:
         n = np.linalg.norm(a)
         if abs(n - 1.0) > 1e-9:
-            raise ValueError(f"{what} must be a unit vector, got {v!r} (norm {n:.6g})")
+            raise ParameterError(f"{what} must be a unit vector, got {v!r} (norm {n:.6g})")
     return a
 
 
@@ -68,9 +72,9 @@ class VectorLoop:
             try:
                 kind, v = it
             except (TypeError, ValueError):
-                raise ValueError(f"loop item {n} must be (kind, vector), got {it!r}") from None
+                raise ParameterError(f"loop item {n} must be (kind, vector), got {it!r}") from None
             if kind not in ("C", "R", "L"):
-                raise ValueError(f"loop item {n}: kind must be 'C', 'R' or 'L', got {kind!r}")
+                raise ParameterError(f"loop item {n}: kind must be 'C', 'R' or 'L', got {kind!r}")
             items.append((kind, _vec3(v, f"loop item {n} ({kind})", unit=kind != "C")))
         object.__setattr__(self, "items", tuple(items))
         object.__setattr__(self, "G", _vec3(self.G, "G"))
@@ -88,9 +92,12 @@ class VectorLoop:
 
 
 def _q(loop: VectorLoop, q) -> np.ndarray:
-    q = np.asarray(q, dtype=float)
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}") from None
     if q.shape != (loop.nq,) or not np.isfinite(q).all():
-        raise ValueError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}")
+        raise ParameterError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}")
     return q
 
 
@@ -158,8 +165,12 @@ def loop_spec(loop: VectorLoop, limits=None):
     from ..spatial.rotations import homogeneous
     from ..models.spec import ChainSpec, JointSpec, rod_link
 
+    if loop.nq == 0:
+        raise ParameterError(f"{loop.name}: the loop has no joint ('R' or 'L' item): nothing to build")
     joints, acc, n = [], np.zeros(3), 0
     lim = list(limits) if limits is not None else None
+    if lim is not None and len(lim) != loop.nq:
+        raise ParameterError(f"{loop.name}: limits needs one (lower, upper) per joint ({loop.nq}), got {len(lim)}")
     for kind, v in loop.items:
         if kind == "C":
             acc = acc + v

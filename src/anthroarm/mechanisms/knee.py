@@ -20,7 +20,8 @@ Frame and units: the thigh frame of the sagittal plane, x anterior, y proximal (
 any point of the thigh part (the default geometry: the nominal knee centre); metres, radians,
 flexion positive when the foot moves posteriorly (the shank turns clockwise in this frame).
 
-Bad input: lengths or pivots that do not form a linkage raise ``ValueError``; a flexion the
+Bad input: lengths or pivots that do not form a linkage raise
+:class:`~anthroarm.errors.ParameterError` (a ``ValueError``); a flexion the
 linkage cannot reach, or a pose with parallel links (ICR at infinity), is a status, never NaN:
 ``status`` in {"ok", "cannot_assemble", "dead_point", "parallel_links"} with zeros in the
 numbers of that sample.
@@ -32,14 +33,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ._util import finite_array
 from .fourbar import fourbar_cartesian
 
 #: |sin| of the angle between the two links below this: the lines are parallel (ICR at infinity)
 PARALLEL_TOL = 1e-9
+#: the most samples :func:`icr_path` takes (1e5 flexion steps: far below a µrad)
+MAX_PATH_SAMPLES = 100_000
 
 __all__ = ["KneeGeometry", "KneeState", "default_knee", "knee_pose", "knee_flexion", "icr_path",
-           "stability_margin", "PARALLEL_TOL"]
+           "stability_margin", "PARALLEL_TOL", "MAX_PATH_SAMPLES"]
 
 
 @dataclass(frozen=True)
@@ -61,7 +65,7 @@ class KneeGeometry:
                  "thigh part": (self.prox_ant, self.prox_post), "shank part": (self.dist_ant, self.dist_post)}
         for what, (a, b) in pairs.items():
             if not np.hypot(*(b - a)) > 0.0:
-                raise ValueError(f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} coincide)")
+                raise ParameterError(f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} coincide)")
 
     @property
     def lengths(self) -> tuple[float, float, float, float]:
@@ -161,6 +165,8 @@ def knee_flexion(knee: KneeGeometry, flexion) -> KneeState:
     (flexion is monotonic in the crank angle between dead points).  A flexion the linkage
     cannot reach gets status "cannot_assemble" (numbers 0)."""
     target = np.atleast_1d(finite_array("flexion", flexion)).astype(float)
+    if target.ndim != 1 or target.size == 0:
+        raise ParameterError(f"flexion must be one angle or a non-empty 1-D array (rad), got shape {target.shape}")
     _, th2_ext, _ = _branch(knee)
     # sample the crank around the extension angle, keep the assembled run that contains it
     grid = th2_ext + np.linspace(-np.pi, np.pi, 4001)
@@ -212,8 +218,8 @@ def icr_path(knee: KneeGeometry, max_flexion: float = np.radians(120.0), n: int 
     """The ICR path (fixed centrode) from full extension to ``max_flexion`` (rad; Table 2.4:
     knee flexion about 120°) in ``n`` equal steps of flexion.  Samples the linkage cannot
     reach carry status "cannot_assemble"."""
-    if not (isinstance(n, (int, np.integer)) and n >= 2):
-        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    if not (isinstance(n, (int, np.integer)) and 2 <= n <= MAX_PATH_SAMPLES):
+        raise ParameterError(f"n must be an integer in 2..{MAX_PATH_SAMPLES}, got {n!r}")
     m = float(finite_array("max_flexion", max_flexion))
     return knee_flexion(knee, np.linspace(0.0, m, int(n)))
 
@@ -226,11 +232,11 @@ def stability_margin(knee: KneeGeometry, hip) -> float:
     hip = finite_array("hip", hip, (2,)).astype(float)
     st = knee_pose(knee, _branch(knee)[1])
     if not st.ok[0]:
-        raise ValueError(f"knee: no finite ICR at extension ({st.status[0]})")
+        raise ParameterError(f"knee: no finite ICR at extension ({st.status[0]})")
     line = knee.ankle - hip
     n = np.hypot(*line)
     if not n > 0:
-        raise ValueError("knee: the hip and the ankle coincide")
+        raise ParameterError("knee: the hip and the ankle coincide")
     p = st.icr[0] - hip
     # anterior is +x: the ICR is posterior when it lies on the -x side of the line (line points down)
     return float((p[0] * line[1] - p[1] * line[0]) / n)
