@@ -249,3 +249,13 @@ def test_table_9_6_unknown_code_is_typed():
         book_tables.melody_lookup("FF")
     with pytest.raises(KeyError):
         book_tables.melody_lookup("")
+
+
+def test_cell_table_of_another_robot_is_refused():
+    """The table's wrist offset P and IK branch are the care robot's: a URDF-loaded copy (no
+    parameter table) or another arm is a ParameterError, not a table built on a guessed P."""
+    with pytest.raises(ParameterError, match="URDF"):
+        cell_table(aa.load(str(REPO / "urdf" / "care_robot.urdf")))
+    with pytest.raises(ParameterError, match="prosthetic_arm"):
+        cell_table(aa.load("prosthetic_arm"))
+

@@ -137,7 +137,11 @@ def cell_table(robot=None, *, rotation=R_FORWARD, bounds=CELL_BOUNDS, D: float =
         from ..robot import load
 
         robot = load("care_robot")
-    P = float(robot.spec.params["P"]) if robot.spec is not None and "P" in robot.spec.params else 0.186
+    if robot.spec is None or robot.spec.name != "care_robot":
+        raise ParameterError("cell_table needs the catalog care_robot (aa.load('care_robot', ...)): the wrist "
+                             f"offset P and the table's IK branch are its own; got {robot.name!r}"
+                             + (" without its parameter table (loaded from a URDF?)" if robot.spec is None else ""))
+    P = float(robot.spec.params["P"])
     table = CellTable.build(robot, np.asarray(rotation, float), D, bounds, branch=branch, progress=False,
                             point=(0.0, 0.0, -P))
     return table.with_pulses(pulses_per_rad(encoder_counts, gear_ratio))
