@@ -121,4 +121,7 @@ def test_table_2_3_as_printed():
         ["立方体", "圆柱体", "球体", "球多球体"]
     assert [f[k].footprint_zh for k in f] == ["大", "较小", "小", "最小"]
     assert [f[k].relative_workspace_zh for k in f] == ["小", "较大", "大", "最大"]
-    assert f["articulated"].remark_zh == "能绕过障碍物进行工作"
+    assert [f[k].intuitiveness_zh for k in f] == ["强", "较强", "一般", "差"]
+    assert [f[k].use_zh for k in f] == ["较多", "多", "较少", "少"]
+    assert [f[k].remark_zh for k in f] == ["", "", "能提取地面上的物体", "能绕过障碍物进行工作"]
+    assert [f[k].form_zh for k in f] == ["直角坐标式", "圆柱坐标式", "球坐标式", "多关节式"]
