@@ -78,6 +78,22 @@ def test_printed_R78_with_cos_theta3_fails():
     assert abs(x_printed - R78[0]) > 1e-3
 
 
+def test_printed_theta3_about_i_fails():
+    """(6-62) as printed turns θ3 about i (E^{iθ3}); the printed matrix is C_y and the expansion
+    (6-63)/(6-64) adds θ2 + θ3 (C23, S23), which needs θ3 about j like θ2.  With the printed
+    axis the loop misses (6-64) by O(link length) at a generic q."""
+    loop, _ = tensor6r_loop(*C6R)
+    items = list(loop.items)
+    rev = [n for n, (kind, _) in enumerate(items) if kind == "R"]
+    assert np.allclose(items[rev[2]][1], J)                  # the corrected θ3 axis
+    items[rev[2]] = ("R", I)                                  # the printed one
+    printed = VectorLoop(tuple(items), G=loop.G, a0=loop.a0, b0=loop.b0)
+    q = np.array([0.3, -0.4, 0.9, 0.5, -0.7, 0.2])
+    expanded = sum(R_components(q, C6R))
+    np.testing.assert_allclose(nested_pose(loop, q)[0], expanded, atol=1e-14)
+    assert np.abs(nested_pose(printed, q)[0] - expanded).max() > 0.05
+
+
 def test_printed_6_65_b_about_k_fails():
     """(6-65) as printed ends with E^{kθ6}(b0ᵏ): that leaves b0 unchanged, so b would not depend
     on θ6; Pinocchio's tool frame does (θ6 about i)."""
