@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..spatial.polar import from_xy, rotate, to_xy
 from ._util import finite_array
 from .fourbar import fourbar_cartesian
 
@@ -145,13 +146,10 @@ def knee_pose(knee: KneeGeometry, theta2) -> KneeState:
     t = (d[0] * w[:, 1] - d[1] * w[:, 0]) / safe                 # prox_ant + t u = prox_post + s w
     icr = knee.prox_ant + t[:, None] * u
     # shank rotation relative to its extension pose: the coupler turned by th3 - th3_ext
-    phi = np.angle(np.exp(1j * (th3 - th3_ext)))
-    c, sn = np.cos(-phi), np.sin(-phi)
-    rel = icr - A
-    icr_shank = knee.dist_ant + np.stack([c * rel[:, 0] - sn * rel[:, 1], sn * rel[:, 0] + c * rel[:, 1]], -1)
-    ra = knee.ankle - knee.dist_ant
-    c2, s2 = np.cos(phi), np.sin(phi)
-    ankle = A + np.stack([c2 * ra[0] - s2 * ra[1], s2 * ra[0] + c2 * ra[1]], -1)
+    phi = np.where(ok, np.angle(np.exp(1j * (th3 - th3_ext))), 0.0)
+    # planar rotations as complex products, Eq. (5-5) (spatial.polar)
+    icr_shank = knee.dist_ant + to_xy(rotate(from_xy(np.where(ok[:, None], icr - A, 0.0)), -phi))
+    ankle = A + to_xy(rotate(from_xy(knee.ankle - knee.dist_ant), phi))
     z = ~ok
     for arr in (icr, icr_shank, A, B, ankle):
         arr[z] = 0.0
