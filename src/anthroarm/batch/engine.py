@@ -100,6 +100,8 @@ def window(client) -> int:
 
 #: glibc's M_TRIM_THRESHOLD set on a worker (bytes), see :func:`_relax_malloc_trim`
 WORKER_TRIM_THRESHOLD = 64 << 20
+#: glibc's M_MMAP_THRESHOLD set on a worker (bytes), see :func:`_relax_malloc_trim`
+WORKER_MMAP_THRESHOLD = 32 << 20
 _trim_relaxed = [False]
 
 
@@ -117,7 +119,13 @@ def _relax_malloc_trim() -> None:
     try:
         import ctypes
 
-        ctypes.CDLL("libc.so.6").mallopt(-1, WORKER_TRIM_THRESHOLD)   # M_TRIM_THRESHOLD = -1
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(-1, WORKER_TRIM_THRESHOLD)   # M_TRIM_THRESHOLD = -1
+        # the nanny's environment variable also freezes the mmap threshold at 128 KiB (glibc
+        # raises it after the first large free otherwise): every temporary of the batched FK
+        # was a fresh mmap, 20 000 page faults per task; 32 MiB (glibc's own dynamic maximum
+        # on 64-bit) serves them from the heap, as in the client's process
+        libc.mallopt(-3, WORKER_MMAP_THRESHOLD)   # M_MMAP_THRESHOLD = -3
     except (OSError, AttributeError):
         pass
 
