@@ -259,3 +259,15 @@ def test_cell_table_of_another_robot_is_refused():
     with pytest.raises(ParameterError, match="prosthetic_arm"):
         cell_table(aa.load("prosthetic_arm"))
 
+
+
+def test_bad_table_parameters_and_pulse_vectors_are_typed(robot, table):
+    for kw in (dict(D="x"), dict(D=np.nan), dict(rotation="abc"), dict(rotation=np.ones((3, 3))),
+               dict(bounds=((0, 0, 0), (1, 1))), dict(D=1e-6)):       # 2e17 lattice points: refused, not built
+        with pytest.raises(ParameterError):
+            cell_table(robot, **kw)
+    for bad in ("abc", [1, 2], [np.nan] * 6):
+        with pytest.raises(ParameterError, match="pulses must be"):
+            table.pulses_to_q(bad)
+    np.testing.assert_allclose(table.pulses_to_q(table.pulses[tuple(np.argwhere(table.valid)[0])]),
+                               table.Q[tuple(np.argwhere(table.valid)[0])], atol=0.5 / table.pulses_per_rad.min())

@@ -153,19 +153,23 @@ class CellTable:
         tool origin."""
         form = _require(robot).form
         name, params = robot.spec.name, dict(robot.spec.params)
-        R = np.asarray(rotation, float)
+        try:
+            R = np.asarray(rotation, float)
+            D = float(D)
+            lo, hi = (np.asarray(b, float) for b in bounds)
+        except (TypeError, ValueError):
+            raise ParameterError(f"rotation (3x3), D (m) and bounds (lo(3), hi(3)) must be numbers, got "
+                                 f"{rotation!r}, {D!r}, {bounds!r}") from None
         if R.shape != (3, 3) or not np.isfinite(R).all() or np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
-            raise ValueError(f"rotation must be a 3x3 rotation matrix, got {R!r}")
-        D = float(D)
+            raise ParameterError(f"rotation must be a 3x3 rotation matrix, got {R!r}")
         if not (np.isfinite(D) and D > 0):
-            raise ValueError(f"cell size D must be > 0 (m), got {D}")
-        lo, hi = (np.asarray(b, float) for b in bounds)
+            raise ParameterError(f"cell size D must be > 0 (m), got {D}")
         if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi <= lo).any():
-            raise ValueError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
+            raise ParameterError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
         point = np.zeros(3) if point is None else _finite_vector(point, "point", 3)
         i0, shape = lattice(lo, hi, D)
         if np.prod(shape) > MAX_LATTICE:
-            raise ValueError(f"lattice of {shape} points is too large; increase D")
+            raise ParameterError(f"lattice of {shape} points is too large; increase D")
         origin = i0 * D
         if q_ref is None:
             lo_q = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
@@ -189,7 +193,7 @@ class CellTable:
             res = analytic_batch(robot, T, **kw)
             if branch is not None:
                 if branch not in res.branches:
-                    raise ValueError(f"branch {branch!r} is not one of {res.branches}")
+                    raise ParameterError(f"branch {branch!r} is not one of {res.branches}")
                 b = res.branches.index(branch)
                 sel = res.solutions[:, b]
                 ok = res.valid[:, b]
@@ -225,9 +229,9 @@ class CellTable:
         try:
             x, y, z = (float(v) for v in p)
         except (TypeError, ValueError):
-            raise ValueError(f"p must be a finite position (3,) in metres, got {p!r}") from None
+            raise ParameterError(f"p must be a finite position (3,) in metres, got {p!r}") from None
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
-            raise ValueError(f"p must be a finite position (3,) in metres, got {p!r}")
+            raise ParameterError(f"p must be a finite position (3,) in metres, got {p!r}")
         D, o, hi = self.D, self._origin_f, self._hi
         r = ((x - o[0]) / D, (y - o[1]) / D, (z - o[2]) / D)
         idx = [math.floor(v) for v in r]
@@ -250,7 +254,7 @@ class CellTable:
         """Vectorised Eq. (7-32) for positions ``P`` (N, 3) m."""
         P = np.asarray(P, float)
         if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
-            raise ValueError(f"P must be finite positions (N, 3) in metres, got shape {P.shape}")
+            raise ParameterError(f"P must be finite positions (N, 3) in metres, got shape {P.shape}")
         idx, m, inside = self._locate(P)
         idc = np.clip(idx, 0, np.array(self.shape) - 2)
         ok = inside & self.cell_ok[idc[:, 0], idc[:, 1], idc[:, 2]]
@@ -317,9 +321,15 @@ class CellTable:
         return self.lookup_pulses(p_to) - self.lookup_pulses(p_from)
 
     def pulses_to_q(self, pulses) -> np.ndarray:
-        """Joint values (rad) of motor pulses counted from the origin."""
+        """Joint values (rad) of motor pulses (nq,) or (N, nq) counted from the origin."""
         self._require_pulses()
-        return np.asarray(pulses, float) / self.pulses_per_rad
+        try:
+            p = np.asarray(pulses, float)
+        except (TypeError, ValueError):
+            p = np.zeros(0)
+        if p.ndim not in (1, 2) or p.shape[-1] != self.nq or not np.isfinite(p).all():
+            raise ParameterError(f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got {pulses!r}")
+        return p / self.pulses_per_rad
 
     @property
     def bounds(self):

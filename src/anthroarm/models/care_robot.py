@@ -142,7 +142,7 @@ def cell_table(robot=None, *, rotation=R_FORWARD, bounds=CELL_BOUNDS, D: float =
                              f"offset P and the table's IK branch are its own; got {robot.name!r}"
                              + (" without its parameter table (loaded from a URDF?)" if robot.spec is None else ""))
     P = float(robot.spec.params["P"])
-    table = CellTable.build(robot, np.asarray(rotation, float), D, bounds, branch=branch, progress=False,
+    table = CellTable.build(robot, rotation, D, bounds, branch=branch, progress=False,
                             point=(0.0, 0.0, -P))
     return table.with_pulses(pulses_per_rad(encoder_counts, gear_ratio))
 
