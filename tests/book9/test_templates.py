@@ -84,6 +84,8 @@ def test_parameters_change_the_model():
     ("cartesian_robot", {"x_stroke": (0, float("inf"))}, "x_stroke"),
     ("cartesian_robot", {"h0": -1}, "h0"),
     ("spherical_robot", {"base": "wide"}, "base"),
+    ("articulated_robot", {"l2": 1e300}, "l2"),               # was an 'inf' link mass blamed on the URDF
+    ("cylindrical_robot", {"reach": (0.0, 1e300)}, "reach"),
 ])
 def test_parameters_out_of_range_are_typed(name, params, match):
     with pytest.raises(ParameterError, match=match):

@@ -45,6 +45,9 @@ REACH = (0.5, 1.0)
 LIFT = (0.0, 1.0)
 
 X, Z, MINUS_Y = (1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0)
+#: the largest length or stroke a template takes (m): beyond it the link masses and inertias of
+#: the default rods overflow (1e300 m gave an 'inf' mass reported against the committed URDF)
+MAX_LENGTH = 1e3
 
 
 def _length(model: str, name: str, v, positive: bool = False) -> float:
@@ -52,12 +55,14 @@ def _length(model: str, name: str, v, positive: bool = False) -> float:
         x = float(v)
     except (TypeError, ValueError):
         raise ParameterError(f"{model}: {name} must be a length in m, got {v!r}") from None
-    if not np.isfinite(x) or x < 0 or (positive and x == 0):
-        raise ParameterError(f"{model}: {name} must be a finite length {'> 0' if positive else '>= 0'} (m), got {v!r}")
+    if not np.isfinite(x) or x < 0 or (positive and x == 0) or x > MAX_LENGTH:
+        raise ParameterError(f"{model}: {name} must be a finite length {'> 0' if positive else '>= 0'} and at most "
+                             f"{MAX_LENGTH:g} m, got {v!r}")
     return x
 
 
-def _range(model: str, name: str, r, lo_min: float = -np.inf, hi_max: float = np.inf, unit: str = "m") -> tuple[float, float]:
+def _range(model: str, name: str, r, lo_min: float = -MAX_LENGTH, hi_max: float = MAX_LENGTH,
+           unit: str = "m") -> tuple[float, float]:
     try:
         lo, hi = (float(x) for x in r)
     except (TypeError, ValueError):
