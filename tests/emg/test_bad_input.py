@@ -1,5 +1,6 @@
-"""Bad input to the public EMG functions: typed EMGErrors naming the parameter, never a raw
-ValueError/TypeError from numpy or scipy, never NaN/inf in a result, never unbounded work."""
+"""Bad input and misuse of the public EMG functions: typed EMGErrors naming the parameter, never
+a raw ValueError/TypeError from numpy or scipy, never NaN/inf in a result, never unbounded work,
+no state carried from one simulation run into the next."""
 
 import numpy as np
 import pytest
@@ -100,3 +101,19 @@ def test_simulate_bad_parameters_are_parameter_errors(arm, kw, match):
     rec = emg.synthesize(0.5, FS, [[(0.1, 0.2, 1.0)], [(0.3, 0.1, 1.0)]], pp=1e-4, rng=0)
     with pytest.raises(ParameterError, match=match):
         simulate_powered_hand(arm, rec.emg, FS, {"elbow": "elbow_flexion", "fingers": None}, **kw)
+
+
+def test_a_reused_code_machine_starts_each_run_from_rest(arm):
+    """The machine is reset per run: a second run with the same machine (left in another mode
+    by the first) gives the first run's trace and motion, not a continuation."""
+    from anthroarm.emg.simulate import simulate_powered_hand
+
+    rec = emg.synthesize(1.5, FS, [[(0.2, 0.3, 1.0), (0.8, 0.4, 1.0)], [(0.2, 0.3, 1.0)]], pp=1e-4, rng=3)
+    machine = emg.CodeMachine(0.005, modes=("elbow", "fingers"))
+    joints = {"elbow": "elbow_flexion", "fingers": None}
+    a = simulate_powered_hand(arm, rec.emg, FS, joints, machine=machine)
+    assert a.trace.mode[-1] == 1                             # the co-contraction at 0.2 s switched to the fingers
+    b = simulate_powered_hand(arm, rec.emg, FS, joints, machine=machine)
+    np.testing.assert_array_equal(b.trace.mode, a.trace.mode)
+    np.testing.assert_array_equal(b.trace.command, a.trace.command)
+    np.testing.assert_allclose(b.angle, a.angle)

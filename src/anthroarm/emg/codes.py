@@ -30,7 +30,8 @@ Not printed, chosen here (assumptions, each a parameter):
 Codes are integers ``2·flexor + extensor`` (:data:`~anthroarm.emg.processor.REST` = 0 …
 :data:`~anthroarm.emg.processor.BOTH` = 3); commands are +1 (flexor direction: close,
 pronate, flex), −1 (extensor direction) or 0.  The machine is run on blocks of frames and
-keeps its state between calls, so blocks of any length give the result of one piece.
+keeps its state between calls, so blocks of any length give the result of one piece.  Like
+:class:`~anthroarm.emg.processor.EMGProcessor` it is not thread-safe: one machine per stream.
 """
 
 from __future__ import annotations

@@ -259,7 +259,8 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         others at 0 clipped to their limits.
     processor, machine
         The signal chain and state machine (defaults: ``EMGProcessor(fs)``,
-        ``CodeMachine(frame_s, modes=tuple(joints))``).
+        ``CodeMachine(frame_s, modes=tuple(joints))``).  Both are reset at the start of the run;
+        they are stateful, so do not share them between threads or concurrent runs.
     servos
         Mode → :class:`~anthroarm.control.servo.PositionServo` for each joint of the mode
         (default: :func:`joint_servo` of :func:`prosthesis_motor` per joint).  A given servo's ``J_L`` is only used for its gains; the
@@ -339,7 +340,8 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
 
     # ---- signal chain
     x = np.asarray(emg, dtype=float)
-    proc = processor.process(x)
+    proc = processor.process(x)                 # reset=True: the run starts from rest
+    machine.reset()                              # so does the state machine (a reused one kept its mode)
     trace = machine.run(proc.code)
     t = proc.t_frames
     n_f = t.size
