@@ -47,6 +47,8 @@ def spec():
     (lambda: emg.FilterBank((np.nan,), FS), "centres_hz"),
     (lambda: emg.FilterBank((40.0,), FS).gains([np.nan]), "NaN"),
     (lambda: emg.band_edges(40.0, FS, 1e6), "octaves"),
+    (lambda: emg.moving_rms(np.zeros(10), 1e12, 0.1), "is fs in Hz"),     # a 1e11-sample window: was a MemoryError
+    (lambda: emg.EMGProcessor(1e12), "is fs in Hz"),
 ])
 def test_bad_parameters_are_emg_errors(call, match):
     with pytest.raises(EMGError, match=match):

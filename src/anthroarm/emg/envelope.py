@@ -35,6 +35,8 @@ PP_PER_RMS = 2.0 * math.sqrt(2.0)
 PP_PER_MAV = math.pi
 #: the longest envelope window or control frame accepted (s)
 MAX_WINDOW_S = 10.0
+#: the most samples in one window (the moving RMS keeps a window of squares per channel)
+MAX_WINDOW_SAMPLES = 10_000_000
 
 
 def window_samples(window_s: float, fs: float) -> int:
@@ -46,6 +48,9 @@ def window_samples(window_s: float, fs: float) -> int:
     n = int(round(w * f))
     if n < 1:
         raise EMGError(f"envelope window {w:g} s is shorter than one sample at {f:g} Hz")
+    if n > MAX_WINDOW_SAMPLES:
+        raise EMGError(f"window {w:g} s at {f:g} Hz is {n:.3g} samples, more than {MAX_WINDOW_SAMPLES:.0e}: "
+                       "is fs in Hz?")
     return n
 
 
