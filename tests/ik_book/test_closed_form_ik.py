@@ -138,7 +138,7 @@ def test_single_equals_batch(seed):
 def test_has_analytic():
     for name in ("sixr_arm", "prosthetic_arm", "planar2r", "human_arm7"):
         assert aa.ik.has_analytic(aa.load(name))
-    assert aa.ik.has_analytic(aa.load("ur5"))              # by its geometry (tests/ik_geo)
+    assert aa.ik.has_analytic(aa.load("ur5"))              # by its geometry (tests/ik_geometric)
     for name in ("unimate5",):
         assert not aa.ik.has_analytic(aa.load(name))
     with pytest.raises(UnsupportedModelError):
