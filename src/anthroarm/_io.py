@@ -31,7 +31,18 @@ def atomic_write_text(path, text: str | bytes) -> None:
     never a partial one; the temp file is removed on failure.  The folder must exist
     (``FileNotFoundError``; ``NotADirectoryError`` when a part of it is a file); a ``path`` that
     is a folder raises ``IsADirectoryError``, one that is a device, FIFO or socket
-    ``OSError(EINVAL)``: neither is replaced."""
+    ``OSError(EINVAL)``: neither is replaced.  Both messages name the path and say what to
+    give instead.  A ``path`` that is not a path, or ``text`` that is neither str nor bytes,
+    raises :class:`~anthroarm.errors.ParameterError`."""
+    from .errors import ParameterError
+
+    if not isinstance(path, (str, os.PathLike)) or (isinstance(path, str) and not path):
+        raise ParameterError(f"atomic_write_text: path must be a file path (str or os.PathLike), "
+                             f"got {type(path).__name__} {path!r}")
+    if not isinstance(text, (str, bytes, bytearray, memoryview)):
+        # bytes(5) would silently write five NUL bytes
+        raise ParameterError(f"atomic_write_text: text must be str or bytes, got {type(text).__name__} "
+                             f"(writing {os.fspath(path)!r})")
     path = Path(path)
     data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
     parent = path.parent
@@ -44,9 +55,11 @@ def atomic_write_text(path, text: str | bytes) -> None:
     except FileNotFoundError:
         mode = None
     if mode is not None and stat.S_ISDIR(mode):
-        raise IsADirectoryError(errno.EISDIR, "is a folder; give a file name", str(path))
+        raise IsADirectoryError(errno.EISDIR, f"is a folder, not a file (left unchanged); give a file name, "
+                                f"e.g. {path / 'NAME'}", str(path))
     if mode is not None and not stat.S_ISREG(mode):
-        raise OSError(errno.EINVAL, "is not a regular file (a device, FIFO or socket); not replaced", str(path))
+        raise OSError(errno.EINVAL, "is not a regular file (a device, FIFO or socket; left unchanged); "
+                      "give the path of a regular file", str(path))
     _remove_stale_temps(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.{secrets.token_hex(4)}.tmp")
     try:

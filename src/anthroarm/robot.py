@@ -36,12 +36,31 @@ LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _REFERENCES = ("LOCAL", "WORLD", "LOCAL_WORLD_ALIGNED")
 
 
+def _short(x, n: int = 80) -> str:
+    """``repr(x)`` cut to ``n`` characters, for error messages."""
+    r = repr(x)
+    return r if len(r) <= n else r[: n - 3] + "..."
+
+
+def _has_text(x) -> bool:
+    """True for a str/bytes, a numpy array of text, or a list/tuple holding a str/bytes/None."""
+    if isinstance(x, (str, bytes)):
+        return True
+    if isinstance(x, np.ndarray):
+        return x.dtype.kind in "US"
+    if isinstance(x, (list, tuple)):
+        return any(v is None or _has_text(v) for v in x)
+    return False
+
+
 def _reference_frame(reference) -> pin.ReferenceFrame:
-    """``pin.ReferenceFrame`` from its name; ``ValueError`` listing the names otherwise."""
+    """``pin.ReferenceFrame`` from its name; :class:`~anthroarm.errors.ParameterError` (a
+    ``ValueError``) listing the names otherwise."""
     if isinstance(reference, pin.ReferenceFrame):
         return reference
-    if reference not in _REFERENCES:
-        raise ValueError(f"reference must be one of {', '.join(_REFERENCES)}, got {reference!r}")
+    if not isinstance(reference, str) or reference not in _REFERENCES:
+        raise ParameterError(f"reference must be one of {', '.join(_REFERENCES)} (or a pin.ReferenceFrame), "
+                             f"got {reference!r}")
     return getattr(pin.ReferenceFrame, reference)
 
 
@@ -244,22 +263,39 @@ class Robot:
     def check_q(self, q, name: str = "q") -> np.ndarray:
         """Validate a configuration or a batch ``(N, nq)``; returns a float array.
 
-        Raises ``ValueError`` for a wrong shape, a NaN/inf value (naming the joint) or a
-        continuous joint whose (cos, sin) pair is not a unit vector."""
-        arr = np.asarray(q, dtype=float)
+        Raises :class:`~anthroarm.errors.ParameterError` (a ``ValueError`` and a ``TypeError``)
+        for entries that are not real numbers, a wrong shape, a NaN/inf value (naming the joint)
+        or a continuous joint whose (cos, sin) pair is not a unit vector."""
+        names = list(self.chain.q_names)
+        if q is None:
+            raise ParameterError(f"{self.name}: {name} is None; give {self.nq} joint values (rad or m) "
+                                 f"for q entries {names}")
+        try:
+            if _has_text(q):   # numpy would parse "0.1" and turn None into NaN
+                raise TypeError("holds text or None")
+            arr = np.asarray(q, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"{self.name}: {name} must be real numbers (rad or m), shape ({self.nq},) or "
+                                 f"(N, {self.nq}) for q entries {names}; got {_short(q)} ({exc})") from None
         if arr.ndim not in (1, 2) or arr.shape[-1] != self.nq:
-            raise ValueError(
+            raise ParameterError(
                 f"{self.name}: {name} must have shape ({self.nq},) or (N, {self.nq}) "
-                f"for q entries {list(self.chain.q_names)}, got shape {arr.shape}"
+                f"for q entries {names}, got shape {arr.shape}"
             )
         bad = ~np.isfinite(arr)
         if bad.any():
             idx = np.argwhere(bad)[0]
             j = int(idx[-1])
             where = f" (row {int(idx[0])})" if arr.ndim == 2 else ""
-            raise ValueError(f"{self.name}: {name}[{j}] for joint {self.chain.q_names[j]!r} is {arr[tuple(idx)]}{where}")
+            raise ParameterError(f"{self.name}: {name}[{j}] for joint {names[j]!r} is {arr[tuple(idx)]}{where}; "
+                                 f"joint values must be finite (rad or m)")
         if self.chain.has_continuous:
-            self.chain.check_unit(arr, name)
+            try:
+                self.chain.check_unit(arr, name)
+            except ParameterError:
+                raise
+            except ValueError as exc:   # Chain.check_unit names the robot, the joint and the norm
+                raise ParameterError(str(exc)) from None
         return arr
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
@@ -413,7 +449,7 @@ def load(source, *, tool: str | None = None, active=None, locked=None, package_d
     if visual_model is not None or collision_model is not None:
         raise ParameterError("visual_model= / collision_model= go with a pin.Model source")
     if not isinstance(source, (str, Path)):
-        raise TypeError(f"load() takes a catalog or example-robot-data name, a URDF path, a pin.Model or a "
+        raise ParameterError(f"load() takes a catalog or example-robot-data name, a URDF path, a pin.Model or a "
                         f"RobotWrapper, got {type(source).__name__}")
     s = str(source)
     if s in models.BOOK_MODELS:

@@ -20,37 +20,77 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotations import UNIT_TOL, as_scalar, check_unit_axis, skew  # noqa: F401  (re-exported)
 
 
+def _short(x, n: int = 80) -> str:
+    """``repr(x)`` cut to ``n`` characters, for error messages."""
+    r = repr(x)
+    return r if len(r) <= n else r[: n - 3] + "..."
+
+
+def _not_a_number(x) -> bool:
+    """None, a str/bytes or a bool: values numpy would turn into a number (NaN, a parsed float,
+    0/1) that are never a length, angle or coordinate the caller meant."""
+    return x is None or isinstance(x, (str, bytes, bool, np.bool_))
+
+
 def finite_scalar(name: str, x) -> float:
-    """``float(x)`` or ``ValueError`` naming ``name`` when x is not a finite real scalar
-    (:func:`anthroarm.spatial.rotations.as_scalar` with the name first)."""
-    return as_scalar(x, name)
+    """``float(x)`` or :class:`~anthroarm.errors.ParameterError` (a ``ValueError``) naming
+    ``name`` when x is not a finite real scalar (:func:`anthroarm.spatial.rotations.as_scalar`
+    with the name first)."""
+    if _not_a_number(x):
+        raise ParameterError(f"{name} must be a finite real number, got {type(x).__name__} {_short(x)}")
+    try:
+        return as_scalar(x, name)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(str(exc)) from None
 
 
 def positive_length(name: str, x) -> float:
+    """``float(x)``; :class:`~anthroarm.errors.ParameterError` naming ``name`` unless x is a
+    finite length > 0."""
     v = finite_scalar(name, x)
     if v <= 0.0:
-        raise ValueError(f"{name} must be a positive length, got {x!r}")
+        raise ParameterError(f"{name} must be a positive length (> 0, finite), got {_short(x)}")
     return v
 
 
 def finite_array(name: str, x, shape=None) -> np.ndarray:
-    """Float array (copy) of ``x``; ``ValueError`` naming ``name`` for a wrong shape or NaN/inf.
+    """Float array (copy) of ``x``; :class:`~anthroarm.errors.ParameterError` (a ``ValueError``
+    and a ``TypeError``) naming ``name`` for a value that is not an array of real numbers, a
+    wrong shape or NaN/inf.
 
     ``shape`` may contain ``None`` for "any size" in that position (checked from the end)."""
+    want = "" if shape is None else f" of shape {tuple('N' if s is None else s for s in shape)}"
+    if _not_a_number(x):
+        raise ParameterError(f"{name} must be a real array{want}, got {type(x).__name__} {_short(x)}")
     try:
         a = np.array(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real array, got {x!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{name} must be a real array{want}, got {_short(x)}") from None
+    if (isinstance(x, np.ndarray) and x.dtype.kind in "USb") or (isinstance(x, (list, tuple)) and _has_strings(x)):
+        raise ParameterError(f"{name} must be a real array{want}, got {_short(x)}")
     if shape is not None:
         tail = a.shape[len(a.shape) - len(shape):] if len(a.shape) >= len(shape) else None
         if tail is None or len(a.shape) != len(shape) or any(s is not None and s != t for s, t in zip(shape, tail)):
-            raise ValueError(f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}")
+            raise ParameterError(f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must be finite, got {x!r}")
+        raise ParameterError(f"{name} must be finite, got {_short(x)}")
     return a
+
+
+def _has_strings(x) -> bool:
+    """True when the nested list/tuple ``x`` holds a str/bytes/None (numpy parses "1.5" and
+    turns None into NaN)."""
+    for v in x:
+        if isinstance(v, (list, tuple)):
+            if _has_strings(v):
+                return True
+        elif v is None or isinstance(v, (str, bytes)):
+            return True
+    return False
 
 
 def point3(name: str, x) -> np.ndarray:
@@ -58,11 +98,18 @@ def point3(name: str, x) -> np.ndarray:
 
 
 def unit_axis(name: str, u) -> np.ndarray:
-    """A 3-vector that must already be a unit vector (|u| = 1 within 1e-9); ``ValueError`` otherwise.
+    """A 3-vector that must already be a unit vector (|u| = 1 within 1e-9);
+    :class:`~anthroarm.errors.ParameterError` (a ``ValueError``) otherwise.
 
     :func:`anthroarm.spatial.rotations.check_unit_axis` restricted to one axis of shape (3,),
     then divided by its norm (so that |u| = 1 to rounding)."""
-    a = check_unit_axis(point3(name, u), name)
+    p = point3(name, u)
+    try:
+        a = check_unit_axis(p, name)
+    except ValueError as exc:
+        if isinstance(exc, ParameterError):
+            raise
+        raise ParameterError(f"{exc} ({name} must be a unit 3-vector, |{name}| = 1 within {UNIT_TOL:g})") from None
     return a / float(np.linalg.norm(a))
 
 
@@ -170,7 +217,7 @@ def pow2_scale(*xs) -> float:
     do not overflow, and finite answers where the squares of the raw lengths would overflow."""
     m = max((float(np.max(np.abs(np.asarray(x, dtype=float)), initial=0.0)) for x in xs), default=0.0)
     if not np.isfinite(m):
-        raise ValueError(f"a length or coordinate is beyond the float range ({m})")
+        raise ParameterError(f"a length or coordinate is beyond the float range ({m}); inputs must be finite")
     if m == 0.0:
         return 1.0
     return float(np.ldexp(1.0, np.frexp(m)[1] - 1))
@@ -178,26 +225,26 @@ def pow2_scale(*xs) -> float:
 
 def norm(name: str, v, axis=-1):
     """|v| along ``axis`` without overflow or underflow of the squares (v / 2^k first);
-    ``ValueError`` naming ``name`` when a difference of coordinates already overflowed."""
+    :class:`~anthroarm.errors.ParameterError` naming ``name`` when a difference of coordinates already overflowed."""
     v = np.asarray(v, dtype=float)
     if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} is beyond the float range: the coordinates are too far apart")
+        raise ParameterError(f"{name} is beyond the float range: the coordinates are too far apart")
     s = pow2_scale(v)
     return s * np.linalg.norm(v / s, axis=axis)
 
 
 def representable(name: str, x, why: str):
     """``x`` (computed under ``np.errstate(over='ignore', invalid='ignore')``) as a float array,
-    or ``ValueError`` naming ``name`` when it holds inf/NaN: the true value exists but is beyond
+    or :class:`~anthroarm.errors.ParameterError` naming ``name`` when it holds inf/NaN: the true value exists but is beyond
     the float range (``why`` says which inputs make it so)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"{name} cannot be represented in floating point ({why}); use other units or smaller rates")
+        raise ParameterError(f"{name} cannot be represented in floating point ({why}); use other units or smaller rates")
     return x
 
 
 def difference(name: str, a, b):
-    """``a - b`` or ``ValueError`` naming ``name`` when the difference overflows."""
+    """``a - b`` or :class:`~anthroarm.errors.ParameterError` naming ``name`` when the difference overflows."""
     with np.errstate(over="ignore", invalid="ignore"):
         d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
     return representable(name, d, "the points are too far apart")
@@ -205,7 +252,7 @@ def difference(name: str, a, b):
 
 def representable_fields(state, why: str):
     """``state`` (a dataclass computed under ``np.errstate(over='ignore', invalid='ignore')``)
-    unchanged, or ``ValueError`` naming the first numeric field that holds inf/NaN (its true
+    unchanged, or :class:`~anthroarm.errors.ParameterError` naming the first numeric field that holds inf/NaN (its true
     value is beyond the float range; ``why`` names the inputs that make it so)."""
     from dataclasses import fields
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..spatial.rotations import as_scalar, homogeneous
 from .spec import ChainSpec, DHRow, JointSpec, from_dh, rod_link
 
@@ -16,24 +17,31 @@ deg = np.pi / 180.0
 
 
 def _lengths(model: str, **values) -> None:
-    """``ValueError`` naming the first length (m) that is not a finite number >= 0."""
+    """:class:`~anthroarm.errors.ParameterError` (a ``ValueError``) naming the first length (m)
+    that is not a finite number >= 0."""
     for name, v in values.items():
-        try:
-            ok = as_scalar(v, name) >= 0.0
-        except ValueError:
+        if v is None or isinstance(v, (bool, np.bool_, str, bytes)):
             ok = False
+        else:
+            try:
+                ok = as_scalar(v, name) >= 0.0
+            except (TypeError, ValueError):
+                ok = False
         if not ok:
-            raise ValueError(f"{model}: {name} must be a finite length >= 0 (m), got {v!r}")
+            raise ParameterError(f"{model}: {name} must be a finite length >= 0 (m), e.g. {name}=0.3; "
+                                 f"got {type(v).__name__} {v!r}")
 
 
 def _stroke(model: str, name: str, stroke) -> tuple[float, float]:
     """A prismatic range (lo, hi) in m with lo < hi, both finite."""
     try:
+        if isinstance(stroke, (str, bytes)):
+            raise TypeError("a string")
         lo, hi = (float(x) for x in stroke)
     except (TypeError, ValueError):
-        raise ValueError(f"{model}: {name} must be a pair (lower, upper) in m, got {stroke!r}") from None
+        raise ParameterError(f"{model}: {name} must be a pair (lower, upper) in m, got {stroke!r}") from None
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise ValueError(f"{model}: {name} must be finite with lower < upper, got {stroke!r}")
+        raise ParameterError(f"{model}: {name} must be finite with lower < upper (m), got {stroke!r}")
     return lo, hi
 
 

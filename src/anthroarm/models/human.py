@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import AnthropometryError, ParameterError
 from ..spatial.rotations import homogeneous
 from .spec import ChainSpec, JointSpec, rod_link
 
@@ -83,14 +83,18 @@ HUMAN_ARM7_LIMITS_DEG = {
 def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "male") -> dict:
     """Length (m), mass (kg), CoM distance from the proximal joint (m) and radii of gyration
     (m; sagittal, transverse, longitudinal) of upper arm, forearm and hand (de Leva 1996)."""
-    if sex not in DE_LEVA_1996:
-        raise ValueError(f"sex must be 'male' or 'female', got {sex!r}")
-    if not isinstance(height, (int, float, np.floating, np.integer)) or not isinstance(mass, (int, float, np.floating, np.integer)):
-        raise ValueError(f"body height and mass must be numbers (m, kg), got {height!r}, {mass!r}")
-    if not (0.5 <= height <= 2.6):
-        raise ValueError(f"body height {height} m is outside 0.5…2.6 m")
+    if not isinstance(sex, str) or sex not in DE_LEVA_1996:
+        raise ParameterError(f"sex must be 'male' or 'female' (de Leva 1996 tables), got {sex!r}")
+    _NUM = (int, float, np.floating, np.integer)
+    for pname, v, unit in (("height", height, "m"), ("mass", mass, "kg")):
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, _NUM):
+            raise AnthropometryError(f"body height and mass must be numbers (m, kg): {pname} got "
+                                     f"{type(v).__name__} {v!r}", pname, v)
+    if not (0.5 <= height <= 2.6):   # also False for NaN
+        raise AnthropometryError(f"body height {height} m is outside 0.5…2.6 m (height= in m, e.g. 1.75)",
+                                 "height", height)
     if not (10.0 <= mass <= 300.0):
-        raise ValueError(f"body mass {mass} kg is outside 10…300 kg")
+        raise AnthropometryError(f"body mass {mass} kg is outside 10…300 kg (mass= in kg, e.g. 75)", "mass", mass)
     tab = DE_LEVA_1996[sex]
     k = height * 1000.0 / tab["stature"]
     out = {}
