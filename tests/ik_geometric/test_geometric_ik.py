@@ -1,7 +1,8 @@
 """Closed-form IK of any 6R arm by its geometry (anthroarm.ik.geometric through aa.ik.analytic):
 the UR3/5/10 (three parallel + two intersecting), kinova and a PUMA 560 (spherical wrist + two
 parallel), the prosthetic arm (spherical shoulder: a reversed spherical_two_intersecting), and
-random user arms of each class written here as standard-DH URDFs.
+random user arms of each class written here as standard-DH URDFs, including the two classes
+solved by a 1-D search (two_parallel, two_intersecting).
 
 Oracles: Pinocchio FK of every returned branch (FK(IK(T)) = T to 1e-9) and the joint values
 the pose was made from; PyPI ik-geo (Rust) for the number of exact solutions and their values
@@ -17,6 +18,7 @@ import anthroarm as aa
 from anthroarm.errors import UnsupportedModelError
 from anthroarm.ik import classify as C
 from anthroarm.ik import geometric as G
+from anthroarm.ik.closed_form import closed_form_info
 
 PI = np.pi
 
@@ -59,6 +61,10 @@ def random_arm(tmp_path, cls, seed):
         alpha, a, d = [A(), A(), A(), A(), A(), A()], [L(), L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
     elif cls == C.THREE_PARALLEL:                  # 2 ∥ 3 ∥ 4 alone (SP6 quartic)
         alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), L(), L()], [L(), L(), L(), L(), L(), L()]
+    elif cls == C.TWO_PARALLEL:                    # 2 ∥ 3 (α2 = 0) alone: a 1-D search over q1
+        alpha, a, d = [A(), 0, A(), A(), A(), A()], [L() for _ in range(6)], [L() for _ in range(6)]
+    elif cls == C.TWO_INTERSECTING:                # 5 × 6 (a5 = 0) alone: a 1-D search over q4
+        alpha, a, d = [A() for _ in range(6)], [L(), L(), L(), L(), 0, L()], [L() for _ in range(6)]
     else:                                          # 2 ∥ 3 ∥ 4 (α2 = α3 = 0), 5 × 6 (a5 = 0)
         alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), 0, L()], [L(), L(), L(), L(), L(), L()]
     return dh_urdf(tmp_path, f"user_{cls}_{seed}", alpha, a, d)
@@ -82,7 +88,7 @@ def _angles(robot, Q):
 def _arms(tmp_path):
     return [("ur3", aa.load("ur3")), ("ur5", aa.load("ur5")), ("ur10", aa.load("ur10")),
             ("kinova", aa.load("kinova")), ("puma560", puma560(tmp_path))] + \
-        [(f"user_{c}", random_arm(tmp_path, c, s)) for s in (1, 2) for c in G.SOLVED]
+        [(f"user_{c}", random_arm(tmp_path, c, s)) for s in (1, 2) for c in G.SOLVED if c not in G.SEARCHED]
 
 
 CLASS = {"ur3": C.THREE_PARALLEL_TWO_INTERSECTING, "ur5": C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -263,3 +269,78 @@ def test_check_rows_pass(name):
     assert len(rows) >= 1 and all(r.ok for r in rows), [(r.quantity, r.max_abs_err, r.note) for r in rows]
     assert rows[0].max_abs_err < 1e-9
     assert G.check_rows(aa.load("unimate5"), 8, np.random.default_rng(0)) == []
+
+
+def _ik_geo_fk(gp, x):
+    """FK in IK-Geo's form (R06, p) of the class kinematics of ``gp``."""
+    R, p = np.eye(3), gp.P[0].copy()
+    for i in range(6):
+        R = R @ G.sp.rot(gp.H[i], x[i])
+        p = p + R @ gp.P[i + 1]
+    return R, p
+
+
+@pytest.mark.parametrize("cls", [C.TWO_PARALLEL, C.TWO_INTERSECTING])
+def test_search_classes_every_branch_fk_verified_and_the_pose_found(tmp_path, cls):
+    """Random user arms of the 1-D search classes: every branch aa.ik.analytic_batch returns is
+    FK-exact (Pinocchio, 1e-9), the sampled posture is among them (mod 2π), the labels name
+    the search root."""
+    for seed in (1, 2):
+        robot = random_arm(tmp_path, cls, seed)
+        gp = G.plan_for(robot)
+        assert gp is not None and gp.cls == cls and not gp.reversed
+        assert aa.ik.has_analytic(robot) and closed_form_info(robot).family == cls
+        th, T = _poses(robot, 20, 3)
+        res = aa.ik.analytic_batch(robot, T)
+        assert res.solutions.shape[1] == G.SEARCH_BRANCHES == len(res.branches)
+        assert res.branches[0] == ("q1root=0" if cls == C.TWO_PARALLEL else "q4root=0")
+        assert res.valid.any(1).all(), res.reasons
+        for i in range(len(T)):
+            r = res[i]
+            for q in r.solutions:
+                assert np.abs(_fk(robot, q) - T[i]).max() < 1e-9
+            d = np.abs(np.angle(np.exp(1j * (r.solutions - th[i])))).max(1)
+            assert d.min() < 1e-7, (cls, seed, i)
+        one = aa.ik.analytic(robot, T[0])
+        np.testing.assert_allclose(one.solutions, res[0].solutions, atol=1e-12)
+
+
+def test_search_class_exact_flag_and_unreachable(tmp_path):
+    """A refined root is exact (its error below SEARCH_TOL); a pose out of reach has no branch
+    and a reason."""
+    robot = random_arm(tmp_path, C.TWO_INTERSECTING, 1)
+    gp = G.plan_for(robot)
+    _, T = _poses(robot, 3, 5)
+    q, valid, exact = G.solve(gp, T)
+    assert q.shape == (3, G.SEARCH_BRANCHES, 6) and exact.any(1).all() and (exact <= valid).all()
+    far = np.eye(4)
+    far[:3, 3] = [5.0, 0.0, 0.0]
+    r = aa.ik.analytic(robot, far)
+    assert not r.success and r.solutions.shape == (0, 6) and "outside the workspace" in r.reason
+
+
+@pytest.mark.parametrize("cls", [C.TWO_PARALLEL, C.TWO_INTERSECTING])
+def test_search_classes_against_ik_geo(tmp_path, cls):
+    """IK-Geo (PyPI ik-geo 1.x) exposes both classes, but its 1-D search (200 samples, a
+    secant refinement stopped at |Δe| < 1e-5) returns 1-3 roots per pose whose FK error is
+    above 1e-5 and flags none exact, so its branch counts are no oracle here: every solution
+    of ik-geo that is FK-exact to 1e-5 must be among ours (to 1e-4 rad), and we find at least
+    as many."""
+    ik_geo = pytest.importorskip("ik_geo")
+    for seed in (1, 2):
+        robot = random_arm(tmp_path, cls, seed)
+        gp = G.plan_for(robot)
+        geo = getattr(ik_geo.Robot, cls)(gp.H.tolist(), gp.P.tolist())
+        _, T = _poses(robot, 20, 3)
+        q, valid, exact = G.solve(gp, T)
+        R06, p06 = G.class_pose(gp, T)
+        for i in range(len(T)):
+            ours = q[i][exact[i]]
+            good = []
+            for s, _ in geo.get_ik(R06[i].T.tolist(), p06[i].tolist()):
+                R, p = _ik_geo_fk(gp, np.array(s))
+                if max(np.abs(R - R06[i]).max(), np.abs(p - p06[i]).max()) < 1e-5:
+                    good.append(np.array(s))
+            assert len(ours) >= len(good)
+            for g in good:
+                assert np.abs(np.angle(np.exp(1j * (ours - g)))).max(1).min() < 1e-4, (cls, seed, i)

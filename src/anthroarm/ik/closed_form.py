@@ -181,10 +181,12 @@ def _form(robot, frame=None):
 
 #: the registry-like entry of an arm solved by its geometry (:mod:`.geometric`), per class;
 #: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of
-#: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py)
-_GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), 8, cost_us=3000.0) for c in _geo.SOLVED}
+#: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py; a 1-D search
+#: class, :data:`.geometric.SEARCHED`, ~30 ms)
+_GEO_COST = {c: 30000.0 if c in _geo.SEARCHED else 3000.0 for c in _geo.SOLVED}
+_GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), _geo.n_branches(c), cost_us=_GEO_COST[c]) for c in _geo.SOLVED}
 #: a 7-joint arm with its last joint held (the family parameter): per value of the grid
-_GEO_FORMS7 = {c: _registry.ClosedForm(c, (), 7, (), 8, cost_us=3000.0) for c in _geo.SOLVED}
+_GEO_FORMS7 = {c: _registry.ClosedForm(c, (), 7, (), _geo.n_branches(c), cost_us=_GEO_COST[c]) for c in _geo.SOLVED}
 #: values of the held joint of a 7-joint arm when ``param`` is not given
 PARAM_GRID = 12
 #: FK residual (m / unitless) up to which a class solution is polished (arm of its class only
@@ -728,7 +730,7 @@ def _no_param(robot, param):
 
 def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, param=None) -> AnalyticBatchResult:
     """:func:`analytic_batch` of an arm solved by its geometry (:mod:`.geometric`): the class
-    solver's 8 branches (per value of ``param`` for a 7-joint arm: its last joint, rad; scalar,
+    solver's branches (8, or 16 slots for a search class; per value of ``param`` for a 7-joint arm: its last joint, rad; scalar,
     (N,), (1, S) or (N, S) as ``swivel``; default :data:`PARAM_GRID` values over its range),
     wrapped by 2π into the joint limits, each verified by FK (the 3×4 pose to ``tol``; candidates
     within :data:`POLISH_MAX` polished first), duplicates removed; a reason for every pose
@@ -757,7 +759,7 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
         pv = np.zeros((N, 1))
     S = pv.shape[1]
     labels = list(gp.labels) if S == 1 else [f"{b},param#{k}" for k in range(S) for b in gp.labels]
-    B = 8 * S
+    B = len(gp.labels) * S
     if N == 0:
         return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
                                    residuals=np.zeros((0, B)), singular=[], model=robot.name)

@@ -22,7 +22,19 @@ class (:mod:`.classify`)                  decomposition                         
                                           SP1, q3 SP3, q2 SP1, q4 by difference
 ``spherical``                             (q1, q2, q3) SP5 (quartic); the wrist   4 × 2
 ``three_parallel``                        (q1, q5) SP6 (quartic); then as above   4 × 2
+``two_parallel``                          1-D search over q1: (q4, q6) SP6,      ≤ 16
+                                          θ23 SP1, error ‖span‖ − ‖p23‖; q2,
+                                          q5 SP1
+``two_intersecting``                      1-D search over q4: (q1, q2, q3) SP5,  ≤ 16
+                                          error h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6;
+                                          q5, q6 SP1
 ========================================  =====================================  ==========
+
+The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``) sample the searched joint
+on :data:`SEARCH_GRID` values for all poses in one batch, follow each root of the inner
+subproblem from sample to sample, and refine every sign change of the error by regula falsi
+(Illinois) to ``|e| ≤`` :data:`SEARCH_TOL`; a root that does not get there is not ``exact``.
+A root where the error only touches zero (no sign change) is not found.
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
 solved on the reversed arm: T = e^{ξ1 q1} ⋯ e^{ξ6 q6} M gives T⁻¹ = e^{ξ'1 q6} ⋯ e^{ξ'6 q1} M⁻¹
@@ -44,9 +56,11 @@ import numpy as np
 from . import classify as C
 from . import subproblems as sp
 
-#: the classes solved here in closed form (the others: use aa.ik.solve)
+#: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
-          C.SPHERICAL, C.THREE_PARALLEL)
+          C.SPHERICAL, C.THREE_PARALLEL, C.TWO_PARALLEL, C.TWO_INTERSECTING)
+#: the classes of :data:`SOLVED` solved by a 1-D search over one joint angle
+SEARCHED = (C.TWO_PARALLEL, C.TWO_INTERSECTING)
 
 #: per class: (the unknowns of each branching subproblem, its number of roots), outermost first
 _LABELS = {
@@ -58,9 +72,20 @@ _LABELS = {
 }
 
 
+def n_branches(cls: str) -> int:
+    """The number of branch slots of a class solver per pose: 8, or :data:`SEARCH_BRANCHES`
+    for a search class."""
+    return SEARCH_BRANCHES if cls in SEARCHED else 8
+
+
 def branch_labels(cls: str) -> tuple[str, ...]:
-    """The 8 branch labels of a class: which root of each of its branching subproblems
-    (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …)."""
+    """The branch labels of a class: which root of each of its branching subproblems
+    (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …); for a search class
+    which root of the search along the searched joint, in the order found from −π
+    (``"q1root=2"``; slots are filled from the first)."""
+    if cls in SEARCHED:
+        j = "q1" if cls == C.TWO_PARALLEL else "q4"
+        return tuple(f"{j}root={k}" for k in range(SEARCH_BRANCHES))
     out = [""]
     for name, k in _LABELS[cls]:
         out = [f"{o},{name}={i}".lstrip(",") for o in out for i in range(k)]
@@ -109,7 +134,8 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     o = np.array(points, dtype=float)
     groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)], C.SPHERICAL: [(3, 4, 5)],
               C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
-              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)], C.THREE_PARALLEL: []}[cls]
+              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)], C.THREE_PARALLEL: [],
+              C.TWO_PARALLEL: [], C.TWO_INTERSECTING: [(4, 5)]}[cls]
     for g in groups:
         c = _common_point(H[list(g)], o[list(g)])
         for i in g:
@@ -322,19 +348,218 @@ def _spherical(H, P, R06, p):
     return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
 
 
+# ----------------------------------------------------------------------------- 1-D search classes
+#: samples of the searched joint over (−π, π] (IK-Geo's reference implementation uses 200)
+SEARCH_GRID = 256
+#: most branches a search class returns per pose (a 6R arm has at most 16 solutions)
+SEARCH_BRANCHES = 16
+#: |e| at which a refined root counts as exact (the error functions are in m or unitless)
+SEARCH_TOL = 1e-12
+#: two roots of the inner subproblem at neighbouring samples are the same branch when their
+#: angles differ by less than this (rad); a branch that appears or vanishes there is not followed
+_MATCH = 0.5
+#: a sample interval where a root moves by more than this (rad) is sampled again more finely
+_FAST = 0.2
+
+
+def _wrap(x):
+    return np.angle(np.exp(1j * x))
+
+
+def _brackets(inner, idx, X):
+    """Sample ``inner`` on the rows of ``X`` (S, L) (increasing angles, pose ``idx`` (S,) per
+    row) in one call; follow each root of the inner subproblem to the next sample by the
+    nearest root there.  Returns the sign changes of the error along followed roots (row,
+    sample, the two angles, errors and roots at the ends) and which sample intervals need a
+    finer look (the number of roots changes — a fold, where a pair of roots appears and
+    moves like a square root — or a root moves by more than ``_FAST`` rad)."""
+    S, L = X.shape
+    R, V, E = inner(np.repeat(idx, L), X.reshape(-1))
+    m = R.shape[-1]
+    R, V, E = R.reshape(S, L, 4, m), V.reshape(S, L, 4), E.reshape(S, L, 4)
+    d = np.abs(_wrap(R[:, :-1, :, None] - R[:, 1:, None])).max(-1)                   # (S, L-1, 4, 4)
+    d = np.where(V[:, :-1, :, None] & V[:, 1:, None], d, np.inf)
+    s1 = d.argmin(-1)
+    dmin = np.take_along_axis(d, s1[..., None], -1)[..., 0]
+    e1 = np.take_along_axis(E[:, 1:], s1, -1)
+    br = V[:, :-1] & (dmin < _MATCH) & ((E[:, :-1] < 0) != (e1 < 0))
+    r, g, s = np.nonzero(br)
+    fine = (V[:, :-1].sum(-1) != V[:, 1:].sum(-1)) | (np.where(V[:, :-1], dmin, 0) > _FAST).any(-1)
+    return (r, g, X[r, g], X[r, g + 1], E[r, g, s], e1[r, g, s], R[r, g, s], R[r, g + 1, s1[r, g, s]], fine)
+
+
+def _search_1d(inner, n, grid=SEARCH_GRID, sub=16, iters=60):
+    """Roots of a branch-valued scalar error over one joint angle x ∈ (−π, π], for n poses.
+
+    ``inner(idx, x)`` solves the inner subproblem for poses ``idx`` (M,) at angles ``x`` (M,) and
+    returns its roots (M, 4, m) (rad), which are valid (M, 4), and the error of each (M, 4).
+    The grid is sampled in one call (:func:`_brackets`); an interval where a pair of roots
+    appears or a root moves fast is sampled again on ``2 sub`` points crowded quadratically
+    towards both ends (a root near a fold moves like the square root of the distance); every
+    sign change of the error along a followed root is a bracket, refined by the Illinois
+    variant of regula falsi (batched over all brackets, the root followed by its nearest
+    neighbour at each new point).  Returns the pose index (K,), x (K,), the inner root (K, m),
+    and |e| at the root (K,)."""
+    X = np.linspace(-np.pi, np.pi, grid + 1)
+    step = X[1] - X[0]
+    r, g, *b1, fine = _brackets(inner, np.arange(n), np.broadcast_to(X, (n, grid + 1)))
+    keep = ~fine[r, g]                                     # intervals looked at again are left out
+    parts = [[r[keep]] + [a[keep] for a in b1]]
+    fr, fg = np.nonzero(fine)
+    if len(fr):
+        u = (np.arange(sub + 1) / sub) ** 2 / 2
+        u = np.concatenate([u, 1 - u[-2::-1]])                                         # 0 … 1
+        r2, _, *b2, _ = _brackets(inner, fr, X[fg][:, None] + step * u[None])
+        parts.append([fr[r2]] + b2)
+    b, xl, xr, el, er, rl, rr = (np.concatenate(a) for a in zip(*parts))
+    active = np.ones(len(b), bool)
+    for _ in range(iters):
+        a = np.flatnonzero(active)
+        if not len(a):
+            break
+        den = er[a] - el[a]
+        w = np.where(den != 0, er[a] / np.where(den != 0, den, 1.0), 0.5)
+        xm = xr[a] - w * (xr[a] - xl[a])
+        Rm, Vm, Em = inner(b[a], xm)
+        # the branch: the root nearest the one interpolated between the bracket's ends
+        t = np.clip((xm - xl[a]) / np.where(xr[a] != xl[a], xr[a] - xl[a], 1.0), 0, 1)[:, None]
+        ref = rl[a] + t * _wrap(rr[a] - rl[a])
+        dm = np.where(Vm, np.abs(_wrap(Rm - ref[:, None])).max(-1), np.inf)
+        k = dm.argmin(-1)
+        lost = ~np.isfinite(dm.min(-1))
+        em = np.where(lost, np.nan, Em[np.arange(len(a)), k])
+        rm = Rm[np.arange(len(a)), k]
+        flip = (em < 0) != (er[a] < 0)
+        # Illinois: the end kept twice has its error halved
+        xl[a] = np.where(flip, xr[a], xl[a])
+        el[a] = np.where(flip, er[a], 0.5 * el[a])
+        rl[a] = np.where(flip[:, None], rr[a], rl[a])
+        xr[a], er[a], rr[a] = xm, em, rm
+        done = lost | (np.abs(em) <= 0.01 * SEARCH_TOL) | (np.abs(xr[a] - xl[a]) <= 1e-15)
+        active[a[done]] = False
+    ok = np.isfinite(er)
+    best = np.abs(el) < np.abs(er)
+    x = np.where(best, xl, xr)
+    root = np.where(best[:, None], rl, rr)
+    err = np.where(best, np.abs(el), np.abs(er))
+    return b[ok], _wrap(x[ok]), root[ok], err[ok]
+
+
+def _slots(n, b, q, ok, ex):
+    """Scatter K branches of poses ``b`` into (n · 16, 6) rows (first 16 per pose, in order)."""
+    out_q = np.full((n, SEARCH_BRANCHES, 6), np.nan)
+    out_v = np.zeros((n, SEARCH_BRANCHES), bool)
+    out_e = np.zeros((n, SEARCH_BRANCHES), bool)
+    order = np.argsort(b, kind="stable")
+    b, q, ok, ex = b[order], q[order], ok[order], ex[order]
+    first = np.searchsorted(b, b)
+    slot = np.arange(len(b)) - first
+    keep = slot < SEARCH_BRANCHES
+    out_q[b[keep], slot[keep]] = q[keep]
+    out_v[b[keep], slot[keep]] = ok[keep]
+    out_e[b[keep], slot[keep]] = ex[keep]
+    return out_q.reshape(-1, 6), out_v.reshape(-1), out_e.reshape(-1)
+
+
+def _two_parallel(H, P, R06, p):
+    """2 ∥ 3 (IK-Geo ``IK_2_parallel``): a 1-D search over q1.  For given q1, (q4, q6) solve
+    the SP6 of the heights along h2 of the position and of h5 (up to 4), θ23 = q2 + q3 follows
+    by SP1 (h5), and the error is the distance the elbow must span minus ‖p23‖; at a root q2
+    is the SP1 of that span, q3 = θ23 − q2 (−(θ23 − q2) when h3 = −h2) and q5 the SP1 of h2."""
+    n = len(p)
+    s3 = np.sign(H[1] @ H[2])
+    p16 = p - R06 @ P[6] - P[0]
+    h2, h4, h5 = H[1], H[3], H[4]
+    d23 = np.linalg.norm(P[2])
+
+    def parts(idx, q1, t6, t4):
+        """θ23 (M,), the span vector (M, 3), R01ᵀ R06 (M, 3, 3), R34, R56."""
+        R16 = rot_t(H[0], q1) @ R06[idx]
+        R34, R56 = sp.rot(h4, t4), sp.rot(H[5], t6)
+        M = len(idx)
+        s23 = sp.sp1(np.einsum("nij,j->ni", R34, h5), np.einsum("nij,nkj,k->ni", R16, R56, h5), _b(h2, M))
+        t23 = s23.theta[:, 0, 0]
+        R13 = sp.rot(h2, t23)
+        v = np.einsum("nij,nj->ni", rot_t(H[0], q1), p16[idx]) - P[1] - R13 @ P[3] \
+            - R13 @ R34 @ P[4] - np.einsum("nij,nkj,k->ni", R16, R56, P[5])
+        return t23, v, R16, R34, R56, s23.exact[:, 0]
+
+    def inner(idx, q1):
+        M = len(idx)
+        R16 = rot_t(H[0], q1) @ R06[idx]
+        h1 = np.einsum("nji,j->ni", R16, h2)                                          # R06ᵀ R01 h2
+        hh = np.stack([h1, _b(h2, M), h1, _b(h2, M)], 1)
+        kk = np.broadcast_to(np.array([-H[5], h4, -H[5], h4]), (M, 4, 3))
+        pp = np.broadcast_to(np.array([P[5], P[4], h5, -h5]), (M, 4, 3))
+        d1 = np.einsum("j,nj->n", h2, np.einsum("nij,nj->ni", rot_t(H[0], q1), p16[idx])) - h2 @ (P[1] + P[2] + P[3])
+        s = sp.sp6(hh, kk, pp, d1, np.zeros(M))
+        th = np.nan_to_num(s.theta)                                                    # (M, 4, 2): t6, t4
+        _, v, *_ = parts(np.repeat(idx, 4), np.repeat(q1, 4), th[..., 0].reshape(-1), th[..., 1].reshape(-1))
+        e = (np.linalg.norm(v, axis=1) - d23).reshape(M, 4)
+        return th, s.valid, np.where(s.valid, e, np.nan)
+
+    b, q1, th, err = _search_1d(inner, n)
+    t6, t4 = th[:, 0], th[:, 1]
+    t23, v, R16, R34, R56, e23 = parts(b, q1, t6, t4)
+    K = len(b)
+    s2 = sp.sp1(_b(P[2], K), v, _b(h2, K))
+    q2 = s2.theta[:, 0, 0]
+    s5 = sp.sp1(np.einsum("nji,j->ni", R34, h2), np.einsum("nij,nkj,k->ni", R56, R16, h2), _b(-h5, K))
+    q = np.stack([q1, q2, s3 * _wrap(t23 - q2), t4, s5.theta[:, 0, 0], t6], -1)
+    ex = (err <= SEARCH_TOL) & e23 & s2.exact[:, 0] & s5.exact[:, 0]
+    return _slots(n, b, q, np.ones(K, bool), ex)
+
+
+def _two_intersecting(H, P, R06, p):
+    """5 × 6 (p56 = 0; IK-Geo ``IK_2_intersecting``): a 1-D search over q4.  For given q4,
+    (q1, q2, q3) place the 5–6 intersection by SP5 (up to 4), and the error is how far h6 of
+    the pose is from the cone of h6 about h5, h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6; at a root q5 and q6
+    follow by SP1."""
+    n = len(p)
+    p16 = p - R06 @ P[6] - P[0]
+
+    def r04(q1, q2, q3, q4):
+        return sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3) @ sp.rot(H[3], q4)
+
+    def inner(idx, q4):
+        M = len(idx)
+        p35 = P[3] + sp._rotate(_b(H[3], M), q4, _b(P[4], M))
+        s = sp.sp5(-_b(P[1], M), p16[idx], _b(P[2], M), p35, -_b(H[0], M), _b(H[1], M), _b(H[2], M))
+        th = np.nan_to_num(s.theta)                                                    # (M, 4, 3)
+        R = r04(th[..., 0].reshape(-1), th[..., 1].reshape(-1), th[..., 2].reshape(-1), np.repeat(q4, 4))
+        e = np.einsum("i,nji,njk,k->n", H[4], R, np.repeat(R06[idx], 4, axis=0), H[5]) - H[4] @ H[5]
+        return th, s.valid, np.where(s.valid, e.reshape(M, 4), np.nan)
+
+    b, q4, th, err = _search_1d(inner, n)
+    K = len(b)
+    R04 = r04(th[:, 0], th[:, 1], th[:, 2], q4)
+    s5 = sp.sp1(_b(H[5], K), np.einsum("nji,njk,k->ni", R04, R06[b], H[5]), _b(H[4], K))
+    s6 = sp.sp1(_b(H[4], K), np.einsum("nji,njk,k->ni", R06[b], R04, H[4]), _b(-H[5], K))
+    q = np.stack([th[:, 0], th[:, 1], th[:, 2], q4, s5.theta[:, 0, 0], s6.theta[:, 0, 0]], -1)
+    ex = (err <= SEARCH_TOL) & s5.exact[:, 0] & s6.exact[:, 0]
+    return _slots(n, b, q, np.ones(K, bool), ex)
+
+
+def rot_t(k, theta):
+    """rot(k, θ)ᵀ = rot(k, −θ) (N, 3, 3)."""
+    return sp.rot(k, -np.asarray(theta, float))
+
+
 _SOLVERS = {C.SPHERICAL: _spherical, C.THREE_PARALLEL: _three_parallel, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
             C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
-            C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting}
+            C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting,
+            C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting}
 
 
 def solve_class(cls: str, H, P, R06, p):
     """Every branch of the class solver ``cls`` in IK-Geo's form (``H`` (6, 3), ``P`` (7, 3),
     ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions, base frame, m).
-    Returns q (N, 8, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, 8),
-    exact (N, 8) (False: least squares, out of reach)."""
-    n = len(p)
+    Returns q (N, B, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, B),
+    exact (N, B) (False: least squares, out of reach; for a search class also a root whose
+    error is above :data:`SEARCH_TOL`), B = :func:`n_branches` (8; 16 for a search class)."""
+    n, nb = len(p), n_branches(cls)
     q, valid, exact = _SOLVERS[cls](np.asarray(H, float), np.asarray(P, float), R06, p)
-    q, valid, exact = q.reshape(n, 8, 6), valid.reshape(n, 8), exact.reshape(n, 8) & valid.reshape(n, 8)
+    q, valid, exact = q.reshape(n, nb, 6), valid.reshape(n, nb), exact.reshape(n, nb) & valid.reshape(n, nb)
     q = np.angle(np.exp(1j * q))
     return np.where(valid[..., None], q, np.nan), valid, exact
 
@@ -358,7 +583,8 @@ def class_pose(plan: GeoPlan, T, param=None):
 
 def solve(plan: GeoPlan, T, param=None):
     """Every branch for poses ``T`` (N, 4, 4) of the tool (base frame, m; valid rotations):
-    θ (N, 8, n) in the order of ``robot.chain.independent`` (rad, (−π, π]), valid, exact.
+    θ (N, B, n) in the order of ``robot.chain.independent`` (rad, (−π, π]), valid, exact
+    (B = :func:`n_branches` of the class).
 
     A 7-joint arm (``plan.param_joint``): ``param`` (N,) the value of its last joint (rad) for
     each pose.  With the last joint's twist ξ7 and M the tool pose at q = 0,
@@ -430,4 +656,4 @@ def check_rows(robot, samples: int, rng) -> list:
     return rows
 
 
-__all__ = ["GeoPlan", "SOLVED", "branch_labels", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
+__all__ = ["GeoPlan", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
