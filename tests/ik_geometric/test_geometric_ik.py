@@ -283,8 +283,8 @@ def _ik_geo_fk(gp, x):
 @pytest.mark.parametrize("cls", [C.TWO_PARALLEL, C.TWO_INTERSECTING])
 def test_search_classes_every_branch_fk_verified_and_the_pose_found(tmp_path, cls):
     """Random user arms of the 1-D search classes: every branch aa.ik.analytic_batch returns is
-    FK-exact (Pinocchio, 1e-9), the sampled posture is among them (mod 2π), the labels name
-    the search root."""
+    FK-exact (Pinocchio, 1e-9), the sampled posture is among them (mod 2π), the number of
+    solutions is even, the labels name the search root."""
     for seed in (1, 2):
         robot = random_arm(tmp_path, cls, seed)
         gp = G.plan_for(robot)
@@ -303,6 +303,10 @@ def test_search_classes_every_branch_fk_verified_and_the_pose_found(tmp_path, cl
             assert d.min() < 1e-7, (cls, seed, i)
         one = aa.ik.analytic(robot, T[0])
         np.testing.assert_allclose(one.solutions, res[0].solutions, atol=1e-12)
+        # a 6R arm's real solutions come in pairs (complex roots of its degree-16 polynomial in
+        # conjugate pairs): an odd count at a generic pose means a missed root (e.g. next to a fold)
+        _, _, exact = G.solve(gp, T)
+        assert (exact.sum(1) % 2 == 0).all(), exact.sum(1)
 
 
 def test_search_class_exact_flag_and_unreachable(tmp_path):

@@ -34,7 +34,10 @@ The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``) sample the 
 on :data:`SEARCH_GRID` values for all poses in one batch, follow each root of the inner
 subproblem from sample to sample, and refine every sign change of the error by regula falsi
 (Illinois) to ``|e| ≤`` :data:`SEARCH_TOL`; a root that does not get there is not ``exact``.
-A root where the error only touches zero (no sign change) is not found.
+Where a pair of inner roots appears or vanishes (a fold) a root of the arm can sit on the arc
+through the fold, a sign change along neither root: the roots next to each fold with a small
+error seed Newton steps on the whole arm's pose (kept where they converge).  A root where the
+error only touches zero (no sign change) is not found.
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
 solved on the reversed arm: T = e^{ξ1 q1} ⋯ e^{ξ6 q6} M gives T⁻¹ = e^{ξ'1 q6} ⋯ e^{ξ'6 q1} M⁻¹
@@ -81,7 +84,7 @@ def n_branches(cls: str) -> int:
 def branch_labels(cls: str) -> tuple[str, ...]:
     """The branch labels of a class: which root of each of its branching subproblems
     (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …); for a search class
-    which root of the search along the searched joint, in the order found from −π
+    which root of the search along the searched joint, in the order found
     (``"q1root=2"``; slots are filled from the first)."""
     if cls in SEARCHED:
         j = "q1" if cls == C.TWO_PARALLEL else "q4"
@@ -360,6 +363,8 @@ SEARCH_TOL = 1e-12
 _MATCH = 0.5
 #: a sample interval where a root moves by more than this (rad) is sampled again more finely
 _FAST = 0.2
+#: a root next to a fold with |e| below this seeds a Newton polish of the whole arm
+_SEED = 0.05
 
 
 def _wrap(x):
@@ -384,8 +389,16 @@ def _brackets(inner, idx, X):
     e1 = np.take_along_axis(E[:, 1:], s1, -1)
     br = V[:, :-1] & (dmin < _MATCH) & ((E[:, :-1] < 0) != (e1 < 0))
     r, g, s = np.nonzero(br)
-    fine = (V[:, :-1].sum(-1) != V[:, 1:].sum(-1)) | (np.where(V[:, :-1], dmin, 0) > _FAST).any(-1)
-    return (r, g, X[r, g], X[r, g + 1], E[r, g, s], e1[r, g, s], R[r, g, s], R[r, g + 1, s1[r, g, s]], fine)
+    cnt = V.sum(-1)
+    fine = (cnt[:, :-1] != cnt[:, 1:]) | (np.where(V[:, :-1], dmin, 0) > _FAST).any(-1)
+    # fold seeds: the roots with a small error at the sample next to a fold (a root on the arc
+    # of a pair of roots through the fold is not a sign change along either)
+    fr, fg = np.nonzero(cnt[:, :-1] != cnt[:, 1:])
+    side = np.where(cnt[fr, fg] > cnt[fr, fg + 1], fg, fg + 1)
+    Vs = V[fr, side] & (np.abs(np.nan_to_num(E[fr, side], nan=np.inf)) < _SEED)
+    k, j = np.nonzero(Vs)
+    seeds = (fr[k], X[fr[k], side[k]], R[fr[k], side[k], j])
+    return (r, g, X[r, g], X[r, g + 1], E[r, g, s], e1[r, g, s], R[r, g, s], R[r, g + 1, s1[r, g, s]], fine, seeds)
 
 
 def _search_1d(inner, n, grid=SEARCH_GRID, sub=16, iters=60):
@@ -399,17 +412,20 @@ def _search_1d(inner, n, grid=SEARCH_GRID, sub=16, iters=60):
     sign change of the error along a followed root is a bracket, refined by the Illinois
     variant of regula falsi (batched over all brackets, the root followed by its nearest
     neighbour at each new point).  Returns the pose index (K,), x (K,), the inner root (K, m),
-    and |e| at the root (K,)."""
+    and |e| at the root (K,), and the fold seeds (pose index, x, inner root) for
+    :func:`_polish`."""
     X = np.linspace(-np.pi, np.pi, grid + 1)
     step = X[1] - X[0]
-    r, g, *b1, fine = _brackets(inner, np.arange(n), np.broadcast_to(X, (n, grid + 1)))
+    r, g, *b1, fine, _ = _brackets(inner, np.arange(n), np.broadcast_to(X, (n, grid + 1)))
     keep = ~fine[r, g]                                     # intervals looked at again are left out
     parts = [[r[keep]] + [a[keep] for a in b1]]
     fr, fg = np.nonzero(fine)
+    seeds = (np.zeros(0, int), np.zeros(0), np.zeros((0, b1[4].shape[1])))
     if len(fr):
         u = (np.arange(sub + 1) / sub) ** 2 / 2
         u = np.concatenate([u, 1 - u[-2::-1]])                                         # 0 … 1
-        r2, _, *b2, _ = _brackets(inner, fr, X[fg][:, None] + step * u[None])
+        r2, _, *b2, _, seeds = _brackets(inner, fr, X[fg][:, None] + step * u[None])
+        seeds = (fr[seeds[0]],) + seeds[1:]
         parts.append([fr[r2]] + b2)
     b, xl, xr, el, er, rl, rr = (np.concatenate(a) for a in zip(*parts))
     active = np.ones(len(b), bool)
@@ -442,16 +458,72 @@ def _search_1d(inner, n, grid=SEARCH_GRID, sub=16, iters=60):
     x = np.where(best, xl, xr)
     root = np.where(best[:, None], rl, rr)
     err = np.where(best, np.abs(el), np.abs(er))
-    return b[ok], _wrap(x[ok]), root[ok], err[ok]
+    return b[ok], _wrap(x[ok]), root[ok], err[ok], seeds
+
+
+def _fk_geo(H, P, q):
+    """FK in IK-Geo's form for joint angles q (K, 6): R06 (K, 3, 3), the tool position (K, 3),
+    and each joint's axis and point in the base frame (K, 6, 3) twice."""
+    K = len(q)
+    R = np.broadcast_to(np.eye(3), (K, 3, 3))
+    o = np.broadcast_to(P[0], (K, 3))
+    axes, pts = [], []
+    for i in range(6):
+        axes.append(R @ H[i])
+        pts.append(o)
+        R = R @ sp.rot(H[i], q[:, i])
+        o = o + R @ P[i + 1]
+    return R, o, np.stack(axes, 1), np.stack(pts, 1)
+
+
+def _polish(H, P, R06, p, q, iters=12):
+    """Newton steps on the whole arm's pose equations from ``q`` (K, 6) (the spatial Jacobian
+    at the tool point; rotation error ½ vee(R06 Rᵀ − R R06ᵀ)).  Returns q and which converged
+    (pose error ≤ :data:`SEARCH_TOL`, max entry of R and p)."""
+    q = q.copy()
+    for _ in range(iters):
+        R, o, ax, pt = _fk_geo(H, P, q)
+        W = R06 @ np.swapaxes(R, 1, 2)
+        w = 0.5 * np.stack([W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0], W[:, 1, 0] - W[:, 0, 1]], -1)
+        F = np.concatenate([p - o, w], -1)
+        J = np.concatenate([np.swapaxes(sp._cross(ax, o[:, None] - pt), 1, 2), np.swapaxes(ax, 1, 2)], 1)
+        ok = np.abs(np.linalg.det(J)) > 1e-12
+        J = np.where(ok[:, None, None], J, np.eye(6))
+        q = q + np.where(ok[:, None], np.linalg.solve(J, F[..., None])[..., 0], 0.0)
+    R, o, *_ = _fk_geo(H, P, q)
+    err = np.maximum(np.abs(R - R06).max((1, 2)), np.abs(o - p).max(1))
+    return _wrap(q), err <= SEARCH_TOL
+
+
+def _finish_search(H, P, R06, p, found, assemble):
+    """The branches of a search class: the refined roots (``assemble(b, x, inner root)`` → q,
+    exactness of its subproblems), then the fold seeds polished by :func:`_polish` (kept where
+    they converge); into 16 slots per pose, duplicates dropped."""
+    b, x, th, err, (sb, sx, sth) = found
+    q, ex = assemble(b, x, th)
+    ex &= err <= SEARCH_TOL
+    if len(sb):
+        qs, _ = assemble(sb, sx, sth)
+        qs, ok = _polish(H, P, R06[sb], p[sb], qs)
+        b, q, ex = np.concatenate([b, sb[ok]]), np.concatenate([q, qs[ok]]), np.concatenate([ex, np.ones(ok.sum(), bool)])
+    return _slots(len(p), b, q, np.ones(len(b), bool), ex)
 
 
 def _slots(n, b, q, ok, ex):
-    """Scatter K branches of poses ``b`` into (n · 16, 6) rows (first 16 per pose, in order)."""
+    """Scatter K branches of poses ``b`` into (n · 16, 6) rows (the first 16 distinct ones per
+    pose, in order; a branch within 1e-8 rad of an earlier one of its pose is dropped)."""
     out_q = np.full((n, SEARCH_BRANCHES, 6), np.nan)
     out_v = np.zeros((n, SEARCH_BRANCHES), bool)
     out_e = np.zeros((n, SEARCH_BRANCHES), bool)
     order = np.argsort(b, kind="stable")
     b, q, ok, ex = b[order], q[order], ok[order], ex[order]
+    dup = np.zeros(len(b), bool)
+    for lag in range(1, 4 * SEARCH_BRANCHES):
+        if lag >= len(b):
+            break
+        same = (b[lag:] == b[:-lag]) & (np.abs(_wrap(q[lag:] - q[:-lag])).max(-1) < 1e-8) & ~dup[:-lag]
+        dup[lag:] |= same
+    b, q, ok, ex = b[~dup], q[~dup], ok[~dup], ex[~dup]
     first = np.searchsorted(b, b)
     slot = np.arange(len(b)) - first
     keep = slot < SEARCH_BRANCHES
@@ -498,16 +570,17 @@ def _two_parallel(H, P, R06, p):
         e = (np.linalg.norm(v, axis=1) - d23).reshape(M, 4)
         return th, s.valid, np.where(s.valid, e, np.nan)
 
-    b, q1, th, err = _search_1d(inner, n)
-    t6, t4 = th[:, 0], th[:, 1]
-    t23, v, R16, R34, R56, e23 = parts(b, q1, t6, t4)
-    K = len(b)
-    s2 = sp.sp1(_b(P[2], K), v, _b(h2, K))
-    q2 = s2.theta[:, 0, 0]
-    s5 = sp.sp1(np.einsum("nji,j->ni", R34, h2), np.einsum("nij,nkj,k->ni", R56, R16, h2), _b(-h5, K))
-    q = np.stack([q1, q2, s3 * _wrap(t23 - q2), t4, s5.theta[:, 0, 0], t6], -1)
-    ex = (err <= SEARCH_TOL) & e23 & s2.exact[:, 0] & s5.exact[:, 0]
-    return _slots(n, b, q, np.ones(K, bool), ex)
+    def assemble(b, q1, th):
+        t6, t4 = th[:, 0], th[:, 1]
+        t23, v, R16, R34, R56, e23 = parts(b, q1, t6, t4)
+        K = len(b)
+        s2 = sp.sp1(_b(P[2], K), v, _b(h2, K))
+        q2 = s2.theta[:, 0, 0]
+        s5 = sp.sp1(np.einsum("nji,j->ni", R34, h2), np.einsum("nij,nkj,k->ni", R56, R16, h2), _b(-h5, K))
+        q = np.stack([q1, q2, s3 * _wrap(t23 - q2), t4, s5.theta[:, 0, 0], t6], -1)
+        return q, e23 & s2.exact[:, 0] & s5.exact[:, 0]
+
+    return _finish_search(H, P, R06, p, _search_1d(inner, n), assemble)
 
 
 def _two_intersecting(H, P, R06, p):
@@ -530,14 +603,15 @@ def _two_intersecting(H, P, R06, p):
         e = np.einsum("i,nji,njk,k->n", H[4], R, np.repeat(R06[idx], 4, axis=0), H[5]) - H[4] @ H[5]
         return th, s.valid, np.where(s.valid, e.reshape(M, 4), np.nan)
 
-    b, q4, th, err = _search_1d(inner, n)
-    K = len(b)
-    R04 = r04(th[:, 0], th[:, 1], th[:, 2], q4)
-    s5 = sp.sp1(_b(H[5], K), np.einsum("nji,njk,k->ni", R04, R06[b], H[5]), _b(H[4], K))
-    s6 = sp.sp1(_b(H[4], K), np.einsum("nji,njk,k->ni", R06[b], R04, H[4]), _b(-H[5], K))
-    q = np.stack([th[:, 0], th[:, 1], th[:, 2], q4, s5.theta[:, 0, 0], s6.theta[:, 0, 0]], -1)
-    ex = (err <= SEARCH_TOL) & s5.exact[:, 0] & s6.exact[:, 0]
-    return _slots(n, b, q, np.ones(K, bool), ex)
+    def assemble(b, q4, th):
+        K = len(b)
+        R04 = r04(th[:, 0], th[:, 1], th[:, 2], q4)
+        s5 = sp.sp1(_b(H[5], K), np.einsum("nji,njk,k->ni", R04, R06[b], H[5]), _b(H[4], K))
+        s6 = sp.sp1(_b(H[4], K), np.einsum("nji,njk,k->ni", R06[b], R04, H[4]), _b(-H[5], K))
+        q = np.stack([th[:, 0], th[:, 1], th[:, 2], q4, s5.theta[:, 0, 0], s6.theta[:, 0, 0]], -1)
+        return q, s5.exact[:, 0] & s6.exact[:, 0]
+
+    return _finish_search(H, P, R06, p, _search_1d(inner, n), assemble)
 
 
 def rot_t(k, theta):
