@@ -221,13 +221,29 @@ def test_near_intersecting_axes_within_tolerance_are_polished(tmp_path):
     assert r.success and all(np.abs(_fk(robot, x) - T[0]).max() < 1e-9 for x in r.solutions)
 
 
-def test_no_closed_form_geometry(tmp_path):
+def test_no_closed_form_geometry():
+    robot = aa.load("rrprr5")                                     # 5 joints, one prismatic
+    assert C.classify(robot).name == C.NOT_6R and G.plan_for(robot) is None
+    assert not aa.ik.has_analytic(robot)
+    with pytest.raises(UnsupportedModelError, match="no closed form for this geometry.*not_6r.*aa.ik.solve"):
+        aa.ik.analytic(robot, np.eye(4))
+
+
+def test_general_6r_by_a_2d_search(tmp_path):
+    """A general 6R (no parallel or intersecting consecutive axes): the 2-D search over
+    (q1, q2) finds the sampled posture on every pose (no completeness claim), each branch
+    FK-exact (Pinocchio, 1e-9)."""
     r = np.random.default_rng(0)
     robot = dh_urdf(tmp_path, "gen6r", r.uniform(0.3, 1.3, 6), r.uniform(0.05, 0.4, 6), r.uniform(0.05, 0.4, 6))
-    assert C.classify(robot).name == C.GEN_SIX_DOF and G.plan_for(robot) is None
-    assert not aa.ik.has_analytic(robot)
-    with pytest.raises(UnsupportedModelError, match="no closed form for this geometry.*gen_six_dof.*aa.ik.solve"):
-        aa.ik.analytic(robot, np.eye(4))
+    gp = G.plan_for(robot)
+    assert C.classify(robot).name == C.GEN_SIX_DOF and gp.cls == C.GEN_SIX_DOF and aa.ik.has_analytic(robot)
+    th, T = _poses(robot, 8, 3)
+    res = aa.ik.analytic_batch(robot, T)
+    assert res.branches[0] == "q1q2root=0" and res.valid.any(1).all(), res.reasons
+    for i in range(len(T)):
+        sols = res[i].solutions
+        assert all(np.abs(_fk(robot, q) - T[i]).max() < 1e-9 for q in sols)
+        assert np.abs(np.angle(np.exp(1j * (sols - th[i])))).max(1).min() < 1e-7, i
 
 
 @pytest.mark.parametrize("name, polish", [("panda", 1e-12), ("xarm7", 1e-4)])

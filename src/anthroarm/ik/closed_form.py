@@ -182,8 +182,9 @@ def _form(robot, frame=None):
 #: the registry-like entry of an arm solved by its geometry (:mod:`.geometric`), per class;
 #: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of
 #: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py; a 1-D search
-#: class, :data:`.geometric.SEARCHED`, ~30 ms)
-_GEO_COST = {c: 30000.0 if c in _geo.SEARCHED else 3000.0 for c in _geo.SOLVED}
+#: class, :data:`.geometric.SEARCHED`, ~30 ms; the 2-D search of gen_six_dof ~0.3 s)
+_GEO_COST = {c: 300000.0 if c == _geo.C.GEN_SIX_DOF else 30000.0 if c in _geo.SEARCHED else 3000.0
+             for c in _geo.SOLVED}
 _GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), _geo.n_branches(c), cost_us=_GEO_COST[c]) for c in _geo.SOLVED}
 #: a 7-joint arm with its last joint held (the family parameter): per value of the grid
 _GEO_FORMS7 = {c: _registry.ClosedForm(c, (), 7, (), _geo.n_branches(c), cost_us=_GEO_COST[c]) for c in _geo.SOLVED}

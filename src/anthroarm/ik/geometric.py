@@ -28,6 +28,10 @@ class (:mod:`.classify`)                  decomposition                         
 ``two_intersecting``                      1-D search over q4: (q1, q2, q3) SP5,  ≤ 16
                                           error h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6;
                                           q5, q6 SP1
+``gen_six_dof``                           2-D search over (q1, q2): (q3, q4,     ≤ 16
+                                          q5) SP5, error ‖R05 h6 − R06 h6‖;
+                                          local minima polished by Newton, q6
+                                          SP1
 ========================================  =====================================  ==========
 
 The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``) sample the searched joint
@@ -38,6 +42,12 @@ Where a pair of inner roots appears or vanishes (a fold) a root of the arm can s
 through the fold, a sign change along neither root: the roots next to each fold with a small
 error seed Newton steps on the whole arm's pose (kept where they converge).  A root where the
 error only touches zero (no sign change) is not found.
+
+``gen_six_dof`` (IK-Geo ``IK_gen_6_dof``) samples (q1, q2) on a :data:`SEARCH_GRID_2D` ²
+grid; every (sample, SP5 root) whose error ``‖R05 h6 − R06 h6‖`` is below 0.3 and not above
+any of its 8 neighbours' seeds Newton steps on the whole pose (kept where they converge to
+:data:`SEARCH_TOL`).  A branch whose basin the grid misses is not found (no completeness
+claim), and it costs ~0.3 s a pose; a 7-joint arm is not solved this way.
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
 solved on the reversed arm: T = e^{ξ1 q1} ⋯ e^{ξ6 q6} M gives T⁻¹ = e^{ξ'1 q6} ⋯ e^{ξ'6 q1} M⁻¹
@@ -61,9 +71,10 @@ from . import subproblems as sp
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
-          C.SPHERICAL, C.THREE_PARALLEL, C.TWO_PARALLEL, C.TWO_INTERSECTING)
-#: the classes of :data:`SOLVED` solved by a 1-D search over one joint angle
-SEARCHED = (C.TWO_PARALLEL, C.TWO_INTERSECTING)
+          C.SPHERICAL, C.THREE_PARALLEL, C.TWO_PARALLEL, C.TWO_INTERSECTING, C.GEN_SIX_DOF)
+#: the classes of :data:`SOLVED` solved by a search (1-D over one joint angle; 2-D for
+#: ``gen_six_dof``)
+SEARCHED = (C.TWO_PARALLEL, C.TWO_INTERSECTING, C.GEN_SIX_DOF)
 
 #: per class: (the unknowns of each branching subproblem, its number of roots), outermost first
 _LABELS = {
@@ -87,7 +98,7 @@ def branch_labels(cls: str) -> tuple[str, ...]:
     which root of the search along the searched joint, in the order found
     (``"q1root=2"``; slots are filled from the first)."""
     if cls in SEARCHED:
-        j = "q1" if cls == C.TWO_PARALLEL else "q4"
+        j = {C.TWO_PARALLEL: "q1", C.TWO_INTERSECTING: "q4", C.GEN_SIX_DOF: "q1q2"}[cls]
         return tuple(f"{j}root={k}" for k in range(SEARCH_BRANCHES))
     out = [""]
     for name, k in _LABELS[cls]:
@@ -138,7 +149,7 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)], C.SPHERICAL: [(3, 4, 5)],
               C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
               C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)], C.THREE_PARALLEL: [],
-              C.TWO_PARALLEL: [], C.TWO_INTERSECTING: [(4, 5)]}[cls]
+              C.TWO_PARALLEL: [], C.TWO_INTERSECTING: [(4, 5)], C.GEN_SIX_DOF: []}[cls]
     for g in groups:
         c = _common_point(H[list(g)], o[list(g)])
         for i in g:
@@ -197,7 +208,9 @@ def _build(robot) -> GeoPlan | None:
         kin6, compatible = c6.kinematics, c6.compatible
     else:
         kin6, compatible = kin, c.compatible
-    pick = next(((n, r) for n, r in compatible if n in SOLVED), None)
+    # a 7-joint arm: not by the 2-D search (seconds per pose for a grid of the held joint)
+    pick = next(((n, r) for n, r in compatible if n in SOLVED and not (param is not None and n == C.GEN_SIX_DOF)),
+                None)
     if pick is None:
         return None
     cls, rev = pick
@@ -354,6 +367,8 @@ def _spherical(H, P, R06, p):
 # ----------------------------------------------------------------------------- 1-D search classes
 #: samples of the searched joint over (−π, π] (IK-Geo's reference implementation uses 200)
 SEARCH_GRID = 256
+#: samples of each searched joint of ``gen_six_dof`` (a grid of its square)
+SEARCH_GRID_2D = 64
 #: most branches a search class returns per pose (a 6R arm has at most 16 solutions)
 SEARCH_BRANCHES = 16
 #: |e| at which a refined root counts as exact (the error functions are in m or unitless)
@@ -614,6 +629,50 @@ def _two_intersecting(H, P, R06, p):
     return _finish_search(H, P, R06, p, _search_1d(inner, n), assemble)
 
 
+def _gen_six_dof(H, P, R06, p, grid=None, chunk=8):
+    """No special axes (IK-Geo ``IK_gen_6_dof``): a 2-D search over (q1, q2).  For given
+    (q1, q2), (q3, q4, q5) place the tool flange's origin by SP5 (up to 4); the error is
+    ‖R05 h6 − R06 h6‖ (≥ 0: minima, no sign changes).  The local minima below 0.3 over the
+    grid (each against the best root of its 8 neighbours) give q6 by SP1 and seed
+    :func:`_polish`."""
+    grid = SEARCH_GRID_2D if grid is None else grid
+    n = len(p)
+    p16 = p - R06 @ P[6] - P[0]
+    h6 = H[5]
+    u = np.cross(h6, np.eye(3)[np.argmin(np.abs(h6))])
+    u /= np.linalg.norm(u)                                            # a unit vector ⟂ h6
+
+    def inner(idx, q1, q2):
+        M = len(idx)
+        p63 = sp._rotate(_b(-H[1], M), q2, sp._rotate(_b(-H[0], M), q1, p16[idx]) - P[1]) - P[2]
+        s = sp.sp5(-_b(P[3], M), p63, _b(P[4], M), _b(P[5], M), -_b(H[2], M), _b(H[3], M), _b(H[4], M))
+        t = np.nan_to_num(s.theta).reshape(-1, 3)
+        q = np.concatenate([np.repeat(np.stack([q1, q2], -1), 4, axis=0), t], -1)              # (4M, 5)
+        R = sp.rot(H[0], q[:, 0])
+        for i in range(1, 5):
+            R = R @ sp.rot(H[i], q[:, i])
+        e = np.linalg.norm(R @ h6 - np.repeat(R06[idx] @ h6, 4, axis=0), axis=1).reshape(M, 4)
+        return q.reshape(M, 4, 5), R.reshape(M, 4, 3, 3), np.where(s.valid, e, np.inf)
+
+    xs = np.linspace(-np.pi, np.pi, grid, endpoint=False)
+    A, B = (a.ravel() for a in np.meshgrid(xs, xs, indexing="ij"))
+    bs, qs = [np.zeros(0, int)], [np.zeros((0, 6))]
+    for c0 in range(0, n, chunk):
+        idx = np.repeat(np.arange(c0, min(n, c0 + chunk)), grid * grid)
+        m = len(idx) // (grid * grid)
+        Q, R05, E = inner(idx, np.tile(A, m), np.tile(B, m))
+        Em = E.min(-1).reshape(m, grid, grid)
+        nb = np.min([np.roll(Em, (a, b), (1, 2)) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], axis=0)
+        k, j = np.nonzero((E <= nb.reshape(-1)[:, None]) & (E < 0.3))
+        K = len(k)
+        s6 = sp.sp1(_b(u, K), np.einsum("nji,njk,k->ni", R05[k, j], R06[idx[k]], u), _b(h6, K))
+        bs.append(idx[k])
+        qs.append(np.concatenate([Q[k, j], s6.theta[:, 0, :]], -1))
+    b, q = np.concatenate(bs), np.concatenate(qs)
+    q, ok = _polish(H, P, R06[b], p[b], q, iters=20)
+    return _slots(n, b[ok], q[ok], np.ones(int(ok.sum()), bool), np.ones(int(ok.sum()), bool))
+
+
 def rot_t(k, theta):
     """rot(k, θ)ᵀ = rot(k, −θ) (N, 3, 3)."""
     return sp.rot(k, -np.asarray(theta, float))
@@ -622,7 +681,7 @@ def rot_t(k, theta):
 _SOLVERS = {C.SPHERICAL: _spherical, C.THREE_PARALLEL: _three_parallel, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
             C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
             C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting,
-            C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting}
+            C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting, C.GEN_SIX_DOF: _gen_six_dof}
 
 
 def solve_class(cls: str, H, P, R06, p):
