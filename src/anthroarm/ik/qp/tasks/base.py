@@ -78,6 +78,22 @@ class Task:
             np.add(ws.c, ct, out=ws.c)
         return 0.0
 
+    def _add_weighted_least_squares(self, ws, first: bool, WJ, WJt, nWe, Ht, ct) -> float:
+        """The in-place tail of :meth:`_accumulate` for a weighted least-squares task: ``WJ``
+        (m, nv) = W J with its transpose view ``WJt``, ``nWe`` (m,) = −αW e; add H = (WJ)ᵀ WJ and
+        c = (WJ)ᵀ (−αW e) into ``ws.H``/``ws.c`` (overwrite when ``first``; ``Ht``/``ct`` are
+        scratch of the same shapes) and return the LM diagonal scalar λ‖αW e‖²."""
+        # ndarray.dot with out=: the BLAS product without np.dot's dispatch cost
+        if first:
+            WJt.dot(WJ, out=ws.H)
+            WJt.dot(nWe, out=ws.c)
+        else:
+            np.add(ws.H, WJt.dot(WJ, out=Ht), out=ws.H)
+            np.add(ws.c, WJt.dot(nWe, out=ct), out=ws.c)
+        if self.lm_damping:
+            return self.lm_damping * float(nWe.dot(nWe))
+        return 0.0
+
     def _objective(self, J, e, nv):
         w = self.cost
         if isinstance(w, float):

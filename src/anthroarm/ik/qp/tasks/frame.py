@@ -131,13 +131,4 @@ class FrameTask(Task):
             else:
                 e = pin.log6(X).vector
                 nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
-        # ndarray.dot with out=: the BLAS product without np.dot's dispatch cost
-        if first:
-            WJt.dot(WJ, out=ws.H)
-            WJt.dot(nWe, out=ws.c)
-        else:
-            np.add(ws.H, WJt.dot(WJ, out=Ht), out=ws.H)
-            np.add(ws.c, WJt.dot(nWe, out=ct), out=ws.c)
-        if self.lm_damping:
-            return self.lm_damping * float(nWe.dot(nWe))
-        return 0.0
+        return self._add_weighted_least_squares(ws, first, WJ, WJt, nWe, Ht, ct)

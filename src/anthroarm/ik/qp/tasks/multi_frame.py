@@ -124,12 +124,4 @@ class MultiFrameTask(Task):
             e[6 * k:6 * k + 6] = pin.log6(X).vector
         np.multiply(WJ, self._wcol, out=WJ)
         nWe = np.multiply(e, self._nwg, out=e)                                # −αW e
-        if first:
-            WJt.dot(WJ, out=ws.H)
-            WJt.dot(nWe, out=ws.c)
-        else:
-            np.add(ws.H, WJt.dot(WJ, out=Ht), out=ws.H)
-            np.add(ws.c, WJt.dot(nWe, out=ct), out=ws.c)
-        if self.lm_damping:
-            return self.lm_damping * float(nWe.dot(nWe))
-        return 0.0
+        return self._add_weighted_least_squares(ws, first, WJ, WJt, nWe, Ht, ct)
