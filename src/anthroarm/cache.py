@@ -2,7 +2,8 @@
 
 Today that is the generated Lagrange code (``lagrange/*.py``, :mod:`anthroarm.dynamics.lagrange`)
 and the compiled C libraries (``lagrange/*.so``, :mod:`anthroarm.dynamics.ccode`;
-``ik/*.so``, :mod:`anthroarm.ik.analytic_c`).
+compiled scalar kernels (``numba/``, Numba's own cache of :mod:`anthroarm.jit` kernels: keyed by
+source file, signature, CPU and Numba version, see there).
 
 **Where.**  ``$ANTHROARM_CACHE`` if set; else ``$XDG_CACHE_HOME/anthroarm`` if set; else the
 platform's user cache folder: ``~/.cache/anthroarm`` (Linux and other Unix),
@@ -49,7 +50,7 @@ from ._io import atomic_write_text
 
 ENV = "ANTHROARM_CACHE"
 #: subfolders this module manages (``cache clear`` empties only these)
-SUBFOLDERS = ("lagrange", "ik", "urdf")
+SUBFOLDERS = ("lagrange", "ik", "urdf", "numba")
 _SIDECAR = ".sha256"
 _LOCK = threading.Lock()
 _CC_IDS: dict[str, str] = {}
@@ -305,7 +306,7 @@ def info() -> dict:
         d = base / sub
         n = size = 0
         if d.is_dir():
-            for p in d.iterdir():
+            for p in d.rglob("*"):            # numba: one folder per source file
                 if p.is_file():
                     size += p.stat().st_size
                     if not p.name.endswith(_SIDECAR) and not p.name.startswith("."):
@@ -324,11 +325,13 @@ def clear() -> int:
         d = base / sub
         if not d.is_dir():
             continue
-        for p in d.iterdir():
+        for p in sorted(d.rglob("*"), reverse=True):
             if p.is_file():
                 if not p.name.endswith(_SIDECAR) and not p.name.startswith("."):
                     removed += 1
                 p.unlink()
+            elif p.is_dir():
+                p.rmdir()
     with _LOCK:
         _STATE["fallback"] = None
     return removed

@@ -4,7 +4,7 @@ Source: A. J. Elias and J. T. Wen, "IK-Geo: Unified robot inverse kinematics usi
 decomposition", *Mechanism and Machine Theory* 209 (2025), arXiv 2211.05737 (cited below as
 "IK-Geo"; equation numbers are those of the arXiv version, §III "Subproblem solutions").  The
 formulation was read from the authors' reference implementation (github.com/rpiRobotics/ik-geo,
-``matlab/+subproblem``); the code here is our own, vectorised over a leading batch axis.
+``matlab/+subproblem``); the code here is our own.
 
 Notation (IK-Geo §II): ``rot(k, θ)`` is the rotation by θ (rad) about the unit axis ``k``
 (Rodrigues, Eq. (1)); every vector is expressed in one common frame (any frame; the base frame
@@ -38,15 +38,23 @@ is marked ``singular`` and one representative is returned (θ = 0 where θ is fr
 
 Bad input (wrong shapes, non-finite numbers, an axis that is not a unit vector) raises
 :class:`~anthroarm.errors.ParameterError`.
+
+Implementation: each subproblem is one scalar kernel (``sp1_one`` … ``sp6_one``, vectors as
+tuples, :mod:`.vec3`) compiled by Numba (:mod:`anthroarm.jit`); the public functions check
+their input and run the kernel over the batch in a compiled loop.  The closed-form IK of
+:mod:`.geometric` calls the same kernels, so every formula exists once.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..jit import kernel
+from .vec3 import add, cross, dot, neg, norm, rotate, scale, sub, vec, wrap
 
 #: default tolerance on the residual of an exact solution (the caller's length unit)
 TOL = 1e-9
@@ -111,17 +119,17 @@ def _inputs(spec: dict):
                 raise ParameterError(f"{name}: batch size {a.shape[0]} differs from {n}")
             n = a.shape[0]
         if kind == "axis":
-            norm = np.linalg.norm(a, axis=-1)
-            if np.any(np.abs(norm - 1.0) > _UNIT_TOL):
-                bad = float(np.atleast_1d(norm)[np.argmax(np.abs(np.atleast_1d(norm) - 1.0))])
+            nrm = np.linalg.norm(a, axis=-1)
+            if np.any(np.abs(nrm - 1.0) > _UNIT_TOL):
+                bad = float(np.atleast_1d(nrm)[np.argmax(np.abs(np.atleast_1d(nrm) - 1.0))])
                 raise ParameterError(f"{name}: the axis must be a unit vector (norm {bad:.6g})")
-            a = a / norm[..., None]
+            a = a / nrm[..., None]
         arrays[name] = a
     n = 1 if n is None else n
     out = []
     for name, a in arrays.items():
         core = () if spec[name][1] == "scalar" else (3,)
-        out.append(np.array(np.broadcast_to(a, (n,) + core)))
+        out.append(np.ascontiguousarray(np.broadcast_to(a, (n,) + core)))
     return out, batched
 
 
@@ -132,7 +140,7 @@ def _tol(tol) -> float:
     return t
 
 
-# ----------------------------------------------------------------------------- helpers
+# ----------------------------------------------------------------------------- numpy helpers
 def _dot(a, b):
     return np.einsum("...i,...i->...", a, b)
 
@@ -164,74 +172,59 @@ def rot(k, theta) -> np.ndarray:
     return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
 
 
-def _basis(k, p):
-    """A = [k × p, −k × (k × p)] (IK-Geo Eq. (2)), ``(N, 3, 2)``."""
-    kxp = _cross(k, p)
-    return np.stack([kxp, -_cross(k, kxp)], axis=-1)
+# ----------------------------------------------------------------------------- SP1, SP4
+@kernel
+def sp1_one(p1, p2, k, tol):
+    """SP1 of one problem (tuples): (θ, exact, singular); see :func:`sp1`."""
+    kxp = cross(k, p1)
+    x0 = dot(kxp, p2)
+    x1 = -dot(cross(k, kxp), p2)                      # x = Aᵀ p2, A = [k × p1, −k × (k × p1)]
+    n1, n2 = norm(p1), norm(p2)
+    sing = norm(kxp) <= 1e-12 * max(1.0, n1) or norm(cross(k, p2)) <= 1e-12 * max(1.0, n2)
+    theta = 0.0 if sing else math.atan2(x0, x1)
+    exact = abs(n1 - n2) <= tol and abs(dot(k, p1) - dot(k, p2)) <= tol
+    return theta, exact, sing
 
 
-def _compact(theta, valid, exact, size):
-    """Move valid slots to the front (stable) and keep ``size`` slots."""
-    order = np.argsort(~valid, axis=1, kind="stable")[:, :size]
-    take = np.take_along_axis
-    return (take(theta, order[..., None], axis=1), take(valid, order, axis=1),
-            take(exact, order, axis=1))
-
-
-def _dedupe(theta, valid, atol=1e-6):
-    """Mark a valid slot invalid when an earlier valid slot holds the same angles."""
-    n, s, _ = theta.shape
-    valid = valid.copy()
-    for j in range(1, s):
-        d = np.abs(np.angle(np.exp(1j * (theta[:, :j] - theta[:, j:j + 1])))).max(-1)   # (N, j)
-        dup = ((d < atol) & valid[:, :j]).any(1)
-        valid[:, j] &= ~dup
-    return valid
-
-
-def _newton(residual, jacobian, theta, iters=3):
-    """Polish candidate roots: Newton steps on the subproblem's own equations (batched over
-    leading axes; square Jacobian).  A step is skipped where the Jacobian is singular."""
-    for _ in range(iters):
-        F, J = residual(theta), jacobian(theta)
-        det = np.linalg.det(J)
-        ok = np.abs(det) > 1e-12
-        Js = np.where(ok[..., None, None], J, np.eye(J.shape[-1]))
-        step = np.linalg.solve(Js, F[..., None])[..., 0]
-        theta = theta - np.where(ok[..., None], step, 0.0)
-    return theta
-
-
-# ----------------------------------------------------------------------------- SP4 core
-def _sp4_core(h, p, k, d, tol):
-    """hᵀ rot(k, θ) p = d for unit h (batched).  Returns theta (N, 2), valid (N, 2),
-    exact (N, 2), singular (N,).  IK-Geo Eqs. (4)–(6)."""
-    A = np.einsum("ni,nij->nj", h, _basis(k, p))                       # (N, 2) = hᵀA
-    b = d - _dot(h, k) * _dot(k, p)
-    nA = np.linalg.norm(A, axis=-1)
-    ab = np.abs(b)
-    margin = nA - ab                                   # > 0: two roots; residual of the LS root
+@kernel
+def sp4_one(h, p, k, d, tol):
+    """SP4 of one problem (tuples; h unit): (θ_a, θ_b, count, exact_a, exact_b, singular), θ_b
+    NaN when count = 1; IK-Geo Eqs. (4)–(6), see :func:`sp4`."""
+    kxp = cross(k, p)
+    a0 = dot(h, kxp)
+    a1 = -dot(h, cross(k, kxp))                       # hᵀA
+    b = d - dot(h, k) * dot(k, p)
+    na = math.sqrt(a0 * a0 + a1 * a1)
+    ab = abs(b)
+    margin = na - ab                                  # > 0: two roots; residual of the LS root
+    sing = na <= 1e-12 * max(1.0, norm(p))
     # two roots wherever the plane cuts the circle (as IK-Geo's sp_4): a near-tangent pair is
     # kept as two roots, not merged into one whose error grows like √margin in the angle
     two = margin > 0.0
-    xi = np.sqrt(np.maximum(nA * nA - b * b, 0.0))
-    x_ls = A * b[:, None]                               # Aᵀb (a multiple of the LS point)
-    jA = np.stack([A[:, 1], -A[:, 0]], -1)              # the null direction of A
-    x1 = x_ls + xi[:, None] * jA
-    x2 = x_ls - xi[:, None] * jA
-    th = np.stack([np.arctan2(x1[:, 0], x1[:, 1]), np.arctan2(x2[:, 0], x2[:, 1])], -1)
-    # one root (tangent or least squares): atan2 of Aᵀb (θ = 0 when A = 0)
-    th[:, 0] = np.where(two, th[:, 0], np.arctan2(x_ls[:, 0], x_ls[:, 1]))
-    scale = 1e-12 * np.maximum(1.0, np.linalg.norm(p, axis=-1))
-    singular = nA <= scale
-    th[:, 0] = np.where(singular, 0.0, th[:, 0])
-    valid = np.stack([np.ones_like(two), two & ~singular], -1)
-    exact1 = np.where(singular, ab <= tol, margin >= -tol)
-    exact = np.stack([exact1 | two, two], -1) & valid
-    return th, valid, exact, singular
+    xi = math.sqrt(max(na * na - b * b, 0.0))
+    if sing:
+        return 0.0, math.nan, 1, ab <= tol or two, False, True
+    if two:
+        ta = math.atan2(a0 * b + xi * a1, a1 * b - xi * a0)
+        tb = math.atan2(a0 * b - xi * a1, a1 * b + xi * a0)
+        return ta, tb, 2, True, True, False
+    # one root (tangent or least squares): atan2 of Aᵀb
+    return math.atan2(a0 * b, a1 * b), math.nan, 1, margin >= -tol, False, False
 
 
-# ----------------------------------------------------------------------------- SP1 … SP4
+@kernel
+def _sp1_loop(p1, p2, k, tol, theta, exact, sing):
+    for i in range(len(p1)):
+        theta[i], exact[i], sing[i] = sp1_one(vec(p1[i]), vec(p2[i]), vec(k[i]), tol)
+
+
+@kernel
+def _sp4_loop(h, p, k, d, tol, theta, count, exact, sing):
+    for i in range(len(h)):
+        theta[i, 0], theta[i, 1], count[i], exact[i, 0], exact[i, 1], sing[i] = sp4_one(
+            vec(h[i]), vec(p[i]), vec(k[i]), d[i], tol)
+
+
 def sp1(p1, p2, k, tol: float = TOL) -> Solutions:
     """Subproblem 1, circle and point: θ with rot(k, θ) p1 = p2.
 
@@ -244,14 +237,15 @@ def sp1(p1, p2, k, tol: float = TOL) -> Solutions:
     ``p1``, ``p2``: ``(3,)`` or ``(N, 3)``; ``k``: unit axis.  One solution (m = 1, S = 1)."""
     tol = _tol(tol)
     (p1, p2, k), batched = _inputs({"p1": (p1, "vec"), "p2": (p2, "vec"), "k": (k, "axis")})
-    x = np.einsum("nij,ni->nj", _basis(k, p1), p2)
-    theta = np.arctan2(x[:, 0], x[:, 1])
-    sing = (np.linalg.norm(_cross(k, p1), axis=-1) <= 1e-12 * np.maximum(1, np.linalg.norm(p1, axis=-1))) | \
-           (np.linalg.norm(_cross(k, p2), axis=-1) <= 1e-12 * np.maximum(1, np.linalg.norm(p2, axis=-1)))
-    theta = np.where(sing, 0.0, theta)
-    exact = (np.abs(np.linalg.norm(p1, axis=-1) - np.linalg.norm(p2, axis=-1)) <= tol) & \
-            (np.abs(_dot(k, p1) - _dot(k, p2)) <= tol)
-    return _finish(theta[:, None, None], np.ones((len(theta), 1), bool), exact[:, None], sing, batched)
+    n = len(p1)
+    theta, exact, sing = np.empty(n), np.empty(n, bool), np.empty(n, bool)
+    _sp1_loop(p1, p2, k, tol, theta, exact, sing)
+    return _finish(theta[:, None, None], np.ones((n, 1), bool), exact[:, None], sing, batched)
+
+
+def _two_roots(theta, count, exact, sing, batched) -> Solutions:
+    valid = np.arange(2)[None, :] < count[:, None]
+    return _finish(theta[..., None], valid, exact, sing, batched)
 
 
 def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
@@ -273,8 +267,36 @@ def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
     tol = _tol(tol)
     (h, p, k, d), batched = _inputs({"h": (h, "axis"), "p": (p, "vec"), "k": (k, "axis"),
                                      "d": (d, "scalar")})
-    th, valid, exact, sing = _sp4_core(h, p, k, d, tol)
-    return _finish(th[..., None], valid, exact, sing, batched)
+    n = len(h)
+    theta, count, exact, sing = np.empty((n, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    _sp4_loop(h, p, k, d, tol, theta, count, exact, sing)
+    return _two_roots(theta, count, exact, sing, batched)
+
+
+# ----------------------------------------------------------------------------- SP3
+@kernel
+def sp3_one(p1, p2, k, d, tol):
+    """SP3 of one problem (tuples): (θ_a, θ_b, count, exact_a, exact_b, singular); see :func:`sp3`."""
+    n2 = norm(p2)
+    zero = n2 <= 1e-300
+    if zero:
+        h, dd, safe = k, dot(k, p1), 1.0
+    else:
+        h, dd, safe = scale(p2, 1.0 / n2), (dot(p1, p1) + n2 * n2 - d * d) / (2.0 * n2), n2
+    # a distance residual δ changes the SP4 height by ≈ δ (2d + δ) / (2‖p2‖)
+    ta, tb, cnt, ea, eb, sing = sp4_one(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
+    if sing or zero:
+        ea = abs(norm(sub(rotate(k, ta, p1), p2)) - d) <= tol
+        if cnt == 2:
+            eb = abs(norm(sub(rotate(k, tb, p1), p2)) - d) <= tol
+    return ta, tb, cnt, ea, eb, sing or zero
+
+
+@kernel
+def _sp3_loop(p1, p2, k, d, tol, theta, count, exact, sing):
+    for i in range(len(p1)):
+        theta[i, 0], theta[i, 1], count[i], exact[i, 0], exact[i, 1], sing[i] = sp3_one(
+            vec(p1[i]), vec(p2[i]), vec(k[i]), d[i], tol)
 
 
 def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
@@ -293,18 +315,43 @@ def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
                                        "d": (d, "scalar")})
     if np.any(d < 0):
         raise ParameterError("d: the sphere radius must be >= 0")
-    n2 = np.linalg.norm(p2, axis=-1)
-    zero = n2 <= 1e-300
-    h = np.where(zero[:, None], k, p2 / np.where(zero, 1.0, n2)[:, None])
-    safe = np.where(zero, 1.0, n2)
-    dd = np.where(zero, _dot(k, p1), (_dot(p1, p1) + n2 * n2 - d * d) / (2.0 * safe))
-    # a distance residual δ changes the SP4 height by ≈ δ (2d + δ) / (2‖p2‖)
-    tol4 = tol * (d + 0.5 * tol) / safe
-    th, valid, exact, sing = _sp4_core(h, p1, k, dd, np.maximum(tol4, 1e-15))
-    r = np.linalg.norm(_rotate(k[:, None], th, p1[:, None]) - p2[:, None], axis=-1)
-    exact = np.where(sing[:, None] | zero[:, None], np.abs(r - d[:, None]) <= tol, exact)
-    sing = sing | zero
-    return _finish(th[..., None], valid, exact, sing, batched)
+    n = len(p1)
+    theta, count, exact, sing = np.empty((n, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    _sp3_loop(p1, p2, k, d, tol, theta, count, exact, sing)
+    return _two_roots(theta, count, exact, sing, batched)
+
+
+# ----------------------------------------------------------------------------- SP2
+@kernel
+def sp2_one(p1, p2, k1, k2, tol):
+    """SP2 of one problem (tuples): (θ1_a, θ2_a, θ1_b, θ2_b, count, exact_a, exact_b,
+    singular); see :func:`sp2`."""
+    n1, n2 = norm(p1), norm(p2)
+    zero = n1 <= 1e-300 or n2 <= 1e-300
+    u1 = scale(p1, 1.0 / n1) if n1 > 1e-300 else p1
+    u2 = scale(p2, 1.0 / n2) if n2 > 1e-300 else p2
+    ta, tb, cnt, ea, eb, sing1 = sp4_one(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
+    k2u2 = cross(k2, u2)
+    k2k2u2 = cross(k2, k2u2)
+    sing2 = norm(k2u2) <= 1e-12
+    sing = sing1 or sing2 or zero
+    out1 = (ta, tb)
+    ex_in = (ea, eb)
+    t2 = [0.0, math.nan]
+    ex = [False, False]
+    for j in range(cnt):
+        v1 = rotate(k1, out1[j], u1)
+        t2[j] = 0.0 if sing2 else math.atan2(dot(k2u2, v1), -dot(k2k2u2, v1))
+        r = norm(sub(rotate(k1, out1[j], p1), rotate(k2, t2[j], p2)))
+        ex[j] = r <= tol if sing else (ex_in[j] and abs(n1 - n2) <= tol and r <= 10.0 * tol)
+    return ta, t2[0], tb, t2[1], cnt, ex[0], ex[1], sing
+
+
+@kernel
+def _sp2_loop(p1, p2, k1, k2, tol, theta, count, exact, sing):
+    for i in range(len(p1)):
+        (theta[i, 0, 0], theta[i, 0, 1], theta[i, 1, 0], theta[i, 1, 1], count[i], exact[i, 0], exact[i, 1],
+         sing[i]) = sp2_one(vec(p1[i]), vec(p2[i]), vec(k1[i]), vec(k2[i]), tol)
 
 
 def sp2(p1, p2, k1, k2, tol: float = TOL) -> Solutions:
@@ -322,66 +369,197 @@ def sp2(p1, p2, k1, k2, tol: float = TOL) -> Solutions:
     tol = _tol(tol)
     (p1, p2, k1, k2), batched = _inputs({"p1": (p1, "vec"), "p2": (p2, "vec"), "k1": (k1, "axis"),
                                          "k2": (k2, "axis")})
-    n1, n2 = np.linalg.norm(p1, axis=-1), np.linalg.norm(p2, axis=-1)
-    zero = (n1 <= 1e-300) | (n2 <= 1e-300)
-    u1 = p1 / np.where(n1 > 1e-300, n1, 1.0)[:, None]
-    u2 = p2 / np.where(n2 > 1e-300, n2, 1.0)[:, None]
-    scale = np.maximum(np.maximum(n1, n2), 1e-300)
-    th1, valid, ex1, sing1 = _sp4_core(k2, u1, k1, _dot(k2, u2), tol / scale)
-    v1 = _rotate(k1[:, None], th1, u1[:, None])                       # (N, 2, 3)
-    x = np.einsum("nij,nsi->nsj", _basis(k2, u2), v1)
-    th2 = np.arctan2(x[..., 0], x[..., 1])
-    sing2 = np.linalg.norm(_cross(k2, u2), axis=-1) <= 1e-12
-    th2 = np.where(sing2[:, None], 0.0, th2)
-    r = np.linalg.norm(_rotate(k1[:, None], th1, p1[:, None]) - _rotate(k2[:, None], th2, p2[:, None]), axis=-1)
-    exact = ex1 & (np.abs(n1 - n2) <= tol)[:, None] & (r <= 10 * tol)
-    exact = np.where((sing1 | sing2 | zero)[:, None], r <= tol, exact)
-    theta = np.stack([th1, th2], -1)
-    return _finish(theta, valid, exact, sing1 | sing2 | zero, batched)
+    n = len(p1)
+    theta, count, exact, sing = np.empty((n, 2, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    _sp2_loop(p1, p2, k1, k2, tol, theta, count, exact, sing)
+    valid = np.arange(2)[None, :] < count[:, None]
+    return _finish(theta, valid, exact, sing, batched)
 
 
 # ----------------------------------------------------------------------------- quartics
-def _polymul(a, b):
-    """Batched polynomial product, coefficients highest power first: (N, na), (N, nb)."""
-    n, na = a.shape
-    nb = b.shape[1]
-    out = np.zeros((n, na + nb - 1))
-    for i in range(na):
-        out[:, i:i + nb] += a[:, i:i + 1] * b
-    return out
+@kernel
+def real_roots(c):
+    """Real roots of a polynomial of degree ≤ 4 (coefficients ``c`` (5,), highest first): roots
+    (4,) and which are real (4,).  Eigenvalues of the companion matrix (LAPACK), polished by
+    two Newton steps on the polynomial."""
+    big = 0.0
+    for i in range(5):
+        big = max(big, abs(c[i]))
+    cn = c / (big if big > 0.0 else 1.0)
+    roots = np.full(4, np.nan + 0j)
+    first = 0
+    while first < 4 and abs(cn[first]) <= (1e-10 if first == 0 else 1e-14):
+        first += 1                                    # lower degree (rare)
+    deg = 4 - first
+    if deg >= 1:
+        comp = np.zeros((deg, deg), dtype=np.complex128)
+        for j in range(deg):
+            comp[0, j] = -cn[first + 1 + j] / cn[first]
+        for j in range(1, deg):
+            comp[j, j - 1] = 1.0
+        ev = np.linalg.eigvals(comp)
+        for j in range(deg):
+            roots[j] = ev[j]
+    x = np.zeros(4)
+    real = np.zeros(4, dtype=np.bool_)
+    for j in range(4):
+        r = roots[j]
+        if math.isfinite(r.real) and math.isfinite(r.imag) and abs(r.imag) <= 1e-6 * max(1.0, abs(r.real)):
+            real[j] = True
+            xj = r.real
+            for _ in range(2):
+                f = (((cn[0] * xj + cn[1]) * xj + cn[2]) * xj + cn[3]) * xj + cn[4]
+                g = ((4.0 * cn[0] * xj + 3.0 * cn[1]) * xj + 2.0 * cn[2]) * xj + cn[3]
+                if abs(g) > 1e-300:
+                    step = f / g
+                    if abs(step) < 1e-3 * max(1.0, abs(xj)):
+                        xj -= step
+            x[j] = xj
+    return x, real
 
 
-def _real_roots(c):
-    """Real roots of N polynomials of degree ≤ 4 (coefficients (N, 5), highest first).
-    Returns roots (N, 4) and a mask (N, 4) of real ones.  Eigenvalues of the companion matrix,
-    polished by two Newton steps on the original polynomial."""
-    n = c.shape[0]
-    roots = np.full((n, 4), np.nan + 0j)
-    big = np.abs(c).max(1)
-    big = np.where(big > 0, big, 1.0)
-    cn = c / big[:, None]
-    lead = np.abs(cn[:, 0]) > 1e-10
-    if np.any(lead):
-        m = cn[lead]
-        comp = np.zeros((len(m), 4, 4))
-        comp[:, 0, :] = -m[:, 1:] / m[:, :1]
-        comp[:, 1, 0] = comp[:, 2, 1] = comp[:, 3, 2] = 1.0
-        roots[lead] = np.linalg.eigvals(comp)
-    for i in np.flatnonzero(~lead):                   # lower degree (rare): one row at a time
-        r = np.roots(np.trim_zeros(np.where(np.abs(cn[i]) > 1e-14, cn[i], 0.0), "f"))
-        roots[i, :len(r)] = r
-    is_real = np.isfinite(roots) & (np.abs(roots.imag) <= 1e-6 * np.maximum(1.0, np.abs(roots.real)))
-    x = np.where(is_real, roots.real, 0.0)
-    dc = cn[:, :4] * np.array([4.0, 3.0, 2.0, 1.0])
-    for _ in range(2):
-        f = ((((cn[:, 0:1] * x + cn[:, 1:2]) * x + cn[:, 2:3]) * x + cn[:, 3:4]) * x + cn[:, 4:5])
-        g = (((dc[:, 0:1] * x + dc[:, 1:2]) * x + dc[:, 2:3]) * x + dc[:, 3:4])
-        step = np.where(np.abs(g) > 1e-300, f / np.where(g == 0, 1.0, g), 0.0)
-        x = np.where(np.abs(step) < 1e-3 * np.maximum(1.0, np.abs(x)), x - step, x)
-    return x, is_real
+@kernel
+def _solve3(J, F):
+    """Solve the 3×3 system J x = F (J as row tuples) by Cramer's rule; (x, ok)."""
+    det = dot(J[0], cross(J[1], J[2]))
+    if abs(det) <= 1e-12:
+        return (0.0, 0.0, 0.0), False
+    c0, c1, c2 = cross(J[1], J[2]), cross(J[2], J[0]), cross(J[0], J[1])   # rows of adj(J)ᵀ
+    return ((c0[0] * F[0] + c1[0] * F[1] + c2[0] * F[2]) / det,
+            (c0[1] * F[0] + c1[1] * F[1] + c2[1] * F[2]) / det,
+            (c0[2] * F[0] + c1[2] * F[1] + c2[2] * F[2]) / det), True
+
+
+@kernel
+def _keep_best(theta, ok, res, out_theta, out_exact, m):
+    """Sort candidate solutions by residual, drop the invalid and duplicates (within 1e-6 rad),
+    keep the first 4 in ``out_theta`` (4, m); returns the count."""
+    order = np.argsort(np.where(ok, res, np.inf), kind="mergesort")
+    cnt = 0
+    for j in order:
+        if not ok[j] or cnt == 4:
+            break
+        dup = False
+        for a in range(cnt):
+            d = 0.0
+            for c in range(m):
+                d = max(d, abs(wrap(theta[j, c] - out_theta[a, c])))
+            if d < 1e-6:
+                dup = True
+                break
+        if not dup:
+            for c in range(m):
+                out_theta[cnt, c] = theta[j, c]
+            out_exact[cnt] = True
+            cnt += 1
+    return cnt
 
 
 # ----------------------------------------------------------------------------- SP5
+@kernel
+def _circle_polynomials(o, k, p, k2, delta):
+    """‖v‖² = P(z) ± √R(z) on the circle {o + rot(k, θ) p}, z = k2ᵀv: P (2 coeffs), R (3),
+    and whether k ∥ k2 (IK-Geo §III-E)."""
+    kxk2 = cross(k, k2)
+    kkk2 = cross(k, kxk2)
+    nk2 = dot(kxk2, kxk2)
+    bad = nk2 <= 1e-20
+    if bad:
+        nk2 = 1.0
+    kxp = cross(k, p)
+    r2 = dot(kxp, kxp)
+    alpha = dot(o, kkk2) / nk2
+    beta = dot(o, kxk2) / nk2
+    cen = add(o, scale(k, dot(k, p)))
+    f = 4.0 * beta * beta
+    return (-2.0 * alpha, r2 + dot(cen, cen) + 2.0 * alpha * delta), \
+        (-f, 2.0 * delta * f, (-delta * delta + r2 * nk2) * f), bad
+
+
+@kernel
+def _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t):
+    return sub(add(p0, rotate(k1, t[0], p1)), rotate(k2, t[1], add(p2, rotate(k3, t[2], p3))))
+
+
+@kernel
+def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
+    """SP5 of one problem (tuples): writes the solutions into ``out_theta`` (4, 3) (valid rows
+    first) and returns (count, singular); see :func:`sp5`."""
+    c1 = add(p0, scale(k1, dot(k1, p1)))                # centre of circle 1
+    c3 = add(p2, scale(k3, dot(k3, p3)))                # centre of circle 3
+    d1, d3 = dot(k2, c1), dot(k2, c3)
+    P1, R1, bad1 = _circle_polynomials(p0, k1, p1, k2, d1)
+    P3, R3, bad3 = _circle_polynomials(p2, k3, p3, k2, d3)
+    sing = bad1 or bad3
+    for j in range(4):
+        for c in range(3):
+            out_theta[j, c] = math.nan
+    if sing:
+        return 0, True
+    a, b = P1[0] - P3[0], P1[1] - P3[1]                # P13 = a z + b
+    sq = (a * a, 2.0 * a * b, b * b)                   # P13²
+    rhs = (R3[0] - R1[0] - sq[0], R3[1] - R1[1] - sq[1], R3[2] - R1[2] - sq[2])
+    eq = np.empty(5)                                   # rhs² − 4 P13² R1
+    eq[0] = rhs[0] * rhs[0] - 4.0 * sq[0] * R1[0]
+    eq[1] = 2.0 * rhs[0] * rhs[1] - 4.0 * (sq[0] * R1[1] + sq[1] * R1[0])
+    eq[2] = rhs[1] * rhs[1] + 2.0 * rhs[0] * rhs[2] - 4.0 * (sq[0] * R1[2] + sq[1] * R1[1] + sq[2] * R1[0])
+    eq[3] = 2.0 * rhs[1] * rhs[2] - 4.0 * (sq[1] * R1[2] + sq[2] * R1[1])
+    eq[4] = rhs[2] * rhs[2] - 4.0 * sq[2] * R1[2]
+    z, real = real_roots(eq)
+    k1p1, k3p3 = cross(k1, p1), cross(k3, p3)
+    a1 = (dot(k1p1, k2), -dot(cross(k1, k1p1), k2))    # A1ᵀ k2
+    a3 = (dot(k3p3, k2), -dot(cross(k3, k3p3), k2))
+    na1 = max(a1[0] * a1[0] + a1[1] * a1[1], 1e-300)
+    na3 = max(a3[0] * a3[0] + a3[1] * a3[1], 1e-300)
+    theta = np.zeros((16, 3))
+    ok = np.zeros(16, dtype=np.bool_)
+    res = np.full(16, np.inf)
+    scl = 1.0 + norm(p0) + norm(p1) + norm(p2) + norm(p3)
+    for r in range(4):
+        if not real[r]:
+            continue
+        e1, e3 = z[r] - d1, z[r] - d3
+        s1 = math.sqrt(max(na1 - e1 * e1, 0.0))
+        s3 = math.sqrt(max(na3 - e3 * e3, 0.0))
+        for g in range(4):
+            sg1 = 1.0 if g < 2 else -1.0
+            sg3 = 1.0 if g % 2 == 0 else -1.0
+            t1 = math.atan2(a1[0] * e1 + sg1 * a1[1] * s1, a1[1] * e1 - sg1 * a1[0] * s1)
+            t3 = math.atan2(a3[0] * e3 + sg3 * a3[1] * s3, a3[1] * e3 - sg3 * a3[0] * s3)
+            v1 = add(p0, rotate(k1, t1, p1))
+            v3 = add(p2, rotate(k3, t3, p3))
+            k2v3 = cross(k2, v3)
+            t2 = math.atan2(dot(k2v3, v1), -dot(cross(k2, k2v3), v1))     # SP1: rot(k2, θ2) v3 = v1
+            t = (t1, t2, t3)
+            if norm(_sp5_residual(p0, p1, p2, p3, k1, k2, k3, t)) > 1e-2 * scl:
+                continue
+            for _ in range(3):                         # Newton (the quartic's roots cluster)
+                F = _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t)
+                r1 = rotate(k1, t[0], p1)
+                r3 = rotate(k3, t[2], p3)
+                w = rotate(k2, t[1], add(p2, r3))
+                c3v = rotate(k2, t[1], cross(k3, r3))
+                j0, j1 = cross(k1, r1), neg(cross(k2, w))
+                J = ((j0[0], j1[0], -c3v[0]), (j0[1], j1[1], -c3v[1]), (j0[2], j1[2], -c3v[2]))
+                step, good = _solve3(J, F)
+                if good:
+                    t = (t[0] - step[0], t[1] - step[1], t[2] - step[2])
+            t = (wrap(t[0]), wrap(t[1]), wrap(t[2]))
+            i = 4 * r + g
+            theta[i, 0], theta[i, 1], theta[i, 2] = t
+            res[i] = norm(_sp5_residual(p0, p1, p2, p3, k1, k2, k3, t))
+            ok[i] = res[i] <= tol
+    exact = np.zeros(4, dtype=np.bool_)
+    return _keep_best(theta, ok, res, out_theta, exact, 3), False
+
+
+@kernel
+def _sp5_loop(p0, p1, p2, p3, k1, k2, k3, tol, theta, count, sing):
+    for i in range(len(p0)):
+        count[i], sing[i] = sp5_one(vec(p0[i]), vec(p1[i]), vec(p2[i]), vec(p3[i]), vec(k1[i]), vec(k2[i]),
+                                    vec(k3[i]), tol, theta[i])
+
+
 def sp5(p0, p1, p2, p3, k1, k2, k3, tol: float = TOL_QUARTIC) -> Solutions:
     """Subproblem 5, three circles: (θ1, θ2, θ3) with
     p0 + rot(k1, θ1) p1 = rot(k2, θ2) (p2 + rot(k3, θ3) p3).
@@ -406,89 +584,125 @@ def sp5(p0, p1, p2, p3, k1, k2, k3, tol: float = TOL_QUARTIC) -> Solutions:
         "p0": (p0, "vec"), "p1": (p1, "vec"), "p2": (p2, "vec"), "p3": (p3, "vec"),
         "k1": (k1, "axis"), "k2": (k2, "axis"), "k3": (k3, "axis")})
     n = len(p0)
-    c1 = p0 + k1 * _dot(k1, p1)[:, None]                 # centre of circle 1
-    c3 = p2 + k3 * _dot(k3, p3)[:, None]                 # centre of circle 3
-    d1, d3 = _dot(k2, c1), _dot(k2, c3)
-
-    def circle_polynomials(o, k, p, delta):
-        # ‖v‖² = P(z) ± √R(z) on circle {o + k kᵀp + A x}, z = k2ᵀv (P: 2 coeffs, R: 3)
-        kxk2 = _cross(k, k2)
-        kkk2 = _cross(k, kxk2)
-        nk2 = _dot(kxk2, kxk2)
-        bad = nk2 <= 1e-20
-        nk2 = np.where(bad, 1.0, nk2)
-        kxp = _cross(k, p)
-        r2 = _dot(kxp, kxp)
-        alpha = _dot(o, kkk2) / nk2
-        beta = _dot(o, kxk2) / nk2
-        cen = o + k * _dot(k, p)[:, None]
-        P = np.stack([-2 * alpha, r2 + _dot(cen, cen) + 2 * alpha * delta], -1)
-        R = np.stack([-np.ones(n), 2 * delta, -delta ** 2 + r2 * nk2], -1) * (4 * beta ** 2)[:, None]
-        return P, R, bad
-
-    P1, R1, bad1 = circle_polynomials(p0, k1, p1, d1)
-    P3, R3, bad3 = circle_polynomials(p2, k3, p3, d3)
-    P13 = P1 - P3
-    P13sq = _polymul(P13, P13)
-    rhs = R3 - R1 - P13sq
-    eqn = _polymul(rhs, rhs) - 4 * _polymul(P13sq, R1)
-    z, real = _real_roots(eqn)                            # (N, 4)
-
-    A1, A3 = _basis(k1, p1), _basis(k3, p3)
-    a1 = np.einsum("nij,ni->nj", A1, k2)                  # A1ᵀk2 (N, 2)
-    a3 = np.einsum("nij,ni->nj", A3, k2)
-    na1, na3 = _dot(a1, a1), _dot(a3, a3)
-    J = lambda a: np.stack([a[..., 1], -a[..., 0]], -1)   # noqa: E731
-
-    cand_t, cand_ok = [], []
-    for sgn1 in (1.0, -1.0):
-        for sgn3 in (1.0, -1.0):
-            e1 = (z - d1[:, None])
-            e3 = (z - d3[:, None])
-            s1 = np.sqrt(np.maximum(na1[:, None] - e1 ** 2, 0.0))
-            s3 = np.sqrt(np.maximum(na3[:, None] - e3 ** 2, 0.0))
-            x1 = (a1[:, None] * e1[..., None] + sgn1 * J(a1)[:, None] * s1[..., None]) / np.maximum(na1, 1e-300)[:, None, None]
-            x3 = (a3[:, None] * e3[..., None] + sgn3 * J(a3)[:, None] * s3[..., None]) / np.maximum(na3, 1e-300)[:, None, None]
-            t1 = np.arctan2(x1[..., 0], x1[..., 1])
-            t3 = np.arctan2(x3[..., 0], x3[..., 1])
-            v1 = p0[:, None] + _rotate(k1[:, None], t1, p1[:, None])
-            v3 = p2[:, None] + _rotate(k3[:, None], t3, p3[:, None])
-            xb = np.einsum("nsij,nsi->nsj", _basis(k2[:, None], v3), v1)   # SP1: rot(k2, θ2) v3 = v1
-            t2 = np.arctan2(xb[..., 0], xb[..., 1])
-            cand_t.append(np.stack([t1, t2, t3], -1))
-            cand_ok.append(real)
-    theta = np.concatenate(cand_t, 1)                     # (N, 16, 3)
-    ok = np.concatenate(cand_ok, 1)
-    K1, K2, K3 = k1[:, None], k2[:, None], k3[:, None]
-    P0, P1, P2, P3 = p0[:, None], p1[:, None], p2[:, None], p3[:, None]
-
-    def residual(t):
-        return P0 + _rotate(K1, t[..., 0], P1) - _rotate(K2, t[..., 1], P2 + _rotate(K3, t[..., 2], P3))
-
-    def jacobian(t):
-        r1 = _rotate(K1, t[..., 0], P1)
-        r3 = _rotate(K3, t[..., 2], P3)
-        w = _rotate(K2, t[..., 1], P2 + r3)
-        c3 = _rotate(K2, t[..., 1], _cross(np.broadcast_to(K3, r3.shape), r3))
-        return np.stack([_cross(np.broadcast_to(K1, r1.shape), r1),
-                         -_cross(np.broadcast_to(K2, w.shape), w), -c3], -1)
-
-    scale = 1.0 + sum(np.linalg.norm(v, axis=-1) for v in (p0, p1, p2, p3))[:, None]
-    near = ok & (np.linalg.norm(residual(theta), axis=-1) <= 1e-2 * scale)
-    theta = _newton(residual, jacobian, theta)            # polish (the quartic's roots cluster)
-    theta = np.angle(np.exp(1j * theta))
-    res = np.linalg.norm(residual(theta), axis=-1)
-    sing = bad1 | bad3
-    ok = near & (res <= tol) & ~sing[:, None]
-    order = np.argsort(np.where(ok, res, np.inf), axis=1, kind="stable")
-    theta = np.take_along_axis(theta, order[..., None], 1)
-    ok = np.take_along_axis(ok, order, 1)
-    ok = _dedupe(theta, ok)
-    theta, valid, exact = _compact(theta, ok, ok.copy(), 4)
-    return _finish(theta, valid, exact, sing, batched)
+    theta, count, sing = np.empty((n, 4, 3)), np.empty(n, np.int64), np.empty(n, bool)
+    _sp5_loop(p0, p1, p2, p3, k1, k2, k3, tol, theta, count, sing)
+    valid = np.arange(4)[None, :] < count[:, None]
+    return _finish(theta, valid, valid.copy(), sing, batched)
 
 
 # ----------------------------------------------------------------------------- SP6
+@kernel
+def _sp6_residual(H, K, P, d1, d2, t0, t1):
+    v0 = dot(H[0], rotate(K[0], t0, P[0]))
+    v1 = dot(H[1], rotate(K[1], t1, P[1]))
+    v2 = dot(H[2], rotate(K[2], t0, P[2]))
+    v3 = dot(H[3], rotate(K[3], t1, P[3]))
+    return v0 + v1 - d1, v2 + v3 - d2
+
+
+@kernel
+def _conic(xm0, xm1, n00, n01, n10, n11):
+    """‖xm + N ξ‖² = 1 (xm (2,), N 2×2) as a ξ1² + b ξ1ξ2 + c ξ2² + d ξ1 + e ξ2 + f = 0."""
+    return (n00 * n00 + n10 * n10, 2.0 * (n00 * n01 + n10 * n11), n01 * n01 + n11 * n11,
+            2.0 * (xm0 * n00 + xm1 * n10), 2.0 * (xm0 * n01 + xm1 * n11), xm0 * xm0 + xm1 * xm1 - 1.0)
+
+
+@kernel
+def sp6_one(H, K, P, d1, d2, tol, out_theta):
+    """SP6 of one problem (H, K, P: 4-tuples of vector tuples): writes the solutions into
+    ``out_theta`` (4, 2) and returns (count, singular); see :func:`sp6`."""
+    A = np.zeros((2, 4))
+    hk = np.empty(4)
+    for q in range(4):
+        kxp = cross(K[q], P[q])
+        row, col = q // 2, 2 * (q % 2)
+        A[row, col] = dot(H[q], kxp)
+        A[row, col + 1] = -dot(H[q], cross(K[q], kxp))
+        hk[q] = dot(H[q], K[q]) * dot(K[q], P[q])
+    b0, b1 = d1 - hk[0] - hk[1], d2 - hk[2] - hk[3]
+    for j in range(4):
+        out_theta[j, 0] = math.nan
+        out_theta[j, 1] = math.nan
+    U, S, Vt = np.linalg.svd(A)                        # A = U diag(S) Vt, Vt (4, 4)
+    amax = np.abs(A).max()
+    if S[0] * S[1] <= 1e-12 * max(1.0, amax) ** 2:
+        return 0, True                                 # the two equations are not independent
+    y0 = (U[0, 0] * b0 + U[1, 0] * b1) / S[0]
+    y1 = (U[0, 1] * b0 + U[1, 1] * b1) / S[1]
+    xm = np.empty(4)
+    for i in range(4):
+        xm[i] = Vt[0, i] * y0 + Vt[1, i] * y1          # minimum-norm solution of A x = b
+    # x = xm + N ξ with N = [Vt[2], Vt[3]]ᵀ (the null space of A)
+    a, b_, c, d, e, f = _conic(xm[0], xm[1], Vt[2, 0], Vt[3, 0], Vt[2, 1], Vt[3, 1])
+    a1, b1_, c1, dd1, e1, fq = _conic(xm[2], xm[3], Vt[2, 2], Vt[3, 2], Vt[2, 3], Vt[3, 3])
+    b1 = b1_
+    # resultant in ξ2 of the two conics (eliminating ξ1)
+    z = np.empty(5)
+    z[4] = (f * a * dd1 ** 2 + a ** 2 * fq ** 2 - d * a * dd1 * fq + a1 ** 2 * f ** 2 - 2 * a * fq * a1 * f
+            - d * dd1 * a1 * f + a1 * d ** 2 * fq)
+    z[3] = (e1 * d ** 2 * a1 - fq * dd1 * a * b_ - 2 * a * fq * a1 * e - f * a1 * b1 * d + 2 * dd1 * b1 * a * f
+            + 2 * e1 * fq * a ** 2 + dd1 ** 2 * a * e - e1 * dd1 * a * d - 2 * a * e1 * a1 * f - f * a1 * dd1 * b_
+            + 2 * f * e * a1 ** 2 - fq * b1 * a * d - e * a1 * dd1 * d + 2 * fq * b_ * a1 * d)
+    z[2] = (e1 ** 2 * a ** 2 + 2 * c1 * fq * a ** 2 - e * a1 * dd1 * b_ + fq * a1 * b_ ** 2 - e * a1 * b1 * d
+            - fq * b1 * a * b_ - 2 * a * e1 * a1 * e + 2 * dd1 * b1 * a * e - c1 * dd1 * a * d - 2 * a * c1 * a1 * f
+            + b1 ** 2 * a * f + 2 * e1 * b_ * a1 * d + e ** 2 * a1 ** 2 - c * a1 * dd1 * d - e1 * b1 * a * d
+            + 2 * f * c * a1 ** 2 - f * a1 * b1 * b_ + c1 * d ** 2 * a1 + dd1 ** 2 * a * c - e1 * dd1 * a * b_
+            - 2 * a * fq * a1 * c)
+    z[1] = (-2 * a * a1 * c * e1 + e1 * a1 * b_ ** 2 + 2 * c1 * b_ * a1 * d - c * a1 * b1 * d + b1 ** 2 * a * e
+            - e1 * b1 * a * b_ - 2 * a * c1 * a1 * e - e * a1 * b1 * b_ - c1 * b1 * a * d + 2 * e1 * c1 * a ** 2
+            + 2 * e * c * a1 ** 2 - c * a1 * dd1 * b_ + 2 * dd1 * b1 * a * c - c1 * dd1 * a * b_)
+    z[0] = (a ** 2 * c1 ** 2 - 2 * a * c1 * a1 * c + a1 ** 2 * c ** 2 - b_ * a * b1 * c1 - b_ * b1 * a1 * c
+            + b_ ** 2 * a1 * c1 + c * a * b1 ** 2)
+    xi2s, real = real_roots(z)
+    theta = np.zeros((4, 2))
+    ok = np.zeros(4, dtype=np.bool_)
+    res = np.full(4, np.inf)
+    scl = 1.0 + norm(P[0]) + norm(P[1]) + norm(P[2]) + norm(P[3])
+    for r in range(4):
+        if not real[r]:
+            continue
+        xi2 = xi2s[r]
+        den = a * b1 * xi2 + a * dd1 - a1 * b_ * xi2 - a1 * d
+        if abs(den) <= 1e-300:
+            continue
+        xi1 = -(a * fq + a * c1 * xi2 ** 2 - a1 * c * xi2 ** 2 + a * e1 * xi2 - a1 * e * xi2 - a1 * f) / den
+        x = np.empty(4)
+        for i in range(4):
+            x[i] = xm[i] + Vt[2, i] * xi1 + Vt[3, i] * xi2
+        t0, t1 = math.atan2(x[0], x[1]), math.atan2(x[2], x[3])
+        if not (math.isfinite(t0) and math.isfinite(t1)):
+            continue
+        F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
+        if max(abs(F0), abs(F1)) > 1e-2 * scl:
+            continue
+        for _ in range(3):                             # Newton polish on the two equations
+            F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
+            g = np.empty(4)
+            for q in range(4):
+                tq = t0 if q % 2 == 0 else t1
+                g[q] = dot(H[q], cross(K[q], rotate(K[q], tq, P[q])))
+            det = g[0] * g[3] - g[1] * g[2]
+            if abs(det) > 1e-12:
+                t0 -= (g[3] * F0 - g[1] * F1) / det
+                t1 -= (-g[2] * F0 + g[0] * F1) / det
+        t0, t1 = wrap(t0), wrap(t1)
+        F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
+        theta[r, 0], theta[r, 1] = t0, t1
+        res[r] = max(abs(F0), abs(F1))
+        ok[r] = res[r] <= tol
+    exact = np.zeros(4, dtype=np.bool_)
+    return _keep_best(theta, ok, res, out_theta, exact, 2), False
+
+
+@kernel
+def _sp6_loop(H, K, P, d1, d2, tol, theta, count, sing):
+    for i in range(len(d1)):
+        Hi = (vec(H[i, 0]), vec(H[i, 1]), vec(H[i, 2]), vec(H[i, 3]))
+        Ki = (vec(K[i, 0]), vec(K[i, 1]), vec(K[i, 2]), vec(K[i, 3]))
+        Pi = (vec(P[i, 0]), vec(P[i, 1]), vec(P[i, 2]), vec(P[i, 3]))
+        count[i], sing[i] = sp6_one(Hi, Ki, Pi, d1[i], d2[i], tol, theta[i])
+
+
 def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
     """Subproblem 6, four circles: (θ1, θ2) with::
 
@@ -497,10 +711,11 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
 
     IK-Geo §III-F: with x = (sin θ1, cos θ1, sin θ2, cos θ2) both equations are linear,
     A x = b (A 2×4 built from Eq. (2)); x = x_min + N ξ with the minimum-norm solution and the
-    null space from a QR factorisation of Aᵀ, and the two unit-circle constraints
+    null space of A (here from its SVD), and the two unit-circle constraints
     ‖x[0:2]‖ = ‖x[2:4]‖ = 1 are two ellipses in ξ ∈ ℝ², whose intersection is a quartic in ξ₂
     (closed-form ellipse–ellipse elimination).  Up to 4 solutions, each verified: both
-    residuals (length unit) at most ``tol``; no least-squares solution.
+    residuals (length unit) at most ``tol``; no least-squares solution.  ``singular``: the
+    two equations are not independent (rank A < 2).
 
     ``h``, ``k``: unit axes ``(4, 3)`` or ``(N, 4, 3)`` (rows h1…h4, k1…k4); ``p``:
     ``(4, 3)``/``(N, 4, 3)``; ``d1``, ``d2``: scalar/``(N,)``.  m = 2, S = 4."""
@@ -518,81 +733,14 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
             for name in ("h", "k", "p") for i in range(4)}
     spec.update({"d1": (d1, "scalar"), "d2": (d2, "scalar")})
     vals, batched = _inputs(spec)
-    H, K, P = (np.stack(vals[4 * j:4 * j + 4], 1) for j in range(3))    # (N, 4, 3)
+    H, K, P = (np.ascontiguousarray(np.stack(vals[4 * j:4 * j + 4], 1)) for j in range(3))    # (N, 4, 3)
     d1, d2 = vals[12], vals[13]
     n = len(d1)
-    Ai = _basis(K.reshape(-1, 3), P.reshape(-1, 3)).reshape(n, 4, 3, 2)
-    hA = np.einsum("nqi,nqij->nqj", H, Ai)                # (N, 4, 2) = hᵢᵀAᵢ
-    A = np.zeros((n, 2, 4))
-    A[:, 0, 0:2], A[:, 0, 2:4] = hA[:, 0], hA[:, 1]
-    A[:, 1, 0:2], A[:, 1, 2:4] = hA[:, 2], hA[:, 3]
-    hk = _dot(H, K) * _dot(K, P)                          # hᵢᵀkᵢ kᵢᵀpᵢ (N, 4)
-    b = np.stack([d1 - hk[:, 0] - hk[:, 1], d2 - hk[:, 2] - hk[:, 3]], -1)
-    Q, R = np.linalg.qr(np.swapaxes(A, 1, 2), mode="complete")          # Aᵀ = Q R
-    R2 = R[:, :2, :2]
-    det = R2[:, 0, 0] * R2[:, 1, 1]
-    rank_ok = np.abs(det) > 1e-12 * np.maximum(1.0, np.abs(A).max((1, 2))) ** 2
-    R2 = np.where(rank_ok[:, None, None], R2, np.eye(2))
-    y = np.linalg.solve(np.swapaxes(R2, 1, 2), b[..., None])[..., 0]    # R2ᵀ y = b
-    xm = np.einsum("nij,nj->ni", Q[:, :, :2], y)                         # (N, 4)
-    xn = Q[:, :, 2:]                                                      # (N, 4, 2)
-
-    def conic(xm_, xn_):
-        # ‖xm + xn ξ‖² = 1  →  a ξ1² + b ξ1ξ2 + c ξ2² + d ξ1 + e ξ2 + f = 0
-        M = np.einsum("nki,nkj->nij", xn_, xn_)
-        B = 2 * np.einsum("nk,nkj->nj", xm_, xn_)
-        return M[:, 0, 0], 2 * M[:, 1, 0], M[:, 1, 1], B[:, 0], B[:, 1], _dot(xm_, xm_) - 1
-    a, b_, c, d, e, f = conic(xm[:, 0:2], xn[:, 0:2])
-    a1, b1, c1, dd1, e1, fq = conic(xm[:, 2:4], xn[:, 2:4])
-    # resultant in ξ2 of the two conics (eliminating ξ1)
-    z0 = (f * a * dd1 ** 2 + a ** 2 * fq ** 2 - d * a * dd1 * fq + a1 ** 2 * f ** 2 - 2 * a * fq * a1 * f
-          - d * dd1 * a1 * f + a1 * d ** 2 * fq)
-    z1 = (e1 * d ** 2 * a1 - fq * dd1 * a * b_ - 2 * a * fq * a1 * e - f * a1 * b1 * d + 2 * dd1 * b1 * a * f
-          + 2 * e1 * fq * a ** 2 + dd1 ** 2 * a * e - e1 * dd1 * a * d - 2 * a * e1 * a1 * f - f * a1 * dd1 * b_
-          + 2 * f * e * a1 ** 2 - fq * b1 * a * d - e * a1 * dd1 * d + 2 * fq * b_ * a1 * d)
-    z2 = (e1 ** 2 * a ** 2 + 2 * c1 * fq * a ** 2 - e * a1 * dd1 * b_ + fq * a1 * b_ ** 2 - e * a1 * b1 * d
-          - fq * b1 * a * b_ - 2 * a * e1 * a1 * e + 2 * dd1 * b1 * a * e - c1 * dd1 * a * d - 2 * a * c1 * a1 * f
-          + b1 ** 2 * a * f + 2 * e1 * b_ * a1 * d + e ** 2 * a1 ** 2 - c * a1 * dd1 * d - e1 * b1 * a * d
-          + 2 * f * c * a1 ** 2 - f * a1 * b1 * b_ + c1 * d ** 2 * a1 + dd1 ** 2 * a * c - e1 * dd1 * a * b_
-          - 2 * a * fq * a1 * c)
-    z3 = (-2 * a * a1 * c * e1 + e1 * a1 * b_ ** 2 + 2 * c1 * b_ * a1 * d - c * a1 * b1 * d + b1 ** 2 * a * e
-          - e1 * b1 * a * b_ - 2 * a * c1 * a1 * e - e * a1 * b1 * b_ - c1 * b1 * a * d + 2 * e1 * c1 * a ** 2
-          + 2 * e * c * a1 ** 2 - c * a1 * dd1 * b_ + 2 * dd1 * b1 * a * c - c1 * dd1 * a * b_)
-    z4 = (a ** 2 * c1 ** 2 - 2 * a * c1 * a1 * c + a1 ** 2 * c ** 2 - b_ * a * b1 * c1 - b_ * b1 * a1 * c
-          + b_ ** 2 * a1 * c1 + c * a * b1 ** 2)
-    xi2, real = _real_roots(np.stack([z4, z3, z2, z1, z0], -1))
-    den = a[:, None] * b1[:, None] * xi2 + (a * dd1)[:, None] - a1[:, None] * b_[:, None] * xi2 - (a1 * d)[:, None]
-    num = ((a * fq)[:, None] + (a * c1)[:, None] * xi2 ** 2 - (a1 * c)[:, None] * xi2 ** 2
-           + (a * e1)[:, None] * xi2 - (a1 * e)[:, None] * xi2 - (a1 * f)[:, None])
-    xi1 = -num / np.where(np.abs(den) > 1e-300, den, 1.0)
-    x = xm[:, None] + xn[:, None, :, 0] * xi1[..., None] + xn[:, None, :, 1] * xi2[..., None]   # (N, 4, 4)
-    theta = np.stack([np.arctan2(x[..., 0], x[..., 1]), np.arctan2(x[..., 2], x[..., 3])], -1)
-    Hs, Ks, Ps = H[:, None], K[:, None], P[:, None]        # (N, 1, 4, 3)
-
-    def residual(t):
-        tt = t[..., [0, 1, 0, 1]]                          # θ of each term (N, S, 4)
-        v = _dot(Hs, _rotate(Ks, tt, Ps))
-        return np.stack([v[..., 0] + v[..., 1] - d1[:, None], v[..., 2] + v[..., 3] - d2[:, None]], -1)
-
-    def jacobian(t):
-        tt = t[..., [0, 1, 0, 1]]
-        rp = _rotate(Ks, tt, Ps)
-        g = _dot(Hs, _cross(np.broadcast_to(Ks, rp.shape), rp))   # d(hᵀ rot p)/dθ (N, S, 4)
-        return np.stack([g[..., 0:2], g[..., 2:4]], -2)
-
-    scale = 1.0 + np.linalg.norm(P, axis=-1).sum(-1)[:, None]
-    fin = real & np.isfinite(theta).all(-1) & (np.abs(den) > 1e-300) & rank_ok[:, None]
-    theta = np.where(fin[..., None], theta, 0.0)
-    near = fin & (np.abs(residual(theta)).max(-1) <= 1e-2 * scale)
-    theta = np.angle(np.exp(1j * _newton(residual, jacobian, theta)))   # polish
-    res = np.abs(residual(theta)).max(-1)
-    ok = near & (res <= tol)
-    order = np.argsort(np.where(ok, res, np.inf), axis=1, kind="stable")
-    theta = np.take_along_axis(theta, order[..., None], 1)
-    ok = np.take_along_axis(ok, order, 1)
-    ok = _dedupe(theta, ok)
-    theta, valid, exact = _compact(theta, ok, ok.copy(), 4)
-    return _finish(theta, valid, exact, ~rank_ok, batched)
+    theta, count, sing = np.empty((n, 4, 2)), np.empty(n, np.int64), np.empty(n, bool)
+    _sp6_loop(H, K, P, d1, d2, tol, theta, count, sing)
+    valid = np.arange(4)[None, :] < count[:, None]
+    return _finish(theta, valid, valid.copy(), sing, batched)
 
 
-__all__ = ["Solutions", "rot", "sp1", "sp2", "sp3", "sp4", "sp5", "sp6", "TOL", "TOL_QUARTIC"]
+__all__ = ["Solutions", "rot", "sp1", "sp2", "sp3", "sp4", "sp5", "sp6", "sp1_one", "sp2_one", "sp3_one",
+           "sp4_one", "sp5_one", "sp6_one", "real_roots", "TOL", "TOL_QUARTIC"]
