@@ -1,0 +1,590 @@
+"""Closed-form IK of two arm families read from the chain's geometry, as compiled kernels.
+
+Source: A. J. Elias and J. T. Wen, "IK-Geo: Unified robot inverse kinematics using subproblem
+decomposition", arXiv 2211.05737, §III (the subproblems SP1–SP4 of :mod:`.subproblems`); the
+redundant shoulder–elbow–wrist arm and its elbow swivel angle follow the book's §6-3 (and
+Kreutz-Delgado, Long & Seraji, IJRR 11(5), 1992), with the swivel angle defined as in
+:func:`anthroarm.ik.qp.tasks.swivel.swivel_angle`.  The code is our own, in the style of
+:mod:`.geometric` (scalar kernels on tuples, :mod:`.vec3`, compiled by :mod:`anthroarm.jit`).
+
+The arm is read from ``robot.chain`` (:func:`anthroarm.ik.classify.classify`), never from its
+name.  Everything is in the **base frame** at q = 0, metres and radians: joint i turns about the
+unit axis ``h_i`` through the point ``o_i``; the tool pose at q = 0 is (R_t, p_t).
+
+``srs_7r`` — 7R arm, spherical shoulder (axes 1, 2, 3 meet at S), elbow joint 4, spherical
+wrist (axes 5, 6, 7 meet at W), one solution family per elbow swivel angle φ:
+
+* wrist centre W(T) = R R_tᵀ (W0 − p_t) + p (joints 5–7 do not move W0);
+* q4 by SP3: ‖rot(h4, q4)(W0 − E0) − (S − E0)‖ = ‖W − S‖ (2 roots), E0 the elbow point on
+  axis 4 (the elbow frame of :func:`~anthroarm.ik.qp.tasks.swivel.swivel_frames`);
+* the elbow E on its circle about n = (W − S)/‖W − S‖ (the triangle S, E, W has sides
+  a = ‖E0 − S‖, b = ‖W0 − E0‖, L = ‖W − S‖): E = S + c n + r (cos φ u + sin φ v),
+  c = (a² − b² + L²)/(2L), r = √(a² − c²), (u, v) of :func:`~anthroarm.ik.qp.tasks.swivel.
+  swivel_basis` (u: −z projected ⊥ n, fallback −y; v = n × u);
+* the shoulder R03 maps E0 − S onto E − S and f = rot(h4, q4)(W0 − E0) onto W − E (a straight
+  elbow, r = 0: h4 onto the elbow axis a_E with d = n × a_E, the swivel angle's convention).
+  When axis 3 lies along the upper arm at q = 0 (route ``"sp2"``): (q1, q2) by SP2,
+  rot(−h1, q1)(E − S) = rot(h2, q2)(E0 − S) (2 roots), q3 by SP1.  Otherwise (route
+  ``"general"``) R03 is the rotation taking the pair to the pair and (q1, q2, q3) follow as a
+  spherical wrist does: q2 by SP4, q1 and q3 by SP1 (2 roots);
+* the wrist from R47 = R04ᵀ R R_tᵀ as :func:`anthroarm.ik.geometric._wrist`: q6 by SP4, q5 and
+  q7 by SP1 (2 roots).
+
+8 branches per φ, q4 root outermost, wrist root innermost: labels ``"q4=0,q1q2=0,q6=0"`` …
+(``q2`` in place of ``q1q2`` for the general shoulder route), see :attr:`SRSPlan.labels`.
+
+``planar_2r`` — two parallel revolute axes, position only: q2 by SP3
+(‖rot(h2, q2)(p_t − o2) − (o1 − o2)‖ = ‖p − o1‖), q1 by SP1; 2 branches ``"q2=0"``, ``"q2=1"``.
+A target off the plane of motion (|h1ᵀ(p − p_t)| > tol) has no candidate.
+
+Drivers (:func:`srs_verified`, :func:`planar_verified`) follow
+:func:`anthroarm.ik.geometric.solve_verified`: one compiled call per batch, each branch wrapped
+by 2π into the joint limits and checked by the chain's FK (product of exponentials of the
+joints as read from ``robot.chain``, unsnapped), joint values in ``robot.chain.independent``
+order.  A branch whose subproblems had only least-squares answers is a candidate with
+``exact = False`` (out of reach on that branch).
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..jit import kernel
+from . import classify as C
+from .geometric import _common_point, _fk_residual, _pose_status, _wrist
+from .subproblems import TOL, sp1_one, sp2_one, sp3_one
+from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
+
+#: shoulder routes of the SRS arm (index stored in the plan)
+SRS_ROUTES = ("sp2", "general")
+#: branches per swivel angle (SRS) and per pose (planar)
+SRS_BRANCHES, PLANAR_BRANCHES = 8, 2
+#: tolerances of the geometry tests (m, and sine of an angle), as :func:`classify.classify`
+GEOM_TOL, ANGLE_TOL = 1e-6, 1e-6
+
+
+def srs_branch_labels(route: str) -> tuple[str, ...]:
+    """The 8 labels of one swivel angle: q4 root (SP3) × shoulder root (SP2 of (q1, q2), or SP4
+    of q2 on the general route) × wrist root (SP4 of q6)."""
+    sh = "q1q2" if route == "sp2" else "q2"
+    return tuple(f"q4={i},{sh}={j},q6={k}" for i in range(2) for j in range(2) for k in range(2))
+
+
+PLANAR_LABELS = ("q2=0", "q2=1")
+
+
+# ----------------------------------------------------------------------------- plans
+@dataclass(frozen=True)
+class SRSPlan:
+    """A 7R shoulder–elbow–wrist arm in the form of the kernels (base frame, q = 0, m):
+    axes ``H`` (7, 3), shoulder centre ``S``, elbow point ``E0`` (on axis 4), wrist centre
+    ``W0``, tool pose ``R_tool``, ``p_tool``; ``route`` index into :data:`SRS_ROUTES`; the map
+    from path order to ``robot.chain.independent`` (``order``), limits in path order
+    (rad, ±inf continuous); the FK check's unsnapped axes/points; ``swivel_frames`` the
+    (shoulder, elbow, wrist) frames whose positions define φ (None: E0 chosen on axis 4)."""
+
+    H: np.ndarray
+    S: np.ndarray
+    E0: np.ndarray
+    W0: np.ndarray
+    R_tool: np.ndarray
+    p_tool: np.ndarray
+    route: int
+    order: np.ndarray
+    lower_path: np.ndarray
+    upper_path: np.ndarray
+    fk_axes: np.ndarray
+    fk_points: np.ndarray
+    fk_M: np.ndarray
+    labels: tuple
+    swivel_frames: tuple | None
+    chain: object
+    tool: str
+    in_order: bool = False         # path order is robot.chain.independent order
+
+
+@dataclass(frozen=True)
+class PlanarPlan:
+    """A planar 2R arm (two parallel axes): ``h1``, ``h2`` (h2 snapped to ±h1), points ``o1``,
+    ``o2`` on the axes, tool point ``p_tool`` at q = 0 (base frame, m); ``order``, limits and
+    the FK check's unsnapped axes/points as :class:`SRSPlan`."""
+
+    h1: np.ndarray
+    h2: np.ndarray
+    o1: np.ndarray
+    o2: np.ndarray
+    p_tool: np.ndarray
+    order: np.ndarray
+    lower_path: np.ndarray
+    upper_path: np.ndarray
+    fk_axes: np.ndarray
+    fk_points: np.ndarray
+    labels: tuple
+    chain: object
+    tool: str
+    in_order: bool = False
+
+
+_SRS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_PLANAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _cached(cache, robot, build):
+    hit = cache.get(robot)
+    if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
+        return hit[2], hit[3]
+    plan, why = build(robot)
+    cache[robot] = (robot.chain, robot.tool, plan, why)
+    return plan, why
+
+
+def srs_plan(robot) -> SRSPlan | None:
+    """The cached :class:`SRSPlan` of ``robot`` at its tool, or None (:func:`srs_reason` says
+    why).  Cached per robot, rebuilt when ``robot.chain`` or ``robot.tool`` change."""
+    return _cached(_SRS, robot, _build_srs)[0]
+
+
+def srs_reason(robot) -> str | None:
+    """Why ``robot`` has no SRS plan (None when it has one)."""
+    return _cached(_SRS, robot, _build_srs)[1]
+
+
+def planar_plan(robot) -> PlanarPlan | None:
+    """The cached :class:`PlanarPlan` of ``robot`` at its tool, or None
+    (:func:`planar_reason`)."""
+    return _cached(_PLANAR, robot, _build_planar)[0]
+
+
+def planar_reason(robot) -> str | None:
+    """Why ``robot`` has no planar-2R plan (None when it has one)."""
+    return _cached(_PLANAR, robot, _build_planar)[1]
+
+
+def _kinematics(robot, n):
+    """(kinematics, limits lo/hi in path order, order) of the revolute path to the tool, or
+    (None, reason)."""
+    try:
+        kin = C.classify(robot).kinematics
+    except Exception as exc:  # noqa: BLE001 - mimic joints, no path: no closed form
+        return None, f"the chain cannot be read: {exc}"
+    ch = robot.chain
+    if kin.n != n:
+        return None, f"{kin.n} joints on the path to the tool, not {n}"
+    if not all(k in ("revolute", "continuous") for k in kin.kinds):
+        return None, "not every joint on the path is revolute"
+    if sorted(kin.joints) != sorted(ch.independent):
+        return None, "joints off the tool path (a solution would not be a configuration)"
+    path = list(kin.joints)
+    order = np.array([path.index(j) for j in ch.independent])
+    lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in path])
+    hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in path])
+    return (kin, np.ascontiguousarray(lo, dtype=float), np.ascontiguousarray(hi, dtype=float), order), None
+
+
+def _line_distance(h, o, x):
+    """Distance of the point x from the line through o along the unit h (m)."""
+    d = x - o
+    return float(np.linalg.norm(d - (d @ h) * h))
+
+
+def _meet(H, pts):
+    """(common point, worst distance of a line from it, min sine between two of the axes)."""
+    c = _common_point(H, pts)
+    dist = max(_line_distance(h, o, c) for h, o in zip(H, pts))
+    sines = [np.linalg.norm(np.cross(H[i], H[j])) for i in range(3) for j in range(i + 1, 3)]
+    return c, dist, min(sines)
+
+
+def _build_srs(robot):
+    got, why = _kinematics(robot, 7)
+    if got is None:
+        return None, why
+    kin, lo, hi, order = got
+    H, O = np.asarray(kin.H, dtype=float), np.asarray(kin.points, dtype=float)
+    S, dS, sS = _meet(H[:3], O[:3])
+    W0, dW, sW = _meet(H[4:], O[4:])
+    if dS > GEOM_TOL or sS <= ANGLE_TOL:
+        return None, f"axes 1-3 do not meet in one point (no spherical shoulder; {dS:.3g} m)"
+    if dW > GEOM_TOL or sW <= ANGLE_TOL:
+        return None, f"axes 5-7 do not meet in one point (no spherical wrist; {dW:.3g} m)"
+    frames, E0 = None, None
+    try:
+        from .qp.tasks.swivel import swivel_frames
+        frames = swivel_frames(robot)
+    except Exception:  # noqa: BLE001 - no human-like layout: the elbow point is chosen below
+        frames = None
+    if frames is not None:
+        q0 = robot.chain.configuration(np.zeros(len(robot.chain.independent)))
+        Sf, Ef, Wf = (np.asarray(robot.fk(q0, f))[:3, 3] for f in frames)
+        path = list(kin.joints)
+        jE = robot.chain.frame(frames[1]).joint
+        ok = (np.linalg.norm(Sf - S) <= GEOM_TOL and np.linalg.norm(Wf - W0) <= GEOM_TOL
+              and _line_distance(H[3], O[3], Ef) <= GEOM_TOL and jE in path and path.index(jE) == 3)
+        if not ok:
+            return None, ("the swivel frames " + ", ".join(frames) + " are not at the shoulder centre, on the "
+                          "elbow axis and at the wrist centre: the swivel angle is not this decomposition's")
+        E0 = Ef
+    if E0 is None:                       # the point of axis 4 nearest the shoulder centre
+        E0 = O[3] + ((S - O[3]) @ H[3]) * H[3]
+    a, b = np.linalg.norm(E0 - S), np.linalg.norm(W0 - E0)
+    if a <= GEOM_TOL or b <= GEOM_TOL:
+        return None, "the elbow point coincides with the shoulder or wrist centre"
+    if min(np.linalg.norm(np.cross(H[3], (E0 - S) / a)), np.linalg.norm(np.cross(H[3], (W0 - E0) / b))) <= ANGLE_TOL:
+        return None, "the elbow axis lies along the upper arm or the forearm (the elbow does not bend)"
+    route = 0 if np.linalg.norm(np.cross(H[2], (E0 - S) / a)) <= ANGLE_TOL else 1
+    M = np.eye(4)
+    M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
+    f = lambda x: np.ascontiguousarray(x, dtype=float)      # noqa: E731
+    plan = SRSPlan(f(H), f(S), f(E0), f(W0), f(kin.R_tool), f(kin.p_tool), route, order, lo, hi, f(H), f(O), M,
+                   srs_branch_labels(SRS_ROUTES[route]), frames, robot.chain, robot.tool,
+                   bool((order == np.arange(7)).all()))
+    return plan, None
+
+
+def _build_planar(robot):
+    got, why = _kinematics(robot, 2)
+    if got is None:
+        return None, why
+    kin, lo, hi, order = got
+    H, O = np.asarray(kin.H, dtype=float), np.asarray(kin.points, dtype=float)
+    if np.linalg.norm(np.cross(H[0], H[1])) > ANGLE_TOL:
+        return None, "the two axes are not parallel"
+    h1 = H[0]
+    h2 = np.sign(h1 @ H[1]) * h1
+    pt = np.asarray(kin.p_tool, dtype=float)
+    if _line_distance(h1, O[0], O[1]) <= GEOM_TOL:
+        return None, "the two axes coincide"
+    if _line_distance(h2, O[1], pt) <= GEOM_TOL:
+        return None, "the tool point lies on the second axis"
+    f = lambda x: np.ascontiguousarray(x, dtype=float)      # noqa: E731
+    return PlanarPlan(f(h1), f(h2), f(O[0]), f(O[1]), f(pt), order, lo, hi, f(H), f(O), PLANAR_LABELS,
+                      robot.chain, robot.tool, bool((order == np.arange(2)).all())), None
+
+
+# ----------------------------------------------------------------------------- SRS kernels
+@kernel
+def _swivel_basis(n):
+    """(u, v) ⊥ n: u = (0, 0, −1) projected ⊥ n (fallback (0, −1, 0)), v = n × u — as
+    :func:`anthroarm.ik.qp.tasks.swivel.swivel_basis`."""
+    r = (0.0, 0.0, -1.0)
+    u = sub(r, scale(n, dot(r, n)))
+    nu = norm(u)
+    if nu < 1e-9:
+        r = (0.0, -1.0, 0.0)
+        u = sub(r, scale(n, dot(r, n)))
+        nu = norm(u)
+    u = scale(u, 1.0 / nu)
+    return u, cross(n, u)
+
+
+@kernel
+def _align(a0, b0, a1, b1):
+    """The rotation R with R a0 ∥ a1 and R b0 in the half-plane of (a1, b1) (R = F1 F0ᵀ of the
+    orthonormal frames of the two pairs)."""
+    x0 = scale(a0, 1.0 / norm(a0))
+    z0 = cross(a0, b0)
+    z0 = scale(z0, 1.0 / norm(z0))
+    y0 = cross(z0, x0)
+    x1 = scale(a1, 1.0 / norm(a1))
+    z1 = cross(a1, b1)
+    z1 = scale(z1, 1.0 / norm(z1))
+    y1 = cross(z1, x1)
+    F0 = (x0, y0, z0)                    # the rows of F0ᵀ; R = x1 x0ᵀ + y1 y0ᵀ + z1 z0ᵀ
+    return ((x1[0] * F0[0][0] + y1[0] * F0[1][0] + z1[0] * F0[2][0],
+             x1[0] * F0[0][1] + y1[0] * F0[1][1] + z1[0] * F0[2][1],
+             x1[0] * F0[0][2] + y1[0] * F0[1][2] + z1[0] * F0[2][2]),
+            (x1[1] * F0[0][0] + y1[1] * F0[1][0] + z1[1] * F0[2][0],
+             x1[1] * F0[0][1] + y1[1] * F0[1][1] + z1[1] * F0[2][1],
+             x1[1] * F0[0][2] + y1[1] * F0[1][2] + z1[1] * F0[2][2]),
+            (x1[2] * F0[0][0] + y1[2] * F0[1][0] + z1[2] * F0[2][0],
+             x1[2] * F0[0][1] + y1[2] * F0[1][1] + z1[2] * F0[2][1],
+             x1[2] * F0[0][2] + y1[2] * F0[1][2] + z1[2] * F0[2][2]))
+
+
+@kernel
+def _srs_one(route, h, S, E0, W0, Rg, W, phi, t4a, t4b, n4, e4a, e4b, Q, V, E, Q6, V6, E6, Qs, Vs, Es):
+    """The 8 branches of one pose and swivel angle φ: Q (8, 7) rad (path order, wrapped into
+    (−π, π]), V (the branch exists), E (every subproblem on it exact).  ``Rg`` = R R_tᵀ, ``W``
+    the wrist centre (base frame, m), q4 roots of the SP3 (module docstring)."""
+    for b in range(8):
+        V6[b] = False
+        E6[b] = False
+        for j in range(6):
+            Q6[b, j] = math.nan
+    q4b = np.empty(8)
+    e0 = sub(E0, S)
+    a = norm(e0)
+    f0 = sub(W0, E0)
+    bb = norm(f0)
+    sw = sub(W, S)
+    L = norm(sw)
+    if L > 1e-12:
+        n = scale(sw, 1.0 / L)
+        u, v = _swivel_basis(n)
+        c = (a * a - bb * bb + L * L) / (2.0 * L)
+        c = min(max(c, -a), a)
+        rad = math.sqrt(max(a * a - c * c, 0.0))
+        d = add(scale(u, math.cos(phi)), scale(v, math.sin(phi)))
+        Ep = add(S, add(scale(n, c), scale(d, rad)))
+        straight = rad <= 1e-9 * (1.0 + a)
+        # straight elbow: h4 goes to a_E with d = n × a_E (the swivel angle's convention)
+        al = dot(h[3], e0) / a
+        aE = add(scale(n, al), scale(cross(d, n), math.sqrt(max(1.0 - al * al, 0.0))))
+        up = sub(Ep, S)
+        fore = sub(W, Ep)
+        for i4 in range(2):
+            if i4 >= n4:
+                continue
+            q4 = t4a if i4 == 0 else t4b
+            ex4 = e4a if i4 == 0 else e4b
+            f = rotate(h[3], q4, f0)
+            src = h[3] if straight else f
+            dst = aE if straight else fore
+            if route == 0:
+                q1a, q2a, q1b, q2b, n12, ea, eb, _ = sp2_one(up, e0, neg(h[0]), h[1], TOL)
+                for j in range(2):
+                    if j >= n12:
+                        continue
+                    q1, q2 = (q1a, q2a) if j == 0 else (q1b, q2b)
+                    R02 = mm(rot(h[0], q1), rot(h[1], q2))
+                    q3, e3, _ = sp1_one(src, mtv(R02, dst), h[2], TOL)
+                    R04 = mm(mm(R02, rot(h[2], q3)), rot(h[3], q4))
+                    b = 4 * i4 + 2 * j
+                    q4b[b], q4b[b + 1] = q4, q4
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, V6, E6, b, q1, q2, q3,
+                           ex4 and (ea if j == 0 else eb) and e3)
+            else:
+                R03 = _align(e0, src, up, dst)
+                ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+                for j in range(2):
+                    Vs[j] = False
+                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Qs, Vs, Es, 0, 0.0, 0.0, 0.0, True)
+                for j in range(2):
+                    if not Vs[j]:
+                        continue
+                    q1, q2, q3 = Qs[j, 3], Qs[j, 4], Qs[j, 5]
+                    R04 = mm(mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3)), rot(h[3], q4))
+                    b = 4 * i4 + 2 * j
+                    q4b[b], q4b[b + 1] = q4, q4
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, V6, E6, b, q1, q2, q3, ex4 and Es[j])
+    for b in range(8):
+        if V6[b]:
+            Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3] = wrap(Q6[b, 0]), wrap(Q6[b, 1]), wrap(Q6[b, 2]), wrap(q4b[b])
+            Q[b, 4], Q[b, 5], Q[b, 6] = wrap(Q6[b, 3]), wrap(Q6[b, 4]), wrap(Q6[b, 5])
+            V[b], E[b] = True, E6[b]
+        else:
+            for j in range(7):
+                Q[b, j] = math.nan
+            V[b], E[b] = False, False
+
+
+@kernel
+def _seven(A):
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
+
+
+@kernel
+def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid):
+    """Wrap q (n,) by 2π into [lo, hi] (clamped there; geometric's rule), write Qout; returns
+    (inside, FK residual — inf when not valid)."""
+    inside = True
+    for j in range(n):
+        lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
+        qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
+        if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
+            inside = False
+        q[j] = min(max(qw, lo[j]), hi[j])
+        Qout[j] = q[j]
+    return inside, (_fk_residual(kH, kO, MR, Mp, q, n, T) if valid else math.inf)
+
+
+@kernel
+def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swivel, tol_orthonormal,
+                  Q, V, E, IN, RES):
+    """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
+    order), V, E, IN, RES; returns the index of the first malformed pose (−1 if none)."""
+    h = _seven(H)
+    Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
+    Rt, pt = mat(R_tool), vec(p_tool)
+    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
+    Q6 = np.empty((8, 6))
+    V6 = np.empty(8, dtype=np.bool_)
+    E6 = np.empty(8, dtype=np.bool_)
+    Qs = np.empty((2, 6))
+    Vs = np.empty(2, dtype=np.bool_)
+    Es = np.empty(2, dtype=np.bool_)
+    Qb = np.empty((8, 7))
+    Vb = np.empty(8, dtype=np.bool_)
+    Eb = np.empty(8, dtype=np.bool_)
+    q = np.empty(7)
+    ns = swivel.shape[1]
+    for i in range(len(T)):
+        if _pose_status(T[i], tol_orthonormal) != 0:
+            return i
+        for k in range(ns):
+            if not math.isfinite(swivel[i, k]):
+                return len(T) + i
+        R, p = mat(T[i]), vec(T[i, :3, 3])
+        Rg = mm(R, transpose(Rt))
+        W = add(mv(Rg, sub(W0v, pt)), p)
+        t4a, t4b, n4, e4a, e4b, _ = sp3_one(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
+        for k in range(ns):
+            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], t4a, t4b, n4, e4a, e4b, Qb, Vb, Eb,
+                     Q6, V6, E6, Qs, Vs, Es)
+            for b in range(8):
+                r = 8 * k + b
+                for j in range(7):
+                    q[j] = Qb[b, j]
+                IN[i, r], RES[i, r] = _limits_fk(q, 7, lo, hi, Q[i, r], kH, kO, MR, Mp, T[i], Vb[b])
+                V[i, r], E[i, r] = Vb[b], Eb[b]
+    return -1
+
+
+def _swivel_array(swivel, N, check=True):
+    """(N, S) swivel angles from a scalar (every pose), (N,) (one per pose) or (N, S)."""
+    sw = np.asarray(swivel, dtype=float)
+    if sw.ndim == 0:
+        sw = np.full((N, 1), float(sw))
+    elif sw.ndim == 1:
+        if len(sw) != N:
+            raise ValueError(f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
+                             f"got {len(sw)}")
+        sw = sw.reshape(N, 1)
+    elif sw.ndim != 2 or sw.shape[0] != N:
+        raise ValueError(f"swivel must be a scalar, (N,) or (N, S) with N = {N}, got shape {sw.shape}")
+    if check and not np.all(np.isfinite(sw)):
+        raise ValueError("swivel must be finite angles (rad)")
+    return sw if sw.flags.c_contiguous else np.ascontiguousarray(sw)
+
+
+def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
+    """Every branch of the SRS arm of ``plan`` for tool poses ``T`` (N, 4, 4) (base frame, m)
+    and elbow swivel angles ``swivel`` (N, S) rad (a scalar or (N,) means S = 1), in one
+    compiled call: rows ``8 k + b`` hold swivel angle k and branch b (:attr:`SRSPlan.labels`).
+    Returns θ (N, 8S, 7) in ``robot.chain.independent`` order (rad, wrapped by 2π into the
+    limits, NaN where the branch does not exist), candidate (N, 8S), exact (N, 8S), inside the
+    limits (N, 8S), FK residual (N, 8S) (max entry of the 3×4 pose by the chain's product of
+    exponentials; inf where there is no candidate).  ``tol`` is accepted for the interface of
+    :func:`anthroarm.ik.geometric.solve_verified` (the caller compares the residual to it).
+    Raises ``ValueError`` naming the first malformed pose (not finite, last row, not a rotation
+    to ``tol_orthonormal``)."""
+    T = np.ascontiguousarray(T, dtype=float)
+    if T.ndim != 3 or T.shape[1:] != (4, 4):
+        raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
+    N = len(T)
+    sw = _swivel_array(swivel, N, check=False)             # finiteness: checked by the kernel
+    B = 8 * sw.shape[1]
+    Q, V, E = np.empty((N, B, 7)), np.empty((N, B), bool), np.empty((N, B), bool)
+    IN, RES = np.empty((N, B), bool), np.empty((N, B))
+    bad = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_M,
+                        plan.fk_axes, plan.fk_points, plan.lower_path, plan.upper_path, T, sw, tol_orthonormal,
+                        Q, V, E, IN, RES)
+    if bad >= N:
+        raise ValueError(f"swivel[{bad - N}] is not finite (rad)")
+    if bad >= 0:
+        raise ValueError(f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a rotation "
+                         f"to {tol_orthonormal:g})")
+    # E is already False wherever V is (the kernel's rule)
+    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES
+
+
+def srs_points(plan: SRSPlan, T, swivel):
+    """The shoulder centre S (3,), the wrist centre W(T) (N, 3) and the elbow E(φ) (N, S, 3)
+    the kernel places for poses ``T`` and swivel angles (N, S) (base frame, m); numpy, for
+    tests and plots."""
+    T = np.asarray(T, dtype=float)
+    sw = _swivel_array(swivel, len(T))
+    Rg = T[:, :3, :3] @ plan.R_tool.T
+    W = np.einsum("nij,j->ni", Rg, plan.W0 - plan.p_tool) + T[:, :3, 3]
+    a, b = np.linalg.norm(plan.E0 - plan.S), np.linalg.norm(plan.W0 - plan.E0)
+    L = np.linalg.norm(W - plan.S, axis=1)
+    n = (W - plan.S) / L[:, None]
+    from .qp.tasks.swivel import swivel_basis
+    u, v = swivel_basis(n)
+    c = np.clip((a * a - b * b + L * L) / (2 * L), -a, a)
+    r = np.sqrt(np.maximum(a * a - c * c, 0))
+    d = np.cos(sw)[..., None] * u[:, None] + np.sin(sw)[..., None] * v[:, None]
+    E = plan.S + c[:, None, None] * n[:, None] + r[:, None, None] * d
+    return plan.S.copy(), W, E
+
+
+# ----------------------------------------------------------------------------- planar 2R
+@kernel
+def _fk_position_residual(kH, kO, p_tool, q, n, p):
+    """max |F(q) p_tool − p| over the 3 position entries (product of exponentials of the
+    revolute joints, axes kH, points kO at q = 0, base frame, m)."""
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    t = (0.0, 0.0, 0.0)
+    for i in range(n):
+        o = vec(kO[i])
+        Ri = rot(vec(kH[i]), q[i])
+        t = add(t, mv(R, sub(o, mv(Ri, o))))
+        R = mm(R, Ri)
+    x = add(t, mv(R, p_tool))
+    return max(abs(x[0] - p[0]), max(abs(x[1] - p[1]), abs(x[2] - p[2])))
+
+
+@kernel
+def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RES):
+    """Both branches of targets P (N, 3): Q (N, 2, 2) path order, V, E, IN, RES (position);
+    returns the index of the first non-finite target (−1 if none)."""
+    q = np.empty(2)
+    p1, p2 = sub(pt, o2), sub(o1, o2)
+    for i in range(len(P)):
+        for j in range(3):
+            if not math.isfinite(P[i, j]):
+                return i
+        p = vec(P[i])
+        for b in range(2):
+            Q[i, b, 0], Q[i, b, 1] = math.nan, math.nan
+            V[i, b], E[i, b], IN[i, b], RES[i, b] = False, False, False, math.inf
+        if abs(dot(h1, sub(p, pt))) > tol:
+            continue                                  # off the plane of motion: no candidate
+        po = sub(p, o1)
+        ta, tb, cnt, ea, eb, _ = sp3_one(p1, p2, h2, norm(po), TOL)
+        for b in range(2):
+            if b >= cnt:
+                continue
+            q2 = ta if b == 0 else tb
+            q1, e1, _ = sp1_one(sub(rotate(h2, q2, p1), p2), po, h1, TOL)
+            q[0], q[1] = wrap(q1), wrap(q2)
+            inside = True
+            for j in range(2):
+                lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
+                qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
+                if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
+                    inside = False
+                q[j] = min(max(qw, lo[j]), hi[j])
+                Q[i, b, j] = q[j]
+            V[i, b], E[i, b], IN[i, b] = True, (ea if b == 0 else eb) and e1, inside
+            RES[i, b] = _fk_position_residual(kH, kO, pt, q, 2, p)
+    return -1
+
+
+def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
+    """Both elbow branches of the planar 2R arm of ``plan`` for tool positions ``P`` (N, 3)
+    (base frame, m), position only, in one compiled call.  Returns θ (N, 2, 2) in
+    ``robot.chain.independent`` order (rad, wrapped into the limits), candidate (N, 2), exact
+    (N, 2), inside (N, 2), FK residual (N, 2) (max |error| of the 3 position entries; inf
+    without a candidate).  A target farther than ``tol`` (m) from the plane of motion has no
+    candidate.  Raises ``ValueError`` naming the first non-finite target."""
+    P = np.ascontiguousarray(P, dtype=float)
+    if P.ndim != 2 or P.shape[1] != 3:
+        raise ValueError(f"P must have shape (N, 3), got {P.shape}")
+    N = len(P)
+    Q, V, E = np.empty((N, 2, 2)), np.empty((N, 2), bool), np.empty((N, 2), bool)
+    IN, RES = np.empty((N, 2), bool), np.empty((N, 2))
+    bad = _planar_verified(vec(plan.h1), vec(plan.h2), vec(plan.o1), vec(plan.o2), vec(plan.p_tool), plan.fk_axes,
+                           plan.fk_points, plan.lower_path, plan.upper_path, P, float(tol), Q, V, E, IN, RES)
+    if bad >= 0:
+        raise ValueError(f"P[{bad}] is not a finite position")
+    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES
+
+
+__all__ = ["PLANAR_BRANCHES", "PLANAR_LABELS", "PlanarPlan", "SRSPlan", "SRS_BRANCHES", "SRS_ROUTES",
+           "planar_plan", "planar_reason", "planar_verified", "srs_branch_labels", "srs_plan", "srs_points",
+           "srs_reason", "srs_verified"]
