@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from .closed_form import _require, analytic_batch
+from .closed_form import analytic_batch, require_form
 
 #: corner offsets (i, j, k) of M0 … M7 in the book's labelling
 CORNERS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1], [1, 1, 1]])
@@ -151,7 +151,7 @@ class CellTable:
         ``point`` (3,) m in the tool frame: the lattice holds the positions of this point (the
         tool pose at lattice point M is the table's rotation R at ``M − R·point``); default the
         tool origin."""
-        form = _require(robot).form
+        form = require_form(robot)
         name, params = robot.spec.name, dict(robot.spec.params)
         try:
             R = np.asarray(rotation, float)

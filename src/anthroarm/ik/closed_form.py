@@ -180,10 +180,10 @@ def _form(robot, frame=None):
 
 
 #: the registry-like entry of an arm solved by its geometry (:mod:`.geometric`), per class;
-#: ``cost_us`` is the numpy class solver's single-pose time with the FK check (order of
-#: magnitude: ~3 ms, about 500 numpy calls; benchmarks/timing_ik_subproblems.py; a 1-D search
+#: ``cost_us`` is the single-pose time with the FK check (order of magnitude,
+#: benchmarks/results/ik_analytic.md: a closed class ~10 µs in one compiled call; a 1-D search
 #: class, :data:`.geometric.SEARCHED`, ~30 ms; the 2-D search of gen_six_dof ~0.3 s)
-_GEO_COST = {c: 300000.0 if c == _geo.C.GEN_SIX_DOF else 30000.0 if c in _geo.SEARCHED else 3000.0
+_GEO_COST = {c: 300000.0 if c == _geo.C.GEN_SIX_DOF else 30000.0 if c in _geo.SEARCHED else 10.0
              for c in _geo.SOLVED}
 _GEO_FORMS = {c: _registry.ClosedForm(c, (), 6, (), _geo.n_branches(c), cost_us=_GEO_COST[c]) for c in _geo.SOLVED}
 #: a 7-joint arm with its last joint held (the family parameter): per value of the grid
@@ -268,6 +268,15 @@ def _require(robot):
             f"this geometry: {why}, solved in closed form are 6R arms of the classes "
             f"{', '.join(_geo.SOLVED)}; use aa.ik.solve(robot, T) for a numerical solution")
     return plan
+
+
+def require_form(robot, frame=None):
+    """:func:`closed_form_info` of ``robot``, or :class:`~anthroarm.errors.UnsupportedModelError`
+    saying why it has no closed form (and pointing to ``aa.ik.solve``)."""
+    form = _form_any(robot, frame)
+    if form is None:
+        _require(robot)
+    return form
 
 
 # ---------------------------------------------------------------------------- input checks
@@ -765,27 +774,38 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
         return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
                                    residuals=np.zeros((0, B)), singular=[], model=robot.name)
     Tr = np.repeat(Ts, S, axis=0)
-    th, cand, exact = _geo.solve(gp, Tr, pv.reshape(-1) if gp.param_joint is not None else None)
-    th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in (th, cand, exact))
-    thw, inside = _wrap_into_limits(th, gp.lower, gp.upper)
-    finite = np.isfinite(thw).all(-1)
-    Q = ch.configuration(np.where(finite[..., None], thw, 0.0))
-    res = np.where(finite, _geo_fk_residual(robot, gp, thw, Q, Ts), np.inf)
+    prm = pv.reshape(-1) if gp.param_joint is not None else None
+    if gp.cls in _geo.CLOSED:              # one compiled call: branches, limits, FK check, duplicates
+        thw, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in
+                                                _geo.solve_verified(gp, Tr, prm, tol, tol_orthonormal))
+        finite = cand
+        Q = thw if gp.plain else ch.configuration(np.where(finite[..., None], thw, 0.0))
+    else:
+        th, cand, exact = _geo.solve(gp, Tr, prm)
+        th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in (th, cand, exact))
+        thw, inside = _wrap_into_limits(th, gp.lower, gp.upper)
+        finite = np.isfinite(thw).all(-1)
+        Q = ch.configuration(np.where(finite[..., None], thw, 0.0))
+        res = np.where(finite, _geo_fk_residual(robot, gp, thw, Q, Ts), np.inf)
+        valid = None
     # an arm of its class only within the classification tolerance (e.g. rounded URDF angles):
     # polish its near-exact candidates on the FK error (joint layout = angles only)
     near = cand & exact & inside & finite & (res > tol) & (res <= POLISH_MAX)
-    if near.any() and robot.nq == len(ch.independent):
+    polished = near.any() and robot.nq == len(ch.independent)
+    if polished:
+        Q = np.array(Q)
         for i, b in zip(*np.nonzero(near)):
             Q[i, b], res[i, b] = _refine(robot, Q[i, b], Ts[i], robot.lower, robot.upper, False)
             thw[i, b] = Q[i, b]
-    valid = cand & inside & finite & (res <= tol)
-    # coincident branches (singular poses): drop a branch equal to an earlier valid one
-    earlier = np.tril(np.ones((B, B), bool), -1)                                         # [b, a]: a < b
-    step = max(1, 2_000_000 // (B * B * thw.shape[-1]))                  # bounded memory (param grids)
-    for i in range(0, N, step):
-        t, v = thw[i:i + step], valid[i:i + step]
-        d = np.abs(np.angle(np.exp(1j * (t[:, :, None] - t[:, None, :])))).max(-1)     # (n, B, B)
-        valid[i:i + step] &= ~((d < 1e-9) & earlier & v[:, None, :]).any(-1)
+    if valid is None or polished:
+        valid = cand & inside & finite & (res <= tol)
+        # coincident branches (singular poses): drop a branch equal to an earlier valid one
+        earlier = np.tril(np.ones((B, B), bool), -1)                                     # [b, a]: a < b
+        step = max(1, 2_000_000 // (B * B * thw.shape[-1]))              # bounded memory (param grids)
+        for i in range(0, N, step):
+            t, v = thw[i:i + step], valid[i:i + step]
+            d = np.abs(np.angle(np.exp(1j * (t[:, :, None] - t[:, None, :])))).max(-1)  # (n, B, B)
+            valid[i:i + step] &= ~((d < 1e-9) & earlier & v[:, None, :]).any(-1)
     reasons = [None] * N
     names = [ch.joints[j].name for j in ch.independent]
     c = gp.classification
@@ -810,6 +830,24 @@ def _geometric_batch(robot, gp, T, swivel, position_only, tol, tol_orthonormal, 
     return AnalyticBatchResult(solutions=sol, valid=valid, branches=labels, reasons=reasons,
                                residuals=np.where(valid, res, np.nan), singular=[None] * N,
                                model=robot.name)
+
+
+def _geometric_single(robot, gp, arr, param, tol, tol_orthonormal):
+    """One pose of a closed class (:data:`.geometric.CLOSED`) in one compiled call, when it has
+    a solution and nothing to polish; else None (:func:`_geometric_batch` answers, with the
+    reasons)."""
+    if arr.dtype != np.float64:
+        return None
+    try:
+        one = _geo.solve_one(gp, arr, 0.0 if param is None else float(param), tol, tol_orthonormal)
+    except (TypeError, ValueError):
+        return None                     # a malformed param: the general path says what is wrong
+    if one is None:
+        return None
+    q, res, idx = one
+    labels = gp.labels
+    return AnalyticIKResult(solutions=q if gp.plain else gp.chain.configuration(q),
+                            branches=[labels[i] for i in idx], residuals=res, model=robot.name)
 
 
 def _kernel(plan, impl, single=True):
@@ -905,19 +943,24 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         _check_tol("tol_orthonormal", tol_orthonormal)
     arr = np.asarray(T, dtype=float) if not isinstance(T, np.ndarray) else T
     if method == "book":
-        plan = _require(robot)
-        if plan.family != PROSTHETIC:
-            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) exists for the prosthetic arm "
-                             f"(closed-form family {PROSTHETIC}) only")
+        spec = getattr(robot, "spec", None)
+        if spec is None or spec.name not in _registry.BOOK_PROCEDURES or robot.nq != 6 or robot.tool != spec.tool_name:
+            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) is the book's procedure for the "
+                             "prosthetic arm of Fig. 7-2 (catalog 'prosthetic_arm', all 6 joints, its tool) only")
         Ts, single = _check_poses(arr, tol_orthonormal=tol_orthonormal)
         if not single:
             raise ValueError("method='book' takes one pose")
-        return _book_result(robot, Ts[0], plan.params, tol)
+        return _book_result(robot, Ts[0], spec.params, tol)
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     if _plan(robot) is None:
         gp = _geo.plan_for(robot)
         if gp is not None:
+            if arr.shape == (4, 4) and gp.cls in _geo.CLOSED and swivel is None and not position_only \
+                    and (param is None) == (gp.param_joint is None) and _impl != "general":
+                fast = _geometric_single(robot, gp, arr, param, tol, tol_orthonormal)
+                if fast is not None:
+                    return fast
             res = _geometric_batch(robot, gp, arr, swivel, position_only, tol, tol_orthonormal, param)
             return res[0] if np.ndim(arr) == 2 else res
     _no_param(robot, param)

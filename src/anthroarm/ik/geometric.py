@@ -61,13 +61,19 @@ the caller's (:func:`anthroarm.ik.closed_form.analytic`).
 
 from __future__ import annotations
 
+import functools
+import math
 import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..jit import kernel
+from ..threads import run_rows
 from . import classify as C
 from . import subproblems as sp
+from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp2_one, sp3_one, sp4_one, sp5_one, sp6_one
+from .vec3 import add, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, rot, rotate, rotate_cs, sub, transpose, vec, wrap
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -131,6 +137,30 @@ class GeoPlan:
     param_axis: np.ndarray | None = None
     param_point: np.ndarray | None = None
     M: np.ndarray | None = None
+    #: the FK check of the compiled path: every joint on the path (path order) as read from the
+    #: chain (not snapped to the class): axes (n, 3) and points (n, 3) at q = 0, the tool pose
+    #: at q = 0 (4×4), limits in path order (rad; ±inf continuous)
+    fk_axes: np.ndarray | None = None
+    fk_points: np.ndarray | None = None
+    fk_M: np.ndarray | None = None
+    lower_path: np.ndarray | None = None
+    upper_path: np.ndarray | None = None
+    #: the configuration q is the joint angles themselves (no continuous joint: no cos/sin pair)
+    plain: bool = False
+
+    @functools.cached_property
+    def packed(self) -> tuple:
+        """The plan's constants as the compiled drivers take them (:func:`_unpack`): one float
+        array (H, P, R_tool, the held joint's axis and point, the tool pose at q = 0, the
+        chain's axes and points, limits in path order) and one int array (class index,
+        reversed, joints on the path, the path position of each independent joint)."""
+        pa = np.zeros(3) if self.param_axis is None else self.param_axis
+        pp = np.zeros(3) if self.param_point is None else self.param_point
+        cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, self.fk_axes,
+                                                 self.fk_points, self.lower_path, self.upper_path)]).astype(float)
+        ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), len(self.fk_axes),
+                       *self.order], dtype=np.int64)
+        return cf, ci
 
 
 def _common_point(H, pts):
@@ -223,145 +253,327 @@ def _build(robot) -> GeoPlan | None:
     order = np.array([path.index(j) for j in ch.independent])
     lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in ch.independent])
     hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in ch.independent])
-    extra = {}
+    M = np.eye(4)
+    M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
+    inv = np.argsort(order)                      # path position -> independent joint
+    extra = dict(fk_axes=np.ascontiguousarray(kin.H, dtype=float), fk_points=np.ascontiguousarray(kin.points, dtype=float),
+                 fk_M=M, lower_path=np.ascontiguousarray(lo[inv]), upper_path=np.ascontiguousarray(hi[inv]),
+                 plain=robot.nq == len(ch.independent) and all(ch.joints[j].kind != "continuous" for j in ch.independent))
     if param is not None:
-        M = np.eye(4)
-        M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
-        extra = dict(param_joint=param, param_axis=kin.H[param], param_point=kin.points[param], M=M)
-    return GeoPlan(cls, rev, np.array(H), P, np.array(R_tool), order, lo, hi, c, ch, robot.tool,
+        extra.update(param_joint=param, param_axis=kin.H[param], param_point=kin.points[param], M=M)
+    return GeoPlan(cls, rev, np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(R_tool, dtype=float), order, lo, hi, c, ch, robot.tool,
                    branch_labels(cls), **extra)
 
 
-# ----------------------------------------------------------------------------- the solvers
-# Each stage solves all branches of the stage before at once: M problems → 2M (a two-root
-# subproblem fans out, the root index innermost), so a pose's 8 branches come out in the order
-# of the labels (first subproblem outermost) after 3 fans, with one subproblem call per stage.
-def _fan(sol, *carry):
-    """Split the two roots of ``sol`` (M problems) into 2M rows; ``carry`` arrays (M, …) are
-    repeated to match.  Returns θ (2M,), valid (2M,), exact (2M,) and the carried arrays."""
-    th = np.nan_to_num(sol.theta[:, :, 0]).reshape(-1)
-    return (th, sol.valid.reshape(-1), sol.exact.reshape(-1), *(np.repeat(c, 2, axis=0) for c in carry))
+# ----------------------------------------------------------------------------- the closed classes
+# One compiled kernel per class and pose (:mod:`anthroarm.jit`), built from the subproblem
+# kernels of :mod:`.subproblems`; vectors are tuples (:mod:`.vec3`).  Each writes its 8
+# branches into Q (8, 6) rad, V (8,) (the branch exists), E (8,) (every subproblem on it was
+# exact), in the order of the labels: the first branching subproblem outermost, the root index
+# innermost.  A branch under a root that does not exist is left NaN / invalid.
+@kernel
+def _put(Q, V, E, b, q1, q2, q3, q4, q5, q6, v, e):
+    Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3], Q[b, 4], Q[b, 5] = q1, q2, q3, q4, q5, q6
+    V[b], E[b] = v, e
 
 
-def _b(v, n):
-    return np.broadcast_to(v, (n, 3))
+@kernel
+def _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex):
+    """Spherical wrist from R36 = R03ᵀ R06: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and
+    q6 by SP1; branches b (first q5 root) and b + 1."""
+    h4, h5, h6 = h[3], h[4], h[5]
+    R36 = mtm(R03, R06)
+    R36h6, R36th4 = mv(R36, h6), mtv(R36, h4)
+    ta, tb, cnt, ea, eb, _ = sp4_one(h4, h6, h5, dot(h4, R36h6), TOL)
+    for j in range(2):
+        if j >= cnt:
+            V[b + j] = False
+            continue
+        q5 = ta if j == 0 else tb
+        c, s = math.cos(q5), math.sin(q5)
+        q4, e4, _ = sp1_one(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
+        q6, e6, _ = sp1_one(rotate_cs(neg(h5), c, s, h4), R36th4, neg(h6), TOL)
+        _put(Q, V, E, b + j, q1, q2, q3, q4, q5, q6, True, ex and (ea if j == 0 else eb) and e4 and e6)
 
 
-def _wrist(H, R36, ok, ex, *carry):
-    """Spherical wrist: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and q6 by SP1 (M
-    problems → 2M).  Returns q4, q5, q6, valid, exact and the carried arrays."""
-    n = len(R36)
-    h4, h5, h6 = _b(H[3], n), _b(H[4], n), _b(H[5], n)
-    s5 = sp.sp4(h4, h6, h5, np.einsum("ni,nij,nj->n", h4, R36, h6))
-    q5, v5, e5, R36, ok, ex, *carry = _fan(s5, R36, ok, ex, *carry)
-    n *= 2
-    h4, h5, h6 = _b(H[3], n), _b(H[4], n), _b(H[5], n)
-    s4 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,nj->ni", R36, h6), h4)
-    s6 = sp.sp1(sp._rotate(-h5, q5, h4), np.einsum("nji,nj->ni", R36, h4), -h6)
-    return (s4.theta[:, 0, 0], q5, s6.theta[:, 0, 0], ok & v5, ex & e5 & s4.exact[:, 0] & s6.exact[:, 0],
-            *carry)
+@kernel
+def _spherical_two_parallel(h, P, R06, p, Q, V, E):
+    """q1 SP4, q3 SP3, q2 SP1, the wrist (spherical wrist, axes 2 ∥ 3)."""
+    wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
+    t1a, t1b, n1, e1a, e1b, _ = sp4_one(h[1], wrist, neg(h[0]), dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
+    for i1 in range(2):
+        if i1 >= n1:
+            V[4 * i1:4 * i1 + 4] = False
+            continue
+        q1 = t1a if i1 == 0 else t1b
+        v = sub(rotate(neg(h[0]), q1, wrist), P[1])                  # R01ᵀ p_16 − p12
+        t3a, t3b, n3, e3a, e3b, _ = sp3_one(neg(P[3]), P[2], h[2], norm(v), TOL)
+        for i3 in range(2):
+            b = 4 * i1 + 2 * i3
+            if i3 >= n3:
+                V[b:b + 2] = False
+                continue
+            q3 = t3a if i3 == 0 else t3b
+            q2, e2, _ = sp1_one(add(P[2], rotate(h[2], q3, P[3])), v, h[1], TOL)
+            R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
+            ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
+            _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex)
 
 
-def _spherical_two_parallel(H, P, R06, p):
-    n = len(p)
-    p01, p12, p23, p34 = P[0], P[1], P[2], P[3]
-    wrist = p - R06 @ P[6] - p01                                        # p_16 (wrist centre − p01)
-    s1 = sp.sp4(_b(H[1], n), wrist, -_b(H[0], n), np.full(n, H[1] @ (p12 + p23 + p34)))
-    q1, ok, ex, wrist, R06 = _fan(s1, wrist, R06)
-    n *= 2
-    v = sp._rotate(-_b(H[0], n), q1, wrist) - p12                       # R01ᵀ p_16 − p12
-    s3 = sp.sp3(-_b(p34, n), _b(p23, n), _b(H[2], n), np.linalg.norm(v, axis=1))
-    q3, v3, e3, q1, ok, ex, v, R06 = _fan(s3, q1, ok, ex, v, R06)
-    n *= 2
-    s2 = sp.sp1(_b(p23, n) + sp._rotate(_b(H[2], n), q3, _b(p34, n)), v, _b(H[1], n))
-    q2 = s2.theta[:, 0, 0]
-    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
-    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok & v3, ex & e3 & s2.exact[:, 0],
-                                            q1, q2, q3)
-    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
+@kernel
+def _spherical_two_intersecting(h, P, R06, p, Q, V, E):
+    """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
+    p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
+    t3a, t3b, n3, e3a, e3b, _ = sp3_one(P[3], neg(P[2]), h[2], norm(p16), TOL)
+    for i3 in range(2):
+        if i3 >= n3:
+            V[4 * i3:4 * i3 + 4] = False
+            continue
+        q3 = t3a if i3 == 0 else t3b
+        q1a, q2a, q1b, q2b, n12, ea, eb, _ = sp2_one(p16, add(P[2], rotate(h[2], q3, P[3])), neg(h[0]), h[1], TOL)
+        for j in range(2):
+            b = 4 * i3 + 2 * j
+            if j >= n12:
+                V[b:b + 2] = False
+                continue
+            q1, q2 = (q1a, q2a) if j == 0 else (q1b, q2b)
+            R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
+            _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
 
 
-def _spherical_two_intersecting(H, P, R06, p):
-    n = len(p)
-    p16 = p - R06 @ P[6] - P[0]                                         # from the 1–2 intersection
-    s3 = sp.sp3(_b(P[3], n), -_b(P[2], n), _b(H[2], n), np.linalg.norm(p16, axis=1))
-    q3, ok, ex, p16, R06 = _fan(s3, p16, R06)
-    n *= 2
-    s12 = sp.sp2(p16, _b(P[2], n) + sp._rotate(_b(H[2], n), q3, _b(P[3], n)), -_b(H[0], n), _b(H[1], n))
-    q1 = np.nan_to_num(s12.theta[:, :, 0]).reshape(-1)
-    q2 = np.nan_to_num(s12.theta[:, :, 1]).reshape(-1)
-    v12, e12 = s12.valid.reshape(-1), s12.exact.reshape(-1)
-    q3, ok, ex, R06 = (np.repeat(a, 2, axis=0) for a in (q3, ok, ex, R06))
-    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
-    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok & v12, ex & e12, q1, q2, q3)
-    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
+@kernel
+def _three_parallel_tail(h, P, R06, p06, q1, q5, ex, Q, V, E, b):
+    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (branches b, b + 1 by the SP3 of q3): θ14 = q2 + q3
+    + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by difference.  h3, h4 may
+    be −h2: rot(h3, q3) = rot(h2, ±q3)."""
+    s3n = 1.0 if dot(h[1], h[2]) >= 0.0 else -1.0
+    s4n = 1.0 if dot(h[1], h[3]) >= 0.0 else -1.0
+    R01 = rot(h[0], q1)
+    c5, s5 = math.cos(q5), math.sin(q5)
+    th14, e14, _ = sp1_one(rotate_cs(h[4], c5, s5, h[5]), mtv(R01, mv(R06, h[5])), h[1], TOL)
+    q6, e6, _ = sp1_one(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
+    d_in = sub(sub(mtv(R01, p06), P[1]), rotate(h[1], th14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
+    ta, tb, n3, ea, eb, _ = sp3_one(neg(P[3]), P[2], h[1], norm(d_in), TOL)
+    for j in range(2):
+        if j >= n3:
+            V[b + j] = False
+            continue
+        t3 = ta if j == 0 else tb
+        q2, e2, _ = sp1_one(add(P[2], rotate(h[1], t3, P[3])), d_in, h[1], TOL)
+        t4 = wrap(th14 - q2 - t3)
+        _put(Q, V, E, b + j, q1, q2, s3n * t3, s4n * t4, q5, q6, True,
+             ex and e14 and e6 and (ea if j == 0 else eb) and e2)
 
 
-def _three_parallel_tail(H, P, R06, p06, q1, q5, ok, ex):
-    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (M problems → 2M): θ14 = q2 + q3 + q4 and q6 by
-    SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by difference.  h3, h4 may be −h2:
-    rot(h3, q3) = rot(h2, ±q3)."""
-    n = len(q1)
-    s3n, s4n = np.sign(H[1] @ H[2]), np.sign(H[1] @ H[3])
-    h2, h5, h6 = _b(H[1], n), _b(H[4], n), _b(H[5], n)
-    R01t = sp.rot(H[0], -q1)
-    s14 = sp.sp1(sp._rotate(h5, q5, h6), np.einsum("nij,njk,k->ni", R01t, R06, H[5]), h2)
-    th14 = s14.theta[:, 0, 0]
-    R01h2 = np.einsum("nji,j->ni", R01t, H[1])
-    s6 = sp.sp1(sp._rotate(-h5, q5, h2), np.einsum("nji,nj->ni", R06, R01h2), -h6)     # R06ᵀ R01 h2
-    # d_inner = R01ᵀ p06 − p12 − R14 (p45 + R45 p56)
-    d_in = np.einsum("nij,nj->ni", R01t, p06) - P[1] - sp._rotate(h2, th14, P[4] + sp._rotate(h5, q5, _b(P[5], n)))
-    s3 = sp.sp3(-_b(P[3], n), _b(P[2], n), h2, np.linalg.norm(d_in, axis=1))
-    ok, ex = ok, ex & s14.exact[:, 0] & s6.exact[:, 0]
-    t3, v3, e3, q1, q5, q6, th14, d_in, ok, ex = _fan(s3, q1, q5, s6.theta[:, 0, 0], th14, d_in, ok, ex)
-    n *= 2
-    s2 = sp.sp1(_b(P[2], n) + sp._rotate(_b(H[1], n), t3, _b(P[3], n)), d_in, _b(H[1], n))
-    q2 = s2.theta[:, 0, 0]
-    t4 = np.angle(np.exp(1j * (th14 - q2 - t3)))
-    q = np.stack([q1, q2, s3n * t3, s4n * t4, q5, q6], -1)
-    return q, ok & v3, ex & e3 & s2.exact[:, 0]
+@kernel
+def _three_parallel_two_intersecting(h, P, R06, p, Q, V, E):
+    """2 ∥ 3 ∥ 4 and 5 × 6 (p56 = 0): q1 by SP4 (h2ᵀ R01ᵀ p16 = h2ᵀ (p12 + … + p45)), q5 by SP4
+    (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
+    p06 = sub(sub(p, mv(R06, P[6])), P[0])
+    d1 = dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4]))
+    t1a, t1b, n1, e1a, e1b, _ = sp4_one(h[1], p06, neg(h[0]), d1, TOL)
+    R06h6 = mv(R06, h[5])
+    for i1 in range(2):
+        if i1 >= n1:
+            V[4 * i1:4 * i1 + 4] = False
+            continue
+        q1 = t1a if i1 == 0 else t1b
+        t5a, t5b, n5, e5a, e5b, _ = sp4_one(h[1], h[5], h[4], dot(h[1], rotate(neg(h[0]), q1, R06h6)), TOL)
+        for i5 in range(2):
+            b = 4 * i1 + 2 * i5
+            if i5 >= n5:
+                V[b:b + 2] = False
+                continue
+            _three_parallel_tail(h, P, R06, p06, q1, t5a if i5 == 0 else t5b,
+                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), Q, V, E, b)
 
 
-def _three_parallel_two_intersecting(H, P, R06, p):
-    """2 ∥ 3 ∥ 4 and 5 × 6 (p56 = 0): q1 by SP4 (h2ᵀ R01ᵀ p16 = h2ᵀ (p12 + … + p45)), q5 by
-    SP4 (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
-    n = len(p)
-    p06 = p - R06 @ P[6] - P[0]
-    s1 = sp.sp4(_b(H[1], n), p06, -_b(H[0], n), np.full(n, H[1] @ P[1:5].sum(0)))
-    q1, ok, ex, p06, R06 = _fan(s1, p06, R06)
-    n *= 2
-    s5 = sp.sp4(_b(H[1], n), _b(H[5], n), _b(H[4], n),
-                np.einsum("i,nji,njk,k->n", H[1], sp.rot(H[0], q1), R06, H[5]))
-    q5, v5, e5, q1, ok, ex, p06, R06 = _fan(s5, q1, ok, ex, p06, R06)
-    return _three_parallel_tail(H, P, R06, p06, q1, q5, ok & v5, ex & e5)
-
-
-def _three_parallel(H, P, R06, p):
+@kernel
+def _three_parallel(h, P, R06, p, Q, V, E):
     """2 ∥ 3 ∥ 4 alone: (q1, q5) by SP6 (the two height equations along h2, of the position
     and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
-    n = len(p)
-    p06 = p - R06 @ P[6] - P[0]
-    h, k = np.array([H[1]] * 4), np.array([-H[0], H[4], -H[0], H[4]])
-    pp = np.stack([p06, -_b(P[5], n), R06 @ H[5], -_b(H[5], n)], 1)
-    s = sp.sp6(np.broadcast_to(h, (n, 4, 3)), np.broadcast_to(k, (n, 4, 3)), pp,
-               np.full(n, H[1] @ P[1:5].sum(0)), np.zeros(n))
-    q1, q5 = (np.nan_to_num(s.theta[:, :, j]).reshape(-1) for j in range(2))
-    ok, ex = s.valid.reshape(-1), s.exact.reshape(-1)
-    return _three_parallel_tail(H, P, np.repeat(R06, 4, axis=0), np.repeat(p06, 4, axis=0), q1, q5, ok, ex)
+    p06 = sub(sub(p, mv(R06, P[6])), P[0])
+    t = np.empty((4, 2))
+    cnt, _ = sp6_one((h[1], h[1], h[1], h[1]), (neg(h[0]), h[4], neg(h[0]), h[4]),
+                     (p06, neg(P[5]), mv(R06, h[5]), neg(h[5])),
+                     dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4])), 0.0, TOL_QUARTIC, t)
+    for j in range(4):
+        if j >= cnt:
+            V[2 * j:2 * j + 2] = False
+            continue
+        _three_parallel_tail(h, P, R06, p06, t[j, 0], t[j, 1], True, Q, V, E, 2 * j)
 
 
-def _spherical(H, P, R06, p):
+@kernel
+def _spherical(h, P, R06, p, Q, V, E):
     """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
     quartic, up to 4), then the wrist."""
-    n = len(p)
-    p16 = p - R06 @ P[6] - P[0]
-    s = sp.sp5(-_b(P[1], n), p16, _b(P[2], n), _b(P[3], n), -_b(H[0], n), _b(H[1], n), _b(H[2], n))
-    q1, q2, q3 = (np.nan_to_num(s.theta[:, :, j]).reshape(-1) for j in range(3))
-    ok, ex = s.valid.reshape(-1), s.exact.reshape(-1)
-    R06 = np.repeat(R06, 4, axis=0)
-    R03 = sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3)
-    q4, q5, q6, ok, ex, q1, q2, q3 = _wrist(H, np.swapaxes(R03, 1, 2) @ R06, ok, ex, q1, q2, q3)
-    return np.stack([q1, q2, q3, q4, q5, q6], -1), ok, ex
+    p16 = sub(sub(p, mv(R06, P[6])), P[0])
+    t = np.empty((4, 3))
+    cnt, _ = sp5_one(neg(P[1]), p16, P[2], P[3], neg(h[0]), h[1], h[2], TOL_QUARTIC, t)
+    for j in range(4):
+        if j >= cnt:
+            V[2 * j:2 * j + 2] = False
+            continue
+        q1, q2, q3 = t[j, 0], t[j, 1], t[j, 2]
+        R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
+        _wrist(h, R03, R06, Q, V, E, 2 * j, q1, q2, q3, True)
+
+
+#: the compiled class solvers, by their index in :data:`CLOSED`
+CLOSED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
+          C.SPHERICAL, C.THREE_PARALLEL)
+
+
+@kernel
+def _solve_closed(cls, h, P, R06, p, Q, V, E):
+    Q[:, :] = math.nan
+    V[:] = False
+    E[:] = False
+    if cls == 0:
+        _spherical_two_parallel(h, P, R06, p, Q, V, E)
+    elif cls == 1:
+        _spherical_two_intersecting(h, P, R06, p, Q, V, E)
+    elif cls == 2:
+        _three_parallel_two_intersecting(h, P, R06, p, Q, V, E)
+    elif cls == 3:
+        _spherical(h, P, R06, p, Q, V, E)
+    else:
+        _three_parallel(h, P, R06, p, Q, V, E)
+    for b in range(8):
+        if V[b]:
+            for j in range(6):
+                Q[b, j] = wrap(Q[b, j])
+        else:
+            Q[b, :] = math.nan
+            E[b] = False
+
+
+@kernel
+def _six(A):
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]))
+
+
+@kernel
+def _seven(A):
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
+
+
+@kernel
+def _closed_loop(cls, H, P, R06, p, Q, V, E):
+    h, PP = _six(H), _seven(P)
+    for i in range(len(p)):
+        _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), Q[i], V[i], E[i])
+
+
+# ----------------------------------------------------------------------------- one call: pose → verified branches
+@kernel
+def _pose_status(T, tol_orthonormal):
+    """0: a valid pose; 1: not finite; 2: last row not [0, 0, 0, 1]; 3: not a rotation."""
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[i, j]):
+                return 1
+    if abs(T[3, 0]) > 1e-12 or abs(T[3, 1]) > 1e-12 or abs(T[3, 2]) > 1e-12 or abs(T[3, 3] - 1.0) > 1e-12:
+        return 2
+    R = mat(T)
+    RtR = mtm(R, R)
+    for i in range(3):
+        for j in range(3):
+            if abs(RtR[i][j] - (1.0 if i == j else 0.0)) > tol_orthonormal:
+                return 3
+    if dot(transpose(R)[0], cross(transpose(R)[1], transpose(R)[2])) < 0.0:
+        return 3
+    return 0
+
+
+@kernel
+def _fk_residual(kH, kO, MR, Mp, q, n, T):
+    """max |F(q) − T| over the 3×4 pose entries, F(q) = e^{ξ1 q1} ⋯ e^{ξn qn} M the product of
+    exponentials of the chain's revolute joints (axes kH, points kO at q = 0, base frame) and
+    the tool pose M at q = 0 (MR, Mp)."""
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    t = (0.0, 0.0, 0.0)
+    for i in range(n):
+        o = vec(kO[i])
+        Ri = rot(vec(kH[i]), q[i])
+        t = add(t, mv(R, sub(o, mv(Ri, o))))
+        R = mm(R, Ri)
+    RT = mm(R, MR)
+    tT = add(t, mv(R, Mp))
+    err = 0.0
+    for i in range(3):
+        err = max(err, abs(tT[i] - T[i, 3]))
+        for j in range(3):
+            err = max(err, abs(RT[i][j] - T[i, j]))
+    return err
+
+
+@kernel
+def _unpack(cf, ci):
+    """The plan's constants from :attr:`GeoPlan.packed`."""
+    n = ci[2]
+    o = 70 + 3 * n
+    return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
+            (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), cf[54:70].reshape((4, 4)),
+            cf[70:o].reshape((n, 3)), cf[o:o + 3 * n].reshape((n, 3)), cf[o + 3 * n:o + 4 * n], cf[o + 4 * n:o + 5 * n])
+
+
+@kernel
+def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
+    """Every branch of poses T (N, 4, 4) in path order, wrapped into the limits and FK-checked:
+    writes Q (N, 8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
+    residual), OK (a solution: candidate, inside, residual ≤ tol, and not within 1e-9 rad of
+    an earlier solution of its pose); returns the index of the first malformed pose (−1 if
+    none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
+    cls, rev, n, H, P, R_tool, p_axis, p_point, M, kH, kO, lo, hi = _unpack(cf, ci)
+    h, PP = _six(H), _seven(P)
+    Rt = mat(R_tool)
+    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
+    Q6 = np.empty((8, 6))
+    V6 = np.empty(8, dtype=np.bool_)
+    E6 = np.empty(8, dtype=np.bool_)
+    q = np.empty(n)
+    for i in range(len(T)):
+        if _pose_status(T[i], tol_orthonormal) != 0:
+            return i
+        R, p = mat(T[i]), vec(T[i, :3, 3])
+        if n == 7:
+            # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
+            Rv = rot(p_axis, -param[i])
+            X = mtm(MR, mm(Rv, MR))
+            x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
+            p = add(mv(R, x), p)
+            R = mm(R, X)
+        if rev:
+            p = neg(mtv(R, p))
+            R = transpose(R)
+        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, Q6, V6, E6)
+        for b in range(8):
+            for j in range(6):
+                q[j] = Q6[b, 5 - j] if rev else Q6[b, j]
+            if n == 7:
+                q[6] = wrap(param[i])
+            inside = True
+            for j in range(n):
+                lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
+                qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
+                if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
+                    inside = False
+                q[j] = min(max(qw, lo[j]), hi[j])
+                Q[i, b, j] = q[j]
+            V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
+            RES[i, b] = _fk_residual(kH, kO, MR, Mp, q, n, T[i]) if V6[b] else math.inf
+            ok = V6[b] and inside and RES[i, b] <= tol
+            for a in range(b):
+                if ok and OK[i, a]:
+                    d = 0.0
+                    for j in range(n):
+                        d = max(d, abs(wrap(Q[i, b, j] - Q[i, a, j])))
+                    if d < 1e-9:
+                        ok = False
+            OK[i, b] = ok
+    return -1
 
 
 # ----------------------------------------------------------------------------- 1-D search classes
@@ -384,6 +596,10 @@ _SEED = 0.05
 
 def _wrap(x):
     return np.angle(np.exp(1j * x))
+
+
+def _b(v, n):
+    return np.broadcast_to(v, (n, 3))
 
 
 def _brackets(inner, idx, X):
@@ -678,10 +894,7 @@ def rot_t(k, theta):
     return sp.rot(k, -np.asarray(theta, float))
 
 
-_SOLVERS = {C.SPHERICAL: _spherical, C.THREE_PARALLEL: _three_parallel, C.SPHERICAL_TWO_PARALLEL: _spherical_two_parallel,
-            C.SPHERICAL_TWO_INTERSECTING: _spherical_two_intersecting,
-            C.THREE_PARALLEL_TWO_INTERSECTING: _three_parallel_two_intersecting,
-            C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting, C.GEN_SIX_DOF: _gen_six_dof}
+_SEARCH_SOLVERS = {C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting, C.GEN_SIX_DOF: _gen_six_dof}
 
 
 def solve_class(cls: str, H, P, R06, p):
@@ -691,7 +904,13 @@ def solve_class(cls: str, H, P, R06, p):
     exact (N, B) (False: least squares, out of reach; for a search class also a root whose
     error is above :data:`SEARCH_TOL`), B = :func:`n_branches` (8; 16 for a search class)."""
     n, nb = len(p), n_branches(cls)
-    q, valid, exact = _SOLVERS[cls](np.asarray(H, float), np.asarray(P, float), R06, p)
+    H, P = np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(P, dtype=float)
+    R06, p = np.ascontiguousarray(R06, dtype=float), np.ascontiguousarray(p, dtype=float)
+    if cls in CLOSED:
+        q, valid, exact = np.empty((n, 8, 6)), np.empty((n, 8), bool), np.empty((n, 8), bool)
+        _closed_loop(CLOSED.index(cls), H, P, R06, p, q, valid, exact)
+        return q, valid, exact & valid
+    q, valid, exact = _SEARCH_SOLVERS[cls](H, P, R06, p)
     q, valid, exact = q.reshape(n, nb, 6), valid.reshape(n, nb), exact.reshape(n, nb) & valid.reshape(n, nb)
     q = np.angle(np.exp(1j * q))
     return np.where(valid[..., None], q, np.nan), valid, exact
@@ -733,6 +952,84 @@ def solve(plan: GeoPlan, T, param=None):
     if plan.param_joint is not None:
         q = np.concatenate([q, np.broadcast_to(np.angle(np.exp(1j * v))[:, None, None], q.shape[:2] + (1,))], -1)
     return q[..., plan.order], valid, exact
+
+
+@kernel
+def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
+    """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 2):
+    θ in independent-joint order, the FK residual, the branch index.  Returns their number K;
+    −1: a malformed pose; −2: no solution, or a candidate to polish (the caller's general path
+    answers: reasons, polishing)."""
+    n = ci[2]
+    Tb = T.reshape((1, 4, 4))
+    pv = np.full(1, param)
+    Q, RES = np.empty((1, 8, n)), np.empty((1, 8))
+    V, E = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
+    IN, OK = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
+    if _verified(cf, ci, Tb, pv, tol, tol_orthonormal, Q, V, E, IN, RES, OK) >= 0:
+        return -1
+    K = 0
+    for b in range(8):
+        if V[0, b] and E[0, b] and IN[0, b] and tol < RES[0, b] <= _POLISH_MAX:
+            return -2
+        if OK[0, b]:
+            for k in range(n):
+                out[K, k] = Q[0, b, ci[3 + k]]
+            out[K, n], out[K, n + 1] = RES[0, b], b
+            K += 1
+    return K if K > 0 else -2
+
+
+#: FK residual up to which a candidate of an arm that is of its class only within the
+#: classification tolerance is polished (:func:`anthroarm.ik.closed_form.analytic`)
+_POLISH_MAX = 1e-4
+_ZERO1 = np.zeros(1)
+
+
+def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
+    """Every branch of a closed class (:data:`CLOSED`) for poses ``T`` (N, 4, 4), in one
+    compiled call per batch: the class solver (:func:`solve`), each branch wrapped by 2π into
+    the joint limits and checked by the chain's FK (product of exponentials of the joints as
+    read from ``robot.chain``, the model Pinocchio holds).  ``param`` (N,) the held joint of a
+    7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad), candidate (N, 8),
+    exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4 pose; inf where
+    there is no candidate).  Raises ``ValueError`` naming the first malformed pose (not finite,
+    last row, not a rotation) — ``anthroarm.ik.closed_form`` checks before it calls."""
+    T = np.ascontiguousarray(T, dtype=float)
+    N, n = len(T), len(plan.fk_axes)
+    pv = _ZERO1 if param is None else np.ascontiguousarray(np.broadcast_to(np.asarray(param, float), (N,)))
+    if param is None and N > 1:
+        pv = np.zeros(N)
+    Q, V, E = np.empty((N, 8, n)), np.empty((N, 8), bool), np.empty((N, 8), bool)
+    IN, RES, OK = np.empty((N, 8), bool), np.empty((N, 8)), np.empty((N, 8), bool)
+    cf, ci = plan.packed
+    first_bad = []
+
+    def rows(a, b):
+        k = _verified(cf, ci, T[a:b], pv[a:b], tol, tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b],
+                      OK[a:b])
+        if k >= 0:
+            first_bad.append(a + k)
+
+    run_rows(rows, N)
+    bad = min(first_bad) if first_bad else -1
+    if bad >= 0:
+        raise ValueError(f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a rotation "
+                         f"to {tol_orthonormal:g})")
+    return Q[..., plan.order], OK, V, E & V, IN, RES
+
+
+def solve_one(plan: GeoPlan, T, param: float = 0.0, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
+    """One pose ``T`` (4, 4) of a closed class, in one compiled call: (θ (K, n) rad in
+    independent-joint order, FK residuals (K,), branch indices (K,)), or None when the pose has
+    no solution, is malformed, or has a candidate to polish (:func:`solve_verified` then)."""
+    cf, ci = plan.packed
+    out = np.empty((8, len(plan.fk_axes) + 2))
+    K = _verified_one(cf, ci, T, param, tol, tol_orthonormal, out)
+    if K <= 0:
+        return None
+    n = ci[2]
+    return out[:K, :n], out[:K, n], out[:K, n + 1].astype(int)
 
 
 # ----------------------------------------------------------------------------- anthroarm check
@@ -789,4 +1086,4 @@ def check_rows(robot, samples: int, rng) -> list:
     return rows
 
 
-__all__ = ["GeoPlan", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
+__all__ = ["CLOSED", "GeoPlan", "solve_one", "solve_verified", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]

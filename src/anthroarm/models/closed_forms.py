@@ -48,17 +48,17 @@ class ClosedForm:
 
 #: catalog name -> its closed form
 REGISTRY: dict[str, ClosedForm] = {
-    # θ1 (shoulder) | θ2, θ3 (elbow) | θ4–θ6 (wrist flip)
-    "sixr_arm": ClosedForm("spherical_wrist_6r", ("s0", "h2", "s3", "P"), 6, (1, 3), 8, cost_us=8.0),
-    # the care robot of §9-3 on the assumed layout of Fig. 6-3 (models/care_robot.py)
-    "care_robot": ClosedForm("spherical_wrist_6r", ("s0", "h2", "s3", "P"), 6, (1, 3), 8, cost_us=8.0),
-    # θ1, θ2 (elbow root × shoulder) | θ3–θ6 (flexion sign)
-    "prosthetic_arm": ClosedForm("prosthetic_6r", ("L1", "L2", "L3"), 6, (2,), 8, cost_us=7.0),
     # one stage: the two elbow branches differ in both joints
     "planar2r": ClosedForm("planar_2r", ("l1", "l2"), 2, (), 2, position_only=True, cost_us=5.0),
     # q1–q4 (elbow × shoulder Euler branch) | q5–q7 (wrist Euler branch)
     "human_arm7": ClosedForm("srs_7r", ("l1", "l2", "l3"), 7, (4,), 8, swivel=True, cost_us=8.0),
 }
+
+
+#: catalog arms with a procedure of the book's own besides the general closed form
+#: (``aa.ik.analytic(robot, T, method="book")``): the prosthetic arm's Cramer-rule solution
+#: (7-17)–(7-31) that Table 7.2 prints (:func:`anthroarm.ik.closed_form.prosthetic_book_procedure`)
+BOOK_PROCEDURES = ("prosthetic_arm",)
 
 
 def names() -> tuple[str, ...]:
