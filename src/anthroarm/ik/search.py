@@ -1,0 +1,518 @@
+"""The search classes of the geometric IK, compiled: one Numba kernel call for a batch of poses.
+
+Source: A. J. Elias and J. T. Wen, "IK-Geo: Unified robot inverse kinematics using subproblem
+decomposition", arXiv 2211.05737, §IV (the 6-DOF solvers ``IK_2_parallel``,
+``IK_2_intersecting``, ``IK_gen_6_dof``); the decompositions were read from the reference
+implementation (github.com/rpiRobotics/ik-geo, ``matlab/+IK``); the code is our own, built on
+the scalar subproblem kernels of :mod:`anthroarm.ik.subproblems` (``sp1_one``, ``sp5_one``,
+``sp6_one``) and the tuple algebra of :mod:`anthroarm.ik.vec3`.
+
+Conventions (IK-Geo): joint i turns about the unit axis ``H[i]`` (base frame, q = 0); ``P[0]``
+is the base → joint 1 offset, ``P[i]`` joint i → joint i + 1, ``P[6]`` joint 6 → tool (m);
+the pose is ``R06`` (the tool orientation with its value at q = 0 removed) and ``p`` the tool
+position (base frame, m); angles in rad.
+
+=====================  ============================================================  =========
+class                  search (IK-Geo)                                               branches
+=====================  ============================================================  =========
+``two_parallel``       ``IK_2_parallel`` (h2 ∥ h3): 1-D over q1; (q4, q6) SP6,        ≤ 16
+                       θ23 SP1, error ‖span‖ − ‖p23‖; at a root q2, q5 SP1
+``two_intersecting``   ``IK_2_intersecting`` (p56 = 0): 1-D over q4; (q1, q2, q3)     ≤ 16
+                       SP5, error h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6; at a root q5, q6 SP1
+``gen_six_dof``        ``IK_gen_6_dof``: 2-D over (q1, q2); (q3, q4, q5) SP5, error   ≤ 16
+                       ‖R05 h6 − R06 h6‖; local minima polished by Newton; q6 SP1
+=====================  ============================================================  =========
+
+The 1-D search (per pose, in the kernel): the searched joint is sampled on :data:`SEARCH_GRID`
++ 1 values over [−π, π]; each root of the inner subproblem is followed to the next sample by
+the nearest root there (a match closer than :data:`_MATCH` rad in every unknown); a sign change
+of the error along a followed root is a bracket, refined by the Illinois variant of regula
+falsi (the root followed by the one nearest its interpolation between the bracket's ends) until
+``|e| ≤ SEARCH_TOL / 100`` or 60 steps; a refined root with ``|e| ≤`` :data:`SEARCH_TOL` is
+``exact``.  A sample interval where the number of roots changes (a fold: a pair of roots
+appears or vanishes there, moving like a square root) or a root moves by more than
+:data:`_FAST` rad is sampled again on 33 points crowded quadratically towards both ends, and
+its brackets come from that finer sampling; the roots next to a fold of the finer sampling with
+``|e| <`` :data:`_SEED` seed Newton steps on the whole arm's pose (a root on the arc through a
+fold is a sign change along neither root), kept where they converge to :data:`SEARCH_TOL`.
+A root where the error only touches zero is not found.
+
+The 2-D search: (q1, q2) on a :data:`SEARCH_GRID_2D` ² periodic grid; every (sample, SP5 root)
+whose error is below 0.3 and not above the best root of any of its 8 neighbours gives q6 by
+SP1 and seeds 20 Newton steps on the pose; the converged ones (pose error ≤ SEARCH_TOL) are
+kept.  A branch whose basin the grid misses is not found (no completeness claim).
+
+Each pose gets up to :data:`SEARCH_BRANCHES` slots, filled in the order the branches are
+found (the refined brackets along the grid, those of finer samplings, then the polished fold
+seeds); a branch within 1e-8 rad (every joint, mod 2π) of an earlier one is dropped.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..jit import kernel
+from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp5_one, sp6_one
+from .vec3 import add, cross, dot, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
+
+#: samples of the searched joint over [−π, π] (IK-Geo's reference implementation uses 200)
+SEARCH_GRID = 256
+#: samples of each searched joint of ``gen_six_dof`` (a grid of its square)
+SEARCH_GRID_2D = 64
+#: most branches a search class returns per pose (a 6R arm has at most 16 solutions)
+SEARCH_BRANCHES = 16
+#: |e| at which a refined root counts as exact (the error functions are in m or unitless)
+SEARCH_TOL = 1e-12
+#: two roots of the inner subproblem at neighbouring samples are the same branch when their
+#: angles differ by less than this (rad); a branch that appears or vanishes there is not followed
+_MATCH = 0.5
+#: a sample interval where a root moves by more than this (rad) is sampled again more finely
+_FAST = 0.2
+#: a root next to a fold with |e| below this seeds a Newton polish of the whole arm
+_SEED = 0.05
+#: points per half of a finer sampling (2 · _SUB + 1 in all) and regula-falsi steps at most
+_SUB = 16
+_ITERS = 60
+#: Newton steps on the pose for a fold seed of a 1-D search and for a 2-D local minimum
+_POLISH_1D = 12
+_POLISH_2D = 20
+#: error below which a local minimum of the 2-D grid seeds Newton
+_MIN_2D = 0.3
+#: most fold seeds kept per pose (more are ignored; a fold has at most a few roots)
+_MAX_SEEDS = 256
+
+#: the classes solved here, by their index in the compiled kernel
+CLASSES = ("two_parallel", "two_intersecting", "gen_six_dof")
+
+
+# ----------------------------------------------------------------------------- helpers
+@kernel
+def _six(A):
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]))
+
+
+@kernel
+def _seven(A):
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
+
+
+@kernel
+def _solve6(A, b):
+    """Solve A x = b (6×6, in place: ``b`` becomes x) by Gaussian elimination with partial
+    pivoting; returns det A (0 when a pivot vanishes, b then undefined)."""
+    det = 1.0
+    for c in range(6):
+        piv, big = c, abs(A[c, c])
+        for r in range(c + 1, 6):
+            if abs(A[r, c]) > big:
+                piv, big = r, abs(A[r, c])
+        if big == 0.0:
+            return 0.0
+        if piv != c:
+            for k in range(6):
+                A[c, k], A[piv, k] = A[piv, k], A[c, k]
+            b[c], b[piv] = b[piv], b[c]
+            det = -det
+        d = A[c, c]
+        det *= d
+        for r in range(c + 1, 6):
+            f = A[r, c] / d
+            if f != 0.0:
+                for k in range(c, 6):
+                    A[r, k] -= f * A[c, k]
+                b[r] -= f * b[c]
+    for c in range(5, -1, -1):
+        s = b[c]
+        for k in range(c + 1, 6):
+            s -= A[c, k] * b[k]
+        b[c] = s / A[c, c]
+    return det
+
+
+@kernel
+def fk_geo(h, PP, q):
+    """FK in IK-Geo's form for joint angles ``q`` (6,) rad: (R06 (row tuples), the tool
+    position (m)), both in the base frame; ``h`` the 6 axes, ``PP`` the 7 offsets (tuples)."""
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    o = PP[0]
+    for i in range(6):
+        R = mm(R, rot(h[i], q[i]))
+        o = add(o, mv(R, PP[i + 1]))
+    return R, o
+
+
+@kernel
+def polish(h, PP, R06, p, q, iters, J, F):
+    """Newton steps on the whole arm's pose equations from ``q`` (6,) rad, in place (the
+    spatial Jacobian at the tool point; position error p − o (m), rotation error
+    ½ vee(R06 Rᵀ − R R06ᵀ)); a step whose Jacobian has |det| ≤ 1e-12 is not taken.  ``q`` is
+    wrapped into (−π, π] at the end; returns whether it converged (max entry of |R − R06| and
+    |o − p| ≤ :data:`SEARCH_TOL`).  ``J`` (6, 6), ``F`` (6,) scratch."""
+    for _ in range(iters):
+        R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        o = PP[0]
+        for i in range(6):
+            J[3, i], J[4, i], J[5, i] = mv(R, h[i])          # the joint's axis (base frame)
+            J[0, i], J[1, i], J[2, i] = o                    # a point of it, crossed below
+            R = mm(R, rot(h[i], q[i]))
+            o = add(o, mv(R, PP[i + 1]))
+        for i in range(6):
+            ax = (J[3, i], J[4, i], J[5, i])
+            c = cross(ax, sub(o, (J[0, i], J[1, i], J[2, i])))
+            J[0, i], J[1, i], J[2, i] = c
+        W = mm(R06, transpose(R))
+        F[0], F[1], F[2] = sub(p, o)
+        F[3] = 0.5 * (W[2][1] - W[1][2])
+        F[4] = 0.5 * (W[0][2] - W[2][0])
+        F[5] = 0.5 * (W[1][0] - W[0][1])
+        if abs(_solve6(J, F)) <= 1e-12:
+            break                                            # the same q (and J) at every later step
+        for i in range(6):
+            q[i] += F[i]
+    R, o = fk_geo(h, PP, q)
+    err = 0.0
+    for i in range(3):
+        err = max(err, abs(o[i] - p[i]))
+        for j in range(3):
+            err = max(err, abs(R[i][j] - R06[i][j]))
+    for i in range(6):
+        q[i] = wrap(q[i])
+    return err <= SEARCH_TOL
+
+
+@kernel
+def _push(Q, V, E, n, q, ex):
+    """Append branch ``q`` (6,) to the slots Q (16, 6), V, E holding ``n`` branches, unless
+    it is within 1e-8 rad of one of them (every joint, mod 2π) or the slots are full; returns
+    the new count."""
+    if n >= SEARCH_BRANCHES:
+        return n
+    for a in range(n):
+        d = 0.0
+        for j in range(6):
+            d = max(d, abs(wrap(q[j] - Q[a, j])))
+        if d < 1e-8:
+            return n
+    for j in range(6):
+        Q[n, j] = wrap(q[j])
+    V[n], E[n] = True, ex
+    return n + 1
+
+
+# ----------------------------------------------------------------------------- 1-D inner subproblems
+@kernel
+def _tp_parts(h, PP, R06, p16, q1, t6, t4):
+    """two_parallel at (q1, q6, q4): θ23 = q2 + q3 by SP1 (of h5), its exactness, the span
+    vector v (the elbow must reach it: ‖v‖ = ‖p23‖), R16 = R01ᵀ R06, R34, R56."""
+    h2, h4, h5 = h[1], h[3], h[4]
+    Rt1 = rot(h[0], -q1)
+    R16 = mm(Rt1, R06)
+    R34, R56 = rot(h4, t4), rot(h[5], t6)
+    t23, e23, _ = sp1_one(mv(R34, h5), mv(R16, mtv(R56, h5)), h2, TOL)
+    R13 = rot(h2, t23)
+    v = sub(sub(sub(sub(mv(Rt1, p16), PP[1]), mv(R13, PP[3])), mv(R13, mv(R34, PP[4]))),
+            mv(R16, mtv(R56, PP[5])))
+    return t23, e23, v, R16, R34, R56
+
+
+@kernel
+def _inner(cls, h, PP, R06, p16, x, th, e, t2):
+    """The inner subproblem of a 1-D search class at the searched angle ``x``: writes its
+    roots into ``th`` (4, 3) (two_parallel: (q6, q4, 0); two_intersecting: (q1, q2, q3)),
+    their errors into ``e`` (4,); returns their number (valid rows first)."""
+    if cls == 0:
+        # two_parallel: the heights along h2 of the position and of h5 (SP6 in q6, q4)
+        h2 = h[1]
+        Rt1 = rot(h[0], -x)
+        R16 = mm(Rt1, R06)
+        h1 = mtv(R16, h2)                                         # R06ᵀ R01 h2
+        d1 = dot(h2, mv(Rt1, p16)) - dot(h2, add(add(PP[1], PP[2]), PP[3]))
+        cnt, _ = sp6_one((h1, h2, h1, h2), (neg(h[5]), h[3], neg(h[5]), h[3]),
+                         (PP[5], PP[4], h[4], neg(h[4])), d1, 0.0, TOL_QUARTIC, t2)
+        d23 = norm(PP[2])
+        for r in range(cnt):
+            _, _, v, _, _, _ = _tp_parts(h, PP, R06, p16, x, t2[r, 0], t2[r, 1])
+            th[r, 0], th[r, 1], th[r, 2] = t2[r, 0], t2[r, 1], 0.0
+            e[r] = norm(v) - d23
+        return cnt
+    # two_intersecting: the 5-6 intersection placed by SP5 in (q1, q2, q3)
+    p35 = add(PP[3], rotate(h[3], x, PP[4]))
+    cnt, _ = sp5_one(neg(PP[1]), p16, PP[2], p35, neg(h[0]), h[1], h[2], TOL_QUARTIC, th)
+    R06h6 = mv(R06, h[5])
+    R4 = rot(h[3], x)
+    for r in range(cnt):
+        R04 = mm(mm(mm(rot(h[0], th[r, 0]), rot(h[1], th[r, 1])), rot(h[2], th[r, 2])), R4)
+        e[r] = dot(h[4], mtv(R04, R06h6)) - dot(h[4], h[5])
+    return cnt
+
+
+@kernel
+def _assemble(cls, h, PP, R06, p16, x, r0, r1, r2, q):
+    """The branch at a root (searched angle ``x``, inner root (r0, r1, r2)) into ``q`` (6,);
+    returns whether every subproblem on it was exact."""
+    if cls == 0:
+        t6, t4 = r0, r1
+        t23, e23, v, R16, R34, R56 = _tp_parts(h, PP, R06, p16, x, t6, t4)
+        h2 = h[1]
+        q2, e2, _ = sp1_one(PP[2], v, h2, TOL)
+        q5, e5, _ = sp1_one(mtv(R34, h2), mv(R56, mtv(R16, h2)), neg(h[4]), TOL)
+        s3 = 1.0 if dot(h[1], h[2]) >= 0.0 else -1.0
+        q[0], q[1], q[2], q[3], q[4], q[5] = x, q2, s3 * wrap(t23 - q2), t4, q5, t6
+        return e23 and e2 and e5
+    R04 = mm(mm(mm(rot(h[0], r0), rot(h[1], r1)), rot(h[2], r2)), rot(h[3], x))
+    q5, e5, _ = sp1_one(h[5], mtv(R04, mv(R06, h[5])), h[4], TOL)
+    q6, e6, _ = sp1_one(h[4], mtv(R06, mv(R04, h[4])), neg(h[5]), TOL)
+    q[0], q[1], q[2], q[3], q[4], q[5] = r0, r1, r2, x, q5, q6
+    return e5 and e6
+
+
+# ----------------------------------------------------------------------------- 1-D search
+@kernel
+def _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2):
+    """The inner subproblem at every angle of ``X``: roots RS (L, 4, 3), errors ES (L, 4),
+    counts CS (L,)."""
+    for i in range(len(X)):
+        CS[i] = _inner(cls, h, PP, R06, p16, X[i], RS[i], ES[i], t2)
+
+
+@kernel
+def _interval(RS, CS, g, S1, DM):
+    """Follow each root at sample g to sample g + 1 (the nearest root there, max over the
+    unknowns of the wrapped difference): S1 (4,) its index, DM (4,) the distance (inf: no
+    root there).  Returns whether the interval needs a finer look (the number of roots changes
+    or a root moves by more than _FAST, or finds no partner)."""
+    fine = CS[g] != CS[g + 1]
+    for s in range(CS[g]):
+        best, k = math.inf, 0
+        for t in range(CS[g + 1]):
+            d = 0.0
+            for c in range(3):
+                d = max(d, abs(wrap(RS[g, s, c] - RS[g + 1, t, c])))
+            if d < best:
+                best, k = d, t
+        S1[s], DM[s] = k, best
+        if best > _FAST:
+            fine = True
+    return fine
+
+
+@kernel
+def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
+    """Illinois regula falsi on the bracket [xl, xr] (errors el, er of opposite signs, inner
+    roots rl, rr (3-tuples) at the ends), the root followed by the one nearest its
+    interpolation between the ends.  Writes (x, root (3), |e|) into ``out`` (5,); returns
+    False where the followed root was lost."""
+    for _ in range(_ITERS):
+        den = er - el
+        w = er / den if den != 0.0 else 0.5
+        xm = xr - w * (xr - xl)
+        cnt = _inner(cls, h, PP, R06, p16, xm, th, e, t2)
+        t = (xm - xl) / (xr - xl if xr != xl else 1.0)
+        t = min(max(t, 0.0), 1.0)
+        ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
+        best, k = math.inf, 0
+        for r in range(cnt):
+            d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
+            if d < best:
+                best, k = d, r
+        lost = not (best < math.inf)
+        em = math.nan if lost else e[k]
+        rm = (th[k, 0], th[k, 1], th[k, 2])
+        if (em < 0.0) != (er < 0.0):
+            xl, el, rl = xr, er, rr
+        else:
+            el = 0.5 * el
+        xr, er, rr = xm, em, rm
+        if lost or abs(em) <= 0.01 * SEARCH_TOL or abs(xr - xl) <= 1e-15:
+            break
+    if not math.isfinite(er):
+        return False
+    if abs(el) < abs(er):
+        out[0], out[1], out[2], out[3], out[4] = xl, rl[0], rl[1], rl[2], abs(el)
+    else:
+        out[0], out[1], out[2], out[3], out[4] = xr, rr[0], rr[1], rr[2], abs(er)
+    return True
+
+
+@kernel
+def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
+    """Every branch of one pose of a 1-D search class into Q (16, 6), V, E; returns their
+    number."""
+    p16 = sub(sub(p, mv(R06, PP[6])), PP[0])
+    L = grid + 1
+    step = 2.0 * math.pi / grid
+    X = np.empty(L)
+    for i in range(L):
+        X[i] = i * step - math.pi
+    X[L - 1] = math.pi
+    RS, ES, CS = np.zeros((L, 4, 3)), np.full((L, 4), math.nan), np.zeros(L, dtype=np.int64)
+    t2, th, e = np.empty((4, 2)), np.empty((4, 3)), np.empty(4)
+    S1, DM = np.zeros(4, dtype=np.int64), np.zeros(4)
+    out, q = np.empty(5), np.empty(6)
+    J, F = np.empty((6, 6)), np.empty(6)
+    _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2)
+    fine = np.zeros(grid, dtype=np.bool_)
+    n = 0
+    for g in range(grid):
+        fine[g] = _interval(RS, CS, g, S1, DM)
+        if fine[g]:
+            continue                                              # its brackets come from the finer look
+        for s in range(CS[g]):
+            s1 = S1[s]
+            if DM[s] < _MATCH and (ES[g, s] < 0.0) != (ES[g + 1, s1] < 0.0):
+                if _refine(cls, h, PP, R06, p16, X[g], X[g + 1], ES[g, s], ES[g + 1, s1],
+                           (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]),
+                           (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2]), th, e, t2, out):
+                    ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
+                    n = _push(Q, V, E, n, q, ex and out[4] <= SEARCH_TOL)
+    # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends
+    L2 = 2 * _SUB + 1
+    u = np.empty(L2)
+    for i in range(_SUB + 1):
+        u[i] = (i / _SUB) ** 2 / 2.0
+    for i in range(_SUB):
+        u[_SUB + 1 + i] = 1.0 - u[_SUB - 1 - i]
+    X2 = np.empty(L2)
+    RS2, ES2, CS2 = np.zeros((L2, 4, 3)), np.full((L2, 4), math.nan), np.zeros(L2, dtype=np.int64)
+    SX, SR = np.empty(_MAX_SEEDS), np.empty((_MAX_SEEDS, 3))
+    ns = 0
+    for g in range(grid):
+        if not fine[g]:
+            continue
+        for i in range(L2):
+            X2[i] = X[g] + step * u[i]
+        _sample(cls, h, PP, R06, p16, X2, RS2, ES2, CS2, t2)
+        for g2 in range(L2 - 1):
+            _interval(RS2, CS2, g2, S1, DM)
+            for s in range(CS2[g2]):
+                s1 = S1[s]
+                if DM[s] < _MATCH and (ES2[g2, s] < 0.0) != (ES2[g2 + 1, s1] < 0.0):
+                    if _refine(cls, h, PP, R06, p16, X2[g2], X2[g2 + 1], ES2[g2, s], ES2[g2 + 1, s1],
+                               (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
+                               (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
+                        ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
+                        n = _push(Q, V, E, n, q, ex and out[4] <= SEARCH_TOL)
+            if CS2[g2] != CS2[g2 + 1]:
+                # fold seeds: the roots with a small error on the side with more roots
+                side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1
+                for j in range(CS2[side]):
+                    if abs(ES2[side, j]) < _SEED and ns < _MAX_SEEDS:
+                        SX[ns] = X2[side]
+                        SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
+                        ns += 1
+    for k in range(ns):
+        _assemble(cls, h, PP, R06, p16, SX[k], SR[k, 0], SR[k, 1], SR[k, 2], q)
+        if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
+            n = _push(Q, V, E, n, q, True)
+    return n
+
+
+# ----------------------------------------------------------------------------- 2-D search
+@kernel
+def _r05(h, q1, q2, t):
+    return mm(mm(mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], t[0])), rot(h[3], t[1])), rot(h[4], t[2]))
+
+
+@kernel
+def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
+    """Every branch found for one pose of ``gen_six_dof`` into Q (16, 6), V, E; returns their
+    number."""
+    p16 = sub(sub(p, mv(R06, PP[6])), PP[0])
+    h6 = h[5]
+    R06h6 = mv(R06, h6)
+    # a unit vector ⟂ h6 (h6 × the axis of its smallest component)
+    a0, a1, a2 = abs(h6[0]), abs(h6[1]), abs(h6[2])
+    ax = (1.0, 0.0, 0.0) if a0 <= a1 and a0 <= a2 else ((0.0, 1.0, 0.0) if a1 <= a2 else (0.0, 0.0, 1.0))
+    u = cross(h6, ax)
+    u = scale(u, 1.0 / norm(u))
+    G2 = grid * grid
+    step = 2.0 * math.pi / grid
+    xs = np.empty(grid)
+    for i in range(grid):
+        xs[i] = i * step - math.pi
+    GQ, GE, GM = np.zeros((G2, 4, 3)), np.full((G2, 4), math.inf), np.full(G2, math.inf)
+    t = np.empty((4, 3))
+    for i in range(grid):
+        for j in range(grid):
+            k = i * grid + j
+            q1, q2 = xs[i], xs[j]
+            p63 = sub(rotate(neg(h[1]), q2, sub(rotate(neg(h[0]), q1, p16), PP[1])), PP[2])
+            cnt, _ = sp5_one(neg(PP[3]), p63, PP[4], PP[5], neg(h[2]), h[3], h[4], TOL_QUARTIC, t)
+            for r in range(cnt):
+                GQ[k, r, 0], GQ[k, r, 1], GQ[k, r, 2] = t[r, 0], t[r, 1], t[r, 2]
+                R05 = _r05(h, q1, q2, (t[r, 0], t[r, 1], t[r, 2]))
+                GE[k, r] = norm(sub(mv(R05, h6), R06h6))
+                GM[k] = min(GM[k], GE[k, r])
+    q = np.empty(6)
+    J, F = np.empty((6, 6)), np.empty(6)
+    n = 0
+    for i in range(grid):
+        for j in range(grid):
+            k = i * grid + j
+            nb = math.inf
+            for a in range(-1, 2):
+                for b in range(-1, 2):
+                    if a != 0 or b != 0:
+                        nb = min(nb, GM[((i + a) % grid) * grid + (j + b) % grid])
+            for r in range(4):
+                if GE[k, r] <= nb and GE[k, r] < _MIN_2D:
+                    tr = (GQ[k, r, 0], GQ[k, r, 1], GQ[k, r, 2])
+                    R05 = _r05(h, xs[i], xs[j], tr)
+                    q6, _, _ = sp1_one(u, mtv(R05, mv(R06, u)), h6, TOL)
+                    q[0], q[1], q[2], q[3], q[4], q[5] = xs[i], xs[j], tr[0], tr[1], tr[2], q6
+                    if polish(h, PP, R06, p, q, _POLISH_2D, J, F):
+                        n = _push(Q, V, E, n, q, True)
+    return n
+
+
+# ----------------------------------------------------------------------------- driver
+@kernel
+def _search_loop(cls, H, P, R06, p, Q, V, E, grid):
+    h, PP = _six(H), _seven(P)
+    for i in range(len(p)):
+        Q[i, :, :] = math.nan
+        V[i, :] = False
+        E[i, :] = False
+        R, pp = (vec(R06[i, 0]), vec(R06[i, 1]), vec(R06[i, 2])), vec(p[i])
+        if cls == 2:
+            _gen_six_dof_pose(h, PP, R, pp, Q[i], V[i], E[i], grid)
+        else:
+            _search_1d_pose(cls, h, PP, R, pp, Q[i], V[i], E[i], grid)
+
+
+def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
+    """Every branch of the search class ``cls`` (``"two_parallel"``, ``"two_intersecting"``
+    or ``"gen_six_dof"``; IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``, ``IK_gen_6_dof``,
+    arXiv 2211.05737 §IV) for N poses, in one compiled call.
+
+    ``H`` (6, 3) unit joint axes and ``P`` (7, 3) offsets (m) in IK-Geo's form (base frame,
+    q = 0), ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions (base frame, m).
+    Returns q (N, 16, 6) rad in (−π, π] (NaN where a slot holds no branch), valid (N, 16),
+    exact (N, 16) (False: a refined root whose error stayed above :data:`SEARCH_TOL`, or a
+    subproblem with only a least-squares answer).  ``grid``: samples of the searched joint
+    (default :data:`SEARCH_GRID`; :data:`SEARCH_GRID_2D` per joint for ``gen_six_dof``).
+    The same algorithm and results as ``anthroarm.ik.geometric.solve_class`` for these classes
+    (module docstring)."""
+    if cls not in CLASSES:
+        raise ValueError(f"cls must be one of {CLASSES}, got {cls!r}")
+    c = CLASSES.index(cls)
+    H = np.ascontiguousarray(H, dtype=float).reshape(6, 3)
+    P = np.ascontiguousarray(P, dtype=float).reshape(7, 3)
+    R06 = np.ascontiguousarray(R06, dtype=float).reshape(-1, 3, 3)
+    p = np.ascontiguousarray(p, dtype=float).reshape(-1, 3)
+    if len(R06) != len(p):
+        raise ValueError(f"R06 has {len(R06)} poses, p {len(p)}")
+    if grid is None:
+        grid = SEARCH_GRID_2D if c == 2 else SEARCH_GRID
+    n = len(p)
+    q = np.empty((n, SEARCH_BRANCHES, 6))
+    valid = np.empty((n, SEARCH_BRANCHES), bool)
+    exact = np.empty((n, SEARCH_BRANCHES), bool)
+    _search_loop(c, H, P, R06, p, q, valid, exact, int(grid))
+    return q, valid, exact & valid
+
+
+__all__ = ["CLASSES", "SEARCH_BRANCHES", "SEARCH_GRID", "SEARCH_GRID_2D", "SEARCH_TOL", "fk_geo", "polish",
+           "solve_search"]
