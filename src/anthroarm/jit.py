@@ -6,11 +6,15 @@ source of its formula: Numba compiles *that* source to machine code on first use
 the same function run by the Python interpreter (what the tests compare against where they
 want the interpreter's answer).  There is no second copy to keep in step.
 
-Disk cache: Numba keeps the compiled code of every kernel (``cache=True``) in the subfolder
-``numba`` of anthroarm's cache (:func:`anthroarm.cache.root`; ``$ANTHROARM_CACHE`` moves it),
-unless ``$NUMBA_CACHE_DIR`` is already set or Numba was imported before anthroarm.  Numba
-keys each entry by the source file's path, modification time and size, the function's
-signature, the target CPU and its own version, and recompiles when any of them changes; the
+Disk cache: the compiled code of every kernel is kept by Numba's per-function cache in the
+subfolder ``numba`` of anthroarm's cache (:func:`anthroarm.cache.root`; ``$ANTHROARM_CACHE``
+moves it), unless ``$NUMBA_CACHE_DIR`` is already set or Numba was imported before anthroarm.
+Numba keys each entry by the source file's path, modification time and size, the function's
+bytecode and signature, the target CPU and its own version, and recompiles when any of them
+changes.  Like every entry of anthroarm's cache, each data file is *verified before it is
+loaded*: it is written atomically with the SHA-256 of its contents in front
+(:class:`VerifiedCacheFile`), and a file that does not match (truncated, edited, half-copied) or
+an index that cannot be read is dropped and the kernel compiled again — never loaded.  The
 first call of a kernel in a fresh cache compiles it (about a second per kernel family), later
 processes load it in milliseconds.  ``anthroarm cache clear`` empties it.
 
@@ -31,14 +35,67 @@ CACHE_SUBFOLDER = "numba"
 if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in __import__("sys").modules:
     os.environ["NUMBA_CACHE_DIR"] = str(_cache.root() / CACHE_SUBFOLDER)
 
-import numba  # noqa: E402
+import hashlib  # noqa: E402
+import pickle  # noqa: E402
 
-OPTIONS = dict(cache=True, nogil=True, error_model="numpy")
+import numba  # noqa: E402
+from numba.core import caching  # noqa: E402
+
+OPTIONS = dict(nogil=True, error_model="numpy")
+_MAGIC = b"anthroarm-sha256\n"
+
+
+class VerifiedCacheFile(caching.IndexDataCacheFile):
+    """Numba's index and data files of one kernel, each data file prefixed by the SHA-256 of
+    its payload and checked before it is unpickled; a damaged index reads as empty."""
+
+    def _load_index(self):
+        try:
+            return super()._load_index()
+        except Exception:                   # noqa: BLE001 - truncated/edited index: compile again
+            return {}
+
+    def _save_data(self, name, data):
+        payload = self._dump(data)
+        with self._open_for_write(self._data_path(name)) as f:       # temp file + os.replace
+            f.write(_MAGIC + hashlib.sha256(payload).digest() + payload)
+
+    def _load_data(self, name):
+        path = self._data_path(name)
+        with open(path, "rb") as f:
+            raw = f.read()
+        head = len(_MAGIC) + 32
+        if not raw.startswith(_MAGIC) or hashlib.sha256(raw[head:]).digest() != raw[len(_MAGIC):head]:
+            try:
+                os.remove(path)
+            except OSError:
+                pass
+            return None                     # not verified: compiled again, never loaded
+        return pickle.loads(raw[head:])
+
+
+class VerifiedCache(caching.FunctionCache):
+    """Numba's per-function cache on :class:`VerifiedCacheFile`; an entry that verifies but
+    cannot be rebuilt (another build of the same version) is compiled again as well."""
+
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        self._cache_file = VerifiedCacheFile(cache_path=self._cache_path, filename_base=self._impl.filename_base,
+                                             source_stamp=self._impl.locator.get_source_stamp())
+
+    def load_overload(self, sig, target_context):
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception:                   # noqa: BLE001 - any unreadable entry: compile again
+            return None
 
 
 def kernel(func):
-    """Compile ``func`` with Numba (:data:`OPTIONS`); the result is called like ``func``."""
-    return numba.njit(**OPTIONS)(func)
+    """Compile ``func`` with Numba (:data:`OPTIONS`, the verified disk cache); the result is
+    called like ``func``, and its ``py_func`` is ``func`` itself."""
+    dispatcher = numba.njit(**OPTIONS)(func)
+    dispatcher._cache = VerifiedCache(func)          # numba.njit(cache=True) with our cache file
+    return dispatcher
 
 
-__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "kernel"]
+__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel"]

@@ -30,11 +30,10 @@ def test_analytic_rejects_non_numeric_tolerance(arm):
         aa.ik.analytic(arm, T, tol="1e-9")
 
 
-@pytest.mark.parametrize("name", ["prosthetic_arm", "sixr_arm", "planar2r", "human_arm7"])
-@pytest.mark.parametrize("impl", ["auto", "python", "c", "general"])
-def test_analytic_batch_of_zero_poses_is_empty(name, impl):
+@pytest.mark.parametrize("name", ["prosthetic_arm", "sixr_arm", "planar2r", "human_arm7", "ur5", "panda"])
+def test_analytic_batch_of_zero_poses_is_empty(name):
     robot = aa.load(name)
-    b = aa.ik.analytic_batch(robot, np.zeros((0, 4, 4)), _impl=impl)
+    b = aa.ik.analytic_batch(robot, np.zeros((0, 4, 4)))
     assert len(b) == 0
     assert b.solutions.shape[0] == 0 and b.valid.shape[0] == 0
     assert b.n_solutions.shape == (0,)

@@ -302,12 +302,13 @@ def test_aligned_seed_table_turns_first_and_last_joint_exactly(robots):
 
 def test_seed_tags_and_restart_cap(robots):
     """Seeds are tagged; max_restarts=0 tries exactly one seed, and the answer is still the
-    closest pose found inside the limits."""
+    closest pose found inside the limits (the closed-form seeds switched off: the table and
+    restart seeds)."""
     robot = robots["panda"]
     tags = set()
     restarted = 0
     for q in robot.random_q(40, rng=31):
-        r = aa.ik.solve(robot, robot.fk(q))
+        r = aa.ik.solve(robot, robot.fk(q), analytic=False)
         assert r.success
         tags.add(r.seed)
         if r.restarts == 0:
@@ -323,33 +324,26 @@ def test_seed_tags_and_restart_cap(robots):
 
 
 def test_closed_form_first_where_cheap(robots):
-    """prosthetic_arm (a six-joint book arm) takes its first seed from the closed form and
-    verifies it in one Gauss–Newton evaluation; so does human_arm7 when the compiled closed-form
-    kernel is available; ur5 and talos_arm (a closed form by geometry, milliseconds) only when
-    asked; the arms without a closed form never do."""
+    """Every arm with a closed form that costs about as much as a few Gauss–Newton iterations
+    (a closed 6R class, an SRS arm's swivel grid, a 7-joint arm's held-joint grid: one compiled
+    call) takes its first seed from it and verifies it in one Gauss–Newton evaluation; the arms
+    without a closed form never do."""
+    for name in ("prosthetic_arm", "ur5", "talos_arm", "panda", "human_arm7"):
+        robot = robots[name]
+        assert _ws(robot).sh.closed_form_first, name
+        for q in robot.random_q(5, rng=41):
+            T = robot.fk(q)
+            r = aa.ik.solve(robot, T)
+            assert r.success and r.seed == "analytic" and r.restarts == 0, name
+            assert pose_error(robot, r.q, T)[0] <= 1e-6
     robot = robots["prosthetic_arm"]
-    assert _ws(robot).sh.closed_form_first
-    for q in robot.random_q(10, rng=41):
-        T = robot.fk(q)
-        r = aa.ik.solve(robot, T)
-        assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
-        assert pose_error(robot, r.q, T)[0] <= 1e-6
     out = aa.ik.solve(robot, robot.fk(robot.random_q(12, rng=42)))   # batch: the same path
     assert out.success.all()
     r = aa.ik.solve(robot, robot.fk(robot.random_q(rng=43)), analytic=False)
     assert r.success and r.seed != "analytic"
-    for name in ("panda", "ur5", "talos_arm"):   # ur5, talos_arm: a closed form by geometry, in ms
-        assert not _ws(robots[name]).sh.closed_form_first
-    for name in ("ur5", "talos_arm"):            # asked for, it answers in one verified step
-        arm = robots[name]
-        T = arm.fk(arm.random_q(rng=45))
-        r = aa.ik.solve(arm, T, analytic=True)
-        assert r.success and r.seed == "analytic" and r.iterations == 1 and r.restarts == 0
-        assert pose_error(arm, r.q, T)[0] <= 1e-6
-    human = robots["human_arm7"]
-    if _ws(human).sh.closed_form_first:
-        r = aa.ik.solve(human, human.fk(human.random_q(rng=44)))
-        assert r.success and r.seed == "analytic"
+    for name in ("rrprr5", "unimate5"):
+        arm = aa.load(name)
+        assert not cf.has_analytic(arm) and not _ws(arm).sh.closed_form_first
 
 
 def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):

@@ -55,7 +55,7 @@ import numpy as np
 
 from ..jit import kernel
 from . import classify as C
-from .geometric import _common_point, _fk_residual, _pose_status, _wrist
+from .geometric import _common_point, _fk_residual, _pose_status, _wrist, into_limits
 from .subproblems import TOL, sp1_one, sp2_one, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
 
@@ -389,15 +389,10 @@ def _seven(A):
 
 @kernel
 def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid):
-    """Wrap q (n,) by 2π into [lo, hi] (clamped there; geometric's rule), write Qout; returns
+    """Wrap q (n,) by 2π into [lo, hi] (:func:`.geometric.into_limits`), write Qout; returns
     (inside, FK residual — inf when not valid)."""
-    inside = True
+    inside = into_limits(q, n, lo, hi)
     for j in range(n):
-        lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
-        qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
-        if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
-            inside = False
-        q[j] = min(max(qw, lo[j]), hi[j])
         Qout[j] = q[j]
     return inside, (_fk_residual(kH, kO, MR, Mp, q, n, T) if valid else math.inf)
 
@@ -552,14 +547,8 @@ def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RE
             q2 = ta if b == 0 else tb
             q1, e1, _ = sp1_one(sub(rotate(h2, q2, p1), p2), po, h1, TOL)
             q[0], q[1] = wrap(q1), wrap(q2)
-            inside = True
-            for j in range(2):
-                lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
-                qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
-                if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
-                    inside = False
-                q[j] = min(max(qw, lo[j]), hi[j])
-                Q[i, b, j] = q[j]
+            inside = into_limits(q, 2, lo, hi)
+            Q[i, b, 0], Q[i, b, 1] = q[0], q[1]
             V[i, b], E[i, b], IN[i, b] = True, (ea if b == 0 else eb) and e1, inside
             RES[i, b] = _fk_position_residual(kH, kO, pt, q, 2, p)
     return -1

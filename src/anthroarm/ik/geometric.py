@@ -34,7 +34,8 @@ class (:mod:`.classify`)                  decomposition                         
                                           SP1
 ========================================  =====================================  ==========
 
-The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``) sample the searched joint
+The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``; compiled in
+:mod:`.search`) sample the searched joint
 on :data:`SEARCH_GRID` values for all poses in one batch, follow each root of the inner
 subproblem from sample to sample, and refine every sign change of the error by regula falsi
 (Illinois) to ``|e| ≤`` :data:`SEARCH_TOL`; a root that does not get there is not ``exact``.
@@ -47,16 +48,19 @@ error only touches zero (no sign change) is not found.
 grid; every (sample, SP5 root) whose error ``‖R05 h6 − R06 h6‖`` is below 0.3 and not above
 any of its 8 neighbours' seeds Newton steps on the whole pose (kept where they converge to
 :data:`SEARCH_TOL`).  A branch whose basin the grid misses is not found (no completeness
-claim), and it costs ~0.3 s a pose; a 7-joint arm is not solved this way.
+claim), and it costs tens of ms a pose; a 7-joint arm is not solved this way.
 
 A class that holds for the reversed chain (a spherical *shoulder*: the prosthetic arm) is
 solved on the reversed arm: T = e^{ξ1 q1} ⋯ e^{ξ6 q6} M gives T⁻¹ = e^{ξ'1 q6} ⋯ e^{ξ'6 q1} M⁻¹
 with ξ'_k the twist of joint 7 − k seen from the tool at q = 0 and its axis negated
 (``h'_k = −R_toolᵀ h_{7−k}`` through ``R_toolᵀ (o_{7−k} − p_tool)``), the same angles.
 
-Every branch returned is a candidate: its ``exact`` flag is False where a subproblem had only a
-least-squares answer (the pose is out of reach on that branch).  Limits and the FK check are
-the caller's (:func:`anthroarm.ik.closed_form.analytic`).
+Every branch returned by :func:`solve` is a candidate: its ``exact`` flag is False where a
+subproblem had only a least-squares answer (the pose is out of reach on that branch).  The
+closed classes (:data:`CLOSED`) are compiled per pose (:mod:`anthroarm.jit`) from the
+subproblem kernels, and :func:`solve_verified` / :func:`solve_one` add in the same compiled
+call the 2π shift into the joint limits, the FK check by the chain's product of exponentials
+and the removal of duplicates (used by :func:`anthroarm.ik.closed_form.analytic`).
 """
 
 from __future__ import annotations
@@ -72,8 +76,9 @@ from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
 from . import subproblems as sp
+from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve_search  # noqa: F401 - re-exported
 from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp2_one, sp3_one, sp4_one, sp5_one, sp6_one
-from .vec3 import add, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, rot, rotate, rotate_cs, sub, transpose, vec, wrap
+from .vec3 import add, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot, rotate, rotate_cs, sub, transpose, vec, wrap
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -283,7 +288,9 @@ def _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex):
     q6 by SP1; branches b (first q5 root) and b + 1."""
     h4, h5, h6 = h[3], h[4], h[5]
     R36 = mtm(R03, R06)
-    R36h6, R36th4 = mv(R36, h6), mtv(R36, h4)
+    R36h6 = mv(R36, h6)
+    x = perpendicular(h6)
+    R36x = mv(R36, x)
     ta, tb, cnt, ea, eb, _ = sp4_one(h4, h6, h5, dot(h4, R36h6), TOL)
     for j in range(2):
         if j >= cnt:
@@ -291,8 +298,10 @@ def _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex):
             continue
         q5 = ta if j == 0 else tb
         c, s = math.cos(q5), math.sin(q5)
+        # q4 (0 where it is free: h4 ∥ rot(h5, q5) h6, the wrist singularity), then q6 from
+        # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
         q4, e4, _ = sp1_one(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
-        q6, e6, _ = sp1_one(rotate_cs(neg(h5), c, s, h4), R36th4, neg(h6), TOL)
+        q6, e6, _ = sp1_one(x, rotate_cs(h5, c, -s, rotate(h4, -q4, R36x)), h6, TOL)
         _put(Q, V, E, b + j, q1, q2, q3, q4, q5, q6, True, ex and (ea if j == 0 else eb) and e4 and e6)
 
 
@@ -350,8 +359,11 @@ def _three_parallel_tail(h, P, R06, p06, q1, q5, ex, Q, V, E, b):
     s4n = 1.0 if dot(h[1], h[3]) >= 0.0 else -1.0
     R01 = rot(h[0], q1)
     c5, s5 = math.cos(q5), math.sin(q5)
-    th14, e14, _ = sp1_one(rotate_cs(h[4], c5, s5, h[5]), mtv(R01, mv(R06, h[5])), h[1], TOL)
+    # q6 (0 where it is free: h6 ∥ h2, the wrist aligned with the parallel axes), then θ14 from
+    # rot(h2, θ14) = R01ᵀ R06 rot(h6, −q6) rot(h5, −q5) applied to x ⟂ h2 (never singular)
     q6, e6, _ = sp1_one(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
+    x = perpendicular(h[1])
+    th14, e14, _ = sp1_one(x, mtv(R01, mv(R06, rotate(h[5], -q6, rotate_cs(h[4], c5, -s5, x)))), h[1], TOL)
     d_in = sub(sub(mtv(R01, p06), P[1]), rotate(h[1], th14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
     ta, tb, n3, ea, eb, _ = sp3_one(neg(P[3]), P[2], h[1], norm(d_in), TOL)
     for j in range(2):
@@ -468,6 +480,24 @@ def _closed_loop(cls, H, P, R06, p, Q, V, E):
 
 # ----------------------------------------------------------------------------- one call: pose → verified branches
 @kernel
+def into_limits(q, n, lo, hi):
+    """Shift the angles q[:n] (rad) by multiples of 2π into [lo, hi] (a continuous joint, ±inf:
+    into [−π, π)), in place; a value within 1e-9 rad outside a limit is put onto it.  Returns
+    whether every joint is inside; a joint that is not keeps its shifted value (the caller may
+    move it along a self-motion, :func:`anthroarm.ik.closed_form.analytic`)."""
+    inside = True
+    for j in range(n):
+        lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
+        qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
+        if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
+            inside = False
+            q[j] = qw
+        else:
+            q[j] = min(max(qw, lo[j]), hi[j])
+    return inside
+
+
+@kernel
 def _pose_status(T, tol_orthonormal):
     """0: a valid pose; 1: not finite; 2: last row not [0, 0, 0, 1]; 3: not a rotation."""
     for i in range(4):
@@ -554,13 +584,8 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
                 q[j] = Q6[b, 5 - j] if rev else Q6[b, j]
             if n == 7:
                 q[6] = wrap(param[i])
-            inside = True
+            inside = into_limits(q, n, lo, hi)
             for j in range(n):
-                lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
-                qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
-                if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
-                    inside = False
-                q[j] = min(max(qw, lo[j]), hi[j])
                 Q[i, b, j] = q[j]
             V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
             RES[i, b] = _fk_residual(kH, kO, MR, Mp, q, n, T[i]) if V6[b] else math.inf
@@ -576,344 +601,20 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     return -1
 
 
-# ----------------------------------------------------------------------------- 1-D search classes
-#: samples of the searched joint over (−π, π] (IK-Geo's reference implementation uses 200)
-SEARCH_GRID = 256
-#: samples of each searched joint of ``gen_six_dof`` (a grid of its square)
-SEARCH_GRID_2D = 64
-#: most branches a search class returns per pose (a 6R arm has at most 16 solutions)
-SEARCH_BRANCHES = 16
-#: |e| at which a refined root counts as exact (the error functions are in m or unitless)
-SEARCH_TOL = 1e-12
-#: two roots of the inner subproblem at neighbouring samples are the same branch when their
-#: angles differ by less than this (rad); a branch that appears or vanishes there is not followed
-_MATCH = 0.5
-#: a sample interval where a root moves by more than this (rad) is sampled again more finely
-_FAST = 0.2
-#: a root next to a fold with |e| below this seeds a Newton polish of the whole arm
-_SEED = 0.05
-
-
-def _wrap(x):
-    return np.angle(np.exp(1j * x))
-
-
-def _b(v, n):
-    return np.broadcast_to(v, (n, 3))
-
-
-def _brackets(inner, idx, X):
-    """Sample ``inner`` on the rows of ``X`` (S, L) (increasing angles, pose ``idx`` (S,) per
-    row) in one call; follow each root of the inner subproblem to the next sample by the
-    nearest root there.  Returns the sign changes of the error along followed roots (row,
-    sample, the two angles, errors and roots at the ends) and which sample intervals need a
-    finer look (the number of roots changes — a fold, where a pair of roots appears and
-    moves like a square root — or a root moves by more than ``_FAST`` rad)."""
-    S, L = X.shape
-    R, V, E = inner(np.repeat(idx, L), X.reshape(-1))
-    m = R.shape[-1]
-    R, V, E = R.reshape(S, L, 4, m), V.reshape(S, L, 4), E.reshape(S, L, 4)
-    d = np.abs(_wrap(R[:, :-1, :, None] - R[:, 1:, None])).max(-1)                   # (S, L-1, 4, 4)
-    d = np.where(V[:, :-1, :, None] & V[:, 1:, None], d, np.inf)
-    s1 = d.argmin(-1)
-    dmin = np.take_along_axis(d, s1[..., None], -1)[..., 0]
-    e1 = np.take_along_axis(E[:, 1:], s1, -1)
-    br = V[:, :-1] & (dmin < _MATCH) & ((E[:, :-1] < 0) != (e1 < 0))
-    r, g, s = np.nonzero(br)
-    cnt = V.sum(-1)
-    fine = (cnt[:, :-1] != cnt[:, 1:]) | (np.where(V[:, :-1], dmin, 0) > _FAST).any(-1)
-    # fold seeds: the roots with a small error at the sample next to a fold (a root on the arc
-    # of a pair of roots through the fold is not a sign change along either)
-    fr, fg = np.nonzero(cnt[:, :-1] != cnt[:, 1:])
-    side = np.where(cnt[fr, fg] > cnt[fr, fg + 1], fg, fg + 1)
-    Vs = V[fr, side] & (np.abs(np.nan_to_num(E[fr, side], nan=np.inf)) < _SEED)
-    k, j = np.nonzero(Vs)
-    seeds = (fr[k], X[fr[k], side[k]], R[fr[k], side[k], j])
-    return (r, g, X[r, g], X[r, g + 1], E[r, g, s], e1[r, g, s], R[r, g, s], R[r, g + 1, s1[r, g, s]], fine, seeds)
-
-
-def _search_1d(inner, n, grid=SEARCH_GRID, sub=16, iters=60):
-    """Roots of a branch-valued scalar error over one joint angle x ∈ (−π, π], for n poses.
-
-    ``inner(idx, x)`` solves the inner subproblem for poses ``idx`` (M,) at angles ``x`` (M,) and
-    returns its roots (M, 4, m) (rad), which are valid (M, 4), and the error of each (M, 4).
-    The grid is sampled in one call (:func:`_brackets`); an interval where a pair of roots
-    appears or a root moves fast is sampled again on ``2 sub`` points crowded quadratically
-    towards both ends (a root near a fold moves like the square root of the distance); every
-    sign change of the error along a followed root is a bracket, refined by the Illinois
-    variant of regula falsi (batched over all brackets, the root followed by its nearest
-    neighbour at each new point).  Returns the pose index (K,), x (K,), the inner root (K, m),
-    and |e| at the root (K,), and the fold seeds (pose index, x, inner root) for
-    :func:`_polish`."""
-    X = np.linspace(-np.pi, np.pi, grid + 1)
-    step = X[1] - X[0]
-    r, g, *b1, fine, _ = _brackets(inner, np.arange(n), np.broadcast_to(X, (n, grid + 1)))
-    keep = ~fine[r, g]                                     # intervals looked at again are left out
-    parts = [[r[keep]] + [a[keep] for a in b1]]
-    fr, fg = np.nonzero(fine)
-    seeds = (np.zeros(0, int), np.zeros(0), np.zeros((0, b1[4].shape[1])))
-    if len(fr):
-        u = (np.arange(sub + 1) / sub) ** 2 / 2
-        u = np.concatenate([u, 1 - u[-2::-1]])                                         # 0 … 1
-        r2, _, *b2, _, seeds = _brackets(inner, fr, X[fg][:, None] + step * u[None])
-        seeds = (fr[seeds[0]],) + seeds[1:]
-        parts.append([fr[r2]] + b2)
-    b, xl, xr, el, er, rl, rr = (np.concatenate(a) for a in zip(*parts))
-    active = np.ones(len(b), bool)
-    for _ in range(iters):
-        a = np.flatnonzero(active)
-        if not len(a):
-            break
-        den = er[a] - el[a]
-        w = np.where(den != 0, er[a] / np.where(den != 0, den, 1.0), 0.5)
-        xm = xr[a] - w * (xr[a] - xl[a])
-        Rm, Vm, Em = inner(b[a], xm)
-        # the branch: the root nearest the one interpolated between the bracket's ends
-        t = np.clip((xm - xl[a]) / np.where(xr[a] != xl[a], xr[a] - xl[a], 1.0), 0, 1)[:, None]
-        ref = rl[a] + t * _wrap(rr[a] - rl[a])
-        dm = np.where(Vm, np.abs(_wrap(Rm - ref[:, None])).max(-1), np.inf)
-        k = dm.argmin(-1)
-        lost = ~np.isfinite(dm.min(-1))
-        em = np.where(lost, np.nan, Em[np.arange(len(a)), k])
-        rm = Rm[np.arange(len(a)), k]
-        flip = (em < 0) != (er[a] < 0)
-        # Illinois: the end kept twice has its error halved
-        xl[a] = np.where(flip, xr[a], xl[a])
-        el[a] = np.where(flip, er[a], 0.5 * el[a])
-        rl[a] = np.where(flip[:, None], rr[a], rl[a])
-        xr[a], er[a], rr[a] = xm, em, rm
-        done = lost | (np.abs(em) <= 0.01 * SEARCH_TOL) | (np.abs(xr[a] - xl[a]) <= 1e-15)
-        active[a[done]] = False
-    ok = np.isfinite(er)
-    best = np.abs(el) < np.abs(er)
-    x = np.where(best, xl, xr)
-    root = np.where(best[:, None], rl, rr)
-    err = np.where(best, np.abs(el), np.abs(er))
-    return b[ok], _wrap(x[ok]), root[ok], err[ok], seeds
-
-
-def _fk_geo(H, P, q):
-    """FK in IK-Geo's form for joint angles q (K, 6): R06 (K, 3, 3), the tool position (K, 3),
-    and each joint's axis and point in the base frame (K, 6, 3) twice."""
-    K = len(q)
-    R = np.broadcast_to(np.eye(3), (K, 3, 3))
-    o = np.broadcast_to(P[0], (K, 3))
-    axes, pts = [], []
-    for i in range(6):
-        axes.append(R @ H[i])
-        pts.append(o)
-        R = R @ sp.rot(H[i], q[:, i])
-        o = o + R @ P[i + 1]
-    return R, o, np.stack(axes, 1), np.stack(pts, 1)
-
-
-def _polish(H, P, R06, p, q, iters=12):
-    """Newton steps on the whole arm's pose equations from ``q`` (K, 6) (the spatial Jacobian
-    at the tool point; rotation error ½ vee(R06 Rᵀ − R R06ᵀ)).  Returns q and which converged
-    (pose error ≤ :data:`SEARCH_TOL`, max entry of R and p)."""
-    q = q.copy()
-    for _ in range(iters):
-        R, o, ax, pt = _fk_geo(H, P, q)
-        W = R06 @ np.swapaxes(R, 1, 2)
-        w = 0.5 * np.stack([W[:, 2, 1] - W[:, 1, 2], W[:, 0, 2] - W[:, 2, 0], W[:, 1, 0] - W[:, 0, 1]], -1)
-        F = np.concatenate([p - o, w], -1)
-        J = np.concatenate([np.swapaxes(sp._cross(ax, o[:, None] - pt), 1, 2), np.swapaxes(ax, 1, 2)], 1)
-        ok = np.abs(np.linalg.det(J)) > 1e-12
-        J = np.where(ok[:, None, None], J, np.eye(6))
-        q = q + np.where(ok[:, None], np.linalg.solve(J, F[..., None])[..., 0], 0.0)
-    R, o, *_ = _fk_geo(H, P, q)
-    err = np.maximum(np.abs(R - R06).max((1, 2)), np.abs(o - p).max(1))
-    return _wrap(q), err <= SEARCH_TOL
-
-
-def _finish_search(H, P, R06, p, found, assemble):
-    """The branches of a search class: the refined roots (``assemble(b, x, inner root)`` → q,
-    exactness of its subproblems), then the fold seeds polished by :func:`_polish` (kept where
-    they converge); into 16 slots per pose, duplicates dropped."""
-    b, x, th, err, (sb, sx, sth) = found
-    q, ex = assemble(b, x, th)
-    ex &= err <= SEARCH_TOL
-    if len(sb):
-        qs, _ = assemble(sb, sx, sth)
-        qs, ok = _polish(H, P, R06[sb], p[sb], qs)
-        b, q, ex = np.concatenate([b, sb[ok]]), np.concatenate([q, qs[ok]]), np.concatenate([ex, np.ones(ok.sum(), bool)])
-    return _slots(len(p), b, q, np.ones(len(b), bool), ex)
-
-
-def _slots(n, b, q, ok, ex):
-    """Scatter K branches of poses ``b`` into (n · 16, 6) rows (the first 16 distinct ones per
-    pose, in order; a branch within 1e-8 rad of an earlier one of its pose is dropped)."""
-    out_q = np.full((n, SEARCH_BRANCHES, 6), np.nan)
-    out_v = np.zeros((n, SEARCH_BRANCHES), bool)
-    out_e = np.zeros((n, SEARCH_BRANCHES), bool)
-    order = np.argsort(b, kind="stable")
-    b, q, ok, ex = b[order], q[order], ok[order], ex[order]
-    dup = np.zeros(len(b), bool)
-    for lag in range(1, 4 * SEARCH_BRANCHES):
-        if lag >= len(b):
-            break
-        same = (b[lag:] == b[:-lag]) & (np.abs(_wrap(q[lag:] - q[:-lag])).max(-1) < 1e-8) & ~dup[:-lag]
-        dup[lag:] |= same
-    b, q, ok, ex = b[~dup], q[~dup], ok[~dup], ex[~dup]
-    first = np.searchsorted(b, b)
-    slot = np.arange(len(b)) - first
-    keep = slot < SEARCH_BRANCHES
-    out_q[b[keep], slot[keep]] = q[keep]
-    out_v[b[keep], slot[keep]] = ok[keep]
-    out_e[b[keep], slot[keep]] = ex[keep]
-    return out_q.reshape(-1, 6), out_v.reshape(-1), out_e.reshape(-1)
-
-
-def _two_parallel(H, P, R06, p):
-    """2 ∥ 3 (IK-Geo ``IK_2_parallel``): a 1-D search over q1.  For given q1, (q4, q6) solve
-    the SP6 of the heights along h2 of the position and of h5 (up to 4), θ23 = q2 + q3 follows
-    by SP1 (h5), and the error is the distance the elbow must span minus ‖p23‖; at a root q2
-    is the SP1 of that span, q3 = θ23 − q2 (−(θ23 − q2) when h3 = −h2) and q5 the SP1 of h2."""
-    n = len(p)
-    s3 = np.sign(H[1] @ H[2])
-    p16 = p - R06 @ P[6] - P[0]
-    h2, h4, h5 = H[1], H[3], H[4]
-    d23 = np.linalg.norm(P[2])
-
-    def parts(idx, q1, t6, t4):
-        """θ23 (M,), the span vector (M, 3), R01ᵀ R06 (M, 3, 3), R34, R56."""
-        R16 = rot_t(H[0], q1) @ R06[idx]
-        R34, R56 = sp.rot(h4, t4), sp.rot(H[5], t6)
-        M = len(idx)
-        s23 = sp.sp1(np.einsum("nij,j->ni", R34, h5), np.einsum("nij,nkj,k->ni", R16, R56, h5), _b(h2, M))
-        t23 = s23.theta[:, 0, 0]
-        R13 = sp.rot(h2, t23)
-        v = np.einsum("nij,nj->ni", rot_t(H[0], q1), p16[idx]) - P[1] - R13 @ P[3] \
-            - R13 @ R34 @ P[4] - np.einsum("nij,nkj,k->ni", R16, R56, P[5])
-        return t23, v, R16, R34, R56, s23.exact[:, 0]
-
-    def inner(idx, q1):
-        M = len(idx)
-        R16 = rot_t(H[0], q1) @ R06[idx]
-        h1 = np.einsum("nji,j->ni", R16, h2)                                          # R06ᵀ R01 h2
-        hh = np.stack([h1, _b(h2, M), h1, _b(h2, M)], 1)
-        kk = np.broadcast_to(np.array([-H[5], h4, -H[5], h4]), (M, 4, 3))
-        pp = np.broadcast_to(np.array([P[5], P[4], h5, -h5]), (M, 4, 3))
-        d1 = np.einsum("j,nj->n", h2, np.einsum("nij,nj->ni", rot_t(H[0], q1), p16[idx])) - h2 @ (P[1] + P[2] + P[3])
-        s = sp.sp6(hh, kk, pp, d1, np.zeros(M))
-        th = np.nan_to_num(s.theta)                                                    # (M, 4, 2): t6, t4
-        _, v, *_ = parts(np.repeat(idx, 4), np.repeat(q1, 4), th[..., 0].reshape(-1), th[..., 1].reshape(-1))
-        e = (np.linalg.norm(v, axis=1) - d23).reshape(M, 4)
-        return th, s.valid, np.where(s.valid, e, np.nan)
-
-    def assemble(b, q1, th):
-        t6, t4 = th[:, 0], th[:, 1]
-        t23, v, R16, R34, R56, e23 = parts(b, q1, t6, t4)
-        K = len(b)
-        s2 = sp.sp1(_b(P[2], K), v, _b(h2, K))
-        q2 = s2.theta[:, 0, 0]
-        s5 = sp.sp1(np.einsum("nji,j->ni", R34, h2), np.einsum("nij,nkj,k->ni", R56, R16, h2), _b(-h5, K))
-        q = np.stack([q1, q2, s3 * _wrap(t23 - q2), t4, s5.theta[:, 0, 0], t6], -1)
-        return q, e23 & s2.exact[:, 0] & s5.exact[:, 0]
-
-    return _finish_search(H, P, R06, p, _search_1d(inner, n), assemble)
-
-
-def _two_intersecting(H, P, R06, p):
-    """5 × 6 (p56 = 0; IK-Geo ``IK_2_intersecting``): a 1-D search over q4.  For given q4,
-    (q1, q2, q3) place the 5–6 intersection by SP5 (up to 4), and the error is how far h6 of
-    the pose is from the cone of h6 about h5, h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6; at a root q5 and q6
-    follow by SP1."""
-    n = len(p)
-    p16 = p - R06 @ P[6] - P[0]
-
-    def r04(q1, q2, q3, q4):
-        return sp.rot(H[0], q1) @ sp.rot(H[1], q2) @ sp.rot(H[2], q3) @ sp.rot(H[3], q4)
-
-    def inner(idx, q4):
-        M = len(idx)
-        p35 = P[3] + sp._rotate(_b(H[3], M), q4, _b(P[4], M))
-        s = sp.sp5(-_b(P[1], M), p16[idx], _b(P[2], M), p35, -_b(H[0], M), _b(H[1], M), _b(H[2], M))
-        th = np.nan_to_num(s.theta)                                                    # (M, 4, 3)
-        R = r04(th[..., 0].reshape(-1), th[..., 1].reshape(-1), th[..., 2].reshape(-1), np.repeat(q4, 4))
-        e = np.einsum("i,nji,njk,k->n", H[4], R, np.repeat(R06[idx], 4, axis=0), H[5]) - H[4] @ H[5]
-        return th, s.valid, np.where(s.valid, e.reshape(M, 4), np.nan)
-
-    def assemble(b, q4, th):
-        K = len(b)
-        R04 = r04(th[:, 0], th[:, 1], th[:, 2], q4)
-        s5 = sp.sp1(_b(H[5], K), np.einsum("nji,njk,k->ni", R04, R06[b], H[5]), _b(H[4], K))
-        s6 = sp.sp1(_b(H[4], K), np.einsum("nji,njk,k->ni", R06[b], R04, H[4]), _b(-H[5], K))
-        q = np.stack([th[:, 0], th[:, 1], th[:, 2], q4, s5.theta[:, 0, 0], s6.theta[:, 0, 0]], -1)
-        return q, s5.exact[:, 0] & s6.exact[:, 0]
-
-    return _finish_search(H, P, R06, p, _search_1d(inner, n), assemble)
-
-
-def _gen_six_dof(H, P, R06, p, grid=None, chunk=8):
-    """No special axes (IK-Geo ``IK_gen_6_dof``): a 2-D search over (q1, q2).  For given
-    (q1, q2), (q3, q4, q5) place the tool flange's origin by SP5 (up to 4); the error is
-    ‖R05 h6 − R06 h6‖ (≥ 0: minima, no sign changes).  The local minima below 0.3 over the
-    grid (each against the best root of its 8 neighbours) give q6 by SP1 and seed
-    :func:`_polish`."""
-    grid = SEARCH_GRID_2D if grid is None else grid
-    n = len(p)
-    p16 = p - R06 @ P[6] - P[0]
-    h6 = H[5]
-    u = np.cross(h6, np.eye(3)[np.argmin(np.abs(h6))])
-    u /= np.linalg.norm(u)                                            # a unit vector ⟂ h6
-
-    def inner(idx, q1, q2):
-        M = len(idx)
-        p63 = sp._rotate(_b(-H[1], M), q2, sp._rotate(_b(-H[0], M), q1, p16[idx]) - P[1]) - P[2]
-        s = sp.sp5(-_b(P[3], M), p63, _b(P[4], M), _b(P[5], M), -_b(H[2], M), _b(H[3], M), _b(H[4], M))
-        t = np.nan_to_num(s.theta).reshape(-1, 3)
-        q = np.concatenate([np.repeat(np.stack([q1, q2], -1), 4, axis=0), t], -1)              # (4M, 5)
-        R = sp.rot(H[0], q[:, 0])
-        for i in range(1, 5):
-            R = R @ sp.rot(H[i], q[:, i])
-        e = np.linalg.norm(R @ h6 - np.repeat(R06[idx] @ h6, 4, axis=0), axis=1).reshape(M, 4)
-        return q.reshape(M, 4, 5), R.reshape(M, 4, 3, 3), np.where(s.valid, e, np.inf)
-
-    xs = np.linspace(-np.pi, np.pi, grid, endpoint=False)
-    A, B = (a.ravel() for a in np.meshgrid(xs, xs, indexing="ij"))
-    bs, qs = [np.zeros(0, int)], [np.zeros((0, 6))]
-    for c0 in range(0, n, chunk):
-        idx = np.repeat(np.arange(c0, min(n, c0 + chunk)), grid * grid)
-        m = len(idx) // (grid * grid)
-        Q, R05, E = inner(idx, np.tile(A, m), np.tile(B, m))
-        Em = E.min(-1).reshape(m, grid, grid)
-        nb = np.min([np.roll(Em, (a, b), (1, 2)) for a in (-1, 0, 1) for b in (-1, 0, 1) if a or b], axis=0)
-        k, j = np.nonzero((E <= nb.reshape(-1)[:, None]) & (E < 0.3))
-        K = len(k)
-        s6 = sp.sp1(_b(u, K), np.einsum("nji,njk,k->ni", R05[k, j], R06[idx[k]], u), _b(h6, K))
-        bs.append(idx[k])
-        qs.append(np.concatenate([Q[k, j], s6.theta[:, 0, :]], -1))
-    b, q = np.concatenate(bs), np.concatenate(qs)
-    q, ok = _polish(H, P, R06[b], p[b], q, iters=20)
-    return _slots(n, b[ok], q[ok], np.ones(int(ok.sum()), bool), np.ones(int(ok.sum()), bool))
-
-
-def rot_t(k, theta):
-    """rot(k, θ)ᵀ = rot(k, −θ) (N, 3, 3)."""
-    return sp.rot(k, -np.asarray(theta, float))
-
-
-_SEARCH_SOLVERS = {C.TWO_PARALLEL: _two_parallel, C.TWO_INTERSECTING: _two_intersecting, C.GEN_SIX_DOF: _gen_six_dof}
-
-
 def solve_class(cls: str, H, P, R06, p):
     """Every branch of the class solver ``cls`` in IK-Geo's form (``H`` (6, 3), ``P`` (7, 3),
     ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions, base frame, m).
     Returns q (N, B, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, B),
     exact (N, B) (False: least squares, out of reach; for a search class also a root whose
     error is above :data:`SEARCH_TOL`), B = :func:`n_branches` (8; 16 for a search class)."""
-    n, nb = len(p), n_branches(cls)
+    n = len(p)
     H, P = np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(P, dtype=float)
     R06, p = np.ascontiguousarray(R06, dtype=float), np.ascontiguousarray(p, dtype=float)
     if cls in CLOSED:
         q, valid, exact = np.empty((n, 8, 6)), np.empty((n, 8), bool), np.empty((n, 8), bool)
         _closed_loop(CLOSED.index(cls), H, P, R06, p, q, valid, exact)
         return q, valid, exact & valid
-    q, valid, exact = _SEARCH_SOLVERS[cls](H, P, R06, p)
-    q, valid, exact = q.reshape(n, nb, 6), valid.reshape(n, nb), exact.reshape(n, nb) & valid.reshape(n, nb)
-    q = np.angle(np.exp(1j * q))
-    return np.where(valid[..., None], q, np.nan), valid, exact
+    return solve_search(cls, H, P, R06, p)
 
 
 def class_pose(plan: GeoPlan, T, param=None):
@@ -970,7 +671,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
         return -1
     K = 0
     for b in range(8):
-        if V[0, b] and E[0, b] and IN[0, b] and tol < RES[0, b] <= _POLISH_MAX:
+        if V[0, b] and E[0, b] and IN[0, b] and tol < RES[0, b] <= POLISH_MAX:
             return -2
         if OK[0, b]:
             for k in range(n):
@@ -982,7 +683,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
 
 #: FK residual up to which a candidate of an arm that is of its class only within the
 #: classification tolerance is polished (:func:`anthroarm.ik.closed_form.analytic`)
-_POLISH_MAX = 1e-4
+POLISH_MAX = 1e-4
 _ZERO1 = np.zeros(1)
 
 

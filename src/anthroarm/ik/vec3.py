@@ -65,6 +65,19 @@ def norm(a):
 
 
 @kernel
+def perpendicular(k):
+    """A unit vector ⟂ k (k a unit axis): k × e_i for the axis e_i least aligned with k."""
+    ax, ay, az = abs(k[0]), abs(k[1]), abs(k[2])
+    if ax <= ay and ax <= az:
+        v = (0.0, k[2], -k[1])                        # k × e_x
+    elif ay <= az:
+        v = (-k[2], 0.0, k[0])                        # k × e_y
+    else:
+        v = (k[1], -k[0], 0.0)                        # k × e_z
+    return scale(v, 1.0 / norm(v))
+
+
+@kernel
 def rotate_cs(k, c, s, p):
     """rot(k, θ) p from c = cos θ, s = sin θ (Rodrigues; k a unit axis)."""
     kxp = cross(k, p)
@@ -142,5 +155,5 @@ def as_array(t) -> np.ndarray:
     return np.array(t, dtype=float)
 
 
-__all__ = ["add", "as_array", "cross", "dot", "mat", "mm", "mtm", "mtv", "mv", "neg", "norm", "rot",
+__all__ = ["add", "as_array", "cross", "dot", "mat", "mm", "mtm", "mtv", "mv", "neg", "norm", "perpendicular", "rot",
            "rot_cs", "rotate", "rotate_cs", "scale", "sub", "transpose", "vec", "wrap"]

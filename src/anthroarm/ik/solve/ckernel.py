@@ -25,10 +25,9 @@ same seeds and asserts the same iterates, iteration counts and flags.
 Build and load: one shared library per (robot, frame) (limits, placements and axes are
 compile-time constants) through the one disk cache (:func:`anthroarm.cache.shared_library`:
 ``ik/lm_<hash>.so`` keyed by the source, compiler and flags, verified before it is loaded), the
-flags of :mod:`anthroarm.ik.analytic_c` (``-fno-fast-math -ffp-contract=off``).  Without a
-compiler, if compilation fails, or with ``ANTHROARM_IK_C=0`` (the switch of
-:func:`anthroarm.ik.analytic_c.enabled`), :func:`kernel_for` returns None and the Python kernel
-runs.  Called through :mod:`ctypes` with the per-thread buffers of
+flags :data:`FLAGS` (``-fno-fast-math -ffp-contract=off``: the same rounding as the Python
+kernel).  Without a compiler, if compilation fails, or with ``ANTHROARM_IK_C=0``,
+:func:`kernel_for` returns None and the Python kernel runs.  Called through :mod:`ctypes` with the per-thread buffers of
 :class:`~anthroarm.ik.solve.workspace.Workspace` (no allocation per call but the returned θ).
 """
 
@@ -42,7 +41,6 @@ import numpy as np
 
 from ... import cache
 from ...chain import PRISMATIC
-from ..analytic_c import FLAGS
 from ..fk_codegen import frame_product
 from ...codegen.graph import straight_line
 from . import kernel
@@ -50,8 +48,9 @@ from .targets import ORIENTATION, POSE, POSITION
 
 _LOCK = threading.Lock()
 _LIBS: dict[str, "CKernel"] = {}      # source key -> loaded library (no Robot referenced)
-#: the attempt kernels: one per (robot, frame), switched off by ANTHROARM_IK_C=0 like the
-#: closed-form kernels (:data:`anthroarm.ik.analytic_c.KERNELS`)
+#: compiler flags: no fast-math, no fused multiply-add contraction (the Python kernel's rounding)
+FLAGS = ["-O2", "-fPIC", "-shared", "-std=c99", "-fno-fast-math", "-ffp-contract=off"]
+#: the attempt kernels: one per (robot, frame), switched off by ANTHROARM_IK_C=0
 KERNELS = cache.CompiledOnce("ANTHROARM_IK_C", "Python kernel", "available (compiled on first use per robot and frame)")
 enabled = KERNELS.enabled
 status = KERNELS.status

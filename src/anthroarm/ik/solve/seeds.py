@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from ...chain import PRISMATIC
 from ...errors import UnsupportedModelError
-from .. import analytic_c, closed_form
+from .. import closed_form
 from .targets import POSE
 
 SEED_TABLE = 2048       # configurations in the per-(robot, frame) seed table
@@ -230,15 +230,13 @@ class TableSeeds:
 def closed_form_cheap(robot, fid) -> bool:
     """True when ``analytic="auto"`` puts the closed form first (where it exists,
     :func:`anthroarm.ik.closed_form.closed_form_info`): a call costs about as much as a few
-    Gauss–Newton iterations (``cost_us`` ≤ :data:`CHEAP_US`; an arm solved by its geometry in
-    numpy, :mod:`anthroarm.ik.geometric`, costs milliseconds and joins after
-    ``ANALYTIC_AFTER`` failed attempts) — a non-redundant arm (~10 µs), a redundant arm's swivel grid
-    (:data:`SWIVEL_GRID`) only with the compiled kernel of :mod:`anthroarm.ik.analytic_c`
-    (~15 µs; ~0.5 ms in NumPy).  Fixed per robot and environment, so the same call gives the
-    same answer."""
+    Gauss–Newton iterations (``cost_us`` ≤ :data:`CHEAP_US`: a closed 6R class or an SRS arm's
+    swivel grid, ~10 µs per pose and swivel angle in one compiled call; an arm solved by a
+    search, :data:`anthroarm.ik.geometric.SEARCHED`, costs milliseconds and joins after
+    ``ANALYTIC_AFTER`` failed attempts).  Fixed per robot, so the same call gives the same
+    answer."""
     info = closed_form.closed_form_info(robot, fid)
-    return info is not None and info.cost_us <= CHEAP_US and \
-        (not info.swivel or bool(analytic_c.enabled() and analytic_c.compiler() is not None))
+    return info is not None and info.cost_us <= CHEAP_US
 
 
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
