@@ -125,6 +125,20 @@ def test_lattice_points_reach_their_wrist_position(robot, table):
     assert np.abs(R - table.rotation).max() < 1e-4
 
 
+def test_table_branch_is_the_books_front_up_noflip(robot, table):
+    """The stored branch is the book's shoulder front, elbow up, wrist no-flip: θ1 faces the
+    wrist centre (Eq. (7-2): (cos θ1, sin θ1)·d > 0 for d the wrist centre above the shoulder),
+    θ3 = asin k ∈ [−90°, 90°] (Eq. (7-6)) and θ5 ≥ 0 (Eq. (7-12): atan2 of a non-negative
+    sine).  Oracle: the lattice points themselves and the printed lengths, not the IK labels."""
+    idx = np.argwhere(table.valid)
+    M = table.origin + table.D * idx
+    q = table.Q[table.valid]
+    d = M - np.array([0.0, 0.0, robot.spec.params["s0"]])
+    assert (np.cos(q[:, 0]) * d[:, 0] + np.sin(q[:, 0]) * d[:, 1] > 0).all()
+    assert (np.abs(q[:, 2]) <= np.pi / 2 + 1e-9).all()
+    assert (q[:, 4] >= -1e-9).all()
+
+
 def test_interpolated_wrist_within_the_printed_1_cm(robot, table):
     """The book's claim: 1 cm per axis with the 10 cm lattice.  On the assumed layout the
     claim holds for at least 90 % of random points of the covered cells and the median error

@@ -13,9 +13,9 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("name", aa.models.book_names())
-def test_committed_urdf_equals_generator(name):
+def test_committed_urdf_equals_generator(name, same_urdf_text):
     committed = (REPO / "urdf" / f"{name}.urdf").read_text()
-    assert committed == aa.models.urdf_text(name), f"urdf/{name}.urdf is stale: run aa.models.write_urdfs()"
+    assert same_urdf_text(committed, aa.models.urdf_text(name)), f"urdf/{name}.urdf is stale: run aa.models.write_urdfs()"
 
 
 def test_write_urdfs_roundtrip(tmp_path):
@@ -143,3 +143,12 @@ def test_erd_arms_lock_unused_joints():
     h = aa.load("human_right_arm")
     assert h.joint_names[0] == "right_shoulder_Z" and h.nq == 7
     assert "left_elbow_Z" in h.locked
+
+
+def test_same_urdf_text_tells_a_stale_file(same_urdf_text):
+    """The comparison forgives the 16th digit, not a changed number or tag."""
+    a = '<origin xyz="0.1 0 -0.08994824117884934" rpy="-1.5707963267948966 -0.8591786503008974 0"/>'
+    assert same_urdf_text(a, a.replace("0.08994824117884934", "0.08994824117884936").replace(" 0 ", " -6.9e-18 "))
+    assert not same_urdf_text(a, a.replace("0.08994824117884934", "0.0899482"))
+    assert not same_urdf_text(a, a.replace("rpy", "xyz"))
+    assert not same_urdf_text(a, a + '<axis xyz="0 0 1"/>')

@@ -480,8 +480,7 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
         for i, b in zip(*np.nonzero(near)):
             Q[i, b], res[i, b] = _refine(robot, Q[i, b], Ts[i], robot.lower, robot.upper, position_only)
     if valid is None or polished:
-        valid = cand & inside & (res <= tol)
-        _drop_duplicates(Q, valid)
+        valid = _geo.mark_solutions(Q if polished else th, cand, inside, res, tol, s.form.branches)
     else:
         valid = np.array(valid)
     if s.kind != "srs" and s.plain:
@@ -498,18 +497,6 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     return AnalyticBatchResult(solutions=np.where(valid[..., None], Q, np.nan), valid=valid, branches=labels,
                                reasons=reasons, swivel=None if swivel is None else np.where(valid, swivel, np.nan),
                                residuals=np.where(valid, res, np.nan), singular=[None] * N, model=robot.name)
-
-
-def _drop_duplicates(Q, valid):
-    """Coincident branches (singular poses): drop a branch within 1e-9 rad of an earlier valid
-    one of its pose (in place on ``valid``; bounded memory for swivel grids)."""
-    N, B = valid.shape
-    earlier = np.tril(np.ones((B, B), bool), -1)                                         # [b, a]: a < b
-    step = max(1, 2_000_000 // (B * B * Q.shape[-1]))
-    for i in range(0, N, step):
-        t, v = Q[i:i + step], valid[i:i + step]
-        d = np.abs(np.angle(np.exp(1j * (t[:, :, None] - t[:, None, :])))).max(-1)      # (n, B, B)
-        valid[i:i + step] &= ~((d < 1e-9) & earlier & v[:, None, :]).any(-1)
 
 
 def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:

@@ -589,16 +589,43 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
                 Q[i, b, j] = q[j]
             V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
             RES[i, b] = _fk_residual(kH, kO, MR, Mp, q, n, T[i]) if V6[b] else math.inf
-            ok = V6[b] and inside and RES[i, b] <= tol
-            for a in range(b):
-                if ok and OK[i, a]:
-                    d = 0.0
-                    for j in range(n):
-                        d = max(d, abs(wrap(Q[i, b, j] - Q[i, a, j])))
-                    if d < 1e-9:
-                        ok = False
-            OK[i, b] = ok
+        _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, 8, OK[i])
     return -1
+
+
+@kernel
+def _mark_solutions(Q, V, IN, RES, tol, group, OK):
+    """The solutions among the branches of one pose (Q (B, n), flags (B,)): a candidate inside
+    the limits with FK residual ≤ ``tol``, not within 1e-9 rad of an earlier solution of its
+    group (``group`` consecutive branches: one swivel angle or held-joint value) — coincident
+    branches at singular poses.  Writes OK (B,)."""
+    for b in range(len(V)):
+        ok = V[b] and IN[b] and RES[b] <= tol
+        a = b - b % group
+        while ok and a < b:
+            if OK[a]:
+                d = 0.0
+                for j in range(Q.shape[1]):
+                    d = max(d, abs(wrap(Q[b, j] - Q[a, j])))
+                ok = d >= 1e-9
+            a += 1
+        OK[b] = ok
+
+
+@kernel
+def _mark_loop(Q, V, IN, RES, tol, group, OK):
+    for i in range(len(V)):
+        _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, group, OK[i])
+
+
+def mark_solutions(Q, V, IN, RES, tol: float, group: int) -> np.ndarray:
+    """The solutions (N, B) among candidate branches Q (N, B, n) rad with flags V (candidate),
+    IN (inside the limits) and FK residuals RES (N, B): residual ≤ ``tol``, duplicates within
+    1e-9 rad inside each ``group`` of consecutive branches dropped (compiled)."""
+    OK = np.empty(V.shape, bool)
+    _mark_loop(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(V), np.ascontiguousarray(IN),
+               np.ascontiguousarray(RES, dtype=float), float(tol), int(group), OK)
+    return OK
 
 
 def solve_class(cls: str, H, P, R06, p):

@@ -78,6 +78,8 @@ _ITERS = 60
 #: Newton steps on the pose for a fold seed of a 1-D search and for a 2-D local minimum
 _POLISH_1D = 12
 _POLISH_2D = 20
+#: Newton steps on the pose for a refined root whose error stayed above SEARCH_TOL
+_POLISH_ROOT = 3
 #: error below which a local minimum of the 2-D grid seeds Newton
 _MIN_2D = 0.3
 #: most fold seeds kept per pose (more are ignored; a fold has at most a few roots)
@@ -337,6 +339,24 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
 
 
 @kernel
+def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
+    """The branch at a refined root ``out`` (x, inner root, |e|) into ``q`` (6,); returns
+    whether it is exact.  A root whose error stayed above :data:`SEARCH_TOL` (regula falsi
+    stalls where two roots share a sample interval) while every subproblem on it was exact
+    gets :data:`_POLISH_ROOT` Newton steps on the whole pose (scratch ``q2``), kept where they
+    converge (quadratic convergence from a root already good to ~1e-10)."""
+    ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
+    if ex and out[4] > SEARCH_TOL:
+        for j in range(6):
+            q2[j] = q[j]
+        ex = polish(h, PP, R06, p, q2, _POLISH_ROOT, J, F)
+        if ex:
+            for j in range(6):
+                q[j] = q2[j]
+    return ex
+
+
+@kernel
 def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     """Every branch of one pose of a 1-D search class into Q (16, 6), V, E; returns their
     number."""
@@ -350,7 +370,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     RS, ES, CS = np.zeros((L, 4, 3)), np.full((L, 4), math.nan), np.zeros(L, dtype=np.int64)
     t2, th, e = np.empty((4, 2)), np.empty((4, 3)), np.empty(4)
     S1, DM = np.zeros(4, dtype=np.int64), np.zeros(4)
-    out, q = np.empty(5), np.empty(6)
+    out, q, q2 = np.empty(5), np.empty(6), np.empty(6)
     J, F = np.empty((6, 6)), np.empty(6)
     _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2)
     fine = np.zeros(grid, dtype=np.bool_)
@@ -365,8 +385,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                 if _refine(cls, h, PP, R06, p16, X[g], X[g + 1], ES[g, s], ES[g + 1, s1],
                            (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]),
                            (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2]), th, e, t2, out):
-                    ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
-                    n = _push(Q, V, E, n, q, ex and out[4] <= SEARCH_TOL)
+                    n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
     # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends
     L2 = 2 * _SUB + 1
     u = np.empty(L2)
@@ -392,8 +411,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                     if _refine(cls, h, PP, R06, p16, X2[g2], X2[g2 + 1], ES2[g2, s], ES2[g2 + 1, s1],
                                (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
                                (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
-                        ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
-                        n = _push(Q, V, E, n, q, ex and out[4] <= SEARCH_TOL)
+                        n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
             if CS2[g2] != CS2[g2 + 1]:
                 # fold seeds: the roots with a small error on the side with more roots
                 side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1

@@ -378,43 +378,155 @@ def sp2(p1, p2, k1, k2, tol: float = TOL) -> Solutions:
 
 # ----------------------------------------------------------------------------- quartics
 @kernel
+def _poly_d(a, n, x):
+    """p(x) and p'(x) of the degree-n polynomial a[0..n] (highest first), by Horner."""
+    f, g = a[0], 0.0
+    for i in range(1, n + 1):
+        g = g * x + f
+        f = f * x + a[i]
+    return f, g
+
+
+@kernel
+def _refine_root(a, n, lo, hi, flo):
+    """The root of a[0..n] in (lo, hi) where p changes sign (p(lo) = ``flo``): Newton's
+    method safeguarded by bisection (Press et al., *Numerical Recipes*, 3rd ed., §9.4
+    "rtsafe"); Newton steps until the step is at rounding level."""
+    x = 0.5 * (lo + hi)
+    dxold = hi - lo
+    dx = dxold
+    neg_lo = flo < 0.0
+    for _ in range(200):
+        f, g = _poly_d(a, n, x)
+        if f == 0.0:
+            return x
+        if (f < 0.0) == neg_lo:
+            lo = x
+        else:
+            hi = x
+        xn = x - f / g if g != 0.0 else lo - 1.0
+        if not (lo < xn < hi) or abs(2.0 * f) > abs(dxold * g):
+            xn = 0.5 * (lo + hi)                        # bisection: Newton leaves the bracket or stalls
+        dxold = dx
+        dx = xn - x
+        if xn == x or abs(dx) <= 4.4e-16 * abs(x) or hi - lo <= 4.4e-16 * max(abs(lo), abs(hi)):
+            return xn
+        x = xn
+    return x
+
+
+@kernel
+def _bracket_roots(a, n, crit, cmul, m, out, omul):
+    """Distinct real roots (ascending, into ``out``) and their multiplicities (``omul``) of the
+    degree-n polynomial a[0..n] (a[0] ≠ 0), given the distinct real roots ``crit[:m]``
+    (ascending, multiplicities ``cmul``) of its derivative; returns their number.
+
+    p is monotone between consecutive critical points, so each interval holds at most one
+    simple root (found by :func:`_refine_root` where p changes sign).  A critical point c is a
+    root of multiplicity ``cmul + 1`` where: p has an extremum there (odd ``cmul``) that is 0 or
+    misses zero by a pair of complex roots c ± iβ with β ≤ 1e-6 max(1, abs(c)) (β² ≈
+    2 p(c) / p''(c), the tangent case; an extremum whose computed value crosses zero, however
+    slightly, gives two simple roots, so close pairs are not merged); p is monotone across c
+    (even ``cmul``) and vanishes there to rounding (``abs(p(c)) ≤ 4 (n + 1) ε Σ abs(aᵢ) abs(c)ⁱ``,
+    a triple or higher root)."""
+    a0 = a[0]
+    bound = 0.0                                         # Fujiwara's bound on abs(root)
+    for i in range(1, n + 1):
+        t = abs(a[i] / a0)
+        if i == n:
+            t *= 0.5
+        if t > 0.0:
+            bound = max(bound, t ** (1.0 / i))
+    bound *= 2.0
+    for j in range(m):
+        bound = max(bound, abs(crit[j]))
+    bound = 1.5 * bound + 1e-300
+    cnt = 0
+    px = -bound
+    pv, _ = _poly_d(a, n, px)
+    for j in range(m + 1):
+        last = j == m
+        cx = bound if last else crit[j]
+        cv, _ = _poly_d(a, n, cx)
+        root = False
+        if not last:
+            s, ax = 0.0, abs(cx)
+            for i in range(n + 1):
+                s = s * ax + abs(a[i])
+            if cmul[j] % 2 == 0:                        # p monotone across c: a root of
+                root = abs(cv) <= 4.0 * (n + 1) * 2.220446049250313e-16 * s    # odd multiplicity?
+            elif cv == 0.0:
+                root = True
+            else:                                       # an extremum: tangent within 1e-6?
+                p2 = 0.0
+                for i in range(n - 1):
+                    p2 = p2 * cx + a[i] * (n - i) * (n - i - 1)
+                beta = 1e-6 * max(1.0, ax)
+                if cv * p2 > 0.0 and 2.0 * cv / p2 <= beta * beta:
+                    root = True
+            if root:
+                cv = 0.0
+        if pv * cv < 0.0:
+            out[cnt] = _refine_root(a, n, px, cx, pv)
+            omul[cnt] = 1
+            cnt += 1
+        if root:
+            out[cnt] = cx
+            omul[cnt] = cmul[j] + 1
+            cnt += 1
+        px, pv = cx, cv
+    return cnt
+
+
+@kernel
 def real_roots(c):
     """Real roots of a polynomial of degree ≤ 4 (coefficients ``c`` (5,), highest first): roots
-    (4,) and which are real (4,).  Eigenvalues of the companion matrix (LAPACK), polished by
-    two Newton steps on the polynomial."""
+    (4,) ascending with multiplicity (a double root twice) and which are real (4,) (the real
+    ones first; 0.0 in the other slots).  The coefficients are scaled by the largest abs(cᵢ);
+    leading ones below 1e-10 (the first) or 1e-14 (the next) of it are dropped (lower degree);
+    the zero polynomial and constants have no roots.
+
+    Method: isolation by the derivatives (the real roots of p' split the line into intervals
+    where p is monotone, so each holds at most one root; applied from the linear (deg−1)-th
+    derivative up to p), each root found by bisection-safeguarded Newton iteration to rounding
+    level (Press et al., *Numerical Recipes*, 3rd ed., §9.4; the derivative-bracketing scheme
+    is e.g. that of Collins & Loos' real root isolation, see also Flocke, "Algorithm 954",
+    ACM TOMS 41 (2015) for closed-form alternatives).  Double roots (tangent cases) are
+    extrema of p that vanish or miss zero by a complex pair c ± iβ with β ≤ 1e-6 max(1, abs(c))
+    (the tolerance of the former companion-matrix test), see :func:`_bracket_roots`."""
     big = 0.0
     for i in range(5):
         big = max(big, abs(c[i]))
-    cn = c / (big if big > 0.0 else 1.0)
-    roots = np.full(4, np.nan + 0j)
+    s = big if big > 0.0 else 1.0
     first = 0
-    while first < 4 and abs(cn[first]) <= (1e-10 if first == 0 else 1e-14):
+    while first < 4 and abs(c[first] / s) <= (1e-10 if first == 0 else 1e-14):
         first += 1                                    # lower degree (rare)
     deg = 4 - first
-    if deg >= 1:
-        comp = np.zeros((deg, deg), dtype=np.complex128)
-        for j in range(deg):
-            comp[0, j] = -cn[first + 1 + j] / cn[first]
-        for j in range(1, deg):
-            comp[j, j - 1] = 1.0
-        ev = np.linalg.eigvals(comp)
-        for j in range(deg):
-            roots[j] = ev[j]
     x = np.zeros(4)
     real = np.zeros(4, dtype=np.bool_)
-    for j in range(4):
-        r = roots[j]
-        if math.isfinite(r.real) and math.isfinite(r.imag) and abs(r.imag) <= 1e-6 * max(1.0, abs(r.real)):
-            real[j] = True
-            xj = r.real
-            for _ in range(2):
-                f = (((cn[0] * xj + cn[1]) * xj + cn[2]) * xj + cn[3]) * xj + cn[4]
-                g = ((4.0 * cn[0] * xj + 3.0 * cn[1]) * xj + 2.0 * cn[2]) * xj + cn[3]
-                if abs(g) > 1e-300:
-                    step = f / g
-                    if abs(step) < 1e-3 * max(1.0, abs(xj)):
-                        xj -= step
-            x[j] = xj
+    if deg == 0:
+        return x, real
+    D = np.zeros((4, 5))                              # D[k]: k-th derivative, degree deg − k
+    for i in range(deg + 1):
+        D[0, i] = c[first + i] / s
+    for k in range(1, deg):
+        mk = deg - k + 1
+        for i in range(mk):
+            D[k, i] = D[k - 1, i] * (mk - i)
+    R = np.zeros((4, 4))
+    M = np.zeros((4, 4), dtype=np.int64)
+    cnt = 1
+    R[deg - 1, 0] = -D[deg - 1, 1] / D[deg - 1, 0]
+    M[deg - 1, 0] = 1
+    for k in range(deg - 2, -1, -1):
+        cnt = _bracket_roots(D[k], deg - k, R[k + 1], M[k + 1], cnt, R[k], M[k])
+    j = 0
+    for r in range(cnt):
+        for _ in range(M[0, r]):
+            if j < 4:
+                x[j] = R[0, r]
+                real[j] = True
+                j += 1
     return x, real
 
 
@@ -482,6 +594,29 @@ def _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t):
 
 
 @kernel
+def _sp5_newton(p0, p1, p2, p3, k1, k2, k3, t, stop):
+    """Newton's method on the SP5 equation (3 equations, 3 angles) from ``t``: at most three
+    steps, fewer once the residual is below ``stop``; returns the wrapped angles and the
+    residual norm there."""
+    res = math.inf
+    for it in range(4):
+        r1 = rotate(k1, t[0], p1)
+        r3 = rotate(k3, t[2], p3)
+        w = rotate(k2, t[1], add(p2, r3))
+        F = sub(add(p0, r1), w)                        # _sp5_residual at t
+        res = norm(F)
+        if it == 3 or res <= stop:
+            break
+        c3v = rotate(k2, t[1], cross(k3, r3))
+        j0, j1 = cross(k1, r1), neg(cross(k2, w))
+        J = ((j0[0], j1[0], -c3v[0]), (j0[1], j1[1], -c3v[1]), (j0[2], j1[2], -c3v[2]))
+        step, good = _solve3(J, F)
+        if good:
+            t = (t[0] - step[0], t[1] - step[1], t[2] - step[2])
+    return (wrap(t[0]), wrap(t[1]), wrap(t[2])), res
+
+
+@kernel
 def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
     """SP5 of one problem (tuples): writes the solutions into ``out_theta`` (4, 3) (valid rows
     first) and returns (count, singular); see :func:`sp5`."""
@@ -507,48 +642,57 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
     eq[4] = rhs[2] * rhs[2] - 4.0 * sq[2] * R1[2]
     z, real = real_roots(eq)
     k1p1, k3p3 = cross(k1, p1), cross(k3, p3)
-    a1 = (dot(k1p1, k2), -dot(cross(k1, k1p1), k2))    # A1ᵀ k2
-    a3 = (dot(k3p3, k2), -dot(cross(k3, k3p3), k2))
+    kk1p1, kk3p3 = cross(k1, k1p1), cross(k3, k3p3)
+    a1 = (dot(k1p1, k2), -dot(kk1p1, k2))              # A1ᵀ k2
+    a3 = (dot(k3p3, k2), -dot(kk3p3, k2))
     na1 = max(a1[0] * a1[0] + a1[1] * a1[1], 1e-300)
     na3 = max(a3[0] * a3[0] + a3[1] * a3[1], 1e-300)
     theta = np.zeros((16, 3))
     ok = np.zeros(16, dtype=np.bool_)
     res = np.full(16, np.inf)
     scl = 1.0 + norm(p0) + norm(p1) + norm(p2) + norm(p3)
+    # Newton stops early below this residual (far below tol: the same exact solutions)
+    stop = min(1e-13 * scl, 1e-3 * tol)
     for r in range(4):
-        if not real[r]:
-            continue
+        if not real[r] or (r > 0 and z[r] == z[r - 1]):
+            continue                                   # a double root: the same candidates
         e1, e3 = z[r] - d1, z[r] - d3
         s1 = math.sqrt(max(na1 - e1 * e1, 0.0))
         s3 = math.sqrt(max(na3 - e3 * e3, 0.0))
         for g in range(4):
             sg1 = 1.0 if g < 2 else -1.0
             sg3 = 1.0 if g % 2 == 0 else -1.0
-            t1 = math.atan2(a1[0] * e1 + sg1 * a1[1] * s1, a1[1] * e1 - sg1 * a1[0] * s1)
-            t3 = math.atan2(a3[0] * e3 + sg3 * a3[1] * s3, a3[1] * e3 - sg3 * a3[0] * s3)
-            v1 = add(p0, rotate(k1, t1, p1))
-            v3 = add(p2, rotate(k3, t3, p3))
+            if (sg1 < 0.0 and s1 == 0.0) or (sg3 < 0.0 and s3 == 0.0):
+                continue                               # the same point as sign +1
+            # the SP4 points at height z (IK-Geo Eqs. (4)-(6)): x = (sin θ, cos θ) unnormalised
+            x10, x11 = a1[0] * e1 + sg1 * a1[1] * s1, a1[1] * e1 - sg1 * a1[0] * s1
+            x30, x31 = a3[0] * e3 + sg3 * a3[1] * s3, a3[1] * e3 - sg3 * a3[0] * s3
+            n1, n3 = math.hypot(x10, x11), math.hypot(x30, x31)
+            if n1 > 0.0:
+                x10, x11 = x10 / n1, x11 / n1
+            else:
+                x10, x11 = 0.0, 1.0                    # atan2(0, 0) = 0
+            if n3 > 0.0:
+                x30, x31 = x30 / n3, x31 / n3
+            else:
+                x30, x31 = 0.0, 1.0
+            v1 = add(c1, sub(scale(k1p1, x10), scale(kk1p1, x11)))      # p0 + rot(k1, θ1) p1
+            v3 = add(c3, sub(scale(k3p3, x30), scale(kk3p3, x31)))      # p2 + rot(k3, θ3) p3
+            # residual after θ2 by SP1 (rot(k2, θ2) v3 nearest v1): heights h and radii ρ about
+            # k2 (the spurious sign pairs of the squared quartic have ‖v1‖ ≠ ‖v3‖)
+            h1, h3 = dot(k2, v1), dot(k2, v3)
+            rho1 = math.sqrt(max(dot(v1, v1) - h1 * h1, 0.0))
+            rho3 = math.sqrt(max(dot(v3, v3) - h3 * h3, 0.0))
+            if math.hypot(h1 - h3, rho1 - rho3) > 1e-2 * scl:
+                continue
+            t1, t3 = math.atan2(x10, x11), math.atan2(x30, x31)
             k2v3 = cross(k2, v3)
             t2 = math.atan2(dot(k2v3, v1), -dot(cross(k2, k2v3), v1))     # SP1: rot(k2, θ2) v3 = v1
-            t = (t1, t2, t3)
-            if norm(_sp5_residual(p0, p1, p2, p3, k1, k2, k3, t)) > 1e-2 * scl:
-                continue
-            for _ in range(3):                         # Newton (the quartic's roots cluster)
-                F = _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t)
-                r1 = rotate(k1, t[0], p1)
-                r3 = rotate(k3, t[2], p3)
-                w = rotate(k2, t[1], add(p2, r3))
-                c3v = rotate(k2, t[1], cross(k3, r3))
-                j0, j1 = cross(k1, r1), neg(cross(k2, w))
-                J = ((j0[0], j1[0], -c3v[0]), (j0[1], j1[1], -c3v[1]), (j0[2], j1[2], -c3v[2]))
-                step, good = _solve3(J, F)
-                if good:
-                    t = (t[0] - step[0], t[1] - step[1], t[2] - step[2])
-            t = (wrap(t[0]), wrap(t[1]), wrap(t[2]))
+            t, rs = _sp5_newton(p0, p1, p2, p3, k1, k2, k3, (t1, t2, t3), stop)
             i = 4 * r + g
             theta[i, 0], theta[i, 1], theta[i, 2] = t
-            res[i] = norm(_sp5_residual(p0, p1, p2, p3, k1, k2, k3, t))
-            ok[i] = res[i] <= tol
+            res[i] = rs
+            ok[i] = rs <= tol
     exact = np.zeros(4, dtype=np.bool_)
     return _keep_best(theta, ok, res, out_theta, exact, 3), False
 

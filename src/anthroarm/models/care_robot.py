@@ -63,8 +63,11 @@ GEAR_RATIO = 200.0
 R_FORWARD = ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0), (-1.0, 0.0, 0.0))
 #: the box (m, base frame) of wrist positions the table covers (assumed): in front of the arm
 CELL_BOUNDS = ((0.1, -0.4, -0.3), (0.5, 0.4, 0.4))
-#: the IK branch stored in the table (one branch, so that the 8 corners of a cell agree)
-CELL_BRANCH = "shoulder=front,elbow=up,wrist=noflip"
+#: the IK branch stored in the table (one branch, so that the 8 corners of a cell agree): the
+#: book's shoulder front, elbow up, wrist no-flip of Eqs. (7-2), (7-6), (7-8) — θ1 facing the
+#: wrist centre (|θ1| ≤ 90° in front of the arm), θ3 = asin k in [−90°, 90°], θ5 ≥ 0 — which is
+#: branch (1, 0, 1) of the spherical-wrist + two-parallel class solver (aa.ik.analytic's labels)
+CELL_BRANCH = "q1=1,q3=0,q5=1"
 #: degrees of freedom printed (6 arm joints + 3 fingers) and the motor count of the pair of arms
 DOF_PRINTED = 9
 MOTORS_PRINTED = 18
