@@ -19,33 +19,20 @@ from anthroarm.errors import UnsupportedModelError
 from anthroarm.ik import classify as C
 from anthroarm.ik import geometric as G
 from anthroarm.ik.closed_form import closed_form_info
+from anthroarm.models.standard_dh import PUMA560, standard_dh_urdf
 
 PI = np.pi
 
 
 def dh_urdf(tmp_path, name, alpha, a, d, lim=PI):
-    """A 6R arm from standard DH parameters (T = Π Rz(θ) Tz(d) Tx(a) Rx(α), Craig/Corke), joint
-    limits ±lim, tool at the last DH frame."""
-    links = "".join(f'<link name="l{i}"/>' for i in range(7)) + '<link name="tool"/>'
-    js = []
-    for i in range(6):
-        xyz, rpy = ("0 0 0", "0 0 0") if i == 0 else (f"{a[i-1]} 0 {d[i-1]}", f"{alpha[i-1]} 0 0")
-        js.append(f'<joint name="j{i+1}" type="revolute"><origin xyz="{xyz}" rpy="{rpy}"/>'
-                  f'<parent link="l{i}"/><child link="l{i+1}"/><axis xyz="0 0 1"/>'
-                  f'<limit lower="{-lim!r}" upper="{lim!r}" effort="10" velocity="1"/></joint>')
-    js.append(f'<joint name="jt" type="fixed"><origin xyz="{a[5]} 0 {d[5]}" rpy="{alpha[5]} 0 0"/>'
-              '<parent link="l6"/><child link="tool"/></joint>')
+    """A 6R arm from standard DH parameters (anthroarm.models.standard_dh), joint limits ±lim."""
     path = tmp_path / f"{name}.urdf"
-    path.write_text(f'<?xml version="1.0"?><robot name="{name}"><link name="base"/>'
-                    '<joint name="j0" type="fixed"><parent link="base"/><child link="l0"/></joint>'
-                    f'{links}{"".join(js)}</robot>')
+    path.write_text(standard_dh_urdf(name, alpha, a, d, lim))
     return aa.load(str(path))
 
 
 def puma560(tmp_path):
-    # Corke, RTB models/DH/Puma560: d1 = 0.6718, a2 = 0.4318, d3 = 0.15005, a3 = 0.0203, d4 = 0.4318
-    return dh_urdf(tmp_path, "puma560", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
-                   [0, 0.4318, 0.0203, 0, 0, 0], [0.6718, 0, 0.15005, 0.4318, 0, 0])
+    return dh_urdf(tmp_path, "puma560", **PUMA560)
 
 
 def random_arm(tmp_path, cls, seed):
@@ -246,12 +233,13 @@ def test_general_6r_by_a_2d_search(tmp_path):
         assert np.abs(np.angle(np.exp(1j * (sols - th[i])))).max(1).min() < 1e-7, i
 
 
-@pytest.mark.parametrize("name, polish", [("panda", 1e-12), ("xarm7", 1e-4)])
+@pytest.mark.parametrize("name, polish", [("panda", 1e-12), ("xarm7", 1e-12)])
 def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
     """panda and xarm7 with the last joint held are 6R arms with a spherical shoulder
     (spherical_two_intersecting of the reversed chain).  xarm7's URDF rounds its angles (axes
     ~4e-6 rad off, shoulder lines 5e-7 m apart): the class solution is polished onto the exact
-    pose, which moves the held joint by ~1e-6."""
+    pose by Newton steps on the first six joints in the compiled call, the held joint stays
+    where it was asked to be."""
     robot = aa.load(name)
     gp = G.plan_for(robot)
     assert gp.cls == C.SPHERICAL_TWO_INTERSECTING and gp.reversed and gp.param_joint == 6
@@ -364,3 +352,30 @@ def test_search_classes_against_ik_geo(tmp_path, cls):
             assert len(ours) >= len(good)
             for g in good:
                 assert np.abs(np.angle(np.exp(1j * (ours - g)))).max(1).min() < 1e-4, (cls, seed, i)
+
+
+def test_standard_dh_urdf_is_the_dh_product_and_rejects_bad_rows(tmp_path):
+    """The written PUMA 560 is Π Rz(θi) Tz(di) Tx(ai) Rx(αi) (computed here from the DH table)
+    by Pinocchio's FK; bad rows are ParameterErrors."""
+    from anthroarm.errors import ParameterError
+
+    robot = puma560(tmp_path)
+
+    def dh(q):
+        T = np.eye(4)
+        for th, al, a, d in zip(q, PUMA560["alpha"], PUMA560["a"], PUMA560["d"]):
+            ct, st, ca, sa = np.cos(th), np.sin(th), np.cos(al), np.sin(al)
+            T = T @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+                              [0, sa, ca, d], [0, 0, 0, 1]])
+        return T
+
+    for q in robot.random_q(20, np.random.default_rng(5)):
+        np.testing.assert_allclose(_fk(robot, q), dh(q), atol=1e-12)
+    with pytest.raises(ParameterError):
+        standard_dh_urdf("x", [0] * 5, [0] * 6, [0] * 6)
+    with pytest.raises(ParameterError):
+        standard_dh_urdf("x", [0] * 6, [np.nan] * 6, [0] * 6)
+    with pytest.raises(ParameterError):
+        standard_dh_urdf("x", [0] * 6, [0] * 6, [0] * 6, limit=-1)
+    with pytest.raises(ParameterError):
+        standard_dh_urdf('x"/><evil', [0] * 6, [0] * 6, [0] * 6)

@@ -224,6 +224,15 @@ def closed_form_info(robot, frame=None) -> ClosedForm | None:
     return None if s is None else s.form
 
 
+def held_joint(robot, frame=None) -> int | None:
+    """Index (in ``robot.chain.independent`` order, the order of θ) of the joint a 7-joint arm
+    holds as the parameter of its family (``param=`` of :func:`analytic`), or None."""
+    s = _at(robot, frame)
+    if s is None or s.kind != "geo" or s.plan.param_joint is None:
+        return None
+    return s.plan.order.tolist().index(s.plan.param_joint)
+
+
 def analytic_cost(robot, frame=None) -> float:
     """Cost hint of one :func:`analytic` call at ``frame`` in µs per pose (per swivel angle of a
     redundant arm), ``inf`` without a closed form."""

@@ -101,7 +101,7 @@ def _seven(A):
 
 
 @kernel
-def _solve6(A, b):
+def solve6(A, b):
     """Solve A x = b (6×6, in place: ``b`` becomes x) by Gaussian elimination with partial
     pivoting; returns det A (0 when a pivot vanishes, b then undefined)."""
     det = 1.0
@@ -169,7 +169,7 @@ def polish(h, PP, R06, p, q, iters, J, F):
         F[3] = 0.5 * (W[2][1] - W[1][2])
         F[4] = 0.5 * (W[0][2] - W[2][0])
         F[5] = 0.5 * (W[1][0] - W[0][1])
-        if abs(_solve6(J, F)) <= 1e-12:
+        if abs(solve6(J, F)) <= 1e-12:
             break                                            # the same q (and J) at every later step
         for i in range(6):
             q[i] += F[i]
@@ -533,4 +533,4 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
 
 
 __all__ = ["CLASSES", "SEARCH_BRANCHES", "SEARCH_GRID", "SEARCH_GRID_2D", "SEARCH_TOL", "fk_geo", "polish",
-           "solve_search"]
+           "solve6", "solve_search"]

@@ -242,7 +242,10 @@ def closed_form_cheap(robot, fid) -> bool:
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, and a note ("" or
     why the closed form failed).  A redundant arm (a swivel family of solutions) is solved
-    at ``swivel`` (rad) if given, else on ``grid``."""
+    at ``swivel`` (rad) if given, else on ``grid``.  A 7-joint arm whose last joint is held
+    (``param=`` of the closed form) is solved at that joint's value in the seed-table entry
+    nearest the target (one closed-form call: 8 branches), and on the closed form's own grid
+    of values only when that gives nothing inside the limits."""
     sh = ws.sh
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
@@ -253,8 +256,14 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
             kw["swivel"] = swivel
         elif grid is not None:
             kw["swivel"] = grid
+    T = tg.x.reshape(4, 4)
     try:
-        res = closed_form.analytic(robot, tg.x.reshape(4, 4), **kw)
+        res = None
+        if sh.held is not None:
+            near = TableSeeds(ws, tg, None).next()
+            res = closed_form.analytic(robot, T, param=float(near[sh.held]))
+        if res is None or not len(res):
+            res = closed_form.analytic(robot, T, **kw)
     except (ValueError, ArithmeticError, UnsupportedModelError) as exc:   # a seed source only
         return none, f"analytic seed failed: {exc}"
     S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))

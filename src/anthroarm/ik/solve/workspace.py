@@ -74,6 +74,7 @@ class Shared:
         info = closed_form.closed_form_info(robot, fid)
         self.has_closed_form = info is not None
         self.swivel_family = bool(info is not None and info.swivel)
+        self.held = closed_form.held_joint(robot, fid)     # θ index of a 7-joint arm's held joint
         self.closed_form_first = seeds.closed_form_cheap(robot, fid)
         self.all_on_path = bool(self.on_path.all())
         self.local = threading.local()
