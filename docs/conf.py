@@ -63,7 +63,7 @@ nitpicky = True
 nitpick_ignore_regex = [
     (r"py:.*", r"(numpy|np|scipy|sympy|pinocchio|pin|meshcat|matplotlib|dask|distributed|xarray"
                r"|yourdfpy|lxml|qpsolvers|osqp|tornado|zmq|pathlib|os|typing|collections|concurrent"
-               r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes)(\..*)?"),
+               r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes|numba)(\..*)?"),
     # prose in numpydoc type fields ("array (N, 3)", "float, rad") is not a Python name
     (r"py:class", r"[a-z_][a-z0-9_]*|.*[^\w.].*|True|False|[A-Z]|\d+|Eq\.?|\."),
     # module constants without a doc comment are not in the reference (names in prose)

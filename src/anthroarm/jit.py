@@ -2,7 +2,7 @@
 
 A kernel written here once (plain Python on floats, tuples and small numpy arrays) is the one
 source of its formula: Numba compiles *that* source to machine code on first use
-(https://numba.readthedocs.io, ``numba.njit``), and :attr:`py_func` of the compiled object is
+(https://numba.readthedocs.io, ``numba.njit``), and ``py_func`` of the compiled object is
 the same function run by the Python interpreter (what the tests compare against where they
 want the interpreter's answer).  There is no second copy to keep in step.
 

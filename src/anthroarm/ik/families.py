@@ -19,8 +19,8 @@ wrist (axes 5, 6, 7 meet at W), one solution family per elbow swivel angle φ:
   axis 4 (the elbow frame of :func:`~anthroarm.ik.qp.tasks.swivel.swivel_frames`);
 * the elbow E on its circle about n = (W − S)/‖W − S‖ (the triangle S, E, W has sides
   a = ‖E0 − S‖, b = ‖W0 − E0‖, L = ‖W − S‖): E = S + c n + r (cos φ u + sin φ v),
-  c = (a² − b² + L²)/(2L), r = √(a² − c²), (u, v) of :func:`~anthroarm.ik.qp.tasks.swivel.
-  swivel_basis` (u: −z projected ⊥ n, fallback −y; v = n × u);
+  c = (a² − b² + L²)/(2L), r = √(a² − c²), (u, v) of
+  :func:`~anthroarm.ik.qp.tasks.swivel.swivel_basis` (u: −z projected ⊥ n, fallback −y; v = n × u);
 * the shoulder R03 maps E0 − S onto E − S and f = rot(h4, q4)(W0 − E0) onto W − E (a straight
   elbow, r = 0: h4 onto the elbow axis a_E with d = n × a_E, the swivel angle's convention).
   When axis 3 lies along the upper arm at q = 0 (route ``"sp2"``): (q1, q2) by SP2,

@@ -853,15 +853,16 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
 
 def solve_one(plan: GeoPlan, T, param: float = 0.0, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
     """One pose ``T`` (4, 4) of a closed class, in one compiled call: (θ (K, n) rad in
-    independent-joint order, FK residuals (K,), branch indices (K,)), or None when the pose has
+    independent-joint order, FK residuals (K,), branch indices (a list of K)), or None when the pose has
     no solution, is malformed, or has a candidate to polish (:func:`solve_verified` then)."""
     cf, ci = plan.packed
-    out = np.empty((8, len(plan.fk_axes) + 2))
+    n = len(ci) - 3
+    out = np.empty((8, n + 2))
     K = _verified_one(cf, ci, T, param, tol, tol_orthonormal, out)
     if K <= 0:
         return None
-    n = ci[2]
-    return out[:K, :n], out[:K, n], out[:K, n + 1].astype(int)
+    sol = out[:K]
+    return sol[:, :n], sol[:, n], [int(b) for b in sol[:, n + 1].tolist()]
 
 
 # ----------------------------------------------------------------------------- anthroarm check

@@ -84,6 +84,16 @@ _POLISH_ROOT = 3
 _MIN_2D = 0.3
 #: most fold seeds kept per pose (more are ignored; a fold has at most a few roots)
 _MAX_SEEDS = 256
+#: a dip of the error along a followed root (|e| smallest at a sample, of one sign at it and
+#: both neighbours) is searched for a sign change where |e| there is at most this times the
+#: steeper secant slope to a neighbour times the wider gap (``_low``; 2: a safety factor over
+#: a V, for a slope that steepens towards the dip)
+_DIP = 2.0
+#: steps of the minimisation of |e| in a dip, and the bracket width (rad) where it stops
+_DIP_ITERS = 40
+_DIP_TOL = 1e-10
+#: a dip whose minimum stays above zero but within this of it (|e|) seeds a Newton polish
+_TOUCH = 1e-9
 
 #: the classes solved here, by their index in the compiled kernel
 CLASSES = ("two_parallel", "two_intersecting", "gen_six_dof")
@@ -357,6 +367,134 @@ def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
 
 
 @kernel
+def _nearest(RS, CS, i, r):
+    """The root at sample ``i`` of RS (L, 4, 3) nearest to ``r`` (3-tuple; max over the unknowns
+    of the wrapped difference): (its index, the distance; inf where there is none)."""
+    best, k = math.inf, 0
+    for t in range(CS[i]):
+        d = max(abs(wrap(RS[i, t, 0] - r[0])), max(abs(wrap(RS[i, t, 1] - r[1])), abs(wrap(RS[i, t, 2] - r[2]))))
+        if d < best:
+            best, k = d, t
+    return k, best
+
+
+@kernel
+def _follow(cls, h, PP, R06, p16, x, xl, xr, rl, rr, th, e, t2):
+    """The inner root at ``x`` (between ``xl`` and ``xr``, whose followed roots are ``rl``,
+    ``rr``) nearest to the linear interpolation of rl, rr: (its error (NaN: no root), the
+    root)."""
+    cnt = _inner(cls, h, PP, R06, p16, x, th, e, t2)
+    t = (x - xl) / (xr - xl if xr != xl else 1.0)
+    t = min(max(t, 0.0), 1.0)
+    ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
+    best, k = math.inf, 0
+    for r in range(cnt):
+        d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
+        if d < best:
+            best, k = d, r
+    if not best < _MATCH:
+        return math.nan, ref
+    return e[k], (th[k, 0], th[k, 1], th[k, 2])
+
+
+@kernel
+def _low(xa, xb, xc, fa, fb, fc):
+    """Whether a zero may hide in the dip fa ≥ fb ≤ fc > 0 at xa < xb < xc: fb is at most
+    :data:`_DIP` times the steeper of its two secant slopes times the wider of its two gaps (a
+    function that falls no faster than that slope reaches zero within the wider gap; a
+    parabola through a pair of roots in one gap, or a V through them, always passes; a smooth
+    dip that stays away from zero, |e| large against its variation over a gap, does not)."""
+    s = max((fa - fb) / (xb - xa), (fc - fb) / (xc - xb))
+    return fb <= _DIP * s * max(xb - xa, xc - xb)
+
+
+@kernel
+def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+    """A dip of the error along a followed root: |e| at ``xb`` below its value at ``xa`` < xb
+    and ``xc`` > xb, all three of one sign (``ea``, ``eb``, ``ec``; followed inner roots ``ra``,
+    ``rb``, ``rc``).  |e| is minimised over [xa, xc] along the root by successive parabolic
+    interpolation (a golden-section step where the vertex would not shrink the bracket); at
+    the first point where e changes sign, the two brackets it makes with xa and xc are refined
+    (``_refine``) and their branches pushed — the pair of roots inside one sample interval that
+    no sample sees.  A minimum that stays above zero by at most :data:`_TOUCH` (the error
+    touching zero) seeds a Newton polish of the whole arm.  Returns the new branch count."""
+    sg = 1.0 if eb > 0.0 else -1.0
+    fa, fb, fc = sg * ea, sg * eb, sg * ec
+    gold = 0.381966011250105
+    for it in range(_DIP_ITERS):
+        if xc - xa <= _DIP_TOL or not _low(xa, xb, xc, fa, fb, fc):
+            break                                                # no zero can hide in [xa, xc] any more
+        # the vertex of the parabola through (a, fa), (b, fb), (c, fc)
+        u1, u2 = (xb - xa) * (fb - fc), (xb - xc) * (fb - fa)
+        den = 2.0 * (u1 - u2)
+        ok = den != 0.0
+        if ok:
+            xu = xb - ((xb - xa) * u1 - (xb - xc) * u2) / den
+            m = 0.05 * min(xb - xa, xc - xb)
+            ok = xa + m < xu < xc - m and abs(xu - xb) > 0.25 * _DIP_TOL and it % 4 != 3
+        if not ok:                                               # golden section of the larger side
+            xu = xb + gold * (xc - xb) if xc - xb > xb - xa else xb - gold * (xb - xa)
+        if xu < xb:
+            eu, ru = _follow(cls, h, PP, R06, p16, xu, xa, xb, ra, rb, th, e, t2)
+        else:
+            eu, ru = _follow(cls, h, PP, R06, p16, xu, xb, xc, rb, rc, th, e, t2)
+        if not math.isfinite(eu):
+            return n                                             # the root is lost (a fold): not a dip
+        fu = sg * eu
+        if fu <= 0.0:
+            # a sign change: a root on either side of xu (one where fu is exactly 0)
+            if fu == 0.0:
+                out[0], out[1], out[2], out[3], out[4] = xu, ru[0], ru[1], ru[2], 0.0
+                return _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+            if _refine(cls, h, PP, R06, p16, xa, xu, ea, eu, ra, ru, th, e, t2, out):
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+            if _refine(cls, h, PP, R06, p16, xu, xc, eu, ec, ru, rc, th, e, t2, out):
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+            return n
+        if fu < fb:
+            if xu < xb:
+                xc, fc, ec, rc = xb, fb, eb, rb
+            else:
+                xa, fa, ea, ra = xb, fb, eb, rb
+            xb, fb, eb, rb = xu, fu, eu, ru
+        elif xu < xb:
+            xa, fa, ea, ra = xu, fu, eu, ru
+        else:
+            xc, fc, ec, rc = xu, fu, eu, ru
+    if fb <= _TOUCH:
+        _assemble(cls, h, PP, R06, p16, wrap(xb), rb[0], rb[1], rb[2], q)
+        if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
+            n = _push(Q, V, E, n, q, True)
+    return n
+
+
+@kernel
+def _dips(cls, h, PP, R06, p, p16, RS0, ES0, CS0, i0, x0, RS1, ES1, CS1, i1, x1, RS2, ES2, CS2, i2, x2,
+          th, e, t2, out, q, q2, J, F, Q, V, E, n):
+    """Every dip of the error at sample ``i1`` of RS1, ES1, CS1 (angle ``x1``) between its
+    neighbours, sample ``i0`` of RS0, … (angle ``x0`` < x1) and sample ``i2`` of RS2, … (angle
+    ``x2`` > x1): a root there followed to both (nearest, closer than :data:`_MATCH`) whose |e|
+    is the smallest of the three, all of one sign, and low enough that a zero may hide next to
+    it (:func:`_low`) — searched by ``_dip``.  Returns the new branch count."""
+    for t in range(CS1[i1]):
+        eb = ES1[i1, t]
+        rb = (RS1[i1, t, 0], RS1[i1, t, 1], RS1[i1, t, 2])
+        k0, d0 = _nearest(RS0, CS0, i0, rb)
+        k2, d2 = _nearest(RS2, CS2, i2, rb)
+        if not (d0 < _MATCH and d2 < _MATCH) or eb == 0.0:
+            continue
+        ea, ec = ES0[i0, k0], ES2[i2, k2]
+        sg = 1.0 if eb > 0.0 else -1.0
+        fa, fb, fc = sg * ea, sg * eb, sg * ec
+        if not (fa > 0.0 and fc > 0.0 and fb <= fa and fb <= fc) or not _low(x0, x1, x2, fa, fb, fc):
+            continue
+        n = _dip(cls, h, PP, R06, p, p16, x0, x1, x2, ea, eb, ec,
+                 (RS0[i0, k0, 0], RS0[i0, k0, 1], RS0[i0, k0, 2]), rb, (RS2[i2, k2, 0], RS2[i2, k2, 1], RS2[i2, k2, 2]),
+                 th, e, t2, out, q, q2, J, F, Q, V, E, n)
+    return n
+
+
+@kernel
 def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     """Every branch of one pose of a 1-D search class into Q (16, 6), V, E; returns their
     number."""
@@ -386,6 +524,14 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                            (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]),
                            (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2]), th, e, t2, out):
                     n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+    # dips at the samples between two plain intervals (sample 0 ≡ L − 1: its left neighbour is L − 2)
+    for g in range(grid):
+        gl = g - 1 if g > 0 else grid - 1
+        if fine[gl] or fine[g]:
+            continue
+        il, xl = (g - 1, X[g - 1]) if g > 0 else (L - 2, X[L - 2] - 2.0 * math.pi)
+        n = _dips(cls, h, PP, R06, p, p16, RS, ES, CS, il, xl, RS, ES, CS, g, X[g],
+                  RS, ES, CS, g + 1, X[g + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
     # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends
     L2 = 2 * _SUB + 1
     u = np.empty(L2)
@@ -412,6 +558,9 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                                (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
                                (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
                         n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+            if g2 > 0:
+                n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
+                          RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
             if CS2[g2] != CS2[g2 + 1]:
                 # fold seeds: the roots with a small error on the side with more roots
                 side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1
@@ -420,6 +569,13 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                         SX[ns] = X2[side]
                         SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
                         ns += 1
+        # the ends of the finer look, between its next samples and the grid samples beyond
+        il, xl = (g - 1, X[g - 1]) if g > 0 else (L - 2, X[L - 2] - 2.0 * math.pi)
+        ir, xr = (g + 2, X[g + 2]) if g + 2 < L else (1, X[1] + 2.0 * math.pi)
+        n = _dips(cls, h, PP, R06, p, p16, RS, ES, CS, il, xl, RS2, ES2, CS2, 0, X2[0],
+                  RS2, ES2, CS2, 1, X2[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, L2 - 2, X2[L2 - 2], RS2, ES2, CS2, L2 - 1, X2[L2 - 1],
+                  RS, ES, CS, ir, xr, th, e, t2, out, q, q2, J, F, Q, V, E, n)
     for k in range(ns):
         _assemble(cls, h, PP, R06, p16, SX[k], SR[k, 0], SR[k, 1], SR[k, 2], q)
         if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
