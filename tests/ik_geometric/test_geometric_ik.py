@@ -190,6 +190,17 @@ def test_bad_rotation_and_options():
         aa.ik.analytic(robot, T, swivel=0.3)
     empty = aa.ik.analytic_batch(robot, np.zeros((0, 4, 4)))
     assert len(empty) == 0
+    # a batch: the compiled call finds the bad pose; the message names it as the caller indexed it
+    Ts = robot.fk(robot.random_q(8, np.random.default_rng(1)))
+    for i, fix in ((5, lambda M: M[:3, :3].__imul__(1.01)), (2, lambda M: M[3].__setitem__(0, 0.1)),
+                   (7, lambda M: M[:3, :3].__setitem__(slice(None), -M[:3, :3]))):
+        bad = Ts.copy()
+        fix(bad[i])
+        with pytest.raises(ValueError, match=rf"T\[{i}\]"):
+            aa.ik.analytic_batch(robot, bad)
+    with pytest.raises(ValueError, match="param"):
+        aa.ik.analytic_batch(aa.load("panda"), np.repeat(aa.load("panda").fk(aa.load("panda").neutral())[None], 3, 0),
+                             param=[[0.1, np.nan]])
 
 
 def test_near_intersecting_axes_within_tolerance_are_polished(tmp_path):

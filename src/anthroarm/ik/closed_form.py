@@ -272,8 +272,10 @@ def require_form(robot, frame=None) -> ClosedForm:
 
 
 # ---------------------------------------------------------------------------- input checks
-def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False) -> tuple[np.ndarray, bool]:
-    """Return (N, 4, 4) and whether the input was a single pose.  ValueError on bad input."""
+def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=True) -> tuple[np.ndarray, bool]:
+    """Return (N, 4, 4) and whether the input was a single pose.  ValueError on bad input:
+    the shape, a value that is not finite, and (``rigid``) the last row and the rotation part
+    (``rigid=False``: the caller's compiled solver checks those, :class:`.geometric.BadPoseError`)."""
     arr = np.asarray(T, dtype=float)
     single = arr.ndim == 2
     if position_only and arr.ndim in (1, 2) and arr.shape[-1] == 3 and arr.shape != (3, 3):
@@ -290,6 +292,8 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False) -> tupl
     if not np.isfinite(arr).all():
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
         raise ValueError(f"{name}{list(idx) if not single else list(idx[1:])} is {arr[idx]} (not finite)")
+    if not rigid:
+        return arr, single
     if np.abs(arr[:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max() > 1e-12:
         raise ValueError(f"{name}: the last row of a homogeneous pose must be [0, 0, 0, 1]")
     R = arr[:, :3, :3]
@@ -406,7 +410,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     if position_only:
         raise ValueError(f"{robot.name}: a {s.form.family} arm is solved for the full pose (position and "
                          "rotation); for a position alone use aa.ik.solve(robot, p, position_only=True)")
-    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal)
+    closed = s.kind == "geo" and s.plan.cls in _geo.CLOSED      # the compiled call checks the rotations
+    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal, rigid=not closed)
     N = Ts.shape[0]
     if s.kind == "srs":
         grid = _swivel_array(swivel, N, grid_1d=single or _single_grid)
@@ -435,9 +440,14 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     B = len(labels)
     Tr = np.repeat(Ts, S, axis=0)
     prm = pv.reshape(-1) if gp.param_joint is not None else None
-    if gp.cls in _geo.CLOSED:
-        th, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in
-                                               _geo.solve_verified(gp, Tr, prm, tol, tol_orthonormal))
+    if closed:
+        try:
+            out = _geo.solve_verified(gp, Tr, prm, tol, tol_orthonormal)
+        except _geo.BadPoseError as exc:                # the detailed message, at the caller's index
+            i = exc.index // S
+            _check_poses(Ts[i], name="T" if single else f"T[{i}]", tol_orthonormal=tol_orthonormal)
+            raise
+        th, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in out)
     else:
         th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in _geo.solve(gp, Tr, prm))
         th, inside = _wrap_into_limits(th, gp.lower, gp.upper)

@@ -154,6 +154,11 @@ class GeoPlan:
     plain: bool = False
 
     @functools.cached_property
+    def order_is_path(self) -> bool:
+        """The independent joints are the path's joints in path order (no reordering)."""
+        return bool((self.order == np.arange(len(self.order))).all())
+
+    @functools.cached_property
     def packed(self) -> tuple:
         """The plan's constants as the compiled drivers take them (:func:`_unpack`): one float
         array (H, P, R_tool, the held joint's axis and point, the tool pose at q = 0, the
@@ -643,9 +648,10 @@ def _unpack(cf, ci):
 def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     """Every branch of poses T (N, 4, 4) in path order, wrapped into the limits and FK-checked:
     writes Q (N, 8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
-    residual), OK (a solution: candidate, inside, residual ≤ tol, and not within 1e-9 rad of
-    an earlier solution of its pose); returns the index of the first malformed pose (−1 if
-    none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
+    residual; inf where there is no candidate, and for an exact candidate outside the limits,
+    which is never returned and so not checked), OK (a solution: candidate, inside, residual
+    ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); returns the index of
+    the first malformed pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, kH, kO, lo, hi = _unpack(cf, ci)
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
@@ -656,6 +662,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     q = np.empty(n)
     S = np.empty((n + 1, 12))
     J, F = np.empty((6, 6)), np.empty(6)
+    CHK = np.empty(8, dtype=np.bool_)
     for i in range(len(T)):
         if _pose_status(T[i], tol_orthonormal) != 0:
             return i
@@ -680,7 +687,8 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
             for j in range(n):
                 Q[i, b, j] = q[j]
             V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
-        _fk_residuals(kH, kO, MR, Mp, Q[i], V[i], n, T[i], RES[i], S)
+            CHK[b] = V6[b] and (inside or not E6[b])
+        _fk_residuals(kH, kO, MR, Mp, Q[i], CHK, n, T[i], RES[i], S)
         for b in range(8):
             if V[i, b] and E[i, b] and IN[i, b] and tol < RES[i, b] <= POLISH_MAX:
                 for j in range(n):
@@ -809,6 +817,15 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
     return K if K > 0 else -2
 
 
+class BadPoseError(ValueError):
+    """A pose of a batch is not a rigid transform (not finite, last row, rotation part);
+    ``index`` is the first such pose."""
+
+    def __init__(self, index: int, message: str):
+        super().__init__(message)
+        self.index = index
+
+
 #: FK residual up to which a candidate of an arm that is of its class only within the
 #: classification tolerance is polished (:func:`_polish_chain` in the compiled call; what
 #: that leaves, :func:`anthroarm.ik.closed_form.analytic`)
@@ -825,7 +842,7 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     read from ``robot.chain``, the model Pinocchio holds).  ``param`` (N,) the held joint of a
     7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad), candidate (N, 8),
     exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4 pose; inf where
-    there is no candidate).  Raises ``ValueError`` naming the first malformed pose (not finite,
+    there is no candidate or an exact one outside the limits, :func:`_verified`).  Raises ``ValueError`` naming the first malformed pose (not finite,
     last row, not a rotation) — ``anthroarm.ik.closed_form`` checks before it calls."""
     T = np.ascontiguousarray(T, dtype=float)
     N, n = len(T), len(plan.fk_axes)
@@ -846,8 +863,10 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     run_rows(rows, N)
     bad = min(first_bad) if first_bad else -1
     if bad >= 0:
-        raise ValueError(f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a rotation "
-                         f"to {tol_orthonormal:g})")
+        raise BadPoseError(bad, f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a "
+                                f"rotation to {tol_orthonormal:g})")
+    if plan.order_is_path:
+        return Q, OK, V, E & V, IN, RES
     return Q[..., plan.order], OK, V, E & V, IN, RES
 
 

@@ -28,14 +28,25 @@ The 1-D search (per pose, in the kernel): the searched joint is sampled on :data
 the nearest root there (a match closer than :data:`_MATCH` rad in every unknown); a sign change
 of the error along a followed root is a bracket, refined by the Illinois variant of regula
 falsi (the root followed by the one nearest its interpolation between the bracket's ends) until
-``|e| ≤ SEARCH_TOL / 100`` or 60 steps; a refined root with ``|e| ≤`` :data:`SEARCH_TOL` is
-``exact``.  A sample interval where the number of roots changes (a fold: a pair of roots
-appears or vanishes there, moving like a square root) or a root moves by more than
-:data:`_FAST` rad is sampled again on 33 points crowded quadratically towards both ends, and
-its brackets come from that finer sampling; the roots next to a fold of the finer sampling with
-``|e| <`` :data:`_SEED` seed Newton steps on the whole arm's pose (a root on the arc through a
-fold is a sign change along neither root), kept where they converge to :data:`SEARCH_TOL`.
-A root where the error only touches zero is not found.
+``|e| ≤ SEARCH_TOL / 100`` or 60 steps; a refined root with ``|e| ≤`` :data:`SEARCH_TOL` whose
+pose error (FK) is above :data:`_FK_TOL` gets a few Newton steps on the pose (|e| pins the
+angle loosely where e is flat); it is ``exact`` where the pose is met to SEARCH_TOL.  A sample
+interval where the number of roots changes (a fold: a pair of roots appears or vanishes there,
+moving like a square root), a root moves by more than :data:`_FAST` rad, or two roots at an
+end are closer than _FAST (a near fold: the error along them turns fast) is sampled again on
+33 points crowded quadratically towards both ends, and its brackets come from that finer
+sampling.  A pair of roots inside one sample interval (two IK solutions closer than it — near
+a singular pose, a few % of random poses) is no sign change at the samples: at every *dip*
+(|e| along a followed root smallest at a sample, of one sign there and at both neighbours, grid
+or finer samples) low enough that a zero may hide next to it (|e| ≤ :data:`_DIP` × the steeper
+secant slope × the wider gap), |e| is minimised along the root by safeguarded parabolic
+interpolation until it changes sign (two brackets, refined as above), the bound proves no zero
+can hide, or the bracket is narrower than :data:`_DIP_TOL` (a minimum within :data:`_TOUCH` of
+zero — the error touching zero — seeds Newton on the pose).  Next to a fold of the finer
+sampling, the roots with ``|e| <`` :data:`_SEED`, and the pair that meets at the fold where
+their errors differ in sign, seed Newton steps on the whole arm's pose (a root on the arc
+through a fold is a sign change along neither root), kept where they converge to
+:data:`SEARCH_TOL`.
 
 The 2-D search: (q1, q2) on a :data:`SEARCH_GRID_2D` ² periodic grid; every (sample, SP5 root)
 whose error is below 0.3 and not above the best root of any of its 8 neighbours gives q6 by
@@ -43,8 +54,9 @@ SP1 and seeds 20 Newton steps on the pose; the converged ones (pose error ≤ SE
 kept.  A branch whose basin the grid misses is not found (no completeness claim).
 
 Each pose gets up to :data:`SEARCH_BRANCHES` slots, filled in the order the branches are
-found (the refined brackets along the grid, those of finer samplings, then the polished fold
-seeds); a branch within 1e-8 rad (every joint, mod 2π) of an earlier one is dropped.
+found (the refined brackets along the grid, the dips of the grid, the brackets and dips of
+finer samplings, then the polished fold seeds); a branch within 1e-8 rad (every joint, mod 2π)
+of an earlier one is dropped.
 """
 
 from __future__ import annotations
@@ -78,8 +90,11 @@ _ITERS = 60
 #: Newton steps on the pose for a fold seed of a 1-D search and for a 2-D local minimum
 _POLISH_1D = 12
 _POLISH_2D = 20
-#: Newton steps on the pose for a refined root whose error stayed above SEARCH_TOL
+#: Newton steps on the pose for a refined root whose error stayed above SEARCH_TOL or whose
+#: pose error is above _FK_TOL
 _POLISH_ROOT = 3
+#: pose error (max entry of |R − R06| and |o − p|, m) above which a refined root is polished
+_FK_TOL = 1e-11
 #: error below which a local minimum of the 2-D grid seeds Newton
 _MIN_2D = 0.3
 #: most fold seeds kept per pose (more are ignored; a fold has at most a few roots)
@@ -183,15 +198,23 @@ def polish(h, PP, R06, p, q, iters, J, F):
             break                                            # the same q (and J) at every later step
         for i in range(6):
             q[i] += F[i]
+    err = pose_error(h, PP, R06, p, q)
+    for i in range(6):
+        q[i] = wrap(q[i])
+    return err <= SEARCH_TOL
+
+
+@kernel
+def pose_error(h, PP, R06, p, q):
+    """The pose error of joint angles ``q`` (6,) rad: the max entry of |R − R06| and |o − p|
+    (m) at their FK."""
     R, o = fk_geo(h, PP, q)
     err = 0.0
     for i in range(3):
         err = max(err, abs(o[i] - p[i]))
         for j in range(3):
             err = max(err, abs(R[i][j] - R06[i][j]))
-    for i in range(6):
-        q[i] = wrap(q[i])
-    return err <= SEARCH_TOL
+    return err
 
 
 @kernel
@@ -307,6 +330,16 @@ def _interval(RS, CS, g, S1, DM):
         S1[s], DM[s] = k, best
         if best > _FAST:
             fine = True
+    # two roots closer than _FAST at an end: a near fold (a pair of roots passing close, the
+    # error along them turning fast)
+    for i in range(g, g + 2):
+        for s in range(CS[i]):
+            for t in range(s + 1, CS[i]):
+                d = 0.0
+                for c in range(3):
+                    d = max(d, abs(wrap(RS[i, s, c] - RS[i, t, c])))
+                if d < _FAST:
+                    fine = True
     return fine
 
 
@@ -352,11 +385,13 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
 def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
     """The branch at a refined root ``out`` (x, inner root, |e|) into ``q`` (6,); returns
     whether it is exact.  A root whose error stayed above :data:`SEARCH_TOL` (regula falsi
-    stalls where two roots share a sample interval) while every subproblem on it was exact
-    gets :data:`_POLISH_ROOT` Newton steps on the whole pose (scratch ``q2``), kept where they
-    converge (quadratic convergence from a root already good to ~1e-10)."""
+    stalls where two roots share a sample interval), or whose pose error is above
+    :data:`_FK_TOL` (|e| ≤ SEARCH_TOL pins the angle only to SEARCH_TOL / |e′|, loose where e
+    is flat: at a pair of roots close together), while every subproblem on it was exact gets
+    :data:`_POLISH_ROOT` Newton steps on the whole pose (scratch ``q2``), kept where they
+    converge (quadratic convergence from a root already good to ~1e-7)."""
     ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
-    if ex and out[4] > SEARCH_TOL:
+    if ex and (out[4] > SEARCH_TOL or pose_error(h, PP, R06, p, q) > _FK_TOL):
         for j in range(6):
             q2[j] = q[j]
         ex = polish(h, PP, R06, p, q2, _POLISH_ROOT, J, F)
@@ -413,11 +448,13 @@ def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2,
     """A dip of the error along a followed root: |e| at ``xb`` below its value at ``xa`` < xb
     and ``xc`` > xb, all three of one sign (``ea``, ``eb``, ``ec``; followed inner roots ``ra``,
     ``rb``, ``rc``).  |e| is minimised over [xa, xc] along the root by successive parabolic
-    interpolation (a golden-section step where the vertex would not shrink the bracket); at
-    the first point where e changes sign, the two brackets it makes with xa and xc are refined
-    (``_refine``) and their branches pushed — the pair of roots inside one sample interval that
-    no sample sees.  A minimum that stays above zero by at most :data:`_TOUCH` (the error
-    touching zero) seeds a Newton polish of the whole arm.  Returns the new branch count."""
+    interpolation (a golden-section step where the vertex falls outside the bracket or next
+    to xb, and every 4th step); at the first point where e changes sign, the two brackets it
+    makes with xa and xc are refined (``_refine``) and their branches pushed — the pair of
+    roots inside one sample interval that no sample sees.  It stops without a root where
+    ``_low`` no longer holds for the shrunk bracket or it is narrower than :data:`_DIP_TOL`;
+    a minimum then within :data:`_TOUCH` of zero (the error touching zero) seeds a Newton
+    polish of the whole arm.  Returns the new branch count."""
     sg = 1.0 if eb > 0.0 else -1.0
     fa, fb, fc = sg * ea, sg * eb, sg * ec
     gold = 0.381966011250105
@@ -541,7 +578,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
         u[_SUB + 1 + i] = 1.0 - u[_SUB - 1 - i]
     X2 = np.empty(L2)
     RS2, ES2, CS2 = np.zeros((L2, 4, 3)), np.full((L2, 4), math.nan), np.zeros(L2, dtype=np.int64)
-    SX, SR = np.empty(_MAX_SEEDS), np.empty((_MAX_SEEDS, 3))
+    SX, SR, FM = np.empty(_MAX_SEEDS), np.empty((_MAX_SEEDS, 3)), np.empty(4, dtype=np.bool_)
     ns = 0
     for g in range(grid):
         if not fine[g]:
@@ -562,10 +599,23 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                 n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
                           RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
             if CS2[g2] != CS2[g2 + 1]:
-                # fold seeds: the roots with a small error on the side with more roots
+                # fold seeds: on the side with more roots, those with a small error, and all those
+                # nearest to no root of the other side (the pair that meets at the fold) where
+                # their errors differ in sign (a root on the arc through the fold)
                 side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1
+                other = g2 + 1 if side == g2 else g2
+                for j in range(4):
+                    FM[j] = True
+                for t in range(CS2[other]):
+                    k, _ = _nearest(RS2, CS2, side, (RS2[other, t, 0], RS2[other, t, 1], RS2[other, t, 2]))
+                    FM[k] = False
+                pos = neg_ = False
                 for j in range(CS2[side]):
-                    if abs(ES2[side, j]) < _SEED and ns < _MAX_SEEDS:
+                    if FM[j]:
+                        pos = pos or ES2[side, j] > 0.0
+                        neg_ = neg_ or ES2[side, j] < 0.0
+                for j in range(CS2[side]):
+                    if (abs(ES2[side, j]) < _SEED or (FM[j] and pos and neg_)) and ns < _MAX_SEEDS:
                         SX[ns] = X2[side]
                         SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
                         ns += 1
@@ -667,8 +717,7 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
     exact (N, 16) (False: a refined root whose error stayed above :data:`SEARCH_TOL`, or a
     subproblem with only a least-squares answer).  ``grid``: samples of the searched joint
     (default :data:`SEARCH_GRID`; :data:`SEARCH_GRID_2D` per joint for ``gen_six_dof``).
-    The same algorithm and results as ``anthroarm.ik.geometric.solve_class`` for these classes
-    (module docstring)."""
+    ``anthroarm.ik.geometric.solve_class`` calls this for these classes (module docstring)."""
     if cls not in CLASSES:
         raise ValueError(f"cls must be one of {CLASSES}, got {cls!r}")
     c = CLASSES.index(cls)
@@ -689,4 +738,4 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
 
 
 __all__ = ["CLASSES", "SEARCH_BRANCHES", "SEARCH_GRID", "SEARCH_GRID_2D", "SEARCH_TOL", "fk_geo", "polish",
-           "solve6", "solve_search"]
+           "pose_error", "solve6", "solve_search"]
