@@ -617,6 +617,19 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
                           tol_orthonormal=tol_orthonormal, param=param, _single_grid=True)[0]
 
 
+def solution_angles(robot, T, param=None):
+    """The joint angles θ (K, n) (``robot.chain.independent`` order, rad) of the solutions
+    :func:`analytic` returns for one pose ``T`` (4×4 float array) of an arm of a closed class
+    (``param`` for a 7-joint arm), in branch order, nothing else — the seeds of
+    :func:`anthroarm.ik.solve` — or None where :func:`analytic` itself must answer (no closed
+    class, no solution, a candidate to polish)."""
+    s = _solver(robot)
+    if s is None or s.kind != "geo" or s.plan.cls not in _geo.CLOSED or (param is None) != (s.plan.param_joint is None):
+        return None
+    one = _geo.solve_one(s.plan, T, 0.0 if param is None else float(param))
+    return None if one is None else one[0]
+
+
 def _geometric_single(robot, s, arr, param, tol, tol_orthonormal):
     """One pose of a closed class in one compiled call, when it has a solution and nothing to
     polish; else None (:func:`analytic_batch` answers, with the reasons)."""
