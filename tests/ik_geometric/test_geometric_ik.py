@@ -390,3 +390,34 @@ def test_standard_dh_urdf_is_the_dh_product_and_rejects_bad_rows(tmp_path):
         standard_dh_urdf("x", [0] * 6, [0] * 6, [0] * 6, limit=-1)
     with pytest.raises(ParameterError):
         standard_dh_urdf('x"/><evil', [0] * 6, [0] * 6, [0] * 6)
+
+
+def test_singular_poses_say_so_and_stay_exact(tmp_path):
+    """Poses made at singular configurations — a PUMA / 6R wrist with q5 = 0 (axes 4 and 6 one
+    line), a UR with q5 = 0 (axes 2, 3, 4, 6 parallel) and a stretched UR elbow (q3 = 0) — give
+    FK-exact solutions (Pinocchio), no NaN, the sampled one among them where the solutions only
+    coincide (the elbow; at a wrist family one member is returned), and `singular` says so;
+    the Jacobian volume it uses is checked against numpy's SVD of Pinocchio's Jacobian (zero
+    smallest singular value exactly when the volume vanishes).  A generic pose is not singular."""
+    cases = [(puma560(tmp_path), [0.2, 0.3, 0.4, 0.5, 0.0, 0.6], False),
+             (aa.load("sixr_arm"), [0.3, 0.5, 0.0, 0.2, 0.0, 0.4], False),
+             (aa.load("ur5"), [0.3, -1.0, 1.0, -0.5, 0.0, 0.2], False), (aa.load("ur5"), [0.3, -1.0, 0.0, -0.5, 0.7, 0.2], True)]
+    for robot, q, among in cases:
+        q = np.array(q)
+        T = _fk(robot, q)
+        assert np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] < 1e-12
+        for r in (aa.ik.analytic(robot, T), aa.ik.analytic_batch(robot, T[None])[0]):
+            assert len(r) and np.isfinite(r.solutions).all() and r.reason is None
+            assert all(np.abs(_fk(robot, s) - T).max() < 1e-9 for s in r.solutions)
+            assert not among or np.abs(np.angle(np.exp(1j * (r.solutions - q)))).max(1).min() < 1e-6
+            assert r.singular and "singular configuration" in r.singular, robot.name
+        assert aa.ik.analytic_batch(robot, T[None]).singular[0] == r.singular
+    robot = aa.load("ur5")
+    q = np.array([0.3, -1.0, 1.0, -0.5, 0.7, 0.2])
+    assert np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1] > 1e-2
+    r = aa.ik.analytic(robot, _fk(robot, q))
+    assert len(r) == 8 and r.singular is None and r.as_dict()["singular"] is None
+    vol = G.jacobian_volumes(G.plan_for(robot), r.solutions[None], np.ones((1, len(r)), bool))[0]
+    for v, s in zip(vol, r.solutions):
+        J = robot.jacobian(s)
+        assert np.isclose(v, abs(np.linalg.det(J)) / np.prod(np.linalg.norm(J, axis=0)), rtol=1e-9)

@@ -31,7 +31,9 @@ branches, each shifted by 2π into the joint limits and checked by the chain's f
 kinematics (product of exponentials of the joints as read from ``robot.chain``, the model
 Pinocchio holds; ``tol`` on every entry of the 3×4 pose, or the position for ``planar_2r``),
 duplicates dropped.  Arms of a class only within the classification tolerance (rounded URDF
-numbers) get their near-exact candidates polished (:data:`POLISH_MAX`); a pose whose only
+numbers) get their near-exact candidates (FK residual ≤ :data:`POLISH_MAX`) polished by
+Newton steps on the chain inside that call (a held 7th joint stays where it was asked to be),
+and by bounded least squares where that leaves any; a pose whose only
 candidates lie on or just beyond a limit, or on a singular family whose representative is
 outside the limits, is rescued along its self-motions (:func:`_rescue`).
 
@@ -44,6 +46,7 @@ Pinocchio is called with the calling thread's ``robot.data``.
 
 from __future__ import annotations
 
+import functools
 import math
 import weakref
 from dataclasses import dataclass, field
@@ -75,16 +78,27 @@ class AnalyticIKResult:
     ``branches`` K labels; ``reason`` is None when K > 0, else why there is none;
     ``swivel`` (K,) the swivel angle of each solution (human_arm7 only, else None);
     ``residuals`` (K,) the FK check: max |FK(q) − T| over the 3×4 pose entries (m / unitless);
-    ``singular`` names a singular configuration family if the pose is singular (a
-    representative member was returned), else None."""
+    :attr:`singular` says whether the solutions lie at a singular configuration."""
 
     solutions: np.ndarray
     branches: list
     reason: str | None = None
     swivel: np.ndarray | None = None
     residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    singular: str | None = None
+    #: the text of :attr:`singular`, or a function of no argument that makes it (on first use)
+    _singular: object = field(default=None, repr=False, compare=False)
     model: str = ""
+
+    @property
+    def singular(self) -> str | None:
+        """None, or what makes the pose singular: a solution whose 6×6 Jacobian has a normalised
+        volume |det J| / Π‖J_k‖ ≤ :data:`.geometric.SINGULAR_TOL` (aligned wrist axes, a stretched
+        elbow, the wrist centre on the first axis) — there solutions coincide in pairs or form a
+        one-parameter family, of which one member is returned per branch.  Computed on first
+        use (arms solved by their geometry; None for the swivel and planar families)."""
+        if callable(self._singular):
+            self._singular = self._singular()
+        return self._singular
 
     @property
     def success(self) -> bool:
@@ -112,7 +126,8 @@ class AnalyticBatchResult:
     ``solutions`` (N, B, nq): entry [i, b] is a verified solution inside the limits where
     ``valid[i, b]``; elsewhere it is NaN (there is no solution on that branch — read ``valid``).
     ``branches`` the B labels, ``reasons`` N entries (None where some branch is valid),
-    ``swivel`` (N, B) for human_arm7.  ``result[i]`` gives pose i as an AnalyticIKResult."""
+    ``swivel`` (N, B) for human_arm7, :attr:`singular` N entries.  ``result[i]`` gives pose i
+    as an AnalyticIKResult."""
 
     solutions: np.ndarray
     valid: np.ndarray
@@ -120,21 +135,33 @@ class AnalyticBatchResult:
     reasons: list
     swivel: np.ndarray | None = None
     residuals: np.ndarray | None = None
-    singular: list | None = None
+    #: a function of the pose indices (a list) giving their :attr:`AnalyticIKResult.singular`
+    #: texts, called on first use; None: never singular (the swivel and planar families)
+    _singular_of: object = field(default=None, repr=False, compare=False)
     model: str = ""
+
+    @functools.cached_property
+    def singular(self) -> list:
+        """:attr:`AnalyticIKResult.singular` of every pose (N entries), computed on first use."""
+        n = len(self)
+        return [None] * n if self._singular_of is None else self._singular_of(list(range(n)))
 
     def __len__(self) -> int:
         return self.solutions.shape[0]
 
     def __getitem__(self, i: int) -> AnalyticIKResult:
         v = self.valid[i]
+        if self._singular_of is None or "singular" in self.__dict__:
+            sing = self.singular[i]
+        else:
+            sing = functools.partial(lambda f, k: f([k])[0], self._singular_of, int(i))
         return AnalyticIKResult(
             solutions=self.solutions[i][v].copy(),
             branches=[b for b, ok in zip(self.branches, v) if ok],
             reason=self.reasons[i],
             swivel=None if self.swivel is None else self.swivel[i][v].copy(),
             residuals=np.zeros(int(v.sum())) if self.residuals is None else self.residuals[i][v].copy(),
-            singular=None if self.singular is None else self.singular[i],
+            _singular=sing,
             model=self.model,
         )
 
@@ -466,7 +493,7 @@ def _empty(robot, labels, swivel=False):
     B = len(labels)
     return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
                                swivel=np.zeros((0, B)) if swivel else None, residuals=np.zeros((0, B)),
-                               singular=[], model=robot.name)
+                               model=robot.name)
 
 
 def _planar_batch(robot, s, T, position_only, tol):
@@ -513,9 +540,17 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     reasons = [None] * N
     for i in np.flatnonzero(~valid.any(1)):
         reasons[i] = _reason(robot, s, Ts[i], cand[i], exact[i], inside[i], res[i], tol, position_only)
+    singular_of = None
+    if s.kind == "geo":
+        TH = Q if polished else th                                  # polished: a plain arm, Q = θ
+        plan = s.plan
+
+        def singular_of(rows):
+            vol = _geo.jacobian_volumes(plan, TH[rows], valid[rows]).min(1)
+            return [_singular_text(float(v)) for v in vol]
     return AnalyticBatchResult(solutions=np.where(valid[..., None], Q, np.nan), valid=valid, branches=labels,
                                reasons=reasons, swivel=None if swivel is None else np.where(valid, swivel, np.nan),
-                               residuals=np.where(valid, res, np.nan), singular=[None] * N, model=robot.name)
+                               residuals=np.where(valid, res, np.nan), _singular_of=singular_of, model=robot.name)
 
 
 def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
@@ -641,8 +676,21 @@ def _geometric_single(robot, s, arr, param, tol, tol_orthonormal):
         return None
     q, res, idx = one
     labels = s.plan.labels
+    plan = s.plan
     return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
-                            branches=[labels[i] for i in idx], residuals=res, model=robot.name)
+                            branches=[labels[i] for i in idx], residuals=res, model=robot.name,
+                            _singular=lambda: _singular_text(float(
+                                _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())))
+
+
+def _singular_text(volume: float) -> str | None:
+    """None, or what a normalised Jacobian volume ≤ :data:`.geometric.SINGULAR_TOL` of a
+    solution (:func:`.geometric.jacobian_volumes`) means, in words."""
+    if volume > _geo.SINGULAR_TOL:
+        return None
+    return (f"a singular configuration (normalised |det J| = {volume:.2g}: aligned wrist axes, a stretched "
+            "elbow or the wrist centre on the first axis): solutions coincide in pairs or form a one-parameter "
+            "family, one member is returned per branch")
 
 
 # ---------------------------------------------------------------------------- the book's procedure

@@ -702,6 +702,62 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     return -1
 
 
+#: a solution whose normalised Jacobian volume (:func:`_volume`) is at most this is at a
+#: singular configuration of the arm
+SINGULAR_TOL = 1e-6
+
+
+@kernel
+def _volume(kH, kO, MR, Mp, q, n, J, F):
+    """The normalised volume |det J| / Π‖J_k‖ ∈ [0, 1] (Hadamard's inequality) of the 6×6
+    Jacobian of the first six joints at ``q`` (path order, rad), at the tool point, in the base
+    frame (columns (w × (x − o); w) as in :func:`_polish_chain`): 0 at a singular configuration
+    — a wrist with aligned axes, a stretched elbow, the wrist centre on the first axis — where
+    solutions coincide in pairs or form a one-parameter family.  ``J`` (6, 6), ``F`` (6,)
+    scratch."""
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    t = (0.0, 0.0, 0.0)
+    for i in range(n):
+        if i < 6:
+            J[3, i], J[4, i], J[5, i] = mv(R, vec(kH[i]))
+            J[0, i], J[1, i], J[2, i] = add(mv(R, vec(kO[i])), t)
+        R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+    x = add(t, mv(R, Mp))
+    scale = 1.0
+    for i in range(6):
+        w = (J[3, i], J[4, i], J[5, i])
+        c = cross(w, sub(x, (J[0, i], J[1, i], J[2, i])))
+        J[0, i], J[1, i], J[2, i] = c
+        scale *= math.sqrt(dot(c, c) + dot(w, w))
+        F[i] = 0.0
+    return abs(solve6(J, F)) / scale
+
+
+@kernel
+def _volume_loop(cf, ci, TH, OK, VOL):
+    """:func:`_volume` of every solution (``OK``) of θ (N, B, n) in independent-joint order
+    into VOL (N, B) (1 elsewhere)."""
+    _, _, n, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
+    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
+    q, J, F = np.empty(n), np.empty((6, 6)), np.empty(6)
+    for i in range(TH.shape[0]):
+        for b in range(TH.shape[1]):
+            VOL[i, b] = 1.0
+            if OK[i, b]:
+                for k in range(n):
+                    q[ci[3 + k]] = TH[i, b, k]
+                VOL[i, b] = _volume(kH, kO, MR, Mp, q, n, J, F)
+
+
+def jacobian_volumes(plan: GeoPlan, TH, OK) -> np.ndarray:
+    """The normalised Jacobian volume (:func:`_volume`) of each solution θ (N, B, n)
+    (independent-joint order, rad) where ``OK`` (N, B); 1 elsewhere."""
+    cf, ci = plan.packed
+    VOL = np.empty(OK.shape)
+    _volume_loop(cf, ci, np.ascontiguousarray(TH, dtype=float), np.ascontiguousarray(OK), VOL)
+    return VOL
+
+
 @kernel
 def _mark_solutions(Q, V, IN, RES, tol, group, OK):
     """The solutions among the branches of one pose (Q (B, n), flags (B,)): a candidate inside
@@ -794,9 +850,8 @@ def solve(plan: GeoPlan, T, param=None):
 @kernel
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
     """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 2):
-    θ in independent-joint order, the FK residual, the branch index.  Returns their number K;
-    −1: a malformed pose; −2: no solution, or a candidate to polish (the caller's general path
-    answers: reasons, polishing)."""
+    θ in independent-joint order, the FK residual, the branch index.  Returns their number K; −1: a malformed pose; −2: no solution,
+    or a candidate to polish (the caller's general path answers: reasons, polishing)."""
     n = ci[2]
     Tb = T.reshape((1, 4, 4))
     pv = np.full(1, param)
