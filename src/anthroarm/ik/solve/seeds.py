@@ -30,10 +30,10 @@ SEED_POSTURE_WEIGHT = 0.05  # w_q / reach: + w_q²‖θ − θ_ref‖² in that 
 TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
 ALIGN_RANGE = np.pi   # first / last joints spanning at least a half turn are aligned (see Aligned; so101: median 10 % faster)
 ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
-#: swivel angles (rad) of a redundant arm's closed-form seeds: 8 (45° apart; human_arm7, 200 random
-#: poses: median solve 0.20 ms, mean distance of the answer to the comfortable posture 2.268 rad;
-#: 24 angles 0.29 ms and 2.260 rad — the posture phase moves the seed along the family anyway)
-SWIVEL_GRID = np.linspace(-np.pi, np.pi, 8, endpoint=False)
+#: swivel angles (rad) of a redundant arm's closed-form seeds: 16 (human_arm7, 100 random poses:
+#: the answer misses the member of the family nearest the comfortable posture on 2, median solve
+#: 0.24 ms; 24 angles: 2 and 0.28 ms; 12: 4 and 0.21 ms; 8: 7 and 0.20 ms)
+SWIVEL_GRID = np.linspace(-np.pi, np.pi, 16, endpoint=False)
 #: a closed form costing at most this (µs, ``ClosedForm.cost_us``) is tried first
 CHEAP_US = 50.0
 
