@@ -94,8 +94,13 @@ def test_the_sampled_angles_are_found(solved):
         for i in range(len(p)):
             total += 1
             found += bool(exact[i].any() and _dist(q[i][exact[i]], Q[i]).min() < 1e-6)
-    # the 2-D grid may miss a basin; the 1-D searches still miss a rare root (seed 1 pose 7)
-    assert found >= (0.85 if cls == "gen_six_dof" else 0.95) * total, (cls, found, total)
+    # the 2-D grid may miss a basin; the 1-D searches find every one (two_intersecting seed 1
+    # pose 7, a solution on the arc between two folds of SP5 closer than a finer sample interval,
+    # was missed until the finer looks were applied again where a root still jumps)
+    if cls == "gen_six_dof":
+        assert found >= 0.85 * total, (cls, found, total)
+    else:
+        assert found == total, (cls, found, total)
 
 
 @pytest.mark.parametrize("cls", ["two_parallel", "two_intersecting"])
@@ -108,20 +113,24 @@ def test_every_sampled_configuration_is_found_by_the_1d_searches(cls):
     of the inner subproblem, or one where two inner roots pass close (the error along them
     turns within a fraction of a sample interval); the search used to miss them (1-4 poses of
     each arm here) and finds them now by the dips of the error along followed roots, the
-    finer look at near folds and the fold seeds of a pair straddling zero (module docstring)."""
-    for seed in (3, 4, 5, 6):
+    finer look at near folds and the fold seeds of a pair straddling zero (module docstring).
+    The (arm, poses) seeds (1, 11), (6, 16), (9, 19), (9, 109) each held one pose missed until
+    a finer look was applied again where a followed root still jumps (by more than _JUMP)
+    between its samples (two folds of the inner subproblem inside one finer interval, the solution on
+    the arc between them; or a root turning fast past a near singularity)."""
+    for seed, pose_seed in ((1, 11), (3, 103), (4, 104), (5, 105), (6, 106), (6, 16), (9, 19), (9, 109)):
         H, P = random_arm(cls, seed)
-        Q, R06, p = poses(H, P, 100, 100 + seed)
+        Q, R06, p = poses(H, P, 100, pose_seed)
         q, valid, exact = S.solve_search(cls, H, P, R06, p)
         missed = [i for i in range(len(p)) if not (exact[i].any() and _dist(q[i][exact[i]], Q[i]).min() < 1e-6)]
-        assert not missed, (cls, seed, missed)
+        assert not missed, (cls, seed, pose_seed, missed)
         for i in range(len(p)):
             qi = q[i][valid[i]]
             for k in range(1, len(qi)):
-                assert _dist(qi[:k], qi[k]).min() >= 1e-8, (cls, seed, i)
+                assert _dist(qi[:k], qi[k]).min() >= 1e-8, (cls, seed, pose_seed, i)
             for s in q[i][exact[i]]:
                 R, x = fk(H, P, s)
-                assert max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-9, (cls, seed, i)
+                assert max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-9, (cls, seed, pose_seed, i)
 
 
 def test_exact_solutions_of_ik_geo_are_ours(solved):

@@ -35,8 +35,15 @@ interval where the number of roots changes (a fold: a pair of roots appears or v
 moving like a square root), a root moves by more than :data:`_FAST` rad, or two roots at an
 end are closer than _FAST (a near fold: the error along them turns fast) is sampled again on
 33 points crowded quadratically towards both ends, and its brackets come from that finer
-sampling.  A pair of roots inside one sample interval (two IK solutions closer than it — near
-a singular pose, a few % of random poses) is no sign change at the samples: at every *dip*
+sampling.  An interval of a finer look where the number of roots is the same at both ends
+but a followed root still moves by more than :data:`_JUMP` (two folds of the inner
+subproblem inside it — the root runs back on an arc between them, and a solution on that arc
+is seen by no sample — or a root turning fast past a near singularity) is looked at again
+the same way, down to :data:`_DEPTH` levels; where the number of roots changes inside a finer
+look, a sign change is bracketed only between mutually nearest roots (a root vanishing at the
+fold is nearest to another root beyond it, with no root between them).  A pair of roots
+inside one sample interval (two IK solutions closer than it — near a singular pose, a few %
+of random poses) is no sign change at the samples: at every *dip*
 (|e| along a followed root smallest at a sample, of one sign there and at both neighbours, grid
 or finer samples) low enough that a zero may hide next to it (|e| ≤ :data:`_DIP` × the steeper
 secant slope × the wider gap), |e| is minimised along the root by safeguarded parabolic
@@ -55,8 +62,8 @@ kept.  A branch whose basin the grid misses is not found (no completeness claim)
 
 Each pose gets up to :data:`SEARCH_BRANCHES` slots, filled in the order the branches are
 found (the refined brackets along the grid, the dips of the grid, the brackets and dips of
-finer samplings, then the polished fold seeds); a branch within 1e-8 rad (every joint, mod 2π)
-of an earlier one is dropped.
+finer samplings, each followed by those of its own finer looks, then the polished fold seeds);
+a branch within 1e-8 rad (every joint, mod 2π) of an earlier one is dropped.
 """
 
 from __future__ import annotations
@@ -84,6 +91,12 @@ _MATCH = 0.5
 _FAST = 0.2
 #: a root next to a fold with |e| below this seeds a Newton polish of the whole arm
 _SEED = 0.05
+#: an interval of a finer look (≤ 1/16 of a sample interval wide) where a followed root moves by
+#: more than this (rad) with the number of roots unchanged is looked at again the same way (a
+#: rate ≥ 8× that of _FAST over a sample interval: roots the finer samples do not resolve)
+_JUMP = 0.1
+#: levels of finer looks (interval widths ≤ 1.5e-3, 9e-5, 5e-6 rad at levels 1-3)
+_DEPTH = 3
 #: points per half of a finer sampling (2 · _SUB + 1 in all) and regula-falsi steps at most
 _SUB = 16
 _ITERS = 60
@@ -532,6 +545,90 @@ def _dips(cls, h, PP, R06, p, p16, RS0, ES0, CS0, i0, x0, RS1, ES1, CS1, i1, x1,
 
 
 @kernel
+def _copy_sample(RS, ES, CS, i, RD, ED, CD, j):
+    """Copy sample ``i`` of RS, ES, CS into slot ``j`` of RD, ED, CD."""
+    CD[j] = CS[i]
+    for r in range(4):
+        ED[j, r] = ES[i, r]
+        for c in range(3):
+            RD[j, r, c] = RS[i, r, c]
+
+
+@kernel
+def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR, NE, NC, NX, S1, DM, FM, SX, SR,
+          ns, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+    """A finer look at the interval [xa, xb]: its samples X2 = xa + (xb − xa) ``u`` (roots RS2,
+    errors ES2, counts CS2), the brackets and dips of them, the dips at both ends (with the
+    samples next to the interval: slot 0 (left, angle NX[0]) and 1 (right, NX[1]) of NR, NE,
+    NC) and the fold seeds (appended to SX, SR, ``ns`` of them).  Where ``deeper``, an interval
+    of it where the number of roots is unchanged but a followed root moves by more than
+    :data:`_JUMP` (the finer samples still do not resolve the roots there: two folds of the inner
+    subproblem inside it, the root running back and forth, or a root turning fast past a near
+    singularity) is flagged in FL for a finer look again, and its brackets and the dips at its
+    ends are left to that.  Returns (the new branch count, the new seed count)."""
+    L2 = len(u)
+    for i in range(L2):
+        X2[i] = xa + (xb - xa) * u[i]
+    X2[L2 - 1] = xb
+    _sample(cls, h, PP, R06, p16, X2, RS2, ES2, CS2, t2)
+    for g2 in range(L2 - 1):
+        _interval(RS2, CS2, g2, S1, DM)
+        fast = False
+        if deeper and CS2[g2] == CS2[g2 + 1]:
+            for s in range(CS2[g2]):
+                fast = fast or DM[s] > _JUMP
+        FL[g2] = fast
+        if not fast:
+            for s in range(CS2[g2]):
+                s1 = S1[s]
+                if DM[s] < _MATCH and (ES2[g2, s] < 0.0) != (ES2[g2 + 1, s1] < 0.0):
+                    # where the count changes, only a pair of mutually nearest roots: a root of the
+                    # pair that vanishes at the fold is nearest to another root beyond it (no root
+                    # to refine between them: the refinement would end at the fold, inexact)
+                    if CS2[g2] != CS2[g2 + 1]:
+                        r1 = (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2])
+                        k0, _ = _nearest(RS2, CS2, g2, r1)
+                        if k0 != s:
+                            continue
+                    if _refine(cls, h, PP, R06, p16, X2[g2], X2[g2 + 1], ES2[g2, s], ES2[g2 + 1, s1],
+                               (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
+                               (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
+                        n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+        if g2 > 0 and not FL[g2 - 1] and not fast:
+            n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
+                      RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        if CS2[g2] != CS2[g2 + 1]:
+            # fold seeds: on the side with more roots, those with a small error, and all those
+            # nearest to no root of the other side (the pair that meets at the fold) where
+            # their errors differ in sign (a root on the arc through the fold)
+            side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1
+            other = g2 + 1 if side == g2 else g2
+            for j in range(4):
+                FM[j] = True
+            for t in range(CS2[other]):
+                k, _ = _nearest(RS2, CS2, side, (RS2[other, t, 0], RS2[other, t, 1], RS2[other, t, 2]))
+                FM[k] = False
+            pos = neg_ = False
+            for j in range(CS2[side]):
+                if FM[j]:
+                    pos = pos or ES2[side, j] > 0.0
+                    neg_ = neg_ or ES2[side, j] < 0.0
+            for j in range(CS2[side]):
+                if (abs(ES2[side, j]) < _SEED or (FM[j] and pos and neg_)) and ns < _MAX_SEEDS:
+                    SX[ns] = X2[side]
+                    SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
+                    ns += 1
+    # the ends of the finer look, between its next samples and the samples beyond it
+    if not FL[0]:
+        n = _dips(cls, h, PP, R06, p, p16, NR, NE, NC, 0, NX[0], RS2, ES2, CS2, 0, X2[0],
+                  RS2, ES2, CS2, 1, X2[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+    if not FL[L2 - 2]:
+        n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, L2 - 2, X2[L2 - 2], RS2, ES2, CS2, L2 - 1, X2[L2 - 1],
+                  NR, NE, NC, 1, NX[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+    return n, ns
+
+
+@kernel
 def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     """Every branch of one pose of a 1-D search class into Q (16, 6), V, E; returns their
     number."""
@@ -569,63 +666,61 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
         il, xl = (g - 1, X[g - 1]) if g > 0 else (L - 2, X[L - 2] - 2.0 * math.pi)
         n = _dips(cls, h, PP, R06, p, p16, RS, ES, CS, il, xl, RS, ES, CS, g, X[g],
                   RS, ES, CS, g + 1, X[g + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
-    # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends
+    # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends, at up to
+    # _DEPTH levels (level d + 1 looks again at the flagged intervals of level d, depth first)
     L2 = 2 * _SUB + 1
     u = np.empty(L2)
     for i in range(_SUB + 1):
         u[i] = (i / _SUB) ** 2 / 2.0
     for i in range(_SUB):
         u[_SUB + 1 + i] = 1.0 - u[_SUB - 1 - i]
-    X2 = np.empty(L2)
-    RS2, ES2, CS2 = np.zeros((L2, 4, 3)), np.full((L2, 4), math.nan), np.zeros(L2, dtype=np.int64)
+    XL = np.empty((_DEPTH, L2))
+    RSL, ESL = np.zeros((_DEPTH, L2, 4, 3)), np.full((_DEPTH, L2, 4), math.nan)
+    CSL, FL = np.zeros((_DEPTH, L2), dtype=np.int64), np.zeros((_DEPTH, L2 - 1), dtype=np.bool_)
+    # the samples next to each level's interval (0: left, 1: right), copied from its parent
+    NR, NE = np.zeros((_DEPTH, 2, 4, 3)), np.full((_DEPTH, 2, 4), math.nan)
+    NC, NX = np.zeros((_DEPTH, 2), dtype=np.int64), np.empty((_DEPTH, 2))
+    pos = np.zeros(_DEPTH, dtype=np.int64)
     SX, SR, FM = np.empty(_MAX_SEEDS), np.empty((_MAX_SEEDS, 3)), np.empty(4, dtype=np.bool_)
     ns = 0
     for g in range(grid):
         if not fine[g]:
             continue
-        for i in range(L2):
-            X2[i] = X[g] + step * u[i]
-        _sample(cls, h, PP, R06, p16, X2, RS2, ES2, CS2, t2)
-        for g2 in range(L2 - 1):
-            _interval(RS2, CS2, g2, S1, DM)
-            for s in range(CS2[g2]):
-                s1 = S1[s]
-                if DM[s] < _MATCH and (ES2[g2, s] < 0.0) != (ES2[g2 + 1, s1] < 0.0):
-                    if _refine(cls, h, PP, R06, p16, X2[g2], X2[g2 + 1], ES2[g2, s], ES2[g2 + 1, s1],
-                               (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
-                               (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
-                        n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
-            if g2 > 0:
-                n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
-                          RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
-            if CS2[g2] != CS2[g2 + 1]:
-                # fold seeds: on the side with more roots, those with a small error, and all those
-                # nearest to no root of the other side (the pair that meets at the fold) where
-                # their errors differ in sign (a root on the arc through the fold)
-                side = g2 if CS2[g2] > CS2[g2 + 1] else g2 + 1
-                other = g2 + 1 if side == g2 else g2
-                for j in range(4):
-                    FM[j] = True
-                for t in range(CS2[other]):
-                    k, _ = _nearest(RS2, CS2, side, (RS2[other, t, 0], RS2[other, t, 1], RS2[other, t, 2]))
-                    FM[k] = False
-                pos = neg_ = False
-                for j in range(CS2[side]):
-                    if FM[j]:
-                        pos = pos or ES2[side, j] > 0.0
-                        neg_ = neg_ or ES2[side, j] < 0.0
-                for j in range(CS2[side]):
-                    if (abs(ES2[side, j]) < _SEED or (FM[j] and pos and neg_)) and ns < _MAX_SEEDS:
-                        SX[ns] = X2[side]
-                        SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
-                        ns += 1
-        # the ends of the finer look, between its next samples and the grid samples beyond
         il, xl = (g - 1, X[g - 1]) if g > 0 else (L - 2, X[L - 2] - 2.0 * math.pi)
         ir, xr = (g + 2, X[g + 2]) if g + 2 < L else (1, X[1] + 2.0 * math.pi)
-        n = _dips(cls, h, PP, R06, p, p16, RS, ES, CS, il, xl, RS2, ES2, CS2, 0, X2[0],
-                  RS2, ES2, CS2, 1, X2[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
-        n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, L2 - 2, X2[L2 - 2], RS2, ES2, CS2, L2 - 1, X2[L2 - 1],
-                  RS, ES, CS, ir, xr, th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        _copy_sample(RS, ES, CS, il, NR[0], NE[0], NC[0], 0)
+        _copy_sample(RS, ES, CS, ir, NR[0], NE[0], NC[0], 1)
+        NX[0, 0], NX[0, 1] = xl, xr
+        n, ns = _look(cls, h, PP, R06, p, p16, X[g], X[g + 1], u, _DEPTH > 1, XL[0], RSL[0], ESL[0], CSL[0],
+                      FL[0], NR[0], NE[0], NC[0], NX[0], S1, DM, FM, SX, SR, ns, th, e, t2, out, q, q2, J, F,
+                      Q, V, E, n)
+        d = 0
+        pos[0] = 0
+        while d >= 0:
+            k = pos[d]
+            while k < L2 - 1 and not FL[d, k]:
+                k += 1
+            if k >= L2 - 1:
+                d -= 1                                            # every flagged interval of level d done
+                continue
+            pos[d] = k + 1
+            if k > 0:
+                _copy_sample(RSL[d], ESL[d], CSL[d], k - 1, NR[d + 1], NE[d + 1], NC[d + 1], 0)
+                NX[d + 1, 0] = XL[d, k - 1]
+            else:
+                _copy_sample(NR[d], NE[d], NC[d], 0, NR[d + 1], NE[d + 1], NC[d + 1], 0)
+                NX[d + 1, 0] = NX[d, 0]
+            if k + 2 < L2:
+                _copy_sample(RSL[d], ESL[d], CSL[d], k + 2, NR[d + 1], NE[d + 1], NC[d + 1], 1)
+                NX[d + 1, 1] = XL[d, k + 2]
+            else:
+                _copy_sample(NR[d], NE[d], NC[d], 1, NR[d + 1], NE[d + 1], NC[d + 1], 1)
+                NX[d + 1, 1] = NX[d, 1]
+            d += 1
+            n, ns = _look(cls, h, PP, R06, p, p16, XL[d - 1, k], XL[d - 1, k + 1], u, d + 1 < _DEPTH, XL[d],
+                          RSL[d], ESL[d], CSL[d], FL[d], NR[d], NE[d], NC[d], NX[d], S1, DM, FM, SX, SR, ns,
+                          th, e, t2, out, q, q2, J, F, Q, V, E, n)
+            pos[d] = 0
     for k in range(ns):
         _assemble(cls, h, PP, R06, p16, SX[k], SR[k, 0], SR[k, 1], SR[k, 2], q)
         if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
