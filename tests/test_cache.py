@@ -244,3 +244,32 @@ def test_damaged_bytecode_entry_is_recompiled(cdir):
     q, v, a = np.array([0.2, 0.5]), np.array([0.3, -1.0]), np.array([1.0, 2.0])
     assert np.allclose(dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12)
     assert cache.read("lagrange", code.name) is not None
+
+
+def test_a_kernel_is_compiled_again_when_a_kernel_it_calls_changes(tmp_path):
+    """Numba keys a cached kernel by its own file only, but the compiled code holds the kernels
+    it calls from other modules: package module b's kernel calls module a's; after a's kernel is
+    edited (b untouched), a fresh process must run the new a (anthroarm.jit stamps every entry
+    with the digest of the package's kernel modules).  Without that it ran the old a."""
+    pkg = tmp_path / "kpkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 1.0\n")
+    (pkg / "b.py").write_text("from anthroarm.jit import kernel\n\nfrom .a import f\n\n\n@kernel\ndef g(x):\n"
+                              "    return 10.0 * f(x)\n")
+    env = dict(os.environ, ANTHROARM_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
+    env.pop("NUMBA_CACHE_DIR", None)
+
+    def run():
+        r = subprocess.run([sys.executable, "-c", "from kpkg.b import g; print(g(1.0))"], capture_output=True,
+                           text=True, env=env, timeout=300)
+        assert r.returncode == 0, r.stderr[-2000:]
+        return float(r.stdout)
+
+    assert run() == 20.0
+    assert list((tmp_path / "cache" / "numba").rglob("*.nbi"))            # cached
+    assert run() == 20.0
+    b_stat = (pkg / "b.py").stat()
+    (pkg / "a.py").write_text("from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 2.0\n")
+    assert (pkg / "b.py").stat().st_mtime_ns == b_stat.st_mtime_ns
+    assert run() == 30.0

@@ -11,7 +11,11 @@ subfolder ``numba`` of anthroarm's cache (:func:`anthroarm.cache.root`; ``$ANTHR
 moves it), unless ``$NUMBA_CACHE_DIR`` is already set or Numba was imported before anthroarm.
 Numba keys each entry by the source file's path, modification time and size, the function's
 bytecode and signature, the target CPU and its own version, and recompiles when any of them
-changes.  Like every entry of anthroarm's cache, each data file is *verified before it is
+changes.  A compiled kernel also holds the code of the kernels it calls, which may live in other
+modules (the class solvers call the subproblems of :mod:`anthroarm.ik.subproblems`), and Numba
+does not look at those; so the stamp of every entry here also holds the SHA-256 of the sources
+of all the kernel modules of its package (:func:`kernel_sources_digest`): an edited subproblem
+recompiles its callers instead of leaving them with the old code.  Like every entry of anthroarm's cache, each data file is *verified before it is
 loaded*: it is written atomically with the SHA-256 of its contents in front
 (:class:`VerifiedCacheFile`), and a file that does not match (truncated, edited, half-copied) or
 an index that cannot be read is dropped and the kernel compiled again — never loaded.  The
@@ -35,8 +39,10 @@ CACHE_SUBFOLDER = "numba"
 if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in __import__("sys").modules:
     os.environ["NUMBA_CACHE_DIR"] = str(_cache.root() / CACHE_SUBFOLDER)
 
+import functools  # noqa: E402
 import hashlib  # noqa: E402
 import pickle  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numba  # noqa: E402
 from numba.core import caching  # noqa: E402
@@ -74,14 +80,46 @@ class VerifiedCacheFile(caching.IndexDataCacheFile):
         return pickle.loads(raw[head:])
 
 
+def _package_root(func) -> str:
+    """The folder of the top-level package that defines ``func`` (its own folder for a module
+    outside a package)."""
+    import sys
+
+    mod = sys.modules.get(func.__module__.split(".")[0])
+    path = getattr(mod, "__path__", None)
+    if path:
+        return str(Path(list(path)[0]).resolve())
+    return str(Path(func.__code__.co_filename).resolve().parent)
+
+
+@functools.lru_cache(maxsize=None)
+def kernel_sources_digest(root: str) -> str:
+    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
+    kernels (their text holds ``@kernel``), with their paths relative to ``root``; read once per
+    process and folder."""
+    base = Path(root)
+    h = hashlib.sha256()
+    for p in sorted(base.rglob("*.py")):
+        try:
+            text = p.read_bytes()
+        except OSError:
+            continue
+        if b"@kernel" in text:
+            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
+    return h.hexdigest()
+
+
 class VerifiedCache(caching.FunctionCache):
     """Numba's per-function cache on :class:`VerifiedCacheFile`; an entry that verifies but
-    cannot be rebuilt (another build of the same version) is compiled again as well."""
+    cannot be rebuilt (another build of the same version) is compiled again as well.  The
+    source stamp is Numba's (the function's file) and :func:`kernel_sources_digest` (the
+    kernels it may call)."""
 
     def __init__(self, py_func):
         super().__init__(py_func)
+        stamp = (self._impl.locator.get_source_stamp(), kernel_sources_digest(_package_root(py_func)))
         self._cache_file = VerifiedCacheFile(cache_path=self._cache_path, filename_base=self._impl.filename_base,
-                                             source_stamp=self._impl.locator.get_source_stamp())
+                                             source_stamp=stamp)
 
     def load_overload(self, sig, target_context):
         try:
@@ -98,4 +136,4 @@ def kernel(func):
     return dispatcher
 
 
-__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel"]
+__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel", "kernel_sources_digest"]

@@ -593,19 +593,26 @@ def _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t):
     return sub(add(p0, rotate(k1, t[0], p1)), rotate(k2, t[1], add(p2, rotate(k3, t[2], p3))))
 
 
+#: Newton steps at most on an SP5 candidate (:func:`_sp5_newton`; quadratic convergence: most
+#: stop after one or two)
+SP5_NEWTON = 6
+
+
 @kernel
 def _sp5_newton(p0, p1, p2, p3, k1, k2, k3, t, stop):
-    """Newton's method on the SP5 equation (3 equations, 3 angles) from ``t``: at most three
-    steps, fewer once the residual is below ``stop``; returns the wrapped angles and the
-    residual norm there."""
+    """Newton's method on the SP5 equation (3 equations, 3 angles) from ``t``: at most
+    :data:`SP5_NEWTON` steps, fewer once the residual is below ``stop``; returns the wrapped
+    angles and the residual norm there.  (Three steps left a candidate near a close pair of
+    quartic roots at a residual of ~1e-7, accepted under ``TOL_QUARTIC`` but 1.4e-6 rad from the
+    converged copy of the same solution: a duplicate root.)"""
     res = math.inf
-    for it in range(4):
+    for it in range(SP5_NEWTON + 1):
         r1 = rotate(k1, t[0], p1)
         r3 = rotate(k3, t[2], p3)
         w = rotate(k2, t[1], add(p2, r3))
         F = sub(add(p0, r1), w)                        # _sp5_residual at t
         res = norm(F)
-        if it == 3 or res <= stop:
+        if it == SP5_NEWTON or res <= stop:
             break
         c3v = rotate(k2, t[1], cross(k3, r3))
         j0, j1 = cross(k1, r1), neg(cross(k2, w))
