@@ -256,3 +256,29 @@ def test_planar_off_plane_and_out_of_reach():
     with pytest.raises(ValueError, match=r"P\[1\]"):
         F.planar_verified(plan, np.array([[0, 1.0, 0], [np.inf, 0, 0]]))
     assert F.planar_plan(aa.load("human_arm7")) is None
+
+
+@pytest.mark.parametrize("name", ["human_arm7", "planar2r"])
+def test_one_pose_path_is_the_batch_answer(name):
+    """aa.ik.analytic of one pose (its lean compiled path) gives exactly what analytic_batch
+    gives for that pose — solutions, labels, swivel angles — on reachable poses (each solution
+    FK-exact by Pinocchio) and the batch's reason where there is none (a pose out of reach)."""
+    robot = aa.load(name)
+    model, data = robot.model, robot.model.createData()
+    Q = robot.random_q(40, np.random.default_rng(8))
+    T = robot.fk(Q)
+    for k in range(len(Q)):
+        kw = {"swivel": float(swivel_angle(robot, Q[k]))} if name == "human_arm7" else {}
+        a, b = aa.ik.analytic(robot, T[k], **kw), aa.ik.analytic_batch(robot, T[k][None], **kw)[0]
+        assert a.branches == b.branches and len(a) > 0
+        np.testing.assert_array_equal(a.solutions, b.solutions)
+        if kw:
+            np.testing.assert_array_equal(a.swivel, b.swivel)
+        for q in a.solutions:
+            pin.framesForwardKinematics(model, data, q)
+            err = data.oMf[robot.tool_id].translation - T[k][:3, 3]
+            assert np.abs(err).max() < 1e-9
+    far = T[0].copy()
+    far[:3, 3] *= 100.0
+    a, b = aa.ik.analytic(robot, far), aa.ik.analytic_batch(robot, far[None])[0]
+    assert len(a) == 0 and a.reason == b.reason and a.reason

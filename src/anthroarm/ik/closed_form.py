@@ -645,6 +645,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         fast = _geometric_single(robot, s, arr, param, tol, tol_orthonormal)
         if fast is not None:
             return fast
+    if s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
+            arr.shape == (4, 4) or (s.kind == "planar" and arr.shape == (3,))):
+        fast = _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal)
+        if fast is not None:
+            return fast
     if arr.ndim == 3:
         return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
                               tol_orthonormal=tol_orthonormal, param=param)
@@ -663,6 +668,44 @@ def solution_angles(robot, T, param=None):
         return None
     one = _geo.solve_one(s.plan, T, 0.0 if param is None else float(param))
     return None if one is None else one[0]
+
+
+def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
+    """One pose of an SRS arm (at ``swivel``, a scalar or a 1-D grid; default
+    :data:`DEFAULT_SWIVEL`) or a planar 2R arm (position only) in one compiled call, when it has
+    a solution and nothing to polish — the same solutions, labels and order as
+    :func:`analytic_batch`, without its batch bookkeeping; else None (the batch path answers,
+    with the reasons and the polish)."""
+    try:
+        if s.kind == "srs":
+            if position_only:
+                return None
+            grid = _swivel_array(swivel, 1, grid_1d=True)
+            th, cand, exact, inside, res = (a[0] for a in _fam.srs_verified(s.plan, arr[None], grid, tol,
+                                                                             tol_orthonormal))
+            labels = s.plan.labels
+            sw = np.repeat(grid[0], len(labels))
+        else:
+            if position_only is False:
+                return None
+            p = arr if arr.shape == (3,) else arr[:3, 3]
+            if arr.shape == (4, 4) and np.abs(arr[3] - (0.0, 0.0, 0.0, 1.0)).max() > 1e-12:
+                return None
+            th, cand, exact, inside, res = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
+            labels, sw = s.plan.labels, None
+    except ValueError:
+        return None                     # a malformed pose or swivel: the batch path says what is wrong
+    if s.plain and (cand & exact & inside & (res > tol) & (res <= POLISH_MAX)).any():
+        return None
+    valid = _geo.mark_solutions(th[None], cand[None], inside[None], res[None], tol, s.form.branches)[0]
+    if not valid.any():
+        return None
+    k = np.flatnonzero(valid).tolist()
+    if len(labels) != len(valid):
+        labels = _grid_labels(labels, len(valid) // len(labels), "swivel")
+    q = th[valid]
+    return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q), branches=[labels[i] for i in k],
+                            swivel=None if sw is None else sw[valid], residuals=res[valid], model=robot.name)
 
 
 def _geometric_single(robot, s, arr, param, tol, tol_orthonormal):
