@@ -657,17 +657,17 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
                           tol_orthonormal=tol_orthonormal, param=param, _single_grid=True)[0]
 
 
-def solution_angles(robot, T, param=None):
+def solution_angles(robot, T, ref, param=None):
     """The joint angles θ (K, n) (``robot.chain.independent`` order, rad) of the solutions
     :func:`analytic` returns for one pose ``T`` (4×4 float array) of an arm of a closed class
-    (``param`` for a 7-joint arm), in branch order, nothing else — the seeds of
-    :func:`anthroarm.ik.solve` — or None where :func:`analytic` itself must answer (no closed
-    class, no solution, a candidate to polish)."""
+    (``param`` for a 7-joint arm), the one nearest ``ref`` (θ, (n,)) first, nothing else — the
+    seeds of :func:`anthroarm.ik.solve` — or None where :func:`analytic` itself must answer (no
+    closed class, no solution, a candidate to polish)."""
     s = _solver(robot)
     if s is None or s.kind != "geo" or s.plan.cls not in _geo.CLOSED or (param is None) != (s.plan.param_joint is None):
         return None
-    one = _geo.solve_one(s.plan, T, 0.0 if param is None else float(param))
-    return None if one is None else one[0]
+    ref = _geo._NO_REF if ref is None else np.ascontiguousarray(ref, dtype=float)
+    return _geo.solve_nearest(s.plan, T, 0.0 if param is None else float(param), ref)
 
 
 def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):

@@ -848,10 +848,12 @@ def solve(plan: GeoPlan, T, param=None):
 
 
 @kernel
-def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
+def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 2):
-    θ in independent-joint order, the FK residual, the branch index.  Returns their number K; −1: a malformed pose; −2: no solution,
-    or a candidate to polish (the caller's general path answers: reasons, polishing)."""
+    θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
+    (n,) (θ, rad; an empty array: none) the solution nearest it (Euclidean in θ) is swapped
+    into the first row.  Returns their number K; −1: a malformed pose; −2: no solution, or a
+    candidate to polish (the caller's general path answers: reasons, polishing)."""
     n = ci[2]
     Tb = T.reshape((1, 4, 4))
     pv = np.full(1, param)
@@ -869,7 +871,22 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, out):
                 out[K, k] = Q[0, b, ci[3 + k]]
             out[K, n], out[K, n + 1] = RES[0, b], b
             K += 1
-    return K if K > 0 else -2
+    if K == 0:
+        return -2
+    if len(ref) == n:
+        best, kb = math.inf, 0
+        for k in range(K):
+            d = 0.0
+            for j in range(n):
+                d += (out[k, j] - ref[j]) ** 2
+            if d < best:
+                best, kb = d, k
+        for j in range(n + 2):
+            out[0, j], out[kb, j] = out[kb, j], out[0, j]
+    return K
+
+
+_NO_REF = np.zeros(0)
 
 
 class BadPoseError(ValueError):
@@ -932,11 +949,22 @@ def solve_one(plan: GeoPlan, T, param: float = 0.0, tol: float = 1e-9, tol_ortho
     cf, ci = plan.packed
     n = len(ci) - 3
     out = np.empty((8, n + 2))
-    K = _verified_one(cf, ci, T, param, tol, tol_orthonormal, out)
+    K = _verified_one(cf, ci, T, param, tol, tol_orthonormal, _NO_REF, out)
     if K <= 0:
         return None
     sol = out[:K]
     return sol[:, :n], sol[:, n], [int(b) for b in sol[:, n + 1].tolist()]
+
+
+def solve_nearest(plan: GeoPlan, T, param: float, ref):
+    """The solutions θ (K, n) (independent-joint order, rad) of :func:`solve_one` (default
+    tolerances) with the one nearest ``ref`` (n,) first, or None — the seeds of
+    :func:`anthroarm.ik.solve`, one compiled call and one slice."""
+    cf, ci = plan.packed
+    n = len(ci) - 3
+    out = np.empty((8, n + 2))
+    K = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
+    return out[:K, :n] if K > 0 else None
 
 
 # ----------------------------------------------------------------------------- anthroarm check

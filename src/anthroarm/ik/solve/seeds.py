@@ -262,12 +262,13 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     T = tg.x.reshape(4, 4)
     try:
         prm = None if sh.held is None else float(TableSeeds(ws, tg, None).next()[sh.held])
-        S = closed_form.solution_angles(robot, T, prm)            # one compiled call, θ directly
-        if S is None:
-            res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
-            if res is None or not len(res):
-                res = closed_form.analytic(robot, T, **kw)
-            S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))
+        S = closed_form.solution_angles(robot, T, th_ref, prm)    # one compiled call, nearest first
+        if S is not None:
+            return S, ""
+        res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
+        if res is None or not len(res):
+            res = closed_form.analytic(robot, T, **kw)
+        S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))
     except (ValueError, ArithmeticError, UnsupportedModelError) as exc:   # a seed source only
         return none, f"analytic seed failed: {exc}"
     if len(S) > 1:
