@@ -13,7 +13,7 @@ from ..result import IKBatchResult, IKResult
 from . import ckernel
 from .kernel import MAX_ITER, STALL, attempt as py_attempt, clock, damped_step, damping
 from .nullspace import Swivel, posture, swivel as swivel_phase
-from .seeds import SWIVEL_GRID, TableSeeds, analytic_seeds
+from .seeds import SWIVEL_GRID, SWIVEL_GRID_COARSE, TableSeeds, analytic_seeds
 from .targets import ORIENTATION, POSE, Target, parse
 from .workspace import workspace
 
@@ -199,7 +199,11 @@ def solve_one(pb: Problem, tg: Target, seed):
     ana, ana_i, note = None, 0, ""
     if not out_of_reach and pb.closed_form_first(seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
-        ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
+        # without a posture objective any member of a swivel family will do: a coarse grid first
+        grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
+        ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid)
+        if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
+            ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
     table = None      # seed-table entries, nearest first (made when needed)
     attempt = pb.attempt
     total_it = restarts = attempts = 0

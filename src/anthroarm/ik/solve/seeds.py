@@ -34,6 +34,8 @@ ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in th
 #: the answer misses the member of the family nearest the comfortable posture on 2, median solve
 #: 0.24 ms; 24 angles: 2 and 0.28 ms; 12: 4 and 0.21 ms; 8: 7 and 0.20 ms)
 SWIVEL_GRID = np.linspace(-np.pi, np.pi, 16, endpoint=False)
+#: the swivel angles tried first where any solution will do (no posture objective), 90° apart
+SWIVEL_GRID_COARSE = SWIVEL_GRID[::4]
 #: a closed form costing at most this (µs, ``ClosedForm.cost_us``) is tried first
 CHEAP_US = 50.0
 
