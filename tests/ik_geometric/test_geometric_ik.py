@@ -421,3 +421,24 @@ def test_singular_poses_say_so_and_stay_exact(tmp_path):
     for v, s in zip(vol, r.solutions):
         J = robot.jacobian(s)
         assert np.isclose(v, abs(np.linalg.det(J)) / np.prod(np.linalg.norm(J, axis=0)), rtol=1e-9)
+
+
+def test_into_limits_takes_the_turn_nearest_zero():
+    """Of the angles q + 2πk inside the limits, the one nearest 0 (a ±2π UR joint answers 0.4,
+    not 0.4 − 2π); within 1e-9 outside a limit: onto it; no turn inside: not inside (oracle: the
+    candidates q + 2πk listed by hand)."""
+    two_pi = 2 * np.pi
+    lo = np.array([-two_pi, 0.0, -np.pi, -3 * np.pi, -np.inf, -1.0])
+    hi = np.array([two_pi, two_pi, 0.0, 3 * np.pi, np.inf, 1.0])
+    Q = np.array([[0.4, -0.5, 0.2, 7.0, 4.0, 1.0 + 1e-10],
+                  [3.5, 0.3, -0.5 + two_pi, -7.0, -4.0, 2.0]])
+    Qw, inside = G.wrap_into_limits(Q, lo, hi)
+    np.testing.assert_allclose(Qw[0], [0.4, two_pi - 0.5, 0.2, 7.0 - two_pi, 4.0 - two_pi, 1.0], atol=1e-12)
+    assert not inside[0]                                   # 0.2 has no turn in [−π, 0]
+    np.testing.assert_allclose(Qw[1, :5], [3.5 - two_pi, 0.3, -0.5, -7.0 + two_pi, -4.0 + two_pi], atol=1e-12)
+    assert not inside[1]                                   # 2.0 has no turn in [−1, 1]
+    assert G.wrap_into_limits(Q[:, :5], lo[:5], hi[:5])[1][1]
+    ur5 = aa.load("ur5")
+    q = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
+    r = aa.ik.analytic(ur5, _fk(ur5, q))
+    assert np.abs(r.solutions - q).max(1).min() < 1e-9     # the sampled angles themselves, no turn added

@@ -337,17 +337,6 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=T
 
 
 # ---------------------------------------------------------------------------- helpers
-def _wrap_into_limits(Q, lo, hi, tol=1e-9):
-    """Shift revolute angles by multiples of 2π into [lo, hi] where possible; returns (Q, inside).
-    Values within ``tol`` outside a limit are clipped onto it."""
-    lo_f = np.where(np.isfinite(lo), lo, -np.pi)
-    k = np.floor((Q - lo_f + tol) / TWO_PI)
-    Qw = Q - k * TWO_PI
-    inside = (Qw >= lo - tol) & (Qw <= hi + tol)
-    Qw = np.clip(Qw, lo, hi)
-    return Qw, inside.all(axis=-1)
-
-
 
 def _fk_residual(robot, Qw, Ts, position_only):
     """max |FK(q) − T| (3×4 entries, or position) of candidates Qw (N, B, nq) against Ts (N, 4, 4),
@@ -477,7 +466,7 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
         th, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in out)
     else:
         th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in _geo.solve(gp, Tr, prm))
-        th, inside = _wrap_into_limits(th, gp.lower, gp.upper)
+        th, inside = _geo.wrap_into_limits(th, gp.lower, gp.upper)
         cand = cand & np.isfinite(th).all(-1)
         Q = gp.chain.configuration(np.where(cand[..., None], th, 0.0))
         res = np.where(cand, _fk_residual(robot, Q, Ts, False), np.inf)
@@ -806,7 +795,7 @@ def _book_result(robot, T, prm, tol):
     if not sols:
         return AnalyticIKResult(np.zeros((0, robot.nq)), [], reason, model=robot.name)
     Q = np.array(sols)
-    Qw, inside = _wrap_into_limits(Q, robot.lower, robot.upper)
+    Qw, inside = _geo.wrap_into_limits(Q, robot.lower, robot.upper)
     res = _fk_residual(robot, Qw[None], T[None], False)[0]
     ok = inside & (res <= tol)
     labels = ["elbow_root=+", "elbow_root=-"]

@@ -487,19 +487,48 @@ def _closed_loop(cls, H, P, R06, p, Q, V, E):
 @kernel
 def into_limits(q, n, lo, hi):
     """Shift the angles q[:n] (rad) by multiples of 2π into [lo, hi] (a continuous joint, ±inf:
-    into [−π, π)), in place; a value within 1e-9 rad outside a limit is put onto it.  Returns
-    whether every joint is inside; a joint that is not keeps its shifted value (the caller may
-    move it along a self-motion, :func:`anthroarm.ik.closed_form.analytic`)."""
+    into (−π, π]), in place: of the values q + 2πk inside the limits, the one nearest 0 (a UR
+    joint of ±2π keeps 0.4, not 0.4 − 2π); a value within 1e-9 rad outside a limit is put onto
+    it.  Returns whether every joint is inside; a joint that is not keeps the smallest shifted
+    value ≥ its lower limit (the caller may move it along a self-motion,
+    :func:`anthroarm.ik.closed_form.analytic`)."""
     inside = True
     for j in range(n):
-        lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
-        qw = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
-        if qw < lo[j] - 1e-9 or qw > hi[j] + 1e-9:
-            inside = False
-            q[j] = qw
+        lo_j, hi_j = lo[j] - 1e-9, hi[j] + 1e-9
+        x = wrap(q[j])
+        best = x if lo_j <= x <= hi_j else math.nan
+        k = 1
+        while best != best and (x + 2.0 * math.pi * k <= hi_j or x - 2.0 * math.pi * k >= lo_j):
+            up, down = x + 2.0 * math.pi * k, x - 2.0 * math.pi * k
+            if lo_j <= up <= hi_j:
+                best = up
+            if lo_j <= down <= hi_j and not (abs(best) <= abs(down)):
+                best = down
+            k += 1
+        if best == best:
+            q[j] = min(max(best, lo[j]), hi[j])
         else:
-            q[j] = min(max(qw, lo[j]), hi[j])
+            inside = False
+            lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
+            q[j] = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
     return inside
+
+
+@kernel
+def _into_limits_rows(Q, lo, hi, inside):
+    for i in range(Q.shape[0]):
+        inside[i] = into_limits(Q[i], Q.shape[1], lo, hi)
+
+
+def wrap_into_limits(Q, lo, hi):
+    """:func:`into_limits` of every row of Q (..., n) rad (a copy; NaN rows stay NaN): (Q
+    shifted, inside (...,))."""
+    Q = np.array(Q, dtype=float)
+    shape = Q.shape
+    Q2 = np.ascontiguousarray(Q.reshape(-1, shape[-1]))
+    inside = np.empty(len(Q2), dtype=bool)
+    _into_limits_rows(Q2, np.ascontiguousarray(lo, dtype=float), np.ascontiguousarray(hi, dtype=float), inside)
+    return Q2.reshape(shape), inside.reshape(shape[:-1])
 
 
 @kernel

@@ -238,7 +238,7 @@ def solve_one(pb: Problem, tg: Target, seed):
             best_q, best_E = bq, bE
         if ok:
             pe, re = math.sqrt(pe2), math.sqrt(re2)
-            msg = f"converged from a {tag} seed"
+            msg = f"converged from {_article(tag)} {tag} seed"
             if sw is not None:
                 ths, it2 = swivel_phase(ws, tg, ths, sw, deadline + 0.5 * max_time)
                 total_it += it2
@@ -376,7 +376,7 @@ def solve_lockstep(pb: Problem, tgs, seeds):
         if converged[k] and pb.th_ref is None and pb.swivel is None:
             tag = ("q0" if seeds[k] is not None else "table") if restarts == 0 else "restart"
             results.append(IKResult(Th[k].copy(), True, "success", math.sqrt(PE2[k]), math.sqrt(RE2[k]),
-                                    int(its[k]), restarts, f"converged from a {tag} seed (batch)", tg.mode, tag))
+                                    int(its[k]), restarts, f"converged from {_article(tag)} {tag} seed (batch)", tg.mode, tag))
             continue
         # a redundant arm's null-space phase, or stalled LOCKSTEP_ATTEMPTS times: the one-target solver
         r = solve_one(pb, tg, Th[k] if converged[k] else seeds[k])
@@ -385,3 +385,8 @@ def solve_lockstep(pb: Problem, tgs, seeds):
             r.restarts += restarts
         results.append(r)
     return results
+
+
+def _article(word: str) -> str:
+    """'an' before a seed tag that starts with a vowel ('analytic'), else 'a' ('table', 'q0')."""
+    return "an" if word[:1] in "aeiou" else "a"
