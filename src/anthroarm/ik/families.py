@@ -388,13 +388,14 @@ def _seven(A):
 
 
 @kernel
-def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid):
+def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid, exact):
     """Wrap q (n,) by 2π into [lo, hi] (:func:`.geometric.into_limits`), write Qout; returns
-    (inside, FK residual — inf when not valid)."""
+    (inside, FK residual — inf when not valid, and for an exact candidate outside the limits,
+    which is never returned and so not checked, as in :func:`.geometric._verified`)."""
     inside = into_limits(q, n, lo, hi)
     for j in range(n):
         Qout[j] = q[j]
-    return inside, (_fk_residual(kH, kO, MR, Mp, q, n, T) if valid else math.inf)
+    return inside, (_fk_residual(kH, kO, MR, Mp, q, n, T) if valid and (inside or not exact) else math.inf)
 
 
 @kernel
@@ -434,7 +435,7 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
                 r = 8 * k + b
                 for j in range(7):
                     q[j] = Qb[b, j]
-                IN[i, r], RES[i, r] = _limits_fk(q, 7, lo, hi, Q[i, r], kH, kO, MR, Mp, T[i], Vb[b])
+                IN[i, r], RES[i, r] = _limits_fk(q, 7, lo, hi, Q[i, r], kH, kO, MR, Mp, T[i], Vb[b], Eb[b])
                 V[i, r], E[i, r] = Vb[b], Eb[b]
     return -1
 
@@ -463,7 +464,7 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     Returns θ (N, 8S, 7) in ``robot.chain.independent`` order (rad, wrapped by 2π into the
     limits, NaN where the branch does not exist), candidate (N, 8S), exact (N, 8S), inside the
     limits (N, 8S), FK residual (N, 8S) (max entry of the 3×4 pose by the chain's product of
-    exponentials; inf where there is no candidate).  ``tol`` is accepted for the interface of
+    exponentials; inf where there is no candidate or an exact one outside the limits).  ``tol`` is accepted for the interface of
     :func:`anthroarm.ik.geometric.solve_verified` (the caller compares the residual to it).
     Raises ``ValueError`` naming the first malformed pose (not finite, last row, not a rotation
     to ``tol_orthonormal``)."""
