@@ -35,14 +35,14 @@ class (:mod:`.classify`)                  decomposition                         
 ========================================  =====================================  ==========
 
 The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``; compiled in
-:mod:`.search`) sample the searched joint
-on :data:`SEARCH_GRID` values for all poses in one batch, follow each root of the inner
-subproblem from sample to sample, and refine every sign change of the error by regula falsi
-(Illinois) to ``|e| ≤`` :data:`SEARCH_TOL`; a root that does not get there is not ``exact``.
-Where a pair of inner roots appears or vanishes (a fold) a root of the arm can sit on the arc
-through the fold, a sign change along neither root: the roots next to each fold with a small
-error seed Newton steps on the whole arm's pose (kept where they converge).  A root where the
-error only touches zero (no sign change) is not found.
+:mod:`.search`, whose docstring has the details) sample the searched joint on
+:data:`SEARCH_GRID` values, follow each root of the inner subproblem from sample to sample,
+refine every sign change of the error by regula falsi (Illinois) to ``|e| ≤``
+:data:`SEARCH_TOL`, minimise the dips of ``|e|`` between samples (a pair of roots closer than a
+sample interval), look again more finely where roots fold or jump, and polish the roots next
+to a fold by Newton steps on the whole arm's pose; ~1–3 ms a pose.  A root that lives inside
+one grid interval with no root of the inner subproblem at either end is not found (4 of 9 600
+random reachable poses of 96 random arms).
 
 ``gen_six_dof`` (IK-Geo ``IK_gen_6_dof``) samples (q1, q2) on a :data:`SEARCH_GRID_2D` ²
 grid; every (sample, SP5 root) whose error ``‖R05 h6 − R06 h6‖`` is below 0.3 and not above
