@@ -442,3 +442,18 @@ def test_into_limits_takes_the_turn_nearest_zero():
     q = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
     r = aa.ik.analytic(ur5, _fk(ur5, q))
     assert np.abs(r.solutions - q).max(1).min() < 1e-9     # the sampled angles themselves, no turn added
+
+
+def test_results_pickle_with_their_singular_text(tmp_path):
+    """A single and a batch result cross a process boundary (pickle) with `singular` evaluated:
+    the singular PUMA pose keeps its text, a generic pose its None."""
+    import pickle
+
+    robot = puma560(tmp_path)
+    T = np.stack([_fk(robot, np.array(q)) for q in ([0.2, 0.3, 0.4, 0.5, 0.0, 0.6], [0.2, 0.3, 0.4, 0.5, 0.7, 0.6])])
+    one = pickle.loads(pickle.dumps(aa.ik.analytic(robot, T[0])))
+    assert one.singular and "singular configuration" in one.singular
+    batch = pickle.loads(pickle.dumps(aa.ik.analytic_batch(robot, T)))
+    assert batch.singular[0] == one.singular and batch.singular[1] is None
+    assert batch[0].singular == one.singular and batch[1].singular is None
+    np.testing.assert_array_equal(batch[0].solutions, aa.ik.analytic_batch(robot, T)[0].solutions)

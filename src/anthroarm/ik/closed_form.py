@@ -100,6 +100,12 @@ class AnalyticIKResult:
             self._singular = self._singular()
         return self._singular
 
+    def __getstate__(self):
+        """Pickled with :attr:`singular` evaluated (its lazy maker is a closure)."""
+        state = self.__dict__.copy()
+        state["_singular"] = self.singular
+        return state
+
     @property
     def success(self) -> bool:
         return len(self.branches) > 0
@@ -145,6 +151,13 @@ class AnalyticBatchResult:
         """:attr:`AnalyticIKResult.singular` of every pose (N entries), computed on first use."""
         n = len(self)
         return [None] * n if self._singular_of is None else self._singular_of(list(range(n)))
+
+    def __getstate__(self):
+        """Pickled with :attr:`singular` evaluated (its lazy maker is a closure)."""
+        self.singular                                      # noqa: B018 - evaluated into __dict__
+        state = self.__dict__.copy()
+        state["_singular_of"] = None
+        return state
 
     def __len__(self) -> int:
         return self.solutions.shape[0]
