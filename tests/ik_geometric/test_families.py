@@ -208,6 +208,17 @@ def test_malformed_pose_raises_with_index():
         F.srs_verified(plan, T, np.array([0.0, np.nan, 0.0, 0.0]))
     with pytest.raises(ValueError, match="length N = 4"):
         F.srs_verified(plan, T, np.zeros(3))
+    # through aa.ik.analytic_batch (its compiled call finds the pose, the message details it),
+    # also from a batch large enough to be split across threads
+    _, T = _poses(r, 5000, 6)
+    T[4321, :3, :3] *= 1.01
+    with pytest.raises(ValueError, match=r"T\[4321\]: the rotation part is not a rotation matrix"):
+        aa.ik.analytic_batch(r, T, swivel=0.0)
+    T[4321] = r.fk(r.neutral())
+    sw = np.zeros(5000)
+    sw[3000] = np.inf
+    with pytest.raises(ValueError, match="swivel"):
+        aa.ik.analytic_batch(r, T, swivel=sw)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -439,15 +439,20 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     if position_only:
         raise ValueError(f"{robot.name}: a {s.form.family} arm is solved for the full pose (position and "
                          "rotation); for a position alone use aa.ik.solve(robot, p, position_only=True)")
-    closed = s.kind == "geo" and s.plan.cls in _geo.CLOSED      # the compiled call checks the rotations
-    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal, rigid=not closed)
+    closed = s.kind == "geo" and s.plan.cls in _geo.CLOSED
+    # a closed class and the SRS family check the rotations in their compiled call
+    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal, rigid=not (closed or s.kind == "srs"))
     N = Ts.shape[0]
     if s.kind == "srs":
         grid = _swivel_array(swivel, N, grid_1d=single or _single_grid)
         labels = _grid_labels(s.plan.labels, grid.shape[1], "swivel")
         if N == 0:
             return _empty(robot, labels, swivel=True)
-        th, cand, exact, inside, res = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
+        try:
+            th, cand, exact, inside, res = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
+        except _geo.BadPoseError as exc:                # the detailed message, at the caller's index
+            _check_poses(Ts[exc.index], name="T" if single else f"T[{exc.index}]", tol_orthonormal=tol_orthonormal)
+            raise
         sw = np.repeat(grid, len(s.plan.labels), axis=1)
         return _finish(robot, s, Ts, th, cand, exact, inside, res, None, labels, tol, False, swivel=sw)
     gp = s.plan

@@ -54,8 +54,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..jit import kernel
+from ..threads import run_rows
 from . import classify as C
-from .geometric import _common_point, _fk_residual, _pose_status, _wrist, into_limits
+from .geometric import BadPoseError, _common_point, _fk_residual, _pose_status, _wrist, into_limits
 from .subproblems import TOL, sp1_one, sp2_one, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
 
@@ -476,14 +477,23 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     B = 8 * sw.shape[1]
     Q, V, E = np.empty((N, B, 7)), np.empty((N, B), bool), np.empty((N, B), bool)
     IN, RES = np.empty((N, B), bool), np.empty((N, B))
-    bad = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_M,
-                        plan.fk_axes, plan.fk_points, plan.lower_path, plan.upper_path, T, sw, tol_orthonormal,
-                        Q, V, E, IN, RES)
-    if bad >= N:
-        raise ValueError(f"swivel[{bad - N}] is not finite (rad)")
-    if bad >= 0:
-        raise ValueError(f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a rotation "
-                         f"to {tol_orthonormal:g})")
+    bad_pose, bad_swivel = [], []
+
+    def rows(a, b):                                          # a slice of poses, on one core
+        k = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_M,
+                          plan.fk_axes, plan.fk_points, plan.lower_path, plan.upper_path, T[a:b], sw[a:b],
+                          tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b])
+        if k >= b - a:
+            bad_swivel.append(a + k - (b - a))
+        elif k >= 0:
+            bad_pose.append(a + k)
+
+    run_rows(rows, N)
+    if bad_swivel:
+        raise ValueError(f"swivel[{min(bad_swivel)}] is not finite (rad)")
+    if bad_pose:
+        raise BadPoseError(min(bad_pose), f"T[{min(bad_pose)}] is not a valid pose (finite, last row [0, 0, 0, 1], "
+                                          f"rotation part a rotation to {tol_orthonormal:g})")
     # E is already False wherever V is (the kernel's rule)
     return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES
 
