@@ -59,6 +59,7 @@ from . import families as _fam
 from . import geometric as _geo
 
 TWO_PI = 2.0 * np.pi
+_F64 = np.dtype(np.float64)
 #: default swivel grid of a redundant (srs_7r) arm (rad)
 DEFAULT_SWIVEL = np.linspace(-np.pi, np.pi, 36, endpoint=False)
 #: values of the held joint of a 7-joint arm when ``param`` is not given
@@ -215,6 +216,15 @@ class _Solver:
     plan: object
     form: ClosedForm
     plain: bool                          # q is the joint angles themselves (no continuous joint)
+
+    @functools.cached_property
+    def one_call(self):
+        """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints,
+        labels, whether a 7th joint is held); None for the other kinds."""
+        if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
+            return None
+        cf, ci = self.plan.packed
+        return cf, ci, len(ci) - 3, self.plan.labels, self.plan.param_joint is not None
 
 
 _SOLVERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -646,10 +656,10 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     s = _solver(robot)
-    if s is not None and s.kind == "geo" and arr.shape == (4, 4) and arr.dtype == np.float64 \
-            and s.plan.cls in _geo.CLOSED and swivel is None and not position_only \
-            and (param is None) == (s.plan.param_joint is None):
-        fast = _geometric_single(robot, s, arr, param, tol, tol_orthonormal)
+    one = None if s is None else s.one_call
+    if one is not None and arr.shape == (4, 4) and arr.dtype == _F64 and swivel is None and not position_only \
+            and (param is None) != one[4]:
+        fast = _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal)
         if fast is not None:
             return fast
     if s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
@@ -715,20 +725,25 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
                             swivel=None if sw is None else sw[valid], residuals=res[valid], model=robot.name)
 
 
-def _geometric_single(robot, s, arr, param, tol, tol_orthonormal):
+def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
     """One pose of a closed class in one compiled call, when it has a solution and nothing to
-    polish; else None (:func:`analytic_batch` answers, with the reasons)."""
+    polish; else None (:func:`analytic_batch` answers, with the reasons).  ``one``:
+    :attr:`_Solver.one_call`."""
+    cf, ci, n, labels, _ = one
     try:
-        one = _geo.solve_one(s.plan, arr, 0.0 if param is None else float(param), tol, tol_orthonormal)
+        prm = 0.0 if param is None else float(param)
     except (TypeError, ValueError):
         return None                     # a malformed param: the batch path says what is wrong
-    if one is None:
+    out = np.empty((8, n + 2))
+    K = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo._NO_REF, out)
+    if K <= 0:
         return None
-    q, res, idx = one
-    labels = s.plan.labels
+    sol = out[:K]
+    q = sol[:, :n]
     plan = s.plan
-    return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
-                            branches=[labels[i] for i in idx], residuals=res, model=robot.name,
+    return AnalyticIKResult(solutions=q if s.plain else plan.chain.configuration(q),
+                            branches=[labels[int(b)] for b in sol[:, n + 1].tolist()], residuals=sol[:, n],
+                            model=robot.name,
                             _singular=lambda: _singular_text(float(
                                 _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())))
 

@@ -58,7 +58,7 @@ with ξ'_k the twist of joint 7 − k seen from the tool at q = 0 and its axis n
 Every branch returned by :func:`solve` is a candidate: its ``exact`` flag is False where a
 subproblem had only a least-squares answer (the pose is out of reach on that branch).  The
 closed classes (:data:`CLOSED`) are compiled per pose (:mod:`anthroarm.jit`) from the
-subproblem kernels, and :func:`solve_verified` / :func:`solve_one` add in the same compiled
+subproblem kernels, and :func:`solve_verified` / :func:`solve_nearest` add in the same compiled
 call the 2π shift into the joint limits, the FK check by the chain's product of exponentials
 and the removal of duplicates (used by :func:`anthroarm.ik.closed_form.analytic`).
 """
@@ -971,24 +971,11 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     return Q[..., plan.order], OK, V, E & V, IN, RES
 
 
-def solve_one(plan: GeoPlan, T, param: float = 0.0, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
-    """One pose ``T`` (4, 4) of a closed class, in one compiled call: (θ (K, n) rad in
-    independent-joint order, FK residuals (K,), branch indices (a list of K)), or None when the pose has
-    no solution, is malformed, or has a candidate to polish (:func:`solve_verified` then)."""
-    cf, ci = plan.packed
-    n = len(ci) - 3
-    out = np.empty((8, n + 2))
-    K = _verified_one(cf, ci, T, param, tol, tol_orthonormal, _NO_REF, out)
-    if K <= 0:
-        return None
-    sol = out[:K]
-    return sol[:, :n], sol[:, n], [int(b) for b in sol[:, n + 1].tolist()]
-
-
 def solve_nearest(plan: GeoPlan, T, param: float, ref):
-    """The solutions θ (K, n) (independent-joint order, rad) of :func:`solve_one` (default
-    tolerances) with the one nearest ``ref`` (n,) first, or None — the seeds of
-    :func:`anthroarm.ik.solve`, one compiled call and one slice."""
+    """The solutions θ (K, n) (independent-joint order, rad) of one pose ``T`` (4, 4) of a
+    closed class (default tolerances; ``param`` the held 7th joint) with the one nearest ``ref``
+    (n,) first, or None where the pose has no solution, is malformed or has a candidate to
+    polish — the seeds of :func:`anthroarm.ik.solve`, one compiled call and one slice."""
     cf, ci = plan.packed
     n = len(ci) - 3
     out = np.empty((8, n + 2))
@@ -1050,4 +1037,4 @@ def check_rows(robot, samples: int, rng) -> list:
     return rows
 
 
-__all__ = ["CLOSED", "GeoPlan", "solve_one", "solve_verified", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
+__all__ = ["CLOSED", "GeoPlan", "solve_nearest", "solve_verified", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
