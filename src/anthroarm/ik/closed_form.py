@@ -359,6 +359,13 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=T
     return arr, single
 
 
+def _detail_bad_pose(Ts, i, single, tol_orthonormal):
+    """Raise :func:`_check_poses`'s detailed ValueError for pose ``i`` of ``Ts``, named as the
+    caller indexed it — the pose a compiled call found malformed (its
+    :class:`.geometric.BadPoseError` says only which)."""
+    _check_poses(Ts[i], name="T" if single else f"T[{i}]", tol_orthonormal=tol_orthonormal)
+
+
 # ---------------------------------------------------------------------------- helpers
 
 def _fk_residual(robot, Qw, Ts, position_only):
@@ -460,8 +467,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
             return _empty(robot, labels, swivel=True)
         try:
             th, cand, exact, inside, res = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
-        except _geo.BadPoseError as exc:                # the detailed message, at the caller's index
-            _check_poses(Ts[exc.index], name="T" if single else f"T[{exc.index}]", tol_orthonormal=tol_orthonormal)
+        except _geo.BadPoseError as exc:
+            _detail_bad_pose(Ts, exc.index, single, tol_orthonormal)
             raise
         sw = np.repeat(grid, len(s.plan.labels), axis=1)
         return _finish(robot, s, Ts, th, cand, exact, inside, res, None, labels, tol, False, swivel=sw)
@@ -487,9 +494,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     if closed:
         try:
             out = _geo.solve_verified(gp, Tr, prm, tol, tol_orthonormal)
-        except _geo.BadPoseError as exc:                # the detailed message, at the caller's index
-            i = exc.index // S
-            _check_poses(Ts[i], name="T" if single else f"T[{i}]", tol_orthonormal=tol_orthonormal)
+        except _geo.BadPoseError as exc:
+            _detail_bad_pose(Ts, exc.index // S, single, tol_orthonormal)
             raise
         th, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in out)
     else:

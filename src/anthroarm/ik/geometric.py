@@ -586,14 +586,33 @@ def _fk_residual(kH, kO, MR, Mp, q, n, T):
 
 
 @kernel
+def _chain_jacobian(kH, kO, Mp, q, n, J):
+    """The 6×6 Jacobian J of the first six joints at ``q`` (path order, rad; a 7th held), at the
+    tool point x, base frame: column i is (w × (x − o); w) with the joint's axis
+    w = R_{i−1} kH[i] through o = R_{i−1} kO[i] + t_{i−1} ((R, t) the product of the
+    exponentials before it).  Returns (R, t), the product of all ``n`` of them (the tool pose
+    is (R, t) · M, M's translation ``Mp``)."""
+    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    t = (0.0, 0.0, 0.0)
+    for i in range(n):
+        if i < 6:
+            J[3, i], J[4, i], J[5, i] = mv(R, vec(kH[i]))
+            J[0, i], J[1, i], J[2, i] = add(mv(R, vec(kO[i])), t)
+        R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+    x = add(t, mv(R, Mp))
+    for i in range(6):
+        c = cross((J[3, i], J[4, i], J[5, i]), sub(x, (J[0, i], J[1, i], J[2, i])))
+        J[0, i], J[1, i], J[2, i] = c
+    return R, t
+
+
+@kernel
 def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
     """Newton steps on the pose equations F(q) = T of the chain's first six joints (a 7th held),
     in place on ``q`` (n,) rad, for a candidate of an arm that is of its class only within the
     classification tolerance (its class solution is off by up to that much, ~1e-7 m).
 
-    The twist of joint i at q in the base frame: axis w = R_{i−1} kH[i] through
-    o = R_{i−1} kO[i] + t_{i−1} ((R, t) the product of the exponentials before it); the
-    Jacobian column at the tool point x is (w × (x − o); w), the error (x* − x;
+    The Jacobian :func:`_chain_jacobian`, the error (x* − x;
     ½ vee(R* Rᵀ − R R*ᵀ)) (the same step as :func:`anthroarm.ik.search.polish`).  At most
     :data:`POLISH_STEPS` steps, fewer once the residual is ≤ 1e-3 ``tol``; a step on a singular
     Jacobian (|det| ≤ 1e-12) ends it.  Returns the FK residual (:func:`_fk_residual`) at the
@@ -601,21 +620,12 @@ def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
     scratch."""
     res = math.inf
     for it in range(POLISH_STEPS + 1):
-        R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        t = (0.0, 0.0, 0.0)
-        for i in range(n):
-            if i < 6:
-                J[3, i], J[4, i], J[5, i] = mv(R, vec(kH[i]))
-                J[0, i], J[1, i], J[2, i] = add(mv(R, vec(kO[i])), t)
-            R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+        R, t = _chain_jacobian(kH, kO, Mp, q, n, J)
         res = _pose_error(R, t, MR, Mp, T)
         if res <= 1e-3 * tol or it == POLISH_STEPS:
             break
         RT = mm(R, MR)
         x = add(t, mv(R, Mp))
-        for i in range(6):
-            c = cross((J[3, i], J[4, i], J[5, i]), sub(x, (J[0, i], J[1, i], J[2, i])))
-            J[0, i], J[1, i], J[2, i] = c
         W = mm(mat(T), transpose(RT))
         F[0], F[1], F[2] = T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2]
         F[3] = 0.5 * (W[2][1] - W[1][2])
@@ -740,23 +750,14 @@ SINGULAR_TOL = 1e-6
 def _volume(kH, kO, MR, Mp, q, n, J, F):
     """The normalised volume |det J| / Π‖J_k‖ ∈ [0, 1] (Hadamard's inequality) of the 6×6
     Jacobian of the first six joints at ``q`` (path order, rad), at the tool point, in the base
-    frame (columns (w × (x − o); w) as in :func:`_polish_chain`): 0 at a singular configuration
+    frame (:func:`_chain_jacobian`): 0 at a singular configuration
     — a wrist with aligned axes, a stretched elbow, the wrist centre on the first axis — where
     solutions coincide in pairs or form a one-parameter family.  ``J`` (6, 6), ``F`` (6,)
     scratch."""
-    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    t = (0.0, 0.0, 0.0)
-    for i in range(n):
-        if i < 6:
-            J[3, i], J[4, i], J[5, i] = mv(R, vec(kH[i]))
-            J[0, i], J[1, i], J[2, i] = add(mv(R, vec(kO[i])), t)
-        R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
-    x = add(t, mv(R, Mp))
+    _chain_jacobian(kH, kO, Mp, q, n, J)
     scale = 1.0
     for i in range(6):
-        w = (J[3, i], J[4, i], J[5, i])
-        c = cross(w, sub(x, (J[0, i], J[1, i], J[2, i])))
-        J[0, i], J[1, i], J[2, i] = c
+        c, w = (J[0, i], J[1, i], J[2, i]), (J[3, i], J[4, i], J[5, i])
         scale *= math.sqrt(dot(c, c) + dot(w, w))
         F[i] = 0.0
     return abs(solve6(J, F)) / scale

@@ -326,6 +326,18 @@ def _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2):
 
 
 @kernel
+def _nearest(RS, CS, i, r):
+    """The root at sample ``i`` of RS (L, 4, 3) nearest to ``r`` (3-tuple; max over the unknowns
+    of the wrapped difference): (its index, the distance; inf where there is none)."""
+    best, k = math.inf, 0
+    for t in range(CS[i]):
+        d = max(abs(wrap(RS[i, t, 0] - r[0])), max(abs(wrap(RS[i, t, 1] - r[1])), abs(wrap(RS[i, t, 2] - r[2]))))
+        if d < best:
+            best, k = d, t
+    return k, best
+
+
+@kernel
 def _interval(RS, CS, g, S1, DM):
     """Follow each root at sample g to sample g + 1 (the nearest root there, max over the
     unknowns of the wrapped difference): S1 (4,) its index, DM (4,) the distance (inf: no
@@ -333,13 +345,7 @@ def _interval(RS, CS, g, S1, DM):
     or a root moves by more than _FAST, or finds no partner)."""
     fine = CS[g] != CS[g + 1]
     for s in range(CS[g]):
-        best, k = math.inf, 0
-        for t in range(CS[g + 1]):
-            d = 0.0
-            for c in range(3):
-                d = max(d, abs(wrap(RS[g, s, c] - RS[g + 1, t, c])))
-            if d < best:
-                best, k = d, t
+        k, best = _nearest(RS, CS, g + 1, (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]))
         S1[s], DM[s] = k, best
         if best > _FAST:
             fine = True
@@ -357,6 +363,24 @@ def _interval(RS, CS, g, S1, DM):
 
 
 @kernel
+def _interpolated_root(cls, h, PP, R06, p16, x, xl, xr, rl, rr, th, e, t2):
+    """The inner roots at ``x`` (into ``th``, errors ``e``) and the one nearest to the linear
+    interpolation at x of the roots ``rl`` at ``xl`` and ``rr`` at ``xr`` (max over the unknowns
+    of the wrapped difference): (its index, the distance — inf without a root —, the
+    interpolation)."""
+    cnt = _inner(cls, h, PP, R06, p16, x, th, e, t2)
+    t = (x - xl) / (xr - xl if xr != xl else 1.0)
+    t = min(max(t, 0.0), 1.0)
+    ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
+    best, k = math.inf, 0
+    for r in range(cnt):
+        d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
+        if d < best:
+            best, k = d, r
+    return k, best, ref
+
+
+@kernel
 def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
     """Illinois regula falsi on the bracket [xl, xr] (errors el, er of opposite signs, inner
     roots rl, rr (3-tuples) at the ends), the root followed by the one nearest its
@@ -366,15 +390,7 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
         den = er - el
         w = er / den if den != 0.0 else 0.5
         xm = xr - w * (xr - xl)
-        cnt = _inner(cls, h, PP, R06, p16, xm, th, e, t2)
-        t = (xm - xl) / (xr - xl if xr != xl else 1.0)
-        t = min(max(t, 0.0), 1.0)
-        ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
-        best, k = math.inf, 0
-        for r in range(cnt):
-            d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
-            if d < best:
-                best, k = d, r
+        k, best, _ = _interpolated_root(cls, h, PP, R06, p16, xm, xl, xr, rl, rr, th, e, t2)
         lost = not (best < math.inf)
         em = math.nan if lost else e[k]
         rm = (th[k, 0], th[k, 1], th[k, 2])
@@ -392,6 +408,26 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
     else:
         out[0], out[1], out[2], out[3], out[4] = xr, rr[0], rr[1], rr[2], abs(er)
     return True
+
+
+@kernel
+def _brackets(cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+    """The brackets of sample interval ``g`` of X, RS, ES, CS (roots followed by
+    :func:`_interval`: S1, DM): every followed root (closer than :data:`_MATCH`) whose error
+    changes sign is refined (:func:`_refine`) and its branch pushed.  Where the number of roots
+    changes (a fold, inside a finer look), only a pair of mutually nearest roots: a root of the
+    pair that vanishes at the fold is nearest to another root beyond it (no root to refine
+    between them: the refinement would end at the fold, inexact).  Returns the branch count."""
+    for s in range(CS[g]):
+        s1 = S1[s]
+        if DM[s] < _MATCH and (ES[g, s] < 0.0) != (ES[g + 1, s1] < 0.0):
+            r1 = (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2])
+            if CS[g] != CS[g + 1] and _nearest(RS, CS, g, r1)[0] != s:
+                continue
+            if _refine(cls, h, PP, R06, p16, X[g], X[g + 1], ES[g, s], ES[g + 1, s1],
+                       (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]), r1, th, e, t2, out):
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+    return n
 
 
 @kernel
@@ -415,31 +451,11 @@ def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
 
 
 @kernel
-def _nearest(RS, CS, i, r):
-    """The root at sample ``i`` of RS (L, 4, 3) nearest to ``r`` (3-tuple; max over the unknowns
-    of the wrapped difference): (its index, the distance; inf where there is none)."""
-    best, k = math.inf, 0
-    for t in range(CS[i]):
-        d = max(abs(wrap(RS[i, t, 0] - r[0])), max(abs(wrap(RS[i, t, 1] - r[1])), abs(wrap(RS[i, t, 2] - r[2]))))
-        if d < best:
-            best, k = d, t
-    return k, best
-
-
-@kernel
 def _follow(cls, h, PP, R06, p16, x, xl, xr, rl, rr, th, e, t2):
     """The inner root at ``x`` (between ``xl`` and ``xr``, whose followed roots are ``rl``,
     ``rr``) nearest to the linear interpolation of rl, rr: (its error (NaN: no root), the
     root)."""
-    cnt = _inner(cls, h, PP, R06, p16, x, th, e, t2)
-    t = (x - xl) / (xr - xl if xr != xl else 1.0)
-    t = min(max(t, 0.0), 1.0)
-    ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
-    best, k = math.inf, 0
-    for r in range(cnt):
-        d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
-        if d < best:
-            best, k = d, r
+    k, best, ref = _interpolated_root(cls, h, PP, R06, p16, x, xl, xr, rl, rr, th, e, t2)
     if not best < _MATCH:
         return math.nan, ref
     return e[k], (th[k, 0], th[k, 1], th[k, 2])
@@ -579,21 +595,8 @@ def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR,
                 fast = fast or DM[s] > _JUMP
         FL[g2] = fast
         if not fast:
-            for s in range(CS2[g2]):
-                s1 = S1[s]
-                if DM[s] < _MATCH and (ES2[g2, s] < 0.0) != (ES2[g2 + 1, s1] < 0.0):
-                    # where the count changes, only a pair of mutually nearest roots: a root of the
-                    # pair that vanishes at the fold is nearest to another root beyond it (no root
-                    # to refine between them: the refinement would end at the fold, inexact)
-                    if CS2[g2] != CS2[g2 + 1]:
-                        r1 = (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2])
-                        k0, _ = _nearest(RS2, CS2, g2, r1)
-                        if k0 != s:
-                            continue
-                    if _refine(cls, h, PP, R06, p16, X2[g2], X2[g2 + 1], ES2[g2, s], ES2[g2 + 1, s1],
-                               (RS2[g2, s, 0], RS2[g2, s, 1], RS2[g2, s, 2]),
-                               (RS2[g2 + 1, s1, 0], RS2[g2 + 1, s1, 1], RS2[g2 + 1, s1, 2]), th, e, t2, out):
-                        n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+            n = _brackets(cls, h, PP, R06, p, p16, X2, RS2, ES2, CS2, g2, S1, DM, th, e, t2, out, q, q2, J, F,
+                          Q, V, E, n)
         if g2 > 0 and not FL[g2 - 1] and not fast:
             n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
                       RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
@@ -651,13 +654,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
         fine[g] = _interval(RS, CS, g, S1, DM)
         if fine[g]:
             continue                                              # its brackets come from the finer look
-        for s in range(CS[g]):
-            s1 = S1[s]
-            if DM[s] < _MATCH and (ES[g, s] < 0.0) != (ES[g + 1, s1] < 0.0):
-                if _refine(cls, h, PP, R06, p16, X[g], X[g + 1], ES[g, s], ES[g + 1, s1],
-                           (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]),
-                           (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2]), th, e, t2, out):
-                    n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+        n = _brackets(cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n)
     # dips at the samples between two plain intervals (sample 0 ≡ L − 1: its left neighbour is L − 2)
     for g in range(grid):
         gl = g - 1 if g > 0 else grid - 1
