@@ -457,3 +457,40 @@ def test_results_pickle_with_their_singular_text(tmp_path):
     assert batch.singular[0] == one.singular and batch.singular[1] is None
     assert batch[0].singular == one.singular and batch[1].singular is None
     np.testing.assert_array_equal(batch[0].solutions, aa.ik.analytic_batch(robot, T)[0].solutions)
+
+
+def test_target_errors_are_pinocchios():
+    """The position and rotation errors the one-pose kernel reports with its nearest solution
+    (what ``aa.ik.solve`` returns for a closed-form answer) are Pinocchio's ‖p* − p‖ and
+    ‖log₃(Rᵀ R*)‖ of the same configuration, for targets off by up to a few cm and rotations
+    up to and near π (where a cos-only formula loses its digits)."""
+    robot = aa.load("ur5")
+    plan = G.plan_for(robot)
+    cf, ci = plan.packed
+    _, _, n, _, _, _, _, _, M, kH, kO, _, _ = G._unpack(cf, ci)
+    rng = np.random.default_rng(7)
+    for k, q in enumerate(robot.random_q(40, rng=rng)):
+        F = pin.SE3(_fk(robot, q))
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        angle = [1e-7, 0.3, 2.0, np.pi - 1e-9, np.pi][k % 5]
+        T = (F * pin.SE3(pin.exp3(angle * axis), rng.normal(scale=0.02, size=3))).homogeneous
+        assert plan.order_is_path and robot.nq == n            # ur5: q is θ in path order
+        pe, re = G._target_errors(kH, kO, G.mat(M[:3, :3]), G.vec(M[:3, 3]), q, n, np.ascontiguousarray(T))
+        assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-13)
+        assert re == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13)
+
+
+def test_solve_answers_a_closed_class_from_the_compiled_call():
+    """On a closed 6R class without a posture objective ``aa.ik.solve`` returns the closed form's
+    solution nearest the comfortable posture with no Gauss–Newton iteration; its reported errors
+    are Pinocchio's (recomputed here), and it is inside the limits."""
+    for name in ("ur5", "prosthetic_arm", "kinova"):
+        robot = aa.load(name)
+        for q in robot.random_q(10, rng=3):
+            T = _fk(robot, q)
+            r = aa.ik.solve(robot, T)
+            assert r.success and r.seed == "analytic" and r.iterations == 0 and robot.within_limits(r.q), name
+            F = pin.SE3(_fk(robot, r.q))
+            assert r.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-14)
+            assert r.rot_err == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-12)

@@ -16,7 +16,7 @@ from anthroarm.ik import qp
 from anthroarm.ik.qp import _qpgen2
 from anthroarm.ik.qp.limits.base import BIG, combine, combine_into
 from anthroarm.ik.qp.step import _Workspace
-from anthroarm.ik.qp.targets import as_se3
+from anthroarm.ik.qp.targets import as_rigid, as_se3
 
 BACKENDS = ["osqp", "daqp", "quadprog", "proxqp"]
 
@@ -236,6 +236,23 @@ def test_as_se3_fast_path_equals_checked_path(panda):
     with pytest.raises(ValueError, match="not a rotation"):
         as_se3(refl)
     assert np.array_equal(as_se3(np.eye(4, dtype=int)).homogeneous, np.eye(4))
+
+
+def test_as_rigid_is_as_se3_as_an_array(panda):
+    """``as_rigid`` (the pose targets of ``aa.ik.solve``) gives the matrix of ``as_se3`` as a
+    C-order float array: the same checks, the same re-orthonormalisation, never the caller's
+    array."""
+    T = panda.fk(panda.random_q(rng=5))
+    H = as_rigid(T)
+    assert H is not T and H.flags.c_contiguous and np.array_equal(H, T)
+    Tf = np.asfortranarray(T)
+    assert as_rigid(Tf).flags.c_contiguous and np.array_equal(as_rigid(Tf), T)
+    T2 = T.copy()
+    T2[:3, :3] *= 1.0 + 1e-9
+    assert np.array_equal(as_rigid(T2), as_se3(T2).homogeneous)
+    assert np.abs(as_rigid(T2)[:3, :3] @ as_rigid(T2)[:3, :3].T - np.eye(3)).max() < 1e-14
+    with pytest.raises(ValueError, match="not a rotation"):
+        as_rigid(np.diag([1.0, 1.0, -1.0, 1.0]))
 
 
 def _random_box_qp(rng, n, active=True):

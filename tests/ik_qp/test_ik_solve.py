@@ -326,7 +326,8 @@ def test_seed_tags_and_restart_cap(robots):
 def test_closed_form_first_where_cheap(robots):
     """Every arm with a closed form that costs about as much as a few Gauss–Newton iterations
     (a closed 6R class, an SRS arm's swivel grid, a 7-joint arm's held-joint grid: one compiled
-    call) takes its first seed from it and verifies it in one Gauss–Newton evaluation; the arms
+    call) takes its first seed from it, verified by one FK (of the compiled closed-form call on a
+    closed 6R class without a posture objective, else one Gauss–Newton evaluation); the arms
     without a closed form never do."""
     for name in ("prosthetic_arm", "ur5", "talos_arm", "panda", "human_arm7"):
         robot = robots[name]

@@ -680,17 +680,21 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
                           tol_orthonormal=tol_orthonormal, param=param, _single_grid=True)[0]
 
 
-def solution_angles(robot, T, ref, param=None):
-    """The joint angles θ (K, n) (``robot.chain.independent`` order, rad) of the solutions
-    :func:`analytic` returns for one pose ``T`` (4×4 float array) of an arm of a closed class
-    (``param`` for a 7-joint arm), the one nearest ``ref`` (θ, (n,)) first, nothing else — the
-    seeds of :func:`anthroarm.ik.solve` — or None where :func:`analytic` itself must answer (no
-    closed class, no solution, a candidate to polish)."""
-    s = _solver(robot)
-    if s is None or s.kind != "geo" or s.plan.cls not in _geo.CLOSED or (param is None) != (s.plan.param_joint is None):
+def nearest_solver(robot, frame=None):
+    """The seeds of :func:`anthroarm.ik.solve` on an arm of a closed class at ``frame`` (default
+    the tool): a function ``f(T, ref, param)`` of one pose ``T`` (4×4 C-order float array,
+    base frame, m), a reference θ ``ref`` (n,) (rad) and the held 7th joint ``param`` (rad; 0.0
+    for a 6-joint arm) that returns the joint angles θ (K, n) (``robot.chain.independent``
+    order, rad) of the solutions :func:`analytic` returns, the one nearest ``ref`` first, with
+    that one's position and rotation errors (m, rad) — or None where :func:`analytic` itself
+    must answer (no solution, a malformed pose, a candidate to polish).  None for other arms.
+    One compiled call (:func:`.geometric.solve_nearest`); the function holds the plan's
+    packed constants, not the robot."""
+    s = _at(robot, frame)
+    if s is None or s.one_call is None:
         return None
-    ref = _geo._NO_REF if ref is None else np.ascontiguousarray(ref, dtype=float)
-    return _geo.solve_nearest(s.plan, T, 0.0 if param is None else float(param), ref)
+    cf, ci, _, _, _ = s.one_call
+    return functools.partial(_geo.solve_nearest, cf, ci)
 
 
 def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
@@ -740,8 +744,8 @@ def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
         prm = 0.0 if param is None else float(param)
     except (TypeError, ValueError):
         return None                     # a malformed param: the batch path says what is wrong
-    out = np.empty((8, n + 2))
-    K = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo._NO_REF, out)
+    out = np.empty((8, n + 4))
+    K = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
     if K <= 0:
         return None
     sol = out[:K]

@@ -574,15 +574,36 @@ def _pose_error(R, t, MR, Mp, T):
 
 
 @kernel
-def _fk_residual(kH, kO, MR, Mp, q, n, T):
-    """max |F(q) − T| over the 3×4 pose entries, F(q) = e^{ξ1 q1} ⋯ e^{ξn qn} M the product of
-    exponentials of the chain's revolute joints (axes kH, points kO at q = 0, base frame) and
-    the tool pose M at q = 0 (MR, Mp)."""
+def _chain_fk(kH, kO, q, n):
+    """(R, t) = e^{ξ1 q1} ⋯ e^{ξn qn}, the product of exponentials of the chain's revolute joints
+    (axes kH, points kO at q = 0, base frame, m; q rad): the tool pose is (R, t) · M."""
     R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     t = (0.0, 0.0, 0.0)
     for i in range(n):
         R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+    return R, t
+
+
+@kernel
+def _fk_residual(kH, kO, MR, Mp, q, n, T):
+    """max |F(q) − T| over the 3×4 pose entries, F(q) = :func:`_chain_fk` · M with M the tool
+    pose at q = 0 (MR, Mp)."""
+    R, t = _chain_fk(kH, kO, q, n)
     return _pose_error(R, t, MR, Mp, T)
+
+
+@kernel
+def _target_errors(kH, kO, MR, Mp, q, n, T):
+    """(‖p* − p‖ m, ‖log₃(Rᵀ R*)‖ rad) of the tool pose (R, p) = F(q) (:func:`_fk_residual`)
+    against T = (R*, p*) — the position and rotation errors :func:`anthroarm.ik.solve` reports
+    (the angle of W = Rᵀ R* as atan2(‖vee(W − Wᵀ)‖ / 2, (tr W − 1) / 2), accurate near 0 and π)."""
+    R, t = _chain_fk(kH, kO, q, n)
+    RT = mm(R, MR)
+    x = add(t, mv(R, Mp))
+    W = mtm(RT, mat(T))
+    v = (W[2][1] - W[1][2], W[0][2] - W[2][0], W[1][0] - W[0][1])
+    return (norm((T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2])),
+            math.atan2(0.5 * norm(v), 0.5 * (W[0][0] + W[1][1] + W[2][2] - 1.0)))
 
 
 @kernel
@@ -879,11 +900,13 @@ def solve(plan: GeoPlan, T, param=None):
 
 @kernel
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
-    """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 2):
+    """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 4):
     θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
     (n,) (θ, rad; an empty array: none) the solution nearest it (Euclidean in θ) is swapped
-    into the first row.  Returns their number K; −1: a malformed pose; −2: no solution, or a
-    candidate to polish (the caller's general path answers: reasons, polishing)."""
+    into the first row, and that row's last two columns hold its position and rotation errors
+    (:func:`_target_errors`, m and rad).  Returns their number K; −1: a malformed pose; −2: no
+    solution, or a candidate to polish (the caller's general path answers: reasons,
+    polishing)."""
     n = ci[2]
     Tb = T.reshape((1, 4, 4))
     pv = np.full(1, param)
@@ -913,10 +936,13 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
                 best, kb = d, k
         for j in range(n + 2):
             out[0, j], out[kb, j] = out[kb, j], out[0, j]
+        _, _, _, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
+        out[0, n + 2], out[0, n + 3] = _target_errors(kH, kO, mat(M[:3, :3]), vec(M[:3, 3]), Q[0, int(out[0, n + 1])],
+                                                      n, T)
     return K
 
 
-_NO_REF = np.zeros(0)
+NO_REF = np.zeros(0)   # "no reference" of the one-pose kernels (an empty array)
 
 
 class BadPoseError(ValueError):
@@ -972,16 +998,19 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     return Q[..., plan.order], OK, V, E & V, IN, RES
 
 
-def solve_nearest(plan: GeoPlan, T, param: float, ref):
+def solve_nearest(cf, ci, T, ref, param: float):
     """The solutions θ (K, n) (independent-joint order, rad) of one pose ``T`` (4, 4) of a
-    closed class (default tolerances; ``param`` the held 7th joint) with the one nearest ``ref``
-    (n,) first, or None where the pose has no solution, is malformed or has a candidate to
-    polish — the seeds of :func:`anthroarm.ik.solve`, one compiled call and one slice."""
-    cf, ci = plan.packed
+    closed class (``cf``, ``ci``: :attr:`GeoPlan.packed`; default tolerances; ``param`` the held
+    7th joint) with the one nearest ``ref`` (n,) first, and that one's position and rotation
+    errors (m, rad; :func:`_target_errors`) — or None where the pose has no solution, is
+    malformed or has a candidate to polish.  The seeds of :func:`anthroarm.ik.solve`, one
+    compiled call."""
     n = len(ci) - 3
-    out = np.empty((8, n + 2))
+    out = np.empty((8, n + 4))
     K = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
-    return out[:K, :n] if K > 0 else None
+    if K <= 0:
+        return None
+    return out[:K, :n], float(out[0, n + 2]), float(out[0, n + 3])
 
 
 # ----------------------------------------------------------------------------- anthroarm check

@@ -75,12 +75,14 @@ def as_position(p, name: str = "p") -> np.ndarray:
     return p
 
 
-def as_se3(T, name: str = "T") -> pin.SE3:
-    """A ``pin.SE3`` from a rigid 4×4 homogeneous matrix (or a ``pin.SE3``), or ``ValueError``."""
+def as_rigid(T, name: str = "T") -> np.ndarray:
+    """A rigid 4×4 homogeneous matrix (a fresh float64 C-order array) from ``T`` (array-like or
+    ``pin.SE3``), or ``ValueError``; a rotation block off by more than 1e-12 (at most
+    :data:`RIGID_TOL`) is replaced by the nearest rotation."""
     if T.__class__ is np.ndarray and T.shape == (4, 4) and T.dtype == _F64 and _clean_rigid(T.tolist()):
         # fast path (a per-step target): taken as it is; anything else goes through the full
         # checks below (which raise or re-orthonormalise)
-        return pin.SE3(T)
+        return np.array(T, order="C")
     if isinstance(T, pin.SE3):
         T = T.homogeneous
     T = np.asarray(T, dtype=float)
@@ -90,5 +92,13 @@ def as_se3(T, name: str = "T") -> pin.SE3:
     b = T[3].tolist()
     if abs(b[0]) > RIGID_TOL or abs(b[1]) > RIGID_TOL or abs(b[2]) > RIGID_TOL or abs(b[3] - 1.0) > RIGID_TOL:
         raise ValueError(f"{name} is not rigid: bottom row {b} is not [0, 0, 0, 1]")
-    R = as_rotation(T[:3, :3], f"{name}[:3, :3]")
-    return pin.SE3(R, T[:3, 3])
+    H = np.eye(4)
+    H[:3, :3] = as_rotation(T[:3, :3], f"{name}[:3, :3]")
+    H[:3, 3] = T[:3, 3]
+    return H
+
+
+def as_se3(T, name: str = "T") -> pin.SE3:
+    """A ``pin.SE3`` from a rigid 4×4 homogeneous matrix (or a ``pin.SE3``), or ``ValueError``
+    (:func:`as_rigid`)."""
+    return pin.SE3(as_rigid(T, name))

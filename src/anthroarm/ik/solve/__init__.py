@@ -25,7 +25,9 @@ Seeds, in order (:mod:`.seeds`):
 
 1. the closed-form solutions of :func:`anthroarm.ik.analytic` (nearest the posture first), when
    ``analytic=True``, or with ``analytic="auto"`` and no ``q0`` where the closed form is cheap
-   (:func:`.seeds.closed_form_cheap`); they are exact, so one evaluation verifies them;
+   (:func:`.seeds.closed_form_cheap`); they are exact, so one evaluation verifies them (on a
+   closed 6R class without a posture or swivel objective the FK of the closed form's own
+   compiled call, which also gives the reported errors: the answer in one call);
 2. ``q0`` when given (clipped into the limits);
 3. the seed table, nearest the target first (aligned on the first and last joints where they
    turn fully), then the next :data:`.seeds.TABLE_SEEDS` − 1 nearest entries;

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..qp.targets import as_se3
+from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
 from . import ckernel
@@ -101,9 +101,9 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     ws = workspace(robot, robot.frame_id(frame))
     sh = ws.sh
     if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):
-        mode, batch, targets, x = "pose", False, [as_se3(T, "T")], T.ravel()
+        mode, batch, targets = "pose", False, [as_rigid(T, "T")]
     else:
-        (mode, batch, targets), x = parse(T, mode), None
+        mode, batch, targets = parse(T, mode)
     if not (type(tol_pos) is float and type(tol_rot) is float and type(max_time) is float   # the usual call
             and 0.0 < tol_pos < math.inf and 0.0 < tol_rot < math.inf and 0.0 < max_time < math.inf):
         for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
@@ -145,7 +145,7 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         ws.aligned()
     pb.attempt = ckernel.attempt if ckernel.ready(ws) else py_attempt    # compiled where available
     if not batch:
-        return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr, x), Q0), Q0)
+        return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
     seeds = [None if Q0 is None else (Q0[i] if Q0.ndim == 2 else Q0) for i in range(len(tgs))]
     if not warm_start and len(tgs) >= LOCKSTEP_MIN and not (pb.closed_form_first(Q0) and mode == "pose"):
@@ -201,9 +201,13 @@ def solve_one(pb: Problem, tg: Target, seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
         # without a posture objective any member of a swivel family will do: a coarse grid first
         grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
-        ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid)
+        ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid)
         if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
-            ana, note = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
+            ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
+        if err is not None and th_ref is None and sw is None and tg.ok(err[0] * err[0], err[1] * err[1]):
+            # the closed form's nearest solution, checked by the FK of its compiled call: the answer
+            return IKResult(ana[0], True, "success", err[0], err[1], 0, 0, "converged from an analytic seed",
+                            tg.mode, "analytic")
     table = None      # seed-table entries, nearest first (made when needed)
     attempt = pb.attempt
     total_it = restarts = attempts = 0
@@ -254,7 +258,7 @@ def solve_one(pb: Problem, tg: Target, seed):
         if out_of_reach and attempts >= 3:
             break
         if pb.analytic == "auto" and ana is None and not out_of_reach and attempts >= ANALYTIC_AFTER:
-            ana, note = analytic_seeds(pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID)
+            ana, note, _ = analytic_seeds(pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID)
         if clock() > deadline or (pb.max_restarts is not None and restarts >= pb.max_restarts):
             break
     th = best_q if best_q is not None else th
@@ -282,7 +286,7 @@ def _settle_swivel(pb, tg, ths, pe, re, msg):
     tried = ""
     if pb.analytic is not False:
         ref = ws.sh.ref if pb.th_ref is None else pb.th_ref
-        S, _ = analytic_seeds(pb.robot, ws, tg, ref, sw.target)
+        S, _, _ = analytic_seeds(pb.robot, ws, tg, ref, sw.target)
         if ws.sh.has_closed_form:
             tried = " and the closed form has no solution at that angle inside the limits"
         for cand in S:

@@ -501,7 +501,7 @@ def attempt(ws, tg, th, deadline):
     b.th[:] = th
     kind = tg.kind
     if kind == POSE:
-        b.T[:] = tg.Ms.homogeneous
+        b.T[:] = tg.H
     elif kind == POSITION:
         b.T[:3, 3] = tg.ps
     else:

@@ -21,6 +21,7 @@ import pinocchio as pin
 from ...chain import PRISMATIC
 from ...errors import UnsupportedModelError
 from .. import closed_form
+from ..geometric import NO_REF
 from .targets import POSE
 
 SEED_TABLE = 2048       # configurations in the per-(robot, frame) seed table
@@ -245,8 +246,9 @@ def closed_form_cheap(robot, fid) -> bool:
 
 
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
-    """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, and a note ("" or
-    why the closed form failed).  A redundant arm (a swivel family of solutions) is solved
+    """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, a note ("" or why
+    the closed form failed), and the first one's (position, rotation) errors (m, rad) where
+    the one-call kernel of a closed class computed them (its FK), else None.  A redundant arm (a swivel family of solutions) is solved
     at ``swivel`` (rad) if given, else on ``grid``.  A 7-joint arm whose last joint is held
     (``param=`` of the closed form) is solved at that joint's value in the seed-table entry
     nearest the target (one closed-form call: 8 branches), and on the closed form's own grid
@@ -254,28 +256,29 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     sh = ws.sh
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
-        return none, ""
+        return none, "", None
     kw = {}
     if sh.swivel_family:
         if swivel is not None:
             kw["swivel"] = swivel
         elif grid is not None:
             kw["swivel"] = grid
-    T = tg.x.reshape(4, 4)
+    T = tg.H
     try:
         prm = None if sh.held is None else float(TableSeeds(ws, tg, None).next()[sh.held])
-        S = closed_form.solution_angles(robot, T, th_ref, prm)    # one compiled call, nearest first
-        if S is not None:
-            return S, ""
+        if sh.nearest is not None:
+            one = sh.nearest(T, NO_REF if th_ref is None else th_ref, 0.0 if prm is None else prm)
+            if one is not None:                # one compiled call, nearest first
+                return one[0], "", one[1:]
         res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
         if res is None or not len(res):
             res = closed_form.analytic(robot, T, **kw)
         S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))
     except (ValueError, ArithmeticError, UnsupportedModelError) as exc:   # a seed source only
-        return none, f"analytic seed failed: {exc}"
+        return none, f"analytic seed failed: {exc}", None
     if len(S) > 1:
         D = S - th_ref
         k = int((D * D).sum(1).argmin())
         if k:                                  # nearest first (the order of the others matters little)
             S[[0, k]] = S[[k, 0]]
-    return S, ""
+    return S, "", None

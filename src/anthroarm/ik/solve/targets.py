@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from ..qp.targets import as_position, as_rotation, as_se3
+from ..qp.targets import as_position, as_rigid, as_rotation
 
 LOCAL = pin.ReferenceFrame.LOCAL
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -31,13 +31,16 @@ KIND = {"pose": POSE, "position": POSITION, "orientation": ORIENTATION}
 
 
 class Target:
-    """One target: kind, T* (``pin.SE3``), p* (3,), R* (3, 3), tolerances (m, rad), task
-    dimension m, and the seed-table features x: T*.ravel() (16,) for a pose, (p*, 1) for a
-    position, R*.ravel() for a rotation (see :meth:`anthroarm.ik.solve.seeds.build_table`)."""
+    """One target: kind, T* (``H`` (4, 4), and as ``pin.SE3`` ``Ms``, made on first use), p* (3,),
+    R* (3, 3), tolerances (m, rad), task dimension m, and the seed-table features x: T*.ravel()
+    (16,) for a pose, (p*, 1) for a position, R*.ravel() for a rotation (see
+    :meth:`anthroarm.ik.solve.seeds.build_table`).  A pose ``tgt`` is a rigid 4×4 float array
+    (:func:`~anthroarm.ik.qp.targets.as_rigid`, not copied) or a ``pin.SE3``."""
 
-    __slots__ = ("kind", "mode", "m", "Ms", "ps", "Rs", "tol_p", "tol_r", "tp2", "tr2", "tsum", "x", "ref", "rows")
+    __slots__ = ("kind", "mode", "m", "H", "_Ms", "ps", "Rs", "tol_p", "tol_r", "tp2", "tr2", "tsum", "x", "ref",
+                 "rows")
 
-    def __init__(self, mode, tgt, tol_p, tol_r, x=None):
+    def __init__(self, mode, tgt, tol_p, tol_r):
         self.mode = mode
         self.kind = KIND[mode]
         self.tol_p = tol_p
@@ -47,13 +50,15 @@ class Target:
         # a pose's v = V(ω)⁻¹ t with ‖V(ω)⁻¹‖ ≤ (1 + ‖ω‖)², so ‖e‖² ≤ tsum is necessary for
         # convergence: the exact errors are computed only then (see residual)
         self.tsum = (self.tp2 * (1.0 + tol_r) ** 2 + self.tr2) * (1.0 + 1e-12)
-        self.Ms = self.ps = self.Rs = None
+        self.H = self._Ms = self.ps = self.Rs = None
         if mode == "pose":
             self.m, self.ref, self.rows = 6, LOCAL, None
-            self.Ms = tgt
-            self.ps = tgt.translation
-            self.Rs = tgt.rotation
-            self.x = tgt.homogeneous.ravel() if x is None else x
+            if isinstance(tgt, pin.SE3):
+                self._Ms, tgt = tgt, tgt.homogeneous
+            self.H = tgt
+            self.ps = tgt[:3, 3]
+            self.Rs = tgt[:3, :3]
+            self.x = tgt.reshape(16)
         elif mode == "position":
             self.m, self.ref, self.rows = 3, LWA, slice(0, 3)
             self.ps = np.asarray(tgt, dtype=float)
@@ -62,6 +67,13 @@ class Target:
             self.m, self.ref, self.rows = 3, LOCAL, slice(3, 6)
             self.Rs = np.ascontiguousarray(tgt, dtype=float)
             self.x = self.Rs.reshape(9)
+
+    @property
+    def Ms(self) -> pin.SE3:
+        """T* as a ``pin.SE3`` (a pose target only)."""
+        if self._Ms is None:
+            self._Ms = pin.SE3(self.H)
+        return self._Ms
 
     def residual(self, ws, th):
         """(e (m,), ‖e‖², pos_err², rot_err²) at θ (0.0 for the unchecked part; a pose's both
@@ -111,7 +123,7 @@ class Target:
 
 
 def parse(T, mode):
-    """-> (mode, batch: bool, list of targets: ``pin.SE3``, p (3,) or R (3, 3)).
+    """-> (mode, batch: bool, list of targets: rigid 4×4 arrays, p (3,) or R (3, 3)).
     ``ValueError`` naming the defect for a wrong shape, NaN or a non-rigid transform."""
     if mode not in (None, "pose", "position", "orientation"):
         raise ValueError(f"mode must be None, 'pose', 'position' or 'orientation', got {mode!r}")
@@ -124,8 +136,8 @@ def parse(T, mode):
         batch = arr.ndim == 3
         out = []
         for i, a in enumerate(arr if batch else [arr]):
-            M = as_se3(a, f"T[{i}]" if batch else "T")
-            out.append(M if m == "pose" else (M.translation.copy() if m == "position" else M.rotation.copy()))
+            H = as_rigid(a, f"T[{i}]" if batch else "T")
+            out.append(H if m == "pose" else (H[:3, 3].copy() if m == "position" else H[:3, :3].copy()))
         return m, batch, out
     if sh == (3,):
         if mode not in (None, "position"):
