@@ -1,6 +1,6 @@
 """One-shot IK: anthroarm vs RTB ik_LM, TRAC-IK, pink, Pinocchio CLIK and ikpy on the same poses.
 
-For each robot (panda, ur5, ur10, xarm7, z1, so101, kinova, talos_arm, human_arm7,
+For each robot (panda, ur5, ur10, xarm7, z1, so101, kinova, talos_arm, human_arm7, sixr_arm,
 prosthetic_arm, all through ``anthroarm.load``): 1000 random configurations uniform inside the
 joint limits, their tool poses as targets (reachable by construction).  Every solver gets the
 same targets and is judged by Pinocchio FK of the robot's model: success = q within the joint
@@ -23,7 +23,7 @@ import anthroarm as aa
 
 from . import ik_peers
 
-ROBOTS = ["panda", "ur5", "ur10", "xarm7", "z1", "so101", "kinova", "talos_arm", "human_arm7", "prosthetic_arm"]
+ROBOTS = ["panda", "ur5", "ur10", "xarm7", "z1", "so101", "kinova", "talos_arm", "human_arm7", "prosthetic_arm", "sixr_arm"]
 #: anthroarm.load keywords: the arm without its gripper joint (z1: the flange link06, since pink
 #: cannot name "gripperStator", which is both a joint and a link)
 LOAD = {"z1": dict(tool="link06", locked=["jointGripper"]),

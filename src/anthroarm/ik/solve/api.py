@@ -29,13 +29,22 @@ class Problem:
     (None: none), the closed-form policy, and the attempt kernel (:func:`.kernel.attempt` or
     its compiled form :func:`.ckernel.attempt`)."""
 
-    __slots__ = ("robot", "ws", "max_time", "max_restarts", "rng", "_gen", "th_ref", "swivel", "analytic", "attempt")
+    __slots__ = ("robot", "ws", "max_time", "max_restarts", "rng", "_gen", "th_ref", "swivel", "analytic", "_attempt")
 
     def __init__(self, robot, ws, max_time, max_restarts, rng, th_ref, swivel, analytic):
         self.robot, self.ws, self.max_time, self.max_restarts = robot, ws, max_time, max_restarts
         self.rng, self._gen = rng, None
         self.th_ref, self.swivel, self.analytic = th_ref, swivel, analytic
-        self.attempt = py_attempt   # kernel.attempt or its compiled form (ckernel.attempt)
+        self._attempt = None
+
+    @property
+    def attempt(self):
+        """The attempt kernel, chosen on first use (an answer straight from the closed form
+        needs none): the compiled one where available (:func:`.ckernel.ready`), else
+        :func:`.kernel.attempt`."""
+        if self._attempt is None:
+            self._attempt = ckernel.attempt if ckernel.ready(self.ws) else py_attempt
+        return self._attempt
 
     def random(self):
         """A uniform random θ in the sampling box (the generator made on first use: most
@@ -143,7 +152,6 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     ws.table()      # the one-time seed tables and compiled kernel: built here, before any clock
     if mode == "pose":                         # starts, so the first call is not charged for them
         ws.aligned()
-    pb.attempt = ckernel.attempt if ckernel.ready(ws) else py_attempt    # compiled where available
     if not batch:
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
@@ -209,7 +217,6 @@ def solve_one(pb: Problem, tg: Target, seed):
             return IKResult(ana[0], True, "success", err[0], err[1], 0, 0, "converged from an analytic seed",
                             tg.mode, "analytic")
     table = None      # seed-table entries, nearest first (made when needed)
-    attempt = pb.attempt
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
     while True:
@@ -235,7 +242,7 @@ def solve_one(pb: Problem, tg: Target, seed):
             if ths is not None:
                 return IKResult(ths, True, "success", math.sqrt(pe2), math.sqrt(re2), total_it, restarts,
                                 "converged from an analytic seed", tg.mode, tag)
-        ths, ok, it, pe2, re2, bq, bE = attempt(ws, tg, th, deadline)
+        ths, ok, it, pe2, re2, bq, bE = pb.attempt(ws, tg, th, deadline)
         total_it += it
         attempts += 1
         if bE < best_E:
