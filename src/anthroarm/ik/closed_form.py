@@ -220,11 +220,13 @@ class _Solver:
     @functools.cached_property
     def one_call(self):
         """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints,
-        labels, whether a 7th joint is held); None for the other kinds."""
+        the labels by branch index as a float (how the compiled call returns it), whether a 7th
+        joint is held); None for the other kinds."""
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
-        return cf, ci, len(ci) - 3, self.plan.labels, self.plan.param_joint is not None
+        return (cf, ci, len(ci) - 3, {float(b): label for b, label in enumerate(self.plan.labels)},
+                self.plan.param_joint is not None)
 
 
 _SOLVERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -752,7 +754,7 @@ def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
     q = sol[:, :n]
     plan = s.plan
     return AnalyticIKResult(solutions=q if s.plain else plan.chain.configuration(q),
-                            branches=[labels[int(b)] for b in sol[:, n + 1].tolist()], residuals=sol[:, n],
+                            branches=list(map(labels.__getitem__, sol[:, n + 1].tolist())), residuals=sol[:, n],
                             model=robot.name,
                             _singular=lambda: _singular_text(float(
                                 _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())))

@@ -820,10 +820,11 @@ def _mark_solutions(Q, V, IN, RES, tol, group, OK):
         a = b - b % group
         while ok and a < b:
             if OK[a]:
-                d = 0.0
+                ok = False                       # a duplicate of a unless some joint differs
                 for j in range(Q.shape[1]):
-                    d = max(d, abs(wrap(Q[b, j] - Q[a, j])))
-                ok = d >= 1e-9
+                    if abs(wrap(Q[b, j] - Q[a, j])) >= 1e-9:
+                        ok = True
+                        break
             a += 1
         OK[b] = ok
 
