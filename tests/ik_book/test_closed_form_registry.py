@@ -48,13 +48,13 @@ def test_closed_forms_solve_their_arm(name):
     form = cf.closed_form_info(robot)
     assert aa.ik.has_analytic(robot) and aa.ik.has_analytic(robot, robot.tool) and aa.ik.has_analytic(robot, robot.tool_id)
     assert cf.analytic_cost(robot) == form.cost_us > 0
-    assert form.nq == robot.nq
+    assert form.nq == len(robot.chain.path(robot.tool))     # the joints on the path (a tree: its arm)
     q = robot.random_q(None, np.random.default_rng(3), margin=0.05)
     T = robot.fk(q)
     kw = {"swivel": aa.ik.swivel_angle(robot, q)} if form.swivel else {}
     if form.param:                      # the last joint on the path held at its sampled value
         kw = {"param": q[robot.chain.independent.index(robot.chain.path(robot.tool)[-1])]}
-    res = aa.ik.analytic(robot, T, **kw)
+    res = aa.ik.analytic(robot, T, q_rest=q, **kw)             # a tree's other joints as sampled
     assert res.model == robot.name
     batch = aa.ik.analytic_batch(robot, T[None], **kw)
     assert len(batch.branches) == form.branches
@@ -108,6 +108,14 @@ def test_plan_cache_does_not_keep_robots_alive():
     del robot
     gc.collect()
     assert ref() is None
+    # a tree: its cached arm (a robot of its own) goes with it
+    limb = aa.load("human_upper_limb")
+    q = limb.random_q(rng=2)
+    assert len(aa.ik.analytic(limb, limb.fk(q), swivel=aa.ik.swivel_angle(limb, q)))
+    refs = [weakref.ref(limb), weakref.ref(cf._solver(limb).arm.robot)]
+    del limb
+    gc.collect()
+    assert all(r() is None for r in refs)
 
 
 def _evaluate(g, outputs, env):

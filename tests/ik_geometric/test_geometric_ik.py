@@ -494,3 +494,72 @@ def test_solve_answers_a_closed_class_from_the_compiled_call():
             F = pin.SE3(_fk(robot, r.q))
             assert r.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-14)
             assert r.rot_err == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-12)
+
+
+@pytest.fixture(scope="module")
+def panda_with_fingers(tmp_path_factory):
+    """The panda URDF with its fingers (a tree: the hand's two prismatic joints, the second a
+    mimic of the first, are off the path to panda_hand) and the catalog panda (fingers locked)."""
+    arm = aa.load("panda")
+    f = tmp_path_factory.mktemp("tree") / "panda_fingers.urdf"
+    f.write_text(arm.info.text)
+    return aa.load(str(f), tool=arm.tool), arm
+
+
+def test_tree_is_solved_by_its_arm(panda_with_fingers):
+    """A tree whose path to the tool is an arm with a closed form (here the panda's 7 joints,
+    the fingers off the path) gets that arm's closed form: the same branches as the arm alone,
+    every solution a configuration of the whole robot checked here by Pinocchio's FK, the joints
+    off the path at the comfortable posture (the middle of the finger's range) or at q_rest."""
+    robot, arm = panda_with_fingers
+    assert robot.nq == 8 and closed_form_info(robot).family == closed_form_info(arm).family
+    assert aa.ik.closed_form.held_joint(robot) == 6
+    finger = robot.model.getJointId("panda_finger_joint1")
+    iq = robot.model.joints[finger].idx_q
+    mid = 0.5 * (robot.model.lowerPositionLimit[iq] + robot.model.upperPositionLimit[iq])
+    for q in robot.random_q(8, rng=11):
+        T = _fk(robot, q)
+        res = aa.ik.analytic(robot, T, param=q[6])
+        ref = aa.ik.analytic(arm, T, param=q[6])
+        assert res.branches == ref.branches and len(res) >= 1
+        assert np.array_equal(res.solutions[:, :7], ref.solutions)
+        assert np.allclose(res.solutions[:, iq], mid)
+        for x in res.solutions:
+            assert np.abs(_fk(robot, x)[:3] - T[:3]).max() < 1e-9 and robot.within_limits(x)
+        rest = q.copy()
+        rest[iq] = 0.031
+        assert np.allclose(aa.ik.analytic(robot, T, param=q[6], q_rest=rest).solutions[:, iq], 0.031)
+    Ts = np.array([_fk(robot, q) for q in robot.random_q(6, rng=12)])
+    b = aa.ik.analytic_batch(robot, Ts, param=0.3)
+    assert b.solutions.shape == (6, b.valid.shape[1], 8)
+    assert np.isnan(b.solutions[~b.valid]).all() and np.isfinite(b.solutions[b.valid]).all()
+    with pytest.raises(ValueError, match="q_rest"):
+        aa.ik.analytic(robot, Ts[0], param=0.3, q_rest=np.zeros(7))
+
+
+def test_tree_solve_answers_from_the_arm(panda_with_fingers):
+    """``aa.ik.solve`` on the tree seeds from its arm's closed form; the answer's errors are
+    Pinocchio's and the finger stays at its reference (or the caller's q0)."""
+    robot, _ = panda_with_fingers
+    for q in robot.random_q(5, rng=13):
+        T = _fk(robot, q)
+        r = aa.ik.solve(robot, T)
+        assert r.success and r.seed == "analytic" and robot.within_limits(r.q)
+        F = pin.SE3(_fk(robot, r.q))
+        assert r.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-14)
+
+
+def test_tree_without_a_closed_form_says_how_to_get_one():
+    """A humanoid's arm with the torso on the path (9 joints) has no closed form; the message
+    says to lock joints on the path; with the torso locked the 7-joint arm has one."""
+    talos = aa.load("talos", tool="gripper_left_base_link")
+    assert not aa.ik.has_analytic(talos)
+    with pytest.raises(UnsupportedModelError, match="lock joints on the path"):
+        aa.ik.analytic(talos, talos.fk(talos.neutral()))
+    locked = aa.load("talos", tool="gripper_left_base_link", locked=["torso_1_joint", "torso_2_joint"])
+    assert aa.ik.has_analytic(locked) and closed_form_info(locked).param
+    q = locked.random_q(rng=14)
+    res = aa.ik.analytic(locked, _fk(locked, q), param=float(q[locked.chain.joints[locked.chain.path(locked.tool_id)[-1]].idx_q]))
+    assert len(res) >= 1
+    for x in res.solutions:
+        assert np.abs(_fk(locked, x)[:3] - _fk(locked, q)[:3]).max() < 1e-9

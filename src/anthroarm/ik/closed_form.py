@@ -37,6 +37,11 @@ and by bounded least squares where that leaves any; a pose whose only
 candidates lie on or just beyond a limit, or on a singular family whose representative is
 outside the limits, is rescued along its self-motions (:func:`_rescue`).
 
+A tree (a humanoid, two arms on a torso, an arm with a hand or a gripper): the closed form is
+that of the joints on the path from the base to the tool (:class:`_Arm`, the robot reduced to
+them); every other joint keeps its value in ``q_rest`` (default the comfortable posture,
+:func:`anthroarm.ik.qp.tasks.posture.comfortable_posture`) — it does not move the tool.
+
 Frames and units: ``T`` is the 4×4 pose (SE(3), metres) of the robot's tool frame
 (``robot.tool``) in the base frame; joint values in radians.  A robot without a closed form
 raises :class:`~anthroarm.errors.UnsupportedModelError` naming its class and pointing to
@@ -49,7 +54,7 @@ from __future__ import annotations
 import functools
 import math
 import weakref
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -211,11 +216,69 @@ def _cost(cls: str) -> float:
 
 
 @dataclass(frozen=True)
+class _Arm:
+    """The arm of a tree: ``robot`` reduced to the joints on the path from its base to its tool
+    (:func:`anthroarm.robot.reduce_model`, every other joint locked), which the closed form
+    solves, and where the arm's configuration sits in the robot's: ``q_idx`` (nq_arm,) the
+    robot's q index of each arm q entry, ``th_idx`` (n_arm,) the robot's θ index
+    (``chain.independent`` order) of each arm θ entry; ``q_rest`` (nq,) and ``th_rest`` (n,)
+    the comfortable posture, the default of the joints off the path."""
+
+    robot: object
+    q_idx: np.ndarray
+    th_idx: np.ndarray
+    q_rest: np.ndarray
+    th_rest: np.ndarray
+
+    def configurations(self, Qa, q_rest=None, valid=None) -> np.ndarray:
+        """The robot's configurations (..., nq) of the arm's ``Qa`` (..., nq_arm): the joints off
+        the path at ``q_rest`` (default :attr:`q_rest`); rows where ``valid`` (...) is False are
+        NaN, as the arm's are."""
+        rest = self.q_rest if q_rest is None else q_rest
+        Q = np.empty(Qa.shape[:-1] + rest.shape)
+        Q[...] = rest
+        Q[..., self.q_idx] = Qa
+        if valid is not None:
+            Q[~valid] = np.nan
+        return Q
+
+
+def _arm_of(robot):
+    """The :class:`_Arm` of ``robot`` where some of its joints are off the path to its tool;
+    None where every joint is on it; False where the arm cannot be cut out (a mimic joint on
+    the path following one off it)."""
+    from ..robot import Robot, reduce_model
+    from .qp.tasks.posture import comfortable_posture
+
+    ch = robot.chain
+    path = ch.path(robot.tool_id)
+    if all(j in path for j in ch.independent):
+        return None
+    try:
+        model, _ = reduce_model(robot.model, robot.name, active=[ch.joints[j].name for j in path])
+    except UnsupportedModelError:
+        return False
+    arm = Robot(model, name=robot.name, tool=robot.tool)
+    full = robot.model
+    q_idx = np.concatenate([np.arange(full.joints[full.getJointId(model.names[j])].idx_q,
+                                      full.joints[full.getJointId(model.names[j])].idx_q + model.joints[j].nq)
+                            for j in range(1, model.njoints)]).astype(int)
+    pos = {ch.joints[j].name: k for k, j in enumerate(ch.independent)}
+    th_idx = np.array([pos[arm.chain.joints[j].name] for j in arm.chain.independent], dtype=int)
+    q_rest = comfortable_posture(robot)
+    th_rest = ch.angles(q_rest)[list(ch.independent)]
+    for a in (q_idx, th_idx, q_rest, th_rest):
+        a.setflags(write=False)
+    return _Arm(arm, q_idx, th_idx, q_rest, th_rest)
+
+
+@dataclass(frozen=True)
 class _Solver:
     kind: str                            # "geo", "srs", "planar"
     plan: object
     form: ClosedForm
     plain: bool                          # q is the joint angles themselves (no continuous joint)
+    arm: _Arm | None = None              # a tree: the closed form is the arm's (its own _Solver)
 
     @functools.cached_property
     def one_call(self):
@@ -238,6 +301,12 @@ def _solver(robot):
     if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
         return hit[2]
     ch = robot.chain
+    arm = _arm_of(robot)
+    if arm is not None:
+        inner = _solver(arm.robot) if arm else None
+        out = None if inner is None else _Solver(inner.kind, inner.plan, inner.form, False, arm)
+        _SOLVERS[robot] = (robot.chain, robot.tool, out)
+        return out
     plain = robot.nq == len(ch.independent) and all(ch.joints[j].kind != "continuous" for j in ch.independent)
     out = None
     pl = _fam.planar_plan(robot)
@@ -282,7 +351,8 @@ def held_joint(robot, frame=None) -> int | None:
     s = _at(robot, frame)
     if s is None or s.kind != "geo" or s.plan.param_joint is None:
         return None
-    return s.plan.order.tolist().index(s.plan.param_joint)
+    k = s.plan.order.tolist().index(s.plan.param_joint)
+    return k if s.arm is None else int(s.arm.th_idx[k])
 
 
 def analytic_cost(robot, frame=None) -> float:
@@ -293,12 +363,17 @@ def analytic_cost(robot, frame=None) -> float:
 
 
 def _why_not(robot) -> str:
-    c = _geo.classification(robot)
+    arm = _arm_of(robot)
+    c = _geo.classification(robot if not arm else arm.robot)
     why = ("its chain could not be read" if c is None else
            f"its kinematic class is {c.name}" + (f" ({c.reason})" if c.reason else ""))
-    srs = _fam.srs_reason(robot)
+    if arm is False:
+        why += " (a mimic joint on the path to the tool follows one off it)"
+    srs = _fam.srs_reason(robot if not arm else arm.robot)
+    on_path = len(robot.chain.path(robot.tool_id))
     return (f"{robot.name}: no closed form for this geometry at the tool {robot.tool!r}: {why}"
-            + (f"; not an SRS arm: {srs}" if srs and robot.nq == 7 else "")
+            + (f"; not an SRS arm: {srs}" if srs and on_path == 7 else "")
+            + ("; lock joints on the path (aa.load(..., locked=[...])) to leave 6 or 7" if on_path > 7 else "")
             + f". Closed forms exist for 6R arms of the classes {', '.join(_geo.SOLVED)} (and 7-joint arms whose "
             "first six are one, with the last joint held), SRS 7R arms by swivel angle, and planar 2R arms; "
             "use aa.ik.solve(robot, T) for a numerical solution")
@@ -309,6 +384,25 @@ def _require(robot) -> _Solver:
     if s is None:
         raise UnsupportedModelError(_why_not(robot))
     return s
+
+
+def _q_rest(robot, arm, q_rest) -> np.ndarray | None:
+    """The configuration (nq,) whose joints off the tool's path a tree's solutions keep:
+    ``q_rest`` checked (``robot.check_q``), else the arm's default (its comfortable posture)."""
+    if q_rest is None:
+        return None if arm is None else arm.q_rest
+    q = robot.check_q(q_rest, name="q_rest")
+    if q.ndim != 1:
+        raise ValueError(f"{robot.name}: q_rest is one configuration, shape ({robot.nq},), got shape {q.shape}")
+    return q
+
+
+def _on_robot(arm: _Arm, res, q_rest):
+    """A result of the arm of a tree as the robot's: every solution a configuration of the
+    robot, the joints off the path at ``q_rest``."""
+    if isinstance(res, AnalyticBatchResult):
+        return replace(res, solutions=arm.configurations(res.solutions, q_rest, res.valid))
+    return replace(res, solutions=arm.configurations(res.solutions, q_rest))
 
 
 def require_form(robot, frame=None) -> ClosedForm:
@@ -427,7 +521,8 @@ def _swivel_array(swivel, N, grid_1d=False):
 
 # ---------------------------------------------------------------------------- batches
 def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-                   tol_orthonormal: float = 1e-6, param=None, _single_grid: bool = False) -> AnalyticBatchResult:
+                   tol_orthonormal: float = 1e-6, param=None, q_rest=None,
+                   _single_grid: bool = False) -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see the module docstring).
 
     Candidates are wrapped into the joint limits (multiples of 2π), rejected if outside, and
@@ -436,7 +531,9 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     ``planar_2r`` only) compares the position alone.  An SRS arm: ``swivel`` a scalar (all
     poses), shape (N,) (one angle per pose), (1, S) (a grid shared by all poses) or (N, S);
     default :data:`DEFAULT_SWIVEL` for every pose.  A 7-joint arm solved with its last joint
-    held: ``param`` with the same rules (default :data:`PARAM_GRID` values over its range).
+    held: ``param`` with the same rules (default :data:`PARAM_GRID` values over its range).  A
+    tree: the joints off the path to the tool take their values in ``q_rest`` (nq,) (default
+    the comfortable posture).
 
     Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) or a
     ``swivel``/``param`` the arm does not take, and
@@ -444,6 +541,13 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     s = _require(robot)
+    if s.arm is not None:
+        rest = _q_rest(robot, s.arm, q_rest)
+        return _on_robot(s.arm, analytic_batch(s.arm.robot, T, swivel=swivel, position_only=position_only, tol=tol,
+                                               tol_orthonormal=tol_orthonormal, param=param,
+                                               _single_grid=_single_grid), rest)
+    if q_rest is not None:
+        _q_rest(robot, None, q_rest)
     if s.kind != "srs" and swivel is not None:
         raise ValueError(f"{robot.name}: swivel= applies to a redundant SRS arm's family of solutions; this arm "
                          f"({s.form.family}) has finitely many solutions" +
@@ -632,7 +736,7 @@ def _rescue(robot, Q, which, T, tol, position_only):
 
 # ---------------------------------------------------------------------------- one pose
 def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-             tol_orthonormal: float = 1e-6, method: str = "robust", param=None):
+             tol_orthonormal: float = 1e-6, method: str = "robust", param=None, q_rest=None):
     """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
 
     ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
@@ -640,7 +744,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     position (3,).  ``swivel`` (SRS arm, rad) a scalar or a 1-D grid; ``param`` (7-joint arm
     with its last joint held, rad) likewise.  ``method="book"`` (the prosthetic arm of
     Fig. 7-2 only) runs the book's Cramer-rule procedure :func:`prosthetic_book_procedure`,
-    whose elbow determinant Δ may vanish.
+    whose elbow determinant Δ may vanish.  A tree (joints off the path to the tool): those
+    joints take their values in ``q_rest`` (nq,) (default the comfortable posture).
 
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
@@ -664,6 +769,12 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if method != "robust":
         raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     s = _solver(robot)
+    if s is not None and s.arm is not None:
+        rest = _q_rest(robot, s.arm, q_rest)
+        return _on_robot(s.arm, analytic(s.arm.robot, T, swivel=swivel, position_only=position_only, tol=tol,
+                                         tol_orthonormal=tol_orthonormal, param=param), rest)
+    if q_rest is not None:
+        _q_rest(robot, None, q_rest)
     one = None if s is None else s.one_call
     if one is not None and arr.shape == (4, 4) and arr.dtype == _F64 and swivel is None and not position_only \
             and (param is None) != one[4]:
@@ -696,7 +807,20 @@ def nearest_solver(robot, frame=None):
     if s is None or s.one_call is None:
         return None
     cf, ci, _, _, _ = s.one_call
-    return functools.partial(_geo.solve_nearest, cf, ci)
+    inner = functools.partial(_geo.solve_nearest, cf, ci)
+    return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+
+
+def _nearest_on_arm(inner, th_idx, th_rest, T, ref, param):
+    """:func:`nearest_solver` of a tree from its arm's (``inner``): the arm's θ put into the
+    robot's, the joints off the path at ``ref`` (default ``th_rest``)."""
+    base = th_rest if len(ref) == 0 else ref
+    out = inner(T, base[th_idx], param)
+    if out is None:
+        return None
+    S = np.repeat(base[None], len(out[0]), axis=0)
+    S[:, th_idx] = out[0]
+    return S, out[1], out[2]
 
 
 def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
