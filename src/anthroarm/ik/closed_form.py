@@ -62,6 +62,7 @@ from ..errors import UnsupportedModelError
 from ..models import closed_forms as _models
 from . import families as _fam
 from . import geometric as _geo
+from .vec3 import WRAP_MAX
 
 TWO_PI = 2.0 * np.pi
 _F64 = np.dtype(np.float64)
@@ -244,9 +245,10 @@ class _Arm:
 
 
 def _arm_of(robot):
-    """The :class:`_Arm` of ``robot`` where some of its joints are off the path to its tool;
-    None where every joint is on it; False where the arm cannot be cut out (a mimic joint on
-    the path following one off it)."""
+    """The :class:`_Arm` of ``robot`` where some of its joints are off the path to its tool (a
+    mimic joint off the path that follows one on it stays in the arm, following it); None where
+    every joint is on it; a text saying why where the arm cannot be cut out of the tree (a
+    mimic joint on the path following one off it, a model the reduction does not take)."""
     from ..robot import Robot, reduce_model
     from .qp.tasks.posture import comfortable_posture
 
@@ -254,11 +256,12 @@ def _arm_of(robot):
     path = ch.path(robot.tool_id)
     if all(j in path for j in ch.independent):
         return None
+    keep = set(path) | {j.index for j in ch.joints if j.is_mimic and j.mimic.source in path}
     try:
-        model, _ = reduce_model(robot.model, robot.name, active=[ch.joints[j].name for j in path])
-    except UnsupportedModelError:
-        return False
-    arm = Robot(model, name=robot.name, tool=robot.tool)
+        model, _ = reduce_model(robot.model, robot.name, active=[ch.joints[j].name for j in sorted(keep)])
+        arm = Robot(model, name=robot.name, tool=robot.tool)
+    except Exception as exc:  # noqa: BLE001 - UnsupportedModelError (a mimic pair cut), a model without frames
+        return f"the arm on the path to the tool could not be cut out of the tree: {exc}"
     full = robot.model
     q_idx = np.concatenate([np.arange(full.joints[full.getJointId(model.names[j])].idx_q,
                                       full.joints[full.getJointId(model.names[j])].idx_q + model.joints[j].nq)
@@ -303,7 +306,7 @@ def _solver(robot):
     ch = robot.chain
     arm = _arm_of(robot)
     if arm is not None:
-        inner = _solver(arm.robot) if arm else None
+        inner = _solver(arm.robot) if isinstance(arm, _Arm) else None
         out = None if inner is None else _Solver(inner.kind, inner.plan, inner.form, False, arm)
         _SOLVERS[robot] = (robot.chain, robot.tool, out)
         return out
@@ -364,12 +367,13 @@ def analytic_cost(robot, frame=None) -> float:
 
 def _why_not(robot) -> str:
     arm = _arm_of(robot)
-    c = _geo.classification(robot if not arm else arm.robot)
+    sub = arm.robot if isinstance(arm, _Arm) else robot
+    c = _geo.classification(sub)
     why = ("its chain could not be read" if c is None else
            f"its kinematic class is {c.name}" + (f" ({c.reason})" if c.reason else ""))
-    if arm is False:
-        why += " (a mimic joint on the path to the tool follows one off it)"
-    srs = _fam.srs_reason(robot if not arm else arm.robot)
+    if isinstance(arm, str):
+        why += f"; {arm}"
+    srs = _fam.srs_reason(sub)
     on_path = len(robot.chain.path(robot.tool_id))
     return (f"{robot.name}: no closed form for this geometry at the tool {robot.tool!r}: {why}"
             + (f"; not an SRS arm: {srs}" if srs and on_path == 7 else "")
@@ -394,6 +398,13 @@ def _q_rest(robot, arm, q_rest) -> np.ndarray | None:
     q = robot.check_q(q_rest, name="q_rest")
     if q.ndim != 1:
         raise ValueError(f"{robot.name}: q_rest is one configuration, shape ({robot.nq},), got shape {q.shape}")
+    if arm is not None:
+        off = np.setdiff1d(np.arange(robot.nq), arm.q_idx)
+        bad = off[(q[off] < robot.lower[off]) | (q[off] > robot.upper[off])]
+        if len(bad):
+            names = robot.chain.q_names
+            raise ValueError(f"{robot.name}: q_rest puts {', '.join(names[i] for i in bad)} outside the joint limits "
+                             "(the solutions keep its joints off the tool's path, and every solution is inside them)")
     return q
 
 
@@ -503,8 +514,8 @@ def _swivel_array(swivel, N, grid_1d=False):
     if swivel is None:
         return np.broadcast_to(DEFAULT_SWIVEL[None, :], (N, DEFAULT_SWIVEL.size)).copy()
     sw = np.asarray(swivel, dtype=float)
-    if not np.isfinite(sw).all():
-        raise ValueError(f"swivel must be finite angles (rad), got {swivel!r}")
+    if not (np.abs(sw) < WRAP_MAX).all():
+        raise ValueError(f"swivel must be finite angles (rad) of magnitude below {WRAP_MAX:g}, got {swivel!r}")
     if sw.ndim == 0:
         return np.full((N, 1), float(sw))
     if sw.ndim == 1 and grid_1d:
@@ -870,6 +881,8 @@ def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
         prm = 0.0 if param is None else float(param)
     except (TypeError, ValueError):
         return None                     # a malformed param: the batch path says what is wrong
+    if not abs(prm) < WRAP_MAX:
+        return None                     # not an angle: the batch path says so
     out = np.empty((8, n + 4))
     K = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
     if K <= 0:

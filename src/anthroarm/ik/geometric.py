@@ -1003,14 +1003,16 @@ def solve_nearest(cf, ci, T, ref, param: float):
     """The solutions θ (K, n) (independent-joint order, rad) of one pose ``T`` (4, 4) of a
     closed class (``cf``, ``ci``: :attr:`GeoPlan.packed`; default tolerances; ``param`` the held
     7th joint) with the one nearest ``ref`` (n,) first, and that one's position and rotation
-    errors (m, rad; :func:`_target_errors`) — or None where the pose has no solution, is
-    malformed or has a candidate to polish.  The seeds of :func:`anthroarm.ik.solve`, one
-    compiled call."""
+    errors (m, rad; :func:`_target_errors`; None, None without a reference: an empty ``ref``)
+    — or None where the pose has no solution, is malformed or has a candidate to polish.  The
+    seeds of :func:`anthroarm.ik.solve`, one compiled call."""
     n = len(ci) - 3
     out = np.empty((8, n + 4))
     K = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
     if K <= 0:
         return None
+    if len(ref) != n:
+        return out[:K, :n], None, None
     return out[:K, :n], float(out[0, n + 2]), float(out[0, n + 3])
 
 

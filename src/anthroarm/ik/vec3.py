@@ -14,6 +14,9 @@ import numpy as np
 
 from ..jit import kernel
 
+#: the largest |angle| (rad) :func:`wrap` reduces by turns (a double's spacing there is ~1e-4 rad)
+WRAP_MAX = 1e12
+
 
 @kernel
 def vec(a):
@@ -143,9 +146,12 @@ def mtm(A, B):
 
 @kernel
 def wrap(x):
-    """x wrapped into (−π, π]."""
+    """x wrapped into (−π, π]; NaN for x not finite or |x| ≥ :data:`WRAP_MAX` (its digits below
+    a turn are lost: not an angle to wrap)."""
     if -math.pi < x <= math.pi:
         return x
+    if not abs(x) < WRAP_MAX:
+        return math.nan
     y = x - 2.0 * math.pi * math.floor((x + math.pi) / (2.0 * math.pi))      # in [−π, π)
     return math.pi if y <= -math.pi else y
 

@@ -152,6 +152,8 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     ws.table()      # the one-time seed tables and compiled kernel: built here, before any clock
     if mode == "pose":                         # starts, so the first call is not charged for them
         ws.aligned()
+    if ws.cbuf is None:
+        ckernel.ready(ws)
     if not batch:
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]

@@ -252,9 +252,11 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
     (a swivel family of solutions) is solved at ``swivel`` (rad) if given, else on ``grid``.
     A 7-joint arm whose last joint is held
     (``param=`` of the closed form) is solved at that joint's value in the seed-table entry
-    nearest the target (one closed-form call: 8 branches), and on the closed form's own grid
-    of values only when that and the next :data:`TABLE_SEEDS` − 1 entries' values give nothing
-    inside the limits (panda, 1000 random poses: 73 % at the nearest entry, 98 % within 8)."""
+    nearest the target (one closed-form call: 8 branches), then at the values of the next
+    :data:`TABLE_SEEDS` − 1 entries (panda, 1000 random poses: 73 % answered at the nearest
+    entry, 98 % within 8); where none gives a solution inside the limits, the general
+    :func:`~anthroarm.ik.closed_form.analytic` at the nearest entry's value (polishing, rescue
+    along the self-motions), then on the closed form's own grid of values."""
     sh = ws.sh
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
@@ -273,14 +275,15 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
             prm = float(table.next()[sh.held])
         if sh.nearest is not None:
             ref = NO_REF if th_ref is None else th_ref
+            p = prm
             while True:
-                one = sh.nearest(T, ref, 0.0 if prm is None else prm)
+                one = sh.nearest(T, ref, 0.0 if p is None else p)
                 if one is not None:            # one compiled call, nearest first
-                    return one[0], "", one[1:]
+                    return one[0], "", (None if one[1] is None else one[1:])
                 th = None if table is None else table.next()
                 if th is None:
                     break
-                prm = float(th[sh.held])       # the held joint of the next-nearest table entry
+                p = float(th[sh.held])         # the held joint of the next-nearest table entry
         res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
         if res is None or not len(res):
             res = closed_form.analytic(robot, T, **kw)
