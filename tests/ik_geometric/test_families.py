@@ -297,3 +297,51 @@ def test_one_pose_path_is_the_batch_answer(name):
     far[:3, 3] *= 100.0
     a, b = aa.ik.analytic(robot, far), aa.ik.analytic_batch(robot, far[None])[0]
     assert len(a) == 0 and a.reason == b.reason and a.reason
+
+
+def test_srs_nearest_is_the_verified_family_in_one_call():
+    """``srs_nearest`` (the seeds of ``aa.ik.solve`` on an SRS arm): at every swivel angle of a
+    grid, the same solutions as ``srs_verified`` with duplicates dropped, the one nearest the
+    reference first, and that one's position / rotation errors equal to Pinocchio's; with
+    ``first`` only those of the first angle that has any."""
+    from anthroarm.ik import closed_form as cf
+    from anthroarm.ik import geometric as G
+
+    r = aa.load("human_arm7")
+    plan = cf._solver(r).plan
+    grid = np.linspace(-np.pi, np.pi, 8, endpoint=False)
+    rng = np.random.default_rng(31)
+    for T in _poses(r, 12, 32)[1]:
+        T = np.ascontiguousarray(T)
+        ref = r.random_q(rng=rng)
+        th, cand, exact, inside, res = (a[0] for a in F.srs_verified(plan, T[None], grid[None]))
+        ok = G.mark_solutions(th[None], cand[None], inside[None], res[None], 1e-9, 8)[0]
+        out = F.srs_nearest(plan, T, ref, grid, False)
+        if not ok.any():
+            assert out is None
+            continue
+        S, pe, re = out
+        assert sorted(map(tuple, np.round(S, 10))) == sorted(map(tuple, np.round(th[ok], 10)))
+        assert np.argmin(((S - ref) ** 2).sum(1)) == 0
+        F_ = _pin_pose(r, S[0])
+        assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F_[:3, 3]), abs=1e-14)
+        assert re == pytest.approx(np.linalg.norm(pin.log3(F_[:3, :3].T @ T[:3, :3])), abs=1e-12)
+        k0 = int(np.flatnonzero(ok)[0]) // 8                       # the first angle with a solution
+        first = F.srs_nearest(plan, T, ref, grid, True)[0]
+        assert sorted(map(tuple, np.round(first, 10))) == sorted(map(tuple, np.round(th[ok][np.flatnonzero(ok) // 8 == k0], 10)))
+
+
+def test_solve_answers_an_srs_arm_from_the_compiled_call():
+    """``aa.ik.solve`` without a posture objective answers the human arm (and the 27-joint limb,
+    a tree) with the closed form's solution from one compiled call, its errors Pinocchio's."""
+    for name in ("human_arm7", "human_upper_limb"):
+        r = aa.load(name)
+        for q in r.random_q(6, rng=33):
+            T = r.fk(q)
+            res = aa.ik.solve(r, T, posture=None)
+            assert res.success and res.seed == "analytic" and res.iterations == 0 and r.within_limits(res.q), name
+            data = r.model.createData()
+            pin.framesForwardKinematics(r.model, data, res.q)
+            M = data.oMf[r.tool_id]
+            assert res.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - M.translation), abs=1e-14)
+            assert res.rot_err == pytest.approx(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])), abs=1e-12)

@@ -822,11 +822,24 @@ def nearest_solver(robot, frame=None):
     return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
 
 
-def _nearest_on_arm(inner, th_idx, th_rest, T, ref, param):
+def nearest_swivel_solver(robot, frame=None):
+    """:func:`nearest_solver` of an SRS arm at ``frame`` (default the tool): ``f(T, ref, swivel,
+    first)`` of one pose, a reference θ ``ref`` (n,) and swivel angles ``swivel`` (S,) (rad,
+    finite) that returns the solutions at those angles — only at the first that has any where
+    ``first`` (any solution will do) — nearest ``ref`` first, with that one's errors, or None
+    (:func:`.families.srs_nearest`).  None for other arms."""
+    s = _at(robot, frame)
+    if s is None or s.kind != "srs":
+        return None
+    inner = functools.partial(_fam.srs_nearest, s.plan)
+    return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+
+
+def _nearest_on_arm(inner, th_idx, th_rest, T, ref, *args):
     """:func:`nearest_solver` of a tree from its arm's (``inner``): the arm's θ put into the
     robot's, the joints off the path at ``ref`` (default ``th_rest``)."""
     base = th_rest if len(ref) == 0 else ref
-    out = inner(T, base[th_idx], param)
+    out = inner(T, base[th_idx], *args)
     if out is None:
         return None
     S = np.repeat(base[None], len(out[0]), axis=0)

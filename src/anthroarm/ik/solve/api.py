@@ -211,9 +211,10 @@ def solve_one(pb: Problem, tg: Target, seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
         # without a posture objective any member of a swivel family will do: a coarse grid first
         grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
-        ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid)
+        anyone = th_ref is None and sw is None
+        ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid, anyone)
         if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
-            ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID)
+            ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID, anyone)
         if err is not None and th_ref is None and sw is None and tg.ok(err[0] * err[0], err[1] * err[1]):
             # the closed form's nearest solution, checked by the FK of its compiled call: the answer
             return IKResult(ana[0], True, "success", err[0], err[1], 0, 0, "converged from an analytic seed",

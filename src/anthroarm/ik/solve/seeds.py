@@ -22,6 +22,7 @@ from ...chain import PRISMATIC
 from ...errors import UnsupportedModelError
 from .. import closed_form
 from ..geometric import NO_REF
+from ..vec3 import WRAP_MAX
 from .targets import POSE
 
 SEED_TABLE = 2048       # configurations in the per-(robot, frame) seed table
@@ -245,11 +246,12 @@ def closed_form_cheap(robot, fid) -> bool:
     return info is not None and info.cost_us <= CHEAP_US
 
 
-def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
+def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=False):
     """Closed-form solutions (K, n) in θ, the one nearest ``th_ref`` first, a note ("" or why
     the closed form failed), and the first one's (position, rotation) errors (m, rad) where
     the one-call kernel of a closed class computed them (its FK), else None.  A redundant arm
-    (a swivel family of solutions) is solved at ``swivel`` (rad) if given, else on ``grid``.
+    (a swivel family of solutions) is solved at ``swivel`` (rad) if given, else on ``grid``
+    (where ``any_solution``, only up to the first angle that has one).
     A 7-joint arm whose last joint is held
     (``param=`` of the closed form) is solved at that joint's value in the seed-table entry
     nearest the target (one closed-form call: 8 branches), then at the values of the next
@@ -268,6 +270,13 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None):
         elif grid is not None:
             kw["swivel"] = grid
     T = tg.H
+    if sh.nearest_swivel is not None and th_ref is not None:
+        g = closed_form.DEFAULT_SWIVEL if swivel is None and grid is None else (swivel if swivel is not None else grid)
+        g = np.atleast_1d(np.asarray(g, dtype=float))
+        if (np.abs(g) < WRAP_MAX).all():
+            one = sh.nearest_swivel(T, th_ref, g, any_solution)
+            if one is not None:                # one compiled call, nearest first
+                return one[0], "", one[1:]
     try:
         prm, table = None, None
         if sh.held is not None:

@@ -42,7 +42,8 @@ class Shared:
     * ``ref``: the comfortable posture (:func:`~anthroarm.ik.qp.tasks.posture.comfortable_posture`);
       ``posture_auto``: it again where ``posture="auto"`` applies it (the human arm), else None;
     * ``has_closed_form``, ``closed_form_first`` (see :func:`anthroarm.ik.solve.seeds.closed_form_cheap`),
-      ``nearest`` (:func:`anthroarm.ik.closed_form.nearest_solver`);
+      ``nearest``, ``nearest_swivel`` (:func:`anthroarm.ik.closed_form.nearest_solver`,
+      :func:`~anthroarm.ik.closed_form.nearest_swivel_solver`);
     * the seed table and the aligned seed table, built on first use.
     """
 
@@ -78,6 +79,7 @@ class Shared:
         self.held = closed_form.held_joint(robot, fid)     # θ index of a 7-joint arm's held joint
         self.closed_form_first = seeds.closed_form_cheap(robot, fid)
         self.nearest = closed_form.nearest_solver(robot, fid)   # closed-form seeds in one call, or None
+        self.nearest_swivel = closed_form.nearest_swivel_solver(robot, fid)   # the same for an SRS arm
         self.all_on_path = bool(self.on_path.all())
         self.local = threading.local()
         self._lock = threading.Lock()
