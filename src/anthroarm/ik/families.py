@@ -401,40 +401,6 @@ def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid, exact):
 
 
 @kernel
-def _srs_pose(T, Rt, pt, h, Sv, E0v, W0v):
-    """What every swivel angle of one pose T (4, 4) shares: Rg = R R_toolᵀ, the wrist centre W
-    (base frame, m) and the roots of q4 (SP3: the elbow angle from the shoulder–wrist
-    distance)."""
-    R, p = mat(T), vec(T[:3, 3])
-    Rg = mm(R, transpose(Rt))
-    W = add(mv(Rg, sub(W0v, pt)), p)
-    t4a, t4b, n4, e4a, e4b, _ = sp3_one(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
-    return Rg, W, t4a, t4b, n4, e4a, e4b
-
-
-@kernel
-def _srs_angle(route, h, Sv, E0v, W0v, pose, phi, lo, hi, kH, kO, MR, Mp, T, Q, V, E, IN, RES, scratch):
-    """The 8 branches of one pose (``pose``: :func:`_srs_pose`) at swivel angle φ, each wrapped
-    into the limits and FK-checked (:func:`_limits_fk`): writes Q (8, 7) (path order), V, E,
-    IN, RES (8,).  ``scratch``: the work arrays of :func:`_srs_one`."""
-    Rg, W, t4a, t4b, n4, e4a, e4b = pose
-    Qb, Vb, Eb, Q6, V6, E6, Qs, Vs, Es, q = scratch
-    _srs_one(route, h, Sv, E0v, W0v, Rg, W, phi, t4a, t4b, n4, e4a, e4b, Qb, Vb, Eb, Q6, V6, E6, Qs, Vs, Es)
-    for b in range(8):
-        for j in range(7):
-            q[j] = Qb[b, j]
-        IN[b], RES[b] = _limits_fk(q, 7, lo, hi, Q[b], kH, kO, MR, Mp, T, Vb[b], Eb[b])
-        V[b], E[b] = Vb[b], Eb[b]
-
-
-@kernel
-def _srs_scratch():
-    return (np.empty((8, 7)), np.empty(8, dtype=np.bool_), np.empty(8, dtype=np.bool_), np.empty((8, 6)),
-            np.empty(8, dtype=np.bool_), np.empty(8, dtype=np.bool_), np.empty((2, 6)),
-            np.empty(2, dtype=np.bool_), np.empty(2, dtype=np.bool_), np.empty(7))
-
-
-@kernel
 def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swivel, tol_orthonormal,
                   Q, V, E, IN, RES):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
@@ -443,7 +409,16 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    scratch = _srs_scratch()
+    Q6 = np.empty((8, 6))
+    V6 = np.empty(8, dtype=np.bool_)
+    E6 = np.empty(8, dtype=np.bool_)
+    Qs = np.empty((2, 6))
+    Vs = np.empty(2, dtype=np.bool_)
+    Es = np.empty(2, dtype=np.bool_)
+    Qb = np.empty((8, 7))
+    Vb = np.empty(8, dtype=np.bool_)
+    Eb = np.empty(8, dtype=np.bool_)
+    q = np.empty(7)
     ns = swivel.shape[1]
     for i in range(len(T)):
         if _pose_status(T[i], tol_orthonormal) != 0:
@@ -451,11 +426,19 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
         for k in range(ns):
             if not math.isfinite(swivel[i, k]):
                 return len(T) + i
-        pose = _srs_pose(T[i], Rt, pt, h, Sv, E0v, W0v)
+        R, p = mat(T[i]), vec(T[i, :3, 3])
+        Rg = mm(R, transpose(Rt))
+        W = add(mv(Rg, sub(W0v, pt)), p)
+        t4a, t4b, n4, e4a, e4b, _ = sp3_one(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
         for k in range(ns):
-            r = 8 * k
-            _srs_angle(route, h, Sv, E0v, W0v, pose, swivel[i, k], lo, hi, kH, kO, MR, Mp, T[i],
-                       Q[i, r:r + 8], V[i, r:r + 8], E[i, r:r + 8], IN[i, r:r + 8], RES[i, r:r + 8], scratch)
+            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], t4a, t4b, n4, e4a, e4b, Qb, Vb, Eb,
+                     Q6, V6, E6, Qs, Vs, Es)
+            for b in range(8):
+                r = 8 * k + b
+                for j in range(7):
+                    q[j] = Qb[b, j]
+                IN[i, r], RES[i, r] = _limits_fk(q, 7, lo, hi, Q[i, r], kH, kO, MR, Mp, T[i], Vb[b], Eb[b])
+                V[i, r], E[i, r] = Vb[b], Eb[b]
     return -1
 
 
@@ -469,19 +452,20 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
     each), the nearest ``ref`` (7,) first, and its position and rotation errors
     (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K;
     −1: a malformed pose; −2: a candidate to polish (the caller's general path answers)."""
-    if _pose_status(T, tol_orthonormal) != 0:
-        return -1
-    h = _seven(H)
-    Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    pose = _srs_pose(T, mat(R_tool), vec(p_tool), h, Sv, E0v, W0v)
-    scratch = _srs_scratch()
-    Q, RES = np.empty((8, 7)), np.empty(8)
-    V, E = np.empty(8, dtype=np.bool_), np.empty(8, dtype=np.bool_)
-    IN, OK = np.empty(8, dtype=np.bool_), np.empty(8, dtype=np.bool_)
+    Tb = T.reshape((1, 4, 4))
+    sw = np.empty((1, 1))
+    q = np.empty(7)
+    Q1, RES1 = np.empty((1, 8, 7)), np.empty((1, 8))
+    V1, E1, IN1 = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
+    Q, V, E, IN, RES = Q1[0], V1[0], E1[0], IN1[0], RES1[0]
+    OK = np.empty(8, dtype=np.bool_)
     K, kb, best = 0, 0, math.inf
     for k in range(len(swivel)):
-        _srs_angle(route, h, Sv, E0v, W0v, pose, swivel[k], lo, hi, kH, kO, MR, Mp, T, Q, V, E, IN, RES, scratch)
+        sw[0, 0] = swivel[k]
+        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, Tb, sw, tol_orthonormal,
+                         Q1, V1, E1, IN1, RES1) >= 0:
+            return -1                                  # a malformed pose, or an angle not finite
         for b in range(8):
             if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
                 return -2
@@ -500,7 +484,6 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
     if K > 0:
         for j in range(7):
             out[0, j], out[kb, j] = out[kb, j], out[0, j]
-        q = np.empty(7)
         for j in range(7):
             q[order[j]] = out[0, j]
         out[0, 7], out[0, 8] = _target_errors(kH, kO, MR, Mp, q, 7, T)
