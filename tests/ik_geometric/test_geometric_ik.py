@@ -620,3 +620,25 @@ def test_tree_without_a_closed_form_says_how_to_get_one():
     assert len(res) >= 1
     for x in res.solutions:
         assert np.abs(_fk(locked, x)[:3] - _fk(locked, q)[:3]).max() < 1e-9
+
+
+@pytest.mark.parametrize("name, tip, family", [("talos", "left_sole_link", C.SPHERICAL_TWO_PARALLEL),
+                                               ("solo8", "HR_FOOT", "planar_2r")])
+def test_legs_of_a_humanoid_and_a_quadruped_in_closed_form(name, tip, family):
+    """Trees from example-robot-data: the humanoid's 6R leg (32 joints in all) and the
+    quadruped's 2R leg (position only) are solved by the closed form of the joints on the path
+    to the foot; every solution, a configuration of the whole robot, is checked by Pinocchio's
+    FK, the other joints where q_rest puts them."""
+    robot = aa.load(name, tool=tip)
+    info = closed_form_info(robot)
+    assert info is not None and info.family == family
+    on = [robot.chain.joints[j].idx_q for j in robot.chain.path(robot.tool)]
+    for q in robot.random_q(6, rng=41):
+        T = _fk(robot, q)
+        res = aa.ik.analytic(robot, T, q_rest=q)
+        assert len(res) >= 1
+        for x in res.solutions:
+            F = _fk(robot, x)
+            err = np.abs(F[:3, 3] - T[:3, 3]).max() if info.position_only else np.abs(F[:3] - T[:3]).max()
+            assert err < 1e-9 and robot.within_limits(x)
+            assert np.array_equal(np.delete(x, on), np.delete(q, on))
