@@ -642,3 +642,33 @@ def test_legs_of_a_humanoid_and_a_quadruped_in_closed_form(name, tip, family):
             err = np.abs(F[:3, 3] - T[:3, 3]).max() if info.position_only else np.abs(F[:3] - T[:3]).max()
             assert err < 1e-9 and robot.within_limits(x)
             assert np.array_equal(np.delete(x, on), np.delete(q, on))
+
+
+def test_any_tip_of_a_tree_by_frame():
+    """``frame=`` solves another tip of a tree than its tool — the other foot of a humanoid —
+    with that tip's closed form; ``aa.ik.solve(frame=...)`` seeds from it; a tip without one says
+    why; an unknown frame is a typed error."""
+    from anthroarm.errors import UnknownFrameError
+    from anthroarm.ik.closed_form import require_form
+
+    talos = aa.load("talos", tool="left_sole_link")
+    assert closed_form_info(talos, "right_sole_link").family == C.SPHERICAL_TWO_PARALLEL
+    fid = talos.model.getFrameId("right_sole_link")
+    data = talos.model.createData()
+    for q in talos.random_q(5, rng=51):
+        pin.framesForwardKinematics(talos.model, data, q)
+        T = data.oMf[fid].homogeneous.copy()
+        res = aa.ik.analytic(talos, T, frame="right_sole_link", q_rest=q)
+        assert len(res) >= 1
+        for x in res.solutions:
+            pin.framesForwardKinematics(talos.model, data, x)
+            assert np.abs(data.oMf[fid].homogeneous[:3] - T[:3]).max() < 1e-9 and talos.within_limits(x)
+        batch = aa.ik.analytic_batch(talos, T[None], frame=fid)
+        assert batch.valid.sum() == len(aa.ik.analytic(talos, T, frame=fid))
+        r = aa.ik.solve(talos, T, frame="right_sole_link")
+        assert r.success and r.seed == "analytic" and talos.within_limits(r.q)
+    assert not aa.ik.has_analytic(talos, "gripper_left_base_link")
+    with pytest.raises(UnsupportedModelError, match="lock joints on the path"):
+        require_form(talos, "gripper_left_base_link")
+    with pytest.raises(UnknownFrameError):
+        aa.ik.analytic(talos, np.eye(4), frame="no_such_frame")

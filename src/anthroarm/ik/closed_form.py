@@ -256,6 +256,8 @@ def _arm_of(robot):
     path = ch.path(robot.tool_id)
     if all(j in path for j in ch.independent):
         return None
+    if not path:
+        return "no joint moves the frame"
     keep = set(path) | {j.index for j in ch.joints if j.is_mimic and j.mimic.source in path}
     try:
         model, _ = reduce_model(robot.model, robot.name, active=[ch.joints[j].name for j in sorted(keep)])
@@ -328,11 +330,33 @@ def _solver(robot):
     return out
 
 
+_RETOOLED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _retooled(robot, frame):
+    """``robot`` itself where ``frame`` (a name or a Pinocchio frame id; None: the tool) is its
+    tool, else the same model with ``frame`` as its tool (another tip of a tree: the other
+    foot, the other hand), made once per (robot, frame) and kept with the robot.  Unknown
+    frames raise :class:`~anthroarm.errors.UnknownFrameError`."""
+    if frame is None:
+        return robot
+    name = robot.chain.frame(frame).name
+    if name == robot.tool:
+        return robot
+    from ..robot import Robot
+
+    hit = _RETOOLED.get(robot)
+    if hit is None or hit[0] is not robot.chain:
+        hit = _RETOOLED[robot] = (robot.chain, {})
+    other = hit[1].get(name)
+    if other is None:
+        other = hit[1][name] = Robot(robot.model, name=robot.name, tool=name)
+    return other
+
+
 def _at(robot, frame):
-    """The solver for ``frame`` (default the tool): None unless ``frame`` is the tool."""
-    if frame is not None and robot.chain.frame(frame).name != robot.tool:
-        return None
-    return _solver(robot)
+    """The solver for ``frame`` (default the tool), or None."""
+    return _solver(_retooled(robot, frame))
 
 
 def has_analytic(robot, frame=None) -> bool:
@@ -421,10 +445,7 @@ def require_form(robot, frame=None) -> ClosedForm:
     saying why it has no closed form (and pointing to ``aa.ik.solve``)."""
     s = _at(robot, frame)
     if s is None:
-        if frame is not None and robot.chain.frame(frame).name != robot.tool:
-            raise UnsupportedModelError(f"{robot.name}: the closed form solves for the tool frame {robot.tool!r}, "
-                                        f"not {robot.chain.frame(frame).name!r}")
-        raise UnsupportedModelError(_why_not(robot))
+        raise UnsupportedModelError(_why_not(_retooled(robot, frame)))
     return s.form
 
 
@@ -532,7 +553,7 @@ def _swivel_array(swivel, N, grid_1d=False):
 
 # ---------------------------------------------------------------------------- batches
 def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-                   tol_orthonormal: float = 1e-6, param=None, q_rest=None,
+                   tol_orthonormal: float = 1e-6, param=None, q_rest=None, frame=None,
                    _single_grid: bool = False) -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see the module docstring).
 
@@ -544,13 +565,16 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     default :data:`DEFAULT_SWIVEL` for every pose.  A 7-joint arm solved with its last joint
     held: ``param`` with the same rules (default :data:`PARAM_GRID` values over its range).  A
     tree: the joints off the path to the tool take their values in ``q_rest`` (nq,) (default
-    the comfortable posture).
+    the comfortable posture); ``frame`` solves for another frame (:func:`analytic`).
 
     Raises ``ValueError`` for a malformed ``T`` (shape, NaN, non-orthonormal rotation) or a
     ``swivel``/``param`` the arm does not take, and
     :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form."""
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
+    if frame is not None and _retooled(robot, frame) is not robot:
+        return analytic_batch(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
+                              tol_orthonormal=tol_orthonormal, param=param, q_rest=q_rest, _single_grid=_single_grid)
     s = _require(robot)
     if s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
@@ -747,7 +771,7 @@ def _rescue(robot, Q, which, T, tol, position_only):
 
 # ---------------------------------------------------------------------------- one pose
 def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-             tol_orthonormal: float = 1e-6, method: str = "robust", param=None, q_rest=None):
+             tol_orthonormal: float = 1e-6, method: str = "robust", param=None, q_rest=None, frame=None):
     """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
 
     ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
@@ -756,7 +780,9 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     with its last joint held, rad) likewise.  ``method="book"`` (the prosthetic arm of
     Fig. 7-2 only) runs the book's Cramer-rule procedure :func:`prosthetic_book_procedure`,
     whose elbow determinant Δ may vanish.  A tree (joints off the path to the tool): those
-    joints take their values in ``q_rest`` (nq,) (default the comfortable posture).
+    joints take their values in ``q_rest`` (nq,) (default the comfortable posture); ``frame``
+    (a name or a Pinocchio frame id; default the tool) solves for another frame instead (the
+    other foot of a humanoid: ``T`` is then that frame's pose).
 
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
@@ -766,6 +792,9 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
         _check_tol("tol_orthonormal", tol_orthonormal)
+    if frame is not None and _retooled(robot, frame) is not robot:
+        return analytic(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
+                        tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
     if method == "book":
         spec = getattr(robot, "spec", None)

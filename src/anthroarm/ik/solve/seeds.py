@@ -293,9 +293,9 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
                 if th is None:
                     break
                 p = float(th[sh.held])         # the held joint of the next-nearest table entry
-        res = closed_form.analytic(robot, T, param=prm) if prm is not None else None
+        res = closed_form.analytic(robot, T, param=prm, frame=sh.fid) if prm is not None else None
         if res is None or not len(res):
-            res = closed_form.analytic(robot, T, **kw)
+            res = closed_form.analytic(robot, T, frame=sh.fid, **kw)
         S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))
     except (ValueError, ArithmeticError, UnsupportedModelError) as exc:   # a seed source only
         return none, f"analytic seed failed: {exc}", None
