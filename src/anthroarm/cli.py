@@ -728,15 +728,15 @@ def _pose_err(robot, q, T, frame):
 
 def solve_pose(robot, T, q0=None, frame=None) -> _IKOutcome:
     """IK for the CLI: ``aa.ik.solve``, plus every closed-form branch inside the limits
-    (``aa.ik.analytic``) for an arm that has one at the tool.  Errors are recomputed here from
+    (``aa.ik.analytic``) for an arm that has one at the frame (default the tool).  Errors are recomputed here from
     ``robot.fk`` whatever the solver says."""
     import numpy as np
 
     from . import ik
 
     sols = []
-    if frame is None and ik.has_analytic(robot):
-        sols = list(np.reshape(ik.analytic(robot, T).solutions, (-1, robot.nq)))
+    if ik.has_analytic(robot, frame):
+        sols = list(np.reshape(ik.analytic(robot, T, frame=frame).solutions, (-1, robot.nq)))
     r = ik.solve(robot, T, q0=q0, frame=frame)
     pe, re = _pose_err(robot, r.q, T, frame)
     return _IKOutcome(r.q, r.success, r.status, pe, re, r.iterations, "aa.ik.solve", sols)
