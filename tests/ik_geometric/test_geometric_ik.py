@@ -672,3 +672,35 @@ def test_any_tip_of_a_tree_by_frame():
         require_form(talos, "gripper_left_base_link")
     with pytest.raises(UnknownFrameError):
         aa.ik.analytic(talos, np.eye(4), frame="no_such_frame")
+    with pytest.raises(UnsupportedModelError, match="no joint moves the frame 'base_link'"):
+        require_form(talos, "base_link")
+
+
+def test_frame_keeps_the_comfortable_posture_and_refuses_a_shared_name():
+    """``frame=`` solves with the robot's own spec (its comfortable posture for the joints off
+    the frame's path, as ``aa.load(..., tool=frame)`` would); a frame whose name an earlier frame
+    also has cannot be the closed form's tool (it would be the other one): a typed error, and
+    ``aa.ik.solve`` for it stays numerical with errors that are the frame's own."""
+    from anthroarm.ik.qp.tasks.posture import comfortable_posture
+
+    arm = aa.load("human_arm7")
+    frame = "wrist_deviation"
+    assert aa.ik.has_analytic(arm, frame)
+    on = [arm.chain.joints[j].idx_q for j in arm.chain.path(frame)]
+    q = arm.random_q(rng=61)
+    res = aa.ik.analytic(arm, arm.fk(q, frame), frame=frame)
+    assert len(res) >= 1
+    assert np.array_equal(np.delete(res.solutions, on, axis=1)[0], np.delete(comfortable_posture(arm), on))
+    m = arm.model.copy()
+    hand = m.frames[m.getFrameId("hand")]
+    dup = m.addFrame(pin.Frame("hand", hand.parentJoint, m.getFrameId("hand"),
+                               hand.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1])), pin.FrameType.OP_FRAME))
+    robot = aa.Robot(m, name="dup", tool=arm.tool)
+    assert robot.chain.frame(dup).index == dup != robot.chain.frame("hand").index
+    T = robot.fk(robot.random_q(rng=62), dup)
+    assert not aa.ik.has_analytic(robot, dup)
+    with pytest.raises(UnsupportedModelError, match="shares its name 'hand'"):
+        aa.ik.analytic(robot, T, frame=dup)
+    r = aa.ik.solve(robot, T, frame=dup, posture=None)
+    assert r.success and r.seed != "analytic"
+    assert r.pos_err == pytest.approx(np.linalg.norm(robot.fk(r.q, dup)[:3, 3] - T[:3, 3]), abs=1e-12)

@@ -336,27 +336,37 @@ _RETOOLED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 def _retooled(robot, frame):
     """``robot`` itself where ``frame`` (a name or a Pinocchio frame id; None: the tool) is its
     tool, else the same model with ``frame`` as its tool (another tip of a tree: the other
-    foot, the other hand), made once per (robot, frame) and kept with the robot.  Unknown
-    frames raise :class:`~anthroarm.errors.UnknownFrameError`."""
+    foot, the other hand; the same spec, so the same comfortable posture), made once per
+    (robot, frame) and kept with the robot; None where that frame's name is also an earlier
+    frame's (a tool is named, so it would be the other one).  Unknown frames raise
+    :class:`~anthroarm.errors.UnknownFrameError`."""
     if frame is None:
         return robot
-    name = robot.chain.frame(frame).name
-    if name == robot.tool:
+    f = robot.chain.frame(frame)
+    if f.index == robot.tool_id:
         return robot
     from ..robot import Robot
 
     hit = _RETOOLED.get(robot)
     if hit is None or hit[0] is not robot.chain:
         hit = _RETOOLED[robot] = (robot.chain, {})
-    other = hit[1].get(name)
-    if other is None:
-        other = hit[1][name] = Robot(robot.model, name=robot.name, tool=name)
-    return other
+    if f.index not in hit[1]:
+        other = Robot(robot.model, name=robot.name, tool=f.name, info=robot.info, spec=robot.spec,
+                      locked=robot.locked)
+        hit[1][f.index] = other if other.tool_id == f.index else None
+    return hit[1][f.index]
+
+
+def _unnamed(robot, frame) -> str:
+    f = robot.chain.frame(frame)
+    return (f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame {robot.chain.frame(f.name).index}; "
+            "the closed form solves for a frame known by its name: use aa.ik.solve(robot, T, frame=...)")
 
 
 def _at(robot, frame):
     """The solver for ``frame`` (default the tool), or None."""
-    return _solver(_retooled(robot, frame))
+    r = _retooled(robot, frame)
+    return None if r is None else _solver(r)
 
 
 def has_analytic(robot, frame=None) -> bool:
@@ -390,6 +400,8 @@ def analytic_cost(robot, frame=None) -> float:
 
 
 def _why_not(robot) -> str:
+    if not robot.chain.path(robot.tool_id):
+        return f"{robot.name}: no joint moves the frame {robot.tool!r}: there is nothing to solve for"
     arm = _arm_of(robot)
     sub = arm.robot if isinstance(arm, _Arm) else robot
     c = _geo.classification(sub)
@@ -445,7 +457,8 @@ def require_form(robot, frame=None) -> ClosedForm:
     saying why it has no closed form (and pointing to ``aa.ik.solve``)."""
     s = _at(robot, frame)
     if s is None:
-        raise UnsupportedModelError(_why_not(_retooled(robot, frame)))
+        r = _retooled(robot, frame)
+        raise UnsupportedModelError(_unnamed(robot, frame) if r is None else _why_not(r))
     return s.form
 
 
@@ -573,6 +586,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None and _retooled(robot, frame) is not robot:
+        if _retooled(robot, frame) is None:
+            raise UnsupportedModelError(_unnamed(robot, frame))
         return analytic_batch(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
                               tol_orthonormal=tol_orthonormal, param=param, q_rest=q_rest, _single_grid=_single_grid)
     s = _require(robot)
@@ -793,6 +808,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         _check_tol("tol", tol)
         _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None and _retooled(robot, frame) is not robot:
+        if _retooled(robot, frame) is None:
+            raise UnsupportedModelError(_unnamed(robot, frame))
         return analytic(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
                         tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
