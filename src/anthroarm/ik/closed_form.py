@@ -265,9 +265,8 @@ def _arm_of(robot):
     except Exception as exc:  # noqa: BLE001 - UnsupportedModelError (a mimic pair cut), a model without frames
         return f"the arm on the path to the tool could not be cut out of the tree: {exc}"
     full = robot.model
-    q_idx = np.concatenate([np.arange(full.joints[full.getJointId(model.names[j])].idx_q,
-                                      full.joints[full.getJointId(model.names[j])].idx_q + model.joints[j].nq)
-                            for j in range(1, model.njoints)]).astype(int)
+    starts = [full.joints[full.getJointId(model.names[j])].idx_q for j in range(1, model.njoints)]
+    q_idx = np.concatenate([np.arange(i, i + model.joints[j].nq) for j, i in enumerate(starts, 1)]).astype(int)
     pos = {ch.joints[j].name: k for k, j in enumerate(ch.independent)}
     th_idx = np.array([pos[arm.chain.joints[j].name] for j in arm.chain.independent], dtype=int)
     q_rest = comfortable_posture(robot)
@@ -400,7 +399,8 @@ def analytic_cost(robot, frame=None) -> float:
 
 
 def _why_not(robot) -> str:
-    if not robot.chain.path(robot.tool_id):
+    on_path = len(robot.chain.path(robot.tool_id))
+    if not on_path:
         return f"{robot.name}: no joint moves the frame {robot.tool!r}: there is nothing to solve for"
     arm = _arm_of(robot)
     sub = arm.robot if isinstance(arm, _Arm) else robot
@@ -410,7 +410,6 @@ def _why_not(robot) -> str:
     if isinstance(arm, str):
         why += f"; {arm}"
     srs = _fam.srs_reason(sub)
-    on_path = len(robot.chain.path(robot.tool_id))
     return (f"{robot.name}: no closed form for this geometry at the tool {robot.tool!r}: {why}"
             + (f"; not an SRS arm: {srs}" if srs and on_path == 7 else "")
             + ("; lock joints on the path (aa.load(..., locked=[...])) to leave 6 or 7" if on_path > 7 else "")
@@ -585,10 +584,11 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form."""
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
-    if frame is not None and _retooled(robot, frame) is not robot:
-        if _retooled(robot, frame) is None:
+    other = _retooled(robot, frame)
+    if other is not robot:
+        if other is None:
             raise UnsupportedModelError(_unnamed(robot, frame))
-        return analytic_batch(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
+        return analytic_batch(other, T, swivel=swivel, position_only=position_only, tol=tol,
                               tol_orthonormal=tol_orthonormal, param=param, q_rest=q_rest, _single_grid=_single_grid)
     s = _require(robot)
     if s.arm is not None:
@@ -807,10 +807,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
         _check_tol("tol_orthonormal", tol_orthonormal)
-    if frame is not None and _retooled(robot, frame) is not robot:
-        if _retooled(robot, frame) is None:
+    other = _retooled(robot, frame)
+    if other is not robot:
+        if other is None:
             raise UnsupportedModelError(_unnamed(robot, frame))
-        return analytic(_retooled(robot, frame), T, swivel=swivel, position_only=position_only, tol=tol,
+        return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
                         tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
     if method == "book":

@@ -57,7 +57,7 @@ from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (POLISH_MAX, BadPoseError, _common_point, _fk_residual, _mark_solutions, _pose_status,
-                        _target_errors, _wrist, into_limits)
+                        _target_errors, _wrist, into_limits, nearest_first)
 from .subproblems import TOL, sp1_one, sp2_one, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
 
@@ -460,7 +460,7 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
     V1, E1, IN1 = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
     Q, V, E, IN, RES = Q1[0], V1[0], E1[0], IN1[0], RES1[0]
     OK = np.empty(8, dtype=np.bool_)
-    K, kb, best = 0, 0, math.inf
+    K = 0
     for k in range(len(swivel)):
         sw[0, 0] = swivel[k]
         if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, Tb, sw, tol_orthonormal,
@@ -472,18 +472,13 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
         _mark_solutions(Q, V, IN, RES, tol, 8, OK)
         for b in range(8):
             if OK[b]:
-                d = 0.0
                 for j in range(7):
                     out[K, j] = Q[b, order[j]]
-                    d += (out[K, j] - ref[j]) ** 2
-                if d < best:
-                    best, kb = d, K
                 K += 1
         if first and K > 0:
             break
     if K > 0:
-        for j in range(7):
-            out[0, j], out[kb, j] = out[kb, j], out[0, j]
+        nearest_first(out, K, 7, ref, 7)
         for j in range(7):
             q[order[j]] = out[0, j]
         out[0, 7], out[0, 8] = _target_errors(kH, kO, MR, Mp, q, 7, T)

@@ -900,6 +900,21 @@ def solve(plan: GeoPlan, T, param=None):
 
 
 @kernel
+def nearest_first(out, K, n, ref, width):
+    """Swap the row of ``out[:K]`` whose first ``n`` entries (θ, rad) are nearest ``ref`` (n,)
+    (Euclidean) into row 0, columns ``:width`` (the one-pose kernels' solutions first)."""
+    best, kb = math.inf, 0
+    for k in range(K):
+        d = 0.0
+        for j in range(n):
+            d += (out[k, j] - ref[j]) ** 2
+        if d < best:
+            best, kb = d, k
+    for j in range(width):
+        out[0, j], out[kb, j] = out[kb, j], out[0, j]
+
+
+@kernel
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 4):
     θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
@@ -928,15 +943,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     if K == 0:
         return -2
     if len(ref) == n:
-        best, kb = math.inf, 0
-        for k in range(K):
-            d = 0.0
-            for j in range(n):
-                d += (out[k, j] - ref[j]) ** 2
-            if d < best:
-                best, kb = d, k
-        for j in range(n + 2):
-            out[0, j], out[kb, j] = out[kb, j], out[0, j]
+        nearest_first(out, K, n, ref, n + 2)
         _, _, _, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
         out[0, n + 2], out[0, n + 3] = _target_errors(kH, kO, mat(M[:3, :3]), vec(M[:3, 3]), Q[0, int(out[0, n + 1])],
                                                       n, T)

@@ -215,7 +215,7 @@ def solve_one(pb: Problem, tg: Target, seed):
         ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid, anyone)
         if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
             ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID, anyone)
-        if err is not None and th_ref is None and sw is None and tg.ok(err[0] * err[0], err[1] * err[1]):
+        if err is not None and anyone and tg.ok(err[0] * err[0], err[1] * err[1]):
             # the closed form's nearest solution, checked by the FK of its compiled call: the answer
             return IKResult(ana[0], True, "success", err[0], err[1], 0, 0, "converged from an analytic seed",
                             tg.mode, "analytic")

@@ -263,16 +263,11 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
         return none, "", None
-    kw = {}
-    if sh.swivel_family:
-        if swivel is not None:
-            kw["swivel"] = swivel
-        elif grid is not None:
-            kw["swivel"] = grid
+    angles = swivel if swivel is not None else grid     # the swivel angles of an SRS arm (None: default)
+    kw = {"swivel": angles} if sh.swivel_family and angles is not None else {}
     T = tg.H
     if sh.nearest_swivel is not None and th_ref is not None:
-        g = closed_form.DEFAULT_SWIVEL if swivel is None and grid is None else (swivel if swivel is not None else grid)
-        g = np.atleast_1d(np.asarray(g, dtype=float))
+        g = np.atleast_1d(np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float))
         if (np.abs(g) < WRAP_MAX).all():
             one = sh.nearest_swivel(T, th_ref, g, any_solution)
             if one is not None:                # one compiled call, nearest first
