@@ -287,13 +287,14 @@ class _Solver:
     @functools.cached_property
     def one_call(self):
         """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints,
-        the labels by branch index as a float (how the compiled call returns it), whether a 7th
-        joint is held); None for the other kinds."""
+        the labels of the solutions by the bit mask of their branches (how the compiled call
+        returns them: 256 tuples), whether a 7th joint is held); None for the other kinds."""
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
-        return (cf, ci, len(ci) - 3, {float(b): label for b, label in enumerate(self.plan.labels)},
-                self.plan.param_joint is not None)
+        labels = self.plan.labels
+        by_mask = tuple(tuple(labels[b] for b in range(8) if mask >> b & 1) for mask in range(256))
+        return cf, ci, len(ci) - 3, by_mask, self.plan.param_joint is not None
 
 
 _SOLVERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -944,17 +945,19 @@ def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
     if not abs(prm) < WRAP_MAX:
         return None                     # not an angle: the batch path says so
     out = np.empty((8, n + 4))
-    K = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
-    if K <= 0:
+    mask = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
+    if mask <= 0:
         return None
-    sol = out[:K]
-    q = sol[:, :n]
+    branches = labels[mask]
+    K = len(branches)
+    q = out[:K, :n]
     plan = s.plan
-    return AnalyticIKResult(solutions=q if s.plain else plan.chain.configuration(q),
-                            branches=list(map(labels.__getitem__, sol[:, n + 1].tolist())), residuals=sol[:, n],
-                            model=robot.name,
-                            _singular=lambda: _singular_text(float(
-                                _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())))
+    # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — this is
+    # the path of every single pose, and keywords cost a third of the result's construction
+    return AnalyticIKResult(q if s.plain else plan.chain.configuration(q), list(branches), None, None, out[:K, n],
+                            lambda: _singular_text(float(
+                                _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())),
+                            robot.name)
 
 
 def _singular_text(volume: float) -> str | None:

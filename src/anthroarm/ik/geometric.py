@@ -920,8 +920,9 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
     (n,) (θ, rad; an empty array: none) the solution nearest it (Euclidean in θ) is swapped
     into the first row, and that row's last two columns hold its position and rotation errors
-    (:func:`_target_errors`, m and rad).  Returns their number K; −1: a malformed pose; −2: no
-    solution, or a candidate to polish (the caller's general path answers: reasons,
+    (:func:`_target_errors`, m and rad).  Returns the set of branches that are solutions as a
+    bit mask (bit b: branch b; their number K is its count of ones, > 0); −1: a malformed pose;
+    −2: no solution, or a candidate to polish (the caller's general path answers: reasons,
     polishing)."""
     n = ci[2]
     Tb = T.reshape((1, 4, 4))
@@ -931,7 +932,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     IN, OK = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
     if _verified(cf, ci, Tb, pv, tol, tol_orthonormal, Q, V, E, IN, RES, OK) >= 0:
         return -1
-    K = 0
+    K, mask = 0, 0
     for b in range(8):
         if V[0, b] and E[0, b] and IN[0, b] and tol < RES[0, b] <= POLISH_MAX:
             return -2
@@ -940,6 +941,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
                 out[K, k] = Q[0, b, ci[3 + k]]
             out[K, n], out[K, n + 1] = RES[0, b], b
             K += 1
+            mask |= 1 << b
     if K == 0:
         return -2
     if len(ref) == n:
@@ -947,7 +949,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
         _, _, _, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
         out[0, n + 2], out[0, n + 3] = _target_errors(kH, kO, mat(M[:3, :3]), vec(M[:3, 3]), Q[0, int(out[0, n + 1])],
                                                       n, T)
-    return K
+    return mask
 
 
 NO_REF = np.zeros(0)   # "no reference" of the one-pose kernels (an empty array)
@@ -1015,9 +1017,10 @@ def solve_nearest(cf, ci, T, ref, param: float):
     seeds of :func:`anthroarm.ik.solve`, one compiled call."""
     n = len(ci) - 3
     out = np.empty((8, n + 4))
-    K = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
-    if K <= 0:
+    mask = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
+    if mask <= 0:
         return None
+    K = mask.bit_count()
     if len(ref) != n:
         return out[:K, :n], None, None
     return out[:K, :n], float(out[0, n + 2]), float(out[0, n + 3])
