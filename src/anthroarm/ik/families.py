@@ -57,9 +57,9 @@ from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (POLISH_MAX, BadPoseError, _common_point, _fk_residual, _mark_solutions, _pose_status,
-                        _target_errors, _wrist, into_limits, nearest_first)
-from .subproblems import TOL, sp1_one, sp2_one, sp3_one
-from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
+                        _rot3, _target_errors, _wrist, into_limits, nearest_first)
+from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
+from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, scale, sub, transpose, vec, wrap
 
 #: shoulder routes of the SRS arm (index stored in the plan)
 SRS_ROUTES = ("sp2", "general")
@@ -308,10 +308,12 @@ def _align(a0, b0, a1, b1):
 
 
 @kernel
-def _srs_one(route, h, S, E0, W0, Rg, W, phi, t4a, t4b, n4, e4a, e4b, Q, V, E, Q6, V6, E6, Qs, Vs, Es):
+def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, V, E, Q6, C6, S6, V6, E6, Qs, Cs, Ss, Vs,
+             Es):
     """The 8 branches of one pose and swivel angle φ: Q (8, 7) rad (path order, wrapped into
     (−π, π]), V (the branch exists), E (every subproblem on it exact).  ``Rg`` = R R_tᵀ, ``W``
-    the wrist centre (base frame, m), q4 roots of the SP3 (module docstring)."""
+    the wrist centre (base frame, m), ``a4a``, ``a4b`` the q4 roots of the SP3 (module
+    docstring) as triples (θ, cos θ, sin θ) (:mod:`.geometric`); the rest scratch."""
     for b in range(8):
         V6[b] = False
         E6[b] = False
@@ -341,38 +343,43 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, t4a, t4b, n4, e4a, e4b, Q, V, E, Q
         for i4 in range(2):
             if i4 >= n4:
                 continue
-            q4 = t4a if i4 == 0 else t4b
+            a4 = a4a if i4 == 0 else a4b
+            q4 = a4[0]
             ex4 = e4a if i4 == 0 else e4b
-            f = rotate(h[3], q4, f0)
+            R34 = rot_cs(h[3], a4[1], a4[2])
+            f = mv(R34, f0)
             src = h[3] if straight else f
             dst = aE if straight else fore
             if route == 0:
-                q1a, q2a, q1b, q2b, n12, ea, eb, _ = sp2_one(up, e0, neg(h[0]), h[1], TOL)
+                (u1a, c1a, s1a, u2a, c2a, s2a, u1b, c1b, s1b, u2b, c2b, s2b,
+                 n12, ea, eb, _) = sp2_cs(up, e0, neg(h[0]), h[1], TOL)
                 for j in range(2):
                     if j >= n12:
                         continue
-                    q1, q2 = (q1a, q2a) if j == 0 else (q1b, q2b)
-                    R02 = mm(rot(h[0], q1), rot(h[1], q2))
-                    q3, e3, _ = sp1_one(src, mtv(R02, dst), h[2], TOL)
-                    R04 = mm(mm(R02, rot(h[2], q3)), rot(h[3], q4))
+                    a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
+                    R02 = mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2]))
+                    t3, c3, s3, e3, _ = sp1_cs(src, mtv(R02, dst), h[2], TOL)
+                    R04 = mm(mm(R02, rot_cs(h[2], c3, s3)), R34)
                     b = 4 * i4 + 2 * j
                     q4b[b], q4b[b + 1] = q4, q4
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, V6, E6, b, q1, q2, q3,
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, C6, S6, V6, E6, b, a1, a2, (t3, c3, s3),
                            ex4 and (ea if j == 0 else eb) and e3)
             else:
                 R03 = _align(e0, src, up, dst)
                 ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
                 for j in range(2):
                     Vs[j] = False
-                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Qs, Vs, Es, 0, 0.0, 0.0, 0.0, True)
+                zero = (0.0, 1.0, 0.0)
+                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Qs, Cs, Ss, Vs, Es, 0, zero, zero, zero, True)
                 for j in range(2):
                     if not Vs[j]:
                         continue
-                    q1, q2, q3 = Qs[j, 3], Qs[j, 4], Qs[j, 5]
-                    R04 = mm(mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3)), rot(h[3], q4))
+                    a1, a2, a3 = (Qs[j, 3], Cs[j, 3], Ss[j, 3]), (Qs[j, 4], Cs[j, 4], Ss[j, 4]), (Qs[j, 5], Cs[j, 5], Ss[j, 5])
+                    R04 = mm(_rot3(h, a1, a2, a3), R34)
                     b = 4 * i4 + 2 * j
                     q4b[b], q4b[b + 1] = q4, q4
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, V6, E6, b, q1, q2, q3, ex4 and Es[j])
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, C6, S6, V6, E6, b, a1, a2, a3,
+                           ex4 and Es[j])
     for b in range(8):
         if V6[b]:
             Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3] = wrap(Q6[b, 0]), wrap(Q6[b, 1]), wrap(Q6[b, 2]), wrap(q4b[b])
@@ -409,10 +416,10 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    Q6 = np.empty((8, 6))
+    Q6, C6, S6 = np.empty((8, 6)), np.empty((8, 6)), np.empty((8, 6))
     V6 = np.empty(8, dtype=np.bool_)
     E6 = np.empty(8, dtype=np.bool_)
-    Qs = np.empty((2, 6))
+    Qs, Cs, Ss = np.empty((2, 6)), np.empty((2, 6)), np.empty((2, 6))
     Vs = np.empty(2, dtype=np.bool_)
     Es = np.empty(2, dtype=np.bool_)
     Qb = np.empty((8, 7))
@@ -429,10 +436,10 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
         R, p = mat(T[i]), vec(T[i, :3, 3])
         Rg = mm(R, transpose(Rt))
         W = add(mv(Rg, sub(W0v, pt)), p)
-        t4a, t4b, n4, e4a, e4b, _ = sp3_one(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
+        t4a, c4a, s4a, t4b, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
         for k in range(ns):
-            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], t4a, t4b, n4, e4a, e4b, Qb, Vb, Eb,
-                     Q6, V6, E6, Qs, Vs, Es)
+            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (t4a, c4a, s4a), (t4b, c4b, s4b), n4, e4a, e4b,
+                     Qb, Vb, Eb, Q6, C6, S6, V6, E6, Qs, Cs, Ss, Vs, Es)
             for b in range(8):
                 r = 8 * k + b
                 for j in range(7):

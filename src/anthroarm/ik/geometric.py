@@ -77,8 +77,9 @@ from ..threads import run_rows
 from . import classify as C
 from . import subproblems as sp
 from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search  # noqa: F401 - re-exported
-from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp2_one, sp3_one, sp4_one, sp5_one, sp6_one
-from .vec3 import add, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot, rotate, rotate_cs, sub, transpose, vec, wrap
+from .subproblems import TOL, TOL_QUARTIC, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5_one, sp6_one
+from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot, rot_cs, rotate_cs, sub,
+                   transpose, vec, wrap)
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -278,135 +279,155 @@ def _build(robot) -> GeoPlan | None:
 # ----------------------------------------------------------------------------- the closed classes
 # One compiled kernel per class and pose (:mod:`anthroarm.jit`), built from the subproblem
 # kernels of :mod:`.subproblems`; vectors are tuples (:mod:`.vec3`).  Each writes its 8
-# branches into Q (8, 6) rad, V (8,) (the branch exists), E (8,) (every subproblem on it was
-# exact), in the order of the labels: the first branching subproblem outermost, the root index
-# innermost.  A branch under a root that does not exist is left NaN / invalid.
+# branches into Q (8, 6) rad, QC, QS (8, 6) the cosine and sine of each angle, V (8,) (the
+# branch exists), E (8,) (every subproblem on it was exact), in the order of the labels: the
+# first branching subproblem outermost, the root index innermost.  A branch under a root that
+# does not exist is left NaN / invalid.  An angle travels as a triple a = (θ, cos θ, sin θ):
+# the subproblems give the rotation they find as (cos, sin) with its angle (``sp*_cs``), so
+# the rotations that follow, and the FK check of :func:`_verified`, evaluate no trigonometry.
 @kernel
-def _put(Q, V, E, b, q1, q2, q3, q4, q5, q6, v, e):
-    Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3], Q[b, 4], Q[b, 5] = q1, q2, q3, q4, q5, q6
+def _put(Q, QC, QS, V, E, b, a1, a2, a3, a4, a5, a6, v, e):
+    """Branch b: the six angles (triples (θ, cos θ, sin θ)) and its flags."""
+    Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3], Q[b, 4], Q[b, 5] = a1[0], a2[0], a3[0], a4[0], a5[0], a6[0]
+    QC[b, 0], QC[b, 1], QC[b, 2], QC[b, 3], QC[b, 4], QC[b, 5] = a1[1], a2[1], a3[1], a4[1], a5[1], a6[1]
+    QS[b, 0], QS[b, 1], QS[b, 2], QS[b, 3], QS[b, 4], QS[b, 5] = a1[2], a2[2], a3[2], a4[2], a5[2], a6[2]
     V[b], E[b] = v, e
 
 
 @kernel
-def _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex):
+def _rot3(h, a1, a2, a3):
+    """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three angle triples."""
+    return mm(mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2])), rot_cs(h[2], a3[1], a3[2]))
+
+
+@kernel
+def _wrist(h, R03, R06, Q, QC, QS, V, E, b, a1, a2, a3, ex):
     """Spherical wrist from R36 = R03ᵀ R06: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and
-    q6 by SP1; branches b (first q5 root) and b + 1."""
+    q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
     h4, h5, h6 = h[3], h[4], h[5]
     R36 = mtm(R03, R06)
     R36h6 = mv(R36, h6)
     x = perpendicular(h6)
     R36x = mv(R36, x)
-    ta, tb, cnt, ea, eb, _ = sp4_one(h4, h6, h5, dot(h4, R36h6), TOL)
+    ta, ca, sa, tb, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, R36h6), TOL)
     for j in range(2):
         if j >= cnt:
             V[b + j] = False
             continue
-        q5 = ta if j == 0 else tb
-        c, s = math.cos(q5), math.sin(q5)
+        a5 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
+        c, s = a5[1], a5[2]
         # q4 (0 where it is free: h4 ∥ rot(h5, q5) h6, the wrist singularity), then q6 from
         # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
-        q4, e4, _ = sp1_one(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
-        q6, e6, _ = sp1_one(x, rotate_cs(h5, c, -s, rotate(h4, -q4, R36x)), h6, TOL)
-        _put(Q, V, E, b + j, q1, q2, q3, q4, q5, q6, True, ex and (ea if j == 0 else eb) and e4 and e6)
+        t4, c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
+        t6, c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, R36x)), h6, TOL)
+        _put(Q, QC, QS, V, E, b + j, a1, a2, a3, (t4, c4, s4), a5, (t6, c6, s6), True,
+             ex and (ea if j == 0 else eb) and e4 and e6)
 
 
 @kernel
-def _spherical_two_parallel(h, P, R06, p, Q, V, E):
+def _spherical_two_parallel(h, P, R06, p, Q, QC, QS, V, E):
     """q1 SP4, q3 SP3, q2 SP1, the wrist (spherical wrist, axes 2 ∥ 3)."""
     wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
-    t1a, t1b, n1, e1a, e1b, _ = sp4_one(h[1], wrist, neg(h[0]), dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
+    t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]),
+                                                           dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
     for i1 in range(2):
         if i1 >= n1:
             V[4 * i1:4 * i1 + 4] = False
             continue
-        q1 = t1a if i1 == 0 else t1b
-        v = sub(rotate(neg(h[0]), q1, wrist), P[1])                  # R01ᵀ p_16 − p12
-        t3a, t3b, n3, e3a, e3b, _ = sp3_one(neg(P[3]), P[2], h[2], norm(v), TOL)
+        a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
+        v = sub(rotate_cs(neg(h[0]), a1[1], a1[2], wrist), P[1])       # R01ᵀ p_16 − p12
+        t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(neg(P[3]), P[2], h[2], norm(v), TOL)
         for i3 in range(2):
             b = 4 * i1 + 2 * i3
             if i3 >= n3:
                 V[b:b + 2] = False
                 continue
-            q3 = t3a if i3 == 0 else t3b
-            q2, e2, _ = sp1_one(add(P[2], rotate(h[2], q3, P[3])), v, h[1], TOL)
-            R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
+            a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
+            t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), v, h[1], TOL)
+            a2 = (t2, c2, s2)
             ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
-            _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, ex)
+            _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, b, a1, a2, a3, ex)
 
 
 @kernel
-def _spherical_two_intersecting(h, P, R06, p, Q, V, E):
+def _spherical_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
-    t3a, t3b, n3, e3a, e3b, _ = sp3_one(P[3], neg(P[2]), h[2], norm(p16), TOL)
+    t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
         if i3 >= n3:
             V[4 * i3:4 * i3 + 4] = False
             continue
-        q3 = t3a if i3 == 0 else t3b
-        q1a, q2a, q1b, q2b, n12, ea, eb, _ = sp2_one(p16, add(P[2], rotate(h[2], q3, P[3])), neg(h[0]), h[1], TOL)
+        a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
+        (u1a, c1a, s1a, u2a, c2a, s2a, u1b, c1b, s1b, u2b, c2b, s2b,
+         n12, ea, eb, _) = sp2_cs(p16, add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), neg(h[0]), h[1], TOL)
         for j in range(2):
             b = 4 * i3 + 2 * j
             if j >= n12:
                 V[b:b + 2] = False
                 continue
-            q1, q2 = (q1a, q2a) if j == 0 else (q1b, q2b)
-            R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
-            _wrist(h, R03, R06, Q, V, E, b, q1, q2, q3, (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
+            a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
+            _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, b, a1, a2, a3,
+                   (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
 
 
 @kernel
-def _three_parallel_tail(h, P, R06, p06, q1, q5, ex, Q, V, E, b):
-    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (branches b, b + 1 by the SP3 of q3): θ14 = q2 + q3
-    + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by difference.  h3, h4 may
-    be −h2: rot(h3, q3) = rot(h2, ±q3)."""
+def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, Q, QC, QS, V, E, b):
+    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (triples a1, a5; branches b, b + 1 by the SP3 of
+    q3): θ14 = q2 + q3 + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by
+    difference.  h3, h4 may be −h2: rot(h3, q3) = rot(h2, ±q3)."""
     s3n = 1.0 if dot(h[1], h[2]) >= 0.0 else -1.0
     s4n = 1.0 if dot(h[1], h[3]) >= 0.0 else -1.0
-    R01 = rot(h[0], q1)
-    c5, s5 = math.cos(q5), math.sin(q5)
+    R01 = rot_cs(h[0], a1[1], a1[2])
+    c5, s5 = a5[1], a5[2]
     # q6 (0 where it is free: h6 ∥ h2, the wrist aligned with the parallel axes), then θ14 from
     # rot(h2, θ14) = R01ᵀ R06 rot(h6, −q6) rot(h5, −q5) applied to x ⟂ h2 (never singular)
-    q6, e6, _ = sp1_one(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
+    t6, c6, s6, e6, _ = sp1_cs(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
     x = perpendicular(h[1])
-    th14, e14, _ = sp1_one(x, mtv(R01, mv(R06, rotate(h[5], -q6, rotate_cs(h[4], c5, -s5, x)))), h[1], TOL)
-    d_in = sub(sub(mtv(R01, p06), P[1]), rotate(h[1], th14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
-    ta, tb, n3, ea, eb, _ = sp3_one(neg(P[3]), P[2], h[1], norm(d_in), TOL)
+    t14, c14, s14, e14, _ = sp1_cs(x, mtv(R01, mv(R06, rotate_cs(h[5], c6, -s6, rotate_cs(h[4], c5, -s5, x)))),
+                                   h[1], TOL)
+    d_in = sub(sub(mtv(R01, p06), P[1]), rotate_cs(h[1], c14, s14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
+    ta, ca, sa, tb, cb, sb, n3, ea, eb, _ = sp3_cs(neg(P[3]), P[2], h[1], norm(d_in), TOL)
     for j in range(2):
         if j >= n3:
             V[b + j] = False
             continue
-        t3 = ta if j == 0 else tb
-        q2, e2, _ = sp1_one(add(P[2], rotate(h[1], t3, P[3])), d_in, h[1], TOL)
-        t4 = wrap(th14 - q2 - t3)
-        _put(Q, V, E, b + j, q1, q2, s3n * t3, s4n * t4, q5, q6, True,
+        t3, c3, s3 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
+        t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[1], c3, s3, P[3])), d_in, h[1], TOL)
+        # q4 = θ14 − q2 − q3: its rotation is e^{iθ14} e^{−i(q2 + q3)}
+        c23, s23 = c2 * c3 - s2 * s3, s2 * c3 + c2 * s3
+        c4, s4 = c14 * c23 + s14 * s23, s14 * c23 - c14 * s23
+        _put(Q, QC, QS, V, E, b + j, a1, (t2, c2, s2), (s3n * t3, c3, s3n * s3),
+             (s4n * wrap(t14 - t2 - t3), c4, s4n * s4), a5, (t6, c6, s6), True,
              ex and e14 and e6 and (ea if j == 0 else eb) and e2)
 
 
 @kernel
-def _three_parallel_two_intersecting(h, P, R06, p, Q, V, E):
+def _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
     """2 ∥ 3 ∥ 4 and 5 × 6 (p56 = 0): q1 by SP4 (h2ᵀ R01ᵀ p16 = h2ᵀ (p12 + … + p45)), q5 by SP4
     (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
     d1 = dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4]))
-    t1a, t1b, n1, e1a, e1b, _ = sp4_one(h[1], p06, neg(h[0]), d1, TOL)
+    t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], p06, neg(h[0]), d1, TOL)
     R06h6 = mv(R06, h[5])
     for i1 in range(2):
         if i1 >= n1:
             V[4 * i1:4 * i1 + 4] = False
             continue
-        q1 = t1a if i1 == 0 else t1b
-        t5a, t5b, n5, e5a, e5b, _ = sp4_one(h[1], h[5], h[4], dot(h[1], rotate(neg(h[0]), q1, R06h6)), TOL)
+        a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
+        t5a, c5a, s5a, t5b, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(h[1], h[5], h[4], dot(h[1], rotate_cs(
+            neg(h[0]), a1[1], a1[2], R06h6)), TOL)
         for i5 in range(2):
             b = 4 * i1 + 2 * i5
             if i5 >= n5:
                 V[b:b + 2] = False
                 continue
-            _three_parallel_tail(h, P, R06, p06, q1, t5a if i5 == 0 else t5b,
-                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), Q, V, E, b)
+            _three_parallel_tail(h, P, R06, p06, a1, (t5a, c5a, s5a) if i5 == 0 else (t5b, c5b, s5b),
+                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), Q, QC, QS, V, E, b)
 
 
 @kernel
-def _three_parallel(h, P, R06, p, Q, V, E):
+def _three_parallel(h, P, R06, p, Q, QC, QS, V, E):
     """2 ∥ 3 ∥ 4 alone: (q1, q5) by SP6 (the two height equations along h2, of the position
     and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
@@ -418,11 +439,11 @@ def _three_parallel(h, P, R06, p, Q, V, E):
         if j >= cnt:
             V[2 * j:2 * j + 2] = False
             continue
-        _three_parallel_tail(h, P, R06, p06, t[j, 0], t[j, 1], True, Q, V, E, 2 * j)
+        _three_parallel_tail(h, P, R06, p06, angle_cs(t[j, 0]), angle_cs(t[j, 1]), True, Q, QC, QS, V, E, 2 * j)
 
 
 @kernel
-def _spherical(h, P, R06, p, Q, V, E):
+def _spherical(h, P, R06, p, Q, QC, QS, V, E):
     """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
     quartic, up to 4), then the wrist."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])
@@ -432,9 +453,8 @@ def _spherical(h, P, R06, p, Q, V, E):
         if j >= cnt:
             V[2 * j:2 * j + 2] = False
             continue
-        q1, q2, q3 = t[j, 0], t[j, 1], t[j, 2]
-        R03 = mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], q3))
-        _wrist(h, R03, R06, Q, V, E, 2 * j, q1, q2, q3, True)
+        a1, a2, a3 = angle_cs(t[j, 0]), angle_cs(t[j, 1]), angle_cs(t[j, 2])
+        _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, 2 * j, a1, a2, a3, True)
 
 
 #: the compiled class solvers, by their index in :data:`CLOSED`
@@ -443,20 +463,20 @@ CLOSED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALL
 
 
 @kernel
-def _solve_closed(cls, h, P, R06, p, Q, V, E):
+def _solve_closed(cls, h, P, R06, p, Q, QC, QS, V, E):
     Q[:, :] = math.nan
     V[:] = False
     E[:] = False
     if cls == 0:
-        _spherical_two_parallel(h, P, R06, p, Q, V, E)
+        _spherical_two_parallel(h, P, R06, p, Q, QC, QS, V, E)
     elif cls == 1:
-        _spherical_two_intersecting(h, P, R06, p, Q, V, E)
+        _spherical_two_intersecting(h, P, R06, p, Q, QC, QS, V, E)
     elif cls == 2:
-        _three_parallel_two_intersecting(h, P, R06, p, Q, V, E)
+        _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E)
     elif cls == 3:
-        _spherical(h, P, R06, p, Q, V, E)
+        _spherical(h, P, R06, p, Q, QC, QS, V, E)
     else:
-        _three_parallel(h, P, R06, p, Q, V, E)
+        _three_parallel(h, P, R06, p, Q, QC, QS, V, E)
     for b in range(8):
         if V[b]:
             for j in range(6):
@@ -479,8 +499,9 @@ def _seven(A):
 @kernel
 def _closed_loop(cls, H, P, R06, p, Q, V, E):
     h, PP = _six(H), _seven(P)
+    QC, QS = np.empty((8, 6)), np.empty((8, 6))
     for i in range(len(p)):
-        _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), Q[i], V[i], E[i])
+        _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), Q[i], QC, QS, V[i], E[i])
 
 
 # ----------------------------------------------------------------------------- one call: pose → verified branches
@@ -552,11 +573,18 @@ def _pose_status(T, tol_orthonormal):
 
 
 @kernel
-def _poe_step(R, t, axis, point, q):
+def _poe_step_cs(R, t, axis, point, c, s):
     """The partial product of exponentials (R, t) times e^{ξ q} of one revolute joint (unit
-    ``axis`` through ``point``, base frame at q = 0, m): R Rq and t + R (o − Rq o)."""
-    Ri = rot(axis, q)
+    ``axis`` through ``point``, base frame at q = 0, m), from c = cos q and s = sin q:
+    R Rq and t + R (o − Rq o)."""
+    Ri = rot_cs(axis, c, s)
     return mm(R, Ri), add(t, mv(R, sub(point, mv(Ri, point))))
+
+
+@kernel
+def _poe_step(R, t, axis, point, q):
+    """:func:`_poe_step_cs` of the angle q (rad)."""
+    return _poe_step_cs(R, t, axis, point, math.cos(q), math.sin(q))
 
 
 @kernel
@@ -664,11 +692,13 @@ def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
 
 
 @kernel
-def _fk_residuals(kH, kO, MR, Mp, Q, V, n, T, RES, S):
+def _fk_residuals(kH, kO, MR, Mp, Q, QC, QS, V, n, T, RES, S):
     """:func:`_fk_residual` of every candidate branch b (``V[b]``) of Q (B, n) into RES (B,)
-    (inf where there is none), the product of exponentials shared along the branch tree:
-    branches come root index innermost, so a branch repeats the leading angles of the one
-    before it, and the partial products up to the first joint whose angle differs are kept
+    (inf where there is none), each joint's rotation from QC, QS (B, n), the cosine and sine
+    of its angle (the rotation the class solver found, whose angle Q is, or cos and sin of Q
+    where :func:`_verified` moved it), the product of exponentials shared along the branch
+    tree: branches come root index innermost, so a branch repeats the leading angles of the
+    one before it, and the partial products up to the first joint whose angle differs are kept
     (scratch S (n + 1, 12): rotation rows and translation after each joint) — the same
     arithmetic as one product per branch, about a third fewer joint factors for 8 branches."""
     S[0, :] = 0.0
@@ -685,7 +715,7 @@ def _fk_residuals(kH, kO, MR, Mp, Q, V, n, T, RES, S):
         prev = b
         for i in range(j0, n):
             R = ((S[i, 0], S[i, 1], S[i, 2]), (S[i, 3], S[i, 4], S[i, 5]), (S[i, 6], S[i, 7], S[i, 8]))
-            R, t = _poe_step(R, (S[i, 9], S[i, 10], S[i, 11]), vec(kH[i]), vec(kO[i]), Q[b, i])
+            R, t = _poe_step_cs(R, (S[i, 9], S[i, 10], S[i, 11]), vec(kH[i]), vec(kO[i]), QC[b, i], QS[b, i])
             S[i + 1, 0], S[i + 1, 1], S[i + 1, 2] = R[0]
             S[i + 1, 3], S[i + 1, 4], S[i + 1, 5] = R[1]
             S[i + 1, 6], S[i + 1, 7], S[i + 1, 8] = R[2]
@@ -716,10 +746,11 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    Q6 = np.empty((8, 6))
+    Q6, C6, S6 = np.empty((8, 6)), np.empty((8, 6)), np.empty((8, 6))
     V6 = np.empty(8, dtype=np.bool_)
     E6 = np.empty(8, dtype=np.bool_)
     q = np.empty(n)
+    QC, QS = np.empty((8, n)), np.empty((8, n))
     S = np.empty((n + 1, 12))
     J, F = np.empty((6, 6)), np.empty(6)
     CHK = np.empty(8, dtype=np.bool_)
@@ -727,9 +758,11 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
         if _pose_status(T[i], tol_orthonormal) != 0:
             return i
         R, p = mat(T[i]), vec(T[i, :3, 3])
+        a7 = (0.0, 1.0, 0.0)
         if n == 7:
+            a7 = angle_cs(wrap(param[i]))
             # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
-            Rv = rot(p_axis, -param[i])
+            Rv = rot_cs(p_axis, a7[1], -a7[2])
             X = mtm(MR, mm(Rv, MR))
             x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
             p = add(mv(R, x), p)
@@ -737,18 +770,23 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
         if rev:
             p = neg(mtv(R, p))
             R = transpose(R)
-        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, Q6, V6, E6)
+        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, Q6, C6, S6, V6, E6)
         for b in range(8):
             for j in range(6):
-                q[j] = Q6[b, 5 - j] if rev else Q6[b, j]
+                jj = 5 - j if rev else j
+                q[j], QC[b, j], QS[b, j] = Q6[b, jj], C6[b, jj], S6[b, jj]
             if n == 7:
-                q[6] = wrap(param[i])
+                q[6], QC[b, 6], QS[b, 6] = a7
+            for j in range(n):
+                Q[i, b, j] = q[j]
             inside = into_limits(q, n, lo, hi)
             for j in range(n):
+                if V6[b] and q[j] != Q[i, b, j]:         # moved by 2π or onto a limit: its own cos, sin
+                    QC[b, j], QS[b, j] = math.cos(q[j]), math.sin(q[j])
                 Q[i, b, j] = q[j]
             V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
             CHK[b] = V6[b] and (inside or not E6[b])
-        _fk_residuals(kH, kO, MR, Mp, Q[i], CHK, n, T[i], RES[i], S)
+        _fk_residuals(kH, kO, MR, Mp, Q[i], QC, QS, CHK, n, T[i], RES[i], S)
         for b in range(8):
             if V[i, b] and E[i, b] and IN[i, b] and tol < RES[i, b] <= POLISH_MAX:
                 for j in range(n):

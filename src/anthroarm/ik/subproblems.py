@@ -54,7 +54,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..jit import kernel
-from .vec3 import add, cross, dot, neg, norm, rotate, scale, sub, vec, wrap
+from .vec3 import add, cross, dot, neg, norm, rotate, rotate_cs, scale, sub, vec, wrap
 
 #: default tolerance on the residual of an exact solution (the caller's length unit)
 TOL = 1e-9
@@ -172,24 +172,54 @@ def rot(k, theta) -> np.ndarray:
     return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
 
 
+# ----------------------------------------------------------------------------- angles as (θ, cos θ, sin θ)
+@kernel
+def atan2_cs(y, x):
+    """θ = atan2(y, x) (rad) with cos θ = x / r and sin θ = y / r, r = ‖(x, y)‖ — the rotation a
+    subproblem finds, for the rotations that follow it without evaluating cos and sin of θ
+    again (θ is read once, the rotation kept exact to rounding).  (cos θ, sin θ) from θ where
+    r is 0 or not finite."""
+    theta = math.atan2(y, x)
+    r = math.sqrt(x * x + y * y)
+    if 0.0 < r < math.inf:
+        return theta, x / r, y / r
+    return theta, math.cos(theta), math.sin(theta)
+
+
 # ----------------------------------------------------------------------------- SP1, SP4
 @kernel
-def sp1_one(p1, p2, k, tol):
-    """SP1 of one problem (tuples): (θ, exact, singular); see :func:`sp1`."""
+def sp1_cs(p1, p2, k, tol):
+    """SP1 of one problem (tuples): (θ, cos θ, sin θ, exact, singular); see :func:`sp1`."""
     kxp = cross(k, p1)
     x0 = dot(kxp, p2)
     x1 = -dot(cross(k, kxp), p2)                      # x = Aᵀ p2, A = [k × p1, −k × (k × p1)]
     n1, n2 = norm(p1), norm(p2)
     sing = norm(kxp) <= 1e-12 * max(1.0, n1) or norm(cross(k, p2)) <= 1e-12 * max(1.0, n2)
-    theta = 0.0 if sing else math.atan2(x0, x1)
+    theta, c, s = (0.0, 1.0, 0.0) if sing else atan2_cs(x0, x1)
     exact = abs(n1 - n2) <= tol and abs(dot(k, p1) - dot(k, p2)) <= tol
+    return theta, c, s, exact, sing
+
+
+@kernel
+def sp1_one(p1, p2, k, tol):
+    """SP1 of one problem (tuples): (θ, exact, singular); see :func:`sp1` (:func:`sp1_cs`)."""
+    theta, _, _, exact, sing = sp1_cs(p1, p2, k, tol)
     return theta, exact, sing
 
 
 @kernel
 def sp4_one(h, p, k, d, tol):
     """SP4 of one problem (tuples; h unit): (θ_a, θ_b, count, exact_a, exact_b, singular), θ_b
-    NaN when count = 1; IK-Geo Eqs. (4)–(6), see :func:`sp4`."""
+    NaN when count = 1; IK-Geo Eqs. (4)–(6), see :func:`sp4` (:func:`sp4_cs`)."""
+    ta, _, _, tb, _, _, cnt, ea, eb, sing = sp4_cs(h, p, k, d, tol)
+    return ta, tb, cnt, ea, eb, sing
+
+
+@kernel
+def sp4_cs(h, p, k, d, tol):
+    """SP4 of one problem (tuples; h unit): (θ_a, cos θ_a, sin θ_a, θ_b, cos θ_b, sin θ_b,
+    count, exact_a, exact_b, singular), the b root NaN when count = 1; IK-Geo Eqs. (4)–(6), see
+    :func:`sp4`."""
     kxp = cross(k, p)
     a0 = dot(h, kxp)
     a1 = -dot(h, cross(k, kxp))                       # hᵀA
@@ -203,13 +233,14 @@ def sp4_one(h, p, k, d, tol):
     two = margin > 0.0
     xi = math.sqrt(max(na * na - b * b, 0.0))
     if sing:
-        return 0.0, math.nan, 1, ab <= tol or two, False, True
+        return 0.0, 1.0, 0.0, math.nan, math.nan, math.nan, 1, ab <= tol or two, False, True
     if two:
-        ta = math.atan2(a0 * b + xi * a1, a1 * b - xi * a0)
-        tb = math.atan2(a0 * b - xi * a1, a1 * b + xi * a0)
-        return ta, tb, 2, True, True, False
+        ta, ca, sa = atan2_cs(a0 * b + xi * a1, a1 * b - xi * a0)
+        tb, cb, sb = atan2_cs(a0 * b - xi * a1, a1 * b + xi * a0)
+        return ta, ca, sa, tb, cb, sb, 2, True, True, False
     # one root (tangent or least squares): atan2 of Aᵀb
-    return math.atan2(a0 * b, a1 * b), math.nan, 1, margin >= -tol, False, False
+    ta, ca, sa = atan2_cs(a0 * b, a1 * b)
+    return ta, ca, sa, math.nan, math.nan, math.nan, 1, margin >= -tol, False, False
 
 
 @kernel
@@ -275,8 +306,9 @@ def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
 
 # ----------------------------------------------------------------------------- SP3
 @kernel
-def sp3_one(p1, p2, k, d, tol):
-    """SP3 of one problem (tuples): (θ_a, θ_b, count, exact_a, exact_b, singular); see :func:`sp3`."""
+def sp3_cs(p1, p2, k, d, tol):
+    """SP3 of one problem (tuples): (θ_a, cos θ_a, sin θ_a, θ_b, cos θ_b, sin θ_b, count,
+    exact_a, exact_b, singular); see :func:`sp3`."""
     n2 = norm(p2)
     zero = n2 <= 1e-300
     if zero:
@@ -284,12 +316,20 @@ def sp3_one(p1, p2, k, d, tol):
     else:
         h, dd, safe = scale(p2, 1.0 / n2), (dot(p1, p1) + n2 * n2 - d * d) / (2.0 * n2), n2
     # a distance residual δ changes the SP4 height by ≈ δ (2d + δ) / (2‖p2‖)
-    ta, tb, cnt, ea, eb, sing = sp4_one(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
+    ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing = sp4_cs(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
     if sing or zero:
-        ea = abs(norm(sub(rotate(k, ta, p1), p2)) - d) <= tol
+        ea = abs(norm(sub(rotate_cs(k, ca, sa, p1), p2)) - d) <= tol
         if cnt == 2:
-            eb = abs(norm(sub(rotate(k, tb, p1), p2)) - d) <= tol
-    return ta, tb, cnt, ea, eb, sing or zero
+            eb = abs(norm(sub(rotate_cs(k, cb, sb, p1), p2)) - d) <= tol
+    return ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing or zero
+
+
+@kernel
+def sp3_one(p1, p2, k, d, tol):
+    """SP3 of one problem (tuples): (θ_a, θ_b, count, exact_a, exact_b, singular); see :func:`sp3`
+    (:func:`sp3_cs`)."""
+    ta, _, _, tb, _, _, cnt, ea, eb, sing = sp3_cs(p1, p2, k, d, tol)
+    return ta, tb, cnt, ea, eb, sing
 
 
 @kernel
@@ -323,28 +363,41 @@ def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
 
 # ----------------------------------------------------------------------------- SP2
 @kernel
-def sp2_one(p1, p2, k1, k2, tol):
-    """SP2 of one problem (tuples): (θ1_a, θ2_a, θ1_b, θ2_b, count, exact_a, exact_b,
-    singular); see :func:`sp2`."""
+def _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, c1, s1, sing2, tol, sing, ex_in, n1, n2):
+    """θ2 of SP2 for one root (c1, s1) of θ1 (:func:`sp2_cs`): (θ2, cos θ2, sin θ2, exact)."""
+    v1 = rotate_cs(k1, c1, s1, u1)
+    t2, c2, s2 = (0.0, 1.0, 0.0) if sing2 else atan2_cs(dot(k2u2, v1), -dot(k2k2u2, v1))
+    r = norm(sub(rotate_cs(k1, c1, s1, p1), rotate_cs(k2, c2, s2, p2)))
+    return t2, c2, s2, (r <= tol if sing else (ex_in and abs(n1 - n2) <= tol and r <= 10.0 * tol))
+
+
+@kernel
+def sp2_cs(p1, p2, k1, k2, tol):
+    """SP2 of one problem (tuples): the roots a and b, each as θ1, cos θ1, sin θ1, θ2, cos θ2,
+    sin θ2 (12 numbers, root a first; NaN for a root that does not exist), then count, exact_a,
+    exact_b, singular; see :func:`sp2`."""
     n1, n2 = norm(p1), norm(p2)
     zero = n1 <= 1e-300 or n2 <= 1e-300
     u1 = scale(p1, 1.0 / n1) if n1 > 1e-300 else p1
     u2 = scale(p2, 1.0 / n2) if n2 > 1e-300 else p2
-    ta, tb, cnt, ea, eb, sing1 = sp4_one(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
+    ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing1 = sp4_cs(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
     k2u2 = cross(k2, u2)
     k2k2u2 = cross(k2, k2u2)
     sing2 = norm(k2u2) <= 1e-12
     sing = sing1 or sing2 or zero
-    out1 = (ta, tb)
-    ex_in = (ea, eb)
-    t2 = [0.0, math.nan]
-    ex = [False, False]
-    for j in range(cnt):
-        v1 = rotate(k1, out1[j], u1)
-        t2[j] = 0.0 if sing2 else math.atan2(dot(k2u2, v1), -dot(k2k2u2, v1))
-        r = norm(sub(rotate(k1, out1[j], p1), rotate(k2, t2[j], p2)))
-        ex[j] = r <= tol if sing else (ex_in[j] and abs(n1 - n2) <= tol and r <= 10.0 * tol)
-    return ta, t2[0], tb, t2[1], cnt, ex[0], ex[1], sing
+    t2a, c2a, s2a, xa = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, ca, sa, sing2, tol, sing, ea, n1, n2)
+    t2b, c2b, s2b, xb = math.nan, math.nan, math.nan, False
+    if cnt == 2:
+        t2b, c2b, s2b, xb = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, cb, sb, sing2, tol, sing, eb, n1, n2)
+    return ta, ca, sa, t2a, c2a, s2a, tb, cb, sb, t2b, c2b, s2b, cnt, xa, xb, sing
+
+
+@kernel
+def sp2_one(p1, p2, k1, k2, tol):
+    """SP2 of one problem (tuples): (θ1_a, θ2_a, θ1_b, θ2_b, count, exact_a, exact_b,
+    singular); see :func:`sp2` (:func:`sp2_cs`)."""
+    ta, _, _, t2a, _, _, tb, _, _, t2b, _, _, cnt, xa, xb, sing = sp2_cs(p1, p2, k1, k2, tol)
+    return ta, t2a, tb, t2b, cnt, xa, xb, sing
 
 
 @kernel

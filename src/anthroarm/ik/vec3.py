@@ -96,6 +96,12 @@ def rotate(k, theta, p):
 
 
 @kernel
+def angle_cs(theta):
+    """The triple (θ, cos θ, sin θ) in which the closed-form kernels carry an angle (rad)."""
+    return theta, math.cos(theta), math.sin(theta)
+
+
+@kernel
 def rot_cs(k, c, s):
     """The matrix rot(k, θ) = I + s [k]× + (1 − c) [k]×² from c = cos θ, s = sin θ."""
     v = 1.0 - c
@@ -161,5 +167,5 @@ def as_array(t) -> np.ndarray:
     return np.array(t, dtype=float)
 
 
-__all__ = ["add", "as_array", "cross", "dot", "mat", "mm", "mtm", "mtv", "mv", "neg", "norm", "perpendicular", "rot",
+__all__ = ["add", "angle_cs", "as_array", "cross", "dot", "mat", "mm", "mtm", "mtv", "mv", "neg", "norm", "perpendicular", "rot",
            "rot_cs", "rotate", "rotate_cs", "scale", "sub", "transpose", "vec", "wrap"]
