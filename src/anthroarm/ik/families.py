@@ -56,8 +56,9 @@ import numpy as np
 from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
-from .geometric import (POLISH_MAX, BadPoseError, _common_point, _fk_residual, _mark_solutions, _pose_status,
-                        _rot3, _target_errors, _wrist, into_limits, nearest_first)
+from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, POLISH_MAX, SIN, BadPoseError, _common_point, _fk_residuals,
+                        _joint_vectors, _mark_solutions, _pose_status, _rot3, _target_errors, _wrist, into_limit,
+                        into_limits, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, scale, sub, transpose, vec, wrap
 
@@ -308,18 +309,23 @@ def _align(a0, b0, a1, b1):
 
 
 @kernel
-def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, V, E, Q6, C6, S6, V6, E6, Qs, Cs, Ss, Vs,
-             Es):
+def _q4(q4b, b, a4):
+    """q4's triple (θ, cos θ, sin θ) for branches b and b + 1."""
+    for k in range(2):
+        q4b[b + k, 0], q4b[b + k, 1], q4b[b + k, 2] = a4
+
+
+@kernel
+def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS, V, E, B6, Bs, q4b):
     """The 8 branches of one pose and swivel angle φ: Q (8, 7) rad (path order, wrapped into
-    (−π, π]), V (the branch exists), E (every subproblem on it exact).  ``Rg`` = R R_tᵀ, ``W``
-    the wrist centre (base frame, m), ``a4a``, ``a4b`` the q4 roots of the SP3 (module
-    docstring) as triples (θ, cos θ, sin θ) (:mod:`.geometric`); the rest scratch."""
+    (−π, π]), QC, QS (8, 7) their cosines and sines, V (the branch exists), E (every
+    subproblem on it exact).  ``Rg`` = R R_tᵀ, ``W`` the wrist centre (base frame, m), ``a4a``,
+    ``a4b`` the q4 roots of the SP3 (module docstring) as triples (θ, cos θ, sin θ); B6 (8, ·),
+    Bs (2, ·) rows of branches as :mod:`.geometric`'s class solvers write them, q4b (8, 3)
+    scratch."""
     for b in range(8):
-        V6[b] = False
-        E6[b] = False
-        for j in range(6):
-            Q6[b, j] = math.nan
-    q4b = np.empty(8)
+        B6[b, EXISTS] = 0.0
+        B6[b, EXACT] = 0.0
     e0 = sub(E0, S)
     a = norm(e0)
     f0 = sub(W0, E0)
@@ -344,7 +350,6 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, V, E, Q
             if i4 >= n4:
                 continue
             a4 = a4a if i4 == 0 else a4b
-            q4 = a4[0]
             ex4 = e4a if i4 == 0 else e4b
             R34 = rot_cs(h[3], a4[1], a4[2])
             f = mv(R34, f0)
@@ -361,30 +366,33 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, V, E, Q
                     t3, c3, s3, e3, _ = sp1_cs(src, mtv(R02, dst), h[2], TOL)
                     R04 = mm(mm(R02, rot_cs(h[2], c3, s3)), R34)
                     b = 4 * i4 + 2 * j
-                    q4b[b], q4b[b + 1] = q4, q4
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, C6, S6, V6, E6, b, a1, a2, (t3, c3, s3),
+                    _q4(q4b, b, a4)
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, (t3, c3, s3),
                            ex4 and (ea if j == 0 else eb) and e3)
             else:
                 R03 = _align(e0, src, up, dst)
                 ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
                 for j in range(2):
-                    Vs[j] = False
+                    Bs[j, EXISTS] = 0.0
                 zero = (0.0, 1.0, 0.0)
-                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Qs, Cs, Ss, Vs, Es, 0, zero, zero, zero, True)
+                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Bs, 0, zero, zero, zero, True)
                 for j in range(2):
-                    if not Vs[j]:
+                    if Bs[j, EXISTS] == 0.0:
                         continue
-                    a1, a2, a3 = (Qs[j, 3], Cs[j, 3], Ss[j, 3]), (Qs[j, 4], Cs[j, 4], Ss[j, 4]), (Qs[j, 5], Cs[j, 5], Ss[j, 5])
+                    a1, a2, a3 = ((Bs[j, 3], Bs[j, COS + 3], Bs[j, SIN + 3]), (Bs[j, 4], Bs[j, COS + 4], Bs[j, SIN + 4]),
+                                  (Bs[j, 5], Bs[j, COS + 5], Bs[j, SIN + 5]))
                     R04 = mm(_rot3(h, a1, a2, a3), R34)
                     b = 4 * i4 + 2 * j
-                    q4b[b], q4b[b + 1] = q4, q4
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, Q6, C6, S6, V6, E6, b, a1, a2, a3,
-                           ex4 and Es[j])
+                    _q4(q4b, b, a4)
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, a3,
+                           ex4 and Bs[j, EXACT] != 0.0)
     for b in range(8):
-        if V6[b]:
-            Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3] = wrap(Q6[b, 0]), wrap(Q6[b, 1]), wrap(Q6[b, 2]), wrap(q4b[b])
-            Q[b, 4], Q[b, 5], Q[b, 6] = wrap(Q6[b, 3]), wrap(Q6[b, 4]), wrap(Q6[b, 5])
-            V[b], E[b] = True, E6[b]
+        if B6[b, EXISTS] != 0.0:
+            for j in range(7):                        # the wrist's joints are 4, 5, 6 of B6's row
+                k = j if j < 3 else j - 1
+                x, c, s = (q4b[b, 0], q4b[b, 1], q4b[b, 2]) if j == 3 else (B6[b, k], B6[b, COS + k], B6[b, SIN + k])
+                Q[b, j], QC[b, j], QS[b, j] = wrap(x), c, s
+            V[b], E[b] = True, B6[b, EXACT] != 0.0
         else:
             for j in range(7):
                 Q[b, j] = math.nan
@@ -397,55 +405,52 @@ def _seven(A):
 
 
 @kernel
-def _limits_fk(q, n, lo, hi, Qout, kH, kO, MR, Mp, T, valid, exact):
-    """Wrap q (n,) by 2π into [lo, hi] (:func:`.geometric.into_limits`), write Qout; returns
-    (inside, FK residual — inf when not valid, and for an exact candidate outside the limits,
-    which is never returned and so not checked, as in :func:`.geometric._verified`)."""
-    inside = into_limits(q, n, lo, hi)
-    for j in range(n):
-        Qout[j] = q[j]
-    return inside, (_fk_residual(kH, kO, MR, Mp, q, n, T) if valid and (inside or not exact) else math.inf)
-
-
-@kernel
 def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swivel, tol_orthonormal,
                   Q, V, E, IN, RES):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
-    order), V, E, IN, RES; returns the index of the first malformed pose (−1 if none)."""
+    order, shifted by 2π into the limits, :func:`.geometric.into_limit`), V, E, IN, RES (the
+    FK residual of :func:`.geometric._fk_residuals`: inf where there is no candidate, and for
+    an exact candidate outside the limits, which is never returned and so not checked, as in
+    :func:`.geometric._verified`); returns the index of the first malformed pose (−1 if
+    none)."""
     h = _seven(H)
+    kHt, kOt = _joint_vectors(kH, 7), _joint_vectors(kO, 7)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    Q6, C6, S6 = np.empty((8, 6)), np.empty((8, 6)), np.empty((8, 6))
-    V6 = np.empty(8, dtype=np.bool_)
-    E6 = np.empty(8, dtype=np.bool_)
-    Qs, Cs, Ss = np.empty((2, 6)), np.empty((2, 6)), np.empty((2, 6))
-    Vs = np.empty(2, dtype=np.bool_)
-    Es = np.empty(2, dtype=np.bool_)
-    Qb = np.empty((8, 7))
+    B6, Bs, q4b = np.empty((8, BRANCH_ROW)), np.empty((2, BRANCH_ROW)), np.empty((8, 3))
+    Qb, QC, QS = np.empty((8, 7)), np.empty((8, 7)), np.empty((8, 7))
     Vb = np.empty(8, dtype=np.bool_)
     Eb = np.empty(8, dtype=np.bool_)
-    q = np.empty(7)
+    CHK = np.empty(8, dtype=np.bool_)
+    Sfk = np.empty((8, 12))
     ns = swivel.shape[1]
     for i in range(len(T)):
-        if _pose_status(T[i], tol_orthonormal) != 0:
+        Ti, Qi, Vi, Ei, INi, RESi = T[i], Q[i], V[i], E[i], IN[i], RES[i]
+        if _pose_status(Ti, tol_orthonormal) != 0:
             return i
         for k in range(ns):
             if not math.isfinite(swivel[i, k]):
                 return len(T) + i
-        R, p = mat(T[i]), vec(T[i, :3, 3])
+        R, p = mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3])
         Rg = mm(R, transpose(Rt))
         W = add(mv(Rg, sub(W0v, pt)), p)
         t4a, c4a, s4a, t4b, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
         for k in range(ns):
             _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (t4a, c4a, s4a), (t4b, c4b, s4b), n4, e4a, e4b,
-                     Qb, Vb, Eb, Q6, C6, S6, V6, E6, Qs, Cs, Ss, Vs, Es)
+                     Qb, QC, QS, Vb, Eb, B6, Bs, q4b)
             for b in range(8):
                 r = 8 * k + b
+                inside = True
                 for j in range(7):
-                    q[j] = Qb[b, j]
-                IN[i, r], RES[i, r] = _limits_fk(q, 7, lo, hi, Q[i, r], kH, kO, MR, Mp, T[i], Vb[b], Eb[b])
-                V[i, r], E[i, r] = Vb[b], Eb[b]
+                    x = Qb[b, j]
+                    Qi[r, j], ok = into_limit(x, lo[j], hi[j])
+                    inside = inside and ok
+                    if Vb[b] and Qi[r, j] != x:           # moved by 2π or onto a limit: its own cos, sin
+                        QC[b, j], QS[b, j] = math.cos(Qi[r, j]), math.sin(Qi[r, j])
+                Vi[r], Ei[r], INi[r] = Vb[b], Eb[b], inside
+                CHK[b] = Vb[b] and (inside or not Eb[b])
+            _fk_residuals(kHt, kOt, MR, Mp, Qi[8 * k:8 * k + 8], QC, QS, CHK, 7, Ti, RESi[8 * k:8 * k + 8], Sfk)
     return -1
 
 
@@ -488,7 +493,7 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
         nearest_first(out, K, 7, ref, 7)
         for j in range(7):
             q[order[j]] = out[0, j]
-        out[0, 7], out[0, 8] = _target_errors(kH, kO, MR, Mp, q, 7, T)
+        out[0, 7], out[0, 8] = _target_errors(_joint_vectors(kH, 7), _joint_vectors(kO, 7), MR, Mp, q, 7, T)
     return K
 
 

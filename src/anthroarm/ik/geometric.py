@@ -279,19 +279,31 @@ def _build(robot) -> GeoPlan | None:
 # ----------------------------------------------------------------------------- the closed classes
 # One compiled kernel per class and pose (:mod:`anthroarm.jit`), built from the subproblem
 # kernels of :mod:`.subproblems`; vectors are tuples (:mod:`.vec3`).  Each writes its 8
-# branches into Q (8, 6) rad, QC, QS (8, 6) the cosine and sine of each angle, V (8,) (the
-# branch exists), E (8,) (every subproblem on it was exact), in the order of the labels: the
-# first branching subproblem outermost, the root index innermost.  A branch under a root that
-# does not exist is left NaN / invalid.  An angle travels as a triple a = (θ, cos θ, sin θ):
-# the subproblems give the rotation they find as (cos, sin) with its angle (``sp*_cs``), so
-# the rotations that follow, and the FK check of :func:`_verified`, evaluate no trigonometry.
+# branches into the rows of B (8, :data:`BRANCH_ROW`): the six angles (rad), their cosines
+# (from column :data:`COS`) and sines (:data:`SIN`), whether the branch exists (:data:`EXISTS`,
+# 1.0 / 0.0) and whether every subproblem on it was exact (:data:`EXACT`) — one array, so a
+# call passes one reference, not five — in the order of the labels: the first branching
+# subproblem outermost, the root index innermost.  A branch under a root that does not exist
+# is left NaN / not existing.  An angle travels as a triple a = (θ, cos θ, sin θ): the
+# subproblems give the rotation they find as (cos, sin) with its angle (``sp*_cs``), so the
+# rotations that follow, and the FK check of :func:`_verified`, evaluate no trigonometry.
+COS, SIN, EXISTS, EXACT, BRANCH_ROW = 6, 12, 18, 19, 20
+
+
 @kernel
-def _put(Q, QC, QS, V, E, b, a1, a2, a3, a4, a5, a6, v, e):
+def _none(B, b0, b1):
+    """Branches b0 … b1 − 1 do not exist (their root does not)."""
+    for b in range(b0, b1):
+        B[b, EXISTS] = 0.0
+
+
+@kernel
+def _put(B, b, a1, a2, a3, a4, a5, a6, v, e):
     """Branch b: the six angles (triples (θ, cos θ, sin θ)) and its flags."""
-    Q[b, 0], Q[b, 1], Q[b, 2], Q[b, 3], Q[b, 4], Q[b, 5] = a1[0], a2[0], a3[0], a4[0], a5[0], a6[0]
-    QC[b, 0], QC[b, 1], QC[b, 2], QC[b, 3], QC[b, 4], QC[b, 5] = a1[1], a2[1], a3[1], a4[1], a5[1], a6[1]
-    QS[b, 0], QS[b, 1], QS[b, 2], QS[b, 3], QS[b, 4], QS[b, 5] = a1[2], a2[2], a3[2], a4[2], a5[2], a6[2]
-    V[b], E[b] = v, e
+    row = (a1, a2, a3, a4, a5, a6)
+    for j in range(6):
+        B[b, j], B[b, COS + j], B[b, SIN + j] = row[j]
+    B[b, EXISTS], B[b, EXACT] = 1.0 if v else 0.0, 1.0 if e else 0.0
 
 
 @kernel
@@ -301,7 +313,7 @@ def _rot3(h, a1, a2, a3):
 
 
 @kernel
-def _wrist(h, R03, R06, Q, QC, QS, V, E, b, a1, a2, a3, ex):
+def _wrist(h, R03, R06, B, b, a1, a2, a3, ex):
     """Spherical wrist from R36 = R03ᵀ R06: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and
     q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
     h4, h5, h6 = h[3], h[4], h[5]
@@ -312,7 +324,7 @@ def _wrist(h, R03, R06, Q, QC, QS, V, E, b, a1, a2, a3, ex):
     ta, ca, sa, tb, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, R36h6), TOL)
     for j in range(2):
         if j >= cnt:
-            V[b + j] = False
+            B[b + j, EXISTS] = 0.0
             continue
         a5 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
         c, s = a5[1], a5[2]
@@ -320,19 +332,19 @@ def _wrist(h, R03, R06, Q, QC, QS, V, E, b, a1, a2, a3, ex):
         # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
         t4, c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
         t6, c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, R36x)), h6, TOL)
-        _put(Q, QC, QS, V, E, b + j, a1, a2, a3, (t4, c4, s4), a5, (t6, c6, s6), True,
+        _put(B, b + j, a1, a2, a3, (t4, c4, s4), a5, (t6, c6, s6), True,
              ex and (ea if j == 0 else eb) and e4 and e6)
 
 
 @kernel
-def _spherical_two_parallel(h, P, R06, p, Q, QC, QS, V, E):
+def _spherical_two_parallel(h, P, R06, p, B):
     """q1 SP4, q3 SP3, q2 SP1, the wrist (spherical wrist, axes 2 ∥ 3)."""
     wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
     t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]),
                                                            dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
     for i1 in range(2):
         if i1 >= n1:
-            V[4 * i1:4 * i1 + 4] = False
+            _none(B, 4 * i1, 4 * i1 + 4)
             continue
         a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
         v = sub(rotate_cs(neg(h[0]), a1[1], a1[2], wrist), P[1])       # R01ᵀ p_16 − p12
@@ -340,23 +352,23 @@ def _spherical_two_parallel(h, P, R06, p, Q, QC, QS, V, E):
         for i3 in range(2):
             b = 4 * i1 + 2 * i3
             if i3 >= n3:
-                V[b:b + 2] = False
+                _none(B, b, b + 2)
                 continue
             a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
             t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), v, h[1], TOL)
             a2 = (t2, c2, s2)
             ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
-            _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, b, a1, a2, a3, ex)
+            _wrist(h, _rot3(h, a1, a2, a3), R06, B, b, a1, a2, a3, ex)
 
 
 @kernel
-def _spherical_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
+def _spherical_two_intersecting(h, P, R06, p, B):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
     t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
         if i3 >= n3:
-            V[4 * i3:4 * i3 + 4] = False
+            _none(B, 4 * i3, 4 * i3 + 4)
             continue
         a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
         (u1a, c1a, s1a, u2a, c2a, s2a, u1b, c1b, s1b, u2b, c2b, s2b,
@@ -364,15 +376,15 @@ def _spherical_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
         for j in range(2):
             b = 4 * i3 + 2 * j
             if j >= n12:
-                V[b:b + 2] = False
+                _none(B, b, b + 2)
                 continue
             a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
-            _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, b, a1, a2, a3,
+            _wrist(h, _rot3(h, a1, a2, a3), R06, B, b, a1, a2, a3,
                    (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
 
 
 @kernel
-def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, Q, QC, QS, V, E, b):
+def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, B, b):
     """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (triples a1, a5; branches b, b + 1 by the SP3 of
     q3): θ14 = q2 + q3 + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by
     difference.  h3, h4 may be −h2: rot(h3, q3) = rot(h2, ±q3)."""
@@ -390,20 +402,20 @@ def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, Q, QC, QS, V, E, b):
     ta, ca, sa, tb, cb, sb, n3, ea, eb, _ = sp3_cs(neg(P[3]), P[2], h[1], norm(d_in), TOL)
     for j in range(2):
         if j >= n3:
-            V[b + j] = False
+            B[b + j, EXISTS] = 0.0
             continue
         t3, c3, s3 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
         t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[1], c3, s3, P[3])), d_in, h[1], TOL)
         # q4 = θ14 − q2 − q3: its rotation is e^{iθ14} e^{−i(q2 + q3)}
         c23, s23 = c2 * c3 - s2 * s3, s2 * c3 + c2 * s3
         c4, s4 = c14 * c23 + s14 * s23, s14 * c23 - c14 * s23
-        _put(Q, QC, QS, V, E, b + j, a1, (t2, c2, s2), (s3n * t3, c3, s3n * s3),
+        _put(B, b + j, a1, (t2, c2, s2), (s3n * t3, c3, s3n * s3),
              (s4n * wrap(t14 - t2 - t3), c4, s4n * s4), a5, (t6, c6, s6), True,
              ex and e14 and e6 and (ea if j == 0 else eb) and e2)
 
 
 @kernel
-def _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
+def _three_parallel_two_intersecting(h, P, R06, p, B):
     """2 ∥ 3 ∥ 4 and 5 × 6 (p56 = 0): q1 by SP4 (h2ᵀ R01ᵀ p16 = h2ᵀ (p12 + … + p45)), q5 by SP4
     (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
@@ -412,7 +424,7 @@ def _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
     R06h6 = mv(R06, h[5])
     for i1 in range(2):
         if i1 >= n1:
-            V[4 * i1:4 * i1 + 4] = False
+            _none(B, 4 * i1, 4 * i1 + 4)
             continue
         a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
         t5a, c5a, s5a, t5b, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(h[1], h[5], h[4], dot(h[1], rotate_cs(
@@ -420,14 +432,14 @@ def _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E):
         for i5 in range(2):
             b = 4 * i1 + 2 * i5
             if i5 >= n5:
-                V[b:b + 2] = False
+                _none(B, b, b + 2)
                 continue
             _three_parallel_tail(h, P, R06, p06, a1, (t5a, c5a, s5a) if i5 == 0 else (t5b, c5b, s5b),
-                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), Q, QC, QS, V, E, b)
+                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), B, b)
 
 
 @kernel
-def _three_parallel(h, P, R06, p, Q, QC, QS, V, E):
+def _three_parallel(h, P, R06, p, B):
     """2 ∥ 3 ∥ 4 alone: (q1, q5) by SP6 (the two height equations along h2, of the position
     and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
@@ -437,13 +449,13 @@ def _three_parallel(h, P, R06, p, Q, QC, QS, V, E):
                      dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4])), 0.0, TOL_QUARTIC, t)
     for j in range(4):
         if j >= cnt:
-            V[2 * j:2 * j + 2] = False
+            _none(B, 2 * j, 2 * j + 2)
             continue
-        _three_parallel_tail(h, P, R06, p06, angle_cs(t[j, 0]), angle_cs(t[j, 1]), True, Q, QC, QS, V, E, 2 * j)
+        _three_parallel_tail(h, P, R06, p06, angle_cs(t[j, 0]), angle_cs(t[j, 1]), True, B, 2 * j)
 
 
 @kernel
-def _spherical(h, P, R06, p, Q, QC, QS, V, E):
+def _spherical(h, P, R06, p, B):
     """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
     quartic, up to 4), then the wrist."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])
@@ -451,10 +463,10 @@ def _spherical(h, P, R06, p, Q, QC, QS, V, E):
     cnt, _ = sp5_one(neg(P[1]), p16, P[2], P[3], neg(h[0]), h[1], h[2], TOL_QUARTIC, t)
     for j in range(4):
         if j >= cnt:
-            V[2 * j:2 * j + 2] = False
+            _none(B, 2 * j, 2 * j + 2)
             continue
         a1, a2, a3 = angle_cs(t[j, 0]), angle_cs(t[j, 1]), angle_cs(t[j, 2])
-        _wrist(h, _rot3(h, a1, a2, a3), R06, Q, QC, QS, V, E, 2 * j, a1, a2, a3, True)
+        _wrist(h, _rot3(h, a1, a2, a3), R06, B, 2 * j, a1, a2, a3, True)
 
 
 #: the compiled class solvers, by their index in :data:`CLOSED`
@@ -463,27 +475,26 @@ CLOSED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALL
 
 
 @kernel
-def _solve_closed(cls, h, P, R06, p, Q, QC, QS, V, E):
-    Q[:, :] = math.nan
-    V[:] = False
-    E[:] = False
-    if cls == 0:
-        _spherical_two_parallel(h, P, R06, p, Q, QC, QS, V, E)
-    elif cls == 1:
-        _spherical_two_intersecting(h, P, R06, p, Q, QC, QS, V, E)
-    elif cls == 2:
-        _three_parallel_two_intersecting(h, P, R06, p, Q, QC, QS, V, E)
-    elif cls == 3:
-        _spherical(h, P, R06, p, Q, QC, QS, V, E)
-    else:
-        _three_parallel(h, P, R06, p, Q, QC, QS, V, E)
+def _solve_closed(cls, h, P, R06, p, B):
     for b in range(8):
-        if V[b]:
-            for j in range(6):
-                Q[b, j] = wrap(Q[b, j])
-        else:
-            Q[b, :] = math.nan
-            E[b] = False
+        for j in range(6):
+            B[b, j] = math.nan
+        B[b, EXISTS], B[b, EXACT] = 0.0, 0.0
+    if cls == 0:
+        _spherical_two_parallel(h, P, R06, p, B)
+    elif cls == 1:
+        _spherical_two_intersecting(h, P, R06, p, B)
+    elif cls == 2:
+        _three_parallel_two_intersecting(h, P, R06, p, B)
+    elif cls == 3:
+        _spherical(h, P, R06, p, B)
+    else:
+        _three_parallel(h, P, R06, p, B)
+    for b in range(8):
+        for j in range(6):
+            B[b, j] = wrap(B[b, j]) if B[b, EXISTS] != 0.0 else math.nan
+        if B[b, EXISTS] == 0.0:
+            B[b, EXACT] = 0.0
 
 
 @kernel
@@ -499,39 +510,49 @@ def _seven(A):
 @kernel
 def _closed_loop(cls, H, P, R06, p, Q, V, E):
     h, PP = _six(H), _seven(P)
-    QC, QS = np.empty((8, 6)), np.empty((8, 6))
+    B = np.empty((8, BRANCH_ROW))
     for i in range(len(p)):
-        _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), Q[i], QC, QS, V[i], E[i])
+        _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), B)
+        for b in range(8):
+            for j in range(6):
+                Q[i, b, j] = B[b, j]
+            V[i, b], E[i, b] = B[b, EXISTS] != 0.0, B[b, EXACT] != 0.0
 
 
 # ----------------------------------------------------------------------------- one call: pose → verified branches
 @kernel
-def into_limits(q, n, lo, hi):
-    """Shift the angles q[:n] (rad) by multiples of 2π into [lo, hi] (a continuous joint, ±inf:
-    into (−π, π]), in place: of the values q + 2πk inside the limits, the one nearest 0 (a UR
-    joint of ±2π keeps 0.4, not 0.4 − 2π); a value within 1e-9 rad outside a limit is put onto
-    it.  Returns whether every joint is inside; a joint that is not keeps the smallest shifted
-    value ≥ its lower limit (the caller may move it along a self-motion,
+def into_limit(x, lo, hi):
+    """The angle x (rad) shifted by a multiple of 2π into [lo, hi] (a continuous joint, ±inf:
+    into (−π, π]): of the values x + 2πk inside the limits, the one nearest 0 (a UR joint of
+    ±2π keeps 0.4, not 0.4 − 2π); a value within 1e-9 rad outside a limit is put onto it.
+    Returns (the angle, whether it is inside); an angle that is not keeps the smallest shifted
+    value ≥ the lower limit (the caller may move it along a self-motion,
     :func:`anthroarm.ik.closed_form.analytic`)."""
+    lo_j, hi_j = lo - 1e-9, hi + 1e-9
+    w = wrap(x)
+    best = w if lo_j <= w <= hi_j else math.nan
+    k = 1
+    while best != best and (w + 2.0 * math.pi * k <= hi_j or w - 2.0 * math.pi * k >= lo_j):
+        up, down = w + 2.0 * math.pi * k, w - 2.0 * math.pi * k
+        if lo_j <= up <= hi_j:
+            best = up
+        if lo_j <= down <= hi_j and not (abs(best) <= abs(down)):
+            best = down
+        k += 1
+    if best == best:
+        return min(max(best, lo), hi), True
+    lo_f = lo if math.isfinite(lo) else -math.pi
+    return x - 2.0 * math.pi * math.floor((x - lo_f + 1e-9) / (2.0 * math.pi)), False
+
+
+@kernel
+def into_limits(q, n, lo, hi):
+    """:func:`into_limit` of the angles q[:n] (rad) in place, limits lo, hi (n,); returns
+    whether every joint is inside."""
     inside = True
     for j in range(n):
-        lo_j, hi_j = lo[j] - 1e-9, hi[j] + 1e-9
-        x = wrap(q[j])
-        best = x if lo_j <= x <= hi_j else math.nan
-        k = 1
-        while best != best and (x + 2.0 * math.pi * k <= hi_j or x - 2.0 * math.pi * k >= lo_j):
-            up, down = x + 2.0 * math.pi * k, x - 2.0 * math.pi * k
-            if lo_j <= up <= hi_j:
-                best = up
-            if lo_j <= down <= hi_j and not (abs(best) <= abs(down)):
-                best = down
-            k += 1
-        if best == best:
-            q[j] = min(max(best, lo[j]), hi[j])
-        else:
-            inside = False
-            lo_f = lo[j] if math.isfinite(lo[j]) else -math.pi
-            q[j] = q[j] - 2.0 * math.pi * math.floor((q[j] - lo_f + 1e-9) / (2.0 * math.pi))
+        q[j], ok = into_limit(q[j], lo[j], hi[j])
+        inside = inside and ok
     return inside
 
 
@@ -604,11 +625,12 @@ def _pose_error(R, t, MR, Mp, T):
 @kernel
 def _chain_fk(kH, kO, q, n):
     """(R, t) = e^{ξ1 q1} ⋯ e^{ξn qn}, the product of exponentials of the chain's revolute joints
-    (axes kH, points kO at q = 0, base frame, m; q rad): the tool pose is (R, t) · M."""
+    (axes kH, points kO at q = 0 as :func:`_joint_vectors`, base frame, m; q rad): the tool pose
+    is (R, t) · M."""
     R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     t = (0.0, 0.0, 0.0)
     for i in range(n):
-        R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+        R, t = _poe_step(R, t, kH[i], kO[i], q[i])
     return R, t
 
 
@@ -645,9 +667,9 @@ def _chain_jacobian(kH, kO, Mp, q, n, J):
     t = (0.0, 0.0, 0.0)
     for i in range(n):
         if i < 6:
-            J[3, i], J[4, i], J[5, i] = mv(R, vec(kH[i]))
-            J[0, i], J[1, i], J[2, i] = add(mv(R, vec(kO[i])), t)
-        R, t = _poe_step(R, t, vec(kH[i]), vec(kO[i]), q[i])
+            J[3, i], J[4, i], J[5, i] = mv(R, kH[i])
+            J[0, i], J[1, i], J[2, i] = add(mv(R, kO[i]), t)
+        R, t = _poe_step(R, t, kH[i], kO[i], q[i])
     x = add(t, mv(R, Mp))
     for i in range(6):
         c = cross((J[3, i], J[4, i], J[5, i]), sub(x, (J[0, i], J[1, i], J[2, i])))
@@ -715,7 +737,7 @@ def _fk_residuals(kH, kO, MR, Mp, Q, QC, QS, V, n, T, RES, S):
         prev = b
         for i in range(j0, n):
             R = ((S[i, 0], S[i, 1], S[i, 2]), (S[i, 3], S[i, 4], S[i, 5]), (S[i, 6], S[i, 7], S[i, 8]))
-            R, t = _poe_step_cs(R, (S[i, 9], S[i, 10], S[i, 11]), vec(kH[i]), vec(kO[i]), QC[b, i], QS[b, i])
+            R, t = _poe_step_cs(R, (S[i, 9], S[i, 10], S[i, 11]), kH[i], kO[i], QC[b, i], QS[b, i])
             S[i + 1, 0], S[i + 1, 1], S[i + 1, 2] = R[0]
             S[i + 1, 3], S[i + 1, 4], S[i + 1, 5] = R[1]
             S[i + 1, 6], S[i + 1, 7], S[i + 1, 8] = R[2]
@@ -725,13 +747,24 @@ def _fk_residuals(kH, kO, MR, Mp, Q, QC, QS, V, n, T, RES, S):
 
 
 @kernel
+def _joint_vectors(A, n):
+    """The n (6 or 7) rows of A (n, 3) as a 7-tuple of vectors (zeros in place of a 7th):
+    the chain's axes and points as the FK kernels read them — a tuple lives in registers,
+    where a row of an array would be a new view (a reference count) at every joint."""
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]),
+            vec(A[6]) if n == 7 else (0.0, 0.0, 0.0))
+
+
+@kernel
 def _unpack(cf, ci):
-    """The plan's constants from :attr:`GeoPlan.packed`."""
+    """The plan's constants from :attr:`GeoPlan.packed` (the chain's axes ``kH`` and points
+    ``kO`` as :func:`_joint_vectors`)."""
     n = ci[2]
     o = 70 + 3 * n
     return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
             (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), cf[54:70].reshape((4, 4)),
-            cf[70:o].reshape((n, 3)), cf[o:o + 3 * n].reshape((n, 3)), cf[o + 3 * n:o + 4 * n], cf[o + 4 * n:o + 5 * n])
+            _joint_vectors(cf[70:o].reshape((n, 3)), n), _joint_vectors(cf[o:o + 3 * n].reshape((n, 3)), n),
+            cf[o + 3 * n:o + 4 * n], cf[o + 4 * n:o + 5 * n])
 
 
 @kernel
@@ -746,18 +779,18 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    Q6, C6, S6 = np.empty((8, 6)), np.empty((8, 6)), np.empty((8, 6))
-    V6 = np.empty(8, dtype=np.bool_)
-    E6 = np.empty(8, dtype=np.bool_)
+    B6 = np.empty((8, BRANCH_ROW))
     q = np.empty(n)
     QC, QS = np.empty((8, n)), np.empty((8, n))
     S = np.empty((n + 1, 12))
     J, F = np.empty((6, 6)), np.empty(6)
     CHK = np.empty(8, dtype=np.bool_)
     for i in range(len(T)):
-        if _pose_status(T[i], tol_orthonormal) != 0:
+        # each row of the batch viewed once (a view is a reference count)
+        Ti, Qi, Vi, Ei, INi, RESi, OKi = T[i], Q[i], V[i], E[i], IN[i], RES[i], OK[i]
+        if _pose_status(Ti, tol_orthonormal) != 0:
             return i
-        R, p = mat(T[i]), vec(T[i, :3, 3])
+        R, p = mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3])
         a7 = (0.0, 1.0, 0.0)
         if n == 7:
             a7 = angle_cs(wrap(param[i]))
@@ -770,33 +803,29 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
         if rev:
             p = neg(mtv(R, p))
             R = transpose(R)
-        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, Q6, C6, S6, V6, E6)
+        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, B6)
         for b in range(8):
-            for j in range(6):
+            exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
+            for j in range(n):
                 jj = 5 - j if rev else j
-                q[j], QC[b, j], QS[b, j] = Q6[b, jj], C6[b, jj], S6[b, jj]
-            if n == 7:
-                q[6], QC[b, 6], QS[b, 6] = a7
-            for j in range(n):
-                Q[i, b, j] = q[j]
-            inside = into_limits(q, n, lo, hi)
-            for j in range(n):
-                if V6[b] and q[j] != Q[i, b, j]:         # moved by 2π or onto a limit: its own cos, sin
-                    QC[b, j], QS[b, j] = math.cos(q[j]), math.sin(q[j])
-                Q[i, b, j] = q[j]
-            V[i, b], E[i, b], IN[i, b] = V6[b], E6[b], inside
-            CHK[b] = V6[b] and (inside or not E6[b])
-        _fk_residuals(kH, kO, MR, Mp, Q[i], QC, QS, CHK, n, T[i], RES[i], S)
+                x, QC[b, j], QS[b, j] = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
+                Qi[b, j], ok = into_limit(x, lo[j], hi[j])
+                inside = inside and ok
+                if exists and Qi[b, j] != x:             # moved by 2π or onto a limit: its own cos, sin
+                    QC[b, j], QS[b, j] = math.cos(Qi[b, j]), math.sin(Qi[b, j])
+            Vi[b], Ei[b], INi[b] = exists, exact, inside
+            CHK[b] = exists and (inside or not exact)
+        _fk_residuals(kH, kO, MR, Mp, Qi, QC, QS, CHK, n, Ti, RESi, S)
         for b in range(8):
-            if V[i, b] and E[i, b] and IN[i, b] and tol < RES[i, b] <= POLISH_MAX:
+            if Vi[b] and Ei[b] and INi[b] and tol < RESi[b] <= POLISH_MAX:
                 for j in range(n):
-                    q[j] = Q[i, b, j]
-                r = _polish_chain(kH, kO, MR, Mp, q, n, T[i], lo, hi, tol, J, F)
+                    q[j] = Qi[b, j]
+                r = _polish_chain(kH, kO, MR, Mp, q, n, Ti, lo, hi, tol, J, F)
                 if r <= tol:
                     for j in range(n):
-                        Q[i, b, j] = q[j]
-                    RES[i, b] = r
-        _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, 8, OK[i])
+                        Qi[b, j] = q[j]
+                    RESi[b] = r
+        _mark_solutions(Qi, Vi, INi, RESi, tol, 8, OKi)
     return -1
 
 
