@@ -646,7 +646,7 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     if N == 0:
         return _empty(robot, labels)
     B = len(labels)
-    Tr = np.repeat(Ts, S, axis=0)
+    Tr = Ts if S == 1 else np.repeat(Ts, S, axis=0)
     prm = pv.reshape(-1) if gp.param_joint is not None else None
     if closed:
         try:
@@ -709,8 +709,9 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
         valid = _geo.mark_solutions(Q if polished else th, cand, inside, res, tol, s.form.branches)
     else:
         valid = np.array(valid)
-    if s.kind != "srs" and s.plain:
-        todo = np.flatnonzero(~valid.any(1) & (cand & (exact | (res <= POLISH_MAX)) & ~inside).any(1))
+    none = ~valid.any(1)                                            # poses without a solution
+    if s.kind != "srs" and s.plain and none.any():
+        todo = np.flatnonzero(none & (cand & (exact | (res <= POLISH_MAX)) & ~inside).any(1))
         if todo.size:
             Q = np.array(Q)
             for i in todo:
@@ -718,7 +719,7 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
                                        Ts[i], tol, position_only):
                     Q[i, b], valid[i, b], res[i, b], inside[i, b] = q, True, r, True
     reasons = [None] * N
-    for i in np.flatnonzero(~valid.any(1)):
+    for i in np.flatnonzero(~valid.any(1)) if none.any() else ():
         reasons[i] = _reason(robot, s, Ts[i], cand[i], exact[i], inside[i], res[i], tol, position_only)
     singular_of = None
     if s.kind == "geo":
@@ -728,9 +729,14 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
         def singular_of(rows):
             vol = _geo.jacobian_volumes(plan, TH[rows], valid[rows]).min(1)
             return [_singular_text(float(v)) for v in vol]
-    return AnalyticBatchResult(solutions=np.where(valid[..., None], Q, np.nan), valid=valid, branches=labels,
-                               reasons=reasons, swivel=None if swivel is None else np.where(valid, swivel, np.nan),
-                               residuals=np.where(valid, res, np.nan), _singular_of=singular_of, model=robot.name)
+    # Q and res are this call's own arrays (the compiled call's, or copies): NaN in place where
+    # no solution (a new 8·n·N array would cost more than the rest of this function)
+    invalid = ~valid
+    Q[invalid] = np.nan
+    res[invalid] = np.nan
+    return AnalyticBatchResult(solutions=Q, valid=valid, branches=labels, reasons=reasons,
+                               swivel=None if swivel is None else np.where(valid, swivel, np.nan), residuals=res,
+                               _singular_of=singular_of, model=robot.name)
 
 
 def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
