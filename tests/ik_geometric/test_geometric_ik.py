@@ -470,6 +470,34 @@ def test_results_pickle_with_their_singular_text(tmp_path):
     np.testing.assert_array_equal(batch[0].solutions, aa.ik.analytic_batch(robot, T)[0].solutions)
 
 
+def test_local_frames_fk_is_pinocchios():
+    """The FK of the compiled check (the chain as :func:`geometric.local_frames`, the product
+    A_0 Rz(q1) A_1 ⋯ Rz(qn) A_n) is Pinocchio's tool pose, on 6- and 7-joint arms (panda's
+    held 7th joint, human_arm7's SRS plan, kinova's continuous joints); where q is the joint
+    angles, the Jacobian of the polish is Pinocchio's world-aligned frame Jacobian of the first
+    six joints on the path."""
+    from anthroarm.ik import families as fam
+
+    rng = np.random.default_rng(11)
+    for name in ("ur5", "kinova", "panda", "prosthetic_arm", "human_arm7"):
+        robot = aa.load(name)
+        plan = fam.srs_plan(robot) if name == "human_arm7" else G.plan_for(robot)
+        A = plan.fk_frames if name == "human_arm7" else G._unpack(*plan.packed)[9]
+        n = len(plan.fk_axes)
+        for q in robot.random_q(10, rng=rng):
+            th = np.empty(n)
+            th[plan.order] = robot.angles(q)                    # path order
+            R, t = G._chain_fk(A, th, n)
+            F = _fk(robot, q)
+            np.testing.assert_allclose(np.array(R), F[:3, :3], atol=1e-12, err_msg=name)
+            np.testing.assert_allclose(np.array(t), F[:3, 3], atol=1e-12, err_msg=name)
+            if robot.nq == n and name != "human_arm7":
+                J = np.empty((6, 6))
+                G._chain_jacobian(A, th, n, J)
+                Jp = pin.computeFrameJacobian(robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED)
+                np.testing.assert_allclose(J, Jp[:, np.argsort(plan.order)[:6]], atol=1e-12, err_msg=name)
+
+
 def test_target_errors_are_pinocchios():
     """The position and rotation errors the one-pose kernel reports with its nearest solution
     (what ``aa.ik.solve`` returns for a closed-form answer) are Pinocchio's ‖p* − p‖ and
@@ -478,7 +506,7 @@ def test_target_errors_are_pinocchios():
     robot = aa.load("ur5")
     plan = G.plan_for(robot)
     cf, ci = plan.packed
-    _, _, n, _, _, _, _, _, M, kH, kO, _, _ = G._unpack(cf, ci)
+    n, A = ci[2], G._unpack(cf, ci)[9]
     rng = np.random.default_rng(7)
     for k, q in enumerate(robot.random_q(40, rng=rng)):
         F = pin.SE3(_fk(robot, q))
@@ -487,7 +515,7 @@ def test_target_errors_are_pinocchios():
         angle = [1e-7, 0.3, 2.0, np.pi - 1e-9, np.pi][k % 5]
         T = (F * pin.SE3(pin.exp3(angle * axis), rng.normal(scale=0.02, size=3))).homogeneous
         assert plan.order_is_path and robot.nq == n            # ur5: q is θ in path order
-        pe, re = G._target_errors(kH, kO, G.mat(M[:3, :3]), G.vec(M[:3, 3]), q, n, np.ascontiguousarray(T))
+        pe, re = G._target_errors(A, q, n, np.ascontiguousarray(T))
         assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-13)
         assert re == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13)
 

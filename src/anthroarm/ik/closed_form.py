@@ -29,7 +29,7 @@ is the general one above, and Table 7.2 reproduces through it.
 Every solver runs as one compiled call (:mod:`anthroarm.jit`) per batch: the class solver's
 branches, each shifted by 2π into the joint limits and checked by the chain's forward
 kinematics (product of exponentials of the joints as read from ``robot.chain``, the model
-Pinocchio holds; ``tol`` on every entry of the 3×4 pose, or the position for ``planar_2r``),
+Pinocchio holds, in joint-local frames: :func:`.geometric.local_frames`; ``tol`` on every entry of the 3×4 pose, or the position for ``planar_2r``),
 duplicates dropped.  Arms of a class only within the classification tolerance (rounded URDF
 numbers) get their near-exact candidates (FK residual ≤ :data:`POLISH_MAX`) polished by
 Newton steps on the chain inside that call (a held 7th joint stays where it was asked to be),

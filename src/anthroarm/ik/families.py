@@ -40,13 +40,14 @@ A target off the plane of motion (|h1ᵀ(p − p_t)| > tol) has no candidate.
 Drivers (:func:`srs_verified`, :func:`planar_verified`) follow
 :func:`anthroarm.ik.geometric.solve_verified`: one compiled call per batch, each branch wrapped
 by 2π into the joint limits and checked by the chain's FK (product of exponentials of the
-joints as read from ``robot.chain``, unsnapped), joint values in ``robot.chain.independent``
+joints as read from ``robot.chain``, unsnapped; :func:`.geometric.local_frames`), joint values in ``robot.chain.independent``
 order.  A branch whose subproblems had only least-squares answers is a candidate with
 ``exact = False`` (out of reach on that branch).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import weakref
 from dataclasses import dataclass
@@ -57,8 +58,8 @@ from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, POLISH_MAX, SIN, BadPoseError, _common_point, _fk_residuals,
-                        _joint_vectors, _mark_solutions, _pose_status, _rot3, _target_errors, _wrist, into_limit,
-                        into_limits, nearest_first)
+                        _mark_solutions, _pose_status, _rot3, _target_errors, _wrist, into_limit,
+                        into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, scale, sub, transpose, vec, wrap
 
@@ -108,6 +109,11 @@ class SRSPlan:
     chain: object
     tool: str
     in_order: bool = False         # path order is robot.chain.independent order
+
+    @functools.cached_property
+    def fk_frames(self) -> np.ndarray:
+        """The FK check's chain as :func:`.geometric.local_frames` (8, 12)."""
+        return local_frames(self.fk_axes, self.fk_points, self.fk_M)
 
 
 @dataclass(frozen=True)
@@ -405,8 +411,7 @@ def _seven(A):
 
 
 @kernel
-def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swivel, tol_orthonormal,
-                  Q, V, E, IN, RES):
+def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol_orthonormal, Q, V, E, IN, RES):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
     order, shifted by 2π into the limits, :func:`.geometric.into_limit`), V, E, IN, RES (the
     FK residual of :func:`.geometric._fk_residuals`: inf where there is no candidate, and for
@@ -414,10 +419,8 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
     :func:`.geometric._verified`); returns the index of the first malformed pose (−1 if
     none)."""
     h = _seven(H)
-    kHt, kOt = _joint_vectors(kH, 7), _joint_vectors(kO, 7)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
-    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
     B6, Bs, q4b = np.empty((8, BRANCH_ROW)), np.empty((2, BRANCH_ROW)), np.empty((8, 3))
     Qb, QC, QS = np.empty((8, 7)), np.empty((8, 7)), np.empty((8, 7))
     Vb = np.empty(8, dtype=np.bool_)
@@ -450,12 +453,12 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swi
                         QC[b, j], QS[b, j] = math.cos(Qi[r, j]), math.sin(Qi[r, j])
                 Vi[r], Ei[r], INi[r] = Vb[b], Eb[b], inside
                 CHK[b] = Vb[b] and (inside or not Eb[b])
-            _fk_residuals(kHt, kOt, MR, Mp, Qi[8 * k:8 * k + 8], QC, QS, CHK, 7, Ti, RESi[8 * k:8 * k + 8], Sfk)
+            _fk_residuals(A, Qi[8 * k:8 * k + 8], QC, QS, CHK, 7, Ti, RESi[8 * k:8 * k + 8], Sfk)
     return -1
 
 
 @kernel
-def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swivel, first, tol, tol_orthonormal,
+def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, first, tol, tol_orthonormal,
                  order, ref, out):
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
     duplicates at one angle dropped: :func:`.geometric._mark_solutions`) at the swivel angles
@@ -464,7 +467,6 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
     each), the nearest ``ref`` (7,) first, and its position and rotation errors
     (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K;
     −1: a malformed pose; −2: a candidate to polish (the caller's general path answers)."""
-    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
     Tb = T.reshape((1, 4, 4))
     sw = np.empty((1, 1))
     q = np.empty(7)
@@ -475,7 +477,7 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
     K = 0
     for k in range(len(swivel)):
         sw[0, 0] = swivel[k]
-        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, Tb, sw, tol_orthonormal,
+        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, Tb, sw, tol_orthonormal,
                          Q1, V1, E1, IN1, RES1) >= 0:
             return -1                                  # a malformed pose, or an angle not finite
         for b in range(8):
@@ -493,7 +495,7 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, M, kH, kO, lo, hi, T, swiv
         nearest_first(out, K, 7, ref, 7)
         for j in range(7):
             q[order[j]] = out[0, j]
-        out[0, 7], out[0, 8] = _target_errors(_joint_vectors(kH, 7), _joint_vectors(kO, 7), MR, Mp, q, 7, T)
+        out[0, 7], out[0, 8] = _target_errors(A, q, 7, T)
     return K
 
 
@@ -505,8 +507,8 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
     is malformed or has a candidate to polish (the general path answers).  The seeds of
     :func:`anthroarm.ik.solve` (:func:`anthroarm.ik.closed_form.nearest_solver`)."""
     out = np.empty((8 * len(swivel), 9))
-    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_M,
-                     plan.fk_axes, plan.fk_points, plan.lower_path, plan.upper_path, T, swivel, first, 1e-9, 1e-6,
+    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
+                     plan.lower_path, plan.upper_path, T, swivel, first, 1e-9, 1e-6,
                      plan.order, ref, out)
     if K <= 0:
         return None
@@ -552,8 +554,8 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     bad_pose, bad_swivel = [], []
 
     def rows(a, b):                                          # a slice of poses, on one core
-        k = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_M,
-                          plan.fk_axes, plan.fk_points, plan.lower_path, plan.upper_path, T[a:b], sw[a:b],
+        k = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
+                          plan.lower_path, plan.upper_path, T[a:b], sw[a:b],
                           tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b])
         if k >= b - a:
             bad_swivel.append(a + k - (b - a))

@@ -60,7 +60,7 @@ subproblem had only a least-squares answer (the pose is out of reach on that bra
 closed classes (:data:`CLOSED`) are compiled per pose (:mod:`anthroarm.jit`) from the
 subproblem kernels, and :func:`solve_verified` / :func:`solve_nearest` add in the same compiled
 call the 2π shift into the joint limits, the FK check by the chain's product of exponentials
-and the removal of duplicates (used by :func:`anthroarm.ik.closed_form.analytic`).
+(in joint-local frames, :func:`local_frames`) and the removal of duplicates (used by :func:`anthroarm.ik.closed_form.analytic`).
 """
 
 from __future__ import annotations
@@ -163,12 +163,13 @@ class GeoPlan:
     def packed(self) -> tuple:
         """The plan's constants as the compiled drivers take them (:func:`_unpack`): one float
         array (H, P, R_tool, the held joint's axis and point, the tool pose at q = 0, the
-        chain's axes and points, limits in path order) and one int array (class index,
+        chain's FK as :func:`local_frames`, limits in path order) and one int array (class index,
         reversed, joints on the path, the path position of each independent joint)."""
         pa = np.zeros(3) if self.param_axis is None else self.param_axis
         pp = np.zeros(3) if self.param_point is None else self.param_point
-        cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, self.fk_axes,
-                                                 self.fk_points, self.lower_path, self.upper_path)]).astype(float)
+        frames = local_frames(self.fk_axes, self.fk_points, self.fk_M)
+        cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, frames,
+                                                 self.lower_path, self.upper_path)]).astype(float)
         ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), len(self.fk_axes),
                        *self.order], dtype=np.int64)
         return cf, ci
@@ -593,92 +594,105 @@ def _pose_status(T, tol_orthonormal):
     return 0
 
 
-@kernel
-def _poe_step_cs(R, t, axis, point, c, s):
-    """The partial product of exponentials (R, t) times e^{ξ q} of one revolute joint (unit
-    ``axis`` through ``point``, base frame at q = 0, m), from c = cos q and s = sin q:
-    R Rq and t + R (o − Rq o)."""
-    Ri = rot_cs(axis, c, s)
-    return mm(R, Ri), add(t, mv(R, sub(point, mv(Ri, point))))
+# ----------------------------------------------------------------------------- the chain's FK (local frames)
+def local_frames(axes, points, M) -> np.ndarray:
+    """The forward kinematics of a chain of revolute joints as constant rigid transforms:
+    F(q) = A_0 Rz(q1) A_1 Rz(q2) ⋯ Rz(qn) A_n, returned as A (n + 1, 12) (each row: the
+    rotation row by row, then the translation; base frame, m).
+
+    ``axes`` (n, 3) unit joint axes through ``points`` (n, 3) at q = 0, ``M`` (4×4) the tool
+    pose at q = 0 (base frame, m).  Joint i gets a frame F_i whose z axis is its axis, at its
+    point; then e^{ξi qi} = F_i Rz(qi) F_i⁻¹, and the product of exponentials
+    e^{ξ1 q1} ⋯ e^{ξn qn} M (Lynch & Park, *Modern Robotics*, 2017, §4.1.1) becomes the product
+    above with A_0 = F_1, A_i = F_i⁻¹ F_{i+1}, A_n = F_n⁻¹ M.  A joint's rotation then turns
+    two columns of the partial product (:func:`_joint_step`): about three quarters of the
+    arithmetic of a product of exponentials, and the tool pose comes out without a last
+    multiplication by M."""
+    axes, points, M = (np.asarray(a, dtype=float) for a in (axes, points, M))
+    frames = []
+    for k, o in zip(axes, points):
+        i = int(np.argmin(np.abs(k)))                              # :func:`.vec3.perpendicular`
+        x = np.cross(k, np.eye(3)[i])
+        x /= np.linalg.norm(x)
+        frames.append((np.column_stack([x, np.cross(k, x), k]), o))
+    A = np.empty((len(frames) + 1, 12))
+    chain = [(np.eye(3), np.zeros(3))] + frames + [(M[:3, :3], M[:3, 3])]
+    for i in range(len(frames) + 1):
+        (Ra, pa), (Rb, pb) = chain[i], chain[i + 1]
+        A[i, :9], A[i, 9:] = (Ra.T @ Rb).ravel(), Ra.T @ (pb - pa)
+    return A
 
 
 @kernel
-def _poe_step(R, t, axis, point, q):
-    """:func:`_poe_step_cs` of the angle q (rad)."""
-    return _poe_step_cs(R, t, axis, point, math.cos(q), math.sin(q))
+def _frame(A, i):
+    """Row i of A (:func:`local_frames`) as (R, t)."""
+    return (((A[i, 0], A[i, 1], A[i, 2]), (A[i, 3], A[i, 4], A[i, 5]), (A[i, 6], A[i, 7], A[i, 8])),
+            (A[i, 9], A[i, 10], A[i, 11]))
 
 
 @kernel
-def _pose_error(R, t, MR, Mp, T):
-    """max |F − T| over the 3×4 entries, F = (R, t) · M with M = (MR, Mp) the tool pose at
-    q = 0."""
-    RT = mm(R, MR)
-    tT = add(t, mv(R, Mp))
+def _joint_step(R, t, A, i, c, s):
+    """(R, t) · Rz(q) · A_i, a partial product of :func:`local_frames` taken one joint further,
+    from c = cos q and s = sin q: the first two columns of R turned by q, then A_i."""
+    Rq = ((R[0][0] * c + R[0][1] * s, R[0][1] * c - R[0][0] * s, R[0][2]),
+          (R[1][0] * c + R[1][1] * s, R[1][1] * c - R[1][0] * s, R[1][2]),
+          (R[2][0] * c + R[2][1] * s, R[2][1] * c - R[2][0] * s, R[2][2]))
+    B, a = _frame(A, i)
+    return mm(Rq, B), add(mv(Rq, a), t)
+
+
+@kernel
+def _pose_error(R, t, T):
+    """max |F − T| over the 3×4 entries of the pose F = (R, t)."""
     err = 0.0
     for i in range(3):
-        err = max(err, abs(tT[i] - T[i, 3]))
+        err = max(err, abs(t[i] - T[i, 3]))
         for j in range(3):
-            err = max(err, abs(RT[i][j] - T[i, j]))
+            err = max(err, abs(R[i][j] - T[i, j]))
     return err
 
 
 @kernel
-def _chain_fk(kH, kO, q, n):
-    """(R, t) = e^{ξ1 q1} ⋯ e^{ξn qn}, the product of exponentials of the chain's revolute joints
-    (axes kH, points kO at q = 0 as :func:`_joint_vectors`, base frame, m; q rad): the tool pose
-    is (R, t) · M."""
-    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    t = (0.0, 0.0, 0.0)
+def _chain_fk(A, q, n):
+    """The tool pose (R, t) = F(q) of the chain (:func:`local_frames`; q (n,) rad, path order)."""
+    R, t = _frame(A, 0)
     for i in range(n):
-        R, t = _poe_step(R, t, kH[i], kO[i], q[i])
+        R, t = _joint_step(R, t, A, i + 1, math.cos(q[i]), math.sin(q[i]))
     return R, t
 
 
 @kernel
-def _fk_residual(kH, kO, MR, Mp, q, n, T):
-    """max |F(q) − T| over the 3×4 pose entries, F(q) = :func:`_chain_fk` · M with M the tool
-    pose at q = 0 (MR, Mp)."""
-    R, t = _chain_fk(kH, kO, q, n)
-    return _pose_error(R, t, MR, Mp, T)
-
-
-@kernel
-def _target_errors(kH, kO, MR, Mp, q, n, T):
-    """(‖p* − p‖ m, ‖log₃(Rᵀ R*)‖ rad) of the tool pose (R, p) = F(q) (:func:`_fk_residual`)
+def _target_errors(A, q, n, T):
+    """(‖p* − p‖ m, ‖log₃(Rᵀ R*)‖ rad) of the tool pose (R, p) = F(q) (:func:`_chain_fk`)
     against T = (R*, p*) — the position and rotation errors :func:`anthroarm.ik.solve` reports
     (the angle of W = Rᵀ R* as atan2(‖vee(W − Wᵀ)‖ / 2, (tr W − 1) / 2), accurate near 0 and π)."""
-    R, t = _chain_fk(kH, kO, q, n)
-    RT = mm(R, MR)
-    x = add(t, mv(R, Mp))
-    W = mtm(RT, mat(T))
+    R, x = _chain_fk(A, q, n)
+    W = mtm(R, mat(T))
     v = (W[2][1] - W[1][2], W[0][2] - W[2][0], W[1][0] - W[0][1])
     return (norm((T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2])),
             math.atan2(0.5 * norm(v), 0.5 * (W[0][0] + W[1][1] + W[2][2] - 1.0)))
 
 
 @kernel
-def _chain_jacobian(kH, kO, Mp, q, n, J):
+def _chain_jacobian(A, q, n, J):
     """The 6×6 Jacobian J of the first six joints at ``q`` (path order, rad; a 7th held), at the
-    tool point x, base frame: column i is (w × (x − o); w) with the joint's axis
-    w = R_{i−1} kH[i] through o = R_{i−1} kO[i] + t_{i−1} ((R, t) the product of the
-    exponentials before it).  Returns (R, t), the product of all ``n`` of them (the tool pose
-    is (R, t) · M, M's translation ``Mp``)."""
-    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    t = (0.0, 0.0, 0.0)
+    tool point x, base frame: column i is (w × (x − o); w) with the joint's axis w, the z axis
+    of the partial product (R, t) of :func:`local_frames` before the joint's rotation, through
+    its point o = t.  Returns the tool pose (R, t) = F(q)."""
+    R, t = _frame(A, 0)
     for i in range(n):
         if i < 6:
-            J[3, i], J[4, i], J[5, i] = mv(R, kH[i])
-            J[0, i], J[1, i], J[2, i] = add(mv(R, kO[i]), t)
-        R, t = _poe_step(R, t, kH[i], kO[i], q[i])
-    x = add(t, mv(R, Mp))
+            J[3, i], J[4, i], J[5, i] = R[0][2], R[1][2], R[2][2]
+            J[0, i], J[1, i], J[2, i] = t
+        R, t = _joint_step(R, t, A, i + 1, math.cos(q[i]), math.sin(q[i]))
     for i in range(6):
-        c = cross((J[3, i], J[4, i], J[5, i]), sub(x, (J[0, i], J[1, i], J[2, i])))
+        c = cross((J[3, i], J[4, i], J[5, i]), sub(t, (J[0, i], J[1, i], J[2, i])))
         J[0, i], J[1, i], J[2, i] = c
     return R, t
 
 
 @kernel
-def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
+def _polish_chain(A, q, n, T, lo, hi, tol, J, F):
     """Newton steps on the pose equations F(q) = T of the chain's first six joints (a 7th held),
     in place on ``q`` (n,) rad, for a candidate of an arm that is of its class only within the
     classification tolerance (its class solution is off by up to that much, ~1e-7 m).
@@ -686,18 +700,16 @@ def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
     The Jacobian :func:`_chain_jacobian`, the error (x* − x;
     ½ vee(R* Rᵀ − R R*ᵀ)) (the same step as :func:`anthroarm.ik.search.polish`).  At most
     :data:`POLISH_STEPS` steps, fewer once the residual is ≤ 1e-3 ``tol``; a step on a singular
-    Jacobian (|det| ≤ 1e-12) ends it.  Returns the FK residual (:func:`_fk_residual`) at the
+    Jacobian (|det| ≤ 1e-12) ends it.  Returns the FK residual (:func:`_pose_error`) at the
     end, inf if a joint left its limits by more than 1e-9 rad.  ``J`` (6, 6), ``F`` (6,)
     scratch."""
     res = math.inf
     for it in range(POLISH_STEPS + 1):
-        R, t = _chain_jacobian(kH, kO, Mp, q, n, J)
-        res = _pose_error(R, t, MR, Mp, T)
+        R, x = _chain_jacobian(A, q, n, J)
+        res = _pose_error(R, x, T)
         if res <= 1e-3 * tol or it == POLISH_STEPS:
             break
-        RT = mm(R, MR)
-        x = add(t, mv(R, Mp))
-        W = mm(mat(T), transpose(RT))
+        W = mm(mat(T), transpose(R))
         F[0], F[1], F[2] = T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2]
         F[3] = 0.5 * (W[2][1] - W[1][2])
         F[4] = 0.5 * (W[0][2] - W[2][0])
@@ -714,17 +726,18 @@ def _polish_chain(kH, kO, MR, Mp, q, n, T, lo, hi, tol, J, F):
 
 
 @kernel
-def _fk_residuals(kH, kO, MR, Mp, Q, QC, QS, V, n, T, RES, S):
-    """:func:`_fk_residual` of every candidate branch b (``V[b]``) of Q (B, n) into RES (B,)
+def _fk_residuals(A, Q, QC, QS, V, n, T, RES, S):
+    """The FK residual max |F(θ) − T| over the 3×4 pose entries (:func:`_chain_fk`,
+    :func:`_pose_error`) of every candidate branch b (``V[b]``) of Q (B, n) into RES (B,)
     (inf where there is none), each joint's rotation from QC, QS (B, n), the cosine and sine
     of its angle (the rotation the class solver found, whose angle Q is, or cos and sin of Q
-    where :func:`_verified` moved it), the product of exponentials shared along the branch
-    tree: branches come root index innermost, so a branch repeats the leading angles of the
-    one before it, and the partial products up to the first joint whose angle differs are kept
+    where :func:`_verified` moved it), the partial products shared along the branch tree:
+    branches come root index innermost, so a branch repeats the leading angles of the one
+    before it, and the partial products up to the first joint whose angle differs are kept
     (scratch S (n + 1, 12): rotation rows and translation after each joint) — the same
     arithmetic as one product per branch, about a third fewer joint factors for 8 branches."""
-    S[0, :] = 0.0
-    S[0, 0] = S[0, 4] = S[0, 8] = 1.0
+    for k in range(12):
+        S[0, k] = A[0, k]
     prev = -1
     for b in range(len(V)):
         if not V[b]:
@@ -736,35 +749,24 @@ def _fk_residuals(kH, kO, MR, Mp, Q, QC, QS, V, n, T, RES, S):
                 j0 += 1
         prev = b
         for i in range(j0, n):
-            R = ((S[i, 0], S[i, 1], S[i, 2]), (S[i, 3], S[i, 4], S[i, 5]), (S[i, 6], S[i, 7], S[i, 8]))
-            R, t = _poe_step_cs(R, (S[i, 9], S[i, 10], S[i, 11]), kH[i], kO[i], QC[b, i], QS[b, i])
+            R, t = _frame(S, i)
+            R, t = _joint_step(R, t, A, i + 1, QC[b, i], QS[b, i])
             S[i + 1, 0], S[i + 1, 1], S[i + 1, 2] = R[0]
             S[i + 1, 3], S[i + 1, 4], S[i + 1, 5] = R[1]
             S[i + 1, 6], S[i + 1, 7], S[i + 1, 8] = R[2]
             S[i + 1, 9], S[i + 1, 10], S[i + 1, 11] = t
-        R = ((S[n, 0], S[n, 1], S[n, 2]), (S[n, 3], S[n, 4], S[n, 5]), (S[n, 6], S[n, 7], S[n, 8]))
-        RES[b] = _pose_error(R, (S[n, 9], S[n, 10], S[n, 11]), MR, Mp, T)
-
-
-@kernel
-def _joint_vectors(A, n):
-    """The n (6 or 7) rows of A (n, 3) as a 7-tuple of vectors (zeros in place of a 7th):
-    the chain's axes and points as the FK kernels read them — a tuple lives in registers,
-    where a row of an array would be a new view (a reference count) at every joint."""
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]),
-            vec(A[6]) if n == 7 else (0.0, 0.0, 0.0))
+        R, t = _frame(S, n)
+        RES[b] = _pose_error(R, t, T)
 
 
 @kernel
 def _unpack(cf, ci):
-    """The plan's constants from :attr:`GeoPlan.packed` (the chain's axes ``kH`` and points
-    ``kO`` as :func:`_joint_vectors`)."""
+    """The plan's constants from :attr:`GeoPlan.packed`."""
     n = ci[2]
-    o = 70 + 3 * n
+    o = 70 + 12 * (n + 1)
     return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
             (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), cf[54:70].reshape((4, 4)),
-            _joint_vectors(cf[70:o].reshape((n, 3)), n), _joint_vectors(cf[o:o + 3 * n].reshape((n, 3)), n),
-            cf[o + 3 * n:o + 4 * n], cf[o + 4 * n:o + 5 * n])
+            cf[70:o].reshape((n + 1, 12)), cf[o:o + n], cf[o + n:o + 2 * n])
 
 
 @kernel
@@ -775,7 +777,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     which is never returned and so not checked), OK (a solution: candidate, inside, residual
     ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); returns the index of
     the first malformed pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
-    cls, rev, n, H, P, R_tool, p_axis, p_point, M, kH, kO, lo, hi = _unpack(cf, ci)
+    cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
@@ -815,12 +817,12 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
                     QC[b, j], QS[b, j] = math.cos(Qi[b, j]), math.sin(Qi[b, j])
             Vi[b], Ei[b], INi[b] = exists, exact, inside
             CHK[b] = exists and (inside or not exact)
-        _fk_residuals(kH, kO, MR, Mp, Qi, QC, QS, CHK, n, Ti, RESi, S)
+        _fk_residuals(A, Qi, QC, QS, CHK, n, Ti, RESi, S)
         for b in range(8):
             if Vi[b] and Ei[b] and INi[b] and tol < RESi[b] <= POLISH_MAX:
                 for j in range(n):
                     q[j] = Qi[b, j]
-                r = _polish_chain(kH, kO, MR, Mp, q, n, Ti, lo, hi, tol, J, F)
+                r = _polish_chain(A, q, n, Ti, lo, hi, tol, J, F)
                 if r <= tol:
                     for j in range(n):
                         Qi[b, j] = q[j]
@@ -835,14 +837,14 @@ SINGULAR_TOL = 1e-6
 
 
 @kernel
-def _volume(kH, kO, MR, Mp, q, n, J, F):
+def _volume(A, q, n, J, F):
     """The normalised volume |det J| / Π‖J_k‖ ∈ [0, 1] (Hadamard's inequality) of the 6×6
     Jacobian of the first six joints at ``q`` (path order, rad), at the tool point, in the base
     frame (:func:`_chain_jacobian`): 0 at a singular configuration
     — a wrist with aligned axes, a stretched elbow, the wrist centre on the first axis — where
     solutions coincide in pairs or form a one-parameter family.  ``J`` (6, 6), ``F`` (6,)
     scratch."""
-    _chain_jacobian(kH, kO, Mp, q, n, J)
+    _chain_jacobian(A, q, n, J)
     scale = 1.0
     for i in range(6):
         c, w = (J[0, i], J[1, i], J[2, i]), (J[3, i], J[4, i], J[5, i])
@@ -855,8 +857,7 @@ def _volume(kH, kO, MR, Mp, q, n, J, F):
 def _volume_loop(cf, ci, TH, OK, VOL):
     """:func:`_volume` of every solution (``OK``) of θ (N, B, n) in independent-joint order
     into VOL (N, B) (1 elsewhere)."""
-    _, _, n, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
-    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
+    n, A = ci[2], _unpack(cf, ci)[9]
     q, J, F = np.empty(n), np.empty((6, 6)), np.empty(6)
     for i in range(TH.shape[0]):
         for b in range(TH.shape[1]):
@@ -864,7 +865,7 @@ def _volume_loop(cf, ci, TH, OK, VOL):
             if OK[i, b]:
                 for k in range(n):
                     q[ci[3 + k]] = TH[i, b, k]
-                VOL[i, b] = _volume(kH, kO, MR, Mp, q, n, J, F)
+                VOL[i, b] = _volume(A, q, n, J, F)
 
 
 def jacobian_volumes(plan: GeoPlan, TH, OK) -> np.ndarray:
@@ -1013,9 +1014,8 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
         return -2
     if len(ref) == n:
         nearest_first(out, K, n, ref, n + 2)
-        _, _, _, _, _, _, _, _, M, kH, kO, _, _ = _unpack(cf, ci)
-        out[0, n + 2], out[0, n + 3] = _target_errors(kH, kO, mat(M[:3, :3]), vec(M[:3, 3]), Q[0, int(out[0, n + 1])],
-                                                      n, T)
+        A = _unpack(cf, ci)[9]
+        out[0, n + 2], out[0, n + 3] = _target_errors(A, Q[0, int(out[0, n + 1])], n, T)
     return mask
 
 
@@ -1044,7 +1044,7 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     """Every branch of a closed class (:data:`CLOSED`) for poses ``T`` (N, 4, 4), in one
     compiled call per batch: the class solver (:func:`solve`), each branch wrapped by 2π into
     the joint limits and checked by the chain's FK (product of exponentials of the joints as
-    read from ``robot.chain``, the model Pinocchio holds).  ``param`` (N,) the held joint of a
+    read from ``robot.chain``, the model Pinocchio holds; :func:`local_frames`).  ``param`` (N,) the held joint of a
     7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad), candidate (N, 8),
     exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4 pose; inf where
     there is no candidate or an exact one outside the limits, :func:`_verified`).  Raises ``ValueError`` naming the first malformed pose (not finite,
