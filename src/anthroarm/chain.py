@@ -30,6 +30,7 @@ joints' θ back to q.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import re
 from dataclasses import dataclass
@@ -60,6 +61,14 @@ def _homogeneous(R, p) -> np.ndarray:
     T[:3, :3] = R
     T[:3, 3] = p
     return T
+
+
+@functools.cache
+def _kernels():
+    """The compiled kernels of this module's methods, imported on first use (importing
+    anthroarm, or reading a model, does not load Numba)."""
+    from . import chain_kernels
+    return chain_kernels
 
 
 @dataclass(frozen=True, eq=False)
@@ -393,15 +402,17 @@ class Chain:
         if theta.shape[-1] != len(ind):
             raise ValueError(f"{self.name}: theta must have {len(ind)} entries (one per independent joint: "
                              f"{', '.join(self.joints[i].name for i in ind)}), got shape {theta.shape}")
-        q = np.empty(theta.shape[:-1] + (self.nq,))
-        for k, i in enumerate(ind):
-            j = self.joints[i]
-            if j.kind == CONTINUOUS:
-                q[..., j.idx_q] = np.cos(theta[..., k])
-                q[..., j.idx_q + 1] = np.sin(theta[..., k])
-            else:
-                q[..., j.idx_q] = theta[..., k]
-        return q
+        th = np.ascontiguousarray(theta.reshape(-1, len(ind)))
+        q = np.empty((th.shape[0], self.nq))
+        _kernels().configure(th, self._configuration_index, q)
+        return q.reshape(theta.shape[:-1] + (self.nq,))
+
+    @cached_property
+    def _configuration_index(self) -> np.ndarray:
+        """For :meth:`configuration`: row k (independent joint k) holds its first entry in q and
+        whether it is continuous (q holds cos θ, sin θ)."""
+        return np.array([(self.joints[i].idx_q, self.joints[i].kind == CONTINUOUS) for i in self.independent],
+                        dtype=np.int64).reshape(-1, 2)
 
     @cached_property
     def sampling_box(self) -> tuple[np.ndarray, np.ndarray]:
