@@ -39,6 +39,25 @@ def test_analytic_batch_of_zero_poses_is_empty(name):
     assert b.n_solutions.shape == (0,)
 
 
+@pytest.mark.parametrize("name", ["ur5", "kinova", "human_arm7", "planar2r", "panda"])
+def test_analytic_takes_a_strided_pose(name):
+    """A pose that is a strided view (a slice of a larger array, neither C nor Fortran order)
+    is answered as its contiguous copy — it had raised a TypingError from inside Numba."""
+    robot = aa.load(name)
+    kw = {"param": 0.4} if name == "panda" else {}
+    for q in robot.random_q(3, rng=5):
+        T = robot.fk(q)
+        big = np.zeros((8, 8))
+        big[::2, ::2] = T
+        view = big[::2, ::2]
+        assert not view.flags.c_contiguous and not view.flags.f_contiguous
+        a, b = aa.ik.analytic(robot, view, **kw), aa.ik.analytic(robot, np.ascontiguousarray(T), **kw)
+        assert a.branches == b.branches and a.reason == b.reason, name
+        np.testing.assert_array_equal(a.solutions, b.solutions)
+        r = aa.ik.solve(robot, view if name != "planar2r" else np.ascontiguousarray(view[:3, 3]))
+        assert r.success, name
+
+
 @pytest.mark.parametrize("damping", [-10.0, -1e-12, math.nan, math.inf])
 @pytest.mark.parametrize("solver", ["osqp", "proxqp"])
 def test_qp_step_rejects_negative_or_non_finite_damping(arm, damping, solver):

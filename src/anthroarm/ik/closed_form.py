@@ -821,6 +821,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
                         tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
+    if not arr.flags.c_contiguous:
+        arr = np.ascontiguousarray(arr)          # a strided view: the compiled calls take C order
     if method == "book":
         spec = getattr(robot, "spec", None)
         if spec is None or spec.name not in _models.BOOK_PROCEDURES or robot.nq != 6 or robot.tool != spec.tool_name:
@@ -911,32 +913,33 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
         if s.kind == "srs":
             if position_only:
                 return None
-            grid = _swivel_array(swivel, 1, grid_1d=True)
-            th, cand, exact, inside, res = (a[0] for a in _fam.srs_verified(s.plan, arr[None], grid, tol,
-                                                                             tol_orthonormal))
-            labels = s.plan.labels
-            sw = np.repeat(grid[0], len(labels))
+            grid = _swivel_array(swivel, 1, grid_1d=True)[0]
+            got = _fam.srs_solutions(s.plan, arr, grid, tol, tol_orthonormal)
+            if got is None:
+                return None
+            q, res, rows = got
+            labels = s.plan.labels if len(grid) == 1 else _grid_labels(s.plan.labels, len(grid), "swivel")
+            return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[i] for i in rows.tolist()],
+                                    None, grid[rows // len(s.plan.labels)], res, None, robot.name)
         else:
             if position_only is False:
                 return None
             p = arr if arr.shape == (3,) else arr[:3, 3]
-            if arr.shape == (4, 4) and np.abs(arr[3] - (0.0, 0.0, 0.0, 1.0)).max() > 1e-12:
-                return None
+            if arr.shape == (4, 4) and arr[3].tolist() != [0.0, 0.0, 0.0, 1.0]:
+                return None             # the batch path's check (to 1e-12) says whether it is one
             th, cand, exact, inside, res = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
-            labels, sw = s.plan.labels, None
     except ValueError:
         return None                     # a malformed pose or swivel: the batch path says what is wrong
-    if s.plain and (cand & exact & inside & (res > tol) & (res <= POLISH_MAX)).any():
+    flags = list(zip(cand.tolist(), exact.tolist(), inside.tolist(), res.tolist()))   # 2 branches: no numpy
+    if s.plain and any(c and e and i and tol < r <= POLISH_MAX for c, e, i, r in flags):
         return None
     valid = _geo.mark_solutions(th[None], cand[None], inside[None], res[None], tol, s.form.branches)[0]
-    if not valid.any():
+    k = [b for b, ok in enumerate(valid.tolist()) if ok]
+    if not k:
         return None
-    k = np.flatnonzero(valid).tolist()
-    if len(labels) != len(valid):
-        labels = _grid_labels(labels, len(valid) // len(labels), "swivel")
-    q = th[valid]
-    return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q), branches=[labels[i] for i in k],
-                            swivel=None if sw is None else sw[valid], residuals=res[valid], model=robot.name)
+    q = th[k]
+    return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
+                            branches=[s.plan.labels[b] for b in k], residuals=res[k], model=robot.name)
 
 
 def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):

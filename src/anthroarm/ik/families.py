@@ -463,10 +463,12 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, firs
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
     duplicates at one angle dropped: :func:`.geometric._mark_solutions`) at the swivel angles
     ``swivel`` (S,) in turn — only at the first angle that has any where ``first`` — into the
-    rows of ``out`` (8 S, 9): θ in independent-joint order (``order``: the path position of
-    each), the nearest ``ref`` (7,) first, and its position and rotation errors
-    (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K;
-    −1: a malformed pose; −2: a candidate to polish (the caller's general path answers)."""
+    rows of ``out`` (8 S, 11): θ in independent-joint order (``order``: the path position of
+    each), the FK residual (column 9) and the branch (column 10: 8 k + b, swivel angle k, branch
+    b), in that order — with a reference ``ref`` (7,) (an empty array: none) the nearest it
+    first, and its position and rotation errors (:func:`.geometric._target_errors`) in columns
+    7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
+    (the caller's general path answers)."""
     Tb = T.reshape((1, 4, 4))
     sw = np.empty((1, 1))
     q = np.empty(7)
@@ -488,11 +490,12 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, firs
             if OK[b]:
                 for j in range(7):
                     out[K, j] = Q[b, order[j]]
+                out[K, 9], out[K, 10] = RES[b], 8 * k + b
                 K += 1
         if first and K > 0:
             break
-    if K > 0:
-        nearest_first(out, K, 7, ref, 7)
+    if K > 0 and len(ref) == 7:
+        nearest_first(out, K, 7, ref, 11)
         for j in range(7):
             q[order[j]] = out[0, j]
         out[0, 7], out[0, 8] = _target_errors(A, q, 7, T)
@@ -506,13 +509,30 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
     rotation errors (m, rad), in one compiled call; None where the pose has no solution there,
     is malformed or has a candidate to polish (the general path answers).  The seeds of
     :func:`anthroarm.ik.solve` (:func:`anthroarm.ik.closed_form.nearest_solver`)."""
-    out = np.empty((8 * len(swivel), 9))
+    out = np.empty((8 * len(swivel), 11))
     K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
                      plan.lower_path, plan.upper_path, T, swivel, first, 1e-9, 1e-6,
                      plan.order, ref, out)
     if K <= 0:
         return None
     return out[:K, :7], float(out[0, 7]), float(out[0, 8])
+
+
+def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
+    """Every solution of one pose ``T`` (4, 4) (a C-order float array) at the swivel angles
+    ``swivel`` (S,) (rad, finite), in the order of :func:`srs_verified`'s rows, in one compiled
+    call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (K,) into the
+    8 S branches) — or None where there is none, the pose is malformed or a candidate is to
+    be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with the reasons)."""
+    out = np.empty((8 * len(swivel), 11))
+    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
+                     plan.lower_path, plan.upper_path, T, swivel, False, tol, tol_orthonormal, plan.order, _NO_REF, out)
+    if K <= 0:
+        return None
+    return out[:K, :7], out[:K, 9], out[:K, 10].astype(np.intp)
+
+
+_NO_REF = np.zeros(0)
 
 
 def _swivel_array(swivel, N, check=True):
@@ -611,7 +631,9 @@ def _fk_position_residual(kH, kO, p_tool, q, n, p):
 @kernel
 def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RES):
     """Both branches of targets P (N, 3): Q (N, 2, 2) path order, V, E, IN, RES (position);
-    returns the index of the first non-finite target (−1 if none)."""
+    returns the index of the first non-finite target (−1 if none).  ``h1`` … ``pt``: the
+    plan's vectors (3,)."""
+    h1, h2, o1, o2, pt = vec(h1), vec(h2), vec(o1), vec(o2), vec(pt)
     q = np.empty(2)
     p1, p2 = sub(pt, o2), sub(o1, o2)
     for i in range(len(P)):
@@ -652,7 +674,7 @@ def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
     N = len(P)
     Q, V, E = np.empty((N, 2, 2)), np.empty((N, 2), bool), np.empty((N, 2), bool)
     IN, RES = np.empty((N, 2), bool), np.empty((N, 2))
-    bad = _planar_verified(vec(plan.h1), vec(plan.h2), vec(plan.o1), vec(plan.o2), vec(plan.p_tool), plan.fk_axes,
+    bad = _planar_verified(plan.h1, plan.h2, plan.o1, plan.o2, plan.p_tool, plan.fk_axes,
                            plan.fk_points, plan.lower_path, plan.upper_path, P, float(tol), Q, V, E, IN, RES)
     if bad >= 0:
         raise ValueError(f"P[{bad}] is not a finite position")
