@@ -39,6 +39,7 @@ from functools import cached_property
 import numpy as np
 
 from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, UnsupportedModelError
+from .threads import MIN_ROWS_PER_THREAD, run_rows
 
 REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 
@@ -404,7 +405,11 @@ class Chain:
                              f"{', '.join(self.joints[i].name for i in ind)}), got shape {theta.shape}")
         th = np.ascontiguousarray(theta.reshape(-1, len(ind)))
         q = np.empty((th.shape[0], self.nq))
-        _kernels().configure(th, self._configuration_index, q)
+        configure, index = _kernels().configure, self._configuration_index
+        if len(th) < 2 * MIN_ROWS_PER_THREAD:
+            configure(th, index, q)                       # one thread (run_rows's rule, without its call)
+        else:
+            run_rows(lambda a, b: configure(th[a:b], index, q[a:b]), len(th))
         return q.reshape(theta.shape[:-1] + (self.nq,))
 
     @cached_property

@@ -51,7 +51,9 @@ def _pool(n: int) -> ThreadPoolExecutor:
 def run_rows(fn, n_rows: int) -> None:
     """Call ``fn(start, stop)`` on contiguous slices covering ``range(n_rows)``, in parallel
     threads when the batch is large enough; exceptions propagate (the first one raised)."""
-    k = min(workers(), n_rows // MIN_ROWS_PER_THREAD)
+    k = n_rows // MIN_ROWS_PER_THREAD
+    if k > 1:                                          # a large batch: ask how many threads
+        k = min(workers(), k)
     if k <= 1:
         fn(0, n_rows)
         return

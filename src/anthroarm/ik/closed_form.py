@@ -697,7 +697,7 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     candidates, duplicates, the rescue of poses whose candidates lie on a limit, reasons."""
     N, B = cand.shape
     ch = robot.chain
-    Q = th if s.plain else ch.configuration(np.where(cand[..., None], th, 0.0))
+    Q = th if s.plain else ch.configuration(th)          # NaN where no candidate, NaN below where no solution
     res = np.array(res, dtype=float)
     near = cand & exact & inside & (res > tol) & (res <= POLISH_MAX)
     polished = bool(near.any()) and s.plain
