@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import math
 import re
 from dataclasses import dataclass
 from functools import cached_property
@@ -66,8 +67,11 @@ def _homogeneous(R, p) -> np.ndarray:
 
 @functools.cache
 def _kernels():
-    """The compiled kernels of this module's methods, imported on first use (importing
-    anthroarm, or reading a model, does not load Numba)."""
+    """The compiled kernels of this module's methods, imported on first use: importing
+    anthroarm or reading a model does not load Numba; the first :meth:`Chain.configuration`
+    (also :meth:`Chain.random_q`) does, about 0.4 s once per process (the kernel itself comes
+    from the disk cache, :mod:`anthroarm.jit`) — a choice: it is 3–4× faster than numpy on
+    the few rows of one IK answer, where Numba is loaded anyway."""
     from . import chain_kernels
     return chain_kernels
 
@@ -400,10 +404,10 @@ class Chain:
         ``(n,)`` or ``(N, n)``): the inverse of :meth:`angles` restricted to them."""
         theta = np.asarray(theta, dtype=float)
         ind = self.independent
-        if theta.shape[-1] != len(ind):
+        if theta.ndim == 0 or theta.shape[-1] != len(ind):
             raise ValueError(f"{self.name}: theta must have {len(ind)} entries (one per independent joint: "
                              f"{', '.join(self.joints[i].name for i in ind)}), got shape {theta.shape}")
-        th = np.ascontiguousarray(theta.reshape(-1, len(ind)))
+        th = np.ascontiguousarray(theta.reshape(math.prod(theta.shape[:-1]), len(ind)))
         q = np.empty((th.shape[0], self.nq))
         configure, index = _kernels().configure, self._configuration_index
         if len(th) < 2 * MIN_ROWS_PER_THREAD:

@@ -10,8 +10,9 @@ from .jit import kernel
 
 @kernel
 def configure(theta, index, q):
-    """q (N, nq) from θ (N, n) of the independent joints (:meth:`Chain.configuration`; ``index``
-    :attr:`Chain._configuration_index`)."""
+    """q (N, nq) from the positions θ (N, n) of the independent joints (rad, m for a prismatic
+    joint; :meth:`Chain.configuration`): a joint's θ, or (cos θ, sin θ) for a continuous one
+    (``index`` :attr:`Chain._configuration_index`: its first entry in q, continuous or not)."""
     for i in range(theta.shape[0]):
         for k in range(theta.shape[1]):
             j = index[k, 0]

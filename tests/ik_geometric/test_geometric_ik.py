@@ -732,3 +732,102 @@ def test_frame_keeps_the_comfortable_posture_and_refuses_a_shared_name():
     r = aa.ik.solve(robot, T, frame=dup, posture=None)
     assert r.success and r.seed != "analytic"
     assert r.pos_err == pytest.approx(np.linalg.norm(robot.fk(r.q, dup)[:3, 3] - T[:3, 3]), abs=1e-12)
+
+
+def _special_q(robot, n, seed):
+    """Configurations with joints at 0, ±π/2, ±π, just inside ±π, on a limit or 1e-11 inside it
+    (singular wrists, stretched elbows, angles at the wrap) — where a branch's angle may be
+    shifted by 2π or put onto a limit after the class solver found it."""
+    rng = np.random.default_rng(seed)
+    Q = robot.random_q(n, rng=rng)
+    lo, hi = robot.lower, robot.upper
+    for q in Q:
+        for j in range(robot.nq):
+            if rng.random() < 0.4:
+                q[j] = rng.choice([0.0, PI / 2, -PI / 2, PI, -PI, PI - 1e-12, lo[j], hi[j], lo[j] + 1e-11, hi[j] - 1e-11])
+        np.clip(q, lo, hi, out=q)
+    return Q
+
+
+def test_reported_residuals_are_pinocchios_of_the_returned_angles(tmp_path):
+    """Every ``residuals`` entry is Pinocchio's max |FK(q) − T| over the 3×4 pose of the very
+    ``q`` returned (to 1e-12), and ≤ tol — on random and special configurations (joints on a
+    limit of ±π, wrists aligned), at the default tol and at 1e-11.  The FK check had reported
+    the residual of a polished candidate before its joint was put onto a limit (a PUMA 560 with
+    q1 = −π at q5 = 0: reported 2.6e-16, true 5.5e-10, returned at tol = 1e-11)."""
+    puma = puma560(tmp_path)
+    arms = [puma, aa.load("ur5"), aa.load("sixr_arm"), aa.load("prosthetic_arm"), aa.load("talos_arm")]
+    T0 = _fk(puma, np.array([-PI, 1.970655768409248, 2.511687152757056, 0.0, 0.0, PI - 1e-12]))
+    checked = 0
+    for robot in arms:
+        Ts = [_fk(robot, q) for q in np.vstack([robot.random_q(20, rng=2), _special_q(robot, 40, 3)])]
+        if robot is puma:
+            Ts.append(T0)
+        for tol in (1e-9, 1e-11):
+            for T in Ts:
+                r = aa.ik.analytic(robot, T, tol=tol)
+                for q, res in zip(r.solutions, r.residuals):
+                    e = np.abs(_fk(robot, q)[:3] - T[:3]).max()
+                    assert abs(e - res) <= 1e-12 and e <= tol, (robot.name, tol, res, e)
+                    checked += 1
+    assert checked > 2000
+
+
+def test_carried_cos_sin_are_those_of_the_returned_angle(tmp_path):
+    """The class solvers carry each angle as (θ, cos θ, sin θ), the rotation the subproblem
+    found: cos and sin must be those of the θ they return (the FK check rotates by them), on
+    every closed class — reversed chains, axes 3 and 4 antiparallel to 2 (the sign flips of the
+    three-parallel tail), singular poses where a subproblem returns (0, 1, 0)."""
+    arms = [puma560(tmp_path), aa.load("ur5"), aa.load("prosthetic_arm"), aa.load("talos_arm"), aa.load("kinova"),
+            random_arm(tmp_path, C.SPHERICAL, 4), random_arm(tmp_path, C.THREE_PARALLEL, 5),
+            dh_urdf(tmp_path, "ur5_antiparallel", [PI / 2, 0, PI, PI / 2, -PI / 2, 0],
+                    [0, -0.425, 0.392, 0, 0, 0], [0.089, 0, 0, 0.109, 0.095, 0.082])]
+    rows = 0
+    for robot in arms:
+        plan = G.plan_for(robot)
+        cls, rev, n, H, P = G._unpack(*plan.packed)[:5]
+        Q = np.vstack([robot.random_q(30, rng=6), _special_q(robot, 30, 7)])
+        T = np.array([_fk(robot, q) for q in Q])
+        R06, p06 = G.class_pose(plan, T, None if plan.param_joint is None else 0.0)
+        B = np.empty((8, G.BRANCH_ROW))
+        for i in range(len(T)):
+            G._solve_closed(cls, G._six(H), G._seven(P), G.mat(np.ascontiguousarray(R06[i])), G.vec(p06[i]), B)
+            ex = B[:, G.EXISTS] != 0
+            th = B[ex, :6]
+            np.testing.assert_allclose(B[ex, G.COS:G.COS + 6], np.cos(th), atol=1e-14, err_msg=robot.name)
+            np.testing.assert_allclose(B[ex, G.SIN:G.SIN + 6], np.sin(th), atol=1e-14, err_msg=robot.name)
+            rows += int(ex.sum())
+    assert rows > 2000
+
+
+def test_srs_single_pose_is_the_batch_row():
+    """The SRS arm's one-pose path (one compiled call) gives exactly the batch path's row:
+    solutions, labels, swivel angles, residuals and reasons — at one angle and on the default
+    grid, with and without a solution."""
+    from anthroarm.ik.qp.tasks.swivel import swivel_angle
+
+    robot = aa.load("human_arm7")
+    Q = robot.random_q(40, rng=8)
+    for q in Q:
+        T = _fk(robot, q)
+        for sw in (swivel_angle(robot, q), 2.5):
+            a, b = aa.ik.analytic(robot, T, swivel=sw), aa.ik.analytic_batch(robot, T[None], swivel=sw)[0]
+            assert a.branches == b.branches and a.reason == b.reason
+            for x, y in ((a.solutions, b.solutions), (a.swivel, b.swivel), (a.residuals, b.residuals)):
+                np.testing.assert_array_equal(x, y)
+    for q in Q[:5]:
+        T = _fk(robot, q)
+        a, b = aa.ik.analytic(robot, T), aa.ik.analytic_batch(robot, T[None], _single_grid=True)[0]
+        assert a.branches == b.branches and len(a) > 0
+        np.testing.assert_array_equal(a.solutions, b.solutions)
+        np.testing.assert_array_equal(a.swivel, b.swivel)
+
+
+def test_batch_singular_is_that_of_the_solutions_found():
+    """``singular`` of a batch result describes the solutions the call found, whatever a caller
+    later writes into ``solutions`` (they had shared one array)."""
+    robot = aa.load("ur5")
+    T = _fk(robot, np.array([0.3, -1.2, 1.4, -0.5, 1.1, 0.2]))[None]
+    B = aa.ik.analytic_batch(robot, T)
+    B.solutions[0, :, 4] = 0.0                                 # aligned wrist axes, had it been found
+    assert B[0].singular is None

@@ -29,8 +29,8 @@ is the general one above, and Table 7.2 reproduces through it.
 Every solver runs as one compiled call (:mod:`anthroarm.jit`) per batch: the class solver's
 branches, each shifted by 2π into the joint limits and checked by the chain's forward
 kinematics (product of exponentials of the joints as read from ``robot.chain``, the model
-Pinocchio holds, in joint-local frames: :func:`.geometric.local_frames`; ``tol`` on every entry of the 3×4 pose, or the position for ``planar_2r``),
-duplicates dropped.  Arms of a class only within the classification tolerance (rounded URDF
+Pinocchio holds, in joint-local frames: :func:`.geometric.local_frames`; ``tol`` on every
+entry of the 3×4 pose, or the position for ``planar_2r``), duplicates dropped.  Arms of a class only within the classification tolerance (rounded URDF
 numbers) get their near-exact candidates (FK residual ≤ :data:`POLISH_MAX`) polished by
 Newton steps on the chain inside that call (a held 7th joint stays where it was asked to be),
 and by bounded least squares where that leaves any; a pose whose only
@@ -724,6 +724,8 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     singular_of = None
     if s.kind == "geo":
         TH = Q if polished else th                                  # polished: a plain arm, Q = θ
+        if TH is Q:
+            TH = TH.copy()               # `singular` describes the solutions found, whatever a caller writes into them
         plan = s.plan
 
         def singular_of(rows):
@@ -925,8 +927,8 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
             if position_only is False:
                 return None
             p = arr if arr.shape == (3,) else arr[:3, 3]
-            if arr.shape == (4, 4) and arr[3].tolist() != [0.0, 0.0, 0.0, 1.0]:
-                return None             # the batch path's check (to 1e-12) says whether it is one
+            if arr.shape == (4, 4) and (arr[3].tolist() != [0.0, 0.0, 0.0, 1.0] or not np.isfinite(arr).all()):
+                return None             # the batch path's checks say what is wrong, or that it is fine
             th, cand, exact, inside, res = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
     except ValueError:
         return None                     # a malformed pose or swivel: the batch path says what is wrong

@@ -40,8 +40,8 @@ A target off the plane of motion (|h1ᵀ(p − p_t)| > tol) has no candidate.
 Drivers (:func:`srs_verified`, :func:`planar_verified`) follow
 :func:`anthroarm.ik.geometric.solve_verified`: one compiled call per batch, each branch wrapped
 by 2π into the joint limits and checked by the chain's FK (product of exponentials of the
-joints as read from ``robot.chain``, unsnapped; :func:`.geometric.local_frames`), joint values in ``robot.chain.independent``
-order.  A branch whose subproblems had only least-squares answers is a candidate with
+joints as read from ``robot.chain``, unsnapped; :func:`.geometric.local_frames`), joint values
+in ``robot.chain.independent`` order.  A branch whose subproblems had only least-squares answers is a candidate with
 ``exact = False`` (out of reach on that branch).
 """
 
@@ -559,8 +559,9 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     Returns θ (N, 8S, 7) in ``robot.chain.independent`` order (rad, wrapped by 2π into the
     limits, NaN where the branch does not exist), candidate (N, 8S), exact (N, 8S), inside the
     limits (N, 8S), FK residual (N, 8S) (max entry of the 3×4 pose by the chain's product of
-    exponentials; inf where there is no candidate or an exact one outside the limits).  ``tol`` is accepted for the interface of
-    :func:`anthroarm.ik.geometric.solve_verified` (the caller compares the residual to it).
+    exponentials; inf where there is no candidate or an exact one outside the limits).  ``tol``
+    is accepted for the interface of :func:`anthroarm.ik.geometric.solve_verified` (the caller
+    compares the residual to it).
     Raises ``ValueError`` naming the first malformed pose (not finite, last row, not a rotation
     to ``tol_orthonormal``)."""
     T = np.ascontiguousarray(T, dtype=float)

@@ -60,7 +60,8 @@ subproblem had only a least-squares answer (the pose is out of reach on that bra
 closed classes (:data:`CLOSED`) are compiled per pose (:mod:`anthroarm.jit`) from the
 subproblem kernels, and :func:`solve_verified` / :func:`solve_nearest` add in the same compiled
 call the 2π shift into the joint limits, the FK check by the chain's product of exponentials
-(in joint-local frames, :func:`local_frames`) and the removal of duplicates (used by :func:`anthroarm.ik.closed_form.analytic`).
+(in joint-local frames, :func:`local_frames`) and the removal of duplicates (used by
+:func:`anthroarm.ik.closed_form.analytic`).
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ from . import classify as C
 from . import subproblems as sp
 from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search  # noqa: F401 - re-exported
 from .subproblems import TOL, TOL_QUARTIC, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5_one, sp6_one
-from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot, rot_cs, rotate_cs, sub,
+from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs, sub,
                    transpose, vec, wrap)
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
@@ -700,8 +701,9 @@ def _polish_chain(A, q, n, T, lo, hi, tol, J, F):
     The Jacobian :func:`_chain_jacobian`, the error (x* − x;
     ½ vee(R* Rᵀ − R R*ᵀ)) (the same step as :func:`anthroarm.ik.search.polish`).  At most
     :data:`POLISH_STEPS` steps, fewer once the residual is ≤ 1e-3 ``tol``; a step on a singular
-    Jacobian (|det| ≤ 1e-12) ends it.  Returns the FK residual (:func:`_pose_error`) at the
-    end, inf if a joint left its limits by more than 1e-9 rad.  ``J`` (6, 6), ``F`` (6,)
+    Jacobian (|det| ≤ 1e-12) ends it.  A joint within 1e-9 rad outside a limit is put onto it.
+    Returns the FK residual (:func:`_pose_error`) of the angles it leaves in ``q``, inf if a
+    joint left its limits by more than 1e-9 rad.  ``J`` (6, 6), ``F`` (6,)
     scratch."""
     res = math.inf
     for it in range(POLISH_STEPS + 1):
@@ -718,10 +720,16 @@ def _polish_chain(A, q, n, T, lo, hi, tol, J, F):
             break
         for i in range(6):
             q[i] += F[i]
+    moved = False
     for j in range(n):
         if q[j] < lo[j] - 1e-9 or q[j] > hi[j] + 1e-9:
             return math.inf
-        q[j] = min(max(q[j], lo[j]), hi[j])
+        x = min(max(q[j], lo[j]), hi[j])
+        moved = moved or x != q[j]
+        q[j] = x
+    if moved:                                    # put onto a limit: the residual of the angles returned
+        R, x = _chain_fk(A, q, n)
+        res = _pose_error(R, x, T)
     return res
 
 
@@ -1044,10 +1052,11 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     """Every branch of a closed class (:data:`CLOSED`) for poses ``T`` (N, 4, 4), in one
     compiled call per batch: the class solver (:func:`solve`), each branch wrapped by 2π into
     the joint limits and checked by the chain's FK (product of exponentials of the joints as
-    read from ``robot.chain``, the model Pinocchio holds; :func:`local_frames`).  ``param`` (N,) the held joint of a
-    7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad), candidate (N, 8),
-    exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4 pose; inf where
-    there is no candidate or an exact one outside the limits, :func:`_verified`).  Raises ``ValueError`` naming the first malformed pose (not finite,
+    read from ``robot.chain``, the model Pinocchio holds; :func:`local_frames`).  ``param``
+    (N,) the held joint of a 7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad),
+    candidate (N, 8), exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4
+    pose; inf where there is no candidate or an exact one outside the limits,
+    :func:`_verified`).  Raises ``ValueError`` naming the first malformed pose (not finite,
     last row, not a rotation) — ``anthroarm.ik.closed_form`` checks before it calls."""
     T = np.ascontiguousarray(T, dtype=float)
     N, n = len(T), len(plan.fk_axes)

@@ -177,10 +177,12 @@ def rot(k, theta) -> np.ndarray:
 def atan2_cs(y, x):
     """θ = atan2(y, x) (rad) with cos θ = x / r and sin θ = y / r, r = ‖(x, y)‖ — the rotation a
     subproblem finds, for the rotations that follow it without evaluating cos and sin of θ
-    again (θ is read once, the rotation kept exact to rounding).  (cos θ, sin θ) from θ where
-    r is 0 or not finite."""
+    again (θ is read once, the rotation kept exact to rounding).  r by ``math.hypot`` where
+    x² + y² would lose digits (below 1e-290 or above 1e290); (cos θ, sin θ) from θ where r is
+    0 or not finite."""
     theta = math.atan2(y, x)
-    r = math.sqrt(x * x + y * y)
+    rr = x * x + y * y
+    r = math.sqrt(rr) if 1e-290 < rr < 1e290 else math.hypot(x, y)
     if 0.0 < r < math.inf:
         return theta, x / r, y / r
     return theta, math.cos(theta), math.sin(theta)
@@ -947,4 +949,5 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
 
 
 __all__ = ["Solutions", "rot", "sp1", "sp2", "sp3", "sp4", "sp5", "sp6", "sp1_one", "sp2_one", "sp3_one",
-           "sp4_one", "sp5_one", "sp6_one", "real_roots", "TOL", "TOL_QUARTIC"]
+           "sp4_one", "sp5_one", "sp6_one", "atan2_cs", "sp1_cs", "sp2_cs", "sp3_cs", "sp4_cs", "real_roots", "TOL",
+           "TOL_QUARTIC"]
