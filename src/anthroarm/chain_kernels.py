@@ -11,8 +11,9 @@ from .jit import kernel
 @kernel
 def configure(theta, index, q):
     """q (N, nq) from the positions θ (N, n) of the independent joints (rad, m for a prismatic
-    joint; :meth:`Chain.configuration`): a joint's θ, or (cos θ, sin θ) for a continuous one
-    (``index`` :attr:`Chain._configuration_index`: its first entry in q, continuous or not)."""
+    joint; :meth:`anthroarm.chain.Chain.configuration`): a joint's θ, or (cos θ, sin θ) for a
+    continuous one (``index`` (n, 2), ``Chain._configuration_index``: its first entry in q,
+    continuous or not)."""
     for i in range(theta.shape[0]):
         for k in range(theta.shape[1]):
             j = index[k, 0]
