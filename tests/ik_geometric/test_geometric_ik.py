@@ -824,10 +824,40 @@ def test_srs_single_pose_is_the_batch_row():
 
 
 def test_batch_singular_is_that_of_the_solutions_found():
-    """``singular`` of a batch result describes the solutions the call found, whatever a caller
-    later writes into ``solutions`` (they had shared one array)."""
+    """``singular`` of a batch result describes the solutions the call found: the arrays it
+    reads later (``solutions``, ``valid``) are read-only, so a caller cannot change them under
+    it (they had been writable, and shared); the per-pose results are writable copies."""
     robot = aa.load("ur5")
     T = _fk(robot, np.array([0.3, -1.2, 1.4, -0.5, 1.1, 0.2]))[None]
     B = aa.ik.analytic_batch(robot, T)
-    B.solutions[0, :, 4] = 0.0                                 # aligned wrist axes, had it been found
+    for name in ("solutions", "valid", "residuals"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(B, name)[0, 0] = 0.0
     assert B[0].singular is None
+    one = B[0]
+    one.solutions[0, 4] = 0.0                                   # a copy: the batch is unchanged
+    assert B.solutions[0, 0, 4] != 0.0 and B[0].singular is None
+
+
+def test_a_reachable_pose_at_a_tangent_root_is_solved():
+    """A pose reached by a configuration inside the limits has a solution, also where a
+    subproblem's two roots meet (panda's shoulder at q2 = 0, joints on their limits): its only
+    in-limit candidates are least-squares roots off by ~1e-8, which the compiled Newton polish
+    takes to the pose (FK-verified); they had been dropped with 'all 6 closed-form solutions
+    violate the joint limits'."""
+    robot = aa.load("panda")
+    lo, hi = robot.lower, robot.upper
+    Q = [np.array([-2.8973, 1e-13, 2.89729999999, -1.7704468480934643, 2.8973, 2.127241565806812, 2.897299999])]
+    rng = np.random.default_rng(12)
+    for q in robot.random_q(60, rng=rng):
+        q[1] = rng.choice([0.0, 1e-13, -1e-13])                       # the shoulder singularity
+        for j in (0, 2, 4, 6):
+            if rng.random() < 0.5:
+                q[j] = rng.choice([lo[j], hi[j]])
+        Q.append(q)
+    for q in Q:
+        T = _fk(robot, q)
+        r = aa.ik.analytic(robot, T, param=float(q[6]))
+        assert len(r) > 0, (q.tolist(), r.reason)
+        for s in r.solutions:
+            assert np.abs(_fk(robot, s)[:3] - T[:3]).max() <= 1e-9 and robot.within_limits(s)

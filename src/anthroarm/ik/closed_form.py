@@ -30,10 +30,12 @@ Every solver runs as one compiled call (:mod:`anthroarm.jit`) per batch: the cla
 branches, each shifted by 2π into the joint limits and checked by the chain's forward
 kinematics (product of exponentials of the joints as read from ``robot.chain``, the model
 Pinocchio holds, in joint-local frames: :func:`.geometric.local_frames`; ``tol`` on every
-entry of the 3×4 pose, or the position for ``planar_2r``), duplicates dropped.  Arms of a class only within the classification tolerance (rounded URDF
-numbers) get their near-exact candidates (FK residual ≤ :data:`POLISH_MAX`) polished by
-Newton steps on the chain inside that call (a held 7th joint stays where it was asked to be),
-and by bounded least squares where that leaves any; a pose whose only
+entry of the 3×4 pose, or the position for ``planar_2r``), duplicates dropped.  Candidates
+inside the limits that are near a solution (FK residual ≤ :data:`POLISH_MAX`: an arm of its
+class only within the classification tolerance, with rounded URDF numbers; a least-squares
+root where a subproblem's two roots meet, at a singular pose) are polished by Newton steps on
+the chain inside that call (a held 7th joint stays where it was asked to be), and the exact
+ones by bounded least squares where that leaves any; a pose whose only
 candidates lie on or just beyond a limit, or on a singular family whose representative is
 outside the limits, is rescued along its self-motions (:func:`_rescue`).
 
@@ -140,7 +142,9 @@ class AnalyticBatchResult:
     ``valid[i, b]``; elsewhere it is NaN (there is no solution on that branch — read ``valid``).
     ``branches`` the B labels, ``reasons`` N entries (None where some branch is valid),
     ``swivel`` (N, B) for human_arm7, :attr:`singular` N entries.  ``result[i]`` gives pose i
-    as an AnalyticIKResult."""
+    as an AnalyticIKResult.  ``solutions``, ``valid`` and ``residuals`` are read-only: a record
+    of what the call found, which :attr:`singular` reads when it is first asked for (copy
+    them to edit; ``result[i]`` holds copies)."""
 
     solutions: np.ndarray
     valid: np.ndarray
@@ -724,8 +728,6 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     singular_of = None
     if s.kind == "geo":
         TH = Q if polished else th                                  # polished: a plain arm, Q = θ
-        if TH is Q:
-            TH = TH.copy()               # `singular` describes the solutions found, whatever a caller writes into them
         plan = s.plan
 
         def singular_of(rows):
@@ -736,6 +738,8 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     invalid = ~valid
     Q[invalid] = np.nan
     res[invalid] = np.nan
+    for a in (Q, res, valid):            # a record of what the call found (`singular` reads θ and valid later)
+        a.flags.writeable = False
     return AnalyticBatchResult(solutions=Q, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swivel is None else np.where(valid, swivel, np.nan), residuals=res,
                                _singular_of=singular_of, model=robot.name)

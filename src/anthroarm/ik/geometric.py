@@ -783,8 +783,10 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     writes Q (N, 8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
     residual; inf where there is no candidate, and for an exact candidate outside the limits,
     which is never returned and so not checked), OK (a solution: candidate, inside, residual
-    ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); returns the index of
-    the first malformed pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
+    ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); a candidate inside the
+    limits with tol < residual ≤ :data:`POLISH_MAX` is polished (:func:`_polish_chain`) and
+    kept polished where that brings it within tol.  Returns the index of the first malformed
+    pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
@@ -827,7 +829,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
             CHK[b] = exists and (inside or not exact)
         _fk_residuals(A, Qi, QC, QS, CHK, n, Ti, RESi, S)
         for b in range(8):
-            if Vi[b] and Ei[b] and INi[b] and tol < RESi[b] <= POLISH_MAX:
+            if Vi[b] and INi[b] and tol < RESi[b] <= POLISH_MAX:
                 for j in range(n):
                     q[j] = Qi[b, j]
                 r = _polish_chain(A, q, n, Ti, lo, hi, tol, J, F)
@@ -1039,9 +1041,10 @@ class BadPoseError(ValueError):
         self.index = index
 
 
-#: FK residual up to which a candidate of an arm that is of its class only within the
-#: classification tolerance is polished (:func:`_polish_chain` in the compiled call; what
-#: that leaves, :func:`anthroarm.ik.closed_form.analytic`)
+#: FK residual up to which a candidate inside the limits is polished (:func:`_polish_chain` in
+#: the compiled call): an arm that is of its class only within the classification tolerance, a
+#: least-squares root where a subproblem's two roots meet (a singular pose); what that leaves,
+#: :func:`anthroarm.ik.closed_form.analytic`
 POLISH_MAX = 1e-4
 #: Newton steps of :func:`_polish_chain` at most (quadratic convergence from ~1e-7: two suffice)
 POLISH_STEPS = 4
