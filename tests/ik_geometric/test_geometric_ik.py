@@ -837,6 +837,10 @@ def test_batch_singular_is_that_of_the_solutions_found():
     one = B[0]
     one.solutions[0, 4] = 0.0                                   # a copy: the batch is unchanged
     assert B.solutions[0, 0, 4] != 0.0 and B[0].singular is None
+    tree = aa.load("human_upper_limb")                         # a tree's result, mapped onto the robot
+    Bt = aa.ik.analytic_batch(tree, _fk(tree, tree.random_q(rng=3))[None])
+    with pytest.raises(ValueError, match="read-only"):
+        Bt.solutions[0, 0] = 0.0
 
 
 def test_a_reachable_pose_at_a_tangent_root_is_solved():

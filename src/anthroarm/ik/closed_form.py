@@ -157,6 +157,11 @@ class AnalyticBatchResult:
     _singular_of: object = field(default=None, repr=False, compare=False)
     model: str = ""
 
+    def __post_init__(self):
+        for a in (self.solutions, self.valid, self.residuals):   # what `singular` reads later
+            if a is not None:
+                a.flags.writeable = False
+
     @functools.cached_property
     def singular(self) -> list:
         """:attr:`AnalyticIKResult.singular` of every pose (N entries), computed on first use."""
@@ -365,6 +370,15 @@ def _unnamed(robot, frame) -> str:
     f = robot.chain.frame(frame)
     return (f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame {robot.chain.frame(f.name).index}; "
             "the closed form solves for a frame known by its name: use aa.ik.solve(robot, T, frame=...)")
+
+
+def _frame_robot(robot, frame):
+    """:func:`_retooled`, or :class:`~anthroarm.errors.UnsupportedModelError` where ``frame`` has
+    no closed form of its own (its name is an earlier frame's)."""
+    other = _retooled(robot, frame)
+    if other is None:
+        raise UnsupportedModelError(_unnamed(robot, frame))
+    return other
 
 
 def _at(robot, frame):
@@ -589,10 +603,8 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     :class:`~anthroarm.errors.UnsupportedModelError` for a robot without a closed form."""
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
-    other = _retooled(robot, frame)
+    other = _frame_robot(robot, frame)
     if other is not robot:
-        if other is None:
-            raise UnsupportedModelError(_unnamed(robot, frame))
         return analytic_batch(other, T, swivel=swivel, position_only=position_only, tol=tol,
                               tol_orthonormal=tol_orthonormal, param=param, q_rest=q_rest, _single_grid=_single_grid)
     s = _require(robot)
@@ -738,8 +750,6 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
     invalid = ~valid
     Q[invalid] = np.nan
     res[invalid] = np.nan
-    for a in (Q, res, valid):            # a record of what the call found (`singular` reads θ and valid later)
-        a.flags.writeable = False
     return AnalyticBatchResult(solutions=Q, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swivel is None else np.where(valid, swivel, np.nan), residuals=res,
                                _singular_of=singular_of, model=robot.name)
@@ -820,10 +830,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
         _check_tol("tol_orthonormal", tol_orthonormal)
-    other = _retooled(robot, frame)
+    other = _frame_robot(robot, frame)
     if other is not robot:
-        if other is None:
-            raise UnsupportedModelError(_unnamed(robot, frame))
         return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
                         tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
@@ -924,7 +932,7 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
             if got is None:
                 return None
             q, res, rows = got
-            labels = s.plan.labels if len(grid) == 1 else _grid_labels(s.plan.labels, len(grid), "swivel")
+            labels = _grid_labels(s.plan.labels, len(grid), "swivel")
             return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[i] for i in rows.tolist()],
                                     None, grid[rows // len(s.plan.labels)], res, None, robot.name)
         else:

@@ -509,13 +509,18 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
     rotation errors (m, rad), in one compiled call; None where the pose has no solution there,
     is malformed or has a candidate to polish (the general path answers).  The seeds of
     :func:`anthroarm.ik.solve` (:func:`anthroarm.ik.closed_form.nearest_solver`)."""
-    out = np.empty((8 * len(swivel), 11))
-    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
-                     plan.lower_path, plan.upper_path, T, swivel, first, 1e-9, 1e-6,
-                     plan.order, ref, out)
+    K, out = _one_pose(plan, T, swivel, first, 1e-9, 1e-6, ref)
     if K <= 0:
         return None
     return out[:K, :7], float(out[0, 7]), float(out[0, 8])
+
+
+def _one_pose(plan: SRSPlan, T, swivel, first: bool, tol: float, tol_orthonormal: float, ref):
+    """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 11))."""
+    out = np.empty((8 * len(swivel), 11))
+    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
+                     plan.lower_path, plan.upper_path, T, swivel, first, tol, tol_orthonormal, plan.order, ref, out)
+    return K, out
 
 
 def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
@@ -524,9 +529,7 @@ def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
     call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (K,) into the
     8 S branches) — or None where there is none, the pose is malformed or a candidate is to
     be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with the reasons)."""
-    out = np.empty((8 * len(swivel), 11))
-    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
-                     plan.lower_path, plan.upper_path, T, swivel, False, tol, tol_orthonormal, plan.order, _NO_REF, out)
+    K, out = _one_pose(plan, T, swivel, False, tol, tol_orthonormal, _NO_REF)
     if K <= 0:
         return None
     return out[:K, :7], out[:K, 9], out[:K, 10].astype(np.intp)
