@@ -54,7 +54,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..jit import kernel
-from .vec3 import add, cross, dot, neg, norm, rotate, rotate_cs, scale, sub, vec, wrap
+from .vec3 import add, atan2, cross, dot, neg, norm, rotate, rotate_cs, scale, sub, vec, wrap
 
 #: default tolerance on the residual of an exact solution (the caller's length unit)
 TOL = 1e-9
@@ -180,7 +180,7 @@ def atan2_cs(y, x):
     again (θ is read once, the rotation kept exact to rounding).  r by ``math.hypot`` where
     x² + y² would lose digits (below 1e-290 or above 1e290); (cos θ, sin θ) from θ where r is
     0 or not finite."""
-    theta = math.atan2(y, x)
+    theta = atan2(y, x)
     rr = x * x + y * y
     r = math.sqrt(rr) if 1e-290 < rr < 1e290 else math.hypot(x, y)
     if 0.0 < r < math.inf:
