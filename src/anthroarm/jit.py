@@ -45,7 +45,11 @@ import pickle  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numba  # noqa: E402
-from numba.core import caching  # noqa: E402
+import numpy as np  # noqa: E402
+from numba import types  # noqa: E402
+from numba.core import caching, cgutils  # noqa: E402
+from numba.extending import intrinsic  # noqa: E402
+from numba.np.arrayobj import populate_array  # noqa: E402
 
 OPTIONS = dict(nogil=True, error_model="numpy")
 _MAGIC = b"anthroarm-sha256\n"
@@ -128,12 +132,66 @@ class VerifiedCache(caching.FunctionCache):
             return None
 
 
-def kernel(func):
+def kernel(func=None, *, counted: bool = True, inline: bool = False):
     """Compile ``func`` with Numba (:data:`OPTIONS`, the verified disk cache); the result is
-    called like ``func``, and its ``py_func`` is ``func`` itself."""
-    dispatcher = numba.njit(**OPTIONS)(func)
-    dispatcher._cache = VerifiedCache(func)          # numba.njit(cache=True) with our cache file
-    return dispatcher
+    called like ``func``, and its ``py_func`` is ``func`` itself.
+
+    ``@kernel(counted=False)`` compiles an entry point without Numba's reference counting
+    (``_nrt=False``): every array it or a kernel it calls touches is an argument or a
+    :func:`local` array, so no array is allocated on the heap, and the atomic reference counts
+    of each view (a large part of a call on small inputs) are not made.  A heap allocation in
+    any kernel it calls fails to compile.  Numba keeps one compiled body of a kernel per
+    argument types, whichever entry point compiled it first, so a kernel that such an entry
+    point calls must not return an array (a view returned uncounted to a counting caller would
+    be released once too often): a kernel that returns views is ``inline=True`` (compiled
+    into each caller's body, ``numba.njit(inline="always")``)."""
+    def wrap(f):
+        options = OPTIONS if counted else dict(OPTIONS, _nrt=False)
+        if inline:
+            options = dict(options, inline="always")
+        dispatcher = numba.njit(**options)(f)
+        dispatcher._cache = VerifiedCache(f)         # numba.njit(cache=True) with our cache file
+        return dispatcher
+    return wrap if func is None else wrap(func)
 
 
-__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel", "kernel_sources_digest"]
+def _local_array(dtype, ndim: int):
+    """A Numba intrinsic ``f(*shape)`` (``ndim`` literal sizes) that makes a C-order array of
+    ``dtype`` in the calling kernel's stack frame (LLVM ``alloca`` in its entry block: made once
+    per call, freed at its return; no heap, no reference count).  Its contents are undefined."""
+    def typer(typingctx, *sizes):
+        if len(sizes) != ndim or not all(isinstance(n, types.IntegerLiteral) for n in sizes):
+            raise numba.errors.RequireLiteralValue(f"a local array takes {ndim} literal sizes")
+        shape = [n.literal_value for n in sizes]
+        arrty = types.Array(dtype, ndim, "C")
+
+        def codegen(context, builder, sig, args):
+            ary = context.make_array(arrty)(context, builder)
+            llty = context.get_data_type(dtype)
+            size = context.get_abi_sizeof(llty)
+            intp = functools.partial(context.get_constant, types.intp)
+            strides = [size * int(np.prod(shape[i + 1:])) for i in range(ndim)]
+            populate_array(ary, data=cgutils.alloca_once(builder, llty, size=int(np.prod(shape))),
+                           shape=[intp(n) for n in shape], strides=[intp(s) for s in strides], itemsize=intp(size),
+                           meminfo=None)
+            return ary._getvalue()
+
+        return arrty(*sizes), codegen
+
+    if ndim == 1:
+        return intrinsic(lambda typingctx, n: typer(typingctx, n))
+    return intrinsic(lambda typingctx, rows, cols: typer(typingctx, rows, cols))
+
+
+#: ``local(n)`` / ``local2(rows, cols)``: float64 scratch arrays of literal sizes in the stack
+#: frame of the kernel that makes them (:func:`_local_array`); ``local_flags(n)`` booleans,
+#: ``local_ints2(rows, cols)`` int64.  Such an array must not outlive its kernel: it is never
+#: returned (copy out its values).
+local = _local_array(types.float64, 1)
+local2 = _local_array(types.float64, 2)
+local_flags = _local_array(types.boolean, 1)
+local_ints2 = _local_array(types.int64, 2)
+
+
+__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel", "kernel_sources_digest",
+           "local", "local2", "local_flags", "local_ints2"]

@@ -865,3 +865,4 @@ def test_a_reachable_pose_at_a_tangent_root_is_solved():
         assert len(r) > 0, (q.tolist(), r.reason)
         for s in r.solutions:
             assert np.abs(_fk(robot, s)[:3] - T[:3]).max() <= 1e-9 and robot.within_limits(s)
+

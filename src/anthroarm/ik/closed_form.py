@@ -306,21 +306,30 @@ class _Solver:
         return cf, ci, len(ci) - 3, by_mask, self.plan.param_joint is not None
 
 
-_SOLVERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+#: id(robot) → (its chain, its tool, its :class:`_Solver` or None); an entry leaves with its
+#: robot (``weakref.finalize``), and holds no reference to it
+_SOLVERS: dict = {}
 
 
 def _solver(robot):
     """The :class:`_Solver` of ``robot`` at its tool (cached per robot and chain), or None."""
-    hit = _SOLVERS.get(robot)
+    hit = _SOLVERS.get(id(robot))
     if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
         return hit[2]
+    out = _new_solver(robot)
+    if hit is None:
+        weakref.finalize(robot, _SOLVERS.pop, id(robot), None)
+    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out)
+    return out
+
+
+def _new_solver(robot):
+    """The :class:`_Solver` of ``robot`` at its tool, made (:func:`_solver` keeps it), or None."""
     ch = robot.chain
     arm = _arm_of(robot)
     if arm is not None:
         inner = _solver(arm.robot) if isinstance(arm, _Arm) else None
-        out = None if inner is None else _Solver(inner.kind, inner.plan, inner.form, False, arm)
-        _SOLVERS[robot] = (robot.chain, robot.tool, out)
-        return out
+        return None if inner is None else _Solver(inner.kind, inner.plan, inner.form, False, arm)
     plain = robot.nq == len(ch.independent) and all(ch.joints[j].kind != "continuous" for j in ch.independent)
     out = None
     pl = _fam.planar_plan(robot)
@@ -335,7 +344,6 @@ def _solver(robot):
         if gp is not None:
             out = _Solver("geo", gp, ClosedForm(gp.cls, len(gp.fk_axes), _geo.n_branches(gp.cls),
                                                 param=gp.param_joint is not None, cost_us=_cost(gp.cls)), plain)
-    _SOLVERS[robot] = (robot.chain, robot.tool, out)
     return out
 
 
@@ -830,14 +838,17 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
         _check_tol("tol_orthonormal", tol_orthonormal)
-    other = _frame_robot(robot, frame)
-    if other is not robot:
-        return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
-                        tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
+    if frame is not None:
+        other = _frame_robot(robot, frame)
+        if other is not robot:
+            return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
+                            tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
     arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
     if not arr.flags.c_contiguous:
         arr = np.ascontiguousarray(arr)          # a strided view: the compiled calls take C order
-    if method == "book":
+    if method != "robust":
+        if method != "book":
+            raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
         spec = getattr(robot, "spec", None)
         if spec is None or spec.name not in _models.BOOK_PROCEDURES or robot.nq != 6 or robot.tool != spec.tool_name:
             raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) is the book's procedure for the "
@@ -847,8 +858,6 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         if not single:
             raise ValueError("method='book' takes one pose")
         return _book_result(robot, Ts[0], spec.params, tol)
-    if method != "robust":
-        raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
     s = _solver(robot)
     if s is not None and s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
@@ -857,7 +866,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if q_rest is not None:
         _q_rest(robot, None, q_rest)
     one = None if s is None else s.one_call
-    if one is not None and arr.shape == (4, 4) and arr.dtype == _F64 and swivel is None and not position_only \
+    if one is not None and arr.shape == (4, 4) and arr.dtype is _F64 and swivel is None and not position_only \
             and (param is None) != one[4]:
         fast = _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal)
         if fast is not None:

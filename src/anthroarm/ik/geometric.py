@@ -73,7 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..jit import kernel
+from ..jit import kernel, local, local2, local_flags
 from ..threads import run_rows
 from . import classify as C
 from . import subproblems as sp
@@ -445,7 +445,7 @@ def _three_parallel(h, P, R06, p, B):
     """2 ∥ 3 ∥ 4 alone: (q1, q5) by SP6 (the two height equations along h2, of the position
     and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
-    t = np.empty((4, 2))
+    t = local2(4, 2)
     cnt, _ = sp6_one((h[1], h[1], h[1], h[1]), (neg(h[0]), h[4], neg(h[0]), h[4]),
                      (p06, neg(P[5]), mv(R06, h[5]), neg(h[5])),
                      dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4])), 0.0, TOL_QUARTIC, t)
@@ -461,7 +461,7 @@ def _spherical(h, P, R06, p, B):
     """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
     quartic, up to 4), then the wrist."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])
-    t = np.empty((4, 3))
+    t = local2(4, 3)
     cnt, _ = sp5_one(neg(P[1]), p16, P[2], P[3], neg(h[0]), h[1], h[2], TOL_QUARTIC, t)
     for j in range(4):
         if j >= cnt:
@@ -767,9 +767,10 @@ def _fk_residuals(A, Q, QC, QS, V, n, T, RES, S):
         RES[b] = _pose_error(R, t, T)
 
 
-@kernel
+@kernel(inline=True)
 def _unpack(cf, ci):
-    """The plan's constants from :attr:`GeoPlan.packed`."""
+    """The plan's constants from :attr:`GeoPlan.packed` (views of ``cf``: compiled into each
+    caller, :func:`anthroarm.jit.kernel`)."""
     n = ci[2]
     o = 70 + 12 * (n + 1)
     return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
@@ -777,7 +778,7 @@ def _unpack(cf, ci):
             cf[70:o].reshape((n + 1, 12)), cf[o:o + n], cf[o + n:o + 2 * n])
 
 
-@kernel
+@kernel(counted=False)
 def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     """Every branch of poses T (N, 4, 4) in path order, wrapped into the limits and FK-checked:
     writes Q (N, 8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
@@ -786,17 +787,18 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); a candidate inside the
     limits with tol < residual ≤ :data:`POLISH_MAX` is polished (:func:`_polish_chain`) and
     kept polished where that brings it within tol.  Returns the index of the first malformed
-    pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`."""
+    pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference
+    counts (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    B6 = np.empty((8, BRANCH_ROW))
-    q = np.empty(n)
-    QC, QS = np.empty((8, n)), np.empty((8, n))
-    S = np.empty((n + 1, 12))
-    J, F = np.empty((6, 6)), np.empty(6)
-    CHK = np.empty(8, dtype=np.bool_)
+    B6 = local2(8, 20)                               # BRANCH_ROW columns
+    q = local(7)
+    QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
+    S = local(96)[:12 * (n + 1)].reshape((n + 1, 12))
+    J, F = local2(6, 6), local(6)
+    CHK = local_flags(8)
     for i in range(len(T)):
         # each row of the batch viewed once (a view is a reference count)
         Ti, Qi, Vi, Ei, INi, RESi, OKi = T[i], Q[i], V[i], E[i], IN[i], RES[i], OK[i]
@@ -992,7 +994,7 @@ def nearest_first(out, K, n, ref, width):
         out[0, j], out[kb, j] = out[kb, j], out[0, j]
 
 
-@kernel
+@kernel(counted=False)
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 4):
     θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
@@ -1004,10 +1006,11 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     polishing)."""
     n = ci[2]
     Tb = T.reshape((1, 4, 4))
-    pv = np.full(1, param)
-    Q, RES = np.empty((1, 8, n)), np.empty((1, 8))
-    V, E = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
-    IN, OK = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
+    pv = local(1)
+    pv[0] = param
+    Q, RES = local(56)[:8 * n].reshape((1, 8, n)), local2(1, 8)
+    V, E = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
+    IN, OK = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
     if _verified(cf, ci, Tb, pv, tol, tol_orthonormal, Q, V, E, IN, RES, OK) >= 0:
         return -1
     K, mask = 0, 0

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..jit import kernel
+from ..jit import kernel, local, local2, local_flags, local_ints2
 from .vec3 import add, atan2, cross, dot, neg, norm, rotate, rotate_cs, scale, sub, vec, wrap
 
 #: default tolerance on the residual of an exact solution (the caller's length unit)
@@ -534,10 +534,10 @@ def _bracket_roots(a, n, crit, cmul, m, out, omul):
 
 
 @kernel
-def real_roots(c):
-    """Real roots of a polynomial of degree ≤ 4 (coefficients ``c`` (5,), highest first): roots
-    (4,) ascending with multiplicity (a double root twice) and which are real (4,) (the real
-    ones first; 0.0 in the other slots).  The coefficients are scaled by the largest abs(cᵢ);
+def real_roots(c, x, real):
+    """Real roots of a polynomial of degree ≤ 4 (coefficients ``c`` (5,), highest first) into
+    ``x`` (4,) ascending with multiplicity (a double root twice) and ``real`` (4,) which are
+    real (the real ones first; 0.0 in the other slots).  The coefficients are scaled by the largest abs(cᵢ);
     leading ones below 1e-10 (the first) or 1e-14 (the next) of it are dropped (lower degree);
     the zero polynomial and constants have no roots.
 
@@ -557,19 +557,24 @@ def real_roots(c):
     while first < 4 and abs(c[first] / s) <= (1e-10 if first == 0 else 1e-14):
         first += 1                                    # lower degree (rare)
     deg = 4 - first
-    x = np.zeros(4)
-    real = np.zeros(4, dtype=np.bool_)
+    for i in range(4):
+        x[i], real[i] = 0.0, False
     if deg == 0:
-        return x, real
-    D = np.zeros((4, 5))                              # D[k]: k-th derivative, degree deg − k
+        return
+    D = local2(4, 5)                                  # D[k]: k-th derivative, degree deg − k
+    R = local2(4, 4)
+    M = local_ints2(4, 4)
+    for k in range(4):
+        for i in range(5):
+            D[k, i] = 0.0
+        for i in range(4):
+            R[k, i], M[k, i] = 0.0, 0
     for i in range(deg + 1):
         D[0, i] = c[first + i] / s
     for k in range(1, deg):
         mk = deg - k + 1
         for i in range(mk):
             D[k, i] = D[k - 1, i] * (mk - i)
-    R = np.zeros((4, 4))
-    M = np.zeros((4, 4), dtype=np.int64)
     cnt = 1
     R[deg - 1, 0] = -D[deg - 1, 1] / D[deg - 1, 0]
     M[deg - 1, 0] = 1
@@ -582,7 +587,6 @@ def real_roots(c):
                 x[j] = R[0, r]
                 real[j] = True
                 j += 1
-    return x, real
 
 
 @kernel
@@ -600,12 +604,17 @@ def _solve3(J, F):
 @kernel
 def _keep_best(theta, ok, res, out_theta, out_exact, m):
     """Sort candidate solutions by residual, drop the invalid and duplicates (within 1e-6 rad),
-    keep the first 4 in ``out_theta`` (4, m); returns the count."""
-    order = np.argsort(np.where(ok, res, np.inf), kind="mergesort")
+    keep the first 4 in ``out_theta`` (4, m); returns the count.  ``ok`` is consumed (the
+    candidates are taken in order of residual, the first of equal ones first)."""
     cnt = 0
-    for j in order:
-        if not ok[j] or cnt == 4:
+    while cnt < 4:
+        j = -1
+        for i in range(len(ok)):
+            if ok[i] and (j < 0 or res[i] < res[j]):
+                j = i
+        if j < 0:
             break
+        ok[j] = False
         dup = False
         for a in range(cnt):
             d = 0.0
@@ -696,22 +705,23 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
     a, b = P1[0] - P3[0], P1[1] - P3[1]                # P13 = a z + b
     sq = (a * a, 2.0 * a * b, b * b)                   # P13²
     rhs = (R3[0] - R1[0] - sq[0], R3[1] - R1[1] - sq[1], R3[2] - R1[2] - sq[2])
-    eq = np.empty(5)                                   # rhs² − 4 P13² R1
+    eq = local(5)                                      # rhs² − 4 P13² R1
     eq[0] = rhs[0] * rhs[0] - 4.0 * sq[0] * R1[0]
     eq[1] = 2.0 * rhs[0] * rhs[1] - 4.0 * (sq[0] * R1[1] + sq[1] * R1[0])
     eq[2] = rhs[1] * rhs[1] + 2.0 * rhs[0] * rhs[2] - 4.0 * (sq[0] * R1[2] + sq[1] * R1[1] + sq[2] * R1[0])
     eq[3] = 2.0 * rhs[1] * rhs[2] - 4.0 * (sq[1] * R1[2] + sq[2] * R1[1])
     eq[4] = rhs[2] * rhs[2] - 4.0 * sq[2] * R1[2]
-    z, real = real_roots(eq)
+    z, real = local(4), local_flags(4)
+    real_roots(eq, z, real)
     k1p1, k3p3 = cross(k1, p1), cross(k3, p3)
     kk1p1, kk3p3 = cross(k1, k1p1), cross(k3, k3p3)
     a1 = (dot(k1p1, k2), -dot(kk1p1, k2))              # A1ᵀ k2
     a3 = (dot(k3p3, k2), -dot(kk3p3, k2))
     na1 = max(a1[0] * a1[0] + a1[1] * a1[1], 1e-300)
     na3 = max(a3[0] * a3[0] + a3[1] * a3[1], 1e-300)
-    theta = np.zeros((16, 3))
-    ok = np.zeros(16, dtype=np.bool_)
-    res = np.full(16, np.inf)
+    theta, ok, res = local2(16, 3), local_flags(16), local(16)
+    for i in range(16):
+        theta[i, 0], theta[i, 1], theta[i, 2], ok[i], res[i] = 0.0, 0.0, 0.0, False, math.inf
     scl = 1.0 + norm(p0) + norm(p1) + norm(p2) + norm(p3)
     # Newton stops early below this residual (far below tol: the same exact solutions)
     stop = min(1e-13 * scl, 1e-3 * tol)
@@ -755,7 +765,7 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
             theta[i, 0], theta[i, 1], theta[i, 2] = t
             res[i] = rs
             ok[i] = rs <= tol
-    exact = np.zeros(4, dtype=np.bool_)
+    exact = local_flags(4)
     return _keep_best(theta, ok, res, out_theta, exact, 3), False
 
 
@@ -817,8 +827,7 @@ def _conic(xm0, xm1, n00, n01, n10, n11):
 def sp6_one(H, K, P, d1, d2, tol, out_theta):
     """SP6 of one problem (H, K, P: 4-tuples of vector tuples): writes the solutions into
     ``out_theta`` (4, 2) and returns (count, singular); see :func:`sp6`."""
-    A = np.zeros((2, 4))
-    hk = np.empty(4)
+    A, hk = local2(2, 4), local(4)
     for q in range(4):
         kxp = cross(K[q], P[q])
         row, col = q // 2, 2 * (q % 2)
@@ -829,21 +838,58 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
     for j in range(4):
         out_theta[j, 0] = math.nan
         out_theta[j, 1] = math.nan
-    U, S, Vt = np.linalg.svd(A)                        # A = U diag(S) Vt, Vt (4, 4)
-    amax = np.abs(A).max()
-    if S[0] * S[1] <= 1e-12 * max(1.0, amax) ** 2:
+    # A = L Eᵀ: the rows of A orthonormalised (Gram–Schmidt), L lower triangular; the
+    # product of A's singular values is |det L| = ‖a0‖ ‖w‖
+    Vt, amax = local2(4, 4), 0.0
+    n0 = 0.0
+    for i in range(4):
+        n0 += A[0, i] * A[0, i]
+        amax = max(amax, abs(A[0, i]), abs(A[1, i]))
+    n0 = math.sqrt(n0)
+    if n0 <= 0.0:
+        return 0, True
+    l10, nw = 0.0, 0.0
+    for i in range(4):
+        Vt[0, i] = A[0, i] / n0
+        l10 += Vt[0, i] * A[1, i]
+    for i in range(4):
+        Vt[1, i] = A[1, i] - l10 * Vt[0, i]
+        nw += Vt[1, i] * Vt[1, i]
+    nw = math.sqrt(nw)
+    if n0 * nw <= 1e-12 * max(1.0, amax) ** 2:
         return 0, True                                 # the two equations are not independent
-    y0 = (U[0, 0] * b0 + U[1, 0] * b1) / S[0]
-    y1 = (U[0, 1] * b0 + U[1, 1] * b1) / S[1]
-    xm = np.empty(4)
+    for i in range(4):
+        Vt[1, i] /= nw
+    y0 = b0 / n0
+    y1 = (b1 - l10 * y0) / nw
+    xm = local(4)
     for i in range(4):
         xm[i] = Vt[0, i] * y0 + Vt[1, i] * y1          # minimum-norm solution of A x = b
+    # the null space of A: the columns of I − E Eᵀ of largest norm, one after the other
+    for r in (2, 3):
+        best, kb = -1.0, 0
+        for k in range(4):
+            d = 1.0
+            for m in range(r):
+                d -= Vt[m, k] * Vt[m, k]
+            if d > best:
+                best, kb = d, k
+        nn = 0.0
+        for i in range(4):
+            v = 1.0 if i == kb else 0.0
+            for m in range(r):
+                v -= Vt[m, i] * Vt[m, kb]
+            Vt[r, i] = v
+            nn += v * v
+        nn = math.sqrt(nn)
+        for i in range(4):
+            Vt[r, i] /= nn
     # x = xm + N ξ with N = [Vt[2], Vt[3]]ᵀ (the null space of A)
     a, b_, c, d, e, f = _conic(xm[0], xm[1], Vt[2, 0], Vt[3, 0], Vt[2, 1], Vt[3, 1])
     a1, b1_, c1, dd1, e1, fq = _conic(xm[2], xm[3], Vt[2, 2], Vt[3, 2], Vt[2, 3], Vt[3, 3])
     b1 = b1_
     # resultant in ξ2 of the two conics (eliminating ξ1)
-    z = np.empty(5)
+    z = local(5)
     z[4] = (f * a * dd1 ** 2 + a ** 2 * fq ** 2 - d * a * dd1 * fq + a1 ** 2 * f ** 2 - 2 * a * fq * a1 * f
             - d * dd1 * a1 * f + a1 * d ** 2 * fq)
     z[3] = (e1 * d ** 2 * a1 - fq * dd1 * a * b_ - 2 * a * fq * a1 * e - f * a1 * b1 * d + 2 * dd1 * b1 * a * f
@@ -859,10 +905,11 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
             + 2 * e * c * a1 ** 2 - c * a1 * dd1 * b_ + 2 * dd1 * b1 * a * c - c1 * dd1 * a * b_)
     z[0] = (a ** 2 * c1 ** 2 - 2 * a * c1 * a1 * c + a1 ** 2 * c ** 2 - b_ * a * b1 * c1 - b_ * b1 * a1 * c
             + b_ ** 2 * a1 * c1 + c * a * b1 ** 2)
-    xi2s, real = real_roots(z)
-    theta = np.zeros((4, 2))
-    ok = np.zeros(4, dtype=np.bool_)
-    res = np.full(4, np.inf)
+    xi2s, real = local(4), local_flags(4)
+    real_roots(z, xi2s, real)
+    theta, ok, res = local2(4, 2), local_flags(4), local(4)
+    for i in range(4):
+        theta[i, 0], theta[i, 1], ok[i], res[i] = 0.0, 0.0, False, math.inf
     scl = 1.0 + norm(P[0]) + norm(P[1]) + norm(P[2]) + norm(P[3])
     for r in range(4):
         if not real[r]:
@@ -872,7 +919,7 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         if abs(den) <= 1e-300:
             continue
         xi1 = -(a * fq + a * c1 * xi2 ** 2 - a1 * c * xi2 ** 2 + a * e1 * xi2 - a1 * e * xi2 - a1 * f) / den
-        x = np.empty(4)
+        x = local(4)
         for i in range(4):
             x[i] = xm[i] + Vt[2, i] * xi1 + Vt[3, i] * xi2
         t0, t1 = math.atan2(x[0], x[1]), math.atan2(x[2], x[3])
@@ -883,7 +930,7 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
             continue
         for _ in range(3):                             # Newton polish on the two equations
             F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
-            g = np.empty(4)
+            g = local(4)
             for q in range(4):
                 tq = t0 if q % 2 == 0 else t1
                 g[q] = dot(H[q], cross(K[q], rotate(K[q], tq, P[q])))
@@ -896,7 +943,7 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         theta[r, 0], theta[r, 1] = t0, t1
         res[r] = max(abs(F0), abs(F1))
         ok[r] = res[r] <= tol
-    exact = np.zeros(4, dtype=np.bool_)
+    exact = local_flags(4)
     return _keep_best(theta, ok, res, out_theta, exact, 2), False
 
 
@@ -917,7 +964,7 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
 
     IK-Geo §III-F: with x = (sin θ1, cos θ1, sin θ2, cos θ2) both equations are linear,
     A x = b (A 2×4 built from Eq. (2)); x = x_min + N ξ with the minimum-norm solution and the
-    null space of A (here from its SVD), and the two unit-circle constraints
+    null space of A (here by Gram–Schmidt on the rows of A), and the two unit-circle constraints
     ‖x[0:2]‖ = ‖x[2:4]‖ = 1 are two ellipses in ξ ∈ ℝ², whose intersection is a quartic in ξ₂
     (closed-form ellipse–ellipse elimination).  Up to 4 solutions, each verified: both
     residuals (length unit) at most ``tol``; no least-squares solution.  ``singular``: the
