@@ -833,7 +833,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
     (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
-    (≈ 5–6 µs from Python, limits and FK check included); see the module docstring."""
+    (≈ 4–5 µs from Python, limits and FK check included); see the module docstring."""
     if not (type(tol) is float and type(tol_orthonormal) is float        # the usual call: one test
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
