@@ -57,9 +57,9 @@ import numpy as np
 from ..jit import kernel
 from ..threads import run_rows
 from . import classify as C
-from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, POLISH_MAX, SIN, BadPoseError, _common_point, _fk_residuals,
-                        _mark_solutions, _pose_status, _rot3, _target_errors, _wrist, into_limit,
-                        into_limits, local_frames, nearest_first)
+from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _common_point,
+                        _fk_residuals, _mark_solutions, _pose_status, _rot3, _target_errors, _wrist,
+                        into_limit_cs, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
 from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, scale, sub, transpose, vec, wrap
 
@@ -446,11 +446,9 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol
                 r = 8 * k + b
                 inside = True
                 for j in range(7):
-                    x = Qb[b, j]
-                    Qi[r, j], ok = into_limit(x, lo[j], hi[j])
+                    Qi[r, j], QC[b, j], QS[b, j], ok = into_limit_cs(Qb[b, j], QC[b, j], QS[b, j], lo[j], hi[j],
+                                                                     Vb[b])
                     inside = inside and ok
-                    if Vb[b] and Qi[r, j] != x:           # moved by 2π or onto a limit: its own cos, sin
-                        QC[b, j], QS[b, j] = math.cos(Qi[r, j]), math.sin(Qi[r, j])
                 Vi[r], Ei[r], INi[r] = Vb[b], Eb[b], inside
                 CHK[b] = Vb[b] and (inside or not Eb[b])
             _fk_residuals(A, Qi[8 * k:8 * k + 8], QC, QS, CHK, 7, Ti, RESi[8 * k:8 * k + 8], Sfk)
@@ -529,13 +527,10 @@ def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
     call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (K,) into the
     8 S branches) — or None where there is none, the pose is malformed or a candidate is to
     be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with the reasons)."""
-    K, out = _one_pose(plan, T, swivel, False, tol, tol_orthonormal, _NO_REF)
+    K, out = _one_pose(plan, T, swivel, False, tol, tol_orthonormal, NO_REF)
     if K <= 0:
         return None
     return out[:K, :7], out[:K, 9], out[:K, 10].astype(np.intp)
-
-
-_NO_REF = np.zeros(0)
 
 
 def _swivel_array(swivel, N, check=True):

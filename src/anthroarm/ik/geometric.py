@@ -548,6 +548,17 @@ def into_limit(x, lo, hi):
 
 
 @kernel
+def into_limit_cs(x, c, s, lo, hi, exists):
+    """:func:`into_limit` of an angle x carried with its cosine and sine (c, s): (the angle, its
+    cosine, its sine, whether it is inside) — cos and sin of the angle returned where that is
+    not x (moved by 2π or onto a limit) and the branch ``exists``."""
+    q, ok = into_limit(x, lo, hi)
+    if exists and q != x:
+        c, s = math.cos(q), math.sin(q)
+    return q, c, s, ok
+
+
+@kernel
 def into_limits(q, n, lo, hi):
     """:func:`into_limit` of the angles q[:n] (rad) in place, limits lo, hi (n,); returns
     whether every joint is inside."""
@@ -612,9 +623,7 @@ def local_frames(axes, points, M) -> np.ndarray:
     axes, points, M = (np.asarray(a, dtype=float) for a in (axes, points, M))
     frames = []
     for k, o in zip(axes, points):
-        i = int(np.argmin(np.abs(k)))                              # :func:`.vec3.perpendicular`
-        x = np.cross(k, np.eye(3)[i])
-        x /= np.linalg.norm(x)
+        x = np.array(perpendicular(tuple(k)))
         frames.append((np.column_stack([x, np.cross(k, x), k]), o))
     A = np.empty((len(frames) + 1, 12))
     chain = [(np.eye(3), np.zeros(3))] + frames + [(M[:3, :3], M[:3, 3])]
@@ -793,14 +802,13 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
-    B6 = local2(8, 20)                               # BRANCH_ROW columns
+    B6 = local2(8, BRANCH_ROW)
     q = local(7)
     QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
     S = local(96)[:12 * (n + 1)].reshape((n + 1, 12))
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
-        # each row of the batch viewed once (a view is a reference count)
         Ti, Qi, Vi, Ei, INi, RESi, OKi = T[i], Q[i], V[i], E[i], IN[i], RES[i], OK[i]
         if _pose_status(Ti, tol_orthonormal) != 0:
             return i
@@ -822,11 +830,9 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
             exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
             for j in range(n):
                 jj = 5 - j if rev else j
-                x, QC[b, j], QS[b, j] = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
-                Qi[b, j], ok = into_limit(x, lo[j], hi[j])
+                x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
+                Qi[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(x, c, s, lo[j], hi[j], exists)
                 inside = inside and ok
-                if exists and Qi[b, j] != x:             # moved by 2π or onto a limit: its own cos, sin
-                    QC[b, j], QS[b, j] = math.cos(Qi[b, j]), math.sin(Qi[b, j])
             Vi[b], Ei[b], INi[b] = exists, exact, inside
             CHK[b] = exists and (inside or not exact)
         _fk_residuals(A, Qi, QC, QS, CHK, n, Ti, RESi, S)

@@ -602,7 +602,7 @@ def _solve3(J, F):
 
 
 @kernel
-def _keep_best(theta, ok, res, out_theta, out_exact, m):
+def _keep_best(theta, ok, res, out_theta, m):
     """Sort candidate solutions by residual, drop the invalid and duplicates (within 1e-6 rad),
     keep the first 4 in ``out_theta`` (4, m); returns the count.  ``ok`` is consumed (the
     candidates are taken in order of residual, the first of equal ones first)."""
@@ -626,7 +626,6 @@ def _keep_best(theta, ok, res, out_theta, out_exact, m):
         if not dup:
             for c in range(m):
                 out_theta[cnt, c] = theta[j, c]
-            out_exact[cnt] = True
             cnt += 1
     return cnt
 
@@ -765,8 +764,7 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
             theta[i, 0], theta[i, 1], theta[i, 2] = t
             res[i] = rs
             ok[i] = rs <= tol
-    exact = local_flags(4)
-    return _keep_best(theta, ok, res, out_theta, exact, 3), False
+    return _keep_best(theta, ok, res, out_theta, 3), False
 
 
 @kernel
@@ -943,8 +941,7 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         theta[r, 0], theta[r, 1] = t0, t1
         res[r] = max(abs(F0), abs(F1))
         ok[r] = res[r] <= tol
-    exact = local_flags(4)
-    return _keep_best(theta, ok, res, out_theta, exact, 2), False
+    return _keep_best(theta, ok, res, out_theta, 2), False
 
 
 @kernel
