@@ -9,18 +9,25 @@ from .jit import kernel
 
 
 @kernel
+def put_joint(q, j, continuous, theta, c, s):
+    """One joint's entries of a configuration q: θ at q[j], or (c, s) = (cos θ, sin θ) at q[j],
+    q[j + 1] for a continuous joint (Pinocchio's unit-complex form)."""
+    if continuous:
+        q[j], q[j + 1] = c, s
+    else:
+        q[j] = theta
+
+
+@kernel
 def configure(theta, index, q):
     """q (N, nq) from the positions θ (N, n) of the independent joints (rad, m for a prismatic
     joint; :meth:`anthroarm.chain.Chain.configuration`): a joint's θ, or (cos θ, sin θ) for a
     continuous one (``index`` (n, 2), ``Chain._configuration_index``: its first entry in q,
-    continuous or not)."""
+    continuous or not; :func:`put_joint`)."""
     for i in range(theta.shape[0]):
         for k in range(theta.shape[1]):
-            j = index[k, 0]
-            if index[k, 1]:
-                q[i, j], q[i, j + 1] = math.cos(theta[i, k]), math.sin(theta[i, k])
-            else:
-                q[i, j] = theta[i, k]
+            t, cont = theta[i, k], index[k, 1] != 0
+            put_joint(q[i], index[k, 0], cont, t, math.cos(t) if cont else 0.0, math.sin(t) if cont else 0.0)
 
 
-__all__ = ["configure"]
+__all__ = ["configure", "put_joint"]

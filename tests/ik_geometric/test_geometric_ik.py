@@ -10,6 +10,8 @@ on the same poses (skipped when ik_geo is not installed)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -455,6 +457,24 @@ def test_into_limits_takes_the_turn_nearest_zero():
     assert np.abs(r.solutions - q).max(1).min() < 1e-9     # the sampled angles themselves, no turn added
 
 
+def test_into_limit_keeps_the_rotation_of_a_turn_and_recomputes_it_on_a_limit():
+    """An angle carried with its (cos, sin): moved by whole turns it keeps them (the same
+    rotation, no trigonometry); put onto a limit it gets cos and sin of the angle returned
+    (oracle: math.cos / math.sin of the returned angle)."""
+    x = -0.5
+    c, s = math.cos(x), math.sin(x)
+    q, qc, qs, ok = G.into_limit_cs(x, c, s, 0.0, 2 * np.pi, True)
+    assert ok and q == pytest.approx(2 * np.pi - 0.5, abs=1e-15)
+    assert (qc, qs) == (c, s)                                    # the turn: the same numbers
+    assert abs(qc - math.cos(q)) < 1e-15 and abs(qs - math.sin(q)) < 1e-15
+    x = 1.0 + 5e-10                                              # onto the limit 1.0
+    q, qc, qs, ok = G.into_limit_cs(x, math.cos(x), math.sin(x), -1.0, 1.0, True)
+    assert ok and q == 1.0 and (qc, qs) == (math.cos(1.0), math.sin(1.0))
+    x = 1.0 + 5e-10 + 2 * np.pi                                  # a turn, then onto the limit 1.0
+    q, qc, qs, ok = G.into_limit_cs(x, math.cos(x), math.sin(x), -1.0, 1.0, True)
+    assert ok and q == 1.0 and (qc, qs) == (math.cos(1.0), math.sin(1.0))
+
+
 def test_results_pickle_with_their_singular_text(tmp_path):
     """A single and a batch result cross a process boundary (pickle) with `singular` evaluated:
     the singular PUMA pose keeps its text, a generic pose its None."""
@@ -518,6 +538,25 @@ def test_target_errors_are_pinocchios():
         pe, re = G._target_errors(A, q, n, np.ascontiguousarray(T))
         assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-13)
         assert re == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13)
+
+
+def test_continuous_joints_come_out_as_the_chains_configuration():
+    """kinova (3 continuous joints, nq = 9): the configurations the compiled call writes (one
+    pose and a batch) are Chain.configuration of their own angles (unit (cos, sin) pairs, to
+    1e-15), and Pinocchio's FK of each is the pose."""
+    robot = aa.load("kinova")
+    ch = robot.chain
+    T = np.array([_fk(robot, q) for q in robot.random_q(20, rng=5)])
+    batch = aa.ik.analytic_batch(robot, T)
+    for i in range(len(T)):
+        one = aa.ik.analytic(robot, T[i])
+        assert one.solutions.shape == (len(one), robot.nq) and len(one) > 0
+        np.testing.assert_array_equal(one.solutions, batch.solutions[i][batch.valid[i]])
+        th = ch.angles(one.solutions)[:, list(ch.independent)]
+        np.testing.assert_allclose(one.solutions, ch.configuration(th), rtol=0, atol=1e-15)
+        for q in one.solutions:
+            assert np.abs(_fk(robot, q) - T[i])[:3].max() <= 1e-9
+    assert np.isnan(batch.solutions[~batch.valid]).all()
 
 
 def test_solve_answers_a_closed_class_from_the_compiled_call():

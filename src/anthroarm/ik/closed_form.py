@@ -295,19 +295,22 @@ class _Solver:
 
     @functools.cached_property
     def one_call(self):
-        """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints,
-        the labels of the solutions by the bit mask of their branches (how the compiled call
-        returns them: 256 tuples), whether a 7th joint is held); None for the other kinds."""
+        """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints
+        n, the labels of the solutions by the bit mask of their branches (how the compiled call
+        returns them: 256 tuples), whether a 7th joint is held, the width of a solution: n, or
+        nq where q is not θ (continuous joints)); None for the other kinds."""
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
         labels = self.plan.labels
         by_mask = tuple(tuple(labels[b] for b in range(8) if mask >> b & 1) for mask in range(256))
-        return cf, ci, len(ci) - 3, by_mask, self.plan.param_joint is not None
+        n = int(ci[2])
+        return cf, ci, n, by_mask, self.plan.param_joint is not None, n if self.plain else self.plan.chain.nq
 
 
-#: id(robot) → (its chain, its tool, its :class:`_Solver` or None); an entry leaves with its
-#: robot (``weakref.finalize``), and holds no reference to it
+#: id(robot) → (its chain, its tool, its :class:`_Solver` or None, the solver's
+#: :attr:`_Solver.one_call` where :func:`analytic` may answer one pose by it (no tree), else
+#: None); an entry leaves with its robot (``weakref.finalize``), and holds no reference to it
 _SOLVERS: dict = {}
 
 
@@ -319,7 +322,7 @@ def _solver(robot):
     out = _new_solver(robot)
     if hit is None:
         weakref.finalize(robot, _SOLVERS.pop, id(robot), None)
-    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out)
+    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out, None if out is None or out.arm is not None else out.one_call)
     return out
 
 
@@ -678,15 +681,15 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
         except _geo.BadPoseError as exc:
             _detail_bad_pose(Ts, exc.index // S, single, tol_orthonormal)
             raise
-        th, valid, cand, exact, inside, res = (a.reshape((N, B) + a.shape[2:]) for a in out)
+        th, valid, cand, exact, inside, res, conf = (a.reshape((N, B) + a.shape[2:]) for a in out)
     else:
         th, cand, exact = (a.reshape((N, B) + a.shape[2:]) for a in _geo.solve(gp, Tr, prm))
         th, inside = _geo.wrap_into_limits(th, gp.lower, gp.upper)
         cand = cand & np.isfinite(th).all(-1)
         Q = gp.chain.configuration(np.where(cand[..., None], th, 0.0))
         res = np.where(cand, _fk_residual(robot, Q, Ts, False), np.inf)
-        valid = None
-    return _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, False)
+        valid = conf = None
+    return _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, False, conf=conf)
 
 
 def _grid_labels(labels, S, what):
@@ -716,12 +719,13 @@ def _planar_batch(robot, s, T, position_only, tol):
     return _finish(robot, s, Ts, th, cand, exact, inside, res, None, labels, tol, po)
 
 
-def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, position_only, swivel=None):
-    """From the compiled solver's branches to the result: configurations, polish of near-exact
-    candidates, duplicates, the rescue of poses whose candidates lie on a limit, reasons."""
+def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, position_only, swivel=None, conf=None):
+    """From the compiled solver's branches to the result: configurations (``conf``, where the
+    compiled call made them), polish of near-exact candidates, duplicates, the rescue of poses
+    whose candidates lie on a limit, reasons."""
     N, B = cand.shape
     ch = robot.chain
-    Q = th if s.plain else ch.configuration(th)          # NaN where no candidate, NaN below where no solution
+    Q = th if s.plain else conf if conf is not None else ch.configuration(th)   # NaN below where no solution
     res = np.array(res, dtype=float)
     near = cand & exact & inside & (res > tol) & (res <= POLISH_MAX)
     polished = bool(near.any()) and s.plain
@@ -834,6 +838,16 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
     (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
     (≈ 4–5 µs from Python, limits and FK check included); see the module docstring."""
+    hit = _SOLVERS.get(id(robot))
+    if (hit is not None and hit[3] is not None and type(T) is np.ndarray and T.shape == (4, 4) and T.dtype is _F64
+            and swivel is None and frame is None and q_rest is None and not position_only and method == "robust"
+            and type(tol) is float and type(tol_orthonormal) is float and 0.0 < tol < math.inf
+            and 0.0 < tol_orthonormal < math.inf and (param is None) != hit[3][4] and hit[0] is robot.chain
+            and hit[1] == robot.tool and T.flags.c_contiguous):
+        # the usual call, one pose of a closed class by its defaults: one test, one compiled call
+        fast = _geometric_single(robot, hit[2], hit[3], T, param, tol, tol_orthonormal)
+        if fast is not None:
+            return fast
     if not (type(tol) is float and type(tol_orthonormal) is float        # the usual call: one test
             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
         _check_tol("tol", tol)
@@ -896,7 +910,7 @@ def nearest_solver(robot, frame=None):
     s = _at(robot, frame)
     if s is None or s.one_call is None:
         return None
-    cf, ci, _, _, _ = s.one_call
+    cf, ci = s.one_call[:2]
     inner = functools.partial(_geo.solve_nearest, cf, ci)
     return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
 
@@ -969,26 +983,29 @@ def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
     """One pose of a closed class in one compiled call, when it has a solution and nothing to
     polish; else None (:func:`analytic_batch` answers, with the reasons).  ``one``:
     :attr:`_Solver.one_call`."""
-    cf, ci, n, labels, _ = one
-    try:
-        prm = 0.0 if param is None else float(param)
-    except (TypeError, ValueError):
-        return None                     # a malformed param: the batch path says what is wrong
-    if not abs(prm) < WRAP_MAX:
-        return None                     # not an angle: the batch path says so
-    out = np.empty((8, n + 4))
+    cf, ci, n, labels, _, w = one
+    prm = 0.0
+    if param is not None:
+        try:
+            prm = float(param)
+        except (TypeError, ValueError):
+            return None                 # a malformed param: the batch path says what is wrong
+        if not abs(prm) < WRAP_MAX:
+            return None                 # not an angle: the batch path says so
+    out = np.empty((8, w + 4))
     mask = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
     if mask <= 0:
         return None
     branches = labels[mask]
     K = len(branches)
-    q = out[:K, :n]
+    q = out[:K, :w]
     plan = s.plan
     # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — this is
     # the path of every single pose, and keywords cost a third of the result's construction
-    return AnalyticIKResult(q if s.plain else plan.chain.configuration(q), list(branches), None, None, out[:K, n],
-                            lambda: _singular_text(float(
-                                _geo.jacobian_volumes(plan, q[None], np.ones((1, len(q)), bool)).min())),
+    return AnalyticIKResult(q, list(branches), None, None, out[:K, w],
+                            lambda: _singular_text(float(_geo.jacobian_volumes(
+                                plan, (q if s.plain else plan.chain.angles(q)[:, list(plan.chain.independent)])[None],
+                                np.ones((1, K), bool)).min())),
                             robot.name)
 
 

@@ -73,6 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..chain_kernels import put_joint
 from ..jit import kernel, local, local2, local_flags
 from ..threads import run_rows
 from . import classify as C
@@ -165,14 +166,16 @@ class GeoPlan:
         """The plan's constants as the compiled drivers take them (:func:`_unpack`): one float
         array (H, P, R_tool, the held joint's axis and point, the tool pose at q = 0, the
         chain's FK as :func:`local_frames`, limits in path order) and one int array (class index,
-        reversed, joints on the path, the path position of each independent joint)."""
+        reversed, joints on the path n, the path position of each independent joint, the
+        chain's nq, then per independent joint its first entry in q and whether it is
+        continuous: ``Chain._configuration_index``)."""
         pa = np.zeros(3) if self.param_axis is None else self.param_axis
         pp = np.zeros(3) if self.param_point is None else self.param_point
         frames = local_frames(self.fk_axes, self.fk_points, self.fk_M)
         cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, frames,
                                                  self.lower_path, self.upper_path)]).astype(float)
         ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), len(self.fk_axes),
-                       *self.order], dtype=np.int64)
+                       *self.order, self.chain.nq, *self.chain._configuration_index.ravel()], dtype=np.int64)
         return cf, ci
 
 
@@ -550,10 +553,11 @@ def into_limit(x, lo, hi):
 @kernel
 def into_limit_cs(x, c, s, lo, hi, exists):
     """:func:`into_limit` of an angle x carried with its cosine and sine (c, s): (the angle, its
-    cosine, its sine, whether it is inside) — cos and sin of the angle returned where that is
-    not x (moved by 2π or onto a limit) and the branch ``exists``."""
+    cosine, its sine, whether it is inside) — (c, s) kept where the angle returned is x moved
+    by whole turns (the same rotation), cos and sin of the angle returned where it was put
+    onto a limit (it is then the limit) and the branch ``exists``."""
     q, ok = into_limit(x, lo, hi)
-    if exists and q != x:
+    if exists and q != x and (q == lo or q == hi):
         c, s = math.cos(q), math.sin(q)
     return q, c, s, ok
 
@@ -788,16 +792,12 @@ def _unpack(cf, ci):
 
 
 @kernel(counted=False)
-def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
-    """Every branch of poses T (N, 4, 4) in path order, wrapped into the limits and FK-checked:
-    writes Q (N, 8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
-    residual; inf where there is no candidate, and for an exact candidate outside the limits,
-    which is never returned and so not checked), OK (a solution: candidate, inside, residual
-    ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); a candidate inside the
-    limits with tol < residual ≤ :data:`POLISH_MAX` is polished (:func:`_polish_chain`) and
-    kept polished where that brings it within tol.  Returns the index of the first malformed
-    pose (−1 if none).  ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference
-    counts (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
+def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF):
+    """Every branch of poses T (N, 4, 4) (:func:`_verify_pose` of each, ``param`` (N,) the held
+    7th joint): writes Q (N, 8, n), V, E, IN, RES, OK (N, 8) and, unless its last axis is
+    empty, CONF (N, 8, nq).  Returns the index of the first malformed pose (−1 if none).
+    ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference counts
+    (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
     h, PP = _six(H), _seven(P)
     Rt = mat(R_tool)
@@ -809,44 +809,84 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
-        Ti, Qi, Vi, Ei, INi, RESi, OKi = T[i], Q[i], V[i], E[i], IN[i], RES[i], OK[i]
-        if _pose_status(Ti, tol_orthonormal) != 0:
+        if not _verify_pose(ci, (cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi), T[i], param[i], tol,
+                            tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i], CONF[i],
+                            (B6, q, QC, QS, S, J, F, CHK)):
             return i
-        R, p = mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3])
-        a7 = (0.0, 1.0, 0.0)
-        if n == 7:
-            a7 = angle_cs(wrap(param[i]))
-            # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
-            Rv = rot_cs(p_axis, a7[1], -a7[2])
-            X = mtm(MR, mm(Rv, MR))
-            x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
-            p = add(mv(R, x), p)
-            R = mm(R, X)
-        if rev:
-            p = neg(mtv(R, p))
-            R = transpose(R)
-        _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, B6)
-        for b in range(8):
-            exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
-            for j in range(n):
-                jj = 5 - j if rev else j
-                x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
-                Qi[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(x, c, s, lo[j], hi[j], exists)
-                inside = inside and ok
-            Vi[b], Ei[b], INi[b] = exists, exact, inside
-            CHK[b] = exists and (inside or not exact)
-        _fk_residuals(A, Qi, QC, QS, CHK, n, Ti, RESi, S)
-        for b in range(8):
-            if Vi[b] and INi[b] and tol < RESi[b] <= POLISH_MAX:
-                for j in range(n):
-                    q[j] = Qi[b, j]
-                r = _polish_chain(A, q, n, Ti, lo, hi, tol, J, F)
-                if r <= tol:
-                    for j in range(n):
-                        Qi[b, j] = q[j]
-                    RESi[b] = r
-        _mark_solutions(Qi, Vi, INi, RESi, tol, 8, OKi)
     return -1
+
+
+@kernel(inline=True)
+def _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
+    """Every branch of one pose T (4, 4) in path order, wrapped into the limits and FK-checked:
+    writes Q (8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
+    residual; inf where there is no candidate, and for an exact candidate outside the limits,
+    which is never returned and so not checked), OK (a solution: candidate, inside, residual
+    ≤ tol, and not within 1e-9 rad of an earlier solution of its pose); a candidate inside the
+    limits with tol < residual ≤ :data:`POLISH_MAX` is polished (:func:`_polish_chain`) and
+    kept polished where that brings it within tol.  ``CONF`` (8, nq), unless its last axis is
+    empty: the chain's configuration q of each solution (:func:`_configurations`).  ``param``
+    the held 7th joint (rad).  Returns False for a malformed pose (:func:`_pose_status`).
+    ``plan``: the constants of :func:`_unpack`, their vectors and matrices as tuples (:mod:`.vec3`),
+    the tool pose at q = 0 as (MR, Mp); ``scratch``: B6 (8, :data:`BRANCH_ROW`), q (7,), QC, QS
+    (8, n), S (n + 1, 12), J (6, 6), F (6,), CHK (8,).  Compiled into each caller
+    (:func:`_verified`, :func:`_verified_one`)."""
+    cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi = plan
+    B6, q, QC, QS, S, J, F, CHK = scratch
+    if _pose_status(T, tol_orthonormal) != 0:
+        return False
+    R, p = mat(T), (T[0, 3], T[1, 3], T[2, 3])
+    a7 = (0.0, 1.0, 0.0)
+    if n == 7:
+        a7 = angle_cs(wrap(param))
+        # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
+        Rv = rot_cs(p_axis, a7[1], -a7[2])
+        X = mtm(MR, mm(Rv, MR))
+        x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
+        p = add(mv(R, x), p)
+        R = mm(R, X)
+    if rev:
+        p = neg(mtv(R, p))
+        R = transpose(R)
+    _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, B6)
+    for b in range(8):
+        exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
+        for j in range(n):
+            jj = 5 - j if rev else j
+            x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
+            Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(x, c, s, lo[j], hi[j], exists)
+            inside = inside and ok
+        V[b], E[b], IN[b] = exists, exact, inside
+        CHK[b] = exists and (inside or not exact)
+    _fk_residuals(A, Q, QC, QS, CHK, n, T, RES, S)
+    for b in range(8):
+        if V[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
+            for j in range(n):
+                q[j] = Q[b, j]
+            r = _polish_chain(A, q, n, T, lo, hi, tol, J, F)
+            if r <= tol:
+                for j in range(n):
+                    Q[b, j], QC[b, j], QS[b, j] = q[j], math.cos(q[j]), math.sin(q[j])
+                RES[b] = r
+    _mark_solutions(Q, V, IN, RES, tol, 8, OK)
+    if CONF.shape[1] > 0:
+        _configurations(ci, n, Q, QC, QS, OK, CONF)
+    return True
+
+
+@kernel
+def _configurations(ci, n, Q, QC, QS, OK, CONF):
+    """The chain's configuration q (:func:`anthroarm.chain_kernels.put_joint`) of each solution
+    b (``OK[b]``) of θ Q (8, n) (path order) with its cosines QC and sines QS into CONF (8, nq)
+    (NaN rows elsewhere); ``ci``: :attr:`GeoPlan.packed`."""
+    for b in range(8):
+        if not OK[b]:
+            for j in range(CONF.shape[1]):
+                CONF[b, j] = math.nan
+            continue
+        for k in range(n):
+            j = ci[3 + k]
+            put_joint(CONF[b], ci[4 + n + 2 * k], ci[5 + n + 2 * k] != 0, Q[b, j], QC[b, j], QS[b, j])
 
 
 #: a solution whose normalised Jacobian volume (:func:`_volume`) is at most this is at a
@@ -908,7 +948,8 @@ def _mark_solutions(Q, V, IN, RES, tol, group, OK):
             if OK[a]:
                 ok = False                       # a duplicate of a unless some joint differs
                 for j in range(Q.shape[1]):
-                    if abs(wrap(Q[b, j] - Q[a, j])) >= 1e-9:
+                    d = abs(Q[b, j] - Q[a, j])   # differs by 1e-9 rad, and (below a turn: no wrap) as a rotation
+                    if d >= 1e-9 and (d <= 2.0 * math.pi - 1e-9 or abs(wrap(d)) >= 1e-9):
                         ok = True
                         break
             a += 1
@@ -1002,39 +1043,46 @@ def nearest_first(out, K, n, ref, width):
 
 @kernel(counted=False)
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
-    """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, n + 4):
-    θ in independent-joint order, the FK residual, the branch index; with a reference ``ref``
-    (n,) (θ, rad; an empty array: none) the solution nearest it (Euclidean in θ) is swapped
-    into the first row, and that row's last two columns hold its position and rotation errors
-    (:func:`_target_errors`, m and rad).  Returns the set of branches that are solutions as a
-    bit mask (bit b: branch b; their number K is its count of ones, > 0); −1: a malformed pose;
-    −2: no solution, or a candidate to polish (the caller's general path answers: reasons,
-    polishing)."""
-    n = ci[2]
-    Tb = T.reshape((1, 4, 4))
-    pv = local(1)
-    pv[0] = param
-    Q, RES = local(56)[:8 * n].reshape((1, 8, n)), local2(1, 8)
-    V, E = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
-    IN, OK = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
-    if _verified(cf, ci, Tb, pv, tol, tol_orthonormal, Q, V, E, IN, RES, OK) >= 0:
+    """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, w + 4):
+    θ in independent-joint order (w = n joints) or the chain's configuration q (w = nq ≠ n: a
+    continuous joint as (cos, sin), :func:`_configurations`), then the FK residual, the branch
+    index; with a reference ``ref`` (n,) (θ, rad; an empty array: none; θ output only) the
+    solution nearest it (Euclidean in θ) is swapped into the first row, and that row's last two
+    columns hold its position and rotation errors (:func:`_target_errors`, m and rad).  Returns
+    the set of branches that are solutions as a bit mask (bit b: branch b; their number K is
+    its count of ones, > 0); −1: a malformed pose; −2: no solution, or a candidate to polish
+    (the caller's general path answers: reasons, polishing).  One :func:`_verify_pose`, its
+    scratch local."""
+    n, w = ci[2], out.shape[1] - 4
+    cls, rev, _, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
+    Q, RES = local(56)[:8 * n].reshape((8, n)), local(8)
+    V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
+    CONF = local(112)[:8 * w if w != n else 0].reshape((8, w if w != n else 0))
+    QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
+    plan = (cls, rev, n, _six(H), _seven(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi)
+    scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, local(96)[:12 * (n + 1)].reshape((n + 1, 12)),
+               local2(6, 6), local(6), local_flags(8))
+    if not _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
         return -1
     K, mask = 0, 0
     for b in range(8):
-        if V[0, b] and E[0, b] and IN[0, b] and tol < RES[0, b] <= POLISH_MAX:
+        if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
             return -2
-        if OK[0, b]:
-            for k in range(n):
-                out[K, k] = Q[0, b, ci[3 + k]]
-            out[K, n], out[K, n + 1] = RES[0, b], b
+        if OK[b]:
+            if w != n:
+                for k in range(w):
+                    out[K, k] = CONF[b, k]
+            else:
+                for k in range(n):
+                    out[K, k] = Q[b, ci[3 + k]]
+            out[K, w], out[K, w + 1] = RES[b], b
             K += 1
             mask |= 1 << b
     if K == 0:
         return -2
-    if len(ref) == n:
+    if len(ref) == n and w == n:
         nearest_first(out, K, n, ref, n + 2)
-        A = _unpack(cf, ci)[9]
-        out[0, n + 2], out[0, n + 3] = _target_errors(A, Q[0, int(out[0, n + 1])], n, T)
+        out[0, n + 2], out[0, n + 3] = _target_errors(A, Q[int(out[0, n + 1])], n, T)
     return mask
 
 
@@ -1066,9 +1114,10 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     the joint limits and checked by the chain's FK (product of exponentials of the joints as
     read from ``robot.chain``, the model Pinocchio holds; :func:`local_frames`).  ``param``
     (N,) the held joint of a 7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad),
-    candidate (N, 8), exact (N, 8), inside (N, 8), FK residual (N, 8) (max entry of the 3×4
-    pose; inf where there is no candidate or an exact one outside the limits,
-    :func:`_verified`).  Raises ``ValueError`` naming the first malformed pose (not finite,
+    solution (N, 8), candidate (N, 8), exact (N, 8), inside (N, 8), FK residual (N, 8) (max
+    entry of the 3×4 pose; inf where there is no candidate or an exact one outside the limits,
+    :func:`_verified`) and the chain's configuration q (N, 8, nq) of each solution (θ itself
+    where there is no continuous joint; NaN rows where there is no solution).  Raises ``ValueError`` naming the first malformed pose (not finite,
     last row, not a rotation) — ``anthroarm.ik.closed_form`` checks before it calls."""
     T = np.ascontiguousarray(T, dtype=float)
     N, n = len(T), len(plan.fk_axes)
@@ -1077,12 +1126,13 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
         pv = np.zeros(N)
     Q, V, E = np.empty((N, 8, n)), np.empty((N, 8), bool), np.empty((N, 8), bool)
     IN, RES, OK = np.empty((N, 8), bool), np.empty((N, 8)), np.empty((N, 8), bool)
+    CONF = np.empty((N, 8, 0 if plan.plain else plan.chain.nq))
     cf, ci = plan.packed
     first_bad = []
 
     def rows(a, b):
         k = _verified(cf, ci, T[a:b], pv[a:b], tol, tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b],
-                      OK[a:b])
+                      OK[a:b], CONF[a:b])
         if k >= 0:
             first_bad.append(a + k)
 
@@ -1091,9 +1141,9 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     if bad >= 0:
         raise BadPoseError(bad, f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a "
                                 f"rotation to {tol_orthonormal:g})")
-    if plan.order_is_path:
-        return Q, OK, V, E & V, IN, RES
-    return Q[..., plan.order], OK, V, E & V, IN, RES
+    if not plan.order_is_path:
+        Q = Q[..., plan.order]
+    return Q, OK, V, E & V, IN, RES, (Q if plan.plain else CONF)
 
 
 def solve_nearest(cf, ci, T, ref, param: float):
@@ -1103,7 +1153,7 @@ def solve_nearest(cf, ci, T, ref, param: float):
     errors (m, rad; :func:`_target_errors`; None, None without a reference: an empty ``ref``)
     — or None where the pose has no solution, is malformed or has a candidate to polish.  The
     seeds of :func:`anthroarm.ik.solve`, one compiled call."""
-    n = len(ci) - 3
+    n = ci[2]
     out = np.empty((8, n + 4))
     mask = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
     if mask <= 0:
