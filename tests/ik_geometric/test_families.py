@@ -88,7 +88,7 @@ def _check_srs(r, n=60, seed=0, route=None):
         assert F.SRS_ROUTES[plan.route] == route
     Q, T = _poses(r, n, seed)
     phi = swivel_angle(r, Q)
-    th, cand, exact, inside, res = F.srs_verified(plan, T, phi[:, None])
+    th, cand, exact, inside, res, _ = F.srs_verified(plan, T, phi[:, None])
     assert th.shape == (n, 8, 7) and cand.shape == exact.shape == inside.shape == res.shape == (n, 8)
     # the sampled configuration is among the branches
     theta = r.chain.angles(Q)
@@ -144,7 +144,7 @@ def test_swivel_grid_agrees_with_swivel_angle():
     Q, T = _poses(r, 50, 3)
     grid = np.linspace(-PI, PI, 12, endpoint=False)
     wide = dataclasses.replace(plan, lower_path=np.full(7, -np.inf), upper_path=np.full(7, np.inf))
-    th, cand, exact, inside, res = F.srs_verified(wide, T, np.broadcast_to(grid, (50, 12)))
+    th, cand, exact, inside, res, _ = F.srs_verified(wide, T, np.broadcast_to(grid, (50, 12)))
     assert th.shape == (50, 96, 7)
     assert (exact.sum(1) == 96).all()                  # reachable poses: every branch of every swivel
     assert res[exact].max() < 1e-9
@@ -169,10 +169,26 @@ def test_straight_elbow():
     th0[:, 3] = 0.0
     Q = r.chain.configuration(th0)
     T = r.fk(Q)
-    th, cand, exact, inside, res = F.srs_verified(plan, T, swivel_angle(r, Q))
+    th, cand, exact, inside, res, _ = F.srs_verified(plan, T, swivel_angle(r, Q))
     d = np.nanmin(_wrapdiff(th, th0[:, None, :]).max(-1), 1)
     assert d.max() < 1e-9
     assert res[exact & inside].max() < 1e-9
+
+
+def test_solutions_are_the_candidates_inside_that_pass_fk():
+    """The kernel's solution flags: a candidate inside the limits whose residual is ≤ tol, at a
+    generic pose (no two branches coincide) exactly those — each of them checked against
+    Pinocchio's FK of its configuration — and with a tol below every residual, none."""
+    r = aa.load("human_arm7")
+    plan = F.srs_plan(r)
+    Q, T = _poses(r, 40, 6)
+    th, cand, exact, inside, res, ok = F.srs_verified(plan, T, swivel_angle(r, Q), 1e-9)
+    np.testing.assert_array_equal(ok, cand & inside & (res <= 1e-9))
+    assert ok.any(1).all()
+    for i, b in zip(*np.nonzero(ok)):
+        q = r.chain.configuration(th[i, b])
+        assert np.abs(r.fk(q) - T[i])[:3].max() <= 1e-9
+    assert not F.srs_verified(plan, T, swivel_angle(r, Q), 1e-300)[5].any()
 
 
 def test_unreachable_pose_no_valid_branch():
@@ -180,7 +196,7 @@ def test_unreachable_pose_no_valid_branch():
     plan = F.srs_plan(r)
     Q, T = _poses(r, 10, 5)
     T[:5, :3, 3] *= 10.0                                          # far out of reach
-    th, cand, exact, inside, res = F.srs_verified(plan, T, np.zeros((10, 3)))
+    th, cand, exact, inside, res, _ = F.srs_verified(plan, T, np.zeros((10, 3)))
     assert not exact[:5].any()
     assert (res[:5][cand[:5]] > 1e-3).all()                      # least-squares candidates only
     assert not np.isnan(th[cand]).any()                          # no NaN in a candidate row
@@ -314,7 +330,7 @@ def test_srs_nearest_is_the_verified_family_in_one_call():
     for T in _poses(r, 12, 32)[1]:
         T = np.ascontiguousarray(T)
         ref = r.random_q(rng=rng)
-        th, cand, exact, inside, res = (a[0] for a in F.srs_verified(plan, T[None], grid[None]))
+        th, cand, exact, inside, res, _ = (a[0] for a in F.srs_verified(plan, T[None], grid[None]))
         ok = G.mark_solutions(th[None], cand[None], inside[None], res[None], 1e-9, 8)[0]
         out = F.srs_nearest(plan, T, ref, grid, False)
         if not ok.any():

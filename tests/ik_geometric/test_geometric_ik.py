@@ -830,7 +830,7 @@ def test_carried_cos_sin_are_those_of_the_returned_angle(tmp_path):
         R06, p06 = G.class_pose(plan, T, None if plan.param_joint is None else 0.0)
         B = np.empty((8, G.BRANCH_ROW))
         for i in range(len(T)):
-            G._solve_closed(cls, G._six(H), G._seven(P), G.mat(np.ascontiguousarray(R06[i])), G.vec(p06[i]), B)
+            G._solve_closed(cls, G.rows6(H), G.rows7(P), G.mat(np.ascontiguousarray(R06[i])), G.vec(p06[i]), B)
             ex = B[:, G.EXISTS] != 0
             th = B[ex, :6]
             np.testing.assert_allclose(B[ex, G.COS:G.COS + 6], np.cos(th), atol=1e-14, err_msg=robot.name)

@@ -576,6 +576,10 @@ def _swivel_array(swivel, N, grid_1d=False):
     (1, S) -> a grid per pose; None -> :data:`DEFAULT_SWIVEL` for every pose."""
     if swivel is None:
         return np.broadcast_to(DEFAULT_SWIVEL[None, :], (N, DEFAULT_SWIVEL.size)).copy()
+    if type(swivel) is float and abs(swivel) < WRAP_MAX:      # the usual one angle: no numpy checks
+        sw = np.empty((N, 1))
+        sw.fill(swivel)
+        return sw
     sw = np.asarray(swivel, dtype=float)
     if not (np.abs(sw) < WRAP_MAX).all():
         raise ValueError(f"swivel must be finite angles (rad) of magnitude below {WRAP_MAX:g}, got {swivel!r}")
@@ -650,12 +654,12 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
         if N == 0:
             return _empty(robot, labels, swivel=True)
         try:
-            th, cand, exact, inside, res = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
+            th, cand, exact, inside, res, ok = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
         except _geo.BadPoseError as exc:
             _detail_bad_pose(Ts, exc.index, single, tol_orthonormal)
             raise
         sw = np.repeat(grid, len(s.plan.labels), axis=1)
-        return _finish(robot, s, Ts, th, cand, exact, inside, res, None, labels, tol, False, swivel=sw)
+        return _finish(robot, s, Ts, th, cand, exact, inside, res, ok, labels, tol, False, swivel=sw)
     gp = s.plan
     if gp.param_joint is not None:
         if param is None:                 # a grid over the held joint's range
@@ -759,9 +763,7 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
             return [_singular_text(float(v)) for v in vol]
     # Q and res are this call's own arrays (the compiled call's, or copies): NaN in place where
     # no solution (a new 8·n·N array would cost more than the rest of this function)
-    invalid = ~valid
-    Q[invalid] = np.nan
-    res[invalid] = np.nan
+    _geo.blank_unsolved(Q, res, valid)
     return AnalyticBatchResult(solutions=Q, valid=valid, branches=labels, reasons=reasons,
                                swivel=None if swivel is None else np.where(valid, swivel, np.nan), residuals=res,
                                _singular_of=singular_of, model=robot.name)

@@ -54,14 +54,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..jit import kernel
+from ..jit import kernel, local, local2, local_flags
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _common_point,
                         _fk_residuals, _mark_solutions, _pose_status, _rot3, _target_errors, _wrist,
                         into_limit_cs, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
-from .vec3 import add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, scale, sub, transpose, vec, wrap
+from .vec3 import (add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose, vec,
+                   wrap)
 
 #: shoulder routes of the SRS arm (index stored in the plan)
 SRS_ROUTES = ("sp2", "general")
@@ -405,31 +406,28 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
             V[b], E[b] = False, False
 
 
-@kernel
-def _seven(A):
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
 
-
-@kernel
-def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol_orthonormal, Q, V, E, IN, RES):
+@kernel(counted=False)
+def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES,
+                  OK):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
     order, shifted by 2π into the limits, :func:`.geometric.into_limit`), V, E, IN, RES (the
     FK residual of :func:`.geometric._fk_residuals`: inf where there is no candidate, and for
     an exact candidate outside the limits, which is never returned and so not checked, as in
-    :func:`.geometric._verified`); returns the index of the first malformed pose (−1 if
-    none)."""
-    h = _seven(H)
+    :func:`.geometric._verified`), OK (the solutions: residual ≤ ``tol``, duplicates at one
+    angle dropped, :func:`.geometric._mark_solutions`); returns the index of the first
+    malformed pose (−1 if none; N + i: swivel row i not finite).  Compiled without reference
+    counts (:func:`anthroarm.jit.kernel`): its scratch is local."""
+    h = rows7(H)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
-    B6, Bs, q4b = np.empty((8, BRANCH_ROW)), np.empty((2, BRANCH_ROW)), np.empty((8, 3))
-    Qb, QC, QS = np.empty((8, 7)), np.empty((8, 7)), np.empty((8, 7))
-    Vb = np.empty(8, dtype=np.bool_)
-    Eb = np.empty(8, dtype=np.bool_)
-    CHK = np.empty(8, dtype=np.bool_)
-    Sfk = np.empty((8, 12))
+    B6, Bs, q4b = local2(8, BRANCH_ROW), local2(2, BRANCH_ROW), local2(8, 3)
+    Qb, QC, QS = local2(8, 7), local2(8, 7), local2(8, 7)
+    Vb, Eb, CHK = local_flags(8), local_flags(8), local_flags(8)
+    Sfk = local2(8, 12)
     ns = swivel.shape[1]
     for i in range(len(T)):
-        Ti, Qi, Vi, Ei, INi, RESi = T[i], Q[i], V[i], E[i], IN[i], RES[i]
+        Ti, Qi, Vi, Ei, INi, RESi, OKi = T[i], Q[i], V[i], E[i], IN[i], RES[i], OK[i]
         if _pose_status(Ti, tol_orthonormal) != 0:
             return i
         for k in range(ns):
@@ -451,11 +449,13 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol
                     inside = inside and ok
                 Vi[r], Ei[r], INi[r] = Vb[b], Eb[b], inside
                 CHK[b] = Vb[b] and (inside or not Eb[b])
-            _fk_residuals(A, Qi[8 * k:8 * k + 8], QC, QS, CHK, 7, Ti, RESi[8 * k:8 * k + 8], Sfk)
+            rows = slice(8 * k, 8 * k + 8)
+            _fk_residuals(A, Qi[rows], QC, QS, CHK, 7, Ti, RESi[rows], Sfk)
+            _mark_solutions(Qi[rows], Vi[rows], INi[rows], RESi[rows], tol, 8, OKi[rows])
     return -1
 
 
-@kernel
+@kernel(counted=False)
 def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, first, tol, tol_orthonormal,
                  order, ref, out):
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
@@ -466,24 +466,23 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, firs
     b), in that order — with a reference ``ref`` (7,) (an empty array: none) the nearest it
     first, and its position and rotation errors (:func:`.geometric._target_errors`) in columns
     7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
-    (the caller's general path answers)."""
+    (the caller's general path answers).  Scratch local (:func:`anthroarm.jit.local`)."""
     Tb = T.reshape((1, 4, 4))
-    sw = np.empty((1, 1))
-    q = np.empty(7)
-    Q1, RES1 = np.empty((1, 8, 7)), np.empty((1, 8))
-    V1, E1, IN1 = np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_), np.empty((1, 8), dtype=np.bool_)
-    Q, V, E, IN, RES = Q1[0], V1[0], E1[0], IN1[0], RES1[0]
-    OK = np.empty(8, dtype=np.bool_)
+    sw = local2(1, 1)
+    q = local(7)
+    Q1, RES1 = local(56).reshape((1, 8, 7)), local2(1, 8)
+    V1, E1 = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
+    IN1, OK1 = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
+    Q, V, E, IN, RES, OK = Q1[0], V1[0], E1[0], IN1[0], RES1[0], OK1[0]
     K = 0
     for k in range(len(swivel)):
         sw[0, 0] = swivel[k]
-        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, Tb, sw, tol_orthonormal,
-                         Q1, V1, E1, IN1, RES1) >= 0:
+        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, Tb, sw, tol, tol_orthonormal,
+                         Q1, V1, E1, IN1, RES1, OK1) >= 0:
             return -1                                  # a malformed pose, or an angle not finite
         for b in range(8):
             if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
                 return -2
-        _mark_solutions(Q, V, IN, RES, tol, 8, OK)
         for b in range(8):
             if OK[b]:
                 for j in range(7):
@@ -557,9 +556,8 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     Returns θ (N, 8S, 7) in ``robot.chain.independent`` order (rad, wrapped by 2π into the
     limits, NaN where the branch does not exist), candidate (N, 8S), exact (N, 8S), inside the
     limits (N, 8S), FK residual (N, 8S) (max entry of the 3×4 pose by the chain's product of
-    exponentials; inf where there is no candidate or an exact one outside the limits).  ``tol``
-    is accepted for the interface of :func:`anthroarm.ik.geometric.solve_verified` (the caller
-    compares the residual to it).
+    exponentials; inf where there is no candidate or an exact one outside the limits) and
+    solution (N, 8S) (residual ≤ ``tol``, duplicates at one angle dropped).
     Raises ``ValueError`` naming the first malformed pose (not finite, last row, not a rotation
     to ``tol_orthonormal``)."""
     T = np.ascontiguousarray(T, dtype=float)
@@ -569,13 +567,13 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     sw = _swivel_array(swivel, N, check=False)             # finiteness: checked by the kernel
     B = 8 * sw.shape[1]
     Q, V, E = np.empty((N, B, 7)), np.empty((N, B), bool), np.empty((N, B), bool)
-    IN, RES = np.empty((N, B), bool), np.empty((N, B))
+    IN, RES, OK = np.empty((N, B), bool), np.empty((N, B)), np.empty((N, B), bool)
     bad_pose, bad_swivel = [], []
 
     def rows(a, b):                                          # a slice of poses, on one core
         k = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
-                          plan.lower_path, plan.upper_path, T[a:b], sw[a:b],
-                          tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b])
+                          plan.lower_path, plan.upper_path, T[a:b], sw[a:b], tol,
+                          tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b], OK[a:b])
         if k >= b - a:
             bad_swivel.append(a + k - (b - a))
         elif k >= 0:
@@ -588,7 +586,7 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
         raise BadPoseError(min(bad_pose), f"T[{min(bad_pose)}] is not a valid pose (finite, last row [0, 0, 0, 1], "
                                           f"rotation part a rotation to {tol_orthonormal:g})")
     # E is already False wherever V is (the kernel's rule)
-    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES
+    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES, OK
 
 
 def srs_points(plan: SRSPlan, T, swivel):

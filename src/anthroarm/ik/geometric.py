@@ -80,8 +80,8 @@ from . import classify as C
 from . import subproblems as sp
 from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search  # noqa: F401 - re-exported
 from .subproblems import TOL, TOL_QUARTIC, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5_one, sp6_one
-from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs, sub,
-                   transpose, vec, wrap)
+from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs, rows6,
+                   rows7, sub, transpose, vec, wrap)
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -503,18 +503,8 @@ def _solve_closed(cls, h, P, R06, p, B):
 
 
 @kernel
-def _six(A):
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]))
-
-
-@kernel
-def _seven(A):
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
-
-
-@kernel
 def _closed_loop(cls, H, P, R06, p, Q, V, E):
-    h, PP = _six(H), _seven(P)
+    h, PP = rows6(H), rows7(P)
     B = np.empty((8, BRANCH_ROW))
     for i in range(len(p)):
         _solve_closed(cls, h, PP, mat(R06[i]), vec(p[i]), B)
@@ -799,7 +789,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference counts
     (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
-    h, PP = _six(H), _seven(P)
+    h, PP = rows6(H), rows7(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
     B6 = local2(8, BRANCH_ROW)
@@ -962,6 +952,19 @@ def _mark_loop(Q, V, IN, RES, tol, group, OK):
         _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, group, OK[i])
 
 
+@kernel
+def blank_unsolved(Q, RES, valid):
+    """NaN in place in the rows of Q (N, B, n) and entries of RES (N, B) where not ``valid``
+    (N, B): the batch result's "no solution on this branch" (a boolean-mask assignment costs
+    several times this loop)."""
+    for i in range(Q.shape[0]):
+        for b in range(Q.shape[1]):
+            if not valid[i, b]:
+                RES[i, b] = math.nan
+                for j in range(Q.shape[2]):
+                    Q[i, b, j] = math.nan
+
+
 def mark_solutions(Q, V, IN, RES, tol: float, group: int) -> np.ndarray:
     """The solutions (N, B) among candidate branches Q (N, B, n) rad with flags V (candidate),
     IN (inside the limits) and FK residuals RES (N, B): residual ≤ ``tol``, duplicates within
@@ -1059,7 +1062,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
     CONF = local(112)[:8 * w if w != n else 0].reshape((8, w if w != n else 0))
     QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
-    plan = (cls, rev, n, _six(H), _seven(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi)
+    plan = (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi)
     scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, local(96)[:12 * (n + 1)].reshape((n + 1, 12)),
                local2(6, 6), local(6), local_flags(8))
     if not _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):

@@ -74,7 +74,7 @@ import numpy as np
 
 from ..jit import kernel
 from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp5_one, sp6_one
-from .vec3 import add, cross, dot, mm, mtv, mv, neg, norm, rot, rotate, scale, sub, transpose, vec, wrap
+from .vec3 import add, cross, dot, mm, mtv, mv, neg, norm, rot, rotate, rows6, rows7, scale, sub, transpose, vec, wrap
 
 #: samples of the searched joint over [−π, π] (IK-Geo's reference implementation uses 200)
 SEARCH_GRID = 256
@@ -128,16 +128,6 @@ CLASSES = ("two_parallel", "two_intersecting", "gen_six_dof")
 
 
 # ----------------------------------------------------------------------------- helpers
-@kernel
-def _six(A):
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]))
-
-
-@kernel
-def _seven(A):
-    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
-
-
 @kernel
 def solve6(A, b):
     """Solve A x = b (6×6, in place: ``b`` becomes x) by Gaussian elimination with partial
@@ -786,7 +776,7 @@ def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
 # ----------------------------------------------------------------------------- driver
 @kernel
 def _search_loop(cls, H, P, R06, p, Q, V, E, grid):
-    h, PP = _six(H), _seven(P)
+    h, PP = rows6(H), rows7(P)
     for i in range(len(p)):
         Q[i, :, :] = math.nan
         V[i, :] = False

@@ -25,6 +25,19 @@ def vec(a):
 
 
 @kernel
+def rows6(A):
+    """The six rows of a (6, 3) array as tuples (:func:`vec`): the axes h of a 6R arm."""
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]))
+
+
+@kernel
+def rows7(A):
+    """The seven rows of a (7, 3) array as tuples (:func:`vec`): the offsets P of a 6R arm, the
+    axes h of a 7R arm."""
+    return (vec(A[0]), vec(A[1]), vec(A[2]), vec(A[3]), vec(A[4]), vec(A[5]), vec(A[6]))
+
+
+@kernel
 def mat(a):
     """The row tuples of a 3×3 array."""
     return ((float(a[0, 0]), float(a[0, 1]), float(a[0, 2])),
