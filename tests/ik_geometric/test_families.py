@@ -261,7 +261,7 @@ def test_planar_both_branches():
     assert plan is not None and plan.labels == ("q2=0", "q2=1")
     Q, T = _poses(r, 100, 7)
     P = T[:, :3, 3]
-    th, cand, exact, inside, res = F.planar_verified(plan, P)
+    th, cand, exact, inside, res, _ = F.planar_verified(plan, P)
     assert th.shape == (100, 2, 2)
     assert exact.all() and res.max() < 1e-9
     theta = r.chain.angles(Q)
@@ -279,10 +279,10 @@ def test_planar_off_plane_and_out_of_reach():
     _, T = _poses(r, 20, 8)
     P = T[:, :3, 3].copy()
     off = P + plan.h1 * 0.05
-    th, cand, exact, inside, res = F.planar_verified(plan, off)
+    th, cand, exact, inside, res, _ = F.planar_verified(plan, off)
     assert not cand.any() and not exact.any() and np.isnan(th).all() and np.isinf(res).all()
     far = P + 5.0 * (P - plan.o1) / np.linalg.norm(P - plan.o1, axis=1)[:, None]   # beyond reach 2
-    th, cand, exact, inside, res = F.planar_verified(plan, far)
+    th, cand, exact, inside, res, _ = F.planar_verified(plan, far)
     assert not exact.any() and not np.isnan(th[cand]).any()
     with pytest.raises(ValueError, match=r"P\[1\]"):
         F.planar_verified(plan, np.array([[0, 1.0, 0], [np.inf, 0, 0]]))

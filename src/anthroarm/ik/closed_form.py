@@ -716,11 +716,12 @@ def _planar_batch(robot, s, T, position_only, tol):
     labels = list(s.plan.labels)
     if N == 0:
         return _empty(robot, labels)
-    th, cand, exact, inside, res = _fam.planar_verified(s.plan, np.ascontiguousarray(Ts[:, :3, 3]), tol)
-    if not po:
+    th, cand, exact, inside, res, ok = _fam.planar_verified(s.plan, np.ascontiguousarray(Ts[:, :3, 3]), tol)
+    if not po:                          # the rotation too: Pinocchio's residuals, solutions marked again
         Q = s.plan.chain.configuration(np.where(cand[..., None], th, 0.0))
         res = np.where(cand, _fk_residual(robot, Q, Ts, False), np.inf)
-    return _finish(robot, s, Ts, th, cand, exact, inside, res, None, labels, tol, po)
+        ok = None
+    return _finish(robot, s, Ts, th, cand, exact, inside, res, ok, labels, tol, po)
 
 
 def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, position_only, swivel=None, conf=None):
@@ -966,13 +967,12 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
             p = arr if arr.shape == (3,) else arr[:3, 3]
             if arr.shape == (4, 4) and (arr[3].tolist() != [0.0, 0.0, 0.0, 1.0] or not np.isfinite(arr).all()):
                 return None             # the batch path's checks say what is wrong, or that it is fine
-            th, cand, exact, inside, res = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
+            th, cand, exact, inside, res, valid = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
     except ValueError:
         return None                     # a malformed pose or swivel: the batch path says what is wrong
     flags = list(zip(cand.tolist(), exact.tolist(), inside.tolist(), res.tolist()))   # 2 branches: no numpy
     if s.plain and any(c and e and i and tol < r <= POLISH_MAX for c, e, i, r in flags):
         return None
-    valid = _geo.mark_solutions(th[None], cand[None], inside[None], res[None], tol, s.form.branches)[0]
     k = [b for b, ok in enumerate(valid.tolist()) if ok]
     if not k:
         return None

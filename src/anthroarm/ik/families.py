@@ -626,10 +626,10 @@ def _fk_position_residual(kH, kO, p_tool, q, n, p):
 
 
 @kernel
-def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RES):
-    """Both branches of targets P (N, 3): Q (N, 2, 2) path order, V, E, IN, RES (position);
-    returns the index of the first non-finite target (−1 if none).  ``h1`` … ``pt``: the
-    plan's vectors (3,)."""
+def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RES, OK):
+    """Both branches of targets P (N, 3): Q (N, 2, 2) path order, V, E, IN, RES (position), OK
+    (the solutions, :func:`.geometric._mark_solutions`); returns the index of the first
+    non-finite target (−1 if none).  ``h1`` … ``pt``: the plan's vectors (3,)."""
     h1, h2, o1, o2, pt = vec(h1), vec(h2), vec(o1), vec(o2), vec(pt)
     q = np.empty(2)
     p1, p2 = sub(pt, o2), sub(o1, o2)
@@ -655,6 +655,7 @@ def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RE
             Q[i, b, 0], Q[i, b, 1] = q[0], q[1]
             V[i, b], E[i, b], IN[i, b] = True, (ea if b == 0 else eb) and e1, inside
             RES[i, b] = _fk_position_residual(kH, kO, pt, q, 2, p)
+        _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, 2, OK[i])
     return -1
 
 
@@ -663,19 +664,20 @@ def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
     (base frame, m), position only, in one compiled call.  Returns θ (N, 2, 2) in
     ``robot.chain.independent`` order (rad, wrapped into the limits), candidate (N, 2), exact
     (N, 2), inside (N, 2), FK residual (N, 2) (max |error| of the 3 position entries; inf
-    without a candidate).  A target farther than ``tol`` (m) from the plane of motion has no
+    without a candidate), solution (N, 2) (residual ≤ ``tol``, inside, not a duplicate of
+    the other branch).  A target farther than ``tol`` (m) from the plane of motion has no
     candidate.  Raises ``ValueError`` naming the first non-finite target."""
     P = np.ascontiguousarray(P, dtype=float)
     if P.ndim != 2 or P.shape[1] != 3:
         raise ValueError(f"P must have shape (N, 3), got {P.shape}")
     N = len(P)
     Q, V, E = np.empty((N, 2, 2)), np.empty((N, 2), bool), np.empty((N, 2), bool)
-    IN, RES = np.empty((N, 2), bool), np.empty((N, 2))
+    IN, RES, OK = np.empty((N, 2), bool), np.empty((N, 2)), np.empty((N, 2), bool)
     bad = _planar_verified(plan.h1, plan.h2, plan.o1, plan.o2, plan.p_tool, plan.fk_axes,
-                           plan.fk_points, plan.lower_path, plan.upper_path, P, float(tol), Q, V, E, IN, RES)
+                           plan.fk_points, plan.lower_path, plan.upper_path, P, float(tol), Q, V, E, IN, RES, OK)
     if bad >= 0:
         raise ValueError(f"P[{bad}] is not a finite position")
-    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES
+    return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES, OK
 
 
 __all__ = ["PLANAR_BRANCHES", "PLANAR_LABELS", "PlanarPlan", "SRSPlan", "SRS_BRANCHES", "SRS_ROUTES",
