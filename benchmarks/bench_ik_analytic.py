@@ -126,19 +126,37 @@ def _row(case, method, n, checks, t, ratio="", same="", note=""):
 
 
 # ---------------------------------------------------------------------------- anthroarm rows
-def _single_row(case, n, t_geo, note):
-    """``aa.ik.analytic`` pose by pose: the median of the per-call times (after a warm-up);
-    ``t_geo`` ik-geo's single-pose time (s) or None."""
-    robot, T = case.robot, case.T
+def _single_times(case, n, geo):
+    """One pose at a time, ``aa.ik.analytic`` and (``geo``: (ik-geo robot, its argument lists),
+    or None) ik-geo's ``get_ik`` on the same pose right after it — interleaved, so that both see
+    the same moments of a shared machine.  Each of our poses is its own 4×4 array and each of
+    ik-geo's its lists, made before timing.  Returns (our per-call times, our results, ik-geo's
+    per-call times or None) (s)."""
+    robot = case.robot
+    T = [np.ascontiguousarray(x) for x in case.T[:n]]
     kws = [case.kw_one(i) for i in range(n)]
-    for i in range(min(n, 20)):
+    for i in range(min(n, 20)):                                                 # warm-up
         aa.ik.analytic(robot, T[i], **kws[i])
-    times, results = [], []
+        if geo is not None:
+            geo[0].get_ik(*geo[1][i])
+    times, geo_times, results = [], [], []
     for i in range(n):
         t0 = time.perf_counter()
         r = aa.ik.analytic(robot, T[i], **kws[i])
         times.append(time.perf_counter() - t0)
         results.append(r)
+        if geo is not None:
+            a = geo[1][i]
+            t0 = time.perf_counter()
+            geo[0].get_ik(*a)
+            geo_times.append(time.perf_counter() - t0)
+    return times, results, (geo_times if geo is not None else None)
+
+
+def _single_row(case, n, times, results, t_geo, note):
+    """``aa.ik.analytic`` pose by pose (:func:`_single_times`): the median of the per-call
+    times; ``t_geo`` ik-geo's single-pose time (s) or None."""
+    robot = case.robot
     pose = np.repeat(np.arange(n), [len(r) for r in results])
     sols = np.concatenate([r.solutions for r in results]) if len(pose) else np.zeros((0, robot.nq))
     t = float(np.median(times))
@@ -169,30 +187,35 @@ def _to_ours(gp, th, v):
     return th[:, gp.order]
 
 
-def _ik_geo_rows(case, n_single, n_loop):
-    """ik-geo's ``get_ik`` on the class pose of each of the first n = max(n_single, n_loop)
-    poses: its single row (median per-call time over the first n_single; solutions checked and
-    compared with ours over all n) and its Python-loop row (per pose over the first n_loop).
-    Returns (rows, single time, loop time per pose) (s); ([], None, None) without ik-geo or for
-    an arm it has no solver for."""
+def _ik_geo(case, n):
+    """ik-geo's solver of the arm's class and its argument lists (the class pose: reversed
+    chain, panda's first six joints; the rotation transposed, as it takes it) for the first n
+    poses; None without ik-geo or for an arm it has no solver for."""
     try:
         import ik_geo
     except ImportError:
-        return [], None, None
+        return None
     gp = case.gp
     if gp is None or not hasattr(ik_geo.Robot, gp.cls):
-        return [], None, None
+        return None
     geo = getattr(ik_geo.Robot, gp.cls)(gp.H.tolist(), gp.P.tolist())
-    n = max(n_single, n_loop)
     prm = case.kw["param"][:n] if "param" in case.kw else None
     R06, p = G.class_pose(gp, case.T[:n], prm)
-    args = [(R.T.tolist(), x.tolist()) for R, x in zip(R06, p)]     # ik-geo takes the rotation transposed
-    geo.get_ik(*args[0])
-    times, out = [], []
-    for a in args:
-        t0 = time.perf_counter()
-        out.append(geo.get_ik(*a))
-        times.append(time.perf_counter() - t0)
+    return geo, [(R.T.tolist(), x.tolist()) for R, x in zip(R06, p)]
+
+
+def _ik_geo_rows(case, geo, times, n_single, n_loop):
+    """ik-geo's single row (the median of its per-call ``times`` over the first n_single poses,
+    :func:`_single_times`; its solutions checked and compared with ours over the first
+    n = max(n_single, n_loop)) and its Python-loop row (per pose over the first n_loop).
+    Returns (rows, single time, loop time per pose) (s); ([], None, None) without ``geo``."""
+    if geo is None:
+        return [], None, None
+    geo, args = geo
+    gp = case.gp
+    n = max(n_single, n_loop)
+    prm = case.kw["param"][:n] if "param" in case.kw else None
+    out = [geo.get_ik(*a) for a in args[:n]]
     t_single = float(np.median(times[:n_single]))
     loop = args[:n_loop]
     t_loop = time_call(lambda: [geo.get_ik(*a) for a in loop], repeat=7) / n_loop
@@ -236,8 +259,11 @@ def _arm_rows(case, n_single, n_batch, n_loop, n_clik=0):
     what = [gp.cls + (" (reversed)" if gp.reversed else "") if gp is not None else case.family]
     what += [{"swivel": "at the sampled swivel angle", "param": "q7 held at the sampled value"}[k] for k in case.kw]
     what += ["position only"] if case.position_only else []
-    geo_rows, t_geo1, t_geo_loop = _ik_geo_rows(case, n_single, n_loop)
-    rows = [_single_row(case, n_single, t_geo1, "; ".join(what)), _batch_row(case, n_batch, t_geo_loop), *geo_rows]
+    geo = _ik_geo(case, max(n_single, n_loop))
+    times, results, geo_times = _single_times(case, n_single, geo)
+    geo_rows, t_geo1, t_geo_loop = _ik_geo_rows(case, geo, geo_times, n_single, n_loop)
+    rows = [_single_row(case, n_single, times, results, t_geo1, "; ".join(what)), _batch_row(case, n_batch, t_geo_loop),
+            *geo_rows]
     return rows + ([_clik_row(case, n_clik)] if n_clik else [])
 
 
@@ -290,7 +316,8 @@ def run(quick: bool = False) -> dict:
             "afterwards with Pinocchio. human_arm7: one swivel angle (the sampled configuration's); panda: q7 held "
             "at the sampled value (param=); planar2r: position only. "
             "'ik-geo single (Rust)' = ik_geo.Robot.<class>.get_ik on the same poses, reduced to its class pose "
-            "(reversed chain, panda's first six joints) with the lists built beforehand (not timed): all branches, "
+            "(reversed chain, panda's first six joints) with the lists built beforehand (not timed; ours: each pose "
+            "its own 4×4 array, made beforehand), timed interleaved with ours pose by pose: all branches, "
             "no limits, no FK check; its 'solutions/pose' counts the exact (not least-squares) ones, 'success' and "
             "'max FK err' are Pinocchio's on those; 'same solutions as ik-geo' = poses whose exact solutions equal "
             "our class solver's exact branches before limit filtering (geometric.solve) as sets mod 2π to 1e-8 rad. "
