@@ -319,14 +319,27 @@ def _rot3(h, a1, a2, a3):
 
 @kernel
 def _wrist(h, R03, R06, B, b, a1, a2, a3, ex):
-    """Spherical wrist from R36 = R03ᵀ R06: q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4 and
-    q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
-    h4, h5, h6 = h[3], h[4], h[5]
+    """Spherical wrist from R36 = R03ᵀ R06 (:func:`_wrist_of`); branches b (first q5 root) and
+    b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
     R36 = mtm(R03, R06)
-    R36h6 = mv(R36, h6)
+    _wrist_of(h, mv(R36, h[5]), mv(R36, perpendicular(h[5])), B, b, a1, a2, a3, ex)
+
+
+@kernel
+def _back3(h, a1, a2, a3, v):
+    """R03ᵀ v = rot(h3, −q3) rot(h2, −q2) rot(h1, −q1) v of the angle triples a1, a2, a3."""
+    return rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], a2[1], -a2[2], rotate_cs(h[0], a1[1], -a1[2], v)))
+
+
+@kernel
+def _wrist_of(h, u, w, B, b, a1, a2, a3, ex):
+    """Spherical wrist from u = R36 h6 and w = R36 x (x = :func:`.vec3.perpendicular` of h6; the
+    two columns of R36 = R03ᵀ R06 it reads): q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4
+    and q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the triples of q1, q2,
+    q3."""
+    h4, h5, h6 = h[3], h[4], h[5]
     x = perpendicular(h6)
-    R36x = mv(R36, x)
-    ta, ca, sa, tb, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, R36h6), TOL)
+    ta, ca, sa, tb, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, u), TOL)
     for j in range(2):
         if j >= cnt:
             B[b + j, EXISTS] = 0.0
@@ -335,8 +348,8 @@ def _wrist(h, R03, R06, B, b, a1, a2, a3, ex):
         c, s = a5[1], a5[2]
         # q4 (0 where it is free: h4 ∥ rot(h5, q5) h6, the wrist singularity), then q6 from
         # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
-        t4, c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), R36h6, h4, TOL)
-        t6, c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, R36x)), h6, TOL)
+        t4, c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), u, h4, TOL)
+        t6, c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, w)), h6, TOL)
         _put(B, b + j, a1, a2, a3, (t4, c4, s4), a5, (t6, c6, s6), True,
              ex and (ea if j == 0 else eb) and e4 and e6)
 
@@ -347,12 +360,14 @@ def _spherical_two_parallel(h, P, R06, p, B):
     wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
     t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]),
                                                            dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
+    u0, w0 = mv(R06, h[5]), mv(R06, perpendicular(h[5]))                # R06 h6, R06 x: what the wrist reads
     for i1 in range(2):
         if i1 >= n1:
             _none(B, 4 * i1, 4 * i1 + 4)
             continue
         a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
         v = sub(rotate_cs(neg(h[0]), a1[1], a1[2], wrist), P[1])       # R01ᵀ p_16 − p12
+        u1, w1 = rotate_cs(h[0], a1[1], -a1[2], u0), rotate_cs(h[0], a1[1], -a1[2], w0)
         t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(neg(P[3]), P[2], h[2], norm(v), TOL)
         for i3 in range(2):
             b = 4 * i1 + 2 * i3
@@ -363,13 +378,16 @@ def _spherical_two_parallel(h, P, R06, p, B):
             t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), v, h[1], TOL)
             a2 = (t2, c2, s2)
             ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
-            _wrist(h, _rot3(h, a1, a2, a3), R06, B, b, a1, a2, a3, ex)
+            u = rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], c2, -s2, u1))    # R03ᵀ R06 h6
+            w = rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], c2, -s2, w1))
+            _wrist_of(h, u, w, B, b, a1, a2, a3, ex)
 
 
 @kernel
 def _spherical_two_intersecting(h, P, R06, p, B):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
+    u0, w0 = mv(R06, h[5]), mv(R06, perpendicular(h[5]))                # R06 h6, R06 x: what the wrist reads
     t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
         if i3 >= n3:
@@ -384,8 +402,8 @@ def _spherical_two_intersecting(h, P, R06, p, B):
                 _none(B, b, b + 2)
                 continue
             a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
-            _wrist(h, _rot3(h, a1, a2, a3), R06, B, b, a1, a2, a3,
-                   (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
+            _wrist_of(h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, b, a1, a2, a3,
+                      (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
 
 
 @kernel
@@ -471,7 +489,8 @@ def _spherical(h, P, R06, p, B):
             _none(B, 2 * j, 2 * j + 2)
             continue
         a1, a2, a3 = angle_cs(t[j, 0]), angle_cs(t[j, 1]), angle_cs(t[j, 2])
-        _wrist(h, _rot3(h, a1, a2, a3), R06, B, 2 * j, a1, a2, a3, True)
+        _wrist_of(h, _back3(h, a1, a2, a3, mv(R06, h[5])), _back3(h, a1, a2, a3, mv(R06, perpendicular(h[5]))), B,
+                  2 * j, a1, a2, a3, True)
 
 
 #: the compiled class solvers, by their index in :data:`CLOSED`
