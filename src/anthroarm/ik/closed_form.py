@@ -840,7 +840,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
     (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
-    (≈ 4–5 µs from Python, limits and FK check included); see the module docstring."""
+    (≈ 4 µs from Python, limits and FK check included); see the module docstring."""
     hit = _SOLVERS.get(id(robot))
     if (hit is not None and hit[3] is not None and type(T) is np.ndarray and T.shape == (4, 4) and T.dtype is _F64
             and swivel is None and frame is None and q_rest is None and not position_only and method == "robust"
