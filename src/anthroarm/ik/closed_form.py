@@ -958,9 +958,9 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
             if got is None:
                 return None
             q, res, rows = got
-            labels = _grid_labels(s.plan.labels, len(grid), "swivel")
-            return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[i] for i in rows.tolist()],
-                                    None, grid[rows // len(s.plan.labels)], res, None, robot.name)
+            labels, B, angle = _grid_labels(s.plan.labels, len(grid), "swivel"), len(s.plan.labels), grid.tolist()
+            return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[r] for r in rows], None,
+                                    np.array([angle[r // B] for r in rows]), res, None, robot.name)
         else:
             if position_only is False:
                 return None

@@ -116,6 +116,16 @@ class SRSPlan:
         """The FK check's chain as :func:`.geometric.local_frames` (8, 12)."""
         return local_frames(self.fk_axes, self.fk_points, self.fk_M)
 
+    @functools.cached_property
+    def packed(self) -> tuple:
+        """The plan's constants as the compiled drivers take them (:func:`_srs_unpack`): one
+        float array (H, S, E0, W0, R_tool, p_tool, :attr:`fk_frames`, limits in path order) and
+        one int array (route, then ``order``)."""
+        cf = np.concatenate([np.asarray(a, dtype=float).ravel() for a in (
+            self.H, self.S, self.E0, self.W0, self.R_tool, self.p_tool, self.fk_frames, self.lower_path,
+            self.upper_path)])
+        return cf, np.array([self.route, *self.order], dtype=np.int64)
+
 
 @dataclass(frozen=True)
 class PlanarPlan:
@@ -407,17 +417,27 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
 
 
 
+@kernel(inline=True)
+def _srs_unpack(cf, ci):
+    """The constants of :attr:`SRSPlan.packed`: (route, H (7, 3), S, E0, W0 (3,), R_tool
+    (3, 3), p_tool (3,), the FK frames A (8, 12), lo, hi (7,), order (7,)) — views of ``cf``,
+    ``ci``, compiled into each caller (:func:`anthroarm.jit.kernel`)."""
+    return (ci[0], cf[0:21].reshape((7, 3)), cf[21:24], cf[24:27], cf[27:30], cf[30:39].reshape((3, 3)), cf[39:42],
+            cf[42:138].reshape((8, 12)), cf[138:145], cf[145:152], ci[1:8])
+
+
 @kernel(counted=False)
-def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES,
-                  OK):
+def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
     order, shifted by 2π into the limits, :func:`.geometric.into_limit`), V, E, IN, RES (the
     FK residual of :func:`.geometric._fk_residuals`: inf where there is no candidate, and for
     an exact candidate outside the limits, which is never returned and so not checked, as in
     :func:`.geometric._verified`), OK (the solutions: residual ≤ ``tol``, duplicates at one
     angle dropped, :func:`.geometric._mark_solutions`); returns the index of the first
-    malformed pose (−1 if none; N + i: swivel row i not finite).  Compiled without reference
-    counts (:func:`anthroarm.jit.kernel`): its scratch is local."""
+    malformed pose (−1 if none; N + i: swivel row i not finite).  ``cf``, ``ci``:
+    :attr:`SRSPlan.packed`.  Compiled without reference counts (:func:`anthroarm.jit.kernel`):
+    its scratch is local."""
+    route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, _ = _srs_unpack(cf, ci)
     h = rows7(H)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
@@ -456,8 +476,7 @@ def _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, tol
 
 
 @kernel(counted=False)
-def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, first, tol, tol_orthonormal,
-                 order, ref, out):
+def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
     duplicates at one angle dropped: :func:`.geometric._mark_solutions`) at the swivel angles
     ``swivel`` (S,) in turn — only at the first angle that has any where ``first`` — into the
@@ -466,7 +485,9 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, firs
     b), in that order — with a reference ``ref`` (7,) (an empty array: none) the nearest it
     first, and its position and rotation errors (:func:`.geometric._target_errors`) in columns
     7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
-    (the caller's general path answers).  Scratch local (:func:`anthroarm.jit.local`)."""
+    (the caller's general path answers).  ``cf``, ``ci``: :attr:`SRSPlan.packed`.  Scratch
+    local (:func:`anthroarm.jit.local`)."""
+    A, order = _srs_unpack(cf, ci)[7], _srs_unpack(cf, ci)[10]
     Tb = T.reshape((1, 4, 4))
     sw = local2(1, 1)
     q = local(7)
@@ -477,8 +498,7 @@ def _srs_nearest(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, T, swivel, firs
     K = 0
     for k in range(len(swivel)):
         sw[0, 0] = swivel[k]
-        if _srs_verified(route, H, S, E0, W0, R_tool, p_tool, A, lo, hi, Tb, sw, tol, tol_orthonormal,
-                         Q1, V1, E1, IN1, RES1, OK1) >= 0:
+        if _srs_verified(cf, ci, Tb, sw, tol, tol_orthonormal, Q1, V1, E1, IN1, RES1, OK1) >= 0:
             return -1                                  # a malformed pose, or an angle not finite
         for b in range(8):
             if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
@@ -515,21 +535,21 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
 def _one_pose(plan: SRSPlan, T, swivel, first: bool, tol: float, tol_orthonormal: float, ref):
     """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 11))."""
     out = np.empty((8 * len(swivel), 11))
-    K = _srs_nearest(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
-                     plan.lower_path, plan.upper_path, T, swivel, first, tol, tol_orthonormal, plan.order, ref, out)
-    return K, out
+    cf, ci = plan.packed
+    return _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out), out
 
 
 def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
     """Every solution of one pose ``T`` (4, 4) (a C-order float array) at the swivel angles
     ``swivel`` (S,) (rad, finite), in the order of :func:`srs_verified`'s rows, in one compiled
-    call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (K,) into the
-    8 S branches) — or None where there is none, the pose is malformed or a candidate is to
-    be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with the reasons)."""
+    call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (a list of K
+    ints) into the 8 S branches) — or None where there is none, the pose is malformed or a
+    candidate is to be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with
+    the reasons)."""
     K, out = _one_pose(plan, T, swivel, False, tol, tol_orthonormal, NO_REF)
     if K <= 0:
         return None
-    return out[:K, :7], out[:K, 9], out[:K, 10].astype(np.intp)
+    return out[:K, :7], out[:K, 9], [int(r) for r in out[:K, 10].tolist()]
 
 
 def _swivel_array(swivel, N, check=True):
@@ -570,10 +590,11 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     IN, RES, OK = np.empty((N, B), bool), np.empty((N, B)), np.empty((N, B), bool)
     bad_pose, bad_swivel = [], []
 
+    cf, ci = plan.packed
+
     def rows(a, b):                                          # a slice of poses, on one core
-        k = _srs_verified(plan.route, plan.H, plan.S, plan.E0, plan.W0, plan.R_tool, plan.p_tool, plan.fk_frames,
-                          plan.lower_path, plan.upper_path, T[a:b], sw[a:b], tol,
-                          tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b], OK[a:b])
+        k = _srs_verified(cf, ci, T[a:b], sw[a:b], tol, tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b],
+                          OK[a:b])
         if k >= b - a:
             bad_swivel.append(a + k - (b - a))
         elif k >= 0:
