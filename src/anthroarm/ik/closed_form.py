@@ -976,9 +976,10 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
     k = [b for b, ok in enumerate(valid.tolist()) if ok]
     if not k:
         return None
-    q = th[k]
+    rows = slice(k[0], k[-1] + 1)            # two branches: the solutions are a slice (no fancy index)
+    q = th[rows]
     return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
-                            branches=[s.plan.labels[b] for b in k], residuals=res[k], model=robot.name)
+                            branches=[s.plan.labels[b] for b in k], residuals=res[rows], model=robot.name)
 
 
 def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
