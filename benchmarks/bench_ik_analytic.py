@@ -133,7 +133,7 @@ def _single_times(case, n, geo):
     ik-geo's its lists, made before timing.  Returns (our per-call times, our results, ik-geo's
     per-call times or None) (s)."""
     robot = case.robot
-    T = [np.ascontiguousarray(x) for x in case.T[:n]]
+    T = [x.copy() for x in case.T[:n]]
     kws = [case.kw_one(i) for i in range(n)]
     for i in range(min(n, 20)):                                                 # warm-up
         aa.ik.analytic(robot, T[i], **kws[i])
@@ -190,7 +190,8 @@ def _to_ours(gp, th, v):
 def _ik_geo(case, n):
     """ik-geo's solver of the arm's class and its argument lists (the class pose: reversed
     chain, panda's first six joints; the rotation transposed, as it takes it) for the first n
-    poses; None without ik-geo or for an arm it has no solver for."""
+    poses, and the held joint's values there (None: none held); None without ik-geo or for an
+    arm it has no solver for."""
     try:
         import ik_geo
     except ImportError:
@@ -201,7 +202,7 @@ def _ik_geo(case, n):
     geo = getattr(ik_geo.Robot, gp.cls)(gp.H.tolist(), gp.P.tolist())
     prm = case.kw["param"][:n] if "param" in case.kw else None
     R06, p = G.class_pose(gp, case.T[:n], prm)
-    return geo, [(R.T.tolist(), x.tolist()) for R, x in zip(R06, p)]
+    return geo, [(R.T.tolist(), x.tolist()) for R, x in zip(R06, p)], prm
 
 
 def _ik_geo_rows(case, geo, times, n_single, n_loop):
@@ -211,10 +212,9 @@ def _ik_geo_rows(case, geo, times, n_single, n_loop):
     Returns (rows, single time, loop time per pose) (s); ([], None, None) without ``geo``."""
     if geo is None:
         return [], None, None
-    geo, args = geo
+    geo, args, prm = geo
     gp = case.gp
     n = max(n_single, n_loop)
-    prm = case.kw["param"][:n] if "param" in case.kw else None
     out = [geo.get_ik(*a) for a in args[:n]]
     t_single = float(np.median(times[:n_single]))
     loop = args[:n_loop]

@@ -882,6 +882,31 @@ def test_batch_singular_is_that_of_the_solutions_found():
         Bt.solutions[0, 0] = 0.0
 
 
+def test_limits_reason_names_the_limits_of_the_joints_solved_for():
+    """kinova (continuous joints: q holds cos/sin pairs, nq = 9 ≠ 6): a pose whose every solution
+    violates the limits is reported with the six joints' own limits (oracle: the URDF's, read
+    here from the chain), the continuous ones as such — not with the bounds of q's cos/sin
+    entries."""
+    robot = aa.load("kinova")
+    ch = robot.chain
+    rng = np.random.default_rng(0)
+    texts = []
+    for _ in range(20):
+        th = rng.uniform(-np.pi, np.pi, 6)
+        th[1] = 0.3                                                  # joint 2 below its lower limit 0.82
+        r = aa.ik.analytic(robot, robot.fk(ch.configuration(th)))
+        if len(r) == 0:
+            texts.append(r.reason)
+    assert texts
+    for text in texts:
+        assert "violate the joint limits" in text
+        for j in ch.independent:
+            joint = ch.joints[j]
+            want = "continuous" if joint.kind == "continuous" else f"[{joint.lower:.4g}, {joint.upper:.4g}]"
+            assert f"{joint.name} {want}" in text
+        assert "[-1, 1]" not in text
+
+
 def test_a_reachable_pose_at_a_tangent_root_is_solved():
     """A pose reached by a configuration inside the limits has a solution, also where a
     subproblem's two roots meet (panda's shoulder at q2 = 0, joints on their limits): its only

@@ -783,9 +783,11 @@ def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
         return (f"outside the workspace: no branch of the {fam} closed form reaches this pose (its "
                 f"subproblems have least-squares answers only; best FK residual {best:.3g})")
     if not (cand & exact & inside).any():
-        names = robot.joint_names
+        ch = robot.chain                 # the limits of the joints solved for (θ, not q: kinova's cos/sin pairs)
+        joints = [ch.joints[j] for j in ch.independent]
         return (f"all {int((cand & exact).sum())} closed-form solutions violate the joint limits ("
-                + ", ".join(f"{n} [{lo:.4g}, {hi:.4g}]" for n, lo, hi in zip(names, robot.lower, robot.upper)) + ")")
+                + ", ".join(f"{j.name} continuous" if j.kind == "continuous" else f"{j.name} [{j.lower:.4g}, {j.upper:.4g}]"
+                            for j in joints) + ")")
     worst = float(np.min(np.where(cand & exact & inside, res, np.inf)))
     text = (f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); the pose is at a "
             "singularity or not reachable with this orientation")
@@ -842,27 +844,26 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
     (≈ 4 µs from Python, limits and FK check included); see the module docstring."""
     hit = _SOLVERS.get(id(robot))
-    if (hit is not None and hit[3] is not None and type(T) is np.ndarray and T.shape == (4, 4) and T.dtype is _F64
-            and swivel is None and frame is None and q_rest is None and not position_only and method == "robust"
-            and type(tol) is float and type(tol_orthonormal) is float and 0.0 < tol < math.inf
-            and 0.0 < tol_orthonormal < math.inf and (param is None) != hit[3][4] and hit[0] is robot.chain
-            and hit[1] == robot.tool and T.flags.c_contiguous):
-        # the usual call, one pose of a closed class by its defaults: one test, one compiled call
-        fast = _geometric_single(robot, hit[2], hit[3], T, param, tol, tol_orthonormal)
+    if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
+        _solver(robot)                            # the cache entry: a first call, or a new chain or tool
+        hit = _SOLVERS[id(robot)]
+    arr = T if type(T) is np.ndarray and T.flags.c_contiguous else _c_order(T)
+    if (hit[3] is not None and arr.shape == (4, 4) and arr.dtype is _F64 and swivel is None and frame is None
+            and q_rest is None and not position_only and method == "robust" and type(tol) is float
+            and type(tol_orthonormal) is float and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf
+            and (param is None) != hit[3][4]):
+        # one pose of a closed class (no tree, no other frame): one compiled call, when it has a
+        # solution and nothing to polish; else the general path below says what happened
+        fast = _geometric_single(robot, hit[2], hit[3], arr, param, tol, tol_orthonormal)
         if fast is not None:
             return fast
-    if not (type(tol) is float and type(tol_orthonormal) is float        # the usual call: one test
-            and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf):
-        _check_tol("tol", tol)
-        _check_tol("tol_orthonormal", tol_orthonormal)
+    _check_tol("tol", tol)
+    _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None:
         other = _frame_robot(robot, frame)
         if other is not robot:
             return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
                             tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
-    arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
-    if not arr.flags.c_contiguous:
-        arr = np.ascontiguousarray(arr)          # a strided view: the compiled calls take C order
     if method != "robust":
         if method != "book":
             raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
@@ -875,19 +876,13 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         if not single:
             raise ValueError("method='book' takes one pose")
         return _book_result(robot, Ts[0], spec.params, tol)
-    s = _solver(robot)
+    s = hit[2]
     if s is not None and s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
         return _on_robot(s.arm, analytic(s.arm.robot, T, swivel=swivel, position_only=position_only, tol=tol,
                                          tol_orthonormal=tol_orthonormal, param=param), rest)
     if q_rest is not None:
         _q_rest(robot, None, q_rest)
-    one = None if s is None else s.one_call
-    if one is not None and arr.shape == (4, 4) and arr.dtype is _F64 and swivel is None and not position_only \
-            and (param is None) != one[4]:
-        fast = _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal)
-        if fast is not None:
-            return fast
     if s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
             arr.shape == (4, 4) or (s.kind == "planar" and arr.shape == (3,))):
         fast = _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal)
@@ -1112,6 +1107,13 @@ def _book_result(robot, T, prm, tol):
 #: a joint exactly on its limit then yields a candidate up to a few 1e-8 rad beyond it.  1e-6 rad
 #: covers that with margin; every kept candidate still passes the FK check (``tol``).
 LIMIT_SLACK = 1e-6
+
+
+def _c_order(T) -> np.ndarray:
+    """``T`` as an array in C order (the compiled calls take C order): a list as floats, an
+    array as it is (its dtype checked later), a strided view copied."""
+    arr = T if isinstance(T, np.ndarray) else np.asarray(T, dtype=float)
+    return arr if arr.flags.c_contiguous else np.ascontiguousarray(arr)
 
 
 def _check_tol(name, value):

@@ -58,7 +58,7 @@ from ..jit import kernel, local, local2, local_flags
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _common_point,
-                        _fk_residuals, _mark_solutions, _pose_status, _rot3, _target_errors, _wrist,
+                        _fk_residuals, _mark_solutions, _pose_status, _target_errors, _wrist,
                         into_limit_cs, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
 from .vec3 import (add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose, vec,
@@ -326,6 +326,12 @@ def _align(a0, b0, a1, b1):
 
 
 @kernel
+def _rot3(h, a1, a2, a3):
+    """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three angle triples."""
+    return mm(mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2])), rot_cs(h[2], a3[1], a3[2]))
+
+
+@kernel
 def _q4(q4b, b, a4):
     """q4's triple (θ, cos θ, sin θ) for branches b and b + 1."""
     for k in range(2):
@@ -487,7 +493,7 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
     (the caller's general path answers).  ``cf``, ``ci``: :attr:`SRSPlan.packed`.  Scratch
     local (:func:`anthroarm.jit.local`)."""
-    A, order = _srs_unpack(cf, ci)[7], _srs_unpack(cf, ci)[10]
+    _, _, _, _, _, _, _, A, _, _, order = _srs_unpack(cf, ci)
     Tb = T.reshape((1, 4, 4))
     sw = local2(1, 1)
     q = local(7)

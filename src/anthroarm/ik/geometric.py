@@ -153,7 +153,8 @@ class GeoPlan:
     fk_M: np.ndarray | None = None
     lower_path: np.ndarray | None = None
     upper_path: np.ndarray | None = None
-    #: the configuration q is the joint angles themselves (no continuous joint: no cos/sin pair)
+    #: the configuration q is the joint angles themselves (nq = n, and no continuous joint: no
+    #: cos/sin pair)
     plain: bool = False
 
     @functools.cached_property
@@ -174,8 +175,11 @@ class GeoPlan:
         frames = local_frames(self.fk_axes, self.fk_points, self.fk_M)
         cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, frames,
                                                  self.lower_path, self.upper_path)]).astype(float)
-        ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), len(self.fk_axes),
-                       *self.order, self.chain.nq, *self.chain._configuration_index.ravel()], dtype=np.int64)
+        n, nq = len(self.fk_axes), self.chain.nq
+        if nq > 2 * n:                   # the compiled calls' scratch (local arrays) holds 2 entries a joint
+            raise ValueError(f"{self.chain.name}: nq = {nq} > 2 × {n} joints on the path")
+        ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), n, *self.order, nq,
+                       *self.chain._configuration_index.ravel()], dtype=np.int64)
         return cf, ci
 
 
@@ -312,17 +316,18 @@ def _put(B, b, a1, a2, a3, a4, a5, a6, v, e):
 
 
 @kernel
-def _rot3(h, a1, a2, a3):
-    """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three angle triples."""
-    return mm(mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2])), rot_cs(h[2], a3[1], a3[2]))
-
-
-@kernel
 def _wrist(h, R03, R06, B, b, a1, a2, a3, ex):
     """Spherical wrist from R36 = R03ᵀ R06 (:func:`_wrist_of`); branches b (first q5 root) and
     b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
-    R36 = mtm(R03, R06)
-    _wrist_of(h, mv(R36, h[5]), mv(R36, perpendicular(h[5])), B, b, a1, a2, a3, ex)
+    u, w = _wrist_reads(h, mtm(R03, R06))
+    _wrist_of(h, u, w, B, b, a1, a2, a3, ex)
+
+
+@kernel
+def _wrist_reads(h, R):
+    """(R h6, R x), x = :func:`.vec3.perpendicular` of h6: the two columns of a rotation R that
+    :func:`_wrist_of` reads of R36 (R = R36, or R06 before it is turned back, :func:`_back3`)."""
+    return mv(R, h[5]), mv(R, perpendicular(h[5]))
 
 
 @kernel
@@ -360,7 +365,7 @@ def _spherical_two_parallel(h, P, R06, p, B):
     wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
     t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]),
                                                            dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
-    u0, w0 = mv(R06, h[5]), mv(R06, perpendicular(h[5]))                # R06 h6, R06 x: what the wrist reads
+    u0, w0 = _wrist_reads(h, R06)
     for i1 in range(2):
         if i1 >= n1:
             _none(B, 4 * i1, 4 * i1 + 4)
@@ -387,7 +392,7 @@ def _spherical_two_parallel(h, P, R06, p, B):
 def _spherical_two_intersecting(h, P, R06, p, B):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
-    u0, w0 = mv(R06, h[5]), mv(R06, perpendicular(h[5]))                # R06 h6, R06 x: what the wrist reads
+    u0, w0 = _wrist_reads(h, R06)
     t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
         if i3 >= n3:
@@ -482,6 +487,7 @@ def _spherical(h, P, R06, p, B):
     """Spherical wrist only: (q1, q2, q3) by SP5 (−p12 + R01ᵀ p16 = R12 (p23 + R23 p34), a
     quartic, up to 4), then the wrist."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])
+    u0, w0 = _wrist_reads(h, R06)
     t = local2(4, 3)
     cnt, _ = sp5_one(neg(P[1]), p16, P[2], P[3], neg(h[0]), h[1], h[2], TOL_QUARTIC, t)
     for j in range(4):
@@ -489,8 +495,7 @@ def _spherical(h, P, R06, p, B):
             _none(B, 2 * j, 2 * j + 2)
             continue
         a1, a2, a3 = angle_cs(t[j, 0]), angle_cs(t[j, 1]), angle_cs(t[j, 2])
-        _wrist_of(h, _back3(h, a1, a2, a3, mv(R06, h[5])), _back3(h, a1, a2, a3, mv(R06, perpendicular(h[5]))), B,
-                  2 * j, a1, a2, a3, True)
+        _wrist_of(h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, 2 * j, a1, a2, a3, True)
 
 
 #: the compiled class solvers, by their index in :data:`CLOSED`
@@ -760,8 +765,9 @@ def _fk_residuals(A, Q, QC, QS, V, n, T, RES, S):
     """The FK residual max |F(θ) − T| over the 3×4 pose entries (:func:`_chain_fk`,
     :func:`_pose_error`) of every candidate branch b (``V[b]``) of Q (B, n) into RES (B,)
     (inf where there is none), each joint's rotation from QC, QS (B, n), the cosine and sine
-    of its angle (the rotation the class solver found, whose angle Q is, or cos and sin of Q
-    where :func:`_verified` moved it), the partial products shared along the branch tree:
+    of its angle (the rotation the class solver found, whose angle Q is, whole turns added
+    or not; cos and sin of Q where :func:`into_limit_cs` put it onto a limit or the polish
+    moved it), the partial products shared along the branch tree:
     branches come root index innermost, so a branch repeats the leading angles of the one
     before it, and the partial products up to the first joint whose angle differs are kept
     (scratch S (n + 1, 12): rotation rows and translation after each joint) — the same
@@ -791,13 +797,17 @@ def _fk_residuals(A, Q, QC, QS, V, n, T, RES, S):
 
 @kernel(inline=True)
 def _unpack(cf, ci):
-    """The plan's constants from :attr:`GeoPlan.packed` (views of ``cf``: compiled into each
-    caller, :func:`anthroarm.jit.kernel`)."""
+    """The plan's constants from :attr:`GeoPlan.packed`: (class index, reversed, n, H, P,
+    R_tool, the held joint's axis and point, the tool pose at q = 0, the FK frames A (n + 1, 12),
+    lo, hi (n,), order (n,): the path position of each independent joint, index (n, 2): its
+    first entry in q and whether it is continuous) — views of ``cf``, ``ci``, compiled into each
+    caller (:func:`anthroarm.jit.kernel`)."""
     n = ci[2]
     o = 70 + 12 * (n + 1)
     return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
             (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), cf[54:70].reshape((4, 4)),
-            cf[70:o].reshape((n + 1, 12)), cf[o:o + n], cf[o + n:o + 2 * n])
+            cf[70:o].reshape((n + 1, 12)), cf[o:o + n], cf[o + n:o + 2 * n], ci[3:3 + n],
+            ci[4 + n:4 + 3 * n].reshape((n, 2)))
 
 
 @kernel(counted=False)
@@ -807,7 +817,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     empty, CONF (N, 8, nq).  Returns the index of the first malformed pose (−1 if none).
     ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference counts
     (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
-    cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
+    cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
     h, PP = rows6(H), rows7(P)
     Rt = mat(R_tool)
     MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
@@ -818,15 +828,15 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
-        if not _verify_pose(ci, (cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi), T[i], param[i], tol,
-                            tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i], CONF[i],
+        if not _verify_pose((cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi, order, index), T[i],
+                            param[i], tol, tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i], CONF[i],
                             (B6, q, QC, QS, S, J, F, CHK)):
             return i
     return -1
 
 
 @kernel(inline=True)
-def _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
+def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
     """Every branch of one pose T (4, 4) in path order, wrapped into the limits and FK-checked:
     writes Q (8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
     residual; inf where there is no candidate, and for an exact candidate outside the limits,
@@ -840,7 +850,7 @@ def _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK,
     the tool pose at q = 0 as (MR, Mp); ``scratch``: B6 (8, :data:`BRANCH_ROW`), q (7,), QC, QS
     (8, n), S (n + 1, 12), J (6, 6), F (6,), CHK (8,).  Compiled into each caller
     (:func:`_verified`, :func:`_verified_one`)."""
-    cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi = plan
+    cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi, order, index = plan
     B6, q, QC, QS, S, J, F, CHK = scratch
     if _pose_status(T, tol_orthonormal) != 0:
         return False
@@ -879,23 +889,23 @@ def _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK,
                 RES[b] = r
     _mark_solutions(Q, V, IN, RES, tol, 8, OK)
     if CONF.shape[1] > 0:
-        _configurations(ci, n, Q, QC, QS, OK, CONF)
+        _configurations(order, index, n, Q, QC, QS, OK, CONF)
     return True
 
 
 @kernel
-def _configurations(ci, n, Q, QC, QS, OK, CONF):
+def _configurations(order, index, n, Q, QC, QS, OK, CONF):
     """The chain's configuration q (:func:`anthroarm.chain_kernels.put_joint`) of each solution
     b (``OK[b]``) of θ Q (8, n) (path order) with its cosines QC and sines QS into CONF (8, nq)
-    (NaN rows elsewhere); ``ci``: :attr:`GeoPlan.packed`."""
+    (NaN rows elsewhere); ``order``, ``index``: :func:`_unpack`'s."""
     for b in range(8):
         if not OK[b]:
             for j in range(CONF.shape[1]):
                 CONF[b, j] = math.nan
             continue
         for k in range(n):
-            j = ci[3 + k]
-            put_joint(CONF[b], ci[4 + n + 2 * k], ci[5 + n + 2 * k] != 0, Q[b, j], QC[b, j], QS[b, j])
+            j = order[k]
+            put_joint(CONF[b], index[k, 0], index[k, 1] != 0, Q[b, j], QC[b, j], QS[b, j])
 
 
 #: a solution whose normalised Jacobian volume (:func:`_volume`) is at most this is at a
@@ -924,14 +934,14 @@ def _volume(A, q, n, J, F):
 def _volume_loop(cf, ci, TH, OK, VOL):
     """:func:`_volume` of every solution (``OK``) of θ (N, B, n) in independent-joint order
     into VOL (N, B) (1 elsewhere)."""
-    n, A = ci[2], _unpack(cf, ci)[9]
+    _, _, n, _, _, _, _, _, _, A, _, _, order, _ = _unpack(cf, ci)
     q, J, F = np.empty(n), np.empty((6, 6)), np.empty(6)
     for i in range(TH.shape[0]):
         for b in range(TH.shape[1]):
             VOL[i, b] = 1.0
             if OK[i, b]:
                 for k in range(n):
-                    q[ci[3 + k]] = TH[i, b, k]
+                    q[order[k]] = TH[i, b, k]
                 VOL[i, b] = _volume(A, q, n, J, F)
 
 
@@ -1076,15 +1086,16 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     (the caller's general path answers: reasons, polishing).  One :func:`_verify_pose`, its
     scratch local."""
     n, w = ci[2], out.shape[1] - 4
-    cls, rev, _, H, P, R_tool, p_axis, p_point, M, A, lo, hi = _unpack(cf, ci)
+    cls, rev, _, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
     Q, RES = local(56)[:8 * n].reshape((8, n)), local(8)
     V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
     CONF = local(112)[:8 * w if w != n else 0].reshape((8, w if w != n else 0))
     QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
-    plan = (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi)
+    plan = (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi,
+            order, index)
     scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, local(96)[:12 * (n + 1)].reshape((n + 1, 12)),
                local2(6, 6), local(6), local_flags(8))
-    if not _verify_pose(ci, plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
+    if not _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
         return -1
     K, mask = 0, 0
     for b in range(8):
@@ -1096,7 +1107,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
                     out[K, k] = CONF[b, k]
             else:
                 for k in range(n):
-                    out[K, k] = Q[b, ci[3 + k]]
+                    out[K, k] = Q[b, order[k]]
             out[K, w], out[K, w + 1] = RES[b], b
             K += 1
             mask |= 1 << b
