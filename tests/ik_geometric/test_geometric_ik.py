@@ -232,6 +232,35 @@ def test_near_intersecting_axes_within_tolerance_are_polished(tmp_path):
     assert r.success and all(np.abs(_fk(robot, x) - T[0]).max() < 1e-9 for x in r.solutions)
 
 
+def test_polished_solutions_of_continuous_joints_come_out_polished(tmp_path):
+    """The arm above with joints 1, 4 and 6 continuous (nq = 9): the compiled call polishes its
+    candidates and writes their configurations, the (cos, sin) pairs of the polished angles —
+    Pinocchio's FK of every solution, one pose and a batch, is the pose to 1e-9 (the class
+    solution's pairs would be ~1e-7 off)."""
+    text = standard_dh_urdf("puma_off_cont", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0, 0.4318, 0.0203, 0, 0, 0],
+                            [0.6718, 0, 0.15005, 0.4318, 1e-7, 0])
+    for j in ("j1", "j4", "j6"):
+        text = text.replace(f'<joint name="{j}" type="revolute">', f'<joint name="{j}" type="continuous">')
+    path = tmp_path / "puma_off_cont.urdf"
+    path.write_text(text)
+    robot = aa.load(str(path))
+    assert robot.nq == 9 and G.plan_for(robot).cls == C.SPHERICAL_TWO_PARALLEL
+    th, T = _poses(robot, 6, 8)
+    gp = G.plan_for(robot)
+    q, _, exact = G.solve(gp, T[:1])
+    assert max(np.abs(_fk(robot, robot.chain.configuration(x)) - T[0]).max() for x in q[0][exact[0]]) > 1e-9
+    ch = robot.chain
+    cos_at = [ch.joints[j].idx_q for j in ch.independent if ch.joints[j].kind == "continuous"]
+    assert len(cos_at) == 3
+    batch = aa.ik.analytic_batch(robot, T)
+    for i in range(len(T)):
+        one = aa.ik.analytic(robot, T[i])
+        assert len(one) > 0 and one.solutions.shape[1] == 9
+        for x in list(one.solutions) + list(batch.solutions[i][batch.valid[i]]):
+            assert np.abs(_fk(robot, x) - T[i]).max() < 1e-9
+            np.testing.assert_allclose(np.hypot(x[cos_at], x[[k + 1 for k in cos_at]]), 1.0, atol=1e-15)
+
+
 def test_no_closed_form_geometry():
     robot = aa.load("rrprr5")                                     # 5 joints, one prismatic
     assert C.classify(robot).name == C.NOT_6R and G.plan_for(robot) is None
