@@ -295,7 +295,7 @@ class _Solver:
 
     @functools.cached_property
     def one_call(self):
-        """For one pose of a closed class (:func:`_geometric_single`): (packed constants, joints
+        """For one pose of a closed class (:func:`analytic`'s compiled call): (packed constants, joints
         n, the labels of the solutions by the bit mask of their branches (how the compiled call
         returns them: 256 tuples), whether a 7th joint is held, the width of a solution: n, or
         nq where q is not θ (continuous joints)); None for the other kinds."""
@@ -854,9 +854,19 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             and (param is None) != hit[3][4]):
         # one pose of a closed class (no tree, no other frame): one compiled call, when it has a
         # solution and nothing to polish; else the general path below says what happened
-        fast = _geometric_single(robot, hit[2], hit[3], arr, param, tol, tol_orthonormal)
-        if fast is not None:
-            return fast
+        cf, ci, _, labels, _, w = hit[3]
+        prm = 0.0 if param is None else _held_angle(param)
+        out = np.empty((8, w + 4))
+        mask = -1 if prm is None else _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
+        if mask > 0:
+            branches = labels[mask]
+            K, plan, plain = len(branches), hit[2].plan, hit[2].plain
+            q = out[:K, :w]
+            # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
+            # path of every single pose, where keywords cost a third of the result's construction
+            return AnalyticIKResult(q, list(branches), None, None, out[:K, w], lambda: _singular_text(float(
+                _geo.jacobian_volumes(plan, (q if plain else plan.chain.angles(q)[:, list(plan.chain.independent)])[None],
+                                      np.ones((1, K), bool)).min())), robot.name)
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None:
@@ -977,34 +987,14 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
                             branches=[s.plan.labels[b] for b in k], residuals=res[rows], model=robot.name)
 
 
-def _geometric_single(robot, s, one, arr, param, tol, tol_orthonormal):
-    """One pose of a closed class in one compiled call, when it has a solution and nothing to
-    polish; else None (:func:`analytic_batch` answers, with the reasons).  ``one``:
-    :attr:`_Solver.one_call`."""
-    cf, ci, n, labels, _, w = one
-    prm = 0.0
-    if param is not None:
-        try:
-            prm = float(param)
-        except (TypeError, ValueError):
-            return None                 # a malformed param: the batch path says what is wrong
-        if not abs(prm) < WRAP_MAX:
-            return None                 # not an angle: the batch path says so
-    out = np.empty((8, w + 4))
-    mask = _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
-    if mask <= 0:
+def _held_angle(param) -> float | None:
+    """A held joint's value ``param`` as a float angle, or None where it is not one (the batch
+    path says what is wrong)."""
+    try:
+        prm = float(param)
+    except (TypeError, ValueError):
         return None
-    branches = labels[mask]
-    K = len(branches)
-    q = out[:K, :w]
-    plan = s.plan
-    # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — this is
-    # the path of every single pose, and keywords cost a third of the result's construction
-    return AnalyticIKResult(q, list(branches), None, None, out[:K, w],
-                            lambda: _singular_text(float(_geo.jacobian_volumes(
-                                plan, (q if s.plain else plan.chain.angles(q)[:, list(plan.chain.independent)])[None],
-                                np.ones((1, K), bool)).min())),
-                            robot.name)
+    return prm if abs(prm) < WRAP_MAX else None
 
 
 def _singular_text(volume: float) -> str | None:
