@@ -936,6 +936,30 @@ def test_limits_reason_names_the_limits_of_the_joints_solved_for():
         assert "[-1, 1]" not in text
 
 
+def test_a_single_precision_pose_is_a_near_miss_not_outside_the_workspace():
+    """A reachable pose rounded to float32 is no rigid transform to 1e-9 (its rotation is
+    orthonormal to ~1e-8): no solution at the default tol, and the reason says it was missed by
+    ~1e-8 and how to accept it — not "outside the workspace"; with tol = 1e-6 every branch comes
+    back, each within 1e-6 of the rounded pose by Pinocchio's FK (ur5, sixr_arm, human_arm7)."""
+    from anthroarm.ik import swivel_angle
+
+    for name in ("ur5", "sixr_arm", "human_arm7"):
+        robot = aa.load(name)
+        q = robot.random_q(rng=2)
+        kw = {"swivel": float(swivel_angle(robot, q[None])[0])} if name == "human_arm7" else {}
+        T32 = _fk(robot, q).astype(np.float32)
+        r = aa.ik.analytic(robot, T32, **kw)
+        assert len(r) == 0 and r.reason.startswith("not reached to tol = 1e-09"), (name, r.reason)
+        assert "outside the workspace" not in r.reason and "larger tol" in r.reason
+        r = aa.ik.analytic(robot, T32, tol=1e-6, **kw)
+        assert len(r) > 0, (name, r.reason)
+        for x in r.solutions:
+            assert np.abs(_fk(robot, x) - T32).max() <= 1e-6
+    far = _fk(aa.load("ur5"), aa.load("ur5").random_q(rng=2))
+    far[:3, 3] *= 3.0
+    assert aa.ik.analytic(aa.load("ur5"), far).reason.startswith("outside the workspace")
+
+
 def test_a_reachable_pose_at_a_tangent_root_is_solved():
     """A pose reached by a configuration inside the limits has a solution, also where a
     subproblem's two roots meet (panda's shoulder at q2 = 0, joints on their limits): its only

@@ -770,6 +770,11 @@ def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, posi
                                _singular_of=singular_of, model=robot.name)
 
 
+#: an FK residual (m / unitless) up to which a pose without a solution is reported as a near miss
+#: (rounding of the pose, not the workspace) by :func:`_reason`
+NEAR_MISS = 1e-6
+
+
 def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
     """Why pose ``T`` has no solution, from its branches' flags."""
     fam = s.form.family
@@ -780,6 +785,11 @@ def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
                     "mechanism (normal to its parallel axes)")
     if not (cand & exact).any():
         best = float(np.min(res)) if np.isfinite(res).any() else float("inf")
+        if best <= NEAR_MISS:
+            return (f"not reached to tol = {tol:g}: the best candidate leaves an FK residual of {best:.3g} "
+                    "(the pose is not a rigid transform to that precision — a single-precision pose, a rotation "
+                    "orthonormal only to ~1e-8 — or lies that close to the workspace boundary); pass a larger tol "
+                    "to accept it")
         return (f"outside the workspace: no branch of the {fam} closed form reaches this pose (its "
                 f"subproblems have least-squares answers only; best FK residual {best:.3g})")
     if not (cand & exact & inside).any():
