@@ -858,10 +858,10 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         _solver(robot)                            # the cache entry: a first call, or a new chain or tool
         hit = _SOLVERS[id(robot)]
     arr = T if type(T) is np.ndarray and T.flags.c_contiguous else _c_order(T)
-    if (hit[3] is not None and arr.shape == (4, 4) and arr.dtype is _F64 and swivel is None and frame is None
-            and q_rest is None and not position_only and method == "robust" and type(tol) is float
-            and type(tol_orthonormal) is float and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf
-            and (param is None) != hit[3][4]):
+    usual = (arr.shape == (4, 4) and arr.dtype is _F64 and frame is None and q_rest is None and not position_only
+             and method == "robust" and type(tol) is float and type(tol_orthonormal) is float
+             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf)
+    if usual and hit[3] is not None and swivel is None and (param is None) != hit[3][4]:
         # one pose of a closed class (no tree, no other frame): one compiled call, when it has a
         # solution and nothing to polish; else the general path below says what happened
         cf, ci, _, labels, _, w = hit[3]
@@ -877,6 +877,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             return AnalyticIKResult(q, list(branches), None, None, out[:K, w], lambda: _singular_text(float(
                 _geo.jacobian_volumes(plan, (q if plain else plan.chain.angles(q)[:, list(plan.chain.independent)])[None],
                                       np.ones((1, K), bool)).min())), robot.name)
+    elif usual and type(swivel) is float and param is None and hit[2] is not None and hit[2].kind == "srs" \
+            and hit[2].arm is None:
+        fast = _srs_single(robot, hit[2], arr, swivel, tol, tol_orthonormal)     # one swivel angle
+        if fast is not None:
+            return fast
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None:
@@ -958,33 +963,51 @@ def _nearest_on_arm(inner, th_idx, th_rest, T, ref, *args):
     return S, out[1], out[2]
 
 
-def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
-    """One pose of an SRS arm (at ``swivel``, a scalar or a 1-D grid; default
-    :data:`DEFAULT_SWIVEL`) or a planar 2R arm (position only) in one compiled call, when it has
-    a solution and nothing to polish — the same solutions, labels and order as
-    :func:`analytic_batch`, without its batch bookkeeping; else None (the batch path answers,
-    with the reasons and the polish)."""
+def _srs_single(robot, s, arr, swivel, tol, tol_orthonormal):
+    """One pose ``arr`` (4×4, C order) of an SRS arm at ``swivel`` (a scalar or a 1-D grid;
+    default :data:`DEFAULT_SWIVEL`) in one compiled call (:func:`.families.srs_solutions`), when
+    it has a solution and nothing to polish — the same solutions, labels and order as
+    :func:`analytic_batch`; else None (a malformed pose or swivel, no solution: the batch path
+    says what happened)."""
     try:
-        if s.kind == "srs":
-            if position_only:
-                return None
-            grid = _swivel_array(swivel, 1, grid_1d=True)[0]
-            got = _fam.srs_solutions(s.plan, arr, grid, tol, tol_orthonormal)
-            if got is None:
-                return None
-            q, res, rows = got
-            labels, B, angle = _grid_labels(s.plan.labels, len(grid), "swivel"), len(s.plan.labels), grid.tolist()
-            return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[r] for r in rows], None,
-                                    np.array([angle[r // B] for r in rows]), res, None, robot.name)
+        if type(swivel) is float and abs(swivel) < WRAP_MAX:          # one angle: no numpy checks
+            grid = np.empty(1)
+            grid[0] = swivel
         else:
-            if position_only is False:
-                return None
-            p = arr if arr.shape == (3,) else arr[:3, 3]
-            if arr.shape == (4, 4) and (arr[3].tolist() != [0.0, 0.0, 0.0, 1.0] or not np.isfinite(arr).all()):
-                return None             # the batch path's checks say what is wrong, or that it is fine
-            th, cand, exact, inside, res, valid = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
+            grid = _swivel_array(swivel, 1, grid_1d=True)[0]
+        got = _fam.srs_solutions(s.plan, arr, grid, tol, tol_orthonormal)
     except ValueError:
-        return None                     # a malformed pose or swivel: the batch path says what is wrong
+        return None
+    if got is None:
+        return None
+    q, res, rows = got
+    if len(grid) == 1:                                                 # one angle: its labels, its value
+        angles = np.empty(len(rows))
+        angles.fill(grid[0])
+        labels = s.plan.labels
+    else:
+        B, angle = len(s.plan.labels), grid.tolist()
+        angles, labels = np.array([angle[r // B] for r in rows]), _grid_labels(s.plan.labels, len(grid), "swivel")
+    return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[r] for r in rows], None, angles,
+                            res, None, robot.name)
+
+
+def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
+    """One pose of an SRS arm (:func:`_srs_single`) or a planar 2R arm (position only) in one
+    compiled call, when it has a solution and nothing to polish — the same solutions, labels and
+    order as :func:`analytic_batch`, without its batch bookkeeping; else None (the batch path
+    answers, with the reasons and the polish)."""
+    if s.kind == "srs":
+        return None if position_only else _srs_single(robot, s, arr, swivel, tol, tol_orthonormal)
+    if position_only is False:
+        return None
+    p = arr if arr.shape == (3,) else arr[:3, 3]
+    if arr.shape == (4, 4) and (arr[3].tolist() != [0.0, 0.0, 0.0, 1.0] or not np.isfinite(arr).all()):
+        return None                     # the batch path's checks say what is wrong, or that it is fine
+    try:
+        th, cand, exact, inside, res, valid = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
+    except ValueError:
+        return None                     # a malformed position: the batch path says what is wrong
     flags = list(zip(cand.tolist(), exact.tolist(), inside.tolist(), res.tolist()))   # 2 branches: no numpy
     if s.plain and any(c and e and i and tol < r <= POLISH_MAX for c, e, i, r in flags):
         return None
