@@ -44,6 +44,9 @@ PI = np.pi
 ARMS = ["sixr_arm", "prosthetic_arm", "care_robot", "ur3", "ur5", "ur10", "kinova", "talos_arm", "panda",
         "human_arm7", "planar2r"]
 CLIK_ARMS = ("sixr_arm", "prosthetic_arm", "human_arm7")
+#: one-call timings of a batch (ours and ik-geo's Python loop) per row: their median (a 10 000-pose
+#: call is ~9 ms, so a moment of load on the shared machine takes one or two of them)
+BATCH_REPEAT = 15
 SEARCH_CLASSES = ("two_parallel", "two_intersecting")
 OK_TOL = 1e-10         # Pinocchio FK error of a solution counted as a success
 SAME_TOL = 1e-8        # rad: our exact branches vs ik-geo's, mod 2π
@@ -165,16 +168,16 @@ def _single_row(case, n, times, results, t_geo, note):
 
 
 def _batch_row(case, n, t_geo):
-    """``aa.ik.analytic_batch`` on n poses: one call (median of 7), per pose; ``t_geo`` the
+    """``aa.ik.analytic_batch`` on n poses: one call (median of :data:`BATCH_REPEAT`), per pose; ``t_geo`` the
     per-pose time of ik-geo's Python loop (s) or None."""
     robot, T, kw = case.robot, case.T[:n], case.kw_batch(n)
     aa.ik.analytic_batch(robot, T[:20], **case.kw_batch(20))                     # warm-up
     res = aa.ik.analytic_batch(robot, T, **kw)
-    t = time_call(lambda: aa.ik.analytic_batch(robot, T, **kw), repeat=7) / n
+    t = time_call(lambda: aa.ik.analytic_batch(robot, T, **kw), repeat=BATCH_REPEAT) / n
     pose, b = np.nonzero(res.valid)
     return _row(case, "anthroarm analytic batch", n, _check(case, res.solutions[pose, b], pose, n), t,
                 t / t_geo if t_geo else "",
-                note="one call, median of 7" + ("; vs ik-geo's per-pose Python loop" if t_geo else ""))
+                note=f"one call, median of {BATCH_REPEAT}" + ("; vs ik-geo's per-pose Python loop" if t_geo else ""))
 
 
 # ---------------------------------------------------------------------------- ik-geo rows
@@ -218,7 +221,7 @@ def _ik_geo_rows(case, geo, times, n_single, n_loop):
     out = [geo.get_ik(*a) for a in args[:n]]
     t_single = float(np.median(times[:n_single]))
     loop = args[:n_loop]
-    t_loop = time_call(lambda: [geo.get_ik(*a) for a in loop], repeat=7) / n_loop
+    t_loop = time_call(lambda: [geo.get_ik(*a) for a in loop], repeat=BATCH_REPEAT) / n_loop
     # its exact solutions in our joint order: FK-checked, and the same sets as our class solver's?
     q, _, exact = G.solve(gp, case.T[:n], prm)
     same, sols, pose = 0, [], []
@@ -235,7 +238,7 @@ def _ik_geo_rows(case, geo, times, n_single, n_loop):
     rows = [_row(case, "ik-geo single (Rust)", n_single, checks, t_single, same=f"{same}/{n}",
                  note=f"get_ik on the class pose, exact solutions, no limits; checks over {n} poses"),
             _row(case, "ik-geo batch (Rust, Python loop)", n_loop, ("", "", "", ""), t_loop,
-                 note="no batch API: a Python loop over get_ik (median of 7), per pose")]
+                 note=f"no batch API: a Python loop over get_ik (median of {BATCH_REPEAT}), per pose")]
     return rows, t_single, t_loop
 
 
@@ -310,7 +313,7 @@ def run(quick: bool = False) -> dict:
             "limit filtering and FK verification included, no slower than IK-Geo (PyPI ik-geo, called from "
             "Python) on the same pose; batched ≤ 1 µs a pose at N = 10 000. "
             "Rows: 'anthroarm analytic single' = aa.ik.analytic on one 4×4 pose, median of the per-call times; "
-            "'anthroarm analytic batch' = aa.ik.analytic_batch on N poses, one call (median of 7), per pose. Every "
+            f"'anthroarm analytic batch' = aa.ik.analytic_batch on N poses, one call (median of {BATCH_REPEAT}), per pose. Every "
             "analytic solution is FK-verified inside the call (1e-9 on the 3×4 pose) and limit-filtered; 'success' "
             "(≥ 1 solution with Pinocchio-FK error ≤ 1e-10), 'max FK err' and 'limit violations' are checked "
             "afterwards with Pinocchio. human_arm7: one swivel angle (the sampled configuration's); panda: q7 held "
