@@ -61,8 +61,8 @@ from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN,
                         _fk_residuals, _mark_solutions, _pose_status, _target_errors, _wrist,
                         into_limit_cs, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
-from .vec3 import (add, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose, vec,
-                   wrap)
+from .vec3 import (add, atan2, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose,
+                   vec, wrap)
 
 #: shoulder routes of the SRS arm (index stored in the plan)
 SRS_ROUTES = ("sp2", "general")
@@ -327,15 +327,15 @@ def _align(a0, b0, a1, b1):
 
 @kernel
 def _rot3(h, a1, a2, a3):
-    """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three angle triples."""
-    return mm(mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2])), rot_cs(h[2], a3[1], a3[2]))
+    """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three rotations (cos, sin)."""
+    return mm(mm(rot_cs(h[0], a1[0], a1[1]), rot_cs(h[1], a2[0], a2[1])), rot_cs(h[2], a3[0], a3[1]))
 
 
 @kernel
 def _q4(q4b, b, a4):
-    """q4's triple (θ, cos θ, sin θ) for branches b and b + 1."""
+    """q4's rotation (cos θ, sin θ) for branches b and b + 1."""
     for k in range(2):
-        q4b[b + k, 0], q4b[b + k, 1], q4b[b + k, 2] = a4
+        q4b[b + k, 0], q4b[b + k, 1] = a4
 
 
 @kernel
@@ -343,9 +343,9 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
     """The 8 branches of one pose and swivel angle φ: Q (8, 7) rad (path order, wrapped into
     (−π, π]), QC, QS (8, 7) their cosines and sines, V (the branch exists), E (every
     subproblem on it exact).  ``Rg`` = R R_tᵀ, ``W`` the wrist centre (base frame, m), ``a4a``,
-    ``a4b`` the q4 roots of the SP3 (module docstring) as triples (θ, cos θ, sin θ); B6 (8, ·),
-    Bs (2, ·) rows of branches as :mod:`.geometric`'s class solvers write them, q4b (8, 3)
-    scratch."""
+    ``a4b`` the q4 roots of the SP3 (module docstring) as rotations (cos θ, sin θ); B6 (8, ·),
+    Bs (2, ·) rows of branches as :mod:`.geometric`'s class solvers write them (their rotations),
+    q4b (8, 2) scratch.  The angles are read from the rotations at the end (atan2)."""
     for b in range(8):
         B6[b, EXISTS] = 0.0
         B6[b, EXACT] = 0.0
@@ -374,36 +374,35 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                 continue
             a4 = a4a if i4 == 0 else a4b
             ex4 = e4a if i4 == 0 else e4b
-            R34 = rot_cs(h[3], a4[1], a4[2])
+            R34 = rot_cs(h[3], a4[0], a4[1])
             f = mv(R34, f0)
             src = h[3] if straight else f
             dst = aE if straight else fore
             if route == 0:
-                (u1a, c1a, s1a, u2a, c2a, s2a, u1b, c1b, s1b, u2b, c2b, s2b,
-                 n12, ea, eb, _) = sp2_cs(up, e0, neg(h[0]), h[1], TOL)
+                c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, n12, ea, eb, _ = sp2_cs(up, e0, neg(h[0]), h[1], TOL)
                 for j in range(2):
                     if j >= n12:
                         continue
-                    a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
-                    R02 = mm(rot_cs(h[0], a1[1], a1[2]), rot_cs(h[1], a2[1], a2[2]))
-                    t3, c3, s3, e3, _ = sp1_cs(src, mtv(R02, dst), h[2], TOL)
+                    a1, a2 = ((c1a, s1a), (c2a, s2a)) if j == 0 else ((c1b, s1b), (c2b, s2b))
+                    R02 = mm(rot_cs(h[0], a1[0], a1[1]), rot_cs(h[1], a2[0], a2[1]))
+                    c3, s3, e3, _ = sp1_cs(src, mtv(R02, dst), h[2], TOL)
                     R04 = mm(mm(R02, rot_cs(h[2], c3, s3)), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, (t3, c3, s3),
+                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, (c3, s3),
                            ex4 and (ea if j == 0 else eb) and e3)
             else:
                 R03 = _align(e0, src, up, dst)
                 ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
                 for j in range(2):
                     Bs[j, EXISTS] = 0.0
-                zero = (0.0, 1.0, 0.0)
+                zero = (1.0, 0.0)
                 _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Bs, 0, zero, zero, zero, True)
                 for j in range(2):
                     if Bs[j, EXISTS] == 0.0:
                         continue
-                    a1, a2, a3 = ((Bs[j, 3], Bs[j, COS + 3], Bs[j, SIN + 3]), (Bs[j, 4], Bs[j, COS + 4], Bs[j, SIN + 4]),
-                                  (Bs[j, 5], Bs[j, COS + 5], Bs[j, SIN + 5]))
+                    a1, a2, a3 = ((Bs[j, COS + 3], Bs[j, SIN + 3]), (Bs[j, COS + 4], Bs[j, SIN + 4]),
+                                  (Bs[j, COS + 5], Bs[j, SIN + 5]))
                     R04 = mm(_rot3(h, a1, a2, a3), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
@@ -413,8 +412,8 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
         if B6[b, EXISTS] != 0.0:
             for j in range(7):                        # the wrist's joints are 4, 5, 6 of B6's row
                 k = j if j < 3 else j - 1
-                x, c, s = (q4b[b, 0], q4b[b, 1], q4b[b, 2]) if j == 3 else (B6[b, k], B6[b, COS + k], B6[b, SIN + k])
-                Q[b, j], QC[b, j], QS[b, j] = wrap(x), c, s
+                c, s = (q4b[b, 0], q4b[b, 1]) if j == 3 else (B6[b, COS + k], B6[b, SIN + k])
+                Q[b, j], QC[b, j], QS[b, j] = atan2(s, c), c, s       # the angle from its rotation
             V[b], E[b] = True, B6[b, EXACT] != 0.0
         else:
             for j in range(7):
@@ -447,7 +446,7 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
     h = rows7(H)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
-    B6, Bs, q4b = local2(8, BRANCH_ROW), local2(2, BRANCH_ROW), local2(8, 3)
+    B6, Bs, q4b = local2(8, BRANCH_ROW), local2(2, BRANCH_ROW), local2(8, 2)
     Qb, QC, QS = local2(8, 7), local2(8, 7), local2(8, 7)
     Vb, Eb, CHK = local_flags(8), local_flags(8), local_flags(8)
     Sfk = local2(8, 12)
@@ -462,9 +461,9 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
         R, p = mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3])
         Rg = mm(R, transpose(Rt))
         W = add(mv(Rg, sub(W0v, pt)), p)
-        t4a, c4a, s4a, t4b, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
+        c4a, s4a, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
         for k in range(ns):
-            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (t4a, c4a, s4a), (t4b, c4b, s4b), n4, e4a, e4b,
+            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (c4a, s4a), (c4b, s4b), n4, e4a, e4b,
                      Qb, QC, QS, Vb, Eb, B6, Bs, q4b)
             for b in range(8):
                 r = 8 * k + b

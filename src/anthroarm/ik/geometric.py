@@ -80,8 +80,8 @@ from . import classify as C
 from . import subproblems as sp
 from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search  # noqa: F401 - re-exported
 from .subproblems import TOL, TOL_QUARTIC, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5_one, sp6_one
-from .vec3 import (add, angle_cs, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs, rows6,
-                   rows7, sub, transpose, vec, wrap)
+from .vec3 import (add, angle_cs, atan2, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs,
+                   rows6, rows7, sub, transpose, vec, wrap)
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
@@ -293,9 +293,10 @@ def _build(robot) -> GeoPlan | None:
 # 1.0 / 0.0) and whether every subproblem on it was exact (:data:`EXACT`) — one array, so a
 # call passes one reference, not five — in the order of the labels: the first branching
 # subproblem outermost, the root index innermost.  A branch under a root that does not exist
-# is left NaN / not existing.  An angle travels as a triple a = (θ, cos θ, sin θ): the
-# subproblems give the rotation they find as (cos, sin) with its angle (``sp*_cs``), so the
-# rotations that follow, and the FK check of :func:`_verified`, evaluate no trigonometry.
+# is left NaN / not existing.  An angle travels as its rotation, the pair a = (cos θ, sin θ):
+# the subproblems give the rotation they find so (``sp*_cs``, :func:`.subproblems.unit_cs`),
+# the rotations that follow and the FK check of :func:`_verified` evaluate no trigonometry,
+# and the angles themselves are read at the end, in one vectorised loop (:func:`_angles`).
 COS, SIN, EXISTS, EXACT, BRANCH_ROW = 6, 12, 18, 19, 20
 
 
@@ -308,17 +309,35 @@ def _none(B, b0, b1):
 
 @kernel
 def _put(B, b, a1, a2, a3, a4, a5, a6, v, e):
-    """Branch b: the six angles (triples (θ, cos θ, sin θ)) and its flags."""
+    """Branch b: its six rotations (pairs (cos θ, sin θ)) and its flags; the angles are read
+    from them at the end (:func:`_angles`)."""
     row = (a1, a2, a3, a4, a5, a6)
     for j in range(6):
-        B[b, j], B[b, COS + j], B[b, SIN + j] = row[j]
+        B[b, COS + j], B[b, SIN + j] = row[j]
     B[b, EXISTS], B[b, EXACT] = 1.0 if v else 0.0, 1.0 if e else 0.0
+
+
+@kernel
+def _angles(B):
+    """The six angles of every branch row of B read from their cosines and sines,
+    θ = atan2(sin, cos) ∈ (−π, π] (:func:`.vec3.atan2`): one loop of 48 independent atan2 on
+    contiguous scratch, which the compiler vectorises — the subproblems hand on rotations, and
+    an angle is only read once its branch is complete."""
+    C, S, A = local(48), local(48), local(48)
+    for b in range(8):
+        for j in range(6):
+            C[6 * b + j], S[6 * b + j] = B[b, COS + j], B[b, SIN + j]
+    for k in range(48):
+        A[k] = atan2(S[k], C[k])
+    for b in range(8):
+        for j in range(6):
+            B[b, j] = A[6 * b + j]
 
 
 @kernel
 def _wrist(h, R03, R06, B, b, a1, a2, a3, ex):
     """Spherical wrist from R36 = R03ᵀ R06 (:func:`_wrist_of`); branches b (first q5 root) and
-    b + 1.  a1, a2, a3: the triples of q1, q2, q3."""
+    b + 1.  a1, a2, a3: the rotations (cos, sin) of q1, q2, q3."""
     u, w = _wrist_reads(h, mtm(R03, R06))
     _wrist_of(h, u, w, B, b, a1, a2, a3, ex)
 
@@ -332,60 +351,57 @@ def _wrist_reads(h, R):
 
 @kernel
 def _back3(h, a1, a2, a3, v):
-    """R03ᵀ v = rot(h3, −q3) rot(h2, −q2) rot(h1, −q1) v of the angle triples a1, a2, a3."""
-    return rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], a2[1], -a2[2], rotate_cs(h[0], a1[1], -a1[2], v)))
+    """R03ᵀ v = rot(h3, −q3) rot(h2, −q2) rot(h1, −q1) v of the rotations (cos, sin) a1, a2, a3."""
+    return rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], a2[0], -a2[1], rotate_cs(h[0], a1[0], -a1[1], v)))
 
 
 @kernel
 def _wrist_of(h, u, w, B, b, a1, a2, a3, ex):
     """Spherical wrist from u = R36 h6 and w = R36 x (x = :func:`.vec3.perpendicular` of h6; the
     two columns of R36 = R03ᵀ R06 it reads): q5 by SP4 (h4ᵀ R36 h6 = h4ᵀ rot(h5, q5) h6), q4
-    and q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the triples of q1, q2,
-    q3."""
+    and q6 by SP1; branches b (first q5 root) and b + 1.  a1, a2, a3: the rotations (cos, sin)
+    of q1, q2, q3."""
     h4, h5, h6 = h[3], h[4], h[5]
     x = perpendicular(h6)
-    ta, ca, sa, tb, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, u), TOL)
+    ca, sa, cb, sb, cnt, ea, eb, _ = sp4_cs(h4, h6, h5, dot(h4, u), TOL)
     for j in range(2):
         if j >= cnt:
             B[b + j, EXISTS] = 0.0
             continue
-        a5 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
-        c, s = a5[1], a5[2]
+        c, s = (ca, sa) if j == 0 else (cb, sb)
         # q4 (0 where it is free: h4 ∥ rot(h5, q5) h6, the wrist singularity), then q6 from
         # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
-        t4, c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), u, h4, TOL)
-        t6, c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, w)), h6, TOL)
-        _put(B, b + j, a1, a2, a3, (t4, c4, s4), a5, (t6, c6, s6), True,
-             ex and (ea if j == 0 else eb) and e4 and e6)
+        c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), u, h4, TOL)
+        c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, w)), h6, TOL)
+        _put(B, b + j, a1, a2, a3, (c4, s4), (c, s), (c6, s6), True, ex and (ea if j == 0 else eb) and e4 and e6)
 
 
 @kernel
 def _spherical_two_parallel(h, P, R06, p, B):
     """q1 SP4, q3 SP3, q2 SP1, the wrist (spherical wrist, axes 2 ∥ 3)."""
     wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
-    t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]),
-                                                           dot(h[1], add(add(P[1], P[2]), P[3])), TOL)
+    c1a, s1a, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]), dot(h[1], add(add(P[1], P[2]), P[3])),
+                                                 TOL)
     u0, w0 = _wrist_reads(h, R06)
     for i1 in range(2):
         if i1 >= n1:
             _none(B, 4 * i1, 4 * i1 + 4)
             continue
-        a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
-        v = sub(rotate_cs(neg(h[0]), a1[1], a1[2], wrist), P[1])       # R01ᵀ p_16 − p12
-        u1, w1 = rotate_cs(h[0], a1[1], -a1[2], u0), rotate_cs(h[0], a1[1], -a1[2], w0)
-        t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(neg(P[3]), P[2], h[2], norm(v), TOL)
+        a1 = (c1a, s1a) if i1 == 0 else (c1b, s1b)
+        v = sub(rotate_cs(neg(h[0]), a1[0], a1[1], wrist), P[1])       # R01ᵀ p_16 − p12
+        u1, w1 = rotate_cs(h[0], a1[0], -a1[1], u0), rotate_cs(h[0], a1[0], -a1[1], w0)
+        c3a, s3a, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(neg(P[3]), P[2], h[2], norm(v), TOL)
         for i3 in range(2):
             b = 4 * i1 + 2 * i3
             if i3 >= n3:
                 _none(B, b, b + 2)
                 continue
-            a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
-            t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), v, h[1], TOL)
-            a2 = (t2, c2, s2)
+            a3 = (c3a, s3a) if i3 == 0 else (c3b, s3b)
+            c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[0], a3[1], P[3])), v, h[1], TOL)
             ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
-            u = rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], c2, -s2, u1))    # R03ᵀ R06 h6
-            w = rotate_cs(h[2], a3[1], -a3[2], rotate_cs(h[1], c2, -s2, w1))
-            _wrist_of(h, u, w, B, b, a1, a2, a3, ex)
+            u = rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], c2, -s2, u1))    # R03ᵀ R06 h6
+            w = rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], c2, -s2, w1))
+            _wrist_of(h, u, w, B, b, a1, (c2, s2), a3, ex)
 
 
 @kernel
@@ -393,52 +409,50 @@ def _spherical_two_intersecting(h, P, R06, p, B):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
     p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
     u0, w0 = _wrist_reads(h, R06)
-    t3a, c3a, s3a, t3b, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
+    c3a, s3a, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
         if i3 >= n3:
             _none(B, 4 * i3, 4 * i3 + 4)
             continue
-        a3 = (t3a, c3a, s3a) if i3 == 0 else (t3b, c3b, s3b)
-        (u1a, c1a, s1a, u2a, c2a, s2a, u1b, c1b, s1b, u2b, c2b, s2b,
-         n12, ea, eb, _) = sp2_cs(p16, add(P[2], rotate_cs(h[2], a3[1], a3[2], P[3])), neg(h[0]), h[1], TOL)
+        a3 = (c3a, s3a) if i3 == 0 else (c3b, s3b)
+        c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, n12, ea, eb, _ = sp2_cs(
+            p16, add(P[2], rotate_cs(h[2], a3[0], a3[1], P[3])), neg(h[0]), h[1], TOL)
         for j in range(2):
             b = 4 * i3 + 2 * j
             if j >= n12:
                 _none(B, b, b + 2)
                 continue
-            a1, a2 = ((u1a, c1a, s1a), (u2a, c2a, s2a)) if j == 0 else ((u1b, c1b, s1b), (u2b, c2b, s2b))
+            a1, a2 = ((c1a, s1a), (c2a, s2a)) if j == 0 else ((c1b, s1b), (c2b, s2b))
             _wrist_of(h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, b, a1, a2, a3,
                       (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
 
 
 @kernel
 def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, B, b):
-    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (triples a1, a5; branches b, b + 1 by the SP3 of
-    q3): θ14 = q2 + q3 + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1, q4 by
-    difference.  h3, h4 may be −h2: rot(h3, q3) = rot(h2, ±q3)."""
+    """Axes 2 ∥ 3 ∥ 4 with q1 and q5 known (rotations (cos, sin) a1, a5; branches b, b + 1 by
+    the SP3 of q3): θ14 = q2 + q3 + q4 and q6 by SP1, q3 by SP3 (the planar elbow), q2 by SP1,
+    q4 by difference.  h3, h4 may be −h2: rot(h3, q3) = rot(h2, ±q3)."""
     s3n = 1.0 if dot(h[1], h[2]) >= 0.0 else -1.0
     s4n = 1.0 if dot(h[1], h[3]) >= 0.0 else -1.0
-    R01 = rot_cs(h[0], a1[1], a1[2])
-    c5, s5 = a5[1], a5[2]
+    R01 = rot_cs(h[0], a1[0], a1[1])
+    c5, s5 = a5
     # q6 (0 where it is free: h6 ∥ h2, the wrist aligned with the parallel axes), then θ14 from
     # rot(h2, θ14) = R01ᵀ R06 rot(h6, −q6) rot(h5, −q5) applied to x ⟂ h2 (never singular)
-    t6, c6, s6, e6, _ = sp1_cs(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
+    c6, s6, e6, _ = sp1_cs(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
     x = perpendicular(h[1])
-    t14, c14, s14, e14, _ = sp1_cs(x, mtv(R01, mv(R06, rotate_cs(h[5], c6, -s6, rotate_cs(h[4], c5, -s5, x)))),
-                                   h[1], TOL)
+    c14, s14, e14, _ = sp1_cs(x, mtv(R01, mv(R06, rotate_cs(h[5], c6, -s6, rotate_cs(h[4], c5, -s5, x)))), h[1], TOL)
     d_in = sub(sub(mtv(R01, p06), P[1]), rotate_cs(h[1], c14, s14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
-    ta, ca, sa, tb, cb, sb, n3, ea, eb, _ = sp3_cs(neg(P[3]), P[2], h[1], norm(d_in), TOL)
+    ca, sa, cb, sb, n3, ea, eb, _ = sp3_cs(neg(P[3]), P[2], h[1], norm(d_in), TOL)
     for j in range(2):
         if j >= n3:
             B[b + j, EXISTS] = 0.0
             continue
-        t3, c3, s3 = (ta, ca, sa) if j == 0 else (tb, cb, sb)
-        t2, c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[1], c3, s3, P[3])), d_in, h[1], TOL)
+        c3, s3 = (ca, sa) if j == 0 else (cb, sb)
+        c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[1], c3, s3, P[3])), d_in, h[1], TOL)
         # q4 = θ14 − q2 − q3: its rotation is e^{iθ14} e^{−i(q2 + q3)}
         c23, s23 = c2 * c3 - s2 * s3, s2 * c3 + c2 * s3
         c4, s4 = c14 * c23 + s14 * s23, s14 * c23 - c14 * s23
-        _put(B, b + j, a1, (t2, c2, s2), (s3n * t3, c3, s3n * s3),
-             (s4n * wrap(t14 - t2 - t3), c4, s4n * s4), a5, (t6, c6, s6), True,
+        _put(B, b + j, a1, (c2, s2), (c3, s3n * s3), (c4, s4n * s4), a5, (c6, s6), True,
              ex and e14 and e6 and (ea if j == 0 else eb) and e2)
 
 
@@ -448,21 +462,21 @@ def _three_parallel_two_intersecting(h, P, R06, p, B):
     (h2ᵀ R01ᵀ R06 h6 = h2ᵀ R45 h6), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
     d1 = dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4]))
-    t1a, c1a, s1a, t1b, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], p06, neg(h[0]), d1, TOL)
+    c1a, s1a, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], p06, neg(h[0]), d1, TOL)
     R06h6 = mv(R06, h[5])
     for i1 in range(2):
         if i1 >= n1:
             _none(B, 4 * i1, 4 * i1 + 4)
             continue
-        a1 = (t1a, c1a, s1a) if i1 == 0 else (t1b, c1b, s1b)
-        t5a, c5a, s5a, t5b, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(h[1], h[5], h[4], dot(h[1], rotate_cs(
-            neg(h[0]), a1[1], a1[2], R06h6)), TOL)
+        a1 = (c1a, s1a) if i1 == 0 else (c1b, s1b)
+        c5a, s5a, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(h[1], h[5], h[4], dot(h[1], rotate_cs(
+            neg(h[0]), a1[0], a1[1], R06h6)), TOL)
         for i5 in range(2):
             b = 4 * i1 + 2 * i5
             if i5 >= n5:
                 _none(B, b, b + 2)
                 continue
-            _three_parallel_tail(h, P, R06, p06, a1, (t5a, c5a, s5a) if i5 == 0 else (t5b, c5b, s5b),
+            _three_parallel_tail(h, P, R06, p06, a1, (c5a, s5a) if i5 == 0 else (c5b, s5b),
                                  (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), B, b)
 
 
@@ -519,10 +533,11 @@ def _solve_closed(cls, h, P, R06, p, B):
         _spherical(h, P, R06, p, B)
     else:
         _three_parallel(h, P, R06, p, B)
+    _angles(B)
     for b in range(8):
-        for j in range(6):
-            B[b, j] = wrap(B[b, j]) if B[b, EXISTS] != 0.0 else math.nan
         if B[b, EXISTS] == 0.0:
+            for j in range(6):
+                B[b, j] = math.nan
             B[b, EXACT] = 0.0
 
 
@@ -855,11 +870,12 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
     if _pose_status(T, tol_orthonormal) != 0:
         return False
     R, p = mat(T), (T[0, 3], T[1, 3], T[2, 3])
-    a7 = (0.0, 1.0, 0.0)
+    t7, a7 = 0.0, (1.0, 0.0)
     if n == 7:
-        a7 = angle_cs(wrap(param))
+        t7 = wrap(param)
+        a7 = angle_cs(t7)
         # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
-        Rv = rot_cs(p_axis, a7[1], -a7[2])
+        Rv = rot_cs(p_axis, a7[0], -a7[1])
         X = mtm(MR, mm(Rv, MR))
         x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
         p = add(mv(R, x), p)
@@ -872,7 +888,7 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
         exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
         for j in range(n):
             jj = 5 - j if rev else j
-            x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else a7
+            x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else (t7, a7[0], a7[1])
             Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(x, c, s, lo[j], hi[j], exists)
             inside = inside and ok
         V[b], E[b], IN[b] = exists, exact, inside

@@ -172,56 +172,58 @@ def rot(k, theta) -> np.ndarray:
     return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
 
 
-# ----------------------------------------------------------------------------- angles as (θ, cos θ, sin θ)
+# ----------------------------------------------------------------------------- angles as (cos θ, sin θ)
 @kernel
-def atan2_cs(y, x):
-    """θ = atan2(y, x) (rad) with cos θ = x / r and sin θ = y / r, r = ‖(x, y)‖ — the rotation a
-    subproblem finds, for the rotations that follow it without evaluating cos and sin of θ
-    again (θ is read once, the rotation kept exact to rounding).  r by ``math.hypot`` where
-    x² + y² would lose digits (below 1e-290 or above 1e290); (cos θ, sin θ) from θ where r is
-    0 or not finite."""
-    theta = atan2(y, x)
+def unit_cs(y, x):
+    """(cos θ, sin θ) = (x / r, y / r), r = ‖(x, y)‖, of θ = atan2(y, x): the rotation a
+    subproblem finds, in the form the rotations that follow it use (no trigonometry; its angle
+    is read once, by atan2 of the pair, where the caller needs it: the ``*_one`` functions,
+    :func:`anthroarm.ik.geometric._angles`).  r by ``math.hypot`` where x² + y² would lose
+    digits (below 1e-290 or above 1e290); cos and sin of atan2(y, x) where r is 0 or not
+    finite."""
     rr = x * x + y * y
     r = math.sqrt(rr) if 1e-290 < rr < 1e290 else math.hypot(x, y)
     if 0.0 < r < math.inf:
-        return theta, x / r, y / r
-    return theta, math.cos(theta), math.sin(theta)
+        return x / r, y / r
+    theta = atan2(y, x)
+    return math.cos(theta), math.sin(theta)
 
 
 # ----------------------------------------------------------------------------- SP1, SP4
 @kernel
 def sp1_cs(p1, p2, k, tol):
-    """SP1 of one problem (tuples): (θ, cos θ, sin θ, exact, singular); see :func:`sp1`."""
+    """SP1 of one problem (tuples): (cos θ, sin θ, exact, singular) (:func:`unit_cs`); see
+    :func:`sp1`."""
     kxp = cross(k, p1)
     x0 = dot(kxp, p2)
     x1 = -dot(cross(k, kxp), p2)                      # x = Aᵀ p2, A = [k × p1, −k × (k × p1)]
     n1, n2 = norm(p1), norm(p2)
     sing = norm(kxp) <= 1e-12 * max(1.0, n1) or norm(cross(k, p2)) <= 1e-12 * max(1.0, n2)
-    theta, c, s = (0.0, 1.0, 0.0) if sing else atan2_cs(x0, x1)
+    c, s = (1.0, 0.0) if sing else unit_cs(x0, x1)
     exact = abs(n1 - n2) <= tol and abs(dot(k, p1) - dot(k, p2)) <= tol
-    return theta, c, s, exact, sing
+    return c, s, exact, sing
 
 
 @kernel
 def sp1_one(p1, p2, k, tol):
     """SP1 of one problem (tuples): (θ, exact, singular); see :func:`sp1` (:func:`sp1_cs`)."""
-    theta, _, _, exact, sing = sp1_cs(p1, p2, k, tol)
-    return theta, exact, sing
+    c, s, exact, sing = sp1_cs(p1, p2, k, tol)
+    return atan2(s, c), exact, sing
 
 
 @kernel
 def sp4_one(h, p, k, d, tol):
     """SP4 of one problem (tuples; h unit): (θ_a, θ_b, count, exact_a, exact_b, singular), θ_b
     NaN when count = 1; IK-Geo Eqs. (4)–(6), see :func:`sp4` (:func:`sp4_cs`)."""
-    ta, _, _, tb, _, _, cnt, ea, eb, sing = sp4_cs(h, p, k, d, tol)
-    return ta, tb, cnt, ea, eb, sing
+    ca, sa, cb, sb, cnt, ea, eb, sing = sp4_cs(h, p, k, d, tol)
+    return atan2(sa, ca), atan2(sb, cb), cnt, ea, eb, sing
 
 
 @kernel
 def sp4_cs(h, p, k, d, tol):
-    """SP4 of one problem (tuples; h unit): (θ_a, cos θ_a, sin θ_a, θ_b, cos θ_b, sin θ_b,
-    count, exact_a, exact_b, singular), the b root NaN when count = 1; IK-Geo Eqs. (4)–(6), see
-    :func:`sp4`."""
+    """SP4 of one problem (tuples; h unit): (cos θ_a, sin θ_a, cos θ_b, sin θ_b, count,
+    exact_a, exact_b, singular) (:func:`unit_cs`), the b root NaN when count = 1; IK-Geo
+    Eqs. (4)–(6), see :func:`sp4`."""
     kxp = cross(k, p)
     a0 = dot(h, kxp)
     a1 = -dot(h, cross(k, kxp))                       # hᵀA
@@ -235,14 +237,14 @@ def sp4_cs(h, p, k, d, tol):
     two = margin > 0.0
     xi = math.sqrt(max(na * na - b * b, 0.0))
     if sing:
-        return 0.0, 1.0, 0.0, math.nan, math.nan, math.nan, 1, ab <= tol or two, False, True
+        return 1.0, 0.0, math.nan, math.nan, 1, ab <= tol or two, False, True
     if two:
-        ta, ca, sa = atan2_cs(a0 * b + xi * a1, a1 * b - xi * a0)
-        tb, cb, sb = atan2_cs(a0 * b - xi * a1, a1 * b + xi * a0)
-        return ta, ca, sa, tb, cb, sb, 2, True, True, False
-    # one root (tangent or least squares): atan2 of Aᵀb
-    ta, ca, sa = atan2_cs(a0 * b, a1 * b)
-    return ta, ca, sa, math.nan, math.nan, math.nan, 1, margin >= -tol, False, False
+        ca, sa = unit_cs(a0 * b + xi * a1, a1 * b - xi * a0)
+        cb, sb = unit_cs(a0 * b - xi * a1, a1 * b + xi * a0)
+        return ca, sa, cb, sb, 2, True, True, False
+    # one root (tangent or least squares): the direction of Aᵀb
+    ca, sa = unit_cs(a0 * b, a1 * b)
+    return ca, sa, math.nan, math.nan, 1, margin >= -tol, False, False
 
 
 @kernel
@@ -309,8 +311,8 @@ def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
 # ----------------------------------------------------------------------------- SP3
 @kernel
 def sp3_cs(p1, p2, k, d, tol):
-    """SP3 of one problem (tuples): (θ_a, cos θ_a, sin θ_a, θ_b, cos θ_b, sin θ_b, count,
-    exact_a, exact_b, singular); see :func:`sp3`."""
+    """SP3 of one problem (tuples): (cos θ_a, sin θ_a, cos θ_b, sin θ_b, count, exact_a,
+    exact_b, singular) (:func:`unit_cs`); see :func:`sp3`."""
     n2 = norm(p2)
     zero = n2 <= 1e-300
     if zero:
@@ -318,20 +320,20 @@ def sp3_cs(p1, p2, k, d, tol):
     else:
         h, dd, safe = scale(p2, 1.0 / n2), (dot(p1, p1) + n2 * n2 - d * d) / (2.0 * n2), n2
     # a distance residual δ changes the SP4 height by ≈ δ (2d + δ) / (2‖p2‖)
-    ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing = sp4_cs(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
+    ca, sa, cb, sb, cnt, ea, eb, sing = sp4_cs(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
     if sing or zero:
         ea = abs(norm(sub(rotate_cs(k, ca, sa, p1), p2)) - d) <= tol
         if cnt == 2:
             eb = abs(norm(sub(rotate_cs(k, cb, sb, p1), p2)) - d) <= tol
-    return ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing or zero
+    return ca, sa, cb, sb, cnt, ea, eb, sing or zero
 
 
 @kernel
 def sp3_one(p1, p2, k, d, tol):
     """SP3 of one problem (tuples): (θ_a, θ_b, count, exact_a, exact_b, singular); see :func:`sp3`
     (:func:`sp3_cs`)."""
-    ta, _, _, tb, _, _, cnt, ea, eb, sing = sp3_cs(p1, p2, k, d, tol)
-    return ta, tb, cnt, ea, eb, sing
+    ca, sa, cb, sb, cnt, ea, eb, sing = sp3_cs(p1, p2, k, d, tol)
+    return atan2(sa, ca), atan2(sb, cb), cnt, ea, eb, sing
 
 
 @kernel
@@ -366,40 +368,40 @@ def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
 # ----------------------------------------------------------------------------- SP2
 @kernel
 def _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, c1, s1, sing2, tol, sing, ex_in, n1, n2):
-    """θ2 of SP2 for one root (c1, s1) of θ1 (:func:`sp2_cs`): (θ2, cos θ2, sin θ2, exact)."""
+    """θ2 of SP2 for one root (c1, s1) of θ1 (:func:`sp2_cs`): (cos θ2, sin θ2, exact)."""
     v1 = rotate_cs(k1, c1, s1, u1)
-    t2, c2, s2 = (0.0, 1.0, 0.0) if sing2 else atan2_cs(dot(k2u2, v1), -dot(k2k2u2, v1))
+    c2, s2 = (1.0, 0.0) if sing2 else unit_cs(dot(k2u2, v1), -dot(k2k2u2, v1))
     r = norm(sub(rotate_cs(k1, c1, s1, p1), rotate_cs(k2, c2, s2, p2)))
-    return t2, c2, s2, (r <= tol if sing else (ex_in and abs(n1 - n2) <= tol and r <= 10.0 * tol))
+    return c2, s2, (r <= tol if sing else (ex_in and abs(n1 - n2) <= tol and r <= 10.0 * tol))
 
 
 @kernel
 def sp2_cs(p1, p2, k1, k2, tol):
-    """SP2 of one problem (tuples): the roots a and b, each as θ1, cos θ1, sin θ1, θ2, cos θ2,
-    sin θ2 (12 numbers, root a first; NaN for a root that does not exist), then count, exact_a,
-    exact_b, singular; see :func:`sp2`."""
+    """SP2 of one problem (tuples): the roots a and b, each as cos θ1, sin θ1, cos θ2, sin θ2
+    (8 numbers, root a first; NaN for a root that does not exist; :func:`unit_cs`), then count,
+    exact_a, exact_b, singular; see :func:`sp2`."""
     n1, n2 = norm(p1), norm(p2)
     zero = n1 <= 1e-300 or n2 <= 1e-300
     u1 = scale(p1, 1.0 / n1) if n1 > 1e-300 else p1
     u2 = scale(p2, 1.0 / n2) if n2 > 1e-300 else p2
-    ta, ca, sa, tb, cb, sb, cnt, ea, eb, sing1 = sp4_cs(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
+    ca, sa, cb, sb, cnt, ea, eb, sing1 = sp4_cs(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
     k2u2 = cross(k2, u2)
     k2k2u2 = cross(k2, k2u2)
     sing2 = norm(k2u2) <= 1e-12
     sing = sing1 or sing2 or zero
-    t2a, c2a, s2a, xa = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, ca, sa, sing2, tol, sing, ea, n1, n2)
-    t2b, c2b, s2b, xb = math.nan, math.nan, math.nan, False
+    c2a, s2a, xa = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, ca, sa, sing2, tol, sing, ea, n1, n2)
+    c2b, s2b, xb = math.nan, math.nan, False
     if cnt == 2:
-        t2b, c2b, s2b, xb = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, cb, sb, sing2, tol, sing, eb, n1, n2)
-    return ta, ca, sa, t2a, c2a, s2a, tb, cb, sb, t2b, c2b, s2b, cnt, xa, xb, sing
+        c2b, s2b, xb = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, cb, sb, sing2, tol, sing, eb, n1, n2)
+    return ca, sa, c2a, s2a, cb, sb, c2b, s2b, cnt, xa, xb, sing
 
 
 @kernel
 def sp2_one(p1, p2, k1, k2, tol):
     """SP2 of one problem (tuples): (θ1_a, θ2_a, θ1_b, θ2_b, count, exact_a, exact_b,
     singular); see :func:`sp2` (:func:`sp2_cs`)."""
-    ta, _, _, t2a, _, _, tb, _, _, t2b, _, _, cnt, xa, xb, sing = sp2_cs(p1, p2, k1, k2, tol)
-    return ta, t2a, tb, t2b, cnt, xa, xb, sing
+    ca, sa, c2a, s2a, cb, sb, c2b, s2b, cnt, xa, xb, sing = sp2_cs(p1, p2, k1, k2, tol)
+    return atan2(sa, ca), atan2(s2a, c2a), atan2(sb, cb), atan2(s2b, c2b), cnt, xa, xb, sing
 
 
 @kernel
@@ -993,5 +995,5 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
 
 
 __all__ = ["Solutions", "rot", "sp1", "sp2", "sp3", "sp4", "sp5", "sp6", "sp1_one", "sp2_one", "sp3_one",
-           "sp4_one", "sp5_one", "sp6_one", "atan2_cs", "sp1_cs", "sp2_cs", "sp3_cs", "sp4_cs", "real_roots", "TOL",
+           "sp4_one", "sp5_one", "sp6_one", "unit_cs", "sp1_cs", "sp2_cs", "sp3_cs", "sp4_cs", "real_roots", "TOL",
            "TOL_QUARTIC"]

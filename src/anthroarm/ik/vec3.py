@@ -110,8 +110,9 @@ def rotate(k, theta, p):
 
 @kernel
 def angle_cs(theta):
-    """The triple (θ, cos θ, sin θ) in which the closed-form kernels carry an angle (rad)."""
-    return theta, math.cos(theta), math.sin(theta)
+    """The pair (cos θ, sin θ) in which the closed-form kernels carry an angle θ (rad): its
+    rotation (:func:`anthroarm.ik.subproblems.unit_cs`)."""
+    return math.cos(theta), math.sin(theta)
 
 
 @kernel
