@@ -57,7 +57,7 @@ import numpy as np
 from ..jit import kernel, local, local2, local_flags
 from ..threads import run_rows
 from . import classify as C
-from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _common_point,
+from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _angles, _common_point,
                         _fk_residuals, _mark_solutions, _pose_status, _target_errors, _wrist,
                         into_limit_cs, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
@@ -408,12 +408,15 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                     _q4(q4b, b, a4)
                     _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, a3,
                            ex4 and Bs[j, EXACT] != 0.0)
+    _angles(B6)                                       # the angles from their rotations, vectorised
     for b in range(8):
         if B6[b, EXISTS] != 0.0:
             for j in range(7):                        # the wrist's joints are 4, 5, 6 of B6's row
                 k = j if j < 3 else j - 1
-                c, s = (q4b[b, 0], q4b[b, 1]) if j == 3 else (B6[b, COS + k], B6[b, SIN + k])
-                Q[b, j], QC[b, j], QS[b, j] = atan2(s, c), c, s       # the angle from its rotation
+                if j == 3:
+                    Q[b, j], QC[b, j], QS[b, j] = atan2(q4b[b, 1], q4b[b, 0]), q4b[b, 0], q4b[b, 1]
+                else:
+                    Q[b, j], QC[b, j], QS[b, j] = B6[b, k], B6[b, COS + k], B6[b, SIN + k]
             V[b], E[b] = True, B6[b, EXACT] != 0.0
         else:
             for j in range(7):

@@ -519,9 +519,10 @@ CLOSED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALL
 
 @kernel
 def _solve_closed(cls, h, P, R06, p, B):
+    """The 8 branches of one pose of class ``cls`` (index in :data:`CLOSED`) into B: the
+    class solver writes their rotations and flags, :func:`_angles` reads the angles; a branch
+    that does not exist is NaN."""
     for b in range(8):
-        for j in range(6):
-            B[b, j] = math.nan
         B[b, EXISTS], B[b, EXACT] = 0.0, 0.0
     if cls == 0:
         _spherical_two_parallel(h, P, R06, p, B)
