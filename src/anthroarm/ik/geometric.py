@@ -586,6 +586,8 @@ def into_limit_cs(x, c, s, lo, hi, exists):
     cosine, its sine, whether it is inside) — (c, s) kept where the angle returned is x moved
     by whole turns (the same rotation), cos and sin of the angle returned where it was put
     onto a limit (it is then the limit) and the branch ``exists``."""
+    if -math.pi < x <= math.pi and lo <= x <= hi:       # the usual case: already the angle returned
+        return x, c, s, True
     q, ok = into_limit(x, lo, hi)
     if exists and q != x and (q == lo or q == hi):
         c, s = math.cos(q), math.sin(q)
