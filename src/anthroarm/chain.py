@@ -40,7 +40,7 @@ from functools import cached_property
 import numpy as np
 
 from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, UnsupportedModelError
-from .threads import MIN_ROWS_PER_THREAD, run_rows
+from .threads import run_rows
 
 REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 
@@ -410,10 +410,7 @@ class Chain:
         th = np.ascontiguousarray(theta.reshape(math.prod(theta.shape[:-1]), len(ind)))
         q = np.empty((th.shape[0], self.nq))
         configure, index = _kernels().configure, self._configuration_index
-        if len(th) < 2 * MIN_ROWS_PER_THREAD:
-            configure(th, index, q)                       # one thread (run_rows's rule, without its call)
-        else:
-            run_rows(lambda a, b: configure(th[a:b], index, q[a:b]), len(th))
+        run_rows(lambda a, b: configure(th[a:b], index, q[a:b]), len(th))
         return q.reshape(theta.shape[:-1] + (self.nq,))
 
     @cached_property

@@ -796,8 +796,8 @@ def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
         ch = robot.chain                 # the limits of the joints solved for (θ, not q: kinova's cos/sin pairs)
         joints = [ch.joints[j] for j in ch.independent]
         return (f"all {int((cand & exact).sum())} closed-form solutions violate the joint limits ("
-                + ", ".join(f"{j.name} continuous" if j.kind == "continuous" else f"{j.name} [{j.lower:.4g}, {j.upper:.4g}]"
-                            for j in joints) + ")")
+                + ", ".join(f"{j.name} continuous" if j.kind == "continuous"
+                            else f"{j.name} [{j.lower:.4g}, {j.upper:.4g}]" for j in joints) + ")")
     worst = float(np.min(np.where(cand & exact & inside, res, np.inf)))
     text = (f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); the pose is at a "
             "singularity or not reachable with this orientation")
@@ -970,11 +970,7 @@ def _srs_single(robot, s, arr, swivel, tol, tol_orthonormal):
     :func:`analytic_batch`; else None (a malformed pose or swivel, no solution: the batch path
     says what happened)."""
     try:
-        if type(swivel) is float and abs(swivel) < WRAP_MAX:          # one angle: no numpy checks
-            grid = np.empty(1)
-            grid[0] = swivel
-        else:
-            grid = _swivel_array(swivel, 1, grid_1d=True)[0]
+        grid = _swivel_array(swivel, 1, grid_1d=True)[0]
         got = _fam.srs_solutions(s.plan, arr, grid, tol, tol_orthonormal)
     except ValueError:
         return None

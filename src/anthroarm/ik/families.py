@@ -59,7 +59,7 @@ from ..threads import run_rows
 from . import classify as C
 from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _angles, _common_point,
                         _fk_residuals, _mark_solutions, _pose_status, _target_errors, _wrist,
-                        into_limit_cs, into_limits, local_frames, nearest_first)
+                        into_limit_rows, into_limits, local_frames, nearest_first)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
 from .vec3 import (add, atan2, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose,
                    vec, wrap)
@@ -411,11 +411,11 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
     _angles(B6)                                       # the angles from their rotations, vectorised
     for b in range(8):
         if B6[b, EXISTS] != 0.0:
-            for j in range(7):                        # the wrist's joints are 4, 5, 6 of B6's row
-                k = j if j < 3 else j - 1
+            for j in range(7):
                 if j == 3:
                     Q[b, j], QC[b, j], QS[b, j] = atan2(q4b[b, 1], q4b[b, 0]), q4b[b, 0], q4b[b, 1]
-                else:
+                else:                                 # the wrist's joints are 4, 5, 6 of B6's row
+                    k = j if j < 3 else j - 1
                     Q[b, j], QC[b, j], QS[b, j] = B6[b, k], B6[b, COS + k], B6[b, SIN + k]
             V[b], E[b] = True, B6[b, EXACT] != 0.0
         else:
@@ -450,8 +450,7 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
     Sv, E0v, W0v = vec(S), vec(E0), vec(W0)
     Rt, pt = mat(R_tool), vec(p_tool)
     B6, Bs, q4b = local2(8, BRANCH_ROW), local2(2, BRANCH_ROW), local2(8, 2)
-    Qb, QC, QS = local2(8, 7), local2(8, 7), local2(8, 7)
-    Vb, Eb, CHK = local_flags(8), local_flags(8), local_flags(8)
+    QC, QS, CHK = local2(8, 7), local2(8, 7), local_flags(8)
     Sfk = local2(8, 12)
     ns = swivel.shape[1]
     for i in range(len(T)):
@@ -466,18 +465,10 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
         W = add(mv(Rg, sub(W0v, pt)), p)
         c4a, s4a, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
         for k in range(ns):
-            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (c4a, s4a), (c4b, s4b), n4, e4a, e4b,
-                     Qb, QC, QS, Vb, Eb, B6, Bs, q4b)
-            for b in range(8):
-                r = 8 * k + b
-                inside = True
-                for j in range(7):
-                    Qi[r, j], QC[b, j], QS[b, j], ok = into_limit_cs(Qb[b, j], QC[b, j], QS[b, j], lo[j], hi[j],
-                                                                     Vb[b])
-                    inside = inside and ok
-                Vi[r], Ei[r], INi[r] = Vb[b], Eb[b], inside
-                CHK[b] = Vb[b] and (inside or not Eb[b])
             rows = slice(8 * k, 8 * k + 8)
+            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (c4a, s4a), (c4b, s4b), n4, e4a, e4b,
+                     Qi[rows], QC, QS, Vi[rows], Ei[rows], B6, Bs, q4b)
+            into_limit_rows(Qi[rows], QC, QS, Vi[rows], Ei[rows], 7, lo, hi, INi[rows], CHK)
             _fk_residuals(A, Qi[rows], QC, QS, CHK, 7, Ti, RESi[rows], Sfk)
             _mark_solutions(Qi[rows], Vi[rows], INi[rows], RESi[rows], tol, 8, OKi[rows])
     return -1

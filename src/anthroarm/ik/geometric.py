@@ -595,6 +595,21 @@ def into_limit_cs(x, c, s, lo, hi, exists):
 
 
 @kernel
+def into_limit_rows(Q, QC, QS, V, E, n, lo, hi, IN, CHK):
+    """:func:`into_limit_cs` of the candidate branches of one pose in place: rows Q (B, n) (rad)
+    with their cosines QC and sines QS, flags V (a candidate) and E (exact); writes IN (every
+    joint inside) and CHK (its FK residual is wanted: a candidate inside the limits, or a
+    least-squares one, :func:`_fk_residuals`)."""
+    for b in range(len(V)):
+        inside = True
+        for j in range(n):
+            Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(Q[b, j], QC[b, j], QS[b, j], lo[j], hi[j], V[b])
+            inside = inside and ok
+        IN[b] = inside
+        CHK[b] = V[b] and (inside or not E[b])
+
+
+@kernel
 def into_limits(q, n, lo, hi):
     """:func:`into_limit` of the angles q[:n] (rad) in place, limits lo, hi (n,); returns
     whether every joint is inside."""
@@ -835,10 +850,8 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     empty, CONF (N, 8, nq).  Returns the index of the first malformed pose (−1 if none).
     ``cf``, ``ci``: :attr:`GeoPlan.packed`.  Compiled without reference counts
     (:func:`anthroarm.jit.kernel`): its scratch is local (n ≤ 7 joints)."""
-    cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
-    h, PP = rows6(H), rows7(P)
-    Rt = mat(R_tool)
-    MR, Mp = mat(M[:3, :3]), vec(M[:3, 3])
+    plan = _pose_plan(cf, ci)
+    n = plan[2]
     B6 = local2(8, BRANCH_ROW)
     q = local(7)
     QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
@@ -846,11 +859,21 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
-        if not _verify_pose((cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi, order, index), T[i],
-                            param[i], tol, tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i], CONF[i],
-                            (B6, q, QC, QS, S, J, F, CHK)):
+        if not _verify_pose(plan, T[i], param[i], tol, tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i],
+                            CONF[i], (B6, q, QC, QS, S, J, F, CHK)):
             return i
     return -1
+
+
+@kernel(inline=True)
+def _pose_plan(cf, ci):
+    """The constants :func:`_verify_pose` takes, from :attr:`GeoPlan.packed` (:func:`_unpack`,
+    its vectors and matrices as tuples, :mod:`.vec3`; the tool pose at q = 0 as (MR, Mp)):
+    (class index, reversed, n, h, P, R_tool, MR, Mp, the held joint's axis and point, A, lo,
+    hi, order, index).  Compiled into each caller."""
+    cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
+    return (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi,
+            order, index)
 
 
 @kernel(inline=True)
@@ -864,8 +887,7 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
     kept polished where that brings it within tol.  ``CONF`` (8, nq), unless its last axis is
     empty: the chain's configuration q of each solution (:func:`_configurations`).  ``param``
     the held 7th joint (rad).  Returns False for a malformed pose (:func:`_pose_status`).
-    ``plan``: the constants of :func:`_unpack`, their vectors and matrices as tuples (:mod:`.vec3`),
-    the tool pose at q = 0 as (MR, Mp); ``scratch``: B6 (8, :data:`BRANCH_ROW`), q (7,), QC, QS
+    ``plan``: :func:`_pose_plan`; ``scratch``: B6 (8, :data:`BRANCH_ROW`), q (7,), QC, QS
     (8, n), S (n + 1, 12), J (6, 6), F (6,), CHK (8,).  Compiled into each caller
     (:func:`_verified`, :func:`_verified_one`)."""
     cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi, order, index = plan
@@ -888,14 +910,12 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
         R = transpose(R)
     _solve_closed(cls, h, PP, mm(R, transpose(Rt)), p, B6)
     for b in range(8):
-        exists, exact, inside = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0, True
+        V[b], E[b] = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0
         for j in range(n):
-            jj = 5 - j if rev else j
-            x, c, s = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else (t7, a7[0], a7[1])
-            Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(x, c, s, lo[j], hi[j], exists)
-            inside = inside and ok
-        V[b], E[b], IN[b] = exists, exact, inside
-        CHK[b] = exists and (inside or not exact)
+            jj = 5 - j if rev else j                  # a reversed chain's joints come last first
+            x = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else (t7, a7[0], a7[1])
+            Q[b, j], QC[b, j], QS[b, j] = x
+    into_limit_rows(Q, QC, QS, V, E, n, lo, hi, IN, CHK)
     _fk_residuals(A, Q, QC, QS, CHK, n, T, RES, S)
     for b in range(8):
         if V[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
@@ -1104,14 +1124,12 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     its count of ones, > 0); −1: a malformed pose; −2: no solution, or a candidate to polish
     (the caller's general path answers: reasons, polishing).  One :func:`_verify_pose`, its
     scratch local."""
-    n, w = ci[2], out.shape[1] - 4
-    cls, rev, _, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
+    plan = _pose_plan(cf, ci)
+    n, w, A, order = plan[2], out.shape[1] - 4, plan[10], plan[13]
     Q, RES = local(56)[:8 * n].reshape((8, n)), local(8)
     V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
     CONF = local(112)[:8 * w if w != n else 0].reshape((8, w if w != n else 0))
     QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
-    plan = (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi,
-            order, index)
     scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, local(96)[:12 * (n + 1)].reshape((n + 1, 12)),
                local2(6, 6), local(6), local_flags(8))
     if not _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
