@@ -155,6 +155,17 @@ def kernel(func=None, *, counted: bool = True, inline: bool = False):
     return wrap if func is None else wrap(func)
 
 
+def entry_point(dispatcher, *args):
+    """The compiled body of kernel ``dispatcher`` for the Numba types of ``args`` (example
+    arguments; compiled, or loaded from the disk cache, now if it is not yet), as a function
+    called with arguments of exactly those types.  It skips the dispatcher's resolution of the
+    argument types on every call (about 40 ns an array argument) — and its checks: an array of
+    another dtype, dimension, layout or alignment, or of a size the kernel does not expect, is
+    undefined behaviour.  For a hot call whose caller has checked its arguments (the one-pose
+    closed-form IK, :func:`anthroarm.ik.closed_form.analytic`)."""
+    return dispatcher.compile(tuple(numba.typeof(a) for a in args))
+
+
 def _local_array(dtype, ndim: int):
     """A Numba intrinsic ``f(*shape)`` (``ndim`` literal sizes) that makes a C-order array of
     ``dtype`` in the calling kernel's stack frame (LLVM ``alloca`` in its entry block: made once
@@ -193,5 +204,5 @@ local_flags = _local_array(types.boolean, 1)
 local_ints2 = _local_array(types.int64, 2)
 
 
-__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "kernel", "kernel_sources_digest",
-           "local", "local2", "local_flags", "local_ints2"]
+__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "entry_point", "kernel",
+           "kernel_sources_digest", "local", "local2", "local_flags", "local_ints2"]

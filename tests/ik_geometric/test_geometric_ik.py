@@ -983,3 +983,53 @@ def test_a_reachable_pose_at_a_tangent_root_is_solved():
         for s in r.solutions:
             assert np.abs(_fk(robot, s)[:3] - T[:3]).max() <= 1e-9 and robot.within_limits(s)
 
+
+
+@pytest.mark.parametrize("layout", ["fortran", "misaligned", "read_only", "list", "strided_view"])
+def test_every_array_layout_of_one_pose_gets_the_same_solutions(layout):
+    """One pose reaches the compiled call unchecked by Numba's dispatcher (jit.entry_point) only
+    as a C-order, aligned float64 4×4 array; any other layout of the same pose (Fortran order,
+    an unaligned buffer, a strided view, a list, a read-only array) is copied or answered by the
+    general path — with the same solutions, each verified here by Pinocchio FK."""
+    robot = aa.load("ur5")
+    q = robot.random_q(1, rng=11)[0]
+    T = _fk(robot, q)
+    ref = aa.ik.analytic(robot, T)
+    assert len(ref) >= 1
+    if layout == "fortran":
+        X = np.asfortranarray(T)
+    elif layout == "misaligned":
+        X = np.ndarray((4, 4), dtype=np.float64, buffer=bytearray(16 * 8 + 1), offset=1)
+        X[...] = T
+        assert not X.flags.aligned
+    elif layout == "read_only":
+        X = T.copy()
+        X.flags.writeable = False
+    elif layout == "list":
+        X = T.tolist()
+    else:
+        big = np.zeros((4, 8))
+        big[:, ::2] = T
+        X = big[:, ::2]
+    got = aa.ik.analytic(robot, X)
+    assert got.branches == ref.branches and np.array_equal(got.solutions, ref.solutions)
+    assert np.array_equal(got.residuals, ref.residuals)
+    for s in got.solutions:
+        assert np.abs(_fk(robot, s) - T)[:3].max() <= 1e-9
+
+
+def test_entry_point_is_the_kernel_for_those_types():
+    """jit.entry_point gives the compiled body the dispatcher itself would call for those
+    argument types: the same outputs as the dispatcher on a pose of ur5 (the branch mask, and in
+    each solution row θ, the FK residual and the branch; the rest of ``out`` left untouched)."""
+    from anthroarm import jit
+    robot = aa.load("ur5")
+    T = np.ascontiguousarray(_fk(robot, robot.random_q(1, rng=5)[0]))
+    cf, ci = G.plan_for(robot).packed
+    a, b = np.full((8, 10), np.nan), np.full((8, 10), np.nan)
+    call = jit.entry_point(G._verified_one, cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, a)
+    m1 = call(cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, a)
+    m2 = G._verified_one(cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, b)
+    assert m1 == m2 > 0
+    K = bin(m1).count("1")
+    assert np.array_equal(a, b, equal_nan=True) and not np.isnan(a[:K, :8]).any()

@@ -57,9 +57,11 @@ import functools
 import math
 import weakref
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
+from .. import jit as _jit
 from ..errors import UnsupportedModelError
 from ..models import closed_forms as _models
 from . import families as _fam
@@ -94,7 +96,7 @@ class AnalyticIKResult:
     reason: str | None = None
     swivel: np.ndarray | None = None
     residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    #: the text of :attr:`singular`, or a function of no argument that makes it (on first use)
+    #: the text of :attr:`singular`, or a function of :attr:`solutions` that makes it (on first use)
     _singular: object = field(default=None, repr=False, compare=False)
     model: str = ""
 
@@ -106,7 +108,7 @@ class AnalyticIKResult:
         one-parameter family, of which one member is returned per branch.  Computed on first
         use (arms solved by their geometry; None for the swivel and planar families)."""
         if callable(self._singular):
-            self._singular = self._singular()
+            self._singular = self._singular(self.solutions)
         return self._singular
 
     def __getstate__(self):
@@ -183,7 +185,7 @@ class AnalyticBatchResult:
         if self._singular_of is None or "singular" in self.__dict__:
             sing = self.singular[i]
         else:
-            sing = functools.partial(lambda f, k: f([k])[0], self._singular_of, int(i))
+            sing = functools.partial(_pose_singular, self._singular_of, int(i))
         return AnalyticIKResult(
             solutions=self.solutions[i][v].copy(),
             branches=[b for b, ok in zip(self.branches, v) if ok],
@@ -197,6 +199,12 @@ class AnalyticBatchResult:
     @property
     def n_solutions(self) -> np.ndarray:
         return self.valid.sum(axis=1)
+
+
+def _pose_singular(singular_of, i: int, _solutions) -> str | None:
+    """:attr:`AnalyticIKResult.singular` of pose ``i`` of a batch, from the batch's maker
+    ``singular_of`` (its solutions are those the batch holds)."""
+    return singular_of([i])[0]
 
 
 # ---------------------------------------------------------------------------- which closed form
@@ -294,18 +302,49 @@ class _Solver:
     arm: _Arm | None = None              # a tree: the closed form is the arm's (its own _Solver)
 
     @functools.cached_property
-    def one_call(self):
-        """For one pose of a closed class (:func:`analytic`'s compiled call): (packed constants, joints
-        n, the labels of the solutions by the bit mask of their branches (how the compiled call
-        returns them: 256 tuples), whether a 7th joint is held, the width of a solution: n, or
-        nq where q is not θ (continuous joints)); None for the other kinds."""
+    def one_call(self) -> _OneCall | None:
+        """How :func:`analytic` answers one pose of a closed class in one compiled call
+        (:class:`_OneCall`); None for the other kinds."""
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
         labels = self.plan.labels
-        by_mask = tuple(tuple(labels[b] for b in range(8) if mask >> b & 1) for mask in range(256))
         n = int(ci[2])
-        return cf, ci, n, by_mask, self.plan.param_joint is not None, n if self.plain else self.plan.chain.nq
+        w = n if self.plain else self.plan.chain.nq
+        by_mask = tuple((lab, len(lab)) for lab in
+                        ([labels[b] for b in range(8) if mask >> b & 1] for mask in range(256)))
+        call = _jit.entry_point(_geo._verified_one, cf, ci, np.eye(4), 0.0, 1.0, 1.0, _geo.NO_REF, np.empty((8, w + 4)))
+        return _OneCall(cf, ci, by_mask, self.plan.param_joint is not None, w, call, _SingularOf(self.plan, self.plain))
+
+
+class _OneCall(NamedTuple):
+    """One pose of a closed class in one compiled call (:func:`analytic`)."""
+
+    cf: np.ndarray                       # the plan's packed constants (:attr:`.geometric.GeoPlan.packed`)
+    ci: np.ndarray
+    by_mask: tuple                       # 256 × (labels of the solutions, their number K) by the bit
+    #                                      mask of their branches (how the compiled call returns them)
+    holds_param: bool                    # a 7th joint is held (``param=``)
+    width: int                           # of a solution: n, or nq where q is not θ (continuous joints)
+    call: object                         # :func:`.geometric._verified_one` compiled for these types
+    #                                      (:func:`anthroarm.jit.entry_point`: the caller checks T)
+    singular: _SingularOf
+
+
+class _SingularOf:
+    """:attr:`AnalyticIKResult.singular` of one pose's solutions (K, width) of a closed class,
+    made on first use: the smallest normalised Jacobian volume of the K solutions
+    (:func:`.geometric.jacobian_volumes`) in words (:func:`_singular_text`)."""
+
+    __slots__ = ("plan", "plain")
+
+    def __init__(self, plan, plain: bool):
+        self.plan, self.plain = plan, plain
+
+    def __call__(self, solutions: np.ndarray) -> str | None:
+        plan, K = self.plan, len(solutions)
+        th = solutions if self.plain else plan.chain.angles(solutions)[:, list(plan.chain.independent)]
+        return _singular_text(float(_geo.jacobian_volumes(plan, th[None], np.ones((1, K), bool)).min()))
 
 
 #: id(robot) → (its chain, its tool, its :class:`_Solver` or None, the solver's
@@ -857,31 +896,32 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
         _solver(robot)                            # the cache entry: a first call, or a new chain or tool
         hit = _SOLVERS[id(robot)]
-    arr = T if type(T) is np.ndarray and T.flags.c_contiguous else _c_order(T)
-    usual = (arr.shape == (4, 4) and arr.dtype is _F64 and frame is None and q_rest is None and not position_only
-             and method == "robust" and type(tol) is float and type(tol_orthonormal) is float
-             and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf)
-    if usual and hit[3] is not None and swivel is None and (param is None) != hit[3][4]:
+    arr = T if type(T) is np.ndarray else _c_order(T)
+    usual = (type(arr) is np.ndarray and arr.shape == (4, 4) and arr.dtype is _F64 and frame is None
+             and q_rest is None and not position_only and method == "robust" and type(tol) is float
+             and type(tol_orthonormal) is float and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf)
+    if usual:
+        flags = arr.flags                         # what the compiled calls take without a copy
+        usual = flags.c_contiguous and flags.aligned
+    one = hit[3]
+    if usual and one is not None and swivel is None and (param is None) != one[3]:
         # one pose of a closed class (no tree, no other frame): one compiled call, when it has a
         # solution and nothing to polish; else the general path below says what happened
-        cf, ci, _, labels, _, w = hit[3]
+        cf, ci, by_mask, _, w, call, singular = one
         prm = 0.0 if param is None else _held_angle(param)
         out = np.empty((8, w + 4))
-        mask = -1 if prm is None else _geo._verified_one(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
+        mask = -1 if prm is None else call(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
         if mask > 0:
-            branches = labels[mask]
-            K, plan, plain = len(branches), hit[2].plan, hit[2].plain
-            q = out[:K, :w]
+            branches, K = by_mask[mask]
             # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
             # path of every single pose, where keywords cost a third of the result's construction
-            return AnalyticIKResult(q, list(branches), None, None, out[:K, w], lambda: _singular_text(float(
-                _geo.jacobian_volumes(plan, (q if plain else plan.chain.angles(q)[:, list(plan.chain.independent)])[None],
-                                      np.ones((1, K), bool)).min())), robot.name)
+            return AnalyticIKResult(out[:K, :w], branches[:], None, None, out[:K, w], singular, robot.name)
     elif usual and type(swivel) is float and param is None and hit[2] is not None and hit[2].kind == "srs" \
             and hit[2].arm is None:
         fast = _srs_single(robot, hit[2], arr, swivel, tol, tol_orthonormal)     # one swivel angle
         if fast is not None:
             return fast
+    arr = _c_order(arr)
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None:
