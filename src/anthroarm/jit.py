@@ -49,6 +49,7 @@ import numpy as np  # noqa: E402
 from numba import types  # noqa: E402
 from numba.core import caching, cgutils  # noqa: E402
 from numba.extending import intrinsic  # noqa: E402
+from numba.core.imputils import impl_ret_borrowed  # noqa: E402
 from numba.np.arrayobj import populate_array  # noqa: E402
 
 OPTIONS = dict(nogil=True, error_model="numpy")
@@ -194,6 +195,41 @@ def _local_array(dtype, ndim: int):
     return intrinsic(lambda typingctx, rows, cols: typer(typingctx, rows, cols))
 
 
+def _view_array(ndim: int):
+    """A Numba intrinsic ``f(a, *shape)`` (``ndim`` integer sizes): the first prod(shape) entries
+    of the C-order array ``a`` (in memory order) as a C-order array of that shape (same data,
+    dtype and owner; :data:`view2`)."""
+    def typer(typingctx, arr, sizes):
+        if not (isinstance(arr, types.Array) and arr.layout == "C") or not all(isinstance(n, types.Integer) for n in sizes):
+            raise numba.errors.TypingError(f"a view takes a C-order array and {ndim} integer sizes")
+        outty = arr.copy(ndim=ndim, layout="C")
+
+        def codegen(context, builder, sig, args):
+            src = context.make_array(sig.args[0])(context, builder, args[0])
+            shape = [context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:])]
+            strides = [src.itemsize]
+            for n in shape[:0:-1]:
+                strides.insert(0, builder.mul(strides[0], n))
+            out = context.make_array(outty)(context, builder)
+            populate_array(out, data=src.data, shape=shape, strides=strides, itemsize=src.itemsize,
+                           meminfo=src.meminfo, parent=src.parent)
+            return impl_ret_borrowed(context, builder, outty, out._getvalue())
+
+        return outty(arr, *sizes), codegen
+
+    if ndim == 2:
+        return intrinsic(lambda typingctx, arr, rows, cols: typer(typingctx, arr, (rows, cols)))
+    return intrinsic(lambda typingctx, arr, d0, d1, d2: typer(typingctx, arr, (d0, d1, d2)))
+
+
+#: ``view2(a, rows, cols)`` / ``view3(a, d0, d1, d2)``: ``a.ravel()[:k].reshape(shape)`` of a
+#: C-order array ``a`` (:func:`_view_array`) without reshape's run-time layout search (a call
+#: of Numba's C helper: the dozen a one-pose IK kernel made on every call took 0.25 µs of its
+#: 1.6).  Unchecked: the sizes must fit in ``a``.
+view2 = _view_array(2)
+view3 = _view_array(3)
+
+
 #: ``local(n)`` / ``local2(rows, cols)``: float64 scratch arrays of literal sizes in the stack
 #: frame of the kernel that makes them (:func:`_local_array`); ``local_flags(n)`` booleans,
 #: ``local_ints2(rows, cols)`` int64.  Such an array must not outlive its kernel: it is never
@@ -205,4 +241,4 @@ local_ints2 = _local_array(types.int64, 2)
 
 
 __all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "entry_point", "kernel",
-           "kernel_sources_digest", "local", "local2", "local_flags", "local_ints2"]
+           "kernel_sources_digest", "local", "local2", "local_flags", "local_ints2", "view2", "view3"]

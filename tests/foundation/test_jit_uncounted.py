@@ -1,5 +1,6 @@
-"""Kernels compiled without reference counts (jit.kernel(counted=False)) and their local
-arrays (jit.local*): values, shapes, and the heap allocation they refuse."""
+"""Kernels compiled without reference counts (jit.kernel(counted=False)), their local
+arrays (jit.local*) and views (jit.view2, view3): values, shapes, and the heap allocation
+they refuse."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numba
 import numpy as np
 import pytest
 
-from anthroarm.jit import kernel, local, local2, local_flags, local_ints2
+from anthroarm.jit import kernel, local, local2, local_flags, local_ints2, view2, view3
 
 
 @kernel(counted=False)
@@ -53,3 +54,43 @@ def test_local_sizes_must_be_literal():
 
     with pytest.raises(numba.core.errors.TypingError):
         runtime_size(3)
+
+
+@kernel(counted=False)
+def _views(a, n, out):
+    v, w = view2(a, 3, n), view3(a[2:], 2, 2, 2)
+    s = view2(local(12), 3, n)                        # a view of a local array, uncounted
+    for i in range(3):
+        for j in range(n):
+            s[i, j] = v[i, j] * 2.0
+    out[0], out[1], out[2] = v[2, 1], w[1, 1, 0], s[2, 3]
+    out[3], out[4], out[5], out[6] = v.shape[0], v.shape[1], v.strides[0], w.strides[1]
+
+
+@kernel
+def _view_returned(a):
+    return view2(a, 2, 3)
+
+
+def test_views_are_numpys_reshape_of_the_leading_entries():
+    a = np.arange(20.0)
+    out = np.zeros(7)
+    _views(a, 4, out)
+    v, w = a[:12].reshape(3, 4), a[2:10].reshape(2, 2, 2)
+    assert out.tolist() == [v[2, 1], w[1, 1, 0], 2 * v[2, 3], 3, 4, v.strides[0], w.strides[1]]
+
+
+def test_a_returned_view_keeps_its_owner_alive():
+    a = np.arange(6.0) + 0.5
+    x = _view_returned(a)
+    del a
+    import gc
+    gc.collect()
+    assert x.tolist() == [[0.5, 1.5, 2.5], [3.5, 4.5, 5.5]]
+    b = np.arange(6, dtype=np.int64)
+    assert _view_returned(b).dtype == np.int64 and _view_returned(b)[1, 2] == 5
+
+
+def test_a_view_takes_only_c_order_arrays():
+    with pytest.raises(numba.core.errors.TypingError, match="C-order"):
+        _view_returned(np.arange(12.0)[::2])

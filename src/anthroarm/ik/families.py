@@ -54,7 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..jit import kernel, local, local2, local_flags
+from ..jit import kernel, local, local2, local_flags, view2, view3
 from ..threads import run_rows
 from . import classify as C
 from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _angles, _common_point,
@@ -430,8 +430,8 @@ def _srs_unpack(cf, ci):
     """The constants of :attr:`SRSPlan.packed`: (route, H (7, 3), S, E0, W0 (3,), R_tool
     (3, 3), p_tool (3,), the FK frames A (8, 12), lo, hi (7,), order (7,)) — views of ``cf``,
     ``ci``, compiled into each caller (:func:`anthroarm.jit.kernel`)."""
-    return (ci[0], cf[0:21].reshape((7, 3)), cf[21:24], cf[24:27], cf[27:30], cf[30:39].reshape((3, 3)), cf[39:42],
-            cf[42:138].reshape((8, 12)), cf[138:145], cf[145:152], ci[1:8])
+    return (ci[0], view2(cf, 7, 3), cf[21:24], cf[24:27], cf[27:30], view2(cf[30:], 3, 3), cf[39:42],
+            view2(cf[42:], 8, 12), cf[138:145], cf[145:152], ci[1:8])
 
 
 @kernel(counted=False)
@@ -487,12 +487,12 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     (the caller's general path answers).  ``cf``, ``ci``: :attr:`SRSPlan.packed`.  Scratch
     local (:func:`anthroarm.jit.local`)."""
     _, _, _, _, _, _, _, A, _, _, order = _srs_unpack(cf, ci)
-    Tb = T.reshape((1, 4, 4))
+    Tb = view3(T, 1, 4, 4)
     sw = local2(1, 1)
     q = local(7)
-    Q1, RES1 = local(56).reshape((1, 8, 7)), local2(1, 8)
-    V1, E1 = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
-    IN1, OK1 = local_flags(8).reshape((1, 8)), local_flags(8).reshape((1, 8))
+    Q1, RES1 = view3(local(56), 1, 8, 7), local2(1, 8)
+    V1, E1 = view2(local_flags(8), 1, 8), view2(local_flags(8), 1, 8)
+    IN1, OK1 = view2(local_flags(8), 1, 8), view2(local_flags(8), 1, 8)
     Q, V, E, IN, RES, OK = Q1[0], V1[0], E1[0], IN1[0], RES1[0], OK1[0]
     K = 0
     for k in range(len(swivel)):

@@ -74,7 +74,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..chain_kernels import put_joint
-from ..jit import kernel, local, local2, local_flags
+from ..jit import kernel, local, local2, local_flags, view2
 from ..threads import run_rows
 from . import classify as C
 from . import subproblems as sp
@@ -837,10 +837,9 @@ def _unpack(cf, ci):
     caller (:func:`anthroarm.jit.kernel`)."""
     n = ci[2]
     o = 70 + 12 * (n + 1)
-    return (ci[0], ci[1] == 1, n, cf[0:18].reshape((6, 3)), cf[18:39].reshape((7, 3)), cf[39:48].reshape((3, 3)),
-            (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), cf[54:70].reshape((4, 4)),
-            cf[70:o].reshape((n + 1, 12)), cf[o:o + n], cf[o + n:o + 2 * n], ci[3:3 + n],
-            ci[4 + n:4 + 3 * n].reshape((n, 2)))
+    return (ci[0], ci[1] == 1, n, view2(cf, 6, 3), view2(cf[18:], 7, 3), view2(cf[39:], 3, 3),
+            (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), view2(cf[54:], 4, 4),
+            view2(cf[70:], n + 1, 12), cf[o:o + n], cf[o + n:o + 2 * n], ci[3:3 + n], view2(ci[4 + n:], n, 2))
 
 
 @kernel(counted=False)
@@ -854,8 +853,8 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     n = plan[2]
     B6 = local2(8, BRANCH_ROW)
     q = local(7)
-    QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
-    S = local(96)[:12 * (n + 1)].reshape((n + 1, 12))
+    QC, QS = view2(local(56), 8, n), view2(local(56), 8, n)
+    S = view2(local(96), n + 1, 12)
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
@@ -1126,11 +1125,11 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     scratch local."""
     plan = _pose_plan(cf, ci)
     n, w, A, order = plan[2], out.shape[1] - 4, plan[10], plan[13]
-    Q, RES = local(56)[:8 * n].reshape((8, n)), local(8)
+    Q, RES = view2(local(56), 8, n), local(8)
     V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
-    CONF = local(112)[:8 * w if w != n else 0].reshape((8, w if w != n else 0))
-    QC, QS = local(56)[:8 * n].reshape((8, n)), local(56)[:8 * n].reshape((8, n))
-    scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, local(96)[:12 * (n + 1)].reshape((n + 1, 12)),
+    CONF = view2(local(112), 8, w if w != n else 0)
+    QC, QS = view2(local(56), 8, n), view2(local(56), 8, n)
+    scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, view2(local(96), n + 1, 12),
                local2(6, 6), local(6), local_flags(8))
     if not _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
         return -1
