@@ -878,7 +878,8 @@ def test_srs_single_pose_is_the_batch_row():
     Q = robot.random_q(40, rng=8)
     for q in Q:
         T = _fk(robot, q)
-        for sw in (swivel_angle(robot, q), 2.5):
+        a0 = swivel_angle(robot, q)
+        for sw in (a0, float(a0), 2.5):             # a numpy scalar (general path), floats (one call)
             a, b = aa.ik.analytic(robot, T, swivel=sw), aa.ik.analytic_batch(robot, T[None], swivel=sw)[0]
             assert a.branches == b.branches and a.reason == b.reason
             for x, y in ((a.solutions, b.solutions), (a.swivel, b.swivel), (a.residuals, b.residuals)):

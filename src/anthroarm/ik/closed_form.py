@@ -303,32 +303,46 @@ class _Solver:
 
     @functools.cached_property
     def one_call(self) -> _OneCall | None:
-        """How :func:`analytic` answers one pose of a closed class in one compiled call
-        (:class:`_OneCall`); None for the other kinds."""
+        """How :func:`analytic` answers one pose in one compiled call (:class:`_OneCall`): a
+        closed class, or an SRS arm whose q is θ at one swivel angle; None for the others."""
+        if self.kind == "srs" and self.plain:
+            cf, ci = self.plan.packed
+            call = _jit.entry_point(_fam.srs_pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, 12)))
+            return _OneCall(cf, ci, _by_mask(self.plan.labels), False, 7, call, None, True, (8, 12))
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
-        labels = self.plan.labels
         n = int(ci[2])
         w = n if self.plain else self.plan.chain.nq
-        by_mask = tuple((lab, len(lab)) for lab in
-                        ([labels[b] for b in range(8) if mask >> b & 1] for mask in range(256)))
-        call = _jit.entry_point(_geo._verified_one, cf, ci, np.eye(4), 0.0, 1.0, 1.0, _geo.NO_REF, np.empty((8, w + 4)))
-        return _OneCall(cf, ci, by_mask, self.plan.param_joint is not None, w, call, _SingularOf(self.plan, self.plain))
+        call = _jit.entry_point(_geo.pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, w + 4)))
+        return _OneCall(cf, ci, _by_mask(self.plan.labels), self.plan.param_joint is not None, w, call,
+                        _SingularOf(self.plan, self.plain), False, (8, w + 4))
+
+
+def _by_mask(labels) -> tuple:
+    """The labels of a pose's solutions and their number K, by the bit mask of their branches
+    (bit b: branch b of 8; how the one-pose kernels return them): 256 entries."""
+    return tuple((lab, len(lab)) for lab in ([labels[b] for b in range(8) if mask >> b & 1] for mask in range(256)))
 
 
 class _OneCall(NamedTuple):
-    """One pose of a closed class in one compiled call (:func:`analytic`)."""
+    """One pose in one compiled call (:func:`analytic`): ``call(cf, ci, T, angle, tol,
+    tol_orthonormal, out)`` writes the solutions into the rows of ``out`` and returns the bit
+    mask of their branches (≤ 0: the general path answers) — :func:`.geometric.pose_solutions`
+    (``angle`` the held 7th joint, 0.0 for none; a row: θ or q (``width``), the FK residual in
+    column ``width``) or :func:`.families.srs_pose_solutions` (``angle`` the swivel angle; a
+    row: θ (7), the FK residual in column 9, the swivel angle in column 11)."""
 
-    cf: np.ndarray                       # the plan's packed constants (:attr:`.geometric.GeoPlan.packed`)
+    cf: np.ndarray                       # the plan's packed constants
     ci: np.ndarray
-    by_mask: tuple                       # 256 × (labels of the solutions, their number K) by the bit
-    #                                      mask of their branches (how the compiled call returns them)
+    by_mask: tuple                       # :func:`_by_mask` of the plan's labels
     holds_param: bool                    # a 7th joint is held (``param=``)
     width: int                           # of a solution: n, or nq where q is not θ (continuous joints)
-    call: object                         # :func:`.geometric._verified_one` compiled for these types
-    #                                      (:func:`anthroarm.jit.entry_point`: the caller checks T)
-    singular: _SingularOf
+    call: object                         # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
+    #                                      the caller checks T)
+    singular: _SingularOf | None         # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
+    swivel: bool                         # an SRS arm: ``angle`` is the swivel angle
+    shape: tuple                         # of ``out``
 
 
 class _SingularOf:
@@ -891,7 +905,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
     (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
-    (≈ 4 µs from Python, limits and FK check included); see the module docstring."""
+    (≈ 3 µs from Python, limits and FK check included), as is one pose of an SRS arm at one
+    swivel angle; see the module docstring."""
     hit = _SOLVERS.get(id(robot))
     if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
         _solver(robot)                            # the cache entry: a first call, or a new chain or tool
@@ -904,23 +919,27 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         flags = arr.flags                         # what the compiled calls take without a copy
         usual = flags.c_contiguous and flags.aligned
     one = hit[3]
-    if usual and one is not None and swivel is None and (param is None) != one[3]:
-        # one pose of a closed class (no tree, no other frame): one compiled call, when it has a
-        # solution and nothing to polish; else the general path below says what happened
-        cf, ci, by_mask, _, w, call, singular = one
-        prm = 0.0 if param is None else _held_angle(param)
-        out = np.empty((8, w + 4))
-        mask = -1 if prm is None else call(cf, ci, arr, prm, tol, tol_orthonormal, _geo.NO_REF, out)
-        if mask > 0:
-            branches, K = by_mask[mask]
-            # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
-            # path of every single pose, where keywords cost a third of the result's construction
-            return AnalyticIKResult(out[:K, :w], branches[:], None, None, out[:K, w], singular, robot.name)
-    elif usual and type(swivel) is float and param is None and hit[2] is not None and hit[2].kind == "srs" \
-            and hit[2].arm is None:
-        fast = _srs_single(robot, hit[2], arr, swivel, tol, tol_orthonormal)     # one swivel angle
-        if fast is not None:
-            return fast
+    if usual and one is not None:
+        # one pose of a closed class (no tree, no other frame), or of an SRS arm at one swivel
+        # angle: one compiled call, when it has a solution and nothing to polish; else the
+        # general path below says what happened
+        cf, ci, by_mask, holds_param, w, call, singular, srs, shape = one
+        if srs:
+            angle = swivel if param is None and type(swivel) is float and -WRAP_MAX < swivel < WRAP_MAX else None
+        elif swivel is None and (param is None) != holds_param:
+            angle = 0.0 if param is None else _held_angle(param)
+        else:
+            angle = None
+        if angle is not None:
+            out = np.empty(shape)
+            mask = call(cf, ci, arr, angle, tol, tol_orthonormal, out)
+            if mask > 0:
+                branches, K = by_mask[mask]
+                # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
+                # path of every single pose, where keywords cost a third of the result's construction
+                if srs:
+                    return AnalyticIKResult(out[:K, :7], branches[:], None, out[:K, 11], out[:K, 9], None, robot.name)
+                return AnalyticIKResult(out[:K, :w], branches[:], None, None, out[:K, w], singular, robot.name)
     arr = _c_order(arr)
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
@@ -1016,14 +1035,8 @@ def _srs_single(robot, s, arr, swivel, tol, tol_orthonormal):
         return None
     if got is None:
         return None
-    q, res, rows = got
-    if len(grid) == 1:                                                 # one angle: its labels, its value
-        angles = np.empty(len(rows))
-        angles.fill(grid[0])
-        labels = s.plan.labels
-    else:
-        B, angle = len(s.plan.labels), grid.tolist()
-        angles, labels = np.array([angle[r // B] for r in rows]), _grid_labels(s.plan.labels, len(grid), "swivel")
+    q, res, rows, angles = got
+    labels = s.plan.labels if len(grid) == 1 else _grid_labels(s.plan.labels, len(grid), "swivel")
     return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[r] for r in rows], None, angles,
                             res, None, robot.name)
 

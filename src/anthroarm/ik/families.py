@@ -479,11 +479,11 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
     duplicates at one angle dropped: :func:`.geometric._mark_solutions`) at the swivel angles
     ``swivel`` (S,) in turn — only at the first angle that has any where ``first`` — into the
-    rows of ``out`` (8 S, 11): θ in independent-joint order (``order``: the path position of
-    each), the FK residual (column 9) and the branch (column 10: 8 k + b, swivel angle k, branch
-    b), in that order — with a reference ``ref`` (7,) (an empty array: none) the nearest it
-    first, and its position and rotation errors (:func:`.geometric._target_errors`) in columns
-    7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
+    rows of ``out`` (8 S, 12): θ in independent-joint order (``order``: the path position of
+    each), the FK residual (column 9), the branch (column 10: 8 k + b, swivel angle k, branch
+    b) and its swivel angle (column 11), in that order — with a reference ``ref`` (7,) (an
+    empty array: none) the nearest it first, and its position and rotation errors
+    (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
     (the caller's general path answers).  ``cf``, ``ci``: :attr:`SRSPlan.packed`.  Scratch
     local (:func:`anthroarm.jit.local`)."""
     _, _, _, _, _, _, _, A, _, _, order = _srs_unpack(cf, ci)
@@ -506,16 +506,32 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
             if OK[b]:
                 for j in range(7):
                     out[K, j] = Q[b, order[j]]
-                out[K, 9], out[K, 10] = RES[b], 8 * k + b
+                out[K, 9], out[K, 10], out[K, 11] = RES[b], 8 * k + b, swivel[k]
                 K += 1
         if first and K > 0:
             break
     if K > 0 and len(ref) == 7:
-        nearest_first(out, K, 7, ref, 11)
+        nearest_first(out, K, 7, ref, 12)
         for j in range(7):
             q[order[j]] = out[0, j]
         out[0, 7], out[0, 8] = _target_errors(A, q, 7, T)
     return K
+
+
+@kernel(counted=False)
+def srs_pose_solutions(cf, ci, T, swivel, tol, tol_orthonormal, out):
+    """:func:`_srs_nearest` of one pose T (4, 4) at one swivel angle ``swivel`` (rad, finite)
+    without a reference: the solutions into the rows of ``out`` (8, 12); returns the bit mask
+    of their branches (bit b: branch b; ≤ 0: none, a malformed pose or a candidate to polish —
+    the general path answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one
+    pose at one swivel angle (:func:`anthroarm.jit.entry_point`)."""
+    sw = local(1)
+    sw[0] = swivel
+    K = _srs_nearest(cf, ci, T, sw, False, tol, tol_orthonormal, sw[:0], out)
+    mask = 0
+    for k in range(K):
+        mask |= 1 << int(out[k, 10])
+    return mask if K >= 0 else K
 
 
 def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
@@ -532,8 +548,8 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
 
 
 def _one_pose(plan: SRSPlan, T, swivel, first: bool, tol: float, tol_orthonormal: float, ref):
-    """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 11))."""
-    out = np.empty((8 * len(swivel), 11))
+    """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 12))."""
+    out = np.empty((8 * len(swivel), 12))
     cf, ci = plan.packed
     return _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out), out
 
@@ -542,13 +558,13 @@ def srs_solutions(plan: SRSPlan, T, swivel, tol: float, tol_orthonormal: float):
     """Every solution of one pose ``T`` (4, 4) (a C-order float array) at the swivel angles
     ``swivel`` (S,) (rad, finite), in the order of :func:`srs_verified`'s rows, in one compiled
     call: (θ (K, 7) in independent-joint order, FK residuals (K,), row indices (a list of K
-    ints) into the 8 S branches) — or None where there is none, the pose is malformed or a
-    candidate is to be polished (:func:`anthroarm.ik.closed_form.analytic_batch` answers, with
-    the reasons)."""
+    ints) into the 8 S branches, swivel angles (K,)) — or None where there is none, the pose is
+    malformed or a candidate is to be polished (:func:`anthroarm.ik.closed_form.analytic_batch`
+    answers, with the reasons)."""
     K, out = _one_pose(plan, T, swivel, False, tol, tol_orthonormal, NO_REF)
     if K <= 0:
         return None
-    return out[:K, :7], out[:K, 9], [int(r) for r in out[:K, 10].tolist()]
+    return out[:K, :7], out[:K, 9], [int(r) for r in out[:K, 10].tolist()], out[:K, 11]
 
 
 def _swivel_array(swivel, N, check=True):

@@ -1155,6 +1155,15 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     return mask
 
 
+@kernel(counted=False)
+def pose_solutions(cf, ci, T, param, tol, tol_orthonormal, out):
+    """:func:`_verified_one` of one pose without a reference: the solutions into the rows of
+    ``out`` (8, w + 4), the bit mask of their branches returned (≤ 0: the general path
+    answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one pose of a closed
+    class (:func:`anthroarm.jit.entry_point`)."""
+    return _verified_one(cf, ci, T, param, tol, tol_orthonormal, local(1)[:0], out)
+
+
 NO_REF = np.zeros(0)   # "no reference" of the one-pose kernels (an empty array)
 
 
