@@ -279,8 +279,14 @@ def test_planar_off_plane_and_out_of_reach():
     _, T = _poses(r, 20, 8)
     P = T[:, :3, 3].copy()
     off = P + plan.h1 * 0.05
-    th, cand, exact, inside, res, _ = F.planar_verified(plan, off)
-    assert not cand.any() and not exact.any() and np.isnan(th).all() and np.isinf(res).all()
+    th, cand, exact, inside, res, ok = F.planar_verified(plan, off)
+    assert not cand.any() and not exact.any() and np.isnan(th).all() and np.isinf(res).all() and not ok.any()
+    # a batch of off-plane targets: no solution flagged (the flags are written, not left as found)
+    big = np.repeat(off, 200, axis=0)
+    assert not F.planar_verified(plan, big)[5].any()
+    res_b = aa.ik.analytic_batch(r, np.repeat(T, 200, axis=0) + np.pad(plan.h1 * 0.05, (0, 1))[None, :, None]
+                                 * np.array([0, 0, 0, 1.0])[None, None, :])
+    assert not res_b.valid.any() and all("plane of motion" in x for x in res_b.reasons)
     far = P + 5.0 * (P - plan.o1) / np.linalg.norm(P - plan.o1, axis=1)[:, None]   # beyond reach 2
     th, cand, exact, inside, res, _ = F.planar_verified(plan, far)
     assert not exact.any() and not np.isnan(th[cand]).any()

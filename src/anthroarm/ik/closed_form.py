@@ -304,11 +304,15 @@ class _Solver:
     @functools.cached_property
     def one_call(self) -> _OneCall | None:
         """How :func:`analytic` answers one pose in one compiled call (:class:`_OneCall`): a
-        closed class, or an SRS arm whose q is θ at one swivel angle; None for the others."""
-        if self.kind == "srs" and self.plain:
+        closed class; an SRS arm at one swivel angle or a planar 2R arm (position only) whose q
+        is θ; None for the others."""
+        if self.kind in ("srs", "planar") and self.plain:
             cf, ci = self.plan.packed
-            call = _jit.entry_point(_fam.srs_pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, 12)))
-            return _OneCall(cf, ci, _by_mask(self.plan.labels), False, 7, call, None, True, (8, 12))
+            srs = self.kind == "srs"
+            shape = (8, 12) if srs else (2, 4)
+            kernel = _fam.srs_pose_solutions if srs else _fam.planar_pose_solutions
+            call = _jit.entry_point(kernel, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty(shape))
+            return _OneCall(cf, ci, _by_mask(self.plan.labels), False, 7 if srs else 2, call, None, self.kind, shape)
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
@@ -316,13 +320,14 @@ class _Solver:
         w = n if self.plain else self.plan.chain.nq
         call = _jit.entry_point(_geo.pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, w + 4)))
         return _OneCall(cf, ci, _by_mask(self.plan.labels), self.plan.param_joint is not None, w, call,
-                        _SingularOf(self.plan, self.plain), False, (8, w + 4))
+                        _SingularOf(self.plan, self.plain), self.kind, (8, w + 4))
 
 
 def _by_mask(labels) -> tuple:
     """The labels of a pose's solutions and their number K, by the bit mask of their branches
-    (bit b: branch b of 8; how the one-pose kernels return them): 256 entries."""
-    return tuple((lab, len(lab)) for lab in ([labels[b] for b in range(8) if mask >> b & 1] for mask in range(256)))
+    (bit b: branch b; how the one-pose kernels return them): 2 ** B entries for B labels."""
+    B = len(labels)
+    return tuple((lab, len(lab)) for lab in ([labels[b] for b in range(B) if mask >> b & 1] for mask in range(1 << B)))
 
 
 class _OneCall(NamedTuple):
@@ -330,8 +335,9 @@ class _OneCall(NamedTuple):
     tol_orthonormal, out)`` writes the solutions into the rows of ``out`` and returns the bit
     mask of their branches (≤ 0: the general path answers) — :func:`.geometric.pose_solutions`
     (``angle`` the held 7th joint, 0.0 for none; a row: θ or q (``width``), the FK residual in
-    column ``width``) or :func:`.families.srs_pose_solutions` (``angle`` the swivel angle; a
-    row: θ (7), the FK residual in column 9, the swivel angle in column 11)."""
+    column ``width``), :func:`.families.srs_pose_solutions` (``angle`` the swivel angle; a
+    row: θ (7), the FK residual in column 9, the swivel angle in column 11) or
+    :func:`.families.planar_pose_solutions` (position only; a row: θ (2), the residual)."""
 
     cf: np.ndarray                       # the plan's packed constants
     ci: np.ndarray
@@ -341,7 +347,8 @@ class _OneCall(NamedTuple):
     call: object                         # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
     #                                      the caller checks T)
     singular: _SingularOf | None         # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
-    swivel: bool                         # an SRS arm: ``angle`` is the swivel angle
+    kind: str                            # of the :class:`_Solver`: "geo", "srs" (``angle`` is the swivel
+    #                                      angle), "planar" (position only)
     shape: tuple                         # of ``out``
 
 
@@ -920,13 +927,14 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         usual = flags.c_contiguous and flags.aligned
     one = hit[3]
     if usual and one is not None:
-        # one pose of a closed class (no tree, no other frame), or of an SRS arm at one swivel
-        # angle: one compiled call, when it has a solution and nothing to polish; else the
+        # one pose of a closed class (no tree, no other frame), of an SRS arm at one swivel
+        # angle or of a planar 2R arm (position only): one compiled call, when it has a solution and nothing to polish; else the
         # general path below says what happened
-        cf, ci, by_mask, holds_param, w, call, singular, srs, shape = one
+        cf, ci, by_mask, holds_param, w, call, singular, kind, shape = one
+        srs = kind == "srs"
         if srs:
             angle = swivel if param is None and type(swivel) is float and -WRAP_MAX < swivel < WRAP_MAX else None
-        elif swivel is None and (param is None) != holds_param:
+        elif swivel is None and (param is None) != holds_param and (position_only is None or kind != "planar"):
             angle = 0.0 if param is None else _held_angle(param)
         else:
             angle = None
@@ -990,9 +998,9 @@ def nearest_solver(robot, frame=None):
     One compiled call (:func:`.geometric.solve_nearest`); the function holds the plan's
     packed constants, not the robot."""
     s = _at(robot, frame)
-    if s is None or s.one_call is None:
+    if s is None or s.kind != "geo" or s.one_call is None:
         return None
-    cf, ci = s.one_call[:2]
+    cf, ci = s.plan.packed
     inner = functools.partial(_geo.solve_nearest, cf, ci)
     return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
 

@@ -148,6 +148,16 @@ class PlanarPlan:
     tool: str
     in_order: bool = False
 
+    @functools.cached_property
+    def packed(self) -> tuple:
+        """The plan's constants as the compiled drivers take them (:func:`_planar_unpack`): one
+        float array (h1, h2, o1, o2, p_tool, the FK check's axes and points (2, 3), limits in
+        path order) and one int array (``order``)."""
+        cf = np.concatenate([np.asarray(a, dtype=float).ravel() for a in (
+            self.h1, self.h2, self.o1, self.o2, self.p_tool, self.fk_axes, self.fk_points, self.lower_path,
+            self.upper_path)])
+        return cf, np.array(self.order, dtype=np.int64)
+
 
 _SRS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _PLANAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
@@ -661,38 +671,81 @@ def _fk_position_residual(kH, kO, p_tool, q, n, p):
     return max(abs(x[0] - p[0]), max(abs(x[1] - p[1]), abs(x[2] - p[2])))
 
 
-@kernel
-def _planar_verified(h1, h2, o1, o2, pt, kH, kO, lo, hi, P, tol, Q, V, E, IN, RES, OK):
-    """Both branches of targets P (N, 3): Q (N, 2, 2) path order, V, E, IN, RES (position), OK
-    (the solutions, :func:`.geometric._mark_solutions`); returns the index of the first
-    non-finite target (−1 if none).  ``h1`` … ``pt``: the plan's vectors (3,)."""
-    h1, h2, o1, o2, pt = vec(h1), vec(h2), vec(o1), vec(o2), vec(pt)
-    q = np.empty(2)
+@kernel(inline=True)
+def _planar_unpack(cf):
+    """The constants of :attr:`PlanarPlan.packed`: (h1, h2, o1, o2, p_tool (3-tuples), the FK
+    check's axes and points (2, 3), lo, hi (2,)) — views of ``cf``, compiled into each caller."""
+    return (vec(cf[0:3]), vec(cf[3:6]), vec(cf[6:9]), vec(cf[9:12]), vec(cf[12:15]), view2(cf[15:], 2, 3),
+            view2(cf[21:], 2, 3), cf[27:29], cf[29:31])
+
+
+@kernel(inline=True)
+def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
+    """Both branches of one target ``p`` (3-tuple, finite): Q (2, 2) path order, V, E, IN, RES
+    (position), OK (the solutions, :func:`.geometric._mark_solutions`); ``plan``:
+    :func:`_planar_unpack`; ``q`` (2,) scratch."""
+    h1, h2, o1, o2, pt, kH, kO, lo, hi = plan
     p1, p2 = sub(pt, o2), sub(o1, o2)
-    for i in range(len(P)):
-        for j in range(3):
-            if not math.isfinite(P[i, j]):
-                return i
-        p = vec(P[i])
-        for b in range(2):
-            Q[i, b, 0], Q[i, b, 1] = math.nan, math.nan
-            V[i, b], E[i, b], IN[i, b], RES[i, b] = False, False, False, math.inf
-        if abs(dot(h1, sub(p, pt))) > tol:
-            continue                                  # off the plane of motion: no candidate
+    for b in range(2):
+        Q[b, 0], Q[b, 1] = math.nan, math.nan
+        V[b], E[b], IN[b], RES[b] = False, False, False, math.inf
+    if abs(dot(h1, sub(p, pt))) <= tol:               # else off the plane of motion: no candidate
         po = sub(p, o1)
         ta, tb, cnt, ea, eb, _ = sp3_one(p1, p2, h2, norm(po), TOL)
-        for b in range(2):
-            if b >= cnt:
-                continue
+        for b in range(cnt):
             q2 = ta if b == 0 else tb
             q1, e1, _ = sp1_one(sub(rotate(h2, q2, p1), p2), po, h1, TOL)
             q[0], q[1] = wrap(q1), wrap(q2)
             inside = into_limits(q, 2, lo, hi)
-            Q[i, b, 0], Q[i, b, 1] = q[0], q[1]
-            V[i, b], E[i, b], IN[i, b] = True, (ea if b == 0 else eb) and e1, inside
-            RES[i, b] = _fk_position_residual(kH, kO, pt, q, 2, p)
-        _mark_solutions(Q[i], V[i], IN[i], RES[i], tol, 2, OK[i])
+            Q[b, 0], Q[b, 1] = q[0], q[1]
+            V[b], E[b], IN[b] = True, (ea if b == 0 else eb) and e1, inside
+            RES[b] = _fk_position_residual(kH, kO, pt, q, 2, p)
+    _mark_solutions(Q, V, IN, RES, tol, 2, OK)
+
+
+@kernel(counted=False)
+def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
+    """Both branches of targets P (N, 3) (:func:`_planar_pose` of each): Q (N, 2, 2) path
+    order, V, E, IN, RES, OK (N, 2); returns the index of the first non-finite target (−1 if
+    none).  ``cf``: :attr:`PlanarPlan.packed`."""
+    plan = _planar_unpack(cf)
+    q = local(2)
+    for i in range(len(P)):
+        for j in range(3):
+            if not math.isfinite(P[i, j]):
+                return i
+        _planar_pose(plan, (P[i, 0], P[i, 1], P[i, 2]), tol, Q[i], V[i], E[i], IN[i], RES[i], OK[i], q)
     return -1
+
+
+@kernel(counted=False)
+def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
+    """One pose T (4, 4) of a planar 2R arm, position only (its rotation is not compared; its
+    last row must be [0, 0, 0, 1] and every entry finite): the solutions into the rows of
+    ``out`` (2, 4) — θ in independent-joint order (``ci``: ``order``), the FK residual, the
+    branch — and the bit mask of their branches returned (≤ 0: none, a malformed pose or a
+    candidate to polish — the general path answers).  ``angle`` and ``tol_orthonormal`` are
+    not read (the signature of :func:`.geometric.pose_solutions`).  ``cf``, ``ci``:
+    :attr:`PlanarPlan.packed`."""
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[i, j]):
+                return -1
+    if T[3, 0] != 0.0 or T[3, 1] != 0.0 or T[3, 2] != 0.0 or T[3, 3] != 1.0:
+        return -1
+    Q, RES, q = local2(2, 2), local(2), local(2)
+    V, E, IN, OK = local_flags(2), local_flags(2), local_flags(2), local_flags(2)
+    _planar_pose(_planar_unpack(cf), (T[0, 3], T[1, 3], T[2, 3]), tol, Q, V, E, IN, RES, OK, q)
+    K, mask = 0, 0
+    for b in range(2):
+        if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
+            return -2
+        if OK[b]:
+            out[K, 0], out[K, 1] = Q[b, ci[0]], Q[b, ci[1]]
+            out[K, 2], out[K, 3] = RES[b], b
+            K += 1
+            mask |= 1 << b
+    return mask
 
 
 def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
@@ -709,8 +762,7 @@ def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
     N = len(P)
     Q, V, E = np.empty((N, 2, 2)), np.empty((N, 2), bool), np.empty((N, 2), bool)
     IN, RES, OK = np.empty((N, 2), bool), np.empty((N, 2)), np.empty((N, 2), bool)
-    bad = _planar_verified(plan.h1, plan.h2, plan.o1, plan.o2, plan.p_tool, plan.fk_axes,
-                           plan.fk_points, plan.lower_path, plan.upper_path, P, float(tol), Q, V, E, IN, RES, OK)
+    bad = _planar_verified(plan.packed[0], P, float(tol), Q, V, E, IN, RES, OK)
     if bad >= 0:
         raise ValueError(f"P[{bad}] is not a finite position")
     return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES, OK
