@@ -928,8 +928,8 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     one = hit[3]
     if usual and one is not None:
         # one pose of a closed class (no tree, no other frame), of an SRS arm at one swivel
-        # angle or of a planar 2R arm (position only): one compiled call, when it has a solution and nothing to polish; else the
-        # general path below says what happened
+        # angle or of a planar 2R arm (position only): one compiled call, when it has a
+        # solution and nothing to polish; else the general path below says what happened
         cf, ci, by_mask, holds_param, w, call, singular, kind, shape = one
         srs = kind == "srs"
         if srs:

@@ -493,9 +493,9 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     each), the FK residual (column 9), the branch (column 10: 8 k + b, swivel angle k, branch
     b) and its swivel angle (column 11), in that order — with a reference ``ref`` (7,) (an
     empty array: none) the nearest it first, and its position and rotation errors
-    (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K; −1: a malformed pose; −2: a candidate to polish
-    (the caller's general path answers).  ``cf``, ``ci``: :attr:`SRSPlan.packed`.  Scratch
-    local (:func:`anthroarm.jit.local`)."""
+    (:func:`.geometric._target_errors`) in columns 7, 8 of row 0.  Returns their number K; −1:
+    a malformed pose; −2: a candidate to polish (the caller's general path answers).  ``cf``,
+    ``ci``: :attr:`SRSPlan.packed`.  Scratch local (:func:`anthroarm.jit.local`)."""
     _, _, _, _, _, _, _, A, _, _, order = _srs_unpack(cf, ci)
     Tb = view3(T, 1, 4, 4)
     sw = local2(1, 1)
