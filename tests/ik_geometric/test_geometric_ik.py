@@ -1022,15 +1022,40 @@ def test_every_array_layout_of_one_pose_gets_the_same_solutions(layout):
 def test_entry_point_is_the_kernel_for_those_types():
     """jit.entry_point gives the compiled body the dispatcher itself would call for those
     argument types: the same outputs as the dispatcher on a pose of ur5 (the branch mask, and in
-    each solution row θ, the FK residual and the branch; the rest of ``out`` left untouched)."""
+    each solution row θ, the FK residual and the branch; the rest of ``out`` left untouched) —
+    for the kernel aa.ik.analytic calls (geometric.pose_solutions), and its result is
+    analytic's."""
     from anthroarm import jit
     robot = aa.load("ur5")
     T = np.ascontiguousarray(_fk(robot, robot.random_q(1, rng=5)[0]))
     cf, ci = G.plan_for(robot).packed
     a, b = np.full((8, 10), np.nan), np.full((8, 10), np.nan)
-    call = jit.entry_point(G._verified_one, cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, a)
-    m1 = call(cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, a)
-    m2 = G._verified_one(cf, ci, T, 0.0, 1e-9, 1e-6, G.NO_REF, b)
+    call = jit.entry_point(G.pose_solutions, cf, ci, T, 0.0, 1e-9, 1e-6, a)
+    m1 = call(cf, ci, T, 0.0, 1e-9, 1e-6, a)
+    m2 = G.pose_solutions(cf, ci, T, 0.0, 1e-9, 1e-6, b)
     assert m1 == m2 > 0
+    res = aa.ik.analytic(robot, T)
+    assert np.array_equal(res.solutions, a[:len(res), :6]) and np.array_equal(res.residuals, a[:len(res), 6])
     K = bin(m1).count("1")
     assert np.array_equal(a, b, equal_nan=True) and not np.isnan(a[:K, :8]).any()
+
+
+def test_singular_text_of_a_tree_is_that_of_its_arms_solutions():
+    """A tree's one-pose result holds the robot's configurations, but its ``singular`` is that
+    of the arm's solutions — as the batch path and the leg alone say.  talos's right leg with
+    the knee straight (singular: normalised |det J| of the leg ≈ 0, Pinocchio-free check: the
+    leg solved alone) and bent (not singular), the left leg folded off the path; the fast
+    path's maker once read the robot's q as the leg's θ and called the straight knee regular."""
+    robot = aa.load("talos", tool="right_sole_link")
+    arm = aa.ik.closed_form._solver(robot).arm.robot
+    on = [robot.chain.joints[j].idx_q for j in robot.chain.path(robot.tool)]
+    for knee, singular in ((1e-7, True), (0.8, False)):
+        q = robot.neutral().copy()
+        q[on[3]] = knee
+        q[:6] = [0, 0, -0.4, 1.0, -0.5, 0]
+        T = _fk(robot, q)
+        one = aa.ik.analytic(robot, T, q_rest=q)
+        row = aa.ik.analytic_batch(robot, T[None], q_rest=q)[0]
+        alone = aa.ik.analytic(arm, T)
+        assert len(one) >= 1
+        assert (one.singular is not None) == (row.singular is not None) == (alone.singular is not None) == singular

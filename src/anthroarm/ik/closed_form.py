@@ -96,7 +96,8 @@ class AnalyticIKResult:
     reason: str | None = None
     swivel: np.ndarray | None = None
     residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    #: the text of :attr:`singular`, or a function of :attr:`solutions` that makes it (on first use)
+    #: the text of :attr:`singular`, or a function of :attr:`solutions` that makes it on first use
+    #: (or of the solutions it was made for: a batch row's, the arm's of a tree)
     _singular: object = field(default=None, repr=False, compare=False)
     model: str = ""
 
@@ -201,6 +202,13 @@ class AnalyticBatchResult:
         return self.valid.sum(axis=1)
 
 
+def _singular_from(make, solutions, _held) -> str | None:
+    """:attr:`AnalyticIKResult.singular` by ``make`` (a :class:`_SingularOf`) from the
+    ``solutions`` it was made for, not those the result holds (``_held``: a tree's result holds
+    the robot's configurations, its arm's maker reads the arm's θ)."""
+    return make(solutions)
+
+
 def _pose_singular(singular_of, i: int, _solutions) -> str | None:
     """:attr:`AnalyticIKResult.singular` of pose ``i`` of a batch, from the batch's maker
     ``singular_of`` (its solutions are those the batch holds)."""
@@ -230,7 +238,7 @@ class ClosedForm:
 def _cost(cls: str) -> float:
     if cls == _geo.C.GEN_SIX_DOF:
         return 3e5                       # the 2-D search
-    return 2e3 if cls in _geo.SEARCHED else 10.0
+    return 2e3 if cls in _geo.SEARCHED else 3.0
 
 
 @dataclass(frozen=True)
@@ -369,9 +377,11 @@ class _SingularOf:
 
 
 #: id(robot) → (its chain, its tool, its :class:`_Solver` or None, the solver's
-#: :attr:`_Solver.one_call` where :func:`analytic` may answer one pose by it (no tree), else
-#: None); an entry leaves with its robot (``weakref.finalize``), and holds no reference to it
+#: :attr:`_Solver.one_call` where :func:`analytic` may answer one pose by it (no tree; made on
+#: the first such pose, :data:`_PENDING` until then), else None); an entry leaves with its
+#: robot (``weakref.finalize``), and holds no reference to it
 _SOLVERS: dict = {}
+_PENDING = object()
 
 
 def _solver(robot):
@@ -382,8 +392,16 @@ def _solver(robot):
     out = _new_solver(robot)
     if hit is None:
         weakref.finalize(robot, _SOLVERS.pop, id(robot), None)
-    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out, None if out is None or out.arm is not None else out.one_call)
+    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out, None if out is None or out.arm is not None else _PENDING)
     return out
+
+
+def _one_call_of(robot, hit) -> _OneCall | None:
+    """The :attr:`_Solver.one_call` of a :data:`_SOLVERS` entry ``hit`` still :data:`_PENDING`,
+    made (the one-pose kernel compiled or loaded) and kept in the entry."""
+    one = hit[2].one_call
+    _SOLVERS[id(robot)] = (*hit[:3], one)
+    return one
 
 
 def _new_solver(robot):
@@ -397,11 +415,11 @@ def _new_solver(robot):
     out = None
     pl = _fam.planar_plan(robot)
     if pl is not None:
-        out = _Solver("planar", pl, ClosedForm(PLANAR, 2, 2, position_only=True, cost_us=5.0), plain)
+        out = _Solver("planar", pl, ClosedForm(PLANAR, 2, 2, position_only=True, cost_us=2.0), plain)
     if out is None:
         sp = _fam.srs_plan(robot)
         if sp is not None:
-            out = _Solver("srs", sp, ClosedForm(SRS, 7, 8, swivel=True, cost_us=10.0), plain)
+            out = _Solver("srs", sp, ClosedForm(SRS, 7, 8, swivel=True, cost_us=4.0), plain)
     if out is None:
         gp = _geo.plan_for(robot)
         if gp is not None:
@@ -538,7 +556,8 @@ def _on_robot(arm: _Arm, res, q_rest):
     robot, the joints off the path at ``q_rest``."""
     if isinstance(res, AnalyticBatchResult):
         return replace(res, solutions=arm.configurations(res.solutions, q_rest, res.valid))
-    return replace(res, solutions=arm.configurations(res.solutions, q_rest))
+    sing = functools.partial(_singular_from, res._singular, res.solutions) if callable(res._singular) else res._singular
+    return replace(res, solutions=arm.configurations(res.solutions, q_rest), _singular=sing)
 
 
 def require_form(robot, frame=None) -> ClosedForm:
@@ -911,9 +930,10 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
 
     Returns :class:`AnalyticIKResult`: ``solutions`` (K, nq), ``branches``, ``reason`` (None,
     or why there is none: outside the workspace, joint limits, a singular pose), ``swivel``
-    (SRS arm), ``residuals`` (FK check).  One pose of a closed 6R class is one compiled call
-    (≈ 3 µs from Python, limits and FK check included), as is one pose of an SRS arm at one
-    swivel angle; see the module docstring."""
+    (SRS arm), ``residuals`` (FK check).  One pose of a closed class (a 7-joint arm at one
+    ``param``) is one compiled call (≈ 3 µs from Python, limits and FK check included), as is
+    one pose of an SRS arm at one swivel angle (≈ 4 µs) or of a planar 2R arm (≈ 2 µs); see the
+    module docstring."""
     hit = _SOLVERS.get(id(robot))
     if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
         _solver(robot)                            # the cache entry: a first call, or a new chain or tool
@@ -925,7 +945,9 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if usual:
         flags = arr.flags                         # what the compiled calls take without a copy
         usual = flags.c_contiguous and flags.aligned
-    one = hit[3]
+    one, tried = hit[3], False
+    if usual and one is _PENDING:
+        one = _one_call_of(robot, hit)
     if usual and one is not None:
         # one pose of a closed class (no tree, no other frame), of an SRS arm at one swivel
         # angle or of a planar 2R arm (position only): one compiled call, when it has a
@@ -940,7 +962,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             angle = None
         if angle is not None:
             out = np.empty(shape)
-            mask = call(cf, ci, arr, angle, tol, tol_orthonormal, out)
+            mask, tried = call(cf, ci, arr, angle, tol, tol_orthonormal, out), True
             if mask > 0:
                 branches, K = by_mask[mask]
                 # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
@@ -975,7 +997,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
                                          tol_orthonormal=tol_orthonormal, param=param), rest)
     if q_rest is not None:
         _q_rest(robot, None, q_rest)
-    if s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
+    if not tried and s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
             arr.shape == (4, 4) or (s.kind == "planar" and arr.shape == (3,))):
         fast = _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal)
         if fast is not None:
@@ -998,7 +1020,7 @@ def nearest_solver(robot, frame=None):
     One compiled call (:func:`.geometric.solve_nearest`); the function holds the plan's
     packed constants, not the robot."""
     s = _at(robot, frame)
-    if s is None or s.kind != "geo" or s.one_call is None:
+    if s is None or s.kind != "geo" or s.plan.cls not in _geo.CLOSED:
         return None
     cf, ci = s.plan.packed
     inner = functools.partial(_geo.solve_nearest, cf, ci)

@@ -550,7 +550,7 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
     has any where ``first`` — with the one nearest ``ref`` (7,) first and its position and
     rotation errors (m, rad), in one compiled call; None where the pose has no solution there,
     is malformed or has a candidate to polish (the general path answers).  The seeds of
-    :func:`anthroarm.ik.solve` (:func:`anthroarm.ik.closed_form.nearest_solver`)."""
+    :func:`anthroarm.ik.solve` (:func:`anthroarm.ik.closed_form.nearest_swivel_solver`)."""
     K, out = _one_pose(plan, T, swivel, first, 1e-9, 1e-6, ref)
     if K <= 0:
         return None
@@ -558,7 +558,10 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
 
 
 def _one_pose(plan: SRSPlan, T, swivel, first: bool, tol: float, tol_orthonormal: float, ref):
-    """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 12))."""
+    """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 12)).  ``T``: a C-order float 4×4
+    array (ValueError otherwise: the kernel reads 16 entries)."""
+    if not (isinstance(T, np.ndarray) and T.shape == (4, 4) and T.dtype == np.float64 and T.flags.c_contiguous):
+        raise ValueError("T must be a C-order float64 4x4 array")
     out = np.empty((8 * len(swivel), 12))
     cf, ci = plan.packed
     return _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out), out
