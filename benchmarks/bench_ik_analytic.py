@@ -95,9 +95,6 @@ class Case:
     def kw_batch(self, n):
         return {k: v[:n] for k, v in self.kw.items()}
 
-    def kw_one(self, i):
-        return {k: float(v[i]) for k, v in self.kw.items()}
-
 
 # ---------------------------------------------------------------------------- checks
 def _pin_fk_err(robot, sols, T, position_only):
@@ -133,25 +130,39 @@ def _single_times(case, n, geo):
     """One pose at a time, ``aa.ik.analytic`` and (``geo``: (ik-geo robot, its argument lists),
     or None) ik-geo's ``get_ik`` on the same pose right after it — interleaved, so that both see
     the same moments of a shared machine.  Each of our poses is its own 4×4 array and each of
-    ik-geo's its lists, made before timing.  Returns (our per-call times, our results, ik-geo's
-    per-call times or None) (s)."""
-    robot = case.robot
+    ik-geo's its lists, made before timing; each is called as a user writes it (our keyword
+    ``param=`` / ``swivel=`` spelled out, not unpacked from a dict; ik-geo's two arguments
+    likewise).  Returns (our per-call times, our results, ik-geo's per-call times or None) (s)."""
+    robot, analytic = case.robot, aa.ik.analytic
     T = [x.copy() for x in case.T[:n]]
-    kws = [case.kw_one(i) for i in range(n)]
+    key = next(iter(case.kw), None)                          # "param", "swivel" or None
+    val = [float(v) for v in case.kw[key][:n]] if key else [None] * n
     for i in range(min(n, 20)):                                                 # warm-up
-        aa.ik.analytic(robot, T[i], **kws[i])
+        analytic(robot, T[i], **({key: val[i]} if key else {}))
         if geo is not None:
             geo[0].get_ik(*geo[1][i])
     times, geo_times, results = [], [], []
+    get_ik = geo[0].get_ik if geo is not None else None
     for i in range(n):
-        t0 = time.perf_counter()
-        r = aa.ik.analytic(robot, T[i], **kws[i])
-        times.append(time.perf_counter() - t0)
-        results.append(r)
-        if geo is not None:
-            a = geo[1][i]
+        Ti, v = T[i], val[i]
+        if key is None:
             t0 = time.perf_counter()
-            geo[0].get_ik(*a)
+            r = analytic(robot, Ti)
+            t = time.perf_counter() - t0
+        elif key == "param":
+            t0 = time.perf_counter()
+            r = analytic(robot, Ti, param=v)
+            t = time.perf_counter() - t0
+        else:
+            t0 = time.perf_counter()
+            r = analytic(robot, Ti, swivel=v)
+            t = time.perf_counter() - t0
+        times.append(t)
+        results.append(r)
+        if get_ik is not None:
+            R, p = geo[1][i]
+            t0 = time.perf_counter()
+            get_ik(R, p)
             geo_times.append(time.perf_counter() - t0)
     return times, results, (geo_times if geo is not None else None)
 
@@ -320,7 +331,8 @@ def run(quick: bool = False) -> dict:
             "at the sampled value (param=); planar2r: position only. "
             "'ik-geo single (Rust)' = ik_geo.Robot.<class>.get_ik on the same poses, reduced to its class pose "
             "(reversed chain, panda's first six joints) with the lists built beforehand (not timed; ours: each pose "
-            "its own 4×4 array, made beforehand), timed interleaved with ours pose by pose: all branches, "
+            "its own 4×4 array, made beforehand; each called as a user writes it: param=/swivel= spelled out, "
+            "get_ik(R, p)), timed interleaved with ours pose by pose: all branches, "
             "no limits, no FK check; its 'solutions/pose' counts the exact (not least-squares) ones, 'success' and "
             "'max FK err' are Pinocchio's on those; 'same solutions as ik-geo' = poses whose exact solutions equal "
             "our class solver's exact branches before limit filtering (geometric.solve) as sets mod 2π to 1e-8 rad. "
