@@ -320,38 +320,44 @@ class _Solver:
             shape = (8, 12) if srs else (2, 4)
             kernel = _fam.srs_pose_solutions if srs else _fam.planar_pose_solutions
             call = _jit.entry_point(kernel, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty(shape))
-            return _OneCall(cf, ci, _by_mask(self.plan.labels), False, 7 if srs else 2, call, None, self.kind, shape)
+            rows = _by_mask(self.plan.labels, 7, 9, 11) if srs else _by_mask(self.plan.labels, 2, 2)
+            return _OneCall(cf, ci, rows, False, call, None, self.kind, shape)
         if self.kind != "geo" or self.plan.cls not in _geo.CLOSED:
             return None
         cf, ci = self.plan.packed
         n = int(ci[2])
         w = n if self.plain else self.plan.chain.nq
         call = _jit.entry_point(_geo.pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, w + 4)))
-        return _OneCall(cf, ci, _by_mask(self.plan.labels), self.plan.param_joint is not None, w, call,
+        return _OneCall(cf, ci, _by_mask(self.plan.labels, w, w), self.plan.param_joint is not None, call,
                         _SingularOf(self.plan, self.plain), self.kind, (8, w + 4))
 
 
-def _by_mask(labels) -> tuple:
-    """The labels of a pose's solutions and their number K, by the bit mask of their branches
-    (bit b: branch b; how the one-pose kernels return them): 2 ** B entries for B labels."""
-    B = len(labels)
-    return tuple((lab, len(lab)) for lab in ([labels[b] for b in range(B) if mask >> b & 1] for mask in range(1 << B)))
+def _by_mask(labels, width: int, residual: int, swivel: int | None = None) -> tuple:
+    """By the bit mask of a pose's branches that are solutions (bit b: branch b; how the
+    one-pose kernels return them; 2 ** B entries for B labels): (their labels, and the keys into
+    the kernel's ``out`` of their K rows: the solutions ``[:K, :width]``, the residuals
+    ``[:K, residual]``, the swivel angles ``[:K, swivel]`` or None) — made once, not per call."""
+    B, out = len(labels), []
+    for mask in range(1 << B):
+        lab = [labels[b] for b in range(B) if mask >> b & 1]
+        rows = slice(0, len(lab))
+        out.append((lab, (rows, slice(0, width)), (rows, residual), None if swivel is None else (rows, swivel)))
+    return tuple(out)
 
 
 class _OneCall(NamedTuple):
     """One pose in one compiled call (:func:`analytic`): ``call(cf, ci, T, angle, tol,
     tol_orthonormal, out)`` writes the solutions into the rows of ``out`` and returns the bit
     mask of their branches (≤ 0: the general path answers) — :func:`.geometric.pose_solutions`
-    (``angle`` the held 7th joint, 0.0 for none; a row: θ or q (``width``), the FK residual in
-    column ``width``), :func:`.families.srs_pose_solutions` (``angle`` the swivel angle; a
+    (``angle`` the held 7th joint, 0.0 for none; a row: θ (n), or q (nq) where q is not θ, then
+    the FK residual), :func:`.families.srs_pose_solutions` (``angle`` the swivel angle; a
     row: θ (7), the FK residual in column 9, the swivel angle in column 11) or
     :func:`.families.planar_pose_solutions` (position only; a row: θ (2), the residual)."""
 
     cf: np.ndarray                       # the plan's packed constants
     ci: np.ndarray
-    by_mask: tuple                       # :func:`_by_mask` of the plan's labels
+    by_mask: tuple                       # :func:`_by_mask` of the plan's labels and ``out``'s columns
     holds_param: bool                    # a 7th joint is held (``param=``)
-    width: int                           # of a solution: n, or nq where q is not θ (continuous joints)
     call: object                         # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
     #                                      the caller checks T)
     singular: _SingularOf | None         # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
@@ -361,7 +367,7 @@ class _OneCall(NamedTuple):
 
 
 class _SingularOf:
-    """:attr:`AnalyticIKResult.singular` of one pose's solutions (K, width) of a closed class,
+    """:attr:`AnalyticIKResult.singular` of one pose's solutions (K, n or nq) of a closed class,
     made on first use: the smallest normalised Jacobian volume of the K solutions
     (:func:`.geometric.jacobian_volumes`) in words (:func:`_singular_text`)."""
 
@@ -952,7 +958,7 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         # one pose of a closed class (no tree, no other frame), of an SRS arm at one swivel
         # angle or of a planar 2R arm (position only): one compiled call, when it has a
         # solution and nothing to polish; else the general path below says what happened
-        cf, ci, by_mask, holds_param, w, call, singular, kind, shape = one
+        cf, ci, by_mask, holds_param, call, singular, kind, shape = one
         srs = kind == "srs"
         if srs:
             angle = swivel if param is None and type(swivel) is float and -WRAP_MAX < swivel < WRAP_MAX else None
@@ -964,12 +970,11 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
             out = np.empty(shape)
             mask, tried = call(cf, ci, arr, angle, tol, tol_orthonormal, out), True
             if mask > 0:
-                branches, K = by_mask[mask]
+                branches, rows, res, sw = by_mask[mask]
                 # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
                 # path of every single pose, where keywords cost a third of the result's construction
-                if srs:
-                    return AnalyticIKResult(out[:K, :7], branches[:], None, out[:K, 11], out[:K, 9], None, robot.name)
-                return AnalyticIKResult(out[:K, :w], branches[:], None, None, out[:K, w], singular, robot.name)
+                return AnalyticIKResult(out[rows], branches[:], None, None if sw is None else out[sw], out[res],
+                                        singular, robot.name)
     arr = _c_order(arr)
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
