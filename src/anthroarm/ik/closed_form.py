@@ -70,6 +70,7 @@ from .vec3 import WRAP_MAX
 
 TWO_PI = 2.0 * np.pi
 _F64 = np.dtype(np.float64)
+_INF = math.inf
 #: default swivel grid of a redundant (srs_7r) arm (rad)
 DEFAULT_SWIVEL = np.linspace(-np.pi, np.pi, 36, endpoint=False)
 #: values of the held joint of a 7-joint arm when ``param`` is not given
@@ -944,13 +945,17 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
         _solver(robot)                            # the cache entry: a first call, or a new chain or tool
         hit = _SOLVERS[id(robot)]
-    arr = T if type(T) is np.ndarray else _c_order(T)
-    usual = (type(arr) is np.ndarray and arr.shape == (4, 4) and arr.dtype is _F64 and frame is None
-             and q_rest is None and not position_only and method == "robust" and type(tol) is float
-             and type(tol_orthonormal) is float and 0.0 < tol < math.inf and 0.0 < tol_orthonormal < math.inf)
-    if usual:
+    if type(T) is np.ndarray:
+        arr, usual = T, T.shape == (4, 4) and T.dtype is _F64
+    else:
+        arr = _c_order(T)
+        usual = type(arr) is np.ndarray and arr.shape == (4, 4) and arr.dtype is _F64
+    if usual and frame is None and q_rest is None and not position_only and method == "robust" and type(tol) is float \
+            and type(tol_orthonormal) is float and 0.0 < tol < _INF and 0.0 < tol_orthonormal < _INF:
         flags = arr.flags                         # what the compiled calls take without a copy
         usual = flags.c_contiguous and flags.aligned
+    else:
+        usual = False
     one, tried = hit[3], False
     if usual and one is _PENDING:
         one = _one_call_of(robot, hit)
