@@ -367,3 +367,31 @@ def test_solve_answers_an_srs_arm_from_the_compiled_call():
             M = data.oMf[r.tool_id]
             assert res.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - M.translation), abs=1e-14)
             assert res.rot_err == pytest.approx(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])), abs=1e-12)
+
+
+def test_planar_position_and_pose_give_the_batch_answer():
+    """A planar 2R arm's one-pose paths — a position (3,) and a 4×4 pose (position only) —
+    give exactly analytic_batch's row (solutions, labels, residuals) on reachable targets, on
+    targets off the plane of motion (beyond and within tol), out of reach, and on a joint
+    limit (q2 = ±π: the arm folded back); each solution's position checked by Pinocchio."""
+    robot = aa.load("planar2r")
+    plan = F.planar_plan(robot)
+    model, data = robot.model, robot.model.createData()
+    Q = robot.random_q(30, np.random.default_rng(12))
+    Q[0] = [0.3, np.pi] if robot.upper[1] >= np.pi else Q[0]
+    T = robot.fk(Q)
+    P = [t[:3, 3].copy() for t in T]
+    P += [P[1] + plan.h1 * 1e-3, P[2] + plan.h1 * 1e-10, P[3] * 100.0]
+    for i, p in enumerate(P):
+        pose = np.eye(4)
+        pose[:3, 3] = p
+        b = aa.ik.analytic_batch(robot, p[None])[0]
+        assert (len(b) > 0) == (i < 30 or i == 31), i        # reachable: sampled, or off the plane by 1e-10
+        for target in (p, pose):
+            a = aa.ik.analytic(robot, target)
+            assert a.branches == b.branches and a.reason == b.reason
+            np.testing.assert_array_equal(a.solutions, b.solutions)
+            np.testing.assert_array_equal(a.residuals, b.residuals)
+            for q in a.solutions:
+                pin.framesForwardKinematics(model, data, q)
+                assert np.abs(data.oMf[robot.tool_id].translation - p).max() < 1e-9

@@ -1082,31 +1082,30 @@ def _srs_single(robot, s, arr, swivel, tol, tol_orthonormal):
 
 
 def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
-    """One pose of an SRS arm (:func:`_srs_single`) or a planar 2R arm (position only) in one
-    compiled call, when it has a solution and nothing to polish — the same solutions, labels and
-    order as :func:`analytic_batch`, without its batch bookkeeping; else None (the batch path
-    answers, with the reasons and the polish)."""
+    """One pose of an SRS arm (:func:`_srs_single`) or a planar 2R arm (position only: a 4×4
+    pose or a position (3,); :func:`.families.planar_pose_solutions`) in one compiled call, when
+    it has a solution and nothing to polish — the same solutions, labels and order as
+    :func:`analytic_batch`, without its batch bookkeeping; else None (the batch path answers,
+    with the reasons and the polish)."""
     if s.kind == "srs":
         return None if position_only else _srs_single(robot, s, arr, swivel, tol, tol_orthonormal)
     if position_only is False:
         return None
-    p = arr if arr.shape == (3,) else arr[:3, 3]
-    if arr.shape == (4, 4) and (arr[3].tolist() != [0.0, 0.0, 0.0, 1.0] or not np.isfinite(arr).all()):
-        return None                     # the batch path's checks say what is wrong, or that it is fine
-    try:
-        th, cand, exact, inside, res, valid = (a[0] for a in _fam.planar_verified(s.plan, p[None], tol))
-    except ValueError:
-        return None                     # a malformed position: the batch path says what is wrong
-    flags = list(zip(cand.tolist(), exact.tolist(), inside.tolist(), res.tolist()))   # 2 branches: no numpy
-    if s.plain and any(c and e and i and tol < r <= POLISH_MAX for c, e, i, r in flags):
-        return None
-    k = [b for b, ok in enumerate(valid.tolist()) if ok]
-    if not k:
-        return None
-    rows = slice(k[0], k[-1] + 1)            # two branches: the solutions are a slice (no fancy index)
-    q = th[rows]
+    if arr.shape == (3,):                    # a position: the pose the planar kernel reads it from
+        pose = np.eye(4)
+        pose[:3, 3] = arr
+    else:
+        pose = arr
+    cf, ci = s.plan.packed
+    out = np.empty((2, 4))
+    mask = _fam.planar_pose_solutions(cf, ci, pose, 0.0, float(tol), float(tol_orthonormal), out)
+    if mask <= 0:
+        return None                          # none, a malformed target, a candidate to polish: the batch path
+    labels = s.plan.labels
+    k = [b for b in range(len(labels)) if mask >> b & 1]
+    q = out[:len(k), :2]
     return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
-                            branches=[s.plan.labels[b] for b in k], residuals=res[rows], model=robot.name)
+                            branches=[labels[b] for b in k], residuals=out[:len(k), 2], model=robot.name)
 
 
 def _held_angle(param) -> float | None:
