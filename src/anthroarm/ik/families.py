@@ -723,18 +723,14 @@ def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
 
 @kernel(counted=False)
 def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
-    """One pose T (4, 4) of a planar 2R arm, position only (its rotation is not compared; its
-    last row must be [0, 0, 0, 1] and every entry finite): the solutions into the rows of
-    ``out`` (2, 4) — θ in independent-joint order (``ci``: ``order``), the FK residual, the
-    branch — and the bit mask of their branches returned (≤ 0: none, a malformed pose or a
-    candidate to polish — the general path answers).  ``angle`` and ``tol_orthonormal`` are
-    not read (the signature of :func:`.geometric.pose_solutions`).  ``cf``, ``ci``:
-    :attr:`PlanarPlan.packed`."""
-    for i in range(4):
-        for j in range(4):
-            if not math.isfinite(T[i, j]):
-                return -1
-    if T[3, 0] != 0.0 or T[3, 1] != 0.0 or T[3, 2] != 0.0 or T[3, 3] != 1.0:
+    """One pose T (4, 4) of a planar 2R arm, position only (its rotation is not compared; every
+    entry finite and its last row [0, 0, 0, 1], :func:`.geometric._pose_status`): the solutions
+    into the rows of ``out`` (2, 4) — θ in independent-joint order (``ci``: ``order``), the FK
+    residual, the branch — and the bit mask of their branches returned (≤ 0: none, a malformed
+    pose or a candidate to polish — the general path answers).  ``angle`` and
+    ``tol_orthonormal`` are not read (the signature of :func:`.geometric.pose_solutions`).
+    ``cf``, ``ci``: :attr:`PlanarPlan.packed`."""
+    if 0 < _pose_status(T, math.inf) < 3:           # not finite, or not its last row (the rotation: unread)
         return -1
     Q, RES, q = local2(2, 2), local(2), local(2)
     V, E, IN, OK = local_flags(2), local_flags(2), local_flags(2), local_flags(2)

@@ -1195,8 +1195,9 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     solution (N, 8), candidate (N, 8), exact (N, 8), inside (N, 8), FK residual (N, 8) (max
     entry of the 3×4 pose; inf where there is no candidate or an exact one outside the limits,
     :func:`_verified`) and the chain's configuration q (N, 8, nq) of each solution (θ itself
-    where there is no continuous joint; NaN rows where there is no solution).  Raises ``ValueError`` naming the first malformed pose (not finite,
-    last row, not a rotation) — ``anthroarm.ik.closed_form`` checks before it calls."""
+    where there is no continuous joint; NaN rows where there is no solution).  Raises
+    ``ValueError`` naming the first malformed pose (not finite, last row, not a rotation) —
+    ``anthroarm.ik.closed_form`` checks before it calls."""
     T = np.ascontiguousarray(T, dtype=float)
     N, n = len(T), len(plan.fk_axes)
     pv = _ZERO1 if param is None else np.ascontiguousarray(np.broadcast_to(np.asarray(param, float), (N,)))
