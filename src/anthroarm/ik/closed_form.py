@@ -879,7 +879,7 @@ def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
         return (f"outside the workspace: no branch of the {fam} closed form reaches this pose (its "
                 f"subproblems have least-squares answers only; best FK residual {best:.3g})")
     if not (cand & exact & inside).any():
-        ch = robot.chain                 # the limits of the joints solved for (θ, not q: kinova's cos/sin pairs)
+        ch = robot.chain             # limits of the joints solved for (θ, not q: a continuous joint is cos, sin in q)
         joints = [ch.joints[j] for j in ch.independent]
         return (f"all {int((cand & exact).sum())} closed-form solutions violate the joint limits ("
                 + ", ".join(f"{j.name} continuous" if j.kind == "continuous"
