@@ -13,7 +13,11 @@ from .common import QUICK_DIR, RESULTS_DIR, markdown_table, steady_state_allocat
 
 def available() -> list[str]:
     here = Path(__file__).resolve().parent
-    return sorted(m.name[len("bench_"):] for m in pkgutil.iter_modules([str(here)]) if m.name.startswith("bench_"))
+    return sorted(
+        m.name[len("bench_") :]
+        for m in pkgutil.iter_modules([str(here)])
+        if m.name.startswith("bench_")
+    )
 
 
 def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
@@ -26,7 +30,10 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
     written = []
     for n in names:
         mod = importlib.import_module(f"benchmarks.bench_{n}")
-        print(f"== benchmark {n}: {mod.__doc__.strip().splitlines()[0] if mod.__doc__ else ''}", flush=True)
+        print(
+            f"== benchmark {n}: {mod.__doc__.strip().splitlines()[0] if mod.__doc__ else ''}",
+            flush=True,
+        )
         steady_state_allocator()
         result = mod.run(quick=quick)
         if quick:
@@ -39,11 +46,23 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks", description="Run anthroarm's benchmarks.")
-    ap.add_argument("names", nargs="*", help=f"benchmarks to run (default: all): {', '.join(available())}")
-    ap.add_argument("--quick", action="store_true", help=f"fewer samples, for smoke tests (written to {QUICK_DIR})")
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks", description="Run anthroarm's benchmarks."
+    )
+    ap.add_argument(
+        "names", nargs="*", help=f"benchmarks to run (default: all): {', '.join(available())}"
+    )
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help=f"fewer samples, for smoke tests (written to {QUICK_DIR})",
+    )
     ap.add_argument("--list", action="store_true", help="list the benchmarks and exit")
-    ap.add_argument("--out", default=None, help=f"output folder (default {RESULTS_DIR}; with --quick {QUICK_DIR}, never {RESULTS_DIR})")
+    ap.add_argument(
+        "--out",
+        default=None,
+        help=f"output folder (default {RESULTS_DIR}; with --quick {QUICK_DIR}, never {RESULTS_DIR})",
+    )
     a = ap.parse_args(argv)
     if a.list:
         print("\n".join(available()))

@@ -58,28 +58,63 @@ def run(quick: bool = False) -> dict:
             A = rng.standard_normal((N, robot.nv))
             reps = 3 if N >= 10_000 else 5
             cases = {
-                "M": (lambda dd, Q=Q: dd.mass_matrix(Q if N > 1 else Q[0]),
-                      lambda Q=Q: [pin.crba(m, d, q) for q in Q]),
-                "g": (lambda dd, Q=Q: dd.gravity(Q if N > 1 else Q[0]),
-                      lambda Q=Q: [pin.computeGeneralizedGravity(m, d, q) for q in Q]),
-                "tau": (lambda dd, Q=Q, V=V, A=A: dd.tau(Q, V, A) if N > 1 else dd.tau(Q[0], V[0], A[0]),
-                        lambda Q=Q, V=V, A=A: [pin.rnea(m, d, q, v, a) for q, v, a in zip(Q, V, A)]),
+                "M": (
+                    lambda dd, Q=Q: dd.mass_matrix(Q if N > 1 else Q[0]),
+                    lambda Q=Q: [pin.crba(m, d, q) for q in Q],
+                ),
+                "g": (
+                    lambda dd, Q=Q: dd.gravity(Q if N > 1 else Q[0]),
+                    lambda Q=Q: [pin.computeGeneralizedGravity(m, d, q) for q in Q],
+                ),
+                "tau": (
+                    lambda dd, Q=Q, V=V, A=A: (
+                        dd.tau(Q, V, A) if N > 1 else dd.tau(Q[0], V[0], A[0])
+                    ),
+                    lambda Q=Q, V=V, A=A: [pin.rnea(m, d, q, v, a) for q, v, a in zip(Q, V, A)],
+                ),
             }
             for qty, (ours, theirs) in cases.items():
                 mt = 0.2 if N == 1 else 0.0
                 t_np = time_call(lambda: ours(dyn), repeat=reps, min_time=mt) / N
-                t_cc = time_call(lambda: ours(dync), repeat=reps, min_time=mt) / N if dync else float("nan")
+                t_cc = (
+                    time_call(lambda: ours(dync), repeat=reps, min_time=mt) / N
+                    if dync
+                    else float("nan")
+                )
                 t_pin = time_call(theirs, repeat=reps, min_time=mt) / N
-                rows.append([name, qty, N, t_np * 1e6, t_cc * 1e6, t_pin * 1e6, t_pin / t_np, t_pin / t_cc])
+                rows.append(
+                    [name, qty, N, t_np * 1e6, t_cc * 1e6, t_pin * 1e6, t_pin / t_np, t_pin / t_cc]
+                )
     for name, t_der, t_gen, t_c, nodes in derive_rows:
-        rows.append([name, "derive / generate py / compile C [s]", nodes, t_der, t_gen, t_c, float("nan"), float("nan")])
+        rows.append(
+            [
+                name,
+                "derive / generate py / compile C [s]",
+                nodes,
+                t_der,
+                t_gen,
+                t_c,
+                float("nan"),
+                float("nan"),
+            ]
+        )
     return dict(
         title="Generated Lagrange dynamics vs Pinocchio (time per configuration)",
-        columns=["model", "quantity", "N (nodes for derive rows)", "numpy µs/config", "C µs/config",
-                 "pin loop µs/config", "pin/numpy", "pin/C"],
+        columns=[
+            "model",
+            "quantity",
+            "N (nodes for derive rows)",
+            "numpy µs/config",
+            "C µs/config",
+            "pin loop µs/config",
+            "pin/numpy",
+            "pin/C",
+        ],
         rows=rows,
-        notes=("Time per configuration; N = 1 is a single call (scalar Python path for numpy, ctypes for C), "
-               "N > 1 one batched call vs a Python loop of N Pinocchio calls. The last rows give, per model, "
-               "the symbolic derivation time, the Python code generation time and the C compile time (s; "
-               "the C time is the first call in a fresh cache) and the number of expression-graph nodes."),
+        notes=(
+            "Time per configuration; N = 1 is a single call (scalar Python path for numpy, ctypes for C), "
+            "N > 1 one batched call vs a Python loop of N Pinocchio calls. The last rows give, per model, "
+            "the symbolic derivation time, the Python code generation time and the C compile time (s; "
+            "the C time is the first call in a fresh cache) and the number of expression-graph nodes."
+        ),
     )

@@ -41,7 +41,7 @@ def run(quick: bool = False) -> dict:
         machine.reset()
         return machine.run(proc.process(x).code)
 
-    blocks = np.split(x, 50, axis=1)                       # 20 ms blocks, as a real-time controller gets them
+    blocks = np.split(x, 50, axis=1)  # 20 ms blocks, as a real-time controller gets them
 
     def streaming():
         proc.reset()
@@ -61,13 +61,13 @@ def run(quick: bool = False) -> dict:
         t = time_call(fn, repeat=repeat, min_time=min_time)
         t_ours[name] = t
         goal = "met" if t <= GOAL_S else "NOT met"
-        if fn is streaming:       # the goal is for one call on the whole second; say the per-block cost
+        if fn is streaming:  # the goal is for one call on the whole second; say the per-block cost
             goal = f"n/a ({t / len(blocks) * 1e6:.0f} µs per 20 ms block)"
         rows.append([name, t * 1e3, 1.0 / t, goal, ""])
 
     try:
         import neurokit2 as nk
-    except ImportError:      # the peer is optional: the table says so
+    except ImportError:  # the peer is optional: the table says so
         rows.append(["neurokit2: not installed", "", "", "", ""])
     else:
         ref = t_ours["ours: EMGProcessor (RMS envelope, thresholds, codes)"]
@@ -80,16 +80,26 @@ def run(quick: bool = False) -> dict:
         def nk_amplitude():
             return [nk.emg_amplitude(nk.emg_clean(c, sampling_rate=int(FS))) for c in x]
 
-        for name, fn in (("neurokit2: emg_process x 2 channels", nk_process),
-                         ("neurokit2: emg_clean + emg_amplitude x 2 channels", nk_amplitude)):
+        for name, fn in (
+            ("neurokit2: emg_process x 2 channels", nk_process),
+            ("neurokit2: emg_clean + emg_amplitude x 2 channels", nk_amplitude),
+        ):
             t = time_call(fn, repeat=max(3, repeat // 3), min_time=min_time / 5)
             rows.append([name, t * 1e3, 1.0 / t, "met" if t <= GOAL_S else "NOT met", t / ref])
     return dict(
         title="EMG signal chain: 1 s x 2 channels at 2 kHz",
-        columns=["pipeline", "median ms per 1 s of EMG", "x real time", "goal <= 1 ms", "peer / ours"],
+        columns=[
+            "pipeline",
+            "median ms per 1 s of EMG",
+            "x real time",
+            "goal <= 1 ms",
+            "peer / ours",
+        ],
         rows=rows,
-        notes=("One call processes the whole second (2 x 2000 samples). 'peer / ours' divides the peer's time by "
-               "ours (EMGProcessor with RMS envelope); > 1 means ours is faster. neurokit2 filters with filtfilt "
-               "(zero-phase, offline) and finds activity with its own thresholds; ours is causal (real-time "
-               "usable) and keeps its filter state between blocks."),
+        notes=(
+            "One call processes the whole second (2 x 2000 samples). 'peer / ours' divides the peer's time by "
+            "ours (EMGProcessor with RMS envelope); > 1 means ours is faster. neurokit2 filters with filtfilt "
+            "(zero-phase, offline) and finds activity with its own thresholds; ours is causal (real-time "
+            "usable) and keeps its filter state between blocks."
+        ),
     )

@@ -29,7 +29,9 @@ def _ours(robot):
     tabulated joint origins and axes of a catalog spec (for the §6-3 arm Eq. (6-31)-(6-33)),
     else the product of exponentials of robot.chain (continuous joints included)."""
     if robot.spec is not None and robot.spec.dh is not None:
-        return "H-D chain (6-12)-(6-14)", SerialChain.from_dh(robot.spec.dh, robot.spec.tool_dh).fk_jacobian
+        return "H-D chain (6-12)-(6-14)", SerialChain.from_dh(
+            robot.spec.dh, robot.spec.tool_dh
+        ).fk_jacobian
     if robot.spec is not None:
         return "chain (6-31)-(6-33)", SerialChain.from_spec(robot.spec).fk_jacobian
     return "serial chain (PoE)", robot.chain.serial().fk_jacobian
@@ -57,8 +59,10 @@ def _timed(ours, ref, Q):
     """(ours s/config, pin loop s/config) over repeated runs."""
     N = Q.shape[0]
     repeat = 5 if N >= 10_000 else 7
-    return (time_call(lambda: ours(Q), repeat=repeat, min_time=0.02) / N,
-            time_call(lambda: ref(Q), repeat=repeat, min_time=0.02) / N)
+    return (
+        time_call(lambda: ours(Q), repeat=repeat, min_time=0.02) / N,
+        time_call(lambda: ref(Q), repeat=repeat, min_time=0.02) / N,
+    )
 
 
 def run(quick: bool = False) -> dict:
@@ -80,10 +84,20 @@ def run(quick: bool = False) -> dict:
         ref = _pin_loop(robot, jacobian=False)
         err = float(np.abs(robot.fk(Q) - ref(Q)).max())
         t_o, t_p = _timed(robot.fk, ref, Q)
-        rows.append([name, "Robot.fk(Q), pose only", sizes[-1], t_o * 1e6, t_p * 1e6, t_p / t_o, err])
+        rows.append(
+            [name, "Robot.fk(Q), pose only", sizes[-1], t_o * 1e6, t_p * 1e6, t_p / t_o, err]
+        )
     return {
         "title": "Batched closed-form FK + Jacobian vs a Python loop over Pinocchio",
-        "columns": ["model", "ours", "N", "ours µs/config", "pin loop µs/config", "speed-up (pin/ours)", "max abs diff"],
+        "columns": [
+            "model",
+            "ours",
+            "N",
+            "ours µs/config",
+            "pin loop µs/config",
+            "speed-up (pin/ours)",
+            "max abs diff",
+        ],
         "rows": rows,
         "notes": (
             "Per configuration: tool pose (4x4) + 6xn LOCAL_WORLD_ALIGNED Jacobian. 'pin loop' = Python loop of "

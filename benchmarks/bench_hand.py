@@ -47,8 +47,12 @@ from anthroarm.ik.qp.tasks.surface_contact import SurfaceContactTask
 BACKENDS = ["osqp", "daqp", "quadprog", "proxqp"]
 DT = 0.01
 FRAMES = ["index_tip", "little_tip", "middle_tip", "ring_tip", "thumb_tip", "palm"]
-COUPLED = [("index_dip", "index_pip"), ("little_dip", "little_pip"), ("middle_dip", "middle_pip"),
-           ("ring_dip", "ring_pip")]
+COUPLED = [
+    ("index_dip", "index_pip"),
+    ("little_dip", "little_pip"),
+    ("middle_dip", "middle_pip"),
+    ("ring_dip", "ring_pip"),
+]
 
 
 # --------------------------------------------------------------------------- part 1: QP step
@@ -59,7 +63,11 @@ def _trajectory(robot, n):
     d = robot.model.createData()
     targets = []
     for k in range(n):
-        q = np.clip(q0 + 0.15 * np.sin(2 * np.pi * k / 200.0 + phase) * np.sin(np.pi * k / n), robot.lower, robot.upper)
+        q = np.clip(
+            q0 + 0.15 * np.sin(2 * np.pi * k / 200.0 + phase) * np.sin(np.pi * k / n),
+            robot.lower,
+            robot.upper,
+        )
         pin.framesForwardKinematics(robot.model, d, q)
         targets.append([d.oMf[robot.model.getFrameId(f)].homogeneous for f in FRAMES])
     return q0, targets
@@ -67,8 +75,12 @@ def _trajectory(robot, n):
 
 def _run_ours(robot, q0, targets, backend):
     conf = qp.IKConfiguration(robot, q0)
-    frames = qp.MultiFrameTask(robot, FRAMES, position_cost=1.0, orientation_cost=0.1, lm_damping=1e-3)
-    couplings = qp.JointCouplingsTask(robot, [qp.JointCouplingTask.mimic(robot, a, b, 2.0 / 3.0) for a, b in COUPLED])
+    frames = qp.MultiFrameTask(
+        robot, FRAMES, position_cost=1.0, orientation_cost=0.1, lm_damping=1e-3
+    )
+    couplings = qp.JointCouplingsTask(
+        robot, [qp.JointCouplingTask.mimic(robot, a, b, 2.0 / 3.0) for a, b in COUPLED]
+    )
     tasks = [frames, couplings, qp.PostureTask(robot, cost=1e-3, target=q0)]
     t, Q = [], []
     for Ts in targets:
@@ -116,8 +128,13 @@ def _mink_model(robot):
 
     import mujoco
 
-    txt = aa.models.to_urdf(robot.spec)          # the catalog model's URDF text
-    txt = re.sub(r"(<robot[^>]*>)", r'\1<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>', txt, count=1)
+    txt = aa.models.to_urdf(robot.spec)  # the catalog model's URDF text
+    txt = re.sub(
+        r"(<robot[^>]*>)",
+        r'\1<mujoco><compiler fusestatic="false" discardvisual="true"/></mujoco>',
+        txt,
+        count=1,
+    )
     model = mujoco.MjModel.from_xml_string(txt)
     names = [model.joint(i).name for i in range(model.njnt)]
     perm = np.array([model.jnt_qposadr[names.index(j.name)] for j in robot.chain.joints])
@@ -128,14 +145,19 @@ def _mink_model(robot):
     for f in FRAMES:
         b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f)
         T = robot.fk(q, frame=f)
-        assert np.abs(d.xpos[b] - T[:3, 3]).max() < 1e-9 and np.abs(d.xmat[b].reshape(3, 3) - T[:3, :3]).max() < 1e-9
+        assert (
+            np.abs(d.xpos[b] - T[:3, 3]).max() < 1e-9
+            and np.abs(d.xmat[b].reshape(3, 3) - T[:3, :3]).max() < 1e-9
+        )
     return model, perm
 
 
 def _run_mink(mink, robot, q0, targets, backend):
     model, perm = _mink_model(robot)
 
-    class Linear(mink.Task):     # the couplings: A q = 0 in MuJoCo's order (pink's LinearHolonomicTask)
+    class Linear(
+        mink.Task
+    ):  # the couplings: A q = 0 in MuJoCo's order (pink's LinearHolonomicTask)
         def __init__(self, A):
             super().__init__(cost=np.ones(len(A)))
             self.A = A
@@ -147,11 +169,16 @@ def _run_mink(mink, robot, q0, targets, backend):
             return self.A
 
     A = np.zeros((len(COUPLED), model.nv))
-    A[:, perm] = np.vstack([qp.JointCouplingTask.mimic(robot, a, b, 2.0 / 3.0)._row for a, b in COUPLED])
+    A[:, perm] = np.vstack(
+        [qp.JointCouplingTask.mimic(robot, a, b, 2.0 / 3.0)._row for a, b in COUPLED]
+    )
     qm = np.zeros(model.nq)
     qm[perm] = q0
     conf = mink.Configuration(model, qm)
-    tasks = [mink.FrameTask(f, "body", position_cost=1.0, orientation_cost=0.1, lm_damping=1e-3) for f in FRAMES]
+    tasks = [
+        mink.FrameTask(f, "body", position_cost=1.0, orientation_cost=0.1, lm_damping=1e-3)
+        for f in FRAMES
+    ]
     post = mink.PostureTask(model, cost=1e-3)
     post.set_target(qm)
     tasks += [Linear(A), post]
@@ -186,11 +213,23 @@ def _mink_rows(n_steps, backends):
         tm2, _ = _run_mink(mink, robot, q0, targets, backend)
         t_o = np.concatenate([to[5:], to2[5:]]) * 1e6
         t_m = np.concatenate([tm[5:], tm2[5:]]) * 1e6
-        rows.append(["qp step vs mink (6 frame tasks + 4 couplings + posture)", "human_upper_limb (27 DOF)", backend,
-                     np.median(t_o), np.percentile(t_o, 90), np.median(t_m), np.percentile(t_m, 90),
-                     np.median(t_m) / np.median(t_o), "", "", len(to),
-                     f"peer = mink {version('mink')} on MuJoCo {version('mujoco')} (URDF -> MjModel, "
-                     f"FK checked against Pinocchio); max |q diff| {float(np.abs(Qo - Qm).max()):.1e} rad"])
+        rows.append(
+            [
+                "qp step vs mink (6 frame tasks + 4 couplings + posture)",
+                "human_upper_limb (27 DOF)",
+                backend,
+                np.median(t_o),
+                np.percentile(t_o, 90),
+                np.median(t_m),
+                np.percentile(t_m, 90),
+                np.median(t_m) / np.median(t_o),
+                "",
+                "",
+                len(to),
+                f"peer = mink {version('mink')} on MuJoCo {version('mujoco')} (URDF -> MjModel, "
+                f"FK checked against Pinocchio); max |q diff| {float(np.abs(Qo - Qm).max()):.1e} rad",
+            ]
+        )
     return rows
 
 
@@ -201,8 +240,22 @@ def _step_rows(pink, n_steps, backends):
     for backend in backends:
         to, Qo = _run_ours(robot, q0, targets, backend)
         if pink is None:
-            rows.append(["qp step (6 frame tasks + 4 couplings + posture)", "human_upper_limb (27 DOF)", backend,
-                         np.median(to[5:]) * 1e6, np.percentile(to[5:], 90) * 1e6, "", "", "", "", "", len(to), ""])
+            rows.append(
+                [
+                    "qp step (6 frame tasks + 4 couplings + posture)",
+                    "human_upper_limb (27 DOF)",
+                    backend,
+                    np.median(to[5:]) * 1e6,
+                    np.percentile(to[5:], 90) * 1e6,
+                    "",
+                    "",
+                    "",
+                    "",
+                    "",
+                    len(to),
+                    "",
+                ]
+            )
             continue
         tp, Qp, errs = _run_pink(pink, robot, q0, targets, backend)
         to2, _ = _run_ours(robot, q0, targets, backend)
@@ -210,10 +263,22 @@ def _step_rows(pink, n_steps, backends):
         t_o = np.concatenate([to[5:], to2[5:]]) * 1e6
         t_p = np.concatenate([tp[5:], tp2[5:]]) * 1e6
         dev = float(np.abs(Qo - Qp).max())
-        rows.append(["qp step (6 frame tasks + 4 couplings + posture)", "human_upper_limb (27 DOF)", backend,
-                     np.median(t_o), np.percentile(t_o, 90), np.median(t_p), np.percentile(t_p, 90),
-                     np.median(t_p) / np.median(t_o), "", "", len(to),
-                     f"max |q diff| {dev:.1e} rad; pink exceptions {errs}"])
+        rows.append(
+            [
+                "qp step (6 frame tasks + 4 couplings + posture)",
+                "human_upper_limb (27 DOF)",
+                backend,
+                np.median(t_o),
+                np.percentile(t_o, 90),
+                np.median(t_p),
+                np.percentile(t_p, 90),
+                np.median(t_p) / np.median(t_o),
+                "",
+                "",
+                len(to),
+                f"max |q diff| {dev:.1e} rad; pink exceptions {errs}",
+            ]
+        )
     return rows
 
 
@@ -229,11 +294,11 @@ class _PinkStep:
         self.robot = robot
         self.FrameTask = FrameTask
         self.model = robot.model
-        self.lim_model = robot.model.copy()          # carries the limits of the current solve
+        self.lim_model = robot.model.copy()  # carries the limits of the current solve
         self.pconf = pink.Configuration(robot.model, robot.model.createData(), robot.neutral())
         self.cache = {}
 
-        class Normal(Task):      # ContactNormalTask's residual and Jacobian, pink's Task API
+        class Normal(Task):  # ContactNormalTask's residual and Jacobian, pink's Task API
             def __init__(self, frame, axis, target, cost, lm_damping):
                 super().__init__(cost=cost, lm_damping=lm_damping)
                 self.frame, self.axis, self.target = frame, axis, target
@@ -242,14 +307,17 @@ class _PinkStep:
                 return f"ContactNormal({self.frame})"
 
             def compute_error(self, configuration):
-                return configuration.get_transform_frame_to_world(self.frame).rotation @ self.axis - self.target
+                return (
+                    configuration.get_transform_frame_to_world(self.frame).rotation @ self.axis
+                    - self.target
+                )
 
             def compute_jacobian(self, configuration):
                 R = configuration.get_transform_frame_to_world(self.frame).rotation
-                J = configuration.get_frame_jacobian(self.frame)          # LOCAL
+                J = configuration.get_frame_jacobian(self.frame)  # LOCAL
                 return -cross_matrix(R @ self.axis) @ (R @ J[3:])
 
-        class Surface(Task):     # SurfaceContactTask likewise
+        class Surface(Task):  # SurfaceContactTask likewise
             def __init__(self, frame, axis, surface, cost, lm_damping):
                 super().__init__(cost=cost, lm_damping=lm_damping)
                 self.frame, self.axis, self.surface = frame, axis, surface
@@ -260,15 +328,21 @@ class _PinkStep:
             def compute_error(self, configuration):
                 T = configuration.get_transform_frame_to_world(self.frame)
                 p = T.translation
-                return np.concatenate([[self.surface.distance(p)], T.rotation @ self.axis + self.surface.normal(p)])
+                return np.concatenate(
+                    [[self.surface.distance(p)], T.rotation @ self.axis + self.surface.normal(p)]
+                )
 
             def compute_jacobian(self, configuration):
                 T = configuration.get_transform_frame_to_world(self.frame)
                 R, p = T.rotation, T.translation
                 J = configuration.get_frame_jacobian(self.frame)
                 Jv, Jw = R @ J[:3], R @ J[3:]
-                return np.vstack([self.surface.normal(p) @ Jv,
-                                  -cross_matrix(R @ self.axis) @ Jw + self.surface.normal_jacobian(p) @ Jv])
+                return np.vstack(
+                    [
+                        self.surface.normal(p) @ Jv,
+                        -cross_matrix(R @ self.axis) @ Jw + self.surface.normal_jacobian(p) @ Jv,
+                    ]
+                )
 
         self.Normal, self.Surface = Normal, Surface
 
@@ -282,7 +356,9 @@ class _PinkStep:
         elif isinstance(t, SurfaceContactTask):
             p = self.Surface(name, t.axis, t.surface, t.cost, t.lm_damping)
         elif isinstance(t, qp.PositionTask):
-            p = self.FrameTask(name, position_cost=float(t.cost[0]), orientation_cost=0.0, lm_damping=t.lm_damping)
+            p = self.FrameTask(
+                name, position_cost=float(t.cost[0]), orientation_cost=0.0, lm_damping=t.lm_damping
+            )
             p.set_target(pin.SE3(np.eye(3), np.asarray(t.target, dtype=float)))
         else:
             raise TypeError(f"no pink equivalent of {t!r}")
@@ -293,14 +369,24 @@ class _PinkStep:
         from pink.limits import ConfigurationLimit, VelocityLimit
 
         cl, vl = limits
-        held = cl.lower == cl.upper          # pink ignores a joint whose range is empty: give it 2e-9
+        held = cl.lower == cl.upper  # pink ignores a joint whose range is empty: give it 2e-9
         self.lim_model.lowerPositionLimit = np.where(held, cl.lower - 1e-9, cl.lower)
         self.lim_model.upperPositionLimit = np.where(held, cl.upper + 1e-9, cl.upper)
-        plim = [ConfigurationLimit(self.lim_model, config_limit_gain=cl.gain), VelocityLimit(self.model, vl.v_max)]
+        plim = [
+            ConfigurationLimit(self.lim_model, config_limit_gain=cl.gain),
+            VelocityLimit(self.model, vl.v_max),
+        ]
         self.pconf.update(conf.q)
         try:
-            v = self.pink.solve_ik(self.pconf, [self._task(t) for t in tasks], 1.0, solver=solver, damping=1e-9,
-                                   limits=plim, safety_break=False)
+            v = self.pink.solve_ik(
+                self.pconf,
+                [self._task(t) for t in tasks],
+                1.0,
+                solver=solver,
+                damping=1e-9,
+                limits=plim,
+                safety_break=False,
+            )
             return qp.StepResult(v, "optimal", solver, None, None)
         except Exception as e:  # NoSolutionFound
             return qp.StepResult(np.zeros(conf.nv), "failed", solver, None, None, {"error": str(e)})
@@ -324,7 +410,10 @@ def _check(robot, hand, pb, q, sliding):
 
 def _grasp_rows(pink, n, quick):
     rows = []
-    cases = [("human_upper_limb", dict(), False, 10), ("allegro_right_hand", dict(tool="link_3.0_tip"), True, 1)]
+    cases = [
+        ("human_upper_limb", dict(), False, 10),
+        ("allegro_right_hand", dict(tool="link_3.0_tip"), True, 1),
+    ]
     for name, kw, sliding, per_hand in cases:
         robot = aa.load(name, **kw)
         hand = H.Hand(robot)
@@ -336,27 +425,62 @@ def _grasp_rows(pink, n, quick):
         pstep = _PinkStep(pink, robot) if pink is not None else None
         res = {"ours": ([], [], []), "pink": ([], [], [])}
         for pb in problems:
-            for who in (("ours", "pink") if pstep is not None else ("ours",)):
+            for who in ("ours", "pink") if pstep is not None else ("ours",):
                 t1 = time.process_time()
-                r = H.solve_grasp(robot, pb.obj, None if sliding else pb.contacts, hand=hand, q0=q0,
-                                  step_fn=None if who == "ours" else pstep)
+                r = H.solve_grasp(
+                    robot,
+                    pb.obj,
+                    None if sliding else pb.contacts,
+                    hand=hand,
+                    q0=q0,
+                    step_fn=None if who == "ours" else pstep,
+                )
                 res[who][0].append(time.process_time() - t1)
                 res[who][1].append(_check(robot, hand, pb, r.q, sliding) and r.success)
                 res[who][2].append(r.iterations)
         to, so, io = (np.array(a) for a in res["ours"])
         label = f"grasp solve ({'sliding' if sliding else 'given'} contacts, cylinder, {len(hand.fingers)} fingertips)"
         desc = f"{name} ({robot.nv} DOF{', arm + hand' if hand.arm_joints else ', palm fixed'})"
-        note = (f"{len(problems)} reachable problems (generated in {t_gen:.0f} s"
-                f"{f', {per_hand} arm poses per hand grasp' if per_hand > 1 else ''}); "
-                f"median iterations ours {np.median(io):.0f}")
+        note = (
+            f"{len(problems)} reachable problems (generated in {t_gen:.0f} s"
+            f"{f', {per_hand} arm poses per hand grasp' if per_hand > 1 else ''}); "
+            f"median iterations ours {np.median(io):.0f}"
+        )
         if pstep is None:
-            rows.append([label, desc, "daqp", np.median(to) * 1e3, np.percentile(to, 90) * 1e3, "", "", "",
-                         100 * so.mean(), "", len(problems), note])
+            rows.append(
+                [
+                    label,
+                    desc,
+                    "daqp",
+                    np.median(to) * 1e3,
+                    np.percentile(to, 90) * 1e3,
+                    "",
+                    "",
+                    "",
+                    100 * so.mean(),
+                    "",
+                    len(problems),
+                    note,
+                ]
+            )
         else:
             tp, sp, ip = (np.array(a) for a in res["pink"])
-            rows.append([label, desc, "daqp", np.median(to) * 1e3, np.percentile(to, 90) * 1e3, np.median(tp) * 1e3,
-                         np.percentile(tp, 90) * 1e3, np.median(tp) / np.median(to), 100 * so.mean(), 100 * sp.mean(),
-                         len(problems), note + f", pink {np.median(ip):.0f}"])
+            rows.append(
+                [
+                    label,
+                    desc,
+                    "daqp",
+                    np.median(to) * 1e3,
+                    np.percentile(to, 90) * 1e3,
+                    np.median(tp) * 1e3,
+                    np.percentile(tp, 90) * 1e3,
+                    np.median(tp) / np.median(to),
+                    100 * so.mean(),
+                    100 * sp.mean(),
+                    len(problems),
+                    note + f", pink {np.median(ip):.0f}",
+                ]
+            )
     return rows
 
 
@@ -373,14 +497,31 @@ def run(quick: bool = False) -> dict:
     rows += _mink_rows(40 if quick else 400, ["daqp"] if quick else ["daqp", "quadprog", "osqp"])
     rows += _grasp_rows(pink, 20 if quick else 500, quick)
     logging.disable(logging.NOTSET)
-    notes = ("QP step rows: times in us (CPU time of this process, time.process_time; 2 shared cores); ratio = peer "
-             "median / ours with the same backend; runs A B A B; the peer is pink, or mink in the 'vs mink' rows (the "
-             "same step on MuJoCo, model from the same URDF). Grasp rows: times in ms per solve (CPU time, all "
-             "attempts and the palm approach included), success % checked on the returned q by Pinocchio FK "
-             "(1 mm, 5 deg, limits); ours and pink run the same solve loop (hand.solve_grasp) and differ only in "
-             "the QP step (step_fn=)." + ("" if pink is not None else " pink is not installed: ours only."))
+    notes = (
+        "QP step rows: times in us (CPU time of this process, time.process_time; 2 shared cores); ratio = peer "
+        "median / ours with the same backend; runs A B A B; the peer is pink, or mink in the 'vs mink' rows (the "
+        "same step on MuJoCo, model from the same URDF). Grasp rows: times in ms per solve (CPU time, all "
+        "attempts and the palm approach included), success % checked on the returned q by Pinocchio FK "
+        "(1 mm, 5 deg, limits); ours and pink run the same solve loop (hand.solve_grasp) and differ only in "
+        "the QP step (step_fn=)."
+        + ("" if pink is not None else " pink is not installed: ours only.")
+    )
     return dict(
         title="Multi-finger IK: QP step on the 27-DOF limb and grasp solves, anthroarm vs pink and mink",
-        columns=["measure", "robot", "backend", "ours median", "ours p90", "peer median", "peer p90",
-                 "ratio peer/ours", "ours success %", "pink success %", "n", "note"],
-        rows=rows, notes=notes)
+        columns=[
+            "measure",
+            "robot",
+            "backend",
+            "ours median",
+            "ours p90",
+            "peer median",
+            "peer p90",
+            "ratio peer/ours",
+            "ours success %",
+            "pink success %",
+            "n",
+            "note",
+        ],
+        rows=rows,
+        notes=notes,
+    )

@@ -23,18 +23,32 @@ import anthroarm as aa
 
 from . import ik_peers
 
-ROBOTS = ["panda", "ur5", "ur10", "xarm7", "z1", "so101", "kinova", "talos_arm", "human_arm7", "prosthetic_arm", "sixr_arm"]
+ROBOTS = [
+    "panda",
+    "ur5",
+    "ur10",
+    "xarm7",
+    "z1",
+    "so101",
+    "kinova",
+    "talos_arm",
+    "human_arm7",
+    "prosthetic_arm",
+    "sixr_arm",
+]
 #: anthroarm.load keywords: the arm without its gripper joint (z1: the flange link06, since pink
 #: cannot name "gripperStator", which is both a joint and a link)
-LOAD = {"z1": dict(tool="link06", locked=["jointGripper"]),
-        "so101": dict(tool="gripper_frame_link", locked=["gripper"])}
-POSTURE_ROBOTS = ["human_arm7"]   # aa.ik.solve's default adds the comfortable-posture objective
+LOAD = {
+    "z1": dict(tool="link06", locked=["jointGripper"]),
+    "so101": dict(tool="gripper_frame_link", locked=["gripper"]),
+}
+POSTURE_ROBOTS = ["human_arm7"]  # aa.ik.solve's default adds the comfortable-posture objective
 SOLVERS = ["anthroarm", "rtb-ik_LM", "trac-ik", "pink", "pin-clik", "ikpy"]
 N_FULL = 1000
 N_IKPY = 100
 CHUNK = 50
-TOL = 1e-6                        # strict judge, m and rad
-TOL_PEERS = (1e-5, 1e-4)          # peers.md §0b judge: m, rad
+TOL = 1e-6  # strict judge, m and rad
+TOL_PEERS = (1e-5, 1e-4)  # peers.md §0b judge: m, rad
 
 
 def _score(robot, q, T):
@@ -46,8 +60,14 @@ def _score(robot, q, T):
     inside = bool(robot.within_limits(q))
     viol = float(np.max(np.maximum(robot.lower - q, 0) + np.maximum(q - robot.upper, 0)))
     conv = pe <= TOL and re <= TOL
-    return (conv and inside, pe <= TOL_PEERS[0] and re <= TOL_PEERS[1] and inside,
-            pe <= 1e-3 and re <= 1e-3 and inside, inside, viol, conv)
+    return (
+        conv and inside,
+        pe <= TOL_PEERS[0] and re <= TOL_PEERS[1] and inside,
+        pe <= 1e-3 and re <= 1e-3 and inside,
+        inside,
+        viol,
+        conv,
+    )
 
 
 def _warm(adapter, Ts):
@@ -92,7 +112,9 @@ def run(quick: bool = False) -> dict:
             adapter, why = ik_peers.make(sname, robot)
             exc = _warm(adapter, Ts) if adapter is not None else None
             if exc is not None:
-                if sname == "anthroarm" and not quick:   # a full run measures anthroarm on every robot
+                if (
+                    sname == "anthroarm" and not quick
+                ):  # a full run measures anthroarm on every robot
                     raise exc
                 adapter, why = None, f"{sname} fails on {name} ({type(exc).__name__}: {exc})"
             if adapter is None:
@@ -128,9 +150,19 @@ def run(quick: bool = False) -> dict:
             med = float(np.median(times)) * 1e3
             if sname == "anthroarm":
                 ours_median = med
-            rows.append([name, sname, n, *_rates(res[sname]["score"]), med,
-                         float(np.median(res[sname]["wall"])) * 1e3, float(np.percentile(times, 95)) * 1e3,
-                         float(times.mean()) * 1e3, med / ours_median if ours_median else ""])
+            rows.append(
+                [
+                    name,
+                    sname,
+                    n,
+                    *_rates(res[sname]["score"]),
+                    med,
+                    float(np.median(res[sname]["wall"])) * 1e3,
+                    float(np.percentile(times, 95)) * 1e3,
+                    float(times.mean()) * 1e3,
+                    med / ours_median if ours_median else "",
+                ]
+            )
             curves[(name, sname)] = (times, np.array(res[sname]["score"], dtype=float)[:, 1] > 0)
         # the batch form: all targets in one call (lockstep Gauss–Newton, vectorised linear algebra)
         try:
@@ -143,8 +175,19 @@ def run(quick: bool = False) -> dict:
                 raise
             skipped.append(f"anthroarm (batch call) fails on {name} ({type(exc).__name__}: {exc})")
             continue
-        rows.append([name, "anthroarm (batch call)", len(Ts), *_rates([_score(robot, q, T) for q, T in zip(out.q, Ts)]),
-                     "", "", "", tb * 1e3, ""])
+        rows.append(
+            [
+                name,
+                "anthroarm (batch call)",
+                len(Ts),
+                *_rates([_score(robot, q, T) for q, T in zip(out.q, Ts)]),
+                "",
+                "",
+                "",
+                tb * 1e3,
+                "",
+            ]
+        )
     notes = (
         "Robots: all through anthroarm.load (z1 with jointGripper locked and tool link06, so101 with "
         "its gripper locked and tool gripper_frame_link: the arm without its jaw; kinova: three continuous "
@@ -174,23 +217,44 @@ def run(quick: bool = False) -> dict:
         f"{n_ikpy} targets only. 'anthroarm (batch call)': one aa.ik.solve call on all targets (N, 4, 4), which "
         "iterates them in lockstep with vectorised linear algebra (one target after the other where the closed "
         "form comes first); its 'mean ms' is the call's CPU time / N. Plot: ik_success_vs_time.png (success at "
-        "1e-5 m / 1e-4 rad)."
-        + (" Skipped: " + "; ".join(skipped) if skipped else "")
+        "1e-5 m / 1e-4 rad)." + (" Skipped: " + "; ".join(skipped) if skipped else "")
     )
     return dict(
         title="One-shot IK: success and time per target (same poses; judged at 1e-6 m / 1e-6 rad and 1e-5 m / 1e-4 rad)",
-        columns=["robot", "solver", "targets", "success %", "success 1e-5 %", "success 1 mm %", "limit violations",
-                 "max violation (rad)", "converged (any q) %", "median ms", "median wall ms", "p95 ms", "mean ms",
-                 "ratio median vs anthroarm"],
-        rows=rows, notes=notes, figures={"ik_success_vs_time.png": _plot(curves)})
+        columns=[
+            "robot",
+            "solver",
+            "targets",
+            "success %",
+            "success 1e-5 %",
+            "success 1 mm %",
+            "limit violations",
+            "max violation (rad)",
+            "converged (any q) %",
+            "median ms",
+            "median wall ms",
+            "p95 ms",
+            "mean ms",
+            "ratio median vs anthroarm",
+        ],
+        rows=rows,
+        notes=notes,
+        figures={"ik_success_vs_time.png": _plot(curves)},
+    )
 
 
 def _rates(scores):
     """success %, success 1e-5 %, success 1 mm %, limit violations, max violation, converged %."""
     sc = np.array(scores, dtype=float).reshape(-1, 6)
     ok, ok5, loose, inside, viol, conv = (sc[:, k] for k in range(6))
-    return [100.0 * (ok > 0).mean(), 100.0 * (ok5 > 0).mean(), 100.0 * (loose > 0).mean(), int((inside == 0).sum()),
-            float(viol.max()), 100.0 * (conv > 0).mean()]
+    return [
+        100.0 * (ok > 0).mean(),
+        100.0 * (ok5 > 0).mean(),
+        100.0 * (loose > 0).mean(),
+        int((inside == 0).sum()),
+        float(viol.max()),
+        100.0 * (conv > 0).mean(),
+    ]
 
 
 def _plot(curves):
@@ -208,18 +272,25 @@ def _plot(curves):
         return None
     ncol = min(5, len(robots))
     nrow = math.ceil(len(robots) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.8 * nrow), sharey=True, squeeze=False)
-    for ax in axes.flat[len(robots):]:
+    fig, axes = plt.subplots(
+        nrow, ncol, figsize=(4.2 * ncol, 3.8 * nrow), sharey=True, squeeze=False
+    )
+    for ax in axes.flat[len(robots) :]:
         ax.set_visible(False)
-    solvers = list(dict.fromkeys(s for _, s in curves))       # one colour per solver on every panel
+    solvers = list(dict.fromkeys(s for _, s in curves))  # one colour per solver on every panel
     for ax, rname in zip(axes.flat, robots):
         for (r, s), (times, ok) in curves.items():
             if r != rname:
                 continue
             t = np.sort(times[ok]) * 1e3
             y = np.arange(1, len(t) + 1) / len(times) * 100.0
-            ax.step(np.concatenate([[1e-3], t]), np.concatenate([[0.0], y]), where="post", label=s,
-                    color=f"C{solvers.index(s) % 10}")
+            ax.step(
+                np.concatenate([[1e-3], t]),
+                np.concatenate([[0.0], y]),
+                where="post",
+                label=s,
+                color=f"C{solvers.index(s) % 10}",
+            )
         ax.set_xscale("log")
         ax.set_xlim(1e-2, 1e3)
         ax.set_title(rname)

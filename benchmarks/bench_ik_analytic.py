@@ -41,17 +41,39 @@ from .common import time_call
 from .ik_peers import PinCLIK, pose_errors
 
 PI = np.pi
-ARMS = ["sixr_arm", "prosthetic_arm", "care_robot", "ur3", "ur5", "ur10", "kinova", "talos_arm", "panda",
-        "human_arm7", "planar2r"]
+ARMS = [
+    "sixr_arm",
+    "prosthetic_arm",
+    "care_robot",
+    "ur3",
+    "ur5",
+    "ur10",
+    "kinova",
+    "talos_arm",
+    "panda",
+    "human_arm7",
+    "planar2r",
+]
 CLIK_ARMS = ("sixr_arm", "prosthetic_arm", "human_arm7")
 #: one-call timings of a batch (ours and ik-geo's Python loop) per row: their median (a 10 000-pose
 #: call is ~9 ms, so a moment of load on the shared machine takes one or two of them)
 BATCH_REPEAT = 15
 SEARCH_CLASSES = ("two_parallel", "two_intersecting")
-OK_TOL = 1e-10         # Pinocchio FK error of a solution counted as a success
-SAME_TOL = 1e-8        # rad: our exact branches vs ik-geo's, mod 2π
-COLUMNS = ["arm", "method", "poses", "success %", "solutions/pose", "time µs/pose", "vs ik-geo", "max FK err",
-           "limit violations %", "same solutions as ik-geo", "notes"]
+OK_TOL = 1e-10  # Pinocchio FK error of a solution counted as a success
+SAME_TOL = 1e-8  # rad: our exact branches vs ik-geo's, mod 2π
+COLUMNS = [
+    "arm",
+    "method",
+    "poses",
+    "success %",
+    "solutions/pose",
+    "time µs/pose",
+    "vs ik-geo",
+    "max FK err",
+    "limit violations %",
+    "same solutions as ik-geo",
+    "notes",
+]
 
 
 # ---------------------------------------------------------------------------- arms and poses
@@ -65,11 +87,11 @@ def dh_urdf(folder, name, alpha, a, d):
 def search_arm(folder, cls, seed=1):
     """A random user 6R arm of a search class (``random_arm`` of the geometric IK tests)."""
     r = np.random.default_rng(seed)
-    L = lambda: r.uniform(0.05, 0.5)                                   # noqa: E731
-    A = lambda: r.choice([-1, 1]) * r.uniform(0.3, 1.3)                 # a generic twist
-    if cls == "two_parallel":                      # 2 ∥ 3 (α2 = 0) alone: a 1-D search over q1
+    L = lambda: r.uniform(0.05, 0.5)  # noqa: E731
+    A = lambda: r.choice([-1, 1]) * r.uniform(0.3, 1.3)  # a generic twist
+    if cls == "two_parallel":  # 2 ∥ 3 (α2 = 0) alone: a 1-D search over q1
         alpha, a, d = [A(), 0, A(), A(), A(), A()], [L() for _ in range(6)], [L() for _ in range(6)]
-    elif cls == "two_intersecting":                # 5 × 6 (a5 = 0) alone: a 1-D search over q4
+    elif cls == "two_intersecting":  # 5 × 6 (a5 = 0) alone: a 1-D search over q4
         alpha, a, d = [A() for _ in range(6)], [L(), L(), L(), L(), 0, L()], [L() for _ in range(6)]
     else:
         raise ValueError(cls)
@@ -87,8 +109,13 @@ class Case:
         self.T = robot.fk(self.Q)
         form = closed_form_info(robot)
         self.position_only = form.position_only
-        self.kw = ({"swivel": swivel_angle(robot, self.Q)} if form.swivel else
-                   {"param": self.Q[:, 6]} if form.param else {})
+        self.kw = (
+            {"swivel": swivel_angle(robot, self.Q)}
+            if form.swivel
+            else {"param": self.Q[:, 6]}
+            if form.param
+            else {}
+        )
         self.family = form.family
         self.gp = G.plan_for(robot) if not (form.swivel or form.position_only) else None
 
@@ -105,7 +132,9 @@ def _pin_fk_err(robot, sols, T, position_only):
     for k, (q, Tk) in enumerate(zip(sols, T)):
         pin.framesForwardKinematics(model, data, q)
         M = data.oMf[fid].homogeneous
-        out[k] = np.abs(M[:3, 3] - Tk[:3, 3]).max() if position_only else np.abs(M[:3] - Tk[:3]).max()
+        out[k] = (
+            np.abs(M[:3, 3] - Tk[:3, 3]).max() if position_only else np.abs(M[:3] - Tk[:3]).max()
+        )
     return out
 
 
@@ -115,8 +144,13 @@ def _check(case, sols, pose, n, limits=True):
     err = _pin_fk_err(case.robot, sols, case.T[pose], case.position_only)
     ok = np.zeros(n, bool)
     np.logical_or.at(ok, pose, err <= OK_TOL)
-    viol = ("" if not limits else
-            100.0 * float((~case.robot.within_limits(sols)).mean()) if len(sols) else 0.0)
+    viol = (
+        ""
+        if not limits
+        else 100.0 * float((~case.robot.within_limits(sols)).mean())
+        if len(sols)
+        else 0.0
+    )
     return 100.0 * ok.mean(), len(sols) / n, float(err.max()) if len(err) else "", viol
 
 
@@ -135,9 +169,9 @@ def _single_times(case, n, geo):
     likewise).  Returns (our per-call times, our results, ik-geo's per-call times or None) (s)."""
     robot, analytic = case.robot, aa.ik.analytic
     T = [x.copy() for x in case.T[:n]]
-    key = next(iter(case.kw), None)                          # "param", "swivel" or None
+    key = next(iter(case.kw), None)  # "param", "swivel" or None
     val = [float(v) for v in case.kw[key][:n]] if key else [None] * n
-    for i in range(min(n, 20)):                                                 # warm-up
+    for i in range(min(n, 20)):  # warm-up
         analytic(robot, T[i], **({key: val[i]} if key else {}))
         if geo is not None:
             geo[0].get_ik(*geo[1][i])
@@ -174,21 +208,35 @@ def _single_row(case, n, times, results, t_geo, note):
     pose = np.repeat(np.arange(n), [len(r) for r in results])
     sols = np.concatenate([r.solutions for r in results]) if len(pose) else np.zeros((0, robot.nq))
     t = float(np.median(times))
-    return _row(case, "anthroarm analytic single", n, _check(case, sols, pose, n), t, t / t_geo if t_geo else "",
-                note=f"{note}; median of per-call times")
+    return _row(
+        case,
+        "anthroarm analytic single",
+        n,
+        _check(case, sols, pose, n),
+        t,
+        t / t_geo if t_geo else "",
+        note=f"{note}; median of per-call times",
+    )
 
 
 def _batch_row(case, n, t_geo):
     """``aa.ik.analytic_batch`` on n poses: one call (median of :data:`BATCH_REPEAT`), per pose; ``t_geo`` the
     per-pose time of ik-geo's Python loop (s) or None."""
     robot, T, kw = case.robot, case.T[:n], case.kw_batch(n)
-    aa.ik.analytic_batch(robot, T[:20], **case.kw_batch(20))                     # warm-up
+    aa.ik.analytic_batch(robot, T[:20], **case.kw_batch(20))  # warm-up
     res = aa.ik.analytic_batch(robot, T, **kw)
     t = time_call(lambda: aa.ik.analytic_batch(robot, T, **kw), repeat=BATCH_REPEAT) / n
     pose, b = np.nonzero(res.valid)
-    return _row(case, "anthroarm analytic batch", n, _check(case, res.solutions[pose, b], pose, n), t,
-                t / t_geo if t_geo else "",
-                note=f"one call, median of {BATCH_REPEAT}" + ("; vs ik-geo's per-pose Python loop" if t_geo else ""))
+    return _row(
+        case,
+        "anthroarm analytic batch",
+        n,
+        _check(case, res.solutions[pose, b], pose, n),
+        t,
+        t / t_geo if t_geo else "",
+        note=f"one call, median of {BATCH_REPEAT}"
+        + ("; vs ik-geo's per-pose Python loop" if t_geo else ""),
+    )
 
 
 # ---------------------------------------------------------------------------- ik-geo rows
@@ -237,8 +285,11 @@ def _ik_geo_rows(case, geo, times, n_single, n_loop):
     q, _, exact = G.solve(gp, case.T[:n], prm)
     same, sols, pose = 0, [], []
     for i, s in enumerate(out):
-        th = _to_ours(gp, np.array([x for x, ls in s if not ls], dtype=float).reshape(-1, 6),
-                      None if prm is None else prm[i])
+        th = _to_ours(
+            gp,
+            np.array([x for x, ls in s if not ls], dtype=float).reshape(-1, 6),
+            None if prm is None else prm[i],
+        )
         ours = q[i][exact[i]]
         if len(th) == len(ours):
             d = np.abs(np.angle(np.exp(1j * (ours[:, None] - th[None])))).max(-1)
@@ -246,10 +297,25 @@ def _ik_geo_rows(case, geo, times, n_single, n_loop):
         sols.append(gp.chain.configuration(th))
         pose += [i] * len(th)
     checks = _check(case, np.concatenate(sols), np.array(pose, dtype=int), n, limits=False)
-    rows = [_row(case, "ik-geo single (Rust)", n_single, checks, t_single, same=f"{same}/{n}",
-                 note=f"get_ik on the class pose, exact solutions, no limits; checks over {n} poses"),
-            _row(case, "ik-geo batch (Rust, Python loop)", n_loop, ("", "", "", ""), t_loop,
-                 note=f"no batch API: a Python loop over get_ik (median of {BATCH_REPEAT}), per pose")]
+    rows = [
+        _row(
+            case,
+            "ik-geo single (Rust)",
+            n_single,
+            checks,
+            t_single,
+            same=f"{same}/{n}",
+            note=f"get_ik on the class pose, exact solutions, no limits; checks over {n} poses",
+        ),
+        _row(
+            case,
+            "ik-geo batch (Rust, Python loop)",
+            n_loop,
+            ("", "", "", ""),
+            t_loop,
+            note=f"no batch API: a Python loop over get_ik (median of {BATCH_REPEAT}), per pose",
+        ),
+    ]
     return rows, t_single, t_loop
 
 
@@ -264,20 +330,32 @@ def _clik_row(case, n):
         pe, re = pose_errors(case.robot, q, case.T[k])
         succ += pe <= 1e-6 and re <= 1e-6
         viol += not bool(case.robot.within_limits(q))
-    return _row(case, "pin CLIK recipe", n, (100.0 * succ / n, "", "", 100.0 * viol / n), float(np.median(tt)),
-                note="DLS damp 1e-6, DT 0.1, 1000 it, seed = comfortable posture")
+    return _row(
+        case,
+        "pin CLIK recipe",
+        n,
+        (100.0 * succ / n, "", "", 100.0 * viol / n),
+        float(np.median(tt)),
+        note="DLS damp 1e-6, DT 0.1, 1000 it, seed = comfortable posture",
+    )
 
 
 def _arm_rows(case, n_single, n_batch, n_loop, n_clik=0):
     gp = case.gp
     what = [gp.cls + (" (reversed)" if gp.reversed else "") if gp is not None else case.family]
-    what += [{"swivel": "at the sampled swivel angle", "param": "q7 held at the sampled value"}[k] for k in case.kw]
+    what += [
+        {"swivel": "at the sampled swivel angle", "param": "q7 held at the sampled value"}[k]
+        for k in case.kw
+    ]
     what += ["position only"] if case.position_only else []
     geo = _ik_geo(case, max(n_single, n_loop))
     times, results, geo_times = _single_times(case, n_single, geo)
     geo_rows, t_geo1, t_geo_loop = _ik_geo_rows(case, geo, geo_times, n_single, n_loop)
-    rows = [_single_row(case, n_single, times, results, t_geo1, "; ".join(what)), _batch_row(case, n_batch, t_geo_loop),
-            *geo_rows]
+    rows = [
+        _single_row(case, n_single, times, results, t_geo1, "; ".join(what)),
+        _batch_row(case, n_batch, t_geo_loop),
+        *geo_rows,
+    ]
     return rows + ([_clik_row(case, n_clik)] if n_clik else [])
 
 
@@ -292,9 +370,34 @@ def _cell_rows(n):
     p0 = P[n // 3]
     t_s = time_call(lambda: tab.lookup(p0), number=200, repeat=7)
     err = np.abs(robot.fk(look.q[look.ok][:500])[:, :3, 3] - P[look.ok][:500]).max()
-    return [["prosthetic_arm", "cell lookup batch (D=50 mm)", n, 100.0 * look.ok.mean(), "", t_b * 1e6, "",
-             float(err), "", "", "max FK err: position, the method's interpolation error"],
-            ["prosthetic_arm", "cell lookup single (D=50 mm)", 1, 100.0, "", t_s * 1e6, "", "", "", "", ""]]
+    return [
+        [
+            "prosthetic_arm",
+            "cell lookup batch (D=50 mm)",
+            n,
+            100.0 * look.ok.mean(),
+            "",
+            t_b * 1e6,
+            "",
+            float(err),
+            "",
+            "",
+            "max FK err: position, the method's interpolation error",
+        ],
+        [
+            "prosthetic_arm",
+            "cell lookup single (D=50 mm)",
+            1,
+            100.0,
+            "",
+            t_s * 1e6,
+            "",
+            "",
+            "",
+            "",
+            "",
+        ],
+    ]
 
 
 def run(quick: bool = False) -> dict:
@@ -309,14 +412,19 @@ def run(quick: bool = False) -> dict:
         case = Case(name, aa.load(name), max(n_batch, n_loop), rng)
         rows += _arm_rows(case, n_single, n_batch, n_loop, n_clik if name in CLIK_ARMS else 0)
     with tempfile.TemporaryDirectory() as folder:
-        rows += _arm_rows(Case("puma560", dh_urdf(folder, "puma560", **PUMA560), max(n_batch, n_loop), rng), n_single, n_batch, n_loop)
+        rows += _arm_rows(
+            Case("puma560", dh_urdf(folder, "puma560", **PUMA560), max(n_batch, n_loop), rng),
+            n_single,
+            n_batch,
+            n_loop,
+        )
         for cls in SEARCH_CLASSES:
             case = Case(f"user {cls} (seed 1)", search_arm(folder, cls), n_search, rng)
             rows += _arm_rows(case, n_search, n_search, n_search)
     rows += _cell_rows(n_batch)
     return {
         "title": "Closed-form IK of every arm whose geometry allows it, ik-geo (Rust), Pinocchio's CLIK recipe, "
-                 "cell lookup",
+        "cell lookup",
         "columns": COLUMNS,
         "rows": rows,
         "notes": (
@@ -341,5 +449,6 @@ def run(quick: bool = False) -> dict:
             "classes (two_parallel, two_intersecting: a 1-D search) on a random user arm (seed 1), few poses. "
             "'pin CLIK recipe' = Pinocchio's inverse-kinematics example (ik_peers.PinCLIK), converged to 1e-6. "
             "Cell lookup: prosthetic arm, hand horizontal-forward, D = 50 mm. Shared 2-core machine: read "
-            "times ±30 %."),
+            "times ±30 %."
+        ),
     }

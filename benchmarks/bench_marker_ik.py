@@ -23,7 +23,14 @@ import pinocchio as pin
 
 import anthroarm as aa
 from anthroarm.ik.qp import comfortable_posture
-from anthroarm.motion import Marker, MarkerIK, MarkerSet, MarkerTrajectories, default_marker_set, segment_length
+from anthroarm.motion import (
+    Marker,
+    MarkerIK,
+    MarkerSet,
+    MarkerTrajectories,
+    default_marker_set,
+    segment_length,
+)
 
 SIGMA = 1e-3
 BACKENDS = ["daqp", "quadprog", "osqp"]
@@ -33,8 +40,14 @@ def _sets(robot):
     full = default_marker_set(robot)
     eight = full.subset(["UA", "EL", "EM", "RS", "US", "MC2", "MC3", "MC5"])
     L1, L2 = segment_length(robot, "upper_arm"), segment_length(robot, "forearm")
-    twelve = MarkerSet(list(full) + [Marker("FA2", "forearm", (0.03, -0.03, -0.3 * L2)),
-                                     Marker("UA2", "upper_arm", (0.03, 0.03, -0.3 * L1))], name="isb12")
+    twelve = MarkerSet(
+        list(full)
+        + [
+            Marker("FA2", "forearm", (0.03, -0.03, -0.3 * L2)),
+            Marker("UA2", "upper_arm", (0.03, 0.03, -0.3 * L1)),
+        ],
+        name="isb12",
+    )
     return {"8": eight, "10": full, "12": twelve}
 
 
@@ -42,8 +55,9 @@ def _motion(robot, n):
     rng = np.random.default_rng(0)
     t = np.arange(n) / 100.0
     half = 0.5 * (robot.upper - robot.lower)
-    Q = comfortable_posture(robot) + 0.3 * half * np.sin(2 * np.pi * rng.uniform(0.3, 1.0, 7) * t[:, None]
-                                                          + rng.uniform(0, 2 * np.pi, 7))
+    Q = comfortable_posture(robot) + 0.3 * half * np.sin(
+        2 * np.pi * rng.uniform(0.3, 1.0, 7) * t[:, None] + rng.uniform(0, 2 * np.pi, 7)
+    )
     return np.clip(Q, robot.lower + 1e-3, robot.upper - 1e-3)
 
 
@@ -65,6 +79,7 @@ def _pin_markers(robot, ms):
             r = data.oMf[f].rotation @ p
             rows.append(J[:3] + np.cross(J[3:].T, r).T)
         return np.vstack(rows)
+
     return pos, jac
 
 
@@ -91,24 +106,53 @@ def run(quick: bool = False) -> dict:
     rows = []
     for label, ms in _sets(robot).items():
         pos, _ = _pin_markers(robot, ms)
-        P = np.array([pos(q) for q in Q]) + np.random.default_rng(1).normal(0, SIGMA, (n, len(ms), 3))
+        P = np.array([pos(q) for q in Q]) + np.random.default_rng(1).normal(
+            0, SIGMA, (n, len(ms), 3)
+        )
         trial = MarkerTrajectories(ms.names, P, rate=100.0)
         q_sp, ms_sp, nfev_sp = _scipy(robot, ms, P)
         rms_sp = float(np.sqrt(np.mean((q_sp - Q) ** 2)))
         for backend in BACKENDS:
             ik = MarkerIK(robot, ms, solver=backend)
-            ik.solve(MarkerTrajectories(ms.names, P[:20], rate=100.0))    # warm-up
+            ik.solve(MarkerTrajectories(ms.names, P[:20], rate=100.0))  # warm-up
             res = ik.solve(trial)
-            rows.append([len(ms), backend, 1e3 * res.seconds / n, float(np.mean(res.iterations)),
-                         float(np.sqrt(np.mean((res.q - Q) ** 2))), float(np.median(res.rms)) * 1e3,
-                         1e3 * ms_sp, nfev_sp, rms_sp, float(np.abs(res.q - q_sp).max()),
-                         int(res.counts()["ok"]), n])
+            rows.append(
+                [
+                    len(ms),
+                    backend,
+                    1e3 * res.seconds / n,
+                    float(np.mean(res.iterations)),
+                    float(np.sqrt(np.mean((res.q - Q) ** 2))),
+                    float(np.median(res.rms)) * 1e3,
+                    1e3 * ms_sp,
+                    nfev_sp,
+                    rms_sp,
+                    float(np.abs(res.q - q_sp).max()),
+                    int(res.counts()["ok"]),
+                    n,
+                ]
+            )
     best = min(r[2] for r in rows if r[0] == 10)
-    notes = (__doc__.split("\n\n", 1)[1].replace("\n", " ").strip()
-             + f" Headline: {best:.2f} ms per frame for the 10-marker ISB set (target <= 1 ms).")
+    notes = (
+        __doc__.split("\n\n", 1)[1].replace("\n", " ").strip()
+        + f" Headline: {best:.2f} ms per frame for the 10-marker ISB set (target <= 1 ms)."
+    )
     return dict(
         title="Marker IK per frame: anthroarm (QP layer, warm start) vs scipy least_squares",
-        columns=["markers", "backend", "ours ms/frame", "ours iterations", "ours angle RMS err (rad)",
-                 "ours median marker RMS (mm)", "scipy ms/frame", "scipy nfev", "scipy angle RMS err (rad)",
-                 "max |q ours - q scipy| (rad)", "frames ok", "frames"],
-        rows=rows, notes=notes)
+        columns=[
+            "markers",
+            "backend",
+            "ours ms/frame",
+            "ours iterations",
+            "ours angle RMS err (rad)",
+            "ours median marker RMS (mm)",
+            "scipy ms/frame",
+            "scipy nfev",
+            "scipy angle RMS err (rad)",
+            "max |q ours - q scipy| (rad)",
+            "frames ok",
+            "frames",
+        ],
+        rows=rows,
+        notes=notes,
+    )

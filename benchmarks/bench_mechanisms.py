@@ -12,9 +12,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from anthroarm.mechanisms import (ClosedLoop, FingerGeometry, RRSSGeometry, RSSRGeometry, ThumbGeometry, finger,
-                                  finger_spec, fourbar, fourbar_spec, rrss, rrss_branch_through, rrss_spec, rrss_track,
-                                  rssr, rssr_branch_through, rssr_spec, thumb, thumb_spec)
+from anthroarm.mechanisms import (
+    ClosedLoop,
+    FingerGeometry,
+    RRSSGeometry,
+    RSSRGeometry,
+    ThumbGeometry,
+    finger,
+    finger_spec,
+    fourbar,
+    fourbar_spec,
+    rrss,
+    rrss_branch_through,
+    rrss_spec,
+    rrss_track,
+    rssr,
+    rssr_branch_through,
+    rssr_spec,
+    thumb,
+    thumb_spec,
+)
 
 from .common import time_call
 
@@ -28,6 +45,7 @@ def _pin_march(loop, xs, q0, out_index):
             q = st.q
             outs[k] = st.q[out_index]
         return outs
+
     return run
 
 
@@ -49,7 +67,9 @@ def run(quick: bool = False) -> dict:
     rows.append(["four-bar (5-12)-(5-22)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err])
 
     # RSSR (D1 of ch9-and-002.md)
-    g = RSSRGeometry(a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3])
+    g = RSSRGeometry(
+        a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3]
+    )
     br = rssr_branch_through(g)
     loop = ClosedLoop(rssr_spec(g))
     t_cf = time_call(lambda: rssr(g, th, 1.0, 0.0, br), repeat=repeat, min_time=0.05)
@@ -59,8 +79,14 @@ def run(quick: bool = False) -> dict:
     rows.append(["RSSR (4-18)-(4-30)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err])
 
     # RRSS (D2): closed form, 002 Newton march, Pinocchio
-    g = RRSSGeometry(a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=np.array([0, 1, 1]) / np.sqrt(2), b0=[1, 1, 5],
-                     b1=[2, 0.5, -0.5])
+    g = RRSSGeometry(
+        a0=[0, 0, 0],
+        u0=[0, 0, 1],
+        a1=[1, 0, 0],
+        u1=np.array([0, 1, 1]) / np.sqrt(2),
+        b0=[1, 1, 5],
+        b1=[2, 0.5, -0.5],
+    )
     br = rrss_branch_through(g)
     loop = ClosedLoop(rrss_spec(g))
     ref = rrss(g, th, 1.0, 0.0, br).theta2
@@ -72,7 +98,9 @@ def run(quick: bool = False) -> dict:
     newton = lambda: rrss_track(g, th, 1.0, 0.0)  # noqa: E731
     t_nw = time_call(newton, repeat=repeat)
     err = np.max(np.abs(np.angle(np.exp(1j * (np.array([x.theta2 for x in newton()]) - ref)))))
-    rows.append(["RRSS 002 Newton march (rotation vector)", N, t_nw * 1e3, t_pin * 1e3, t_pin / t_nw, err])
+    rows.append(
+        ["RRSS 002 Newton march (rotation vector)", N, t_nw * 1e3, t_pin * 1e3, t_pin / t_nw, err]
+    )
 
     # thumb (Ch. 4 geometry), theta1 in [0, 30 deg]
     tg = ThumbGeometry.book()
@@ -82,7 +110,9 @@ def run(quick: bool = False) -> dict:
     pin_run = _pin_march(loop, t1, None, loop.joint_q_index("r3"))
     t_pin = time_call(pin_run, repeat=repeat)
     err = np.max(np.abs(pin_run() - thumb(tg, t1).theta3))
-    rows.append(["thumb RRSS + four-bar (6-93)-(6-116)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err])
+    rows.append(
+        ["thumb RRSS + four-bar (6-93)-(6-116)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err]
+    )
 
     # finger six-bar (our lengths)
     fg = FingerGeometry.default()
@@ -93,15 +123,26 @@ def run(quick: bool = False) -> dict:
     t_pin = time_call(pin_run, repeat=repeat)
     s = finger(fg, ph)
     err = np.max(np.abs(pin_run() - (s.q[:, 2] - s.q[0, 2])))
-    rows.append(["index-finger six-bar (6-66)-(6-87)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err])
+    rows.append(
+        ["index-finger six-bar (6-66)-(6-87)", N, t_cf * 1e3, t_pin * 1e3, t_pin / t_cf, err]
+    )
 
     return dict(
         title="Mechanism solvers: closed forms vs Pinocchio closed loop",
-        columns=["mechanism", "N inputs", "ours: pos+vel+acc [ms]", "Pinocchio march [ms]", "ratio", "max |output diff| [rad]"],
+        columns=[
+            "mechanism",
+            "N inputs",
+            "ours: pos+vel+acc [ms]",
+            "Pinocchio march [ms]",
+            "ratio",
+            "max |output diff| [rad]",
+        ],
         rows=rows,
-        notes=("Ours: one vectorised numpy call over all N inputs (RRSS Newton: the 002 continuation in pure Python, "
-               "tangent predictor + Newton per input). Pinocchio: ClosedLoop.solve per input (least-norm Newton from "
-               "the previous solution, then J_c v = 0 and J_c a = -gamma with classical drift). Output angles agree "
-               "to round-off (the thumb's theta3 is ~1e3 times more sensitive: its coupler is 0.79 mm). 'ratio' = "
-               "Pinocchio time / ours."),
+        notes=(
+            "Ours: one vectorised numpy call over all N inputs (RRSS Newton: the 002 continuation in pure Python, "
+            "tangent predictor + Newton per input). Pinocchio: ClosedLoop.solve per input (least-norm Newton from "
+            "the previous solution, then J_c v = 0 and J_c a = -gamma with classical drift). Output angles agree "
+            "to round-off (the thumb's theta3 is ~1e3 times more sensitive: its coupler is 0.79 mm). 'ratio' = "
+            "Pinocchio time / ours."
+        ),
     )

@@ -85,7 +85,8 @@ def run(quick: bool = False) -> dict:
     logging.disable(logging.WARNING)  # pink logs every out-of-limit step
     try:
         import pink
-        from pink.tasks import FrameTask as PFrame, PostureTask as PPosture
+        from pink.tasks import FrameTask as PFrame
+        from pink.tasks import PostureTask as PPosture
     except ImportError:  # peers are the optional "bench" extra
         pink = None
 
@@ -98,11 +99,25 @@ def run(quick: bool = False) -> dict:
             ours = _run_ours(robot, q0, targets, backend)
             if pink is None:
                 t = ours["t"][5:] * 1e6
-                rows.append([name, backend, np.median(t), np.percentile(t, 90), "", "", "", "",
-                             int(sum(not robot.within_limits(q) for q in ours["q"])), "", "", ""])
+                rows.append(
+                    [
+                        name,
+                        backend,
+                        np.median(t),
+                        np.percentile(t, 90),
+                        "",
+                        "",
+                        "",
+                        "",
+                        int(sum(not robot.within_limits(q) for q in ours["q"])),
+                        "",
+                        "",
+                        "",
+                    ]
+                )
                 continue
             theirs = _run_pink(pink, PFrame, PPosture, robot, q0, targets, backend)
-            ours2 = _run_ours(robot, q0, targets, backend)      # A B A B: both see the same load drift
+            ours2 = _run_ours(robot, q0, targets, backend)  # A B A B: both see the same load drift
             theirs2 = _run_pink(pink, PFrame, PPosture, robot, q0, targets, backend)
             t_ours = np.concatenate([ours["t"][5:], ours2["t"][5:]])
             t_pink = np.concatenate([theirs["t"][5:], theirs2["t"][5:]])
@@ -111,32 +126,67 @@ def run(quick: bool = False) -> dict:
             bad = [q for q in theirs["q"] if not robot.within_limits(q)]
             worst_p = max((_violation(robot, q) for q in bad), default=0.0)
             mo, mp = np.median(t_ours) * 1e6, np.median(t_pink) * 1e6
-            rows.append([name, backend, mo, np.percentile(t_ours, 90) * 1e6, mp, np.percentile(t_pink, 90) * 1e6,
-                         mp / mo, dev, viol_o, len(bad), worst_p, theirs["errors"]])
+            rows.append(
+                [
+                    name,
+                    backend,
+                    mo,
+                    np.percentile(t_ours, 90) * 1e6,
+                    mp,
+                    np.percentile(t_pink, 90) * 1e6,
+                    mp / mo,
+                    dev,
+                    viol_o,
+                    len(bad),
+                    worst_p,
+                    theirs["errors"],
+                ]
+            )
     # headline: our OSQP path against pink's quadprog, and the same-backend ratios, per robot
     summary = []
     for name in sorted({r[0] for r in rows}, key=ROBOTS.index) if pink is not None else []:
         ours_osqp = next(r[2] for r in rows if r[0] == name and r[1] == "osqp")
         pink_qp = next(r[4] for r in rows if r[0] == name and r[1] == "quadprog")
         ratios = ", ".join(f"{r[1]} {r[6]:.2f}x" for r in rows if r[0] == name and r[1] != "osqp")
-        summary.append(f"{name}: ours/osqp {ours_osqp:.0f} us vs pink/quadprog {pink_qp:.0f} us "
-                       f"({pink_qp / ours_osqp:.2f}x); same backend pink/ours: {ratios}")
+        summary.append(
+            f"{name}: ours/osqp {ours_osqp:.0f} us vs pink/quadprog {pink_qp:.0f} us "
+            f"({pink_qp / ours_osqp:.2f}x); same backend pink/ours: {ratios}"
+        )
     logging.disable(logging.NOTSET)
-    notes = ("FrameTask + PostureTask + configuration/velocity limits, dt 10 ms, 5 cm circular target; "
-             f"{n_steps} steps per run (first 5 not timed). Step = set_target + solve + integrate; times are CPU "
-             "time of this process (time.process_time; the 2 cores are shared with other jobs); runs A B A B. "
-             "'ratio' = pink median / ours median with the SAME backend. 'max |q diff|' = largest joint difference "
-             "between the two trajectories. Violations = steps whose q lies outside the joint limits "
-             "(exact comparison). Ours assembles H, c and the limit box in preallocated arrays and calls the "
-             "solvers directly: OSQP keeps one sparse workspace (update + warm start through the compiled solver, "
-             "eps 1e-9, rho 10) and the active set it finds is solved exactly (KKT-checked polish); daqp.solve; quadprog's compiled qpgen2_ routine through ctypes with preallocated "
-             "arrays (bit-identical to quadprog.solve_qp); ProxQP keeps a warm-started dense workspace (eps 1e-9) "
-             "and its active set is solved exactly (KKT-checked polish). pink goes through qpsolvers (CSC conversion "
-             "per call for OSQP, default tolerances). "
-             + ("Headline: " + "; ".join(summary) + "." if summary else "pink is not installed: ours only."))
+    notes = (
+        "FrameTask + PostureTask + configuration/velocity limits, dt 10 ms, 5 cm circular target; "
+        f"{n_steps} steps per run (first 5 not timed). Step = set_target + solve + integrate; times are CPU "
+        "time of this process (time.process_time; the 2 cores are shared with other jobs); runs A B A B. "
+        "'ratio' = pink median / ours median with the SAME backend. 'max |q diff|' = largest joint difference "
+        "between the two trajectories. Violations = steps whose q lies outside the joint limits "
+        "(exact comparison). Ours assembles H, c and the limit box in preallocated arrays and calls the "
+        "solvers directly: OSQP keeps one sparse workspace (update + warm start through the compiled solver, "
+        "eps 1e-9, rho 10) and the active set it finds is solved exactly (KKT-checked polish); daqp.solve; quadprog's compiled qpgen2_ routine through ctypes with preallocated "
+        "arrays (bit-identical to quadprog.solve_qp); ProxQP keeps a warm-started dense workspace (eps 1e-9) "
+        "and its active set is solved exactly (KKT-checked polish). pink goes through qpsolvers (CSC conversion "
+        "per call for OSQP, default tolerances). "
+        + (
+            "Headline: " + "; ".join(summary) + "."
+            if summary
+            else "pink is not installed: ours only."
+        )
+    )
     return dict(
         title="QP differential-IK step: anthroarm vs pink (same tasks, limits and backend)",
-        columns=["robot", "backend", "ours median us", "ours p90 us", "pink median us", "pink p90 us",
-                 "ratio pink/ours", "max |q diff| (rad)", "ours violations", "pink violations",
-                 "pink worst violation (rad)", "pink exceptions"],
-        rows=rows, notes=notes)
+        columns=[
+            "robot",
+            "backend",
+            "ours median us",
+            "ours p90 us",
+            "pink median us",
+            "pink p90 us",
+            "ratio pink/ours",
+            "max |q diff| (rad)",
+            "ours violations",
+            "pink violations",
+            "pink worst violation (rad)",
+            "pink exceptions",
+        ],
+        rows=rows,
+        notes=notes,
+    )

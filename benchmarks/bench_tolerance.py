@@ -25,7 +25,9 @@ def _pin_loop(robot, chain):
     model = robot.model.copy()
     data = model.createData()
     fid = chain.fid
-    base_j = {p.index: model.jointPlacements[p.index].copy() for p in chain.params if p.kind == "joint"}
+    base_j = {
+        p.index: model.jointPlacements[p.index].copy() for p in chain.params if p.kind == "joint"
+    }
     base_f = model.frames[fid].placement.copy()
 
     def f(Q, dL):
@@ -69,7 +71,12 @@ def run(quick: bool = False) -> dict:
         t_o = time_call(lambda: chain.pose(Q, dL), repeat=5) / N
         t_p = time_call(lambda: ref(Q, dL), repeat=3) / N
         rows.append([name, len(chain.params), N, t_o * 1e6, t_p * 1e6, t_p / t_o, err])
-    from anthroarm.mechanisms.rccc import RCCCGeometry, rccc_acceleration, rccc_position, rccc_velocity
+    from anthroarm.mechanisms.rccc import (
+        RCCCGeometry,
+        rccc_acceleration,
+        rccc_position,
+        rccc_velocity,
+    )
     from anthroarm.spatial.dual import Dual
 
     g = RCCCGeometry(Dual(0.5, 1.0), Dual(1.0, 2.5), Dual(0.8, 1.5), Dual(1.2, 3.0), 0.7)
@@ -83,7 +90,15 @@ def run(quick: bool = False) -> dict:
     t_r = time_call(rccc, repeat=7, min_time=0.05)
     return {
         "title": "Monte Carlo tolerance analysis: batched perturbed FK vs a Pinocchio loop",
-        "columns": ["model", "link parameters", "N", "ours µs/sample", "pin loop µs/sample", "speed-up", "max abs diff"],
+        "columns": [
+            "model",
+            "link parameters",
+            "N",
+            "ours µs/sample",
+            "pin loop µs/sample",
+            "speed-up",
+            "max abs diff",
+        ],
         "rows": rows,
         "notes": (
             "Per sample: joint values and every placement-translation component perturbed (σ = 1 mm / 1 mrad), tool "

@@ -45,6 +45,7 @@ def _per_link(v: Viewer):
         for cmd in v._pose_commands(q):
             v.store.apply(cmd)
             v.server.send(cmd)
+
     return f
 
 
@@ -68,7 +69,10 @@ def page_sizes(name: str = "panda") -> tuple[int, int]:
     """Bytes of the Jupyter cell (static page in an iframe) of ``Viewer(name)``: meshes packed
     (default ``mesh_triangles``) and sent as the files are (``mesh_triangles=None``)."""
     robot = aa.load(name)
-    return (len(Viewer(robot)._repr_html_().encode()), len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()))
+    return (
+        len(Viewer(robot)._repr_html_().encode()),
+        len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()),
+    )
 
 
 def run(quick: bool = False) -> dict:
@@ -85,10 +89,12 @@ def run(quick: bool = False) -> dict:
             t_batch = _per_frame(v.display, Q)
             t_link = _per_frame(_per_link(v), Q[: max(20, n // 4)])
             t_browser = _browser_frame_time(v, Q)
-        for label, t, msgs in (("batched (anthroarm)", t_batch, 1),
-                               ("batched + headless Chromium tab", t_browser, 1),
-                               ("one message per link (meshcat-python style)", t_link, nb),
-                               ("in memory, no server (FK + commands)", t_mem, 0)):
+        for label, t, msgs in (
+            ("batched (anthroarm)", t_batch, 1),
+            ("batched + headless Chromium tab", t_browser, 1),
+            ("one message per link (meshcat-python style)", t_link, nb),
+            ("in memory, no server (FK + commands)", t_mem, 0),
+        ):
             if t is None:
                 rows.append([name, label, nb, msgs, "n/a (no chromium)", "n/a"])
             else:
@@ -97,11 +103,13 @@ def run(quick: bool = False) -> dict:
         "title": "Viewer pose updates: ms per frame and frames per second",
         "columns": ["model", "path", "moving bodies", "messages/frame", "ms/frame", "fps"],
         "rows": rows,
-        "notes": ("Viewer.display(q): Pinocchio FK, one 4x4 per moving body, sent to the 127.0.0.1 server "
-                  "(ZeroMQ REQ/REP round trip) which forwards it to every connected tab.  The browser draws at "
-                  "its own requestAnimationFrame rate; these numbers are the rate at which complete poses "
-                  "reach it.  Target: >= 60 fps for human_arm7.  Peer: Pinocchio MeshcatVisualizer.display "
-                  "3.9 ms/frame on the panda (peers.md §4.4).  Jupyter cell of Viewer('panda') (static page): "
-                  f"{packed / 2**20:.2f} MB with the meshes packed (mesh_triangles=5000), {raw / 2**20:.1f} MB with "
-                  "the mesh files as they are (mesh_triangles=None)."),
+        "notes": (
+            "Viewer.display(q): Pinocchio FK, one 4x4 per moving body, sent to the 127.0.0.1 server "
+            "(ZeroMQ REQ/REP round trip) which forwards it to every connected tab.  The browser draws at "
+            "its own requestAnimationFrame rate; these numbers are the rate at which complete poses "
+            "reach it.  Target: >= 60 fps for human_arm7.  Peer: Pinocchio MeshcatVisualizer.display "
+            "3.9 ms/frame on the panda (peers.md §4.4).  Jupyter cell of Viewer('panda') (static page): "
+            f"{packed / 2**20:.2f} MB with the meshes packed (mesh_triangles=5000), {raw / 2**20:.1f} MB with "
+            "the mesh files as they are (mesh_triangles=None)."
+        ),
     }

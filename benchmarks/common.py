@@ -92,8 +92,10 @@ def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[
     quick = bool(result.get("quick"))
     out = Path(out_dir) if out_dir else (QUICK_DIR if quick else RESULTS_DIR)
     if quick and out.resolve() == RESULTS_DIR.resolve():
-        raise ValueError(f"a quick run does not write into {RESULTS_DIR} (committed full runs); "
-                         f"default for quick runs: {QUICK_DIR}")
+        raise ValueError(
+            f"a quick run does not write into {RESULTS_DIR} (committed full runs); "
+            f"default for quick runs: {QUICK_DIR}"
+        )
     out.mkdir(parents=True, exist_ok=True)
     figures = result.pop("figures", None) or {}
     result.setdefault("environment", environment())
@@ -105,8 +107,11 @@ def write_result(name: str, result: dict, out_dir: Path | None = None) -> tuple[
         md += [result["notes"], ""]
     md.append(markdown_table(result["columns"], result["rows"]))
     env = result["environment"]
-    md += ["", f"Machine: {env['processor']}, {env['cpus']} CPUs, Python {env['python']}, numpy {env['numpy']}, "
-           f"pinocchio {env['pinocchio']}; {env['date']}."]
+    md += [
+        "",
+        f"Machine: {env['processor']}, {env['cpus']} CPUs, Python {env['python']}, numpy {env['numpy']}, "
+        f"pinocchio {env['pinocchio']}; {env['date']}.",
+    ]
     atomic_write_text(mp, "\n".join(md) + "\n")
     for fname, fig in figures.items():
         if fig is not None:

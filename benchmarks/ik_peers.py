@@ -42,7 +42,9 @@ def pose_errors(robot, q, T):
     d = robot.model.createData()
     pin.framesForwardKinematics(robot.model, d, np.asarray(q, dtype=float))
     M = d.oMf[robot.tool_id]
-    return float(np.linalg.norm(M.translation - T[:3, 3])), float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])))
+    return float(np.linalg.norm(M.translation - T[:3, 3])), float(
+        np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))
+    )
 
 
 class Angles:
@@ -62,7 +64,9 @@ class Angles:
             elif jm.nq or jm.nv:
                 raise NotImplementedError(f"{robot.name}: joint type {jm.shortname()} has no angle")
         self.nq, self.nv = model.nq, model.nv
-        self.one_q, self.one_v, self.two_q, self.two_v = (np.array(a, dtype=int) for a in (one_q, one_v, two_q, two_v))
+        self.one_q, self.one_v, self.two_q, self.two_v = (
+            np.array(a, dtype=int) for a in (one_q, one_v, two_q, two_v)
+        )
         self.lower = np.full(self.nv, -np.inf)
         self.upper = np.full(self.nv, np.inf)
         self.lower[self.one_v] = robot.lower[self.one_q]
@@ -109,10 +113,12 @@ class Chain:
         pin.forwardKinematics(model, data, pin.neutral(model))
         self.axes = []
         for j in self.joints:
-            S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)   # motion subspace
+            S = np.asarray(data.joints[j].S, dtype=float).reshape(6, -1)  # motion subspace
             if S.shape[1] != 1 or np.abs(S[:3, 0]).max() > 0:
-                raise NotImplementedError(f"{robot.name}: joint {model.names[j]} ({model.joints[j].shortname()}) "
-                                          "is not revolute")
+                raise NotImplementedError(
+                    f"{robot.name}: joint {model.names[j]} ({model.joints[j].shortname()}) "
+                    "is not revolute"
+                )
             self.axes.append(S[3:, 0] / np.linalg.norm(S[3:, 0]))
         self.vidx = np.array([model.joints[j].idx_v for j in self.joints], dtype=int)
         self.lower, self.upper = self.angles.lower[self.vidx], self.angles.upper[self.vidx]
@@ -122,7 +128,9 @@ class Chain:
 
     def limits(self, span: float):
         """(lower, upper) with each continuous joint's replaced by ±``span``."""
-        return np.where(self.continuous, -span, self.lower), np.where(self.continuous, span, self.upper)
+        return np.where(self.continuous, -span, self.lower), np.where(
+            self.continuous, span, self.upper
+        )
 
     def to_q(self, angles):
         """q with the chain at ``angles`` and every other joint at the seed."""
@@ -220,13 +228,26 @@ class Ikpy:
         links = [OriginLink()]
         for k, j in enumerate(ch.joints):
             M = model.jointPlacements[j]
-            links.append(URDFLink(name=model.names[j], origin_translation=M.translation.copy(),
-                                  origin_orientation=pin.rpy.matrixToRpy(M.rotation), rotation=ch.axes[k],
-                                  bounds=(float(lo[k]), float(hi[k]))))
-        links.append(URDFLink(name="tool", origin_translation=ch.frame.placement.translation.copy(),
-                              origin_orientation=pin.rpy.matrixToRpy(ch.frame.placement.rotation),
-                              joint_type="fixed"))
-        self.ikpy_chain = IkpyChain(links, active_links_mask=[False] + [True] * len(ch.joints) + [False])
+            links.append(
+                URDFLink(
+                    name=model.names[j],
+                    origin_translation=M.translation.copy(),
+                    origin_orientation=pin.rpy.matrixToRpy(M.rotation),
+                    rotation=ch.axes[k],
+                    bounds=(float(lo[k]), float(hi[k])),
+                )
+            )
+        links.append(
+            URDFLink(
+                name="tool",
+                origin_translation=ch.frame.placement.translation.copy(),
+                origin_orientation=pin.rpy.matrixToRpy(ch.frame.placement.rotation),
+                joint_type="fixed",
+            )
+        )
+        self.ikpy_chain = IkpyChain(
+            links, active_links_mask=[False] + [True] * len(ch.joints) + [False]
+        )
         self.robot = robot
 
     def full(self, angles):
@@ -236,8 +257,12 @@ class Ikpy:
         return self.ikpy_chain.forward_kinematics(self.full(self.chain.of_q(q)))
 
     def solve(self, T):
-        out = self.ikpy_chain.inverse_kinematics(target_position=T[:3, 3], target_orientation=T[:3, :3],
-                                                 orientation_mode="all", initial_position=self.full(self.chain.seed))
+        out = self.ikpy_chain.inverse_kinematics(
+            target_position=T[:3, 3],
+            target_orientation=T[:3, :3],
+            orientation_mode="all",
+            initial_position=self.full(self.chain.seed),
+        )
         return self.chain.to_q(out[1:-1])
 
 
@@ -249,8 +274,11 @@ def _rtb_revolute(rtb, sm, axis, k, qlim):
         if abs(abs(axis[i]) - 1.0) < 1e-12:
             return rtb.ETS([ctor(jindex=k, qlim=qlim, flip=bool(axis[i] < 0))])
     R = pin.Quaternion.FromTwoVectors(np.array([0.0, 0.0, 1.0]), axis).matrix()
-    return (rtb.ET.SE3(sm.SE3(pin.SE3(R, np.zeros(3)).homogeneous, check=False)) * rtb.ET.Rz(jindex=k, qlim=qlim)
-            * rtb.ET.SE3(sm.SE3(pin.SE3(R.T, np.zeros(3)).homogeneous, check=False)))
+    return (
+        rtb.ET.SE3(sm.SE3(pin.SE3(R, np.zeros(3)).homogeneous, check=False))
+        * rtb.ET.Rz(jindex=k, qlim=qlim)
+        * rtb.ET.SE3(sm.SE3(pin.SE3(R.T, np.zeros(3)).homogeneous, check=False))
+    )
 
 
 class RtbLM:
@@ -262,7 +290,7 @@ class RtbLM:
 
         model = robot.model
         self.chain = ch = Chain(robot)
-        lo, hi = ch.limits(2 * np.pi)   # continuous joints: the ±2π TRAC-IK restarts from too
+        lo, hi = ch.limits(2 * np.pi)  # continuous joints: the ±2π TRAC-IK restarts from too
         ets = rtb.ETS()
         for k, j in enumerate(ch.joints):
             ets = ets * rtb.ET.SE3(sm.SE3(model.jointPlacements[j].homogeneous, check=False))
@@ -279,7 +307,7 @@ class RtbLM:
 
 
 # ------------------------------------------------------------------------------ TRAC-IK
-_F32 = float(np.finfo(np.float32).max)   # TRAC-IK's "no limit" (a continuous joint)
+_F32 = float(np.finfo(np.float32).max)  # TRAC-IK's "no limit" (a continuous joint)
 
 
 def urdf_chain(robot, chain):
@@ -299,15 +327,17 @@ def urdf_chain(robot, chain):
     while link in child_of:
         path.append(child_of[link])
         link = info.joints[child_of[link]]["parent"]
-    path.reverse()                                      # URDF joints root -> tool link
+    path.reverse()  # URDF joints root -> tool link
     movable = [n for n in path if info.joints[n]["type"] != "fixed"]
     active = [n for n in movable if n not in robot.locked]
     if active != chain.names:
-        raise NotImplementedError(f"{robot.name}: URDF path {active} is not the model's chain {chain.names}")
+        raise NotImplementedError(
+            f"{robot.name}: URDF path {active} is not the model's chain {chain.names}"
+        )
     first, last = movable.index(active[0]), movable.index(active[-1])
     base = info.joints[movable[first - 1]]["child"] if first > 0 else link
     tip = info.joints[movable[last + 1]]["parent"] if last + 1 < len(movable) else f.name
-    return base, tip, [(n, robot.locked.get(n)) for n in movable[first:last + 1]]
+    return base, tip, [(n, robot.locked.get(n)) for n in movable[first : last + 1]]
 
 
 class TracIK:
@@ -319,11 +349,19 @@ class TracIK:
         self.robot = robot
         self.chain = ch = Chain(robot)
         self.base, self.tip, joints = urdf_chain(robot, ch)
-        self.ik = pytracik.TRAC_IK(self.base, self.tip, robot.info.text, timeout, eps,
-                                   getattr(pytracik.SolveType, solve_type))
+        self.ik = pytracik.TRAC_IK(
+            self.base,
+            self.tip,
+            robot.info.text,
+            timeout,
+            eps,
+            getattr(pytracik.SolveType, solve_type),
+        )
         if pytracik.get_num_joints(self.ik) != len(joints):
-            raise AssertionError(f"{robot.name}: TRAC-IK chain {self.base} -> {self.tip} has "
-                                 f"{pytracik.get_num_joints(self.ik)} joints, expected {len(joints)}")
+            raise AssertionError(
+                f"{robot.name}: TRAC-IK chain {self.base} -> {self.tip} has "
+                f"{pytracik.get_num_joints(self.ik)} joints, expected {len(joints)}"
+            )
         self.active = np.array([k for k, (_, v) in enumerate(joints) if v is None], dtype=int)
         lo, hi = ch.limits(_F32)
         lower = np.array([v if v is not None else np.nan for _, v in joints])
@@ -347,13 +385,17 @@ class TracIK:
         return th
 
     def fk(self, q):
-        return np.linalg.inv(self.bMo) @ self._fk(self.ik, self._angles(q)) @ np.linalg.inv(self.toolMt)
+        return (
+            np.linalg.inv(self.bMo)
+            @ self._fk(self.ik, self._angles(q))
+            @ np.linalg.inv(self.toolMt)
+        )
 
     def solve(self, T):
         M = self.bMo @ T @ self.toolMt
         x, y, z, w = pin.Quaternion(M[:3, :3]).coeffs()
         r = self._ik(self.ik, self.seed, M[0, 3], M[1, 3], M[2, 3], x, y, z, w)
-        if r[0] < 0:    # no solution within the timeout
+        if r[0] < 0:  # no solution within the timeout
             return None
         return self.chain.to_q(r[1:][self.active])
 
@@ -370,7 +412,14 @@ def assert_same_fk(robot, fk, n=5, tol=1e-9):
             raise AssertionError(f"{robot.name}: peer FK differs from Pinocchio by {err:.3g}")
 
 
-PEERS = {"anthroarm": Ours, "pink": Pink, "pin-clik": PinCLIK, "ikpy": Ikpy, "rtb-ik_LM": RtbLM, "trac-ik": TracIK}
+PEERS = {
+    "anthroarm": Ours,
+    "pink": Pink,
+    "pin-clik": PinCLIK,
+    "ikpy": Ikpy,
+    "rtb-ik_LM": RtbLM,
+    "trac-ik": TracIK,
+}
 
 
 def make(name, robot):

@@ -14,7 +14,6 @@ Generated at build time (not committed, see docs/.gitignore), so they cannot go 
 
 from __future__ import annotations
 
-import shutil
 import sys
 from pathlib import Path
 
@@ -23,8 +22,9 @@ ROOT = DOCS.parent
 sys.path.insert(0, str(DOCS / "_ext"))
 sys.path.insert(0, str(ROOT / "src"))
 
-import anthroarm  # noqa: E402
 import build_pages  # noqa: E402  (docs/_ext/build_pages.py)
+
+import anthroarm  # noqa: E402
 
 project = "anthroarm"
 author = "the anthroarm developers"
@@ -46,36 +46,68 @@ build_pages.benchmark_pages(ROOT / "benchmarks" / "results", DOCS / "benchmarks"
 build_pages.equation_table(DOCS / "book_map_equations.md")
 build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
-GUIDE = ["load", "kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "grasp", "motion", "prosthesis", "emg",
-         "control", "book_systems", "viewer",
-         *(["/batch"] if (DOCS / "batch.md").is_file() else []), "benchmarks"]
-build_pages.write_if_changed(DOCS / "guide" / "_toc.md",
-                             "```{toctree}\n:maxdepth: 1\n\n" + "\n".join(GUIDE) + "\n```\n")
+GUIDE = [
+    "load",
+    "kinematics",
+    "ik",
+    "dynamics",
+    "mechanisms",
+    "design",
+    "hand",
+    "grasp",
+    "motion",
+    "prosthesis",
+    "emg",
+    "control",
+    "book_systems",
+    "viewer",
+    *(["/batch"] if (DOCS / "batch.md").is_file() else []),
+    "benchmarks",
+]
+build_pages.write_if_changed(
+    DOCS / "guide" / "_toc.md", "```{toctree}\n:maxdepth: 1\n\n" + "\n".join(GUIDE) + "\n```\n"
+)
 
-exclude_patterns = ["_build", "jupyter_execute", "**.ipynb_checkpoints", "guide/_toc.md", "book_map_equations.md"]
+exclude_patterns = [
+    "_build",
+    "jupyter_execute",
+    "**.ipynb_checkpoints",
+    "guide/_toc.md",
+    "book_map_equations.md",
+]
 templates_path: list[str] = []
-source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}  # .rst first: autosummary writes its pages with the first suffix
+source_suffix = {
+    ".rst": "restructuredtext",
+    ".md": "myst-nb",
+    ".ipynb": "myst-nb",
+}  # .rst first: autosummary writes its pages with the first suffix
 
 # ---------------------------------------------------------------- warnings are errors (-W)
 nitpicky = True
 # third-party and builtin types named in our docstrings: the site is built offline, so there is
 # no intersphinx inventory to resolve them against.  Our own names are never listed here.
 nitpick_ignore_regex = [
-    (r"py:.*", r"(numpy|np|scipy|sympy|pinocchio|pin|meshcat|matplotlib|dask|distributed|xarray"
-               r"|yourdfpy|lxml|qpsolvers|osqp|tornado|zmq|pathlib|os|typing|collections|concurrent"
-               r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes|numba)(\..*)?"),
+    (
+        r"py:.*",
+        r"(numpy|np|scipy|sympy|pinocchio|pin|meshcat|matplotlib|dask|distributed|xarray"
+        r"|yourdfpy|lxml|qpsolvers|osqp|tornado|zmq|pathlib|os|typing|collections|concurrent"
+        r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes|numba)(\..*)?",
+    ),
     # prose in numpydoc type fields ("array (N, 3)", "float, rad") is not a Python name
     (r"py:class", r"[a-z_][a-z0-9_]*|.*[^\w.].*|True|False|[A-Z]|\d+|Eq\.?|\."),
     # module constants without a doc comment are not in the reference (names in prose)
     (r"py:data", r"(.*\.)?[A-Z][A-Z0-9_]*"),
     # private objects are not part of the API reference
     (r"py:.*", r"(.*\.)?_[^.]*(\..*)?"),
-    (r"py:.*", r"(ndarray|ArrayLike|NDArray|Path|PathLike|Sequence|Mapping|Iterable|Iterator|Callable"
-               r"|Any|Optional|Union|Literal|Self|TypeVar|Generator|Hashable|Enum|IntEnum|Exception"
-               r"|RuntimeError|ValueError|TypeError|KeyError|FileNotFoundError|OSError|LookupError"
-               r"|int|float|str|bytes|bool|complex|dict|list|tuple|set|frozenset|object|type|None"
-               r"|array_like|array-like|optional|callable|sequence|mapping|iterable|default|shape"
-               r"|N|n|m|nq|nv)"),
+    (
+        r"py:.*",
+        r"(ndarray|ArrayLike|NDArray|Path|PathLike|Sequence|Mapping|Iterable|Iterator|Callable"
+        r"|Any|Optional|Union|Literal|Self|TypeVar|Generator|Hashable|Enum|IntEnum|Exception"
+        r"|RuntimeError|ValueError|TypeError|KeyError|FileNotFoundError|OSError|LookupError"
+        r"|int|float|str|bytes|bool|complex|dict|list|tuple|set|frozenset|object|type|None"
+        r"|array_like|array-like|optional|callable|sequence|mapping|iterable|default|shape"
+        r"|N|n|m|nq|nv)",
+    ),
 ]
 
 # ---------------------------------------------------------------- API reference

@@ -17,6 +17,7 @@ import anthroarm as aa
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks import common, ik_peers  # noqa: E402
 
+
 @pytest.fixture(scope="module")
 def load_odd(tmp_path_factory):
     """anthroarm.load of ODD_ARM (below) with the given joints locked."""
@@ -52,7 +53,7 @@ ODD_ARM = """<robot name="oddarm">
 
 def _targets(robot, n, rng=5):
     ang = ik_peers.Angles(robot)
-    qs = ang.to_q(ang.from_q(robot.random_q(n, rng=rng)))   # unit (cos, sin) pairs
+    qs = ang.to_q(ang.from_q(robot.random_q(n, rng=rng)))  # unit (cos, sin) pairs
     return robot.fk(qs)
 
 
@@ -85,7 +86,7 @@ def test_angles_round_trip_continuous(load_odd):
 def test_trac_ik_chain_moves_base_and_tip_past_locked_joints(load_odd):
     pytest.importorskip("pytracik")
     robot = load_odd(pre=0.3, jaw=-0.2)
-    a, why = ik_peers.make("trac-ik", robot)   # make() checks its FK against Pinocchio's
+    a, why = ik_peers.make("trac-ik", robot)  # make() checks its FK against Pinocchio's
     assert a is not None, why
     assert (a.base, a.tip) == ("base", "l6")
     assert _solved(robot, a, _targets(robot, 12)) >= 10
@@ -100,7 +101,7 @@ def test_trac_ik_pins_a_locked_joint_inside_the_chain(load_odd):
     assert a.seed[2] == pytest.approx(0.7) and list(a.active) == [0, 1, 3, 4, 5]
 
 
-@pytest.mark.parametrize("peer, at_least", [("rtb-ik_LM", 6), ("ikpy", 3)])   # ikpy: local, ~90 %
+@pytest.mark.parametrize("peer, at_least", [("rtb-ik_LM", 6), ("ikpy", 3)])  # ikpy: local, ~90 %
 def test_peers_on_continuous_and_skew_axes(load_odd, peer, at_least):
     pytest.importorskip({"rtb-ik_LM": "roboticstoolbox", "ikpy": "ikpy"}[peer])
     robot = load_odd(pre=0.3, jaw=-0.2)
@@ -125,15 +126,30 @@ def test_trac_ik_on_catalog_arms(name):
 
 
 def _result(quick):
-    return {"title": "t", "columns": ["a"], "rows": [[1]], "notes": "", "quick": quick,
-            "environment": {"processor": "p", "cpus": 1, "python": "3", "numpy": "2", "pinocchio": "4", "date": "d"}}
+    return {
+        "title": "t",
+        "columns": ["a"],
+        "rows": [[1]],
+        "notes": "",
+        "quick": quick,
+        "environment": {
+            "processor": "p",
+            "cpus": 1,
+            "python": "3",
+            "numpy": "2",
+            "pinocchio": "4",
+            "date": "d",
+        },
+    }
 
 
 def test_quick_results_never_land_in_results(tmp_path, monkeypatch):
     monkeypatch.setattr(common, "RESULTS_DIR", tmp_path / "results")
     monkeypatch.setattr(common, "QUICK_DIR", tmp_path / "results" / "quick")
     jp, mp = common.write_result("x", _result(True))
-    assert jp.parent == tmp_path / "results" / "quick" and mp.read_text().startswith("# t (quick run)")
+    assert jp.parent == tmp_path / "results" / "quick" and mp.read_text().startswith(
+        "# t (quick run)"
+    )
     assert json.loads(jp.read_text())["quick"] is True
     with pytest.raises(ValueError, match="quick run"):
         common.write_result("x", _result(True), tmp_path / "results")

@@ -58,12 +58,15 @@ def test_folder_precedence(monkeypatch, tmp_path):
 def test_entry_roundtrip_and_damage_detected(cdir):
     assert cache.write("lagrange", "x.py", b"A = 1\n") == cdir / "lagrange" / "x.py"
     assert cache.read("lagrange", "x.py") == b"A = 1\n"
-    assert sorted(p.name for p in (cdir / "lagrange").iterdir()) == ["x.py", "x.py.sha256"]   # no temp files
-    (cdir / "lagrange" / "x.py").write_bytes(b"A = 2\n")           # same size, other content
+    assert sorted(p.name for p in (cdir / "lagrange").iterdir()) == [
+        "x.py",
+        "x.py.sha256",
+    ]  # no temp files
+    (cdir / "lagrange" / "x.py").write_bytes(b"A = 2\n")  # same size, other content
     assert cache.read("lagrange", "x.py") is None
-    assert not (cdir / "lagrange" / "x.py").exists()               # the damaged entry is gone
+    assert not (cdir / "lagrange" / "x.py").exists()  # the damaged entry is gone
     cache.write("lagrange", "y.py", b"B = 1\n")
-    (cdir / "lagrange" / "y.py.sha256").unlink()                   # no record: not trusted
+    (cdir / "lagrange" / "y.py.sha256").unlink()  # no record: not trusted
     assert cache.read("lagrange", "y.py") is None
     with pytest.raises(ValueError, match="lagrange, ik"):
         cache.folder("seeds")
@@ -72,9 +75,9 @@ def test_entry_roundtrip_and_damage_detected(cdir):
 def _flip_a_digit(text: str) -> str:
     """Change one digit of the first long numeric constant (a model parameter) of ``tau_1``."""
     start = text.index("def tau_1(")
-    m = re.compile(r"(?<![\w.])(\d\.\d{6,})(?![\de])").search(text, start)   # no 1e-16 noise
+    m = re.compile(r"(?<![\w.])(\d\.\d{6,})(?![\de])").search(text, start)  # no 1e-16 noise
     i = m.start(1) + 3
-    return text[:i] + ("7" if text[i] != "7" else "3") + text[i + 1:]
+    return text[:i] + ("7" if text[i] != "7" else "3") + text[i + 1 :]
 
 
 def test_edited_cached_python_is_rebuilt_not_run(cdir):
@@ -96,9 +99,9 @@ def test_edited_cached_python_is_rebuilt_not_run(cdir):
     assert np.max(np.abs(ns["tau_1"](th, v, a) - ref)) > 1e-6
     L._MEMO.clear()
     dyn2 = L.load(robot)
-    assert dyn2.source == "derived"                              # detected, derived again
+    assert dyn2.source == "derived"  # detected, derived again
     assert np.max(np.abs(dyn2.tau(q, v, a) - ref)) < 1e-12
-    assert path.read_text() == good                              # and the entry repaired
+    assert path.read_text() == good  # and the entry repaired
     L._MEMO.clear()
     assert L.load(robot).source == "cache"
 
@@ -107,7 +110,7 @@ def test_edited_cached_python_is_rebuilt_not_run(cdir):
 def test_truncated_shared_library_is_rebuilt_in_a_fresh_process(cdir):
     """A .so cut to a third: loading it used to kill the process with SIGBUS.  A fresh
     process must detect it, rebuild, and compute τ equal to Pinocchio's."""
-    L.load(aa.load("planar2r", l1=0.57), backend="c")          # a fresh parameterisation: not loaded yet
+    L.load(aa.load("planar2r", l1=0.57), backend="c")  # a fresh parameterisation: not loaded yet
     libs = list((cdir / "lagrange").glob("lagrange_*.so"))
     assert len(libs) == 1
     data = libs[0].read_bytes()
@@ -120,11 +123,16 @@ def test_truncated_shared_library_is_rebuilt_in_a_fresh_process(cdir):
         q, v, a = np.array([0.3, -0.7]), np.array([1.1, 0.4]), np.array([-0.2, 0.9])
         print(float(np.max(np.abs(d.tau(q, v, a) - pin.rnea(r.model, r.model.createData(), q, v, a)))))
     """)
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=os.environ.copy(),
-                       timeout=300)
+    r = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env=os.environ.copy(),
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr[-2000:]
     assert float(r.stdout.strip().splitlines()[-1]) < 1e-12
-    assert cache.read("lagrange", libs[0].name) is not None   # rebuilt and verified
+    assert cache.read("lagrange", libs[0].name) is not None  # rebuilt and verified
 
 
 def test_damaged_compiled_kernels_are_compiled_again(tmp_path):
@@ -142,7 +150,9 @@ def test_damaged_compiled_kernels_are_compiled_again(tmp_path):
     env.pop("NUMBA_CACHE_DIR", None)
 
     def run():
-        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+        r = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600
+        )
         assert r.returncode == 0, r.stderr[-2000:]
         ok, err = r.stdout.split()
         assert ok == "True" and float(err) < 1e-9
@@ -153,17 +163,17 @@ def test_damaged_compiled_kernels_are_compiled_again(tmp_path):
     assert data and index
     raw = data[0].read_bytes()
     assert raw.startswith(b"anthroarm-sha256")
-    damage(data[0], raw[:len(raw) // 2])                                  # truncated
+    damage(data[0], raw[: len(raw) // 2])  # truncated
     flipped = bytearray(data[1].read_bytes())
     flipped[-1] ^= 0xFF
-    damage(data[1], bytes(flipped))                                       # one bit pattern changed
-    damage(data[2], b"not numba's")                                       # foreign
-    damage(index[3], index[3].read_bytes()[:20])                          # garbled index
+    damage(data[1], bytes(flipped))  # one bit pattern changed
+    damage(data[2], b"not numba's")  # foreign
+    damage(index[3], index[3].read_bytes()[:20])  # garbled index
     run()
-    for f in data[:3]:                                                    # rewritten, verified
+    for f in data[:3]:  # rewritten, verified
         body = f.read_bytes()
         head = len(b"anthroarm-sha256\n")
-        assert hashlib.sha256(body[head + 32:]).digest() == body[head:head + 32]
+        assert hashlib.sha256(body[head + 32 :]).digest() == body[head : head + 32]
 
 
 def test_unwritable_cache_falls_back_to_memory(tmp_path, monkeypatch):
@@ -172,16 +182,18 @@ def test_unwritable_cache_falls_back_to_memory(tmp_path, monkeypatch):
     blocker.write_text("not a folder")
     monkeypatch.setenv("ANTHROARM_CACHE", str(blocker / "cache"))
     L._MEMO.clear()
-    robot = aa.load("planar2r", l1=0.61)                      # a fresh parameterisation (no memo anywhere)
+    robot = aa.load("planar2r", l1=0.61)  # a fresh parameterisation (no memo anywhere)
     dyn = L.load(robot)
     assert dyn.source == "derived"
     q, v, a = np.array([0.2, 0.5]), np.array([0.3, -1.0]), np.array([1.0, 2.0])
-    assert np.allclose(dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12)
+    assert np.allclose(
+        dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12
+    )
     assert "in memory" in cache.status() and str(blocker) in cache.status()
     if cache.compiler() is not None:
         dc = L.load(robot, backend="c")
         assert np.allclose(dc.tau(q, v, a), dyn.tau(q, v, a), atol=1e-13)
-        assert not str(dc._c.path).startswith(str(blocker))   # compiled into a private folder
+        assert not str(dc._c.path).startswith(str(blocker))  # compiled into a private folder
     assert blocker.read_text() == "not a folder"
     L._MEMO.clear()
 
@@ -211,7 +223,7 @@ def test_atomic_write_keeps_old_file_on_failure(tmp_path):
     atomic_write_text(p, "old")
 
     with pytest.raises(TypeError):
-        atomic_write_text(p, object())                         # not text: nothing is written
+        atomic_write_text(p, object())  # not text: nothing is written
     assert p.read_text() == "old" and sorted(x.name for x in tmp_path.iterdir()) == ["f.txt"]
     with pytest.raises(FileNotFoundError, match="does not exist"):
         atomic_write_text(tmp_path / "nope" / "x", "text")
@@ -227,7 +239,7 @@ def test_cli_cache_info_and_clear(cdir, capsys):
     assert cli_main(["cache", "clear"]) == 0
     assert "removed" in capsys.readouterr().out
     assert not list((cdir / "lagrange").iterdir())
-    assert (cdir / "keep.txt").is_file()                      # only the cache's own files go
+    assert (cdir / "keep.txt").is_file()  # only the cache's own files go
     assert cli_main(["cache", "info"]) == 0
     out = capsys.readouterr().out
     assert "entries 0" in out and str(cdir) in out
@@ -240,9 +252,11 @@ def test_damaged_bytecode_entry_is_recompiled(cdir):
     damage(code, code.read_bytes()[:50])
     L._MEMO.clear()
     dyn = L.load(robot)
-    assert dyn.source == "cache"                               # the verified source, compiled again
+    assert dyn.source == "cache"  # the verified source, compiled again
     q, v, a = np.array([0.2, 0.5]), np.array([0.3, -1.0]), np.array([1.0, 2.0])
-    assert np.allclose(dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12)
+    assert np.allclose(
+        dyn.tau(q, v, a), pin.rnea(robot.model, robot.model.createData(), q, v, a), atol=1e-12
+    )
     assert cache.read("lagrange", code.name) is not None
 
 
@@ -254,22 +268,33 @@ def test_a_kernel_is_compiled_again_when_a_kernel_it_calls_changes(tmp_path):
     pkg = tmp_path / "kpkg"
     pkg.mkdir()
     (pkg / "__init__.py").write_text("")
-    (pkg / "a.py").write_text("from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 1.0\n")
-    (pkg / "b.py").write_text("from anthroarm.jit import kernel\n\nfrom .a import f\n\n\n@kernel\ndef g(x):\n"
-                              "    return 10.0 * f(x)\n")
+    (pkg / "a.py").write_text(
+        "from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 1.0\n"
+    )
+    (pkg / "b.py").write_text(
+        "from anthroarm.jit import kernel\n\nfrom .a import f\n\n\n@kernel\ndef g(x):\n"
+        "    return 10.0 * f(x)\n"
+    )
     env = dict(os.environ, ANTHROARM_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(tmp_path))
     env.pop("NUMBA_CACHE_DIR", None)
 
     def run():
-        r = subprocess.run([sys.executable, "-c", "from kpkg.b import g; print(g(1.0))"], capture_output=True,
-                           text=True, env=env, timeout=300)
+        r = subprocess.run(
+            [sys.executable, "-c", "from kpkg.b import g; print(g(1.0))"],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=300,
+        )
         assert r.returncode == 0, r.stderr[-2000:]
         return float(r.stdout)
 
     assert run() == 20.0
-    assert list((tmp_path / "cache" / "numba").rglob("*.nbi"))            # cached
+    assert list((tmp_path / "cache" / "numba").rglob("*.nbi"))  # cached
     assert run() == 20.0
     b_stat = (pkg / "b.py").stat()
-    (pkg / "a.py").write_text("from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 2.0\n")
+    (pkg / "a.py").write_text(
+        "from anthroarm.jit import kernel\n\n\n@kernel\ndef f(x):\n    return x + 2.0\n"
+    )
     assert (pkg / "b.py").stat().st_mtime_ns == b_stat.st_mtime_ns
     assert run() == 30.0

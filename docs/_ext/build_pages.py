@@ -49,7 +49,9 @@ def copy_notebooks(src: Path, dst: Path) -> list[Path]:
         data = json.loads(nb.read_text(encoding="utf-8"))
         for cell in data.get("cells", []):
             if cell.get("cell_type") == "markdown":
-                src_text = "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+                src_text = (
+                    "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+                )
                 cell["source"] = src_text.replace("](../docs/", "](../")
         write_if_changed(dst / nb.name, json.dumps(data, indent=1, ensure_ascii=False) + "\n")
         keep.add(nb.name)
@@ -73,7 +75,12 @@ def escape_cell_bars(text: str) -> str:
     out = []
     for line in text.split("\n"):
         row = line.rstrip()
-        if row.startswith("|") and row.endswith("|") and len(row) > 1 and not TABLE_DELIMITER.match(row):
+        if (
+            row.startswith("|")
+            and row.endswith("|")
+            and len(row) > 1
+            and not TABLE_DELIMITER.match(row)
+        ):
             cells = []
             for i, ch in enumerate(row):
                 inner = 0 < i < len(row) - 1
@@ -106,9 +113,11 @@ def benchmark_pages(results: Path, dst: Path) -> list[str]:
                 shutil.copy2(p, dst / p.name)
                 text += f"```{{image}} {p.name}\n:alt: {p.stem}\n:width: 100%\n```\n\n"
         run_json = results / f"{name}.json"
-        text += (f"\n---\n\nSource: `benchmarks/results/{name}.md`"
-                 + (f" and `{run_json.name}` (every number of the run)" if run_json.is_file() else "")
-                 + f"; re-run with `anthroarm bench {name}` in a source checkout.\n")
+        text += (
+            f"\n---\n\nSource: `benchmarks/results/{name}.md`"
+            + (f" and `{run_json.name}` (every number of the run)" if run_json.is_file() else "")
+            + f"; re-run with `anthroarm bench {name}` in a source checkout.\n"
+        )
         write_if_changed(dst / f"{name}.md", f"(bench-{name})=\n" + text)
         names.append(name)
     return names
@@ -133,7 +142,9 @@ def _eq_ids(doc: str) -> list[tuple[int, int, str]]:
     return ids
 
 
-def collect_equations(package: str = "anthroarm") -> dict[tuple[int, int, str], list[tuple[str, str]]]:
+def collect_equations(
+    package: str = "anthroarm",
+) -> dict[tuple[int, int, str], list[tuple[str, str]]]:
     """{(chapter, number, prime): [(role, target)]}: where each equation is named in a docstring.
 
     role is ``mod``, ``class``, ``func`` or ``meth``; the target is documented on the API pages
@@ -172,14 +183,24 @@ def equation_table(out: Path, package: str = "anthroarm") -> int:
     by_ch: dict = defaultdict(list)
     for eq in sorted(where):
         by_ch[eq[0]].append(eq)
-    lines = [f"Every equation of the book named in a docstring — {len(where)} equations, found by "
-             "searching the docstrings for `Eq. (…)` when this site was built — with the functions, "
-             "classes and modules that implement or use it.", ""]
+    lines = [
+        f"Every equation of the book named in a docstring — {len(where)} equations, found by "
+        "searching the docstrings for `Eq. (…)` when this site was built — with the functions, "
+        "classes and modules that implement or use it.",
+        "",
+    ]
     for ch in sorted(by_ch):
-        lines += [f"### {CHAPTERS.get(ch, f'Ch. {ch}')}", "", "| equation | implemented in |", "|---|---|"]
+        lines += [
+            f"### {CHAPTERS.get(ch, f'Ch. {ch}')}",
+            "",
+            "| equation | implemented in |",
+            "|---|---|",
+        ]
         for eq in by_ch[ch]:
-            refs = ", ".join(f"{{py:{role}}}`~{target}`" if role != "mod" else f"{{py:mod}}`{target}`"
-                             for role, target in where[eq])
+            refs = ", ".join(
+                f"{{py:{role}}}`~{target}`" if role != "mod" else f"{{py:mod}}`{target}`"
+                for role, target in where[eq]
+            )
             lines.append(f"| ({eq[0]}-{eq[1]}{eq[2]}) | {refs} |")
         lines.append("")
     write_if_changed(out, "\n".join(lines) + "\n")
@@ -223,8 +244,12 @@ def escape_bars(app, what, name, obj, options, lines):
     i = 1
     while i < len(lines):
         cur, prev = lines[i].lstrip(), lines[i - 1]
-        if (cur.startswith(("* ", "- ")) and prev.strip() and not prev.lstrip().startswith(("* ", "- "))
-                and len(lines[i]) - len(cur) <= len(prev) - len(prev.lstrip())):
+        if (
+            cur.startswith(("* ", "- "))
+            and prev.strip()
+            and not prev.lstrip().startswith(("* ", "- "))
+            and len(lines[i]) - len(cur) <= len(prev) - len(prev.lstrip())
+        ):
             lines.insert(i, "")
             i += 1
         i += 1

@@ -75,9 +75,15 @@ def missing_reference(app, env, node, contnode):
     # a method or attribute named without its class (:meth:`angles` in anthroarm.chain): the one
     # documented object of that name in the same module
     if mod and "." not in target:
-        hits = [name for name, _ in domain.find_obj(env, mod, None, target, None, 1) if name.startswith(mod + ".")]
+        hits = [
+            name
+            for name, _ in domain.find_obj(env, mod, None, target, None, 1)
+            if name.startswith(mod + ".")
+        ]
         if len(hits) == 1:
-            return domain.resolve_xref(env, node["refdoc"], app.builder, "obj", hits[0], node.deepcopy(), contnode)
+            return domain.resolve_xref(
+                env, node["refdoc"], app.builder, "obj", hits[0], node.deepcopy(), contnode
+            )
     return None
 
 

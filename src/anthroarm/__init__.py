@@ -17,8 +17,25 @@ from .robot import Robot, load
 
 __version__ = "0.1.0"
 
-_LAZY = {"batch", "cache", "control", "crosscheck", "emg", "kinematics", "ik", "dynamics", "spatial", "mechanisms",
-         "design", "viewer", "trajectory", "urdf_io", "motion", "hand", "prosthesis"}
+_LAZY = {
+    "batch",
+    "cache",
+    "control",
+    "crosscheck",
+    "emg",
+    "kinematics",
+    "ik",
+    "dynamics",
+    "spatial",
+    "mechanisms",
+    "design",
+    "viewer",
+    "trajectory",
+    "urdf_io",
+    "motion",
+    "hand",
+    "prosthesis",
+}
 
 
 def __getattr__(name):  # lazy subpackages: `aa.ik.solve(...)` without importing everything up front

@@ -37,33 +37,50 @@ def atomic_write_text(path, text: str | bytes) -> None:
     from .errors import ParameterError
 
     if not isinstance(path, (str, os.PathLike)) or (isinstance(path, str) and not path):
-        raise ParameterError(f"atomic_write_text: path must be a file path (str or os.PathLike), "
-                             f"got {type(path).__name__} {path!r}")
+        raise ParameterError(
+            f"atomic_write_text: path must be a file path (str or os.PathLike), "
+            f"got {type(path).__name__} {path!r}"
+        )
     if not isinstance(text, (str, bytes, bytearray, memoryview)):
         # bytes(5) would silently write five NUL bytes
-        raise ParameterError(f"atomic_write_text: text must be str or bytes, got {type(text).__name__} "
-                             f"(writing {os.fspath(path)!r})")
+        raise ParameterError(
+            f"atomic_write_text: text must be str or bytes, got {type(text).__name__} "
+            f"(writing {os.fspath(path)!r})"
+        )
     path = Path(path)
     data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
     parent = path.parent
     if not parent.is_dir():
         if parent.exists() or any(p.is_file() for p in parent.parents):
-            raise NotADirectoryError(errno.ENOTDIR, f"{parent} is not a folder (cannot write {path.name})", str(path))
+            raise NotADirectoryError(
+                errno.ENOTDIR, f"{parent} is not a folder (cannot write {path.name})", str(path)
+            )
         raise FileNotFoundError(f"folder {parent} does not exist (cannot write {path.name})")
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
         mode = None
     if mode is not None and stat.S_ISDIR(mode):
-        raise IsADirectoryError(errno.EISDIR, f"is a folder, not a file (left unchanged); give a file name, "
-                                f"e.g. {path / 'NAME'}", str(path))
+        raise IsADirectoryError(
+            errno.EISDIR,
+            f"is a folder, not a file (left unchanged); give a file name, e.g. {path / 'NAME'}",
+            str(path),
+        )
     if mode is not None and not stat.S_ISREG(mode):
-        raise OSError(errno.EINVAL, "is not a regular file (a device, FIFO or socket; left unchanged); "
-                      "give the path of a regular file", str(path))
+        raise OSError(
+            errno.EINVAL,
+            "is not a regular file (a device, FIFO or socket; left unchanged); "
+            "give the path of a regular file",
+            str(path),
+        )
     _remove_stale_temps(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.{secrets.token_hex(4)}.tmp")
+    tmp = path.with_name(
+        f".{path.name}.{os.getpid()}.{threading.get_ident()}.{secrets.token_hex(4)}.tmp"
+    )
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)   # the umask applies, as for open()
+        fd = os.open(
+            tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666
+        )  # the umask applies, as for open()
     except OSError as exc:
         raise _naming(exc, path) from None
     try:
@@ -90,7 +107,7 @@ def _remove_stale_temps(path: Path) -> None:
     (their process no longer exists); best effort, never raises."""
     pattern = str(path.with_name(glob.escape(f".{path.name}.") + "*.tmp"))
     for t in glob.glob(pattern):
-        rest = os.path.basename(t)[len(path.name) + 2:].split(".")
+        rest = os.path.basename(t)[len(path.name) + 2 :].split(".")
         if len(rest) != 4 or not rest[0].isdigit():
             continue
         pid = int(rest[0])
@@ -104,4 +121,4 @@ def _remove_stale_temps(path: Path) -> None:
             except OSError:
                 pass
         except (PermissionError, OverflowError, OSError):
-            pass   # alive (another user's) or not a pid: leave it
+            pass  # alive (another user's) or not a pid: leave it

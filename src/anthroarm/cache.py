@@ -89,7 +89,9 @@ def folder(sub: str) -> Path | None:
 
 def _fallback(reason: str) -> None:
     with _LOCK:
-        _STATE["fallback"] = f"{reason}; generated code is kept in memory (set ${ENV} to a writable folder)"
+        _STATE["fallback"] = (
+            f"{reason}; generated code is kept in memory (set ${ENV} to a writable folder)"
+        )
 
 
 def status() -> str:
@@ -183,7 +185,7 @@ def _remove(path: Path) -> None:
             p.unlink()
         except FileNotFoundError:
             pass
-        except OSError:   # read-only folder: the entry stays invalid and is rebuilt in memory
+        except OSError:  # read-only folder: the entry stays invalid and is rebuilt in memory
             pass
 
 
@@ -199,7 +201,7 @@ def read(sub: str, name: str) -> bytes | None:
         stamp = _sidecar(path).read_text(encoding="ascii")
     except (FileNotFoundError, UnicodeDecodeError):
         if path.exists():
-            _remove(path)   # an entry without a valid sidecar cannot be trusted
+            _remove(path)  # an entry without a valid sidecar cannot be trusted
         return None
     except OSError:
         return None
@@ -280,7 +282,9 @@ def _compile(cc: str, source: str, flags: list[str]) -> bytes:
         cpath, opath = Path(tmp) / "src.c", Path(tmp) / "lib.so"
         cpath.write_text(source)
         try:
-            r = subprocess.run([cc, *flags, "-o", str(opath), str(cpath), "-lm"], capture_output=True, text=True)
+            r = subprocess.run(
+                [cc, *flags, "-o", str(opath), str(cpath), "-lm"], capture_output=True, text=True
+            )
         except OSError as exc:
             raise CompileError(f"cannot run the C compiler {cc}: {exc}") from None
         if r.returncode != 0:
@@ -306,14 +310,19 @@ def info() -> dict:
         d = base / sub
         n = size = 0
         if d.is_dir():
-            for p in d.rglob("*"):            # numba: one folder per source file
+            for p in d.rglob("*"):  # numba: one folder per source file
                 if p.is_file():
                     size += p.stat().st_size
                     if not p.name.endswith(_SIDECAR) and not p.name.startswith("."):
                         n += 1
         by[sub] = (n, size)
-    return {"folder": str(base), "entries": sum(v[0] for v in by.values()),
-            "bytes": sum(v[1] for v in by.values()), "by_folder": by, "status": status()}
+    return {
+        "folder": str(base),
+        "entries": sum(v[0] for v in by.values()),
+        "bytes": sum(v[1] for v in by.values()),
+        "by_folder": by,
+        "status": status(),
+    }
 
 
 def clear() -> int:

@@ -48,8 +48,10 @@ REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 NO_LIMIT = 1e100
 
 #: what to tell the user of a joint that no algorithm here handles
-_UNSUPPORTED_ADVICE = ("lock it with locked={{{name!r}: value}} or pick the sub-chain you need with "
-                       "active=[...] (aa.load(..., locked=..., active=...))")
+_UNSUPPORTED_ADVICE = (
+    "lock it with locked={{{name!r}: value}} or pick the sub-chain you need with "
+    "active=[...] (aa.load(..., locked=..., active=...))"
+)
 
 
 def _frozen(a) -> np.ndarray:
@@ -73,6 +75,7 @@ def _kernels():
     from the disk cache, :mod:`anthroarm.jit`) — a choice: it is 3–4× faster than numpy on
     the few rows of one IK answer, where Numba is loaded anyway."""
     from . import chain_kernels
+
     return chain_kernels
 
 
@@ -80,7 +83,7 @@ def _kernels():
 class Mimic:
     """θ_joint = multiplier · θ_source + offset (URDF ``<mimic>``; rad or m)."""
 
-    source: int          # index of the mimicked joint in Chain.joints
+    source: int  # index of the mimicked joint in Chain.joints
     multiplier: float
     offset: float
 
@@ -90,23 +93,23 @@ class Joint:
     """One joint of a :class:`Chain` (SI units, joint frame unless said otherwise)."""
 
     name: str
-    index: int            # position in Chain.joints (= Pinocchio joint id − 1)
-    parent: int           # index of the parent joint, −1 for the base
-    kind: str             # "revolute" | "prismatic" | "continuous"
-    axis: np.ndarray      # (3,) unit axis in the joint frame
+    index: int  # position in Chain.joints (= Pinocchio joint id − 1)
+    parent: int  # index of the parent joint, −1 for the base
+    kind: str  # "revolute" | "prismatic" | "continuous"
+    axis: np.ndarray  # (3,) unit axis in the joint frame
     rotation: np.ndarray  # (3, 3) placement in the parent joint frame at θ = 0
     translation: np.ndarray  # (3,) m
-    idx_q: int            # first entry in q (a mimic joint: its source's)
-    nq: int               # 1, 2 for a continuous joint, 0 for a mimic joint
+    idx_q: int  # first entry in q (a mimic joint: its source's)
+    nq: int  # 1, 2 for a continuous joint, 0 for a mimic joint
     idx_v: int
-    nv: int               # 1, 0 for a mimic joint
-    lower: float          # rad or m (−inf: none)
+    nv: int  # 1, 0 for a mimic joint
+    lower: float  # rad or m (−inf: none)
     upper: float
-    velocity: float       # rad/s or m/s (inf: none given)
-    effort: float         # N m or N (inf: none given)
-    mass: float           # kg, of the body this joint moves
-    com: np.ndarray       # (3,) m
-    inertia: np.ndarray   # (3, 3) kg m², about the centre of mass
+    velocity: float  # rad/s or m/s (inf: none given)
+    effort: float  # N m or N (inf: none given)
+    mass: float  # kg, of the body this joint moves
+    com: np.ndarray  # (3,) m
+    inertia: np.ndarray  # (3, 3) kg m², about the centre of mass
     mimic: Mimic | None = None
 
     @property
@@ -125,13 +128,13 @@ class Frame:
     base); ``rotation``/``translation`` place it in that joint's frame (m)."""
 
     name: str
-    index: int            # Pinocchio frame id
+    index: int  # Pinocchio frame id
     joint: int
     rotation: np.ndarray
     translation: np.ndarray
-    is_body: bool         # a URDF link (Pinocchio BODY frame)
-    is_joint: bool        # a joint frame (Pinocchio JOINT or FIXED_JOINT)
-    parent_frame: int     # Pinocchio id of the frame it hangs from
+    is_body: bool  # a URDF link (Pinocchio BODY frame)
+    is_joint: bool  # a joint frame (Pinocchio JOINT or FIXED_JOINT)
+    parent_frame: int  # Pinocchio id of the frame it hangs from
 
     @property
     def placement(self) -> np.ndarray:
@@ -151,7 +154,7 @@ class Chain:
         self.joints: tuple[Joint, ...] = tuple(joints)
         self.frames: tuple[Frame, ...] = tuple(frames)
         self._frame_ids = {}
-        for f in self.frames:               # Pinocchio keeps the first of equal names
+        for f in self.frames:  # Pinocchio keeps the first of equal names
             self._frame_ids.setdefault(f.name, f.index)
         self._joint_ids = {j.name: j.index for j in self.joints}
         self.tips: tuple[str, ...] = tuple(tips)
@@ -171,11 +174,12 @@ class Chain:
         name = name or getattr(model, "name", "") or "model"
         from .urdf_io import MAX_MOVABLE_JOINTS
 
-        if model.njoints - 1 > MAX_MOVABLE_JOINTS:   # before createData: pin.Data grows as n³
+        if model.njoints - 1 > MAX_MOVABLE_JOINTS:  # before createData: pin.Data grows as n³
             raise UnsupportedModelError(
                 f"{name}: {model.njoints - 1} joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model "
                 "(Pinocchio's data grows as the cube of the joint count); lock joints with "
-                "pin.buildReducedModel first or split the model")
+                "pin.buildReducedModel first or split the model"
+            )
         data = model.createData()
         pin.forwardKinematics(model, data, pin.neutral(model))
         mimic_of = {}
@@ -194,8 +198,10 @@ class Chain:
                 e = jm.extract()
                 mult, off = float(e.scaling), float(e.offset)
                 if mult == 0.0:
-                    raise UnsupportedModelError(f"{name}: mimic joint {jname!r} has multiplier 0; "
-                                                + _UNSUPPORTED_ADVICE.format(name=jname))
+                    raise UnsupportedModelError(
+                        f"{name}: mimic joint {jname!r} has multiplier 0; "
+                        + _UNSUPPORTED_ADVICE.format(name=jname)
+                    )
                 mimic = Mimic(mimic_of[jid] - 1, mult, off)
                 S = np.asarray(data.joints[jid].S).reshape(6) / mult
                 nq = nv = 0
@@ -205,7 +211,8 @@ class Chain:
                     raise UnsupportedModelError(
                         f"{name}: joint {jname!r} is {short} with nq={jm.nq}, nv={jm.nv}; anthroarm handles "
                         "revolute, continuous, prismatic and mimic joints on a fixed base: "
-                        + _UNSUPPORTED_ADVICE.format(name=jname))
+                        + _UNSUPPORTED_ADVICE.format(name=jname)
+                    )
                 S = np.asarray(data.joints[jid].S).reshape(6)
                 nq, nv, idx_q, idx_v = jm.nq, jm.nv, jm.idx_q, jm.idx_v
             lin, ang = S[:3], S[3:]
@@ -217,11 +224,14 @@ class Chain:
             else:
                 raise UnsupportedModelError(
                     f"{name}: joint {jname!r} ({short}) is neither a revolute nor a prismatic motion; "
-                    + _UNSUPPORTED_ADVICE.format(name=jname))
+                    + _UNSUPPORTED_ADVICE.format(name=jname)
+                )
             if nq == 2:
                 if kind != REVOLUTE:
-                    raise UnsupportedModelError(f"{name}: joint {jname!r} ({short}) has a 2-entry configuration "
-                                                "but is not a rotation; " + _UNSUPPORTED_ADVICE.format(name=jname))
+                    raise UnsupportedModelError(
+                        f"{name}: joint {jname!r} ({short}) has a 2-entry configuration "
+                        "but is not a rotation; " + _UNSUPPORTED_ADVICE.format(name=jname)
+                    )
                 kind = CONTINUOUS
                 lo, hi = -np.inf, np.inf
             elif nq == 1:
@@ -230,24 +240,43 @@ class Chain:
                 lo = -np.inf if lo <= -NO_LIMIT else lo
                 hi = np.inf if hi >= NO_LIMIT else hi
             else:
-                lo, hi = -np.inf, np.inf   # set below from the source's limits
+                lo, hi = -np.inf, np.inf  # set below from the source's limits
             axis = np.where(np.abs(axis) < 1e-15, 0.0, axis)
             axis = axis / np.linalg.norm(axis)
             pl = model.jointPlacements[jid]
             Y = model.inertias[jid]
             Ic = np.asarray(Y.inertia, dtype=float)
-            joints.append(dict(
-                name=jname, index=jid - 1, parent=int(model.parents[jid]) - 1, kind=kind, axis=_frozen(axis),
-                rotation=_frozen(pl.rotation), translation=_frozen(pl.translation), idx_q=int(idx_q), nq=int(nq),
-                idx_v=int(idx_v), nv=int(nv), lower=lo, upper=hi,
-                velocity=float(vel[idx_v]) if nv else np.inf, effort=float(eff[idx_v]) if nv else np.inf,
-                mass=float(Y.mass), com=_frozen(Y.lever), inertia=_frozen(0.5 * (Ic + Ic.T)), mimic=mimic))
-        for j in joints:   # a mimic joint's range is its source's, mapped
+            joints.append(
+                dict(
+                    name=jname,
+                    index=jid - 1,
+                    parent=int(model.parents[jid]) - 1,
+                    kind=kind,
+                    axis=_frozen(axis),
+                    rotation=_frozen(pl.rotation),
+                    translation=_frozen(pl.translation),
+                    idx_q=int(idx_q),
+                    nq=int(nq),
+                    idx_v=int(idx_v),
+                    nv=int(nv),
+                    lower=lo,
+                    upper=hi,
+                    velocity=float(vel[idx_v]) if nv else np.inf,
+                    effort=float(eff[idx_v]) if nv else np.inf,
+                    mass=float(Y.mass),
+                    com=_frozen(Y.lever),
+                    inertia=_frozen(0.5 * (Ic + Ic.T)),
+                    mimic=mimic,
+                )
+            )
+        for j in joints:  # a mimic joint's range is its source's, mapped
             m = j["mimic"]
             if m is not None:
                 src = joints[m.source]
                 if src["mimic"] is not None:
-                    raise UnsupportedModelError(f"{name}: mimic joint {j['name']!r} copies another mimic joint")
+                    raise UnsupportedModelError(
+                        f"{name}: mimic joint {j['name']!r} copies another mimic joint"
+                    )
                 if src["kind"] != CONTINUOUS:
                     a = m.multiplier * src["lower"] + m.offset
                     b = m.multiplier * src["upper"] + m.offset
@@ -256,15 +285,26 @@ class Chain:
         joints = [Joint(**j) for j in joints]
         frames = []
         for fid, f in enumerate(model.frames):
-            frames.append(Frame(f.name, fid, int(f.parentJoint) - 1, _frozen(f.placement.rotation),
-                                _frozen(f.placement.translation), f.type == pin.FrameType.BODY,
-                                f.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT), int(f.parentFrame)))
+            frames.append(
+                Frame(
+                    f.name,
+                    fid,
+                    int(f.parentJoint) - 1,
+                    _frozen(f.placement.rotation),
+                    _frozen(f.placement.translation),
+                    f.type == pin.FrameType.BODY,
+                    f.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT),
+                    int(f.parentFrame),
+                )
+            )
         tips = leaf_frames(joints, frames)
         if tool is None:
             tool = _default_tool(name, joints, frames, tips)
         elif tool not in {f.name for f in frames}:
-            raise UnknownFrameError(f"{name}: unknown tool frame {tool!r}; tip frames: {', '.join(tips)}; "
-                                    f"valid frames: {', '.join(f.name for f in frames)}")
+            raise UnknownFrameError(
+                f"{name}: unknown tool frame {tool!r}; tip frames: {', '.join(tips)}; "
+                f"valid frames: {', '.join(f.name for f in frames)}"
+            )
         return cls(name, joints, frames, tool, tips, model.nq, model.nv, model.gravity.linear)
 
     # ------------------------------------------------------------------ lookup
@@ -283,8 +323,10 @@ class Chain:
         try:
             return self.joints[self._joint_ids[name]]
         except KeyError:
-            raise UnknownFrameError(f"{self.name}: unknown joint {name!r}; joints: "
-                                    f"{', '.join(j.name for j in self.joints)}") from None
+            raise UnknownFrameError(
+                f"{self.name}: unknown joint {name!r}; joints: "
+                f"{', '.join(j.name for j in self.joints)}"
+            ) from None
 
     def frame(self, frame) -> Frame:
         """A frame by name or Pinocchio id (``None``: the tool)."""
@@ -292,15 +334,21 @@ class Chain:
             return self.frames[self.tool_frame]
         if isinstance(frame, (int, np.integer)) and not isinstance(frame, bool):
             if not 0 <= frame < len(self.frames):
-                raise UnknownFrameError(f"{self.name}: frame index {frame} out of range 0..{len(self.frames) - 1}")
+                raise UnknownFrameError(
+                    f"{self.name}: frame index {frame} out of range 0..{len(self.frames) - 1}"
+                )
             return self.frames[int(frame)]
         if not isinstance(frame, str):
-            raise UnknownFrameError(f"{self.name}: a frame is a name or an index, got {frame!r}; "
-                                    f"valid frames: {', '.join(f.name for f in self.frames)}")
+            raise UnknownFrameError(
+                f"{self.name}: a frame is a name or an index, got {frame!r}; "
+                f"valid frames: {', '.join(f.name for f in self.frames)}"
+            )
         fid = self._frame_ids.get(frame)
         if fid is None:
-            raise UnknownFrameError(f"{self.name}: unknown frame {frame!r}; tip frames: {', '.join(self.tips)}; "
-                                    f"valid frames: {', '.join(f.name for f in self.frames)}")
+            raise UnknownFrameError(
+                f"{self.name}: unknown frame {frame!r}; tip frames: {', '.join(self.tips)}; "
+                f"valid frames: {', '.join(f.name for f in self.frames)}"
+            )
         return self.frames[fid]
 
     def path(self, frame=None) -> tuple[int, ...]:
@@ -324,7 +372,10 @@ class Chain:
     @cached_property
     def is_serial(self) -> bool:
         """No joint has two children."""
-        return all(len(self.children(j.index)) <= 1 for j in self.joints) and len(self.children(-1)) <= 1
+        return (
+            all(len(self.children(j.index)) <= 1 for j in self.joints)
+            and len(self.children(-1)) <= 1
+        )
 
     @cached_property
     def has_continuous(self) -> bool:
@@ -351,7 +402,7 @@ class Chain:
             if j.is_mimic:
                 continue
             if j.kind == CONTINUOUS:
-                out[j.idx_q:j.idx_q + 2] = 1.0 if which else -1.0
+                out[j.idx_q : j.idx_q + 2] = 1.0 if which else -1.0
             else:
                 out[j.idx_q] = j.upper if which else j.lower
         return _frozen(out)
@@ -405,8 +456,10 @@ class Chain:
         theta = np.asarray(theta, dtype=float)
         ind = self.independent
         if theta.ndim == 0 or theta.shape[-1] != len(ind):
-            raise ValueError(f"{self.name}: theta must have {len(ind)} entries (one per independent joint: "
-                             f"{', '.join(self.joints[i].name for i in ind)}), got shape {theta.shape}")
+            raise ValueError(
+                f"{self.name}: theta must have {len(ind)} entries (one per independent joint: "
+                f"{', '.join(self.joints[i].name for i in ind)}), got shape {theta.shape}"
+            )
         th = np.ascontiguousarray(theta.reshape(math.prod(theta.shape[:-1]), len(ind)))
         q = np.empty((th.shape[0], self.nq))
         configure, index = _kernels().configure, self._configuration_index
@@ -417,8 +470,10 @@ class Chain:
     def _configuration_index(self) -> np.ndarray:
         """For :meth:`configuration`: row k (independent joint k) holds its first entry in q and
         whether it is continuous (q holds cos θ, sin θ)."""
-        return np.array([(self.joints[i].idx_q, self.joints[i].kind == CONTINUOUS) for i in self.independent],
-                        dtype=np.int64).reshape(-1, 2)
+        return np.array(
+            [(self.joints[i].idx_q, self.joints[i].kind == CONTINUOUS) for i in self.independent],
+            dtype=np.int64,
+        ).reshape(-1, 2)
 
     @cached_property
     def sampling_box(self) -> tuple[np.ndarray, np.ndarray]:
@@ -444,10 +499,16 @@ class Chain:
         rng = np.random.default_rng(rng)
         lo, hi = self.sampling_box
         if margin:
-            tight = [self.joints[i].name for i, a, b in zip(self.independent, lo, hi) if b - a < 2 * margin]
+            tight = [
+                self.joints[i].name
+                for i, a, b in zip(self.independent, lo, hi)
+                if b - a < 2 * margin
+            ]
             if tight:
-                raise ParameterError(f"{self.name}: margin={margin} is more than half the range of joints "
-                                     f"{tight}: no configuration is that far inside their limits")
+                raise ParameterError(
+                    f"{self.name}: margin={margin} is more than half the range of joints "
+                    f"{tight}: no configuration is that far inside their limits"
+                )
         lo, hi = lo + margin, hi - margin
         shape = (len(lo),) if n is None else (n, len(lo))
         return self.configuration(lo + (hi - lo) * rng.random(shape))
@@ -467,7 +528,8 @@ class Chain:
                         r = r[bad][0]
                     raise ValueError(
                         f"{self.name}: continuous joint {j.name!r} takes (cos θ, sin θ) in "
-                        f"{name}[{j.idx_q}:{j.idx_q + 2}], a unit vector; its norm is {float(r):.6g}{where}")
+                        f"{name}[{j.idx_q}:{j.idx_q + 2}], a unit vector; its norm is {float(r):.6g}{where}"
+                    )
 
     # ------------------------------------------------------------------ derived
     def reach(self, frame=None) -> float:
@@ -489,10 +551,19 @@ class Chain:
         h.update(self.gravity.tobytes())
         for j in self.joints:
             h.update(f"|{j.name}|{j.parent}|{j.kind}|{j.idx_q}|{j.nq}|{j.idx_v}|{j.nv}|".encode())
-            for a in (j.axis, j.rotation, j.translation, np.array([j.mass, j.lower, j.upper]), j.com, j.inertia):
+            for a in (
+                j.axis,
+                j.rotation,
+                j.translation,
+                np.array([j.mass, j.lower, j.upper]),
+                j.com,
+                j.inertia,
+            ):
                 h.update(np.ascontiguousarray(a, dtype=float).tobytes())
             if j.mimic is not None:
-                h.update(np.array([j.mimic.source, j.mimic.multiplier, j.mimic.offset], float).tobytes())
+                h.update(
+                    np.array([j.mimic.source, j.mimic.multiplier, j.mimic.offset], float).tobytes()
+                )
         return h.hexdigest()
 
     def serial(self, frame=None):
@@ -516,16 +587,22 @@ def _check_sampling(name: str, n, margin) -> tuple[int | None, float]:
     """``(n, margin)`` of :meth:`Chain.random_q`, checked (bools are not counts)."""
     if n is not None:
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-            raise ParameterError(f"{name}: random_q(n) takes None or a whole number >= 0, got {n!r}")
+            raise ParameterError(
+                f"{name}: random_q(n) takes None or a whole number >= 0, got {n!r}"
+            )
         if n < 0:
             raise ParameterError(f"{name}: random_q(n) takes a count >= 0, got {n}")
         n = int(n)
     try:
         margin = float(margin)
     except (TypeError, ValueError):
-        raise ParameterError(f"{name}: random_q margin= is a number (rad or m), got {margin!r}") from None
+        raise ParameterError(
+            f"{name}: random_q margin= is a number (rad or m), got {margin!r}"
+        ) from None
     if not (np.isfinite(margin) and margin >= 0):
-        raise ParameterError(f"{name}: random_q margin= must be finite and >= 0 (rad or m), got {margin}")
+        raise ParameterError(
+            f"{name}: random_q margin= must be finite and >= 0 (rad or m), got {margin}"
+        )
     return n, margin
 
 
@@ -537,7 +614,7 @@ def leaf_frames(joints, frames) -> tuple[str, ...]:
     fixed to the base are no tips."""
     hangs = {f.parent_frame for f in frames if f.is_joint and f.parent_frame != f.index}
     by_joint: dict[int, list] = {}
-    for f in frames:   # links fixed to the base do not move: no tip, unless nothing moves
+    for f in frames:  # links fixed to the base do not move: no tip, unless nothing moves
         if f.is_body and f.index not in hangs and f.index != 0 and (f.joint >= 0 or not joints):
             by_joint.setdefault(f.joint, []).append(f)
     out = []
@@ -554,4 +631,5 @@ def _default_tool(name, joints, frames, tips) -> str:
         return frames[-1].name
     raise AmbiguousToolError(
         f"{name}: this robot is a tree with {len(tips)} tips; say which frame is the tool with tool=..., "
-        f"one of the tips: {', '.join(tips)}")
+        f"one of the tips: {', '.join(tips)}"
+    )

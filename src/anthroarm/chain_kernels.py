@@ -27,7 +27,14 @@ def configure(theta, index, q):
     for i in range(theta.shape[0]):
         for k in range(theta.shape[1]):
             t, cont = theta[i, k], index[k, 1] != 0
-            put_joint(q[i], index[k, 0], cont, t, math.cos(t) if cont else 0.0, math.sin(t) if cont else 0.0)
+            put_joint(
+                q[i],
+                index[k, 0],
+                cont,
+                t,
+                math.cos(t) if cont else 0.0,
+                math.sin(t) if cont else 0.0,
+            )
 
 
 __all__ = ["configure", "put_joint"]

@@ -72,7 +72,9 @@ class CheckRow:
     @classmethod
     def unsupported(cls, model: str, quantity: str, reason: str) -> "CheckRow":
         """A row for a check that cannot run on ``model``: it compares nothing and does not pass."""
-        return cls(model, quantity, math.nan, 0.0, 0, "-", f"{UNSUPPORTED}: {' '.join(reason.split())}")
+        return cls(
+            model, quantity, math.nan, 0.0, 0, "-", f"{UNSUPPORTED}: {' '.join(reason.split())}"
+        )
 
     @property
     def ok(self) -> bool:
@@ -80,7 +82,7 @@ class CheckRow:
 
     @property
     def status(self) -> str:
-        """"ok", "FAIL" or "unsupported"."""
+        """ "ok", "FAIL" or "unsupported"."""
         if self.ok:
             return "ok"
         return UNSUPPORTED if self.note.startswith(UNSUPPORTED + ":") else "FAIL"
@@ -109,8 +111,15 @@ def load_robots(models=None, tool: str | None = None, locked=None) -> list:
     return [e if isinstance(e, Robot) else load(e, **kw) for e in entries]
 
 
-def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress: bool = False,
-        tool: str | None = None, locked=None) -> list[CheckRow]:
+def run(
+    models=None,
+    samples: int = 200,
+    seed: int = 0,
+    providers=None,
+    progress: bool = False,
+    tool: str | None = None,
+    locked=None,
+) -> list[CheckRow]:
     """Run the checks (see the module docstring) and return the rows.
 
     ``models``: names, URDF paths or Robots (default: the whole catalog); ``providers``: dotted
@@ -121,7 +130,7 @@ def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress
     robots = load_robots(models, tool, locked)
     if not models:
         names = catalog.names()
-    elif tool is None and locked is None:   # the book rows are about the catalog models as they are
+    elif tool is None and locked is None:  # the book rows are about the catalog models as they are
         names = [str(m) for m in models if isinstance(m, (str, Path)) and str(m) in catalog.names()]
     else:
         names = []
@@ -144,8 +153,17 @@ def run(models=None, samples: int = 200, seed: int = 0, providers=None, progress
         except UnsupportedModelError as exc:
             rows.append(CheckRow.unsupported(robot.name, ROBOT_PROVIDERS[dotted], str(exc)))
         except Exception as exc:  # noqa: BLE001 - a check that crashes on a user's robot is a failed row, not a traceback
-            rows.append(CheckRow(robot.name, ROBOT_PROVIDERS[dotted], math.nan, 0.0, 0, "-",
-                                 f"{ERROR}: {type(exc).__name__}: {' '.join(str(exc).split())}"))
+            rows.append(
+                CheckRow(
+                    robot.name,
+                    ROBOT_PROVIDERS[dotted],
+                    math.nan,
+                    0.0,
+                    0,
+                    "-",
+                    f"{ERROR}: {type(exc).__name__}: {' '.join(str(exc).split())}",
+                )
+            )
     return rows
 
 
@@ -172,10 +190,22 @@ def ik_rows(robot, samples: int, rng) -> list[CheckRow]:
         solved += 1
         pin.framesForwardKinematics(model, data, res.q)
         M = data.oMf[fid]
-        worst = max(worst, float(np.linalg.norm(M.translation - T[:3, 3])),
-                    float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))))
-    return [CheckRow(robot.name, "aa.ik.solve: FK(solve(T)) = T within limits", worst, 1e-6, n, "pinocchio FK",
-                     f"{solved}/{n} solved; pos (m) / rot (rad), worst of both")]
+        worst = max(
+            worst,
+            float(np.linalg.norm(M.translation - T[:3, 3])),
+            float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))),
+        )
+    return [
+        CheckRow(
+            robot.name,
+            "aa.ik.solve: FK(solve(T)) = T within limits",
+            worst,
+            1e-6,
+            n,
+            "pinocchio FK",
+            f"{solved}/{n} solved; pos (m) / rot (rad), worst of both",
+        )
+    ]
 
 
 def format_table(rows: list[CheckRow]) -> str:
@@ -183,10 +213,20 @@ def format_table(rows: list[CheckRow]) -> str:
     reasons of unsupported rows and a summary line."""
     head = ("model", "quantity", "max_abs_err", "tol", "samples", "oracle", "ok")
     body = [
-        (r.model, r.quantity, f"{r.max_abs_err:.3e}", f"{r.tol:.0e}", str(r.samples), r.oracle, r.status)
+        (
+            r.model,
+            r.quantity,
+            f"{r.max_abs_err:.3e}",
+            f"{r.tol:.0e}",
+            str(r.samples),
+            r.oracle,
+            r.status,
+        )
         for r in rows
     ]
-    widths = [max(len(h), *(len(b[i]) for b in body)) if body else len(h) for i, h in enumerate(head)]
+    widths = [
+        max(len(h), *(len(b[i]) for b in body)) if body else len(h) for i, h in enumerate(head)
+    ]
     fmt = "  ".join(f"{{:<{w}}}" for w in widths)
     lines = [fmt.format(*head).rstrip(), fmt.format(*("-" * w for w in widths))]
     lines += [fmt.format(*b).rstrip() for b in body]
@@ -195,7 +235,9 @@ def format_table(rows: list[CheckRow]) -> str:
         if r.note.startswith((UNSUPPORTED + ":", ERROR + ":")):
             lines.append(f"{r.model}: {r.quantity}: {r.note}")
     n_ok = sum(r.ok for r in rows)
-    lines.append(f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} unsupported")
+    lines.append(
+        f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} unsupported"
+    )
     return "\n".join(lines)
 
 

@@ -252,7 +252,11 @@ class CatalogueError(AnthroarmError, ValueError):
         self.line = line
         self.column = column
         self.problem = problem
-        where = "" if path is None else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
+        where = (
+            ""
+            if path is None
+            else f"{self.path}" + (f", line {line}" if line is not None else "") + ": "
+        )
         super().__init__(where + problem)
 
 

@@ -48,8 +48,8 @@ import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from numba import types  # noqa: E402
 from numba.core import caching, cgutils  # noqa: E402
-from numba.extending import intrinsic  # noqa: E402
 from numba.core.imputils import impl_ret_borrowed  # noqa: E402
+from numba.extending import intrinsic  # noqa: E402
 from numba.np.arrayobj import populate_array  # noqa: E402
 
 OPTIONS = dict(nogil=True, error_model="numpy")
@@ -63,12 +63,12 @@ class VerifiedCacheFile(caching.IndexDataCacheFile):
     def _load_index(self):
         try:
             return super()._load_index()
-        except Exception:                   # noqa: BLE001 - truncated/edited index: compile again
+        except Exception:  # noqa: BLE001 - truncated/edited index: compile again
             return {}
 
     def _save_data(self, name, data):
         payload = self._dump(data)
-        with self._open_for_write(self._data_path(name)) as f:       # temp file + os.replace
+        with self._open_for_write(self._data_path(name)) as f:  # temp file + os.replace
             f.write(_MAGIC + hashlib.sha256(payload).digest() + payload)
 
     def _load_data(self, name):
@@ -76,12 +76,15 @@ class VerifiedCacheFile(caching.IndexDataCacheFile):
         with open(path, "rb") as f:
             raw = f.read()
         head = len(_MAGIC) + 32
-        if not raw.startswith(_MAGIC) or hashlib.sha256(raw[head:]).digest() != raw[len(_MAGIC):head]:
+        if (
+            not raw.startswith(_MAGIC)
+            or hashlib.sha256(raw[head:]).digest() != raw[len(_MAGIC) : head]
+        ):
             try:
                 os.remove(path)
             except OSError:
                 pass
-            return None                     # not verified: compiled again, never loaded
+            return None  # not verified: compiled again, never loaded
         return pickle.loads(raw[head:])
 
 
@@ -122,14 +125,18 @@ class VerifiedCache(caching.FunctionCache):
 
     def __init__(self, py_func):
         super().__init__(py_func)
-        stamp = (self._impl.locator.get_source_stamp(), kernel_sources_digest(_package_root(py_func)))
-        self._cache_file = VerifiedCacheFile(cache_path=self._cache_path, filename_base=self._impl.filename_base,
-                                             source_stamp=stamp)
+        stamp = (
+            self._impl.locator.get_source_stamp(),
+            kernel_sources_digest(_package_root(py_func)),
+        )
+        self._cache_file = VerifiedCacheFile(
+            cache_path=self._cache_path, filename_base=self._impl.filename_base, source_stamp=stamp
+        )
 
     def load_overload(self, sig, target_context):
         try:
             return super().load_overload(sig, target_context)
-        except Exception:                   # noqa: BLE001 - any unreadable entry: compile again
+        except Exception:  # noqa: BLE001 - any unreadable entry: compile again
             return None
 
 
@@ -146,13 +153,15 @@ def kernel(func=None, *, counted: bool = True, inline: bool = False):
     point calls must not return an array (a view returned uncounted to a counting caller would
     be released once too often): a kernel that returns views is ``inline=True`` (compiled
     into each caller's body, ``numba.njit(inline="always")``)."""
+
     def wrap(f):
         options = OPTIONS if counted else dict(OPTIONS, _nrt=False)
         if inline:
             options = dict(options, inline="always")
         dispatcher = numba.njit(**options)(f)
-        dispatcher._cache = VerifiedCache(f)         # numba.njit(cache=True) with our cache file
+        dispatcher._cache = VerifiedCache(f)  # numba.njit(cache=True) with our cache file
         return dispatcher
+
     return wrap if func is None else wrap(func)
 
 
@@ -171,6 +180,7 @@ def _local_array(dtype, ndim: int):
     """A Numba intrinsic ``f(*shape)`` (``ndim`` literal sizes) that makes a C-order array of
     ``dtype`` in the calling kernel's stack frame (LLVM ``alloca`` in its entry block: made once
     per call, freed at its return; no heap, no reference count).  Its contents are undefined."""
+
     def typer(typingctx, *sizes):
         if len(sizes) != ndim or not all(isinstance(n, types.IntegerLiteral) for n in sizes):
             raise numba.errors.RequireLiteralValue(f"a local array takes {ndim} literal sizes")
@@ -182,10 +192,15 @@ def _local_array(dtype, ndim: int):
             llty = context.get_data_type(dtype)
             size = context.get_abi_sizeof(llty)
             intp = functools.partial(context.get_constant, types.intp)
-            strides = [size * int(np.prod(shape[i + 1:])) for i in range(ndim)]
-            populate_array(ary, data=cgutils.alloca_once(builder, llty, size=int(np.prod(shape))),
-                           shape=[intp(n) for n in shape], strides=[intp(s) for s in strides], itemsize=intp(size),
-                           meminfo=None)
+            strides = [size * int(np.prod(shape[i + 1 :])) for i in range(ndim)]
+            populate_array(
+                ary,
+                data=cgutils.alloca_once(builder, llty, size=int(np.prod(shape))),
+                shape=[intp(n) for n in shape],
+                strides=[intp(s) for s in strides],
+                itemsize=intp(size),
+                meminfo=None,
+            )
             return ary._getvalue()
 
         return arrty(*sizes), codegen
@@ -199,20 +214,32 @@ def _view_array(ndim: int):
     """A Numba intrinsic ``f(a, *shape)`` (``ndim`` integer sizes): the first prod(shape) entries
     of the C-order array ``a`` (in memory order) as a C-order array of that shape (same data,
     dtype and owner; :data:`view2`)."""
+
     def typer(typingctx, arr, sizes):
-        if not (isinstance(arr, types.Array) and arr.layout == "C") or not all(isinstance(n, types.Integer) for n in sizes):
+        if not (isinstance(arr, types.Array) and arr.layout == "C") or not all(
+            isinstance(n, types.Integer) for n in sizes
+        ):
             raise numba.errors.TypingError(f"a view takes a C-order array and {ndim} integer sizes")
         outty = arr.copy(ndim=ndim, layout="C")
 
         def codegen(context, builder, sig, args):
             src = context.make_array(sig.args[0])(context, builder, args[0])
-            shape = [context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:])]
+            shape = [
+                context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:])
+            ]
             strides = [src.itemsize]
             for n in shape[:0:-1]:
                 strides.insert(0, builder.mul(strides[0], n))
             out = context.make_array(outty)(context, builder)
-            populate_array(out, data=src.data, shape=shape, strides=strides, itemsize=src.itemsize,
-                           meminfo=src.meminfo, parent=src.parent)
+            populate_array(
+                out,
+                data=src.data,
+                shape=shape,
+                strides=strides,
+                itemsize=src.itemsize,
+                meminfo=src.meminfo,
+                parent=src.parent,
+            )
             return impl_ret_borrowed(context, builder, outty, out._getvalue())
 
         return outty(arr, *sizes), codegen
@@ -240,5 +267,18 @@ local_flags = _local_array(types.boolean, 1)
 local_ints2 = _local_array(types.int64, 2)
 
 
-__all__ = ["CACHE_SUBFOLDER", "OPTIONS", "VerifiedCache", "VerifiedCacheFile", "entry_point", "kernel",
-           "kernel_sources_digest", "local", "local2", "local_flags", "local_ints2", "view2", "view3"]
+__all__ = [
+    "CACHE_SUBFOLDER",
+    "OPTIONS",
+    "VerifiedCache",
+    "VerifiedCacheFile",
+    "entry_point",
+    "kernel",
+    "kernel_sources_digest",
+    "local",
+    "local2",
+    "local_flags",
+    "local_ints2",
+    "view2",
+    "view3",
+]

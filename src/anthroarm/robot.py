@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .chain import CONTINUOUS, Chain
+from .chain import Chain
 from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
 from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf
 
@@ -59,8 +59,10 @@ def _reference_frame(reference) -> pin.ReferenceFrame:
     if isinstance(reference, pin.ReferenceFrame):
         return reference
     if not isinstance(reference, str) or reference not in _REFERENCES:
-        raise ParameterError(f"reference must be one of {', '.join(_REFERENCES)} (or a pin.ReferenceFrame), "
-                             f"got {reference!r}")
+        raise ParameterError(
+            f"reference must be one of {', '.join(_REFERENCES)} (or a pin.ReferenceFrame), "
+            f"got {reference!r}"
+        )
     return getattr(pin.ReferenceFrame, reference)
 
 
@@ -87,7 +89,9 @@ def reduce_model(model, name: str, active=None, locked=None):
         return model, {}
     names = [model.names[i] for i in range(1, model.njoints)]
     if isinstance(locked, (str, bytes)) or (locked is not None and not hasattr(locked, "__iter__")):
-        raise ParameterError(f"{name}: locked= is a list of joint names or a dict name -> value, got {locked!r}")
+        raise ParameterError(
+            f"{name}: locked= is a list of joint names or a dict name -> value, got {locked!r}"
+        )
     locked = dict(locked) if isinstance(locked, dict) else {n: None for n in (locked or ())}
     if isinstance(active, (str, bytes)) or (active is not None and not hasattr(active, "__iter__")):
         raise ParameterError(f"{name}: active= is a list of joint names, got {active!r}")
@@ -99,51 +103,68 @@ def reduce_model(model, name: str, active=None, locked=None):
     for what, given in (("active", active or ()), ("locked", locked)):
         missing = [a for a in given if a not in names]
         if missing:
-            raise UnknownFrameError(f"{name}: {what} joints {missing} are not in the model; joints: {', '.join(names)}")
+            raise UnknownFrameError(
+                f"{name}: {what} joints {missing} are not in the model; joints: {', '.join(names)}"
+            )
     qref = pin.neutral(model)
     lock_ids, values = [], {}
-    mimic_source = {int(m): int(s) for m, s in zip(getattr(model, "mimicking_joints", ()),
-                                                    getattr(model, "mimicked_joints", ()))}
+    mimic_source = {
+        int(m): int(s)
+        for m, s in zip(
+            getattr(model, "mimicking_joints", ()), getattr(model, "mimicked_joints", ())
+        )
+    }
     for jid in range(1, model.njoints):
         jname = model.names[jid]
         if jname in locked or (active is not None and jname not in active):
             jm = model.joints[jid]
             v = locked.get(jname)
-            if jid in mimic_source:   # follows its source: locked with it (checked below)
+            if jid in mimic_source:  # follows its source: locked with it (checked below)
                 lock_ids.append(jid)
                 continue
             if v is not None:
                 try:
                     v = np.atleast_1d(np.asarray(v, dtype=float))
                 except (TypeError, ValueError):
-                    raise ParameterError(f"{name}: locked value of joint {jname!r} must be a number (rad or m), "
-                                         f"got {v!r}") from None
-                if jm.nq == 2 and jm.nv == 1 and v.size == 1:      # a continuous joint: an angle
+                    raise ParameterError(
+                        f"{name}: locked value of joint {jname!r} must be a number (rad or m), "
+                        f"got {v!r}"
+                    ) from None
+                if jm.nq == 2 and jm.nv == 1 and v.size == 1:  # a continuous joint: an angle
                     v = np.array([np.cos(v[0]), np.sin(v[0])])
                 if v.size != jm.nq or not np.all(np.isfinite(v)):
-                    raise ParameterError(f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}")
-                qref[jm.idx_q:jm.idx_q + jm.nq] = v
-            val = qref[jm.idx_q:jm.idx_q + jm.nq].copy()
+                    raise ParameterError(
+                        f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}"
+                    )
+                qref[jm.idx_q : jm.idx_q + jm.nq] = v
+            val = qref[jm.idx_q : jm.idx_q + jm.nq].copy()
             values[jname] = float(val[0]) if val.size == 1 else val
             lock_ids.append(jid)
     for m, src in mimic_source.items():
         if (m in lock_ids) != (src in lock_ids):
             raise UnsupportedModelError(
-                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both or neither")
+                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both or neither"
+            )
         if m in lock_ids:
             e = model.joints[m].extract()
-            values[model.names[m]] = float(e.scaling * np.atleast_1d(values[model.names[src]])[0] + e.offset)
+            values[model.names[m]] = float(
+                e.scaling * np.atleast_1d(values[model.names[src]])[0] + e.offset
+            )
     if not lock_ids:
         return model, {}
     framed = {int(f.parentJoint) for f in model.frames if f.type == pin.FrameType.JOINT}
     missing = [model.names[j] for j in range(1, model.njoints) if j not in framed]
-    if missing:   # buildReducedModel dereferences each joint's frame: it would crash the process
-        raise UnsupportedModelError(f"{name}: joints {missing} have no joint frame (model.addJointFrame); "
-                                    "Pinocchio cannot lock joints of such a model")
+    if missing:  # buildReducedModel dereferences each joint's frame: it would crash the process
+        raise UnsupportedModelError(
+            f"{name}: joints {missing} have no joint frame (model.addJointFrame); "
+            "Pinocchio cannot lock joints of such a model"
+        )
     try:
         return pin.buildReducedModel(model, lock_ids, qref), values
     except Exception as exc:
-        raise UnsupportedModelError(f"{name}: Pinocchio cannot lock joints {list(values)}: {exc}") from None
+        raise UnsupportedModelError(
+            f"{name}: Pinocchio cannot lock joints {list(values)}: {exc}"
+        ) from None
 
 
 class Robot:
@@ -170,9 +191,19 @@ class Robot:
         Geometry of a model given as a ``pin.Model`` / ``RobotWrapper``.
     """
 
-    def __init__(self, model, *, name: str | None = None, tool: str | None = None, info: URDFInfo | None = None,
-                 spec=None, description: str = "", locked: dict | None = None, visual_model=None,
-                 collision_model=None):
+    def __init__(
+        self,
+        model,
+        *,
+        name: str | None = None,
+        tool: str | None = None,
+        info: URDFInfo | None = None,
+        spec=None,
+        description: str = "",
+        locked: dict | None = None,
+        visual_model=None,
+        collision_model=None,
+    ):
         self.info = info
         self.name = name or (info.robot_name if info is not None else "") or model.name or "robot"
         self.spec = spec
@@ -268,15 +299,19 @@ class Robot:
         or a continuous joint whose (cos, sin) pair is not a unit vector."""
         names = list(self.chain.q_names)
         if q is None:
-            raise ParameterError(f"{self.name}: {name} is None; give {self.nq} joint values (rad or m) "
-                                 f"for q entries {names}")
+            raise ParameterError(
+                f"{self.name}: {name} is None; give {self.nq} joint values (rad or m) "
+                f"for q entries {names}"
+            )
         try:
-            if _has_text(q):   # numpy would parse "0.1" and turn None into NaN
+            if _has_text(q):  # numpy would parse "0.1" and turn None into NaN
                 raise TypeError("holds text or None")
             arr = np.asarray(q, dtype=float)
         except (TypeError, ValueError) as exc:
-            raise ParameterError(f"{self.name}: {name} must be real numbers (rad or m), shape ({self.nq},) or "
-                                 f"(N, {self.nq}) for q entries {names}; got {_short(q)} ({exc})") from None
+            raise ParameterError(
+                f"{self.name}: {name} must be real numbers (rad or m), shape ({self.nq},) or "
+                f"(N, {self.nq}) for q entries {names}; got {_short(q)} ({exc})"
+            ) from None
         if arr.ndim not in (1, 2) or arr.shape[-1] != self.nq:
             raise ParameterError(
                 f"{self.name}: {name} must have shape ({self.nq},) or (N, {self.nq}) "
@@ -287,14 +322,16 @@ class Robot:
             idx = np.argwhere(bad)[0]
             j = int(idx[-1])
             where = f" (row {int(idx[0])})" if arr.ndim == 2 else ""
-            raise ParameterError(f"{self.name}: {name}[{j}] for joint {names[j]!r} is {arr[tuple(idx)]}{where}; "
-                                 f"joint values must be finite (rad or m)")
+            raise ParameterError(
+                f"{self.name}: {name}[{j}] for joint {names[j]!r} is {arr[tuple(idx)]}{where}; "
+                f"joint values must be finite (rad or m)"
+            )
         if self.chain.has_continuous:
             try:
                 self.chain.check_unit(arr, name)
             except ParameterError:
                 raise
-            except ValueError as exc:   # Chain.check_unit names the robot, the joint and the norm
+            except ValueError as exc:  # Chain.check_unit names the robot, the joint and the norm
                 raise ParameterError(str(exc)) from None
         return arr
 
@@ -356,12 +393,18 @@ class Robot:
         import yourdfpy
 
         if self.info is None:
-            raise UnsupportedModelError(f"{self.name} was loaded from a pin.Model: it has no URDF for yourdfpy")
+            raise UnsupportedModelError(
+                f"{self.name} was loaded from a pin.Model: it has no URDF for yourdfpy"
+            )
         # the validated text, never the file again (it may have changed since it was validated);
         # mesh URIs go through the same resolution as the loader's (filename_handler)
         return yourdfpy.URDF.load(
-            io.BytesIO(self.info.text.encode("utf-8")), build_scene_graph=True, load_meshes=False,
-            build_collision_scene_graph=False, load_collision_meshes=False, filename_handler=self._filename_handler,
+            io.BytesIO(self.info.text.encode("utf-8")),
+            build_scene_graph=True,
+            load_meshes=False,
+            build_collision_scene_graph=False,
+            load_collision_meshes=False,
+            filename_handler=self._filename_handler,
         )
 
     def _filename_handler(self, fname: str) -> str:
@@ -393,14 +436,24 @@ def _as_model_source(obj):
     tuple as ``pin.buildModelsFromUrdf`` returns it, or None."""
     if isinstance(obj, pin.Model):
         return obj, None, None
-    if hasattr(obj, "model") and isinstance(getattr(obj, "model"), pin.Model):   # RobotWrapper
+    if hasattr(obj, "model") and isinstance(getattr(obj, "model"), pin.Model):  # RobotWrapper
         return obj.model, getattr(obj, "visual_model", None), getattr(obj, "collision_model", None)
     return None
 
 
-def load(source, *, tool: str | None = None, active=None, locked=None, package_dirs=None,
-         check_meshes: bool = True, name: str | None = None, visual_model=None, collision_model=None,
-         **params) -> Robot:
+def load(
+    source,
+    *,
+    tool: str | None = None,
+    active=None,
+    locked=None,
+    package_dirs=None,
+    check_meshes: bool = True,
+    name: str | None = None,
+    visual_model=None,
+    collision_model=None,
+    **params,
+) -> Robot:
     """Load a robot.
 
     ``source`` is one of
@@ -429,7 +482,9 @@ def load(source, *, tool: str | None = None, active=None, locked=None, package_d
 
     def no_params(what):
         if params:
-            raise ParameterError(f"{what} takes no parameters; unknown keyword(s): {', '.join(sorted(params))}")
+            raise ParameterError(
+                f"{what} takes no parameters; unknown keyword(s): {', '.join(sorted(params))}"
+            )
 
     if tool is not None and not isinstance(tool, str):
         raise ParameterError(f"tool= is a frame name (str), got {type(tool).__name__} {tool!r}")
@@ -444,36 +499,69 @@ def load(source, *, tool: str | None = None, active=None, locked=None, package_d
         if package_dirs is not None:
             raise ParameterError("package_dirs= applies to URDF files, not to a pin.Model")
         model, vis, col = src
-        return _make(model, name=name or model.name or "robot", info=None, visual_model=visual_model or vis,
-                     collision_model=collision_model or col, **common)
+        return _make(
+            model,
+            name=name or model.name or "robot",
+            info=None,
+            visual_model=visual_model or vis,
+            collision_model=collision_model or col,
+            **common,
+        )
     if visual_model is not None or collision_model is not None:
         raise ParameterError("visual_model= / collision_model= go with a pin.Model source")
     if not isinstance(source, (str, Path)):
-        raise ParameterError(f"load() takes a catalog or example-robot-data name, a URDF path, a pin.Model or a "
-                        f"RobotWrapper, got {type(source).__name__}")
+        raise ParameterError(
+            f"load() takes a catalog or example-robot-data name, a URDF path, a pin.Model or a "
+            f"RobotWrapper, got {type(source).__name__}"
+        )
     s = str(source)
     if s in models.BOOK_MODELS:
         spec = models.spec(s, **params)
         text = models.to_urdf(spec)
         path = models.REPO_URDF_DIR / f"{s}.urdf"
-        info = parse_urdf_bytes(text.encode(), path, package_dirs=package_dirs, check_meshes=check_meshes)
+        info = parse_urdf_bytes(
+            text.encode(), path, package_dirs=package_dirs, check_meshes=check_meshes
+        )
         if params or not path.is_file() or path.read_text(encoding="utf-8") != text:
             # not the committed default file: keep the text only (yourdfpy reads from memory)
             info.path = Path(f"<generated>/{s}.urdf")
-        return _make(build_model(info), name=name or s, info=info, spec=spec, description=spec.description,
-                     tool=tool or spec.tool_name, active=active, locked=locked)
+        return _make(
+            build_model(info),
+            name=name or s,
+            info=info,
+            spec=spec,
+            description=spec.description,
+            tool=tool or spec.tool_name,
+            active=active,
+            locked=locked,
+        )
     if s in models.ERD_ARMS:
         no_params(f"{s} (example-robot-data)")
         arm = models.ERD_ARMS[s]
         info = read_urdf(arm.urdf_path(), package_dirs=package_dirs, check_meshes=check_meshes)
         if active is None and locked is None:
             active, locked = arm.active, arm.locked_values
-        return _make(build_model(info), name=name or s, info=info, tool=tool or arm.tool, active=active,
-                     locked=locked, description=arm.description)
+        return _make(
+            build_model(info),
+            name=name or s,
+            info=info,
+            tool=tool or arm.tool,
+            active=active,
+            locked=locked,
+            description=arm.description,
+        )
     if s in models.erd_names():
         no_params(f"{s} (example-robot-data)")
-        info = read_urdf(models.erd_urdf_path(s), package_dirs=package_dirs, check_meshes=check_meshes)
-        return _make(build_model(info), name=name or s, info=info, description=f"{s} (example-robot-data)", **common)
+        info = read_urdf(
+            models.erd_urdf_path(s), package_dirs=package_dirs, check_meshes=check_meshes
+        )
+        return _make(
+            build_model(info),
+            name=name or s,
+            info=info,
+            description=f"{s} (example-robot-data)",
+            **common,
+        )
     looks_like_path = s.endswith(".urdf") or "/" in s or Path(s).exists()
     if not looks_like_path:
         raise models._unknown(s)

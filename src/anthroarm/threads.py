@@ -41,7 +41,7 @@ def workers() -> int:
 def _pool(n: int) -> ThreadPoolExecutor:
     with _LOCK:
         pool = _POOL.get("pool")
-        if pool is None or pool._max_workers < n:            # noqa: SLF001 - grow when $ANTHROARM_THREADS rises
+        if pool is None or pool._max_workers < n:  # noqa: SLF001 - grow when $ANTHROARM_THREADS rises
             if pool is not None:
                 pool.shutdown(wait=False)
             pool = _POOL["pool"] = ThreadPoolExecutor(max_workers=n, thread_name_prefix="anthroarm")
@@ -52,7 +52,7 @@ def run_rows(fn, n_rows: int) -> None:
     """Call ``fn(start, stop)`` on contiguous slices covering ``range(n_rows)``, in parallel
     threads when the batch is large enough; exceptions propagate (the first one raised)."""
     k = n_rows // MIN_ROWS_PER_THREAD
-    if k > 1:                                          # a large batch: ask how many threads
+    if k > 1:  # a large batch: ask how many threads
         k = min(workers(), k)
     if k <= 1:
         fn(0, n_rows)

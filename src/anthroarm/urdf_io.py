@@ -103,10 +103,14 @@ PackageDirsLike = Mapping | list | tuple | str | os.PathLike | None
 def _as_folder(value, what: str) -> Path:
     if isinstance(value, (str, os.PathLike)):
         return Path(value)
-    raise ParameterError(f"package_dirs: {what} must be a folder (str or path), got {type(value).__name__} {value!r}")
+    raise ParameterError(
+        f"package_dirs: {what} must be a folder (str or path), got {type(value).__name__} {value!r}"
+    )
 
 
-def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_defaults: bool = True) -> PackageDirs:
+def normalize_package_dirs(
+    package_dirs: PackageDirsLike = None, *, with_defaults: bool = True
+) -> PackageDirs:
     """The one place ``package_dirs`` is interpreted.  Accepted forms:
 
     - a list (or tuple) of folders, Pinocchio's convention: ``package://NAME/rel`` is looked
@@ -131,10 +135,14 @@ def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_default
     elif isinstance(package_dirs, Mapping):
         for name, root in package_dirs.items():
             if not isinstance(name, str):
-                raise ParameterError(f"package_dirs: package names must be str, got {type(name).__name__} {name!r}")
+                raise ParameterError(
+                    f"package_dirs: package names must be str, got {type(name).__name__} {name!r}"
+                )
             if not _is_package_name(name):
-                raise ParameterError(f"package_dirs: {name!r} is not a package name (package://NAME/... needs a "
-                                     "name that is not empty, '.', '..' or a path)")
+                raise ParameterError(
+                    f"package_dirs: {name!r} is not a package name (package://NAME/... needs a "
+                    "name that is not empty, '.', '..' or a path)"
+                )
             named[name] = _as_folder(root, f"the root of package {name!r}")
     elif isinstance(package_dirs, (list, tuple)):
         search.extend(_as_folder(d, f"entry {i}") for i, d in enumerate(package_dirs))
@@ -147,7 +155,12 @@ def normalize_package_dirs(package_dirs: PackageDirsLike = None, *, with_default
 
 
 def _is_package_name(pkg: str) -> bool:
-    return pkg not in ("", ".", "..") and os.sep not in pkg and not (os.altsep and os.altsep in pkg) and "\0" not in pkg
+    return (
+        pkg not in ("", ".", "..")
+        and os.sep not in pkg
+        and not (os.altsep and os.altsep in pkg)
+        and "\0" not in pkg
+    )
 
 
 def _name_list(names) -> str:
@@ -168,7 +181,9 @@ class URDFInfo:
     joints: dict[str, dict] = field(default_factory=dict)  # name -> {type, parent, child, mimic}
     root_link: str = ""
     meshes: dict[str, Path] = field(default_factory=dict)  # URI -> resolved path
-    package_dirs: PackageDirs = field(default_factory=PackageDirs)  # package name -> root, + search folders
+    package_dirs: PackageDirs = field(
+        default_factory=PackageDirs
+    )  # package name -> root, + search folders
 
 
 def default_package_dirs() -> dict[str, Path]:
@@ -209,14 +224,23 @@ def _finite_floats(path, text: str | None, what: str, n: int, default: float = 0
     return vals
 
 
-def _bounded(path, vals: list[float], what: str, bound: float = MAX_LENGTH, unit: str = "m",
-             nonnegative: bool = False) -> list[float]:
+def _bounded(
+    path,
+    vals: list[float],
+    what: str,
+    bound: float = MAX_LENGTH,
+    unit: str = "m",
+    nonnegative: bool = False,
+) -> list[float]:
     """``vals`` unchanged if every ``|v| <= bound`` (and ``v >= 0`` when asked); else
     :class:`URDFStructureError` naming ``what`` and the value."""
     for v in vals:
         if abs(v) > bound:
-            raise URDFStructureError(path, f"{what}: {v:g} is beyond the physical bound of {bound:.0e} {unit} "
-                                           "(see anthroarm.urdf_io)")
+            raise URDFStructureError(
+                path,
+                f"{what}: {v:g} is beyond the physical bound of {bound:.0e} {unit} "
+                "(see anthroarm.urdf_io)",
+            )
         if nonnegative and v < 0:
             raise URDFStructureError(path, f"{what}: {v:g} is negative")
     return vals
@@ -224,14 +248,20 @@ def _bounded(path, vals: list[float], what: str, bound: float = MAX_LENGTH, unit
 
 def _check_origin(path, o, what: str) -> None:
     if o is not None:
-        _bounded(path, _finite_floats(path, o.get("xyz"), f"{what} origin xyz", 3), f"{what} origin xyz")
+        _bounded(
+            path, _finite_floats(path, o.get("xyz"), f"{what} origin xyz", 3), f"{what} origin xyz"
+        )
         _finite_floats(path, o.get("rpy"), f"{what} origin rpy", 3)
 
 
 #: geometry element -> (attribute, count, nonnegative) checked by :func:`_check_geometry`
-_SHAPES = {"box": (("size", 3, True),), "cylinder": (("radius", 1, True), ("length", 1, True)),
-           "sphere": (("radius", 1, True),), "capsule": (("radius", 1, True), ("length", 1, True)),
-           "mesh": (("scale", 3, False),)}
+_SHAPES = {
+    "box": (("size", 3, True),),
+    "cylinder": (("radius", 1, True), ("length", 1, True)),
+    "sphere": (("radius", 1, True),),
+    "capsule": (("radius", 1, True), ("length", 1, True)),
+    "mesh": (("scale", 3, False),),
+}
 
 
 def _check_geometry(path, link: str, el) -> None:
@@ -240,23 +270,30 @@ def _check_geometry(path, link: str, el) -> None:
         for v in el.findall(kind):
             _check_origin(path, v.find("origin"), f"link {link!r} {kind}")
             g = v.find("geometry")
-            for shape in (g if g is not None else ()):
+            for shape in g if g is not None else ():
                 for attr, n, nonneg in _SHAPES.get(shape.tag, ()):
                     text = shape.get(attr)
                     if text is None:
                         continue
                     what = f"link {link!r} {kind} {shape.tag} {attr} (line {shape.sourceline})"
-                    _bounded(path, _finite_floats(path, text, what, n), what, unit="m" if nonneg else "",
-                             nonnegative=nonneg)
+                    _bounded(
+                        path,
+                        _finite_floats(path, text, what, n),
+                        what,
+                        unit="m" if nonneg else "",
+                        nonnegative=nonneg,
+                    )
 
 
 def _check_limit(path, joint: str, jtype: str, which: str, value: float) -> None:
     if jtype in ("revolute", "prismatic") and MAX_LENGTH < abs(value) < NO_LIMIT:
         unit = "m" if jtype == "prismatic" else "rad"
         raise URDFStructureError(
-            path, f"joint {joint!r} {which} limit {value:g} {unit} is beyond the physical bound of {MAX_LENGTH:.0e} "
-                  f"{unit}; write a magnitude of at least {NO_LIMIT:.0e} for no limit"
-                  + (" (or make it a continuous joint)" if jtype == "revolute" else ""))
+            path,
+            f"joint {joint!r} {which} limit {value:g} {unit} is beyond the physical bound of {MAX_LENGTH:.0e} "
+            f"{unit}; write a magnitude of at least {NO_LIMIT:.0e} for no limit"
+            + (" (or make it a continuous joint)" if jtype == "revolute" else ""),
+        )
 
 
 def check_size(info: "URDFInfo") -> None:
@@ -265,8 +302,10 @@ def check_size(info: "URDFInfo") -> None:
     n = sum(j["type"] in MOVABLE for j in info.joints.values())
     if n > MAX_MOVABLE_JOINTS:
         raise URDFStructureError(
-            info.path, f"{n} movable joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model (Pinocchio's data "
-                       "grows as the cube of the joint count: 0.6 GB at 200); split the model or make joints fixed")
+            info.path,
+            f"{n} movable joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model (Pinocchio's data "
+            "grows as the cube of the joint count: 0.6 GB at 200); split the model or make joints fixed",
+        )
 
 
 def _finite_float(path, text: str | None, what: str, default: float | None = None) -> float | None:
@@ -295,7 +334,11 @@ def resolve_uri(uri: str, urdf_path: Path, package_dirs: PackageDirsLike) -> Pat
             if parent.name == pkg:
                 roots.append(parent)
         if not roots:
-            searched = f" (not found in package_dirs folders {[str(d) for d in dirs.search]})" if dirs.search else ""
+            searched = (
+                f" (not found in package_dirs folders {[str(d) for d in dirs.search]})"
+                if dirs.search
+                else ""
+            )
             raise PackagePathError(
                 urdf_path,
                 f"mesh {uri!r}: unknown package {pkg!r}{searched}; pass package_dirs=['/folder/containing/{pkg}'] "
@@ -330,23 +373,39 @@ def read_urdf(path, package_dirs: PackageDirsLike = None, check_meshes: bool = T
     """
     path = Path(path)
     if not path.is_file():
-        what = ("is a folder, not a URDF file" if path.is_dir() else
-                "is not a regular file (a device, FIFO or socket)" if path.exists() else "file does not exist")
+        what = (
+            "is a folder, not a URDF file"
+            if path.is_dir()
+            else "is not a regular file (a device, FIFO or socket)"
+            if path.exists()
+            else "file does not exist"
+        )
         raise URDFNotFoundError(path, what)
     size = path.stat().st_size
     if size > MAX_URDF_BYTES:
-        raise URDFSecurityError(path, f"file is {size} bytes, larger than the {MAX_URDF_BYTES} accepted")
+        raise URDFSecurityError(
+            path, f"file is {size} bytes, larger than the {MAX_URDF_BYTES} accepted"
+        )
     raw = path.read_bytes()
     return parse_urdf_bytes(raw, path, package_dirs=package_dirs, check_meshes=check_meshes)
 
 
-def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, check_meshes: bool = True) -> URDFInfo:
+def parse_urdf_bytes(
+    raw: bytes, path, package_dirs: PackageDirsLike = None, check_meshes: bool = True
+) -> URDFInfo:
     """Validate URDF text already in memory; ``path`` is used for messages and relative URIs."""
     path = Path(path)
     if _DTD_OR_ENTITY.search(raw):
-        raise URDFSecurityError(path, "DTD/entity declarations are not allowed in a URDF (entity expansion or external entity)")
+        raise URDFSecurityError(
+            path,
+            "DTD/entity declarations are not allowed in a URDF (entity expansion or external entity)",
+        )
     parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, remove_comments=True
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=False,
+        remove_comments=True,
     )
     try:
         root = etree.fromstring(raw, parser)
@@ -372,14 +431,22 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             if m is not None:
                 mass = _finite_float(path, m.get("value"), f"link {name!r} mass")
                 if mass is None or mass < 0:
-                    raise URDFStructureError(path, f"link {name!r}: mass must be >= 0, got {m.get('value')!r}")
+                    raise URDFStructureError(
+                        path, f"link {name!r}: mass must be >= 0, got {m.get('value')!r}"
+                    )
                 _bounded(path, [mass], f"link {name!r}: mass", MAX_MASS, "kg")
             _check_origin(path, inertial.find("origin"), f"link {name!r} inertial")
             inertia = inertial.find("inertia")
             if inertia is not None:
                 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"):
                     what = f"link {name!r} inertia {k}"
-                    _bounded(path, [_finite_float(path, inertia.get(k, "0"), what)], what, MAX_INERTIA, "kg m^2")
+                    _bounded(
+                        path,
+                        [_finite_float(path, inertia.get(k, "0"), what)],
+                        what,
+                        MAX_INERTIA,
+                        "kg m^2",
+                    )
         if len(el):
             _check_geometry(path, name, el)
     if not links:
@@ -397,7 +464,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             raise URDFStructureError(path, f"joint {name!r} defined twice (line {el.sourceline})")
         if jtype not in JOINT_TYPES:
             raise URDFStructureError(
-                path, f"joint {name!r} has unknown type {jtype!r} (line {el.sourceline}); known: {', '.join(JOINT_TYPES)}"
+                path,
+                f"joint {name!r} has unknown type {jtype!r} (line {el.sourceline}); known: {', '.join(JOINT_TYPES)}",
             )
         sub = _first_children(el)
         pe, ce = sub.get("parent"), sub.get("child")
@@ -409,7 +477,8 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
                 raise URDFStructureError(path, f"joint {name!r}: {role} link {ln!r} is not defined")
         if child in parent_of:
             raise URDFStructureError(
-                path, f"link {child!r} is the child of two joints ({joint_of[child]!r} and {name!r}): a kinematic loop"
+                path,
+                f"link {child!r} is the child of two joints ({joint_of[child]!r} and {name!r}): a kinematic loop",
             )
         parent_of[child] = parent
         joint_of[child] = name
@@ -426,7 +495,9 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             lo = _finite_float(path, lim.get("lower"), f"joint {name!r} lower limit", 0.0)
             hi = _finite_float(path, lim.get("upper"), f"joint {name!r} upper limit", 0.0)
             if jtype in ("revolute", "prismatic") and lo > hi:
-                raise URDFStructureError(path, f"joint {name!r}: lower limit {lo} > upper limit {hi}")
+                raise URDFStructureError(
+                    path, f"joint {name!r}: lower limit {lo} > upper limit {hi}"
+                )
             _check_limit(path, name, jtype, "lower", lo)
             _check_limit(path, name, jtype, "upper", hi)
             for k in ("effort", "velocity"):
@@ -438,13 +509,19 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
         if mim is not None:
             mimic = {
                 "joint": mim.get("joint"),
-                "multiplier": _finite_float(path, mim.get("multiplier"), f"joint {name!r} mimic multiplier", 1.0),
-                "offset": _finite_float(path, mim.get("offset"), f"joint {name!r} mimic offset", 0.0),
+                "multiplier": _finite_float(
+                    path, mim.get("multiplier"), f"joint {name!r} mimic multiplier", 1.0
+                ),
+                "offset": _finite_float(
+                    path, mim.get("offset"), f"joint {name!r} mimic offset", 0.0
+                ),
             }
         joints[name] = {"type": jtype, "parent": parent, "child": child, "mimic": mimic}
     for name, j in joints.items():
         if j["mimic"] is not None and j["mimic"]["joint"] not in joints:
-            raise URDFStructureError(path, f"joint {name!r} mimics unknown joint {j['mimic']['joint']!r}")
+            raise URDFStructureError(
+                path, f"joint {name!r} mimics unknown joint {j['mimic']['joint']!r}"
+            )
 
     root_link = _check_tree(path, links, parent_of, joint_of)
 
@@ -455,7 +532,12 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
             raise URDFStructureError(path, f"<mesh> without filename (line {mesh.sourceline})")
         scale = mesh.get("scale")
         if scale is not None:
-            _bounded(path, _finite_floats(path, scale, f"mesh {uri!r} scale", 3), f"mesh {uri!r} scale", unit="")
+            _bounded(
+                path,
+                _finite_floats(path, scale, f"mesh {uri!r} scale", 3),
+                f"mesh {uri!r} scale",
+                unit="",
+            )
         if uri in meshes:  # already resolved and checked (a mesh shared by many links)
             continue
         resolved = resolve_uri(uri, path, pkgs)
@@ -466,7 +548,9 @@ def parse_urdf_bytes(raw: bytes, path, package_dirs: PackageDirsLike = None, che
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise URDFSyntaxError(path, f"not UTF-8 text ({exc.reason} at byte {exc.start}); save the URDF as UTF-8") from None
+        raise URDFSyntaxError(
+            path, f"not UTF-8 text ({exc.reason} at byte {exc.start}); save the URDF as UTF-8"
+        ) from None
     return URDFInfo(
         path=path,
         text=text,
@@ -489,7 +573,9 @@ def _check_tree(path, links: list[str], parent_of: dict[str, str], joint_of: dic
     """
     roots = [ln for ln in links if ln not in parent_of]
     if len(roots) > 1:
-        raise URDFStructureError(path, f"links are not connected into one tree: {len(roots)} roots ({_name_list(roots)})")
+        raise URDFStructureError(
+            path, f"links are not connected into one tree: {len(roots)} roots ({_name_list(roots)})"
+        )
     children: dict[str, list[str]] = {}
     for child, parent in parent_of.items():
         children.setdefault(parent, []).append(child)

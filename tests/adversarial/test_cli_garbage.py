@@ -126,13 +126,19 @@ def places(tmp_path):
     junk.write_bytes(os.urandom(4096))
     fifo = tmp_path / "a_fifo"
     os.mkfifo(fifo)
-    return {"dir": str(d), "file": str(f), "junk": str(junk), "fifo": str(fifo), "tmp": str(tmp_path)}
+    return {
+        "dir": str(d),
+        "file": str(f),
+        "junk": str(junk),
+        "fifo": str(fifo),
+        "tmp": str(tmp_path),
+    }
 
 
 def run_cli(argv, capsys):
     try:
         rc = cli.main(argv)
-    except SystemExit as e:   # argparse
+    except SystemExit as e:  # argparse
         rc = e.code
     out, err = capsys.readouterr()
     return rc, out, err
@@ -154,16 +160,24 @@ def test_garbage_is_one_line_and_exit_2(case, places, capsys, tmp_path):
     if argv[0] in ("view", "demo"):
         assert children() <= before, "a server or browser process was started on garbage"
     if "{fifo}" in " ".join(CASES[case]):
-        assert os.path.exists(places["fifo"]) and not os.path.isfile(places["fifo"])   # not replaced
+        assert os.path.exists(places["fifo"]) and not os.path.isfile(places["fifo"])  # not replaced
     assert os.listdir(places["dir"]) == []
 
 
 def test_garbage_in_a_real_process_has_no_traceback(tmp_path):
     """The installed entry point, not only main(): argparse, file and number errors."""
-    for argv in (["ik", "prosthetic_arm", "--xyz", "nan", "0", "0"], ["urdf", "prosthetic_arm", "-o", str(tmp_path)],
-                 ["view", "prosthetic_arm", "--seconds", "nan"], ["cache", "bogus"]):
-        r = subprocess.run([sys.executable, "-m", "anthroarm.cli", *argv], capture_output=True, text=True,
-                           timeout=120)
+    for argv in (
+        ["ik", "prosthetic_arm", "--xyz", "nan", "0", "0"],
+        ["urdf", "prosthetic_arm", "-o", str(tmp_path)],
+        ["view", "prosthetic_arm", "--seconds", "nan"],
+        ["cache", "bogus"],
+    ):
+        r = subprocess.run(
+            [sys.executable, "-m", "anthroarm.cli", *argv],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert r.returncode == 2 and "Traceback" not in r.stderr, (argv, r.stderr)
         assert len(r.stderr.strip().splitlines()) == 1, (argv, r.stderr)
 

@@ -32,8 +32,11 @@ ROOT = Path(__file__).resolve().parents[2]
 def tmpfs(where: Path, size: str = "64k"):
     """A tmpfs of ``size`` mounted at ``where`` (skip if this machine does not allow it)."""
     where.mkdir(parents=True, exist_ok=True)
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(where)], capture_output=True,
-                       text=True)
+    r = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(where)],
+        capture_output=True,
+        text=True,
+    )
     if r.returncode != 0:
         pytest.skip(f"cannot mount a tmpfs here (not root or no CAP_SYS_ADMIN): {r.stderr.strip()}")
     try:
@@ -139,7 +142,9 @@ def test_sigkill_mid_write_leaves_old_or_new_and_stale_temps_are_removed(tmp_pat
     atomic_write_text(target, b"A" * n)
     seen_temp = False
     for delay in (0.05, 0.13, 0.21, 0.34, 0.55):
-        p = subprocess.Popen([sys.executable, "-c", WRITER, str(target), str(n)], stdout=subprocess.PIPE)
+        p = subprocess.Popen(
+            [sys.executable, "-c", WRITER, str(target), str(n)], stdout=subprocess.PIPE
+        )
         assert p.stdout.readline().strip() == b"ready"
         time.sleep(delay)
         p.send_signal(signal.SIGKILL)
@@ -147,15 +152,15 @@ def test_sigkill_mid_write_leaves_old_or_new_and_stale_temps_are_removed(tmp_pat
         data = target.read_bytes()
         assert data in (b"A" * n, b"B" * n), (len(data), data[:1], data[-1:])
         seen_temp |= bool(temps(tmp_path))
-        atomic_write_text(target, b"A" * n)          # the next write cleans the dead writer's temp
+        atomic_write_text(target, b"A" * n)  # the next write cleans the dead writer's temp
         assert temps(tmp_path) == [], temps(tmp_path)
     assert target.read_bytes() == b"A" * n
-    del seen_temp   # how often a temp was caught depends on timing; the cleanup is asserted above
+    del seen_temp  # how often a temp was caught depends on timing; the cleanup is asserted above
 
 
 def test_temp_of_a_live_writer_is_not_removed(tmp_path):
     target = tmp_path / "t.txt"
-    live = tmp_path / f".t.txt.{os.getppid()}.1.abcd.tmp"     # a live process (our parent)
+    live = tmp_path / f".t.txt.{os.getppid()}.1.abcd.tmp"  # a live process (our parent)
     live.write_text("in progress")
     atomic_write_text(target, "x")
     assert live.exists()
@@ -188,7 +193,12 @@ def test_cli_urdf_bad_targets(tmp_path, capsys, where):
     folder.mkdir()
     os.mkfifo(fifo)
     f.write_text("keep")
-    target = {"folder": folder, "fifo": fifo, "under-file": f / "x.urdf", "sysfs": Path("/sys/anthroarm_x.urdf")}
+    target = {
+        "folder": folder,
+        "fifo": fifo,
+        "under-file": f / "x.urdf",
+        "sysfs": Path("/sys/anthroarm_x.urdf"),
+    }
     rc, out, err = run_cli(["urdf", "prosthetic_arm", "-o", str(target[where])], capsys)
     assert_one_line(rc, err)
     assert folder.is_dir() and list(folder.iterdir()) == [] and fifo.exists() and not fifo.is_file()
@@ -218,7 +228,7 @@ def test_cache_write_faults_store_nothing_and_say_why(tmp_path, monkeypatch, fau
         assert cache.write("lagrange", "big.py", b"y = 2\n" * 50_000) is None
         assert "in memory" in cache.status()
         assert cache.read("lagrange", "big.py") is None
-        assert cache.read("lagrange", "small.py") == b"x = 1\n"      # the old entry is intact
+        assert cache.read("lagrange", "small.py") == b"x = 1\n"  # the old entry is intact
         assert temps(d / "lagrange") == []
         cache.clear() if fault == "full" else None
 

@@ -30,7 +30,9 @@ def test_analytic_rejects_non_numeric_tolerance(arm):
         aa.ik.analytic(arm, T, tol="1e-9")
 
 
-@pytest.mark.parametrize("name", ["prosthetic_arm", "sixr_arm", "planar2r", "human_arm7", "ur5", "panda"])
+@pytest.mark.parametrize(
+    "name", ["prosthetic_arm", "sixr_arm", "planar2r", "human_arm7", "ur5", "panda"]
+)
 def test_analytic_batch_of_zero_poses_is_empty(name):
     robot = aa.load(name)
     b = aa.ik.analytic_batch(robot, np.zeros((0, 4, 4)))
@@ -51,7 +53,10 @@ def test_analytic_takes_a_strided_pose(name):
         big[::2, ::2] = T
         view = big[::2, ::2]
         assert not view.flags.c_contiguous and not view.flags.f_contiguous
-        a, b = aa.ik.analytic(robot, view, **kw), aa.ik.analytic(robot, np.ascontiguousarray(T), **kw)
+        a, b = (
+            aa.ik.analytic(robot, view, **kw),
+            aa.ik.analytic(robot, np.ascontiguousarray(T), **kw),
+        )
         assert a.branches == b.branches and a.reason == b.reason, name
         np.testing.assert_array_equal(a.solutions, b.solutions)
         r = aa.ik.solve(robot, view if name != "planar2r" else np.ascontiguousarray(view[:3, 3]))
@@ -75,13 +80,15 @@ def test_qp_step_rejects_negative_or_non_finite_damping(arm, damping, solver):
 def test_rssr_crank_test_rejects_bad_sample_counts(samples):
     from anthroarm.mechanisms.rssr import RSSRGeometry, rssr_crank_test
 
-    g = RSSRGeometry(a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3])
+    g = RSSRGeometry(
+        a0=[0, 0, 0], ua=[0, 0, 1], a1=[1, 0, 0], b0=[3, 0, 1], ub=[0, 1, 0], b1=[3, 0, 3]
+    )
     with pytest.raises(ValueError, match="samples"):
         rssr_crank_test(g, samples=samples)
 
 
 # ----------------------------------------------------------------- fourbar at extreme scales
-FOURBAR = (4.0, 1.5, 3.5, 3.0)   # the module docstring's crank-rocker
+FOURBAR = (4.0, 1.5, 3.5, 3.0)  # the module docstring's crank-rocker
 
 
 @pytest.mark.parametrize("scale", [1e-155, 1e-100, 1e100, 1e155, 1e300])
@@ -142,7 +149,9 @@ def test_fourbar_large_but_representable_rates():
     assert math.isclose(got.alpha4, 1e300 * ref.alpha4, rel_tol=1e-12)
 
 
-@pytest.mark.parametrize("lengths", [(1e-160, 1.0, 1.0, 1.0), (1.0, 1.0, 1e160, 1.0), (1e-320, 1.0, 1.0, 1.0)])
+@pytest.mark.parametrize(
+    "lengths", [(1e-160, 1.0, 1.0, 1.0), (1.0, 1.0, 1e160, 1.0), (1e-320, 1.0, 1.0, 1.0)]
+)
 def test_fourbar_length_ratio_beyond_the_float_range(lengths):
     from anthroarm.mechanisms.fourbar import fourbar, fourbar_input_range
 

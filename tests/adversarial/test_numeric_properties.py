@@ -24,13 +24,26 @@ from hypothesis import strategies as st
 import anthroarm as aa
 from anthroarm.errors import AnthroarmError
 
-SETTINGS = settings(max_examples=25, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=25,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 FEW = settings(SETTINGS, max_examples=10)
 
-FORBIDDEN = (np.linalg.LinAlgError, ZeroDivisionError, OverflowError, IndexError, FloatingPointError,
-             RuntimeWarning, KeyError, AttributeError, AssertionError)
-LIMIT_TOL = 1e-6   # ik.analytic's LIMIT_SLACK
+FORBIDDEN = (
+    np.linalg.LinAlgError,
+    ZeroDivisionError,
+    OverflowError,
+    IndexError,
+    FloatingPointError,
+    RuntimeWarning,
+    KeyError,
+    AttributeError,
+    AssertionError,
+)
+LIMIT_TOL = 1e-6  # ik.analytic's LIMIT_SLACK
 
 
 @pytest.fixture(autouse=True)
@@ -67,7 +80,7 @@ def finite(x, path="out") -> None:
         for f in fields(x):
             finite(getattr(x, f.name), f"{path}.{f.name}")
         return
-    if hasattr(x, "real") and hasattr(x, "dual"):   # spatial.Dual
+    if hasattr(x, "real") and hasattr(x, "dual"):  # spatial.Dual
         finite(np.asarray(x.real), f"{path}.real")
         finite(np.asarray(x.dual), f"{path}.dual")
         return
@@ -157,7 +170,7 @@ def test_analytic_ik_solutions_finite_and_inside_limits(name, frac):
     assert np.all(np.isfinite(sols))
     if sols.size:
         inside_limits(r, sols)
-        for s in sols:   # every solution reaches the pose (IK o FK)
+        for s in sols:  # every solution reaches the pose (IK o FK)
             Ts = np.asarray(r.fk(s))
             if name == "planar2r":
                 assert np.allclose(Ts[:3, 3], T[:3, 3], atol=1e-6)
@@ -215,7 +228,7 @@ def test_lagrange_tau_M_forward_finite_and_consistent(name, seed, scale):
     tau = dyn.tau(q, qd, qdd)
     assert np.all(np.isfinite(M)) and np.all(np.isfinite(tau))
     assert np.allclose(M, M.T)
-    acc = dyn.forward(q, qd, tau)     # mathematics: forward(tau(q, qd, qdd)) = qdd
+    acc = dyn.forward(q, qd, tau)  # mathematics: forward(tau(q, qd, qdd)) = qdd
     assert np.allclose(acc, qdd, rtol=1e-6, atol=1e-6 * scale)
 
 
@@ -225,20 +238,30 @@ def same(a, b, tol):
         d = getattr(a, k) - getattr(b, k)
         assert abs(math.remainder(d, 2 * math.pi)) <= tol, (k, getattr(a, k), getattr(b, k))
     for k in ("omega3", "omega4", "alpha3", "alpha4"):
-        assert math.isclose(getattr(a, k), getattr(b, k), rel_tol=tol, abs_tol=tol), (k, getattr(a, k), getattr(b, k))
+        assert math.isclose(getattr(a, k), getattr(b, k), rel_tol=tol, abs_tol=tol), (
+            k,
+            getattr(a, k),
+            getattr(b, k),
+        )
 
 
 fourbar_lengths = st.tuples(*[st.floats(0.2, 5.0)] * 4)
 
 
 @SETTINGS
-@given(L=fourbar_lengths, th2=st.floats(-np.pi, np.pi), w2=st.floats(-10, 10), a2=st.floats(-10, 10),
-       e=st.integers(-155, 155), branch=st.sampled_from([1, -1]))
+@given(
+    L=fourbar_lengths,
+    th2=st.floats(-np.pi, np.pi),
+    w2=st.floats(-10, 10),
+    a2=st.floats(-10, 10),
+    e=st.integers(-155, 155),
+    branch=st.sampled_from([1, -1]),
+)
 def test_fourbar_is_scale_invariant(L, th2, w2, a2, e, branch):
     """Mathematics: scaling every length by s leaves the angles and angular rates unchanged."""
     from anthroarm.mechanisms.fourbar import fourbar, fourbar_cartesian
 
-    s = 10.0 ** e
+    s = 10.0**e
     ref = fourbar(*L, th2, w2, a2, branch=branch)
     got = typed_or_finite(fourbar, *(s * x for x in L), th2, w2, a2, branch=branch)
     assert got is not None
@@ -246,7 +269,9 @@ def test_fourbar_is_scale_invariant(L, th2, w2, a2, e, branch):
     if ref.status == "ok" and abs(math.sin(ref.theta3 - ref.theta4)) > 1e-3:
         same(got, ref, 1e-9)
         assert got.residual <= 1e-9 * s * sum(L)
-    cart = typed_or_finite(fourbar_cartesian, (s * L[0], 0.0), *(s * x for x in L[1:]), th2, w2, a2, branch=branch)
+    cart = typed_or_finite(
+        fourbar_cartesian, (s * L[0], 0.0), *(s * x for x in L[1:]), th2, w2, a2, branch=branch
+    )
     assert cart is not None and cart.status == ref.status
     if ref.status == "ok" and abs(math.sin(ref.theta3 - ref.theta4)) > 1e-3:
         same(cart, ref, 1e-8)
@@ -259,12 +284,16 @@ def test_fourbar_range_and_grashof_scale_invariant(L, e):
 
     r1, r2, r3, r4 = L
     # away from the boundaries of the range (cos th2 = +-1 there: rounding decides)
-    assume(min(abs(abs(r1 + sg * r2) - abs(r3 + sh * r4)) for sg in (1, -1) for sh in (1, -1)) > 1e-6)
-    s = 10.0 ** e
+    assume(
+        min(abs(abs(r1 + sg * r2) - abs(r3 + sh * r4)) for sg in (1, -1) for sh in (1, -1)) > 1e-6
+    )
+    s = 10.0**e
     assert fourbar_grashof(*(s * x for x in L)) == fourbar_grashof(*L)
     a, b = fourbar_input_range(*L), typed_or_finite(fourbar_input_range, *(s * x for x in L))
     assert b is not None and a.full_turn == b.full_turn
-    assert np.allclose(np.asarray(a.intervals, float).ravel(), np.asarray(b.intervals, float).ravel(), atol=1e-9)
+    assert np.allclose(
+        np.asarray(a.intervals, float).ravel(), np.asarray(b.intervals, float).ravel(), atol=1e-9
+    )
 
 
 @SETTINGS
@@ -277,14 +306,26 @@ def test_fourbar_huge_rates_are_finite_or_value_error(w2, L, th2):
     typed_or_finite(fourbar_cartesian, (L[0], 0.0), *L[1:], th2, w2, 0.0)
 
 
-unit_vec = st.tuples(*[st.floats(-1, 1)] * 3).filter(lambda v: np.linalg.norm(v) > 0.3).map(
-    lambda v: np.asarray(v) / np.linalg.norm(v))
+unit_vec = (
+    st.tuples(*[st.floats(-1, 1)] * 3)
+    .filter(lambda v: np.linalg.norm(v) > 0.3)
+    .map(lambda v: np.asarray(v) / np.linalg.norm(v))
+)
 pt3 = st.tuples(*[st.floats(-2, 2)] * 3).map(np.asarray)
 
 
 @SETTINGS
-@given(a0=pt3, ua=unit_vec, a1=pt3, b0=pt3, ub=unit_vec, b1=pt3, alpha=st.floats(-np.pi, np.pi),
-       w=st.floats(-5, 5), branch=st.sampled_from([1, -1]))
+@given(
+    a0=pt3,
+    ua=unit_vec,
+    a1=pt3,
+    b0=pt3,
+    ub=unit_vec,
+    b1=pt3,
+    alpha=st.floats(-np.pi, np.pi),
+    w=st.floats(-5, 5),
+    branch=st.sampled_from([1, -1]),
+)
 def test_rssr_and_rrss_valid_inputs_are_finite(a0, ua, a1, b0, ub, b1, alpha, w, branch):
     from anthroarm.mechanisms.rrss import RRSSGeometry, rrss
     from anthroarm.mechanisms.rssr import RSSRGeometry, rssr
@@ -298,19 +339,34 @@ def test_rssr_and_rrss_valid_inputs_are_finite(a0, ua, a1, b0, ub, b1, alpha, w,
 
 
 @SETTINGS
-@given(P1=st.tuples(st.floats(-2, 2), st.floats(-2, 2)), P2=st.tuples(st.floats(-2, 2), st.floats(-2, 2)),
-       r1=st.floats(0.1, 3), r2=st.floats(0.1, 3), e=st.integers(-150, 150), branch=st.sampled_from([1, -1]))
+@given(
+    P1=st.tuples(st.floats(-2, 2), st.floats(-2, 2)),
+    P2=st.tuples(st.floats(-2, 2), st.floats(-2, 2)),
+    r1=st.floats(0.1, 3),
+    r2=st.floats(0.1, 3),
+    e=st.integers(-150, 150),
+    branch=st.sampled_from([1, -1]),
+)
 def test_dyad_valid_inputs_are_finite(P1, P2, r1, r2, e, branch):
     from anthroarm.mechanisms.dyads import dyad
 
-    s = 10.0 ** e
+    s = 10.0**e
     z = (0.0, 0.0)
-    typed_or_finite(dyad, np.multiply(P1, s), z, z, np.multiply(P2, s), z, z, r1 * s, r2 * s, branch=branch)
+    typed_or_finite(
+        dyad, np.multiply(P1, s), z, z, np.multiply(P2, s), z, z, r1 * s, r2 * s, branch=branch
+    )
 
 
 @SETTINGS
-@given(u=unit_vec, th=st.floats(-10, 10), s=st.floats(-5, 5), p=pt3, a=st.floats(-np.pi, np.pi),
-       b=st.floats(-np.pi, np.pi), c=st.floats(-np.pi, np.pi))
+@given(
+    u=unit_vec,
+    th=st.floats(-10, 10),
+    s=st.floats(-5, 5),
+    p=pt3,
+    a=st.floats(-np.pi, np.pi),
+    b=st.floats(-np.pi, np.pi),
+    c=st.floats(-np.pi, np.pi),
+)
 def test_spatial_valid_inputs_are_finite_and_orthonormal(u, th, s, p, a, b, c):
     from anthroarm import spatial as sp
     from anthroarm.spatial import dual as du
@@ -336,8 +392,12 @@ def test_spatial_valid_inputs_are_finite_and_orthonormal(u, th, s, p, a, b, c):
 @SETTINGS
 @given(bad=bad_float, which=st.integers(0, 6), L=fourbar_lengths)
 def test_fourbar_bad_numbers(bad, which, L):
-    from anthroarm.mechanisms.fourbar import (fourbar, fourbar_cartesian, fourbar_grashof,
-                                              fourbar_input_range)
+    from anthroarm.mechanisms.fourbar import (
+        fourbar,
+        fourbar_cartesian,
+        fourbar_grashof,
+        fourbar_input_range,
+    )
 
     args = [*L, 0.7, 1.0, 0.0]
     args[which] = bad
@@ -368,14 +428,26 @@ def test_rssr_rrss_bad_numbers(bad, which):
     typed_or_finite(rssr, g, 0.3, 1.0, bad)
     must_raise(rssr, g, 0.3, branch=0)
     typed_or_finite(rssr_crank_test, g, samples=-5)
-    h = RRSSGeometry(a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=[1, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
+    h = RRSSGeometry(
+        a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=[1, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3]
+    )
     typed_or_finite(rrss, h, bad)
     typed_or_finite(rrss, h, 0.3, bad)
-    typed_or_finite(RRSSGeometry, a0=[0, 0, 0], u0=[0, 0, 1], a1=[1, 0, 0], u1=[bad, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
+    typed_or_finite(
+        RRSSGeometry,
+        a0=[0, 0, 0],
+        u0=[0, 0, 1],
+        a1=[1, 0, 0],
+        u1=[bad, 0, 0],
+        b0=[3, 0, 1],
+        b1=[3, 0, 3],
+    )
 
 
 @SETTINGS
-@given(e=st.integers(-300, 308), alpha=st.floats(-np.pi, np.pi), w=st.sampled_from([0.0, 1.0, 1e200]))
+@given(
+    e=st.integers(-300, 308), alpha=st.floats(-np.pi, np.pi), w=st.sampled_from([0.0, 1.0, 1e200])
+)
 def test_rssr_rrss_extreme_scales_are_finite_or_value_error(e, alpha, w):
     """Geometry scaled by 10^e: the geometry is accepted or refused with a ValueError; the
     closed forms return finite states (the same angles, by scale invariance, where the length
@@ -384,7 +456,7 @@ def test_rssr_rrss_extreme_scales_are_finite_or_value_error(e, alpha, w):
     from anthroarm.mechanisms.rrss import RRSSGeometry, rrss
     from anthroarm.mechanisms.rssr import RSSRGeometry, rssr
 
-    s = 10.0 ** e
+    s = 10.0**e
     P = dict(a0=[0, 0, 0], a1=[1, 0, 0], b0=[3, 0, 1], b1=[3, 0, 3])
     sc = {k: [s * x for x in v] for k, v in P.items()}
     g = typed_or_finite(RSSRGeometry, ua=[0, 0, 1], ub=[0, 1, 0], **sc)
@@ -424,7 +496,7 @@ def test_spatial_bad_inputs(bad, shape):
     u = np.array([bad, 0.0, 1.0])
     typed_or_finite(sp.rot_axis, u, 0.3)
     typed_or_finite(sp.rot_axis, [0.0, 0.0, 1.0], bad)
-    typed_or_finite(sp.rot_axis, [0.0, 0.0, 2.0], 0.3)           # non-unit axis
+    typed_or_finite(sp.rot_axis, [0.0, 0.0, 2.0], 0.3)  # non-unit axis
     typed_or_finite(sp.rot_axis, np.zeros(shape), 0.3)
     typed_or_finite(sp.rotation_matrix, 0.3, u)
     typed_or_finite(sp.rotation_matrix, bad, [0.0, 0.0, 1.0])
@@ -473,12 +545,16 @@ def _quad(x):
 
 
 @SETTINGS
-@given(bad=bad_float, count=st.sampled_from([0, -1, -100]), tol=st.sampled_from([0.0, -1e-6, math.nan, math.inf]))
+@given(
+    bad=bad_float,
+    count=st.sampled_from([0, -1, -100]),
+    tol=st.sampled_from([0.0, -1e-6, math.nan, math.inf]),
+)
 def test_design_optimisers_bad_inputs(bad, count, tol):
     from anthroarm.design import optimize as o
 
-    nanf = lambda x: math.nan          # noqa: E731
-    inff = lambda x: math.inf          # noqa: E731
+    nanf = lambda x: math.nan  # noqa: E731
+    inff = lambda x: math.inf  # noqa: E731
     for f in (nanf, inff):
         typed_or_finite(o.golden_section, f, 0.0, 2.0)
         typed_or_finite(o.quadratic_interpolation, f, (0.0, 1.0, 2.0))
@@ -528,7 +604,9 @@ def test_design_optimisers_bad_inputs(bad, count, tol):
 
 @pytest.mark.parametrize("name", ["planar2r", "prosthetic_arm"])
 @SETTINGS
-@given(bad=bad_float, where=st.integers(0, 20), shape=st.sampled_from([None, (1,), (3, 2, 2), (0, 2)]))
+@given(
+    bad=bad_float, where=st.integers(0, 20), shape=st.sampled_from([None, (1,), (3, 2, 2), (0, 2)])
+)
 def test_lagrange_bad_states(name, bad, where, shape):
     from anthroarm.dynamics import lagrange
 
@@ -537,8 +615,14 @@ def test_lagrange_bad_states(name, bad, where, shape):
     q, v = np.zeros(r.nq), np.zeros(r.nv)
     qb = q.copy()
     qb[where % r.nq] = bad
-    for fn, args in ((dyn.mass_matrix, (qb,)), (dyn.tau, (qb, v, v)), (dyn.forward, (qb, v, v)),
-                     (dyn.forward, (q, v, np.full(r.nv, bad))), (dyn.gravity, (qb,)), (dyn.coriolis, (q, qb[: r.nv]))):
+    for fn, args in (
+        (dyn.mass_matrix, (qb,)),
+        (dyn.tau, (qb, v, v)),
+        (dyn.forward, (qb, v, v)),
+        (dyn.forward, (q, v, np.full(r.nv, bad))),
+        (dyn.gravity, (qb,)),
+        (dyn.coriolis, (q, qb[: r.nv])),
+    ):
         typed_or_finite(fn, *args)
     if shape is not None:
         typed_or_finite(dyn.forward, np.zeros(shape), v, v)
@@ -580,9 +664,15 @@ def test_qp_tasks_and_limits_reject_negative_or_non_finite_weights(bad, neg):
         must_raise(qp.DampingTask, cost=x)
         must_raise(qp.SwivelTask, h, cost=x)
         must_raise(qp.RelativeFrameTask, r, r.tool, r.model.frames[1].name, position_cost=x)
-        must_raise(qp.JointCouplingTask, r, [r.chain.joints[0].name, r.chain.joints[1].name], [1.0, -1.0], cost=x)
+        must_raise(
+            qp.JointCouplingTask,
+            r,
+            [r.chain.joints[0].name, r.chain.joints[1].name],
+            [1.0, -1.0],
+            cost=x,
+        )
         must_raise(qp.ConfigurationLimit, r, gain=x)
-        if x != math.inf:   # an infinite speed / acceleration bound is documented as "no limit"
+        if x != math.inf:  # an infinite speed / acceleration bound is documented as "no limit"
             must_raise(qp.VelocityLimit, r, v_max=x)
             must_raise(qp.VelocityLimit, r, v_max=np.r_[np.ones(r.nv - 1), x])
             must_raise(qp.AccelerationLimit, r, a_max=x)

@@ -30,19 +30,23 @@ def arm():
 
 # --------------------------------------------------------------------------- Robot.check_q
 
-@pytest.mark.parametrize("q, words", [
-    ([NAN] * 7, ["q[0]", "shoulder_flexion", "nan", "finite"]),
-    ([0.0] * 3 + [INF] + [0.0] * 3, ["q[3]", "elbow_flexion", "inf"]),
-    (np.zeros(3), ["shape (7,)", "(3,)", "shoulder_flexion"]),
-    (np.zeros((2, 2, 7)), ["shape (7,)", "(2, 2, 7)"]),
-    (None, ["q is None", "7 joint values"]),
-    ("a", ["q must be real numbers", "shoulder_flexion"]),
-    (["0.1"] * 7, ["q must be real numbers"]),            # numpy would parse the strings
-    ([None] * 7, ["q must be real numbers"]),             # numpy would turn None into NaN
-    ([0.0] * 6 + ["x"], ["q must be real numbers"]),
-    (1 + 2j, ["q must be real numbers"]),
-    (object(), ["q must be real numbers"]),
-])
+
+@pytest.mark.parametrize(
+    "q, words",
+    [
+        ([NAN] * 7, ["q[0]", "shoulder_flexion", "nan", "finite"]),
+        ([0.0] * 3 + [INF] + [0.0] * 3, ["q[3]", "elbow_flexion", "inf"]),
+        (np.zeros(3), ["shape (7,)", "(3,)", "shoulder_flexion"]),
+        (np.zeros((2, 2, 7)), ["shape (7,)", "(2, 2, 7)"]),
+        (None, ["q is None", "7 joint values"]),
+        ("a", ["q must be real numbers", "shoulder_flexion"]),
+        (["0.1"] * 7, ["q must be real numbers"]),  # numpy would parse the strings
+        ([None] * 7, ["q must be real numbers"]),  # numpy would turn None into NaN
+        ([0.0] * 6 + ["x"], ["q must be real numbers"]),
+        (1 + 2j, ["q must be real numbers"]),
+        (object(), ["q must be real numbers"]),
+    ],
+)
 def test_check_q_rejects_hostile_q_with_a_typed_error(arm, q, words):
     with pytest.raises(ParameterError) as e:
         arm.check_q(q)
@@ -56,7 +60,9 @@ def test_check_q_rejects_hostile_q_with_a_typed_error(arm, q, words):
 def test_check_q_batch_row_and_custom_name(arm):
     q = np.zeros((3, 7))
     q[2, 5] = NAN
-    with pytest.raises(ParameterError, match=r"q_start\[5\] for joint 'wrist_deviation' is nan \(row 2\)"):
+    with pytest.raises(
+        ParameterError, match=r"q_start\[5\] for joint 'wrist_deviation' is nan \(row 2\)"
+    ):
         arm.check_q(q, "q_start")
 
 
@@ -75,10 +81,12 @@ def test_public_calls_through_check_q_raise_typed(arm):
 
 
 def test_jacobian_reference_is_a_parameter_error(arm):
-    with pytest.raises(ParameterError, match="reference must be one of LOCAL, WORLD, LOCAL_WORLD_ALIGNED"):
+    with pytest.raises(
+        ParameterError, match="reference must be one of LOCAL, WORLD, LOCAL_WORLD_ALIGNED"
+    ):
         arm.jacobian(arm.neutral(), reference="world")
     with pytest.raises(ParameterError, match="reference"):
-        arm.jacobian(arm.neutral(), reference=["WORLD"])     # unhashable: no bare TypeError
+        arm.jacobian(arm.neutral(), reference=["WORLD"])  # unhashable: no bare TypeError
 
 
 def test_load_with_a_bad_source_type_is_a_parameter_error():
@@ -88,20 +96,36 @@ def test_load_with_a_bad_source_type_is_a_parameter_error():
 
 # --------------------------------------------------------------------------- human_arm7
 
-@pytest.mark.parametrize("kw, name", [
-    ({"height": NAN}, "height"), ({"height": INF}, "height"), ({"height": -1.0}, "height"),
-    ({"height": 17.5}, "height"), ({"height": "1.75"}, "height"), ({"height": None}, "height"),
-    ({"height": True}, "height"), ({"mass": NAN}, "mass"), ({"mass": -5}, "mass"),
-    ({"mass": "75"}, "mass"), ({"mass": 1e6}, "mass"),
-])
+
+@pytest.mark.parametrize(
+    "kw, name",
+    [
+        ({"height": NAN}, "height"),
+        ({"height": INF}, "height"),
+        ({"height": -1.0}, "height"),
+        ({"height": 17.5}, "height"),
+        ({"height": "1.75"}, "height"),
+        ({"height": None}, "height"),
+        ({"height": True}, "height"),
+        ({"mass": NAN}, "mass"),
+        ({"mass": -5}, "mass"),
+        ({"mass": "75"}, "mass"),
+        ({"mass": 1e6}, "mass"),
+    ],
+)
 def test_human_arm7_body_measurements_raise_anthropometry_error(kw, name):
-    for call in (lambda: aa.load("human_arm7", **kw), lambda: aa.models.spec("human_arm7", **kw),
-                 lambda: segment_parameters(**kw)):
+    for call in (
+        lambda: aa.load("human_arm7", **kw),
+        lambda: aa.models.spec("human_arm7", **kw),
+        lambda: segment_parameters(**kw),
+    ):
         with pytest.raises(AnthropometryError) as e:
             call()
         assert e.value.name == name
         v = kw[name]
-        assert e.value.value is v or (isinstance(v, float) and math.isnan(v) and math.isnan(e.value.value))
+        assert e.value.value is v or (
+            isinstance(v, float) and math.isnan(v) and math.isnan(e.value.value)
+        )
         assert name in str(e.value)
         assert isinstance(e.value, ValueError)
 
@@ -124,6 +148,7 @@ def test_human_arm7_sex_lists_the_choices(sex):
 
 # --------------------------------------------------------------------------- models/book.py
 
+
 @pytest.mark.parametrize("value", [-1, -0.1, NAN, INF, "0.3", None, [1, 2], True, b"1"])
 def test_book_lengths_raise_parameter_error_naming_the_length(value):
     with pytest.raises(ParameterError) as e:
@@ -133,8 +158,16 @@ def test_book_lengths_raise_parameter_error_naming_the_length(value):
     assert isinstance(e.value, ValueError)
 
 
-@pytest.mark.parametrize("model, name", [("prosthetic_arm", "L1"), ("sixr_arm", "P"), ("unimate5", "h2"),
-                                         ("rrprr5", "p"), ("planar2r", "l2")])
+@pytest.mark.parametrize(
+    "model, name",
+    [
+        ("prosthetic_arm", "L1"),
+        ("sixr_arm", "P"),
+        ("unimate5", "h2"),
+        ("rrprr5", "p"),
+        ("planar2r", "l2"),
+    ],
+)
 def test_every_book_builder_names_its_length(model, name):
     with pytest.raises(ParameterError, match=f"{model}: {name} must be a finite length"):
         aa.models.spec(model, **{name: -1.0})
@@ -153,20 +186,24 @@ def test_book_defaults_still_build():
 
 # --------------------------------------------------------------------------- mechanisms/_util
 
-@pytest.mark.parametrize("x, words", [
-    (None, ["p must be a real array", "(3,)", "None"]),
-    ("abc", ["p must be a real array"]),
-    (["1", "2", "3"], ["p must be a real array"]),          # numpy would parse the strings
-    ([1.0, None, 2.0], ["p must be a real array"]),         # numpy would turn None into NaN
-    (np.array(["1", "2", "3"]), ["p must be a real array"]),
-    (object(), ["p must be a real array"]),
-    (1 + 2j, ["p must be a real array"]),
-    ([[1.0], [1.0, 2.0]], ["p must be a real array"]),      # ragged
-    ([1.0, NAN, 0.0], ["p must be finite"]),
-    ([1.0, 2.0, INF], ["p must be finite"]),
-    ([1.0, 2.0], ["p must have shape (3,)", "(2,)"]),
-    ([[1.0, 2.0, 3.0]], ["p must have shape (3,)", "(1, 3)"]),
-])
+
+@pytest.mark.parametrize(
+    "x, words",
+    [
+        (None, ["p must be a real array", "(3,)", "None"]),
+        ("abc", ["p must be a real array"]),
+        (["1", "2", "3"], ["p must be a real array"]),  # numpy would parse the strings
+        ([1.0, None, 2.0], ["p must be a real array"]),  # numpy would turn None into NaN
+        (np.array(["1", "2", "3"]), ["p must be a real array"]),
+        (object(), ["p must be a real array"]),
+        (1 + 2j, ["p must be a real array"]),
+        ([[1.0], [1.0, 2.0]], ["p must be a real array"]),  # ragged
+        ([1.0, NAN, 0.0], ["p must be finite"]),
+        ([1.0, 2.0, INF], ["p must be finite"]),
+        ([1.0, 2.0], ["p must have shape (3,)", "(2,)"]),
+        ([[1.0, 2.0, 3.0]], ["p must have shape (3,)", "(1, 3)"]),
+    ],
+)
 def test_finite_array_raises_parameter_error_naming_the_parameter(x, words):
     with pytest.raises(ParameterError) as e:
         _util.finite_array("p", x, (3,))
@@ -181,17 +218,20 @@ def test_finite_array_accepts_real_arrays():
     assert _util.finite_array("p", 2.5).shape == ()
 
 
-@pytest.mark.parametrize("fn, x, words", [
-    (_util.finite_scalar, None, ["L must be a finite real number", "None"]),
-    (_util.finite_scalar, "1.0", ["L must be a finite real number"]),
-    (_util.finite_scalar, NAN, ["L must be finite"]),
-    (_util.finite_scalar, [1.0, 2.0], ["L must be a scalar"]),
-    (_util.positive_length, -1.0, ["L must be a positive length"]),
-    (_util.positive_length, 0.0, ["L must be a positive length"]),
-    (_util.positive_length, INF, ["L must be finite"]),
-    (_util.unit_axis, [0.0, 0.0, 2.0], ["L", "unit"]),
-    (_util.unit_axis, [0.0, 0.0, 0.0], ["L"]),
-])
+@pytest.mark.parametrize(
+    "fn, x, words",
+    [
+        (_util.finite_scalar, None, ["L must be a finite real number", "None"]),
+        (_util.finite_scalar, "1.0", ["L must be a finite real number"]),
+        (_util.finite_scalar, NAN, ["L must be finite"]),
+        (_util.finite_scalar, [1.0, 2.0], ["L must be a scalar"]),
+        (_util.positive_length, -1.0, ["L must be a positive length"]),
+        (_util.positive_length, 0.0, ["L must be a positive length"]),
+        (_util.positive_length, INF, ["L must be finite"]),
+        (_util.unit_axis, [0.0, 0.0, 2.0], ["L", "unit"]),
+        (_util.unit_axis, [0.0, 0.0, 0.0], ["L"]),
+    ],
+)
 def test_scalar_and_axis_validators_raise_parameter_error(fn, x, words):
     with pytest.raises(ParameterError) as e:
         fn("L", x)
@@ -215,11 +255,12 @@ def test_a_public_mechanism_call_raises_parameter_error():
         fourbar(0.1, 0.03, 0.1, 0.08, NAN)
     with pytest.raises(ParameterError, match="theta2 must be a real array"):
         fourbar(0.1, 0.03, 0.1, 0.08, "0.5")
-    with pytest.raises(ValueError, match="theta2"):       # old callers
+    with pytest.raises(ValueError, match="theta2"):  # old callers
         fourbar(0.1, 0.03, 0.1, 0.08, None)
 
 
 # --------------------------------------------------------------------------- _io.atomic_write_text
+
 
 def test_atomic_write_to_a_folder_keeps_oserror_semantics_with_an_actionable_message(tmp_path):
     folder = tmp_path / "out"
@@ -248,7 +289,7 @@ def test_atomic_write_text_rejects_non_text(tmp_path, text):
     with pytest.raises(ParameterError, match="text must be str or bytes") as e:
         atomic_write_text(target, text)
     assert str(target) in str(e.value)
-    assert not target.exists()          # bytes(5) used to write five NUL bytes
+    assert not target.exists()  # bytes(5) used to write five NUL bytes
 
 
 @pytest.mark.parametrize("path", [None, 3, "", ["a"]])

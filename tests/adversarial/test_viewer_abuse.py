@@ -118,14 +118,38 @@ MALFORMED = {
     "invalid_msgpack": [b"set_object", b"", b"\xc1\xc1\xc1"],
     "msgpack_not_a_dict": [b"set_transform", b"", umsgpack.packb(5)],
     "msgpack_without_path": [b"set_transform", b"", umsgpack.packb({"type": "set_transform"})],
-    "msgpack_wrong_field_types": [b"set_transform", b"", umsgpack.packb({"type": "set_transform", "path": 5, "matrix": "x"})],
-    "msgpack_unknown_type": [b"set_transform", b"", umsgpack.packb({"type": "format_disk", "path": "/x"})],
+    "msgpack_wrong_field_types": [
+        b"set_transform",
+        b"",
+        umsgpack.packb({"type": "set_transform", "path": 5, "matrix": "x"}),
+    ],
+    "msgpack_unknown_type": [
+        b"set_transform",
+        b"",
+        umsgpack.packb({"type": "format_disk", "path": "/x"}),
+    ],
     "msgpack_array_length_bomb": [b"set_object", b"", b"\xdd\xff\xff\xff\xff"],
     "msgpack_deep_nesting": [b"set_object", b"", b"\x91" * 200_000 + b"\xc0"],
-    "batch_commands_not_a_list": [b"anthroarm_batch", b"", umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": 5})],
-    "batch_of_garbage": [b"anthroarm_batch", b"", umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": [1, "x", None]})],
-    "ui_spec_not_a_map": [b"anthroarm_ui", b"", umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": "<script>"})],
-    "ui_unknown_kind": [b"anthroarm_ui", b"", umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": {"kind": "html"}})],
+    "batch_commands_not_a_list": [
+        b"anthroarm_batch",
+        b"",
+        umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": 5}),
+    ],
+    "batch_of_garbage": [
+        b"anthroarm_batch",
+        b"",
+        umsgpack.packb({"type": "anthroarm_batch", "path": "", "commands": [1, "x", None]}),
+    ],
+    "ui_spec_not_a_map": [
+        b"anthroarm_ui",
+        b"",
+        umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": "<script>"}),
+    ],
+    "ui_unknown_kind": [
+        b"anthroarm_ui",
+        b"",
+        umsgpack.packb({"type": "anthroarm_ui", "path": "/u", "spec": {"kind": "html"}}),
+    ],
     "huge_garbage_payload": [b"set_object", b"", b"\xc1" * (48 * 2**20)],
     "clients_with_arguments": [b"clients", b"x"],
     "ten_thousand_frames": [b"url"] + [b""] * 10_000,
@@ -177,7 +201,9 @@ def test_a_real_viewer_keeps_working_after_abuse():
     try:
         for frames in ([b"wait", b"99", b"inf"], [b"\xff"], [b"wait", b"abc"]):
             assert (raw_request(v.server.zmq_url, frames) or b"").startswith(b"error")
-            assert (raw_request(v.server.zmq_url, [v.server.secret, *frames]) or b"").startswith(b"error")
+            assert (raw_request(v.server.zmq_url, [v.server.secret, *frames]) or b"").startswith(
+                b"error"
+            )
         for q in v.robot.random_q(3, rng=1):
             v.display(q)
         assert v.server.clients() == 0
@@ -191,7 +217,11 @@ STRANGER = {
     "get_scene": [b"get_scene"],
     "url": [b"url"],
     "wait_forever": [b"wait", b"99", b"inf"],
-    "inject_object": [b"set_transform", b"/meshcat/injected", umsgpack.packb(transform("/meshcat/injected"))],
+    "inject_object": [
+        b"set_transform",
+        b"/meshcat/injected",
+        umsgpack.packb(transform("/meshcat/injected")),
+    ],
 }
 
 
@@ -204,14 +234,23 @@ def test_request_without_the_secret_is_refused(srv, case):
     assert "injected" not in srv.static_html()
 
 
-@pytest.mark.parametrize("kind", ["wrong_same_length", "prefix", "longer", "empty", "secret_as_command"])
+@pytest.mark.parametrize(
+    "kind", ["wrong_same_length", "prefix", "longer", "empty", "secret_as_command"]
+)
 def test_request_with_a_wrong_secret_is_refused(srv, kind):
     good = srv.secret
-    bad = {"wrong_same_length": bytes(len(good)), "prefix": good[:-1], "longer": good + b"0", "empty": b"",
-           "secret_as_command": None}[kind]
+    bad = {
+        "wrong_same_length": bytes(len(good)),
+        "prefix": good[:-1],
+        "longer": good + b"0",
+        "empty": b"",
+        "secret_as_command": None,
+    }[kind]
     frames = [b"get_scene", good] if bad is None else [bad, b"get_scene"]
     reply = raw_request(srv.zmq_url, frames)
-    assert reply is not None and reply.startswith(b"error") and b"secret" in reply, (reply or b"")[:200]
+    assert reply is not None and reply.startswith(b"error") and b"secret" in reply, (reply or b"")[
+        :200
+    ]
     assert b"<html" not in reply.lower()
     assert_healthy(srv)
 
@@ -258,21 +297,46 @@ def http_status(port: int, path: str, host: str | None, extra: dict | None = Non
 
 def ws_status(port: int, host: str | None, origin: str | None) -> int:
     key = base64.b64encode(os.urandom(16)).decode()
-    extra = {"Upgrade": "websocket", "Connection": "Upgrade", "Sec-WebSocket-Key": key, "Sec-WebSocket-Version": "13"}
+    extra = {
+        "Upgrade": "websocket",
+        "Connection": "Upgrade",
+        "Sec-WebSocket-Key": key,
+        "Sec-WebSocket-Version": "13",
+    }
     if origin is not None:
         extra["Origin"] = origin
     with socket.create_connection(("127.0.0.1", port), timeout=REPLY_TIMEOUT) as s:
         s.settimeout(REPLY_TIMEOUT)
-        lines = ["GET / HTTP/1.1"] + ([f"Host: {host}"] if host is not None else []) + [f"{k}: {v}" for k, v in extra.items()]
+        lines = (
+            ["GET / HTTP/1.1"]
+            + ([f"Host: {host}"] if host is not None else [])
+            + [f"{k}: {v}" for k, v in extra.items()]
+        )
         s.sendall(("\r\n".join(lines) + "\r\n\r\n").encode("latin-1"))
         head = s.recv(4096)
     status = head.split(b"\r\n", 1)[0].split()
     return int(status[1]) if len(status) > 1 else 0
 
 
-BAD_HOSTS = ["evil.example", "evil.example:{port}", "127.0.0.1.evil.example:{port}", "localhost.evil.example",
-             "10.0.0.1:{port}", "0.0.0.0:{port}", "", "127.0.0.1:{port}@evil.example", "[::1].evil.example"]
-GOOD_HOSTS = ["127.0.0.1:{port}", "127.0.0.1", "localhost:{port}", "LocalHost", "[::1]:{port}", "[::1]"]
+BAD_HOSTS = [
+    "evil.example",
+    "evil.example:{port}",
+    "127.0.0.1.evil.example:{port}",
+    "localhost.evil.example",
+    "10.0.0.1:{port}",
+    "0.0.0.0:{port}",
+    "",
+    "127.0.0.1:{port}@evil.example",
+    "[::1].evil.example",
+]
+GOOD_HOSTS = [
+    "127.0.0.1:{port}",
+    "127.0.0.1",
+    "localhost:{port}",
+    "LocalHost",
+    "[::1]:{port}",
+    "[::1]",
+]
 
 
 @pytest.mark.parametrize("path", ["/static/", "/static/index.html", "/static/main.min.js", "/"])
@@ -302,33 +366,41 @@ def test_http_with_a_loopback_host_is_served(srv, host):
         conn.close()
 
 
-@pytest.mark.parametrize("host,origin", [
-    ("evil.example:{port}", "http://evil.example:{port}"),       # the rebinding attack itself
-    ("evil.example:{port}", None),
-    ("127.0.0.1:{port}", "http://evil.example:{port}"),
-    ("127.0.0.1:{port}", "null"),
-    ("127.0.0.1:{port}", "http://127.0.0.1.evil.example"),
-    ("localhost:{port}", "https://localhost.evil.example:{port}"),
-    (None, None),
-])
+@pytest.mark.parametrize(
+    "host,origin",
+    [
+        ("evil.example:{port}", "http://evil.example:{port}"),  # the rebinding attack itself
+        ("evil.example:{port}", None),
+        ("127.0.0.1:{port}", "http://evil.example:{port}"),
+        ("127.0.0.1:{port}", "null"),
+        ("127.0.0.1:{port}", "http://127.0.0.1.evil.example"),
+        ("localhost:{port}", "https://localhost.evil.example:{port}"),
+        (None, None),
+    ],
+)
 def test_websocket_from_a_foreign_host_or_origin_is_refused(srv, host, origin):
-    fmt = (lambda x: None if x is None else x.format(port=srv.port))
+    fmt = lambda x: None if x is None else x.format(port=srv.port)
     assert ws_status(srv.port, fmt(host), fmt(origin)) != 101
 
 
-@pytest.mark.parametrize("host,origin", [
-    ("127.0.0.1:{port}", "http://127.0.0.1:{port}"),
-    ("localhost:{port}", "http://localhost:{port}"),
-    ("[::1]:{port}", "http://[::1]:{port}"),
-    ("127.0.0.1:{port}", None),                                 # a non-browser client
-])
+@pytest.mark.parametrize(
+    "host,origin",
+    [
+        ("127.0.0.1:{port}", "http://127.0.0.1:{port}"),
+        ("localhost:{port}", "http://localhost:{port}"),
+        ("[::1]:{port}", "http://[::1]:{port}"),
+        ("127.0.0.1:{port}", None),  # a non-browser client
+    ],
+)
 def test_websocket_from_loopback_is_accepted(srv, host, origin):
-    fmt = (lambda x: None if x is None else x.format(port=srv.port))
+    fmt = lambda x: None if x is None else x.format(port=srv.port)
     assert ws_status(srv.port, fmt(host), fmt(origin)) == 101
 
 
 # ---------------------------------------------------------------------------------- item 12: bad arguments
-@pytest.mark.parametrize("port", [True, False, 1.0, 7000.0, "7000", -1, 0, 65536, 10**20, float("nan"), [7000]])
+@pytest.mark.parametrize(
+    "port", [True, False, 1.0, 7000.0, "7000", -1, 0, 65536, 10**20, float("nan"), [7000]]
+)
 def test_bad_viewer_ports_are_typed_errors_and_start_nothing(port):
     exc = TypeError if isinstance(port, (bool, float, str, list)) else ValueError
     with pytest.raises(exc, match="port") as ei:
@@ -359,9 +431,22 @@ def live_viewer():
     v.close()
 
 
-@pytest.mark.parametrize("kw", [{"timeout": math.inf}, {"timeout": math.nan}, {"timeout": -1.0}, {"timeout": 1e9},
-                                {"timeout": "1"}, {"n": 0}, {"n": -2}, {"n": 1.5}, {"n": True}, {"n": 10**12},
-                                {"n": "1"}])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"timeout": math.inf},
+        {"timeout": math.nan},
+        {"timeout": -1.0},
+        {"timeout": 1e9},
+        {"timeout": "1"},
+        {"n": 0},
+        {"n": -2},
+        {"n": 1.5},
+        {"n": True},
+        {"n": 10**12},
+        {"n": "1"},
+    ],
+)
 def test_bad_wait_arguments_are_typed_errors(live_viewer, kw):
     t0 = time.monotonic()
     with pytest.raises((TypeError, ValueError)) as ei:
@@ -380,17 +465,36 @@ def test_wait_times_out_with_a_viewer_error(live_viewer):
     live_viewer.display(live_viewer.robot.neutral())
 
 
-@pytest.mark.parametrize("q", [np.zeros(3), np.zeros((2, 2)), np.array([np.nan, 0.0]), np.array([np.inf, 0.0]),
-                               "abc", None, [[0.0, 0.0]], np.zeros(0)])
+@pytest.mark.parametrize(
+    "q",
+    [
+        np.zeros(3),
+        np.zeros((2, 2)),
+        np.array([np.nan, 0.0]),
+        np.array([np.inf, 0.0]),
+        "abc",
+        None,
+        [[0.0, 0.0]],
+        np.zeros(0),
+    ],
+)
 def test_bad_display_configurations_are_value_errors_and_the_viewer_keeps_working(live_viewer, q):
     with pytest.raises(ValueError):
         live_viewer.display(q)
     live_viewer.display(live_viewer.robot.neutral())
 
 
-@pytest.mark.parametrize("kw", [{"background": "red"}, {"background": ((0, 0, 0),)}, {"background": ((0, 0, "x"), (1, 1, 1))},
-                                {"background": ((0, 0, np.nan), (1, 1, 1))}, {"background": ((0, 0, 300), (1, 1, 1))},
-                                {"style": 5}])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"background": "red"},
+        {"background": ((0, 0, 0),)},
+        {"background": ((0, 0, "x"), (1, 1, 1))},
+        {"background": ((0, 0, np.nan), (1, 1, 1))},
+        {"background": ((0, 0, 300), (1, 1, 1))},
+        {"style": 5},
+    ],
+)
 def test_bad_viewer_arguments_are_typed_errors(kw):
     with pytest.raises((TypeError, ValueError), match="background|style"):
         Viewer("planar2r", **kw)

@@ -25,7 +25,9 @@ distributed = pytest.importorskip("distributed")
 def client():
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+    )
     c = Client(cluster, set_as_default=False)
     try:
         yield c
@@ -41,7 +43,7 @@ def arm():
 
 # ----------------------------------------------------------------------------- local oracles
 def test_reachability_local_equals_direct_fk_loop(arm):
-    n, chunk, voxel = 50_000, 20_000, 0.05      # 3 tasks; 20 000 > BLOCK: blocks inside a task
+    n, chunk, voxel = 50_000, 20_000, 0.05  # 3 tasks; 20 000 > BLOCK: blocks inside a task
     res = batch.reachability_map(arm, n=n, voxel=voxel, chunk_size=chunk, seed=7, progress=False)
     lo, shape = batch.voxel_grid(arm, voxel)
     expected = np.zeros(shape, np.int64)
@@ -62,7 +64,7 @@ def test_discomfort_zero_at_the_comfortable_posture(arm):
     assert batch.discomfort(arm, q[None])[0] == 0.0
     lo, hi = arm.chain.sampling_box
     q2 = q.copy()
-    q2[3] += 0.1 * (hi[3] - lo[3])                    # one joint off by 10 % of its range
+    q2[3] += 0.1 * (hi[3] - lo[3])  # one joint off by 10 % of its range
     assert batch.discomfort(arm, q2[None])[0] == pytest.approx(0.1 / np.sqrt(7), rel=1e-12)
 
 
@@ -80,11 +82,20 @@ def test_tolerance_equals_monte_carlo_per_configuration(arm):
     from anthroarm.kinematics.error_propagation import monte_carlo
 
     Q = arm.chain.random_q(2, rng=5)
-    res = batch.tolerance_monte_carlo(arm, Q, sigma_q=1e-3, sigma_L=2e-4, n=3000, chunk_size=3000, seed=11,
-                                      progress=False)
+    res = batch.tolerance_monte_carlo(
+        arm, Q, sigma_q=1e-3, sigma_L=2e-4, n=3000, chunk_size=3000, seed=11, progress=False
+    )
     for i, s in enumerate(batch.chunk_seeds(11, 2)):
-        mc = monte_carlo(arm, Q[i], sigma_q=1e-3, sigma_L=2e-4, n=3000, rng=np.random.default_rng(s), batch=3000,
-                         progress=False)
+        mc = monte_carlo(
+            arm,
+            Q[i],
+            sigma_q=1e-3,
+            sigma_L=2e-4,
+            n=3000,
+            rng=np.random.default_rng(s),
+            batch=3000,
+            progress=False,
+        )
         assert res["rms_position"][i] == pytest.approx(mc.rms_position, rel=1e-12)
         assert res["p95_position"][i] == pytest.approx(mc.p95_position, rel=1e-12)
         assert res["max_position"][i] == pytest.approx(mc.max_position, rel=1e-12)
@@ -114,11 +125,18 @@ def test_ik_dataset_round_trip(arm):
 
 
 def test_population_volume_grows_with_height():
-    res = batch.population_reach(heights=[1.55, 1.85], masses=[70.0], sexes=["male"], n=20_000, voxel=0.05,
-                                 chunk_size=10_000, progress=False)
+    res = batch.population_reach(
+        heights=[1.55, 1.85],
+        masses=[70.0],
+        sexes=["male"],
+        n=20_000,
+        voxel=0.05,
+        chunk_size=10_000,
+        progress=False,
+    )
     v, r = res["volume"][:, 0, 0], res["max_reach"][:, 0, 0]
     assert v[1] > v[0] > 0 and r[1] > r[0]
-    for k, h in enumerate([1.55, 1.85]):           # the largest distance is at most the arm's length
+    for k, h in enumerate([1.55, 1.85]):  # the largest distance is at most the arm's length
         assert r[k] <= aa.load("human_arm7", height=h, mass=70.0, sex="male").chain.reach() + 1e-12
     env = res["envelope"][:, 0, 0]
     assert np.all(env[:, 0] < env[:, 1])
@@ -126,14 +144,38 @@ def test_population_volume_grows_with_height():
 
 # ----------------------------------------------------------------------------- Dask = local
 SMALL = {
-    "reach": lambda arm: (batch.reachability_map, (arm,), dict(n=40_000, voxel=0.05, chunk_size=8_000, seed=1)),
-    "comfort": lambda arm: (batch.comfort_map, ("human_arm7",), dict(n=30_000, voxel=0.06, chunk_size=6_000)),
-    "population": lambda arm: (batch.population_reach, (), dict(heights=[1.6, 1.8], masses=[60.0, 80.0],
-                                                                sexes=["female"], n=8_000, voxel=0.05, chunk_size=4_000)),
-    "tolerance": lambda arm: (batch.tolerance_monte_carlo, (arm, arm.chain.random_q(3, rng=2)),
-                              dict(sigma_q=1e-3, sigma_L=1e-4, n=2_000, chunk_size=700)),
-    "ik": lambda arm: (batch.ik_dataset, (arm, arm.fk(arm.chain.random_q(16, rng=3, margin=0.05))),
-                       dict(chunk_size=4, max_restarts=20, max_time=1.0)),
+    "reach": lambda arm: (
+        batch.reachability_map,
+        (arm,),
+        dict(n=40_000, voxel=0.05, chunk_size=8_000, seed=1),
+    ),
+    "comfort": lambda arm: (
+        batch.comfort_map,
+        ("human_arm7",),
+        dict(n=30_000, voxel=0.06, chunk_size=6_000),
+    ),
+    "population": lambda arm: (
+        batch.population_reach,
+        (),
+        dict(
+            heights=[1.6, 1.8],
+            masses=[60.0, 80.0],
+            sexes=["female"],
+            n=8_000,
+            voxel=0.05,
+            chunk_size=4_000,
+        ),
+    ),
+    "tolerance": lambda arm: (
+        batch.tolerance_monte_carlo,
+        (arm, arm.chain.random_q(3, rng=2)),
+        dict(sigma_q=1e-3, sigma_L=1e-4, n=2_000, chunk_size=700),
+    ),
+    "ik": lambda arm: (
+        batch.ik_dataset,
+        (arm, arm.fk(arm.chain.random_q(16, rng=3, margin=0.05))),
+        dict(chunk_size=4, max_restarts=20, max_time=1.0),
+    ),
     "cells": lambda arm: (batch.cell_table, (arm,), dict(D=0.15, chunk_size=3)),
 }
 
@@ -147,7 +189,7 @@ def test_dask_result_is_bitwise_the_local_result(job, arm, client):
 
 
 def test_worker_killed_mid_job_loses_and_duplicates_nothing(arm, client):
-    kw = dict(n=120_000, voxel=0.05, chunk_size=6_000, seed=9, progress=False)   # 20 tasks
+    kw = dict(n=120_000, voxel=0.05, chunk_size=6_000, seed=9, progress=False)  # 20 tasks
     local = batch.reachability_map(arm, **kw)
     pids = client.run(os.getpid)
     victim = sorted(pids.values())[0]
@@ -162,7 +204,7 @@ def test_worker_killed_mid_job_loses_and_duplicates_nothing(arm, client):
     assert killed and killed[0] < 20
     assert local.equals(remote)
     assert remote["counts"].sum() == kw["n"]
-    client.wait_for_workers(2, timeout=60)   # the nanny restarts the worker for the next tests
+    client.wait_for_workers(2, timeout=60)  # the nanny restarts the worker for the next tests
 
 
 @pytest.mark.parametrize("where", ["local", "dask"])
@@ -174,10 +216,19 @@ def test_cancelled_job_leaves_no_output_file(arm, client, tmp_path, where):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        batch.run_job("reach", arm, out=out, client=client if where == "dask" else None, n=60_000, voxel=0.05,
-                      chunk_size=5_000, progress=False, callback=interrupt)
+        batch.run_job(
+            "reach",
+            arm,
+            out=out,
+            client=client if where == "dask" else None,
+            n=60_000,
+            voxel=0.05,
+            chunk_size=5_000,
+            progress=False,
+            callback=interrupt,
+        )
     assert list(tmp_path.iterdir()) == []
-    if where == "dask":   # the job's pending tasks were cancelled, none keeps running
+    if where == "dask":  # the job's pending tasks were cancelled, none keeps running
         deadline = time.monotonic() + 20
         while any(client.processing().values()) and time.monotonic() < deadline:
             time.sleep(0.1)
@@ -186,10 +237,23 @@ def test_cancelled_job_leaves_no_output_file(arm, client, tmp_path, where):
 
 def test_run_job_writes_the_result_atomically(arm, client, tmp_path):
     out, png = tmp_path / "comfort.npz", tmp_path / "comfort.png"
-    res = batch.run_job("comfort", arm, out=out, plot=png, client=client, n=20_000, voxel=0.06, chunk_size=5_000,
-                        progress=False)
+    res = batch.run_job(
+        "comfort",
+        arm,
+        out=out,
+        plot=png,
+        client=client,
+        n=20_000,
+        voxel=0.06,
+        chunk_size=5_000,
+        progress=False,
+    )
     back = batch.load(out)
-    assert back.equals(res) and back.attrs["n"] == 20_000 and back.dims("discomfort") == ("x", "y", "z")
+    assert (
+        back.equals(res)
+        and back.attrs["n"] == 20_000
+        and back.dims("discomfort") == ("x", "y", "z")
+    )
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["comfort.npz", "comfort.png"]
 
@@ -209,7 +273,7 @@ def test_unreachable_scheduler_fails_fast_with_a_typed_error():
 
 
 def test_robot_without_description_is_refused_for_dask_but_runs_locally(arm, client):
-    robot = aa.load(arm.model)                      # from an in-memory pin.Model: no URDF text
+    robot = aa.load(arm.model)  # from an in-memory pin.Model: no URDF text
     with pytest.raises(batch.RobotDescriptionError, match="URDF"):
         batch.reachability_map(robot, n=1000, voxel=0.1, client=client, progress=False)
     assert batch.reachability_map(robot, n=1000, voxel=0.1, progress=False)["counts"].sum() == 1000
@@ -217,11 +281,15 @@ def test_robot_without_description_is_refused_for_dask_but_runs_locally(arm, cli
 
 def test_worker_that_rebuilds_another_robot_raises_rebuild_error(arm, client):
     d = batch.describe(arm)
-    bad = batch.RobotDescription(d.kind, d.source, d.name, (("height", 1.5),), d.tool, d.locked, d.key)
+    bad = batch.RobotDescription(
+        d.kind, d.source, d.name, (("height", 1.5),), d.tool, d.locked, d.key
+    )
     lo, shape = batch.voxel_grid(arm, 0.1)
     payload = dict(n=100, seed=np.random.SeedSequence(0), frame=None, lo=lo, voxel=0.1, shape=shape)
     with pytest.raises(batch.RobotRebuildError, match="Remedy"):
-        engine.run([(jobs._reach_task, bad, payload)], lambda i, p: None, client=client, progress=False)
+        engine.run(
+            [(jobs._reach_task, bad, payload)], lambda i, p: None, client=client, progress=False
+        )
 
 
 def test_urdf_robot_is_shipped_as_text_and_rebuilt(tmp_path, client):
@@ -231,7 +299,9 @@ def test_urdf_robot_is_shipped_as_text_and_rebuilt(tmp_path, client):
     d = batch.describe(robot)
     assert d.kind == "urdf" and d.key == robot.chain.key()
     kw = dict(n=10_000, voxel=0.08, chunk_size=5_000, progress=False)
-    assert batch.reachability_map(robot, **kw).equals(batch.reachability_map(robot, client=client, **kw))
+    assert batch.reachability_map(robot, **kw).equals(
+        batch.reachability_map(robot, client=client, **kw)
+    )
 
 
 def test_output_too_large_is_refused_before_allocating(arm):
@@ -257,10 +327,24 @@ def test_tasks_are_chunked_never_one_giant_array(arm, monkeypatch):
 def test_cli_batch_on_the_cluster_equals_in_process(client, tmp_path, capsys):
     from anthroarm.cli import main
 
-    common = ["batch", "reach", "--param", "height=1.62", "--n", "20000", "--voxel", "0.06", "--chunk-size", "5000",
-              "--no-progress"]
+    common = [
+        "batch",
+        "reach",
+        "--param",
+        "height=1.62",
+        "--n",
+        "20000",
+        "--voxel",
+        "0.06",
+        "--chunk-size",
+        "5000",
+        "--no-progress",
+    ]
     assert main(common + ["--out", str(tmp_path / "a.npz")]) == 0
-    assert main(common + ["--scheduler", client.scheduler.address, "--out", str(tmp_path / "b.npz")]) == 0
+    assert (
+        main(common + ["--scheduler", client.scheduler.address, "--out", str(tmp_path / "b.npz")])
+        == 0
+    )
     assert '"n": 20000' in capsys.readouterr().out
     assert batch.load(tmp_path / "a.npz").equals(batch.load(tmp_path / "b.npz"))
 
@@ -269,7 +353,18 @@ def test_cli_batch_unreachable_scheduler_is_one_line_exit_2(capsys):
     from anthroarm.cli import main
 
     t0 = time.monotonic()
-    rc = main(["batch", "reach", "--n", "100", "--scheduler", f"tcp://127.0.0.1:{_free_port()}", "--timeout", "2"])
+    rc = main(
+        [
+            "batch",
+            "reach",
+            "--n",
+            "100",
+            "--scheduler",
+            f"tcp://127.0.0.1:{_free_port()}",
+            "--timeout",
+            "2",
+        ]
+    )
     err = capsys.readouterr().err
     assert rc == 2 and "no Dask scheduler answered" in err and err.count("\n") == 1
     assert time.monotonic() - t0 < 15

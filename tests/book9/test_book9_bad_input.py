@@ -39,7 +39,7 @@ def test_inertia_force_bad_mass_and_vectors():
 
 
 def test_oblique_decomposition_on_dependent_axes_is_refused():
-    axes = np.column_stack([[1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0]])      # p3 in the plane of p1, p2
+    axes = np.column_stack([[1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0]])  # p3 in the plane of p1, p2
     for fn in (inf.oblique_components, inf.oblique_components_printed):
         with pytest.raises(ParameterError, match="not independent"):
             fn([1.0, 2.0, 3.0], axes)

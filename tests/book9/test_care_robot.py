@@ -12,8 +12,15 @@ import anthroarm as aa
 from anthroarm.errors import ParameterError, UnknownCodeError
 from anthroarm.ik.cells import CellTable, OutsideCellTableError
 from anthroarm.models import book_tables
-from anthroarm.models.care_robot import (CELL_ACCURACY, CELL_D, TABLE_9_5, cell_table, pulses_per_rad,
-                                         table_9_5_length_sum_mm, table_9_5_mass_sum_kg)
+from anthroarm.models.care_robot import (
+    CELL_ACCURACY,
+    CELL_D,
+    TABLE_9_5,
+    cell_table,
+    pulses_per_rad,
+    table_9_5_length_sum_mm,
+    table_9_5_mass_sum_kg,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -39,8 +46,20 @@ def wrist(robot, q):
 
 def test_table_9_5_printed_values():
     # l. 7568-7572, verbatim
-    assert [TABLE_9_5[k][0] for k in ("base", "upper_arm", "forearm", "finger_palm", "total")] == [115, 295, 280, 186, 856]
-    assert [TABLE_9_5[k][1] for k in ("base", "upper_arm", "forearm", "finger_palm", "total")] == [2.38, 1.82, 1.16, 0.57, 5.93]
+    assert [TABLE_9_5[k][0] for k in ("base", "upper_arm", "forearm", "finger_palm", "total")] == [
+        115,
+        295,
+        280,
+        186,
+        856,
+    ]
+    assert [TABLE_9_5[k][1] for k in ("base", "upper_arm", "forearm", "finger_palm", "total")] == [
+        2.38,
+        1.82,
+        1.16,
+        0.57,
+        5.93,
+    ]
 
 
 def test_table_9_5_masses_add_up():
@@ -66,7 +85,12 @@ def test_model_segment_lengths_are_the_printed_ones(robot):
     pin.updateFramePlacements(robot.model, data)
     o = [data.oMi[i].translation for i in range(1, robot.model.njoints)]
     tip = data.oMf[robot.tool_id].translation
-    seg = [np.linalg.norm(o[1] - o[0]), np.linalg.norm(o[2] - o[1]), np.linalg.norm(o[4] - o[2]), np.linalg.norm(tip - o[4])]
+    seg = [
+        np.linalg.norm(o[1] - o[0]),
+        np.linalg.norm(o[2] - o[1]),
+        np.linalg.norm(o[4] - o[2]),
+        np.linalg.norm(tip - o[4]),
+    ]
     np.testing.assert_allclose(np.array(seg) * 1000, [115, 295, 280, 186], atol=1e-9)
     assert np.linalg.norm(o[0]) == 0.0
 
@@ -152,8 +176,10 @@ def test_interpolated_wrist_within_the_printed_1_cm(robot, table):
     assert np.median(err) < CELL_ACCURACY
     assert (err <= CELL_ACCURACY).mean() >= 0.9
     assert err.max() < 3 * CELL_ACCURACY
-    assert err.max() > CELL_ACCURACY         # ... but it is not a bound everywhere (docs/guide/book_systems.md)
-    assert err.max() > 1e-3          # interpolation is not exact between lattice points
+    assert (
+        err.max() > CELL_ACCURACY
+    )  # ... but it is not a bound everywhere (docs/guide/book_systems.md)
+    assert err.max() > 1e-3  # interpolation is not exact between lattice points
 
 
 def test_lookup_pulses_equals_interpolated_q(robot, table):
@@ -182,7 +208,9 @@ def test_relative_pulses_are_register_differences(table):
     # between two lattice points: the difference of the stored ROM entries
     i, j = np.argwhere(table.valid)[:2]
     pa, pb = table.origin + table.D * i, table.origin + table.D * j
-    np.testing.assert_array_equal(table.relative_pulses(pa, pb), table.pulses[tuple(j)] - table.pulses[tuple(i)])
+    np.testing.assert_array_equal(
+        table.relative_pulses(pa, pb), table.pulses[tuple(j)] - table.pulses[tuple(i)]
+    )
 
 
 def test_one_newton_step_from_the_table(robot, table):
@@ -207,7 +235,9 @@ def test_bad_pulse_scales_are_typed(table):
     for bad in ((0, 200), (2000, np.nan), ("x", 200)):
         with pytest.raises(ParameterError, match="encoder_counts and gear_ratio"):
             pulses_per_rad(*bad)
-    plain = CellTable(table.model, table.params, table.rotation, table.origin, table.D, table.Q, table.valid)
+    plain = CellTable(
+        table.model, table.params, table.rotation, table.origin, table.D, table.Q, table.valid
+    )
     with pytest.raises(ParameterError, match="no motor pulses"):
         plain.lookup_pulses([0.3, 0.0, 0.1])
 
@@ -225,15 +255,42 @@ def test_save_and_load_keep_pulses(table, tmp_path):
 
 #: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display, output)
 TABLE_9_6_PRINT = {
-    1: ("15", "请一会儿来"), 2: ("25", "不是"), 3: ("35", "是"), 4: ("13", "请擦身"), 5: ("23", "请梳头"),
-    6: ("33", "请刷牙"), 7: ("14", "您早"), 8: ("24", "您好"), 9: ("34", "晚上好"), 10: ("5D", "是想吃什么吗?"),
-    11: ("9D", "请让吃药"), 12: ("BD", "请开窗"), 13: ("ED", "请关窗"), 14: ("57", "是想喝什么吗?"),
-    15: ("B7", "请开门"), 16: ("E7", "请关门"), 17: ("5B", "对不起"), 18: ("6B", "请开电视机"),
-    19: ("DB", "请关电视机"), 20: ("7B", "请开收音机"), 21: ("9B", "请熄灯"), 22: ("BB", "请拉开窗帘"),
-    23: ("EB", "请关窗帘"), 24: ("58", "请帮助"), 25: ("68", "像是有点冷"), 26: ("D8", "像是有点热"),
-    27: ("78", "晚安"), 28: ("98", "是想上厕所吗?"), 29: ("B8", "请点灯"), 30: ("E8", "请息灯"),
-    31: ("5A", "请拿报纸来"), 32: ("6A", "请拿书来"), 33: ("DA", "请拿杂志来"), 34: ("7A", "像是伤风了"),
-    35: ("9A", "想要翻身吗?"), 36: ("BA", "是否有点不舒服?"),
+    1: ("15", "请一会儿来"),
+    2: ("25", "不是"),
+    3: ("35", "是"),
+    4: ("13", "请擦身"),
+    5: ("23", "请梳头"),
+    6: ("33", "请刷牙"),
+    7: ("14", "您早"),
+    8: ("24", "您好"),
+    9: ("34", "晚上好"),
+    10: ("5D", "是想吃什么吗?"),
+    11: ("9D", "请让吃药"),
+    12: ("BD", "请开窗"),
+    13: ("ED", "请关窗"),
+    14: ("57", "是想喝什么吗?"),
+    15: ("B7", "请开门"),
+    16: ("E7", "请关门"),
+    17: ("5B", "对不起"),
+    18: ("6B", "请开电视机"),
+    19: ("DB", "请关电视机"),
+    20: ("7B", "请开收音机"),
+    21: ("9B", "请熄灯"),
+    22: ("BB", "请拉开窗帘"),
+    23: ("EB", "请关窗帘"),
+    24: ("58", "请帮助"),
+    25: ("68", "像是有点冷"),
+    26: ("D8", "像是有点热"),
+    27: ("78", "晚安"),
+    28: ("98", "是想上厕所吗?"),
+    29: ("B8", "请点灯"),
+    30: ("E8", "请息灯"),
+    31: ("5A", "请拿报纸来"),
+    32: ("6A", "请拿书来"),
+    33: ("DA", "请拿杂志来"),
+    34: ("7A", "像是伤风了"),
+    35: ("9A", "想要翻身吗?"),
+    36: ("BA", "是否有点不舒服?"),
 }
 
 
@@ -247,7 +304,7 @@ def test_table_9_6_is_the_print_row_by_row():
 def test_table_9_6_rows():
     rows = book_tables.melody_codes()
     assert [r.no for r in rows] == list(range(1, 37))
-    assert len({r.display for r in rows}) == 36                     # display codes are unique
+    assert len({r.display for r in rows}) == 36  # display codes are unique
     assert all(len(r.display) == 2 and int(r.display, 16) >= 0 for r in rows)
     # spot checks against the print (l. 7627-7640)
     assert book_tables.melody_lookup("15").output_zh == "请一会儿来"
@@ -274,14 +331,22 @@ def test_cell_table_of_another_robot_is_refused():
         cell_table(aa.load("prosthetic_arm"))
 
 
-
 def test_bad_table_parameters_and_pulse_vectors_are_typed(robot, table):
-    for kw in (dict(D="x"), dict(D=np.nan), dict(rotation="abc"), dict(rotation=np.ones((3, 3))),
-               dict(bounds=((0, 0, 0), (1, 1))), dict(D=1e-6)):       # 2e17 lattice points: refused, not built
+    for kw in (
+        dict(D="x"),
+        dict(D=np.nan),
+        dict(rotation="abc"),
+        dict(rotation=np.ones((3, 3))),
+        dict(bounds=((0, 0, 0), (1, 1))),
+        dict(D=1e-6),
+    ):  # 2e17 lattice points: refused, not built
         with pytest.raises(ParameterError):
             cell_table(robot, **kw)
     for bad in ("abc", [1, 2], [np.nan] * 6):
         with pytest.raises(ParameterError, match="pulses must be"):
             table.pulses_to_q(bad)
-    np.testing.assert_allclose(table.pulses_to_q(table.pulses[tuple(np.argwhere(table.valid)[0])]),
-                               table.Q[tuple(np.argwhere(table.valid)[0])], atol=0.5 / table.pulses_per_rad.min())
+    np.testing.assert_allclose(
+        table.pulses_to_q(table.pulses[tuple(np.argwhere(table.valid)[0])]),
+        table.Q[tuple(np.argwhere(table.valid)[0])],
+        atol=0.5 / table.pulses_per_rad.min(),
+    )

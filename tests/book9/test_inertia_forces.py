@@ -7,10 +7,22 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.dynamics.inertia_forces import (angular_momentum, joint_frame_from_links, axis_projections, dalembert_torques,
-                                               inertia_couple, inertia_couple_expanded, inertia_couple_fixed,
-                                               inertia_force, inertia_force_body, joint_frame, link_inertia_loads,
-                                               oblique_components, oblique_components_printed, torque_terms)
+from anthroarm.dynamics.inertia_forces import (
+    angular_momentum,
+    axis_projections,
+    dalembert_torques,
+    inertia_couple,
+    inertia_couple_expanded,
+    inertia_couple_fixed,
+    inertia_force,
+    inertia_force_body,
+    joint_frame,
+    joint_frame_from_links,
+    link_inertia_loads,
+    oblique_components,
+    oblique_components_printed,
+    torque_terms,
+)
 from anthroarm.spatial.rotations import rot_axis
 
 RNG = np.random.default_rng(11)
@@ -25,12 +37,26 @@ def pin_terms(r, q, v, a):
     m, d = r.model, r.model.createData()
     z = np.zeros(r.nv)
     g = pin.computeGeneralizedGravity(m, d, q)
-    return {"M_qdd": pin.rnea(m, d, q, z, a) - g, "C_qd": pin.rnea(m, d, q, v, z) - g, "g": g,
-            "tau": pin.rnea(m, d, q, v, a)}
+    return {
+        "M_qdd": pin.rnea(m, d, q, z, a) - g,
+        "C_qd": pin.rnea(m, d, q, v, z) - g,
+        "g": g,
+        "tau": pin.rnea(m, d, q, v, a),
+    }
 
 
-@pytest.mark.parametrize("name", ["care_robot", "prosthetic_arm", "unimate5", "human_arm7", "spherical_robot",
-                                  "cartesian_robot", "ur10"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "care_robot",
+        "prosthetic_arm",
+        "unimate5",
+        "human_arm7",
+        "spherical_robot",
+        "cartesian_robot",
+        "ur10",
+    ],
+)
 def test_dalembert_terms_equal_rnea_split(name):
     r = aa.load(name)
     for _ in range(3):
@@ -42,7 +68,9 @@ def test_dalembert_terms_equal_rnea_split(name):
             np.testing.assert_allclose(ours[k], ref[k], atol=1e-12 * scale, err_msg=k)
         # M q̈ is linear in q̈: the columns are crba's
         M = pin.crba(r.model, r.model.createData(), q)
-        np.testing.assert_allclose(ours["M_qdd"], np.triu(M) @ a + np.triu(M, 1).T @ a, atol=1e-12 * scale)
+        np.testing.assert_allclose(
+            ours["M_qdd"], np.triu(M) @ a + np.triu(M, 1).T @ a, atol=1e-12 * scale
+        )
 
 
 MIMIC_URDF = """<?xml version="1.0"?>
@@ -72,7 +100,9 @@ def test_mimic_and_prismatic_joints_against_a_coupled_reference(tmp_path):
     p.write_text(MIMIC_URDF)
     r = aa.load(str(p))
     assert r.nv == 3
-    free = pin.buildModelFromXML(MIMIC_URDF.replace('<mimic joint="j2" multiplier="0.6" offset="0.1"/>', ""))
+    free = pin.buildModelFromXML(
+        MIMIC_URDF.replace('<mimic joint="j2" multiplier="0.6" offset="0.1"/>', "")
+    )
     G = np.array([[1, 0, 0], [0, 1, 0], [0, 0.6, 0], [0, 0, 1.0]])
     for _ in range(3):
         q = r.random_q(None, RNG)
@@ -86,7 +116,9 @@ def test_inertia_couple_expanded_is_the_vector_form():
     """(8-39) as printed = (8-38) −(Jε + ω × Jω), for full tensors (products of inertia)."""
     for _ in range(20):
         J, w, e = random_inertia(RNG), RNG.normal(size=3), RNG.normal(size=3)
-        np.testing.assert_allclose(inertia_couple_expanded(J, w, e), inertia_couple(J, w, e), atol=1e-12)
+        np.testing.assert_allclose(
+            inertia_couple_expanded(J, w, e), inertia_couple(J, w, e), atol=1e-12
+        )
 
 
 def test_inertia_couple_is_pinocchios_body_wrench():
@@ -95,7 +127,9 @@ def test_inertia_couple_is_pinocchios_body_wrench():
     J, m = random_inertia(RNG), 1.7
     w, e = RNG.normal(size=3), RNG.normal(size=3)
     Y = pin.Inertia(m, np.zeros(3), J)
-    f = Y * pin.Motion(np.zeros(3), e) + pin.Motion(np.zeros(3), w).cross(Y * pin.Motion(np.zeros(3), w))
+    f = Y * pin.Motion(np.zeros(3), e) + pin.Motion(np.zeros(3), w).cross(
+        Y * pin.Motion(np.zeros(3), w)
+    )
     np.testing.assert_allclose(inertia_couple(J, w, e), -f.angular, atol=1e-12)
     np.testing.assert_allclose(inertia_force(m, [1.0, -2.0, 0.5]), -m * np.array([1.0, -2.0, 0.5]))
 
@@ -107,7 +141,7 @@ def test_couple_is_minus_the_rate_of_angular_momentum():
     w0, w1 = RNG.normal(size=3), RNG.normal(size=3)
 
     def state(t):
-        wb = w0 + t * w1                                  # body angular velocity ωᵦ(t)
+        wb = w0 + t * w1  # body angular velocity ωᵦ(t)
         return wb
 
     # integrate R' = R [ωᵦ]× with a fine RK-free exact step: piecewise-constant rate over tiny steps
@@ -139,8 +173,11 @@ def test_link_loads_are_zero_at_rest_and_balance_gravity():
     L = link_inertia_loads(r, q, z, z)
     assert np.abs(L.F).max() == 0.0 and np.abs(L.M).max() == 0.0
     # gravity alone: the d'Alembert torques are Pinocchio's generalized gravity
-    np.testing.assert_allclose(dalembert_torques(r, q, z, z), pin.computeGeneralizedGravity(r.model, r.model.createData(), q),
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        dalembert_torques(r, q, z, z),
+        pin.computeGeneralizedGravity(r.model, r.model.createData(), q),
+        atol=1e-12,
+    )
 
 
 def test_bad_inputs_are_value_errors():
@@ -163,7 +200,7 @@ def test_joint_frame_third_axis():
     A = joint_frame(p1, p2)
     np.testing.assert_allclose(np.linalg.norm(A, axis=0), 1.0)
     np.testing.assert_allclose(A[:, 2], [0, 0, 1.0], atol=1e-15)
-    assert abs(A[:, 0] @ A[:, 1] - np.cos(1.0)) < 1e-15             # oblique: not orthogonal
+    assert abs(A[:, 0] @ A[:, 1] - np.cos(1.0)) < 1e-15  # oblique: not orthogonal
 
 
 def test_oblique_decomposition_reconstructs_the_moment_printed_form_fails():
@@ -173,7 +210,7 @@ def test_oblique_decomposition_reconstructs_the_moment_printed_form_fails():
     np.testing.assert_allclose(c[0] * A[:, 0] + c[1] * A[:, 1] + c[2] * A[:, 2], M, atol=1e-14)
     c_printed = oblique_components_printed(M, A)
     back = c_printed[0] * A[:, 0] + c_printed[1] * A[:, 1] + c_printed[2] * A[:, 2]
-    assert np.abs(back - M).max() > 0.05                               # (8-86) as printed: not M
+    assert np.abs(back - M).max() > 0.05  # (8-86) as printed: not M
 
 
 def test_orthonormal_joint_frame_gives_pinocchios_spherical_joint_torque():
@@ -181,7 +218,9 @@ def test_orthonormal_joint_frame_gives_pinocchios_spherical_joint_torque():
     components (8-86) are the body-frame moment pin.rnea returns for the spherical joint."""
     model = pin.Model()
     jid = model.addJoint(0, pin.JointModelSpherical(), pin.SE3.Identity(), "ball")
-    model.appendBodyToJoint(jid, pin.Inertia(1.3, np.array([0.1, 0.05, -0.2]), random_inertia(RNG)), pin.SE3.Identity())
+    model.appendBodyToJoint(
+        jid, pin.Inertia(1.3, np.array([0.1, 0.05, -0.2]), random_inertia(RNG)), pin.SE3.Identity()
+    )
     data = model.createData()
     q = pin.randomConfiguration(model, -np.ones(4), np.ones(4))
     v, a = RNG.normal(size=3), RNG.normal(size=3)
@@ -191,7 +230,9 @@ def test_orthonormal_joint_frame_gives_pinocchios_spherical_joint_torque():
     A = joint_frame(R[:, 0], R[:, 1])
     np.testing.assert_allclose(A, R, atol=1e-12)
     np.testing.assert_allclose(oblique_components(M_world, A), tau, atol=1e-12)
-    np.testing.assert_allclose(oblique_components_printed(M_world, A), tau, atol=1e-12)   # orthonormal: same
+    np.testing.assert_allclose(
+        oblique_components_printed(M_world, A), tau, atol=1e-12
+    )  # orthonormal: same
     np.testing.assert_allclose(axis_projections(M_world, A), tau, atol=1e-12)
 
 
@@ -201,12 +242,12 @@ def test_printed_8_33_angular_momentum_fails():
     pts, ms = RNG.normal(size=(6, 3)), RNG.uniform(0.1, 1.0, 6)
     J = sum(m * (p @ p * np.eye(3) - np.outer(p, p)) for m, p in zip(ms, pts))
     w = RNG.normal(size=3)
-    H_true = sum(m * np.cross(p, np.cross(w, p)) for m, p in zip(ms, pts))          # (8-32)
+    H_true = sum(m * np.cross(p, np.cross(w, p)) for m, p in zip(ms, pts))  # (8-32)
     np.testing.assert_allclose(angular_momentum(J, w), H_true, atol=1e-12)
     Jy, Jz = J[1, 1], J[2, 2]
     Jxy, Jyz, Jzx = -J[0, 1], -J[1, 2], -J[2, 0]
-    Hx_printed = w[0] * Jz - w[1] * Jyz - w[2] * Jzx          # J_zy = J_yz
-    Hy_printed = -w[0] * Jyz + w[1] * Jy - w[2] * Jxy          # J_yx = J_xy
+    Hx_printed = w[0] * Jz - w[1] * Jyz - w[2] * Jzx  # J_zy = J_yz
+    Hy_printed = -w[0] * Jyz + w[1] * Jy - w[2] * Jxy  # J_yx = J_xy
     # each printed component is wrong on its own (J_z for J_x in H_x; J_yz and J_yx swapped in H_y)
     assert abs(Hx_printed - H_true[0]) > 1e-3 and abs(Hy_printed - H_true[1]) > 1e-3
 
@@ -223,4 +264,4 @@ def test_8_84_row_vectors_with_the_passive_matrices_are_the_rotated_axes():
     np.testing.assert_allclose(A[:, 0], R1 @ l1, atol=1e-14)
     np.testing.assert_allclose(A[:, 1], R2 @ l2, atol=1e-14)
     c = np.cross(R1 @ l1, R2 @ l2)
-    np.testing.assert_allclose(A[:, 2], c / np.linalg.norm(c), atol=1e-14)          # (8-85)
+    np.testing.assert_allclose(A[:, 2], c / np.linalg.norm(c), atol=1e-14)  # (8-85)

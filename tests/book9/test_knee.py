@@ -6,7 +6,14 @@ import numpy as np
 import pytest
 
 from anthroarm.mechanisms.closed_loop import ClosedLoop
-from anthroarm.mechanisms.knee import KneeGeometry, default_knee, icr_path, knee_flexion, knee_pose, stability_margin
+from anthroarm.mechanisms.knee import (
+    KneeGeometry,
+    default_knee,
+    icr_path,
+    knee_flexion,
+    knee_pose,
+    stability_margin,
+)
 from anthroarm.mechanisms.pin_models import fourbar_spec
 from anthroarm.models.book_tables import lower_limb_limits
 
@@ -33,7 +40,11 @@ def test_link_lengths_are_kept_over_flexion():
     np.testing.assert_allclose(np.linalg.norm(st.dist_post - K.prox_post, axis=1), r4, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(st.dist_post - st.dist_ant, axis=1), r3, atol=1e-12)
     # the ankle is rigid with the distal link
-    np.testing.assert_allclose(np.linalg.norm(st.ankle - st.dist_ant, axis=1), np.linalg.norm(K.ankle - K.dist_ant), atol=1e-12)
+    np.testing.assert_allclose(
+        np.linalg.norm(st.ankle - st.dist_ant, axis=1),
+        np.linalg.norm(K.ankle - K.dist_ant),
+        atol=1e-12,
+    )
 
 
 def test_table_2_4_knee_flexion_is_reached():
@@ -68,10 +79,10 @@ def test_icr_is_the_zero_velocity_point_by_finite_differences():
     h = 1e-6
     for th2, icr in zip(st.theta2, st.icr):
         p, m = knee_pose(K, th2 + h), knee_pose(K, th2 - h)
-        v = (p.dist_ant[0] - m.dist_ant[0]) / (2 * h)            # dA/dθ2
-        w = -(p.flexion[0] - m.flexion[0]) / (2 * h)             # dθ3/dθ2 (flexion = -Δθ3)
+        v = (p.dist_ant[0] - m.dist_ant[0]) / (2 * h)  # dA/dθ2
+        w = -(p.flexion[0] - m.flexion[0]) / (2 * h)  # dθ3/dθ2 (flexion = -Δθ3)
         A = knee_pose(K, th2).dist_ant[0]
-        c = A + np.array([-v[1], v[0]]) / w                       # C = P + k × v / ω
+        c = A + np.array([-v[1], v[0]]) / w  # C = P + k × v / ω
         np.testing.assert_allclose(icr, c, atol=1e-7)
 
 
@@ -86,7 +97,7 @@ def test_icr_is_the_intersection_of_the_link_lines():
 def test_moving_centrode_maps_back_to_the_fixed_one():
     st = icr_path(K, np.radians(120), 13)
     for f, icr, ics, A in zip(st.flexion, st.icr, st.icr_shank, st.dist_ant):
-        c, s = np.cos(-f), np.sin(-f)                         # shank turned by -flexion
+        c, s = np.cos(-f), np.sin(-f)  # shank turned by -flexion
         R = np.array([[c, -s], [s, c]])
         np.testing.assert_allclose(A + R @ (ics - K.dist_ant), icr, atol=1e-12)
 
@@ -95,7 +106,7 @@ def test_radcliffe_stability_margin():
     """TKA line vertical through x0: the margin is x0 - x_ICR (exact); stable (> 0) with the hip
     above the ankle, unstable when the hip is aligned 6 cm posterior."""
     icr = knee_flexion(K, 0.0).icr[0]
-    assert icr[1] > 0.05                                       # a high (proximal) ICR at extension
+    assert icr[1] > 0.05  # a high (proximal) ICR at extension
     assert stability_margin(K, (0.0, 0.45)) == pytest.approx(0.0 - icr[0], abs=1e-12)
     assert stability_margin(K, (0.0, 0.45)) > 0
     # hip 6 cm posterior: at the height of the ICR the TKA line passes behind it
@@ -109,13 +120,20 @@ def test_unreachable_flexion_is_a_status_not_nan():
     st = knee_flexion(K, np.radians([60, 400]))
     assert st.ok.tolist() == [True, False]
     assert st.status[1] == "cannot_assemble"
-    assert np.isfinite(st.icr).all() and np.isfinite(st.flexion).all() and np.isfinite(st.ankle).all()
+    assert (
+        np.isfinite(st.icr).all() and np.isfinite(st.flexion).all() and np.isfinite(st.ankle).all()
+    )
 
 
 def test_parallel_links_have_no_finite_icr():
     # a parallelogram: the links stay parallel, the ICR is at infinity
-    par = KneeGeometry(prox_ant=(0.01, 0.03), prox_post=(-0.01, 0.03), dist_ant=(0.01, -0.01),
-                       dist_post=(-0.01, -0.01), ankle=(0.0, -0.4))
+    par = KneeGeometry(
+        prox_ant=(0.01, 0.03),
+        prox_post=(-0.01, 0.03),
+        dist_ant=(0.01, -0.01),
+        dist_post=(-0.01, -0.01),
+        ankle=(0.0, -0.4),
+    )
     st = knee_pose(par, -np.pi / 2)
     assert st.status[0] == "parallel_links" and not st.ok[0]
     assert np.isfinite(st.icr).all()
@@ -125,8 +143,20 @@ def test_parallel_links_have_no_finite_icr():
 
 def test_bad_geometry_is_a_value_error():
     with pytest.raises(ValueError, match="anterior link has zero length"):
-        KneeGeometry(prox_ant=(0, 0), prox_post=(-0.01, 0), dist_ant=(0, 0), dist_post=(-0.01, -0.04), ankle=(0, -0.4))
+        KneeGeometry(
+            prox_ant=(0, 0),
+            prox_post=(-0.01, 0),
+            dist_ant=(0, 0),
+            dist_post=(-0.01, -0.04),
+            ankle=(0, -0.4),
+        )
     with pytest.raises(ValueError):
-        KneeGeometry(prox_ant=(np.nan, 0), prox_post=(-0.01, 0), dist_ant=(0, -0.04), dist_post=(-0.01, -0.04), ankle=(0, -0.4))
+        KneeGeometry(
+            prox_ant=(np.nan, 0),
+            prox_post=(-0.01, 0),
+            dist_ant=(0, -0.04),
+            dist_post=(-0.01, -0.04),
+            ankle=(0, -0.4),
+        )
     with pytest.raises(ValueError, match="n must be"):
         icr_path(K, 1.0, n=1)

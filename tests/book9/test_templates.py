@@ -24,7 +24,12 @@ def tool_positions(name, n=200, **params):
 
 
 def test_templates_are_in_the_catalog_in_table_order():
-    assert [f.form for f in book_tables.robot_forms()] == ["cartesian", "cylindrical", "spherical", "articulated"]
+    assert [f.form for f in book_tables.robot_forms()] == [
+        "cartesian",
+        "cylindrical",
+        "spherical",
+        "articulated",
+    ]
     assert list(TEMPLATES) == [f"{f.form}_robot" for f in book_tables.robot_forms()]
     assert set(TEMPLATES) <= set(aa.models.names())
 
@@ -75,18 +80,21 @@ def test_parameters_change_the_model():
     np.testing.assert_allclose([r.lower[2], r.upper[2]], [0.2, 0.4])
 
 
-@pytest.mark.parametrize("name,params,match", [
-    ("cylindrical_robot", {"reach": (1.0, 0.5)}, "reach"),
-    ("cylindrical_robot", {"reach": (-0.1, 0.5)}, "reach"),
-    ("spherical_robot", {"elevation": (-2.0, 1.0)}, "elevation"),
-    ("articulated_robot", {"l2": 0.0}, "l2"),
-    ("articulated_robot", {"l3": float("nan")}, "l3"),
-    ("cartesian_robot", {"x_stroke": (0, float("inf"))}, "x_stroke"),
-    ("cartesian_robot", {"h0": -1}, "h0"),
-    ("spherical_robot", {"base": "wide"}, "base"),
-    ("articulated_robot", {"l2": 1e300}, "l2"),               # was an 'inf' link mass blamed on the URDF
-    ("cylindrical_robot", {"reach": (0.0, 1e300)}, "reach"),
-])
+@pytest.mark.parametrize(
+    "name,params,match",
+    [
+        ("cylindrical_robot", {"reach": (1.0, 0.5)}, "reach"),
+        ("cylindrical_robot", {"reach": (-0.1, 0.5)}, "reach"),
+        ("spherical_robot", {"elevation": (-2.0, 1.0)}, "elevation"),
+        ("articulated_robot", {"l2": 0.0}, "l2"),
+        ("articulated_robot", {"l3": float("nan")}, "l3"),
+        ("cartesian_robot", {"x_stroke": (0, float("inf"))}, "x_stroke"),
+        ("cartesian_robot", {"h0": -1}, "h0"),
+        ("spherical_robot", {"base": "wide"}, "base"),
+        ("articulated_robot", {"l2": 1e300}, "l2"),  # was an 'inf' link mass blamed on the URDF
+        ("cylindrical_robot", {"reach": (0.0, 1e300)}, "reach"),
+    ],
+)
 def test_parameters_out_of_range_are_typed(name, params, match):
     with pytest.raises(ParameterError, match=match):
         aa.models.spec(name, **params)
@@ -106,9 +114,15 @@ def test_crba_positive_definite_and_mass():
 def test_table_2_4_as_printed():
     rows = book_tables.lower_limb_rom()
     got = [(r.joint, r.motion, r.range_deg) for r in rows]
-    assert got == [("hip", "flexion", 120.0), ("hip", "extension", 30.0), ("hip", "internal_external_rotation", 45.0),
-                   ("knee", "flexion", 120.0), ("knee", "extension", None),
-                   ("ankle", "dorsiflexion", 45.0), ("ankle", "plantarflexion", 45.0)]
+    assert got == [
+        ("hip", "flexion", 120.0),
+        ("hip", "extension", 30.0),
+        ("hip", "internal_external_rotation", 45.0),
+        ("knee", "flexion", 120.0),
+        ("knee", "extension", None),
+        ("ankle", "dorsiflexion", 45.0),
+        ("ankle", "plantarflexion", 45.0),
+    ]
     assert rows[0].joint_zh == "股关节" and rows[0].printed == "约 120°"
     lim = book_tables.lower_limb_limits()
     np.testing.assert_allclose(np.degrees(lim["hip_flexion"]), [-30, 120])
@@ -119,8 +133,9 @@ def test_table_2_4_as_printed():
 
 def test_table_2_3_as_printed():
     f = {r.form: r for r in book_tables.robot_forms()}
-    assert [f[k].workspace_shape_zh for k in ("cartesian", "cylindrical", "spherical", "articulated")] == \
-        ["立方体", "圆柱体", "球体", "球多球体"]
+    assert [
+        f[k].workspace_shape_zh for k in ("cartesian", "cylindrical", "spherical", "articulated")
+    ] == ["立方体", "圆柱体", "球体", "球多球体"]
     assert [f[k].footprint_zh for k in f] == ["大", "较小", "小", "最小"]
     assert [f[k].relative_workspace_zh for k in f] == ["小", "较大", "大", "最大"]
     assert [f[k].intuitiveness_zh for k in f] == ["强", "较强", "一般", "差"]

@@ -6,7 +6,15 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from anthroarm.kinematics.vector_loop import I, J, K, VectorLoop, loop_spec, nested_pose, product_pose
+from anthroarm.kinematics.vector_loop import (
+    I,
+    J,
+    K,
+    VectorLoop,
+    loop_spec,
+    nested_pose,
+    product_pose,
+)
 from anthroarm.models.spec import to_urdf
 from anthroarm.models.templates import tensor6r_loop, unimate2600_loop
 from anthroarm.spatial.rotation_tensor import rotation_tensor
@@ -27,8 +35,8 @@ def test_nested_and_product_forms_equal_pinocchio(make):
     lo, hi = np.array(lim).T
     for _ in range(25):
         q = RNG.uniform(lo, hi)
-        P, a, b = nested_pose(loop, q)                      # (6-50)/(6-59), (6-53)
-        P2, a2, b2 = product_pose(loop, q)                  # (6-60)/(6-61)
+        P, a, b = nested_pose(loop, q)  # (6-50)/(6-59), (6-53)
+        P2, a2, b2 = product_pose(loop, q)  # (6-60)/(6-61)
         pin.framesForwardKinematics(m, d, q)
         T = d.oMf[fid]
         for x, y in ((P, P2), (a, a2), (b, b2)):
@@ -47,9 +55,13 @@ def R_components(q, c):
     R3 = c[2] * np.array([C1, S1, 0])
     R4 = c[3] * np.array([C1 * np.cos(t2), S1 * np.cos(t2), -np.sin(t2)])
     R56 = (c[4] + c[5]) * np.array([C1 * C23, S1 * C23, -S23])
-    R78 = (c[6] + c[7]) * np.array([C1 * C5 * C23 - S1 * S4 * S5 - C1 * C4 * S5 * S23,
-                                    S1 * C5 * C23 + C1 * S4 * S5 - S1 * C4 * S5 * S23,
-                                    -C5 * S23 - C4 * S5 * C23])
+    R78 = (c[6] + c[7]) * np.array(
+        [
+            C1 * C5 * C23 - S1 * S4 * S5 - C1 * C4 * S5 * S23,
+            S1 * C5 * C23 + C1 * S4 * S5 - S1 * C4 * S5 * S23,
+            -C5 * S23 - C4 * S5 * C23,
+        ]
+    )
     return R12, R3, R4, R56, R78
 
 
@@ -61,7 +73,7 @@ def test_6r_expanded_components_6_63_6_64():
     for _ in range(25):
         q = RNG.uniform(-np.pi, np.pi, 6)
         P, _, _ = nested_pose(loop, q)
-        np.testing.assert_allclose(sum(R_components(q, C6R)), P, atol=1e-14)      # (6-64)
+        np.testing.assert_allclose(sum(R_components(q, C6R)), P, atol=1e-14)  # (6-64)
 
 
 def test_printed_R78_with_cos_theta3_fails():
@@ -85,8 +97,8 @@ def test_printed_theta3_about_i_fails():
     loop, _ = tensor6r_loop(*C6R)
     items = list(loop.items)
     rev = [n for n, (kind, _) in enumerate(items) if kind == "R"]
-    assert np.allclose(items[rev[2]][1], J)                  # the corrected θ3 axis
-    items[rev[2]] = ("R", I)                                  # the printed one
+    assert np.allclose(items[rev[2]][1], J)  # the corrected θ3 axis
+    items[rev[2]] = ("R", I)  # the printed one
     printed = VectorLoop(tuple(items), G=loop.G, a0=loop.a0, b0=loop.b0)
     q = np.array([0.3, -0.4, 0.9, 0.5, -0.7, 0.2])
     expanded = sum(R_components(q, C6R))
@@ -119,13 +131,22 @@ def test_unimate_expanded_6_51_and_attitude_vector():
     k, i = np.array(K), np.array(I)
     for _ in range(20):
         t1, t2, L, t3, t4, t5 = RNG.uniform(np.array(lim)[:, 0], np.array(lim)[:, 1])
-        E1, E2, E3, E4, E5 = (rotation_tensor(w, t) for w, t in ((K, t1), (J, t2), (I, t3), (J, t4), (I, t5)))
-        P51 = (c1 + c2) * k + E1 @ E2 @ ((L + c4) * i) + E1 @ E2 @ E3 @ E4 @ (c5 * k) + E1 @ E2 @ E3 @ E4 @ E5 @ (g6 * k)
+        E1, E2, E3, E4, E5 = (
+            rotation_tensor(w, t) for w, t in ((K, t1), (J, t2), (I, t3), (J, t4), (I, t5))
+        )
+        P51 = (
+            (c1 + c2) * k
+            + E1 @ E2 @ ((L + c4) * i)
+            + E1 @ E2 @ E3 @ E4 @ (c5 * k)
+            + E1 @ E2 @ E3 @ E4 @ E5 @ (g6 * k)
+        )
         P, a, _ = nested_pose(loop, [t1, t2, L, t3, t4, t5])
         np.testing.assert_allclose(P, P51, atol=1e-14)
-        np.testing.assert_allclose(a, E1 @ E2 @ E3 @ E4 @ E5 @ k, atol=1e-14)        # (6-53)
-        np.testing.assert_allclose(rotation_tensor(I, t3) @ i, i, atol=1e-15)        # (6-49) ordinary vector
-        assert np.linalg.norm(E5 @ k - k) > 1e-6 or abs(np.sin(t5)) < 1e-6            # attitude vector
+        np.testing.assert_allclose(a, E1 @ E2 @ E3 @ E4 @ E5 @ k, atol=1e-14)  # (6-53)
+        np.testing.assert_allclose(
+            rotation_tensor(I, t3) @ i, i, atol=1e-15
+        )  # (6-49) ordinary vector
+        assert np.linalg.norm(E5 @ k - k) > 1e-6 or abs(np.sin(t5)) < 1e-6  # attitude vector
 
 
 def test_bad_loops_are_value_errors():

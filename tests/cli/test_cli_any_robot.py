@@ -39,10 +39,32 @@ def test_view_example_robot_data_tree_needs_a_tool(tmp_path, capsys):
 def test_view_user_urdf_takes_a_continuous_joint_as_its_angle(tmp_path, user_urdf, capsys):
     out = tmp_path / "user.html"
     # joints spin (continuous), shoulder, wrist (continuous), grip: four values, not nq = 6
-    assert cli.main(["view", str(user_urdf), "--tool", "tool", "--q", "30", "10", "200", "20", "--deg",
-                     "--html", str(out)]) == 0
+    assert (
+        cli.main(
+            [
+                "view",
+                str(user_urdf),
+                "--tool",
+                "tool",
+                "--q",
+                "30",
+                "10",
+                "200",
+                "20",
+                "--deg",
+                "--html",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert out.is_file()
-    assert cli.main(["view", str(user_urdf), "--tool", "tool", "--q", "1", "2", "3", "--html", str(out)]) == 2
+    assert (
+        cli.main(
+            ["view", str(user_urdf), "--tool", "tool", "--q", "1", "2", "3", "--html", str(out)]
+        )
+        == 2
+    )
     assert "--q needs 4 values" in capsys.readouterr().err
 
 
@@ -66,7 +88,9 @@ def test_ik_on_continuous_joints_prints_one_angle_per_joint(capsys):
     pin.framesForwardKinematics(r.model, d, q)
     M = d.oMf[r.tool_id]
     rpy = pin.rpy.matrixToRpy(M.rotation)
-    rc = cli.main(["ik", "kinova", "--xyz", *map(str, M.translation), "--rpy", *map(str, rpy), "--json"])
+    rc = cli.main(
+        ["ik", "kinova", "--xyz", *map(str, M.translation), "--rpy", *map(str, rpy), "--json"]
+    )
     out = capsys.readouterr().out
     assert rc == 0, out
 
@@ -89,14 +113,15 @@ def test_ik_book_arm_lists_its_closed_form_branches(capsys):
     r = aa.load("prosthetic_arm")
     T = r.fk(r.random_q(rng=4, margin=0.2))
     rpy = pin.rpy.matrixToRpy(T[:3, :3])
-    rc = cli.main(["ik", "prosthetic_arm", "--xyz", *map(str, T[:3, 3]), "--rpy", *map(str, rpy), "--json"])
-
+    rc = cli.main(
+        ["ik", "prosthetic_arm", "--xyz", *map(str, T[:3, 3]), "--rpy", *map(str, rpy), "--json"]
+    )
 
     res = json.loads(capsys.readouterr().out)
     assert rc == 0 and res["success"]
     branches = np.array(res["closed_form_solutions"])
     assert len(branches) >= 1
-    for qb in branches:   # every listed branch reaches the pose (Pinocchio)
+    for qb in branches:  # every listed branch reaches the pose (Pinocchio)
         d = r.model.createData()
         pin.framesForwardKinematics(r.model, d, qb)
         assert np.linalg.norm(d.oMf[r.tool_id].translation - T[:3, 3]) < 1e-9

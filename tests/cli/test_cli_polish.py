@@ -17,8 +17,13 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _run(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "anthroarm.cli", *args], capture_output=True, text=True,
-                          timeout=60, env=env)
+    return subprocess.run(
+        [sys.executable, "-m", "anthroarm.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env,
+    )
 
 
 def test_urdf_help_lists_the_model_parameters_with_units_and_defaults():
@@ -43,10 +48,19 @@ def test_urdf_help_of_another_book_model_lists_its_own_parameters(capsys):
 
 def test_urdf_accepts_parameters_as_options_and_as_param(tmp_path, capsys):
     a, b, c = tmp_path / "a.urdf", tmp_path / "b.urdf", tmp_path / "c.urdf"
-    assert cli.main(["urdf", "human_arm7", "-o", str(a), "--height", "1.62", "--sex", "female"]) == 0
-    assert cli.main(["urdf", "human_arm7", "-o", str(b), "--param", "height=1.62", "--param", "sex=female"]) == 0
+    assert (
+        cli.main(["urdf", "human_arm7", "-o", str(a), "--height", "1.62", "--sex", "female"]) == 0
+    )
+    assert (
+        cli.main(
+            ["urdf", "human_arm7", "-o", str(b), "--param", "height=1.62", "--param", "sex=female"]
+        )
+        == 0
+    )
     assert cli.main(["urdf", "human_arm7", "-o", str(c)]) == 0
-    assert a.read_text() == b.read_text() == models.urdf_text("human_arm7", height=1.62, sex="female")
+    assert (
+        a.read_text() == b.read_text() == models.urdf_text("human_arm7", height=1.62, sex="female")
+    )
     assert a.read_text() != c.read_text()
     # a pair parameter (the boom stroke) as MIN,MAX
     d = tmp_path / "d.urdf"
@@ -54,14 +68,17 @@ def test_urdf_accepts_parameters_as_options_and_as_param(tmp_path, capsys):
     assert d.read_text() == models.urdf_text("unimate5", boom=(0.2, 0.9))
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["urdf", "human_arm7", "--heigth", "1.62"], "--height, --mass, --sex"),
-    (["urdf", "human_arm7", "--param", "heigth=1.62"], "height, mass, sex"),
-    (["urdf", "ur10", "--height", "1.62"], "ur10 has no builder parameters"),
-    (["urdf", "human_arm7", "--height", "tall"], "expects a number"),
-    (["urdf", "unimate5", "--boom", "0.2"], "two numbers"),
-    (["urdf", "human_arm7", "--height", "1.6", "--param", "height=1.7"], "given twice"),
-])
+@pytest.mark.parametrize(
+    "args, needle",
+    [
+        (["urdf", "human_arm7", "--heigth", "1.62"], "--height, --mass, --sex"),
+        (["urdf", "human_arm7", "--param", "heigth=1.62"], "height, mass, sex"),
+        (["urdf", "ur10", "--height", "1.62"], "ur10 has no builder parameters"),
+        (["urdf", "human_arm7", "--height", "tall"], "expects a number"),
+        (["urdf", "unimate5", "--boom", "0.2"], "two numbers"),
+        (["urdf", "human_arm7", "--height", "1.6", "--param", "height=1.7"], "given twice"),
+    ],
+)
 def test_bad_model_parameters_are_one_line_errors(tmp_path, capsys, args, needle):
     out = tmp_path / "x.urdf"
     assert cli.main([*args, "-o", str(out)]) == 2
@@ -73,7 +90,11 @@ def test_bad_model_parameters_are_one_line_errors(tmp_path, capsys, args, needle
 def test_unknown_model_parameter_in_a_subprocess_exits_2_with_the_choices(tmp_path):
     r = _run("urdf", "human_arm7", "-o", str(tmp_path / "x.urdf"), "--weight", "70")
     assert r.returncode == 2
-    assert r.stderr.count("\n") == 1 and "--height, --mass, --sex" in r.stderr and "Traceback" not in r.stderr
+    assert (
+        r.stderr.count("\n") == 1
+        and "--height, --mass, --sex" in r.stderr
+        and "Traceback" not in r.stderr
+    )
 
 
 def test_view_takes_the_model_parameters_too(tmp_path, capsys):
@@ -98,13 +119,17 @@ def test_bench_out_into_a_path_under_a_file_is_one_line_error(tmp_path):
     assert r.stderr.count("\n") == 1 and "cannot write" in r.stderr and "Traceback" not in r.stderr
 
 
-@pytest.mark.parametrize("args", [["--quick", "--update-results"], ["--out", "x", "--update-results"]])
+@pytest.mark.parametrize(
+    "args", [["--quick", "--update-results"], ["--out", "x", "--update-results"]]
+)
 def test_bench_update_results_conflicts(capsys, args):
     before = {p: p.stat().st_mtime_ns for p in (ROOT / "benchmarks" / "results").glob("*.*")}
     assert cli.main(["bench", "tolerance", *args]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--update-results" in err
-    assert {p: p.stat().st_mtime_ns for p in (ROOT / "benchmarks" / "results").glob("*.*")} == before
+    assert {
+        p: p.stat().st_mtime_ns for p in (ROOT / "benchmarks" / "results").glob("*.*")
+    } == before
 
 
 def test_bench_writes_to_out_and_by_default_to_the_user_folder(tmp_path):
@@ -122,7 +147,9 @@ def test_bench_writes_to_out_and_by_default_to_the_user_folder(tmp_path):
         env = {**os.environ, "XDG_DATA_HOME": str(tmp_path / "xdg")}
         r = _run("bench", "tolerance", "--quick", env=env)
         assert r.returncode == 0, r.stderr
-        assert (tmp_path / "xdg" / "anthroarm" / "benchmarks" / "quick" / "tolerance.json").is_file()
+        assert (
+            tmp_path / "xdg" / "anthroarm" / "benchmarks" / "quick" / "tolerance.json"
+        ).is_file()
     assert {p: p.stat().st_mtime_ns for p in results.glob("*.*")} == before
 
 
@@ -132,7 +159,11 @@ def test_urdf_help_gives_angle_ranges_in_rad_and_they_are_used_as_rad(tmp_path, 
     with pytest.raises(SystemExit) as e:
         cli.main(["urdf", "spherical_robot", "--help"])
     assert e.value.code == 0
-    opts = {ln.split()[0]: ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("--")}
+    opts = {
+        ln.split()[0]: ln
+        for ln in capsys.readouterr().out.splitlines()
+        if ln.strip().startswith("--")
+    }
     assert opts["--elevation"].split()[2] == "rad," and opts["--base"].split()[2] == "rad,"
     assert opts["--reach"].split()[2] == "m,"
     out = tmp_path / "s.urdf"
@@ -141,6 +172,11 @@ def test_urdf_help_gives_angle_ranges_in_rad_and_they_are_used_as_rad(tmp_path, 
 
     m = pin.buildModelFromUrdf(str(out))
     revolute = [j for j in range(1, m.njoints) if m.joints[j].shortname().startswith("JointModelR")]
-    lims = sorted((float(m.lowerPositionLimit[m.joints[j].idx_q]), float(m.upperPositionLimit[m.joints[j].idx_q]))
-                  for j in revolute)
+    lims = sorted(
+        (
+            float(m.lowerPositionLimit[m.joints[j].idx_q]),
+            float(m.upperPositionLimit[m.joints[j].idx_q]),
+        )
+        for j in revolute
+    )
     assert (-0.5, 0.75) in [(round(a, 12), round(b, 12)) for a, b in lims]

@@ -43,7 +43,9 @@ def assert_one_line_error(rc, err, *needles):
 
 
 def test_top_level_help_lists_every_subcommand():
-    out = subprocess.run([sys.executable, "-m", "anthroarm.cli", "--help"], capture_output=True, text=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-m", "anthroarm.cli", "--help"], capture_output=True, text=True
+    ).stdout
     for c in SUBCOMMANDS:
         assert re.search(rf"^\s+{c}\s", out, re.M), c
 
@@ -58,7 +60,11 @@ def test_every_subcommand_help_has_an_example(cmd, capsys):
 
 
 def test_unknown_model_lists_the_catalog(capsys):
-    for argv in (["view", "robonaut"], ["ik", "robonaut", "--xyz", "0", "0", "0"], ["view", "robonaut", "--html", "x.html"]):
+    for argv in (
+        ["view", "robonaut"],
+        ["ik", "robonaut", "--xyz", "0", "0", "0"],
+        ["view", "robonaut", "--html", "x.html"],
+    ):
         rc, out, err = run(argv, capsys)
         assert_one_line_error(rc, err, "robonaut", "human_arm7", "panda", "prosthetic_arm")
 
@@ -82,8 +88,10 @@ def test_port_in_use(capsys):
     s.listen()
     port = s.getsockname()[1]
     try:
-        for argv in (["view", "planar2r", "--port", str(port), "--no-browser", "--seconds", "0"],
-                     ["demo", "--port", str(port), "--no-browser", "--seconds", "0"]):
+        for argv in (
+            ["view", "planar2r", "--port", str(port), "--no-browser", "--seconds", "0"],
+            ["demo", "--port", str(port), "--no-browser", "--seconds", "0"],
+        ):
             rc, out, err = run(argv, capsys)
             assert_one_line_error(rc, err, f"port {port}", "already in use")
     finally:
@@ -91,26 +99,59 @@ def test_port_in_use(capsys):
 
 
 def test_user_errors_have_no_traceback_in_a_real_process(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "anthroarm.cli", "view", "human_arm7", "--q", "0.1"],
-                       capture_output=True, text=True)
-    assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    r = subprocess.run(
+        [sys.executable, "-m", "anthroarm.cli", "view", "human_arm7", "--q", "0.1"],
+        capture_output=True,
+        text=True,
+    )
+    assert (
+        r.returncode == 2
+        and "Traceback" not in r.stderr
+        and len(r.stderr.strip().splitlines()) == 1
+    )
 
 
 def test_view_writes_html(tmp_path, capsys):
     out_file = tmp_path / "arm.html"
-    rc, out, err = run(["view", "human_arm7", "--q", "40", "-20", "10", "70", "0", "0", "10", "--deg",
-                        "--limits", "--frames", "--workspace", "100", "--html", str(out_file)], capsys)
+    rc, out, err = run(
+        [
+            "view",
+            "human_arm7",
+            "--q",
+            "40",
+            "-20",
+            "10",
+            "70",
+            "0",
+            "0",
+            "10",
+            "--deg",
+            "--limits",
+            "--frames",
+            "--workspace",
+            "100",
+            "--html",
+            str(out_file),
+        ],
+        capsys,
+    )
     assert rc == 0 and f"wrote {out_file}" in out
     cmds = page_commands(out_file)
     paths = {c["path"] for c in cmds}
     assert any(p.endswith("/overlays/workspace") for p in paths)
     assert sum("/overlays/frames/" in p for p in paths) >= 7
     assert any(c["type"] == "anthroarm_color" for c in cmds)  # --limits
-    T = {c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T for c in cmds if c["type"] == "set_transform"}
+    T = {
+        c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T
+        for c in cmds
+        if c["type"] == "set_transform"
+    }
     robot = aa.load("human_arm7")
     q = np.deg2rad([40, -20, 10, 70, 0, 0, 10])
     wrist = robot.fk(q, "wrist_flexion")  # joint frame of the last joint
-    np.testing.assert_allclose(T["/meshcat/anthroarm/human_arm7/bodies/wrist_flexion"], wrist, atol=1e-12)
+    np.testing.assert_allclose(
+        T["/meshcat/anthroarm/human_arm7/bodies/wrist_flexion"], wrist, atol=1e-12
+    )
 
 
 def test_view_live_starts_and_stops(capsys):
@@ -146,8 +187,10 @@ def test_ik_help_example_is_solved_and_checked_by_fk(capsys):
     robot = aa.load(res["model"])
     q = np.deg2rad([res["q"][n] for n in robot.joint_names])
     T = robot.fk(q)
-    xyz = example[example.index("--xyz") + 1: example.index("--xyz") + 4]
-    rpy = np.deg2rad([float(x) for x in example[example.index("--rpy") + 1: example.index("--rpy") + 4]])
+    xyz = example[example.index("--xyz") + 1 : example.index("--xyz") + 4]
+    rpy = np.deg2rad(
+        [float(x) for x in example[example.index("--rpy") + 1 : example.index("--rpy") + 4]]
+    )
     np.testing.assert_allclose(T[:3, 3], [float(x) for x in xyz], atol=1e-5)
     np.testing.assert_allclose(T[:3, :3], pin.rpy.rpyToMatrix(*rpy), atol=1e-5)
 
@@ -156,7 +199,9 @@ def test_ik_panda_text_output(capsys):
     robot = aa.load("panda")
     T = robot.fk(robot.random_q(rng=11, margin=0.2))
     rpy = pin.rpy.matrixToRpy(T[:3, :3])
-    rc, out, err = run(["ik", "panda", "--xyz", *map(str, T[:3, 3]), "--rpy", *map(str, rpy)], capsys)
+    rc, out, err = run(
+        ["ik", "panda", "--xyz", *map(str, T[:3, 3]), "--rpy", *map(str, rpy)], capsys
+    )
     assert rc == 0, out + err
     assert "panda: solved" in out and "panda_joint7" in out
 

@@ -24,12 +24,15 @@ def statics(b: Bilateral, kind, theta_h, wall: Wall, load=0.0):
     rhs[0] = b.K_h * theta_h
     A[1] = [b.K, -b.K - wall.K, 0.0]
     rhs[1] = load - wall.K * wall.theta
-    tau_e = np.array([0.0, wall.K, 0.0]), load - wall.K * wall.theta     # τ_e = K_e θ2 + (load − K_e θw)
-    if kind == "symmetric":                         # τ_1 = −K_m(θ1 − θ2)
+    tau_e = (
+        np.array([0.0, wall.K, 0.0]),
+        load - wall.K * wall.theta,
+    )  # τ_e = K_e θ2 + (load − K_e θw)
+    if kind == "symmetric":  # τ_1 = −K_m(θ1 − θ2)
         A[2] = [-b.K_master, b.K_master, 1.0]
-    elif kind == "force_reflecting":                # τ_1 = −k_f K(θ1 − θ2)
+    elif kind == "force_reflecting":  # τ_1 = −k_f K(θ1 − θ2)
         A[2] = [-b.k_f * b.K, b.k_f * b.K, 1.0]
-    else:                                           # τ_1 = G(τ_h − k_f τ_e)
+    else:  # τ_1 = G(τ_h − k_f τ_e)
         A[2] = [0.0, -b.G * b.k_f * tau_e[0][1], 1.0 + b.G]
         rhs[2] = b.G * b.k_f * tau_e[1]
     th1, th2, tau_h = np.linalg.solve(A, rhs)
@@ -109,15 +112,21 @@ def test_exact_steps_agree_with_an_implicit_integrator():
         return A * np.sin(w * tt), A * w * np.cos(w * tt)
 
     for kind in ("symmetric", "force_reflecting", "force_feedback"):
+
         def f(tt, x):
             th, wh = path(tt)
             tau_h = b.K_h * (th - x[0]) + b.B_h * (wh - x[1])
             e, de = x[0] - x[2], x[1] - x[3]
             tau_2 = b.K * e + b.D * de
-            tau_1 = {"symmetric": -b.K_master * e - b.D_master * de, "force_reflecting": -b.k_f * tau_2,
-                     "force_feedback": b.G * tau_h}[kind]
+            tau_1 = {
+                "symmetric": -b.K_master * e - b.D_master * de,
+                "force_reflecting": -b.k_f * tau_2,
+                "force_feedback": b.G * tau_h,
+            }[kind]
             return [x[1], (tau_h + tau_1 - b.B1 * x[1]) / b.J1, x[3], (tau_2 - b.B2 * x[3]) / b.J2]
 
         sol = solve_ivp(f, (0, 1.0), [0, 0, 0, 0], t_eval=t, method="Radau", rtol=1e-9, atol=1e-12)
         r = b.simulate(kind, t, path)
-        assert np.allclose(r.theta_m, sol.y[0], atol=1e-6) and np.allclose(r.theta_s, sol.y[2], atol=1e-6)
+        assert np.allclose(r.theta_m, sol.y[0], atol=1e-6) and np.allclose(
+            r.theta_s, sol.y[2], atol=1e-6
+        )

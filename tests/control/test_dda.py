@@ -25,14 +25,22 @@ def accumulator_dda(counts, N):
     return np.array(out, dtype=np.int8).reshape(N, len(counts))
 
 
-@pytest.mark.parametrize("counts,N", [([7, -3, 0, 5], None), ([1, 1, 1], None), ([13, 8, -5, 2, 1], 16),
-                                      ([255, 100, -37], 256), ([1], 1)])
+@pytest.mark.parametrize(
+    "counts,N",
+    [
+        ([7, -3, 0, 5], None),
+        ([1, 1, 1], None),
+        ([13, 8, -5, 2, 1], 16),
+        ([255, 100, -37], 256),
+        ([1], 1),
+    ],
+)
 def test_equals_the_accumulator_and_counts_are_exact(counts, N):
     r = dda(counts, N)
     n = max(abs(c) for c in counts) if N is None else N
     assert r.n_ticks == n and r.status == "ok"
     assert np.array_equal(r.pulses, accumulator_dda(counts, n))
-    assert np.array_equal(r.pulses.sum(axis=0), counts)              # exact counts
+    assert np.array_equal(r.pulses.sum(axis=0), counts)  # exact counts
     assert np.array_equal(r.positions()[-1], counts)
 
 
@@ -51,7 +59,7 @@ def test_every_moving_axis_ends_on_the_last_tick_and_pulses_are_even():
         assert np.abs(r.pulses).max() <= 1
         j = np.arange(N + 1)[:, None]
         assert np.all(np.abs(r.positions() - j * counts[None, :] / N) < 1.0)
-        for k, c in enumerate(counts):                     # gaps between pulses differ by <= 1 tick
+        for k, c in enumerate(counts):  # gaps between pulses differ by <= 1 tick
             ticks = np.nonzero(r.pulses[:, k])[0]
             if abs(c) > 1:
                 gaps = np.diff(ticks)

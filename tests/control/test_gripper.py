@@ -6,8 +6,15 @@ import math
 import numpy as np
 import pytest
 
-from anthroarm.control import DCMotor, SlipController, correct_attitude, correct_position, grasp, simulate_slip
-from anthroarm.control import tactile_search
+from anthroarm.control import (
+    DCMotor,
+    SlipController,
+    correct_attitude,
+    correct_position,
+    grasp,
+    simulate_slip,
+    tactile_search,
+)
 from anthroarm.errors import ControlError
 
 
@@ -15,8 +22,11 @@ def test_tactile_search_stops_on_the_first_step_past_the_edge():
     edge, step = 0.137, 0.01
     r = tactile_search(lambda p: p[0] >= edge, [0.0, 0.2, 0.1], [1.0, 0.0, 0.0], step)
     assert r.found and r.status == "contact"
-    assert r.steps == math.ceil(edge / step)                      # 14 unit steps
-    assert r.position[0] == pytest.approx(r.steps * step) and r.position[0] >= edge > r.position[0] - step
+    assert r.steps == math.ceil(edge / step)  # 14 unit steps
+    assert (
+        r.position[0] == pytest.approx(r.steps * step)
+        and r.position[0] >= edge > r.position[0] - step
+    )
     miss = tactile_search(lambda p: False, [0.0, 0.0], [0.0, 2.0], 0.01, max_steps=25)
     assert not miss.found and miss.status == "not found" and miss.steps == 25
     assert miss.position == pytest.approx([0.0, 0.25])
@@ -44,10 +54,11 @@ def test_attitude_correction_makes_the_pad_parallel():
     r = correct_attitude(math.radians(12.0), pad_length=pad, gap=0.01, unit=unit, resolution=res)
     assert r.status == "aligned"
     assert pad * abs(math.tan(r.error)) < res + 1e-15
-    assert np.allclose(np.diff(r.history), -unit)                 # turned one way only
+    assert np.allclose(np.diff(r.history), -unit)  # turned one way only
     assert r.error > 0 or abs(r.error) < unit
-    lim = correct_attitude(math.radians(12.0), pad_length=pad, gap=0.01, unit=unit, resolution=res,
-                           max_corrections=3)
+    lim = correct_attitude(
+        math.radians(12.0), pad_length=pad, gap=0.01, unit=unit, resolution=res, max_corrections=3
+    )
     assert lim.status == "limit" and lim.corrections == 3
     with pytest.raises(ControlError):
         correct_attitude(math.radians(80.0), pad_length=pad, gap=0.01, unit=unit, resolution=res)
@@ -62,7 +73,7 @@ LEAD = 0.002
 @pytest.mark.parametrize("mode", ["hard", "soft", "zero"])
 def test_grasp_modes_reach_their_static_forces(mode):
     r = grasp(MOTOR, mode, gap=0.01, stiffness=2e4, lead=LEAD, duration=4.0, set_force=5.0, n=401)
-    assert 1.0 < r.contact_time < 1.1                  # 10 mm at 10 mm/s, after the start-up
+    assert 1.0 < r.contact_time < 1.1  # 10 mm at 10 mm/s, after the start-up
     assert np.all(r.force[r.t < r.contact_time] == 0.0)
     # statics: hard = the stall force at V_nom through gear and lead; soft = the set force; zero = none
     stall = MOTOR.eta * MOTOR.i * MOTOR.k_m * MOTOR.V_nom / (MOTOR.R * LEAD)
@@ -85,18 +96,18 @@ def test_slip_controller_steps_and_holds():
     c = SlipController(grip=2.0, step=0.5, grip_max=4.0)
     assert c.update(0) == 2.0
     assert c.update(3) == 3.5
-    assert c.update(5) == 4.0                           # capped
+    assert c.update(5) == 4.0  # capped
     with pytest.raises(ControlError):
         c.update(-1)
 
 
 def test_slip_one_pulse_then_hold_matches_constant_acceleration_kinematics():
     m, mu, g, u = 0.2, 0.5, 9.81, 1e-3
-    F0 = 0.9 * m * g / (2 * mu)                         # 10 % short of holding
-    step = 0.5 * m * g / (2 * mu)                       # one step is plenty
+    F0 = 0.9 * m * g / (2 * mu)  # 10 % short of holding
+    step = 0.5 * m * g / (2 * mu)  # one step is plenty
     r = simulate_slip(m, mu, SlipController(F0, step), u, g=g)
     a0 = g - 2 * mu * F0 / m
-    a1 = g - 2 * mu * (F0 + step) / m                   # < 0: decelerates
+    a1 = g - 2 * mu * (F0 + step) / m  # < 0: decelerates
     t1 = math.sqrt(2 * u / a0)
     v1 = a0 * t1
     assert r.status == "held" and r.pulses == 1
@@ -112,7 +123,7 @@ def test_slip_small_steps_grip_equals_start_plus_steps_and_holds_the_weight():
     r = simulate_slip(m, mu, SlipController(F0, step), u)
     assert r.status == "held"
     assert r.grip == pytest.approx(F0 + step * r.pulses)
-    assert 2 * mu * r.grip >= m * 9.81                  # it holds
+    assert 2 * mu * r.grip >= m * 9.81  # it holds
     assert r.pulses * u <= r.slip < (r.pulses + 1) * u
     assert np.all(np.diff(r.pulse_times) > 0)
     # enough grip from the start: no slip at all

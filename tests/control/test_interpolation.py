@@ -51,10 +51,15 @@ def test_arc_of_a_known_circle():
 
 @pytest.mark.parametrize("scale", [1e-150, 1e-6, 1.0, 1e6, 1e150])
 def test_arc_at_any_scale(scale):
-    p = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]) * scale + np.array([2.0, 0.0, 0.0]) * scale
+    p = (
+        np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]) * scale
+        + np.array([2.0, 0.0, 0.0]) * scale
+    )
     arc = circle_through(*p)
     assert arc.radius == pytest.approx(scale, rel=1e-12)
-    assert np.allclose(arc.center / scale, [2.0, 0.0, 0.0], atol=1e-12) and arc.sweep == pytest.approx(np.pi)
+    assert np.allclose(
+        arc.center / scale, [2.0, 0.0, 0.0], atol=1e-12
+    ) and arc.sweep == pytest.approx(np.pi)
 
 
 def test_collinear_and_coincident_points_raise():
@@ -79,7 +84,7 @@ def test_slerp_matches_pinocchio_and_line_poses():
         P = line_poses(T0, T1, np.linspace(0, 1, 11))
         assert np.allclose(P[0], T0, atol=1e-10) and np.allclose(P[-1], T1, atol=1e-10)
         d = np.diff(P[:, :3, 3], axis=0)
-        assert np.allclose(d, (T1[:3, 3] - T0[:3, 3]) / 10)         # straight, constant speed
+        assert np.allclose(d, (T1[:3, 3] - T0[:3, 3]) / 10)  # straight, constant speed
         # constant angular speed: equal rotation angles between samples
         ang = [np.linalg.norm(pin.log3(P[k][:3, :3].T @ P[k + 1][:3, :3])) for k in range(10)]
         assert np.allclose(ang, np.linalg.norm(w) / 10, atol=1e-9)
@@ -89,7 +94,9 @@ def test_arc_poses_ends_and_bad_s():
     T1, T3 = np.eye(4), np.eye(4)
     T1[:3, 3], T3[:3, 3] = [0.3, 0, 0.2], [0, 0.3, 0.2]
     T3[:3, :3] = pin.exp3(np.array([0, 0, np.pi / 2]))
-    P = arc_poses(T1, [0.3 * np.cos(np.pi / 4), 0.3 * np.sin(np.pi / 4), 0.2], T3, np.linspace(0, 1, 5))
+    P = arc_poses(
+        T1, [0.3 * np.cos(np.pi / 4), 0.3 * np.sin(np.pi / 4), 0.2], T3, np.linspace(0, 1, 5)
+    )
     assert np.allclose(P[0], T1) and np.allclose(P[-1], T3, atol=1e-12)
     assert np.allclose(np.linalg.norm(P[:, :2, 3], axis=1), 0.3)
     # here the arc angle and the rotation angle grow together: the hand turns with the arc

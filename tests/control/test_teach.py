@@ -5,14 +5,28 @@ import numpy as np
 import pytest
 
 from anthroarm.control.interpolation import circle_through
-from anthroarm.control.teach import (Call, Jump, Program, Step, play_fixed, play_jump, play_random_access,
-                                     play_select, play_subroutines, record)
+from anthroarm.control.teach import (
+    Call,
+    Jump,
+    Program,
+    Step,
+    play_fixed,
+    play_jump,
+    play_random_access,
+    play_select,
+    play_subroutines,
+    record,
+)
 from anthroarm.errors import ControlError, PlaybackError
 
 
 def pick_and_place():
-    return record("pick", [[0.0, 0.0], [0.5, 0.2], [0.5, 0.6], [0.0, 0.3]], [0.0, 1.0, 0.5, 2.0],
-                  labels=["home", "above", "grasp", "place"])
+    return record(
+        "pick",
+        [[0.0, 0.0], [0.5, 0.2], [0.5, 0.6], [0.0, 0.3]],
+        [0.0, 1.0, 0.5, 2.0],
+        labels=["home", "above", "grasp", "place"],
+    )
 
 
 def test_fixed_sequence_plays_in_taught_order_every_cycle():
@@ -33,12 +47,29 @@ def test_fixed_sequence_plays_in_taught_order_every_cycle():
 
 
 def test_program_jump_skips_when_the_sensor_is_on():
-    items = (Step([0.0], 0, label="start"), Step([1.0], 1, label="a"), Jump("place", "full"),
-             Step([2.0], 1, label="b"), Step([3.0], 1, label="place"))
+    items = (
+        Step([0.0], 0, label="start"),
+        Step([1.0], 1, label="a"),
+        Jump("place", "full"),
+        Step([2.0], 1, label="b"),
+        Step([3.0], 1, label="place"),
+    )
     p = Program("box", items)
     # the box is full on every second cycle: then b is skipped
     pb = play_jump(p, {"full": [False, True]}, cycles=3)
-    assert pb.labels == ["start", "a", "b", "place", "start", "a", "place", "start", "a", "b", "place"]
+    assert pb.labels == [
+        "start",
+        "a",
+        "b",
+        "place",
+        "start",
+        "a",
+        "place",
+        "start",
+        "a",
+        "b",
+        "place",
+    ]
     # a sensor as a function of (name, cycle)
     pb2 = play_jump(p, lambda name, cycle: cycle == 0, cycles=2)
     assert pb2.labels == ["start", "a", "place", "start", "a", "b", "place"]
@@ -65,7 +96,7 @@ def test_program_select_and_subroutines():
     A = record("A", [[0.0], [1.0]], 1.0, labels=["A0", "A1"])
     B = record("B", [[0.0], [-1.0], [-2.0]], 1.0, labels=["B0", "B1", "B2"])
     # Fig. 9-10: judge size/weight, take program A or B
-    pick = lambda s: "B" if s["heavy"] else "A"          # noqa: E731
+    pick = lambda s: "B" if s["heavy"] else "A"  # noqa: E731
     assert play_select([A, B], pick, {"heavy": True}).labels == ["B0", "B1", "B2"]
     assert play_select({"A": A, "B": B}, "A").labels == ["A0", "A1"]
     with pytest.raises(PlaybackError, match="programs: \\['A', 'B'\\]"):
@@ -84,7 +115,7 @@ def test_program_select_and_subroutines():
 def test_random_access_follows_the_addresses_chosen():
     pts = {f"P{k}": Step([float(k)], 1.0, label=f"P{k}") for k in range(5)}
     order = ["P0", "P3", "P1", "P4"]
-    nxt = lambda a, hist: order[len(hist)] if len(hist) < len(order) else None   # noqa: E731
+    nxt = lambda a, hist: order[len(hist)] if len(hist) < len(order) else None  # noqa: E731
     pb = play_random_access(pts, "P0", nxt)
     assert pb.labels == order and pb.status == "done"
     with pytest.raises(PlaybackError, match="address 'P9'"):
@@ -96,8 +127,12 @@ def test_random_access_follows_the_addresses_chosen():
 def test_store_round_trip(tmp_path):
     T = np.eye(4)
     T[:3, 3] = [0.1, 0.0, 0.3]
-    items = (Step(np.eye(4), 0.0, label="a", grip=3.0, motion="line"), Step(T, 1.0, motion="line", dwell=0.5),
-             Jump("a", "again"), Call("sub"))
+    items = (
+        Step(np.eye(4), 0.0, label="a", grip=3.0, motion="line"),
+        Step(T, 1.0, motion="line", dwell=0.5),
+        Jump("a", "again"),
+        Call("sub"),
+    )
     p = Program("stored", items)
     path = tmp_path / "prog.json"
     p.save(path)
@@ -114,8 +149,14 @@ def test_store_round_trip(tmp_path):
 def test_trajectory_hits_taught_points_at_their_times_line_and_arc():
     p1, p2, p3 = np.array([0.4, 0.0, 0.2]), np.array([0.0, 0.4, 0.2]), np.array([-0.4, 0.0, 0.2])
     via = np.array([0.4 * np.cos(2.4), 0.4 * np.sin(2.4), 0.2])
-    prog = Program("cart", (Step(p1, 0.0), Step(p2, 2.0, motion="line", dwell=0.5),
-                            Step(p3, 1.0, motion="arc", via=via)))
+    prog = Program(
+        "cart",
+        (
+            Step(p1, 0.0),
+            Step(p2, 2.0, motion="line", dwell=0.5),
+            Step(p3, 1.0, motion="arc", via=via),
+        ),
+    )
     pb = play_fixed(prog)
     assert pb.duration == pytest.approx(3.5)
     t, P = pb.trajectory(0.01)
@@ -124,7 +165,9 @@ def test_trajectory_hits_taught_points_at_their_times_line_and_arc():
         k = int(np.argmin(np.abs(t - tk)))
         assert abs(t[k] - tk) < 1e-9 and np.allclose(P[k], pk, atol=1e-12)
     line = (t > 0) & (t < 2.0)
-    assert np.allclose(P[line], p1 + (t[line] / 2.0)[:, None] * (p2 - p1))    # straight, constant speed
+    assert np.allclose(
+        P[line], p1 + (t[line] / 2.0)[:, None] * (p2 - p1)
+    )  # straight, constant speed
     arc = t > 2.5
     c = circle_through(p2, via, p3)
     assert np.allclose(np.linalg.norm(P[arc] - c.center, axis=1), c.radius)
@@ -133,8 +176,12 @@ def test_trajectory_hits_taught_points_at_their_times_line_and_arc():
     T1, T2 = np.eye(4), np.eye(4)
     T1[:3, 3], T2[:3, 3] = p1, p2
     T2[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
-    t2, P2 = play_fixed(Program("poses", (Step(T1, 0.0, motion="line"), Step(T2, 1.0, motion="line")))).trajectory(0.1)
-    assert np.allclose(P2[-1], T2) and np.allclose(P2[:, :3, :3] @ np.swapaxes(P2[:, :3, :3], 1, 2), np.eye(3))
+    t2, P2 = play_fixed(
+        Program("poses", (Step(T1, 0.0, motion="line"), Step(T2, 1.0, motion="line")))
+    ).trajectory(0.1)
+    assert np.allclose(P2[-1], T2) and np.allclose(
+        P2[:, :3, :3] @ np.swapaxes(P2[:, :3, :3], 1, 2), np.eye(3)
+    )
 
 
 def test_bad_steps():
@@ -158,14 +205,22 @@ def test_joint_path_on_the_care_robot_reaches_every_sample():
     import anthroarm as aa
 
     robot = aa.load("care_robot")
-    qs = np.array([[0.2, 0.6, -0.9, 0.1, 0.5, 0.0], [0.5, 0.5, -0.7, 0.2, 0.4, 0.2], [0.4, 0.8, -1.1, 0.0, 0.6, 0.1]])
+    qs = np.array(
+        [
+            [0.2, 0.6, -0.9, 0.1, 0.5, 0.0],
+            [0.5, 0.5, -0.7, 0.2, 0.4, 0.2],
+            [0.4, 0.8, -1.1, 0.0, 0.6, 0.1],
+        ]
+    )
     prog = record("arm", [robot.fk(q) for q in qs], [0.0, 0.4, 0.4], motion="line")
     t, q, ok = play_fixed(prog).joint_path(robot, 0.05, q0=qs[0])
     assert ok.all() and len(t) == len(q)
     _, P = play_fixed(prog).trajectory(0.05)
     for k in range(len(t)):
         F = robot.fk(q[k])
-        assert np.allclose(F[:3, 3], P[k][:3, 3], atol=1e-5) and np.allclose(F[:3, :3], P[k][:3, :3], atol=1e-5)
+        assert np.allclose(F[:3, 3], P[k][:3, 3], atol=1e-5) and np.allclose(
+            F[:3, :3], P[k][:3, :3], atol=1e-5
+        )
     assert np.max(np.abs(np.diff(q, axis=0))) < 0.2
     with pytest.raises(ControlError, match="4x4 poses"):
         play_fixed(pick_and_place()).joint_path(robot, 0.1)

@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anthroarm.design import grasp_error as G
 
@@ -16,16 +17,27 @@ def test_translational_zero():
     assert G.grasp_error_translational() == 0.0
 
 
-@pytest.mark.parametrize("a,beta_deg,case,delta", [
-    # ch1-2 notes part 3, self-derived reference table (mathematics, re-checked by brute force below)
-    (0, 90, "same_side", 5.165593), (0, 80, "split", 1.503874),
-    (20, 90, "same_side", 5.265391), (20, 80, "split", 1.535384)])
+@pytest.mark.parametrize(
+    "a,beta_deg,case,delta",
+    [
+        # ch1-2 notes part 3, self-derived reference table (mathematics, re-checked by brute force below)
+        (0, 90, "same_side", 5.165593),
+        (0, 80, "split", 1.503874),
+        (20, 90, "same_side", 5.265391),
+        (20, 80, "split", 1.535384),
+    ],
+)
 def test_reference_table(a, beta_deg, case, delta):
-    r = G.grasp_error_single(L, TH, D(beta_deg), RMIN, RMAX) if a == 0 else \
-        G.grasp_error_double(L, TH, D(beta_deg), a, RMIN, RMAX)
+    r = (
+        G.grasp_error_single(L, TH, D(beta_deg), RMIN, RMAX)
+        if a == 0
+        else G.grasp_error_double(L, TH, D(beta_deg), a, RMIN, RMAX)
+    )
     assert r.case == case
     assert r.delta == pytest.approx(delta, abs=2e-6)
-    assert r.delta == pytest.approx(G.grasp_error_brute(L, TH, D(beta_deg), RMIN, RMAX, a=a or None), abs=1e-6)
+    assert r.delta == pytest.approx(
+        G.grasp_error_brute(L, TH, D(beta_deg), RMIN, RMAX, a=a or None), abs=1e-6
+    )
 
 
 def test_optimal_beta_2_12_centres_hyperbola():
@@ -33,7 +45,7 @@ def test_optimal_beta_2_12_centres_hyperbola():
     assert np.rad2deg(bc) == pytest.approx(76.647574, abs=1e-6)
     r = G.grasp_error_single(L, TH, bc, RMIN, RMAX)
     assert r.r0 == pytest.approx(20.0)
-    assert r.delta1 == pytest.approx(r.delta2)            # X(R_max) = X(R_min)
+    assert r.delta1 == pytest.approx(r.delta2)  # X(R_max) = X(R_min)
     assert r.delta == pytest.approx(0.682793, abs=1e-6)
     assert float(G.x_single(L, RMAX, TH, bc)) == pytest.approx(97.979590, abs=1e-6)
     assert r.x_min == pytest.approx(97.296797, abs=1e-6)
@@ -51,7 +63,10 @@ def test_too_short_finger_for_2_12():
 def test_two_sizes_2_20_zero_error():
     for a in (None, 15.0):
         b0 = G.beta_two_sizes(L, TH, 12.0, 27.0)
-        xs = [G.x_single(L, r, TH, b0) if a is None else G.x_double(L, r, TH, b0, a) for r in (12.0, 27.0)]
+        xs = [
+            G.x_single(L, r, TH, b0) if a is None else G.x_double(L, r, TH, b0, a)
+            for r in (12.0, 27.0)
+        ]
         assert xs[0] == pytest.approx(xs[1], abs=1e-12)
 
 
@@ -61,19 +76,29 @@ def test_hyperbolas_2_7_and_2_15():
         X = G.x_single(L, R, TH, beta)
         np.testing.assert_allclose(G.hyperbola_single_residual(L, R, X, TH, beta), 0, atol=1e-10)
         Xd = G.x_double(L, R, TH, beta, 30.0)
-        np.testing.assert_allclose(G.hyperbola_double_residual(L, R, Xd, TH, beta, 30.0), 0, atol=1e-10)
+        np.testing.assert_allclose(
+            G.hyperbola_double_residual(L, R, Xd, TH, beta, 30.0), 0, atol=1e-10
+        )
 
 
 @settings(max_examples=50, deadline=None)
-@given(st.floats(30, 200), st.floats(10, 85), st.floats(20, 120), st.floats(1, 20), st.floats(1.2, 4),
-       st.floats(0, 0.9))
+@given(
+    st.floats(30, 200),
+    st.floats(10, 85),
+    st.floats(20, 120),
+    st.floats(1, 20),
+    st.floats(1.2, 4),
+    st.floats(0, 0.9),
+)
 def test_case_split_equals_max_minus_min(l, th_deg, beta_deg, rmin, ratio, afrac):
     th, beta, rmax = D(th_deg), D(beta_deg), rmin * ratio
     assert G.grasp_error_single(l, th, beta, rmin, rmax).delta == pytest.approx(
-        G.grasp_error_brute(l, th, beta, rmin, rmax), rel=1e-6, abs=1e-6)
+        G.grasp_error_brute(l, th, beta, rmin, rmax), rel=1e-6, abs=1e-6
+    )
     a = afrac * l * abs(math.sin(beta))
     assert G.grasp_error_double(l, th, beta, a, rmin, rmax).delta == pytest.approx(
-        G.grasp_error_brute(l, th, beta, rmin, rmax, a=a), rel=1e-6, abs=1e-6)
+        G.grasp_error_brute(l, th, beta, rmin, rmax, a=a), rel=1e-6, abs=1e-6
+    )
 
 
 def printed_2_17(l, th, beta, a, rmin, rmax):

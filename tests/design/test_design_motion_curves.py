@@ -2,7 +2,8 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anthroarm.design import motion_curves as M
 
@@ -87,7 +88,10 @@ def test_fit_bad_input():
 
 def test_piecewise_three_segments_recovered():
     knots = np.array([0.0, 40.0, 90.0, 130.0])  # A, B, C, D (deg of elbow flexion)
-    vals = {"shoulder": np.array([0.0, 30.0, 35.0, 10.0]), "wrist": np.array([-10.0, 5.0, 5.0, 25.0])}
+    vals = {
+        "shoulder": np.array([0.0, 30.0, 35.0, 10.0]),
+        "wrist": np.array([-10.0, 5.0, 5.0, 25.0]),
+    }
     th = np.linspace(0, 130, 131)
     rng = np.random.default_rng(3)
     joints = {k: np.interp(th, knots, v) + rng.normal(0, 0.2, th.size) for k, v in vals.items()}

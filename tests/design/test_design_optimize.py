@@ -2,11 +2,11 @@
 Fletcher-Reeves (4-26)-(4-47), the book's simplex (4-48)-(4-64), SUMT (4-65)-(4-78), the §4-3
 constrained example; cross-checked against scipy.optimize."""
 
-
 import numpy as np
 import pytest
 import scipy.optimize as so
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from anthroarm.design import optimize as O
 from anthroarm.errors import ObjectiveError
@@ -34,8 +34,15 @@ def test_golden_interval_shrinks_by_lambda_per_point():
     assert lo <= 0.3 <= hi
 
 
-@pytest.mark.parametrize("f,a,b", [(lambda x: (x - 0.3) ** 2, 0, 1), (lambda x: np.cosh(x - 1.3) + 0.1 * x, -2, 4),
-                                   (lambda x: abs(x - 2.2), 0, 3), (lambda x: -np.sin(x), 0, 3)])
+@pytest.mark.parametrize(
+    "f,a,b",
+    [
+        (lambda x: (x - 0.3) ** 2, 0, 1),
+        (lambda x: np.cosh(x - 1.3) + 0.1 * x, -2, 4),
+        (lambda x: abs(x - 2.2), 0, 3),
+        (lambda x: -np.sin(x), 0, 3),
+    ],
+)
 def test_golden_matches_scipy(f, a, b):
     r = O.golden_section(f, a, b, eps=1e-9)
     assert r.success
@@ -98,17 +105,26 @@ def test_quadratic_4_20_exact_and_printed_4_18_wrong():
 
 
 @settings(max_examples=50, deadline=None)
-@given(st.floats(-5, 5), st.floats(0.1, 10), st.floats(-3, 3), st.floats(0.05, 2), st.floats(0.05, 2),
-       st.floats(-5, 5))
+@given(
+    st.floats(-5, 5),
+    st.floats(0.1, 10),
+    st.floats(-3, 3),
+    st.floats(0.05, 2),
+    st.floats(0.05, 2),
+    st.floats(-5, 5),
+)
 def test_quadratic_step_exact_on_parabolas(xm, c, a1, d1, d2, f0):
     q = lambda a: c * (a - xm) ** 2 + f0  # noqa: E731
     a2, a3 = a1 + d1, a1 + d1 + d2
-    assert O.quadratic_step(a1, a2, a3, q(a1), q(a2), q(a3)) == pytest.approx(xm, abs=1e-7 * (1 + abs(xm)) / min(1, c))
+    assert O.quadratic_step(a1, a2, a3, q(a1), q(a2), q(a3)) == pytest.approx(
+        xm, abs=1e-7 * (1 + abs(xm)) / min(1, c)
+    )
     h = d1
     if q(0) + q(2 * h) > 2 * q(h):
         # (4-23) equal spacing = (4-20) = (4-25)
         assert O.quadratic_step_equal(h, q(0), q(h), q(2 * h)) == pytest.approx(
-            O.quadratic_step(0, h, 2 * h, q(0), q(h), q(2 * h)), rel=1e-9, abs=1e-9)
+            O.quadratic_step(0, h, 2 * h, q(0), q(h), q(2 * h)), rel=1e-9, abs=1e-9
+        )
 
 
 def test_quadratic_bad_input():
@@ -122,8 +138,14 @@ def test_quadratic_bad_input():
     assert r.status == "no_minimum"
 
 
-@pytest.mark.parametrize("f,br", [(lambda x: np.cosh(x - 1.3), (0, 3)), (lambda x: x**4 - 3 * x + 1, (0, 2)),
-                                  (lambda x: np.exp(x) - 2 * x, (-1, 3))])
+@pytest.mark.parametrize(
+    "f,br",
+    [
+        (lambda x: np.cosh(x - 1.3), (0, 3)),
+        (lambda x: x**4 - 3 * x + 1, (0, 2)),
+        (lambda x: np.exp(x) - 2 * x, (-1, 3)),
+    ],
+)
 def test_quadratic_interpolation_matches_brent(f, br):
     r = O.quadratic_interpolation(f, br, eps=1e-12)
     assert r.success
@@ -141,15 +163,19 @@ def test_fr_quadratic_termination_and_conjugacy(n, seed):
     Q = np.linalg.qr(rng.normal(size=(n, n)))[0]
     A = Q @ np.diag(rng.uniform(0.5, 5, n)) @ Q.T
     b = rng.normal(size=n)
-    r = O.fletcher_reeves(lambda x: 0.5 * x @ A @ x - b @ x, np.zeros(n), grad=lambda x: A @ x - b, gtol=1e-7)
-    assert r.success and r.nit <= n                      # at most n steps on an SPD quadratic
+    r = O.fletcher_reeves(
+        lambda x: 0.5 * x @ A @ x - b @ x, np.zeros(n), grad=lambda x: A @ x - b, gtol=1e-7
+    )
+    assert r.success and r.nit <= n  # at most n steps on an SPD quadratic
     np.testing.assert_allclose(r.x, np.linalg.solve(A, b), atol=1e-7)
     G = [A @ x - b for x in r.history]
-    P = np.diff(np.array(r.history), axis=0)             # steps h P^(i)
+    P = np.diff(np.array(r.history), axis=0)  # steps h P^(i)
     for i in range(len(P)):
         for j in range(i):
             assert abs(G[i] @ G[j]) < 1e-6 * (1 + np.linalg.norm(G[i]) * np.linalg.norm(G[j]))
-            assert abs(P[i] @ A @ P[j]) < 1e-6 * (1 + np.linalg.norm(P[i]) * np.linalg.norm(P[j]))  # (4-26)
+            assert abs(P[i] @ A @ P[j]) < 1e-6 * (
+                1 + np.linalg.norm(P[i]) * np.linalg.norm(P[j])
+            )  # (4-26)
 
 
 def test_fr_rosenbrock_vs_scipy():
@@ -157,33 +183,53 @@ def test_fr_rosenbrock_vs_scipy():
     x0 = np.array([-1.2, 1.0])
     r = O.fletcher_reeves(ros, x0, grad=jac, gtol=1e-10)
     assert r.success
-    np.testing.assert_allclose(r.x, so.minimize(ros, x0, jac=jac, method="CG", tol=1e-12).x, atol=1e-5)
-    r_fd = O.fletcher_reeves(ros, x0)                   # numerical gradient
+    np.testing.assert_allclose(
+        r.x, so.minimize(ros, x0, jac=jac, method="CG", tol=1e-12).x, atol=1e-5
+    )
+    r_fd = O.fletcher_reeves(ros, x0)  # numerical gradient
     np.testing.assert_allclose(r_fd.x, [1, 1], atol=1e-4)
     sd = O.steepest_descent(ros, x0, grad=jac, maxiter=200)
-    assert sd.status == "maxiter" and r.nit < 200        # the book's point: SD crawls near the optimum
+    assert sd.status == "maxiter" and r.nit < 200  # the book's point: SD crawls near the optimum
     assert O.fletcher_reeves(lambda x: -x @ x, [1.0, 0.0]).status == "no_minimum"
 
 
 # ----------------------------------------------------------------------------- simplex
 
 
-@pytest.mark.parametrize("f,x0", [(so.rosen, [-1.2, 1.0]), (lambda x: (x[0] - 1) ** 2 + 10 * (x[1] + 2) ** 2 + x[2] ** 2,
-                                                             [3.0, 3.0, 3.0]),
-                                  (lambda x: (x[0] ** 2 + x[1] - 11) ** 2 + (x[0] + x[1] ** 2 - 7) ** 2, [2.5, 2.5])])
+@pytest.mark.parametrize(
+    "f,x0",
+    [
+        (so.rosen, [-1.2, 1.0]),
+        (lambda x: (x[0] - 1) ** 2 + 10 * (x[1] + 2) ** 2 + x[2] ** 2, [3.0, 3.0, 3.0]),
+        (lambda x: (x[0] ** 2 + x[1] - 11) ** 2 + (x[0] + x[1] ** 2 - 7) ** 2, [2.5, 2.5]),
+    ],
+)
 def test_simplex_book_vs_scipy_nelder_mead(f, x0):
     r = O.simplex_book(f, x0, step=0.5, eps1=0.0, xtol=1e-11, maxiter=20000)
-    ref = so.minimize(f, x0, method="Nelder-Mead", options={"xatol": 1e-11, "fatol": 1e-14, "maxiter": 20000})
+    ref = so.minimize(
+        f, x0, method="Nelder-Mead", options={"xatol": 1e-11, "fatol": 1e-14, "maxiter": 20000}
+    )
     assert r.success
     np.testing.assert_allclose(r.x, ref.x, atol=1e-6)
 
 
 def test_simplex_variants_and_bad_input():
     for lam, mu, e in [(0.75, 1.5, "G"), (0.25, 2.0, "L"), (0.3, 1.2, "G")]:
-        r = O.simplex_book(so.rosen, [-1.2, 1.0], step=0.5, lam=lam, mu=mu, expand_if=e, eps1=0, xtol=1e-10,
-                           maxiter=20000)
+        r = O.simplex_book(
+            so.rosen,
+            [-1.2, 1.0],
+            step=0.5,
+            lam=lam,
+            mu=mu,
+            expand_if=e,
+            eps1=0,
+            xtol=1e-10,
+            maxiter=20000,
+        )
         np.testing.assert_allclose(r.x, [1, 1], atol=1e-5)
-    r = O.simplex_book(lambda x: (x @ x - 4) ** 2 + 1, [3.0, 0.0], eps1=0.0, eps2=1e-8)   # (4-64) stop
+    r = O.simplex_book(
+        lambda x: (x @ x - 4) ** 2 + 1, [3.0, 0.0], eps1=0.0, eps2=1e-8
+    )  # (4-64) stop
     assert r.success and "4-64" in r.message
     assert np.linalg.norm(r.x) == pytest.approx(2.0, abs=1e-3)
     with pytest.raises(ValueError, match="0.5"):
@@ -200,15 +246,19 @@ def test_simplex_variants_and_bad_input():
 # ----------------------------------------------------------------------------- SUMT and the §4-3 example
 
 F43 = lambda x: x[0] ** 2 + x[1] ** 2 - 4 * x[0] + 4  # noqa: E731
-G43 = lambda x: np.array([x[0] - x[1] + 2, -x[0] ** 2 + x[1] - 1, x[0], x[1]])  # noqa: E731  (g >= 0)
+G43 = lambda x: np.array([x[0] - x[1] + 2, -(x[0] ** 2) + x[1] - 1, x[0], x[1]])  # noqa: E731  (g >= 0)
 BOOK_X, BOOK_F = np.array([0.58, 1.34]), 3.80
 TRUE_X, TRUE_F = np.array([0.5536, 1.3064]), 3.7989
-TRUE_X_PRECISE = np.array([0.5535737822, 1.3064439324])   # KKT tangency, see test_section_4_3_true_optimum_is_tangency
+TRUE_X_PRECISE = np.array(
+    [0.5535737822, 1.3064439324]
+)  # KKT tangency, see test_section_4_3_true_optimum_is_tangency
 
 
 def _slsqp(f, g, x0, eq=None):
     cons = [{"type": "ineq", "fun": g}] + ([{"type": "eq", "fun": eq}] if eq else [])
-    return so.minimize(f, x0, method="SLSQP", constraints=cons, options={"ftol": 1e-14, "maxiter": 500})
+    return so.minimize(
+        f, x0, method="SLSQP", constraints=cons, options={"ftol": 1e-14, "maxiter": 500}
+    )
 
 
 @pytest.mark.parametrize("method", ["interior", "exterior", "mixed"])
@@ -234,11 +284,12 @@ def test_section_4_3_true_optimum_is_tangency():
     # at the optimum grad F is parallel to grad g2 and g2 = 0: solve by scipy root (mathematics)
     def eqs(z):
         x, y, mu = z
-        return [2 * x - 4 + 2 * mu * x, 2 * y - mu, -x**2 + y - 1]  # grad F = mu grad g2, g2 = 0
+        return [2 * x - 4 + 2 * mu * x, 2 * y - mu, -(x**2) + y - 1]  # grad F = mu grad g2, g2 = 0
+
     x, y, mu = so.fsolve(eqs, [0.5, 1.3, 2.0])
     assert (x, y) == pytest.approx(tuple(TRUE_X), abs=1e-4) and mu > 0
-    assert F43([0.58, 1.34]) == pytest.approx(3.812, abs=1e-3)   # the printed point is not optimal
-    assert -0.58**2 + 1.34 - 1 == pytest.approx(0.0036, abs=1e-4)  # but lies on the parabola
+    assert F43([0.58, 1.34]) == pytest.approx(3.812, abs=1e-3)  # the printed point is not optimal
+    assert -(0.58**2) + 1.34 - 1 == pytest.approx(0.0036, abs=1e-4)  # but lies on the parabola
 
 
 def test_section_4_3_printed_linear_g2_does_not_give_book_answer():
@@ -251,7 +302,10 @@ def test_section_4_3_printed_linear_g2_does_not_give_book_answer():
 
 
 def test_unconstrained_optimum_of_4_3():
-    for r in (O.simplex_book(F43, [0.5, 2.0], eps1=0, xtol=1e-10), O.fletcher_reeves(F43, [0.5, 2.0])):
+    for r in (
+        O.simplex_book(F43, [0.5, 2.0], eps1=0, xtol=1e-10),
+        O.fletcher_reeves(F43, [0.5, 2.0]),
+    ):
         np.testing.assert_allclose(r.x, [2, 0], atol=1e-6)
         assert r.fun == pytest.approx(0, abs=1e-10)
 
@@ -274,12 +328,18 @@ def test_nan_objective_is_a_status():
     g = lambda x: np.array([x[0]])  # noqa: E731
     # an objective that is never finite has no best point: a typed error carrying x and the value
     for bad in (nan, inf):
-        for call in (lambda: O.quadratic_interpolation(bad, (0, 1)),
-                     lambda: O.quadratic_interpolation(bad, (0, 0.5, 1)),
-                     lambda: O.fletcher_reeves(bad, [1.0, 0.0]), lambda: O.steepest_descent(bad, [1.0]),
-                     lambda: O.simplex_book(bad, [1.0, 0.0]), lambda: O.sumt_exterior(bad, [1.0], g),
-                     lambda: O.sumt_interior(bad, [1.0], g), lambda: O.sumt_mixed(bad, [1.0], g),
-                     lambda: O.bracket_minimum(bad, 0.0), lambda: O.line_minimize(bad)):
+        for call in (
+            lambda: O.quadratic_interpolation(bad, (0, 1)),
+            lambda: O.quadratic_interpolation(bad, (0, 0.5, 1)),
+            lambda: O.fletcher_reeves(bad, [1.0, 0.0]),
+            lambda: O.steepest_descent(bad, [1.0]),
+            lambda: O.simplex_book(bad, [1.0, 0.0]),
+            lambda: O.sumt_exterior(bad, [1.0], g),
+            lambda: O.sumt_interior(bad, [1.0], g),
+            lambda: O.sumt_mixed(bad, [1.0], g),
+            lambda: O.bracket_minimum(bad, 0.0),
+            lambda: O.line_minimize(bad),
+        ):
             with pytest.raises(ObjectiveError) as e:
                 call()
             assert isinstance(e.value, ValueError) and not np.isfinite(e.value.value)
@@ -287,41 +347,58 @@ def test_nan_objective_is_a_status():
     with pytest.raises(ObjectiveError):
         O.sumt_exterior(lambda x: x @ x, [1.0], lambda x: np.array([np.nan]))
     # partly NaN: status "nan" with the best point where f was finite
-    part = lambda x: np.nan if np.atleast_1d(x)[0] > 1.5 else float(np.sum((np.atleast_1d(x) - 1.0) ** 2))  # noqa: E731
+    part = lambda x: (
+        np.nan if np.atleast_1d(x)[0] > 1.5 else float(np.sum((np.atleast_1d(x) - 1.0) ** 2))
+    )  # noqa: E731
     r = O.quadratic_interpolation(part, (0.0, 1.0, 3.0))
     assert r.status == "nan" and not r.success, r
     assert np.isfinite(r.x) and r.fun == part(r.x) and r.x <= 1.5
     # the simplex treats NaN like inf (a point to move away from) and still converges
     r = O.simplex_book(part, [1.2, 0.0], step=1.0)
-    assert r.success and r.fun == pytest.approx(part(r.x)) and np.all(np.isfinite(r.x)) and r.x[0] <= 1.5
+    assert (
+        r.success
+        and r.fun == pytest.approx(part(r.x))
+        and np.all(np.isfinite(r.x))
+        and r.x[0] <= 1.5
+    )
 
 
 def test_optimiser_arguments_are_checked():
     q = lambda x: float(np.sum((np.atleast_1d(x) - 1.0) ** 2))  # noqa: E731
     for bad in (0.0, -1e-6, np.nan, np.inf):
-        for call in (lambda: O.quadratic_interpolation(q, (0, 1, 2), eps=bad),
-                     lambda: O.fletcher_reeves(q, [0.5], gtol=bad),
-                     lambda: O.sumt_exterior(q, [0.5], eps1=bad),
-                     lambda: O.sumt_exterior(q, [0.5], c=bad),
-                     lambda: O.sumt_interior(q, [0.5], lambda x: 2 - x, r0=bad),
-                     lambda: O.numerical_gradient(q, [0.5], h=bad), lambda: O.bracket_minimum(q, 0.0, h=bad),
-                     lambda: O.line_minimize(q, h0=bad)):
+        for call in (
+            lambda: O.quadratic_interpolation(q, (0, 1, 2), eps=bad),
+            lambda: O.fletcher_reeves(q, [0.5], gtol=bad),
+            lambda: O.sumt_exterior(q, [0.5], eps1=bad),
+            lambda: O.sumt_exterior(q, [0.5], c=bad),
+            lambda: O.sumt_interior(q, [0.5], lambda x: 2 - x, r0=bad),
+            lambda: O.numerical_gradient(q, [0.5], h=bad),
+            lambda: O.bracket_minimum(q, 0.0, h=bad),
+            lambda: O.line_minimize(q, h0=bad),
+        ):
             with pytest.raises(ValueError):
                 call()
-    for bad in (-1e-6, np.nan, np.inf):          # eps1 = 0 switches (4-63) off
+    for bad in (-1e-6, np.nan, np.inf):  # eps1 = 0 switches (4-63) off
         with pytest.raises(ValueError, match="eps1"):
             O.simplex_book(q, [0.5], eps1=bad)
     for n in (0, -1):
-        for call in (lambda: O.quadratic_interpolation(q, (0, 1, 2), maxiter=n),
-                     lambda: O.fletcher_reeves(q, [0.5], maxiter=n),
-                     lambda: O.steepest_descent(q, [0.5], maxiter=n), lambda: O.simplex_book(q, [0.5], maxiter=n),
-                     lambda: O.bracket_minimum(q, 0.0, maxiter=n), lambda: O.sumt_exterior(q, [0.5], max_stages=n)):
+        for call in (
+            lambda: O.quadratic_interpolation(q, (0, 1, 2), maxiter=n),
+            lambda: O.fletcher_reeves(q, [0.5], maxiter=n),
+            lambda: O.steepest_descent(q, [0.5], maxiter=n),
+            lambda: O.simplex_book(q, [0.5], maxiter=n),
+            lambda: O.bracket_minimum(q, 0.0, maxiter=n),
+            lambda: O.sumt_exterior(q, [0.5], max_stages=n),
+        ):
             with pytest.raises(ValueError, match="maxiter|max_stages"):
                 call()
     with pytest.raises(TypeError, match="integer"):
         O.simplex_book(q, [0.5], maxiter=2.5)
-    for call in (lambda: O.fletcher_reeves(q, [1e308, 0.5]), lambda: O.simplex_book(q, [1e308]),
-                 lambda: O.simplex_book(q, [0.5], step=1e308)):
+    for call in (
+        lambda: O.fletcher_reeves(q, [1e308, 0.5]),
+        lambda: O.simplex_book(q, [1e308]),
+        lambda: O.simplex_book(q, [0.5], step=1e308),
+    ):
         with pytest.raises(ValueError, match="x0|step"):
             call()
 
@@ -335,7 +412,7 @@ def test_infeasible_problems_say_so():
     assert O.sumt_mixed(f, [0.5], g).status == "infeasible"
     rb = O.sumt_interior(f, [0.5], None, bounds=[(2.0, 1.0)])
     assert rb.status == "infeasible_bounds" and "bound 0" in rb.message
-    assert rb.fun == f([0.5])                 # the value at x0, finite
+    assert rb.fun == f([0.5])  # the value at x0, finite
     for bad in (np.nan, -1e308, 1e308):
         with pytest.raises(ValueError, match="bound 0"):
             O.sumt_exterior(f, [0.5], bounds=[(0.0, bad)])

@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import anthroarm as aa
 from anthroarm.design import structure as S
@@ -76,8 +77,13 @@ def test_layouts_64_to_book_4():
 
 def test_reach_min_self_derived_values():
     # planar FK |l1 + l2 e^{it} + l3 e^{2it}| (ch1-2 notes part 3) -- mathematics, not the book
-    cases = [((1, 1, 1), 90, 1.0), ((300, 250, 100), 90, 320.1562), ((300, 250, 100), 145, 138.5309),
-             ((340, 240, 130), 150, 197.2934), ((340, 240, 130), 90, 318.9044)]
+    cases = [
+        ((1, 1, 1), 90, 1.0),
+        ((300, 250, 100), 90, 320.1562),
+        ((300, 250, 100), 145, 138.5309),
+        ((340, 240, 130), 150, 197.2934),
+        ((340, 240, 130), 90, 318.9044),
+    ]
     for ls, deg, val in cases:
         assert S.reach_min(*ls, np.deg2rad(deg)) == pytest.approx(val, abs=1e-4)
     assert S.reach_min(1, 2, 3, 0.0) == pytest.approx(S.reach_max(1, 2, 3))
@@ -128,4 +134,6 @@ def test_printed_2_4_asin_branch_fails_when_elbow_angle_obtuse():
     assert abs(printed_reach_min_2_4(l1, l2, l3, t) - truth) > 0.3
     assert S.reach_min(l1, l2, l3, t) == pytest.approx(truth, abs=1e-12)
     # where l2 + l3 cos t >= 0 the printed form is right (e.g. the book's arm)
-    assert printed_reach_min_2_4(0.34, 0.26, 0.13, 1.2) == pytest.approx(S.reach_min_fk(0.34, 0.26, 0.13, 1.2))
+    assert printed_reach_min_2_4(0.34, 0.26, 0.13, 1.2) == pytest.approx(
+        S.reach_min_fk(0.34, 0.26, 0.13, 1.2)
+    )

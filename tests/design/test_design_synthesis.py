@@ -4,7 +4,8 @@ printed normal-equation misprints, failure statuses, and a finger following the 
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings, strategies as st
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from anthroarm.design import motion_curves as M
 from anthroarm.design import synthesis as S
@@ -27,10 +28,10 @@ def linkage_path(r1, r2, r3, r4, r5, beta, gamma, origin, alpha, sign):
     O = np.asarray(origin, float)
     A = O + r1 * np.stack([np.cos(alpha), np.sin(alpha)], -1)
     Dp = O + r3 * np.array([np.cos(beta), np.sin(beta)])
-    w = r2 - r5 * np.exp(1j * gamma)          # (B - A) = e^{i psi} w
+    w = r2 - r5 * np.exp(1j * gamma)  # (B - A) = e^{i psi} w
     B = circle_intersection(A, abs(w), np.broadcast_to(Dp, A.shape), r4, sign)
     zb = (B - A) @ np.array([1, 1j])
-    zc = zb / w * r2                          # C - A = r2 e^{i psi}
+    zc = zb / w * r2  # C - A = r2 e^{i psi}
     return A + np.stack([zc.real, zc.imag], -1), A, B, Dp
 
 
@@ -53,16 +54,26 @@ def test_notes_linkage_exact_recovery_and_degenerate_root():
         np.testing.assert_allclose([d.r1, d.r2, d.r3, d.r4, d.r5], [20, 50, 45, 35, 20], rtol=1e-9)
         assert res.max_error < 1e-9
         lams = sorted(c.lam for c in res.candidates)
-        assert lams[1] == pytest.approx(900.0, rel=1e-9)           # lambda = r3 r5
+        assert lams[1] == pytest.approx(900.0, rel=1e-9)  # lambda = r3 r5
         deg = [c for c in res.candidates if not c.accepted]
         assert len(deg) == 1 and "degenerate" in deg[0].reason
         assert (deg[0].r3, deg[0].r5, np.sqrt(deg[0].r4sq)) == pytest.approx((0, 50, 20), abs=1e-6)
 
 
 @settings(max_examples=50, deadline=None)
-@given(st.floats(10, 40), st.floats(20, 80), st.floats(20, 80), st.floats(15, 80), st.floats(5, 60),
-       st.floats(-np.pi, np.pi), st.floats(-1.0, 1.0), st.floats(-50, 50), st.floats(-50, 50),
-       st.floats(-np.pi, np.pi), st.sampled_from([1, -1]))
+@given(
+    st.floats(10, 40),
+    st.floats(20, 80),
+    st.floats(20, 80),
+    st.floats(15, 80),
+    st.floats(5, 60),
+    st.floats(-np.pi, np.pi),
+    st.floats(-1.0, 1.0),
+    st.floats(-50, 50),
+    st.floats(-50, 50),
+    st.floats(-np.pi, np.pi),
+    st.sampled_from([1, -1]),
+)
 def test_random_linkages_recovered(r1, r2, r3, r4, r5, beta, gamma, ox, oy, a0, sign):
     alpha = a0 + D(np.linspace(0, 60, 10))
     assume(np.all(assembles(r1, r2, r3, r4, r5, beta, gamma, alpha, margin=0.05 * r4)))
@@ -71,10 +82,13 @@ def test_random_linkages_recovered(r1, r2, r3, r4, r5, beta, gamma, ox, oy, a0, 
     res = S.synthesize_path(C, alpha, beta, gamma, (ox, oy))
     assert res.success, res.message
     d = res.design
-    np.testing.assert_allclose([d.r1, d.r2, d.r3, d.r4, d.r5], [r1, r2, r3, r4, r5], rtol=1e-5, atol=1e-5)
+    np.testing.assert_allclose(
+        [d.r1, d.r2, d.r3, d.r4, d.r5], [r1, r2, r3, r4, r5], rtol=1e-5, atol=1e-5
+    )
     assert res.max_error < 1e-5 * (1 + np.abs(C).max())
-    assert (d.beta - beta) % (2 * np.pi) == pytest.approx(0, abs=1e-9) or \
-        (d.beta - beta) % (2 * np.pi) == pytest.approx(2 * np.pi, abs=1e-9)
+    assert (d.beta - beta) % (2 * np.pi) == pytest.approx(0, abs=1e-9) or (d.beta - beta) % (
+        2 * np.pi
+    ) == pytest.approx(2 * np.pi, abs=1e-9)
 
 
 def printed_stage1(r, delta, alpha):
@@ -114,7 +128,7 @@ def test_lambda_roots_quadratic_3_30():
     L1 = 4 + np.sqrt(6)
     L = np.array([L1, 8 - L1, 0.0])
     np.testing.assert_allclose(sorted(S.lambda_roots(L, np.array([1.0, 1.0, 0]))), [-5, -2])
-    assert S.lambda_roots(np.array([1.0, 1.0, 0]), np.array([1.0, 1.0, 0])).size == 0   # l^2 + l + 1
+    assert S.lambda_roots(np.array([1.0, 1.0, 0]), np.array([1.0, 1.0, 0])).size == 0  # l^2 + l + 1
 
 
 def test_failures_report_status_never_raise():
@@ -151,7 +165,7 @@ def test_bad_input():
 
 
 def test_design_trace_outside_assembly_range_flags_not_ok():
-    d = S.FourBarDesign(20, 50, 45, 20, 20, D(10))   # |AB| = 30, r4 = 20: needs |A - D| <= 50
+    d = S.FourBarDesign(20, 50, 45, 20, 20, D(10))  # |AB| = 30, r4 = 20: needs |A - D| <= 50
     pts, ok, st = d.trace(D(np.array([80.0, 190.0])))  # |A - D| = 42.5 and 65
     assert ok[0] and not ok[1]
     assert np.all(np.isfinite(pts))
@@ -170,12 +184,16 @@ def test_finger_linkage_follows_book_fingertip_curve():
     # independent check of the achieved path: circle intersection here, not the mechanisms solver
     C_indep = None
     for sign in (1, -1):
-        C, *_ = linkage_path(d.r1, d.r2, d.r3, d.r4, d.r5, d.beta, d.gamma, d.origin, fd.alpha, sign)
+        C, *_ = linkage_path(
+            d.r1, d.r2, d.r3, d.r4, d.r5, d.beta, d.gamma, d.origin, fd.alpha, sign
+        )
         if np.allclose(C, res.achieved, atol=1e-8):
             C_indep = C
     assert C_indep is not None
-    err = np.abs(C_indep[:, 1] - M.FINGERTIP_POWER_GRASP(C_indep[:, 0]))   # vertical distance to f(x)
-    assert err.max() < 0.5                      # mm, over a 40 mm by 20 mm fingertip path
+    err = np.abs(
+        C_indep[:, 1] - M.FINGERTIP_POWER_GRASP(C_indep[:, 0])
+    )  # vertical distance to f(x)
+    assert err.max() < 0.5  # mm, over a 40 mm by 20 mm fingertip path
     assert res.max_error < 0.5
     # between the design points the path stays close too
     a = np.linspace(fd.alpha.min(), fd.alpha.max(), 200)

@@ -9,8 +9,12 @@ def rot(axis, angle):
 
 
 JOINTS = {
-    "RX": pin.JointModelRX, "RY": pin.JointModelRY, "RZ": pin.JointModelRZ,
-    "PX": pin.JointModelPX, "PY": pin.JointModelPY, "PZ": pin.JointModelPZ,
+    "RX": pin.JointModelRX,
+    "RY": pin.JointModelRY,
+    "RZ": pin.JointModelRZ,
+    "PX": pin.JointModelPX,
+    "PY": pin.JointModelPY,
+    "PZ": pin.JointModelPZ,
 }
 
 

@@ -20,7 +20,7 @@ def test_J_star_M_star_vs_pinocchio_tree(phi):
     B_rocker = data.oMi[3].act(np.array([fb.r4, 0, 0]))
     assert np.allclose(B_coupler, B_rocker, atol=1e-12)
     J = fb.J_star(phi)
-    assert abs(J - 2 * pin.computeKineticEnergy(model, data, q, G)) < 1e-15              # (8-23)/(8-28)
+    assert abs(J - 2 * pin.computeKineticEnergy(model, data, q, G)) < 1e-15  # (8-23)/(8-28)
     M = pin.crba(model, data, q)
     M = np.triu(M) + np.triu(M, 1).T
     assert abs(J - G @ M @ G) < 1e-15
@@ -29,16 +29,18 @@ def test_J_star_M_star_vs_pinocchio_tree(phi):
     h = 1e-6
     assert abs(fb.dJ_star(phi) - (fb.J_star(phi + h) - fb.J_star(phi - h)) / (2 * h)) < 1e-9
     g = pin.computeGeneralizedGravity(model, data, q)
-    assert abs(fb.M_star(phi) - (-G @ g)) < 1e-15                                          # (8-19)/(8-20)
+    assert abs(fb.M_star(phi) - (-G @ g)) < 1e-15  # (8-19)/(8-20)
     # a drive moment on the crank and a moment on the rocker: M* = M_d + M_r ω4/ω2
-    assert abs(fb.M_star(phi, drive=0.01, rocker_moment=-0.02) - (-G @ g + 0.01 - 0.02 * G[2])) < 1e-15
+    assert (
+        abs(fb.M_star(phi, drive=0.01, rocker_moment=-0.02) - (-G @ g + 0.01 - 0.02 * G[2])) < 1e-15
+    )
 
 
 def test_energy_form_and_moment_form_agree():
     fb = EL.FourBarFinger()
     drive = 0.002
-    phi, om, t = fb.integrate_energy_form(0.0, 5.0, 2 * np.pi, drive=drive, samples=4001)   # (8-15)
-    sol = fb.integrate_moment_form(0.0, 5.0, 0.999 * t[-1], drive=drive)                  # (8-16)
+    phi, om, t = fb.integrate_energy_form(0.0, 5.0, 2 * np.pi, drive=drive, samples=4001)  # (8-15)
+    sol = fb.integrate_moment_form(0.0, 5.0, 0.999 * t[-1], drive=drive)  # (8-16)
     ph_m, om_m = sol.y
     # the same ω(φ) (linear interpolation on the energy-form grid limits the agreement)
     assert np.max(np.abs(np.interp(ph_m, phi, om) - om_m) / om_m) < 1e-4
@@ -59,7 +61,10 @@ def test_energy_form_and_moment_form_agree():
 
     T = 0.1  # inside the moment-form solution's interval
     for _ in range(int(T / dt)):
-        k1 = f(x); k2 = f(x + dt / 2 * k1); k3 = f(x + dt / 2 * k2); k4 = f(x + dt * k3)  # noqa: E702
+        k1 = f(x)
+        k2 = f(x + dt / 2 * k1)
+        k3 = f(x + dt / 2 * k2)
+        k4 = f(x + dt * k3)  # noqa: E702
         x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     assert np.allclose(sol.sol(T), x, rtol=1e-7, atol=1e-8)
 
@@ -68,7 +73,10 @@ def test_generic_formulas_8_20_8_28():
     # one body rotating about a fixed axis through its CoM: J* = J (8-28), M* = M_z (8-20)
     assert EL.equivalent_inertia([(2.0, [0, 0, 0], [0, 0, 1.0], np.diag([1, 2, 3.0]))]) == 3.0
     # a point mass on a 0.5 m arm: J* = m r²
-    assert abs(EL.equivalent_inertia([(2.0, [0, 0.5, 0], [0, 0, 1.0], np.zeros((3, 3)))]) - 0.5) < 1e-15
+    assert (
+        abs(EL.equivalent_inertia([(2.0, [0, 0.5, 0], [0, 0, 1.0], np.zeros((3, 3)))]) - 0.5)
+        < 1e-15
+    )
     assert EL.equivalent_moment([([0, -10.0, 0], [0, 0.5, 0], [0, 0, 2.0], [0, 0, 1.0])]) == -3.0
 
 

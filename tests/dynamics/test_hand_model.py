@@ -12,11 +12,19 @@ def random_hand(rng, axes, isotropic=True):
     n = len(axes)
     m = rng.uniform(0.01, 0.05, n)
     J = rng.uniform(1e-6, 1e-5, n)
-    return H.HandModel(axes=axes, l=rng.uniform(-0.05, 0.05, (n + 1, 3)), r=rng.uniform(-0.03, 0.03, (n, 3)),
-                       m=m, J=J, xi=rng.uniform(0, 0.01, n))
+    return H.HandModel(
+        axes=axes,
+        l=rng.uniform(-0.05, 0.05, (n + 1, 3)),
+        r=rng.uniform(-0.03, 0.03, (n, 3)),
+        m=m,
+        J=J,
+        xi=rng.uniform(0, 0.01, n),
+    )
 
 
-@pytest.mark.parametrize("axes", [["k", "i", "j", "i", "k"], ["k"] * 4, ["j", "i", "i"], ["i", "j", "k", "j", "i", "k"]])
+@pytest.mark.parametrize(
+    "axes", [["k", "i", "j", "i", "k"], ["k"] * 4, ["j", "i", "i"], ["i", "j", "k", "j", "i", "k"]]
+)
 def test_book_recursion_vs_pinocchio(axes):
     rng = np.random.default_rng(len(axes))
     hand = random_hand(rng, axes)
@@ -29,12 +37,16 @@ def test_book_recursion_vs_pinocchio(axes):
         UW, dV, _ = hand.terms(th)
         M = pin.crba(model, data, th)
         M = np.triu(M) + np.triu(M, 1).T
-        assert np.max(np.abs(UW - M)) < 1e-14                                              # (8-105)
-        assert np.max(np.abs(dV - pin.computeGeneralizedGravity(model, data, th))) < 1e-14  # (8-107)
-        F = hand.inverse(th, thd, thdd)                                                      # (8-109)
+        assert np.max(np.abs(UW - M)) < 1e-14  # (8-105)
+        assert (
+            np.max(np.abs(dV - pin.computeGeneralizedGravity(model, data, th))) < 1e-14
+        )  # (8-107)
+        F = hand.inverse(th, thd, thdd)  # (8-109)
         assert np.max(np.abs(F - (pin.rnea(model, data, th, 0 * th, thdd) + hand.xi * thd))) < 1e-13
         Ffull = hand.inverse(th, thd, thdd, coriolis=True)
-        assert np.max(np.abs(Ffull - (pin.rnea(model, data, th, thd, thdd) + hand.xi * thd))) < 1e-13
+        assert (
+            np.max(np.abs(Ffull - (pin.rnea(model, data, th, thd, thdd) + hand.xi * thd))) < 1e-13
+        )
         a = hand.forward(th, thd, F + 0.01)
         assert np.max(np.abs(a - pin.aba(model, data, th, 0 * th, F + 0.01 - hand.xi * thd))) < 1e-9
         # CoM positions (8-98) vs Pinocchio's body placements

@@ -18,7 +18,9 @@ def test_gravity_map_vs_pinocchio_and_statics():
     for i in (0, 4, 8):
         for k in (0, 3, 8):
             q = res["q"][i, k]
-            assert np.allclose(res["tau"][i, k], pin.computeGeneralizedGravity(robot.model, d, q), atol=1e-12)
+            assert np.allclose(
+                res["tau"][i, k], pin.computeGeneralizedGravity(robot.model, d, q), atol=1e-12
+            )
     # arm hanging down (q = 0): no shoulder-flexion torque; arm horizontal forward: maximal
     t_down = dyn.gravity(np.zeros(7))[0]
     q_fwd = np.zeros(7)
@@ -52,10 +54,14 @@ def test_reaching_parts_sum_and_match_rnea():
         assert np.allclose(res["tau"][k], ref, atol=1e-10)
     assert np.allclose(res["q"][-1], q1) and np.allclose(res["qd"][[0, -1]], 0)
     Hu.plot_reaching(res)
-    Hu.plot_gravity_map(Hu.gravity_torque_map(grid=5, robot=robot, dyn=dyn), joint="shoulder_flexion")
+    Hu.plot_gravity_map(
+        Hu.gravity_torque_map(grid=5, robot=robot, dyn=dyn), joint="shoulder_flexion"
+    )
     small, small_dyn = Hu.human_arm(1.55, 50.0, "female")
     # the map reports the body it was computed for, not the keyword defaults
-    assert Hu.gravity_torque_map(grid=2, robot=small, dyn=small_dyn)["params"] == dict(height=1.55, mass=50.0, sex="female")
+    assert Hu.gravity_torque_map(grid=2, robot=small, dyn=small_dyn)["params"] == dict(
+        height=1.55, mass=50.0, sex="female"
+    )
 
 
 def test_bad_input():

@@ -7,14 +7,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import sympy as sp
+from dyn_chains import chain
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import anthroarm as aa
 from anthroarm.dynamics import lagrange as L
 from anthroarm.errors import InertiaError, UnsupportedModelError
-
-from dyn_chains import chain
 
 TOL = 1e-10
 
@@ -46,17 +45,28 @@ def pin_all(model, q, v, a, mimic=False):
     g = pin.computeGeneralizedGravity(model, d, q).copy()
     out = dict(M=M, g=g, tau=pin.rnea(model, d, q, v, a).copy())
     if mimic:
-        out.update(Cqd=pin.nonLinearEffects(model, d, q, v) - g, T=0.5 * v @ M @ v,
-                   V=-pin.computeTotalMass(model) * float(model.gravity.linear @ pin.centerOfMass(model, d, q)))
+        out.update(
+            Cqd=pin.nonLinearEffects(model, d, q, v) - g,
+            T=0.5 * v @ M @ v,
+            V=-pin.computeTotalMass(model)
+            * float(model.gravity.linear @ pin.centerOfMass(model, d, q)),
+        )
     else:
         C = pin.computeCoriolisMatrix(model, d, q, v).copy()
-        out.update(C=C, Cqd=C @ v, T=pin.computeKineticEnergy(model, d, q, v), V=pin.computePotentialEnergy(model, d, q))
+        out.update(
+            C=C,
+            Cqd=C @ v,
+            T=pin.computeKineticEnergy(model, d, q, v),
+            V=pin.computePotentialEnergy(model, d, q),
+        )
     return out
 
 
 #: the catalog plus the linkage hand's plain URDF (mimic joints: the mimic rows of pin_all) until
 #: it is a catalog entry itself
-CATALOG_AND_MIMIC = aa.models.names() + [n for n in ("prosthetic_hand",) if n not in aa.models.names()]
+CATALOG_AND_MIMIC = aa.models.names() + [
+    n for n in ("prosthetic_hand",) if n not in aa.models.names()
+]
 
 
 @pytest.mark.parametrize("name", CATALOG_AND_MIMIC)
@@ -73,19 +83,32 @@ def test_catalog_vs_pinocchio(name):
     Q = robot.random_q(8, rng)
     V = rng.standard_normal((8, robot.nv))
     A = rng.standard_normal((8, robot.nv))
-    batch = dict(M=dyn.mass_matrix(Q), C=dyn.coriolis_matrix(Q, V), Cqd=dyn.coriolis(Q, V), g=dyn.gravity(Q),
-                 tau=dyn.tau(Q, V, A), T=dyn.kinetic_energy(Q, V), V=dyn.potential_energy(Q))
+    batch = dict(
+        M=dyn.mass_matrix(Q),
+        C=dyn.coriolis_matrix(Q, V),
+        Cqd=dyn.coriolis(Q, V),
+        g=dyn.gravity(Q),
+        tau=dyn.tau(Q, V, A),
+        T=dyn.kinetic_energy(Q, V),
+        V=dyn.potential_energy(Q),
+    )
     mimic = robot.chain.has_mimic
     for i in range(len(Q)):
         ref = pin_all(robot.model, Q[i], V[i], A[i], mimic)
-        single = dict(M=dyn.mass_matrix(Q[i]), C=dyn.coriolis_matrix(Q[i], V[i]), Cqd=dyn.coriolis(Q[i], V[i]),
-                      g=dyn.gravity(Q[i]), tau=dyn.tau(Q[i], V[i], A[i]), T=dyn.kinetic_energy(Q[i], V[i]),
-                      V=dyn.potential_energy(Q[i]))
+        single = dict(
+            M=dyn.mass_matrix(Q[i]),
+            C=dyn.coriolis_matrix(Q[i], V[i]),
+            Cqd=dyn.coriolis(Q[i], V[i]),
+            g=dyn.gravity(Q[i]),
+            tau=dyn.tau(Q[i], V[i], A[i]),
+            T=dyn.kinetic_energy(Q[i], V[i]),
+            V=dyn.potential_energy(Q[i]),
+        )
         for k in ref:
             assert rel(batch[k][i], ref[k]) < TOL, (name, k, "batch")
             assert rel(single[k], ref[k]) < TOL, (name, k, "single")
         fd = dyn.forward(Q[i], V[i], A[i])
-        if mimic:   # aba refuses mimic joints: M⁻¹ (τ − nonLinearEffects) with Pinocchio's reduced M
+        if mimic:  # aba refuses mimic joints: M⁻¹ (τ − nonLinearEffects) with Pinocchio's reduced M
             fd_ref = np.linalg.solve(ref["M"], A[i] - ref["Cqd"] - ref["g"])
         else:
             fd_ref = pin.aba(robot.model, robot.model.createData(), Q[i], V[i], A[i])
@@ -96,8 +119,13 @@ def christoffel(M, q):
     """Christoffel symbols of the first kind, written here (not anthroarm's helper):
     Γ[i][j][k] = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)."""
     n = M.shape[0]
-    return [[[(M[i, j].diff(q[k]) + M[i, k].diff(q[j]) - M[j, k].diff(q[i])) / 2 for k in range(n)]
-             for j in range(n)] for i in range(n)]
+    return [
+        [
+            [(M[i, j].diff(q[k]) + M[i, k].diff(q[j]) - M[j, k].diff(q[i])) / 2 for k in range(n)]
+            for j in range(n)
+        ]
+        for i in range(n)
+    ]
 
 
 def _sympy_oracle(params, gravity):
@@ -131,18 +159,29 @@ def _sympy_oracle(params, gravity):
         V += -m * (sp.Matrix(gravity).T * cw)[0]
     T = (qdv.T * M * qdv)[0] / 2
     G = christoffel(M, q)
-    Cqd = sp.Matrix([sum(G[i][j][k] * qd[j] * qd[k] for j in range(n) for k in range(n)) for i in range(n)])
+    Cqd = sp.Matrix(
+        [sum(G[i][j][k] * qd[j] * qd[k] for j in range(n) for k in range(n)) for i in range(n)]
+    )
     g = sp.Matrix([V.diff(q[i]) for i in range(n)])
 
     def f(qv, qdv_):
-        sub = {**{q[i]: sp.Float(qv[i]) for i in range(n)}, **{qd[i]: sp.Float(qdv_[i]) for i in range(n)}}
-        return [np.array(x.xreplace(sub).evalf(), dtype=float) if isinstance(x, sp.MatrixBase)
-                else float(x.xreplace(sub)) for x in (M, Cqd, g, T, V)]
+        sub = {
+            **{q[i]: sp.Float(qv[i]) for i in range(n)},
+            **{qd[i]: sp.Float(qdv_[i]) for i in range(n)},
+        }
+        return [
+            np.array(x.xreplace(sub).evalf(), dtype=float)
+            if isinstance(x, sp.MatrixBase)
+            else float(x.xreplace(sub))
+            for x in (M, Cqd, g, T, V)
+        ]
 
     return f
 
 
-@pytest.mark.parametrize("types,seed", [(["RZ", "RX"], 3), (["RY", "PX", ("RU", (1.0, 2.0, -0.5))], 4)])
+@pytest.mark.parametrize(
+    "types,seed", [(["RZ", "RX"], 3), (["RY", "PX", ("RU", (1.0, 2.0, -0.5))], 4)]
+)
 def test_against_independent_sympy_christoffel(types, seed):
     rng = np.random.default_rng(seed)
     model, params = chain(types, rng)
@@ -166,7 +205,9 @@ def test_planar2r_symbolic_christoffel_and_latex():
     mats = L.sympy_matrices(d, which=("M", "Cqd", "g"))
     q, qd, _ = L.symbols(2)
     G = christoffel(mats["M"], q)
-    C2 = sp.Matrix([sum(G[i][j][k] * qd[j] * qd[k] for j in range(2) for k in range(2)) for i in range(2)])
+    C2 = sp.Matrix(
+        [sum(G[i][j][k] * qd[j] * qd[k] for j in range(2) for k in range(2)) for i in range(2)]
+    )
     assert all(abs(sp.N(sp.simplify(e))) < 1e-12 for e in (mats["Cqd"] - C2))
     # the book's two-link arm (Fig. 7-14): M12 depends on cos q2 only, M22 is constant
     assert mats["M"][1, 1].free_symbols == set()
@@ -183,7 +224,7 @@ def test_fixed_axis_rotation_eq_8_9():
     I = np.diag([0.02, 0.03, 0.04])
     model.appendBodyToJoint(jid, pin.Inertia(1.5, np.array([0.3, 0.1, 0.2]), I), pin.SE3.Identity())
     dyn = L.load(model, name="fixed_axis")
-    J = 0.04 + 1.5 * (0.3 ** 2 + 0.1 ** 2)
+    J = 0.04 + 1.5 * (0.3**2 + 0.1**2)
     assert abs(dyn.mass_matrix(np.array([0.7]))[0, 0] - J) < 1e-14
     assert abs(dyn.tau(np.array([0.7]), np.array([2.0]), np.array([3.0]))[0] - J * 3.0) < 1e-13
 
@@ -250,7 +291,9 @@ def test_nan_and_shape_errors():
         dyn.tau(np.zeros((3, 2)), np.zeros((4, 2)), np.zeros(2))
 
 
-@pytest.mark.parametrize("jm", [pin.JointModelSpherical(), pin.JointModelFreeFlyer(), pin.JointModelPlanar()])
+@pytest.mark.parametrize(
+    "jm", [pin.JointModelSpherical(), pin.JointModelFreeFlyer(), pin.JointModelPlanar()]
+)
 def test_unsupported_joints(jm):
     model = pin.Model()
     jid = model.addJoint(0, jm, pin.SE3.Identity(), "j")
@@ -282,8 +325,12 @@ def test_bad_inertias():
 def test_joint_moving_no_mass_is_refused():
     model = pin.Model()
     j1 = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "a")
-    model.appendBodyToJoint(j1, pin.Inertia(1.0, np.array([0.3, 0, 0]), np.eye(3) * 0.01), pin.SE3.Identity())
-    model.addJoint(j1, pin.JointModelRX(), pin.SE3(np.eye(3), np.array([0.5, 0, 0])), "b")  # massless link
+    model.appendBodyToJoint(
+        j1, pin.Inertia(1.0, np.array([0.3, 0, 0]), np.eye(3) * 0.01), pin.SE3.Identity()
+    )
+    model.addJoint(
+        j1, pin.JointModelRX(), pin.SE3(np.eye(3), np.array([0.5, 0, 0])), "b"
+    )  # massless link
     with pytest.raises(InertiaError, match="positive definite"):
         L.load(model, name="tipless")
 
@@ -297,13 +344,20 @@ def test_printed_lagrange_equation_8_8_fails():
     ref = pin.rnea(robot.model, robot.model.createData(), q, v, a)
     assert rel(dyn.tau(q, v, a), ref) < TOL
     h = 1e-6
-    dTdq = np.array([(dyn.kinetic_energy(q + h * e, v) - dyn.kinetic_energy(q - h * e, v)) / (2 * h) for e in np.eye(2)])
+    dTdq = np.array(
+        [
+            (dyn.kinetic_energy(q + h * e, v) - dyn.kinetic_energy(q - h * e, v)) / (2 * h)
+            for e in np.eye(2)
+        ]
+    )
     printed = dyn.tau(q, v, a) + dTdq - dyn.momentum(q, v)
     assert rel(printed, ref) > 1e-2
 
 
-@pytest.mark.skipif(__import__("anthroarm.dynamics.ccode", fromlist=["compiler"]).compiler() is None,
-                    reason="no C compiler")
+@pytest.mark.skipif(
+    __import__("anthroarm.dynamics.ccode", fromlist=["compiler"]).compiler() is None,
+    reason="no C compiler",
+)
 def test_c_backend_matches_numpy_and_pin():
     robot = aa.load("planar2r")
     dc, dn = L.load(robot, backend="c"), L.load(robot)

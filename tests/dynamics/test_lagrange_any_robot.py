@@ -23,8 +23,17 @@ import anthroarm as aa
 from anthroarm.dynamics import lagrange as L
 
 TOL = 1e-12
-LEFT_ARM = ["left_s0", "left_s1", "left_e0", "left_e1", "left_w0", "left_w1", "left_w2",
-            "l_gripper_l_finger_joint", "l_gripper_r_finger_joint"]
+LEFT_ARM = [
+    "left_s0",
+    "left_s1",
+    "left_e0",
+    "left_e1",
+    "left_w0",
+    "left_w1",
+    "left_w2",
+    "l_gripper_l_finger_joint",
+    "l_gripper_r_finger_joint",
+]
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -39,7 +48,9 @@ def user_urdf_text() -> str:
     """USER_URDF of tests/foundation/test_chain.py (continuous + mimic joints, inertias)."""
     src = (Path(__file__).parents[1] / "foundation" / "test_chain.py").read_text()
     for node in ast.parse(src).body:
-        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "USER_URDF" for t in node.targets):
+        if isinstance(node, ast.Assign) and any(
+            getattr(t, "id", None) == "USER_URDF" for t in node.targets
+        ):
             return ast.literal_eval(node.value)
     raise LookupError("USER_URDF not found in tests/foundation/test_chain.py")
 
@@ -62,15 +73,27 @@ def sym(M):
 
 def states(robot, n, seed):
     rng = np.random.default_rng(seed)
-    return robot.random_q(n, rng), rng.standard_normal((n, robot.nv)), rng.standard_normal((n, robot.nv))
+    return (
+        robot.random_q(n, rng),
+        rng.standard_normal((n, robot.nv)),
+        rng.standard_normal((n, robot.nv)),
+    )
 
 
 def ours(dyn, Q, V, A, i=None):
     """Every quantity for one state (i) or the batch."""
     if i is not None:
         Q, V, A = Q[i], V[i], A[i]
-    return dict(M=dyn.mass_matrix(Q), Cqd=dyn.coriolis(Q, V), C=dyn.coriolis_matrix(Q, V), g=dyn.gravity(Q),
-                tau=dyn.tau(Q, V, A), T=dyn.kinetic_energy(Q, V), V=dyn.potential_energy(Q), fd=dyn.forward(Q, V, A))
+    return dict(
+        M=dyn.mass_matrix(Q),
+        Cqd=dyn.coriolis(Q, V),
+        C=dyn.coriolis_matrix(Q, V),
+        g=dyn.gravity(Q),
+        tau=dyn.tau(Q, V, A),
+        T=dyn.kinetic_energy(Q, V),
+        V=dyn.potential_energy(Q),
+        fd=dyn.forward(Q, V, A),
+    )
 
 
 # ------------------------------------------------------------------ continuous joints
@@ -86,9 +109,16 @@ def test_continuous_joints_vs_pinocchio(name):
     for i in range(len(Q)):
         q, v, a = Q[i], V[i], A[i]
         C = pin.computeCoriolisMatrix(m, d, q, v).copy()
-        ref = dict(M=sym(pin.crba(m, d, q)), C=C, Cqd=C @ v, g=pin.computeGeneralizedGravity(m, d, q).copy(),
-                   tau=pin.rnea(m, d, q, v, a).copy(), T=pin.computeKineticEnergy(m, d, q, v),
-                   V=pin.computePotentialEnergy(m, d, q), fd=pin.aba(m, d, q, v, a).copy())
+        ref = dict(
+            M=sym(pin.crba(m, d, q)),
+            C=C,
+            Cqd=C @ v,
+            g=pin.computeGeneralizedGravity(m, d, q).copy(),
+            tau=pin.rnea(m, d, q, v, a).copy(),
+            T=pin.computeKineticEnergy(m, d, q, v),
+            V=pin.computePotentialEnergy(m, d, q),
+            fd=pin.aba(m, d, q, v, a).copy(),
+        )
         single = ours(dyn, Q, V, A, i)
         for k in ref:
             assert rel(single[k], ref[k]) < (1e-10 if k == "fd" else TOL), (name, k, "single")
@@ -101,7 +131,7 @@ def test_continuous_joint_is_a_revolute_joint_without_limits():
     dyn = L.load(robot)
     th = np.random.default_rng(3).uniform(-np.pi, np.pi, robot.nv)
     q = robot.chain.configuration(th)
-    q2 = robot.chain.configuration(th + 2 * np.pi * np.array([3, 0, -5, 0, 0, 7])[:robot.nv])
+    q2 = robot.chain.configuration(th + 2 * np.pi * np.array([3, 0, -5, 0, 0, 7])[: robot.nv])
     np.testing.assert_allclose(dyn.mass_matrix(q2), dyn.mass_matrix(q), atol=1e-13)
 
 
@@ -110,13 +140,13 @@ def test_non_unit_cos_sin_names_the_joint():
     dyn = L.load(robot)
     j = next(j for j in robot.chain.joints if j.kind == "continuous")
     q = robot.neutral()
-    q[j.idx_q:j.idx_q + 2] = [2.0, 0.0]
+    q[j.idx_q : j.idx_q + 2] = [2.0, 0.0]
     with pytest.raises(ValueError, match=j.name):
         dyn.mass_matrix(q)
     with pytest.raises(ValueError, match=j.name):
         dyn.gravity(np.vstack([robot.neutral(), q]))
     with pytest.raises(ValueError, match=r"shape \(9,\)"):
-        dyn.gravity(np.zeros(robot.nv))          # an angle vector is not the robot's layout
+        dyn.gravity(np.zeros(robot.nv))  # an angle vector is not the robot's layout
 
 
 # ------------------------------------------------------------------ mimic joints
@@ -134,7 +164,9 @@ def coupling(robot, full):
         out = np.zeros(full.nq)
         for j in ch.joints:
             fj = full.joints[full.getJointId(j.name)]
-            out[fj.idx_q:fj.idx_q + fj.nq] = [np.cos(th[j.index]), np.sin(th[j.index])] if fj.nq == 2 else th[j.index]
+            out[fj.idx_q : fj.idx_q + fj.nq] = (
+                [np.cos(th[j.index]), np.sin(th[j.index])] if fj.nq == 2 else th[j.index]
+            )
         return out
 
     return G, q_full
@@ -170,9 +202,16 @@ def test_mimic_joints_vs_pinocchio(which, user_path):
         assert rel(M, G.T @ sym(pin.crba(full, fd, qf)) @ G) < TOL
         assert rel(tau, G.T @ pin.rnea(full, fd, qf, vf, af)) < TOL
         assert rel(g, G.T @ pin.computeGeneralizedGravity(full, fd, qf)) < TOL
-        ref = dict(M=M, Cqd=nle - g, C=G.T @ pin.computeCoriolisMatrix(full, fd, qf, vf) @ G, g=g, tau=tau,
-                   T=pin.computeKineticEnergy(full, fd, qf, vf), V=pin.computePotentialEnergy(full, fd, qf),
-                   fd=np.linalg.solve(M, a - nle))
+        ref = dict(
+            M=M,
+            Cqd=nle - g,
+            C=G.T @ pin.computeCoriolisMatrix(full, fd, qf, vf) @ G,
+            g=g,
+            tau=tau,
+            T=pin.computeKineticEnergy(full, fd, qf, vf),
+            V=pin.computePotentialEnergy(full, fd, qf),
+            fd=np.linalg.solve(M, a - nle),
+        )
         single = ours(dyn, Q, V, A, i)
         for k in ref:
             tol = 1e-10 if k == "fd" else TOL
@@ -208,6 +247,8 @@ def test_check_rows_on_any_robot(which, user_path):
 
     robot = aa.load("kinova") if which == "kinova" else mimic_robots(user_path)[which][0]
     rows = checks.model_rows(robot, 4, np.random.default_rng(5))
-    assert len(rows) == 8 and all(r.ok for r in rows), [(r.quantity, r.max_abs_err) for r in rows if not r.ok]
+    assert len(rows) == 8 and all(r.ok for r in rows), [
+        (r.quantity, r.max_abs_err) for r in rows if not r.ok
+    ]
     if robot.chain.has_mimic:
         assert any("mimic" in r.oracle for r in rows)

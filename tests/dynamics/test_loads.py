@@ -58,11 +58,21 @@ def test_wrench_equals_rnea_with_fext(person, reference, frame):
         res = L.inverse_dynamics(robot, q, qd, qdd, w, engine=engine)
         model, data = robot.model, pin.Data(robot.model)
         fid = robot.frame_id(frame)
-        ref = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k],
-                                 _fext_of_wrench(model, data, q[k], fid, F[k], Mo[k], reference))
-                        for k in range(len(q))])
+        ref = np.array(
+            [
+                pin.rnea(
+                    model,
+                    data,
+                    q[k],
+                    qd[k],
+                    qdd[k],
+                    _fext_of_wrench(model, data, q[k], fid, F[k], Mo[k], reference),
+                )
+                for k in range(len(q))
+            ]
+        )
         np.testing.assert_allclose(res.tau, ref, atol=1e-9, rtol=1e-10)
-        assert np.abs(res.q_ext).max() > 1.0          # the load did something
+        assert np.abs(res.q_ext).max() > 1.0  # the load did something
         np.testing.assert_allclose(res.power, res.tau * qd, rtol=0, atol=0)
 
 
@@ -75,7 +85,8 @@ def test_held_object_equals_body_with_added_inertia(person):
     model = robot.model.copy()
     fr = model.frames[robot.tool_id]
     model.inertias[fr.parentJoint] = model.inertias[fr.parentJoint] + fr.placement.act(
-        pin.Inertia(0.5, cup.com, cup.inertia))
+        pin.Inertia(0.5, cup.com, cup.inertia)
+    )
     data = model.createData()
     ref = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
     np.testing.assert_allclose(res.tau, ref, atol=1e-9, rtol=1e-10)
@@ -138,8 +149,8 @@ def test_static_point_mass_on_a_horizontal_arm(person):
     axis = T_sh[:3, :3] @ robot.chain.joint("shoulder_flexion").axis
     r = robot.fk(q)[:3, 3] - T_sh[:3, 3]
     g = robot.chain.gravity
-    lever = np.cross(r, m * g) @ axis           # moment of the weight about the shoulder axis
-    assert abs(lever) > 0.5 * m * 9.81 * 0.5    # the hand is ~0.6 m out
+    lever = np.cross(r, m * g) @ axis  # moment of the weight about the shoulder axis
+    assert abs(lever) > 0.5 * m * 9.81 * 0.5  # the hand is ~0.6 m out
     j = robot.joint_names.index("shoulder_flexion")
     # the joint must supply the opposite of the weight's moment
     np.testing.assert_allclose(res.tau[j] - res.tau_free[j], -lever, rtol=1e-12, atol=1e-12)
@@ -151,7 +162,9 @@ def test_tree_and_prismatic_robot():
     rng = np.random.default_rng(7)
 
     def body():
-        return pin.Inertia(rng.uniform(0.5, 1.5), rng.uniform(-0.1, 0.1, 3), np.diag(rng.uniform(0.01, 0.02, 3)))
+        return pin.Inertia(
+            rng.uniform(0.5, 1.5), rng.uniform(-0.1, 0.1, 3), np.diag(rng.uniform(0.01, 0.02, 3))
+        )
 
     j1 = model.addJoint(0, pin.JointModelRZ(), pin.SE3(np.eye(3), np.array([0, 0, 0.1])), "j1")
     model.appendBodyToJoint(j1, body(), pin.SE3.Identity())
@@ -160,7 +173,9 @@ def test_tree_and_prismatic_robot():
     j3 = model.addJoint(j1, pin.JointModelRY(), pin.SE3(np.eye(3), np.array([0, 0.2, 0])), "j3")
     model.appendBodyToJoint(j3, body(), pin.SE3.Identity())
     for name, j, p in (("tipA", j2, [0.1, 0, 0]), ("tipB", j3, [0, 0.15, 0.05])):
-        model.addFrame(pin.Frame(name, j, 0, pin.SE3(np.eye(3), np.array(p, float)), pin.FrameType.OP_FRAME))
+        model.addFrame(
+            pin.Frame(name, j, 0, pin.SE3(np.eye(3), np.array(p, float)), pin.FrameType.OP_FRAME)
+        )
     model.lowerPositionLimit[:] = -1
     model.upperPositionLimit[:] = 1
     robot = aa.load(model, tool="tipA")
@@ -169,11 +184,21 @@ def test_tree_and_prismatic_robot():
     res = L.inverse_dynamics(robot, q, qd, qdd, w)
     data = model.createData()
     fid = robot.frame_id("tipB")
-    ref = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k],
-                             _fext_of_wrench(model, data, q[k], fid, w.force, w.moment, w.reference))
-                    for k in range(len(q))])
+    ref = np.array(
+        [
+            pin.rnea(
+                model,
+                data,
+                q[k],
+                qd[k],
+                qdd[k],
+                _fext_of_wrench(model, data, q[k], fid, w.force, w.moment, w.reference),
+            )
+            for k in range(len(q))
+        ]
+    )
     np.testing.assert_allclose(res.tau, ref, atol=1e-10)
-    assert np.all(res.q_ext[:, robot.joint_names.index("j2")] == 0.0)   # other branch
+    assert np.all(res.q_ext[:, robot.joint_names.index("j2")] == 0.0)  # other branch
     assert np.abs(res.q_ext[:, robot.joint_names.index("j3")]).max() > 0.01
 
 
@@ -184,22 +209,29 @@ def test_single_sample_shapes(person):
     assert res.tau.shape == (person.nv,)
     Q = L.generalized_forces(person, q, L.HeldObject(0.2))
     assert Q.shape == (person.nv,)
-    np.testing.assert_allclose(Q, L.generalized_forces(person, q, L.Wrench([0, 0, -0.2 * 9.81])), atol=1e-12)
+    np.testing.assert_allclose(
+        Q, L.generalized_forces(person, q, L.Wrench([0, 0, -0.2 * 9.81])), atol=1e-12
+    )
 
 
-@pytest.mark.parametrize("kw, exc", [
-    (dict(mass=-0.1), InertiaError),
-    (dict(mass=float("nan")), InertiaError),
-    (dict(mass=0.5, inertia=np.diag([1.0, 1.0, 3.0])), InertiaError),     # triangle inequality
-    (dict(mass=0.5, inertia=-np.eye(3)), InertiaError),
-    (dict(mass=0.5, com=[0, 0]), InertiaError),
-])
+@pytest.mark.parametrize(
+    "kw, exc",
+    [
+        (dict(mass=-0.1), InertiaError),
+        (dict(mass=float("nan")), InertiaError),
+        (dict(mass=0.5, inertia=np.diag([1.0, 1.0, 3.0])), InertiaError),  # triangle inequality
+        (dict(mass=0.5, inertia=-np.eye(3)), InertiaError),
+        (dict(mass=0.5, com=[0, 0]), InertiaError),
+    ],
+)
 def test_bad_held_objects(kw, exc):
     with pytest.raises(exc):
         L.HeldObject(**kw)
 
 
-@pytest.mark.parametrize("args", [("1 kg", 0.04, 0.1), (0.5, "wide", 0.1), (0.5, 0.04, -0.1), (np.nan, 0.04, 0.1)])
+@pytest.mark.parametrize(
+    "args", [("1 kg", 0.04, 0.1), (0.5, "wide", 0.1), (0.5, 0.04, -0.1), (np.nan, 0.04, 0.1)]
+)
 def test_bad_cylinders(args):
     with pytest.raises(InertiaError, match="held object"):
         L.HeldObject.cylinder(*args)
@@ -243,7 +275,8 @@ def test_lagrange_with_the_load_term_equals_lagrange_of_the_arm_carrying_the_obj
     model = person.model.copy()
     fr = model.frames[person.tool_id]
     model.inertias[fr.parentJoint] = model.inertias[fr.parentJoint] + fr.placement.act(
-        pin.Inertia(cup.mass, cup.com, cup.inertia))
+        pin.Inertia(cup.mass, cup.com, cup.inertia)
+    )
     heavy = aa.load(model, tool=person.tool)
     q, qd, qdd = _traj(person, 10, 9)
     res = L.inverse_dynamics(person, q, qd, qdd, cup, engine="lagrange")

@@ -12,7 +12,9 @@ def test_conservative_energy_rk4_and_solve_ivp():
     r4 = S.simulate(robot, [0.3, -0.2], [0.0, 0.5], t_end=2.0, dt=1e-3)
     assert r4.status == "ok" and r4.energy_drift < 1e-8
     assert r4.dissipated[-1] == 0 and np.ptp(r4.T) > 1.0  # it really swings
-    ivp = S.simulate(robot, [0.3, -0.2], [0.0, 0.5], t_end=2.0, dt=1e-2, method="DOP853", rtol=1e-11, atol=1e-11)
+    ivp = S.simulate(
+        robot, [0.3, -0.2], [0.0, 0.5], t_end=2.0, dt=1e-2, method="DOP853", rtol=1e-11, atol=1e-11
+    )
     assert ivp.energy_drift < 1e-7
     assert np.max(np.abs(ivp.q[-1] - r4.q[-1])) < 1e-6
 
@@ -37,7 +39,9 @@ def test_lagrange_vs_pin_aba_integration(name):
     robot = aa.load(name)
     rng = np.random.default_rng(0)
     q0 = robot.random_q(rng=rng)
-    cmp = S.compare_with_pinocchio(robot, q0, rng.standard_normal(robot.nv) * 0.5, t_end=0.2, dt=2e-3, damping=0.1)
+    cmp = S.compare_with_pinocchio(
+        robot, q0, rng.standard_normal(robot.nv) * 0.5, t_end=0.2, dt=2e-3, damping=0.1
+    )
     assert cmp["max_dq"] < 1e-10 and cmp["max_dqd"] < 1e-9
 
 
@@ -50,7 +54,9 @@ def test_bad_input():
     with pytest.raises(ValueError, match="shape"):
         S.simulate(robot, [0, 0, 0], [0, 0], 0.1)
     for method in ("rk4", "RK45"):
-        r = S.simulate(robot, [0, 0], [0, 0], 0.05, tau=lambda t, q, qd: np.array([np.nan, 0.0]), method=method)
+        r = S.simulate(
+            robot, [0, 0], [0, 0], 0.05, tau=lambda t, q, qd: np.array([np.nan, 0.0]), method=method
+        )
         assert r.status.startswith("diverged") and np.all(np.isfinite(r.q))
 
 

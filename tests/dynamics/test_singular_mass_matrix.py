@@ -63,7 +63,7 @@ def test_forward_at_singular_M_is_a_typed_error(dyn, q2):
     assert isinstance(err, InertiaError) and isinstance(err, ValueError)
     assert err.joint == "yaw" and "'yaw'" in str(err)
     assert np.array_equal(err.q, q)
-    assert err.cond > 1e12          # mathematics: cond = 1 / cos² q₂ here
+    assert err.cond > 1e12  # mathematics: cond = 1 / cos² q₂ here
 
 
 def test_forward_batch_names_the_singular_item(dyn):
@@ -80,8 +80,11 @@ def test_pinocchio_aba_does_not_flag_it(arm, dyn):
     # away from the singularity both agree (Pinocchio as the oracle)
     for q2 in (0.0, 0.4, 1.2):
         q = np.array([0.1, q2])
-        assert np.allclose(dyn.forward(q, np.array([0.3, -0.2]), tau),
-                           pin.aba(arm.model, arm.model.createData(), q, np.array([0.3, -0.2]), tau), rtol=1e-10)
+        assert np.allclose(
+            dyn.forward(q, np.array([0.3, -0.2]), tau),
+            pin.aba(arm.model, arm.model.createData(), q, np.array([0.3, -0.2]), tau),
+            rtol=1e-10,
+        )
 
 
 def test_well_conditioned_models_are_unaffected():

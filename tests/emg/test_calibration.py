@@ -23,10 +23,17 @@ def test_calibrated_thresholds_stay_off_at_rest_and_switch_at_the_book_sensitivi
     np.testing.assert_allclose(off, cal.rest_mean_pp + 2.5 * cal.rest_sd_pp)
     assert np.all(on < BOOK_SENSITIVITY_PP) and np.all(off < on)
     proc = EMGProcessor(FS, thresholds=cal.thresholds)
-    for seed in (1, 2, 3):                                        # other rest recordings: no false activity
+    for seed in (1, 2, 3):  # other rest recordings: no false activity
         quiet = proc.process(_rest(2e-6, seed=seed))
         assert not quiet.active[:, quiet.t_frames > 0.3].any()
-    burst = synthesize(1.5, FS, [[(0.3, 1.0, 1.0)], [(0.3, 1.0, 1.0)]], pp=BOOK_SENSITIVITY_PP, noise_rms=2e-6, rng=2)
+    burst = synthesize(
+        1.5,
+        FS,
+        [[(0.3, 1.0, 1.0)], [(0.3, 1.0, 1.0)]],
+        pp=BOOK_SENSITIVITY_PP,
+        noise_rms=2e-6,
+        rng=2,
+    )
     res = proc.process(burst.emg)
     assert np.all(res.active[:, (res.t_frames > 0.5) & (res.t_frames < 1.25)])
 

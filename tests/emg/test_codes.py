@@ -11,7 +11,7 @@ import pytest
 from anthroarm.emg import MODES, VIBRATOR_OF_MODE, VIBRATORS, CodeMachine, vibrators_with_grasp
 from anthroarm.errors import EMGError
 
-F = 0.005          # 5 ms frames: debounce 50 ms = 10 frames, co-contraction 150 ms = 30 frames
+F = 0.005  # 5 ms frames: debounce 50 ms = 10 frames, co-contraction 150 ms = 30 frames
 
 
 def seq(*runs):
@@ -26,9 +26,9 @@ def test_book_vibrator_mapping():
 
 def test_flexor_and_extensor_commands_after_the_debounce():
     tr = CodeMachine(F).run(seq((0, 20), (2, 40), (0, 20), (1, 40), (0, 20)))
-    assert np.all(tr.mode == 0)                                   # starts at the elbow
+    assert np.all(tr.mode == 0)  # starts at the elbow
     cmd = tr.command
-    assert np.all(cmd[:29] == 0) and np.all(cmd[29:69] == 1)      # accepted on the 10th frame of "10"
+    assert np.all(cmd[:29] == 0) and np.all(cmd[29:69] == 1)  # accepted on the 10th frame of "10"
     assert np.all(cmd[69:89] == 0) and np.all(cmd[89:129] == -1)  # every change is 10 frames late
     assert np.all(cmd[129:] == 0)
     assert not tr.switched.any()
@@ -44,14 +44,20 @@ def test_co_contraction_cycles_the_modes_with_the_book_vibrators():
     tr = m.run(seq((0, 10), (3, 20), (0, 30), (3, 20), (0, 30), (3, 20), (0, 30)))
     sw = np.flatnonzero(tr.switched)
     assert sw.tolist() == [19, 69, 119]
-    assert tr.mode[18] == 0 and tr.mode[19] == 1 and tr.mode[69] == 2 and tr.mode[119] == 0   # elbow->wrist->fingers->elbow
+    assert (
+        tr.mode[18] == 0 and tr.mode[19] == 1 and tr.mode[69] == 2 and tr.mode[119] == 0
+    )  # elbow->wrist->fingers->elbow
     assert [tr.mode_names[k] for k in sw] == ["wrist", "fingers", "elbow"]
-    assert np.all(tr.command == 0)                                # 11 never drives a joint
+    assert np.all(tr.command == 0)  # 11 never drives a joint
     left, right, middle = tr.vibrators.T
-    assert np.flatnonzero(right).tolist() == list(range(19, 69))  # wrist: right; cut short by the next switch
-    assert not left[:119].any()                                   # fingers (69..118): no vibrator
+    assert np.flatnonzero(right).tolist() == list(
+        range(19, 69)
+    )  # wrist: right; cut short by the next switch
+    assert not left[:119].any()  # fingers (69..118): no vibrator
     n_vib = round(0.3 / F)
-    assert np.flatnonzero(left).tolist() == list(range(119, min(119 + n_vib, tr.code.size)))   # elbow: left
+    assert np.flatnonzero(left).tolist() == list(
+        range(119, min(119 + n_vib, tr.code.size))
+    )  # elbow: left
     assert not middle.any()
 
 
@@ -59,23 +65,27 @@ def test_lock_out_after_a_switch_until_rest():
     """Relaxing a co-contraction one muscle first leaves a "10": it must not drive the new joint."""
     tr = CodeMachine(F).run(seq((0, 10), (3, 20), (2, 30), (0, 20), (2, 30), (0, 5)))
     assert tr.switched.sum() == 1
-    assert np.all(tr.command[:80] == 0)                           # 10 after the switch: locked out
-    assert np.all(tr.command[89:110] == 1) and np.all(tr.mode[89:] == 1)   # after rest: drives the wrist
+    assert np.all(tr.command[:80] == 0)  # 10 after the switch: locked out
+    assert np.all(tr.command[89:110] == 1) and np.all(
+        tr.mode[89:] == 1
+    )  # after rest: drives the wrist
 
 
 def test_asynchronous_onsets_within_the_window_still_switch():
-    tr = CodeMachine(F).run(seq((0, 10), (2, 20), (3, 20), (0, 20)))     # 100 ms flexor lead
+    tr = CodeMachine(F).run(seq((0, 10), (2, 20), (3, 20), (0, 20)))  # 100 ms flexor lead
     assert tr.switched.sum() == 1
-    assert np.all(tr.command[29:39] == 1)                          # the lead moved the elbow briefly
+    assert np.all(tr.command[29:39] == 1)  # the lead moved the elbow briefly
     assert np.all(tr.command[39:] == 0)
 
 
 def test_slow_co_contraction_holds_without_switching():
-    tr = CodeMachine(F).run(seq((0, 10), (2, 60), (3, 30), (2, 20), (0, 20)))   # 300 ms > 150 ms window
+    tr = CodeMachine(F).run(
+        seq((0, 10), (2, 60), (3, 30), (2, 20), (0, 20))
+    )  # 300 ms > 150 ms window
     assert not tr.switched.any()
     assert np.all(tr.command[19:79] == 1)
     assert np.all(tr.command[79:99] == 0) and np.all(tr.hold[79:99])
-    assert np.all(tr.command[109:120] == 1)                       # flexor alone again: moves again
+    assert np.all(tr.command[109:120] == 1)  # flexor alone again: moves again
     assert np.all(tr.mode == 0)
 
 
@@ -90,8 +100,9 @@ def test_blocks_of_any_length_give_the_result_of_one_piece(seed):
     cuts = np.sort(rng.choice(np.arange(1, raw.size), 15, replace=False))
     parts = [m.run(b) for b in np.split(raw, cuts)]
     for name in ("code", "mode", "command", "switched", "hold", "vibrators"):
-        np.testing.assert_array_equal(np.concatenate([getattr(p, name) for p in parts]), getattr(whole, name),
-                                      err_msg=name)
+        np.testing.assert_array_equal(
+            np.concatenate([getattr(p, name) for p in parts]), getattr(whole, name), err_msg=name
+        )
     assert whole.switched.any()
 
 

@@ -8,19 +8,37 @@ peer for the spectral centroid."""
 import numpy as np
 import pytest
 
-from anthroarm.emg import (AMPUTEE_PP, AMPUTEE_TRAINED_PP, EMG_BAND, HEALTHY_PP, PP_PER_MAV, PP_PER_RMS, TYPICAL_PP,
-                           activation, band_limited_noise, band_powers, lowpass_envelope, mean_frequency,
-                           median_frequency, moving_rms, peak_to_peak, rms, spectral_features, spectrum, synthesize)
+from anthroarm.emg import (
+    AMPUTEE_PP,
+    AMPUTEE_TRAINED_PP,
+    EMG_BAND,
+    HEALTHY_PP,
+    PP_PER_MAV,
+    PP_PER_RMS,
+    TYPICAL_PP,
+    activation,
+    band_limited_noise,
+    band_powers,
+    lowpass_envelope,
+    mean_frequency,
+    median_frequency,
+    moving_rms,
+    peak_to_peak,
+    rms,
+    spectral_features,
+    spectrum,
+    synthesize,
+)
 from anthroarm.errors import EMGError, SamplingRateError
 
 FS = 2000.0
 
 
 def test_book_amplitudes():
-    assert HEALTHY_PP == (1e-3, 3e-3)          # 1-3 mV p-p, healthy
-    assert TYPICAL_PP == 100e-6                # typical moderate contraction
+    assert HEALTHY_PP == (1e-3, 3e-3)  # 1-3 mV p-p, healthy
+    assert TYPICAL_PP == 100e-6  # typical moderate contraction
     assert AMPUTEE_PP == 50e-6 and AMPUTEE_TRAINED_PP == 100e-6
-    assert EMG_BAND == (30.0, 300.0)           # main spectral power
+    assert EMG_BAND == (30.0, 300.0)  # main spectral power
 
 
 def test_sine_equivalent_peak_to_peak_of_a_sine():
@@ -38,13 +56,15 @@ def test_sine_equivalent_peak_to_peak_of_a_sine():
 def test_moving_rms_matches_its_definition_and_a_sine():
     rng = np.random.default_rng(0)
     x = rng.standard_normal((2, 700))
-    w = 60                                          # 30 ms at 2 kHz
+    w = 60  # 30 ms at 2 kHz
     got = moving_rms(x, FS, 0.03)
     pad = np.concatenate([np.zeros((2, w - 1)), x], axis=1)
-    brute = np.array([[np.sqrt(np.sum(pad[c, k:k + w] ** 2) / w) for k in range(700)] for c in range(2)])
+    brute = np.array(
+        [[np.sqrt(np.sum(pad[c, k : k + w] ** 2) / w) for k in range(700)] for c in range(2)]
+    )
     np.testing.assert_allclose(got, brute, rtol=1e-10, atol=1e-14)
     t = np.arange(4000) / FS
-    s = 5.0 * np.sin(2 * np.pi * 50 * t)           # 100 ms window = 5 periods
+    s = 5.0 * np.sin(2 * np.pi * 50 * t)  # 100 ms window = 5 periods
     np.testing.assert_allclose(moving_rms(s, FS, 0.1)[0, 400:], 5.0 / np.sqrt(2), rtol=1e-9)
 
 
@@ -54,7 +74,7 @@ def test_linear_envelope_of_a_sine_is_its_mean_rectified_value():
     e = lowpass_envelope(s, FS, cutoff_hz=5.0)[0, 4000:]
     # 150 Hz at 2 kHz: 3 periods in 40 samples; the sampled mean of |sin| is 2 cot(pi/40)/40
     assert np.mean(e) == pytest.approx(2.0 * 2 / np.tan(np.pi / 40) / 40, rel=2e-3)
-    assert np.ptp(e) < 0.01 * np.mean(e)             # the 300 Hz ripple is filtered out
+    assert np.ptp(e) < 0.01 * np.mean(e)  # the 300 Hz ripple is filtered out
     with pytest.raises(SamplingRateError):
         lowpass_envelope(s, 8.0, cutoff_hz=5.0)
 
@@ -92,17 +112,23 @@ def test_band_limited_noise_has_a_flat_spectrum_in_its_band(band):
 
 def test_mean_frequency_agrees_with_neurokit2():
     nk = pytest.importorskip("neurokit2")
-    x = band_limited_noise(int(10 * FS), FS, (30.0, 300.0), rng=4)[0] + 0.5 * np.sin(2 * np.pi * 60 * np.arange(int(10 * FS)) / FS)
+    x = band_limited_noise(int(10 * FS), FS, (30.0, 300.0), rng=4)[0] + 0.5 * np.sin(
+        2 * np.pi * 60 * np.arange(int(10 * FS)) / FS
+    )
     f, p = spectrum(x, FS, segment_s=0.5)
-    psd = nk.signal_psd(x, sampling_rate=FS, method="welch", min_frequency=1.0, max_frequency=1000.0)
+    psd = nk.signal_psd(
+        x, sampling_rate=FS, method="welch", min_frequency=1.0, max_frequency=1000.0
+    )
     theirs = float(np.sum(psd["Frequency"] * psd["Power"]) / np.sum(psd["Power"]))
     ours = mean_frequency(f, p, band=(1.0, 1000.0))[0]
     assert ours == pytest.approx(theirs, rel=0.03)
-    assert median_frequency(f, p)[0] < ours            # the 60 Hz line pulls the median down
+    assert median_frequency(f, p)[0] < ours  # the 60 Hz line pulls the median down
 
 
 def test_synthesized_amplitude_and_envelope():
-    rec = synthesize(3.0, FS, [[(0.5, 2.0, 1.0)], [(1.0, 1.0, 0.5)]], pp=[1e-3, 3e-3], noise_rms=0.0, rng=2)
+    rec = synthesize(
+        3.0, FS, [[(0.5, 2.0, 1.0)], [(1.0, 1.0, 0.5)]], pp=[1e-3, 3e-3], noise_rms=0.0, rng=2
+    )
     assert rec.emg.shape == (2, 6000)
     on = (rec.t > 0.6) & (rec.t < 2.4)
     assert PP_PER_RMS * rms(rec.emg[0, on])[0] == pytest.approx(1e-3, rel=0.05)
@@ -117,14 +143,14 @@ def test_activation_ramps():
     a = activation(t, [(0.2, 0.5, 0.8)], ramp_s=0.1)
     assert a[t < 0.2].max() == 0 and a[t > 0.7].max() == 0
     np.testing.assert_allclose(a[(t >= 0.3) & (t <= 0.6)], 0.8)
-    assert a[250] == pytest.approx(0.4, abs=1e-9)          # half-way up the raised cosine
+    assert a[250] == pytest.approx(0.4, abs=1e-9)  # half-way up the raised cosine
 
 
 def test_synth_bad_input():
     with pytest.raises(EMGError):
-        band_limited_noise(1000, 500.0, (30.0, 300.0))     # band above Nyquist
+        band_limited_noise(1000, 500.0, (30.0, 300.0))  # band above Nyquist
     with pytest.raises(EMGError):
-        synthesize(1.0, FS, [[(0.1, 0.2, 2.0)]])           # level > 1
+        synthesize(1.0, FS, [[(0.1, 0.2, 2.0)]])  # level > 1
     with pytest.raises(EMGError):
         synthesize(1.0, FS, [[(0.1, 0.2, 1.0)]], pp=-1e-6)
     with pytest.raises(EMGError):

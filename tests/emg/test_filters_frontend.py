@@ -9,14 +9,23 @@ import numpy as np
 import pytest
 from scipy import signal as sps
 
-from anthroarm.emg import (BOOK_BANK_2CH, BOOK_BANK_3CH, CONDITIONING_BAND, DifferentialAmplifier, FilterBank,
-                           bandpass_sos, band_edges, electrode_potentials, notch_sos)
+from anthroarm.emg import (
+    BOOK_BANK_2CH,
+    BOOK_BANK_3CH,
+    CONDITIONING_BAND,
+    DifferentialAmplifier,
+    FilterBank,
+    band_edges,
+    bandpass_sos,
+    electrode_potentials,
+    notch_sos,
+)
 from anthroarm.errors import EMGError, SamplingRateError
 
 
 def test_book_centre_frequencies_are_the_printed_ones():
-    assert BOOK_BANK_2CH == (40.0, 100.0, 160.0, 360.0)      # Table 9.1, 方式1
-    assert BOOK_BANK_3CH == (70.0, 160.0, 360.0)             # Table 9.1, 方式2
+    assert BOOK_BANK_2CH == (40.0, 100.0, 160.0, 360.0)  # Table 9.1, 方式1
+    assert BOOK_BANK_3CH == (70.0, 160.0, 360.0)  # Table 9.1, 方式2
 
 
 @pytest.mark.parametrize("fs", [1000.0, 2000.0, 4000.0])
@@ -40,8 +49,10 @@ def test_bank_bands_do_not_overlap_and_are_the_documented_ones():
     bank = FilterBank(BOOK_BANK_2CH, 2000.0)
     assert np.all(bank.edges[1:, 0] > bank.edges[:-1, 1])
     # module docstring: 40 -> 33.6-47.6, 360 -> 303-428 Hz (nominal fc * 2**(+-1/4))
-    np.testing.assert_allclose(bank.edges[0], [40 * 2 ** -0.25, 40 * 2 ** 0.25], rtol=2e-3)
-    np.testing.assert_allclose(bank.edges[3], [312.1, 411.6], atol=0.05)   # documented values at 2 kHz
+    np.testing.assert_allclose(bank.edges[0], [40 * 2**-0.25, 40 * 2**0.25], rtol=2e-3)
+    np.testing.assert_allclose(
+        bank.edges[3], [312.1, 411.6], atol=0.05
+    )  # documented values at 2 kHz
 
 
 def test_conditioning_band_edges_minus_3db():
@@ -56,8 +67,8 @@ def test_bank_separates_tones_with_the_gain_of_its_frequency_response():
     t = np.arange(int(2 * fs)) / fs
     for f in BOOK_BANK_2CH:
         x = np.sin(2 * np.pi * f * t)
-        y = bank.apply(x)[0]                       # (bands, samples)
-        amp = np.sqrt(2) * np.sqrt(np.mean(y[:, int(fs):] ** 2, axis=1))   # steady second half
+        y = bank.apply(x)[0]  # (bands, samples)
+        amp = np.sqrt(2) * np.sqrt(np.mean(y[:, int(fs) :] ** 2, axis=1))  # steady second half
         np.testing.assert_allclose(amp, bank.gains([f])[:, 0], rtol=2e-3)
         assert BOOK_BANK_2CH[int(np.argmax(amp))] == f
 
@@ -69,7 +80,7 @@ def test_white_noise_through_a_band_has_the_wiener_khinchin_variance():
     y = bank.apply(x)[0][:, 2000:]
     f = np.linspace(0, fs / 2, 200_001)
     h2 = bank.gains(f) ** 2
-    expected = np.trapezoid(h2, f, axis=1) * 2 / fs       # sigma^2 = 1: one-sided PSD 2/fs
+    expected = np.trapezoid(h2, f, axis=1) * 2 / fs  # sigma^2 = 1: one-sided PSD 2/fs
     np.testing.assert_allclose(y.var(axis=1), expected, rtol=0.03)
 
 
@@ -83,9 +94,9 @@ def test_notch_removes_mains():
 def test_sampling_rate_below_twice_the_highest_band_is_refused(fs):
     with pytest.raises(SamplingRateError) as e:
         FilterBank(BOOK_BANK_2CH, fs)
-    assert e.value.required == pytest.approx(2 * 360 * 2 ** 0.25)
+    assert e.value.required == pytest.approx(2 * 360 * 2**0.25)
     assert "360" in str(e.value) and "fs >" in str(e.value)
-    FilterBank(BOOK_BANK_2CH, 860.0)                     # just above: fine
+    FilterBank(BOOK_BANK_2CH, 860.0)  # just above: fine
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), 0.0, -2000.0, "fast"])
@@ -106,7 +117,7 @@ def test_bad_bands():
 def test_cmrr_of_the_differential_amplifier():
     fs, amp = 2000.0, DifferentialAmplifier(gain=5000.0, cmrr_db=100.0, rail=None)
     t = np.arange(2000) / fs
-    emg = 100e-6 * np.sin(2 * np.pi * 120 * t)                  # 200 µV p-p differential
+    emg = 100e-6 * np.sin(2 * np.pi * 120 * t)  # 200 µV p-p differential
     vp, vm = electrode_potentials(emg, fs, mains_pp=1.0, mains_hz=50.0, offset_v=0.2)
     out = amp.amplify(vp, vm)
     assert out.status == "ok"
@@ -115,7 +126,9 @@ def test_cmrr_of_the_differential_amplifier():
     np.testing.assert_allclose(out.signal[0], 5000.0 * emg + gc * cm, rtol=0, atol=1e-12)
     # the common-mode hum (1 V p-p, 74 dB above the EMG) leaves 0.05 V p-p beside 1 V p-p of EMG
     assert amp.common_mode_gain == pytest.approx(0.05)
-    np.testing.assert_allclose(amp.input_referred(out.signal), (emg + gc / 5000.0 * cm)[None], atol=1e-15)
+    np.testing.assert_allclose(
+        amp.input_referred(out.signal), (emg + gc / 5000.0 * cm)[None], atol=1e-15
+    )
 
 
 def test_amplifier_saturation_is_reported():
@@ -143,14 +156,19 @@ def test_numbers_beyond_any_voltage_are_refused_not_overflowed():
     from anthroarm.emg import EMGProcessor, moving_rms, spectrum
 
     huge = np.full((2, 400), 1e200)
-    for call in (lambda: EMGProcessor(2000.0).process(huge), lambda: moving_rms(huge, 2000.0),
-                 lambda: spectrum(huge, 2000.0)):
+    for call in (
+        lambda: EMGProcessor(2000.0).process(huge),
+        lambda: moving_rms(huge, 2000.0),
+        lambda: spectrum(huge, 2000.0),
+    ):
         with pytest.raises(EMGError, match="not a voltage"):
             call()
     with pytest.raises(EMGError, match="overflows"):
         DifferentialAmplifier(gain=1e308, rail=None).amplify(np.full((1, 4), 1e5), np.zeros((1, 4)))
     # the largest accepted voltage goes through without inf/NaN
-    out = EMGProcessor(2000.0).process(np.full((2, 400), 1e6) * np.sign(np.sin(np.arange(400)))[None])
+    out = EMGProcessor(2000.0).process(
+        np.full((2, 400), 1e6) * np.sign(np.sin(np.arange(400)))[None]
+    )
     assert np.all(np.isfinite(out.envelope_pp)) and np.all(np.isfinite(out.filtered))
 
 
@@ -162,5 +180,5 @@ def test_sizes_that_would_exhaust_memory_or_never_switch_are_refused():
         EMGProcessor(2000.0, window_s=1e9)
     with pytest.raises(EMGError, match="samples"):
         synthesize(1e9, 2000.0, [[(0.0, 1.0, 1.0)]])
-    with pytest.raises(ThresholdError, match="never switch on"):          # no voltage reaches 1e300 V p-p
+    with pytest.raises(ThresholdError, match="never switch on"):  # no voltage reaches 1e300 V p-p
         EMGProcessor(2000.0, thresholds=Thresholds(1e300, 1e-6))

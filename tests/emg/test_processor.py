@@ -4,8 +4,18 @@ neurokit2's ``emg_simulate``/``emg_process`` as a peer for the envelope and the 
 import numpy as np
 import pytest
 
-from anthroarm.emg import (AMPUTEE_PP, BOTH, EXTENSOR, FLEXOR, REST, DifferentialAmplifier, EMGProcessor, Thresholds,
-                           electrode_potentials, synthesize)
+from anthroarm.emg import (
+    AMPUTEE_PP,
+    BOTH,
+    EXTENSOR,
+    FLEXOR,
+    REST,
+    DifferentialAmplifier,
+    EMGProcessor,
+    Thresholds,
+    electrode_potentials,
+    synthesize,
+)
 from anthroarm.errors import EMGError, SamplingRateError, ThresholdError
 
 FS = 2000.0
@@ -16,7 +26,9 @@ def _sine(pp, f=100.0, dur=1.0):
     return 0.5 * pp * np.sin(2 * np.pi * f * t)
 
 
-@pytest.mark.parametrize("pp, switches", [(50e-6, True), (75e-6, True), (100e-6, True), (20e-6, False)])
+@pytest.mark.parametrize(
+    "pp, switches", [(50e-6, True), (75e-6, True), (100e-6, True), (20e-6, False)]
+)
 def test_book_sensitivity_50_to_100_uV_switches(pp, switches):
     """§9-2 三: a 50-100 µV p-p input must operate the hand (default thresholds)."""
     p = EMGProcessor(FS, 1)
@@ -31,11 +43,11 @@ def test_amputee_level_noise_bursts_switch_and_rest_does_not():
     out = EMGProcessor(FS).process(rec.emg)
     t = out.t_frames
     code = out.code
-    assert np.all(code[(t > 0.75) & (t < 1.45)] == FLEXOR)          # "10": flexor only
-    assert np.all(code[(t > 2.25) & (t < 2.55)] == EXTENSOR)        # "01"
+    assert np.all(code[(t > 0.75) & (t < 1.45)] == FLEXOR)  # "10": flexor only
+    assert np.all(code[(t > 2.25) & (t < 2.55)] == EXTENSOR)  # "01"
     assert np.all(code[t < 0.45] == REST) and np.all(code[(t > 1.7) & (t < 1.95)] == REST)
     on = t[np.argmax(out.active[0])]
-    assert 0.5 < on < 0.5 + 0.1                                       # within the 100 ms window
+    assert 0.5 < on < 0.5 + 0.1  # within the 100 ms window
 
 
 def test_co_contraction_gives_code_11():
@@ -52,22 +64,28 @@ def test_blocks_give_the_result_of_one_piece(envelope):
     rng = np.random.default_rng(0)
     cuts = np.sort(rng.choice(np.arange(1, rec.emg.shape[1]), 9, replace=False))
     parts = [p.process(b, reset=(i == 0)) for i, b in enumerate(np.split(rec.emg, cuts, axis=1))]
-    np.testing.assert_allclose(np.concatenate([q.envelope_pp for q in parts], axis=1), whole.envelope_pp,
-                               rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(
+        np.concatenate([q.envelope_pp for q in parts], axis=1),
+        whole.envelope_pp,
+        rtol=1e-9,
+        atol=1e-15,
+    )
     np.testing.assert_array_equal(np.concatenate([q.code for q in parts]), whole.code)
     np.testing.assert_allclose(np.concatenate([q.t_frames for q in parts]), whole.t_frames)
-    np.testing.assert_allclose(np.concatenate([q.filtered for q in parts], axis=1), whole.filtered, atol=1e-15)
+    np.testing.assert_allclose(
+        np.concatenate([q.filtered for q in parts], axis=1), whole.filtered, atol=1e-15
+    )
 
 
 def test_schmitt_trigger_hysteresis_definition():
     t = np.arange(int(4 * FS)) / FS
-    am = 60e-6 * np.clip(1 - np.abs(t - 2.0) / 1.5, 0, 1)           # slow triangle 0 -> 60 µV -> 0
+    am = 60e-6 * np.clip(1 - np.abs(t - 2.0) / 1.5, 0, 1)  # slow triangle 0 -> 60 µV -> 0
     x = 0.5 * am * np.sin(2 * np.pi * 100 * t)
     out = EMGProcessor(FS, 1).process(x)
     e, a = out.envelope_pp[0], out.active[0]
     k_on = np.flatnonzero(~a[:-1] & a[1:]) + 1
     k_off = np.flatnonzero(a[:-1] & ~a[1:]) + 1
-    assert len(k_on) == 1 and len(k_off) == 1                       # no chatter
+    assert len(k_on) == 1 and len(k_off) == 1  # no chatter
     assert e[k_on[0]] >= 35e-6 > e[k_on[0] - 1]
     assert e[k_off[0]] <= 25e-6 < e[k_off[0] - 1]
     # between the thresholds the state is held (on while falling from 35 to 25 µV)
@@ -85,9 +103,11 @@ def test_gain_refers_the_amplified_signal_back_to_the_electrodes():
 
 
 def test_thresholds_that_can_never_switch_are_refused():
-    amp = DifferentialAmplifier(gain=20_000.0, rail=1.0)              # passes at most 100 µV p-p
+    amp = DifferentialAmplifier(gain=20_000.0, rail=1.0)  # passes at most 100 µV p-p
     with pytest.raises(ThresholdError, match="never switch on"):
-        EMGProcessor(FS, thresholds=Thresholds(150e-6, 100e-6), gain=amp.gain, max_input_pp=amp.max_input_pp)
+        EMGProcessor(
+            FS, thresholds=Thresholds(150e-6, 100e-6), gain=amp.gain, max_input_pp=amp.max_input_pp
+        )
     with pytest.raises(ThresholdError, match="never switch off"):
         EMGProcessor(FS, thresholds=Thresholds(35e-6, 2e-6), noise_rms=1e-6)
     with pytest.raises(ThresholdError, match="hysteresis"):
@@ -96,7 +116,9 @@ def test_thresholds_that_can_never_switch_are_refused():
         with pytest.raises(ThresholdError):
             EMGProcessor(FS, thresholds=Thresholds(bad, 1e-6))
     with pytest.raises(ThresholdError):
-        EMGProcessor(FS, thresholds=Thresholds((35e-6, 35e-6, 35e-6), 25e-6))   # 3 values, 2 channels
+        EMGProcessor(
+            FS, thresholds=Thresholds((35e-6, 35e-6, 35e-6), 25e-6)
+        )  # 3 values, 2 channels
     EMGProcessor(FS, thresholds=Thresholds((35e-6, 50e-6), (25e-6, 40e-6)), noise_rms=1e-6)
 
 
@@ -136,13 +158,15 @@ def test_envelope_and_onsets_against_neurokit2():
     off = out.t_frames[np.flatnonzero(np.diff(a) == -1) + 1]
     truth_on = np.array([1.75, 4.5, 7.25])
     assert len(on) == 3 and len(off) == 3
-    assert np.all((on >= truth_on) & (on <= truth_on + 0.1))            # causal: never early, < window late
+    assert np.all((on >= truth_on) & (on <= truth_on + 0.1))  # causal: never early, < window late
     assert np.all((off >= truth_on + 1.0) & (off <= truth_on + 1.1))
     np.testing.assert_allclose(on, np.asarray(info["EMG_Onsets"]) / 1000.0, atol=0.1)
     np.testing.assert_allclose(off, np.asarray(info["EMG_Offsets"]) / 1000.0, atol=0.1)
 
 
-@pytest.mark.parametrize("cmrr_db, notch, switches", [(100.0, None, False), (60.0, None, True), (60.0, 50.0, False)])
+@pytest.mark.parametrize(
+    "cmrr_db, notch, switches", [(100.0, None, False), (60.0, None, True), (60.0, 50.0, False)]
+)
 def test_mains_hum_and_the_cmrr(cmrr_db, notch, switches):
     """1 V p-p of 50 Hz common-mode hum, no EMG: the differential front end leaves
     1 V * 10**(-CMRR/20) at its input (10 µV p-p at 100 dB, under the 25 µV off-threshold;
@@ -153,5 +177,7 @@ def test_mains_hum_and_the_cmrr(cmrr_db, notch, switches):
     res = EMGProcessor(FS, gain=amp.gain, notch_hz=notch).process(out.signal)
     residual = 1.0 * 10 ** (-cmrr_db / 20)
     if notch is None:
-        assert res.envelope_pp[0, -1] == pytest.approx(residual, rel=0.02)   # 50 Hz: gain ~1 in 20-450 Hz
+        assert res.envelope_pp[0, -1] == pytest.approx(
+            residual, rel=0.02
+        )  # 50 Hz: gain ~1 in 20-450 Hz
     assert res.active[:, -1].tolist() == [switches, switches]

@@ -48,8 +48,11 @@ def test_malformed_xml(tmp_path):
 
 def test_not_utf8_names_the_file(tmp_path):
     p = tmp_path / "latin1.urdf"
-    p.write_bytes('<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="café"><link name="base"/></robot>'
-                  .encode("latin-1"))
+    p.write_bytes(
+        '<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="café"><link name="base"/></robot>'.encode(
+            "latin-1"
+        )
+    )
     with pytest.raises(errors.URDFSyntaxError, match="latin1.urdf.*UTF-8"):
         aa.load(str(p))
 
@@ -60,9 +63,13 @@ def test_not_a_robot(tmp_path):
 
 
 def test_entity_expansion_bomb_is_rejected_before_parsing(tmp_path):
-    bomb = '<!DOCTYPE lolz [<!ENTITY lol "lol">' + "".join(
-        f'<!ENTITY lol{i} "{("&lol%s;" % (i - 1 if i else "")) * 10}">' for i in range(1, 10)
-    ) + "]>"
+    bomb = (
+        '<!DOCTYPE lolz [<!ENTITY lol "lol">'
+        + "".join(
+            f'<!ENTITY lol{i} "{("&lol%s;" % (i - 1 if i else "")) * 10}">' for i in range(1, 10)
+        )
+        + "]>"
+    )
     p = write(tmp_path, bomb + "<robot name='t'><link name='&lol9;'/></robot>")
     with pytest.raises(errors.URDFSecurityError, match="entity"):
         aa.load(str(p))
@@ -71,24 +78,33 @@ def test_entity_expansion_bomb_is_rejected_before_parsing(tmp_path):
 def test_external_entity_is_rejected(tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("top secret")
-    p = write(tmp_path, f'<!DOCTYPE r [<!ENTITY xxe SYSTEM "file://{secret}">]>'
-                        "<robot name='t'><link name='&xxe;'/></robot>")
+    p = write(
+        tmp_path,
+        f'<!DOCTYPE r [<!ENTITY xxe SYSTEM "file://{secret}">]>'
+        "<robot name='t'><link name='&xxe;'/></robot>",
+    )
     with pytest.raises(errors.URDFSecurityError):
         aa.load(str(p))
 
 
 def test_kinematic_cycle(tmp_path):
-    joints = GOOD_JOINT + """
+    joints = (
+        GOOD_JOINT
+        + """
   <joint name="j2" type="revolute"><parent link="l1"/><child link="base"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>"""
+    )
     assert_structure_error(tmp_path, "cycle|two joints", joints=joints)
 
 
 def test_closed_loop_child_with_two_parents(tmp_path):
     links = "<link name='base'/><link name='l1'/><link name='l2'/>"
-    joints = GOOD_JOINT + """
+    joints = (
+        GOOD_JOINT
+        + """
   <joint name="j2" type="fixed"><parent link="base"/><child link="l2"/></joint>
   <joint name="j3" type="fixed"><parent link="l2"/><child link="l1"/></joint>"""
+    )
     assert_structure_error(tmp_path, "child of two joints", links=links, joints=joints)
 
 
@@ -166,22 +182,35 @@ def test_huge_file_is_refused(tmp_path, monkeypatch):
 
 
 def test_errors_are_anthroarm_errors():
-    for cls in (errors.URDFNotFoundError, errors.URDFSyntaxError, errors.URDFSecurityError,
-                errors.URDFStructureError, errors.MeshNotFoundError, errors.PackagePathError):
+    for cls in (
+        errors.URDFNotFoundError,
+        errors.URDFSyntaxError,
+        errors.URDFSecurityError,
+        errors.URDFStructureError,
+        errors.MeshNotFoundError,
+        errors.PackagePathError,
+    ):
         assert issubclass(cls, errors.AnthroarmError)
 
 
 def test_two_roots(tmp_path):
     links = "<link name='base'/><link name='l1'/><link name='loose'/>"
-    assert_structure_error(tmp_path, r"not connected into one tree: 2 roots \('base', 'loose'\)", links=links)
+    assert_structure_error(
+        tmp_path, r"not connected into one tree: 2 roots \('base', 'loose'\)", links=links
+    )
 
 
 def test_cycle_apart_from_the_root_names_its_links_and_joints(tmp_path):
     links = "<link name='base'/><link name='l1'/><link name='a'/><link name='b'/>"
-    joints = GOOD_JOINT + """
+    joints = (
+        GOOD_JOINT
+        + """
   <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
   <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint>"""
-    exc = assert_structure_error(tmp_path, "kinematic cycle through link '[ab]'", links=links, joints=joints)
+    )
+    exc = assert_structure_error(
+        tmp_path, "kinematic cycle through link '[ab]'", links=links, joints=joints
+    )
     assert all(f"'{name}'" in str(exc) for name in ("a", "b", "ab", "ba"))
 
 
@@ -192,22 +221,33 @@ def pkg_tree(tmp_path):
     mesh.parent.mkdir(parents=True)
     mesh.write_text("solid x\nendsolid x\n")
     (tmp_path / "robots").mkdir()
-    return tmp_path, write(tmp_path / "robots", robot_xml(links=mesh_link("package://my_pkg/meshes/a.stl"))), mesh
+    return (
+        tmp_path,
+        write(tmp_path / "robots", robot_xml(links=mesh_link("package://my_pkg/meshes/a.stl"))),
+        mesh,
+    )
 
 
 @pytest.mark.parametrize("form", ["list", "tuple", "str", "path", "dict", "dict_path"])
 def test_package_dirs_forms(pkg_tree, form):
     root, p, mesh = pkg_tree
     package_dirs = {
-        "list": [str(root / "empty_or_missing"), str(root)], "tuple": (root,), "str": str(root), "path": root,
-        "dict": {"my_pkg": str(root / "my_pkg")}, "dict_path": {"my_pkg": root / "my_pkg"},
+        "list": [str(root / "empty_or_missing"), str(root)],
+        "tuple": (root,),
+        "str": str(root),
+        "path": root,
+        "dict": {"my_pkg": str(root / "my_pkg")},
+        "dict_path": {"my_pkg": root / "my_pkg"},
     }[form]
     r = aa.load(str(p), package_dirs=package_dirs)
     assert r.info.meshes["package://my_pkg/meshes/a.stl"] == mesh.resolve()
     # the robot keeps the folders: later look-ups (yourdfpy, viewer) resolve the same way
     from anthroarm.urdf_io import resolve_uri
 
-    assert resolve_uri("package://my_pkg/meshes/a.stl", r.info.path, r.info.package_dirs) == mesh.resolve()
+    assert (
+        resolve_uri("package://my_pkg/meshes/a.stl", r.info.path, r.info.package_dirs)
+        == mesh.resolve()
+    )
 
 
 def test_package_dirs_list_without_the_package(pkg_tree):
@@ -228,13 +268,25 @@ def test_package_dirs_list_keeps_escape_protection(tmp_path):
     # '..' as the package name would make the search folder's parent a package root
     sub = tmp_path / "search"
     sub.mkdir()
-    p = write(tmp_path / "robots", robot_xml(links=mesh_link("package://../outside.stl")), name="dots.urdf")
+    p = write(
+        tmp_path / "robots",
+        robot_xml(links=mesh_link("package://../outside.stl")),
+        name="dots.urdf",
+    )
     with pytest.raises(errors.PackagePathError, match="'..' is not a package name"):
         aa.load(str(p), package_dirs=[str(sub)])
 
 
-@pytest.mark.parametrize("bad, what", [(42, "got int"), (b"/tmp", "got bytes"), ([1], "entry 0"),
-                                       ({"p": 3}, "root of package 'p'"), ({1: "/tmp"}, "package names must be str")])
+@pytest.mark.parametrize(
+    "bad, what",
+    [
+        (42, "got int"),
+        (b"/tmp", "got bytes"),
+        ([1], "entry 0"),
+        ({"p": 3}, "root of package 'p'"),
+        ({1: "/tmp"}, "package names must be str"),
+    ],
+)
 def test_package_dirs_wrong_type(tmp_path, bad, what):
     from anthroarm.urdf_io import normalize_package_dirs
 

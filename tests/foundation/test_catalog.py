@@ -15,7 +15,9 @@ REPO = Path(__file__).resolve().parents[2]
 @pytest.mark.parametrize("name", aa.models.book_names())
 def test_committed_urdf_equals_generator(name, same_urdf_text):
     committed = (REPO / "urdf" / f"{name}.urdf").read_text()
-    assert same_urdf_text(committed, aa.models.urdf_text(name)), f"urdf/{name}.urdf is stale: run aa.models.write_urdfs()"
+    assert same_urdf_text(committed, aa.models.urdf_text(name)), (
+        f"urdf/{name}.urdf is stale: run aa.models.write_urdfs()"
+    )
 
 
 def test_write_urdfs_roundtrip(tmp_path):
@@ -23,14 +25,26 @@ def test_write_urdfs_roundtrip(tmp_path):
     assert sorted(p.name for p in paths) == sorted(f"{n}.urdf" for n in aa.models.book_names())
     for p in paths:
         spec = aa.models.spec(p.stem)
-        r = aa.load(str(p), tool=spec.tool_name)   # a tree (the hand) has several tips: name the tool
+        r = aa.load(
+            str(p), tool=spec.tool_name
+        )  # a tree (the hand) has several tips: name the tool
         assert r.nq == spec.nq
 
 
 def test_catalog_has_the_required_models():
     names = set(aa.models.names())
-    assert {"prosthetic_arm", "human_arm7", "sixr_arm", "unimate5", "rrprr5", "planar2r",
-            "panda", "ur5", "talos_arm", "human_right_arm"} <= names
+    assert {
+        "prosthetic_arm",
+        "human_arm7",
+        "sixr_arm",
+        "unimate5",
+        "rrprr5",
+        "planar2r",
+        "panda",
+        "ur5",
+        "talos_arm",
+        "human_right_arm",
+    } <= names
 
 
 @pytest.mark.parametrize("name", aa.models.names())
@@ -73,7 +87,9 @@ ROW5_LMN = np.array([[-0.6, -0.8, 0.0], [0.0, 0.0, -1.0], [0.8, -0.6, 0.0]]).T  
 
 def test_table_7_2_row5_pose_with_L2_260():
     T = aa.load("prosthetic_arm").fk(np.deg2rad(ROW5_THETA))
-    np.testing.assert_allclose(T[:3, 3] * 1000, ROW5_P_MM, atol=0.01)  # printed to 4 decimals of degrees
+    np.testing.assert_allclose(
+        T[:3, 3] * 1000, ROW5_P_MM, atol=0.01
+    )  # printed to 4 decimals of degrees
     np.testing.assert_allclose(T[:3, :3], ROW5_LMN, atol=2e-5)
 
 
@@ -148,7 +164,9 @@ def test_erd_arms_lock_unused_joints():
 def test_same_urdf_text_tells_a_stale_file(same_urdf_text):
     """The comparison forgives the 16th digit, not a changed number or tag."""
     a = '<origin xyz="0.1 0 -0.08994824117884934" rpy="-1.5707963267948966 -0.8591786503008974 0"/>'
-    assert same_urdf_text(a, a.replace("0.08994824117884934", "0.08994824117884936").replace(" 0 ", " -6.9e-18 "))
+    assert same_urdf_text(
+        a, a.replace("0.08994824117884934", "0.08994824117884936").replace(" 0 ", " -6.9e-18 ")
+    )
     assert not same_urdf_text(a, a.replace("0.08994824117884934", "0.0899482"))
     assert not same_urdf_text(a, a.replace("rpy", "xyz"))
     assert not same_urdf_text(a, a + '<axis xyz="0 0 1"/>')

@@ -12,7 +12,12 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.chain import CONTINUOUS, PRISMATIC, REVOLUTE
-from anthroarm.errors import AmbiguousToolError, UnknownFrameError, UnknownModelError, UnsupportedModelError
+from anthroarm.errors import (
+    AmbiguousToolError,
+    UnknownFrameError,
+    UnknownModelError,
+    UnsupportedModelError,
+)
 
 USER_URDF = """<?xml version="1.0"?>
 <robot name="user_arm">
@@ -72,11 +77,15 @@ def test_kinova_continuous_joints_and_random_q_rigid():
             np.testing.assert_allclose(np.hypot(Q[:, j.idx_q], Q[:, j.idx_q + 1]), 1.0, atol=1e-15)
     T = r.fk(Q)
     R = T[:, :3, :3]
-    np.testing.assert_allclose(np.einsum("nij,nkj->nik", R, R), np.broadcast_to(np.eye(3), R.shape), atol=1e-12)
+    np.testing.assert_allclose(
+        np.einsum("nij,nkj->nik", R, R), np.broadcast_to(np.eye(3), R.shape), atol=1e-12
+    )
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=1e-12)
     # the angles are uniform on the circle: every quadrant is visited
     th = r.chain.angles(Q)[:, [j.index for j in r.chain.joints if j.kind == CONTINUOUS]]
-    assert np.all([np.histogram(th[:, k], bins=4, range=(-np.pi, np.pi))[0].min() > 60 for k in range(3)])
+    assert np.all(
+        [np.histogram(th[:, k], bins=4, range=(-np.pi, np.pi))[0].min() > 60 for k in range(3)]
+    )
 
 
 def test_non_unit_cos_sin_pair_names_the_joint():
@@ -92,12 +101,19 @@ def test_non_unit_cos_sin_pair_names_the_joint():
         r.fk(Q)
 
 
-@pytest.mark.parametrize("name,kw", [
-    ("kinova", {}), ("panda", {}), ("ur10", {}), ("human_arm7", {}), ("prosthetic_arm", {}),
-    ("baxter", {"tool": "l_gripper_r_finger_tip"}),        # through a mimic finger
-    ("allegro_right_hand", {"tool": "link_3.0_tip"}),
-    ("double_pendulum_continuous", {}),
-])
+@pytest.mark.parametrize(
+    "name,kw",
+    [
+        ("kinova", {}),
+        ("panda", {}),
+        ("ur10", {}),
+        ("human_arm7", {}),
+        ("prosthetic_arm", {}),
+        ("baxter", {"tool": "l_gripper_r_finger_tip"}),  # through a mimic finger
+        ("allegro_right_hand", {"tool": "link_3.0_tip"}),
+        ("double_pendulum_continuous", {}),
+    ],
+)
 def test_batched_fk_and_jacobian_equal_pinocchio(name, kw):
     r = aa.load(name, **kw)
     Q = r.random_q(64, rng=11)
@@ -107,7 +123,9 @@ def test_batched_fk_and_jacobian_equal_pinocchio(name, kw):
     for q, Ti, Ji in zip(Q, T, J):
         pin.framesForwardKinematics(m, d, q)
         np.testing.assert_allclose(Ti, d.oMf[r.tool_id].homogeneous, atol=1e-12)
-        np.testing.assert_allclose(Ji, pin.computeFrameJacobian(m, d, q, r.tool_id, pin.LOCAL_WORLD_ALIGNED), atol=1e-12)
+        np.testing.assert_allclose(
+            Ji, pin.computeFrameJacobian(m, d, q, r.tool_id, pin.LOCAL_WORLD_ALIGNED), atol=1e-12
+        )
 
 
 def test_user_urdf_with_continuous_and_mimic(user_urdf):
@@ -119,15 +137,19 @@ def test_user_urdf_with_continuous_and_mimic(user_urdf):
     assert [j.kind for j in c.joints] == [CONTINUOUS, REVOLUTE, CONTINUOUS, REVOLUTE, REVOLUTE]
     mim = c.joint("grip_mimic")
     assert mim.is_mimic and c.joints[mim.mimic.source].name == "grip"
-    assert (mim.mimic.multiplier, mim.mimic.offset) == (-1.0, 0.1)         # the URDF's tag
+    assert (mim.mimic.multiplier, mim.mimic.offset) == (-1.0, 0.1)  # the URDF's tag
     np.testing.assert_allclose(c.joint("wrist").axis, [0.6, 0, 0.8])
     assert (r.nq, r.nv) == (6, 4)
     th = c.angles(r.random_q(10, rng=1))
     np.testing.assert_allclose(th[:, mim.index], -th[:, c.joint("grip").index] + 0.1)
     # FK of the mimic finger equals Pinocchio's
     Q = r.random_q(20, rng=2)
-    np.testing.assert_allclose(r.fk(Q, "finger_b"), np.stack([r.fk(q, "finger_b") for q in Q]), atol=1e-12)
-    np.testing.assert_allclose(r.jacobian(Q, "finger_b"), np.stack([r.jacobian(q, "finger_b") for q in Q]), atol=1e-12)
+    np.testing.assert_allclose(
+        r.fk(Q, "finger_b"), np.stack([r.fk(q, "finger_b") for q in Q]), atol=1e-12
+    )
+    np.testing.assert_allclose(
+        r.jacobian(Q, "finger_b"), np.stack([r.jacobian(q, "finger_b") for q in Q]), atol=1e-12
+    )
 
 
 def test_configuration_inverts_angles(user_urdf):
@@ -228,7 +250,9 @@ def _ff_ball_model(frames: bool):
     j1 = m.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "base_ff")
     m.appendBodyToJoint(j1, pin.Inertia.Random(), pin.SE3.Identity())
     b = m.addBodyFrame("body1", j1, pin.SE3.Identity(), m.addJointFrame(j1, 0)) if frames else 0
-    j2 = m.addJoint(j1, pin.JointModelSpherical(), pin.SE3(pin.utils.rotate("x", 0.3), np.ones(3)), "ball")
+    j2 = m.addJoint(
+        j1, pin.JointModelSpherical(), pin.SE3(pin.utils.rotate("x", 0.3), np.ones(3)), "ball"
+    )
     m.appendBodyToJoint(j2, pin.Inertia.Random(), pin.SE3.Identity())
     if frames:
         m.addBodyFrame("body2", j2, pin.SE3.Identity(), m.addJointFrame(j2, b))
@@ -258,7 +282,7 @@ def test_pin_model_and_robot_wrapper_sources():
     assert r.name == "my_ur10" and r.info is None and r.nq == 6
     q = r.random_q(rng=1)
     np.testing.assert_allclose(r.fk(q), aa.load("ur10").fk(q), atol=1e-14)
-    erd_share = aa.urdf_io.default_package_dirs()["example-robot-data"].parent   # .../share
+    erd_share = aa.urdf_io.default_package_dirs()["example-robot-data"].parent  # .../share
     w = pin.RobotWrapper.BuildFromURDF(path, [str(erd_share)])
     rw = aa.load(w)
     assert rw.visual_model is not None and rw.tool == "tool0"
@@ -296,7 +320,9 @@ def test_default_pinocchio_limits_mean_unbounded():
     assert r.chain.joint("hinge").upper == np.inf and r.tool == "tip"
     Q = r.random_q(1000, rng=0)
     assert np.all(np.isfinite(Q)) and np.all(np.abs(Q) <= np.pi)
-    np.testing.assert_allclose(r.fk(Q)[:, 2, 3], 0.5 * np.cos(Q[:, 0]), atol=1e-15)   # Ry(θ) e_z · 0.5
+    np.testing.assert_allclose(
+        r.fk(Q)[:, 2, 3], 0.5 * np.cos(Q[:, 0]), atol=1e-15
+    )  # Ry(θ) e_z · 0.5
 
 
 def test_batched_positions_equal_pinocchio():
@@ -308,4 +334,4 @@ def test_batched_positions_equal_pinocchio():
         pin.framesForwardKinematics(r.model, d, q)
         np.testing.assert_allclose(p, d.oMf[r.tool_id].translation, atol=1e-12)
     assert r.chain.serial().positions(Q[0]).shape == (3,)
-    assert aa.batch.reachability_map is not None        # aa.batch is a lazy attribute
+    assert aa.batch.reachability_map is not None  # aa.batch is a lazy attribute

@@ -9,23 +9,32 @@ import sys
 import numpy as np
 import pinocchio as pin
 import pytest
+from test_chain import USER_URDF
 
 import anthroarm as aa
 from anthroarm import cli, crosscheck
 from anthroarm.kinematics import book_fk
-from test_chain import USER_URDF
 
 #: the rows every robot gets (book models get more)
 GENERIC = {
-    "fk batched chain robot.fk(Q)", "jacobian batched chain LWA", "fk yourdfpy (all links)",
-    "J_L (6-118) vs FD of perturbed placements", "perturbed FK T(q, L+dL) vs pin on the perturbed model",
-    "dyn M(q) Lagrange", "dyn C(q,qd)qd Christoffel", "dyn g(q) = dV/dq", "dyn tau = M qdd + C qd + g",
-    "dyn forward dynamics", "aa.ik.solve: FK(solve(T)) = T within limits",
+    "fk batched chain robot.fk(Q)",
+    "jacobian batched chain LWA",
+    "fk yourdfpy (all links)",
+    "J_L (6-118) vs FD of perturbed placements",
+    "perturbed FK T(q, L+dL) vs pin on the perturbed model",
+    "dyn M(q) Lagrange",
+    "dyn C(q,qd)qd Christoffel",
+    "dyn g(q) = dV/dq",
+    "dyn tau = M qdd + C qd + g",
+    "dyn forward dynamics",
+    "aa.ik.solve: FK(solve(T)) = T within limits",
 }
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "anthroarm.cli", *args], capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "anthroarm.cli", *args], capture_output=True, text=True, timeout=300
+    )
 
 
 def check_json(argv, capsys):
@@ -50,18 +59,23 @@ def test_check_json_rows():
     assert ours and all(r["ok"] and r["status"] == "ok" for r in ours)
     assert all(r["samples"] == 30 for r in ours if r["quantity"].startswith(("fk", "jacobian")))
     assert GENERIC <= {r["quantity"] for r in ours if r["model"] == "planar2r"}
-    assert "fk printed Fig. 7-14 (y, z)" in {r["quantity"] for r in ours if r["model"] == "planar2r"}
+    assert "fk printed Fig. 7-14 (y, z)" in {
+        r["quantity"] for r in ours if r["model"] == "planar2r"
+    }
 
 
 def test_check_example_robot_data_name(capsys):
     rc, rows, err = check_json(["ur10", "--samples", "20"], capsys)
     assert rc == 0, err
     ur10 = [r for r in rows if r["model"] == "ur10"]
-    geometry = {"closed form by geometry: FK(IK(T)) = T, all branches"}          # a 6R class (ik.geometric)
+    geometry = {"closed form by geometry: FK(IK(T)) = T, all branches"}  # a 6R class (ik.geometric)
     if importlib.util.find_spec("ik_geo"):
         geometry.add("closed form by geometry: branches = IK-Geo's")
     assert {r["quantity"] for r in ur10} == GENERIC | geometry | {
-        "dyn C(q,qd) Christoffel matrix", "dyn kinetic energy T", "dyn potential energy V"}
+        "dyn C(q,qd) Christoffel matrix",
+        "dyn kinetic energy T",
+        "dyn potential energy V",
+    }
     assert all(r["ok"] for r in rows)
     assert all(r["max_abs_err"] <= r["tol"] for r in ur10)
     # no book rows for an arm that is not a book model
@@ -85,8 +99,9 @@ def test_check_comma_separated_models_and_locked(capsys):
     rc, rows, err = check_json(["--models", "z1,planar2r", "--samples", "10"], capsys)
     assert rc == 0, err
     assert {"z1", "planar2r"} <= {r["model"] for r in rows}
-    rc, rows, err = check_json(["so101", "--tool", "gripper_frame_link", "--locked", "gripper", "--samples", "10"],
-                               capsys)
+    rc, rows, err = check_json(
+        ["so101", "--tool", "gripper_frame_link", "--locked", "gripper", "--samples", "10"], capsys
+    )
     assert rc == 0, err
     assert GENERIC <= {r["quantity"] for r in rows if r["model"] == "so101"}
 
@@ -104,14 +119,18 @@ def test_check_tree_without_tool_lists_the_tips(capsys):
 def test_check_unknown_model_is_one_line_error():
     p = run("check", "--models", "nope")
     assert p.returncode == 2
-    assert p.stderr.count("\n") == 1 and "unknown model 'nope'" in p.stderr and "prosthetic_arm" in p.stderr
+    assert (
+        p.stderr.count("\n") == 1
+        and "unknown model 'nope'" in p.stderr
+        and "prosthetic_arm" in p.stderr
+    )
     assert "Traceback" not in p.stderr
 
 
 def test_check_fails_loudly(monkeypatch, capsys):
     real = book_fk.sixr_hand_pose
 
-    def wrong(q, *a):   # a planted 1 mm error in the hand height
+    def wrong(q, *a):  # a planted 1 mm error in the hand height
         T = real(q, *a)
         T[..., 2, 3] += 1e-3
         return T
@@ -143,7 +162,7 @@ def test_models_prints_nq_nv_and_kinds_for_every_entry(capsys):
     assert cli.main(["models", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert [o["name"] for o in out] == aa.models.names()
-    for o in out:   # oracle: Pinocchio on the URDF text, minus the joints the catalog locks
+    for o in out:  # oracle: Pinocchio on the URDF text, minus the joints the catalog locks
         if o["name"] in aa.models.BOOK_MODELS:
             m = pin.buildModelFromXML(aa.models.urdf_text(o["name"]), mimic=True)
             assert (o["nq"], o["nv"]) == (m.nq, m.nv)
@@ -155,8 +174,10 @@ def test_models_prints_nq_nv_and_kinds_for_every_entry(capsys):
         # every joint with a coordinate of its own is counted once (a mimic joint has none)
         own = sum(v for k, v in o["kinds"].items() if k != "mimic")
         assert own == o["nq"] and o["error"] is None and not o["needs_tool"]
-        if o["name"] in aa.models.BOOK_MODELS:   # and the mimic joints are Pinocchio's
-            assert o["kinds"].get("mimic", 0) == sum(1 for j in m.joints[1:] if "Mimic" in j.shortname())
+        if o["name"] in aa.models.BOOK_MODELS:  # and the mimic joints are Pinocchio's
+            assert o["kinds"].get("mimic", 0) == sum(
+                1 for j in m.joints[1:] if "Mimic" in j.shortname()
+            )
     assert cli.main(["models"]) == 0
     text = capsys.readouterr().out
     assert "nq=?" not in text
@@ -208,5 +229,7 @@ def test_book_rows_only_for_the_book_model_as_catalogued():
     assert {r.quantity for r in rows} >= GENERIC and all(r.ok for r in rows)
     assert not [r for r in rows if "printed" in r.quantity or "analytic" in r.quantity]
     rows = crosscheck.run(["human_arm7"], samples=10, providers=provs)
-    assert {"fk printed (6-34)-(6-39)", "(6-119) vs FD of perturbed placements"} <= {r.quantity for r in rows}
+    assert {"fk printed (6-34)-(6-39)", "(6-119) vs FD of perturbed placements"} <= {
+        r.quantity for r in rows
+    }
     assert any("analytic IK" in r.quantity for r in rows) and all(r.ok for r in rows)

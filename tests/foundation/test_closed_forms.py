@@ -26,7 +26,9 @@ def test_dh_transform_is_rz_tz_tx_rx():
     Tz, Tx = np.eye(4), np.eye(4)
     Tz[2, 3], Tx[0, 3] = s, h
     np.testing.assert_allclose(dh_transform(th, s, h, al), Rz @ Tz @ Tx @ Rx, atol=1e-15)
-    np.testing.assert_allclose(dh_matrix(DHRow("R", al, s=s, h=h), th), Rz @ Tz @ Tx @ Rx, atol=1e-15)
+    np.testing.assert_allclose(
+        dh_matrix(DHRow("R", al, s=s, h=h), th), Rz @ Tz @ Tx @ Rx, atol=1e-15
+    )
 
 
 def test_sixr_zero_pose_from_notes():
@@ -50,12 +52,16 @@ def test_printed_hand_poses_vs_pinocchio():
     r = aa.load("sixr_arm")
     p = r.spec.params
     Q = r.random_q(N, 2)
-    np.testing.assert_allclose(cf.sixr_hand_pose(Q, p["s0"], p["h2"], p["s3"], p["P"]), r.fk(Q), atol=1e-13)
+    np.testing.assert_allclose(
+        cf.sixr_hand_pose(Q, p["s0"], p["h2"], p["s3"], p["P"]), r.fk(Q), atol=1e-13
+    )
     for name, P in (("unimate5", "P"), ("rrprr5", "p")):
         r = aa.load(name)
         p = r.spec.params
         Q = r.random_q(N, 3)
-        np.testing.assert_allclose(cf.unimate_hand_pose(Q, p["s0"], p["h2"], p[P]), r.fk(Q), atol=1e-13)
+        np.testing.assert_allclose(
+            cf.unimate_hand_pose(Q, p["s0"], p["h2"], p[P]), r.fk(Q), atol=1e-13
+        )
 
 
 def test_human_arm7_printed_forms_vs_pinocchio():
@@ -79,7 +85,11 @@ def test_prosthetic_arm_points():
     E, W, C = cf.prosthetic_arm_points(Q, p["L1"], p["L2"], p["L3"])
     t1, t2 = Q[:, 0], Q[:, 1]
     # Eq. (7-17): E = L1 (c1 s2, s1 s2, -c2)
-    np.testing.assert_allclose(E, p["L1"] * np.stack([np.cos(t1) * np.sin(t2), np.sin(t1) * np.sin(t2), -np.cos(t2)], -1), atol=1e-15)
+    np.testing.assert_allclose(
+        E,
+        p["L1"] * np.stack([np.cos(t1) * np.sin(t2), np.sin(t1) * np.sin(t2), -np.cos(t2)], -1),
+        atol=1e-15,
+    )
     np.testing.assert_allclose(np.linalg.norm(W - E, axis=1), p["L2"], atol=1e-15)
     np.testing.assert_allclose(C, r.fk(Q)[:, :3, 3], atol=1e-15)
 
@@ -108,6 +118,7 @@ def test_bad_numbers_raise_value_errors():
 
 # ---------------------------------------------------------------- printed forms that fail
 
+
 def _sixr_printed_uvw(q):
     """(6-17) u, v, w as printed (l. 3841-3847): the first factors carry θ5 where θ6 belongs."""
     t1, t2, t3, t4, t5, t6 = q.T
@@ -115,7 +126,9 @@ def _sixr_printed_uvw(q):
     C23, S23 = np.cos(t2 + t3), np.sin(t2 + t3)
     g = (C5 * C5 * C4 + S5 * S4) * C23 + C5 * S5 * S23
     f = C5 * C5 * S4 - S5 * C4
-    return np.stack([g * C1 + f * S1, g * S1 - f * C1, (C5 * C5 * C4 + S5 * S4) * S23 - C5 * S5 * C23], -1)
+    return np.stack(
+        [g * C1 + f * S1, g * S1 - f * C1, (C5 * C5 * C4 + S5 * S4) * S23 - C5 * S5 * C23], -1
+    )
 
 
 def test_printed_6_17_uvw_fails():
@@ -128,7 +141,9 @@ def test_printed_6_17_uvw_fails():
 def _unimate_printed_v(q):
     """(6-23) v as printed (l. 3891): (C5C4C2 + S5S2) S1 - C5 S4 S1."""
     t1, t2, _, t4, t5 = q.T
-    return (np.cos(t5) * np.cos(t4) * np.cos(t2) + np.sin(t5) * np.sin(t2)) * np.sin(t1) - np.cos(t5) * np.sin(t4) * np.sin(t1)
+    return (np.cos(t5) * np.cos(t4) * np.cos(t2) + np.sin(t5) * np.sin(t2)) * np.sin(t1) - np.cos(
+        t5
+    ) * np.sin(t4) * np.sin(t1)
 
 
 def test_printed_6_23_v_fails():
@@ -152,11 +167,14 @@ def test_printed_002_4_52_x_fails():
     Q = r.random_q(50, 10)
     t1, t2, s2, t4, t5 = Q.T
     C1, S1, C2, S2, C4, S4, C5, S5 = (f(t) for t in (t1, t2, t4, t5) for f in (np.cos, np.sin))
-    x_printed = (p["p"] * (S5 * C4 * 1.0 - C5 * S2) + s2 * S2 + p["h2"] * C2) * C1 + p["p"] * S5 * S4 * S1
+    x_printed = (p["p"] * (S5 * C4 * 1.0 - C5 * S2) + s2 * S2 + p["h2"] * C2) * C1 + p[
+        "p"
+    ] * S5 * S4 * S1
     assert np.abs(x_printed - r.fk(Q)[:, 0, 3]).max() > 0.01
 
 
 # ---------------------------------------------------------------- the cross-check can fail
+
 
 def test_crosscheck_passes_and_detects_a_wrong_closed_form(monkeypatch):
     rows = crosscheck.run(["sixr_arm", "human_arm7"], samples=20)

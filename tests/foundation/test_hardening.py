@@ -16,12 +16,20 @@ def arm():
     return aa.load("prosthetic_arm")
 
 
-@pytest.mark.parametrize("args, kw, needle", [
-    ((-1,), {}, "count >= 0"), ((2.5,), {}, "whole number"), (("3",), {}, "whole number"), ((True,), {}, "whole"),
-    ((None,), {"margin": 5}, "more than half the range"), ((None,), {"margin": -1}, ">= 0"),
-    ((None,), {"margin": float("nan")}, "finite"), ((None,), {"margin": float("inf")}, "finite"),
-    ((None,), {"margin": "x"}, "a number"),
-])
+@pytest.mark.parametrize(
+    "args, kw, needle",
+    [
+        ((-1,), {}, "count >= 0"),
+        ((2.5,), {}, "whole number"),
+        (("3",), {}, "whole number"),
+        ((True,), {}, "whole"),
+        ((None,), {"margin": 5}, "more than half the range"),
+        ((None,), {"margin": -1}, ">= 0"),
+        ((None,), {"margin": float("nan")}, "finite"),
+        ((None,), {"margin": float("inf")}, "finite"),
+        ((None,), {"margin": "x"}, "a number"),
+    ],
+)
 def test_random_q_rejects_bad_counts_and_margins(arm, args, kw, needle):
     with pytest.raises(errors.ParameterError, match=needle):
         arm.random_q(*args, **kw)
@@ -35,15 +43,24 @@ def test_random_q_margin_keeps_samples_inside(arm):
     assert arm.random_q(np.int64(3), rng=0).shape == (3, arm.nq)
 
 
-@pytest.mark.parametrize("kw, needle", [
-    ({"tool": 123}, "tool= is a frame name"), ({"active": "abc"}, "active= is a list"),
-    ({"active": 5}, "active= is a list"), ({"active": [1, 2]}, "joint names"),
-    ({"locked": {"elbow_flexion": "x"}}, "must be a number"), ({"locked": {"elbow_flexion": float("nan")}}, "finite"),
-    ({"locked": {"elbow_flexion": [1, 2]}}, "1 finite number"), ({"locked": 5}, "locked= is a list"),
-    ({"locked": "elbow_flexion"}, "locked= is a list"), ({"package_dirs": {"x": None}}, "root of package 'x'"),
-    ({"package_dirs": {"": "/"}}, "not a package name"), ({"name": 5}, "name= is a str"),
-    ({"check_meshes": "no"}, "check_meshes"),
-])
+@pytest.mark.parametrize(
+    "kw, needle",
+    [
+        ({"tool": 123}, "tool= is a frame name"),
+        ({"active": "abc"}, "active= is a list"),
+        ({"active": 5}, "active= is a list"),
+        ({"active": [1, 2]}, "joint names"),
+        ({"locked": {"elbow_flexion": "x"}}, "must be a number"),
+        ({"locked": {"elbow_flexion": float("nan")}}, "finite"),
+        ({"locked": {"elbow_flexion": [1, 2]}}, "1 finite number"),
+        ({"locked": 5}, "locked= is a list"),
+        ({"locked": "elbow_flexion"}, "locked= is a list"),
+        ({"package_dirs": {"x": None}}, "root of package 'x'"),
+        ({"package_dirs": {"": "/"}}, "not a package name"),
+        ({"name": 5}, "name= is a str"),
+        ({"check_meshes": "no"}, "check_meshes"),
+    ],
+)
 def test_loader_argument_abuse_is_a_parameter_error(kw, needle):
     with pytest.raises(errors.ParameterError, match=needle):
         aa.load("prosthetic_arm", **kw)
@@ -66,7 +83,7 @@ def test_urdf_of_a_robot_is_the_validated_text_not_the_file_now(tmp_path):
     p.write_text(src.read_text(encoding="utf-8"), encoding="utf-8")
     r = aa.load(str(p))
     other = (aa.models.REPO_URDF_DIR / "planar2r.urdf").read_text(encoding="utf-8")
-    p.write_text(other, encoding="utf-8")   # swapped after loading
+    p.write_text(other, encoding="utf-8")  # swapped after loading
     u = r.urdf
     assert set(u.actuated_joint_names) == set(r.joint_names)
     q = r.random_q(rng=3)
@@ -80,7 +97,9 @@ def test_reach_counts_axis_aligned_sliders_and_ik_does_not_refuse_reachable_pose
     """Pinocchio builds an axis-aligned prismatic joint as JointModelPX/PY/PZ; the reach bound
     counts its travel (Joint.kind == "prismatic"), so no reachable pose is out_of_reach."""
     r = aa.load(name)
-    kinds = {r.model.joints[j.index + 1].shortname() for j in r.chain.joints if j.kind == "prismatic"}
+    kinds = {
+        r.model.joints[j.index + 1].shortname() for j in r.chain.joints if j.kind == "prismatic"
+    }
     assert kinds and kinds <= {"JointModelPX", "JointModelPY", "JointModelPZ"}, kinds
     q = r.random_q(2000, rng=0)
     far = float(np.max(np.linalg.norm(r.fk(q)[:, :3, 3], axis=1)))

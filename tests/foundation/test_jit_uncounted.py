@@ -24,7 +24,7 @@ def _fill(x, out):
     for i in range(2):
         for j in range(3):
             d[i, j] = 10 * i + j
-    v = a[:4].reshape((2, 14))              # views of a local array, uncounted
+    v = a[:4].reshape((2, 14))  # views of a local array, uncounted
     out[0] = v[1, 13]
     out[1] = b.sum()
     out[2] = c[1] and not c[2]
@@ -59,7 +59,7 @@ def test_local_sizes_must_be_literal():
 @kernel(counted=False)
 def _views(a, n, out):
     v, w = view2(a, 3, n), view3(a[2:], 2, 2, 2)
-    s = view2(local(12), 3, n)                        # a view of a local array, uncounted
+    s = view2(local(12), 3, n)  # a view of a local array, uncounted
     for i in range(3):
         for j in range(n):
             s[i, j] = v[i, j] * 2.0
@@ -85,6 +85,7 @@ def test_a_returned_view_keeps_its_owner_alive():
     x = _view_returned(a)
     del a
     import gc
+
     gc.collect()
     assert x.tolist() == [[0.5, 1.5, 2.5], [3.5, 4.5, 5.5]]
     b = np.arange(6, dtype=np.int64)

@@ -64,8 +64,10 @@ def test_unknown_frame_lists_valid_frames(arm):
 def test_unknown_jacobian_reference_is_a_value_error(arm):
     with pytest.raises(ValueError, match="LOCAL_WORLD_ALIGNED"):
         arm.jacobian(arm.neutral(), reference="world")
-    np.testing.assert_array_equal(arm.jacobian(arm.neutral(), reference=pin.ReferenceFrame.WORLD),
-                                  arm.jacobian(arm.neutral(), reference="WORLD"))
+    np.testing.assert_array_equal(
+        arm.jacobian(arm.neutral(), reference=pin.ReferenceFrame.WORLD),
+        arm.jacobian(arm.neutral(), reference="WORLD"),
+    )
 
 
 @pytest.mark.parametrize("bad", [np.zeros(6), np.zeros(8), np.zeros((2, 6)), np.zeros((2, 2, 7))])
@@ -110,7 +112,9 @@ def test_mimic_joint_is_modelled_like_yourdfpy(tmp_path):
     # l2 turns by q + (2 q + 0.1) about z (mathematics)
     ang = q[0] + 2 * q[0] + 0.1
     T = r.fk(q, frame="l2")
-    np.testing.assert_allclose(T[:2, :2], [[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]], atol=1e-15)
+    np.testing.assert_allclose(
+        T[:2, :2], [[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]], atol=1e-15
+    )
     u = r.urdf
     u.update_cfg(r.yourdfpy_cfg(q))
     np.testing.assert_allclose(u.get_transform("l2", u.base_link), T, atol=1e-15)

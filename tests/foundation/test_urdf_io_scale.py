@@ -18,13 +18,17 @@ LIMIT = "<limit lower='-1' upper='1' effort='1' velocity='1'/>"
 
 
 def joint(name, parent, child):
-    return (f"<joint name='{name}' type='revolute'><parent link='{parent}'/><child link='{child}'/>"
-            f"<origin xyz='0 0 0.1' rpy='0 0 0'/><axis xyz='0 0 1'/>{LIMIT}</joint>")
+    return (
+        f"<joint name='{name}' type='revolute'><parent link='{parent}'/><child link='{child}'/>"
+        f"<origin xyz='0 0 0.1' rpy='0 0 0'/><axis xyz='0 0 1'/>{LIMIT}</joint>"
+    )
 
 
 def chain_urdf(n, extra_links=(), extra_joints=()):
     """A serial chain l0 -> l1 -> ... -> l(n-1) (joint ji has child li)."""
-    links = [f"<link name='l{i}'/>" for i in range(n)] + [f"<link name='{ln}'/>" for ln in extra_links]
+    links = [f"<link name='l{i}'/>" for i in range(n)] + [
+        f"<link name='{ln}'/>" for ln in extra_links
+    ]
     joints = [joint(f"j{i}", f"l{i - 1}", f"l{i}") for i in range(1, n)]
     joints += [joint(*j) for j in extra_joints]
     return ("<robot name='chain'>" + "".join(links) + "".join(joints) + "</robot>").encode()
@@ -63,8 +67,11 @@ def test_long_chain_validates_in_linear_time(tmp_path):
 
 def test_cycle_beside_a_long_chain_is_found_quickly():
     # one root (l0), every other link has one parent, but c0 -> c1 -> c2 -> c0 is not reached
-    raw = chain_urdf(N, extra_links=("c0", "c1", "c2"),
-                     extra_joints=(("k1", "c0", "c1"), ("k2", "c1", "c2"), ("k0", "c2", "c0")))
+    raw = chain_urdf(
+        N,
+        extra_links=("c0", "c1", "c2"),
+        extra_joints=(("k1", "c0", "c1"), ("k2", "c1", "c2"), ("k0", "c2", "c0")),
+    )
     exc, dt = timed(parse_urdf_bytes, raw, "chain.urdf")
     assert isinstance(exc, errors.URDFStructureError), exc
     assert dt < BOUND_S
@@ -75,20 +82,30 @@ def test_cycle_beside_a_long_chain_is_found_quickly():
 
 def test_ring_without_root_is_a_cycle():
     # l0 -> ... -> l(N-1) -> l0: every link has a parent; the message lists a few links only
-    exc, dt = timed(parse_urdf_bytes, chain_urdf(N, extra_joints=(("j0", f"l{N - 1}", "l0"),)), "ring.urdf")
+    exc, dt = timed(
+        parse_urdf_bytes, chain_urdf(N, extra_joints=(("j0", f"l{N - 1}", "l0"),)), "ring.urdf"
+    )
     assert isinstance(exc, errors.URDFStructureError), exc
     assert dt < BOUND_S
-    assert "every link has a parent joint" in str(exc) and "more" in str(exc) and len(str(exc)) < 1000
+    assert (
+        "every link has a parent joint" in str(exc) and "more" in str(exc) and len(str(exc)) < 1000
+    )
 
 
 def test_many_roots_message_is_short():
-    raw = ("<robot name='r'>" + "".join(f"<link name='l{i}'/>" for i in range(N)) + "</robot>").encode()
-    with pytest.raises(errors.URDFStructureError, match=f"not connected into one tree: {N} roots \\('l0', 'l1'"):
+    raw = (
+        "<robot name='r'>" + "".join(f"<link name='l{i}'/>" for i in range(N)) + "</robot>"
+    ).encode()
+    with pytest.raises(
+        errors.URDFStructureError, match=f"not connected into one tree: {N} roots \\('l0', 'l1'"
+    ):
         parse_urdf_bytes(raw, "roots.urdf")
 
 
 def test_duplicate_link_in_long_file_is_named():
     raw = chain_urdf(N, extra_links=(f"l{N // 2}",))
     exc, dt = timed(parse_urdf_bytes, raw, "dup.urdf")
-    assert isinstance(exc, errors.URDFStructureError) and f"link 'l{N // 2}' defined twice" in str(exc)
+    assert isinstance(exc, errors.URDFStructureError) and f"link 'l{N // 2}' defined twice" in str(
+        exc
+    )
     assert dt < BOUND_S

@@ -48,13 +48,15 @@ def test_contact_normal_residual_and_jacobian(limb):
         d /= np.linalg.norm(d)
         task = qp.ContactNormalTask(limb, "index_tip", axis=axis, target=d)
         conf = qp.IKConfiguration(limb, q)
-        a_w = _fk(limb, q, "index_tip").rotation @ axis          # Pinocchio FK
+        a_w = _fk(limb, q, "index_tip").rotation @ axis  # Pinocchio FK
         e = task.compute_error(conf)
         np.testing.assert_allclose(e, a_w - d, atol=1e-12)
         theta = np.arccos(np.clip(a_w @ d, -1, 1))
         assert np.linalg.norm(e) == pytest.approx(2 * np.sin(theta / 2), abs=1e-12)
         assert task.angle(conf) == pytest.approx(theta, abs=1e-9)
-        np.testing.assert_allclose(task.compute_jacobian(conf), _fd_jacobian(limb, task, q), atol=1e-6)
+        np.testing.assert_allclose(
+            task.compute_jacobian(conf), _fd_jacobian(limb, task, q), atol=1e-6
+        )
 
 
 def test_contact_normal_qp_converges_to_a_reachable_direction(limb):
@@ -72,39 +74,51 @@ def test_contact_normal_qp_converges_to_a_reachable_direction(limb):
     assert np.degrees(np.arccos(np.clip(a @ d, -1, 1))) < 1e-4
 
 
-@pytest.mark.parametrize("obj", [Sphere([0.05, 0.1, -0.6], 0.04), Cylinder([0.02, 0.08, -0.7], [1.0, 0.2, 0.1], 0.03)])
+@pytest.mark.parametrize(
+    "obj", [Sphere([0.05, 0.1, -0.6], 0.04), Cylinder([0.02, 0.08, -0.7], [1.0, 0.2, 0.1], 0.03)]
+)
 def test_surface_contact_residual_and_jacobian(limb, obj):
     rng = np.random.default_rng(3)
     axis = np.array([0.0, 1.0, 0.0])
-    task = qp.SurfaceContactTask(limb, "thumb_tip", obj, axis=axis, distance_cost=1.0, normal_cost=0.3)
+    task = qp.SurfaceContactTask(
+        limb, "thumb_tip", obj, axis=axis, distance_cost=1.0, normal_cost=0.3
+    )
     for _ in range(2):
         q = limb.random_q(rng=rng)
         conf = qp.IKConfiguration(limb, q)
         M = _fk(limb, q, "thumb_tip")
         p = M.translation
-        if isinstance(obj, Sphere):                     # geometry written out here
+        if isinstance(obj, Sphere):  # geometry written out here
             w = p - np.array([0.05, 0.1, -0.6])
             dist, m = np.linalg.norm(w) - 0.04, w / np.linalg.norm(w)
         else:
             u = np.array([1.0, 0.2, 0.1]) / np.linalg.norm([1.0, 0.2, 0.1])
-            w = (p - np.array([0.02, 0.08, -0.7]))
+            w = p - np.array([0.02, 0.08, -0.7])
             w = w - (w @ u) * u
             dist, m = np.linalg.norm(w) - 0.03, w / np.linalg.norm(w)
         e = task.compute_error(conf)
         assert e[0] == pytest.approx(dist, abs=1e-12)
         np.testing.assert_allclose(e[1:], M.rotation @ axis + m, atol=1e-12)
-        np.testing.assert_allclose(task.compute_jacobian(conf), _fd_jacobian(limb, task, q), atol=1e-6)
+        np.testing.assert_allclose(
+            task.compute_jacobian(conf), _fd_jacobian(limb, task, q), atol=1e-6
+        )
 
 
-@pytest.mark.parametrize("obj", [Sphere([0.1, -0.2, 0.3], 0.05), Cylinder([0.0, 0.1, 0.0], [0.3, -1.0, 0.5], 0.02)])
+@pytest.mark.parametrize(
+    "obj", [Sphere([0.1, -0.2, 0.3], 0.05), Cylinder([0.0, 0.1, 0.0], [0.3, -1.0, 0.5], 0.02)]
+)
 def test_object_normal_is_distance_gradient(obj):
     rng = np.random.default_rng(4)
     h = 1e-6
     for _ in range(5):
         p = obj.center + rng.normal(scale=0.1, size=3)
-        g = np.array([(obj.distance(p + h * e) - obj.distance(p - h * e)) / (2 * h) for e in np.eye(3)])
+        g = np.array(
+            [(obj.distance(p + h * e) - obj.distance(p - h * e)) / (2 * h) for e in np.eye(3)]
+        )
         np.testing.assert_allclose(obj.normal(p), g, atol=1e-8)
-        N = np.column_stack([(obj.normal(p + h * e) - obj.normal(p - h * e)) / (2 * h) for e in np.eye(3)])
+        N = np.column_stack(
+            [(obj.normal(p + h * e) - obj.normal(p - h * e)) / (2 * h) for e in np.eye(3)]
+        )
         np.testing.assert_allclose(obj.normal_jacobian(p), N, atol=1e-5)
         c = obj.project(p)
         assert abs(obj.distance(c)) < 1e-12

@@ -49,11 +49,23 @@ def test_fingers_are_the_joints_that_move_one_tip_only(name, request):
         assert set(hand.arm_v_indices) == cols[f.tip] & others
     if name == "allegro":
         assert len(hand.fingers) == 4 and hand.arm_joints == () and hand.palm == "palm_link"
-    elif name == "linkage":   # one driver per digit; of each digit's leaves (bars too) the fingertip
-        assert sorted(hand.tips) == ["index_tip", "little_tip", "middle_tip", "ring_tip", "thumb_tip"]
+    elif name == "linkage":  # one driver per digit; of each digit's leaves (bars too) the fingertip
+        assert sorted(hand.tips) == [
+            "index_tip",
+            "little_tip",
+            "middle_tip",
+            "ring_tip",
+            "thumb_tip",
+        ]
         assert all(len(f.v_indices) == 1 for f in hand.fingers) and hand.arm_joints == ()
-    else:   # hand_point is a tip of the tree but no joint of its own moves it: not a finger
-        assert sorted(hand.tips) == ["index_tip", "little_tip", "middle_tip", "ring_tip", "thumb_tip"]
+    else:  # hand_point is a tip of the tree but no joint of its own moves it: not a finger
+        assert sorted(hand.tips) == [
+            "index_tip",
+            "little_tip",
+            "middle_tip",
+            "ring_tip",
+            "thumb_tip",
+        ]
         assert len(hand.arm_joints) == 7 and hand.palm == "palm"
         assert all(len(f.joints) == 4 for f in hand.fingers)
 
@@ -68,7 +80,7 @@ def test_pad_normal_is_the_direction_of_distal_flexion(name, request):
         for f in hand.fingers:
             J = pin.computeFrameJacobian(robot.model, d, q, f.tip_id, pin.LOCAL_WORLD_ALIGNED)
             distal = robot.chain.joints[f.joints[-1]]
-            v = J[:3, distal.idx_v]                       # tip velocity of the distal joint
+            v = J[:3, distal.idx_v]  # tip velocity of the distal joint
             pin.framesForwardKinematics(robot.model, d, q)
             n_world = d.oMf[f.tip_id].rotation @ f.pad_axis
             # flexion = the side of the larger range (the convention), here positive
@@ -87,7 +99,7 @@ def test_span_bounds_fingertip_distances(name, request):
         P = np.array([d.oMf[f.tip_id].translation for f in hand.fingers])
         worst = max(worst, float(np.max(np.linalg.norm(P[:, None] - P[None], axis=-1))))
     assert worst <= hand.span
-    assert hand.span < 3 * worst          # a bound, not a vacuous one
+    assert hand.span < 3 * worst  # a bound, not a vacuous one
 
 
 def test_not_a_fingertip(allegro, limb):
@@ -106,7 +118,7 @@ def test_not_a_fingertip(allegro, limb):
 def test_coupled_joints_inconsistent_values():
     robot = aa.load("human_upper_limb", dip_coupling="2/3")
     hand = Hand(robot)
-    q = hand.configuration({"index_pip": 0.9, "index_dip": 0.6})          # 0.6 = 2/3 · 0.9: consistent
+    q = hand.configuration({"index_pip": 0.9, "index_dip": 0.6})  # 0.6 = 2/3 · 0.9: consistent
     theta = robot.chain.angles(q)
     names = [j.name for j in robot.chain.joints]
     assert theta[names.index("index_dip")] == pytest.approx(0.6, abs=1e-12)

@@ -67,7 +67,7 @@ def test_allegro_cylinder_sliding_contacts(allegro):
     assert len(problems) == 4
     q0 = open_hand(allegro, hand)
     for pb in problems:
-        _check(allegro, hand, pb.obj, pb.witness)              # the witness is one
+        _check(allegro, hand, pb.obj, pb.witness)  # the witness is one
         res = solve_grasp(allegro, pb.obj, hand=hand, q0=q0)
         assert res.success and res.status == "success", res
         _check(allegro, hand, pb.obj, res.q)
@@ -82,7 +82,13 @@ def test_allegro_sphere_tripod_given_contacts(allegro):
     for pb in problems:
         res = solve_grasp(allegro, pb.obj, pb.contacts, hand=hand, q0=q0)
         assert res.success, res
-        _check(allegro, hand, pb.obj, res.q, contacts=np.array([pb.obj.project(c) for c in pb.contacts]))
+        _check(
+            allegro,
+            hand,
+            pb.obj,
+            res.q,
+            contacts=np.array([pb.obj.project(c) for c in pb.contacts]),
+        )
 
 
 def test_limb_arm_and_hand_cylinder(limb):
@@ -93,12 +99,14 @@ def test_limb_arm_and_hand_cylinder(limb):
     assert len(problems) == 8
     q0 = open_hand(limb, hand, comfortable_posture(limb))
     for pb in problems:
-        on_surface = np.array([pb.obj.project(c) for c in pb.contacts])     # what solve_grasp aims at
-        _check(limb, hand, pb.obj, pb.witness, contacts=on_surface)         # the witness is one
+        on_surface = np.array([pb.obj.project(c) for c in pb.contacts])  # what solve_grasp aims at
+        _check(limb, hand, pb.obj, pb.witness, contacts=on_surface)  # the witness is one
         res = solve_grasp(limb, pb.obj, pb.contacts, hand=hand, q0=q0)
         assert res.success, res
         _check(limb, hand, pb.obj, res.q, contacts=on_surface)
-        assert np.abs(res.q[hand.arm_q_indices] - q0[hand.arm_q_indices]).max() > 0.1   # the arm moved
+        assert (
+            np.abs(res.q[hand.arm_q_indices] - q0[hand.arm_q_indices]).max() > 0.1
+        )  # the arm moved
 
 
 def test_hard_coupling_holds(allegro):
@@ -134,10 +142,12 @@ def test_bad_grasps(allegro, limb):
     with pytest.raises(ValueError):
         solve_grasp(allegro, Sphere([0.1, 0.0, 0.05], 0.03), max_step=np.nan)
     # out of reach: a status, finite numbers, no exception
-    res = solve_grasp(allegro, Sphere([2.0, 0.0, 0.0], 0.03), hand=hand, restarts=1, max_iterations=60)
+    res = solve_grasp(
+        allegro, Sphere([2.0, 0.0, 0.0], 0.03), hand=hand, restarts=1, max_iterations=60
+    )
     assert not res.success and res.status in ("stalled", "max_iterations")
     assert np.isfinite(res.q).all() and np.isfinite(res.position_errors).all() and res.within_limits
-    assert res.position_errors.min() > 1.0          # metres away, as the geometry says
+    assert res.position_errors.min() > 1.0  # metres away, as the geometry says
 
 
 def test_grasp_overlays(allegro):
@@ -160,14 +170,16 @@ def test_grasp_overlays(allegro):
 
     import umsgpack
 
-    m = re.search(r"var cmds = (\[.*?\]);", v.static_html(), re.S)         # the page's replayed commands
+    m = re.search(r"var cmds = (\[.*?\]);", v.static_html(), re.S)  # the page's replayed commands
     cmds = [umsgpack.unpackb(base64.b64decode(c)) for c in json.loads(m.group(1))]
     paths = {c["path"]: c for c in cmds if c["type"] in ("set_object", "set_transform")}
     obj = f"{v.root}/overlays/cup_object"
     assert paths[obj]["type"] in ("set_object", "set_transform")
     assert any(p.startswith(f"{v.root}/overlays/cup_points") for p in paths)
     assert any(p.startswith(f"{v.root}/overlays/cup_normals") for p in paths)
-    geo = [c for c in cmds if c["type"] == "set_object" and c["path"] == obj][0]["object"]["geometries"][0]
+    geo = [c for c in cmds if c["type"] == "set_object" and c["path"] == obj][0]["object"][
+        "geometries"
+    ][0]
     assert geo["type"] == "CylinderGeometry" and geo["radiusTop"] == pytest.approx(0.03)
     with pytest.raises(TypeError):
         show_grasp(v, "a cup", contacts)

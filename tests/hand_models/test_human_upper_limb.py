@@ -20,9 +20,13 @@ from anthroarm.models.hand import configuration, mechanism_of
 deg = np.pi / 180
 
 # Buchholz, Armstrong & Goldstein (1992): segment / hand length (wrist->base, then 3 segments)
-BUCHHOLZ = {"thumb": (0.118, 0.251, 0.196, 0.158), "index": (0.463, 0.245, 0.143, 0.097),
-            "middle": (0.446, 0.266, 0.170, 0.108), "ring": (0.421, 0.244, 0.165, 0.107),
-            "little": (0.414, 0.204, 0.117, 0.093)}
+BUCHHOLZ = {
+    "thumb": (0.118, 0.251, 0.196, 0.158),
+    "index": (0.463, 0.245, 0.143, 0.097),
+    "middle": (0.446, 0.266, 0.170, 0.108),
+    "ring": (0.421, 0.244, 0.165, 0.107),
+    "little": (0.414, 0.204, 0.117, 0.093),
+}
 FINGERS = ("index", "middle", "ring", "little")
 
 
@@ -40,8 +44,14 @@ def test_mobility_is_the_books_27_and_20():
     # the finger part: 5 two-axis base pairs (IV) + 10 hinges (V) on 15 phalanges: F = 20 (l. 548)
     counts = m.pair_counts()
     n_fingers = 15
-    assert structure.spatial_mobility(n_fingers, {4: 5, 5: 10}) == 20 == structure.human_fingers().mobility()
-    assert counts[5] == 10 and counts[4] == 5 + 2 and counts[3] == 1     # + wrist U, elbow-forearm U, shoulder S
+    assert (
+        structure.spatial_mobility(n_fingers, {4: 5, 5: 10})
+        == 20
+        == structure.human_fingers().mobility()
+    )
+    assert (
+        counts[5] == 10 and counts[4] == 5 + 2 and counts[3] == 1
+    )  # + wrist U, elbow-forearm U, shoulder S
     assert spec.nq == 27 == aa.load("human_upper_limb").nq
 
 
@@ -53,9 +63,9 @@ def test_mobility_of_the_arm_alone_is_seven():
 
 def test_mimic_coupling_keeps_the_graph_and_drops_four_variables():
     spec = aa.models.spec("human_upper_limb", dip_coupling="2/3")
-    assert mechanism_of(spec).mobility() == 27          # the pairs are the same
+    assert mechanism_of(spec).mobility() == 27  # the pairs are the same
     r = aa.load("human_upper_limb", dip_coupling="2/3")
-    assert r.nq == spec.nq == 27 - 4 == 23              # 4 DIP-PIP couplings (fingers 2-5)
+    assert r.nq == spec.nq == 27 - 4 == 23  # 4 DIP-PIP couplings (fingers 2-5)
     assert r.has_mimic
 
 
@@ -63,8 +73,23 @@ def test_q_order_is_pinocchios(limb):
     spec = aa.models.spec("human_upper_limb")
     assert [j.name for j in spec.joints] == list(limb.model.names)[1:]
     assert limb.tool == "hand_point"
-    assert set(limb.tips) == {"hand_point", "thumb_tip", "index_tip", "middle_tip", "ring_tip", "little_tip"}
-    for f in ("palm", "hand_point", "thumb_tip", "index_tip", "middle_tip", "ring_tip", "little_tip"):
+    assert set(limb.tips) == {
+        "hand_point",
+        "thumb_tip",
+        "index_tip",
+        "middle_tip",
+        "ring_tip",
+        "little_tip",
+    }
+    for f in (
+        "palm",
+        "hand_point",
+        "thumb_tip",
+        "index_tip",
+        "middle_tip",
+        "ring_tip",
+        "little_tip",
+    ):
         assert limb.model.existFrame(f)
 
 
@@ -87,7 +112,11 @@ def test_segment_lengths_are_buchholz(limb):
     tip = {d: limb.fk(q, frame=f"{d}_tip")[:3, 3] for d in BUCHHOLZ}
     wrist = pos["wrist_flexion"]
     for d, c in BUCHHOLZ.items():
-        j = ("thumb_cmc_flexion", "thumb_mcp", "thumb_ip") if d == "thumb" else (f"{d}_mcp_flexion", f"{d}_pip", f"{d}_dip")
+        j = (
+            ("thumb_cmc_flexion", "thumb_mcp", "thumb_ip")
+            if d == "thumb"
+            else (f"{d}_mcp_flexion", f"{d}_pip", f"{d}_dip")
+        )
         pts = [pos[n] for n in j] + [tip[d]]
         lengths = [np.linalg.norm(b - a) for a, b in zip(pts, pts[1:])]
         np.testing.assert_allclose(lengths, np.array(c[1:]) * HL, rtol=1e-12)
@@ -95,26 +124,32 @@ def test_segment_lengths_are_buchholz(limb):
         # one offset that puts the middle MCP at de Leva's l_hand (0 at the default)
         assert wrist[2] - pts[0][2] == pytest.approx(c[0] * HL, abs=1e-12)
     # at q = 0 the middle finger is straight below the hand point: its tip 0.544 HL below it
-    np.testing.assert_allclose(tip["middle"] - limb.fk(q)[:3, 3], [0, 0, -(0.266 + 0.170 + 0.108) * HL], atol=1e-14)
+    np.testing.assert_allclose(
+        tip["middle"] - limb.fk(q)[:3, 3], [0, 0, -(0.266 + 0.170 + 0.108) * HL], atol=1e-14
+    )
 
 
 def test_flexion_moves_fingers_palmar_and_abduction_toward_thumb(limb):
     q0 = np.zeros(limb.nq)
     names = list(limb.model.names)[1:]
     for f in FINGERS:
-        for j, (axis, sign) in ((f"{f}_mcp_flexion", (1, +1)), (f"{f}_pip", (1, +1)), (f"{f}_mcp_abduction", (0, +1))):
+        for j, (axis, sign) in (
+            (f"{f}_mcp_flexion", (1, +1)),
+            (f"{f}_pip", (1, +1)),
+            (f"{f}_mcp_abduction", (0, +1)),
+        ):
             q = q0.copy()
             q[names.index(j)] = 0.2
             d = limb.fk(q, frame=f"{f}_tip")[:3, 3] - limb.fk(q0, frame=f"{f}_tip")[:3, 3]
-            assert sign * d[axis] > 1e-3, (j, d)       # +y palmar, +x radial (thumb side)
+            assert sign * d[axis] > 1e-3, (j, d)  # +y palmar, +x radial (thumb side)
     q = q0.copy()
     q[names.index("thumb_cmc_abduction")] = 0.3
     d = limb.fk(q, frame="thumb_tip")[:3, 3] - limb.fk(q0, frame="thumb_tip")[:3, 3]
-    assert d[1] > 1e-3                                   # palmar abduction
+    assert d[1] > 1e-3  # palmar abduction
     q = q0.copy()
     q[names.index("thumb_mcp")] = 0.5
     d = limb.fk(q, frame="thumb_tip")[:3, 3] - limb.fk(q0, frame="thumb_tip")[:3, 3]
-    assert d[0] < -1e-3                                  # thumb flexion sweeps across the palm (ulnar)
+    assert d[0] < -1e-3  # thumb flexion sweeps across the palm (ulnar)
 
 
 def test_thumb_reaches_the_index_tip_within_the_ranges(limb):
@@ -128,7 +163,9 @@ def test_thumb_reaches_the_index_tip_within_the_ranges(limb):
     def gap(x):
         q = np.zeros(limb.nq)
         q[idx] = x
-        return np.linalg.norm(limb.fk(q, frame="thumb_tip")[:3, 3] - limb.fk(q, frame="index_tip")[:3, 3])
+        return np.linalg.norm(
+            limb.fk(q, frame="thumb_tip")[:3, 3] - limb.fk(q, frame="index_tip")[:3, 3]
+        )
 
     lo, hi = limb.lower[idx], limb.upper[idx]
     res = minimize(gap, (lo + hi) / 2, bounds=list(zip(lo, hi)))
@@ -144,7 +181,12 @@ def test_finger_ranges_are_aaos(limb):
         for k, (a, b) in aaos.items():
             i = names.index(f"{f}_{k}")
             assert (lo[i], hi[i]) == pytest.approx((a, b), abs=1e-12)
-    thumb = {"thumb_cmc_flexion": (-20, 15), "thumb_cmc_abduction": (0, 70), "thumb_mcp": (0, 50), "thumb_ip": (-20, 80)}
+    thumb = {
+        "thumb_cmc_flexion": (-20, 15),
+        "thumb_cmc_abduction": (0, 70),
+        "thumb_mcp": (0, 50),
+        "thumb_ip": (-20, 80),
+    }
     for n, (a, b) in thumb.items():
         i = names.index(n)
         assert (lo[i], hi[i]) == pytest.approx((a, b), abs=1e-12)
@@ -158,7 +200,9 @@ def test_hand_mass_is_de_levas_and_phalanges_are_cylinders(limb):
     ids = {m.names[i]: i for i in range(1, m.njoints)}
     hand_joints = ["wrist_flexion"] + [n for n in ids if n.split("_")[0] in BUCHHOLZ]
     total = sum(m.inertias[ids[n]].mass for n in hand_joints)
-    assert total == pytest.approx(0.0061 * 75.0, rel=1e-12)          # de Leva 1996: hand 0.61 % of body mass
+    assert total == pytest.approx(
+        0.0061 * 75.0, rel=1e-12
+    )  # de Leva 1996: hand 0.61 % of body mass
     HL = limb.spec.params["hand_length"]
     r = limb.spec.params["hand_breadth"] / 8
     # index middle phalanx: solid cylinder, 1160 kg/m^3, radius 0.925 r, length 0.143 HL
@@ -167,7 +211,9 @@ def test_hand_mass_is_de_levas_and_phalanges_are_cylinders(limb):
     mass = 1160 * np.pi * rr**2 * L
     assert Y.mass == pytest.approx(mass, rel=1e-12)
     np.testing.assert_allclose(Y.lever, [0, 0, -L / 2], atol=1e-15)
-    np.testing.assert_allclose(np.diag(Y.inertia), [mass * (3 * rr**2 + L**2) / 12] * 2 + [mass * rr**2 / 2], rtol=1e-12)
+    np.testing.assert_allclose(
+        np.diag(Y.inertia), [mass * (3 * rr**2 + L**2) / 12] * 2 + [mass * rr**2 / 2], rtol=1e-12
+    )
     for i in range(1, m.njoints):
         assert m.inertias[i].mass > 0 and np.linalg.eigvalsh(m.inertias[i].inertia).min() > 0
 
@@ -186,8 +232,10 @@ def test_dip_mimic_equals_the_coupled_tree():
         for f in FINGERS:
             qf[names_f.index(f"{f}_dip")] = 2.0 / 3.0 * qf[names_f.index(f"{f}_pip")]
         for frame in ("index_tip", "little_tip", "thumb_tip", "hand_point"):
-            np.testing.assert_allclose(coupled.fk(qc, frame=frame), free.fk(qf, frame=frame), atol=1e-14)
-    assert len(names_c) == 27      # the mimic joints stay joints of the model
+            np.testing.assert_allclose(
+                coupled.fk(qc, frame=frame), free.fk(qf, frame=frame), atol=1e-14
+            )
+    assert len(names_c) == 27  # the mimic joints stay joints of the model
 
 
 def test_configuration_rejects_an_inconsistent_dip():
@@ -207,16 +255,22 @@ def test_configuration_rejects_an_inconsistent_dip():
         configuration(spec, [0.9, 0.6])
 
 
-@pytest.mark.parametrize("kw, match", [
-    ({"hand_length": 0.30}, "forearm"),                 # longer than the forearm (0.270 m at 1.75 m)
-    ({"hand_breadth": -0.08}, "positive"),
-    ({"hand_breadth": 0.0}, "positive"),
-    ({"hand_length": float("nan")}, "finite"),
-    ({"hand_length": 0.10}, "stature"),                 # 0.057 x stature: not a human hand
-    ({"hand_breadth": 0.15}, "hand length"),            # broader than 0.65 x its length
-    ({"hand_length": "long"}, "finite"),
-    ({"hand_breadth": 1e300}, r"hand_breadth 1e\+300 m is 5.15e\+300 × the hand length"),   # short, readable
-])
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"hand_length": 0.30}, "forearm"),  # longer than the forearm (0.270 m at 1.75 m)
+        ({"hand_breadth": -0.08}, "positive"),
+        ({"hand_breadth": 0.0}, "positive"),
+        ({"hand_length": float("nan")}, "finite"),
+        ({"hand_length": 0.10}, "stature"),  # 0.057 x stature: not a human hand
+        ({"hand_breadth": 0.15}, "hand length"),  # broader than 0.65 x its length
+        ({"hand_length": "long"}, "finite"),
+        (
+            {"hand_breadth": 1e300},
+            r"hand_breadth 1e\+300 m is 5.15e\+300 × the hand length",
+        ),  # short, readable
+    ],
+)
 def test_bad_anthropometry_raises(kw, match):
     with pytest.raises(AnthropometryError, match=match):
         aa.models.spec("human_upper_limb", **kw)
@@ -229,14 +283,20 @@ def test_bad_coupling_raises(bad):
 
 
 def test_user_hand_length_scales_the_hand():
-    s = aa.models.spec("human_upper_limb", height=1.62, mass=55, sex="female", hand_length=0.17, hand_breadth=0.075)
-    r = aa.load("human_upper_limb", height=1.62, mass=55, sex="female", hand_length=0.17, hand_breadth=0.075)
+    s = aa.models.spec(
+        "human_upper_limb", height=1.62, mass=55, sex="female", hand_length=0.17, hand_breadth=0.075
+    )
+    r = aa.load(
+        "human_upper_limb", height=1.62, mass=55, sex="female", hand_length=0.17, hand_breadth=0.075
+    )
     q = np.zeros(r.nq)
     wrist = r.fk(q, frame="palm")[:3, 3] + [0, 0, 0.446 * 0.17 / 2]
     np.testing.assert_allclose(r.fk(q)[:3, 3] - wrist, [0, 0, -0.446 * 0.17], atol=1e-14)
-    np.testing.assert_allclose(r.fk(q, frame="index_tip")[:3, 3] - r.fk(q, frame="middle_tip")[:3, 3],
-                               [0.075 / 4, 0, (0.446 - 0.463 + 0.266 + 0.170 + 0.108 - 0.245 - 0.143 - 0.097) * 0.17],
-                               atol=1e-14)
+    np.testing.assert_allclose(
+        r.fk(q, frame="index_tip")[:3, 3] - r.fk(q, frame="middle_tip")[:3, 3],
+        [0.075 / 4, 0, (0.446 - 0.463 + 0.266 + 0.170 + 0.108 - 0.245 - 0.143 - 0.097) * 0.17],
+        atol=1e-14,
+    )
     assert s.params["hand_length"] == 0.17
 
 
@@ -245,14 +305,42 @@ CLI = "import sys; from anthroarm.cli import main; sys.exit(main(sys.argv[1:]))"
 
 def test_cli_writes_the_model(tmp_path):
     out = tmp_path / "limb.urdf"
-    res = subprocess.run([sys.executable, "-c", CLI, "urdf", "human_upper_limb", "--param", "height=1.62",
-                          "-o", str(out)], capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            CLI,
+            "urdf",
+            "human_upper_limb",
+            "--param",
+            "height=1.62",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr
     assert out.read_text() == aa.models.urdf_text("human_upper_limb", height=1.62)
     r = aa.load(str(out), tool="index_tip")
     assert r.nq == 27
-    res = subprocess.run([sys.executable, "-c", CLI, "urdf", "human_upper_limb", "--param", "hand_length=0.5",
-                          "-o", str(tmp_path / "bad.urdf")], capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            CLI,
+            "urdf",
+            "human_upper_limb",
+            "--param",
+            "hand_length=0.5",
+            "-o",
+            str(tmp_path / "bad.urdf"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode != 0 and "forearm" in res.stderr and "Traceback" not in res.stderr
     from anthroarm import cli
 
@@ -265,8 +353,12 @@ def test_cli_writes_the_model(tmp_path):
 def test_crosscheck_rows_pass():
     from anthroarm import crosscheck
 
-    rows = crosscheck.run(["human_upper_limb"], samples=10, tool="index_tip",
-                          providers=["anthroarm.kinematics.checks:rows", "anthroarm.dynamics.checks:model_rows"])
+    rows = crosscheck.run(
+        ["human_upper_limb"],
+        samples=10,
+        tool="index_tip",
+        providers=["anthroarm.kinematics.checks:rows", "anthroarm.dynamics.checks:model_rows"],
+    )
     assert len(rows) >= 8
     bad = [(r.quantity, r.max_abs_err, r.note) for r in rows if not r.ok]
     assert not bad, bad

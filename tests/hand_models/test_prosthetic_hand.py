@@ -93,7 +93,7 @@ def test_middle_finger_follows_the_scaled_chapter3_curve(hand):
     np.testing.assert_allclose(tip, s * tip0, atol=1e-15)
     x_mm = tip0[:, 0] * 1000
     inside = (x_mm >= 0) & (x_mm <= 40)
-    assert np.max(np.abs(tip0[inside, 1] * 1000 - finger_f(x_mm[inside]))) < 1.0   # mm
+    assert np.max(np.abs(tip0[inside, 1] * 1000 - finger_f(x_mm[inside]))) < 1.0  # mm
 
 
 def test_mobility_five_drivers(hand, loop):
@@ -116,8 +116,11 @@ def test_solve_returns_tips_and_statuses(hand, loop):
     assert st.ok and st.residual < 1e-12
     g = hand.fingers["index"]
     T = hand.mounts["index"]
-    np.testing.assert_allclose(st.tips["index"], T[:3, :3] @ np.r_[finger(g, g.phi_range[0] - 0.1).tip, 0] + T[:3, 3],
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        st.tips["index"],
+        T[:3, :3] @ np.r_[finger(g, g.phi_range[0] - 0.1).tip, 0] + T[:3, 3],
+        atol=1e-9,
+    )
     # drivers outside the range: a status, no NaN
     bad = ph.solve(loop, {"index_mcp": 0.3}, hand)
     assert bad.status == "out_of_range" and "index_mcp" in bad.reason and bad.tips == {}
@@ -141,7 +144,7 @@ def test_inconsistent_passive_joints_are_reported(hand, loop):
     gap, status = ph.closure_status(loop, st.q)
     assert status == "ok" and gap < 1e-12
     q = st.q.copy()
-    q[loop.joint_q_index("middle_pip")] += 0.05          # a PIP that contradicts its driver
+    q[loop.joint_q_index("middle_pip")] += 0.05  # a PIP that contradicts its driver
     gap, status = ph.closure_status(loop, q)
     assert status == "inconsistent" and gap > 1e-4
     for bad in (q[:-1], "abc", np.full_like(q, np.nan)):
@@ -169,7 +172,7 @@ def test_plain_urdf_mimic_approximation_error_is_what_is_reported(hand, loop):
             err = max(err, np.linalg.norm(robot.fk(q, frame=f"{d}_tip")[:3, 3] - exact))
         # Pinocchio on the plain URDF vs the solver = the fit's report, which came from the tree
         assert err == pytest.approx(fit.tip_error[d], abs=1e-9)
-        assert 1e-4 < err < 0.01          # a linear mimic is a few mm off the linkage's path
+        assert 1e-4 < err < 0.01  # a linear mimic is a few mm off the linkage's path
     # the mimic lines in the URDF are the fit's
     for n, (src, a, b, jerr) in fit.joints.items():
         if abs(a) < 1e-9:
@@ -202,7 +205,7 @@ def test_scale_and_bad_parameters():
     for bad in (0.0, -1.0, float("nan"), 10.0, "big", True):
         with pytest.raises(ParameterError):
             ph.prosthetic_hand(scale=bad)
-    for bad in (2, 10**9, 41.0, "41"):               # 10**9 exact solutions would run for hours
+    for bad in (2, 10**9, 41.0, "41"):  # 10**9 exact solutions would run for hours
         with pytest.raises(ParameterError, match="samples"):
             ph.mimic_fit(samples=bad)
 
@@ -211,7 +214,9 @@ def test_committed_urdf_equals_generator_and_loads_everywhere(tmp_path, same_urd
     from pathlib import Path
 
     committed = Path(__file__).resolve().parents[2] / "urdf" / "prosthetic_hand.urdf"
-    assert same_urdf_text(committed.read_text(), ph.urdf_text()), "urdf/prosthetic_hand.urdf is stale: run ph.write_urdf()"
+    assert same_urdf_text(committed.read_text(), ph.urdf_text()), (
+        "urdf/prosthetic_hand.urdf is stale: run ph.write_urdf()"
+    )
     out = ph.write_urdf(tmp_path / "hand.urdf", scale=1.1)
     assert out.read_text() == ph.urdf_text(1.1)
     m = pin.buildModelFromXML(out.read_text(), mimic=True)
@@ -220,15 +225,18 @@ def test_committed_urdf_equals_generator_and_loads_everywhere(tmp_path, same_urd
 
     u = yourdfpy.URDF.load(str(out))
     assert len(u.actuated_joint_names) == 5
-    r = aa.load(str(out), tool="thumb_tip")          # any URDF consumer of the package
+    r = aa.load(str(out), tool="thumb_tip")  # any URDF consumer of the package
     assert r.nq == 5 and r.has_mimic
 
 
 def test_crosscheck_rows_pass_on_the_plain_hand():
     from anthroarm import crosscheck
 
-    rows = crosscheck.run([ph.robot()], samples=6,
-                          providers=["anthroarm.kinematics.checks:rows", "anthroarm.dynamics.checks:model_rows"])
+    rows = crosscheck.run(
+        [ph.robot()],
+        samples=6,
+        providers=["anthroarm.kinematics.checks:rows", "anthroarm.dynamics.checks:model_rows"],
+    )
     assert len(rows) >= 8
     bad = [(r.quantity, r.max_abs_err, r.note) for r in rows if not r.ok]
     assert not bad, bad

@@ -15,7 +15,11 @@ import anthroarm as aa
 from anthroarm.ik import closed_form as cf
 
 #: the catalog arms with a closed form of finitely many solutions (not a swivel family)
-ARMS = [n for n in aa.models.names() if (f := cf.closed_form_info(aa.load(n))) is not None and not f.swivel]
+ARMS = [
+    n
+    for n in aa.models.names()
+    if (f := cf.closed_form_info(aa.load(n))) is not None and not f.swivel
+]
 PATHS = ["single", "batch"]
 
 
@@ -28,12 +32,12 @@ def _configs(robot, seed=7):
             q = rng.uniform(lo + 0.2 * (hi - lo), hi - 0.2 * (hi - lo))
             q[j] = bound[j]
             out.append(q)
-    for _ in range(6):                       # several joints on limits at once
+    for _ in range(6):  # several joints on limits at once
         q = rng.uniform(lo, hi)
         pick = rng.random(q.size) < 0.5
         q[pick] = np.where(rng.random(q.size) < 0.5, lo, hi)[pick]
         out.append(q)
-    if robot.name == "prosthetic_arm":       # straight elbow (θ4 = 0, its lower limit)
+    if robot.name == "prosthetic_arm":  # straight elbow (θ4 = 0, its lower limit)
         for _ in range(4):
             q = rng.uniform(lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo))
             q[3] = 0.0
@@ -67,7 +71,9 @@ def test_limits_and_straight_elbow_found_by_every_path(name):
     misses = []
     for q in _configs(robot):
         T = _pose(robot, q)
-        J = pin.computeFrameJacobian(robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED)
+        J = pin.computeFrameJacobian(
+            robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED
+        )
         J = J[:3] if po else J
         regular = np.linalg.svd(J, compute_uv=False)[-1] > 1e-6
         for path in PATHS:

@@ -7,10 +7,22 @@ import numpy as np
 import pytest
 
 import anthroarm as aa
-from anthroarm.ik.book_methods import (PoseTask, PositionTask, conjugate_direction, feedback_compensation,
-                                       gradual_approach, joint_limit_constraints, newton, penalty_minimize,
-                                       steepest_descent)
-from anthroarm.ik.book_tables import TABLE_7_3, TABLE_7_3_SOLUTION, TABLE_7_3_START, TABLE_7_3_TARGET
+from anthroarm.ik.book_methods import (
+    PoseTask,
+    PositionTask,
+    conjugate_direction,
+    feedback_compensation,
+    gradual_approach,
+    newton,
+    penalty_minimize,
+    steepest_descent,
+)
+from anthroarm.ik.book_tables import (
+    TABLE_7_3,
+    TABLE_7_3_SOLUTION,
+    TABLE_7_3_START,
+    TABLE_7_3_TARGET,
+)
 
 
 @pytest.fixture(scope="module")
@@ -57,10 +69,19 @@ def test_table73_conjugate_direction_first_iterate(task):
     np.testing.assert_allclose(res.q, TABLE_7_3_SOLUTION, atol=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason="book's implementation details unknown (notes §4 E3): Table 7.3 "
-                   "rows beyond the asserted iterates do not reproduce")
-@pytest.mark.parametrize("name,fn", [("feedback_compensation", newton), ("steepest_descent", steepest_descent),
-                                     ("conjugate_direction", conjugate_direction)])
+@pytest.mark.xfail(
+    strict=True,
+    reason="book's implementation details unknown (notes §4 E3): Table 7.3 "
+    "rows beyond the asserted iterates do not reproduce",
+)
+@pytest.mark.parametrize(
+    "name,fn",
+    [
+        ("feedback_compensation", newton),
+        ("steepest_descent", steepest_descent),
+        ("conjugate_direction", conjugate_direction),
+    ],
+)
 def test_table73_remaining_iterates(task, name, fn):
     res = fn(task, TABLE_7_3_START)
     np.testing.assert_allclose(res.iterates[:5], _book(name), atol=5e-3)
@@ -76,8 +97,10 @@ def test_table73_near_start_ranking(task, start):
 
 
 def test_fletcher_reeves_needs_restarts(task):
-    assert conjugate_direction(task, TABLE_7_3_START, tol=1e-6, restart=10**9).iterations > \
-        5 * conjugate_direction(task, TABLE_7_3_START, tol=1e-6, restart=2).iterations
+    assert (
+        conjugate_direction(task, TABLE_7_3_START, tol=1e-6, restart=10**9).iterations
+        > 5 * conjugate_direction(task, TABLE_7_3_START, tol=1e-6, restart=2).iterations
+    )
 
 
 def test_descent_survives_singular_start(task):
@@ -176,14 +199,16 @@ def test_penalty_bad_args(planar):
         penalty_minimize(task, [0, 0.5], [], method="bfgs")
     with pytest.raises(ValueError):
         newton(task, [np.nan, 0])
-    with pytest.raises(ValueError, match="t_end"):   # t_end = inf used to raise OverflowError
+    with pytest.raises(ValueError, match="t_end"):  # t_end = inf used to raise OverflowError
         gradual_approach(task, [0, 0.5], t_end=np.inf)
     with pytest.raises(ValueError, match="dt"):
         feedback_compensation(task, _circle, [0, 0.5], [0, 0], dt=np.inf, num=3)
 
 
 # ---------------------------------------------------------------------------- gradual approach
-@pytest.mark.parametrize("mu", [lambda t: 1 / (1 + t), lambda t: 1 / (1 + t * t), lambda t: 1 / (1 + t**3)])
+@pytest.mark.parametrize(
+    "mu", [lambda t: 1 / (1 + t), lambda t: 1 / (1 + t * t), lambda t: 1 / (1 + t**3)]
+)
 def test_gradual_approach_straight_line(mu):
     """(7-38)/(7-49): error ≈ c μ(t); the path is straight (Fig. 7-9)."""
     robot = aa.load("prosthetic_arm")

@@ -7,8 +7,14 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.ik.book_jacobians import (DELTA, THETA, chain_derivatives, hand_frame_jacobian, trace_jacobian,
-                                         trace_jacobian_derivative)
+from anthroarm.ik.book_jacobians import (
+    DELTA,
+    THETA,
+    chain_derivatives,
+    hand_frame_jacobian,
+    trace_jacobian,
+    trace_jacobian_derivative,
+)
 
 MODELS = ["sixr_arm", "prosthetic_arm", "human_arm7", "unimate5"]
 
@@ -36,7 +42,9 @@ def test_trace_jacobian_equals_pinocchio_world(name):
 def test_hand_frame_jacobian_equals_pinocchio_local(name):
     robot = aa.load(name)
     for q in robot.random_q(10, np.random.default_rng(1)):
-        np.testing.assert_allclose(hand_frame_jacobian(robot, q), robot.jacobian(q, reference="LOCAL"), atol=1e-12)
+        np.testing.assert_allclose(
+            hand_frame_jacobian(robot, q), robot.jacobian(q, reference="LOCAL"), atol=1e-12
+        )
 
 
 @pytest.mark.parametrize("name", ["sixr_arm", "prosthetic_arm"])
@@ -47,7 +55,9 @@ def test_K_exact_equals_pinocchio_and_finite_differences(name):
         qd = rng.normal(size=robot.nv)
         K = trace_jacobian_derivative(robot, q, qd)
         pin.computeJointJacobiansTimeVariation(robot.model, robot.data, q, qd)
-        dJ = pin.getFrameJacobianTimeVariation(robot.model, robot.data, robot.tool_id, pin.ReferenceFrame.WORLD)
+        dJ = pin.getFrameJacobianTimeVariation(
+            robot.model, robot.data, robot.tool_id, pin.ReferenceFrame.WORLD
+        )
         np.testing.assert_allclose(K, _swap(dJ), atol=1e-10)
         h = 1e-6
         fd = (trace_jacobian(robot, q + h * qd) - trace_jacobian(robot, q - h * qd)) / (2 * h)

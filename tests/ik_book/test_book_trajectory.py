@@ -16,14 +16,16 @@ def test_via_points_boundary_and_continuity(k, seed):
     times = np.cumsum(rng.uniform(0.3, 2.0, k)) - 0.3
     Q = rng.uniform(-2, 2, (k, 3))
     tr = ViaPointTrajectory(times, Q)
-    np.testing.assert_allclose(tr(times), Q, atol=1e-9)                   # through every via point
+    np.testing.assert_allclose(tr(times), Q, atol=1e-9)  # through every via point
     for end in (times[0], times[-1]):
-        np.testing.assert_allclose(tr(end, 1), 0, atol=1e-8)              # zero velocity
-        np.testing.assert_allclose(tr(end, 2), 0, atol=1e-7)              # zero acceleration
+        np.testing.assert_allclose(tr(end, 1), 0, atol=1e-8)  # zero velocity
+        np.testing.assert_allclose(tr(end, 2), 0, atol=1e-7)  # zero acceleration
     h = 1e-7
     for tk in times[1:-1]:  # C²: left and right limits of q, q̇, q̈ agree at the via points
         for d in (0, 1, 2):
-            np.testing.assert_allclose(tr(tk - h, d), tr(tk + h, d), atol=1e-4 * (1 + np.abs(tr(tk, d)).max()))
+            np.testing.assert_allclose(
+                tr(tk - h, d), tr(tk + h, d), atol=1e-4 * (1 + np.abs(tr(tk, d)).max())
+            )
     # velocity is the derivative of position (finite differences)
     tm = 0.5 * (times[0] + times[1])
     np.testing.assert_allclose(tr(tm, 1), (tr(tm + 1e-6) - tr(tm - 1e-6)) / 2e-6, atol=1e-5)
@@ -37,7 +39,7 @@ def test_via_points_bad_input():
     with pytest.raises(ValueError):
         ViaPointTrajectory([0, 1], [[0, np.nan], [1, 1]])
     tr = ViaPointTrajectory([0, 1, 2], [[0, 0], [1, 2], [0, 1]])
-    with pytest.raises(ValueError, match="finite"):   # used to return NaN
+    with pytest.raises(ValueError, match="finite"):  # used to return NaN
         tr([0.5, np.nan])
     for d in (-1, 6, 1.5):
         with pytest.raises(ValueError, match="derivative"):

@@ -7,7 +7,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import anthroarm as aa
-from anthroarm.ik.cells import CORNERS, CellTable, OutsideCellTableError, nested_division, trilinear_weights
+from anthroarm.ik.cells import (
+    CORNERS,
+    CellTable,
+    OutsideCellTableError,
+    nested_division,
+    trilinear_weights,
+)
 
 # "hand horizontal and forward": l = (0, -1, 0), m = (0, 0, -1), n = (1, 0, 0) (Table 7.2 row 9)
 R_FWD = np.array([[0.0, 0, 1], [-1, 0, 0], [0, -1, 0]])
@@ -89,7 +95,7 @@ def _printed_chain(M, m):
     m1, m2, m3 = m
     t1, t2, t3 = 1 - m1, 1 - m2, 1 - m3
     N1 = t1 * M[0] + m1 * M[1]
-    N2 = t1 * M[2] - m1 * M[4]
+    N2 = t1 * M[2] - m1 * M[4]  # noqa: F841 - printed, unused by the chain
     N3 = t3 * M[3] + m1 * M[6]
     N4 = t1 * M[5] + m1 * M[7]
     N6 = t2 * N1 + m2 * N3
@@ -112,7 +118,11 @@ def test_cell_save_load_roundtrip(arm, tables, tmp_path):
     back = CellTable.load(path)
     np.testing.assert_array_equal(back.Q, tab.Q)
     np.testing.assert_array_equal(back.valid, tab.valid)
-    assert back.D == tab.D and back.matches(arm) and not back.matches(aa.load("prosthetic_arm", L2=0.24))
+    assert (
+        back.D == tab.D
+        and back.matches(arm)
+        and not back.matches(aa.load("prosthetic_arm", L2=0.24))
+    )
     p = np.array([0.4, -0.1, 0.0])
     np.testing.assert_array_equal(back.lookup(p), tab.lookup(p))
     (tmp_path / "junk.npz").write_bytes(b"not a table")

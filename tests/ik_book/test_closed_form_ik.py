@@ -92,7 +92,9 @@ def test_sixr_book_identities_7_12_7_15():
         T = robot.fk(q)
         l_, m_, n_ = T[:3, 2]
         u, v, w = T[:3, 0]
-        C03 = (dh_matrix(rows[0], q[0]) @ dh_matrix(rows[1], q[1]) @ dh_matrix(rows[2], q[2]))[:3, :3]
+        C03 = (dh_matrix(rows[0], q[0]) @ dh_matrix(rows[1], q[1]) @ dh_matrix(rows[2], q[2]))[
+            :3, :3
+        ]
         L, M, N = C03.T @ np.array([l_, m_, n_])
         U, V, W = C03.T @ np.array([u, v, w])
         assert abs(N + np.cos(q[4])) < 1e-12
@@ -113,7 +115,9 @@ def test_human_arm7_swivel_family():
     res = aa.ik.analytic(robot, T)  # default grid of 36 swivel angles
     assert res.success and res.swivel is not None and len(res.swivel) == len(res)
     assert len(np.unique(np.round(res.swivel, 9))) >= 5  # a genuine one-parameter family
-    np.testing.assert_allclose(np.angle(np.exp(1j * (swivel_angle(robot, res.solutions) - res.swivel))), 0, atol=1e-9)
+    np.testing.assert_allclose(
+        np.angle(np.exp(1j * (swivel_angle(robot, res.solutions) - res.swivel))), 0, atol=1e-9
+    )
     for q in res.solutions:
         np.testing.assert_allclose(robot.fk(q)[:3], T[:3], atol=1e-10)
     # the scalar form and the swivel of q0 recover q0
@@ -138,7 +142,7 @@ def test_single_equals_batch(seed):
 def test_has_analytic():
     for name in ("sixr_arm", "prosthetic_arm", "planar2r", "human_arm7"):
         assert aa.ik.has_analytic(aa.load(name))
-    assert aa.ik.has_analytic(aa.load("ur5"))              # by its geometry (tests/ik_geometric)
+    assert aa.ik.has_analytic(aa.load("ur5"))  # by its geometry (tests/ik_geometric)
     for name in ("unimate5",):
         assert not aa.ik.has_analytic(aa.load(name))
     with pytest.raises(UnsupportedModelError):

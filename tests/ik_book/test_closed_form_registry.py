@@ -22,23 +22,42 @@ from anthroarm.ik import closed_form as cf
 
 IK_DIR = Path(cf.__file__).parent
 #: the catalog arms with a closed form, and which family
-CLOSED = {n: f.family for n in aa.models.names() if (f := cf.closed_form_info(aa.load(n))) is not None}
+CLOSED = {
+    n: f.family for n in aa.models.names() if (f := cf.closed_form_info(aa.load(n))) is not None
+}
 
 
 def test_no_arm_names_in_ik():
     """Arm knowledge lives in models/: no catalog or example-robot-data arm name is a string
     literal in the closed-form modules."""
-    names = set(aa.models.names()) | {"panda", "ur5", "ur10", "talos_arm", "human_right_arm", "kinova"}
+    names = set(aa.models.names()) | {
+        "panda",
+        "ur5",
+        "ur10",
+        "talos_arm",
+        "human_right_arm",
+        "kinova",
+    }
     pat = re.compile(r"""["'](%s)["']""" % "|".join(map(re.escape, sorted(names))))
-    for f in ("closed_form.py", "geometric.py", "families.py", "search.py", "subproblems.py", "classify.py",
-              "vec3.py", "fk_codegen.py", "checks.py", "cells.py"):
+    for f in (
+        "closed_form.py",
+        "geometric.py",
+        "families.py",
+        "search.py",
+        "subproblems.py",
+        "classify.py",
+        "vec3.py",
+        "fk_codegen.py",
+        "checks.py",
+        "cells.py",
+    ):
         hits = pat.findall((IK_DIR / f).read_text(encoding="utf-8"))
         assert not hits, f"{f}: arm names {hits}"
 
 
 def test_the_book_arms_have_their_closed_forms():
     assert CLOSED["sixr_arm"] == CLOSED["care_robot"] == "spherical_two_parallel"
-    assert CLOSED["prosthetic_arm"] == "spherical_two_intersecting"        # a spherical shoulder
+    assert CLOSED["prosthetic_arm"] == "spherical_two_intersecting"  # a spherical shoulder
     assert CLOSED["human_arm7"] == cf.SRS and CLOSED["planar2r"] == cf.PLANAR
 
 
@@ -46,15 +65,19 @@ def test_the_book_arms_have_their_closed_forms():
 def test_closed_forms_solve_their_arm(name):
     robot = aa.load(name)
     form = cf.closed_form_info(robot)
-    assert aa.ik.has_analytic(robot) and aa.ik.has_analytic(robot, robot.tool) and aa.ik.has_analytic(robot, robot.tool_id)
+    assert (
+        aa.ik.has_analytic(robot)
+        and aa.ik.has_analytic(robot, robot.tool)
+        and aa.ik.has_analytic(robot, robot.tool_id)
+    )
     assert cf.analytic_cost(robot) == form.cost_us > 0
-    assert form.nq == len(robot.chain.path(robot.tool))     # the joints on the path (a tree: its arm)
+    assert form.nq == len(robot.chain.path(robot.tool))  # the joints on the path (a tree: its arm)
     q = robot.random_q(None, np.random.default_rng(3), margin=0.05)
     T = robot.fk(q)
     kw = {"swivel": aa.ik.swivel_angle(robot, q)} if form.swivel else {}
-    if form.param:                      # the last joint on the path held at its sampled value
+    if form.param:  # the last joint on the path held at its sampled value
         kw = {"param": q[robot.chain.independent.index(robot.chain.path(robot.tool)[-1])]}
-    res = aa.ik.analytic(robot, T, q_rest=q, **kw)             # a tree's other joints as sampled
+    res = aa.ik.analytic(robot, T, q_rest=q, **kw)  # a tree's other joints as sampled
     assert res.model == robot.name
     batch = aa.ik.analytic_batch(robot, T[None], **kw)
     assert len(batch.branches) == form.branches
@@ -70,26 +93,33 @@ def test_closed_forms_solve_their_arm(name):
 
 def test_a_closed_form_is_a_property_of_the_model_not_of_its_label():
     assert aa.ik.has_analytic(aa.load("sixr_arm", name="my_arm"))
-    robot = aa.load("prosthetic_arm", L2=0.24)                    # other lengths: the same family
+    robot = aa.load("prosthetic_arm", L2=0.24)  # other lengths: the same family
     q = np.array([-1.0, 1.2, 0.3, 1.0, 0.2, -0.4])
     res = aa.ik.analytic(robot, robot.fk(q))
     assert np.abs(res.solutions - q).max(1).min() < 1e-9
 
 
-@pytest.mark.parametrize("name", ["unimate5", "rrprr5"])   # ur10, kinova, panda: closed form by geometry
+@pytest.mark.parametrize(
+    "name", ["unimate5", "rrprr5"]
+)  # ur10, kinova, panda: closed form by geometry
 def test_no_closed_form_is_a_typed_error(name):
     robot = aa.load(name)
     assert not aa.ik.has_analytic(robot)
     assert cf.closed_form_info(robot) is None
     assert math.isinf(cf.analytic_cost(robot))
-    with pytest.raises(UnsupportedModelError, match=r"no closed form for this geometry.*aa\.ik\.solve"):
+    with pytest.raises(
+        UnsupportedModelError, match=r"no closed form for this geometry.*aa\.ik\.solve"
+    ):
         aa.ik.analytic(robot, robot.fk(robot.neutral()))
     with pytest.raises(UnsupportedModelError, match="aa.ik.solve"):
         aa.ik.analytic_batch(robot, robot.fk(robot.neutral())[None])
 
 
 def test_locked_joints_or_another_tool_have_no_closed_form():
-    robot = aa.load("sixr_arm", locked={robot_joint: 0.0 for robot_joint in [aa.load("sixr_arm").joint_names[5]]})
+    robot = aa.load(
+        "sixr_arm",
+        locked={robot_joint: 0.0 for robot_joint in [aa.load("sixr_arm").joint_names[5]]},
+    )
     assert not aa.ik.has_analytic(robot)
     with pytest.raises(UnsupportedModelError, match="5 joints from the base to the frame, not 6"):
         aa.ik.analytic(robot, np.eye(4))
@@ -141,14 +171,24 @@ def test_straight_line_inlining_keeps_the_graph_evaluation_order():
         for _ in range(40):
             a, b = (pool[int(rng.integers(len(pool)))] for _ in range(2))
             r = rng.random()
-            v = g.add(a, b) if r < 0.3 else g.mul(a, b) if r < 0.55 else g.add(a, g.mul(-1.0, b)) if r < 0.8 \
+            v = (
+                g.add(a, b)
+                if r < 0.3
+                else g.mul(a, b)
+                if r < 0.55
+                else g.add(a, g.mul(-1.0, b))
+                if r < 0.8
                 else g.mul(float(rng.choice([-1.0, -2.5, 3.0])), a)
+            )
             if not isinstance(v, float):
                 pool.append(v)
         outs = pool[-3:]
         stmts, ref = straight_line(g, outs, lambda inp: inp.name, name_outputs=bool(trial % 2))
-        src = "def f(x0, x1, x2, x3):\n" + "".join(f"    {n} = {e}\n" for n, e in stmts) \
+        src = (
+            "def f(x0, x1, x2, x3):\n"
+            + "".join(f"    {n} = {e}\n" for n, e in stmts)
             + f"    return ({', '.join(ref(o) for o in outs)},)\n"
+        )
         ns = {}
         exec(src, ns)
         for _ in range(5):

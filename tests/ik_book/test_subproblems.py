@@ -54,9 +54,9 @@ def test_sp1_random():
 
 def test_sp1_least_squares_and_single():
     k, p1 = np.array([0, 0, 1.0]), np.array([1.0, 0, 0])
-    r = sp.sp1(p1, [0, 2.0, 0.5], k)                     # longer and higher: no exact rotation
+    r = sp.sp1(p1, [0, 2.0, 0.5], k)  # longer and higher: no exact rotation
     assert r.count == 1 and not r.exact[0] and abs(r.theta[0, 0] - np.pi / 2) < 1e-14
-    r = sp.sp1(k, k, k)                                  # p1 ∥ k: every θ, singular, exact
+    r = sp.sp1(k, k, k)  # p1 ∥ k: every θ, singular, exact
     assert r.singular and r.exact[0] and r.theta[0, 0] == 0.0
 
 
@@ -66,7 +66,7 @@ def test_sp4_random_two_solutions():
     d = np.einsum("ni,ni->n", h, R(k, t, p))
     r = sp.sp4(h, p, k, d)
     assert found(r.theta, t[:, None]).max() < 1e-6
-    for s in range(2):                                   # every returned solution solves it
+    for s in range(2):  # every returned solution solves it
         ok = r.valid[:, s]
         res = np.einsum("ni,ni->n", h, R(k, r.theta[:, s, 0], p)) - d
         assert np.abs(res[ok]).max() < 1e-9 and r.exact[ok, s].all()
@@ -75,13 +75,13 @@ def test_sp4_random_two_solutions():
 
 def test_sp4_tangent_and_least_squares():
     h, k, p = np.array([1.0, 0, 0]), np.array([0, 0, 1.0]), np.array([2.0, 0, 0.3])
-    r = sp.sp4(h, p, k, 2.0)                             # plane tangent to the circle: θ = 0 once
+    r = sp.sp4(h, p, k, 2.0)  # plane tangent to the circle: θ = 0 once
     assert r.count == 1 and r.exact[0] and abs(r.theta[0, 0]) < 1e-12
-    r = sp.sp4(h, p, k, 3.0)                             # out of reach: LS = the closest point
+    r = sp.sp4(h, p, k, 3.0)  # out of reach: LS = the closest point
     assert r.count == 1 and not r.exact[0] and abs(r.theta[0, 0]) < 1e-12
     r = sp.sp4(h, p, k, -2.5)
     assert r.count == 1 and not r.exact[0] and abs(abs(r.theta[0, 0]) - np.pi) < 1e-12
-    r = sp.sp4(k, p, k, 0.3)                             # h ∥ k: height independent of θ
+    r = sp.sp4(k, p, k, 0.3)  # h ∥ k: height independent of θ
     assert r.singular and r.exact[0]
     r = sp.sp4(k, p, k, 0.4)
     assert r.singular and not r.exact[0]
@@ -89,7 +89,12 @@ def test_sp4_tangent_and_least_squares():
 
 def test_sp3_random_and_cases():
     rng = np.random.default_rng(3)
-    k, p1, p2, t = unit(rng, N), rng.normal(size=(N, 3)), rng.normal(size=(N, 3)), rng.uniform(-np.pi, np.pi, N)
+    k, p1, p2, t = (
+        unit(rng, N),
+        rng.normal(size=(N, 3)),
+        rng.normal(size=(N, 3)),
+        rng.uniform(-np.pi, np.pi, N),
+    )
     d = np.linalg.norm(R(k, t, p1) - p2, axis=1)
     r = sp.sp3(p1, p2, k, d)
     for s in range(2):
@@ -97,14 +102,14 @@ def test_sp3_random_and_cases():
         res = np.linalg.norm(R(k, r.theta[:, s, 0], p1) - p2, axis=1) - d
         assert np.abs(res[ok]).max() < 1e-9
     e = found(r.theta, t[:, None])
-    assert np.all((e < 1e-6) | (r.count == 1))           # a merged near-tangent pair is exact to tol
+    assert np.all((e < 1e-6) | (r.count == 1))  # a merged near-tangent pair is exact to tol
     assert r.exact[r.valid].all()
     k, p1 = np.array([0, 0, 1.0]), np.array([1.0, 0, 0])
-    r = sp.sp3(p1, [3.0, 0, 0], k, 2.0)                  # sphere touches the circle at θ = 0
+    r = sp.sp3(p1, [3.0, 0, 0], k, 2.0)  # sphere touches the circle at θ = 0
     assert r.count == 1 and r.exact[0] and abs(r.theta[0, 0]) < 1e-6
-    r = sp.sp3(p1, [3.0, 0, 0], k, 1.0)                  # too small: LS, closest point θ = 0
+    r = sp.sp3(p1, [3.0, 0, 0], k, 1.0)  # too small: LS, closest point θ = 0
     assert r.count == 1 and not r.exact[0] and abs(r.theta[0, 0]) < 1e-12
-    r = sp.sp3(p1, [0, 0, 0.0], k, 1.0)                  # zero p2: every θ (distance ‖p1‖)
+    r = sp.sp3(p1, [0, 0, 0.0], k, 1.0)  # zero p2: every θ (distance ‖p1‖)
     assert r.singular and r.exact[0]
 
 
@@ -120,11 +125,11 @@ def test_sp2_random_and_cases():
         res = np.linalg.norm(R(k1, r.theta[:, s, 0], p1) - R(k2, r.theta[:, s, 1], p2), axis=1)
         assert res[ok].max() < 1e-9 and r.exact[ok, s].all()
     x, z = np.array([1.0, 0, 0]), np.array([0, 0, 1.0])
-    r = sp.sp2([1.0, 0, 0], [0, 0, 2.0], z, x)           # different norms: LS, flagged
+    r = sp.sp2([1.0, 0, 0], [0, 0, 2.0], z, x)  # different norms: LS, flagged
     assert not r.exact[r.valid].any()
-    r = sp.sp2([1.0, 0, 0.2], [0, 1.0, 0.2], z, z)       # parallel axes: a family
+    r = sp.sp2([1.0, 0, 0.2], [0, 1.0, 0.2], z, z)  # parallel axes: a family
     assert r.singular and r.exact[0]
-    r = sp.sp2([0, 0, 0.0], [0, 0, 0.0], z, x)           # zero vectors
+    r = sp.sp2([0, 0, 0.0], [0, 0, 0.0], z, x)  # zero vectors
     assert r.singular and r.exact[0]
 
 
@@ -140,15 +145,21 @@ def test_sp5_random():
     for s in range(4):
         ok = r.valid[:, s]
         th = np.nan_to_num(r.theta[:, s])
-        res = np.linalg.norm(p0 + R(k1, th[:, 0], p1) - R(k2, th[:, 1], p2 + R(k3, th[:, 2], p3)), axis=1)
+        res = np.linalg.norm(
+            p0 + R(k1, th[:, 0], p1) - R(k2, th[:, 1], p2 + R(k3, th[:, 2], p3)), axis=1
+        )
         assert res[ok].max() < 1e-7
-    r = sp.sp5(p0[0], p1[0], p2[0], p3[0], k1[0], k1[0], k3[0])   # k2 ∥ k1: outside SP5's form
+    r = sp.sp5(p0[0], p1[0], p2[0], p3[0], k1[0], k1[0], k3[0])  # k2 ∥ k1: outside SP5's form
     assert r.singular and r.count == 0
 
 
 def test_sp6_random_and_no_solution():
     rng = np.random.default_rng(6)
-    H, K, P = unit(rng, 4 * N).reshape(N, 4, 3), unit(rng, 4 * N).reshape(N, 4, 3), rng.normal(size=(N, 4, 3))
+    H, K, P = (
+        unit(rng, 4 * N).reshape(N, 4, 3),
+        unit(rng, 4 * N).reshape(N, 4, 3),
+        rng.normal(size=(N, 4, 3)),
+    )
     t = rng.uniform(-np.pi, np.pi, (N, 2))
     term = lambda i, tt: np.einsum("ni,ni->n", H[:, i], R(K[:, i], tt, P[:, i]))  # noqa: E731
     d1, d2 = term(0, t[:, 0]) + term(1, t[:, 1]), term(2, t[:, 0]) + term(3, t[:, 1])
@@ -160,7 +171,7 @@ def test_sp6_random_and_no_solution():
         assert np.abs(term(0, th[:, 0]) + term(1, th[:, 1]) - d1)[ok].max() < 1e-7
         assert np.abs(term(2, th[:, 0]) + term(3, th[:, 1]) - d2)[ok].max() < 1e-7
     big = np.abs(P).sum((1, 2)) * 10
-    r = sp.sp6(H, K, P, big, big)                         # unreachable heights
+    r = sp.sp6(H, K, P, big, big)  # unreachable heights
     assert (r.count == 0).all() and not r.valid.any()
 
 
@@ -174,17 +185,20 @@ def test_single_and_broadcast_shapes():
     assert np.allclose(np.nan_to_num(many.theta[3]), np.nan_to_num(one.theta))
 
 
-@pytest.mark.parametrize("call", [
-    lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 2.0]),              # axis not unit
-    lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 0.0]),              # zero axis
-    lambda: sp.sp1([1, 0], [0, 1, 0], [0, 0, 1.0]),                 # shape
-    lambda: sp.sp1([1, np.nan, 0], [0, 1, 0], [0, 0, 1.0]),         # NaN
-    lambda: sp.sp4([1, 0, 0], np.zeros((3, 3)), [0, 0, 1.0], np.zeros(4)),   # batch sizes
-    lambda: sp.sp3([1, 0, 0], [0, 1, 0], [0, 0, 1.0], -1.0),        # negative radius
-    lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 1.0], tol=0),       # tol
-    lambda: sp.sp6(np.eye(3), np.eye(3), np.eye(3), 0, 0),          # SP6 needs 4 rows
-    lambda: sp.sp1("abc", [0, 1, 0], [0, 0, 1.0]),
-])
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 2.0]),  # axis not unit
+        lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 0.0]),  # zero axis
+        lambda: sp.sp1([1, 0], [0, 1, 0], [0, 0, 1.0]),  # shape
+        lambda: sp.sp1([1, np.nan, 0], [0, 1, 0], [0, 0, 1.0]),  # NaN
+        lambda: sp.sp4([1, 0, 0], np.zeros((3, 3)), [0, 0, 1.0], np.zeros(4)),  # batch sizes
+        lambda: sp.sp3([1, 0, 0], [0, 1, 0], [0, 0, 1.0], -1.0),  # negative radius
+        lambda: sp.sp1([1, 0, 0], [0, 1, 0], [0, 0, 1.0], tol=0),  # tol
+        lambda: sp.sp6(np.eye(3), np.eye(3), np.eye(3), 0, 0),  # SP6 needs 4 rows
+        lambda: sp.sp1("abc", [0, 1, 0], [0, 0, 1.0]),
+    ],
+)
 def test_bad_input_is_typed(call):
     with pytest.raises(ParameterError):
         call()
@@ -214,9 +228,24 @@ def test_compiled_atan2_is_the_c_librarys_within_two_ulps():
     rows(Y, X, got)
     ref = np.array([math.atan2(y, x) for y, x in zip(Y, X)])
     assert (np.abs(got - ref) <= 2 * np.spacing(np.abs(ref))).all()
-    special = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, math.inf, -math.inf, math.nan, 5e-324, -5e-324, 1e308, -1e308]
+    special = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        0.5,
+        2.0,
+        math.inf,
+        -math.inf,
+        math.nan,
+        5e-324,
+        -5e-324,
+        1e308,
+        -1e308,
+    ]
     for y in special:
         for x in special:
             a, b = math.atan2(y, x), atan2(y, x)
-            assert (math.isnan(a) and math.isnan(b)) or (a == b and math.copysign(1.0, a) == math.copysign(1.0, b)), \
-                (y, x, a, b)
+            assert (math.isnan(a) and math.isnan(b)) or (
+                a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+            ), (y, x, a, b)

@@ -10,11 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
+from test_classify import puma_urdf  # same folder (pytest puts it on sys.path)
 
 import anthroarm as aa
 from anthroarm.ik import classify as C
-
-from test_classify import puma_urdf  # same folder (pytest puts it on sys.path)
 
 
 def _wrap_into_limits(q, lo, hi):
@@ -51,13 +50,13 @@ def test_every_branch_fk_verified(tmp_path):
             pin.framesForwardKinematics(model, data, q)
             T = data.oMf[fid].homogeneous.copy()
             sol, valid, exact = C._solve_spherical_two_parallel(c.kinematics, T)
-            assert valid.all() and exact.all()             # reachable generic pose: 8 exact branches
+            assert valid.all() and exact.all()  # reachable generic pose: 8 exact branches
             dist = np.abs(np.angle(np.exp(1j * (sol - theta)))).max(1)
-            assert dist.min() < 1e-7                       # the sampled posture is one of them
+            assert dist.min() < 1e-7  # the sampled posture is one of them
             for k in range(8):
                 qk = _wrap_into_limits(sol[k], lo, hi)
                 if np.isnan(qk).any():
-                    continue                               # outside the limits: not a solution
+                    continue  # outside the limits: not a solution
                 pin.framesForwardKinematics(model, data, ch.configuration(qk))
                 M = data.oMf[fid]
                 assert np.abs(M.homogeneous - T).max() < 1e-9, (robot.name, k)
@@ -69,7 +68,7 @@ def test_unreachable_pose_is_least_squares_flagged():
     robot = aa.load("sixr_arm")
     c = C.classify(robot)
     T = np.eye(4)
-    T[:3, 3] = [10.0, 0, 0]                                # far out of reach
+    T[:3, 3] = [10.0, 0, 0]  # far out of reach
     sol, valid, exact = C._solve_spherical_two_parallel(c.kinematics, T)
     assert valid.any() and not exact.any() and np.isfinite(sol[valid]).all()
 
@@ -84,7 +83,7 @@ def test_same_solutions_as_ik_geo():
     for _ in range(30):
         theta = robot.chain.random_q(None, rng)
         T = robot.fk(theta)
-        R06 = T[:3, :3] @ kin.R_tool.T                     # ik-geo's tool is identity at q = 0
+        R06 = T[:3, :3] @ kin.R_tool.T  # ik-geo's tool is identity at q = 0
         theirs = np.array([s for s, ls in geo.get_ik(R06.T.tolist(), T[:3, 3].tolist()) if not ls])
         ours, valid, exact = C._solve_spherical_two_parallel(kin, T)
         ours = ours[exact]

@@ -6,9 +6,16 @@ import numpy as np
 import pytest
 
 import anthroarm as aa
+from anthroarm.ik.book_tables import (
+    CORRECTED_ANGLE,
+    CORRECTED_P,
+    PRINTED,
+    TOL,
+    expected_angles,
+    nearest_rotation,
+    pose,
+)
 from anthroarm.ik.closed_form import prosthetic_book_procedure
-
-from anthroarm.ik.book_tables import CORRECTED_ANGLE, CORRECTED_P, PRINTED, TOL, expected_angles, nearest_rotation, pose
 
 ROWS_OK = [1, 2, 3, 4, 5, 6, 8, 9]
 
@@ -66,7 +73,9 @@ def test_table72_row1_cramer_determinant_is_zero(arm):
 def test_table72_printed_m2_numerator_fails():
     """Printed A = [m2/2 (L1²+L3²+L0²−L2²) − ...]/Δ: with m2 instead of m3 the rows do not reproduce."""
     for row in (5, 9):
-        sols, reason = prosthetic_book_procedure(pose(row, si=False), 340.0, 260.0, 130.0, printed_m2=True)
+        sols, reason = prosthetic_book_procedure(
+            pose(row, si=False), 340.0, 260.0, 130.0, printed_m2=True
+        )
         d = [np.abs(np.degrees(s) - expected_angles(row)).max() for s in sols] if sols else [np.inf]
         assert min(d) > 1.0
 
@@ -78,7 +87,10 @@ def test_table72_printed_positions_are_misprints(arm, row):
     printed angles."""
     p_print = np.array(PRINTED[row][2])
     p_corr = np.array(CORRECTED_P[row])
-    on_circle = lambda p: abs(np.hypot(*p[:2]) - 400 * np.sqrt(2)) < 0.15 and -90.001 <= np.degrees(np.arctan2(p[1], p[0])) <= 0.001
+    on_circle = lambda p: (
+        abs(np.hypot(*p[:2]) - 400 * np.sqrt(2)) < 0.15
+        and -90.001 <= np.degrees(np.arctan2(p[1], p[0])) <= 0.001
+    )
     assert on_circle(p_corr)
     assert not on_circle(p_print)
     res = aa.ik.analytic(arm, nearest_rotation(pose(row, corrected=False)))
@@ -117,7 +129,10 @@ def test_table72_row7_unresolved_only_theta2_theta5(arm):
     assert abs(got[4] - 3.377) < 2e-3
 
 
-@pytest.mark.xfail(strict=True, reason="Table 7.2 row 7 is unresolved: the printed angles imply p = (525.551, -215.160, 20)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="Table 7.2 row 7 is unresolved: the printed angles imply p = (525.551, -215.160, 20)",
+)
 def test_table72_row7_full_row(arm):
     res = aa.ik.analytic(arm, nearest_rotation(pose(7)))
     got, _ = _closest(res, expected_angles(7))
@@ -126,8 +141,12 @@ def test_table72_row7_full_row(arm):
 
 def test_table72_intermediate_elbow_and_wrist(arm):
     """Notes §4 E1 intermediate values: E and W of rows 1, 4, 6, 9 (mm)."""
-    table = {1: ((-192.98, -261.45, -100), (0, -435.69, -100)), 4: ((64.43, -331.44, -40), (322, -296, -40)),
-             6: ((125.14, -316.13, 0), (370.75, -230.84, 0)), 9: ((265.54, -196.69, 80), (435.59, 0, 80))}
+    table = {
+        1: ((-192.98, -261.45, -100), (0, -435.69, -100)),
+        4: ((64.43, -331.44, -40), (322, -296, -40)),
+        6: ((125.14, -316.13, 0), (370.75, -230.84, 0)),
+        9: ((265.54, -196.69, 80), (435.59, 0, 80)),
+    }
     model, data = arm.model, arm.data
     import pinocchio as pin
 

@@ -59,7 +59,7 @@ def srs_urdf(tmp_path, name, seed, along=False):
     axes = [_unit(r.normal(size=3)) for _ in range(7)]
     if along:
         axes[2] = _unit(up)
-    axes[3] = _unit(np.cross(up, r.normal(size=3)))               # an elbow that bends the arm
+    axes[3] = _unit(np.cross(up, r.normal(size=3)))  # an elbow that bends the arm
     fore = _unit(r.normal(size=3)) * r.uniform(0.2, 0.4)
     offs = [S, np.zeros(3), np.zeros(3), up, fore, np.zeros(3), np.zeros(3)]
     links = "".join(f'<link name="l{i}"/>' for i in range(8)) + '<link name="tool"/>'
@@ -67,17 +67,23 @@ def srs_urdf(tmp_path, name, seed, along=False):
     for i in range(7):
         xyz = " ".join(f"{float(x)!r}" for x in offs[i])
         ax = " ".join(f"{float(x)!r}" for x in axes[i])
-        js.append(f'<joint name="j{i+1}" type="revolute"><origin xyz="{xyz}" rpy="0 0 0"/>'
-                  f'<parent link="l{i}"/><child link="l{i+1}"/><axis xyz="{ax}"/>'
-                  f'<limit lower="{-PI!r}" upper="{PI!r}" effort="10" velocity="1"/></joint>')
+        js.append(
+            f'<joint name="j{i + 1}" type="revolute"><origin xyz="{xyz}" rpy="0 0 0"/>'
+            f'<parent link="l{i}"/><child link="l{i + 1}"/><axis xyz="{ax}"/>'
+            f'<limit lower="{-PI!r}" upper="{PI!r}" effort="10" velocity="1"/></joint>'
+        )
     txyz = " ".join(f"{float(x)!r}" for x in r.uniform(-0.1, 0.1, 3))
     trpy = " ".join(f"{float(x)!r}" for x in r.uniform(-1, 1, 3))
-    js.append(f'<joint name="jt" type="fixed"><origin xyz="{txyz}" rpy="{trpy}"/>'
-              '<parent link="l7"/><child link="tool"/></joint>')
+    js.append(
+        f'<joint name="jt" type="fixed"><origin xyz="{txyz}" rpy="{trpy}"/>'
+        '<parent link="l7"/><child link="tool"/></joint>'
+    )
     path = tmp_path / f"{name}.urdf"
-    path.write_text(f'<?xml version="1.0"?><robot name="{name}"><link name="base"/>'
-                    '<joint name="j0" type="fixed"><parent link="base"/><child link="l0"/></joint>'
-                    f'{links}{"".join(js)}</robot>')
+    path.write_text(
+        f'<?xml version="1.0"?><robot name="{name}"><link name="base"/>'
+        '<joint name="j0" type="fixed"><parent link="base"/><child link="l0"/></joint>'
+        f"{links}{''.join(js)}</robot>"
+    )
     return aa.load(str(path))
 
 
@@ -89,7 +95,10 @@ def _check_srs(r, n=60, seed=0, route=None):
     Q, T = _poses(r, n, seed)
     phi = swivel_angle(r, Q)
     th, cand, exact, inside, res, _ = F.srs_verified(plan, T, phi[:, None])
-    assert th.shape == (n, 8, 7) and cand.shape == exact.shape == inside.shape == res.shape == (n, 8)
+    assert th.shape == (n, 8, 7) and cand.shape == exact.shape == inside.shape == res.shape == (
+        n,
+        8,
+    )
     # the sampled configuration is among the branches
     theta = r.chain.angles(Q)
     d = np.nanmin(_wrapdiff(th, theta[:, None, :]).max(-1), 1)
@@ -114,8 +123,8 @@ def test_human_arm7_fk_of_ik_and_sampled_branch():
     plan = _check_srs(r, n=200, seed=1, route="sp2")
     assert plan.labels == F.srs_branch_labels("sp2")
     assert plan.labels[0] == "q4=0,q1q2=0,q6=0" and plan.labels[5] == "q4=1,q1q2=0,q6=1"
-    assert F.srs_plan(r) is plan                                  # cached
-    r.chain = copy.copy(r.chain)                                  # a new chain: rebuilt
+    assert F.srs_plan(r) is plan  # cached
+    r.chain = copy.copy(r.chain)  # a new chain: rebuilt
     again = F.srs_plan(r)
     assert again is not plan and again.chain is r.chain
 
@@ -146,7 +155,7 @@ def test_swivel_grid_agrees_with_swivel_angle():
     wide = dataclasses.replace(plan, lower_path=np.full(7, -np.inf), upper_path=np.full(7, np.inf))
     th, cand, exact, inside, res, _ = F.srs_verified(wide, T, np.broadcast_to(grid, (50, 12)))
     assert th.shape == (50, 96, 7)
-    assert (exact.sum(1) == 96).all()                  # reachable poses: every branch of every swivel
+    assert (exact.sum(1) == 96).all()  # reachable poses: every branch of every swivel
     assert res[exact].max() < 1e-9
     i, k = np.nonzero(exact)
     got = swivel_angle(r, r.chain.configuration(th[i, k]))
@@ -195,17 +204,17 @@ def test_unreachable_pose_no_valid_branch():
     r = aa.load("human_arm7")
     plan = F.srs_plan(r)
     Q, T = _poses(r, 10, 5)
-    T[:5, :3, 3] *= 10.0                                          # far out of reach
+    T[:5, :3, 3] *= 10.0  # far out of reach
     th, cand, exact, inside, res, _ = F.srs_verified(plan, T, np.zeros((10, 3)))
     assert not exact[:5].any()
-    assert (res[:5][cand[:5]] > 1e-3).all()                      # least-squares candidates only
-    assert not np.isnan(th[cand]).any()                          # no NaN in a candidate row
+    assert (res[:5][cand[:5]] > 1e-3).all()  # least-squares candidates only
+    assert not np.isnan(th[cand]).any()  # no NaN in a candidate row
     # every candidate that can be returned (inside the limits) or explains a failure (inexact) is
     # FK-checked; an exact one outside the limits is never returned and not checked
     checked = cand & (inside | ~exact)
     assert np.isfinite(res[checked]).all() and np.isinf(res[~checked]).all()
     assert (cand & exact & ~inside).any() and checked[:5][cand[:5]].all()
-    assert exact[5:].all()                                       # reachable: every branch (limits aside)
+    assert exact[5:].all()  # reachable: every branch (limits aside)
 
 
 def test_malformed_pose_raises_with_index():
@@ -280,14 +289,23 @@ def test_planar_off_plane_and_out_of_reach():
     P = T[:, :3, 3].copy()
     off = P + plan.h1 * 0.05
     th, cand, exact, inside, res, ok = F.planar_verified(plan, off)
-    assert not cand.any() and not exact.any() and np.isnan(th).all() and np.isinf(res).all() and not ok.any()
+    assert (
+        not cand.any()
+        and not exact.any()
+        and np.isnan(th).all()
+        and np.isinf(res).all()
+        and not ok.any()
+    )
     # a batch of off-plane targets: no solution flagged (the flags are written, not left as found)
     big = np.repeat(off, 200, axis=0)
     assert not F.planar_verified(plan, big)[5].any()
-    res_b = aa.ik.analytic_batch(r, np.repeat(T, 200, axis=0) + np.pad(plan.h1 * 0.05, (0, 1))[None, :, None]
-                                 * np.array([0, 0, 0, 1.0])[None, None, :])
+    res_b = aa.ik.analytic_batch(
+        r,
+        np.repeat(T, 200, axis=0)
+        + np.pad(plan.h1 * 0.05, (0, 1))[None, :, None] * np.array([0, 0, 0, 1.0])[None, None, :],
+    )
     assert not res_b.valid.any() and all("plane of motion" in x for x in res_b.reasons)
-    far = P + 5.0 * (P - plan.o1) / np.linalg.norm(P - plan.o1, axis=1)[:, None]   # beyond reach 2
+    far = P + 5.0 * (P - plan.o1) / np.linalg.norm(P - plan.o1, axis=1)[:, None]  # beyond reach 2
     th, cand, exact, inside, res, _ = F.planar_verified(plan, far)
     assert not exact.any() and not np.isnan(th[cand]).any()
     with pytest.raises(ValueError, match=r"P\[1\]"):
@@ -348,9 +366,11 @@ def test_srs_nearest_is_the_verified_family_in_one_call():
         F_ = _pin_pose(r, S[0])
         assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F_[:3, 3]), abs=1e-14)
         assert re == pytest.approx(np.linalg.norm(pin.log3(F_[:3, :3].T @ T[:3, :3])), abs=1e-12)
-        k0 = int(np.flatnonzero(ok)[0]) // 8                       # the first angle with a solution
+        k0 = int(np.flatnonzero(ok)[0]) // 8  # the first angle with a solution
         first = F.srs_nearest(plan, T, ref, grid, True)[0]
-        assert sorted(map(tuple, np.round(first, 10))) == sorted(map(tuple, np.round(th[ok][np.flatnonzero(ok) // 8 == k0], 10)))
+        assert sorted(map(tuple, np.round(first, 10))) == sorted(
+            map(tuple, np.round(th[ok][np.flatnonzero(ok) // 8 == k0], 10))
+        )
 
 
 def test_solve_answers_an_srs_arm_from_the_compiled_call():
@@ -361,12 +381,19 @@ def test_solve_answers_an_srs_arm_from_the_compiled_call():
         for q in r.random_q(6, rng=33):
             T = r.fk(q)
             res = aa.ik.solve(r, T, posture=None)
-            assert res.success and res.seed == "analytic" and res.iterations == 0 and r.within_limits(res.q), name
+            assert (
+                res.success
+                and res.seed == "analytic"
+                and res.iterations == 0
+                and r.within_limits(res.q)
+            ), name
             data = r.model.createData()
             pin.framesForwardKinematics(r.model, data, res.q)
             M = data.oMf[r.tool_id]
             assert res.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - M.translation), abs=1e-14)
-            assert res.rot_err == pytest.approx(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])), abs=1e-12)
+            assert res.rot_err == pytest.approx(
+                np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])), abs=1e-12
+            )
 
 
 def test_planar_position_and_pose_give_the_batch_answer():
@@ -386,7 +413,9 @@ def test_planar_position_and_pose_give_the_batch_answer():
         pose = np.eye(4)
         pose[:3, 3] = p
         b = aa.ik.analytic_batch(robot, p[None])[0]
-        assert (len(b) > 0) == (i < 30 or i == 31), i        # reachable: sampled, or off the plane by 1e-10
+        assert (len(b) > 0) == (i < 30 or i == 31), (
+            i
+        )  # reachable: sampled, or off the plane by 1e-10
         for target in (p, pose):
             a = aa.ik.analytic(robot, target)
             assert a.branches == b.branches and a.reason == b.reason

@@ -40,22 +40,42 @@ def puma560(tmp_path):
 def random_arm(tmp_path, cls, seed):
     """A random user 6R arm whose DH parameters satisfy the class constraints."""
     r = np.random.default_rng(seed)
-    L = lambda: r.uniform(0.05, 0.5)                                   # noqa: E731
-    A = lambda: r.choice([-1, 1]) * r.uniform(0.3, 1.3)                 # a generic twist
-    if cls == C.SPHERICAL_TWO_PARALLEL:            # 2 ∥ 3 (α2 = 0), a4 = a5 = d5 = 0
-        alpha, a, d = [A(), 0, A(), A(), A(), A()], [L(), L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
-    elif cls == C.SPHERICAL_TWO_INTERSECTING:      # 1 × 2 (a1 = 0), spherical wrist
-        alpha, a, d = [A(), A(), A(), A(), A(), A()], [0, L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
-    elif cls == C.SPHERICAL:                       # a spherical wrist, nothing else (SP5 quartic)
-        alpha, a, d = [A(), A(), A(), A(), A(), A()], [L(), L(), L(), 0, 0, L()], [L(), L(), L(), L(), 0, L()]
-    elif cls == C.THREE_PARALLEL:                  # 2 ∥ 3 ∥ 4 alone (SP6 quartic)
-        alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), L(), L()], [L(), L(), L(), L(), L(), L()]
-    elif cls == C.TWO_PARALLEL:                    # 2 ∥ 3 (α2 = 0) alone: a 1-D search over q1
+    L = lambda: r.uniform(0.05, 0.5)  # noqa: E731
+    A = lambda: r.choice([-1, 1]) * r.uniform(0.3, 1.3)  # a generic twist
+    if cls == C.SPHERICAL_TWO_PARALLEL:  # 2 ∥ 3 (α2 = 0), a4 = a5 = d5 = 0
+        alpha, a, d = (
+            [A(), 0, A(), A(), A(), A()],
+            [L(), L(), L(), 0, 0, L()],
+            [L(), L(), L(), L(), 0, L()],
+        )
+    elif cls == C.SPHERICAL_TWO_INTERSECTING:  # 1 × 2 (a1 = 0), spherical wrist
+        alpha, a, d = (
+            [A(), A(), A(), A(), A(), A()],
+            [0, L(), L(), 0, 0, L()],
+            [L(), L(), L(), L(), 0, L()],
+        )
+    elif cls == C.SPHERICAL:  # a spherical wrist, nothing else (SP5 quartic)
+        alpha, a, d = (
+            [A(), A(), A(), A(), A(), A()],
+            [L(), L(), L(), 0, 0, L()],
+            [L(), L(), L(), L(), 0, L()],
+        )
+    elif cls == C.THREE_PARALLEL:  # 2 ∥ 3 ∥ 4 alone (SP6 quartic)
+        alpha, a, d = (
+            [A(), 0, 0, A(), A(), A()],
+            [L(), L(), L(), L(), L(), L()],
+            [L(), L(), L(), L(), L(), L()],
+        )
+    elif cls == C.TWO_PARALLEL:  # 2 ∥ 3 (α2 = 0) alone: a 1-D search over q1
         alpha, a, d = [A(), 0, A(), A(), A(), A()], [L() for _ in range(6)], [L() for _ in range(6)]
-    elif cls == C.TWO_INTERSECTING:                # 5 × 6 (a5 = 0) alone: a 1-D search over q4
+    elif cls == C.TWO_INTERSECTING:  # 5 × 6 (a5 = 0) alone: a 1-D search over q4
         alpha, a, d = [A() for _ in range(6)], [L(), L(), L(), L(), 0, L()], [L() for _ in range(6)]
-    else:                                          # 2 ∥ 3 ∥ 4 (α2 = α3 = 0), 5 × 6 (a5 = 0)
-        alpha, a, d = [A(), 0, 0, A(), A(), A()], [L(), L(), L(), L(), 0, L()], [L(), L(), L(), L(), L(), L()]
+    else:  # 2 ∥ 3 ∥ 4 (α2 = α3 = 0), 5 × 6 (a5 = 0)
+        alpha, a, d = (
+            [A(), 0, 0, A(), A(), A()],
+            [L(), L(), L(), L(), 0, L()],
+            [L(), L(), L(), L(), L(), L()],
+        )
     return dh_urdf(tmp_path, f"user_{cls}_{seed}", alpha, a, d)
 
 
@@ -75,14 +95,27 @@ def _angles(robot, Q):
 
 
 def _arms(tmp_path):
-    return [("ur3", aa.load("ur3")), ("ur5", aa.load("ur5")), ("ur10", aa.load("ur10")),
-            ("kinova", aa.load("kinova")), ("puma560", puma560(tmp_path))] + \
-        [(f"user_{c}", random_arm(tmp_path, c, s)) for s in (1, 2) for c in G.SOLVED if c not in G.SEARCHED]
+    return [
+        ("ur3", aa.load("ur3")),
+        ("ur5", aa.load("ur5")),
+        ("ur10", aa.load("ur10")),
+        ("kinova", aa.load("kinova")),
+        ("puma560", puma560(tmp_path)),
+    ] + [
+        (f"user_{c}", random_arm(tmp_path, c, s))
+        for s in (1, 2)
+        for c in G.SOLVED
+        if c not in G.SEARCHED
+    ]
 
 
-CLASS = {"ur3": C.THREE_PARALLEL_TWO_INTERSECTING, "ur5": C.THREE_PARALLEL_TWO_INTERSECTING,
-         "ur10": C.THREE_PARALLEL_TWO_INTERSECTING, "kinova": C.SPHERICAL_TWO_PARALLEL,
-         "puma560": C.SPHERICAL_TWO_PARALLEL}
+CLASS = {
+    "ur3": C.THREE_PARALLEL_TWO_INTERSECTING,
+    "ur5": C.THREE_PARALLEL_TWO_INTERSECTING,
+    "ur10": C.THREE_PARALLEL_TWO_INTERSECTING,
+    "kinova": C.SPHERICAL_TWO_PARALLEL,
+    "puma560": C.SPHERICAL_TWO_PARALLEL,
+}
 
 
 def test_every_branch_fk_verified_and_the_pose_found(tmp_path):
@@ -117,7 +150,7 @@ def test_reversed_class_prosthetic_arm():
     assert gp.cls == C.SPHERICAL_TWO_INTERSECTING and gp.reversed
     th, T = _poses(robot, 15, 4)
     q, valid, exact = G.solve(gp, T)
-    assert exact.all()                                            # generic poses: 8 exact branches
+    assert exact.all()  # generic poses: 8 exact branches
     for i in range(len(T)):
         for k in range(8):
             assert np.abs(_fk(robot, robot.chain.configuration(q[i, k])) - T[i]).max() < 1e-9
@@ -125,13 +158,18 @@ def test_reversed_class_prosthetic_arm():
     # the book method (registered) and the class solver find the same solutions inside the limits
     book = aa.ik.analytic_batch(robot, T)
     for i in range(len(T)):
-        ours = np.array([x for x in q[i] if ((x >= robot.lower - 1e-9) & (x <= robot.upper + 1e-9)).all()])
+        ours = np.array(
+            [x for x in q[i] if ((x >= robot.lower - 1e-9) & (x <= robot.upper + 1e-9)).all()]
+        )
         assert len(ours) == len(book[i])
 
 
 def test_branch_counts_and_values_equal_ik_geo(tmp_path):
     ik_geo = pytest.importorskip("ik_geo")
-    arms = _arms(tmp_path) + [("prosthetic_arm", aa.load("prosthetic_arm")), ("sixr_arm", aa.load("sixr_arm"))]
+    arms = _arms(tmp_path) + [
+        ("prosthetic_arm", aa.load("prosthetic_arm")),
+        ("sixr_arm", aa.load("sixr_arm")),
+    ]
     for label, robot in arms:
         gp = G.plan_for(robot)
         geo = getattr(ik_geo.Robot, gp.cls)(gp.H.tolist(), gp.P.tolist())
@@ -142,7 +180,9 @@ def test_branch_counts_and_values_equal_ik_geo(tmp_path):
             R, p = T[i, :3, :3], T[i, :3, 3]
             if gp.reversed:
                 R, p = R.T, -R.T @ p
-            theirs = np.array([s for s, ls in geo.get_ik((R @ gp.R_tool.T).T.tolist(), p.tolist()) if not ls])
+            theirs = np.array(
+                [s for s, ls in geo.get_ik((R @ gp.R_tool.T).T.tolist(), p.tolist()) if not ls]
+            )
             if gp.reversed:
                 theirs = theirs[:, ::-1]
             theirs = theirs[:, gp.order]
@@ -161,7 +201,7 @@ def test_branch_counts_and_values_equal_ik_geo(tmp_path):
 def test_unreachable_pose_says_so():
     robot = aa.load("ur5")
     T = np.eye(4)
-    T[:3, 3] = [3.0, 0.0, 0.0]                                     # 3 m: out of reach
+    T[:3, 3] = [3.0, 0.0, 0.0]  # 3 m: out of reach
     r = aa.ik.analytic(robot, T)
     assert not r.success and r.solutions.shape == (0, 6) and "outside the workspace" in r.reason
     b = aa.ik.analytic_batch(robot, np.stack([T, robot.fk(robot.neutral())]))
@@ -194,15 +234,21 @@ def test_bad_rotation_and_options():
     assert len(empty) == 0
     # a batch: the compiled call finds the bad pose; the message names it as the caller indexed it
     Ts = robot.fk(robot.random_q(8, np.random.default_rng(1)))
-    for i, fix in ((5, lambda M: M[:3, :3].__imul__(1.01)), (2, lambda M: M[3].__setitem__(0, 0.1)),
-                   (7, lambda M: M[:3, :3].__setitem__(slice(None), -M[:3, :3]))):
+    for i, fix in (
+        (5, lambda M: M[:3, :3].__imul__(1.01)),
+        (2, lambda M: M[3].__setitem__(0, 0.1)),
+        (7, lambda M: M[:3, :3].__setitem__(slice(None), -M[:3, :3])),
+    ):
         bad = Ts.copy()
         fix(bad[i])
         with pytest.raises(ValueError, match=rf"T\[{i}\]"):
             aa.ik.analytic_batch(robot, bad)
     with pytest.raises(ValueError, match="param"):
-        aa.ik.analytic_batch(aa.load("panda"), np.repeat(aa.load("panda").fk(aa.load("panda").neutral())[None], 3, 0),
-                             param=[[0.1, np.nan]])
+        aa.ik.analytic_batch(
+            aa.load("panda"),
+            np.repeat(aa.load("panda").fk(aa.load("panda").neutral())[None], 3, 0),
+            param=[[0.1, np.nan]],
+        )
     # a held joint that is not an angle (inf, or so large its digits below a turn are lost):
     # a clear error from the single-pose path and the batch (once an endless 2π-shifting loop)
     panda = aa.load("panda")
@@ -220,14 +266,22 @@ def test_near_intersecting_axes_within_tolerance_are_polished(tmp_path):
     """Wrist axes 1e-7 m from a common point: classified spherical within tol = 1e-6 (the
     classification reports 5e-8 m: the least-squares common point lies midway), so the class
     solution is off by ~1e-7; it is polished onto the pose and then FK-exact."""
-    robot = dh_urdf(tmp_path, "puma_off", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
-                    [0, 0.4318, 0.0203, 0, 0, 0], [0.6718, 0, 0.15005, 0.4318, 1e-7, 0])
+    robot = dh_urdf(
+        tmp_path,
+        "puma_off",
+        [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
+        [0, 0.4318, 0.0203, 0, 0, 0],
+        [0.6718, 0, 0.15005, 0.4318, 1e-7, 0],
+    )
     gp = G.plan_for(robot)
-    assert gp.cls == C.SPHERICAL_TWO_PARALLEL and abs(gp.classification.worst_accepted[0] - 5e-8) < 1e-12
+    assert (
+        gp.cls == C.SPHERICAL_TWO_PARALLEL
+        and abs(gp.classification.worst_accepted[0] - 5e-8) < 1e-12
+    )
     th, T = _poses(robot, 1, 8)
     q, _, exact = G.solve(gp, T)
     raw = max(np.abs(_fk(robot, x) - T[0]).max() for x in q[0][exact[0]])
-    assert 1e-9 < raw < 1e-6                                # the class solution alone is not exact
+    assert 1e-9 < raw < 1e-6  # the class solution alone is not exact
     r = aa.ik.analytic(robot, T[0])
     assert r.success and all(np.abs(_fk(robot, x) - T[0]).max() < 1e-9 for x in r.solutions)
 
@@ -237,10 +291,16 @@ def test_polished_solutions_of_continuous_joints_come_out_polished(tmp_path):
     candidates and writes their configurations, the (cos, sin) pairs of the polished angles —
     Pinocchio's FK of every solution, one pose and a batch, is the pose to 1e-9 (the class
     solution's pairs would be ~1e-7 off)."""
-    text = standard_dh_urdf("puma_off_cont", [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0], [0, 0.4318, 0.0203, 0, 0, 0],
-                            [0.6718, 0, 0.15005, 0.4318, 1e-7, 0])
+    text = standard_dh_urdf(
+        "puma_off_cont",
+        [PI / 2, 0, -PI / 2, PI / 2, -PI / 2, 0],
+        [0, 0.4318, 0.0203, 0, 0, 0],
+        [0.6718, 0, 0.15005, 0.4318, 1e-7, 0],
+    )
     for j in ("j1", "j4", "j6"):
-        text = text.replace(f'<joint name="{j}" type="revolute">', f'<joint name="{j}" type="continuous">')
+        text = text.replace(
+            f'<joint name="{j}" type="revolute">', f'<joint name="{j}" type="continuous">'
+        )
     path = tmp_path / "puma_off_cont.urdf"
     path.write_text(text)
     robot = aa.load(str(path))
@@ -248,7 +308,10 @@ def test_polished_solutions_of_continuous_joints_come_out_polished(tmp_path):
     th, T = _poses(robot, 6, 8)
     gp = G.plan_for(robot)
     q, _, exact = G.solve(gp, T[:1])
-    assert max(np.abs(_fk(robot, robot.chain.configuration(x)) - T[0]).max() for x in q[0][exact[0]]) > 1e-9
+    assert (
+        max(np.abs(_fk(robot, robot.chain.configuration(x)) - T[0]).max() for x in q[0][exact[0]])
+        > 1e-9
+    )
     ch = robot.chain
     cos_at = [ch.joints[j].idx_q for j in ch.independent if ch.joints[j].kind == "continuous"]
     assert len(cos_at) == 3
@@ -258,14 +321,18 @@ def test_polished_solutions_of_continuous_joints_come_out_polished(tmp_path):
         assert len(one) > 0 and one.solutions.shape[1] == 9
         for x in list(one.solutions) + list(batch.solutions[i][batch.valid[i]]):
             assert np.abs(_fk(robot, x) - T[i]).max() < 1e-9
-            np.testing.assert_allclose(np.hypot(x[cos_at], x[[k + 1 for k in cos_at]]), 1.0, atol=1e-15)
+            np.testing.assert_allclose(
+                np.hypot(x[cos_at], x[[k + 1 for k in cos_at]]), 1.0, atol=1e-15
+            )
 
 
 def test_no_closed_form_geometry():
-    robot = aa.load("rrprr5")                                     # 5 joints, one prismatic
+    robot = aa.load("rrprr5")  # 5 joints, one prismatic
     assert C.classify(robot).name == C.NOT_6R and G.plan_for(robot) is None
     assert not aa.ik.has_analytic(robot)
-    with pytest.raises(UnsupportedModelError, match="no closed form for this geometry.*not_6r.*aa.ik.solve"):
+    with pytest.raises(
+        UnsupportedModelError, match="no closed form for this geometry.*not_6r.*aa.ik.solve"
+    ):
         aa.ik.analytic(robot, np.eye(4))
 
 
@@ -274,9 +341,15 @@ def test_general_6r_by_a_2d_search(tmp_path):
     (q1, q2) finds the sampled posture on every pose (no completeness claim), each branch
     FK-exact (Pinocchio, 1e-9)."""
     r = np.random.default_rng(0)
-    robot = dh_urdf(tmp_path, "gen6r", r.uniform(0.3, 1.3, 6), r.uniform(0.05, 0.4, 6), r.uniform(0.05, 0.4, 6))
+    robot = dh_urdf(
+        tmp_path, "gen6r", r.uniform(0.3, 1.3, 6), r.uniform(0.05, 0.4, 6), r.uniform(0.05, 0.4, 6)
+    )
     gp = G.plan_for(robot)
-    assert C.classify(robot).name == C.GEN_SIX_DOF and gp.cls == C.GEN_SIX_DOF and aa.ik.has_analytic(robot)
+    assert (
+        C.classify(robot).name == C.GEN_SIX_DOF
+        and gp.cls == C.GEN_SIX_DOF
+        and aa.ik.has_analytic(robot)
+    )
     th, T = _poses(robot, 8, 3)
     res = aa.ik.analytic_batch(robot, T)
     assert res.branches[0] == "q1q2root=0" and res.valid.any(1).all(), res.reasons
@@ -303,13 +376,13 @@ def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
         r = res[i]
         for q in r.solutions:
             assert np.abs(_fk(robot, q) - T[i]).max() < 1e-9
-            assert abs(np.angle(np.exp(1j * (q[6] - th[i, 6])))) < polish      # the parameter held
+            assert abs(np.angle(np.exp(1j * (q[6] - th[i, 6])))) < polish  # the parameter held
         d = np.abs(np.angle(np.exp(1j * (r.solutions - th[i])))).max(1)
         assert d.min() < max(polish, 1e-9)
-    grid = aa.ik.analytic(robot, T[0])                        # default: a grid of the held joint
+    grid = aa.ik.analytic(robot, T[0])  # default: a grid of the held joint
     assert len(grid) > 0 and all(np.abs(_fk(robot, q) - T[0]).max() < 1e-9 for q in grid.solutions)
     assert "param#" in grid.branches[0]
-    gb = aa.ik.analytic_batch(robot, T[:3])                   # the same grid for every pose of a batch
+    gb = aa.ik.analytic_batch(robot, T[:3])  # the same grid for every pose of a batch
     assert len(gb.branches) == gb.solutions.shape[1] == 8 * 12 and gb.valid.any(1).all()
     assert gb[0].branches == grid.branches
     with pytest.raises(ValueError, match="param: a 1-D array gives one angle per pose"):
@@ -323,7 +396,9 @@ def test_check_rows_pass(name):
     """The `anthroarm check` rows (FK(IK(T)) = T; branch counts = ik-geo's when installed) on a
     6R arm, a 7-joint arm (its sampled last joint held) and a reversed class."""
     rows = G.check_rows(aa.load(name), 8, np.random.default_rng(0))
-    assert len(rows) >= 1 and all(r.ok for r in rows), [(r.quantity, r.max_abs_err, r.note) for r in rows]
+    assert len(rows) >= 1 and all(r.ok for r in rows), [
+        (r.quantity, r.max_abs_err, r.note) for r in rows
+    ]
     assert rows[0].max_abs_err < 1e-9
     assert G.check_rows(aa.load("unimate5"), 8, np.random.default_rng(0)) == []
 
@@ -418,8 +493,14 @@ def test_standard_dh_urdf_is_the_dh_product_and_rejects_bad_rows(tmp_path):
         T = np.eye(4)
         for th, al, a, d in zip(q, PUMA560["alpha"], PUMA560["a"], PUMA560["d"]):
             ct, st, ca, sa = np.cos(th), np.sin(th), np.cos(al), np.sin(al)
-            T = T @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                              [0, sa, ca, d], [0, 0, 0, 1]])
+            T = T @ np.array(
+                [
+                    [ct, -st * ca, st * sa, a * ct],
+                    [st, ct * ca, -ct * sa, a * st],
+                    [0, sa, ca, d],
+                    [0, 0, 0, 1],
+                ]
+            )
         return T
 
     for q in robot.random_q(20, np.random.default_rng(5)):
@@ -441,9 +522,12 @@ def test_singular_poses_say_so_and_stay_exact(tmp_path):
     coincide (the elbow; at a wrist family one member is returned), and `singular` says so;
     the Jacobian volume it uses is checked against numpy's SVD of Pinocchio's Jacobian (zero
     smallest singular value exactly when the volume vanishes).  A generic pose is not singular."""
-    cases = [(puma560(tmp_path), [0.2, 0.3, 0.4, 0.5, 0.0, 0.6], False),
-             (aa.load("sixr_arm"), [0.3, 0.5, 0.0, 0.2, 0.0, 0.4], False),
-             (aa.load("ur5"), [0.3, -1.0, 1.0, -0.5, 0.0, 0.2], False), (aa.load("ur5"), [0.3, -1.0, 0.0, -0.5, 0.7, 0.2], True)]
+    cases = [
+        (puma560(tmp_path), [0.2, 0.3, 0.4, 0.5, 0.0, 0.6], False),
+        (aa.load("sixr_arm"), [0.3, 0.5, 0.0, 0.2, 0.0, 0.4], False),
+        (aa.load("ur5"), [0.3, -1.0, 1.0, -0.5, 0.0, 0.2], False),
+        (aa.load("ur5"), [0.3, -1.0, 0.0, -0.5, 0.7, 0.2], True),
+    ]
     for robot, q, among in cases:
         q = np.array(q)
         T = _fk(robot, q)
@@ -472,18 +556,25 @@ def test_into_limits_takes_the_turn_nearest_zero():
     two_pi = 2 * np.pi
     lo = np.array([-two_pi, 0.0, -np.pi, -3 * np.pi, -np.inf, -1.0])
     hi = np.array([two_pi, two_pi, 0.0, 3 * np.pi, np.inf, 1.0])
-    Q = np.array([[0.4, -0.5, 0.2, 7.0, 4.0, 1.0 + 1e-10],
-                  [3.5, 0.3, -0.5 + two_pi, -7.0, -4.0, 2.0]])
+    Q = np.array(
+        [[0.4, -0.5, 0.2, 7.0, 4.0, 1.0 + 1e-10], [3.5, 0.3, -0.5 + two_pi, -7.0, -4.0, 2.0]]
+    )
     Qw, inside = G.wrap_into_limits(Q, lo, hi)
-    np.testing.assert_allclose(Qw[0], [0.4, two_pi - 0.5, 0.2, 7.0 - two_pi, 4.0 - two_pi, 1.0], atol=1e-12)
-    assert not inside[0]                                   # 0.2 has no turn in [−π, 0]
-    np.testing.assert_allclose(Qw[1, :5], [3.5 - two_pi, 0.3, -0.5, -7.0 + two_pi, -4.0 + two_pi], atol=1e-12)
-    assert not inside[1]                                   # 2.0 has no turn in [−1, 1]
+    np.testing.assert_allclose(
+        Qw[0], [0.4, two_pi - 0.5, 0.2, 7.0 - two_pi, 4.0 - two_pi, 1.0], atol=1e-12
+    )
+    assert not inside[0]  # 0.2 has no turn in [−π, 0]
+    np.testing.assert_allclose(
+        Qw[1, :5], [3.5 - two_pi, 0.3, -0.5, -7.0 + two_pi, -4.0 + two_pi], atol=1e-12
+    )
+    assert not inside[1]  # 2.0 has no turn in [−1, 1]
     assert G.wrap_into_limits(Q[:, :5], lo[:5], hi[:5])[1][1]
     ur5 = aa.load("ur5")
     q = np.array([0.4, -1.1, 1.3, -0.6, 0.9, 0.2])
     r = aa.ik.analytic(ur5, _fk(ur5, q))
-    assert np.abs(r.solutions - q).max(1).min() < 1e-9     # the sampled angles themselves, no turn added
+    assert (
+        np.abs(r.solutions - q).max(1).min() < 1e-9
+    )  # the sampled angles themselves, no turn added
 
 
 def test_into_limit_keeps_the_rotation_of_a_turn_and_recomputes_it_on_a_limit():
@@ -494,12 +585,12 @@ def test_into_limit_keeps_the_rotation_of_a_turn_and_recomputes_it_on_a_limit():
     c, s = math.cos(x), math.sin(x)
     q, qc, qs, ok = G.into_limit_cs(x, c, s, 0.0, 2 * np.pi, True)
     assert ok and q == pytest.approx(2 * np.pi - 0.5, abs=1e-15)
-    assert (qc, qs) == (c, s)                                    # the turn: the same numbers
+    assert (qc, qs) == (c, s)  # the turn: the same numbers
     assert abs(qc - math.cos(q)) < 1e-15 and abs(qs - math.sin(q)) < 1e-15
-    x = 1.0 + 5e-10                                              # onto the limit 1.0
+    x = 1.0 + 5e-10  # onto the limit 1.0
     q, qc, qs, ok = G.into_limit_cs(x, math.cos(x), math.sin(x), -1.0, 1.0, True)
     assert ok and q == 1.0 and (qc, qs) == (math.cos(1.0), math.sin(1.0))
-    x = 1.0 + 5e-10 + 2 * np.pi                                  # a turn, then onto the limit 1.0
+    x = 1.0 + 5e-10 + 2 * np.pi  # a turn, then onto the limit 1.0
     q, qc, qs, ok = G.into_limit_cs(x, math.cos(x), math.sin(x), -1.0, 1.0, True)
     assert ok and q == 1.0 and (qc, qs) == (math.cos(1.0), math.sin(1.0))
 
@@ -510,7 +601,12 @@ def test_results_pickle_with_their_singular_text(tmp_path):
     import pickle
 
     robot = puma560(tmp_path)
-    T = np.stack([_fk(robot, np.array(q)) for q in ([0.2, 0.3, 0.4, 0.5, 0.0, 0.6], [0.2, 0.3, 0.4, 0.5, 0.7, 0.6])])
+    T = np.stack(
+        [
+            _fk(robot, np.array(q))
+            for q in ([0.2, 0.3, 0.4, 0.5, 0.0, 0.6], [0.2, 0.3, 0.4, 0.5, 0.7, 0.6])
+        ]
+    )
     one = pickle.loads(pickle.dumps(aa.ik.analytic(robot, T[0])))
     assert one.singular and "singular configuration" in one.singular
     batch = pickle.loads(pickle.dumps(aa.ik.analytic_batch(robot, T)))
@@ -535,7 +631,7 @@ def test_local_frames_fk_is_pinocchios():
         n = len(plan.fk_axes)
         for q in robot.random_q(10, rng=rng):
             th = np.empty(n)
-            th[plan.order] = robot.angles(q)                    # path order
+            th[plan.order] = robot.angles(q)  # path order
             R, t = G._chain_fk(A, th, n)
             F = _fk(robot, q)
             np.testing.assert_allclose(np.array(R), F[:3, :3], atol=1e-12, err_msg=name)
@@ -543,8 +639,12 @@ def test_local_frames_fk_is_pinocchios():
             if robot.nq == n and name != "human_arm7":
                 J = np.empty((6, 6))
                 G._chain_jacobian(A, th, n, J)
-                Jp = pin.computeFrameJacobian(robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED)
-                np.testing.assert_allclose(J, Jp[:, np.argsort(plan.order)[:6]], atol=1e-12, err_msg=name)
+                Jp = pin.computeFrameJacobian(
+                    robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED
+                )
+                np.testing.assert_allclose(
+                    J, Jp[:, np.argsort(plan.order)[:6]], atol=1e-12, err_msg=name
+                )
 
 
 def test_target_errors_are_pinocchios():
@@ -563,10 +663,12 @@ def test_target_errors_are_pinocchios():
         axis /= np.linalg.norm(axis)
         angle = [1e-7, 0.3, 2.0, np.pi - 1e-9, np.pi][k % 5]
         T = (F * pin.SE3(pin.exp3(angle * axis), rng.normal(scale=0.02, size=3))).homogeneous
-        assert plan.order_is_path and robot.nq == n            # ur5: q is θ in path order
+        assert plan.order_is_path and robot.nq == n  # ur5: q is θ in path order
         pe, re = G._target_errors(A, q, n, np.ascontiguousarray(T))
         assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-13)
-        assert re == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13)
+        assert re == pytest.approx(
+            np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13
+        )
 
 
 def test_continuous_joints_come_out_as_the_chains_configuration():
@@ -597,10 +699,17 @@ def test_solve_answers_a_closed_class_from_the_compiled_call():
         for q in robot.random_q(10, rng=3):
             T = _fk(robot, q)
             r = aa.ik.solve(robot, T)
-            assert r.success and r.seed == "analytic" and r.iterations == 0 and robot.within_limits(r.q), name
+            assert (
+                r.success
+                and r.seed == "analytic"
+                and r.iterations == 0
+                and robot.within_limits(r.q)
+            ), name
             F = pin.SE3(_fk(robot, r.q))
             assert r.pos_err == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-14)
-            assert r.rot_err == pytest.approx(np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-12)
+            assert r.rot_err == pytest.approx(
+                np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-12
+            )
 
 
 @pytest.fixture(scope="module")
@@ -635,7 +744,9 @@ def test_tree_is_solved_by_its_arm(panda_with_fingers):
             assert np.abs(_fk(robot, x)[:3] - T[:3]).max() < 1e-9 and robot.within_limits(x)
         rest = q.copy()
         rest[iq] = 0.031
-        assert np.allclose(aa.ik.analytic(robot, T, param=q[6], q_rest=rest).solutions[:, iq], 0.031)
+        assert np.allclose(
+            aa.ik.analytic(robot, T, param=q[6], q_rest=rest).solutions[:, iq], 0.031
+        )
     Ts = np.array([_fk(robot, q) for q in robot.random_q(6, rng=12)])
     b = aa.ik.analytic_batch(robot, Ts, param=0.3)
     assert b.solutions.shape == (6, b.valid.shape[1], 8)
@@ -643,7 +754,7 @@ def test_tree_is_solved_by_its_arm(panda_with_fingers):
     with pytest.raises(ValueError, match="q_rest"):
         aa.ik.analytic(robot, Ts[0], param=0.3, q_rest=np.zeros(7))
     far = robot.neutral()
-    far[iq] = 5.0                               # the finger's range is [0, 0.04] m
+    far[iq] = 5.0  # the finger's range is [0, 0.04] m
     with pytest.raises(ValueError, match="panda_finger_joint1 outside the joint limits"):
         aa.ik.analytic(robot, Ts[0], param=0.3, q_rest=far)
 
@@ -667,10 +778,12 @@ def test_tree_keeps_a_mimic_joint_following_its_arm(tmp_path):
     ur5 = aa.load("ur5")
     text = ur5.info.text
     link = '<link name="coupled_finger"/>'
-    joint = ('<joint name="coupled" type="revolute"><parent link="forearm_link"/><child link="coupled_finger"/>'
-             '<origin xyz="0 0.1 0" rpy="0 0 0"/><axis xyz="0 0 1"/>'
-             '<limit effort="1" lower="-6.3" upper="6.3" velocity="1"/>'
-             '<mimic joint="elbow_joint" multiplier="0.5" offset="0.1"/></joint>')
+    joint = (
+        '<joint name="coupled" type="revolute"><parent link="forearm_link"/><child link="coupled_finger"/>'
+        '<origin xyz="0 0.1 0" rpy="0 0 0"/><axis xyz="0 0 1"/>'
+        '<limit effort="1" lower="-6.3" upper="6.3" velocity="1"/>'
+        '<mimic joint="elbow_joint" multiplier="0.5" offset="0.1"/></joint>'
+    )
     f = tmp_path / "ur5_coupled.urdf"
     f.write_text(text.replace("</robot>", link + joint + "</robot>"))
     robot = aa.load(str(f), tool=ur5.tool, check_meshes=False)
@@ -692,11 +805,13 @@ def test_first_solve_is_not_charged_for_loading_the_kernel():
     import subprocess
     import sys
 
-    code = ("import numpy as np, anthroarm as aa\n"
-            "robot = aa.load('panda')\n"
-            "T = robot.fk(robot.random_q(rng=4))\n"
-            "r = aa.ik.solve(robot, T, q0=robot.random_q(rng=9), analytic=False, max_time=0.002)\n"
-            "print(r.success, r.status)\n")
+    code = (
+        "import numpy as np, anthroarm as aa\n"
+        "robot = aa.load('panda')\n"
+        "T = robot.fk(robot.random_q(rng=4))\n"
+        "r = aa.ik.solve(robot, T, q0=robot.random_q(rng=9), analytic=False, max_time=0.002)\n"
+        "print(r.success, r.status)\n"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split()[0] == "True", out.stdout
@@ -709,17 +824,25 @@ def test_tree_without_a_closed_form_says_how_to_get_one():
     assert not aa.ik.has_analytic(talos)
     with pytest.raises(UnsupportedModelError, match="lock joints on the path"):
         aa.ik.analytic(talos, talos.fk(talos.neutral()))
-    locked = aa.load("talos", tool="gripper_left_base_link", locked=["torso_1_joint", "torso_2_joint"])
+    locked = aa.load(
+        "talos", tool="gripper_left_base_link", locked=["torso_1_joint", "torso_2_joint"]
+    )
     assert aa.ik.has_analytic(locked) and closed_form_info(locked).param
     q = locked.random_q(rng=14)
-    res = aa.ik.analytic(locked, _fk(locked, q), param=float(q[locked.chain.joints[locked.chain.path(locked.tool_id)[-1]].idx_q]))
+    res = aa.ik.analytic(
+        locked,
+        _fk(locked, q),
+        param=float(q[locked.chain.joints[locked.chain.path(locked.tool_id)[-1]].idx_q]),
+    )
     assert len(res) >= 1
     for x in res.solutions:
         assert np.abs(_fk(locked, x)[:3] - _fk(locked, q)[:3]).max() < 1e-9
 
 
-@pytest.mark.parametrize("name, tip, family", [("talos", "left_sole_link", C.SPHERICAL_TWO_PARALLEL),
-                                               ("solo8", "HR_FOOT", "planar_2r")])
+@pytest.mark.parametrize(
+    "name, tip, family",
+    [("talos", "left_sole_link", C.SPHERICAL_TWO_PARALLEL), ("solo8", "HR_FOOT", "planar_2r")],
+)
 def test_legs_of_a_humanoid_and_a_quadruped_in_closed_form(name, tip, family):
     """Trees from example-robot-data: the humanoid's 6R leg (32 joints in all) and the
     quadruped's 2R leg (position only) are solved by the closed form of the joints on the path
@@ -735,7 +858,11 @@ def test_legs_of_a_humanoid_and_a_quadruped_in_closed_form(name, tip, family):
         assert len(res) >= 1
         for x in res.solutions:
             F = _fk(robot, x)
-            err = np.abs(F[:3, 3] - T[:3, 3]).max() if info.position_only else np.abs(F[:3] - T[:3]).max()
+            err = (
+                np.abs(F[:3, 3] - T[:3, 3]).max()
+                if info.position_only
+                else np.abs(F[:3] - T[:3]).max()
+            )
             assert err < 1e-9 and robot.within_limits(x)
             assert np.array_equal(np.delete(x, on), np.delete(q, on))
 
@@ -758,7 +885,9 @@ def test_any_tip_of_a_tree_by_frame():
         assert len(res) >= 1
         for x in res.solutions:
             pin.framesForwardKinematics(talos.model, data, x)
-            assert np.abs(data.oMf[fid].homogeneous[:3] - T[:3]).max() < 1e-9 and talos.within_limits(x)
+            assert np.abs(
+                data.oMf[fid].homogeneous[:3] - T[:3]
+            ).max() < 1e-9 and talos.within_limits(x)
         batch = aa.ik.analytic_batch(talos, T[None], frame=fid)
         assert batch.valid.sum() == len(aa.ik.analytic(talos, T, frame=fid))
         r = aa.ik.solve(talos, T, frame="right_sole_link")
@@ -786,11 +915,20 @@ def test_frame_keeps_the_comfortable_posture_and_refuses_a_shared_name():
     q = arm.random_q(rng=61)
     res = aa.ik.analytic(arm, arm.fk(q, frame), frame=frame)
     assert len(res) >= 1
-    assert np.array_equal(np.delete(res.solutions, on, axis=1)[0], np.delete(comfortable_posture(arm), on))
+    assert np.array_equal(
+        np.delete(res.solutions, on, axis=1)[0], np.delete(comfortable_posture(arm), on)
+    )
     m = arm.model.copy()
     hand = m.frames[m.getFrameId("hand")]
-    dup = m.addFrame(pin.Frame("hand", hand.parentJoint, m.getFrameId("hand"),
-                               hand.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1])), pin.FrameType.OP_FRAME))
+    dup = m.addFrame(
+        pin.Frame(
+            "hand",
+            hand.parentJoint,
+            m.getFrameId("hand"),
+            hand.placement * pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1])),
+            pin.FrameType.OP_FRAME,
+        )
+    )
     robot = aa.Robot(m, name="dup", tool=arm.tool)
     assert robot.chain.frame(dup).index == dup != robot.chain.frame("hand").index
     T = robot.fk(robot.random_q(rng=62), dup)
@@ -799,7 +937,9 @@ def test_frame_keeps_the_comfortable_posture_and_refuses_a_shared_name():
         aa.ik.analytic(robot, T, frame=dup)
     r = aa.ik.solve(robot, T, frame=dup, posture=None)
     assert r.success and r.seed != "analytic"
-    assert r.pos_err == pytest.approx(np.linalg.norm(robot.fk(r.q, dup)[:3, 3] - T[:3, 3]), abs=1e-12)
+    assert r.pos_err == pytest.approx(
+        np.linalg.norm(robot.fk(r.q, dup)[:3, 3] - T[:3, 3]), abs=1e-12
+    )
 
 
 def _special_q(robot, n, seed):
@@ -812,7 +952,20 @@ def _special_q(robot, n, seed):
     for q in Q:
         for j in range(robot.nq):
             if rng.random() < 0.4:
-                q[j] = rng.choice([0.0, PI / 2, -PI / 2, PI, -PI, PI - 1e-12, lo[j], hi[j], lo[j] + 1e-11, hi[j] - 1e-11])
+                q[j] = rng.choice(
+                    [
+                        0.0,
+                        PI / 2,
+                        -PI / 2,
+                        PI,
+                        -PI,
+                        PI - 1e-12,
+                        lo[j],
+                        hi[j],
+                        lo[j] + 1e-11,
+                        hi[j] - 1e-11,
+                    ]
+                )
         np.clip(q, lo, hi, out=q)
     return Q
 
@@ -824,11 +977,19 @@ def test_reported_residuals_are_pinocchios_of_the_returned_angles(tmp_path):
     the residual of a polished candidate before its joint was put onto a limit (a PUMA 560 with
     q1 = −π at q5 = 0: reported 2.6e-16, true 5.5e-10, returned at tol = 1e-11)."""
     puma = puma560(tmp_path)
-    arms = [puma, aa.load("ur5"), aa.load("sixr_arm"), aa.load("prosthetic_arm"), aa.load("talos_arm")]
+    arms = [
+        puma,
+        aa.load("ur5"),
+        aa.load("sixr_arm"),
+        aa.load("prosthetic_arm"),
+        aa.load("talos_arm"),
+    ]
     T0 = _fk(puma, np.array([-PI, 1.970655768409248, 2.511687152757056, 0.0, 0.0, PI - 1e-12]))
     checked = 0
     for robot in arms:
-        Ts = [_fk(robot, q) for q in np.vstack([robot.random_q(20, rng=2), _special_q(robot, 40, 3)])]
+        Ts = [
+            _fk(robot, q) for q in np.vstack([robot.random_q(20, rng=2), _special_q(robot, 40, 3)])
+        ]
         if robot is puma:
             Ts.append(T0)
         for tol in (1e-9, 1e-11):
@@ -846,10 +1007,22 @@ def test_carried_cos_sin_are_those_of_the_returned_angle(tmp_path):
     found: cos and sin must be those of the θ they return (the FK check rotates by them), on
     every closed class — reversed chains, axes 3 and 4 antiparallel to 2 (the sign flips of the
     three-parallel tail), singular poses where a subproblem returns (0, 1, 0)."""
-    arms = [puma560(tmp_path), aa.load("ur5"), aa.load("prosthetic_arm"), aa.load("talos_arm"), aa.load("kinova"),
-            random_arm(tmp_path, C.SPHERICAL, 4), random_arm(tmp_path, C.THREE_PARALLEL, 5),
-            dh_urdf(tmp_path, "ur5_antiparallel", [PI / 2, 0, PI, PI / 2, -PI / 2, 0],
-                    [0, -0.425, 0.392, 0, 0, 0], [0.089, 0, 0, 0.109, 0.095, 0.082])]
+    arms = [
+        puma560(tmp_path),
+        aa.load("ur5"),
+        aa.load("prosthetic_arm"),
+        aa.load("talos_arm"),
+        aa.load("kinova"),
+        random_arm(tmp_path, C.SPHERICAL, 4),
+        random_arm(tmp_path, C.THREE_PARALLEL, 5),
+        dh_urdf(
+            tmp_path,
+            "ur5_antiparallel",
+            [PI / 2, 0, PI, PI / 2, -PI / 2, 0],
+            [0, -0.425, 0.392, 0, 0, 0],
+            [0.089, 0, 0, 0.109, 0.095, 0.082],
+        ),
+    ]
     rows = 0
     for robot in arms:
         plan = G.plan_for(robot)
@@ -859,11 +1032,17 @@ def test_carried_cos_sin_are_those_of_the_returned_angle(tmp_path):
         R06, p06 = G.class_pose(plan, T, None if plan.param_joint is None else 0.0)
         B = np.empty((8, G.BRANCH_ROW))
         for i in range(len(T)):
-            G._solve_closed(cls, G.rows6(H), G.rows7(P), G.mat(np.ascontiguousarray(R06[i])), G.vec(p06[i]), B)
+            G._solve_closed(
+                cls, G.rows6(H), G.rows7(P), G.mat(np.ascontiguousarray(R06[i])), G.vec(p06[i]), B
+            )
             ex = B[:, G.EXISTS] != 0
             th = B[ex, :6]
-            np.testing.assert_allclose(B[ex, G.COS:G.COS + 6], np.cos(th), atol=1e-14, err_msg=robot.name)
-            np.testing.assert_allclose(B[ex, G.SIN:G.SIN + 6], np.sin(th), atol=1e-14, err_msg=robot.name)
+            np.testing.assert_allclose(
+                B[ex, G.COS : G.COS + 6], np.cos(th), atol=1e-14, err_msg=robot.name
+            )
+            np.testing.assert_allclose(
+                B[ex, G.SIN : G.SIN + 6], np.sin(th), atol=1e-14, err_msg=robot.name
+            )
             rows += int(ex.sum())
     assert rows > 2000
 
@@ -879,10 +1058,17 @@ def test_srs_single_pose_is_the_batch_row():
     for q in Q:
         T = _fk(robot, q)
         a0 = swivel_angle(robot, q)
-        for sw in (a0, float(a0), 2.5):             # a numpy scalar (general path), floats (one call)
-            a, b = aa.ik.analytic(robot, T, swivel=sw), aa.ik.analytic_batch(robot, T[None], swivel=sw)[0]
+        for sw in (a0, float(a0), 2.5):  # a numpy scalar (general path), floats (one call)
+            a, b = (
+                aa.ik.analytic(robot, T, swivel=sw),
+                aa.ik.analytic_batch(robot, T[None], swivel=sw)[0],
+            )
             assert a.branches == b.branches and a.reason == b.reason
-            for x, y in ((a.solutions, b.solutions), (a.swivel, b.swivel), (a.residuals, b.residuals)):
+            for x, y in (
+                (a.solutions, b.solutions),
+                (a.swivel, b.swivel),
+                (a.residuals, b.residuals),
+            ):
                 np.testing.assert_array_equal(x, y)
     for q in Q[:5]:
         T = _fk(robot, q)
@@ -904,9 +1090,9 @@ def test_batch_singular_is_that_of_the_solutions_found():
             getattr(B, name)[0, 0] = 0.0
     assert B[0].singular is None
     one = B[0]
-    one.solutions[0, 4] = 0.0                                   # a copy: the batch is unchanged
+    one.solutions[0, 4] = 0.0  # a copy: the batch is unchanged
     assert B.solutions[0, 0, 4] != 0.0 and B[0].singular is None
-    tree = aa.load("human_upper_limb")                         # a tree's result, mapped onto the robot
+    tree = aa.load("human_upper_limb")  # a tree's result, mapped onto the robot
     Bt = aa.ik.analytic_batch(tree, _fk(tree, tree.random_q(rng=3))[None])
     with pytest.raises(ValueError, match="read-only"):
         Bt.solutions[0, 0] = 0.0
@@ -923,7 +1109,7 @@ def test_limits_reason_names_the_limits_of_the_joints_solved_for():
     texts = []
     for _ in range(20):
         th = rng.uniform(-np.pi, np.pi, 6)
-        th[1] = 0.3                                                  # joint 2 below its lower limit 0.82
+        th[1] = 0.3  # joint 2 below its lower limit 0.82
         r = aa.ik.analytic(robot, robot.fk(ch.configuration(th)))
         if len(r) == 0:
             texts.append(r.reason)
@@ -932,7 +1118,11 @@ def test_limits_reason_names_the_limits_of_the_joints_solved_for():
         assert "violate the joint limits" in text
         for j in ch.independent:
             joint = ch.joints[j]
-            want = "continuous" if joint.kind == "continuous" else f"[{joint.lower:.4g}, {joint.upper:.4g}]"
+            want = (
+                "continuous"
+                if joint.kind == "continuous"
+                else f"[{joint.lower:.4g}, {joint.upper:.4g}]"
+            )
             assert f"{joint.name} {want}" in text
         assert "[-1, 1]" not in text
 
@@ -969,10 +1159,22 @@ def test_a_reachable_pose_at_a_tangent_root_is_solved():
     violate the joint limits'."""
     robot = aa.load("panda")
     lo, hi = robot.lower, robot.upper
-    Q = [np.array([-2.8973, 1e-13, 2.89729999999, -1.7704468480934643, 2.8973, 2.127241565806812, 2.897299999])]
+    Q = [
+        np.array(
+            [
+                -2.8973,
+                1e-13,
+                2.89729999999,
+                -1.7704468480934643,
+                2.8973,
+                2.127241565806812,
+                2.897299999,
+            ]
+        )
+    ]
     rng = np.random.default_rng(12)
     for q in robot.random_q(60, rng=rng):
-        q[1] = rng.choice([0.0, 1e-13, -1e-13])                       # the shoulder singularity
+        q[1] = rng.choice([0.0, 1e-13, -1e-13])  # the shoulder singularity
         for j in (0, 2, 4, 6):
             if rng.random() < 0.5:
                 q[j] = rng.choice([lo[j], hi[j]])
@@ -983,7 +1185,6 @@ def test_a_reachable_pose_at_a_tangent_root_is_solved():
         assert len(r) > 0, (q.tolist(), r.reason)
         for s in r.solutions:
             assert np.abs(_fk(robot, s)[:3] - T[:3]).max() <= 1e-9 and robot.within_limits(s)
-
 
 
 @pytest.mark.parametrize("layout", ["fortran", "misaligned", "read_only", "list", "strided_view"])
@@ -1026,6 +1227,7 @@ def test_entry_point_is_the_kernel_for_those_types():
     for the kernel aa.ik.analytic calls (geometric.pose_solutions), and its result is
     analytic's."""
     from anthroarm import jit
+
     robot = aa.load("ur5")
     T = np.ascontiguousarray(_fk(robot, robot.random_q(1, rng=5)[0]))
     cf, ci = G.plan_for(robot).packed
@@ -1035,7 +1237,9 @@ def test_entry_point_is_the_kernel_for_those_types():
     m2 = G.pose_solutions(cf, ci, T, 0.0, 1e-9, 1e-6, b)
     assert m1 == m2 > 0
     res = aa.ik.analytic(robot, T)
-    assert np.array_equal(res.solutions, a[:len(res), :6]) and np.array_equal(res.residuals, a[:len(res), 6])
+    assert np.array_equal(res.solutions, a[: len(res), :6]) and np.array_equal(
+        res.residuals, a[: len(res), 6]
+    )
     K = bin(m1).count("1")
     assert np.array_equal(a, b, equal_nan=True) and not np.isnan(a[:K, :8]).any()
 
@@ -1058,4 +1262,9 @@ def test_singular_text_of_a_tree_is_that_of_its_arms_solutions():
         row = aa.ik.analytic_batch(robot, T[None], q_rest=q)[0]
         alone = aa.ik.analytic(arm, T)
         assert len(one) >= 1
-        assert (one.singular is not None) == (row.singular is not None) == (alone.singular is not None) == singular
+        assert (
+            (one.singular is not None)
+            == (row.singular is not None)
+            == (alone.singular is not None)
+            == singular
+        )

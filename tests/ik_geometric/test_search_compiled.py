@@ -16,7 +16,11 @@ from anthroarm.ik import subproblems as sp
 
 CLASSES = ("two_parallel", "two_intersecting", "gen_six_dof")
 #: (arm seeds, poses per arm) per class
-CASES = {"two_parallel": ((1, 2, 3), 16), "two_intersecting": ((1, 2, 3), 16), "gen_six_dof": ((1,), 8)}
+CASES = {
+    "two_parallel": ((1, 2, 3), 16),
+    "two_intersecting": ((1, 2, 3), 16),
+    "gen_six_dof": ((1,), 8),
+}
 
 
 def random_arm(cls, seed):
@@ -73,7 +77,10 @@ def test_contract_and_every_exact_branch_fk_verified(solved):
     cls, arms = solved
     for H, P, Q, R06, p, (q, valid, exact) in arms:
         n = len(p)
-        assert q.shape == (n, S.SEARCH_BRANCHES, 6) and valid.shape == exact.shape == (n, S.SEARCH_BRANCHES)
+        assert q.shape == (n, S.SEARCH_BRANCHES, 6) and valid.shape == exact.shape == (
+            n,
+            S.SEARCH_BRANCHES,
+        )
         assert (exact <= valid).all() and np.isnan(q[~valid]).all() and np.isfinite(q[valid]).all()
         assert (q[valid] > -np.pi).all() and (q[valid] <= np.pi).all()
         # slots are filled from the first, no two branches of a pose alike
@@ -118,11 +125,24 @@ def test_every_sampled_configuration_is_found_by_the_1d_searches(cls):
     a finer look was applied again where a followed root still jumps (by more than _JUMP)
     between its samples (two folds of the inner subproblem inside one finer interval, the solution on
     the arc between them; or a root turning fast past a near singularity)."""
-    for seed, pose_seed in ((1, 11), (3, 103), (4, 104), (5, 105), (6, 106), (6, 16), (9, 19), (9, 109)):
+    for seed, pose_seed in (
+        (1, 11),
+        (3, 103),
+        (4, 104),
+        (5, 105),
+        (6, 106),
+        (6, 16),
+        (9, 19),
+        (9, 109),
+    ):
         H, P = random_arm(cls, seed)
         Q, R06, p = poses(H, P, 100, pose_seed)
         q, valid, exact = S.solve_search(cls, H, P, R06, p)
-        missed = [i for i in range(len(p)) if not (exact[i].any() and _dist(q[i][exact[i]], Q[i]).min() < 1e-6)]
+        missed = [
+            i
+            for i in range(len(p))
+            if not (exact[i].any() and _dist(q[i][exact[i]], Q[i]).min() < 1e-6)
+        ]
         assert not missed, (cls, seed, pose_seed, missed)
         for i in range(len(p)):
             qi = q[i][valid[i]]
@@ -130,7 +150,12 @@ def test_every_sampled_configuration_is_found_by_the_1d_searches(cls):
                 assert _dist(qi[:k], qi[k]).min() >= 1e-8, (cls, seed, pose_seed, i)
             for s in q[i][exact[i]]:
                 R, x = fk(H, P, s)
-                assert max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-9, (cls, seed, pose_seed, i)
+                assert max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-9, (
+                    cls,
+                    seed,
+                    pose_seed,
+                    i,
+                )
 
 
 def test_exact_solutions_of_ik_geo_are_ours(solved):
@@ -151,10 +176,11 @@ def test_exact_solutions_of_ik_geo_are_ours(solved):
             ours = q[i][exact[i]]
             n_ours += len(ours)
             good = []
-            for s, _ls in geo.get_ik(R06[i].T.tolist(), p[i].tolist()):     # R as a list of columns
+            for s, _ls in geo.get_ik(R06[i].T.tolist(), p[i].tolist()):  # R as a list of columns
                 R, x = fk(H, P, np.array(s))
-                if max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-8 and \
-                        not (good and _dist(np.array(good), np.array(s)).min() < 1e-6):
+                if max(np.abs(R - R06[i]).max(), np.abs(x - p[i]).max()) < 1e-8 and not (
+                    good and _dist(np.array(good), np.array(s)).min() < 1e-6
+                ):
                     good.append(s)
                     assert len(ours) and _dist(ours, np.array(s)).min() < 1e-3, (cls, i, s)
             n_good += len(good)
@@ -172,7 +198,7 @@ def test_ik_geo_takes_the_rotation_transposed():
     H = r.normal(size=(6, 3))
     H /= np.linalg.norm(H, axis=1)[:, None]
     P = r.uniform(-0.3, 0.3, (7, 3))
-    P[4] = P[5] = 0.0                                   # a spherical wrist
+    P[4] = P[5] = 0.0  # a spherical wrist
     q0 = r.uniform(-np.pi, np.pi, 6)
     R, p = fk(H, P, q0)
     sols = ik_geo.Robot.spherical(H.tolist(), P.tolist()).get_ik(R.T.tolist(), p.tolist())
@@ -183,7 +209,9 @@ def test_unreachable_pose_and_bad_input():
     H, P = random_arm("two_intersecting", 1)
     R06, p = np.eye(3)[None], np.array([[5.0, 0.0, 0.0]])
     for cls in CLASSES:
-        q, valid, exact = S.solve_search(cls, H, P, R06, p, grid=16 if cls == "gen_six_dof" else None)
+        q, valid, exact = S.solve_search(
+            cls, H, P, R06, p, grid=16 if cls == "gen_six_dof" else None
+        )
         assert not exact.any() and np.isnan(q[~valid]).all()
     with pytest.raises(ValueError, match="cls must be one of"):
         S.solve_search("spherical", H, P, R06, p)

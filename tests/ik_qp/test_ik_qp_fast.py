@@ -5,8 +5,6 @@ compute_error), ``limits.combine``, ``quadprog.solve_qp`` called on the general 
 the checked path of ``targets.as_se3``.
 """
 
-import ctypes
-
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -33,7 +31,7 @@ def human():
 
 def _accumulated(tasks, conf):
     ws = _Workspace(conf.nv)
-    ws.Hc[:] = np.nan                       # the first task must overwrite, not add
+    ws.Hc[:] = np.nan  # the first task must overwrite, not add
     diag = 0.0
     for k, t in enumerate(tasks):
         diag += t._accumulate(conf, ws, k == 0)
@@ -68,9 +66,13 @@ def _task_zoo(robot, rng):
     rel.set_target_from_configuration(conf_b)
     w = rng.uniform(0.1, 2.0, robot.nv)
     tasks = [
-        qp.FrameTask(robot, target=T),                                              # W = I
-        qp.FrameTask(robot, position_cost=0.4, orientation_cost=0.4, lm_damping=1e-3, gain=0.6, target=T),
-        qp.FrameTask(robot, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2, target=T),
+        qp.FrameTask(robot, target=T),  # W = I
+        qp.FrameTask(
+            robot, position_cost=0.4, orientation_cost=0.4, lm_damping=1e-3, gain=0.6, target=T
+        ),
+        qp.FrameTask(
+            robot, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2, target=T
+        ),
         _MyFrameTask(robot, lm_damping=1e-3, target=T),
         qp.PostureTask(robot, cost=1e-3, target=qb),
         qp.PostureTask(robot, cost=w, gain=0.5, target=qb),
@@ -125,7 +127,7 @@ def test_frame_task_weights_follow_reassigned_cost_and_gain(panda):
     q, qt = panda.random_q(2, rng=rng)
     conf = qp.IKConfiguration(panda, q)
     t = qp.FrameTask(panda, lm_damping=1e-2, target=panda.fk(qt))
-    _accumulated([t], conf)                     # caches the weights of cost 1, gain 1
+    _accumulated([t], conf)  # caches the weights of cost 1, gain 1
     t.gain = 0.3
     t.cost = np.array([0.5, 1.0, 2.0, 0.1, 0.2, 0.3])
     J, e = t.compute_jacobian(conf), t.compute_error(conf)
@@ -150,9 +152,16 @@ def _box_cases(robot, rng):
         [qp.ConfigurationLimit(robot), qp.VelocityLimit(robot)],
         [qp.VelocityLimit(robot), qp.ConfigurationLimit(robot, gain=0.3)],
         [qp.ConfigurationLimit(robot, gain=1.0)],
-        [qp.ConfigurationLimit(robot, gain=0.5, lower=lo_inf), qp.VelocityLimit(robot, v_max=v_inf)],
+        [
+            qp.ConfigurationLimit(robot, gain=0.5, lower=lo_inf),
+            qp.VelocityLimit(robot, v_max=v_inf),
+        ],
         [qp.VelocityLimit(robot, v_max=np.full(robot.nv, np.inf))],
-        [qp.ConfigurationLimit(robot), qp.VelocityLimit(robot), qp.AccelerationLimit(robot, a_max=2.0)],
+        [
+            qp.ConfigurationLimit(robot),
+            qp.VelocityLimit(robot),
+            qp.AccelerationLimit(robot, a_max=2.0),
+        ],
         [],
     ]
     acc = lim_sets[5][2]
@@ -178,7 +187,7 @@ def test_in_place_box_equals_combine(name):
                 lo, hi = combine(lims, conf, dt)
                 assert np.array_equal(ws.lo, np.clip(lo, -BIG, BIG)), (lims, q)
                 assert np.array_equal(ws.hi, np.clip(hi, -BIG, BIG)), (lims, q)
-                assert np.array_equal(ws.B[robot.nv:], -ws.hi)
+                assert np.array_equal(ws.B[robot.nv :], -ws.hi)
 
 
 def test_in_place_box_skips_combine_inside_the_limits(panda, monkeypatch):
@@ -202,7 +211,7 @@ def test_velocity_limit_cache_follows_v_max_and_dt(panda):
     lim = qp.VelocityLimit(panda)
     conf = qp.IKConfiguration(panda)
     with pytest.raises(ValueError):
-        lim.v_max[0] = 1.0                      # read-only: replace it instead
+        lim.v_max[0] = 1.0  # read-only: replace it instead
     ws = _Workspace(panda.nv)
     for v_max, dt in [(None, 0.01), (None, 0.02), (np.full(7, 0.5), 0.02)]:
         if v_max is not None:
@@ -286,7 +295,7 @@ def _ws_from(H, c, lo, hi):
     ws.H[:] = H
     ws.c[:] = c
     ws.B[: len(c)] = lo
-    ws.B[len(c):] = -hi
+    ws.B[len(c) :] = -hi
     ws.hi[:] = hi
     return ws
 
@@ -339,9 +348,15 @@ def test_step_equals_general_assembly(name):
             q = q.copy()
             q[k % n] = robot.upper[k % n] + 0.2
         conf = qp.IKConfiguration(robot, q)
-        tasks = [qp.FrameTask(robot, lm_damping=1e-3, position_cost=[1.0, 1.0, 0.5],
-                              target=robot.fk(q + 0.1 * (qt - q))),
-                 qp.PostureTask(robot, cost=1e-2, target=qt)]
+        tasks = [
+            qp.FrameTask(
+                robot,
+                lm_damping=1e-3,
+                position_cost=[1.0, 1.0, 0.5],
+                target=robot.fk(q + 0.1 * (qt - q)),
+            ),
+            qp.PostureTask(robot, cost=1e-2, target=qt),
+        ]
         H, c = _summed(tasks, conf)
         H += 1e-12 * np.eye(n)
         lo, hi = combine(lims, conf, 0.01)
@@ -434,4 +449,4 @@ def test_osqp_without_certificate_tightens_and_restores(human, monkeypatch):
         seen.append(np.abs(out.v * 0.01 - x).max())
 
     _circle_steps(human, "osqp", 30, check)
-    assert max(seen) < 1e-4          # ADMM's own accuracy at eps 1e-11 (the pre-polish behaviour)
+    assert max(seen) < 1e-4  # ADMM's own accuracy at eps 1e-11 (the pre-polish behaviour)

@@ -20,7 +20,8 @@ def panda():
 def test_step_matches_pink(panda, solver):
     """Same tasks, same default limits (configuration gain 0.5 + velocity): same velocity."""
     import pink  # noqa: F401  (in the test extra: a missing pink must fail, not skip)
-    from pink.tasks import FrameTask as PFT, PostureTask as PPT
+    from pink.tasks import FrameTask as PFT
+    from pink.tasks import PostureTask as PPT
 
     rng = np.random.default_rng(11)
     q = panda.random_q(rng=rng, margin=0.05)
@@ -55,7 +56,9 @@ def test_backends_agree_with_quadprog_on_random_qps():
             c = rng.normal(size=n)
             lo, hi = -rng.random(n) * 0.5 - 0.05, rng.random(n) * 0.5 + 0.05
             A = rng.normal(size=(n_eq, n)) if n_eq else None
-            b = A @ (0.02 * rng.uniform(-1, 1, n)) if n_eq else None  # feasible: a point inside the box
+            b = (
+                A @ (0.02 * rng.uniform(-1, 1, n)) if n_eq else None
+            )  # feasible: a point inside the box
             xs = {s: be.solve(H, c, lo, hi, A, b) for s, be in bs.items()}
             ref = xs["quadprog"][0]
             for s, (x, status) in xs.items():
@@ -117,14 +120,14 @@ def test_start_outside_limits_is_pulled_back(panda):
     """pink#206: pink's QP is infeasible (or raises) when q starts outside its limits.  Here the
     joint moves back toward its range at the full velocity limit, then stays inside."""
     q = panda.neutral()
-    q[3] = 0.4            # upper limit is −0.0698 rad
+    q[3] = 0.4  # upper limit is −0.0698 rad
     conf = qp.IKConfiguration(panda, q)
     ee = qp.FrameTask(panda, target=_fk_unclipped(panda, q), lm_damping=1e-3)
     dt = 0.01
     vmax = panda.velocity_limit[3]
     out = qp.step(conf, None, [ee], dt, full=True)
     assert out.status == "optimal"
-    assert out.v[3] == pytest.approx(-vmax)   # full speed back toward the range
+    assert out.v[3] == pytest.approx(-vmax)  # full speed back toward the range
     inside_at = None
     for k in range(200):
         out = qp.step(conf, None, [ee], dt, full=True)
@@ -167,20 +170,35 @@ def test_unreachable_target_converges_to_closest_point():
         v = qp.step(conf, None, [task], 1.0, limits=None, solver="osqp")
         assert np.linalg.norm(v) < 2.0
         conf.integrate_inplace(v, 1.0)
-    assert np.linalg.norm(task.compute_error(conf)) == pytest.approx(1.0, abs=1e-4)  # reach 2 m, target 3 m
+    assert np.linalg.norm(task.compute_error(conf)) == pytest.approx(
+        1.0, abs=1e-4
+    )  # reach 2 m, target 3 m
 
 
 @pytest.mark.parametrize("solver", BACKENDS)
 def test_infeasible_constraint_gives_status_and_zero_step(panda, solver):
     conf = qp.IKConfiguration(panda, panda.neutral())
-    hard = qp.JointCouplingTask(panda, ["panda_joint1"], [1.0], offset=2.5)   # q1 = 2.5 now: too fast
-    out = qp.step(conf, None, [qp.PostureTask(panda)], 0.01, solver=solver, constraints=[hard], full=True)
+    hard = qp.JointCouplingTask(
+        panda, ["panda_joint1"], [1.0], offset=2.5
+    )  # q1 = 2.5 now: too fast
+    out = qp.step(
+        conf, None, [qp.PostureTask(panda)], 0.01, solver=solver, constraints=[hard], full=True
+    )
     assert out.status == "infeasible"
     assert np.all(out.v == 0.0)
     # a feasible equality holds exactly
-    hard2 = qp.JointCouplingTask(panda, ["panda_joint1", "panda_joint3"], [1.0, -1.0], offset=conf.q[0] - conf.q[2])
-    out = qp.step(conf, None, [qp.FrameTask(panda, target=panda.fk(panda.random_q(rng=3)))], 0.01,
-                  solver=solver, constraints=[hard2], full=True)
+    hard2 = qp.JointCouplingTask(
+        panda, ["panda_joint1", "panda_joint3"], [1.0, -1.0], offset=conf.q[0] - conf.q[2]
+    )
+    out = qp.step(
+        conf,
+        None,
+        [qp.FrameTask(panda, target=panda.fk(panda.random_q(rng=3)))],
+        0.01,
+        solver=solver,
+        constraints=[hard2],
+        full=True,
+    )
     assert out.ok and abs(out.v[0] - out.v[2]) < 1e-8
 
 
@@ -210,8 +228,8 @@ def test_book_newton_step_planar2r():
         v = qp.step(conf, None, [task], 1.0, limits=None, damping=0.0, solver="quadprog")
         conf.integrate_inplace(v, 1.0)
         its.append(conf.q.copy())
-    assert its[0][0] == pytest.approx(-2.000, abs=5e-4)        # book's printed θ1
-    assert its[0][1] == pytest.approx(4.2556, abs=5e-4)        # Newton (notes E3)
+    assert its[0][0] == pytest.approx(-2.000, abs=5e-4)  # book's printed θ1
+    assert its[0][1] == pytest.approx(4.2556, abs=5e-4)  # Newton (notes E3)
     assert np.allclose(its[1], [-0.6724, 1.8415], atol=5e-4)
     assert np.allclose(its[-1], [-np.pi / 3, 2 * np.pi / 3], atol=1e-10)
 

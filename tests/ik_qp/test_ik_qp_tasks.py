@@ -79,10 +79,13 @@ def test_swivel_jacobian_matches_finite_differences(human):
     assert n_checked >= 3
 
 
-@pytest.mark.parametrize("name, expected", [
-    ("human_arm7", ("shoulder_flexion", "elbow_flexion", "wrist_deviation")),
-    ("human_right_arm", ("right_shoulder_Z", "right_elbow_Z", "right_wrist_Z")),
-])
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        ("human_arm7", ("shoulder_flexion", "elbow_flexion", "wrist_deviation")),
+        ("human_right_arm", ("right_shoulder_Z", "right_elbow_Z", "right_wrist_Z")),
+    ],
+)
 def test_swivel_frames_from_the_chain_geometry(name, expected):
     """The (shoulder, elbow, wrist) frames are found from the joint origins (Pinocchio's joint
     placements at q = 0: three co-located shoulder joints, then the elbow and wrist groups),
@@ -105,7 +108,9 @@ def test_swivel_frames_without_a_human_layout():
     with pytest.raises(ValueError, match="frames="):
         qp.SwivelTask(panda)
     task = qp.SwivelTask(panda, frames=("panda_link1", "panda_link4", "panda_link7"))
-    assert task.frame_ids == tuple(panda.frame_id(f) for f in ("panda_link1", "panda_link4", "panda_link7"))
+    assert task.frame_ids == tuple(
+        panda.frame_id(f) for f in ("panda_link1", "panda_link4", "panda_link7")
+    )
 
 
 def test_swivel_angle_geometry():
@@ -117,7 +122,7 @@ def test_swivel_angle_geometry():
     down = np.array([0.0, 0.0, -1.0])
     perp = down - (down @ u) * u
     perp /= np.linalg.norm(perp)
-    E0 = S + 0.5 * (W - S) + 0.12 * perp       # elbow as low as possible: φ = 0
+    E0 = S + 0.5 * (W - S) + 0.12 * perp  # elbow as low as possible: φ = 0
     assert abs(swivel_from_points(S, E0, W)[0]) < 1e-12
     for ang in np.linspace(-3.0, 3.0, 13):
         R = pin.exp3(u * ang)
@@ -150,7 +155,7 @@ def test_swivel_angle_batch_and_straight_elbow(human):
         assert abs(np.angle(np.exp(1j * (phi - swivel_from_points(*P)[0])))) < 1e-12
         assert qp.swivel_angle(human, q) == pytest.approx(phi, abs=1e-12)
     q = human.random_q(rng=3)
-    q[human.joint_names.index("elbow_flexion")] = 0.0          # straight elbow
+    q[human.joint_names.index("elbow_flexion")] = 0.0  # straight elbow
     with pytest.raises(ValueError, match="straight arm"):
         swivel_from_points(*[human.fk(q, f)[:3, 3] for f in frames])
     phi = qp.swivel_angle(human, q)
@@ -160,7 +165,8 @@ def test_swivel_angle_batch_and_straight_elbow(human):
 
 def test_frame_and_posture_objectives_match_pink(panda):
     import pink  # noqa: F401  (in the test extra: a missing pink must fail, not skip)
-    from pink.tasks import FrameTask as PFT, PostureTask as PPT
+    from pink.tasks import FrameTask as PFT
+    from pink.tasks import PostureTask as PPT
 
     rng = np.random.default_rng(7)
     for _ in range(5):
@@ -168,15 +174,30 @@ def test_frame_and_posture_objectives_match_pink(panda):
         T = panda.fk(qt)
         conf = qp.IKConfiguration(panda, q)
         pc = pink.Configuration(panda.model, panda.model.createData(), q)
-        ours = qp.FrameTask(panda, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2, gain=0.7,
-                            target=T)
-        theirs = PFT(panda.tool, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2, gain=0.7)
+        ours = qp.FrameTask(
+            panda,
+            position_cost=[1.0, 0.5, 2.0],
+            orientation_cost=0.3,
+            lm_damping=1e-2,
+            gain=0.7,
+            target=T,
+        )
+        theirs = PFT(
+            panda.tool,
+            position_cost=[1.0, 0.5, 2.0],
+            orientation_cost=0.3,
+            lm_damping=1e-2,
+            gain=0.7,
+        )
         theirs.set_target(pin.SE3(T))
         for a, b in [(ours.compute_qp_objective(conf), theirs.compute_qp_objective(pc))]:
             assert np.abs(a[0] - b[0]).max() < 1e-12 and np.abs(a[1] - b[1]).max() < 1e-12
         pp = PPT(cost=1e-2)
         pp.set_target(qt)
-        a, b = qp.PostureTask(panda, cost=1e-2, target=qt).compute_qp_objective(conf), pp.compute_qp_objective(pc)
+        a, b = (
+            qp.PostureTask(panda, cost=1e-2, target=qt).compute_qp_objective(conf),
+            pp.compute_qp_objective(pc),
+        )
         assert np.abs(a[0] - b[0]).max() < 1e-15 and np.abs(a[1] - b[1]).max() < 1e-15
 
 
@@ -191,13 +212,17 @@ def test_comfortable_posture(human, panda):
     assert np.allclose(mid, 0.5 * (panda.lower + panda.upper))
     # the posture comes from the model (spec.comfort), not from the robot's name
     assert qp.tasks.has_comfortable_posture(human) and not qp.tasks.has_comfortable_posture(panda)
-    renamed = aa.load(aa.models.urdf_path("human_arm7"))          # same joints, no spec
+    renamed = aa.load(aa.models.urdf_path("human_arm7"))  # same joints, no spec
     assert not qp.tasks.has_comfortable_posture(renamed)
-    np.testing.assert_allclose(qp.comfortable_posture(renamed), 0.5 * (renamed.lower + renamed.upper))
+    np.testing.assert_allclose(
+        qp.comfortable_posture(renamed), 0.5 * (renamed.lower + renamed.upper)
+    )
 
 
 def test_mimic_coupling_task(panda):
-    c = qp.JointCouplingTask.mimic(panda, "panda_joint2", "panda_joint1", multiplier=2.0, offset=0.1)
+    c = qp.JointCouplingTask.mimic(
+        panda, "panda_joint2", "panda_joint1", multiplier=2.0, offset=0.1
+    )
     q = panda.neutral()
     q[0], q[1] = 0.3, 0.7
     conf = qp.IKConfiguration(panda, q)

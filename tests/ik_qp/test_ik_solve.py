@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import anthroarm as aa
-from anthroarm.ik import closed_form as cf
 from anthroarm.errors import UnknownFrameError
 from anthroarm.ik import IKBatchResult, IKResult, qp
+from anthroarm.ik import closed_form as cf
 from anthroarm.ik.solve import seeds, targets, workspace
 
 ROBOTS = ["panda", "ur5", "talos_arm", "human_arm7", "prosthetic_arm"]
@@ -28,7 +28,9 @@ def pose_error(robot, q, T, frame=None):
     d = robot.model.createData()
     pin.framesForwardKinematics(robot.model, d, q)
     M = d.oMf[robot.frame_id(frame)]
-    return np.linalg.norm(M.translation - T[:3, 3]), np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))
+    return np.linalg.norm(M.translation - T[:3, 3]), np.linalg.norm(
+        pin.log3(M.rotation.T @ T[:3, :3])
+    )
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -41,10 +43,12 @@ def test_reachable_poses_are_solved_within_limits(robots, name):
         assert isinstance(res, IKResult)
         assert res.success, res.message
         assert res.status == "success"
-        assert robot.within_limits(res.q)            # exact, no tolerance
+        assert robot.within_limits(res.q)  # exact, no tolerance
         pe, re = pose_error(robot, res.q, T)
         assert pe <= 1e-6 and re <= 1e-6
-        assert res.pos_err == pytest.approx(pe, abs=1e-12) and res.rot_err == pytest.approx(re, abs=1e-12)
+        assert res.pos_err == pytest.approx(pe, abs=1e-12) and res.rot_err == pytest.approx(
+            re, abs=1e-12
+        )
 
 
 def test_position_and_orientation_targets(robots):
@@ -78,7 +82,7 @@ def test_batch_form_and_warm_start(robots):
     assert np.abs(np.diff(w.q, axis=0)).max() < 0.2
     pos = aa.ik.solve(robot, Ts[:, :3, 3])
     assert pos.mode == "position" and pos.success.all()
-    q0s = aa.ik.solve(robot, Ts, q0=qs)   # per-target seeds at the answer: zero restarts
+    q0s = aa.ik.solve(robot, Ts, q0=qs)  # per-target seeds at the answer: zero restarts
     assert q0s.success.all() and (q0s.restarts == 0).all()
 
 
@@ -113,7 +117,9 @@ def test_not_converged_target_within_reach(robots):
     assert "joint-limited workspace" in res.message and "closest pose found" in res.message
     assert robot.within_limits(res.q)
     pe, re = pose_error(robot, res.q, T)
-    assert res.pos_err == pytest.approx(pe, abs=1e-12) and res.rot_err == pytest.approx(re, abs=1e-12)
+    assert res.pos_err == pytest.approx(pe, abs=1e-12) and res.rot_err == pytest.approx(
+        re, abs=1e-12
+    )
     assert pe > 1e-3
     # closest: better than the seed
     assert pe + re < sum(pose_error(robot, qp.comfortable_posture(robot), T))
@@ -174,7 +180,7 @@ def test_human_arm_posture_is_comfortable(robots):
     d_with, d_without = [], []
     for q_goal in robot.random_q(15, rng=21):
         T = robot.fk(q_goal)
-        a = aa.ik.solve(robot, T)                   # posture="auto" for human_arm7
+        a = aa.ik.solve(robot, T)  # posture="auto" for human_arm7
         b = aa.ik.solve(robot, T, posture=None)
         assert a.success and b.success
         assert pose_error(robot, a.q, T)[0] <= 1e-6 and robot.within_limits(a.q)
@@ -191,7 +197,7 @@ def test_human_arm_swivel(robots):
         if abs(np.sin(q_goal[3])) < 0.3:
             continue
         T = robot.fk(q_goal)
-        phi_goal = qp.swivel_angle(robot, q_goal)   # a swivel angle known to be attainable
+        phi_goal = qp.swivel_angle(robot, q_goal)  # a swivel angle known to be attainable
         res = aa.ik.solve(robot, T, swivel=phi_goal, q0=qp.comfortable_posture(robot))
         assert res.success and robot.within_limits(res.q)
         d = qp.swivel_angle(robot, res.q) - phi_goal
@@ -209,7 +215,11 @@ def test_analytic_seed_when_available(robots):
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), name=st.sampled_from(ROBOTS), kind=st.sampled_from(["reach", "random"]))
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    name=st.sampled_from(ROBOTS),
+    kind=st.sampled_from(["reach", "random"]),
+)
 def test_property_never_violates_limits(robots, seed, name, kind):
     """Random targets (reachable, or arbitrary poses that may be unreachable) and random seeds:
     every answer is within the limits, errors are reported honestly, no undocumented exception."""
@@ -247,8 +257,8 @@ def test_human_posture_optimum_matches_closed_form_family(robots):
         d_min = np.min(np.linalg.norm(S - ref, axis=1))
         d = np.linalg.norm(res.q - ref)
         assert res.success
-        assert d <= d_min + 1e-6          # never worse than the best closed-form member found
-        assert d >= d_min - 5e-3          # and within the grid resolution of it
+        assert d <= d_min + 1e-6  # never worse than the best closed-form member found
+        assert d >= d_min - 5e-3  # and within the grid resolution of it
 
 
 # ------------------------------------------------------------------ seeds and fast paths of aa.ik.solve
@@ -269,7 +279,9 @@ def test_seed_table_distance_is_the_pose_distance(robots):
     H = robot.fk(Q)
     T = robot.fk(robot.random_q(rng=11))
     w2 = (seeds.SEED_ROT_WEIGHT * robot.chain.reach()) ** 2
-    direct = ((H[:, :3, 3] - T[:3, 3]) ** 2).sum(1) + w2 * ((H[:, :3, :3] - T[:3, :3]) ** 2).sum((1, 2))
+    direct = ((H[:, :3, 3] - T[:3, 3]) ** 2).sum(1) + w2 * ((H[:, :3, :3] - T[:3, :3]) ** 2).sum(
+        (1, 2)
+    )
     sc = T.ravel().dot(ws.table()[1])[:200]
     np.testing.assert_allclose(sc - sc[0], direct - direct[0], atol=1e-9)
 
@@ -313,12 +325,12 @@ def test_seed_tags_and_restart_cap(robots):
         tags.add(r.seed)
         if r.restarts == 0:
             assert r.seed == "table"
-        if r.seed == "restart":             # uniform random seeds come after the table's
+        if r.seed == "restart":  # uniform random seeds come after the table's
             assert r.restarts >= seeds.TABLE_SEEDS
         restarted += r.restarts > 0
     assert tags <= {"table", "restart"} and "table" in tags and restarted > 0
     T = np.eye(4)
-    T[:3, 3] = [2.0, 0.0, 0.3]                       # out of reach
+    T[:3, 3] = [2.0, 0.0, 0.3]  # out of reach
     r = aa.ik.solve(robot, T, max_restarts=0)
     assert not r.success and r.restarts == 0 and robot.within_limits(r.q)
 
@@ -338,7 +350,7 @@ def test_closed_form_first_where_cheap(robots):
             assert r.success and r.seed == "analytic" and r.restarts == 0, name
             assert pose_error(robot, r.q, T)[0] <= 1e-6
     robot = robots["prosthetic_arm"]
-    out = aa.ik.solve(robot, robot.fk(robot.random_q(12, rng=42)))   # batch: the same path
+    out = aa.ik.solve(robot, robot.fk(robot.random_q(12, rng=42)))  # batch: the same path
     assert out.success.all()
     r = aa.ik.solve(robot, robot.fk(robot.random_q(rng=43)), analytic=False)
     assert r.success and r.seed != "analytic"
@@ -370,7 +382,9 @@ def test_human_posture_optimum_on_uniform_targets(robots, monkeypatch):
         worse += np.linalg.norm(res.q - ref) > d_min + 1e-6
         at_limit += bool(((res.q == robot.lower) | (res.q == robot.upper)).any())
     assert worse <= 1
-    assert at_limit >= 2   # the optimum on a joint limit (frozen joint, shortened null step) is exercised
+    assert (
+        at_limit >= 2
+    )  # the optimum on a joint limit (frozen joint, shortened null step) is exercised
 
 
 def test_rigid_fast_path_and_near_rigid_targets(robots):

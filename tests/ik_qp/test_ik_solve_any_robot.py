@@ -20,8 +20,15 @@ from anthroarm.chain import CONTINUOUS
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "foundation"))
 from test_chain import USER_URDF  # noqa: E402
 
-UNSEEN = [("panda", {}), ("ur5", {}), ("ur10", {}), ("xarm7", {}), ("z1", {}),
-          ("so101", {"tool": "gripper_frame_link", "locked": ["gripper"]}), ("kinova", {})]
+UNSEEN = [
+    ("panda", {}),
+    ("ur5", {}),
+    ("ur10", {}),
+    ("xarm7", {}),
+    ("z1", {}),
+    ("so101", {"tool": "gripper_frame_link", "locked": ["gripper"]}),
+    ("kinova", {}),
+]
 
 
 def judge(robot, q, T, frame=None):
@@ -31,7 +38,11 @@ def judge(robot, q, T, frame=None):
     pin.framesForwardKinematics(m, d, q)
     M = d.oMf[m.getFrameId(frame or robot.tool)]
     inside = bool(np.all((q >= m.lowerPositionLimit) & (q <= m.upperPositionLimit)))
-    return np.linalg.norm(M.translation - T[:3, 3]), np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])), inside
+    return (
+        np.linalg.norm(M.translation - T[:3, 3]),
+        np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3])),
+        inside,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +87,7 @@ def test_kinova_continuous_joints_stay_near_the_seed():
         ch.check_unit(r.q)
         d = ch.angles(r.q)[cont] - ch.angles(q_goal)[cont]
         d = (d + np.pi) % (2 * np.pi) - np.pi
-        assert np.abs(d).max() < 0.3          # the nearby solution, not another turn or branch
+        assert np.abs(d).max() < 0.3  # the nearby solution, not another turn or branch
         pe, re, inside = judge(robot, r.q, T)
         assert pe <= 1e-6 and re <= 1e-6 and inside
 
@@ -146,7 +157,9 @@ def test_four_threads_share_one_robot():
                 if not np.array_equal(r.q, ref_ik[t][k]):
                     errors.append(("ik differs", t, k))
                 j = (k + 10 * t) % len(Qf)
-                if not np.array_equal(robot.fk(Qf[j]), ref_fk[j]) or not np.array_equal(robot.jacobian(Qf[j]), ref_J[j]):
+                if not np.array_equal(robot.fk(Qf[j]), ref_fk[j]) or not np.array_equal(
+                    robot.jacobian(Qf[j]), ref_J[j]
+                ):
                     errors.append(("fk/jacobian", t, k))
         except Exception as exc:  # noqa: BLE001 - reported by the assertion below
             errors.append(("raised", t, repr(exc)))
@@ -189,7 +202,7 @@ def test_theta_to_q_equals_the_chain(user_urdf):
         for th in Th:
             np.testing.assert_allclose(sh.to_q(th), ch.configuration(th), rtol=0, atol=2e-16)
             back = sh.theta(sh.to_q(th))
-            np.testing.assert_allclose(np.cos(back - th), 1.0, atol=1e-12)   # same angle up to turns
+            np.testing.assert_allclose(np.cos(back - th), 1.0, atol=1e-12)  # same angle up to turns
 
 
 def test_first_call_is_not_charged_for_the_seed_table():

@@ -56,7 +56,8 @@ def test_step_matches_pink(robot, solver):
     """Same tasks, pink's default limits (configuration gain 0.5 + velocity), integrated on the
     manifold by both: the same velocity at every step (pink with its dense quadprog)."""
     import pink
-    from pink.tasks import FrameTask as PFT, PostureTask as PPT
+    from pink.tasks import FrameTask as PFT
+    from pink.tasks import PostureTask as PPT
 
     q0 = robot.random_q(rng=5, margin=0.2)
     q1 = robot.random_q(rng=6, margin=0.2)
@@ -68,7 +69,7 @@ def test_step_matches_pink(robot, solver):
     ppost.set_target(q0)
     saturated = 0
     for k in range(30):
-        T = robot.fk(pin.interpolate(robot.model, q0, q1, 1e-3 * k * k))   # accelerating
+        T = robot.fk(pin.interpolate(robot.model, q0, q1, 1e-3 * k * k))  # accelerating
         ee.set_target(T)
         pee.set_target(pin.SE3(T))
         v = qp.step(conf, None, [ee, post], DT, solver=solver)
@@ -78,8 +79,8 @@ def test_step_matches_pink(robot, solver):
         assert np.abs(v - vp).max() * DT < 1e-9, (k, np.abs(v - vp).max())
         saturated += bool(np.any(np.isclose(np.abs(v), robot.chain.velocity_limit, rtol=1e-9)))
         conf.integrate_inplace(v, DT)
-        robot.check_q(conf.q)   # unit (cos, sin) pairs after pin.integrate
-    assert 0 < saturated < 30   # both active and inactive velocity bounds were compared
+        robot.check_q(conf.q)  # unit (cos, sin) pairs after pin.integrate
+    assert 0 < saturated < 30  # both active and inactive velocity bounds were compared
 
 
 def test_step_moves_the_frame_as_predicted(kinova):
@@ -131,7 +132,7 @@ def test_posture_error_is_the_shortest_angle(kinova):
     np.testing.assert_allclose(e, pin.difference(r.model, q_ref, q), atol=1e-15)
     assert e[j.idx_v] == pytest.approx(3.0 - (-3.0) - 2 * np.pi, abs=1e-12)
     np.testing.assert_allclose(np.delete(e, j.idx_v), 0.0, atol=1e-12)
-    dt = 1.0   # the whole way in one step: 0.283 rad at 0.628 rad/s fits in 1 s
+    dt = 1.0  # the whole way in one step: 0.283 rad at 0.628 rad/s fits in 1 s
     v = qp.step(conf, None, [post], dt, solver="quadprog")
     assert v[j.idx_v] > 0 and v[j.idx_v] * dt == pytest.approx(2 * np.pi - 6.0, rel=1e-9)
     conf.integrate_inplace(v, dt)
@@ -149,13 +150,17 @@ def test_configuration_limits_only_on_bounded_joints(robot):
     for jid in range(1, m.njoints):
         jm = m.joints[jid]
         if jm.nv != 1:
-            continue     # a mimic joint: no velocity of its own
-        if jm.nq == 2:   # continuous
+            continue  # a mimic joint: no velocity of its own
+        if jm.nq == 2:  # continuous
             assert lo[jm.idx_v] == -np.inf and hi[jm.idx_v] == np.inf
         else:
             th = conf.q[jm.idx_q]
-            assert lo[jm.idx_v] == pytest.approx(0.5 * (m.lowerPositionLimit[jm.idx_q] - th), abs=1e-15)
-            assert hi[jm.idx_v] == pytest.approx(0.5 * (m.upperPositionLimit[jm.idx_q] - th), abs=1e-15)
+            assert lo[jm.idx_v] == pytest.approx(
+                0.5 * (m.lowerPositionLimit[jm.idx_q] - th), abs=1e-15
+            )
+            assert hi[jm.idx_v] == pytest.approx(
+                0.5 * (m.upperPositionLimit[jm.idx_q] - th), abs=1e-15
+            )
     # a continuous joint parked on cos = −1 or sin = +1 is not "at a limit"
     assert conf.within_limits()
     for j in _continuous(robot):
@@ -169,7 +174,9 @@ def test_configuration_limits_only_on_bounded_joints(robot):
 
 def test_velocity_limits_are_per_velocity(robot):
     vl = qp.VelocityLimit(robot)
-    np.testing.assert_array_equal(vl.v_max, np.where(robot.model.velocityLimit > 0, robot.model.velocityLimit, np.inf))
+    np.testing.assert_array_equal(
+        vl.v_max, np.where(robot.model.velocityLimit > 0, robot.model.velocityLimit, np.inf)
+    )
     conf = qp.IKConfiguration(robot, robot.random_q(rng=8, margin=0.2))
     far = qp.PostureTask(robot, cost=1.0, target=robot.random_q(rng=9, margin=0.2))
     res = qp.step(conf, None, [far], DT, limits=[vl], solver="quadprog", full=True)
@@ -183,11 +190,11 @@ def test_configuration_checks_on_continuous_joints(kinova):
     conf = qp.IKConfiguration(r, r.random_q(rng=0))
     j = _continuous(r)[1]
     q = conf.q.copy()
-    q[j.idx_q:j.idx_q + 2] = (0.6, 0.6)
+    q[j.idx_q : j.idx_q + 2] = (0.6, 0.6)
     with pytest.raises(ValueError, match=j.name):
         conf.update(q)
     assert not any(".cos" in s or ".sin" in s for s in conf.limit_violations())
-    post = qp.PostureTask(r)           # the comfortable posture: a valid configuration
+    post = qp.PostureTask(r)  # the comfortable posture: a valid configuration
     r.check_q(post.target)
     th = r.chain.angles(post.target)
     for jj in r.chain.joints:

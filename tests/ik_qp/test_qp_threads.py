@@ -46,8 +46,12 @@ def test_threads_get_the_single_threaded_velocities(mode, solver):
     _run(robot, Q, T, solver, mode, ref, range(N))
     got = np.full((N, robot.nv), np.nan)
     barrier = threading.Barrier(THREADS)
-    ths = [threading.Thread(target=_run, args=(robot, Q, T, solver, mode, got, range(k, N, THREADS), barrier))
-           for k in range(THREADS)]
+    ths = [
+        threading.Thread(
+            target=_run, args=(robot, Q, T, solver, mode, got, range(k, N, THREADS), barrier)
+        )
+        for k in range(THREADS)
+    ]
     for t in ths:
         t.start()
     for t in ths:

@@ -17,8 +17,10 @@ def test_mechanism_rows_pass_and_are_registered():
         oracles = {r.oracle for r in rows if r.model == m}
         assert {"pinocchio", "finite-diff", "math"} <= oracles, m
     assert {r.quantity for r in rows if r.model == "relative_motion"} == {
-        "position 002 (4-6) vs pin FK (rel.)", "velocity 002 (4-11) vs frame velocity (rel.)",
-        "acceleration 002 (4-17) vs classical acc (rel.)"}
+        "position 002 (4-6) vs pin FK (rel.)",
+        "velocity 002 (4-11) vs frame velocity (rel.)",
+        "acceleration 002 (4-17) vs classical acc (rel.)",
+    }
     assert len([r for r in rows if r.model == "rccc"]) == 4
     bad = [(r.model, r.quantity, r.oracle, r.max_abs_err) for r in rows if not r.ok]
     assert not bad, bad

@@ -16,7 +16,9 @@ FG = FingerGeometry.default()
 
 def test_chapter3_curves_printed_values():
     # ch3-4.md E1/E3 derived values of the printed polynomials
-    np.testing.assert_allclose(finger_f([0, 10, 20, 30, 40]), [55.61, 65.255, 71.618, 74.831, 75.026], atol=1e-3)
+    np.testing.assert_allclose(
+        finger_f([0, 10, 20, 30, 40]), [55.61, 65.255, 71.618, 74.831, 75.026], atol=1e-3
+    )
     np.testing.assert_allclose(thumb_f2([30, 60]), [6.9247, 19.8264], atol=1e-4)
     np.testing.assert_allclose(thumb_f3([20, 30]), [40.3547, 55.6754], atol=1e-4)
 
@@ -25,16 +27,19 @@ def test_thumb_rrss_follows_f2_with_the_chapter4_optimum():
     th = np.deg2rad(np.linspace(0, 30, 31))
     th2 = np.array([thumb(TG, t).theta2 for t in th])
     err = np.abs(np.rad2deg(th2) - thumb_f2(np.rad2deg(th)))
-    assert err.max() < 0.6                       # the printed minimax error e = 0.01 is not reproduced
+    assert err.max() < 0.6  # the printed minimax error e = 0.01 is not reproduced
     assert abs(thumb(TG, 0.0).theta2) < 1e-12 and abs(thumb(TG, 0.0).theta3) < 1e-12
 
 
 def test_thumb_printed_u0_sense_cannot_assemble():
     # with theta1 about +z (the printed u0 read literally) the RRSS cannot even reach 10 deg
-    from anthroarm.mechanisms.rrss import RRSSGeometry, rrss_position, rrss_branch_through
+    from anthroarm.mechanisms.rrss import RRSSGeometry, rrss_branch_through, rrss_position
+
     g = TG.rrss
     plus = RRSSGeometry(a0=g.a0, u0=[0, 0, 1], a1=g.a1, u1=g.u1, b0=g.b0, b1=g.b1)
-    assert rrss_position(plus, np.deg2rad(10), rrss_branch_through(plus)).status == "cannot_assemble"
+    assert (
+        rrss_position(plus, np.deg2rad(10), rrss_branch_through(plus)).status == "cannot_assemble"
+    )
 
 
 def test_thumb_upper_fourbar_literal_reading():
@@ -62,11 +67,14 @@ def test_thumb_against_pinocchio_and_finite_differences(th1):
     sc = max(1.0, np.abs(s.Sddot).max() / L, abs(s.theta3ddot))
     np.testing.assert_allclose(loop.frame_position(st_.q, "S"), s.S, atol=1e-14 * L)
     np.testing.assert_allclose(loop.frame_velocity(st_.q, st_.v, "S"), s.Sdot, atol=1e-12 * L * sc)
-    np.testing.assert_allclose(loop.frame_acceleration(st_.q, st_.v, st_.a, "S"), s.Sddot, atol=1e-11 * L * sc)
+    np.testing.assert_allclose(
+        loop.frame_acceleration(st_.q, st_.v, st_.a, "S"), s.Sddot, atol=1e-11 * L * sc
+    )
     assert abs(st_.a[i3] - s.theta3ddot) < 1e-11 * sc
 
     def traj(t):
         return thumb(TG, th1 + w * t + 0.5 * a * t * t, w + a * t, a)
+
     np.testing.assert_allclose(fd_derivative(lambda t: traj(t).S), s.Sdot, atol=1e-10 * L * sc)
     np.testing.assert_allclose(fd_derivative(lambda t: traj(t).Sdot), s.Sddot, atol=1e-10 * L * sc)
     np.testing.assert_allclose(fd_derivative(lambda t: traj(t).P), s.Pdot, atol=1e-10 * L * sc)
@@ -81,9 +89,13 @@ def test_thumb_bad_input():
     with pytest.raises(ValueError, match="theta1"):
         thumb(TG, np.inf)
     with pytest.raises(ValueError, match="ex"):
-        ThumbGeometry(rrss=TG.rrss, ex=[1, 0, 0], P0=TG.P0, F0=TG.F0, C=TG.C, R3=TG.R3, beta=TG.beta)
-    s = thumb(TG, np.deg2rad(-10))              # below the reference pose the thumb cannot close
-    assert s.status == "cannot_assemble" and "cannot assemble" in s.reason and np.isfinite(s.S).all()
+        ThumbGeometry(
+            rrss=TG.rrss, ex=[1, 0, 0], P0=TG.P0, F0=TG.F0, C=TG.C, R3=TG.R3, beta=TG.beta
+        )
+    s = thumb(TG, np.deg2rad(-10))  # below the reference pose the thumb cannot close
+    assert (
+        s.status == "cannot_assemble" and "cannot assemble" in s.reason and np.isfinite(s.S).all()
+    )
 
 
 def test_finger_follows_the_chapter3_curve():
@@ -92,7 +104,7 @@ def test_finger_follows_the_chapter3_curve():
     assert (np.asarray(s.status) == "ok").all()
     tip = s.tip * 1e3
     assert abs(tip[0, 0]) < 1e-3 and abs(tip[-1, 0] - 40) < 5e-3
-    assert np.max(np.abs(tip[:, 1] - finger_f(tip[:, 0]))) < 0.1          # mm
+    assert np.max(np.abs(tip[:, 1] - finger_f(tip[:, 0]))) < 0.1  # mm
     flex = np.sign(FG.phi_range[1] - FG.phi_range[0]) * (s.q - s.q[0])
     # PIP and DIP flex with the MCP (human-like), apart from < 0.1 deg of extension at the start
     assert (flex[:, 1:] >= np.deg2rad(-0.1)).all() and (flex[-1, 1:] > 0.1).all()
@@ -111,17 +123,30 @@ def test_finger_against_pinocchio_and_finite_differences():
     assert ok.all() and st_.ok
     sc = max(1.0, np.abs(s.accelerations["P8"]).max() / L)
     np.testing.assert_allclose(loop.frame_position(st_.q, "P8")[:2], s.tip, atol=1e-14 * L)
-    np.testing.assert_allclose(loop.frame_velocity(st_.q, st_.v, "P8")[:2], s.velocities["P8"], atol=1e-12 * L * sc)
-    np.testing.assert_allclose(loop.frame_acceleration(st_.q, st_.v, st_.a, "P8")[:2], s.accelerations["P8"],
-                               atol=1e-11 * L * sc)
-    np.testing.assert_allclose(st_.v[[loop.joint_q_index(n) for n in ("pip", "dip")]], s.qdot[1:], atol=1e-12 * sc)
+    np.testing.assert_allclose(
+        loop.frame_velocity(st_.q, st_.v, "P8")[:2], s.velocities["P8"], atol=1e-12 * L * sc
+    )
+    np.testing.assert_allclose(
+        loop.frame_acceleration(st_.q, st_.v, st_.a, "P8")[:2],
+        s.accelerations["P8"],
+        atol=1e-11 * L * sc,
+    )
+    np.testing.assert_allclose(
+        st_.v[[loop.joint_q_index(n) for n in ("pip", "dip")]], s.qdot[1:], atol=1e-12 * sc
+    )
 
     def traj(t):
         return finger(FG, ph + w * t + 0.5 * a * t * t, w + a * t, a)
+
     for k in ("P6", "P8"):
-        np.testing.assert_allclose(fd_derivative(lambda t: traj(t).points[k], 2.5e-4), s.velocities[k], atol=1e-10 * L * sc)
-        np.testing.assert_allclose(fd_derivative(lambda t: traj(t).velocities[k], 2.5e-4), s.accelerations[k],
-                                   atol=1e-10 * L * sc)
+        np.testing.assert_allclose(
+            fd_derivative(lambda t: traj(t).points[k], 2.5e-4), s.velocities[k], atol=1e-10 * L * sc
+        )
+        np.testing.assert_allclose(
+            fd_derivative(lambda t: traj(t).velocities[k], 2.5e-4),
+            s.accelerations[k],
+            atol=1e-10 * L * sc,
+        )
 
 
 def test_finger_out_of_range_and_bad_geometry():

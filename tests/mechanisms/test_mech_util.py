@@ -17,7 +17,9 @@ def test_helpers_equal_spatial_screw_and_pin():
         np.testing.assert_allclose(rot(th, u), pin.exp3(th * u), atol=1e-15)
         np.testing.assert_allclose(skew(u), screw.P(u), atol=0)
         np.testing.assert_allclose(W(wd, u), screw.velocity_matrix(wd, u), atol=1e-15)
-        np.testing.assert_allclose(Wdot(wd, wdd, u), screw.acceleration_matrix(wd, wdd, u), atol=1e-15)
+        np.testing.assert_allclose(
+            Wdot(wd, wdd, u), screw.acceleration_matrix(wd, wdd, u), atol=1e-15
+        )
         # Wdot is the second derivative of R(theta(t)) R(theta0)^T
         R0 = rot(th, u)
         d1, d2 = fd_rates(lambda t: rot(th + wd * t + 0.5 * wdd * t * t, u) @ R0.T)
@@ -34,5 +36,9 @@ def test_unit_axis_and_wrap():
         unit_axis("u", [0, 0, 1.01])
     with pytest.raises(ValueError, match="shape"):
         unit_axis("u", [0, 1])
-    assert wrap(np.pi) == np.pi and wrap(-np.pi) == np.pi and abs(wrap(7.0) - (7.0 - 2 * np.pi)) < 1e-15
+    assert (
+        wrap(np.pi) == np.pi
+        and wrap(-np.pi) == np.pi
+        and abs(wrap(7.0) - (7.0 - 2 * np.pi)) < 1e-15
+    )
     assert abs(fd_derivative(np.sin) - 1.0) < 1e-12

@@ -14,4 +14,3 @@ def arm():
 @pytest.fixture(scope="session")
 def markers(arm):
     return default_marker_set(arm)
-

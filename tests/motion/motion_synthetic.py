@@ -6,9 +6,7 @@ independently of anthroarm.motion's own marker kinematics."""
 import numpy as np
 import pinocchio as pin
 
-import anthroarm as aa
 from anthroarm.ik.qp import comfortable_posture
-from anthroarm.motion import default_marker_set
 
 
 def pin_marker_positions(robot, marker_set, Q):

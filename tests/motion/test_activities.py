@@ -28,20 +28,32 @@ def test_every_activity_reaches_its_keyframes_smoothly(person):
         tr = A.activity_trajectory(robot, name)
         assert tr.reachable, (name, tr.keyframe_status, tr.keyframe_error)
         for kf, qk, tk in zip(tr.activity.keyframes, tr.keyframe_q, tr.keyframe_times):
-            assert np.linalg.norm(_hand(robot, qk) - np.asarray(kf.position)) < 1e-3, (name, kf.name)
+            assert np.linalg.norm(_hand(robot, qk) - np.asarray(kf.position)) < 1e-3, (
+                name,
+                kf.name,
+            )
             i = int(round(tk * 100))
             np.testing.assert_allclose(tr.q[i], qk, atol=1e-12)
-            assert np.abs(tr.qd[i]).max() < 1e-12                           # at rest at a keyframe
+            assert np.abs(tr.qd[i]).max() < 1e-12  # at rest at a keyframe
         assert np.all(tr.q >= robot.lower - 1e-9) and np.all(tr.q <= robot.upper + 1e-9)
         assert np.isfinite(tr.q).all() and np.isfinite(tr.qdd).all()
         dt = tr.t[1] - tr.t[0]
-        np.testing.assert_allclose(np.gradient(tr.q, dt, axis=0)[1:-1], tr.qd[1:-1], atol=5e-3 * max(1, np.abs(tr.qd).max()))
+        np.testing.assert_allclose(
+            np.gradient(tr.q, dt, axis=0)[1:-1],
+            tr.qd[1:-1],
+            atol=5e-3 * max(1, np.abs(tr.qd).max()),
+        )
         # the jerk jumps where a segment starts or ends: central differences are first-order there
-        ends = np.concatenate([tr.keyframe_times, tr.keyframe_times + [kf.hold for kf in tr.activity.keyframes]])
+        ends = np.concatenate(
+            [tr.keyframe_times, tr.keyframe_times + [kf.hold for kf in tr.activity.keyframes]]
+        )
         smooth = np.all(np.abs(tr.t[:, None] - ends[None]) > 1.5 * dt, axis=1)
         smooth[[0, -1]] = False
-        np.testing.assert_allclose(np.gradient(tr.qd, dt, axis=0)[smooth], tr.qdd[smooth],
-                                   atol=2e-2 * max(1, np.abs(tr.qdd).max()))
+        np.testing.assert_allclose(
+            np.gradient(tr.qd, dt, axis=0)[smooth],
+            tr.qdd[smooth],
+            atol=2e-2 * max(1, np.abs(tr.qdd).max()),
+        )
         np.testing.assert_allclose(tr.hand[5], _hand(robot, tr.q[5]), atol=1e-12)
 
 
@@ -52,15 +64,25 @@ def test_minimum_jerk_profile():
     t = np.linspace(0, T, 100001)
     x, v, a = minimum_jerk(0.0, d, T, t)
     assert abs(v.max() - 15 / 8 * d / T) < 1e-9 and abs(t[np.argmax(v)] - T / 2) < 1e-4
-    assert abs(a.max() - 10 / np.sqrt(3) * d / T ** 2) < 1e-6
+    assert abs(a.max() - 10 / np.sqrt(3) * d / T**2) < 1e-6
     assert abs(t[np.argmax(a)] - T * (0.5 - np.sqrt(3) / 6)) < 1e-4
     assert x[0] == 0 and abs(x[-1] - d) < 1e-15 and v[0] == 0 and a[0] == 0 and abs(a[-1]) < 1e-12
     jerk = np.gradient(a, t)
     # the jerk of the quintic is 60 d/T³ (1 − 6τ + 6τ²): 60 d/T³ at the ends
-    assert abs(jerk[1000] - 60 * d / T ** 3 * (1 - 6 * t[1000] / T + 6 * (t[1000] / T) ** 2)) < 1e-3 * 60 * d / T ** 3
-    t2, q2, qd2, qdd2, arr = keyframe_trajectory(np.array([[0.0], [1.0], [0.5]]), [0, 1.0, 2.0], [0.5, 0.0, 0.0], rate=50)
+    assert (
+        abs(jerk[1000] - 60 * d / T**3 * (1 - 6 * t[1000] / T + 6 * (t[1000] / T) ** 2))
+        < 1e-3 * 60 * d / T**3
+    )
+    t2, q2, qd2, qdd2, arr = keyframe_trajectory(
+        np.array([[0.0], [1.0], [0.5]]), [0, 1.0, 2.0], [0.5, 0.0, 0.0], rate=50
+    )
     np.testing.assert_allclose(arr, [0.0, 1.5, 3.5])
-    assert q2.shape == (176, 1) and q2[25, 0] == 0.0 and abs(q2[75, 0] - 1.0) < 1e-15 and abs(q2[-1, 0] - 0.5) < 1e-15
+    assert (
+        q2.shape == (176, 1)
+        and q2[25, 0] == 0.0
+        and abs(q2[75, 0] - 1.0) < 1e-15
+        and abs(q2[-1, 0] - 0.5) < 1e-15
+    )
 
 
 def test_keyframes_take_the_comfortable_posture():
@@ -113,11 +135,19 @@ def test_parameters_and_payload():
     with pytest.raises(ActivityError, match="height"):
         A.activity("pour", aa.load("prosthetic_arm"))
     # bad keyframes and rates are refused before any IK is solved
-    for act, needle in ((A.Activity("none", "none", []), "no keyframes"),
-                        (A.Activity("text", "text", [A.Keyframe("k", "abc")]), "3 finite numbers"),
-                        (A.Activity("inf", "inf", [A.Keyframe("k", (0.0, 0.0, np.inf))]), "3 finite numbers"),
-                        (A.Activity("slow", "slow", [A.Keyframe("a", (0.0, 0.3, 0.0)),
-                                                     A.Keyframe("b", (0.0, 0.3, 0.1), move=1e300)]), "samples")):
+    for act, needle in (
+        (A.Activity("none", "none", []), "no keyframes"),
+        (A.Activity("text", "text", [A.Keyframe("k", "abc")]), "3 finite numbers"),
+        (A.Activity("inf", "inf", [A.Keyframe("k", (0.0, 0.0, np.inf))]), "3 finite numbers"),
+        (
+            A.Activity(
+                "slow",
+                "slow",
+                [A.Keyframe("a", (0.0, 0.3, 0.0)), A.Keyframe("b", (0.0, 0.3, 0.1), move=1e300)],
+            ),
+            "samples",
+        ),
+    ):
         with pytest.raises(ActivityError, match=needle):
             A.activity_trajectory(robot, act)
     with pytest.raises(ActivityError, match="rate"):

@@ -5,13 +5,13 @@ import json
 
 import numpy as np
 import pytest
+from motion_synthetic import known_motion, pin_marker_positions
 
 import anthroarm as aa
 from anthroarm.cli import main
 from anthroarm.errors import C3DError, MotionDataError
 from anthroarm.motion import MarkerTrajectories, marker_ik, read_c3d, write_c3d
 from anthroarm.motion.csv_io import read_joint_csv, write_joint_csv
-from motion_synthetic import known_motion, pin_marker_positions
 
 
 def _write_with_units(path, P, names, unit, scale):
@@ -55,7 +55,7 @@ def test_c3d_negative_residual_is_a_missing_sample(tmp_path):
     pts[:3] = 100.0
     c["data"]["points"] = pts
     res = np.zeros((1, 2, 3))
-    res[0, 1, 2] = -1.0                         # marker B, frame 2: invalid, coordinates left at 100 mm
+    res[0, 1, 2] = -1.0  # marker B, frame 2: invalid, coordinates left at 100 mm
     c["data"]["meta_points"] = {"residuals": res, "camera_masks": np.zeros((7, 2, 3), dtype=bool)}
     c.write(str(tmp_path / "r.c3d"))
     tr = read_c3d(tmp_path / "r.c3d")
@@ -83,7 +83,9 @@ def test_c3d_truncated_and_damaged_files_are_c3d_errors(tmp_path):
     subprocess when this test was written) "group" is a RuntimeError, "desc" never returns and
     "sign" kills the interpreter with SIGSEGV."""
     P = np.random.default_rng(0).uniform(-1, 1, (50, 10, 3))
-    write_c3d(tmp_path / "good.c3d", MarkerTrajectories([f"M{i}" for i in range(10)], P, rate=100.0))
+    write_c3d(
+        tmp_path / "good.c3d", MarkerTrajectories([f"M{i}" for i in range(10)], P, rate=100.0)
+    )
     good = (tmp_path / "good.c3d").read_bytes()
     assert read_c3d(tmp_path / "good.c3d").n_frames == 50
     for cut, needle in ((600, "parameter section"), (len(good) // 2, "announces 50 frames")):
@@ -92,26 +94,28 @@ def test_c3d_truncated_and_damaged_files_are_c3d_errors(tmp_path):
             read_c3d(tmp_path / "cut.c3d")
     # the parameter records of an ezc3d-written file: group POINT first, then its parameters
     start = (good[0] - 1) * 512
-    assert good[start + 4:start + 6] == bytes([5, 0xFF]) and good[start + 6:start + 11] == b"POINT"
+    assert (
+        good[start + 4 : start + 6] == bytes([5, 0xFF]) and good[start + 6 : start + 11] == b"POINT"
+    )
     records, i = [], start + 4
     while good[i]:
-        n = abs(int.from_bytes(good[i:i + 1], "little", signed=True))
-        records.append((i, good[i + 2:i + 2 + n].decode()))
-        nxt = int.from_bytes(good[i + 2 + n:i + 4 + n], "little", signed=True)
+        n = abs(int.from_bytes(good[i : i + 1], "little", signed=True))
+        records.append((i, good[i + 2 : i + 2 + n].decode()))
+        nxt = int.from_bytes(good[i + 2 + n : i + 4 + n], "little", signed=True)
         if nxt == 0:
             break
         i = i + 2 + n + nxt
     where = dict((name, at) for at, name in records)
     damaged = {}
-    d = bytearray(good)                         # a parameter of a group id no group has
+    d = bytearray(good)  # a parameter of a group id no group has
     d[where["USED"] + 1] = 100
     damaged["group"] = bytes(d)
-    d = bytearray(good)                         # a parameter's group id flipped negative (read as a group)
+    d = bytearray(good)  # a parameter's group id flipped negative (read as a group)
     d[where["FORMAT"] + 1] = 0xA7
     damaged["sign"] = bytes(d)
-    d = bytearray(good)                         # a description length that runs into the next record
+    d = bytearray(good)  # a description length that runs into the next record
     at = where["RATE"]
-    d[at + 2 + 4 + 2 + 2 + 4] = 200             # name length, group, "RATE", offset, type + 0 dims, float
+    d[at + 2 + 4 + 2 + 2 + 4] = 200  # name length, group, "RATE", offset, type + 0 dims, float
     damaged["desc"] = bytes(d)
     for kind, data in damaged.items():
         (tmp_path / f"{kind}.c3d").write_bytes(data)
@@ -125,19 +129,26 @@ def test_c3d_truncated_and_damaged_files_are_c3d_errors(tmp_path):
         write_c3d(tmp_path / "no" / "x.c3d", MarkerTrajectories(["A"], np.ones((3, 1, 3))))
     with pytest.raises(C3DError, match="is a folder"):
         write_c3d(tmp_path, MarkerTrajectories(["A"], np.ones((3, 1, 3))))
-    with pytest.raises(C3DError, match="255 bytes"):            # ezc3d writes it, then cannot read it
+    with pytest.raises(C3DError, match="255 bytes"):  # ezc3d writes it, then cannot read it
         write_c3d(tmp_path / "long.c3d", MarkerTrajectories(["A" * 256], np.ones((3, 1, 3))))
     assert not (tmp_path / "long.c3d").exists()
     # a coordinate no lab holds (wrong units, a corrupt sample): its squares would overflow to inf
     with pytest.raises(MotionDataError, match="marker 'B' in frame 2 .* beyond 1e\\+06 m"):
-        MarkerTrajectories(["A", "B"], np.where(np.arange(12).reshape(2, 2, 3) == 9, 1e200, 1.0).repeat(2, 0))
+        MarkerTrajectories(
+            ["A", "B"], np.where(np.arange(12).reshape(2, 2, 3) == 9, 1e200, 1.0).repeat(2, 0)
+        )
     with pytest.raises(MotionDataError, match="wrong units"):
         marker_ik(aa.load("human_arm7"), np.full((2, 10, 3), 2e6))
     # a zero sample is a gap (old capture systems write (0, 0, 0) for missing markers)
     P = np.ones((4, 2, 3))
     P[1, 0] = 0.0
     write_c3d(tmp_path / "z.c3d", MarkerTrajectories(["A", "B"], P))
-    assert read_c3d(tmp_path / "z.c3d").visible.tolist() == [[True, True], [False, True], [True, True], [True, True]]
+    assert read_c3d(tmp_path / "z.c3d").visible.tolist() == [
+        [True, True],
+        [False, True],
+        [True, True],
+        [True, True],
+    ]
     assert read_c3d(tmp_path / "z.c3d", zero_is_missing=False).visible.all()
     # no half-written file: a failing write leaves the old file and no temp file
     before = (tmp_path / "z.c3d").read_bytes()
@@ -153,45 +164,68 @@ def test_csv_round_trip_of_a_marker_ik_result(tmp_path, arm, markers):
     res = marker_ik(arm, MarkerTrajectories(markers.names, P, rate=100.0), markers)
     write_joint_csv(tmp_path / "a.csv", res)
     back = read_joint_csv(tmp_path / "a.csv", arm)
-    np.testing.assert_array_equal(back.q, res.q)                 # repr() of floats: exact
+    np.testing.assert_array_equal(back.q, res.q)  # repr() of floats: exact
     np.testing.assert_array_equal(back.t, res.time)
     assert back.names == tuple(arm.joint_names) and back.valid.all()
     text = (tmp_path / "a.csv").read_text()
     assert "3 skipped" in text and text.splitlines()[2].startswith("t,shoulder_flexion")
     rows = [ln.split(",") for ln in text.splitlines() if ln and not ln.startswith("#")]
-    assert rows[11][-1] == "3" and rows[11][-4] == "nan"          # frame 10: skipped
+    assert rows[11][-1] == "3" and rows[11][-4] == "nan"  # frame 10: skipped
 
 
 def test_csv_degrees_gaps_and_errors(tmp_path, arm):
     names = arm.joint_names
     lines = ["# a spreadsheet in degrees", "time_s," + ",".join(f"{n}_deg" for n in names)]
     lines.append("0.0," + ",".join(["10"] * 7))
-    lines.append("0.1," + ",".join(["20"] * 6 + [""]))           # a gap in one joint
+    lines.append("0.1," + ",".join(["20"] * 6 + [""]))  # a gap in one joint
     lines.append("0.2," + ",".join(["30"] * 7))
     (tmp_path / "d.csv").write_text("\n".join(lines) + "\n")
     tr = read_joint_csv(tmp_path / "d.csv", arm)
     np.testing.assert_allclose(tr.q[0], np.deg2rad(10), rtol=1e-15)
     np.testing.assert_allclose(tr.q[2], np.deg2rad(30), rtol=1e-15)
     assert tr.valid.tolist() == [True, False, True]
-    np.testing.assert_allclose(tr.q[1], tr.q[0])                  # held, not NaN
-    bad = {"nohead.csv": "# only a comment\n", "notime.csv": "a,b\n1,2\n",
-           "word.csv": "t," + ",".join(names) + "\n0," + ",".join(["x"] * 7) + "\n",
-           "short.csv": "t," + ",".join(names) + "\n0,1\n",
-           "back.csv": "t," + ",".join(names) + "\n1," + ",".join(["0"] * 7) + "\n0," + ",".join(["0"] * 7) + "\n",
-           "joint.csv": "t,shoulder_flexion\n0,1\n",
-           "inf.csv": "t," + ",".join(names) + "\n0," + ",".join(["0"] * 6 + ["inf"]) + "\n",
-           "overflow.csv": "t," + ",".join(names) + "\n0," + ",".join(["1e400"] + ["0"] * 6) + "\n",
-           "huge.csv": "t," + ",".join(names) + "\n0," + ",".join(["0"] * 7) + "\n1e7," + ",".join(["0"] * 7) + "\n"}
-    msgs = {"nohead.csv": "header", "notime.csv": "time column", "word.csv": "line 2", "short.csv": "line 2",
-            "back.csv": "increase", "joint.csv": "missing joint", "inf.csv": "line 2, column 'wrist_flexion'",
-            "overflow.csv": "line 2, column 'shoulder_flexion'", "huge.csv": "line 3, column 't'"}
+    np.testing.assert_allclose(tr.q[1], tr.q[0])  # held, not NaN
+    bad = {
+        "nohead.csv": "# only a comment\n",
+        "notime.csv": "a,b\n1,2\n",
+        "word.csv": "t," + ",".join(names) + "\n0," + ",".join(["x"] * 7) + "\n",
+        "short.csv": "t," + ",".join(names) + "\n0,1\n",
+        "back.csv": "t,"
+        + ",".join(names)
+        + "\n1,"
+        + ",".join(["0"] * 7)
+        + "\n0,"
+        + ",".join(["0"] * 7)
+        + "\n",
+        "joint.csv": "t,shoulder_flexion\n0,1\n",
+        "inf.csv": "t," + ",".join(names) + "\n0," + ",".join(["0"] * 6 + ["inf"]) + "\n",
+        "overflow.csv": "t," + ",".join(names) + "\n0," + ",".join(["1e400"] + ["0"] * 6) + "\n",
+        "huge.csv": "t,"
+        + ",".join(names)
+        + "\n0,"
+        + ",".join(["0"] * 7)
+        + "\n1e7,"
+        + ",".join(["0"] * 7)
+        + "\n",
+    }
+    msgs = {
+        "nohead.csv": "header",
+        "notime.csv": "time column",
+        "word.csv": "line 2",
+        "short.csv": "line 2",
+        "back.csv": "increase",
+        "joint.csv": "missing joint",
+        "inf.csv": "line 2, column 'wrist_flexion'",
+        "overflow.csv": "line 2, column 'shoulder_flexion'",
+        "huge.csv": "line 3, column 't'",
+    }
     for f, body in bad.items():
         (tmp_path / f).write_text(body)
         with pytest.raises(MotionDataError, match=msgs[f]):
             read_joint_csv(tmp_path / f, arm)
     with pytest.raises(MotionDataError, match="not found"):
         read_joint_csv(tmp_path / "missing.csv")
-    for name in ("b,c", "#b", ""):                             # would shift or hide a column when read back
+    for name in ("b,c", "#b", ""):  # would shift or hide a column when read back
         with pytest.raises(MotionDataError, match="column names"):
             write_joint_csv(tmp_path / "n.csv", np.arange(3.0), np.zeros((3, 2)), ["a", name])
     assert not (tmp_path / "n.csv").exists()
@@ -205,9 +239,24 @@ def test_cli_ik_markers(tmp_path, capsys):
     _, Q = known_motion(person, n=120, seed=9)
     P = pin_marker_positions(person, ms, Q)
     P[50:52] = np.nan
-    write_c3d(tmp_path / "trial.c3d", MarkerTrajectories([f"S1:{n}" for n in ms.names], P, rate=100.0))
-    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "angles.csv"),
-               "--height", "1.62", "--mass", "55", "--sex", "female", "--no-progress"])
+    write_c3d(
+        tmp_path / "trial.c3d", MarkerTrajectories([f"S1:{n}" for n in ms.names], P, rate=100.0)
+    )
+    rc = main(
+        [
+            "ik-markers",
+            str(tmp_path / "trial.c3d"),
+            "--out",
+            str(tmp_path / "angles.csv"),
+            "--height",
+            "1.62",
+            "--mass",
+            "55",
+            "--sex",
+            "female",
+            "--no-progress",
+        ]
+    )
     out = capsys.readouterr().out.strip().splitlines()[-1]
     assert rc == 0
     summary = json.loads(out)
@@ -219,24 +268,59 @@ def test_cli_ik_markers(tmp_path, capsys):
     # bad input: one line on stderr, exit 2, no output file
     rc = main(["ik-markers", str(tmp_path / "nope.c3d"), "--out", str(tmp_path / "x.csv")])
     err = capsys.readouterr().err
-    assert rc == 2 and "C3D file not found" in err and err.count("\n") == 1 and not (tmp_path / "x.csv").exists()
+    assert (
+        rc == 2
+        and "C3D file not found" in err
+        and err.count("\n") == 1
+        and not (tmp_path / "x.csv").exists()
+    )
     rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "no" / "x.csv")])
     assert rc == 2 and "existing folder" in capsys.readouterr().err
-    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path / "p.csv"), "--model",
-               "prosthetic_arm", "--height", "1.7"])                  # the loader names what the model accepts
+    rc = main(
+        [
+            "ik-markers",
+            str(tmp_path / "trial.c3d"),
+            "--out",
+            str(tmp_path / "p.csv"),
+            "--model",
+            "prosthetic_arm",
+            "--height",
+            "1.7",
+        ]
+    )  # the loader names what the model accepts
     assert rc == 2 and "accepted: ['L1', 'L2', 'L3']" in capsys.readouterr().err
     # every frame empty: a CSV of held postures, exit 1, and the summary is still strict JSON
     write_c3d(tmp_path / "nan.c3d", MarkerTrajectories(ms.names, np.full((5, len(ms), 3), np.nan)))
-    rc = main(["ik-markers", str(tmp_path / "nan.c3d"), "--out", str(tmp_path / "nan.csv"), "--no-progress"])
+    rc = main(
+        [
+            "ik-markers",
+            str(tmp_path / "nan.c3d"),
+            "--out",
+            str(tmp_path / "nan.csv"),
+            "--no-progress",
+        ]
+    )
     cap = capsys.readouterr()
-    summary = json.loads(cap.out.strip().splitlines()[-1], parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
-    assert rc == 1 and summary["skipped"] == 5 and summary["rms_median_m"] is None and "no frame" in cap.err
-    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path)])        # a folder
+    summary = json.loads(
+        cap.out.strip().splitlines()[-1], parse_constant=lambda c: pytest.fail(f"{c} in JSON")
+    )
+    assert (
+        rc == 1
+        and summary["skipped"] == 5
+        and summary["rms_median_m"] is None
+        and "no frame" in cap.err
+    )
+    rc = main(["ik-markers", str(tmp_path / "trial.c3d"), "--out", str(tmp_path)])  # a folder
     assert rc == 2 and "give a file name" in capsys.readouterr().err
     (tmp_path / "garbage.c3d").write_bytes(b"garbage")
     rc = main(["ik-markers", str(tmp_path / "garbage.c3d"), "--out", str(tmp_path / "g.csv")])
     err = capsys.readouterr().err
-    assert rc == 2 and "not a C3D file" in err and err.count("\n") == 1 and not (tmp_path / "g.csv").exists()
+    assert (
+        rc == 2
+        and "not a C3D file" in err
+        and err.count("\n") == 1
+        and not (tmp_path / "g.csv").exists()
+    )
 
 
 def test_own_marker_set_as_json(tmp_path, arm, markers, capsys):
@@ -251,8 +335,17 @@ def test_own_marker_set_as_json(tmp_path, arm, markers, capsys):
     _, Q = known_motion(arm, n=20, seed=13)
     P = pin_marker_positions(arm, own, Q)
     write_c3d(tmp_path / "t.c3d", MarkerTrajectories(own.names, P, rate=100.0))
-    rc = main(["ik-markers", str(tmp_path / "t.c3d"), "--out", str(tmp_path / "a.csv"), "--markers",
-               str(tmp_path / "own.json"), "--no-progress"])
+    rc = main(
+        [
+            "ik-markers",
+            str(tmp_path / "t.c3d"),
+            "--out",
+            str(tmp_path / "a.csv"),
+            "--markers",
+            str(tmp_path / "own.json"),
+            "--no-progress",
+        ]
+    )
     assert rc == 0 and json.loads(capsys.readouterr().out.strip().splitlines()[-1])["ok"] == 20
     assert np.abs(read_joint_csv(tmp_path / "a.csv", arm).q - Q).max() < 1e-4
     (tmp_path / "bad.json").write_text("{not json")

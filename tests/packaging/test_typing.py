@@ -19,9 +19,26 @@ pytestmark = pytest.mark.slow
 
 
 def test_mypy_passes_on_src(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "mypy", "--config-file", str(ROOT / "pyproject.toml"),
-                           "--cache-dir", str(tmp_path / "mypy-cache"), "--no-error-summary", "--hide-error-context",
-                           str(ROOT / "src" / "anthroarm")],
-                          cwd=ROOT, capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "mypy",
+            "--config-file",
+            str(ROOT / "pyproject.toml"),
+            "--cache-dir",
+            str(tmp_path / "mypy-cache"),
+            "--no-error-summary",
+            "--hide-error-context",
+            str(ROOT / "src" / "anthroarm"),
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        stdin=subprocess.DEVNULL,
+    )
     errors = [line for line in proc.stdout.splitlines() if ": error:" in line]
-    assert proc.returncode == 0, f"mypy: {len(errors)} errors\n" + "\n".join(errors[:40]) + proc.stderr[-2000:]
+    assert proc.returncode == 0, (
+        f"mypy: {len(errors)} errors\n" + "\n".join(errors[:40]) + proc.stderr[-2000:]
+    )

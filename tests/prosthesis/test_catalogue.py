@@ -14,13 +14,19 @@ def test_shipped_catalogue_units_and_source():
     # the CSV row: 24 V, 0.299 ohm, 30.2 mNm/A, 142 g cm^2, 170 mNm, 12000 rpm, 480 g, 40 mm
     assert (re40.V_nom, re40.R) == (24.0, 0.299)
     assert re40.k_m == pytest.approx(0.0302, rel=1e-12)
-    assert re40.J_m == pytest.approx(142e-7, rel=1e-12)          # 1 g cm^2 = 1e-7 kg m^2
+    assert re40.J_m == pytest.approx(142e-7, rel=1e-12)  # 1 g cm^2 = 1e-7 kg m^2
     assert re40.tau_cont == pytest.approx(0.170, rel=1e-12)
     assert re40.max_speed == pytest.approx(12000 * 2 * math.pi / 60, rel=1e-12)
     assert (re40.mass, re40.diameter) == (pytest.approx(0.48), pytest.approx(0.04))
     gp = next(g for g in cat.gearboxes if g.name == "GP 42 C 156:1")
     assert gp.fits(re40) and not gp.fits(cat.motors[0])
-    assert (gp.ratio, gp.efficiency, gp.tau_cont, gp.tau_max, gp.stages) == (156.0, 0.64, 15.0, 22.5, 4)
+    assert (gp.ratio, gp.efficiency, gp.tau_cont, gp.tau_max, gp.stages) == (
+        156.0,
+        0.64,
+        15.0,
+        22.5,
+        4,
+    )
     assert len(cat.combinations()) > 10
     note = C.source_note(cat.motor_source)
     assert "maxon" in note and "REPRESENTATIVE" in note
@@ -41,25 +47,53 @@ GOOD_MOTOR = "M1,X,20,24,1.0,20,10,30,10000,100"
 GOOD_GEAR = "G1,X,20,2,20,0.8,2,3,8000,80"
 
 
-@pytest.mark.parametrize("text, line, column, words", [
-    # a missing column
-    ("name,series,diameter_mm\nM1,X,20\n", 1, "nominal_voltage_V", "missing column"),
-    # a negative constant
-    (f"{MOTOR_HEADER}\nM1,X,20,24,-1.0,20,10,30,10000,100\n", 2, "terminal_resistance_ohm", "> 0"),
-    # zero torque constant
-    (f"{MOTOR_HEADER}\n# comment\nM1,X,20,24,1.0,0,10,30,10000,100\n", 3, "torque_constant_mNm_per_A", "> 0"),
-    # not a number
-    (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,abc,10,30,10000,100\n", 2, "torque_constant_mNm_per_A", "not a number"),
-    (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,nan,10,30,10000,100\n", 2, "torque_constant_mNm_per_A", "not finite"),
-    # beyond any data sheet (a typo): 1e300 g cm^2
-    (f"{MOTOR_HEADER}\nM1,X,20,24,1.0,20,1e300,30,10000,100\n", 2, "rotor_inertia_gcm2", "typo"),
-    # duplicate name
-    (f"{MOTOR_HEADER}\n{GOOD_MOTOR}\n{GOOD_MOTOR}\n", 3, "name", "duplicate"),
-    # a short row
-    (f"{MOTOR_HEADER}\nM1,X,20\n", 2, None, "fields"),
-    # no rows
-    (f"# only a header\n{MOTOR_HEADER}\n", None, None, "no rows"),
-])
+@pytest.mark.parametrize(
+    "text, line, column, words",
+    [
+        # a missing column
+        ("name,series,diameter_mm\nM1,X,20\n", 1, "nominal_voltage_V", "missing column"),
+        # a negative constant
+        (
+            f"{MOTOR_HEADER}\nM1,X,20,24,-1.0,20,10,30,10000,100\n",
+            2,
+            "terminal_resistance_ohm",
+            "> 0",
+        ),
+        # zero torque constant
+        (
+            f"{MOTOR_HEADER}\n# comment\nM1,X,20,24,1.0,0,10,30,10000,100\n",
+            3,
+            "torque_constant_mNm_per_A",
+            "> 0",
+        ),
+        # not a number
+        (
+            f"{MOTOR_HEADER}\nM1,X,20,24,1.0,abc,10,30,10000,100\n",
+            2,
+            "torque_constant_mNm_per_A",
+            "not a number",
+        ),
+        (
+            f"{MOTOR_HEADER}\nM1,X,20,24,1.0,nan,10,30,10000,100\n",
+            2,
+            "torque_constant_mNm_per_A",
+            "not finite",
+        ),
+        # beyond any data sheet (a typo): 1e300 g cm^2
+        (
+            f"{MOTOR_HEADER}\nM1,X,20,24,1.0,20,1e300,30,10000,100\n",
+            2,
+            "rotor_inertia_gcm2",
+            "typo",
+        ),
+        # duplicate name
+        (f"{MOTOR_HEADER}\n{GOOD_MOTOR}\n{GOOD_MOTOR}\n", 3, "name", "duplicate"),
+        # a short row
+        (f"{MOTOR_HEADER}\nM1,X,20\n", 2, None, "fields"),
+        # no rows
+        (f"# only a header\n{MOTOR_HEADER}\n", None, None, "no rows"),
+    ],
+)
 def test_bad_motor_files(tmp_path, text, line, column, words):
     p = _write(tmp_path, "motors.csv", text)
     with pytest.raises(CatalogueError, match=words) as ei:
@@ -70,15 +104,18 @@ def test_bad_motor_files(tmp_path, text, line, column, words):
     assert isinstance(ei.value, ValueError)
 
 
-@pytest.mark.parametrize("row, column, words", [
-    ("G1,X,20,2,20,1.2,2,3,8000,80", "efficiency", "<= 1"),
-    ("G1,X,20,2,20,0.8,2,1,8000,80", "max_intermittent_torque_Nm", "below"),
-    ("G1,X,20;x,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "list"),
-    ("G1,X,20,2.5,20,0.8,2,3,8000,80", "stages", "whole"),
-    ("G1,X,20,2,-20,0.8,2,3,8000,80", "ratio", "> 0"),
-    ("G1,X,20,2,1e300,0.8,2,3,8000,80", "ratio", "typo"),             # would overflow the sizing
-    ("G1,X,20;1e9,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "> 0 mm"),
-])
+@pytest.mark.parametrize(
+    "row, column, words",
+    [
+        ("G1,X,20,2,20,1.2,2,3,8000,80", "efficiency", "<= 1"),
+        ("G1,X,20,2,20,0.8,2,1,8000,80", "max_intermittent_torque_Nm", "below"),
+        ("G1,X,20;x,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "list"),
+        ("G1,X,20,2.5,20,0.8,2,3,8000,80", "stages", "whole"),
+        ("G1,X,20,2,-20,0.8,2,3,8000,80", "ratio", "> 0"),
+        ("G1,X,20,2,1e300,0.8,2,3,8000,80", "ratio", "typo"),  # would overflow the sizing
+        ("G1,X,20;1e9,2,20,0.8,2,3,8000,80", "motor_diameters_mm", "> 0 mm"),
+    ],
+)
 def test_bad_gearbox_files(tmp_path, row, column, words):
     p = _write(tmp_path, "gearboxes.csv", f"{GEAR_HEADER}\n{row}\n")
     with pytest.raises(CatalogueError, match=words) as ei:

@@ -23,7 +23,7 @@ def test_adl_activities_carry_the_library_objects(person):
     acts = study.adl_activities(person, payload=0.5, names=["lift_to_table", "reach_shelf"])
     lift = acts[0]
     assert lift["name"] == "lift_to_table" and "status" not in lift
-    assert np.max(lift["payload"]) == 1.0 and np.min(lift["payload"]) == 0.5       # 1 kg while held
+    assert np.max(lift["payload"]) == 1.0 and np.min(lift["payload"]) == 0.5  # 1 kg while held
     assert np.all(acts[1]["payload"] == 0.5)
     for bad in (-1.0, float("nan"), "heavy", [1.0]):
         with pytest.raises(ActivityError, match="payload must be a mass"):
@@ -46,8 +46,16 @@ def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
     t = np.linspace(0, 1.0, 51)
     q0 = person.neutral()
     q, qd, qdd = minimum_jerk(q0, q0 + np.array([1.0, 0, 0, 1.0, 0, 0, 0]), 1.0, t)
-    acts = [dict(name="reach", t=t, q=q, qd=qd, qdd=qdd),
-            dict(name="far shelf", t=t, q=q, status="unreachable", reason="keyframe 'shelf' out of reach (120 mm short)")]
+    acts = [
+        dict(name="reach", t=t, q=q, qd=qd, qdd=qdd),
+        dict(
+            name="far shelf",
+            t=t,
+            q=q,
+            status="unreachable",
+            reason="keyframe 'shelf' out of reach (120 mm short)",
+        ),
+    ]
     st = study.run(person, acts, payload=0.5)
     assert [a.status for a in st.activities] == ["ok", "unreachable"]
     assert [a.name for a in st.envelope.activities] == ["reach"]
@@ -71,8 +79,25 @@ def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
 
 def test_cli_size_end_to_end(tmp_path, capsys):
     out = tmp_path / "report.html"
-    rc = main(["size", "--height", "1.75", "--mass", "70", "--sex", "male", "--activities", "adl", "--payload",
-               "0.5", "--no-viewer", "--no-progress", "--out", str(out)])
+    rc = main(
+        [
+            "size",
+            "--height",
+            "1.75",
+            "--mass",
+            "70",
+            "--sex",
+            "male",
+            "--activities",
+            "adl",
+            "--payload",
+            "0.5",
+            "--no-viewer",
+            "--no-progress",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert summary["out"] == str(out) and out.stat().st_size > 10_000
@@ -80,14 +105,17 @@ def test_cli_size_end_to_end(tmp_path, capsys):
     assert summary["rules"]["L7441"] is True
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--out", "x.txt"], "HTML"),
-    (["--payload", "-1"], "payload"),
-    (["--activities", "nope.npz"], "no such"),
-    (["--motors", "missing.csv"], "not found"),
-    (["--model", "prosthetic_arm"], "person models: "),          # a book arm not scaled by a person
-    (["--model", "ur5"], "person models"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--out", "x.txt"], "HTML"),
+        (["--payload", "-1"], "payload"),
+        (["--activities", "nope.npz"], "no such"),
+        (["--motors", "missing.csv"], "not found"),
+        (["--model", "prosthetic_arm"], "person models: "),  # a book arm not scaled by a person
+        (["--model", "ur5"], "person models"),
+    ],
+)
 def test_cli_size_bad_input(tmp_path, capsys, args, words, monkeypatch):
     monkeypatch.chdir(tmp_path)
     rc = main(["size", "--no-progress", "--no-viewer", *args])
@@ -101,11 +129,15 @@ def test_report_embeds_one_viewer_page_with_the_activities(person, tmp_path):
     t = np.linspace(0, 0.5, 26)
     q0 = person.neutral()
     q, qd, qdd = minimum_jerk(q0, q0 + np.array([0.8, 0, 0, 0.9, 0, 0, 0]), 0.5, t)
-    st = study.run(person, [dict(name="a", t=t, q=q, qd=qd, qdd=qdd), dict(name="b", t=t, q=q[::-1])], payload=0.2)
+    st = study.run(
+        person,
+        [dict(name="a", t=t, q=q, qd=qd, qdd=qdd), dict(name="b", t=t, q=q[::-1])],
+        payload=0.2,
+    )
     text = report.render(st, viewer=True)
     assert text.count("<iframe srcdoc=") == 1 and "set_animation" not in text[:200]
     assert "a at 0.0 s; b at 0.5 s" in text
-    assert text.count("MeshCat.Viewer(") == 1            # meshcat's page once, escaped in srcdoc
+    assert text.count("MeshCat.Viewer(") == 1  # meshcat's page once, escaped in srcdoc
 
 
 def test_cli_size_bad_trajectory_files(tmp_path, capsys, monkeypatch, person):
@@ -120,9 +152,14 @@ def test_cli_size_bad_trajectory_files(tmp_path, capsys, monkeypatch, person):
     (tmp_path / "ragged.csv").write_text(f"{names}\n{row}\n1.0,2.0\n")
     (tmp_path / "word.csv").write_text(f"{names}\n{row}\n{row.replace('0.0', 'x', 1)}\n")
     (tmp_path / "header.csv").write_text(f"# only a header\n{names}\n")
-    for f, words in [("junk.npz", "not a NumPy .npz archive"), ("one.npz", "not a NumPy .npz archive"),
-                     ("text.npz", "must be numbers"), ("ragged.csv", "line 3: 2 values"),
-                     ("word.csv", "line 3: a value is not a number"), ("header.csv", "no samples")]:
+    for f, words in [
+        ("junk.npz", "not a NumPy .npz archive"),
+        ("one.npz", "not a NumPy .npz archive"),
+        ("text.npz", "must be numbers"),
+        ("ragged.csv", "line 3: 2 values"),
+        ("word.csv", "line 3: a value is not a number"),
+        ("header.csv", "no samples"),
+    ]:
         rc = main(["size", "--no-progress", "--no-viewer", "--activities", f])
         err = capsys.readouterr().err
         assert rc == 2 and f in err and words in err and len(err.strip().splitlines()) == 1, err

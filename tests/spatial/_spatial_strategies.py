@@ -7,7 +7,11 @@ angle = st.floats(-np.pi, np.pi, allow_nan=False)
 small = st.floats(-2.0, 2.0, allow_nan=False)
 rate = st.floats(-3.0, 3.0, allow_nan=False)
 vec3 = st.tuples(small, small, small).map(np.array)
-unit3 = st.tuples(small, small, small).filter(lambda v: np.linalg.norm(v) > 0.2).map(lambda v: np.array(v) / np.linalg.norm(v))
+unit3 = (
+    st.tuples(small, small, small)
+    .filter(lambda v: np.linalg.norm(v) > 0.2)
+    .map(lambda v: np.array(v) / np.linalg.norm(v))
+)
 
 
 @st.composite

@@ -3,10 +3,10 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rotation, small, unit3, vec3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _spatial_strategies import angle, rotation, small, unit3, vec3
 from anthroarm.spatial import dual as D
 from anthroarm.spatial.dual import Dual, Line
 
@@ -54,7 +54,9 @@ def test_dual_trigonometry_5_134(t):
     assert s.isclose(Dual(np.sin(t.real), t.dual * np.cos(t.real)))
     assert c.isclose(Dual(np.cos(t.real), -t.dual * np.sin(t.real)))
     assert (s * s + c * c).isclose(Dual(1.0, 0.0), atol=1e-12)
-    assert D.atan2(s, c).isclose(Dual(np.arctan2(np.sin(t.real), np.cos(t.real)), t.dual), atol=1e-12)
+    assert D.atan2(s, c).isclose(
+        Dual(np.arctan2(np.sin(t.real), np.cos(t.real)), t.dual), atol=1e-12
+    )
     if abs(t.real) > 1e-3:
         assert D.sqrt(t * t).isclose(Dual(abs(t.real), np.sign(t.real) * t.dual), atol=1e-9)
 
@@ -68,7 +70,9 @@ def test_dual_bad_input():
         D.sqrt(Dual(0.0, 1.0))
     from anthroarm.errors import DualDivisionError
 
-    with pytest.raises(DualDivisionError, match="zero real part"):   # a ValueError, not ZeroDivisionError
+    with pytest.raises(
+        DualDivisionError, match="zero real part"
+    ):  # a ValueError, not ZeroDivisionError
         Dual(1.0, 1.0) / Dual(0.0, 1.0)
     with pytest.raises(ValueError, match="NaN"):
         Dual(np.nan, 0.0)
@@ -84,7 +88,9 @@ def test_line_5_135_to_5_140_and_5_144(p, u, A):
     L = Line.from_point_direction(p, u)
     assert np.isclose(L.u @ L.u, 1.0) and abs(L.u @ L.moment) < 1e-12  # (5-144)
     d = L.foot()  # (5-138)
-    assert abs(d @ L.u) < 1e-12 and L.distance_to_point(d) < 1e-12 and L.distance_to_point(p) < 1e-12
+    assert (
+        abs(d @ L.u) < 1e-12 and L.distance_to_point(d) < 1e-12 and L.distance_to_point(p) < 1e-12
+    )
     assert np.allclose(np.cross(d, L.u), L.moment)  # (5-137)
     LA = L.moved(A)  # (5-140): the same line referred to A
     assert np.allclose(LA.moment, np.cross(p - A, u))
@@ -104,7 +110,9 @@ def test_line_transforms_like_pinocchio_motion(p, u, R, t):
     A = D.dual_matrix_from_se3(R, t)
     L2 = D.transform_line(A, L)
     mi = M.actInv(L.as_motion())
-    assert np.allclose(L2.u, mi.angular, atol=1e-12) and np.allclose(L2.moment, mi.linear, atol=1e-12)
+    assert np.allclose(L2.u, mi.angular, atol=1e-12) and np.allclose(
+        L2.moment, mi.linear, atol=1e-12
+    )
     R2, t2 = D.se3_from_dual_matrix(A)
     assert np.allclose(R2, R) and np.allclose(t2, t)
 
@@ -129,7 +137,9 @@ def test_dual_angle_5_133_and_products_5_141(p1, u1, p2, u2):
 
 def test_dual_angle_special_cases():
     x = Line.from_point_direction([0, 0, 0], [1, 0, 0])
-    assert D.line_dual_angle(x, Line.from_point_direction([0, 0, 0], [0, 1, 0]))[0].isclose(Dual(np.pi / 2, 0.0))  # intersecting
+    assert D.line_dual_angle(x, Line.from_point_direction([0, 0, 0], [0, 1, 0]))[0].isclose(
+        Dual(np.pi / 2, 0.0)
+    )  # intersecting
     th, n = D.line_dual_angle(x, Line.from_point_direction([0, 0, 2], [1, 0, 0]))
     assert th.isclose(Dual(0.0, 2.0)) and np.allclose(n, [0, 0, 1])  # parallel: pure dual angle
     assert D.line_dual_angle(x, x)[1] is None
@@ -146,7 +156,9 @@ def test_basic_screw_matrices_5_146_to_5_149(phi, ps):
     for k, (fn, ax) in enumerate(((D.screw_x, "x"), (D.screw_y, "y"), (D.screw_z, "z"))):
         A = fn(phi, ps)
         e = np.eye(3)[k]
-        M = pin.exp6(pin.Motion(ps * e, phi * e))  # rotation φ about and translation φ* along the axis
+        M = pin.exp6(
+            pin.Motion(ps * e, phi * e)
+        )  # rotation φ about and translation φ* along the axis
         B = D.dual_matrix_from_se3(M.rotation, M.translation)
         assert np.allclose(A.real, B.real, atol=1e-14) and np.allclose(A.dual, B.dual, atol=1e-14)
         assert np.allclose(A.dual, A.real @ (ps * D.P_matrix(ax)))  # = φ_x (I + ε φ* P_x)
@@ -174,7 +186,9 @@ def test_dual_matrix_composition_matches_se3(R1, p1, R2, p2):
     assert np.allclose(R, M.rotation, atol=1e-12) and np.allclose(p, M.translation, atol=1e-12)
     Ai = A.T  # inverse = transpose (principle of transference)
     Ri, pi_ = D.se3_from_dual_matrix(Ai)
-    assert np.allclose(Ri, M.inverse().rotation, atol=1e-12) and np.allclose(pi_, M.inverse().translation, atol=1e-12)
+    assert np.allclose(Ri, M.inverse().rotation, atol=1e-12) and np.allclose(
+        pi_, M.inverse().translation, atol=1e-12
+    )
 
 
 def test_non_dual_orthogonal_rejected():

@@ -39,7 +39,11 @@ def test_length_jacobian_matches_finite_differences(robots, name, mode):
 def test_6_119_human_arm7_is_the_length_jacobian(robots):
     r = robots["human_arm7"]
     ps = EP.link_parameters(r)
-    assert [p.name for p in ps] == ["elbow_flexion.length", "wrist_deviation.length", "hand_point.length"]
+    assert [p.name for p in ps] == [
+        "elbow_flexion.length",
+        "wrist_deviation.length",
+        "hand_point.length",
+    ]
     l1, l2, l3 = (r.spec.params[k] for k in ("l1", "l2", "l3"))
     assert np.allclose([p.nominal for p in ps], [l1, l2, l3])
     for q in r.random_q(5, np.random.default_rng(3)):
@@ -102,7 +106,9 @@ def test_monte_carlo_matches_linear_covariance(robots):
     sd_lin = np.sqrt(np.diag(res.linear_cov))
     assert np.allclose(sd_mc, sd_lin, rtol=0.05)  # 20000 samples: ~1% sampling error
     assert res.dx.shape == (20000, 6) and res.max_position >= res.p95_position > 0
-    u = EP.monte_carlo(r, q, sigma_q=1e-3, sigma_L=0.0, n=20000, rng=0, distribution="uniform", progress=False)
+    u = EP.monte_carlo(
+        r, q, sigma_q=1e-3, sigma_L=0.0, n=20000, rng=0, distribution="uniform", progress=False
+    )
     assert np.allclose(np.sqrt(np.diag(u.cov)), np.sqrt(np.diag(u.linear_cov)), rtol=0.05)
     z = EP.monte_carlo(r, q, n=10, rng=0, progress=False)
     assert np.allclose(z.dx, 0)
@@ -139,8 +145,10 @@ def user_urdf(tmp_path_factory):
     return p
 
 
-@pytest.mark.parametrize("name,kw", [("kinova", {}), ("user", {"tool": "tool"}),
-                                     ("baxter", {"tool": "l_gripper_r_finger_tip"})])
+@pytest.mark.parametrize(
+    "name,kw",
+    [("kinova", {}), ("user", {"tool": "tool"}), ("baxter", {"tool": "l_gripper_r_finger_tip"})],
+)
 def test_perturbed_chain_continuous_and_mimic_joints(name, kw, user_urdf):
     """PerturbedChain reads robot.chain: continuous joints ((cos, sin) in q), mimic joints (baxter's
     finger, the user arm's grip_mimic) and joint errors dq (on the circle: pin.integrate) equal
@@ -148,7 +156,9 @@ def test_perturbed_chain_continuous_and_mimic_joints(name, kw, user_urdf):
     r = aa.load(str(user_urdf) if name == "user" else name, **kw)
     rng = np.random.default_rng(5)
     chain = EP.PerturbedChain(r, mode="components")
-    assert [j.name for j in chain.joints] == [r.model.names[i] for i in _support(r.model, r.tool_id)]
+    assert [j.name for j in chain.joints] == [
+        r.model.names[i] for i in _support(r.model, r.tool_id)
+    ]
     Q = r.random_q(4, rng)
     dL = 0.01 * rng.normal(size=(4, len(chain.params)))
     dq = 0.05 * rng.normal(size=(4, r.nv))

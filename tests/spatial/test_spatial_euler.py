@@ -3,11 +3,11 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rotation
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from _spatial_strategies import angle, rotation
 from anthroarm.spatial import euler as E
 from anthroarm.spatial.rotations import rot_x, rot_z, unskew
 
@@ -17,20 +17,28 @@ H = settings(max_examples=40, deadline=None)
 def printed_5_80(t, a, d):
     """Eq. (5-80) exactly as printed (line 2968): element (3,2) = sin δ cos δ."""
     ct, st_, ca, sa, cd, sd = np.cos(t), np.sin(t), np.cos(a), np.sin(a), np.cos(d), np.sin(d)
-    return np.array([
-        [ct * cd - st_ * ca * sd, -ct * sd - st_ * ca * cd, st_ * sa],
-        [st_ * cd + ct * ca * sd, -st_ * sd + ct * ca * cd, -ct * sa],
-        [sa * sd, sd * cd, ca],
-    ])
+    return np.array(
+        [
+            [ct * cd - st_ * ca * sd, -ct * sd - st_ * ca * cd, st_ * sa],
+            [st_ * cd + ct * ca * sd, -st_ * sd + ct * ca * cd, -ct * sa],
+            [sa * sd, sd * cd, ca],
+        ]
+    )
 
 
 @H
 @given(angle, angle, angle)
 def test_zxz_5_80_is_product_of_exp3(t, a, d):
     C = E.euler_zxz(t, a, d)
-    ref = pin.exp3(np.array([0, 0, t])) @ pin.exp3(np.array([a, 0, 0])) @ pin.exp3(np.array([0, 0, d]))
+    ref = (
+        pin.exp3(np.array([0, 0, t]))
+        @ pin.exp3(np.array([a, 0, 0]))
+        @ pin.exp3(np.array([0, 0, d]))
+    )
     assert np.allclose(C, ref, atol=1e-14)
-    assert np.allclose(E.euler_zxz_partial(t, a), ref @ pin.exp3(np.array([0, 0, -d])), atol=1e-14)  # (5-81)
+    assert np.allclose(
+        E.euler_zxz_partial(t, a), ref @ pin.exp3(np.array([0, 0, -d])), atol=1e-14
+    )  # (5-81)
 
 
 def test_printed_5_80_element_32_is_wrong():
@@ -80,8 +88,10 @@ def test_xyx_zero_posture_is_singular():
 def test_rate_matrices_give_body_angular_velocity(t, p, f, td, pd, fd):
     h = 1e-6
     e, ed = np.array([t, p, f]), np.array([td, pd, fd])
-    for fun, rate in ((E.euler_xyx, lambda e: E.euler_xyx_rate_matrix(e[1], e[2])),
-                      (E.euler_zxz, lambda e: E.euler_zxz_rate_matrix(e[1], e[2]))):
+    for fun, rate in (
+        (E.euler_xyx, lambda e: E.euler_xyx_rate_matrix(e[1], e[2])),
+        (E.euler_zxz, lambda e: E.euler_zxz_rate_matrix(e[1], e[2])),
+    ):
         Rd = (fun(*(e + h * ed)) - fun(*(e - h * ed))) / (2 * h)
         w_body = unskew(fun(*e).T @ Rd)
         assert np.allclose(rate(e) @ ed, w_body, atol=1e-7)

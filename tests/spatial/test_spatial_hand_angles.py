@@ -3,11 +3,11 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rotation
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import anthroarm as aa
-from _spatial_strategies import angle, rotation
 from anthroarm.spatial.hand_angles import hand_angles, hand_matrix, hand_pointing
 from anthroarm.spatial.rotations import check_rotation
 
@@ -18,11 +18,13 @@ beta_ok = st.floats(-1.5, 1.5)
 def printed_6_44(a, b, g):
     """The result matrix of (6-44) as printed (l. 4021-4025): element (1,3) = +cα cβ."""
     ca, sa, cb, sb, cg, sg = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(g), np.sin(g)
-    return np.array([
-        [sa * cg - ca * sb * sg, sa * sg + ca * sb * cg, ca * cb],
-        [-ca * cg - sa * sb * sg, -ca * sg + sa * sb * cg, -sa * cb],
-        [-cb * sg, cb * cg, sb],
-    ])
+    return np.array(
+        [
+            [sa * cg - ca * sb * sg, sa * sg + ca * sb * cg, ca * cb],
+            [-ca * cg - sa * sb * sg, -ca * sg + sa * sb * cg, -sa * cb],
+            [-cb * sg, cb * cg, sb],
+        ]
+    )
 
 
 def printed_6_47(C):
@@ -35,7 +37,9 @@ def printed_6_47(C):
 def test_hand_matrix_is_the_printed_factor_product(a, b, g):
     C = hand_matrix(a, b, g)
     f = lambda ax, t: pin.utils.rotate(ax, t)
-    assert np.allclose(C, f("z", -np.pi / 2) @ f("x", np.pi / 2) @ f("y", a) @ f("x", -b) @ f("z", -g), atol=1e-14)
+    assert np.allclose(
+        C, f("z", -np.pi / 2) @ f("x", np.pi / 2) @ f("y", a) @ f("x", -b) @ f("z", -g), atol=1e-14
+    )
     P = printed_6_44(a, b, g)
     mask = np.ones((3, 3), bool)
     mask[0, 2] = False

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from _spatial_strategies import angle, rate, vec3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _spatial_strategies import angle, rate, vec3
 from anthroarm.spatial import polar as P
 
 H = settings(max_examples=40, deadline=None)

@@ -7,8 +7,16 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from anthroarm.mechanisms.rccc import (RCCCGeometry, c_elements, d_elements, loop_matrices, pinocchio_chain,
-                                       rccc_acceleration, rccc_position, rccc_velocity)
+from anthroarm.mechanisms.rccc import (
+    RCCCGeometry,
+    c_elements,
+    d_elements,
+    loop_matrices,
+    pinocchio_chain,
+    rccc_acceleration,
+    rccc_position,
+    rccc_velocity,
+)
 from anthroarm.spatial import dual as D
 from anthroarm.spatial.dual import Dual
 
@@ -29,8 +37,10 @@ def test_notes_fixture_both_branches():
     """ch5.md §3 synthetic fixture (computed by the note's author, not printed in the book)."""
     r = rccc_position(FIXTURE, 0.9)
     assert r.status == "ok" and len(r.solutions) == 2
-    expected = [((3.530899, 0.347775), (2.961129, -0.855839), (-0.980084, 0.276170)),
-                ((1.981656, -2.178122), (1.683413, -2.552412), (0.980084, -0.276170))]
+    expected = [
+        ((3.530899, 0.347775), (2.961129, -0.855839), (-0.980084, 0.276170)),
+        ((1.981656, -2.178122), (1.683413, -2.552412), (0.980084, -0.276170)),
+    ]
     for sol in r.solutions:
         match = [e for e in expected if abs(wrap(sol.theta4.real - e[0][0])) < 1e-5]
         assert len(match) == 1
@@ -45,15 +55,26 @@ def test_notes_fixture_both_branches():
 def printed_c(a12, a41, a34, t1, t4):
     """The c-elements as printed (l. 3569-3576), with cα43 read as cα41 (only the ones the
     book gets wrong; c11, c13, c21 are printed correctly)."""
-    c12, s12, c41, s41, c34, s34 = D.cos(a12), D.sin(a12), D.cos(a41), D.sin(a41), D.cos(a34), D.sin(a34)
+    c12, s12, c41, s41, c34, s34 = (
+        D.cos(a12),
+        D.sin(a12),
+        D.cos(a41),
+        D.sin(a41),
+        D.cos(a34),
+        D.sin(a34),
+    )
     ct1, st1, ct4, st4 = D.cos(t1), D.sin(t1), D.cos(t4), D.sin(t4)
     return {
         (0, 1): c34 * (ct1 * st4 + c41 * st1 * ct4) - s34 * (c41 * s12 + s41 * c12 * ct1),
-        (1, 1): -c34 * (s12 * st1 * st4 - ct4 * (s41 * c12 + c41 * s12 * ct1)) - s34 * (c41 * s12 + s41 * c12 * ct1),
-        (1, 2): -s34 * (s12 * st1 * st4 + (s41 * s12 - c41 * c12 * ct1) * ct4) + c34 * (c41 * s12 + s41 * c12 * ct1),
+        (1, 1): -c34 * (s12 * st1 * st4 - ct4 * (s41 * c12 + c41 * s12 * ct1))
+        - s34 * (c41 * s12 + s41 * c12 * ct1),
+        (1, 2): -s34 * (s12 * st1 * st4 + (s41 * s12 - c41 * c12 * ct1) * ct4)
+        + c34 * (c41 * s12 + s41 * c12 * ct1),
         (2, 0): s12 * st1 * ct4 + st4 * (s41 * s12 - c41 * c12 * ct1),
-        (2, 1): c34 * (s12 * st1 * st4 - (s41 * c12 + c41 * s12 * ct1)) - s34 * (c41 * c12 - s41 * s12 * ct1),
-        (2, 2): s34 * (s12 * st1 * st4 - ct4 * (s41 * c12 + c41 * s12 * ct1)) - c34 * (c41 * c12 - s41 * s12 * ct1),
+        (2, 1): c34 * (s12 * st1 * st4 - (s41 * c12 + c41 * s12 * ct1))
+        - s34 * (c41 * c12 - s41 * s12 * ct1),
+        (2, 2): s34 * (s12 * st1 * st4 - ct4 * (s41 * c12 + c41 * s12 * ct1))
+        - c34 * (c41 * c12 - s41 * s12 * ct1),
     }
 
 
@@ -61,7 +82,12 @@ def printed_d(a23, t2, t3):
     """The d-elements as printed that are wrong: d12 (with cα43 read as cα23), d13 ("cθ22" read
     as cθ2), d22, d32."""
     ca, sa, c2, s2, c3, s3 = D.cos(a23), D.sin(a23), D.cos(t2), D.sin(t2), D.cos(t3), D.sin(t3)
-    return {(0, 1): -c2 * s3 + s2 * c3 * ca, (0, 2): sa * c2, (1, 1): -s2 * s3 - c2 * c3 * ca, (2, 1): sa * c2}
+    return {
+        (0, 1): -c2 * s3 + s2 * c3 * ca,
+        (0, 2): sa * c2,
+        (1, 1): -s2 * s3 - c2 * c3 * ca,
+        (2, 1): sa * c2,
+    }
 
 
 @H
@@ -86,7 +112,9 @@ def test_printed_elements_fail():
         assert not v.isclose(De[i, j], atol=1e-3), f"printed d{i + 1}{j + 1} unexpectedly right"
     # the printed input-output equation c33 = d33 does not close the loop of a real solution
     sol = rccc_position(FIXTURE, 0.9).solutions[0]
-    pc33 = printed_c(FIXTURE.alpha12, FIXTURE.alpha41, FIXTURE.alpha34, sol.theta1, sol.theta4)[(2, 2)]
+    pc33 = printed_c(FIXTURE.alpha12, FIXTURE.alpha41, FIXTURE.alpha34, sol.theta1, sol.theta4)[
+        (2, 2)
+    ]
     assert abs(pc33.real - np.cos(FIXTURE.alpha23.real)) > 1e-2
 
 
@@ -124,7 +152,16 @@ def _check_against_pinocchio(g, sol, w1, a1):
 
 
 @H
-@given(dual_link, dual_link, dual_link, dual_link, length, st.floats(-np.pi, np.pi), st.floats(-2, 2), st.floats(-2, 2))
+@given(
+    dual_link,
+    dual_link,
+    dual_link,
+    dual_link,
+    length,
+    st.floats(-np.pi, np.pi),
+    st.floats(-2, 2),
+    st.floats(-2, 2),
+)
 def test_random_rccc_closes_and_rates_match_pinocchio(a12, a23, a34, a41, s1, th1, w1, acc1):
     g = RCCCGeometry(a12, a23, a34, a41, s1)
     r = rccc_position(g, th1)
@@ -160,9 +197,13 @@ def test_cannot_assemble_is_a_status():
 
 
 def test_degenerate_and_dead_point_statuses():
-    g = RCCCGeometry(Dual(0.5, 1.0), Dual(1.0, 2.5), Dual(0.0, 1.5), Dual(1.2, 3.0), 0.7)  # sin α34 = 0
+    g = RCCCGeometry(
+        Dual(0.5, 1.0), Dual(1.0, 2.5), Dual(0.0, 1.5), Dual(1.2, 3.0), 0.7
+    )  # sin α34 = 0
     assert rccc_position(g, 0.9).status == "degenerate"
-    g2 = RCCCGeometry(Dual(0.5, 1.0), Dual(0.0, 2.5), Dual(0.8, 1.5), Dual(1.2, 3.0), 0.7)  # sin α23 = 0
+    g2 = RCCCGeometry(
+        Dual(0.5, 1.0), Dual(0.0, 2.5), Dual(0.8, 1.5), Dual(1.2, 3.0), 0.7
+    )  # sin α23 = 0
     assert rccc_position(g2, 0.9).status in ("degenerate", "cannot assemble")
     # a rocker input: assembly fails for part of the turn; bisect to the dead point
     rocker = RCCCGeometry(Dual(0.6, 1.0), Dual(0.5, 2.5), Dual(0.8, 1.5), Dual(1.2, 3.0), 0.7)
@@ -203,4 +244,6 @@ def test_rccc_bad_input():
         rccc_velocity(FIXTURE, sol, np.nan)
     with pytest.raises(ValueError, match="theta1_ddot"):
         rccc_acceleration(FIXTURE, sol, 1.0, np.inf)
-    assert RCCCGeometry((0.5, 1.0), (1.0, 2.5), (0.8, 1.5), (1.2, 3.0), 0.7).alpha12.isclose(Dual(0.5, 1.0))
+    assert RCCCGeometry((0.5, 1.0), (1.0, 2.5), (0.8, 1.5), (1.2, 3.0), 0.7).alpha12.isclose(
+        Dual(0.5, 1.0)
+    )

@@ -4,11 +4,16 @@ the printed (4-9), (4-14), (4-16) forms fail."""
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rate, unit3, vec3
 from hypothesis import given, settings
 
-from _spatial_strategies import angle, rate, unit3, vec3
-from anthroarm.mechanisms.relative_motion import (RelativeMotionGeometry, pinocchio_model, relative_acceleration,
-                                                  relative_position, relative_velocity)
+from anthroarm.mechanisms.relative_motion import (
+    RelativeMotionGeometry,
+    pinocchio_model,
+    relative_acceleration,
+    relative_position,
+    relative_velocity,
+)
 from anthroarm.spatial.rotations import skew
 
 H = settings(max_examples=40, deadline=None)
@@ -17,7 +22,9 @@ LWA = pin.LOCAL_WORLD_ALIGNED
 
 @H
 @given(unit3, vec3, unit3, vec3, vec3, angle, rate, rate, angle, rate, rate, vec3)
-def test_against_pinocchio_frame_velocity_and_classical_acceleration(u0, p0, u1, p1, q1, th, thd, thdd, ph, phd, phdd, svec):
+def test_against_pinocchio_frame_velocity_and_classical_acceleration(
+    u0, p0, u1, p1, q1, th, thd, thdd, ph, phd, phdd, svec
+):
     s, sd, sdd = svec
     g = RelativeMotionGeometry(u0, p0, u1, p1, q1)
     pos = relative_position(g, th, ph, s)
@@ -25,16 +32,24 @@ def test_against_pinocchio_frame_velocity_and_classical_acceleration(u0, p0, u1,
     a = relative_acceleration(g, th, thd, thdd, ph, phd, phdd, s, sd, sdd)
     model, fid = pinocchio_model(g)
     data = model.createData()
-    pin.forwardKinematics(model, data, np.array([th, s, ph]), np.array([thd, sd, phd]), np.array([thdd, sdd, phdd]))
+    pin.forwardKinematics(
+        model, data, np.array([th, s, ph]), np.array([thd, sd, phd]), np.array([thdd, sdd, phdd])
+    )
     pin.updateFramePlacements(model, data)
     assert np.allclose(pos.q, data.oMf[fid].translation, atol=1e-12)
     assert np.allclose(v.total, pin.getFrameVelocity(model, data, fid, LWA).linear, atol=1e-11)
-    assert np.allclose(a.total, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-10)
+    assert np.allclose(
+        a.total, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-10
+    )
     # transport velocity = velocity of the coincident point of link 2 (joint 1 only)
-    pin.forwardKinematics(model, data, np.array([th, s, ph]), np.array([thd, 0, 0]), np.array([thdd, 0, 0]))
+    pin.forwardKinematics(
+        model, data, np.array([th, s, ph]), np.array([thd, 0, 0]), np.array([thdd, 0, 0])
+    )
     pin.updateFramePlacements(model, data)
     assert np.allclose(v.transport, pin.getFrameVelocity(model, data, fid, LWA).linear, atol=1e-11)
-    assert np.allclose(a.transport, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-10)
+    assert np.allclose(
+        a.transport, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-10
+    )
 
 
 @H
@@ -43,7 +58,11 @@ def test_against_finite_differences(u0, p0, u1, p1, q1, th, thd, ph, phd, svec):
     s, sd, sdd = svec
     g = RelativeMotionGeometry(u0, p0, u1, p1, q1)
     thdd, phdd = 0.3, -0.7
-    traj = lambda t: (th + thd * t + 0.5 * thdd * t * t, ph + phd * t + 0.5 * phdd * t * t, s + sd * t + 0.5 * sdd * t * t)
+    traj = lambda t: (
+        th + thd * t + 0.5 * thdd * t * t,
+        ph + phd * t + 0.5 * phdd * t * t,
+        s + sd * t + 0.5 * sdd * t * t,
+    )
     q = lambda t: relative_position(g, *traj(t)).q
     h = 1e-4
     v = relative_velocity(g, th, thd, ph, phd, s, sd)
@@ -72,7 +91,13 @@ def test_printed_forms_fail():
     assert not np.allclose(2 * W0 @ Wu @ (pos.q - pos.p) + sd * pos.u, a.coriolis, atol=1e-6)
     # (4-17) as printed is right
     E0 = thdd * P0 + thd**2 * P0 @ P0
-    printed_417 = E0 @ (pos.q - g.p0) + Eu @ (pos.q - pos.p) + sdd * pos.u + 2 * W0 @ (sd * pos.u) + 2 * W0 @ Wu @ (pos.q - pos.p)
+    printed_417 = (
+        E0 @ (pos.q - g.p0)
+        + Eu @ (pos.q - pos.p)
+        + sdd * pos.u
+        + 2 * W0 @ (sd * pos.u)
+        + 2 * W0 @ Wu @ (pos.q - pos.p)
+    )
     assert np.allclose(printed_417, a.total, atol=1e-12)
 
 
@@ -82,8 +107,12 @@ def test_coriolis_vanishes_without_transport_rotation_or_relative_motion():
     assert np.allclose(a.coriolis, 0)
     a = relative_acceleration(g, 0.3, 1.0, 0.0, 0.2, 0.0, 0.0, 0.1, 0.0, 0.0)
     assert np.allclose(a.coriolis, 0)
-    a = relative_acceleration(g, 0.3, 1.0, 0.0, 0.2, 0.0, 0.0, 0.1, 0.5, 0.0)  # slide on a rotating link
-    assert np.allclose(a.coriolis, 2 * np.cross([0, 0, 1.0], 0.5 * relative_position(g, 0.3, 0.2, 0.1).u))
+    a = relative_acceleration(
+        g, 0.3, 1.0, 0.0, 0.2, 0.0, 0.0, 0.1, 0.5, 0.0
+    )  # slide on a rotating link
+    assert np.allclose(
+        a.coriolis, 2 * np.cross([0, 0, 1.0], 0.5 * relative_position(g, 0.3, 0.2, 0.1).u)
+    )
 
 
 def test_batch_and_moving_base():

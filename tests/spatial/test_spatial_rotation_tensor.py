@@ -3,10 +3,10 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rate, rotation, unit3, vec3
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _spatial_strategies import angle, rate, rotation, unit3, vec3
 from anthroarm.spatial import rotation_tensor as T
 from anthroarm.spatial.rotations import rot_y, rot_z, skew, unit_axis
 
@@ -18,11 +18,13 @@ def printed_5_104(w, th):
     l, m, n = w
     c, s = np.cos(th), np.sin(th)
     v = 1 - c
-    return np.array([
-        [c + l * l * v, l * m * v - n * s, n * l * v + m * s],
-        [l * m * v + n * s, c + m * m * v, m * n * v - l * s],
-        [n * l * v - m * s, m * n * v + l * s, c + n * n * (1 - c**2)],
-    ])
+    return np.array(
+        [
+            [c + l * l * v, l * m * v - n * s, n * l * v + m * s],
+            [l * m * v + n * s, c + m * m * v, m * n * v - l * s],
+            [n * l * v - m * s, m * n * v + l * s, c + n * n * (1 - c**2)],
+        ]
+    )
 
 
 @H
@@ -43,7 +45,9 @@ def test_rotate_5_88_inverse_transpose_det(w, th, R):
     assert np.allclose(T.rotate(w, -th, Rp), R, atol=1e-12)  # E^{w(-θ)}(R') = R
     E = T.rotation_tensor(w, th)
     assert np.isclose(np.linalg.det(E), 1.0)  # (5-113)
-    assert np.allclose(np.linalg.inv(E), E.T) and np.allclose(E.T, T.rotation_tensor(w, -th))  # (5-114)-(5-116)
+    assert np.allclose(np.linalg.inv(E), E.T) and np.allclose(
+        E.T, T.rotation_tensor(w, -th)
+    )  # (5-114)-(5-116)
     for J in (T.J1(w), T.J2(w), T.J3(w)):
         assert np.linalg.svd(J, compute_uv=False).min() < 1e-12  # (5-117): |J| = 0
 
@@ -54,7 +58,17 @@ def test_J_product_table_5_118(w):
     P = T.component_products(w)
     J1, J2, J3 = T.J1(w), T.J2(w), T.J3(w)
     Z = np.zeros((3, 3))
-    expected = {"J1J1": J1, "J1J2": Z, "J1J3": Z, "J2J1": Z, "J2J2": J2, "J2J3": J3, "J3J1": Z, "J3J2": J3, "J3J3": -J2}
+    expected = {
+        "J1J1": J1,
+        "J1J2": Z,
+        "J1J3": Z,
+        "J2J1": Z,
+        "J2J2": J2,
+        "J2J3": J3,
+        "J3J1": Z,
+        "J3J2": J3,
+        "J3J3": -J2,
+    }
     for k, v in expected.items():
         assert np.allclose(P[k], v, atol=1e-14), k
     assert np.allclose(J3, pin.skew(w))
@@ -81,8 +95,12 @@ def test_noncommutativity_5_109_5_110(a, b, R):
     ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
     R1 = rot_z(b) @ rot_y(a) @ R
     R2 = rot_y(a) @ rot_z(b) @ R
-    assert np.allclose(R1, [(x * ca + z * sa) * cb - y * sb, (x * ca + z * sa) * sb + y * cb, -x * sa + z * ca])
-    assert np.allclose(R2, [(x * cb - y * sb) * ca + z * sa, x * sb + y * cb, -(x * cb - y * sb) * sa + z * ca])
+    assert np.allclose(
+        R1, [(x * ca + z * sa) * cb - y * sb, (x * ca + z * sa) * sb + y * cb, -x * sa + z * ca]
+    )
+    assert np.allclose(
+        R2, [(x * cb - y * sb) * ca + z * sa, x * sb + y * cb, -(x * cb - y * sb) * sa + z * ca]
+    )
 
 
 @H
@@ -117,7 +135,11 @@ def test_tensor_rates_5_122_5_129_with_moving_axis_vs_fd(w0, dv, th0, thd, thdd)
     # fixed axis: (5-125) Ė = θ̇ J3 E and (5-129) Ë = θ̈ J3 E − θ̇² J2 E
     E0 = T.rotation_tensor(w0, th0)
     assert np.allclose(T.rotation_tensor_rate(w0, th0, thd), thd * T.J3(w0) @ E0, atol=1e-12)
-    assert np.allclose(T.rotation_tensor_acc(w0, th0, thd, thdd), thdd * T.J3(w0) @ E0 - thd**2 * T.J2(w0) @ E0, atol=1e-12)
+    assert np.allclose(
+        T.rotation_tensor_acc(w0, th0, thd, thdd),
+        thdd * T.J3(w0) @ E0 - thd**2 * T.J2(w0) @ E0,
+        atol=1e-12,
+    )
 
 
 def _rp_chain(w):
@@ -126,7 +148,11 @@ def _rp_chain(w):
     I = pin.Inertia.FromSphere(1.0, 0.1)
     j = model.addJoint(0, pin.JointModelRevoluteUnaligned(w), pin.SE3.Identity(), "rot")
     model.appendBodyToJoint(j, I, pin.SE3.Identity())
-    for n, jm in (("px", pin.JointModelPX()), ("py", pin.JointModelPY()), ("pz", pin.JointModelPZ())):
+    for n, jm in (
+        ("px", pin.JointModelPX()),
+        ("py", pin.JointModelPY()),
+        ("pz", pin.JointModelPZ()),
+    ):
         j = model.addJoint(j, jm, pin.SE3.Identity(), n)
         model.appendBodyToJoint(j, I, pin.SE3.Identity())
     fid = model.addFrame(pin.Frame("tip", j, 0, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
@@ -144,11 +170,15 @@ def test_rotated_vector_5_126_5_130_vs_pinocchio(w, th, thd, thdd, R, Rd, Rdd):
     LWA = pin.LOCAL_WORLD_ALIGNED
     assert np.allclose(m.position, data.oMf[fid].translation, atol=1e-12)
     assert np.allclose(m.velocity, pin.getFrameVelocity(model, data, fid, LWA).linear, atol=1e-12)
-    assert np.allclose(m.acceleration, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-11)
+    assert np.allclose(
+        m.acceleration, pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear, atol=1e-11
+    )
     # the four named terms of (5-130)
     E = T.rotation_tensor(w, th)
     assert np.allclose(m.tangential, E @ (thdd * np.cross(w, R)))
-    assert np.allclose(m.centripetal, E @ (thd**2 * np.cross(w, np.cross(w, R))))  # −θ̇² J2 R = θ̇² w×(w×R)
+    assert np.allclose(
+        m.centripetal, E @ (thd**2 * np.cross(w, np.cross(w, R)))
+    )  # −θ̇² J2 R = θ̇² w×(w×R)
     assert np.allclose(m.coriolis, 2 * thd * E @ np.cross(w, Rd))
     assert np.allclose(m.relative, E @ Rdd)
     assert np.allclose(m.velocity, m.rotation_velocity + m.stretch_velocity)

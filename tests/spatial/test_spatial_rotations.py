@@ -3,9 +3,9 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rotation, unit3, vec3
 from hypothesis import given, settings
 
-from _spatial_strategies import angle, rotation, unit3, vec3
 from anthroarm.spatial import rotations as R
 
 H = settings(max_examples=40, deadline=None)
@@ -33,11 +33,13 @@ def test_rodrigues_5_84_equals_exp3(n, phi):
     # the printed element form (5-84), v = 1 - cos φ
     ca, cb, cg = n
     v, c, s = 1 - np.cos(phi), np.cos(phi), np.sin(phi)
-    printed = np.array([
-        [ca * ca * v + c, ca * cb * v - cg * s, ca * cg * v + cb * s],
-        [ca * cb * v + cg * s, cb * cb * v + c, cb * cg * v - ca * s],
-        [cg * ca * v - cb * s, cb * cg * v + ca * s, cg * cg * v + c],
-    ])
+    printed = np.array(
+        [
+            [ca * ca * v + c, ca * cb * v - cg * s, ca * cg * v + cb * s],
+            [ca * cb * v + cg * s, cb * cb * v + c, cb * cg * v - ca * s],
+            [cg * ca * v - cb * s, cb * cg * v + ca * s, cg * cg * v + c],
+        ]
+    )
     assert np.allclose(C, printed, atol=1e-14)
 
 

@@ -3,9 +3,9 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from _spatial_strategies import angle, rate, small, unit3, vec3
 from hypothesis import given, settings
 
-from _spatial_strategies import angle, rate, small, unit3, vec3
 from anthroarm.spatial import screw as S
 
 H = settings(max_examples=40, deadline=None)

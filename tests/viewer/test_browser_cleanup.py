@@ -20,8 +20,12 @@ pytestmark = pytest.mark.browser
 
 if browser.find_chromium() is None:  # pragma: no cover - CI installs chromium (.ci/run)
     if os.environ.get("CI"):
-        raise RuntimeError("chromium is not installed but CI requires the real-browser test (.ci/run installs it)")
-    pytest.skip("chromium is not installed (Debian: apt-get install chromium)", allow_module_level=True)
+        raise RuntimeError(
+            "chromium is not installed but CI requires the real-browser test (.ci/run installs it)"
+        )
+    pytest.skip(
+        "chromium is not installed (Debian: apt-get install chromium)", allow_module_level=True
+    )
 
 
 def processes_mentioning(text: str) -> list[int]:
@@ -43,7 +47,7 @@ def test_live_tab_stops_every_browser_process_before_removing_its_profile():
         assert processes_mentioning(profile) == []
         assert browser.group_members(tab.proc.pid) == []
         assert not os.path.exists(profile)
-        v.display([0.3, -0.2])          # the viewer is unaffected
+        v.display([0.3, -0.2])  # the viewer is unaffected
         assert v.server.clients() == 0  # the tab is gone
 
 

@@ -22,22 +22,29 @@ from anthroarm.viewer import Viewer
 from anthroarm.viewer.visuals import PackedMesh, _placement
 
 
-
 def _user_urdf() -> str:
     """The user URDF of the chain tests (continuous joints and a mimic finger), one copy."""
     import importlib.util
     from pathlib import Path
 
     spec = importlib.util.spec_from_file_location(
-        "_chain_tests", Path(__file__).parents[1] / "foundation" / "test_chain.py")
+        "_chain_tests", Path(__file__).parents[1] / "foundation" / "test_chain.py"
+    )
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod.USER_URDF
 
 
 ROBOTS = {
-    "panda": {}, "ur5": {}, "ur10": {}, "xarm7": {}, "z1": {}, "so101": {"tool": "gripper_frame_link"},
-    "kinova": {}, "baxter": {"tool": "left_gripper"}, "allegro_right_hand": {"tool": "link_3.0_tip"},
+    "panda": {},
+    "ur5": {},
+    "ur10": {},
+    "xarm7": {},
+    "z1": {},
+    "so101": {"tool": "gripper_frame_link"},
+    "kinova": {},
+    "baxter": {"tool": "left_gripper"},
+    "allegro_right_hand": {"tool": "link_3.0_tip"},
 }
 
 
@@ -63,7 +70,11 @@ def sent_transforms(v: Viewer, q) -> dict:
     v.display(q)
     v.server = None
     assert len(rec.messages) == 1
-    return {c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T for c in rec.messages[0] if c["type"] == "set_transform"}
+    return {
+        c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T
+        for c in rec.messages[0]
+        if c["type"] == "set_transform"
+    }
 
 
 def pinocchio_pose(robot, data, body) -> np.ndarray:
@@ -81,7 +92,9 @@ def check_against_pinocchio(robot, v: Viewer, q) -> int:
     moving = [b for b in v.bodies if b.joint is not None or b.frame is not None]
     assert set(sent) == {v._bpath(b) for b in moving}
     for b in moving:
-        np.testing.assert_allclose(sent[v._bpath(b)], pinocchio_pose(robot, data, b), atol=1e-12, err_msg=b.name)
+        np.testing.assert_allclose(
+            sent[v._bpath(b)], pinocchio_pose(robot, data, b), atol=1e-12, err_msg=b.name
+        )
     return len(moving)
 
 
@@ -98,7 +111,9 @@ def test_example_robot_data_scene_matches_pinocchio_and_yourdfpy(name):
         u.update_cfg(robot.yourdfpy_cfg(q))
         for b in v.bodies:
             if b.frame is not None and b.name in u.link_map:
-                np.testing.assert_allclose(sent[v._bpath(b)], u.get_transform(b.name), atol=1e-12, err_msg=b.name)
+                np.testing.assert_allclose(
+                    sent[v._bpath(b)], u.get_transform(b.name), atol=1e-12, err_msg=b.name
+                )
 
 
 def test_kinova_continuous_joints_display_and_limit_colours():
@@ -141,7 +156,12 @@ def test_user_urdf_continuous_and_mimic(user_robot):
     robot = user_robot
     assert robot.chain.kind_counts() == {"revolute": 2, "prismatic": 0, "continuous": 2, "mimic": 1}
     v = Viewer(robot)
-    assert {p.group for b in v.bodies for p in b.pieces} >= {"links", "joint", "axis", "palm"}  # the skeleton
+    assert {p.group for b in v.bodies for p in b.pieces} >= {
+        "links",
+        "joint",
+        "axis",
+        "palm",
+    }  # the skeleton
     for q in robot.random_q(4, rng=5):
         check_against_pinocchio(robot, v, q)
     # the mimic finger follows its source: θ_mimic = -θ_grip + 0.1 about x, from the URDF numbers
@@ -195,24 +215,33 @@ def piece_poses_match_omg(robot, v: Viewer, q):
     assert len(poses) == len(gm.geometryObjects)
     for k, go in enumerate(gm.geometryObjects):
         scale = np.diag([*go.meshScale, 1.0])
-        np.testing.assert_allclose(poses[k] @ np.linalg.inv(scale), gd.oMg[k].homogeneous, atol=1e-12, err_msg=go.name)
+        np.testing.assert_allclose(
+            poses[k] @ np.linalg.inv(scale), gd.oMg[k].homogeneous, atol=1e-12, err_msg=go.name
+        )
 
 
 def test_pin_model_with_visual_model_draws_its_meshes():
     path = aa.models.erd_urdf_path("ur5")
     model = pin.buildModelFromUrdf(str(path))
-    visual = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.VISUAL, package_dirs=[str(path.parents[4])])
+    visual = pin.buildGeomFromUrdf(
+        model, str(path), pin.GeometryType.VISUAL, package_dirs=[str(path.parents[4])]
+    )
     robot = aa.load(model, visual_model=visual, name="ur5_model")
-    v = Viewer(robot, mesh_triangles=None)   # the mesh files as they are
+    v = Viewer(robot, mesh_triangles=None)  # the mesh files as they are
     assert sum(len(b.pieces) for b in v.bodies) == len(visual.geometryObjects)
     objs = [umsgpack.unpackb(c) for c in v.store.commands()]
-    files = [o for o in objs if o["type"] == "set_object" and o["object"]["geometries"]
-             and o["object"]["geometries"][0].get("type") == "_meshfile"]
+    files = [
+        o
+        for o in objs
+        if o["type"] == "set_object"
+        and o["object"]["geometries"]
+        and o["object"]["geometries"][0].get("type") == "_meshfile"
+    ]
     assert len(files) == len(visual.geometryObjects)
     for q in robot.random_q(2, rng=8):
         check_against_pinocchio(robot, v, q)
         piece_poses_match_omg(robot, v, q)
-    packed = Viewer(robot)   # default: compact meshes, placed by their own grid-to-metres placement
+    packed = Viewer(robot)  # default: compact meshes, placed by their own grid-to-metres placement
     assert all(isinstance(p.geometry, PackedMesh) for b in packed.bodies for p in b.pieces)
     piece_poses_match_omg(robot, packed, robot.random_q(rng=9))
 
@@ -223,42 +252,72 @@ def test_pin_model_with_primitive_visuals():
     model = pin.buildModelFromUrdf(str(aa.models.erd_urdf_path("ur5")))
     gm = pin.GeometryModel()
     rng = np.random.default_rng(9)
-    shapes = [coal.Box(0.1, 0.2, 0.3), coal.Sphere(0.05), coal.Cylinder(0.04, 0.3), coal.Capsule(0.03, 0.2),
-              coal.Ellipsoid(0.1, 0.05, 0.02), coal.Cone(0.05, 0.1)]
+    shapes = [
+        coal.Box(0.1, 0.2, 0.3),
+        coal.Sphere(0.05),
+        coal.Cylinder(0.04, 0.3),
+        coal.Capsule(0.03, 0.2),
+        coal.Ellipsoid(0.1, 0.05, 0.02),
+        coal.Cone(0.05, 0.1),
+    ]
     for k, g in enumerate(shapes):
         jid = 1 + k % (model.njoints - 1)
-        go = pin.GeometryObject(f"shape{k}", jid, model.frames[model.getFrameId(model.names[jid])].parentFrame,
-                                pin.SE3.Random(), g)
+        go = pin.GeometryObject(
+            f"shape{k}",
+            jid,
+            model.frames[model.getFrameId(model.names[jid])].parentFrame,
+            pin.SE3.Random(),
+            g,
+        )
         go.meshColor = np.array([0.2, 0.4, 0.6, 1.0])
         gm.addGeometryObject(go)
     robot = aa.load(model, visual_model=gm)
     v = Viewer(robot)
     kinds = [type(p.geometry).__name__ for b in v.bodies for p in b.pieces]
     # one body per joint in joint order; a capsule is a cylinder and two end spheres
-    assert kinds == ["Box", "Sphere", "Cylinder", "Cylinder", "Sphere", "Sphere", "Ellipsoid", "Cylinder"]
+    assert kinds == [
+        "Box",
+        "Sphere",
+        "Cylinder",
+        "Cylinder",
+        "Sphere",
+        "Sphere",
+        "Ellipsoid",
+        "Cylinder",
+    ]
     q = robot.random_q(rng=rng)
     sent = sent_transforms(v, q)
     gd = pin.GeometryData(gm)
     data = model.createData()
     pin.forwardKinematics(model, data, q)
     pin.updateGeometryPlacements(model, data, gm, gd)
-    y_to_z = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1.0]])  # meshcat y → coal z
+    y_to_z = np.array(
+        [[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1.0]]
+    )  # meshcat y → coal z
     for b in v.bodies:
         M = sent[v._bpath(b)]
-        gos = [k for k, go in enumerate(gm.geometryObjects) if go.parentJoint == model.getJointId(b.name)]
+        gos = [
+            k
+            for k, go in enumerate(gm.geometryObjects)
+            if go.parentJoint == model.getJointId(b.name)
+        ]
         pieces = iter(b.pieces)
         for k in gos:
             g = shapes[k]
             p = next(pieces)
             W = M @ p.offset
             name = type(g).__name__
-            if name == "Capsule":   # cylinder + two end spheres along the capsule's z
+            if name == "Capsule":  # cylinder + two end spheres along the capsule's z
                 np.testing.assert_allclose(W[:3, 1], gd.oMg[k].rotation[:, 2], atol=1e-12)
                 np.testing.assert_allclose(W[:3, 3], gd.oMg[k].translation, atol=1e-12)
-                assert p.geometry.height == pytest.approx(0.2) and p.geometry.radiusTop == pytest.approx(0.03)
+                assert p.geometry.height == pytest.approx(
+                    0.2
+                ) and p.geometry.radiusTop == pytest.approx(0.03)
                 for s in (-1, 1):
                     e = M @ next(pieces).offset
-                    np.testing.assert_allclose(e[:3, 3], gd.oMg[k].act(np.array([0, 0, s * 0.1])), atol=1e-12)
+                    np.testing.assert_allclose(
+                        e[:3, 3], gd.oMg[k].act(np.array([0, 0, s * 0.1])), atol=1e-12
+                    )
                 continue
             if name in ("Cylinder", "Cone"):
                 W = W @ y_to_z.T
@@ -291,8 +350,11 @@ def test_joint_triads_follow_every_joint(user_robot):
     triads = {p: T for p, T in sent.items() if "/overlays/frames/" in p}
     assert len(triads) == robot.model.njoints - 1
     for j in range(1, robot.model.njoints):
-        np.testing.assert_allclose(triads[f"{v.root}/overlays/frames/{robot.model.names[j]}"], data.oMi[j].homogeneous,
-                                   atol=1e-12)
+        np.testing.assert_allclose(
+            triads[f"{v.root}/overlays/frames/{robot.model.names[j]}"],
+            data.oMi[j].homogeneous,
+            atol=1e-12,
+        )
 
 
 def test_demo_has_no_ik_fallback():

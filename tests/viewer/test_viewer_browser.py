@@ -11,7 +11,6 @@ inside that box and (almost) none outside it.
 from __future__ import annotations
 
 import math
-
 import os
 
 import meshcat.geometry as mg
@@ -30,15 +29,23 @@ W, H = 640, 480
 if browser.find_chromium() is None:  # pragma: no cover - CI installs chromium (.ci/run)
     if os.environ.get("CI"):
         # in CI the browser test is required: .ci/run installs Debian's chromium
-        raise RuntimeError("chromium is not installed but CI requires the real-browser test (.ci/run installs it)")
-    pytest.skip("chromium is not installed (Debian: apt-get install chromium)", allow_module_level=True)
+        raise RuntimeError(
+            "chromium is not installed but CI requires the real-browser test (.ci/run installs it)"
+        )
+    pytest.skip(
+        "chromium is not installed (Debian: apt-get install chromium)", allow_module_level=True
+    )
 
 
 def camera_position(v: Viewer) -> np.ndarray:
     import umsgpack
 
     cam = [umsgpack.unpackb(c) for c in v.store.commands()]
-    pos = [c["value"] for c in cam if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"]
+    pos = [
+        c["value"]
+        for c in cam
+        if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"
+    ]
     x, y_up, z_up = pos[-1]
     return np.array([x, -z_up, y_up])  # meshcat's y-up camera frame -> world
 
@@ -65,22 +72,32 @@ def half_extent_corners(g) -> list[np.ndarray]:
     elif kind == "Ellipsoid":
         e = np.asarray(g.radii, float)
     elif kind == "Cylinder":
-        e = np.array([max(g.radiusTop, g.radiusBottom), g.height / 2, max(g.radiusTop, g.radiusBottom)])
+        e = np.array(
+            [max(g.radiusTop, g.radiusBottom), g.height / 2, max(g.radiusTop, g.radiusBottom)]
+        )
     elif kind == "Box":
         e = np.asarray(g.lengths, float) / 2
-    elif isinstance(g, PackedMesh):        # a packed mesh: its grid's bounds (the offset places the grid)
+    elif isinstance(g, PackedMesh):  # a packed mesh: its grid's bounds (the offset places the grid)
         lo, hi = g.grid.min(0).astype(float), g.grid.max(0).astype(float)
-        return [np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
-                for sx in (0, 1) for sy in (0, 1) for sz in (0, 1)]
-    elif isinstance(g, mg.MeshGeometry):   # a mesh file: its own bounds
+        return [
+            np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
+            for sx in (0, 1)
+            for sy in (0, 1)
+            for sz in (0, 1)
+        ]
+    elif isinstance(g, mg.MeshGeometry):  # a mesh file: its own bounds
         import io
 
         import trimesh
 
         data = g.contents if isinstance(g.contents, bytes) else g.contents.encode()
         lo, hi = trimesh.load(io.BytesIO(data), file_type=g.mesh_format, force="mesh").bounds
-        return [np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
-                for sx in (0, 1) for sy in (0, 1) for sz in (0, 1)]
+        return [
+            np.array([(lo, hi)[sx][0], (lo, hi)[sy][1], (lo, hi)[sz][2]])
+            for sx in (0, 1)
+            for sy in (0, 1)
+            for sz in (0, 1)
+        ]
     else:
         raise AssertionError(f"unexpected geometry {kind}")
     return [e * np.array([sx, sy, sz]) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
@@ -92,8 +109,15 @@ def expected_box(v: Viewer, q) -> tuple[int, int, int, int]:
     pin.framesForwardKinematics(robot.model, robot.data, q)
     pts = []
     for b in v.bodies:
-        M = np.eye(4) if b.joint is None and b.frame is None else (
-            robot.data.oMi[b.joint + 1].homogeneous if b.joint is not None else robot.data.oMf[b.frame].homogeneous)
+        M = (
+            np.eye(4)
+            if b.joint is None and b.frame is None
+            else (
+                robot.data.oMi[b.joint + 1].homogeneous
+                if b.joint is not None
+                else robot.data.oMf[b.frame].homogeneous
+            )
+        )
         for p in b.pieces:
             A = M @ p.offset
             pts.extend(A[:3, :3] @ c + A[:3, 3] for c in half_extent_corners(p.geometry))
@@ -107,7 +131,7 @@ def expected_box(v: Viewer, q) -> tuple[int, int, int, int]:
 
 def robot_pixels(png, base_png, box):
     m = browser.changed_mask(png, base_png)
-    m[:40, W - 260:] = False  # meshcat's "Open Controls" bar
+    m[:40, W - 260 :] = False  # meshcat's "Open Controls" bar
     x0, y0, x1, y1 = box
     inside = int(m[y0:y1, x0:x1].sum())
     return inside, int(m.sum()) - inside
@@ -134,7 +158,7 @@ def base_png(human, tmp_path_factory):
 
 def test_static_html_draws_the_arm(human, base_png, tmp_path):
     q = np.deg2rad([60, -30, 10, 80, 0, 0, 10])
-    v = Viewer(human)   # the camera frames the first pose: the same as the baseline's
+    v = Viewer(human)  # the camera frames the first pose: the same as the baseline's
     v.display(q)
     html = v.export_html(tmp_path / "arm.html")
     shot = browser.screenshot(html, tmp_path / "arm.png", size=(W, H), budget_ms=2000)
@@ -174,7 +198,7 @@ def test_kinova_html_draws_the_arm_and_turns_its_continuous_joints(tmp_path):
     by 90° (a new (cos, sin) pair) moves it there."""
     robot = aa.load("kinova")
     chain = robot.chain
-    theta = np.array([0.0, 2.4, 1.2, 0.5, 1.0, 0.3])   # base, shoulder, elbow, wrists (rad)
+    theta = np.array([0.0, 2.4, 1.2, 0.5, 1.0, 0.3])  # base, shoulder, elbow, wrists (rad)
     base = [j for j in chain.joints if j.kind == "continuous"][0]
     pics = []
     v = Viewer(robot)
@@ -215,7 +239,7 @@ def test_first_display_frames_the_robot(human, base_png, tmp_path):
     html = v.export_html(tmp_path / "framed.html")
     shot = browser.screenshot(html, tmp_path / "framed.png", size=(W, H), budget_ms=2000)
     m = browser.changed_mask(shot, base_png)
-    m[:40, W - 260:] = False
+    m[:40, W - 260 :] = False
     ys, xs = np.nonzero(m)
     height = (ys.max() - ys.min()) / H
     assert height > 0.6, height

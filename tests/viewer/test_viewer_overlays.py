@@ -58,10 +58,18 @@ def test_scene_is_a_meshcat_visualizer_whose_commands_reach_the_page(viewer):
     box = [c for c in cmds if c["type"] == "set_object" and c["path"] == "/meshcat/mine/box"]
     assert len(box) == 1 and box[0]["object"]["geometries"][0]["type"] == "BoxGeometry"
     assert box[0]["object"]["materials"][0]["color"] == 0x00FF00
-    grid = [c["value"] for c in cmds if c["type"] == "set_property" and c["path"] == "/Grid" and c["property"] == "visible"]
+    grid = [
+        c["value"]
+        for c in cmds
+        if c["type"] == "set_property" and c["path"] == "/Grid" and c["property"] == "visible"
+    ]
     assert grid == [True]
-    cam = [c["value"] for c in cmds if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"]
-    assert cam[-1] == [1.0, 3.0, -2.0]      # meshcat's camera frame is y-up: (x, z, -y)
+    cam = [
+        c["value"]
+        for c in cmds
+        if c["type"] == "set_property" and c["path"] == "/Cameras/default/rotated/<object>"
+    ]
+    assert cam[-1] == [1.0, 3.0, -2.0]  # meshcat's camera frame is y-up: (x, z, -y)
     sc["mine"].delete()
     assert not [c for c in page_commands(viewer) if c["path"].startswith("/meshcat/mine")]
     with pytest.raises(ViewerError, match="screenshot"):
@@ -84,7 +92,9 @@ def test_points_coloured_by_values_follow_the_colour_map(viewer):
     # a fixed range clips: everything at or above vmax gets the map's top colour
     viewer.show_points(P, values=w, colormap="viridis", vmin=0.0, vmax=2.0, name="map")
     (obj,) = objects_at(viewer, f"{viewer.root}/overlays/map")
-    np.testing.assert_allclose(attribute(obj, "color"), np.tile(colormaps["viridis"](1.0)[:3], (50, 1)), atol=1e-6)
+    np.testing.assert_allclose(
+        attribute(obj, "color"), np.tile(colormaps["viridis"](1.0)[:3], (50, 1)), atol=1e-6
+    )
     # one colour for all
     viewer.show_points(P[:4], colors=(0.0, 0.5, 1.0), name="map")
     (obj,) = objects_at(viewer, f"{viewer.root}/overlays/map")
@@ -93,19 +103,25 @@ def test_points_coloured_by_values_follow_the_colour_map(viewer):
     assert not objects_at(viewer, f"{viewer.root}/overlays/map")
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"points": np.zeros((4, 2))}, "N>=1, 3"),
-    ({"points": [[0, 0, np.nan]]}, "NaN"),
-    ({"points": "abc"}, "array"),
-    ({"points": np.zeros((4, 3)), "values": np.ones(3)}, "one number per point"),
-    ({"points": np.zeros((4, 3)), "values": [1, 2, np.inf, 4]}, "finite"),
-    ({"points": np.zeros((4, 3)), "values": np.ones(4), "colormap": "nope"}, "colour map"),
-    ({"points": np.zeros((4, 3)), "values": np.ones(4), "colors": (1, 0, 0)}, "not both"),
-    ({"points": np.zeros((4, 3)), "colors": (2, 0, 0)}, "0..1"),
-    ({"points": np.zeros((4, 3)), "colors": np.zeros((3, 3))}, r"\(4, 3\)"),
-    ({"points": np.zeros((4, 3)), "size": -1.0}, "positive"),
-    ({"points": np.zeros((4, 3)), "values": np.arange(4.0), "vmin": 3, "vmax": 1}, "vmin <= vmax"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"points": np.zeros((4, 2))}, "N>=1, 3"),
+        ({"points": [[0, 0, np.nan]]}, "NaN"),
+        ({"points": "abc"}, "array"),
+        ({"points": np.zeros((4, 3)), "values": np.ones(3)}, "one number per point"),
+        ({"points": np.zeros((4, 3)), "values": [1, 2, np.inf, 4]}, "finite"),
+        ({"points": np.zeros((4, 3)), "values": np.ones(4), "colormap": "nope"}, "colour map"),
+        ({"points": np.zeros((4, 3)), "values": np.ones(4), "colors": (1, 0, 0)}, "not both"),
+        ({"points": np.zeros((4, 3)), "colors": (2, 0, 0)}, "0..1"),
+        ({"points": np.zeros((4, 3)), "colors": np.zeros((3, 3))}, r"\(4, 3\)"),
+        ({"points": np.zeros((4, 3)), "size": -1.0}, "positive"),
+        (
+            {"points": np.zeros((4, 3)), "values": np.arange(4.0), "vmin": 3, "vmax": 1},
+            "vmin <= vmax",
+        ),
+    ],
+)
 def test_bad_points_raise_parameter_errors(viewer, kwargs, match):
     with pytest.raises(ParameterError, match=match):
         viewer.show_points(**kwargs)
@@ -114,7 +130,9 @@ def test_bad_points_raise_parameter_errors(viewer, kwargs, match):
 def test_arrows_end_where_they_should(viewer):
     O = np.array([[0.0, 0.0, 0.0], [0.1, -0.2, 0.3], [0.5, 0.5, 0.5]])
     D = np.array([[0.0, 0.0, 2.0], [1.0, 1.0, 0.0], [-3.0, 1.0, 2.0]])
-    tips = viewer.show_arrows(O, D, scale=0.1, radius=0.004, colors=[[1, 0, 0], [0, 1, 0], [0, 0, 1]], name="forces")
+    tips = viewer.show_arrows(
+        O, D, scale=0.1, radius=0.004, colors=[[1, 0, 0], [0, 1, 0], [0, 0, 1]], name="forces"
+    )
     np.testing.assert_allclose(tips, O + 0.1 * D)
     (obj,) = objects_at(viewer, f"{viewer.root}/overlays/forces")
     X, N, C = attribute(obj, "position"), attribute(obj, "normal"), attribute(obj, "color")
@@ -127,9 +145,13 @@ def test_arrows_end_where_they_should(viewer):
         d = v / np.linalg.norm(v)
         along = (Xk - o) @ d
         across = np.linalg.norm((Xk - o) - np.outer(along, d), axis=1)
-        assert along.min() > -1e-6 and abs(along.max() - np.linalg.norm(v)) < 1e-6   # tail at o, tip at o + v
-        assert across.max() < 2.2 * 0.004 + 1e-6                                       # head radius
-        assert np.isclose(across[along < 0.5 * np.linalg.norm(v)].max(), 0.004, atol=1e-6)  # shaft radius
+        assert (
+            along.min() > -1e-6 and abs(along.max() - np.linalg.norm(v)) < 1e-6
+        )  # tail at o, tip at o + v
+        assert across.max() < 2.2 * 0.004 + 1e-6  # head radius
+        assert np.isclose(
+            across[along < 0.5 * np.linalg.norm(v)].max(), 0.004, atol=1e-6
+        )  # shaft radius
     # a zero vector draws nothing; all-zero draws no object at all
     viewer.show_arrows(O[:1], np.zeros((1, 3)), name="forces")
     assert not objects_at(viewer, f"{viewer.root}/overlays/forces")
@@ -161,12 +183,25 @@ def test_batch_voxel_maps_as_point_clouds_with_legends():
     c = counts[i, j, k].astype(float)
     order = np.lexsort(centres.T)
     got = attribute(obj, "color")[np.lexsort(out["points"].T)]
-    np.testing.assert_allclose(got, colormaps["viridis"]((c[order] - c.min()) / (c.max() - c.min()))[:, :3], atol=1e-6)
-    legends = [x["spec"] for x in page_commands(v) if x["type"] == "anthroarm_ui" and x["spec"]["kind"] == "legend"]
-    assert any(sp["title"].startswith("reachability_map: counts") and sp["ticks"][-1] == f"{c.max():.3g}" for sp in legends)
+    np.testing.assert_allclose(
+        got, colormaps["viridis"]((c[order] - c.min()) / (c.max() - c.min()))[:, :3], atol=1e-6
+    )
+    legends = [
+        x["spec"]
+        for x in page_commands(v)
+        if x["type"] == "anthroarm_ui" and x["spec"]["kind"] == "legend"
+    ]
+    assert any(
+        sp["title"].startswith("reachability_map: counts") and sp["ticks"][-1] == f"{c.max():.3g}"
+        for sp in legends
+    )
     comfort = jobs.comfort_map(robot, n=3000, voxel=0.08, seed=0, progress=False)
     out = v.show_map(comfort)
-    assert len(out["points"]) == np.isfinite(comfort["discomfort"]).sum() == (comfort["counts"] > 0).sum()
+    assert (
+        len(out["points"])
+        == np.isfinite(comfort["discomfort"]).sum()
+        == (comfort["counts"] > 0).sum()
+    )
     with pytest.raises(ParameterError, match="voxel map"):
         v.show_map(comfort, "nope")
     with pytest.raises(ParameterError, match="batch result"):
@@ -179,15 +214,20 @@ def test_legends_for_manipulability_and_limits_are_in_the_page_and_go_away():
     specs = lambda: {x["path"]: x["spec"] for x in page_commands(v) if x["type"] == "anthroarm_ui"}
     man = specs()[f"{v.root}/overlays/workspace/legend"]
     assert man["title"].startswith("manipulability (m²")
-    assert man["ticks"] == ["0", f"{res['manipulability'].max() / 2:.3g}", f"{res['manipulability'].max():.3g}"]
+    assert man["ticks"] == [
+        "0",
+        f"{res['manipulability'].max() / 2:.3g}",
+        f"{res['manipulability'].max():.3g}",
+    ]
     assert man["stops"][0] == pytest.approx(list(colormaps["viridis"](0.0)[:3]), abs=1e-4)
     v.show_limits()
     lim = specs()[f"{v.root}/ui/limits"]
-    assert lim["stops"][0] == pytest.approx(list(aa.viewer.limit_color(0.0))) and lim["stops"][-1] == pytest.approx(
-        list(aa.viewer.viewer.LIMIT_RGB))
+    assert lim["stops"][0] == pytest.approx(list(aa.viewer.limit_color(0.0))) and lim["stops"][
+        -1
+    ] == pytest.approx(list(aa.viewer.viewer.LIMIT_RGB))
     v.show_limits(False)
     v.clear("workspace")
-    assert set(specs()) == {f"{v.root}/ui/scale"}    # only the scale-bar note is left
+    assert set(specs()) == {f"{v.root}/ui/scale"}  # only the scale-bar note is left
     v.set_scale_bar(False)
     assert not specs()
 
@@ -195,7 +235,7 @@ def test_legends_for_manipulability_and_limits_are_in_the_page_and_go_away():
 def test_grid_axes_and_scale_bar_are_drawn_to_scale_and_switch_off():
     v = Viewer(aa.load("human_arm7"))
     sp = v.spacing
-    assert sp in {m * 10.0 ** k for m in (1, 2, 5) for k in range(-3, 2)}
+    assert sp in {m * 10.0**k for m in (1, 2, 5) for k in range(-3, 2)}
     (grid,) = objects_at(v, f"{v.root}/grid")
     assert grid["object"]["object"]["type"] == "LineSegments"
     X = attribute(grid, "position").astype(float)
@@ -204,33 +244,54 @@ def test_grid_axes_and_scale_bar_are_drawn_to_scale_and_switch_off():
     along_y = X[0::2][np.isclose(X[0::2, 0], X[1::2, 0])]
     np.testing.assert_allclose(along_y[:, 0] / sp, np.round(along_y[:, 0] / sp), atol=1e-4)
     # the scale bar is one grid square long: its five pieces add up to the spacing
-    bar = [c for c in page_commands(v) if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/scale/")]
+    bar = [
+        c
+        for c in page_commands(v)
+        if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/scale/")
+    ]
     assert len(bar) == 5
     assert sum(c["object"]["geometries"][0]["height"] for c in bar) == pytest.approx(sp)
-    notes = [c["spec"]["text"] for c in page_commands(v) if c["type"] == "anthroarm_ui" and c["spec"]["kind"] == "note"]
+    notes = [
+        c["spec"]["text"]
+        for c in page_commands(v)
+        if c["type"] == "anthroarm_ui" and c["spec"]["kind"] == "note"
+    ]
     assert notes == [f"scale bar and grid squares: {aa.viewer.viewer.format_length(sp)}"]
-    axes = [c for c in page_commands(v) if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/axes/")]
+    axes = [
+        c
+        for c in page_commands(v)
+        if c["type"] == "set_object" and c["path"].startswith(f"{v.root}/axes/")
+    ]
     assert len(axes) == 3
 
     def visible(path):
-        vals = [c["value"] for c in page_commands(v) if c["type"] == "set_property" and c["path"] == path
-                and c["property"] == "visible"]
+        vals = [
+            c["value"]
+            for c in page_commands(v)
+            if c["type"] == "set_property" and c["path"] == path and c["property"] == "visible"
+        ]
         return vals[-1]
 
     assert visible(f"{v.root}/grid") and visible(f"{v.root}/axes") and visible(f"{v.root}/scale")
     v.set_grid(False)
     v.set_axes(False)
     v.set_scale_bar(False)
-    assert not (visible(f"{v.root}/grid") or visible(f"{v.root}/axes") or visible(f"{v.root}/scale"))
+    assert not (
+        visible(f"{v.root}/grid") or visible(f"{v.root}/axes") or visible(f"{v.root}/scale")
+    )
     v2 = Viewer(aa.load("planar2r"), grid=False, axes=False, scale_bar=False)
     cmds = page_commands(v2)
-    assert [c["value"] for c in cmds if c["type"] == "set_property" and c["path"] == f"{v2.root}/grid"] == [False]
+    assert [
+        c["value"] for c in cmds if c["type"] == "set_property" and c["path"] == f"{v2.root}/grid"
+    ] == [False]
 
 
 def test_nice_lengths_and_framing_distance():
     from anthroarm.viewer.viewer import framing_distance, nice_length
 
-    assert [nice_length(x) for x in (0.013, 0.02, 0.049, 0.7, 3.0)] == pytest.approx([0.01, 0.02, 0.02, 0.5, 2.0])
+    assert [nice_length(x) for x in (0.013, 0.02, 0.049, 0.7, 3.0)] == pytest.approx(
+        [0.01, 0.02, 0.02, 0.5, 2.0]
+    )
     # a unit cube seen along x: its near face (depth 0.5) must fit fill · tan(37.5°) (vertical and 4:3)
     corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
     D = framing_distance(corners, np.array([1.0, 0.0, 0.0]), fill=0.8)
@@ -255,7 +316,9 @@ def test_hands_are_drawn_from_their_own_visual_geometry():
         assert with_visuals == urdf_links, (name, urdf_links ^ with_visuals)
         assert len(with_visuals) >= 16
     assert bodies[0].name == "torso"
-    assert {p.group for p in robot_bodies(robot, "generated")[-1].pieces} >= {"links"}   # the skeleton is still there on request
+    assert {p.group for p in robot_bodies(robot, "generated")[-1].pieces} >= {
+        "links"
+    }  # the skeleton is still there on request
     assert any(p.group == "palm" for b in robot_bodies(robot, "generated") for p in b.pieces)
 
 
@@ -283,16 +346,29 @@ def test_joint_values_colour_each_link_by_its_joint_with_a_legend():
     colors = {c["path"]: c["color"] for c in rec.messages[-1] if c["type"] == "anthroarm_color"}
     a = np.abs(tau)
     expect = colormaps["plasma"]((a - a.min()) / (a.max() - a.min()))[:, :3]
-    coloured = [b for b in v.bodies if b.joint is not None and any(p.group == "links" for p in b.pieces)]
-    assert len(coloured) >= 3 and len(colors) == len(coloured)   # joints at one point share the next link
+    coloured = [
+        b for b in v.bodies if b.joint is not None and any(p.group == "links" for p in b.pieces)
+    ]
+    assert len(coloured) >= 3 and len(colors) == len(
+        coloured
+    )  # joints at one point share the next link
     for b in coloured:
-        np.testing.assert_allclose(colors[f"{v.root}/bodies/{b.name}/links"], expect[b.joint], atol=2e-3)
+        np.testing.assert_allclose(
+            colors[f"{v.root}/bodies/{b.name}/links"], expect[b.joint], atol=2e-3
+        )
     np.testing.assert_allclose(out["values"], a)
     legend = [c["spec"] for c in rec.messages[-1] if c["type"] == "anthroarm_ui"]
-    assert legend[0]["title"] == "gravity torque |τ| (N·m)" and legend[0]["ticks"][-1] == f"{a.max():.3g}"
+    assert (
+        legend[0]["title"] == "gravity torque |τ| (N·m)"
+        and legend[0]["ticks"][-1] == f"{a.max():.3g}"
+    )
     n = len(rec.messages)
-    v.show_limits()                                   # replaces the torque colours and legend
-    assert any(c["type"] == "delete" and c["path"].endswith("/ui/joint_values") for m in rec.messages[n:] for c in m)
+    v.show_limits()  # replaces the torque colours and legend
+    assert any(
+        c["type"] == "delete" and c["path"].endswith("/ui/joint_values")
+        for m in rec.messages[n:]
+        for c in m
+    )
     v.show_limits(False)
     restored = [c for c in rec.messages[-1] if c["type"] == "set_object"]
     assert restored and not [c for c in rec.messages[-1] if c["type"] == "anthroarm_color"]

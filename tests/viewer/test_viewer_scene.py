@@ -68,7 +68,11 @@ def test_book_body_transforms_match_yourdfpy(name):
     u = robot.urdf
     for q in robot.random_q(5, rng=2):
         v.display(q)
-        sent = {c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T for c in rec.messages[-1] if c["type"] == "set_transform"}
+        sent = {
+            c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T
+            for c in rec.messages[-1]
+            if c["type"] == "set_transform"
+        }
         u.update_cfg(robot.yourdfpy_cfg(q))
         for b in v.bodies:
             if b.joint is None:
@@ -84,7 +88,11 @@ def test_urdf_mesh_bodies_match_yourdfpy():
     u = robot.urdf
     q = robot.random_q(rng=3)
     v.display(q)
-    sent = {c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T for c in rec.messages[-1] if c["type"] == "set_transform"}
+    sent = {
+        c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T
+        for c in rec.messages[-1]
+        if c["type"] == "set_transform"
+    }
     u.update_cfg(robot.yourdfpy_cfg(q))
     checked = 0
     for b in v.bodies:
@@ -97,10 +105,15 @@ def test_urdf_mesh_bodies_match_yourdfpy():
 
 def test_panda_meshes_are_the_package_files():
     robot = aa.load("panda")
-    v = Viewer(robot, mesh_triangles=None)   # the files as they are
+    v = Viewer(robot, mesh_triangles=None)  # the files as they are
     objs = [umsgpack.unpackb(c) for c in v.store.commands()]
-    meshes = [o for o in objs if o["type"] == "set_object" and o["object"]["geometries"]
-              and o["object"]["geometries"][0].get("type") == "_meshfile"]
+    meshes = [
+        o
+        for o in objs
+        if o["type"] == "set_object"
+        and o["object"]["geometries"]
+        and o["object"]["geometries"][0].get("type") == "_meshfile"
+    ]
     assert len(meshes) >= 8
     first = robot.info.meshes[next(iter(robot.info.meshes))]
     assert first.is_file()
@@ -135,7 +148,9 @@ def test_packed_panda_meshes_approximate_the_files_and_fit_a_jupyter_cell():
         assert len(g.faces) <= MESH_TRIANGLES and g.faces.max() < len(g.grid)
         W = g.vertices
         # the file this mesh came from: the one whose bounding box matches
-        best = min(by_count.values(), key=lambda m: np.abs(m.bounds - np.array([W.min(0), W.max(0)])).max())
+        best = min(
+            by_count.values(), key=lambda m: np.abs(m.bounds - np.array([W.min(0), W.max(0)])).max()
+        )
         side = float(np.ptp(best.vertices, axis=0).max())
         np.testing.assert_allclose([W.min(0), W.max(0)], best.bounds, atol=0.02 * side)
         cell = side / 8  # coarsest grid the budget could need for these meshes is far finer
@@ -143,7 +158,9 @@ def test_packed_panda_meshes_approximate_the_files_and_fit_a_jupyter_cell():
         assert d.max() < cell, (d.max(), side)
         assert np.median(d) < 0.01 * side
     assert len(v._repr_html_().encode()) <= 2 * 2**20
-    assert len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()) > 10 * 2**20   # what it was
+    assert (
+        len(Viewer(robot, mesh_triangles=None)._repr_html_().encode()) > 10 * 2**20
+    )  # what it was
 
 
 @pytest.mark.parametrize("name", BOOK)
@@ -160,7 +177,11 @@ def test_generated_capsules_connect_the_joints(name):
             if p.group == "links" and type(p.geometry).__name__ == "Sphere":
                 ends.append(p.offset[:3, 3])
         jid = model.getJointId(b.name)  # Pinocchio's own tables, not robot.chain
-        targets = [model.jointPlacements[c].translation for c in range(1, model.njoints) if model.parents[c] == jid]
+        targets = [
+            model.jointPlacements[c].translation
+            for c in range(1, model.njoints)
+            if model.parents[c] == jid
+        ]
         tool = model.frames[robot.tool_id]
         if tool.parentJoint == jid:
             targets.append(tool.placement.translation)
@@ -183,7 +204,11 @@ def test_kinds_of_generated_visuals(human):
             # the cylinder (meshcat: along y) is turned onto the joint axis
             ax = axes[0].offset[:3, 1]
             S = np.zeros(3)
-            S[["JointModelRX", "JointModelRY", "JointModelRZ"].index(human.model.joints[human.model.getJointId(b.name)].shortname())] = 1
+            S[
+                ["JointModelRX", "JointModelRY", "JointModelRZ"].index(
+                    human.model.joints[human.model.getJointId(b.name)].shortname()
+                )
+            ] = 1
             assert abs(abs(ax @ S) - 1) < 1e-12
 
 
@@ -209,7 +234,9 @@ def test_limit_proximity_arithmetic():
     np.testing.assert_allclose(limit_proximity([0.0, 1.0, 5.0], lo, hi), [0, 0, 0])
     np.testing.assert_allclose(limit_proximity([1.0, 0.0, 0.0], lo, hi), [1, 1, 0])
     np.testing.assert_allclose(limit_proximity([0.5, 1.5, 0.0], lo, hi), [0.5, 0.5, 0])
-    np.testing.assert_allclose(limit_proximity([3.0, -1.0, 0.0], lo, hi), [1, 1, 0])  # beyond: clipped
+    np.testing.assert_allclose(
+        limit_proximity([3.0, -1.0, 0.0], lo, hi), [1, 1, 0]
+    )  # beyond: clipped
     assert limit_color(0.5) == pytest.approx(limit_color(0.0))
     assert limit_color(1.0) == pytest.approx(LIMIT_RGB)
 
@@ -224,7 +251,10 @@ def test_limit_colours_sent_only_for_changes(human):
     colors = {c["path"]: c["color"] for c in rec.messages[-1] if c["type"] == "anthroarm_color"}
     red = {p for p, c in colors.items() if c == pytest.approx(LIMIT_RGB, abs=1e-3)}
     # the elbow's own centre, and the forearm (drawn from the coincident forearm-rotation joint)
-    assert red == {f"{v.root}/bodies/elbow_flexion/joint", f"{v.root}/bodies/forearm_pronation/links"}
+    assert red == {
+        f"{v.root}/bodies/elbow_flexion/joint",
+        f"{v.root}/bodies/forearm_pronation/links",
+    }
     v.display(q)  # same pose: no colour traffic
     assert not [c for c in rec.messages[-1] if c["type"] == "anthroarm_color"]
     q[3] = 0.5 * (human.lower[3] + human.upper[3])
@@ -243,7 +273,9 @@ def test_manipulability_against_closed_form_and_pinocchio():
     Q = robot.random_q(20, rng=5)
     ref = []
     for q in Q:
-        J = pin.computeFrameJacobian(robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED)[:3]
+        J = pin.computeFrameJacobian(
+            robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED
+        )[:3]
         ref.append(np.sqrt(np.linalg.det(J @ J.T)))
     np.testing.assert_allclose(manipulability(robot, Q), ref, rtol=1e-9, atol=1e-14)
 
@@ -255,7 +287,9 @@ def test_workspace_cloud_points_are_tool_positions(human):
     np.testing.assert_allclose(out["points"], human.fk(Q)[:, :3, 3], atol=1e-12)
     assert out["manipulability"].shape == (200,) and (out["manipulability"] >= 0).all()
     cmds = [umsgpack.unpackb(c) for c in v.store.commands()]
-    cloud = [c for c in cmds if c["type"] == "set_object" and c["path"].endswith("/overlays/workspace")]
+    cloud = [
+        c for c in cmds if c["type"] == "set_object" and c["path"].endswith("/overlays/workspace")
+    ]
     assert len(cloud) == 1 and cloud[0]["object"]["object"]["type"] == "Points"
 
 
@@ -314,7 +348,15 @@ def test_scene_store_keeps_latest_state_only():
     assert cmds[1]["matrix"][0] == 99.0
     st.apply({"type": "delete", "path": "/a"})
     assert st.commands() == []
-    st.apply({"type": "anthroarm_batch", "path": "", "commands": [{"type": "set_property", "path": "/x", "property": "visible", "value": False}]})
+    st.apply(
+        {
+            "type": "anthroarm_batch",
+            "path": "",
+            "commands": [
+                {"type": "set_property", "path": "/x", "property": "visible", "value": False}
+            ],
+        }
+    )
     assert umsgpack.unpackb(st.commands()[0])["property"] == "visible"
 
 
@@ -351,7 +393,9 @@ def test_display_after_play_stops_the_animation(human):
     assert any(c["type"] == "set_animation" for c in html_commands(v.static_html()))
     v.server = rec = Recorder()
     v.display(human.neutral())
-    assert rec.messages[-1][0]["type"] == "set_animation" and rec.messages[-1][0]["animations"] == []
+    assert (
+        rec.messages[-1][0]["type"] == "set_animation" and rec.messages[-1][0]["animations"] == []
+    )
     assert not any(c["type"] == "set_animation" for c in html_commands(v.static_html()))
     v.display(human.neutral())  # no animation left: nothing to stop
     assert all(c["type"] != "set_animation" for c in rec.messages[-1])

@@ -83,7 +83,9 @@ def test_explicit_port_in_use_is_a_clear_error():
     blocker.listen()
     port = blocker.getsockname()[1]
     try:
-        with pytest.raises(ViewerPortInUseError, match=f"port {port} on 127.0.0.1 is already in use"):
+        with pytest.raises(
+            ViewerPortInUseError, match=f"port {port} on 127.0.0.1 is already in use"
+        ):
             ServerProcess(port=port)
         with pytest.raises(ViewerPortInUseError):
             Viewer("planar2r", live=True, port=port)

@@ -18,16 +18,49 @@ run and why results do not depend on the cluster).  Running on Slurm/PBS/Kuberne
 
 from .describe import RobotDescription, describe
 from .engine import chunk_seeds, close, connect
-from .errors import (BatchError, JobTooLargeError, RobotDescriptionError, RobotRebuildError,
-                     SchedulerUnreachableError)
-from .jobs import (cell_table, comfort_map, discomfort, ik_dataset, population_reach, reachability_map,
-                   to_cell_table, tolerance_monte_carlo, voxel_grid)
+from .errors import (
+    BatchError,
+    JobTooLargeError,
+    RobotDescriptionError,
+    RobotRebuildError,
+    SchedulerUnreachableError,
+)
+from .jobs import (
+    cell_table,
+    comfort_map,
+    discomfort,
+    ik_dataset,
+    population_reach,
+    reachability_map,
+    to_cell_table,
+    tolerance_monte_carlo,
+    voxel_grid,
+)
 from .result import BatchResult, load
 from .runner import JOBS, run_job
 
 __all__ = [
-    "BatchError", "BatchResult", "JOBS", "JobTooLargeError", "RobotDescription", "RobotDescriptionError",
-    "RobotRebuildError", "SchedulerUnreachableError", "cell_table", "chunk_seeds", "close", "comfort_map",
-    "connect", "describe", "discomfort", "ik_dataset", "load", "population_reach", "reachability_map", "run_job",
-    "to_cell_table", "tolerance_monte_carlo", "voxel_grid",
+    "BatchError",
+    "BatchResult",
+    "JOBS",
+    "JobTooLargeError",
+    "RobotDescription",
+    "RobotDescriptionError",
+    "RobotRebuildError",
+    "SchedulerUnreachableError",
+    "cell_table",
+    "chunk_seeds",
+    "close",
+    "comfort_map",
+    "connect",
+    "describe",
+    "discomfort",
+    "ik_dataset",
+    "load",
+    "population_reach",
+    "reachability_map",
+    "run_job",
+    "to_cell_table",
+    "tolerance_monte_carlo",
+    "voxel_grid",
 ]

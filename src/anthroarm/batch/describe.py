@@ -52,31 +52,41 @@ class RobotDescription:
 
     def build(self):
         """A fresh :class:`~anthroarm.robot.Robot` (no cache); raises RobotRebuildError."""
+        from .. import load
         from ..robot import _make, build_model
         from ..urdf_io import parse_urdf_bytes
-        from .. import load
 
         locked = dict(self.locked) or None
         try:
             if self.kind == "catalog":
-                robot = load(self.source, tool=self.tool, locked=locked, name=self.name, **dict(self.params))
+                robot = load(
+                    self.source, tool=self.tool, locked=locked, name=self.name, **dict(self.params)
+                )
             elif self.kind == "urdf":
-                info = parse_urdf_bytes(self.source.encode("utf-8"), f"<batch>/{self.name}.urdf", check_meshes=False)
-                robot = _make(build_model(info), name=self.name, info=info, tool=self.tool, locked=locked)
+                info = parse_urdf_bytes(
+                    self.source.encode("utf-8"), f"<batch>/{self.name}.urdf", check_meshes=False
+                )
+                robot = _make(
+                    build_model(info), name=self.name, info=info, tool=self.tool, locked=locked
+                )
             else:
-                raise RobotRebuildError(f"unknown robot description kind {self.kind!r} (expected 'catalog' or 'urdf')")
+                raise RobotRebuildError(
+                    f"unknown robot description kind {self.kind!r} (expected 'catalog' or 'urdf')"
+                )
         except RobotRebuildError:
             raise
         except Exception as exc:
             raise RobotRebuildError(
                 f"the worker could not rebuild robot {self.name!r} from its {self.kind} description: "
                 f"{type(exc).__name__}: {exc}. Remedy: make sure every worker runs the same anthroarm version as "
-                f"the client (pip install the same wheel/commit in the workers' environment)") from None
+                f"the client (pip install the same wheel/commit in the workers' environment)"
+            ) from None
         if self.key and robot.chain.key() != self.key:
             raise RobotRebuildError(
                 f"the worker rebuilt robot {self.name!r} with different kinematics (chain hash "
                 f"{robot.chain.key()[:12]} != {self.key[:12]}); the workers run another anthroarm or "
-                "Pinocchio version than the client. Remedy: install the same versions on the workers")
+                "Pinocchio version than the client. Remedy: install the same versions on the workers"
+            )
         return robot
 
 
@@ -115,20 +125,25 @@ def _describe(robot) -> RobotDescription:
     if spec is not None and spec.name in models.BOOK_MODELS:
         accepted = inspect.signature(models.BOOK_MODELS[spec.name]).parameters
         p = tuple(sorted((k, v) for k, v in spec.params.items() if k in accepted))
-        d = RobotDescription("catalog", spec.name, robot.name, p, robot.tool, locked, robot.chain.key())
-        try:   # the builder must give the same kinematics back (it does unless the spec was edited)
+        d = RobotDescription(
+            "catalog", spec.name, robot.name, p, robot.tool, locked, robot.chain.key()
+        )
+        try:  # the builder must give the same kinematics back (it does unless the spec was edited)
             same = d.build().chain.key() == d.key
         except Exception:
             same = False
         if same:
             return d
     if robot.info is not None and robot.info.text:
-        return RobotDescription("urdf", robot.info.text, robot.name, (), robot.tool, locked, robot.chain.key())
+        return RobotDescription(
+            "urdf", robot.info.text, robot.name, (), robot.tool, locked, robot.chain.key()
+        )
     raise RobotDescriptionError(
         f"robot {robot.name!r} was built from an in-memory pin.Model: a Dask worker cannot rebuild it "
         "(Pinocchio models are not shipped). Remedy: write it as a URDF and load that "
         "(pinocchio: robot.urdf / your exporter; then aa.load('arm.urdf')), or use a catalog name; "
-        "or run the job locally with client=None")
+        "or run the job locally with client=None"
+    )
 
 
 def robot_from(desc: RobotDescription):

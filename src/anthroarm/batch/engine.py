@@ -44,8 +44,12 @@ CONNECT_TIMEOUT = 10.0
 LOCAL_WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
 
 
-def connect(scheduler="local", workers: int | None = None, timeout: float = CONNECT_TIMEOUT,
-            threads_per_worker: int = 1):
+def connect(
+    scheduler="local",
+    workers: int | None = None,
+    timeout: float = CONNECT_TIMEOUT,
+    threads_per_worker: int = 1,
+):
     """A :class:`distributed.Client`: ``"local"`` starts a ``LocalCluster`` of ``workers``
     processes (default: one per core) with ``threads_per_worker`` threads each; anything else is
     a scheduler address (``tcp://host:8786``).  The caller closes it (``with connect(...) as c``;
@@ -56,17 +60,23 @@ def connect(scheduler="local", workers: int | None = None, timeout: float = CONN
     from dask import config as dask_config
     from distributed import Client
 
-    if scheduler in (None, "local"):   # the client owns the cluster: closing it stops the workers
+    if scheduler in (None, "local"):  # the client owns the cluster: closing it stops the workers
         with dask_config.set(LOCAL_WORKER_CONFIG):
-            return Client(n_workers=workers, threads_per_worker=threads_per_worker, processes=True,
-                          dashboard_address=":0", set_as_default=False)
+            return Client(
+                n_workers=workers,
+                threads_per_worker=threads_per_worker,
+                processes=True,
+                dashboard_address=":0",
+                set_as_default=False,
+            )
     try:
         return Client(scheduler, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError) as exc:
         raise SchedulerUnreachableError(
             f"no Dask scheduler answered at {scheduler!r} within {timeout:g} s ({type(exc).__name__}: {exc}). "
             "Remedy: start one (`dask scheduler`, or your dask-jobqueue / dask-kubernetes cluster) and pass its "
-            "address as tcp://HOST:PORT, or run locally with --scheduler local") from None
+            "address as tcp://HOST:PORT, or run locally with --scheduler local"
+        ) from None
 
 
 def close(client) -> None:
@@ -77,7 +87,11 @@ def close(client) -> None:
 def chunk_seeds(seed, n: int) -> list[np.random.SeedSequence]:
     """``n`` independent child seeds of ``seed`` (an int, a SeedSequence or None = 0), one per
     task: task ``i`` draws from ``chunk_seeds(seed, n)[i]`` wherever it runs."""
-    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(0 if seed is None else seed)
+    ss = (
+        seed
+        if isinstance(seed, np.random.SeedSequence)
+        else np.random.SeedSequence(0 if seed is None else seed)
+    )
     return ss.spawn(n)
 
 
@@ -120,12 +134,12 @@ def _relax_malloc_trim() -> None:
         import ctypes
 
         libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(-1, WORKER_TRIM_THRESHOLD)   # M_TRIM_THRESHOLD = -1
+        libc.mallopt(-1, WORKER_TRIM_THRESHOLD)  # M_TRIM_THRESHOLD = -1
         # the nanny's environment variable also freezes the mmap threshold at 128 KiB (glibc
         # raises it after the first large free otherwise): every temporary of the batched FK
         # was a fresh mmap, 20 000 page faults per task; 32 MiB (glibc's own dynamic maximum
         # on 64-bit) serves them from the heap, as in the client's process
-        libc.mallopt(-3, WORKER_MMAP_THRESHOLD)   # M_MMAP_THRESHOLD = -3
+        libc.mallopt(-3, WORKER_MMAP_THRESHOLD)  # M_MMAP_THRESHOLD = -3
     except (OSError, AttributeError):
         pass
 
@@ -141,7 +155,9 @@ def _execute_on_worker(fn, desc, payload):
     return _execute(fn, desc, payload)
 
 
-def run(tasks, consume, *, client=None, progress: bool = True, desc: str = "batch", callback=None) -> int:
+def run(
+    tasks, consume, *, client=None, progress: bool = True, desc: str = "batch", callback=None
+) -> int:
     """Run ``tasks`` (a sequence of ``(fn, robot_description, payload)``) and hand each result
     to ``consume(index, part)``; returns the number of tasks.
 
@@ -179,7 +195,9 @@ def _run_dask(client, tasks, consume, bar, callback, desc):
 
     def submit(i, task):
         fn, d, payload = task
-        f = client.submit(_execute_on_worker, fn, d, payload, key=f"anthroarm-{desc}-{token}-{i}", pure=False)
+        f = client.submit(
+            _execute_on_worker, fn, d, payload, key=f"anthroarm-{desc}-{token}-{i}", pure=False
+        )
         index[f.key] = i
         return f
 
@@ -193,10 +211,10 @@ def _run_dask(client, tasks, consume, bar, callback, desc):
     try:
         for f in ac:
             i = index[f.key]
-            part = f.result()          # re-raises a task's exception with its own type
+            part = f.result()  # re-raises a task's exception with its own type
             live.pop(f.key, None)
             f.release()
-            if i in seen:              # never happens with explicit keys; guard all the same
+            if i in seen:  # never happens with explicit keys; guard all the same
                 continue
             seen.add(i)
             consume(i, part)
@@ -213,5 +231,5 @@ def _run_dask(client, tasks, consume, bar, callback, desc):
     except BaseException:
         client.cancel(list(live.values()))
         raise
-    if done != len(tasks):   # pragma: no cover - as_completed yields each future once
+    if done != len(tasks):  # pragma: no cover - as_completed yields each future once
         raise RuntimeError(f"{desc}: {done} of {len(tasks)} tasks came back")

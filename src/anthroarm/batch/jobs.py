@@ -51,8 +51,10 @@ MEMORY_BUDGET = 4 * 2**30
 
 def _check_memory(nbytes: float, what: str, remedy: str) -> None:
     if nbytes > MEMORY_BUDGET:
-        raise JobTooLargeError(f"{what} would take {nbytes / 2**30:.1f} GiB (budget "
-                               f"{MEMORY_BUDGET / 2**30:.0f} GiB, anthroarm.batch.jobs.MEMORY_BUDGET). Remedy: {remedy}")
+        raise JobTooLargeError(
+            f"{what} would take {nbytes / 2**30:.1f} GiB (budget "
+            f"{MEMORY_BUDGET / 2**30:.0f} GiB, anthroarm.batch.jobs.MEMORY_BUDGET). Remedy: {remedy}"
+        )
 
 
 def _positive_int(x, name):
@@ -153,17 +155,32 @@ def _map_setup(robot, n, voxel, frame, chunk_size, seed):
     n = _positive_int(n, "n")
     chunk_size = _positive_int(chunk_size, "chunk_size")
     lo, shape = voxel_grid(robot, voxel, frame)
-    _check_memory(np.prod(shape) * 16.0, f"a voxel grid of {shape} voxels",
-                  "use a coarser voxel (voxel= in m)")
+    _check_memory(
+        np.prod(shape) * 16.0,
+        f"a voxel grid of {shape} voxels",
+        "use a coarser voxel (voxel= in m)",
+    )
     parts = engine.chunks(n, chunk_size)
     seeds = engine.chunk_seeds(seed, len(parts))
-    payloads = [dict(n=b - a, seed=s, frame=frame, lo=lo, voxel=float(voxel), shape=shape)
-                for (a, b), s in zip(parts, seeds)]
+    payloads = [
+        dict(n=b - a, seed=s, frame=frame, lo=lo, voxel=float(voxel), shape=shape)
+        for (a, b), s in zip(parts, seeds)
+    ]
     return n, lo, shape, payloads
 
 
-def reachability_map(robot, n: int = 10**6, voxel: float = 0.02, frame=None, *, client=None,
-                     chunk_size: int = MAP_CHUNK, seed=0, progress: bool = True, callback=None) -> BatchResult:
+def reachability_map(
+    robot,
+    n: int = 10**6,
+    voxel: float = 0.02,
+    frame=None,
+    *,
+    client=None,
+    chunk_size: int = MAP_CHUNK,
+    seed=0,
+    progress: bool = True,
+    callback=None,
+) -> BatchResult:
     """Monte Carlo reachability map: ``n`` configurations uniform in the joint ranges
     (:meth:`~anthroarm.chain.Chain.random_q`), the position of ``frame`` (default the tool)
     by the batched FK, counted per voxel of side ``voxel`` (m) in the base frame.
@@ -181,16 +198,32 @@ def reachability_map(robot, n: int = 10**6, voxel: float = 0.02, frame=None, *, 
         counts[nz] += c
         outside[0] += out
 
-    _run(_tasks(_reach_task, d, payloads), consume, client, robot, progress, "reachability", callback)
+    _run(
+        _tasks(_reach_task, d, payloads), consume, client, robot, progress, "reachability", callback
+    )
     counts = counts.reshape(shape)
     return BatchResult(
-        "reachability_map", {"counts": (("x", "y", "z"), counts)}, _voxel_coords(lo, shape, voxel),
-        _attrs(robot, frame, n=n, voxel=float(voxel), seed=_seed_attr(seed), chunk_size=chunk_size, outside=outside[0],
-               volume=float(np.count_nonzero(counts)) * float(voxel) ** 3, units={"x": "m", "y": "m", "z": "m"}))
+        "reachability_map",
+        {"counts": (("x", "y", "z"), counts)},
+        _voxel_coords(lo, shape, voxel),
+        _attrs(
+            robot,
+            frame,
+            n=n,
+            voxel=float(voxel),
+            seed=_seed_attr(seed),
+            chunk_size=chunk_size,
+            outside=outside[0],
+            volume=float(np.count_nonzero(counts)) * float(voxel) ** 3,
+            units={"x": "m", "y": "m", "z": "m"},
+        ),
+    )
 
 
 def _attrs(robot, frame, **kw):
-    return dict(robot=robot.name, frame=robot.chain.frame(frame).name, chain_key=robot.chain.key(), **kw)
+    return dict(
+        robot=robot.name, frame=robot.chain.frame(frame).name, chain_key=robot.chain.key(), **kw
+    )
 
 
 def _seed_attr(seed):
@@ -231,8 +264,18 @@ def _comfort_task(robot, p):
     return nz, counts[nz], best[nz]
 
 
-def comfort_map(robot, n: int = 10**6, voxel: float = 0.02, frame=None, *, client=None,
-                chunk_size: int = MAP_CHUNK, seed=0, progress: bool = True, callback=None) -> BatchResult:
+def comfort_map(
+    robot,
+    n: int = 10**6,
+    voxel: float = 0.02,
+    frame=None,
+    *,
+    client=None,
+    chunk_size: int = MAP_CHUNK,
+    seed=0,
+    progress: bool = True,
+    callback=None,
+) -> BatchResult:
     """Comfort over the reachable workspace: for each voxel (side ``voxel`` m, base frame) the
     least :func:`discomfort` among the ``n`` sampled configurations that put ``frame`` there.
 
@@ -252,11 +295,22 @@ def comfort_map(robot, n: int = 10**6, voxel: float = 0.02, frame=None, *, clien
     _run(_tasks(_comfort_task, d, payloads), consume, client, robot, progress, "comfort", callback)
     best[counts == 0] = np.nan
     return BatchResult(
-        "comfort_map", {"discomfort": (("x", "y", "z"), best.reshape(shape)),
-                        "counts": (("x", "y", "z"), counts.reshape(shape))},
+        "comfort_map",
+        {
+            "discomfort": (("x", "y", "z"), best.reshape(shape)),
+            "counts": (("x", "y", "z"), counts.reshape(shape)),
+        },
         _voxel_coords(lo, shape, voxel),
-        _attrs(robot, frame, n=n, voxel=float(voxel), seed=_seed_attr(seed), chunk_size=chunk_size,
-               units={"x": "m", "y": "m", "z": "m", "discomfort": "1"}))
+        _attrs(
+            robot,
+            frame,
+            n=n,
+            voxel=float(voxel),
+            seed=_seed_attr(seed),
+            chunk_size=chunk_size,
+            units={"x": "m", "y": "m", "z": "m", "discomfort": "1"},
+        ),
+    )
 
 
 # ============================================================================ population
@@ -275,9 +329,21 @@ def _population_task(robot, p):
     return p["person"], np.unique(np.concatenate(codes)), rmax, pmin, pmax
 
 
-def population_reach(model: str = "human_arm7", heights=(1.55, 1.65, 1.75, 1.85), masses=(60.0, 75.0),
-                     sexes=("female", "male"), n: int = 10**5, voxel: float = 0.02, frame=None, *, client=None,
-                     chunk_size: int = MAP_CHUNK, seed=0, progress: bool = True, callback=None) -> BatchResult:
+def population_reach(
+    model: str = "human_arm7",
+    heights=(1.55, 1.65, 1.75, 1.85),
+    masses=(60.0, 75.0),
+    sexes=("female", "male"),
+    n: int = 10**5,
+    voxel: float = 0.02,
+    frame=None,
+    *,
+    client=None,
+    chunk_size: int = MAP_CHUNK,
+    seed=0,
+    progress: bool = True,
+    callback=None,
+) -> BatchResult:
     """Workspace of a population: for each (height m, mass kg, sex) of the grid, the catalog
     model ``model`` built with those builder parameters, ``n`` random configurations, and
 
@@ -303,9 +369,16 @@ def population_reach(model: str = "human_arm7", heights=(1.55, 1.65, 1.75, 1.85)
     for k, (h, m, s) in enumerate(people):
         d = RobotDescription("catalog", model, model, (("height", h), ("mass", m), ("sex", s)))
         for j, (a, b) in enumerate(parts):
-            tasks.append((_population_task, d, dict(person=k, n=b - a, seed=seeds[k * len(parts) + j], frame=frame,
-                                                    voxel=voxel)))
-    robot_from(tasks[0][1])   # fail early, here, on a bad model name or parameter
+            tasks.append(
+                (
+                    _population_task,
+                    d,
+                    dict(
+                        person=k, n=b - a, seed=seeds[k * len(parts) + j], frame=frame, voxel=voxel
+                    ),
+                )
+            )
+    robot_from(tasks[0][1])  # fail early, here, on a bad model name or parameter
     P = len(people)
     volume, rmax = np.zeros(P), np.zeros(P)
     lo, hi = np.full((P, 3), np.inf), np.full((P, 3), -np.inf)
@@ -318,21 +391,38 @@ def population_reach(model: str = "human_arm7", heights=(1.55, 1.65, 1.75, 1.85)
         rmax[k] = max(rmax[k], r)
         lo[k], hi[k] = np.minimum(lo[k], pmin), np.maximum(hi[k], pmax)
         pending[k] -= 1
-        if pending[k] == 0:   # this person is complete: keep the number, drop the voxel set
+        if pending[k] == 0:  # this person is complete: keep the number, drop the voxel set
             volume[k] = np.unique(np.concatenate(sets.pop(k))).size * voxel**3
 
-    engine.run(tasks, consume, client=client, progress=progress, desc="population", callback=callback)
+    engine.run(
+        tasks, consume, client=client, progress=progress, desc="population", callback=callback
+    )
     shp = (heights.size, masses.size, len(sexes))
     env = np.stack([lo, hi], axis=1).reshape(shp + (2, 3))
     return BatchResult(
         "population_reach",
-        {"volume": (("height", "mass", "sex"), volume.reshape(shp)),
-         "max_reach": (("height", "mass", "sex"), rmax.reshape(shp)),
-         "envelope": (("height", "mass", "sex", "side", "axis"), env)},
-        {"height": heights, "mass": masses, "sex": np.array(sexes), "side": np.array(["min", "max"]),
-         "axis": np.array(["x", "y", "z"])},
-        dict(model=model, frame=frame, n=n, voxel=voxel, seed=_seed_attr(seed), chunk_size=chunk_size,
-             units={"height": "m", "mass": "kg", "volume": "m^3", "max_reach": "m", "envelope": "m"}))
+        {
+            "volume": (("height", "mass", "sex"), volume.reshape(shp)),
+            "max_reach": (("height", "mass", "sex"), rmax.reshape(shp)),
+            "envelope": (("height", "mass", "sex", "side", "axis"), env),
+        },
+        {
+            "height": heights,
+            "mass": masses,
+            "sex": np.array(sexes),
+            "side": np.array(["min", "max"]),
+            "axis": np.array(["x", "y", "z"]),
+        },
+        dict(
+            model=model,
+            frame=frame,
+            n=n,
+            voxel=voxel,
+            seed=_seed_attr(seed),
+            chunk_size=chunk_size,
+            units={"height": "m", "mass": "kg", "volume": "m^3", "max_reach": "m", "envelope": "m"},
+        ),
+    )
 
 
 # ============================================================================ tolerance
@@ -353,9 +443,23 @@ def _mc_task(robot, p):
     return np.linalg.norm(dx[:, :3], axis=1), dx.sum(0), dx.T @ dx
 
 
-def tolerance_monte_carlo(robot, Q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, frame=None, params=None,
-                          mode: str = "length", distribution: str = "normal", *, client=None,
-                          chunk_size: int = MC_CHUNK, seed=0, progress: bool = True, callback=None) -> BatchResult:
+def tolerance_monte_carlo(
+    robot,
+    Q,
+    sigma_q=0.0,
+    sigma_L=0.0,
+    n: int = 10000,
+    frame=None,
+    params=None,
+    mode: str = "length",
+    distribution: str = "normal",
+    *,
+    client=None,
+    chunk_size: int = MC_CHUNK,
+    seed=0,
+    progress: bool = True,
+    callback=None,
+) -> BatchResult:
     """Monte Carlo tolerance analysis (§6-6) of many configurations ``Q`` (M, nq): per
     configuration ``n`` samples of joint errors (``sigma_q``, rad or m per joint) and link
     errors (``sigma_L``, m per link parameter of
@@ -379,22 +483,48 @@ def tolerance_monte_carlo(robot, Q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, fr
     ps = PerturbedChain(robot, frame, params, mode).params
     sq, sL = _vec(sigma_q, robot.nv, "sigma_q"), _vec(sigma_L, len(ps), "sigma_L")
     if np.any(sq < 0) or np.any(sL < 0):
-        raise ValueError(f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}")
+        raise ValueError(
+            f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}"
+        )
     M = Q.shape[0]
-    _check_memory(M * n * 8.0, f"{M} configurations x {n} samples", "fewer samples n or fewer configurations per job")
+    _check_memory(
+        M * n * 8.0,
+        f"{M} configurations x {n} samples",
+        "fewer samples n or fewer configurations per job",
+    )
     parts = engine.chunks(n, chunk_size)
     C = len(parts)
     seeds = engine.chunk_seeds(seed, M * C)
-    payloads = [dict(q=Q[i], n=b - a, seed=seeds[i * C + j], frame=frame, params=ps, mode=mode,
-                     distribution=distribution, sigma_q=sq, sigma_L=sL)
-                for i in range(M) for j, (a, b) in enumerate(parts)]
+    payloads = [
+        dict(
+            q=Q[i],
+            n=b - a,
+            seed=seeds[i * C + j],
+            frame=frame,
+            params=ps,
+            mode=mode,
+            distribution=distribution,
+            sigma_q=sq,
+            sigma_L=sL,
+        )
+        for i in range(M)
+        for j, (a, b) in enumerate(parts)
+    ]
     store: dict = {}
-    _run(_tasks(_mc_task, d, payloads), store.__setitem__, client, robot, progress, "monte carlo", callback)
+    _run(
+        _tasks(_mc_task, d, payloads),
+        store.__setitem__,
+        client,
+        robot,
+        progress,
+        "monte carlo",
+        callback,
+    )
     rms, p95, mx = np.empty(M), np.empty(M), np.empty(M)
     mean, cov, lin = np.empty((M, 6)), np.empty((M, 6, 6)), np.empty((M, 6, 6))
     var_factor = 1.0 if distribution == "normal" else 1.0 / 3.0
     Sigma = np.diag(np.concatenate([sq, sL]) ** 2 * var_factor)
-    for i in range(M):   # combine in task order: the same bits whatever order tasks finished in
+    for i in range(M):  # combine in task order: the same bits whatever order tasks finished in
         got = [store.pop(i * C + j) for j in range(C)]
         dp = np.concatenate([g[0] for g in got])
         s1 = sum((g[1] for g in got[1:]), got[0][1])
@@ -407,13 +537,34 @@ def tolerance_monte_carlo(robot, Q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, fr
     comp = np.array(["x", "y", "z", "rx", "ry", "rz"])
     return BatchResult(
         "tolerance_monte_carlo",
-        {"q": (("config", "joint"), Q), "rms_position": (("config",), rms), "p95_position": (("config",), p95),
-         "max_position": (("config",), mx), "mean": (("config", "component"), mean),
-         "cov": (("config", "component", "component2"), cov), "linear_cov": (("config", "component", "component2"), lin)},
-        {"config": np.arange(M), "joint": np.array(robot.chain.q_names), "component": comp, "component2": comp},
-        _attrs(robot, frame, n=n, seed=_seed_attr(seed), chunk_size=chunk_size, distribution=distribution,
-               sigma_q=sq, sigma_L=sL, link_parameters=[str(p) for p in ps],
-               units={"rms_position": "m", "p95_position": "m", "max_position": "m"}))
+        {
+            "q": (("config", "joint"), Q),
+            "rms_position": (("config",), rms),
+            "p95_position": (("config",), p95),
+            "max_position": (("config",), mx),
+            "mean": (("config", "component"), mean),
+            "cov": (("config", "component", "component2"), cov),
+            "linear_cov": (("config", "component", "component2"), lin),
+        },
+        {
+            "config": np.arange(M),
+            "joint": np.array(robot.chain.q_names),
+            "component": comp,
+            "component2": comp,
+        },
+        _attrs(
+            robot,
+            frame,
+            n=n,
+            seed=_seed_attr(seed),
+            chunk_size=chunk_size,
+            distribution=distribution,
+            sigma_q=sq,
+            sigma_L=sL,
+            link_parameters=[str(p) for p in ps],
+            units={"rms_position": "m", "p95_position": "m", "max_position": "m"},
+        ),
+    )
 
 
 # ============================================================================ IK
@@ -424,8 +575,18 @@ def _ik_task(robot, p):
     return r.q, r.success, r.pos_err, r.rot_err, r.iterations
 
 
-def ik_dataset(robot, T, q0=None, *, client=None, chunk_size: int = IK_CHUNK, seed=0, progress: bool = True,
-               callback=None, **solve_kw) -> BatchResult:
+def ik_dataset(
+    robot,
+    T,
+    q0=None,
+    *,
+    client=None,
+    chunk_size: int = IK_CHUNK,
+    seed=0,
+    progress: bool = True,
+    callback=None,
+    **solve_kw,
+) -> BatchResult:
     """Inverse kinematics of many targets ``T`` (N, 4, 4) (or positions (N, 3); base frame, m)
     with :func:`anthroarm.ik.solve` (``solve_kw``: frame, tol_pos, max_time, max_restarts,
     posture ...), ``chunk_size`` targets per task, the random restarts of task i seeded by
@@ -436,7 +597,11 @@ def ik_dataset(robot, T, q0=None, *, client=None, chunk_size: int = IK_CHUNK, se
     stops the search (cap the search with ``max_restarts=`` for strict reproducibility)."""
     robot, d = _robot_and_desc(robot, client)
     T = np.asarray(T, float)
-    if T.ndim not in (2, 3) or (T.ndim == 3 and T.shape[1:] != (4, 4)) or (T.ndim == 2 and T.shape[1] != 3):
+    if (
+        T.ndim not in (2, 3)
+        or (T.ndim == 3 and T.shape[1:] != (4, 4))
+        or (T.ndim == 2 and T.shape[1] != 3)
+    ):
         raise ValueError(f"T must be (N, 4, 4) poses or (N, 3) positions, got shape {T.shape}")
     N = T.shape[0]
     if q0 is not None:
@@ -444,13 +609,24 @@ def ik_dataset(robot, T, q0=None, *, client=None, chunk_size: int = IK_CHUNK, se
         if q0.shape != (N, robot.nq):
             raise ValueError(f"q0 must have shape ({N}, {robot.nq}), got {q0.shape}")
     chunk_size = _positive_int(chunk_size, "chunk_size")
-    _check_memory(N * (robot.nq + 4) * 8.0, f"IK results of {N} targets", "split the targets into several jobs")
+    _check_memory(
+        N * (robot.nq + 4) * 8.0,
+        f"IK results of {N} targets",
+        "split the targets into several jobs",
+    )
     parts = engine.chunks(N, chunk_size)
     seeds = engine.chunk_seeds(seed, len(parts))
-    payloads = [dict(T=T[a:b], q0=None if q0 is None else q0[a:b], seed=s, kw=dict(solve_kw))
-                for (a, b), s in zip(parts, seeds)]
+    payloads = [
+        dict(T=T[a:b], q0=None if q0 is None else q0[a:b], seed=s, kw=dict(solve_kw))
+        for (a, b), s in zip(parts, seeds)
+    ]
     q = np.full((N, robot.nq), np.nan)
-    ok, pe, re, it = np.zeros(N, bool), np.full(N, np.nan), np.full(N, np.nan), np.zeros(N, np.int64)
+    ok, pe, re, it = (
+        np.zeros(N, bool),
+        np.full(N, np.nan),
+        np.full(N, np.nan),
+        np.zeros(N, np.int64),
+    )
 
     def consume(i, part):
         a, b = parts[i]
@@ -459,26 +635,62 @@ def ik_dataset(robot, T, q0=None, *, client=None, chunk_size: int = IK_CHUNK, se
     _run(_tasks(_ik_task, d, payloads), consume, client, robot, progress, "ik", callback)
     return BatchResult(
         "ik_dataset",
-        {"q": (("target", "joint"), q), "success": (("target",), ok), "pos_err": (("target",), pe),
-         "rot_err": (("target",), re), "iterations": (("target",), it)},
+        {
+            "q": (("target", "joint"), q),
+            "success": (("target",), ok),
+            "pos_err": (("target",), pe),
+            "rot_err": (("target",), re),
+            "iterations": (("target",), it),
+        },
         {"target": np.arange(N), "joint": np.array(robot.chain.q_names)},
-        _attrs(robot, solve_kw.get("frame"), n=N, seed=_seed_attr(seed), chunk_size=chunk_size,
-               solve_kw={k: v for k, v in solve_kw.items() if isinstance(v, (int, float, str, bool, type(None)))},
-               units={"pos_err": "m", "rot_err": "rad"}))
+        _attrs(
+            robot,
+            solve_kw.get("frame"),
+            n=N,
+            seed=_seed_attr(seed),
+            chunk_size=chunk_size,
+            solve_kw={
+                k: v
+                for k, v in solve_kw.items()
+                if isinstance(v, (int, float, str, bool, type(None)))
+            },
+            units={"pos_err": "m", "rot_err": "rad"},
+        ),
+    )
 
 
 # ============================================================================ cell table
 def _cell_task(robot, p):
     from ..ik.cells import CellTable
 
-    t = CellTable.build(robot, p["rotation"], p["D"], p["bounds"], q_ref=p["q_ref"], branch=p["branch"],
-                        progress=False, swivel=p["swivel"])
+    t = CellTable.build(
+        robot,
+        p["rotation"],
+        p["D"],
+        p["bounds"],
+        q_ref=p["q_ref"],
+        branch=p["branch"],
+        progress=False,
+        swivel=p["swivel"],
+    )
     m = p["m"]
     return t.Q[:, :, :m], t.valid[:, :, :m]
 
 
-def cell_table(robot, rotation=None, D: float = 0.05, bounds=None, *, q_ref=None, branch=None, swivel: float = 0.0,
-               client=None, chunk_size: int = CELL_SLICES, progress: bool = True, callback=None) -> BatchResult:
+def cell_table(
+    robot,
+    rotation=None,
+    D: float = 0.05,
+    bounds=None,
+    *,
+    q_ref=None,
+    branch=None,
+    swivel: float = 0.0,
+    client=None,
+    chunk_size: int = CELL_SLICES,
+    progress: bool = True,
+    callback=None,
+) -> BatchResult:
     """The §7-3 cell table (:meth:`anthroarm.ik.cells.CellTable.build`: exact closed-form IK at
     every lattice point of spacing ``D`` m in the box ``bounds = (lo(3), hi(3))`` m, base frame,
     hand orientation ``rotation`` (3, 3), default identity) computed ``chunk_size`` z slices
@@ -497,19 +709,35 @@ def cell_table(robot, rotation=None, D: float = 0.05, bounds=None, *, q_ref=None
         r = robot.chain.reach()
         bounds = (np.full(3, -r), np.full(3, r))
     lo, hi = (np.asarray(b, float) for b in bounds)
-    if not (np.isfinite(D) and D > 0 and lo.shape == hi.shape == (3,) and np.all(np.isfinite(lo) & np.isfinite(hi) & (hi > lo))):
-        raise ValueError(f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, bounds={bounds!r}")
+    if not (
+        np.isfinite(D)
+        and D > 0
+        and lo.shape == hi.shape == (3,)
+        and np.all(np.isfinite(lo) & np.isfinite(hi) & (hi > lo))
+    ):
+        raise ValueError(
+            f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, bounds={bounds!r}"
+        )
     if robot.spec is None:
-        raise ValueError(f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is None)")
-    i0, shape = lattice(lo, hi, D)      # the lattice of CellTable.build
+        raise ValueError(
+            f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is None)"
+        )
+    i0, shape = lattice(lo, hi, D)  # the lattice of CellTable.build
     if np.prod(shape) > MAX_LATTICE:
-        raise JobTooLargeError(f"lattice of {shape} points is too large. Remedy: increase D or shrink bounds")
+        raise JobTooLargeError(
+            f"lattice of {shape} points is too large. Remedy: increase D or shrink bounds"
+        )
     chunk_size = _positive_int(chunk_size, "chunk_size")
     payloads = []
     for k0, k1 in engine.chunks(shape[2], chunk_size):
         m = k1 - k0
-        b = (np.array([lo[0], lo[1], (i0[2] + k0) * D]), np.array([hi[0], hi[1], (i0[2] + k0 + m) * D]))
-        payloads.append(dict(rotation=R, D=D, bounds=b, q_ref=q_ref, branch=branch, swivel=swivel, m=m))
+        b = (
+            np.array([lo[0], lo[1], (i0[2] + k0) * D]),
+            np.array([hi[0], hi[1], (i0[2] + k0 + m) * D]),
+        )
+        payloads.append(
+            dict(rotation=R, D=D, bounds=b, q_ref=q_ref, branch=branch, swivel=swivel, m=m)
+        )
     Q = np.full(shape + (robot.nq,), np.nan)
     valid = np.zeros(shape, bool)
     slabs = engine.chunks(shape[2], chunk_size)
@@ -523,9 +751,23 @@ def cell_table(robot, rotation=None, D: float = 0.05, bounds=None, *, q_ref=None
     coords = {ax: origin[i] + D * np.arange(shape[i]) for i, ax in enumerate("xyz")}
     coords["joint"] = np.array(robot.chain.q_names)
     return BatchResult(
-        "cell_table", {"Q": (("x", "y", "z", "joint"), Q), "valid": (("x", "y", "z"), valid)}, coords,
-        _attrs(robot, None, model=robot.spec.name, params=dict(robot.spec.params), rotation=R, origin=origin, D=D,
-               branch=branch, swivel=swivel, chunk_size=chunk_size, units={"x": "m", "y": "m", "z": "m", "Q": "rad"}))
+        "cell_table",
+        {"Q": (("x", "y", "z", "joint"), Q), "valid": (("x", "y", "z"), valid)},
+        coords,
+        _attrs(
+            robot,
+            None,
+            model=robot.spec.name,
+            params=dict(robot.spec.params),
+            rotation=R,
+            origin=origin,
+            D=D,
+            branch=branch,
+            swivel=swivel,
+            chunk_size=chunk_size,
+            units={"x": "m", "y": "m", "z": "m", "Q": "rad"},
+        ),
+    )
 
 
 def to_cell_table(result: BatchResult):
@@ -533,5 +775,12 @@ def to_cell_table(result: BatchResult):
     from ..ik.cells import CellTable
 
     a = result.attrs
-    return CellTable(a["model"], a["params"], np.asarray(a["rotation"], float), np.asarray(a["origin"], float),
-                     a["D"], result["Q"], result["valid"])
+    return CellTable(
+        a["model"],
+        a["params"],
+        np.asarray(a["rotation"], float),
+        np.asarray(a["origin"], float),
+        a["D"],
+        result["Q"],
+        result["valid"],
+    )

@@ -11,7 +11,13 @@ from .result import BatchResult
 _MAPS = {"reachability_map": "counts", "comfort_map": "discomfort"}
 
 
-def slice_plot(result: BatchResult, var: str | None = None, axis: str = "z", value: float | None = None, ax=None):
+def slice_plot(
+    result: BatchResult,
+    var: str | None = None,
+    axis: str = "z",
+    value: float | None = None,
+    ax=None,
+):
     """One slice of a voxel map (``reachability_map`` / ``comfort_map``) normal to ``axis``
     ("x", "y" or "z") at the coordinate nearest ``value`` m (default: the slice through the
     base origin); unreached voxels are blank.  Returns the matplotlib Figure."""
@@ -19,7 +25,9 @@ def slice_plot(result: BatchResult, var: str | None = None, axis: str = "z", val
 
     var = var or _MAPS.get(result.job)
     if var is None or var not in result.variables:
-        raise ValueError(f"{result.job}: no voxel map to slice; variables: {list(result.variables)}")
+        raise ValueError(
+            f"{result.job}: no voxel map to slice; variables: {list(result.variables)}"
+        )
     dims = list(result.dims(var))
     if axis not in dims:
         raise ValueError(f"axis must be one of {dims}, got {axis!r}")
@@ -34,8 +42,14 @@ def slice_plot(result: BatchResult, var: str | None = None, axis: str = "z", val
     else:
         fig = ax.figure
     cu, cv = result.coords[u], result.coords[v]
-    h = ax.pcolormesh(cu, cv, a.T, shading="nearest", cmap="viridis_r" if var == "discomfort" else "viridis")
-    fig.colorbar(h, ax=ax, label=var + (" (configurations per voxel)" if var == "counts" else " (0 = comfortable)"))
+    h = ax.pcolormesh(
+        cu, cv, a.T, shading="nearest", cmap="viridis_r" if var == "discomfort" else "viridis"
+    )
+    fig.colorbar(
+        h,
+        ax=ax,
+        label=var + (" (configurations per voxel)" if var == "counts" else " (0 = comfortable)"),
+    )
     ax.set_xlabel(f"{u} (m)")
     ax.set_ylabel(f"{v} (m)")
     ax.set_aspect("equal")

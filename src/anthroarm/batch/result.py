@@ -44,7 +44,11 @@ class BatchResult:
 
     def equals(self, other: "BatchResult") -> bool:
         """Bitwise equality of every variable and coordinate (NaN equal to NaN)."""
-        if self.job != other.job or set(self.variables) != set(other.variables) or set(self.coords) != set(other.coords):
+        if (
+            self.job != other.job
+            or set(self.variables) != set(other.variables)
+            or set(self.coords) != set(other.coords)
+        ):
             return False
         for k, (d, a) in self.variables.items():
             d2, b = other.variables[k]
@@ -56,8 +60,12 @@ class BatchResult:
     def to_bytes(self) -> bytes:
         arrays = {k: a for k, (_, a) in self.variables.items()}
         arrays.update({f"coord:{k}": np.asarray(v) for k, v in self.coords.items()})
-        meta = {"format": FORMAT, "job": self.job, "dims": {k: list(d) for k, (d, _) in self.variables.items()},
-                "attrs": self.attrs}
+        meta = {
+            "format": FORMAT,
+            "job": self.job,
+            "dims": {k: list(d) for k, (d, _) in self.variables.items()},
+            "attrs": self.attrs,
+        }
         arrays["__meta__"] = np.frombuffer(json.dumps(meta, default=_json).encode(), dtype=np.uint8)
         buf = io.BytesIO()
         np.savez_compressed(buf, **arrays)
@@ -73,8 +81,11 @@ class BatchResult:
         """An ``xarray.Dataset`` (needs xarray, which anthroarm does not depend on)."""
         import xarray as xr
 
-        return xr.Dataset({k: (d, a) for k, (d, a) in self.variables.items()}, coords=self.coords,
-                          attrs={k: json.dumps(v, default=_json) for k, v in self.attrs.items()})
+        return xr.Dataset(
+            {k: (d, a) for k, (d, a) in self.variables.items()},
+            coords=self.coords,
+            attrs={k: json.dumps(v, default=_json) for k, v in self.attrs.items()},
+        )
 
 
 def _json(x):

@@ -7,8 +7,14 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import engine
-from .jobs import (cell_table, comfort_map, ik_dataset, population_reach, reachability_map,
-                   tolerance_monte_carlo)
+from .jobs import (
+    cell_table,
+    comfort_map,
+    ik_dataset,
+    population_reach,
+    reachability_map,
+    tolerance_monte_carlo,
+)
 
 JOBS = {
     "reach": reachability_map,
@@ -20,8 +26,17 @@ JOBS = {
 }
 
 
-def run_job(job: str, *args, out=None, plot=None, scheduler=None, workers: int | None = None, client=None,
-            timeout: float = engine.CONNECT_TIMEOUT, **kwargs):
+def run_job(
+    job: str,
+    *args,
+    out=None,
+    plot=None,
+    scheduler=None,
+    workers: int | None = None,
+    client=None,
+    timeout: float = engine.CONNECT_TIMEOUT,
+    **kwargs,
+):
     """Run ``JOBS[job](*args, client=..., **kwargs)`` and return its
     :class:`~anthroarm.batch.result.BatchResult`.
 
@@ -33,7 +48,9 @@ def run_job(job: str, *args, out=None, plot=None, scheduler=None, workers: int |
         raise ValueError(f"unknown batch job {job!r}; choose one of {', '.join(JOBS)}")
     for path in (out, plot):
         if path is not None and not Path(path).parent.is_dir():
-            raise FileNotFoundError(f"folder {Path(path).parent} does not exist (cannot write {Path(path).name})")
+            raise FileNotFoundError(
+                f"folder {Path(path).parent} does not exist (cannot write {Path(path).name})"
+            )
     own = None
     if client is None and scheduler is not None:
         client = own = engine.connect(scheduler, workers=workers, timeout=timeout)
@@ -65,7 +82,9 @@ def _save_plot(result, path) -> None:
     elif result.job == "population_reach":
         fig = population_plot(result)
     else:
-        raise ValueError(f"no plot for {result.job}: --plot applies to reach, comfort and population")
+        raise ValueError(
+            f"no plot for {result.job}: --plot applies to reach, comfort and population"
+        )
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)

@@ -101,7 +101,9 @@ class Graph:
     """Hash-consed expression graph (see the module docstring)."""
 
     def __init__(self):
-        self.ops: list[tuple] = []  # ("in", Input) | ("add", a, b) | ("mul", a, b); a, b: int id or float
+        self.ops: list[
+            tuple
+        ] = []  # ("in", Input) | ("add", a, b) | ("mul", a, b); a, b: int id or float
         self._index: dict[tuple, int] = {}
         self.inputs: dict[Input, Node] = {}
 
@@ -214,8 +216,10 @@ class Graph:
                     d = self.mul(a, tan.get(b, 0.0))
                 else:
                     da, db = tan.get(a, 0.0), tan.get(b, 0.0)
-                    d = self.add(self.mul(da, Node(self, b)) if not (is_const(da) and da == 0.0) else 0.0,
-                                 self.mul(Node(self, a), db) if not (is_const(db) and db == 0.0) else 0.0)
+                    d = self.add(
+                        self.mul(da, Node(self, b)) if not (is_const(da) and da == 0.0) else 0.0,
+                        self.mul(Node(self, a), db) if not (is_const(db) and db == 0.0) else 0.0,
+                    )
             if not (is_const(d) and d == 0.0):
                 tan[i] = d
         return [tan.get(o.i, 0.0) if isinstance(o, Node) else 0.0 for o in outputs]
@@ -365,8 +369,14 @@ def expr_text(g: Graph, i: int, names: dict[int, str], inname, lang: str = "py")
         if name is not None:
             return name
         t = expr_text(g, x, names, inname, lang)
-        if op[0] == "add" and pos != "add_l" or op[0] == "mul" and pos == "mul_r" \
-                or t.startswith("-") and pos in ("sub_r", "neg"):
+        if (
+            op[0] == "add"
+            and pos != "add_l"
+            or op[0] == "mul"
+            and pos == "mul_r"
+            or t.startswith("-")
+            and pos in ("sub_r", "neg")
+        ):
             return f"({t})"
         return t
 
@@ -374,7 +384,11 @@ def expr_text(g: Graph, i: int, names: dict[int, str], inname, lang: str = "py")
     _, a, b = op
     if op[0] == "add":
         if isinstance(a, float):
-            return f"{ref(b, 'add_l')} + {ref(a, 'add_r')}" if a >= 0 else f"{ref(b, 'add_l')} - {ref(-a, 'sub_r')}"
+            return (
+                f"{ref(b, 'add_l')} + {ref(a, 'add_r')}"
+                if a >= 0
+                else f"{ref(b, 'add_l')} - {ref(-a, 'sub_r')}"
+            )
         st = _see_through(g, i, a, b)
         if st is not None:  # a - x
             return f"{ref(st[0], 'add_l')} - {ref(st[1], 'sub_r')}"
@@ -384,8 +398,16 @@ def expr_text(g: Graph, i: int, names: dict[int, str], inname, lang: str = "py")
     return f"{ref(a, 'mul_l')}*{ref(b, 'mul_r')}"
 
 
-def straight_line(g: Graph, outputs, inname, *, known: dict | None = None, lang: str = "py",
-                  prefix: str = "x", name_outputs: bool = True) -> tuple[list[tuple[str, str]], object]:
+def straight_line(
+    g: Graph,
+    outputs,
+    inname,
+    *,
+    known: dict | None = None,
+    lang: str = "py",
+    prefix: str = "x",
+    name_outputs: bool = True,
+) -> tuple[list[tuple[str, str]], object]:
     """Statements ``(name, right-hand side)`` computing ``outputs`` in order, and ``ref(value)``:
     the text of an output (a name, an input, a constant or a short inline expression).
 
@@ -396,7 +418,7 @@ def straight_line(g: Graph, outputs, inname, *, known: dict | None = None, lang:
     not recomputed."""
     known = dict(known or {})
     out_ids = [o.i for o in outputs if isinstance(o, Node)]
-    printed: set[int] = set()          # nodes whose text is needed (a negation seen through is not)
+    printed: set[int] = set()  # nodes whose text is needed (a negation seen through is not)
     stack = [i for i in out_ids if g.ops[i][0] != "in" and i not in known]
     while stack:
         i = stack.pop()
@@ -468,7 +490,9 @@ def emit_python(g: Graph, fname: str, args, outputs, shape, kinds, batched: bool
     else:
         n = len(kinds)
         for a in args:
-            lines.append(f"    {', '.join(f'{a}{k}' for k in range(n))}{',' if n == 1 else ''} = {a}.tolist()")
+            lines.append(
+                f"    {', '.join(f'{a}{k}' for k in range(n))}{',' if n == 1 else ''} = {a}.tolist()"
+            )
         sin, cos = "_ssin", "_scos"
     for i in ins:
         if i.kind == "s":
@@ -487,7 +511,9 @@ def emit_python(g: Graph, fname: str, args, outputs, shape, kinds, batched: bool
     if batched:
         if shape == ():
             o = outputs[0]
-            lines.append(f"    return _np.broadcast_to(_np.asarray({ref(o)}, dtype=float), (N,)).copy()")
+            lines.append(
+                f"    return _np.broadcast_to(_np.asarray({ref(o)}, dtype=float), (N,)).copy()"
+            )
         else:
             lines.append(f"    out = _np.empty((N, {', '.join(map(str, shape))}))")
             idx = np.ndindex(*shape)
@@ -514,8 +540,10 @@ def emit_c(g: Graph, fname: str, args, outputs, nout: int, n: int) -> str:
         return inp.name
 
     params = ", ".join(f"const double *restrict {a}_" for a in args)
-    lines = [f"void {fname}(long N, {params}, double *restrict out_) {{",
-             "  for (long r = 0; r < N; ++r) {"]
+    lines = [
+        f"void {fname}(long N, {params}, double *restrict out_) {{",
+        "  for (long r = 0; r < N; ++r) {",
+    ]
     for a in args:
         lines.append(f"    const double *{a} = {a}_ + r * {n};")
     lines.append(f"    double *out = out_ + r * {nout};")

@@ -22,19 +22,71 @@ from . import bilateral, dda, gripper, interpolation, motor, servo, teach
 from .bilateral import Bilateral, BilateralResult, Wall
 from .dda import DDAResult, pulse_counts
 from .dda import dda as distribute_pulses
-from .gripper import (SlipController, correct_attitude, correct_position, grasp, simulate_slip, tactile_search)
+from .gripper import (
+    SlipController,
+    correct_attitude,
+    correct_position,
+    grasp,
+    simulate_slip,
+    tactile_search,
+)
 from .interpolation import Arc, arc_poses, circle_through, line_points, line_poses, slerp
 from .motor import DCMotor, ThermalCheck, rms
 from .servo import PositionServo, ServoResponse
-from .teach import (Call, Jump, Playback, Program, Step, play_fixed, play_jump, play_random_access, play_select,
-                    play_subroutines, record)
+from .teach import (
+    Call,
+    Jump,
+    Playback,
+    Program,
+    Step,
+    play_fixed,
+    play_jump,
+    play_random_access,
+    play_select,
+    play_subroutines,
+    record,
+)
 
 __all__ = [
-    "bilateral", "dda", "gripper", "interpolation", "motor", "servo", "teach",
-    "Bilateral", "BilateralResult", "Wall", "DDAResult", "distribute_pulses", "pulse_counts",
-    "SlipController", "correct_attitude", "correct_position", "grasp", "simulate_slip", "tactile_search",
-    "Arc", "arc_poses", "circle_through", "line_points", "line_poses", "slerp",
-    "DCMotor", "ThermalCheck", "rms", "PositionServo", "ServoResponse",
-    "Call", "Jump", "Playback", "Program", "Step", "play_fixed", "play_jump", "play_random_access", "play_select",
-    "play_subroutines", "record",
+    "bilateral",
+    "dda",
+    "gripper",
+    "interpolation",
+    "motor",
+    "servo",
+    "teach",
+    "Bilateral",
+    "BilateralResult",
+    "Wall",
+    "DDAResult",
+    "distribute_pulses",
+    "pulse_counts",
+    "SlipController",
+    "correct_attitude",
+    "correct_position",
+    "grasp",
+    "simulate_slip",
+    "tactile_search",
+    "Arc",
+    "arc_poses",
+    "circle_through",
+    "line_points",
+    "line_poses",
+    "slerp",
+    "DCMotor",
+    "ThermalCheck",
+    "rms",
+    "PositionServo",
+    "ServoResponse",
+    "Call",
+    "Jump",
+    "Playback",
+    "Program",
+    "Step",
+    "play_fixed",
+    "play_jump",
+    "play_random_access",
+    "play_select",
+    "play_subroutines",
+    "record",
 ]

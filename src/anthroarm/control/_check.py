@@ -60,7 +60,9 @@ def on_grid(x, t: np.ndarray, name: str) -> np.ndarray:
     if a.ndim == 0:
         return np.full(t.shape, float(a))
     if a.shape != t.shape:
-        raise ControlError(f"{name} must be a scalar or have one value per time sample {t.shape}, got {a.shape}")
+        raise ControlError(
+            f"{name} must be a scalar or have one value per time sample {t.shape}, got {a.shape}"
+        )
     return a
 
 
@@ -82,7 +84,9 @@ def finite_result(func):
         with np.errstate(over="ignore", invalid="ignore"):
             out = func(*args, **kwargs)
         if not np.all(np.isfinite(out)):
-            raise ControlError(f"{func.__name__}: the result is beyond the floating-point range for these inputs")
+            raise ControlError(
+                f"{func.__name__}: the result is beyond the floating-point range for these inputs"
+            )
         return out
 
     return wrapper

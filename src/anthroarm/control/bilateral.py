@@ -144,8 +144,16 @@ class Bilateral:
             s(self, name, _check.positive(getattr(self, name), name))
         for name in ("B1", "B2", "D", "G", "B_h"):
             s(self, name, _check.nonnegative(getattr(self, name), name))
-        s(self, "K_master", self.K if self.K_master is None else _check.positive(self.K_master, "K_master"))
-        s(self, "D_master", self.D if self.D_master is None else _check.nonnegative(self.D_master, "D_master"))
+        s(
+            self,
+            "K_master",
+            self.K if self.K_master is None else _check.positive(self.K_master, "K_master"),
+        )
+        s(
+            self,
+            "D_master",
+            self.D if self.D_master is None else _check.nonnegative(self.D_master, "D_master"),
+        )
 
     def _torques(self, kind, th, wh, x, load, wall, contact=None):
         """(τ_h, τ_e, τ_1, τ_2); ``contact`` True/False forces the wall's linear law on/off."""
@@ -170,10 +178,17 @@ class Bilateral:
     def _affine(self, kind, load, wall, contact):
         """(A, B, c) with ``ẋ = A x + B (θ_h, θ̇_h) + c`` for one contact state: the equations
         are affine in the state and the operator's input while the wall is on or off."""
+
         def f(x, u):
             tau_h, tau_e, tau_1, tau_2 = self._torques(kind, u[0], u[1], x, load, wall, contact)
-            return np.array([x[1], (tau_h + tau_1 - self.B1 * x[1]) / self.J1,
-                             x[3], (tau_2 - tau_e - self.B2 * x[3]) / self.J2])
+            return np.array(
+                [
+                    x[1],
+                    (tau_h + tau_1 - self.B1 * x[1]) / self.J1,
+                    x[3],
+                    (tau_2 - tau_e - self.B2 * x[3]) / self.J2,
+                ]
+            )
 
         z4, z2 = np.zeros(4), np.zeros(2)
         c = f(z4, z2)
@@ -181,8 +196,15 @@ class Bilateral:
         B = np.column_stack([f(z4, e) - c for e in np.eye(2)])
         return A, B, c
 
-    def simulate(self, kind: str, t, theta_h, load: float = 0.0, wall: Wall | None = None,
-                 max_step: float = 1e-3) -> BilateralResult:
+    def simulate(
+        self,
+        kind: str,
+        t,
+        theta_h,
+        load: float = 0.0,
+        wall: Wall | None = None,
+        max_step: float = 1e-3,
+    ) -> BilateralResult:
         """Simulate one type of Fig. 9-17 from rest at the operator's first position.
 
         The equations are linear while the wall is in contact or not, so each step is exact
@@ -225,10 +247,14 @@ class Bilateral:
 
             def path(tt):
                 return np.interp(tt, t, samples), np.interp(tt, t, rate)
+
         th_t, wh_t = (np.broadcast_to(np.asarray(v, dtype=float), t.shape) for v in path(t))
         if not (np.all(np.isfinite(th_t)) and np.all(np.isfinite(wh_t))):
             raise ControlError("theta_h must be finite")
-        modes = {c: self._affine(kind, load, wall, c) for c in ((False, True) if wall is not None else (False,))}
+        modes = {
+            c: self._affine(kind, load, wall, c)
+            for c in ((False, True) if wall is not None else (False,))
+        }
         cache: dict = {}
 
         def discrete(c, h):
@@ -252,8 +278,11 @@ class Bilateral:
             hk = float(np.round(h, 15))
             u0 = np.array([th_t[k], wh_t[k]])
             for j in range(n):
-                u1 = np.asarray(path(t[k] + (j + 1) * h), dtype=float) if j < n - 1 else np.array([th_t[k + 1],
-                                                                                                  wh_t[k + 1]])
+                u1 = (
+                    np.asarray(path(t[k] + (j + 1) * h), dtype=float)
+                    if j < n - 1
+                    else np.array([th_t[k + 1], wh_t[k + 1]])
+                )
                 contact = wall is not None and bool(wall.torque(x[2], x[3]) > 0.0)
                 Ad, Bd, cd, Dd = discrete(contact, hk)
                 x = Ad @ x + Bd @ u0 + cd + Dd @ ((u1 - u0) / h)
@@ -264,11 +293,19 @@ class Bilateral:
         X = X.T
         tau_h, tau_e, tau_1, tau_2 = self._torques(kind, th_t, wh_t, X, load, wall)
         bc = np.broadcast_to
-        return BilateralResult(kind=kind, t=t, theta_h=th_t.copy(), theta_m=X[0], theta_s=X[2], omega_m=X[1],
-                               omega_s=X[3], felt=np.asarray(tau_h, dtype=float),
-                               tau_env=bc(np.asarray(tau_e, float), t.shape).copy(),
-                               tau_master=bc(np.asarray(tau_1, float), t.shape).copy(),
-                               tau_slave=np.asarray(tau_2, dtype=float))
+        return BilateralResult(
+            kind=kind,
+            t=t,
+            theta_h=th_t.copy(),
+            theta_m=X[0],
+            theta_s=X[2],
+            omega_m=X[1],
+            omega_s=X[3],
+            felt=np.asarray(tau_h, dtype=float),
+            tau_env=bc(np.asarray(tau_e, float), t.shape).copy(),
+            tau_master=bc(np.asarray(tau_1, float), t.shape).copy(),
+            tau_slave=np.asarray(tau_2, dtype=float),
+        )
 
     def static_feel(self, kind: str, tau_env) -> np.ndarray:
         """What the operator feels at rest against an environment torque ``tau_env`` (N·m), from

@@ -57,8 +57,12 @@ class DDAResult:
     def positions(self) -> np.ndarray:
         """Cumulative pulse position of every axis after each tick, shape (N + 1, k), starting
         at zero."""
-        return np.vstack([np.zeros((1, self.counts.size), dtype=np.int64),
-                          np.cumsum(self.pulses, axis=0, dtype=np.int64)])
+        return np.vstack(
+            [
+                np.zeros((1, self.counts.size), dtype=np.int64),
+                np.cumsum(self.pulses, axis=0, dtype=np.int64),
+            ]
+        )
 
     def last_pulse_tick(self) -> np.ndarray:
         """The tick (1-based) of each axis's last pulse; 0 for an axis that does not move."""
@@ -71,15 +75,19 @@ class DDAResult:
 def _counts(counts) -> np.ndarray:
     a = np.asarray(counts)
     if a.ndim != 1 or a.size == 0:
-        raise ControlError(f"counts must be a 1-D list of pulse counts (one per axis), got shape {a.shape}")
+        raise ControlError(
+            f"counts must be a 1-D list of pulse counts (one per axis), got shape {a.shape}"
+        )
     if a.dtype.kind not in "iu":
         try:
             f = np.asarray(a, dtype=float)
         except (TypeError, ValueError):
             raise ControlError(f"counts must be integers, got {counts!r}") from None
         if not np.all(np.isfinite(f)) or np.any(f != np.round(f)):
-            raise ControlError(f"counts must be whole numbers of pulses, got {f.tolist()}; "
-                               "round positions to pulses with pulse_counts()")
+            raise ControlError(
+                f"counts must be whole numbers of pulses, got {f.tolist()}; "
+                "round positions to pulses with pulse_counts()"
+            )
         if np.any(np.abs(f) > 2**62):
             raise ControlError("a pulse count is beyond 2**62")
         a = f.astype(np.int64)
@@ -117,16 +125,20 @@ def dda(counts, n_ticks: int | None = None) -> DDAResult:
             raise ControlError(f"n_ticks must be an integer, got {n_ticks!r}")
         N = int(n_ticks)
         if N < 1:
-            raise ControlError(f"n_ticks must be >= 1 (a DDA with zero steps moves nothing), got {N}")
+            raise ControlError(
+                f"n_ticks must be >= 1 (a DDA with zero steps moves nothing), got {N}"
+            )
         if N < need:
-            raise ControlError(f"n_ticks = {N} is below the largest count {need}: a DDA emits at most one pulse "
-                               "per tick and axis")
+            raise ControlError(
+                f"n_ticks = {N} is below the largest count {need}: a DDA emits at most one pulse "
+                "per tick and axis"
+            )
     if need == 0:
         return DDAResult(c, np.zeros((N, c.size), dtype=np.int8), N, "no motion")
     if N > 50_000_000 // max(1, c.size):
         raise ControlError(f"{N} ticks x {c.size} axes is too many pulses to tabulate")
     j = np.arange(N + 1, dtype=np.int64)[:, None]
-    emitted = (j * mag[None, :]) // N              # floor(j |Δ| / N): the accumulator's overflows
+    emitted = (j * mag[None, :]) // N  # floor(j |Δ| / N): the accumulator's overflows
     pulses = (np.diff(emitted, axis=0) * np.sign(c)[None, :]).astype(np.int8)
     return DDAResult(c, pulses, N, "ok")
 
@@ -149,8 +161,15 @@ def pulse_counts(q_from, q_to, resolution) -> np.ndarray:
     b = np.asarray(q_to, dtype=float)
     r = np.asarray(resolution, dtype=float)
     if a.shape != b.shape or a.ndim != 1:
-        raise ControlError(f"q_from and q_to must be 1-D of the same length, got {a.shape} and {b.shape}")
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(r)) and np.all(r > 0)):
+        raise ControlError(
+            f"q_from and q_to must be 1-D of the same length, got {a.shape} and {b.shape}"
+        )
+    if not (
+        np.all(np.isfinite(a))
+        and np.all(np.isfinite(b))
+        and np.all(np.isfinite(r))
+        and np.all(r > 0)
+    ):
         raise ControlError("positions must be finite and the resolution finite and > 0")
     steps = (b - a) / r
     if np.any(np.abs(steps) > 2**62):

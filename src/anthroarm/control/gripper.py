@@ -30,8 +30,19 @@ from ..errors import ControlError
 from . import _check
 from .motor import DCMotor
 
-__all__ = ["CorrectionResult", "GraspResult", "SearchResult", "SlipController", "SlipResult", "correct_attitude",
-           "correct_position", "grasp", "simulate_slip", "tactile_search", "GRASP_MODES"]
+__all__ = [
+    "CorrectionResult",
+    "GraspResult",
+    "SearchResult",
+    "SlipController",
+    "SlipResult",
+    "correct_attitude",
+    "correct_position",
+    "grasp",
+    "simulate_slip",
+    "tactile_search",
+    "GRASP_MODES",
+]
 
 GRASP_MODES = ("hard", "soft", "zero")
 
@@ -59,7 +70,9 @@ class SearchResult:
     status: str
 
 
-def tactile_search(contact: Callable, start, direction, step: float, max_steps: int = 1000) -> SearchResult:
+def tactile_search(
+    contact: Callable, start, direction, step: float, max_steps: int = 1000
+) -> SearchResult:
     """Search by unit steps along ``direction`` until ``contact(position)`` is true (Fig. 9-11).
 
     Parameters
@@ -82,7 +95,9 @@ def tactile_search(contact: Callable, start, direction, step: float, max_steps: 
     p = _check.array(start, "start")
     d = _check.array(direction, "direction")
     if d.shape != p.shape or not np.any(d):
-        raise ControlError(f"direction must be a nonzero vector of the shape of start {p.shape}, got {d.shape}")
+        raise ControlError(
+            f"direction must be a nonzero vector of the shape of start {p.shape}, got {d.shape}"
+        )
     d = d / np.linalg.norm(d)
     step = _check.positive(step, "step (m)")
     max_steps = _check.count(max_steps, "max_steps")
@@ -137,8 +152,14 @@ def _correct(error, unit, gaps, resolution, max_corrections):
     return CorrectionResult(error, int(max_corrections), np.array(hist), "limit")
 
 
-def correct_position(offset: float, width: float, opening: float, unit: float, resolution: float,
-                     max_corrections: int = 1000) -> CorrectionResult:
+def correct_position(
+    offset: float,
+    width: float,
+    opening: float,
+    unit: float,
+    resolution: float,
+    max_corrections: int = 1000,
+) -> CorrectionResult:
     """Position correction R1 of Fig. 9-12 (a) for a two-jaw gripper closing symmetrically.
 
     Model (assumed): jaws at ``±opening/2`` about the hand centre close in increments of
@@ -169,13 +190,21 @@ def correct_position(offset: float, width: float, opening: float, unit: float, r
     unit = _check.positive(unit, "unit (m)")
     resolution = _check.positive(resolution, "resolution (m)")
     if width + 2 * abs(offset) >= opening:
-        raise ControlError(f"the object (width {width}, offset {offset}) does not fit between jaws {opening} m apart")
+        raise ControlError(
+            f"the object (width {width}, offset {offset}) does not fit between jaws {opening} m apart"
+        )
     half = 0.5 * (opening - width)
     return _correct(offset, unit, lambda d: (half + d, half - d), resolution, max_corrections)
 
 
-def correct_attitude(angle: float, pad_length: float, gap: float, unit: float, resolution: float,
-                     max_corrections: int = 1000) -> CorrectionResult:
+def correct_attitude(
+    angle: float,
+    pad_length: float,
+    gap: float,
+    unit: float,
+    resolution: float,
+    max_corrections: int = 1000,
+) -> CorrectionResult:
     """Attitude correction R2 of Fig. 9-12 (b): turn the hand until the jaw pad is parallel to
     the object's face.
 
@@ -208,9 +237,16 @@ def correct_attitude(angle: float, pad_length: float, gap: float, unit: float, r
     unit = _check.positive(unit, "unit (rad)")
     resolution = _check.positive(resolution, "resolution (m)")
     if abs(angle) >= 0.5 * math.pi or 0.5 * pad * abs(math.tan(angle)) >= gap:
-        raise ControlError(f"angle {angle} rad: the pad would already cut into the face (gap {gap} m)")
-    return _correct(angle, unit, lambda a: (gap + 0.5 * pad * math.tan(a), gap - 0.5 * pad * math.tan(a)),
-                    resolution, max_corrections)
+        raise ControlError(
+            f"angle {angle} rad: the pad would already cut into the face (gap {gap} m)"
+        )
+    return _correct(
+        angle,
+        unit,
+        lambda a: (gap + 0.5 * pad * math.tan(a), gap - 0.5 * pad * math.tan(a)),
+        resolution,
+        max_corrections,
+    )
 
 
 # ---------------------------------------------------------------------------- grasp modes
@@ -242,9 +278,23 @@ class GraspResult:
     contact_time: float
 
 
-def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: float, duration: float,
-          approach_speed: float = 0.01, set_force: float = 5.0, jaw_mass: float = 0.05, k_v: float = 100.0,
-          k_p: float = 2.0, k_i: float = 10.0, k_x: float = 2000.0, n: int = 2001) -> GraspResult:
+def grasp(
+    motor: DCMotor,
+    mode: str,
+    *,
+    gap: float,
+    stiffness: float,
+    lead: float,
+    duration: float,
+    approach_speed: float = 0.01,
+    set_force: float = 5.0,
+    jaw_mass: float = 0.05,
+    k_v: float = 100.0,
+    k_p: float = 2.0,
+    k_i: float = 10.0,
+    k_x: float = 2000.0,
+    n: int = 2001,
+) -> GraspResult:
     """Grip-force control of Fig. 9-13: approach at constant speed, then, from the contact on,
     a force loop ("once it touches the object, the grip-force feedback loop closes").
 
@@ -304,8 +354,10 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
     v0 = _check.positive(approach_speed, "approach_speed (m/s)")
     F_set = _check.nonnegative(set_force, "set_force (N)")
     m_eq = _check.positive(jaw_mass, "jaw_mass (kg)") + motor.reflected_inertia / lead**2
-    k_v, k_p, k_i, k_x = (_check.nonnegative(v, nm) for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i"),
-                                                                    (k_x, "k_x")))
+    k_v, k_p, k_i, k_x = (
+        _check.nonnegative(v, nm)
+        for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i"), (k_x, "k_x"))
+    )
     n = _check.count(n, "n", 2)
     Vmax = motor.V_nom
     V0 = float(motor.voltage(0.0, v0 / lead))
@@ -330,21 +382,32 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
         x, v, z = s
         # motoring efficiency in both directions: a smooth model (the power-flow switch of
         # DCMotor.joint_torque is discontinuous at zero speed, where a grasp comes to rest)
-        F_m = motor.eta * motor.i * float(motor.motor_torque(volts(x, v, z, touching), motor.i * v / lead)) / lead
+        F_m = (
+            motor.eta
+            * motor.i
+            * float(motor.motor_torque(volts(x, v, z, touching), motor.i * v / lead))
+            / lead
+        )
         Fo = float(force(x))
         return np.array([v, (F_m - Fo) / m_eq, (F_set - Fo) if touching else 0.0])
 
     # fixed-step classical Runge-Kutta; the step resolves the fastest linearised mode at contact
     s_c = np.array([gap * (1 + 1e-3), 0.0, 0.0])
     eps = np.array([gap * 1e-6, v0 * 1e-6, 1e-6])
-    J = np.column_stack([(f(s_c + e, True) - f(s_c - e, True)) / (2 * e.sum()) for e in np.diag(eps)])
-    J0 = np.column_stack([(f(s_c + e, False) - f(s_c - e, False)) / (2 * e.sum()) for e in np.diag(eps)])
+    J = np.column_stack(
+        [(f(s_c + e, True) - f(s_c - e, True)) / (2 * e.sum()) for e in np.diag(eps)]
+    )
+    J0 = np.column_stack(
+        [(f(s_c + e, False) - f(s_c - e, False)) / (2 * e.sum()) for e in np.diag(eps)]
+    )
     lam = max(np.max(np.abs(np.linalg.eigvals(J))), np.max(np.abs(np.linalg.eigvals(J0))), 1e-9)
     t = np.linspace(0.0, duration, int(n))
     sub = max(1, int(np.ceil((t[1] - t[0]) * lam / 0.2)))
     if (n - 1) * sub > 5_000_000:
-        raise ControlError(f"the grasp needs {(n - 1) * sub} integration steps (stiff object or motor); "
-                           "shorten the duration or soften the gains")
+        raise ControlError(
+            f"the grasp needs {(n - 1) * sub} integration steps (stiff object or motor); "
+            "shorten the duration or soften the gains"
+        )
     h = (t[1] - t[0]) / sub
     X = np.empty((3, t.size))
     touching = np.zeros(t.size, dtype=bool)
@@ -357,7 +420,7 @@ def grasp(motor: DCMotor, mode: str, *, gap: float, stiffness: float, lead: floa
             k3 = f(st + 0.5 * h * k2, on)
             k4 = f(st + h * k3, on)
             st = st + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-            if not on and st[0] >= gap:       # the contact closes the force loop (latched)
+            if not on and st[0] >= gap:  # the contact closes the force loop (latched)
                 on, tc = True, float(t[k - 1] + (j + 1) * h)
         if not np.all(np.isfinite(st)):
             raise ControlError(f"the {mode} grasp simulation diverged at t = {t[k]:g} s")
@@ -429,8 +492,16 @@ class SlipResult:
     status: str
 
 
-def simulate_slip(mass: float, mu: float, controller: SlipController, unit: float, *, n_jaws: int = 2,
-                  g: float = 9.81, max_slip: float = 0.1) -> SlipResult:
+def simulate_slip(
+    mass: float,
+    mu: float,
+    controller: SlipController,
+    unit: float,
+    *,
+    n_jaws: int = 2,
+    g: float = 9.81,
+    max_slip: float = 0.1,
+) -> SlipResult:
     """An object held by friction slides down until the slip controller's grip holds it.
 
     Model (assumed): Coulomb friction, static = kinetic coefficient ``mu`` on ``n_jaws`` jaws;
@@ -466,7 +537,9 @@ def simulate_slip(mass: float, mu: float, controller: SlipController, unit: floa
     max_slip = _check.positive(max_slip, "max_slip (m)")
     n_jaws = _check.count(n_jaws, "n_jaws", 1)
     if max_slip / unit > 1e7:
-        raise ControlError(f"max_slip / unit = {max_slip / unit:.3g} pulses is too many to simulate (at most 1e7)")
+        raise ControlError(
+            f"max_slip / unit = {max_slip / unit:.3g} pulses is too many to simulate (at most 1e7)"
+        )
     if not isinstance(controller, SlipController):
         raise ControlError("controller must be a SlipController")
     t, s, v = 0.0, 0.0, 0.0
@@ -477,10 +550,16 @@ def simulate_slip(mass: float, mu: float, controller: SlipController, unit: floa
             return SlipResult(controller.grip, len(times), s, np.array(times), t, "held")
         target = (len(times) + 1) * unit
         d = target - s
-        if a < 0.0 and v * v / (-2.0 * a) < d:        # stops before the next pulse
+        if a < 0.0 and v * v / (-2.0 * a) < d:  # stops before the next pulse
             tau = v / (-a)
-            return SlipResult(controller.grip, len(times), s + v * tau + 0.5 * a * tau * tau, np.array(times),
-                              t + tau, "held")
+            return SlipResult(
+                controller.grip,
+                len(times),
+                s + v * tau + 0.5 * a * tau * tau,
+                np.array(times),
+                t + tau,
+                "held",
+            )
         # time to slide d: 0.5 a τ² + v τ − d = 0 (the positive root, written without cancellation)
         disc = v * v + 2.0 * a * d
         tau = 2.0 * d / (v + math.sqrt(max(disc, 0.0)))
@@ -490,4 +569,6 @@ def simulate_slip(mass: float, mu: float, controller: SlipController, unit: floa
         if s >= max_slip:
             a = g - n_jaws * mu * controller.grip / m
             if a > 0.0:
-                return SlipResult(controller.grip, len(times), s, np.array(times), math.inf, "dropped")
+                return SlipResult(
+                    controller.grip, len(times), s, np.array(times), math.inf, "dropped"
+                )

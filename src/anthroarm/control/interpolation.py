@@ -175,16 +175,20 @@ def circle_through(p1, p2, p3, tol: float = 1e-9) -> Arc:
     a, b = (p1 - p3) / scale, (p2 - p3) / scale
     la, lb, lab = np.linalg.norm(a), np.linalg.norm(b), np.linalg.norm(b - a)
     if min(la, lb, lab) <= tol * max(la, lb, lab):
-        raise DegenerateArcError(f"two of the arc's points coincide: p1={p1.tolist()}, p2={p2.tolist()}, "
-                                 f"p3={p3.tolist()}")
+        raise DegenerateArcError(
+            f"two of the arc's points coincide: p1={p1.tolist()}, p2={p2.tolist()}, "
+            f"p3={p3.tolist()}"
+        )
     axb = np.cross(a, b)
     n2 = float(axb @ axb)
     if np.sqrt(n2) <= tol * la * lb:
-        raise DegenerateArcError(f"the arc's three points are collinear (no unique circle): p1={p1.tolist()}, "
-                                 f"p2={p2.tolist()}, p3={p3.tolist()}; use a straight line")
+        raise DegenerateArcError(
+            f"the arc's three points are collinear (no unique circle): p1={p1.tolist()}, "
+            f"p2={p2.tolist()}, p3={p3.tolist()}; use a straight line"
+        )
     c = p3 + scale * (np.cross(la * la * b - lb * lb * a, axb) / (2.0 * n2))
     r = float(np.linalg.norm(p1 - c))
-    n = np.cross(b - a, -b)          # (p2 − p1) × (p3 − p2) over scale²
+    n = np.cross(b - a, -b)  # (p2 − p1) × (p3 − p2) over scale²
     n = n / np.linalg.norm(n)
     e1 = (p1 - c) / r
     e2 = np.cross(n, e1)

@@ -190,7 +190,9 @@ class DCMotor:
     def continuous_torque(self) -> float:
         """The rated continuous torque at the joint, ``η i tau_cont`` (N·m, motoring)."""
         if self.tau_cont is None:
-            raise ControlError(f"motor {self.name!r} has no tau_cont (rated continuous torque, N m)")
+            raise ControlError(
+                f"motor {self.name!r} has no tau_cont (rated continuous torque, N m)"
+            )
         return self.eta * self.i * self.tau_cont
 
     def _voltage(self, V):
@@ -274,7 +276,9 @@ class DCMotor:
         """
         tau = _check.array(tau, "tau (joint torque, N m)")
         tm = tau / (self.eta * self.i)
-        return (self.stall_torque_coefficient * self._voltage(V) - tm) / (self.torque_speed_slope * self.i)
+        return (self.stall_torque_coefficient * self._voltage(V) - tm) / (
+            self.torque_speed_slope * self.i
+        )
 
     # ------------------------------------------------------------------ what a joint motion needs
     @_check.finite_result
@@ -348,7 +352,9 @@ class DCMotor:
             No ``tau_cont`` on the motor, or bad samples.
         """
         if self.tau_cont is None:
-            raise ControlError("thermal_check needs the motor's rated continuous torque tau_cont (N m)")
+            raise ControlError(
+                "thermal_check needs the motor's rated continuous torque tau_cont (N m)"
+            )
         t = _check.time_grid(t)
         tau = _check.on_grid(tau, t, "tau")
         omega = _check.on_grid(omega, t, "omega")
@@ -356,4 +362,6 @@ class DCMotor:
         tm = self.required_motor_torque(tau, omega, alpha)
         r = rms(t, tm)
         ratio = r / self.tau_cont
-        return ThermalCheck(r, float(np.max(np.abs(tm))), self.tau_cont, float(ratio), bool(ratio <= 1.0))
+        return ThermalCheck(
+            r, float(np.max(np.abs(tm))), self.tau_cont, float(ratio), bool(ratio <= 1.0)
+        )

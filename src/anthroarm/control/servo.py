@@ -144,12 +144,21 @@ class PositionServo:
         if self.V_max is not None:
             s(self, "V_max", _check.positive(self.V_max, "V_max (amplifier limit, V)"))
         if self.J0 <= 0.0:
-            raise ControlError("J_0 = eta i^2 J_m + J_L must be > 0 (give a motor or a load inertia)")
+            raise ControlError(
+                "J_0 = eta i^2 J_m + J_L must be > 0 (give a motor or a load inertia)"
+            )
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_motor(cls, motor: DCMotor, J_L: float, k_a: float, k_p: float, k_s: float = 0.0,
-                   V_max: float | None = None) -> PositionServo:
+    def from_motor(
+        cls,
+        motor: DCMotor,
+        J_L: float,
+        k_a: float,
+        k_p: float,
+        k_s: float = 0.0,
+        V_max: float | None = None,
+    ) -> PositionServo:
         """The servo of a :class:`~anthroarm.control.motor.DCMotor`: ``k_m = k_m^motor / R``,
         ``k = k_m^motor² / R + b_m`` (Eq. (9-1)), and the motor's ``J_m``, ``i``, ``η``.
 
@@ -170,23 +179,61 @@ class PositionServo:
         """
         if not isinstance(motor, DCMotor):
             raise ControlError(f"motor must be a DCMotor, got {type(motor).__name__}")
-        return cls(k_m=motor.stall_torque_coefficient, k=motor.torque_speed_slope, J_m=motor.J_m, J_L=J_L,
-                   i=motor.i, k_a=k_a, k_p=k_p, k_s=k_s, eta=motor.eta, V_max=V_max)
+        return cls(
+            k_m=motor.stall_torque_coefficient,
+            k=motor.torque_speed_slope,
+            J_m=motor.J_m,
+            J_L=J_L,
+            i=motor.i,
+            k_a=k_a,
+            k_p=k_p,
+            k_s=k_s,
+            eta=motor.eta,
+            V_max=V_max,
+        )
 
     @classmethod
-    def from_book_units(cls, k_m: float, k: float, J_m: float, J_L: float, i: float, k_a: float, k_p: float,
-                        k_s: float = 0.0, eta: float = 1.0, V_max: float | None = None) -> PositionServo:
+    def from_book_units(
+        cls,
+        k_m: float,
+        k: float,
+        J_m: float,
+        J_L: float,
+        i: float,
+        k_a: float,
+        k_p: float,
+        k_s: float = 0.0,
+        eta: float = 1.0,
+        V_max: float | None = None,
+    ) -> PositionServo:
         """The servo from parameters in the book's gravitational units (§9-1 三.3, l. 7119–7133):
         ``k_m`` in kgf·cm/V, ``k`` in kgf·cm·s/rad, ``J_m`` and ``J_L`` in kgf·cm·s²; ``i``,
         ``k_a``, ``k_p`` (V/rad), ``k_s`` (V·s/rad) as they are.  1 kgf·cm = 0.0980665 N·m and
         1 kgf·cm·s² = 0.0980665 kg·m² (standard gravity 9.80665 m/s², ISO 80000-4)."""
         c = KGF_CM
-        return cls(k_m=_check.scalar(k_m, "k_m") * c, k=_check.scalar(k, "k") * c, J_m=_check.scalar(J_m, "J_m") * c,
-                   J_L=_check.scalar(J_L, "J_L") * c, i=i, k_a=k_a, k_p=k_p, k_s=k_s, eta=eta, V_max=V_max)
+        return cls(
+            k_m=_check.scalar(k_m, "k_m") * c,
+            k=_check.scalar(k, "k") * c,
+            J_m=_check.scalar(J_m, "J_m") * c,
+            J_L=_check.scalar(J_L, "J_L") * c,
+            i=i,
+            k_a=k_a,
+            k_p=k_p,
+            k_s=k_s,
+            eta=eta,
+            V_max=V_max,
+        )
 
     @classmethod
-    def tuned(cls, motor: DCMotor, J_L: float, omega_n: float, zeta: float, k_p: float = 1.0,
-              V_max: float | None = None) -> PositionServo:
+    def tuned(
+        cls,
+        motor: DCMotor,
+        J_L: float,
+        omega_n: float,
+        zeta: float,
+        k_p: float = 1.0,
+        V_max: float | None = None,
+    ) -> PositionServo:
         """A servo whose (9-5) has natural frequency ``omega_n`` (rad/s) and damping ratio
         ``zeta``: ``k_a = J_0 ω_n² / (η i k_m k_p)`` from ``K_s = J_0 ω_n²`` and
         ``k_s = (2 ζ ω_n J_0 / (η i²) − k) / (k_m k_a)`` from ``K_v = 2 ζ ω_n J_0``.
@@ -204,8 +251,10 @@ class PositionServo:
         k_s = (2.0 * zeta * omega_n * J0 / (base.eta * base.i**2) - base.k) / (base.k_m * k_a)
         if k_s < 0.0:
             zmin = base.eta * base.i**2 * base.k / (2.0 * omega_n * J0)
-            raise ControlError(f"the motor's own damping gives zeta >= {zmin:.6g} at omega_n = {omega_n:g} rad/s; "
-                               f"asked for zeta = {zeta:g} (no tachogenerator gain can lower it)")
+            raise ControlError(
+                f"the motor's own damping gives zeta >= {zmin:.6g} at omega_n = {omega_n:g} rad/s; "
+                f"asked for zeta = {zeta:g} (no tachogenerator gain can lower it)"
+            )
         return cls.from_motor(motor, J_L, k_a=k_a, k_p=k_p, k_s=k_s, V_max=V_max)
 
     # ------------------------------------------------------------------ coefficients of (9-5)
@@ -250,7 +299,9 @@ class PositionServo:
         numpy.ndarray
             Error voltage ``k_p (θ_i − θ)`` at rest, V.
         """
-        return _check.array(M_L, "M_L (load torque, N m)") / (self.eta * self.i * self.k_m * self.k_a)
+        return _check.array(M_L, "M_L (load torque, N m)") / (
+            self.eta * self.i * self.k_m * self.k_a
+        )
 
     @_check.finite_result
     def estimate_load_torque(self, e):
@@ -301,7 +352,9 @@ class PositionServo:
     def voltage(self, theta, omega, theta_i):
         """Motor voltage of Eq. (9-4), ``k_a k_p (θ_i − θ) − k_a k_s i θ̇`` (V), clipped to
         ``±V_max`` when set."""
-        V = self.k_a * self.k_p * (np.asarray(theta_i) - theta) - self.k_a * self.k_s * self.i * np.asarray(omega)
+        V = self.k_a * self.k_p * (
+            np.asarray(theta_i) - theta
+        ) - self.k_a * self.k_s * self.i * np.asarray(omega)
         return V if self.V_max is None else np.clip(V, -self.V_max, self.V_max)
 
     def rhs(self, x, theta_i, M_L) -> np.ndarray:
@@ -417,12 +470,24 @@ class PositionServo:
             M_m = self.k_m * V - self.k * self.i * omega
             e = self.k_p * (ti - theta)
         if not all(np.all(np.isfinite(a)) for a in (X, V_raw, V, M_m, e)):
-            raise ControlError("the servo's state, voltage or torque left the floating-point range (inputs too large)")
-        return ServoResponse(t=t, theta=theta, omega=omega, theta_i=ti, M_L=ml, e=e, V=V,
-                             M_m=M_m, saturated=np.abs(V_raw) > np.abs(V))
+            raise ControlError(
+                "the servo's state, voltage or torque left the floating-point range (inputs too large)"
+            )
+        return ServoResponse(
+            t=t,
+            theta=theta,
+            omega=omega,
+            theta_i=ti,
+            M_L=ml,
+            e=e,
+            V=V,
+            M_m=M_m,
+            saturated=np.abs(V_raw) > np.abs(V),
+        )
 
-    def step_response(self, duration: float, theta_step: float = 1.0, M_L_step: float = 0.0,
-                      n: int = 1001) -> ServoResponse:
+    def step_response(
+        self, duration: float, theta_step: float = 1.0, M_L_step: float = 0.0, n: int = 1001
+    ) -> ServoResponse:
         """Response from rest to a step of the set-point and/or the load torque at t = 0 (the
         two cases of Fig. 9-16: (a) ``M_L = 0, θ_i = 1/s``; (b) ``θ_i = 0, M_L = 1/s``).
 

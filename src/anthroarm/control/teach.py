@@ -43,8 +43,20 @@ from ..errors import ControlError, PlaybackError
 from . import _check
 from .interpolation import arc_poses, circle_through, line_poses
 
-__all__ = ["Call", "ExecutedStep", "Jump", "Playback", "Program", "Step", "play_fixed", "play_jump",
-           "play_random_access", "play_select", "play_subroutines", "record"]
+__all__ = [
+    "Call",
+    "ExecutedStep",
+    "Jump",
+    "Playback",
+    "Program",
+    "Step",
+    "play_fixed",
+    "play_jump",
+    "play_random_access",
+    "play_select",
+    "play_subroutines",
+    "record",
+]
 
 MOTIONS = ("joint", "line", "arc")
 
@@ -90,9 +102,13 @@ class Step:
         if self.motion not in MOTIONS:
             raise ControlError(f"motion must be one of {MOTIONS}, got {self.motion!r}")
         if self.motion in ("line", "arc") and pos.shape not in ((3,), (4, 4)):
-            raise ControlError(f"{self.motion!r} motion needs a Cartesian point (3,) or pose (4, 4), got {pos.shape}")
+            raise ControlError(
+                f"{self.motion!r} motion needs a Cartesian point (3,) or pose (4, 4), got {pos.shape}"
+            )
         if self.motion == "joint" and pos.shape == (4, 4):
-            raise ControlError("a 4x4 pose cannot be interpolated entry by entry: give motion='line' or 'arc'")
+            raise ControlError(
+                "a 4x4 pose cannot be interpolated entry by entry: give motion='line' or 'arc'"
+            )
         if self.motion == "arc":
             if self.via is None:
                 raise ControlError("an 'arc' step needs its via point (via=...)")
@@ -109,8 +125,13 @@ class Step:
 
     def to_dict(self) -> dict:
         """A JSON-ready dictionary (see :meth:`Program.to_json`)."""
-        d = {"kind": "step", "position": self.position.tolist(), "time": self.time, "dwell": self.dwell,
-             "motion": self.motion}
+        d = {
+            "kind": "step",
+            "position": self.position.tolist(),
+            "time": self.time,
+            "dwell": self.dwell,
+            "motion": self.motion,
+        }
         if self.label is not None:
             d["label"] = self.label
         if self.via is not None:
@@ -168,22 +189,30 @@ class Program:
         shape = None
         for k, it in enumerate(items):
             if not isinstance(it, (Step, Jump, Call)):
-                raise ControlError(f"program {self.name!r} item {k} is not a Step, Jump or Call: {it!r}")
+                raise ControlError(
+                    f"program {self.name!r} item {k} is not a Step, Jump or Call: {it!r}"
+                )
             if isinstance(it, Step):
                 if it.label is not None:
                     if it.label in labels:
-                        raise PlaybackError(f"program {self.name!r}: label {it.label!r} is used twice "
-                                            f"(items {labels[it.label]} and {k})")
+                        raise PlaybackError(
+                            f"program {self.name!r}: label {it.label!r} is used twice "
+                            f"(items {labels[it.label]} and {k})"
+                        )
                     labels[it.label] = k
                 if shape is None:
                     shape = it.position.shape
                 elif it.position.shape != shape:
-                    raise ControlError(f"program {self.name!r}: step {k} has a position of shape "
-                                       f"{it.position.shape}, the program's are {shape}")
+                    raise ControlError(
+                        f"program {self.name!r}: step {k} has a position of shape "
+                        f"{it.position.shape}, the program's are {shape}"
+                    )
         for k, it in enumerate(items):
             if isinstance(it, Jump) and it.label not in labels:
-                raise PlaybackError(f"program {self.name!r}: item {k} jumps to label {it.label!r}, which does not "
-                                    f"exist; labels: {sorted(labels)}")
+                raise PlaybackError(
+                    f"program {self.name!r}: item {k} jumps to label {it.label!r}, which does not "
+                    f"exist; labels: {sorted(labels)}"
+                )
         object.__setattr__(self, "_labels", labels)
 
     @property
@@ -201,12 +230,17 @@ class Program:
         where a step has none), ``"position"`` (array (n, ...) of positions) and ``"time"``
         (array (n,) of move times, s), plus ``"dwell"`` (s)."""
         st = self.steps
-        return {"sequence": [s.label if s.label is not None else f"#{k}" for k, s in enumerate(st)],
-                "position": np.array([s.position for s in st]),
-                "time": np.array([s.time for s in st]), "dwell": np.array([s.dwell for s in st])}
+        return {
+            "sequence": [s.label if s.label is not None else f"#{k}" for k, s in enumerate(st)],
+            "position": np.array([s.position for s in st]),
+            "time": np.array([s.time for s in st]),
+            "dwell": np.array([s.dwell for s in st]),
+        }
 
     @classmethod
-    def from_channels(cls, name: str, sequence, position, time, dwell=None, **step_kwargs) -> Program:
+    def from_channels(
+        cls, name: str, sequence, position, time, dwell=None, **step_kwargs
+    ) -> Program:
         """A program from separately stored channels (the book's 分离存贮): the inverse of
         :meth:`channels` for a program of steps.
 
@@ -235,16 +269,25 @@ class Program:
         t = _check.array(time, "time")
         d = np.zeros(n) if dwell is None else _check.array(dwell, "dwell")
         if pos.shape[:1] != (n,) or t.shape != (n,) or d.shape != (n,):
-            raise ControlError(f"channels of different lengths: sequence {n}, position {pos.shape}, time {t.shape}, "
-                               f"dwell {d.shape}")
+            raise ControlError(
+                f"channels of different lengths: sequence {n}, position {pos.shape}, time {t.shape}, "
+                f"dwell {d.shape}"
+            )
         labels = [None if (isinstance(s, str) and s.startswith("#")) else s for s in sequence]
-        return cls(name, tuple(Step(p, float(tk), label=lb, dwell=float(dk), **step_kwargs)
-                               for p, tk, lb, dk in zip(pos, t, labels, d)))
+        return cls(
+            name,
+            tuple(
+                Step(p, float(tk), label=lb, dwell=float(dk), **step_kwargs)
+                for p, tk, lb, dk in zip(pos, t, labels, d)
+            ),
+        )
 
     # ------------------------------------------------------------------ store
     def to_json(self) -> str:
         """The program as JSON text (round trip with :meth:`from_json`)."""
-        return json.dumps({"name": self.name, "items": [it.to_dict() for it in self.items]}, indent=1)
+        return json.dumps(
+            {"name": self.name, "items": [it.to_dict() for it in self.items]}, indent=1
+        )
 
     @classmethod
     def from_json(cls, text: str) -> Program:
@@ -261,9 +304,17 @@ class Program:
             for it in d["items"]:
                 kind = it["kind"]
                 if kind == "step":
-                    items.append(Step(position=it["position"], time=it["time"], label=it.get("label"),
-                                      dwell=it.get("dwell", 0.0), motion=it.get("motion", "joint"),
-                                      via=it.get("via"), grip=it.get("grip")))
+                    items.append(
+                        Step(
+                            position=it["position"],
+                            time=it["time"],
+                            label=it.get("label"),
+                            dwell=it.get("dwell", 0.0),
+                            motion=it.get("motion", "joint"),
+                            via=it.get("via"),
+                            grip=it.get("grip"),
+                        )
+                    )
                 elif kind == "jump":
                     items.append(Jump(it["label"], it.get("sensor")))
                 elif kind == "call":
@@ -310,7 +361,12 @@ def record(name: str, positions, times, labels=None, **step_kwargs) -> Program:
     labels = [None] * len(positions) if labels is None else list(labels)
     if len(labels) != len(positions):
         raise ControlError(f"{len(labels)} labels for {len(positions)} positions")
-    return Program(name, tuple(Step(p, float(tk), label=lb, **step_kwargs) for p, tk, lb in zip(positions, t, labels)))
+    return Program(
+        name,
+        tuple(
+            Step(p, float(tk), label=lb, **step_kwargs) for p, tk, lb in zip(positions, t, labels)
+        ),
+    )
 
 
 # ---------------------------------------------------------------------------- playback
@@ -393,7 +449,9 @@ class Playback:
             prev = st
         return np.concatenate(ts), np.concatenate(ps)
 
-    def joint_path(self, robot, dt: float, q0=None, frame=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def joint_path(
+        self, robot, dt: float, q0=None, frame=None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Play a program of 4×4 poses on an arm: :meth:`trajectory` sampled every ``dt``
         seconds, each pose solved by :func:`~anthroarm.ik.solve.api.solve` warm-started from the previous
         sample's joints (continuity along the path).
@@ -422,8 +480,10 @@ class Playback:
 
         t, P = self.trajectory(dt)
         if P.shape[1:] != (4, 4):
-            raise ControlError(f"joint_path needs a program of 4x4 poses, this one stores positions of shape "
-                               f"{P.shape[1:]}")
+            raise ControlError(
+                f"joint_path needs a program of 4x4 poses, this one stores positions of shape "
+                f"{P.shape[1:]}"
+            )
         q = robot.neutral() if q0 is None else _check.array(q0, "q0")
         qs, ok = [], []
         for T in P:
@@ -466,12 +526,21 @@ def _sensor(sensors, name: str, cycle: int) -> bool:
 def _check_calls(program: Program, library: Mapping[str, Program]) -> None:
     for k, it in enumerate(program.items):
         if isinstance(it, Call) and it.name not in library:
-            raise PlaybackError(f"program {program.name!r}: item {k} calls subroutine {it.name!r}, which does not "
-                                f"exist; subroutines: {sorted(library)}")
+            raise PlaybackError(
+                f"program {program.name!r}: item {k} calls subroutine {it.name!r}, which does not "
+                f"exist; subroutines: {sorted(library)}"
+            )
 
 
-def _run(program: Program, mode: str, *, library=None, sensors=None, cycles: int = 1,
-         max_steps: int = 100_000) -> Playback:
+def _run(
+    program: Program,
+    mode: str,
+    *,
+    library=None,
+    sensors=None,
+    cycles: int = 1,
+    max_steps: int = 100_000,
+) -> Playback:
     """Execute items with a call stack; jumps test sensors; stop after ``max_steps`` steps."""
     library = {} if library is None else dict(library)
     cycles = _check.count(cycles, "cycles", 1)
@@ -496,7 +565,9 @@ def _run(program: Program, mode: str, *, library=None, sensors=None, cycles: int
                 stack.append((prog, prog._labels[it.label] if on else k + 1))
             else:
                 if len(stack) > 1000:
-                    raise PlaybackError(f"subroutine calls nested deeper than 1000 (recursion through {it.name!r})")
+                    raise PlaybackError(
+                        f"subroutine calls nested deeper than 1000 (recursion through {it.name!r})"
+                    )
                 stack.append((prog, k + 1))
                 stack.append((library[it.name], 0))
     return Playback(mode, tuple(out), "done")
@@ -511,13 +582,16 @@ def play_fixed(program: Program, cycles: int = 1) -> Playback:
         The program has jumps or calls (use :func:`play_jump` / :func:`play_subroutines`).
     """
     if any(not isinstance(it, Step) for it in program.items):
-        raise PlaybackError(f"program {program.name!r} has jumps or calls; a fixed sequence has only steps "
-                            "(use play_jump or play_subroutines)")
+        raise PlaybackError(
+            f"program {program.name!r} has jumps or calls; a fixed sequence has only steps "
+            "(use play_jump or play_subroutines)"
+        )
     return _run(program, "fixed", cycles=cycles)
 
 
-def play_select(programs: Mapping[str, Program] | Sequence[Program], selector, sensors=None,
-                cycles: int = 1) -> Playback:
+def play_select(
+    programs: Mapping[str, Program] | Sequence[Program], selector, sensors=None, cycles: int = 1
+) -> Playback:
     """Program select (程序选择, Fig. 9-9 (a)): play the program that ``selector`` picks.
 
     Parameters
@@ -540,7 +614,9 @@ def play_select(programs: Mapping[str, Program] | Sequence[Program], selector, s
     lib = dict(programs) if isinstance(programs, Mapping) else {p.name: p for p in programs}
     name = selector(sensors) if callable(selector) else selector
     if name not in lib:
-        raise PlaybackError(f"program {name!r} was selected but does not exist; programs: {sorted(lib)}")
+        raise PlaybackError(
+            f"program {name!r} was selected but does not exist; programs: {sorted(lib)}"
+        )
     return _run(lib[name], "select", library=lib, sensors=sensors, cycles=cycles)
 
 
@@ -562,8 +638,9 @@ def play_jump(program: Program, sensors, cycles: int = 1, max_steps: int = 100_0
     return _run(program, "jump", sensors=sensors, cycles=cycles, max_steps=max_steps)
 
 
-def play_subroutines(subroutines: Mapping[str, Program], order: Sequence[str], cycles: int = 1,
-                     sensors=None) -> Playback:
+def play_subroutines(
+    subroutines: Mapping[str, Program], order: Sequence[str], cycles: int = 1, sensors=None
+) -> Playback:
     """Subroutine playback (子程序方式, Fig. 9-9 (c)): run the stored ``order`` of subroutines.
 
     Raises
@@ -575,8 +652,9 @@ def play_subroutines(subroutines: Mapping[str, Program], order: Sequence[str], c
     return _run(main, "subroutine", library=subroutines, sensors=sensors, cycles=cycles)
 
 
-def play_random_access(points: Mapping[str, Step], start: str, next_address: Callable, max_steps: int = 10_000
-                       ) -> Playback:
+def play_random_access(
+    points: Mapping[str, Step], start: str, next_address: Callable, max_steps: int = 10_000
+) -> Playback:
     """Random access (随机存取): every unit motion has an address; after each one
     ``next_address(address, history)`` returns the next address, or None to stop.
 

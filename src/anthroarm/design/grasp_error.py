@@ -81,8 +81,11 @@ def single_x_min(l, theta, beta) -> float:
 
 def hyperbola_single_residual(l, R, X, theta, beta):
     """Eq. (2-7) minus one: ``X²/(l sin β)² − (R − l sin θ cos β)²/(l sin θ sin β)² − 1``."""
-    return (X**2 / (l * np.sin(beta)) ** 2
-            - (R - l * np.sin(theta) * np.cos(beta)) ** 2 / (l * np.sin(theta) * np.sin(beta)) ** 2 - 1)
+    return (
+        X**2 / (l * np.sin(beta)) ** 2
+        - (R - l * np.sin(theta) * np.cos(beta)) ** 2 / (l * np.sin(theta) * np.sin(beta)) ** 2
+        - 1
+    )
 
 
 def grasp_error_single(l, theta, beta, rmin, rmax) -> GraspError:
@@ -105,12 +108,15 @@ def optimal_beta_single(l, theta, rmin, rmax) -> float:
     rcp = 0.5 * (rmin + rmax)
     c = rcp / (l * np.sin(theta))
     if c > 1:
-        raise ValueError(f"(2-12) needs R_cp <= l sin(theta): R_cp = {rcp:g} > l sin(theta) = "
-                         f"{l * np.sin(theta):g}; lengthen the finger or widen the V")
+        raise ValueError(
+            f"(2-12) needs R_cp <= l sin(theta): R_cp = {rcp:g} > l sin(theta) = "
+            f"{l * np.sin(theta):g}; lengthen the finger or widen the V"
+        )
     return float(np.arccos(c))
 
 
 # ------------------------------------------------------------------ double pivot
+
 
 def x_double(l, R, theta, beta, a):
     """Eq. (2-14): distance of the object centre from the pivot line of double-pivot fingers
@@ -119,9 +125,15 @@ def x_double(l, R, theta, beta, a):
     cannot lie between pivots closer than the finger geometry allows)."""
     _check(l, theta, beta, a=a, R=R)
     R = np.asarray(R, dtype=float)
-    x2 = (R - l * np.sin(theta) * np.cos(beta)) ** 2 / np.sin(theta) ** 2 + (l * np.sin(beta)) ** 2 - a**2
+    x2 = (
+        (R - l * np.sin(theta) * np.cos(beta)) ** 2 / np.sin(theta) ** 2
+        + (l * np.sin(beta)) ** 2
+        - a**2
+    )
     if np.any(x2 < 0):
-        raise ValueError(f"double-pivot geometry impossible: |AC| < a={a!r} for some R (l sin(beta) too small)")
+        raise ValueError(
+            f"double-pivot geometry impossible: |AC| < a={a!r} for some R (l sin(beta) too small)"
+        )
     return np.sqrt(x2)
 
 
@@ -130,7 +142,9 @@ def double_x_min(l, theta, beta, a) -> float:
     _check(l, theta, beta, a=a)
     v = (l * np.sin(beta)) ** 2 - a**2
     if v < 0:
-        raise ValueError(f"(2-16) needs l^2 sin^2(beta) >= a^2: {(l * np.sin(beta))**2:g} < {a**2:g}")
+        raise ValueError(
+            f"(2-16) needs l^2 sin^2(beta) >= a^2: {(l * np.sin(beta)) ** 2:g} < {a**2:g}"
+        )
     return float(np.sqrt(v))
 
 
@@ -161,7 +175,9 @@ def beta_two_sizes(l, theta, r1, r2) -> float:
         raise ValueError(f"radii must be positive, got R1={r1!r}, R2={r2!r}")
     c = (r1 + r2) / (2 * l * np.sin(theta))
     if c > 1:
-        raise ValueError(f"(2-20) needs (R1+R2)/2 <= l sin(theta): {(r1 + r2) / 2:g} > {l * np.sin(theta):g}")
+        raise ValueError(
+            f"(2-20) needs (R1+R2)/2 <= l sin(theta): {(r1 + r2) / 2:g} > {l * np.sin(theta):g}"
+        )
     return float(np.arccos(c))
 
 
@@ -175,10 +191,10 @@ def grasp_error_brute(l, theta, beta, rmin, rmax, a=None, n: int = 20001) -> flo
     if rmin < r0 < rmax:
         R = np.append(R, r0)
     B = np.array([l, 0.0])
-    d = np.array([-np.cos(beta), np.sin(beta)])            # bisector B->C, at beta from B->A reversed
+    d = np.array([-np.cos(beta), np.sin(beta)])  # bisector B->C, at beta from B->A reversed
     C = B[None, :] + (R / np.sin(theta))[:, None] * d[None, :]
     if a is None:
-        X = np.linalg.norm(C, axis=1)                       # pivot A at the origin
+        X = np.linalg.norm(C, axis=1)  # pivot A at the origin
     else:
         # A at the origin, the other pivot a mirror image: X = distance from the pivot line,
         # |AC|² = X² + a² (C sits symmetrically between the two pivots 2a apart)
@@ -198,8 +214,11 @@ def plot_grasp_error(l, theta, rmin, rmax, a=0.0, betas=None, ax=None):
         _, ax = plt.subplots(figsize=(5, 3.5))
     lo = np.arcsin(min(1.0, a / l)) + 1e-3 if a > 0 else 1e-3
     betas = np.linspace(lo, np.pi / 2, 400) if betas is None else np.asarray(betas)
-    fn = (lambda b: grasp_error_single(l, theta, b, rmin, rmax).delta) if a == 0 else \
-        (lambda b: grasp_error_double(l, theta, b, a, rmin, rmax).delta)
+    fn = (
+        (lambda b: grasp_error_single(l, theta, b, rmin, rmax).delta)
+        if a == 0
+        else (lambda b: grasp_error_double(l, theta, b, a, rmin, rmax).delta)
+    )
     ax.plot(np.rad2deg(betas), [fn(b) for b in betas], label=f"a = {a:g}")
     try:
         bc = optimal_beta_single(l, theta, rmin, rmax)

@@ -53,21 +53,39 @@ class ReferenceCurve:
 
 #: l. 1077: power-grasp (握取) fingertip path, y = f(x), mm.
 FINGERTIP_POWER_GRASP = ReferenceCurve(
-    "fingertip power grasp f(x)", (55.61, 1.133, -1.707e-2, 0.22e-4), "x", "y", "mm", "000 l.1077")
+    "fingertip power grasp f(x)", (55.61, 1.133, -1.707e-2, 0.22e-4), "x", "y", "mm", "000 l.1077"
+)
 #: l. 1081: three-finger pinch (抓取) fingertip path, y = g(x), mm.
 FINGERTIP_PINCH = ReferenceCurve(
-    "fingertip pinch g(x)", (18.7688, 1.35, -0.0584), "x", "y", "mm", "000 l.1081")
+    "fingertip pinch g(x)", (18.7688, 1.35, -0.0584), "x", "y", "mm", "000 l.1081"
+)
 #: l. 1089: thumb MP angle against CM angle during the power grasp, degrees; mean error 0.271.
 THUMB_F2 = ReferenceCurve(
-    "thumb theta2 = f2(theta1)", (-37.030e-3, 366.517e-3, -8.373e-3, 0.1297e-3),
-    "theta1", "theta2", "deg", "000 l.1089, Fig. 3-6(a)", mean_error=0.271)
+    "thumb theta2 = f2(theta1)",
+    (-37.030e-3, 366.517e-3, -8.373e-3, 0.1297e-3),
+    "theta1",
+    "theta2",
+    "deg",
+    "000 l.1089, Fig. 3-6(a)",
+    mean_error=0.271,
+)
 #: l. 1089: thumb IP angle against MP angle, degrees; mean error 0.744.
 THUMB_F3 = ReferenceCurve(
-    "thumb theta3 = f3(theta2)", (27.533e-2, 92.657e-2, 10.027e-2, -0.232e-2),
-    "theta2", "theta3", "deg", "000 l.1089, Fig. 3-6(b)", mean_error=0.744)
+    "thumb theta3 = f3(theta2)",
+    (27.533e-2, 92.657e-2, 10.027e-2, -0.232e-2),
+    "theta2",
+    "theta3",
+    "deg",
+    "000 l.1089, Fig. 3-6(b)",
+    mean_error=0.744,
+)
 
-LIBRARY = {"power_grasp": FINGERTIP_POWER_GRASP, "pinch": FINGERTIP_PINCH,
-           "thumb_f2": THUMB_F2, "thumb_f3": THUMB_F3}
+LIBRARY = {
+    "power_grasp": FINGERTIP_POWER_GRASP,
+    "pinch": FINGERTIP_PINCH,
+    "thumb_f2": THUMB_F2,
+    "thumb_f3": THUMB_F3,
+}
 
 
 def _xy(x, y):
@@ -82,6 +100,7 @@ def _xy(x, y):
 
 # ----------------------------------------------------------------- difference table
 
+
 def difference_table(y, max_order: int | None = None) -> list[np.ndarray]:
     """``[y, Δy, Δ²y, …]`` with ``Δ^{k+1} y_i = Δ^k y_{i+1} − Δ^k y_i`` (l. 1001–1013)."""
     y = np.asarray(y, dtype=float)
@@ -94,7 +113,9 @@ def difference_table(y, max_order: int | None = None) -> list[np.ndarray]:
     return out
 
 
-def detect_degree(x, y, rtol: float = 1e-6, atol: float | None = None, max_degree: int | None = None) -> int:
+def detect_degree(
+    x, y, rtol: float = 1e-6, atol: float | None = None, max_degree: int | None = None
+) -> int:
     """Difference-table degree test (表差法): the smallest k whose k-th differences are
     constant, i.e. ``ptp(Δ^k y) <= max(rtol·|mean Δ^k y|, atol)`` with at least two of them.
 
@@ -106,17 +127,22 @@ def detect_degree(x, y, rtol: float = 1e-6, atol: float | None = None, max_degre
         raise ValueError("need at least 3 samples")
     dx = np.diff(x)
     if np.any(dx <= 0) or np.ptp(dx) > 1e-9 * abs(dx.mean()):
-        raise ValueError("x must be strictly increasing with a constant step (difference-table method)")
+        raise ValueError(
+            "x must be strictly increasing with a constant step (difference-table method)"
+        )
     atol = 1e-9 * max(np.max(np.abs(y)), 1e-300) if atol is None else float(atol)
     top = len(y) - 2 if max_degree is None else min(int(max_degree), len(y) - 2)
     for k, d in enumerate(difference_table(y, top)):
         if np.ptp(d) <= max(rtol * abs(d.mean()), atol):
             return k
-    raise ValueError(f"no difference order <= {top} is constant within rtol={rtol:g}, atol={atol:g}; "
-                     "raise the tolerance (noisy data) or fit a chosen degree")
+    raise ValueError(
+        f"no difference order <= {top} is constant within rtol={rtol:g}, atol={atol:g}; "
+        "raise the tolerance (noisy data) or fit a chosen degree"
+    )
 
 
 # ----------------------------------------------------------------- least squares
+
 
 @dataclass(frozen=True)
 class PolyFit:
@@ -141,8 +167,13 @@ class PolyFit:
 def error_metrics(pred, y) -> dict:
     """Book error measures of a fit: V = pred − y (3-2), S (3-4), mean |V|, max |V|, rms."""
     v = np.asarray(pred, dtype=float) - np.asarray(y, dtype=float)
-    return dict(residuals=v, S=float(v @ v), mean_error=float(np.mean(np.abs(v))),
-                max_error=float(np.max(np.abs(v))), rms=float(np.sqrt(np.mean(v**2))))
+    return dict(
+        residuals=v,
+        S=float(v @ v),
+        mean_error=float(np.mean(np.abs(v))),
+        max_error=float(np.max(np.abs(v))),
+        rms=float(np.sqrt(np.mean(v**2))),
+    )
 
 
 def normal_equations(x, y, degree: int):
@@ -164,7 +195,9 @@ def fit_polynomial(x, y, degree: int) -> PolyFit:
     x, y = _xy(x, y)
     degree = int(degree)
     if degree < 0 or len(x) < degree + 1:
-        raise ValueError(f"need degree >= 0 and at least degree+1 = {degree + 1} samples, got {len(x)}")
+        raise ValueError(
+            f"need degree >= 0 and at least degree+1 = {degree + 1} samples, got {len(x)}"
+        )
     c, s = x.mean(), (np.ptp(x) / 2 or 1.0)
     t = (x - c) / s
     N, r = normal_equations(t, y, degree)
@@ -190,6 +223,7 @@ def sample_curve(curve: ReferenceCurve, lo: float, hi: float, n: int = 21):
 
 
 # ----------------------------------------------------------------- piecewise coordination
+
 
 @dataclass(frozen=True)
 class PiecewiseLinear:
@@ -223,7 +257,9 @@ def _pwl_lstsq(x, y, knots):
     return vals, float(np.sum((pred - y) ** 2)), float(np.mean(np.abs(pred - y)))
 
 
-def fit_piecewise_linear(x, y, n_segments: int = 3, breakpoints=None, candidates: int = 60) -> PiecewiseLinear:
+def fit_piecewise_linear(
+    x, y, n_segments: int = 3, breakpoints=None, candidates: int = 60
+) -> PiecewiseLinear:
     """Continuous piecewise-linear least squares (Fig. 3-9: segments A–B, B–C, C–D).
 
     With ``breakpoints`` given (interior knots) only the values are fitted; otherwise the
@@ -257,8 +293,10 @@ def fit_piecewise_linear(x, y, n_segments: int = 3, breakpoints=None, candidates
     # polish: local refinement of the knots on a finer grid around the best
     h = (hi - lo) / (int(candidates) + 1)
     for _ in range(2):
-        local = [np.clip(np.linspace(b - h, b + h, 9), lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-                 for b in best.knots[1:-1]]
+        local = [
+            np.clip(np.linspace(b - h, b + h, 9), lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+            for b in best.knots[1:-1]
+        ]
         for bp in itertools.product(*local):
             if np.any(np.diff(bp) <= 0):
                 continue
@@ -281,8 +319,9 @@ class JointCoordination:
         return {k: f(theta1) for k, f in self.segments.items()}
 
 
-def coordinate_joints(theta1, joints: dict, n_segments: int = 3, master: str = "theta1",
-                      breakpoints=None) -> JointCoordination:
+def coordinate_joints(
+    theta1, joints: dict, n_segments: int = 3, master: str = "theta1", breakpoints=None
+) -> JointCoordination:
     """Fit every joint of ``joints`` (name -> samples) against ``theta1`` with ``n_segments``
     straight segments; a shared ``breakpoints`` list imposes the book's common A, B, C, D."""
     out = JointCoordination(master)

@@ -35,7 +35,9 @@ class KinematicPair:
 
     def __post_init__(self):
         if not (isinstance(self.dof, (int, np.integer)) and 0 < self.dof < 6):
-            raise ValueError(f"pair {self.symbol!r}: dof must be an integer in 1..5, got {self.dof!r}")
+            raise ValueError(
+                f"pair {self.symbol!r}: dof must be an integer in 1..5, got {self.dof!r}"
+            )
 
     @property
     def constraints(self) -> int:
@@ -64,11 +66,13 @@ TABLE_2_1: tuple[KinematicPair, ...] = (
 #: the IV-class pair "with two relative rotations" (universal/Hooke, ``U``), the II-class pair
 #: between ulna and radius (4 DOF, ``II``) and a planar pair (3 DOF, class III, ``E``).
 PAIRS: dict[str, KinematicPair] = {p.symbol: p for p in TABLE_2_1}
-PAIRS.update({
-    "U": KinematicPair("universal (two rotations, IV级)", "U", 2),
-    "II": KinematicPair("class-II pair (4 DOF)", "II", 4),
-    "E": KinematicPair("planar", "E", 3),
-})
+PAIRS.update(
+    {
+        "U": KinematicPair("universal (two rotations, IV级)", "U", 2),
+        "II": KinematicPair("class-II pair (4 DOF)", "II", 4),
+        "E": KinematicPair("planar", "E", 3),
+    }
+)
 
 
 def pair(symbol: str | KinematicPair) -> KinematicPair:
@@ -151,7 +155,9 @@ class Mechanism:
     def add_joint(self, name: str, kind, a: str, b: str) -> "Mechanism":
         for end in (a, b):
             if end not in self.links:
-                raise ValueError(f"{self.name}: joint {name!r} names unknown link {end!r}; links: {self.links}")
+                raise ValueError(
+                    f"{self.name}: joint {name!r} names unknown link {end!r}; links: {self.links}"
+                )
         if a == b:
             raise ValueError(f"{self.name}: joint {name!r} joins link {a!r} to itself")
         if any(j.name == name for j in self.joints):
@@ -246,6 +252,7 @@ def rrss_mechanism() -> Mechanism:
 
 # ---------------------------------------------------------------- arm layouts, §2-3
 
+
 def count_layouts(m: int, n: int) -> int:
     """Eq. (2-2): permutations with repetition ``N = m^n`` (m pair types, n positions)."""
     if int(m) != m or int(n) != n or m < 1 or n < 0:
@@ -258,8 +265,9 @@ def count_layouts(m: int, n: int) -> int:
 BOOK_ARM_FORMS = ("R-P-R-P-R-P", "R-P-P-R-P-R", "R-P-R-P-P-R", "P-R-P-R-P-R")
 
 
-def enumerate_arm_layouts(n: int = 6, types: str = "RP", n_R: int | None = 3,
-                          forbid: tuple[str, ...] = ("RR",)) -> list[str]:
+def enumerate_arm_layouts(
+    n: int = 6, types: str = "RP", n_R: int | None = 3, forbid: tuple[str, ...] = ("RR",)
+) -> list[str]:
     """All ``len(types)**n`` joint sequences (Eq. (2-2)), filtered as in §2-3 (l. 579–587):
     exactly ``n_R`` roll joints and no forbidden adjacent pair (default: no R–R).  Pass
     ``n_R=None, forbid=()`` to get all 64.  Returned as ``"R-P-…"`` strings, sorted."""
@@ -278,10 +286,13 @@ def enumerate_arm_layouts(n: int = 6, types: str = "RP", n_R: int | None = 3,
 
 # ---------------------------------------------------------------- reach, (2-3) (2-4)
 
+
 def _link_lengths(l1, l2, l3):
     ls = tuple(np.asarray(v, dtype=float) for v in (l1, l2, l3))
     if not all(np.all(v > 0) and np.all(np.isfinite(v)) for v in ls):  # NaN fails v > 0
-        raise ValueError(f"link lengths l1, l2, l3 must be positive and finite, got {l1!r}, {l2!r}, {l3!r}")
+        raise ValueError(
+            f"link lengths l1, l2, l3 must be positive and finite, got {l1!r}, {l2!r}, {l3!r}"
+        )
     return ls
 
 
@@ -344,7 +355,7 @@ def reach_rows(models, samples, rng):
     robot = load("prosthetic_arm")
     L1, L2, L3 = (robot.spec.params[k] for k in ("L1", "L2", "L3"))
     n = max(int(samples), 1)
-    th = rng.uniform(0.0, np.deg2rad(90.0), n)   # wrist flexion limit is ±90°
+    th = rng.uniform(0.0, np.deg2rad(90.0), n)  # wrist flexion limit is ±90°
     q = prosthetic_arm_bent_q(th)
     q[:, 0] = rng.uniform(robot.lower[0], robot.upper[0], n)
     q[:, 1] = rng.uniform(robot.lower[1], robot.upper[1], n)

@@ -55,7 +55,9 @@ class FourBarDesign:
     @property
     def ground_pivot(self) -> np.ndarray:
         """D = O + r3 e^{iβ}."""
-        return np.asarray(self.origin, float) + self.r3 * np.array([np.cos(self.beta), np.sin(self.beta)])
+        return np.asarray(self.origin, float) + self.r3 * np.array(
+            [np.cos(self.beta), np.sin(self.beta)]
+        )
 
     @property
     def coupler_length(self) -> float:
@@ -75,7 +77,9 @@ class FourBarDesign:
         state)``; ``ok`` is False where the linkage cannot assemble or sits at a dead point."""
         alpha = np.atleast_1d(np.asarray(alpha, dtype=float))
         ground, crank, coupler, rocker, p, g_c = self.mechanism()
-        st = fourbar_cartesian(ground, crank, coupler, rocker, alpha, branch=self.branch if branch is None else branch)
+        st = fourbar_cartesian(
+            ground, crank, coupler, rocker, alpha, branch=self.branch if branch is None else branch
+        )
         pts = coupler_point(st, p, g_c).position + np.asarray(self.origin, float)
         ok = np.atleast_1d(np.asarray(st.assembled)) & ~np.atleast_1d(np.asarray(st.dead_point))
         return pts, ok, st
@@ -88,8 +92,13 @@ class FourBarDesign:
         th3 = np.atleast_1d(np.asarray(st.theta3, float))
         A = O + self.r1 * np.stack([np.cos(th2), np.sin(th2)], -1)
         B = A + self.coupler_length * np.stack([np.cos(th3), np.sin(th3)], -1)
-        return {"O": np.broadcast_to(O, A.shape), "A": A, "B": B, "C": pts,
-                "D": np.broadcast_to(self.ground_pivot, A.shape)}
+        return {
+            "O": np.broadcast_to(O, A.shape),
+            "A": A,
+            "B": B,
+            "C": pts,
+            "D": np.broadcast_to(self.ground_pivot, A.shape),
+        }
 
 
 @dataclass
@@ -142,7 +151,9 @@ def _inputs(points, alpha):
     if not (np.all(np.isfinite(P)) and np.all(np.isfinite(a))):
         raise ValueError("points or alpha contain NaN/inf")
     if P.shape[0] < 4:
-        raise ValueError(f"need at least 4 path points for the two least-squares stages, got {P.shape[0]}")
+        raise ValueError(
+            f"need at least 4 path points for the two least-squares stages, got {P.shape[0]}"
+        )
     return P, a
 
 
@@ -171,7 +182,7 @@ def lambda_roots(L, m) -> np.ndarray:
     """(3-30): real roots of ``m1 m2 λ² + (L1 m2 + L2 m1 − 1) λ + L1 L2 = 0`` (empty if none)."""
     qa, qb, qc = m[0] * m[1], L[0] * m[1] + L[1] * m[0] - 1.0, L[0] * L[1]
     scale = max(abs(qb), 1e-300)
-    if abs(qa) * max(1.0, abs(qc) / scale) < 1e-14 * scale:   # degenerates to linear
+    if abs(qa) * max(1.0, abs(qc) / scale) < 1e-14 * scale:  # degenerates to linear
         return np.array([-qc / qb]) if qb != 0 else np.array([])
     disc = qb * qb - 4 * qa * qc
     if disc < 0:
@@ -180,8 +191,9 @@ def lambda_roots(L, m) -> np.ndarray:
     return np.array([(-qb + s) / (2 * qa), (-qb - s) / (2 * qa)])
 
 
-def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0, 0.0),
-                    degenerate_tol: float = 1e-6) -> SynthesisResult:
+def synthesize_path(
+    points, alpha, beta: float, gamma: float = 0.0, origin=(0.0, 0.0), degenerate_tol: float = 1e-6
+) -> SynthesisResult:
     """Least-squares synthesis of a four-bar whose coupler point C passes through ``points``
     ((N, 2), target frame) at crank angles ``alpha`` ((N,), rad), book Eq. (3-11)–(3-30).
 
@@ -203,12 +215,19 @@ def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0,
     try:
         K1, K2 = stage1(r, delta, alpha)
     except np.linalg.LinAlgError:
-        return SynthesisResult("stage1_failed", "stage-1 normal equations (3-17)/(3-18) are singular "
-                               "(crank angles or points do not vary enough)")
+        return SynthesisResult(
+            "stage1_failed",
+            "stage-1 normal equations (3-17)/(3-18) are singular "
+            "(crank angles or points do not vary enough)",
+        )
     r2sq = K2 + K1 * K1
     if not (K1 > 0 and r2sq > 0):
-        return SynthesisResult("stage1_failed", f"(3-13) gives r1 = K1 = {K1:.6g}, r2² = {r2sq:.6g}: "
-                               "no crank/coupler dyad; change the crank angles or the pivot", K=(K1, K2))
+        return SynthesisResult(
+            "stage1_failed",
+            f"(3-13) gives r1 = K1 = {K1:.6g}, r2² = {r2sq:.6g}: "
+            "no crank/coupler dyad; change the crank angles or the pivot",
+            K=(K1, K2),
+        )
     r1, r2 = float(K1), float(np.sqrt(r2sq))
     A = r1 * np.exp(1j * alpha)
     psi = np.angle(z - A)
@@ -216,7 +235,9 @@ def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0,
     try:
         L, m = stage2(r, delta, phi, beta)
     except np.linalg.LinAlgError:
-        return SynthesisResult("no_valid_root", "stage-2 normal equations (3-23)–(3-29) are singular", K=(K1, K2))
+        return SynthesisResult(
+            "no_valid_root", "stage-2 normal equations (3-23)–(3-29) are singular", K=(K1, K2)
+        )
     lams = lambda_roots(L, m)
     res = SynthesisResult("no_real_root", "(3-30) has no real root", K=(K1, K2), L=L, m=m)
     if lams.size == 0:
@@ -244,7 +265,9 @@ def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0,
             continue
         design_ok = None
         for br in (1, -1):
-            d = FourBarDesign(r1, r2, r3, float(np.sqrt(r4sq)), r5, float(b_), float(g_), tuple(O), br)
+            d = FourBarDesign(
+                r1, r2, r3, float(np.sqrt(r4sq)), r5, float(b_), float(g_), tuple(O), br
+            )
             if d.coupler_length < 1e-12 * scale:
                 break
             pts, ok, _ = d.trace(alpha)
@@ -256,13 +279,21 @@ def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0,
         if design_ok is None:
             cand.reason = "cannot assemble at every prescribed crank angle (either branch)"
             continue
-        cand.accepted, cand.reason, cand.design, cand.max_error = True, "ok", design_ok[0], float(design_ok[1].max())
+        cand.accepted, cand.reason, cand.design, cand.max_error = (
+            True,
+            "ok",
+            design_ok[0],
+            float(design_ok[1].max()),
+        )
         if best is None or design_ok[1].max() < best[1].max():
             best = design_ok
     if best is None:
         if any("assemble" in c.reason for c in res.candidates):
-            res.status, res.message = "cannot_assemble", "no candidate linkage assembles at every crank angle: " + \
-                "; ".join(c.reason for c in res.candidates)
+            res.status, res.message = (
+                "cannot_assemble",
+                "no candidate linkage assembles at every crank angle: "
+                + "; ".join(c.reason for c in res.candidates),
+            )
         else:
             res.status, res.message = "no_valid_root", "; ".join(c.reason for c in res.candidates)
         return res
@@ -274,6 +305,7 @@ def synthesize_path(points, alpha, beta: float, gamma: float = 0.0, origin=(0.0,
 
 
 # ------------------------------------------------------------------ finger from a fingertip curve
+
 
 @dataclass
 class FingerDesign:
@@ -305,8 +337,16 @@ def _finger_objective(target, v, gamma_fixed):
     return res, alpha
 
 
-def design_finger_linkage(curve, x_range, x0, n: int = 12, gamma=0.0, maxiter: int = 600,
-                          span_limits=(np.deg2rad(20), np.deg2rad(150)), max_link: float | None = None) -> FingerDesign:
+def design_finger_linkage(
+    curve,
+    x_range,
+    x0,
+    n: int = 12,
+    gamma=0.0,
+    maxiter: int = 600,
+    span_limits=(np.deg2rad(20), np.deg2rad(150)),
+    max_link: float | None = None,
+) -> FingerDesign:
     """The design loop of §3-3: choose the crank pivot (ox, oy), crank start angle α0 and sweep
     Δα, and the pivot direction β (and γ if ``gamma=None``) so that the least-squares four-bar
     follows the fingertip ``curve`` over ``x_range`` with the smallest worst-case error.
@@ -344,7 +384,14 @@ def design_finger_linkage(curve, x_range, x0, n: int = 12, gamma=0.0, maxiter: i
     return FingerDesign(res, params, target, alpha, outer)
 
 
-def plot_path(result: SynthesisResult, target, alpha=None, ax=None, n_dense: int = 200, show_linkage: bool = True):
+def plot_path(
+    result: SynthesisResult,
+    target,
+    alpha=None,
+    ax=None,
+    n_dense: int = 200,
+    show_linkage: bool = True,
+):
     """Target points vs the achieved coupler path (and the linkage at the first angle)."""
     import matplotlib.pyplot as plt
 
@@ -356,7 +403,9 @@ def plot_path(result: SynthesisResult, target, alpha=None, ax=None, n_dense: int
         a = np.linspace(np.min(alpha), np.max(alpha), n_dense)
         pts, ok, _ = result.design.trace(a)
         ax.plot(pts[ok, 0], pts[ok, 1], "-", label="achieved coupler path")
-        ax.plot(result.achieved[:, 0], result.achieved[:, 1], "x", label="at prescribed crank angles")
+        ax.plot(
+            result.achieved[:, 0], result.achieved[:, 1], "x", label="at prescribed crank angles"
+        )
         if show_linkage:
             j = result.design.joints(np.asarray(alpha)[:1])
             chain = np.array([j["O"][0], j["A"][0], j["B"][0], j["D"][0]])

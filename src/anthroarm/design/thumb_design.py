@@ -60,7 +60,7 @@ BOOK_PLANAR_EPS = 0.001
 #: bounds g1–g10 of the RRSS part (strict in the book); x2 = y_b0 is unbounded
 RRSS_BOUNDS = [(-5.0, 20.0), (None, None), (-50.0, 0.0), (0.0, 20.0), (0.0, 30.0), (-50.0, -20.0)]
 
-FAIL_ERROR = 180.0   # deg, objective value where the mechanism cannot assemble
+FAIL_ERROR = 180.0  # deg, objective value where the mechanism cannot assemble
 
 
 @dataclass
@@ -75,18 +75,18 @@ class ThumbProblem:
     variables: tuple
     x_book: np.ndarray
     e_book: float
-    inputs: np.ndarray            # sample points of the input angle, deg
-    target: object                # human curve
+    inputs: np.ndarray  # sample points of the input angle, deg
+    target: object  # human curve
     min_transmission: float = 35.0
     bounds: list = field(default_factory=list)
 
     # filled by the factory functions
-    _response = None              # x -> (output angles deg, transmission deg, ok)
+    _response = None  # x -> (output angles deg, transmission deg, ok)
 
     def response(self, x):
         x = np.asarray(x, dtype=float)
         key = x.tobytes()
-        if getattr(self, "_cache_key", None) != key:       # objective and constraints share a call
+        if getattr(self, "_cache_key", None) != key:  # objective and constraints share a call
             self._cache_key, self._cache_val = key, self._response(x)
         return self._cache_val
 
@@ -114,14 +114,18 @@ class ThumbProblem:
     def check(self, x) -> dict:
         """``{"g1": (value, holds), …, "S": max error}`` with the book's strict inequalities."""
         g = self.book_g(x)
-        rep = {f"g{i + 1}": (float(v), bool(v < 0 or (i == 9 and self.name == "planar" and v <= 0)))
-               for i, v in enumerate(g) if np.isfinite(v)}
+        rep = {
+            f"g{i + 1}": (float(v), bool(v < 0 or (i == 9 and self.name == "planar" and v <= 0)))
+            for i, v in enumerate(g)
+            if np.isfinite(v)
+        }
         rep["S"] = self.objective(x)
         rep["min_transmission"] = float(np.min(self.transmission(x)))
         return rep
 
 
 # ------------------------------------------------------------------------------ RRSS part
+
 
 def rrss_geometry(x) -> RRSSGeometry:
     """Geometry of the lower thumb for X = (B0, B initial), mm; θ1 about −u0 (see module doc)."""
@@ -132,17 +136,36 @@ def rrss_geometry(x) -> RRSSGeometry:
 class RRSSProblem(ThumbProblem):
     def book_g(self, x):
         x = np.asarray(x, dtype=float)
-        g = [x[0] - 20, -5 - x[0], x[2], -50 - x[2], x[3] - 20, -x[3], x[4] - 30, -x[4], x[5] + 20, -50 - x[5]]
+        g = [
+            x[0] - 20,
+            -5 - x[0],
+            x[2],
+            -50 - x[2],
+            x[3] - 20,
+            -x[3],
+            x[4] - 30,
+            -x[4],
+            x[5] + 20,
+            -50 - x[5],
+        ]
         return np.array(g + [self.min_transmission - float(np.min(self.transmission(x)))])
 
 
 def rrss_problem(theta1_range=(0.0, 30.0), n: int = 13, min_phi: float = 35.0) -> RRSSProblem:
     """The RRSS design problem of §4-5 (1): θ2 = F2(θ1) vs f2, g1–g10 bounds, g11: φ > 35°."""
     th1 = np.linspace(float(theta1_range[0]), float(theta1_range[1]), int(n))
-    p = RRSSProblem("rrss", ("x_b0", "y_b0", "z_b0", "x_b1", "y_b1", "z_b1"), BOOK_RRSS_X.copy(), BOOK_RRSS_E,
-                    th1, THUMB_F2, min_phi, list(RRSS_BOUNDS))
+    p = RRSSProblem(
+        "rrss",
+        ("x_b0", "y_b0", "z_b0", "x_b1", "y_b1", "z_b1"),
+        BOOK_RRSS_X.copy(),
+        BOOK_RRSS_E,
+        th1,
+        THUMB_F2,
+        min_phi,
+        list(RRSS_BOUNDS),
+    )
 
-    th1_all = np.concatenate([[0.0], th1]) * D2R     # the branch is fixed by the initial pose
+    th1_all = np.concatenate([[0.0], th1]) * D2R  # the branch is fixed by the initial pose
 
     def response(x):
         try:
@@ -156,10 +179,12 @@ def rrss_problem(theta1_range=(0.0, 30.0), n: int = 13, min_phi: float = 35.0) -
         root = np.sqrt(np.clip(disc, 0.0, None))
         cands = [2 * np.arctan2(-F + s * root, G - E) for s in (1, -1)]
         cands = [np.mod(c + np.pi, 2 * np.pi) - np.pi for c in cands]
-        t2 = min(cands, key=lambda c: abs(c[0]))    # the branch through theta2 = 0 at theta1 = 0
+        t2 = min(cands, key=lambda c: abs(c[0]))  # the branch through theta2 = 0 at theta1 = 0
         e = bp - a
         c, s_ = np.cos(t2)[:, None], np.sin(t2)[:, None]
-        b = a + e * c + np.cross(ua, e) * s_ + ua * np.sum(ua * e, axis=1)[:, None] * (1 - c)   # (6-96)
+        b = (
+            a + e * c + np.cross(ua, e) * s_ + ua * np.sum(ua * e, axis=1)[:, None] * (1 - c)
+        )  # (6-96)
         lam = b - g.b0
         lam = lam / np.linalg.norm(lam, axis=-1, keepdims=True)
         v = np.cross(ua, b - a)
@@ -173,6 +198,7 @@ def rrss_problem(theta1_range=(0.0, 30.0), n: int = 13, min_phi: float = 35.0) -
 
 # ------------------------------------------------------------------------------ planar part
 
+
 def planar_points(x):
     """P, F, C (mm) of the upper thumb in the frame A = 0, AC = +x, for X = (∠PAC, x_f, y_f, x_c, α, β)."""
     x = np.asarray(x, dtype=float)
@@ -185,17 +211,34 @@ class PlanarProblem(ThumbProblem):
         x = np.asarray(x, dtype=float)
         P, F, C = planar_points(x)
         f, b = np.linalg.norm(F - P), np.linalg.norm(F - C)
-        g = [f - R2 / 3, -f, b - 2 * R1, -b, x[4] - 180, -x[4], x[5] - 180, -x[5], -x[2],
-             x[1] - R2 * np.cos(x[0] * D2R)]
+        g = [
+            f - R2 / 3,
+            -f,
+            b - 2 * R1,
+            -b,
+            x[4] - 180,
+            -x[4],
+            x[5] - 180,
+            -x[5],
+            -x[2],
+            x[1] - R2 * np.cos(x[0] * D2R),
+        ]
         return np.array(g + [self.min_transmission - float(np.min(self.transmission(x)))])
 
 
 def planar_problem(theta2_range=(0.0, 30.0), n: int = 13, min_mu: float = 35.0) -> PlanarProblem:
     """The planar four-bar design problem of §4-5 (2): θ3 = F3(θ2) vs f3, g1–g10, g11: ∠PFC > 35°."""
     th2 = np.linspace(float(theta2_range[0]), float(theta2_range[1]), int(n))
-    p = PlanarProblem("planar", ("angle_PAC", "x_f", "y_f", "x_c", "alpha", "beta"), BOOK_PLANAR_X.copy(),
-                      BOOK_PLANAR_EPS, th2, THUMB_F3, min_mu,
-                      [(0.0, 360.0), (None, None), (0.0, None), (None, None), (0.0, 180.0), (0.0, 180.0)])
+    p = PlanarProblem(
+        "planar",
+        ("angle_PAC", "x_f", "y_f", "x_c", "alpha", "beta"),
+        BOOK_PLANAR_X.copy(),
+        BOOK_PLANAR_EPS,
+        th2,
+        THUMB_F3,
+        min_mu,
+        [(0.0, 360.0), (None, None), (0.0, None), (None, None), (0.0, 180.0), (0.0, 180.0)],
+    )
 
     def response(x):
         P, F, C = planar_points(x)
@@ -226,6 +269,7 @@ def planar_problem(theta2_range=(0.0, 30.0), n: int = 13, min_mu: float = 35.0) 
 
 
 # ------------------------------------------------------------------------------ re-optimisation
+
 
 @dataclass
 class DesignOutcome:
@@ -260,7 +304,11 @@ def optimise(problem: ThumbProblem, method: str = "sumt_exterior", x0=None, **kw
     x0 = problem.x_book.copy() if x0 is None else np.asarray(x0, dtype=float)
     t0 = time.perf_counter()
     if method in ("sumt_exterior", "sumt_interior", "sumt_mixed"):
-        fn = {"sumt_exterior": O.sumt_exterior, "sumt_interior": O.sumt_interior, "sumt_mixed": O.sumt_mixed}[method]
+        fn = {
+            "sumt_exterior": O.sumt_exterior,
+            "sumt_interior": O.sumt_interior,
+            "sumt_mixed": O.sumt_mixed,
+        }[method]
         opts = dict(scale=10.0, max_stages=kw.pop("max_stages", 12))
         if method == "sumt_exterior":
             opts.update(eps1=1e-4)
@@ -268,29 +316,62 @@ def optimise(problem: ThumbProblem, method: str = "sumt_exterior", x0=None, **kw
         x, status, nfev = r.x, r.status, r.nfev
     elif method == "simplex":
         M = kw.pop("M", 1e3)
-        phi = lambda z: problem.objective(z) + M * float(np.sum(np.minimum(0, problem.ineq(z)) ** 2))  # noqa: E731
-        r = O.simplex_book(phi, x0, step=np.maximum(0.1 * np.abs(x0), 1.0), eps1=1e-14, maxiter=4000)
+        phi = lambda z: (
+            problem.objective(z) + M * float(np.sum(np.minimum(0, problem.ineq(z)) ** 2))
+        )  # noqa: E731
+        r = O.simplex_book(
+            phi, x0, step=np.maximum(0.1 * np.abs(x0), 1.0), eps1=1e-14, maxiter=4000
+        )
         x, status, nfev = r.x, r.status, r.nfev
     elif method == "slsqp":
         z0 = np.append(x0, problem.objective(x0))
-        cons = [{"type": "ineq", "fun": lambda z: z[-1] - problem.errors(z[:-1])},
-                {"type": "ineq", "fun": lambda z: z[-1] + problem.errors(z[:-1])},
-                {"type": "ineq", "fun": lambda z: problem.ineq(z[:-1])}]
-        r = minimize(lambda z: z[-1], z0, method="SLSQP", constraints=cons,
-                     options={"maxiter": kw.pop("maxiter", 300), "ftol": 1e-10})
+        cons = [
+            {"type": "ineq", "fun": lambda z: z[-1] - problem.errors(z[:-1])},
+            {"type": "ineq", "fun": lambda z: z[-1] + problem.errors(z[:-1])},
+            {"type": "ineq", "fun": lambda z: problem.ineq(z[:-1])},
+        ]
+        r = minimize(
+            lambda z: z[-1],
+            z0,
+            method="SLSQP",
+            constraints=cons,
+            options={"maxiter": kw.pop("maxiter", 300), "ftol": 1e-10},
+        )
         x, status, nfev = r.x[:-1], ("converged" if r.success else f"scipy: {r.message}"), r.nfev
     else:
-        raise ValueError(f"unknown method {method!r}; use sumt_exterior, sumt_interior, sumt_mixed, simplex, slsqp")
+        raise ValueError(
+            f"unknown method {method!r}; use sumt_exterior, sumt_interior, sumt_mixed, simplex, slsqp"
+        )
     dt = time.perf_counter() - t0
-    return DesignOutcome(method, np.asarray(x, float), problem.objective(x), float(np.min(problem.transmission(x))),
-                         _feasible(problem, x), status, int(nfev), dt)
+    return DesignOutcome(
+        method,
+        np.asarray(x, float),
+        problem.objective(x),
+        float(np.min(problem.transmission(x))),
+        _feasible(problem, x),
+        status,
+        int(nfev),
+        dt,
+    )
 
 
-def comparison_table(problem: ThumbProblem, methods=("sumt_exterior", "sumt_mixed", "slsqp"), x0=None) -> list:
+def comparison_table(
+    problem: ThumbProblem, methods=("sumt_exterior", "sumt_mixed", "slsqp"), x0=None
+) -> list:
     """The printed optimum and each method's result as rows of :class:`DesignOutcome`."""
     xb = problem.x_book
-    rows = [DesignOutcome("book (printed)", xb, problem.objective(xb), float(np.min(problem.transmission(xb))),
-                          _feasible(problem, xb), f"printed e = {problem.e_book:g}", 0, 0.0)]
+    rows = [
+        DesignOutcome(
+            "book (printed)",
+            xb,
+            problem.objective(xb),
+            float(np.min(problem.transmission(xb))),
+            _feasible(problem, xb),
+            f"printed e = {problem.e_book:g}",
+            0,
+            0.0,
+        )
+    ]
     for m in methods:
         rows.append(optimise(problem, m, x0))
     return rows
@@ -299,6 +380,9 @@ def comparison_table(problem: ThumbProblem, methods=("sumt_exterior", "sumt_mixe
 def markdown(rows) -> str:
     """Comparison table as markdown: method, x, S (deg), min transmission (deg), feasible, nfev, s."""
     head = "| method | x | S (deg) | min transmission (deg) | feasible | status | nfev | time (s) |\n|---|---|---|---|---|---|---|---|\n"
-    lines = [f"| {r.method} | {np.array2string(r.x, precision=3, separator=', ')} | {r.S:.4f} | "
-             f"{r.min_transmission:.1f} | {r.feasible} | {r.status} | {r.nfev} | {r.seconds:.2f} |" for r in rows]
+    lines = [
+        f"| {r.method} | {np.array2string(r.x, precision=3, separator=', ')} | {r.S:.4f} | "
+        f"{r.min_transmission:.1f} | {r.feasible} | {r.status} | {r.nfev} | {r.seconds:.2f} |"
+        for r in rows
+    ]
     return head + "\n".join(lines)

@@ -17,7 +17,17 @@ from __future__ import annotations
 
 import importlib
 
-_SUBMODULES = {"lagrange", "equivalent_link", "euler_chain", "hand_model", "simulate", "human", "checks", "ccode", "loads"}
+_SUBMODULES = {
+    "lagrange",
+    "equivalent_link",
+    "euler_chain",
+    "hand_model",
+    "simulate",
+    "human",
+    "checks",
+    "ccode",
+    "loads",
+}
 
 
 def __getattr__(name):

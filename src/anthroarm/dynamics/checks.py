@@ -67,9 +67,11 @@ def model_rows(robot, samples: int, rng) -> list:
             ref["Cqd"].append(Cp @ qd)
             ref["fd"].append(pin.aba(m, d, q, qd, ti).copy())
         ref["tau"].append(pin.rnea(m, d, q, qd, qdd).copy())
-        if mimic:   # computeKineticEnergy / computePotentialEnergy refuse mimic joints
+        if mimic:  # computeKineticEnergy / computePotentialEnergy refuse mimic joints
             ref["T"].append(0.5 * qd @ Mp @ qd)
-            ref["V"].append(-pin.computeTotalMass(m) * float(m.gravity.linear @ pin.centerOfMass(m, d, q)))
+            ref["V"].append(
+                -pin.computeTotalMass(m) * float(m.gravity.linear @ pin.centerOfMass(m, d, q))
+            )
         else:
             ref["T"].append(pin.computeKineticEnergy(m, d, q, qd))
             ref["V"].append(pin.computePotentialEnergy(m, d, q))
@@ -92,8 +94,17 @@ def model_rows(robot, samples: int, rng) -> list:
         label["V"] = (label["V"][0], "-mass g'pin.centerOfMass (mimic)")
     rows = []
     for k, (q_name, oracle) in label.items():
-        rows.append(CheckRow(robot.name, q_name, _rel(ours[k], ref[k]), TOL, samples, oracle,
-                             note=f"relative; generated code from {dyn.source}"))
+        rows.append(
+            CheckRow(
+                robot.name,
+                q_name,
+                _rel(ours[k], ref[k]),
+                TOL,
+                samples,
+                oracle,
+                note=f"relative; generated code from {dyn.source}",
+            )
+        )
     return rows
 
 

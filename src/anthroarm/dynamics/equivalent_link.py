@@ -43,7 +43,9 @@ def equivalent_inertia(links) -> float:
         J = np.asarray(J, float)
         total += m * float(v @ v) + float(w @ (J @ w if J.ndim == 2 else J * w))  # (8-26)
     if not np.isfinite(total):
-        raise ValueError(f"equivalent_inertia: a mass, velocity or inertia is NaN/inf (J* = {total})")
+        raise ValueError(
+            f"equivalent_inertia: a mass, velocity or inertia is NaN/inf (J* = {total})"
+        )
     return total
 
 
@@ -55,7 +57,9 @@ def equivalent_moment(loads) -> float:
     for F, v, M, w in loads:
         total += float(np.dot(F, v)) + float(np.dot(M, w))
     if not np.isfinite(total):
-        raise ValueError(f"equivalent_moment: a force, moment or velocity is NaN/inf (M* = {total})")
+        raise ValueError(
+            f"equivalent_moment: a force, moment or velocity is NaN/inf (M* = {total})"
+        )
     return total
 
 
@@ -80,15 +84,25 @@ class FourBarFinger:
     def __post_init__(self):
         for name in ("r1", "r2", "r3", "r4"):
             if not as_scalar(getattr(self, name), f"FourBarFinger: {name}") > 0:
-                raise ValueError(f"FourBarFinger: {name} must be a positive length (m), got {getattr(self, name)}")
+                raise ValueError(
+                    f"FourBarFinger: {name} must be a positive length (m), got {getattr(self, name)}"
+                )
         g = np.asarray(self.gravity, float)
         if g.shape != (2,) or not np.all(np.isfinite(g)):
-            raise ValueError(f"FourBarFinger: gravity must be 2 finite numbers (m/s²), got {self.gravity}")
+            raise ValueError(
+                f"FourBarFinger: gravity must be 2 finite numbers (m/s²), got {self.gravity}"
+            )
         for name in ("mass", "com", "inertia"):
             v = np.asarray(getattr(self, name), float)
             if v.shape != (3,) or not np.all(np.isfinite(v)):
-                raise ValueError(f"FourBarFinger: {name} must be 3 finite numbers, got {getattr(self, name)}")
-        if np.any(np.asarray(self.mass) < 0) or np.any(np.asarray(self.inertia) < 0) or sum(self.mass) == 0:
+                raise ValueError(
+                    f"FourBarFinger: {name} must be 3 finite numbers, got {getattr(self, name)}"
+                )
+        if (
+            np.any(np.asarray(self.mass) < 0)
+            or np.any(np.asarray(self.inertia) < 0)
+            or sum(self.mass) == 0
+        ):
             raise InertiaError("FourBarFinger: masses and inertias must be >= 0 and not all zero")
 
     # ------------------------------------------------------------------ kinematics (ω = 1)
@@ -98,7 +112,9 @@ class FourBarFinger:
         phi = float(phi)
         if not np.isfinite(phi):
             raise ValueError(f"phi must be finite, got {phi}")
-        s = fourbar(self.r1, self.r2, self.r3, self.r4, phi, omega2=1.0, alpha2=0.0, branch=self.branch)
+        s = fourbar(
+            self.r1, self.r2, self.r3, self.r4, phi, omega2=1.0, alpha2=0.0, branch=self.branch
+        )
         if s.status != "ok":
             raise ValueError(f"four-bar at phi = {phi:.4f} rad: {s.status} ({s.reason})")
         return s
@@ -121,19 +137,28 @@ class FourBarFinger:
         vA = perp(A)
         aA = -A  # ω2 = 1, α2 = 0
         v = [perp(rel[0]), vA + w[1] * perp(rel[1]), w[2] * perp(rel[2])]
-        a = [-rel[0], aA + al[1] * perp(rel[1]) - w[1] ** 2 * rel[1], al[2] * perp(rel[2]) - w[2] ** 2 * rel[2]]
+        a = [
+            -rel[0],
+            aA + al[1] * perp(rel[1]) - w[1] ** 2 * rel[1],
+            al[2] * perp(rel[2]) - w[2] ** 2 * rel[2],
+        ]
         return dict(state=s, com=c, v=v, a=a, omega=w, alpha=al)
 
     def J_star(self, phi) -> float:
         """Equivalent moment of inertia J*(φ) about the crank pivot, Eq. (8-28), kg m²."""
         lm = self.link_motion(phi)
-        return equivalent_inertia((self.mass[k], lm["v"][k], lm["omega"][k], self.inertia[k]) for k in range(3))
+        return equivalent_inertia(
+            (self.mass[k], lm["v"][k], lm["omega"][k], self.inertia[k]) for k in range(3)
+        )
 
     def dJ_star(self, phi) -> float:
         """dJ*/dφ = 2 Σ (m v_s · a_s + J ω α) at ω = 1, φ̈ = 0 (kg m²/rad)."""
         lm = self.link_motion(phi)
-        return 2.0 * sum(self.mass[k] * lm["v"][k] @ lm["a"][k] + self.inertia[k] * lm["omega"][k] * lm["alpha"][k]
-                         for k in range(3))
+        return 2.0 * sum(
+            self.mass[k] * lm["v"][k] @ lm["a"][k]
+            + self.inertia[k] * lm["omega"][k] * lm["alpha"][k]
+            for k in range(3)
+        )
 
     def M_star(self, phi, drive: float = 0.0, rocker_moment: float = 0.0) -> float:
         """Equivalent moment M*(φ), Eq. (8-20): the link weights, a drive moment on the crank
@@ -142,49 +167,89 @@ class FourBarFinger:
         lm = self.link_motion(phi)
         g = np.asarray(self.gravity, float)
         loads = [(self.mass[k] * g, lm["v"][k], 0.0, 0.0) for k in range(3)]
-        loads += [(np.zeros(2), np.zeros(2), drive, 1.0), (np.zeros(2), np.zeros(2), rocker_moment, lm["omega"][2])]
+        loads += [
+            (np.zeros(2), np.zeros(2), drive, 1.0),
+            (np.zeros(2), np.zeros(2), rocker_moment, lm["omega"][2]),
+        ]
         return equivalent_moment(loads)
 
     # ------------------------------------------------------------------ equations of motion
-    def integrate_energy_form(self, phi0: float, omega0: float, phi1: float, drive: float = 0.0,
-                              rocker_moment: float = 0.0, samples: int = 201):
+    def integrate_energy_form(
+        self,
+        phi0: float,
+        omega0: float,
+        phi1: float,
+        drive: float = 0.0,
+        rocker_moment: float = 0.0,
+        samples: int = 201,
+    ):
         """Energy form (8-15): ω(φ) = sqrt((J*(φ₀)ω₀² + 2∫M*dφ)/J*(φ)) on a grid from φ₀ to φ₁,
         and t(φ) = ∫dφ/ω (trapezoid).  Returns (φ, ω, t); ω must stay > 0 (else ValueError:
         the mechanism stops before φ₁)."""
         from scipy.integrate import cumulative_trapezoid
 
-        phi0, omega0, phi1 = as_scalar(phi0, "phi0"), as_scalar(omega0, "omega0"), as_scalar(phi1, "phi1")
+        phi0, omega0, phi1 = (
+            as_scalar(phi0, "phi0"),
+            as_scalar(omega0, "omega0"),
+            as_scalar(phi1, "phi1"),
+        )
         if omega0 <= 0:
-            raise ValueError("the energy form needs omega0 > 0 (the mechanism must move toward phi1)")
+            raise ValueError(
+                "the energy form needs omega0 > 0 (the mechanism must move toward phi1)"
+            )
         phi = np.linspace(phi0, phi1, samples)
         Ms = np.array([self.M_star(p, drive, rocker_moment) for p in phi])
         Js = np.array([self.J_star(p) for p in phi])
         work = cumulative_trapezoid(Ms, phi, initial=0.0)
-        e2 = (Js[0] * omega0 ** 2 + 2 * work) / Js
+        e2 = (Js[0] * omega0**2 + 2 * work) / Js
         if np.any(e2 <= 0):
             k = int(np.argmax(e2 <= 0))
-            raise ValueError(f"the mechanism stops before phi = {phi[k]:.4f} rad (kinetic energy exhausted)")
+            raise ValueError(
+                f"the mechanism stops before phi = {phi[k]:.4f} rad (kinetic energy exhausted)"
+            )
         om = np.sqrt(e2)
         t = cumulative_trapezoid(1.0 / om, phi, initial=0.0)
         return phi, om, t
 
-    def integrate_moment_form(self, phi0: float, omega0: float, t_end: float, drive: float = 0.0,
-                              rocker_moment: float = 0.0, damping: float = 0.0, rtol: float = 1e-10):
+    def integrate_moment_form(
+        self,
+        phi0: float,
+        omega0: float,
+        t_end: float,
+        drive: float = 0.0,
+        rocker_moment: float = 0.0,
+        damping: float = 0.0,
+        rtol: float = 1e-10,
+    ):
         """Moment form (8-16) as an ODE: φ̇ = ω, ω̇ = (M* − ½ω² dJ*/dφ)/J*, with an optional
         viscous moment −damping·ω on the crank.  Returns the ``solve_ivp`` solution."""
         from scipy.integrate import solve_ivp
 
-        phi0, omega0, t_end = as_scalar(phi0, "phi0"), as_scalar(omega0, "omega0"), as_scalar(t_end, "t_end")
+        phi0, omega0, t_end = (
+            as_scalar(phi0, "phi0"),
+            as_scalar(omega0, "omega0"),
+            as_scalar(t_end, "t_end"),
+        )
         damping = as_scalar(damping, "damping")
         if t_end <= 0 or damping < 0:
-            raise ValueError(f"need t_end > 0 and damping >= 0, got t_end={t_end}, damping={damping}")
+            raise ValueError(
+                f"need t_end > 0 and damping >= 0, got t_end={t_end}, damping={damping}"
+            )
 
         def rhs(t, x):
             phi, om = x
             Ms = self.M_star(phi, drive, rocker_moment) - damping * om
             return [om, (Ms - 0.5 * om * om * self.dJ_star(phi)) / self.J_star(phi)]
 
-        return solve_ivp(rhs, (0.0, t_end), [phi0, omega0], method="DOP853", rtol=rtol, atol=1e-12, dense_output=True)
+        return solve_ivp(
+            rhs,
+            (0.0, t_end),
+            [phi0, omega0],
+            method="DOP853",
+            rtol=rtol,
+            atol=1e-12,
+            dense_output=True,
+        )
 
     # ------------------------------------------------------------------ Pinocchio oracle
     def pin_tree(self):
@@ -198,14 +263,21 @@ class FourBarFinger:
 
         def body(jid, L, k):
             I = np.diag([self.inertia[k], self.inertia[k], self.inertia[k]])
-            model.appendBodyToJoint(jid, pin.Inertia(float(self.mass[k]), np.array([self.com[k] * L, 0, 0]), I),
-                                    pin.SE3.Identity())
+            model.appendBodyToJoint(
+                jid,
+                pin.Inertia(float(self.mass[k]), np.array([self.com[k] * L, 0, 0]), I),
+                pin.SE3.Identity(),
+            )
 
         j1 = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "crank")
         body(j1, self.r2, 0)
-        j2 = model.addJoint(j1, pin.JointModelRZ(), pin.SE3(np.eye(3), np.array([self.r2, 0, 0])), "coupler")
+        j2 = model.addJoint(
+            j1, pin.JointModelRZ(), pin.SE3(np.eye(3), np.array([self.r2, 0, 0])), "coupler"
+        )
         body(j2, self.r3, 1)
-        j3 = model.addJoint(0, pin.JointModelRZ(), pin.SE3(np.eye(3), np.array([self.r1, 0, 0])), "rocker")
+        j3 = model.addJoint(
+            0, pin.JointModelRZ(), pin.SE3(np.eye(3), np.array([self.r1, 0, 0])), "rocker"
+        )
         body(j3, self.r4, 2)
         return model
 

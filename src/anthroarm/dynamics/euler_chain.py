@@ -70,10 +70,12 @@ def Pi2_to_5(e):
     """Π₂, Π₃ (8-54) and Π₄, Π₅ (8-56), all as printed (verified)."""
     _, ps, ph = e
     sp_, cp, sf, cf = np.sin(ps), np.cos(ps), np.sin(ph), np.cos(ph)
-    P2 = np.array([[cp ** 2, 0, 1], [sp_ ** 2 * sf ** 2, cf ** 2, 0], [sp_ ** 2 * cf ** 2, sf ** 2, 0]])
+    P2 = np.array([[cp**2, 0, 1], [sp_**2 * sf**2, cf**2, 0], [sp_**2 * cf**2, sf**2, 0]])
     P3 = np.array([[0, 2 * cp, 0], [0, 0, 2 * sp_ * sf * cf], [0, 0, -2 * sp_ * sf * cf]])
-    P4 = np.array([[sp_ ** 2 * sf * cf, -sf * cf, 0], [sp_ * cp * cf, 0, 0], [sp_ * cp * sf, 0, 0]])
-    P5 = np.array([[0, 0, sp_ * (cf ** 2 - sf ** 2)], [-sf, sp_ * cf, -cp * sf], [cf, sp_ * sf, cp * cf]])
+    P4 = np.array([[sp_**2 * sf * cf, -sf * cf, 0], [sp_ * cp * cf, 0, 0], [sp_ * cp * sf, 0, 0]])
+    P5 = np.array(
+        [[0, 0, sp_ * (cf**2 - sf**2)], [-sf, sp_ * cf, -cp * sf], [cf, sp_ * sf, cp * cf]]
+    )
     return P2, P3, P4, P5
 
 
@@ -105,7 +107,7 @@ def body_moment(J, e, ed, edd) -> np.ndarray:
     J = np.asarray(J, float)
     J1, J2 = J1_J2(J)
     P2, P3, P4, P5 = Pi2_to_5(e)
-    e2 = ed ** 2
+    e2 = ed**2
     ex = np.array([ed[1] * ed[2], ed[2] * ed[0], ed[0] * ed[1]])
     return J @ Pi(e) @ edd + (J1 @ P2 + J2 @ P4) @ e2 + (J @ Pi1(e) + J1 @ P3 + J2 @ P5) @ ex
 
@@ -158,7 +160,7 @@ def Lam(l) -> np.ndarray:
     l = np.asarray(l, float).reshape(3, 1)
     out = np.zeros((9, 3))
     for k in range(3):
-        out[3 * k:3 * k + 3, k:k + 1] = l
+        out[3 * k : 3 * k + 3, k : k + 1] = l
     return out
 
 
@@ -186,10 +188,14 @@ class EulerChain:
             if not np.all(np.isfinite(a)):
                 raise ValueError(f"EulerChain: {name} contains NaN/inf")
         if np.any(self.m <= 0):
-            raise InertiaError(f"EulerChain: every link needs a positive mass, got {self.m.tolist()}")
+            raise InertiaError(
+                f"EulerChain: every link needs a positive mass, got {self.m.tolist()}"
+            )
         for k, Jk in enumerate(self.J):
             if np.max(np.abs(Jk - Jk.T)) > 1e-12 or np.linalg.eigvalsh(Jk)[0] <= 0:
-                raise InertiaError(f"EulerChain: J of link {k + 1} must be symmetric positive definite")
+                raise InertiaError(
+                    f"EulerChain: J of link {k + 1} must be symmetric positive definite"
+                )
 
     @property
     def n(self) -> int:
@@ -209,7 +215,9 @@ class EulerChain:
         if S.shape != (self.n, 3):
             S = S.reshape(-1)
             if S.size != 3 * self.n:
-                raise ValueError(f"{what} must have shape ({self.n}, 3) (θ, ψ, φ per link), got {np.shape(S)}")
+                raise ValueError(
+                    f"{what} must have shape ({self.n}, 3) (θ, ψ, φ per link), got {np.shape(S)}"
+                )
             S = S.reshape(self.n, 3)
         if not np.all(np.isfinite(S)):
             raise ValueError(f"{what} contains NaN/inf")
@@ -232,28 +240,40 @@ class EulerChain:
         grav = np.array([0.0, 0.0, self.g])
         for p in range(n):  # joint p (0 = fixed support)
             # lever arms X_ip (8-77/78), i = 1..n (0-based k = i-1)
-            X = [skew(self.e_ip(i, p) * dW[i - 1] + sum((self.delta(i, j, p) * lW[j - 1] for j in range(1, n + 1)),
-                                                          np.zeros(3))) for i in range(1, n + 1)]
+            X = [
+                skew(
+                    self.e_ip(i, p) * dW[i - 1]
+                    + sum((self.delta(i, j, p) * lW[j - 1] for j in range(1, n + 1)), np.zeros(3))
+                )
+                for i in range(1, n + 1)
+            ]
             # S_jp = Σ_i δ_ij0 m_i X_ip (8-82)
-            Sj = [sum((self.delta(i, j, 0) * self.m[i - 1] * X[i - 1] for i in range(1, n + 1)), np.zeros((3, 3)))
-                  for j in range(1, n + 1)]
+            Sj = [
+                sum(
+                    (self.delta(i, j, 0) * self.m[i - 1] * X[i - 1] for i in range(1, n + 1)),
+                    np.zeros((3, 3)),
+                )
+                for j in range(1, n + 1)
+            ]
             for k in range(1, n + 1):  # link k
                 Ak, Bk, Ck = abc[k - 1]
                 Dk, Ek, Fk = defs[k - 1]
                 Delta_k = Lam(self.d[k - 1])
                 Lam_k = Lam(self.l[k - 1])  # γ_kj = [k = j]
                 ek = self.e_ip(k, p)
-                blk = np.s_[3 * p:3 * p + 3, 3 * (k - 1):3 * k]
+                blk = np.s_[3 * p : 3 * p + 3, 3 * (k - 1) : 3 * k]
                 A[blk] = self.m[k - 1] * X[k - 1] @ Ak @ Delta_k + Sj[k - 1] @ Ak @ Lam_k + ek * Dk
                 B[blk] = self.m[k - 1] * X[k - 1] @ Bk @ Delta_k + Sj[k - 1] @ Bk @ Lam_k + ek * Ek
                 C[blk] = self.m[k - 1] * X[k - 1] @ Ck @ Delta_k + Sj[k - 1] @ Ck @ Lam_k + ek * Fk
-            G[3 * p:3 * p + 3] = sum(self.m[i - 1] * X[i - 1] @ grav for i in range(1, n + 1))
+            G[3 * p : 3 * p + 3] = sum(self.m[i - 1] * X[i - 1] @ grav for i in range(1, n + 1))
         return A, B, C, G
 
     @staticmethod
     def _products(Sd):
-        Sd2 = (Sd ** 2).reshape(-1)
-        Sx = np.column_stack([Sd[:, 1] * Sd[:, 2], Sd[:, 2] * Sd[:, 0], Sd[:, 0] * Sd[:, 1]]).reshape(-1)
+        Sd2 = (Sd**2).reshape(-1)
+        Sx = np.column_stack(
+            [Sd[:, 1] * Sd[:, 2], Sd[:, 2] * Sd[:, 0], Sd[:, 0] * Sd[:, 1]]
+        ).reshape(-1)
         return Sd2, Sx
 
     def inverse(self, S, Sd, Sdd) -> np.ndarray:
@@ -277,17 +297,28 @@ class EulerChain:
             ex = np.array([Sd[k, 1] * Sd[k, 2], Sd[k, 2] * Sd[k, 0], Sd[k, 0] * Sd[k, 1]])
             Mrot.append(D @ Sdd[k] + E @ e2 + F @ ex)
             A, B, C = ABC(S[k])
-            acc_d.append(A @ Lam(self.d[k]) @ Sdd[k] + B @ Lam(self.d[k]) @ e2 + C @ Lam(self.d[k]) @ ex)
-            acc_l.append(A @ Lam(self.l[k]) @ Sdd[k] + B @ Lam(self.l[k]) @ e2 + C @ Lam(self.l[k]) @ ex)
-        Xdd = [acc_d[i - 1] + sum((self.delta(i, j, 0) * acc_l[j - 1] for j in range(1, n + 1)), np.zeros(3))
-               for i in range(1, n + 1)]  # (8-76)
+            acc_d.append(
+                A @ Lam(self.d[k]) @ Sdd[k] + B @ Lam(self.d[k]) @ e2 + C @ Lam(self.d[k]) @ ex
+            )
+            acc_l.append(
+                A @ Lam(self.l[k]) @ Sdd[k] + B @ Lam(self.l[k]) @ e2 + C @ Lam(self.l[k]) @ ex
+            )
+        Xdd = [
+            acc_d[i - 1]
+            + sum((self.delta(i, j, 0) * acc_l[j - 1] for j in range(1, n + 1)), np.zeros(3))
+            for i in range(1, n + 1)
+        ]  # (8-76)
         grav = np.array([0.0, 0.0, self.g])
         Q = np.zeros((n, 3))
         for p in range(n):
             for i in range(1, n + 1):
                 arm = self.e_ip(i, p) * R[i - 1] @ self.d[i - 1] + sum(
-                    (self.delta(i, j, p) * R[j - 1] @ self.l[j - 1] for j in range(1, n + 1)), np.zeros(3))
-                Q[p] += self.m[i - 1] * np.cross(arm, Xdd[i - 1] + grav) + self.e_ip(i, p) * Mrot[i - 1]  # (8-80)
+                    (self.delta(i, j, p) * R[j - 1] @ self.l[j - 1] for j in range(1, n + 1)),
+                    np.zeros(3),
+                )
+                Q[p] += (
+                    self.m[i - 1] * np.cross(arm, Xdd[i - 1] + grav) + self.e_ip(i, p) * Mrot[i - 1]
+                )  # (8-80)
         return Q
 
     def check_regular(self, S) -> None:
@@ -298,7 +329,8 @@ class EulerChain:
             k = int(bad[0])
             raise EulerSingularityError(
                 f"link {k + 1}: sin ψ = {np.sin(S[k, 1]):.2e}; the X–Y–X angles are singular at ψ = 0, π "
-                "(det Π = −sin ψ): choose another reference posture or body axes")
+                "(det Π = −sin ψ): choose another reference posture or body axes"
+            )
 
     def forward(self, S, Sd, Q) -> np.ndarray:
         """S̈ = A⁻¹(Q − BṠ² − CṠṠ − G), Eq. (8-92) (rad/s², n × 3), guarded at gimbal lock."""
@@ -321,8 +353,11 @@ class EulerChain:
         for k in range(self.n):
             pl = pin.SE3(np.eye(3), np.zeros(3) if k == 0 else self.l[k - 1].copy())
             jid = model.addJoint(parent, pin.JointModelSpherical(), pl, f"ball{k}")
-            model.appendBodyToJoint(jid, pin.Inertia(float(self.m[k]), self.d[k].copy(), self.J[k].copy()),
-                                    pin.SE3.Identity())
+            model.appendBodyToJoint(
+                jid,
+                pin.Inertia(float(self.m[k]), self.d[k].copy(), self.J[k].copy()),
+                pin.SE3.Identity(),
+            )
             parent = jid
         return model
 
@@ -364,8 +399,10 @@ def mixed(A, h, q_rows, Q0, s_cols, Sdd0):
     c0 = np.asarray(s_cols, int)
     cz = np.setdiff1d(np.arange(N), c0)
     if r0.size != cz.size:
-        raise ValueError(f"the mixed problem needs as many known moments as unknown accelerations "
-                         f"({r0.size} != {cz.size})")
+        raise ValueError(
+            f"the mixed problem needs as many known moments as unknown accelerations "
+            f"({r0.size} != {cz.size})"
+        )
     A00, A0z, Az0, Azz = A[np.ix_(r0, c0)], A[np.ix_(r0, cz)], A[np.ix_(rz, c0)], A[np.ix_(rz, cz)]
     nz, n0 = rz.size, r0.size
     K = np.block([[np.zeros((n0, nz)), -A0z], [np.eye(nz), -Azz]])

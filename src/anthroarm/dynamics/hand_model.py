@@ -76,21 +76,27 @@ class HandModel:
         self.r = np.asarray(self.r, dtype=float).reshape(-1, 3)
         self.m = np.asarray(self.m, dtype=float).reshape(-1)
         if self.l.shape[0] != n + 1 or self.r.shape[0] != n or self.m.shape[0] != n:
-            raise ValueError(f"{self.name}: need l (N+1, 3), r (N, 3), m (N,) for N = {n}; got "
-                             f"{self.l.shape}, {self.r.shape}, {self.m.shape}")
+            raise ValueError(
+                f"{self.name}: need l (N+1, 3), r (N, 3), m (N,) for N = {n}; got "
+                f"{self.l.shape}, {self.r.shape}, {self.m.shape}"
+            )
         J = np.asarray(self.J, dtype=float)
         self.J = np.stack([np.eye(3) * j for j in J]) if J.ndim == 1 else J.reshape(n, 3, 3)
         for name, a in (("l", self.l), ("r", self.r), ("m", self.m), ("J", self.J)):
             if not np.all(np.isfinite(a)):
                 raise ValueError(f"{self.name}: {name} contains NaN/inf")
         if np.any(self.m < 0) or np.all(self.m == 0):
-            raise InertiaError(f"{self.name}: masses must be >= 0 and not all zero, got {self.m.tolist()}")
+            raise InertiaError(
+                f"{self.name}: masses must be >= 0 and not all zero, got {self.m.tolist()}"
+            )
         for i, Ji in enumerate(self.J):
             if np.linalg.eigvalsh(0.5 * (Ji + Ji.T))[0] < -1e-15:
                 raise InertiaError(f"{self.name}: J of link {i + 1} is not positive semidefinite")
         self.xi = np.broadcast_to(np.asarray(self.xi, dtype=float), (n,)).copy()
         if not np.all(np.isfinite(self.xi)) or np.any(self.xi < 0):
-            raise ValueError(f"{self.name}: damping xi must be finite and >= 0, got {self.xi.tolist()}")
+            raise ValueError(
+                f"{self.name}: damping xi must be finite and >= 0, got {self.xi.tolist()}"
+            )
 
     @property
     def n(self) -> int:
@@ -194,11 +200,20 @@ class HandModel:
         jt = {"i": pin.JointModelRX, "j": pin.JointModelRY, "k": pin.JointModelRZ}
         parent = 0
         for i in range(self.n):
-            jid = model.addJoint(parent, jt[self.axes[i]](), pin.SE3(np.eye(3), self.l[i].copy()), f"joint{i + 1}")
-            model.appendBodyToJoint(jid, pin.Inertia(float(self.m[i]), self.r[i].copy(), self.J[i].copy()),
-                                    pin.SE3.Identity())
+            jid = model.addJoint(
+                parent, jt[self.axes[i]](), pin.SE3(np.eye(3), self.l[i].copy()), f"joint{i + 1}"
+            )
+            model.appendBodyToJoint(
+                jid,
+                pin.Inertia(float(self.m[i]), self.r[i].copy(), self.J[i].copy()),
+                pin.SE3.Identity(),
+            )
             parent = jid
-        model.addFrame(pin.Frame("tip", parent, pin.SE3(np.eye(3), self.l[self.n].copy()), pin.FrameType.OP_FRAME))
+        model.addFrame(
+            pin.Frame(
+                "tip", parent, pin.SE3(np.eye(3), self.l[self.n].copy()), pin.FrameType.OP_FRAME
+            )
+        )
         return model
 
     @property
@@ -224,7 +239,7 @@ def default_hand(xi: float = 0.002) -> HandModel:
     m = np.array([0.030, 0.015, 0.010])
     l = np.vstack([np.zeros(3), np.column_stack([np.zeros(3), np.zeros(3), L])])
     r = np.column_stack([np.zeros(3), np.zeros(3), L / 2])
-    return HandModel(axes=["j", "i", "i"], l=l, r=r, m=m, J=m * L ** 2 / 12, xi=xi, name="finger3")
+    return HandModel(axes=["j", "i", "i"], l=l, r=r, m=m, J=m * L**2 / 12, xi=xi, name="finger3")
 
 
 def minimum_jerk(q0, q1, T: float, t):
@@ -233,14 +248,16 @@ def minimum_jerk(q0, q1, T: float, t):
         raise ValueError(f"minimum-jerk duration must be finite and > 0 s, got {T!r}")
     q0, q1 = np.asarray(q0, float), np.asarray(q1, float)
     s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)[..., None]
-    p = 10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5
-    pd = (30 * s ** 2 - 60 * s ** 3 + 30 * s ** 4) / T
-    pdd = (60 * s - 180 * s ** 2 + 120 * s ** 3) / T ** 2
+    p = 10 * s**3 - 15 * s**4 + 6 * s**5
+    pd = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
+    pdd = (60 * s - 180 * s**2 + 120 * s**3) / T**2
     d = q1 - q0
     return q0 + p * d, pd * d, pdd * d
 
 
-def coriolis_over_grasp(hand: HandModel | None = None, closed=(0.2, 1.2, 1.4), duration: float = 0.3, samples: int = 61):
+def coriolis_over_grasp(
+    hand: HandModel | None = None, closed=(0.2, 1.2, 1.4), duration: float = 0.3, samples: int = 61
+):
     """How large are the terms the book drops?  Along a minimum-jerk grasp from θ = 0 to
     ``closed`` (rad) in ``duration`` s, returns a dict of time, the book's torque
     (U+W)θ̈ + ∂V/∂θ + ξθ̇, the full torque (plus Cθ̇), the Coriolis term and the ratio
@@ -263,12 +280,16 @@ def plot_coriolis_over_grasp(result: dict | None = None, ax=None):
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 3.5))
     for j in range(res["F_full"].shape[1]):
-        line, = ax.plot(res["t"], res["F_full"][:, j] * 1e3, label=f"joint {j + 1}: full τ")
-        ax.plot(res["t"], res["coriolis"][:, j] * 1e3, "--", color=line.get_color(),
-                label=f"joint {j + 1}: Cθ̇ ({100 * res['ratio'][j]:.0f} % of max|τ|)")
+        (line,) = ax.plot(res["t"], res["F_full"][:, j] * 1e3, label=f"joint {j + 1}: full τ")
+        ax.plot(
+            res["t"],
+            res["coriolis"][:, j] * 1e3,
+            "--",
+            color=line.get_color(),
+            label=f"joint {j + 1}: Cθ̇ ({100 * res['ratio'][j]:.0f} % of max|τ|)",
+        )
     ax.set_xlabel("t [s]")
     ax.set_ylabel("torque [mN m]")
     ax.set_title("§8-4 hand: velocity terms the book drops, along a grasp")
     ax.legend(fontsize=7)
     return ax
-

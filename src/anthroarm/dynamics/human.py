@@ -40,8 +40,16 @@ def _joint_index(robot, j):
     return robot.joint_names.index(j)
 
 
-def gravity_torque_map(joints=("shoulder_flexion", "elbow_flexion"), grid: int = 41, base_q=None,
-                       height: float = 1.75, mass: float = 75.0, sex: str = "male", robot=None, dyn=None) -> dict:
+def gravity_torque_map(
+    joints=("shoulder_flexion", "elbow_flexion"),
+    grid: int = 41,
+    base_q=None,
+    height: float = 1.75,
+    mass: float = 75.0,
+    sex: str = "male",
+    robot=None,
+    dyn=None,
+) -> dict:
     """Gravity torques over the range of motion of two joints.
 
     Returns dict(x, y (the two joints' grid values, rad), names, tau (grid, grid, 7) N m with
@@ -64,12 +72,28 @@ def gravity_torque_map(joints=("shoulder_flexion", "elbow_flexion"), grid: int =
     params = dict(height=height, mass=mass, sex=sex)
     spec_params = robot.spec.params if robot.spec is not None else {}
     params.update({k: spec_params[k] for k in params if k in spec_params})  # the body actually used
-    return dict(x=x, y=y, names=(robot.joint_names[a], robot.joint_names[b]), joint_names=robot.joint_names,
-                tau=tau, q=Q.reshape(grid, grid, robot.nq), params=params)
+    return dict(
+        x=x,
+        y=y,
+        names=(robot.joint_names[a], robot.joint_names[b]),
+        joint_names=robot.joint_names,
+        tau=tau,
+        q=Q.reshape(grid, grid, robot.nq),
+        params=params,
+    )
 
 
-def reaching_torques(q_start, q_goal, duration: float = 0.8, samples: int = 101, height: float = 1.75,
-                     mass: float = 75.0, sex: str = "male", robot=None, dyn=None) -> dict:
+def reaching_torques(
+    q_start,
+    q_goal,
+    duration: float = 0.8,
+    samples: int = 101,
+    height: float = 1.75,
+    mass: float = 75.0,
+    sex: str = "male",
+    robot=None,
+    dyn=None,
+) -> dict:
     """Joint torques along a minimum-jerk reach from ``q_start`` to ``q_goal`` (rad) in
     ``duration`` s.  Returns dict(t, q, qd, qdd, tau, inertial = M q̈, velocity = C q̇,
     gravity = g, peak = max |τ| per joint)."""
@@ -86,8 +110,18 @@ def reaching_torques(q_start, q_goal, duration: float = 0.8, samples: int = 101,
     vel = dyn.coriolis(q, qd)
     grav = dyn.gravity(q)
     tau = dyn.tau(q, qd, qdd)
-    return dict(t=t, q=q, qd=qd, qdd=qdd, tau=tau, inertial=inertial, velocity=vel, gravity=grav,
-                peak=np.max(np.abs(tau), axis=0), joint_names=robot.joint_names)
+    return dict(
+        t=t,
+        q=q,
+        qd=qd,
+        qdd=qdd,
+        tau=tau,
+        inertial=inertial,
+        velocity=vel,
+        gravity=grav,
+        peak=np.max(np.abs(tau), axis=0),
+        joint_names=robot.joint_names,
+    )
 
 
 def plot_gravity_map(result: dict, joint: int | str = 0, ax=None):
@@ -97,7 +131,13 @@ def plot_gravity_map(result: dict, joint: int | str = 0, ax=None):
     k = result["joint_names"].index(joint) if isinstance(joint, str) else int(joint)
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 4))
-    cs = ax.contourf(np.degrees(result["x"]), np.degrees(result["y"]), result["tau"][:, :, k], levels=21, cmap="RdBu_r")
+    cs = ax.contourf(
+        np.degrees(result["x"]),
+        np.degrees(result["y"]),
+        result["tau"][:, :, k],
+        levels=21,
+        cmap="RdBu_r",
+    )
     plt.colorbar(cs, ax=ax, label=f"{result['joint_names'][k]} torque [N m]")
     ax.set_xlabel(f"{result['names'][0]} [deg]")
     ax.set_ylabel(f"{result['names'][1]} [deg]")

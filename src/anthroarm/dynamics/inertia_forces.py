@@ -44,10 +44,25 @@ from ..chain import PRISMATIC
 from ..errors import ParameterError
 from ..spatial.rotations import rot_axis
 
-__all__ = ["inertia_force", "inertia_force_body", "angular_momentum", "inertia_couple", "inertia_couple_expanded",
-           "inertia_couple_fixed", "LinkMotion", "link_motion", "LinkInertiaLoads", "link_inertia_loads",
-           "dalembert_torques", "torque_terms", "joint_frame", "joint_frame_from_links", "oblique_components", "oblique_components_printed",
-           "axis_projections"]
+__all__ = [
+    "inertia_force",
+    "inertia_force_body",
+    "angular_momentum",
+    "inertia_couple",
+    "inertia_couple_expanded",
+    "inertia_couple_fixed",
+    "LinkMotion",
+    "link_motion",
+    "LinkInertiaLoads",
+    "link_inertia_loads",
+    "dalembert_torques",
+    "torque_terms",
+    "joint_frame",
+    "joint_frame_from_links",
+    "oblique_components",
+    "oblique_components_printed",
+    "axis_projections",
+]
 
 
 def _vec(x, name: str, shape=(3,)) -> np.ndarray:
@@ -97,11 +112,25 @@ def inertia_couple_expanded(J, omega, eps) -> np.ndarray:
     Jxy, Jyz, Jzx = -J[0, 1], -J[1, 2], -J[2, 0]
     wx, wy, wz = w
     ex, ey, ez = e
-    return np.array([
-        -Jx * ex + (Jy - Jz) * wy * wz + Jxy * (ey - wx * wz) + Jzx * (ez + wx * wy) + Jyz * (wy**2 - wz**2),
-        -Jy * ey + (Jz - Jx) * wz * wx + Jyz * (ez - wy * wx) + Jxy * (ex + wy * wz) + Jzx * (wz**2 - wx**2),
-        -Jz * ez + (Jx - Jy) * wx * wy + Jzx * (ex - wz * wy) + Jyz * (ey + wz * wx) + Jxy * (wx**2 - wy**2),
-    ])
+    return np.array(
+        [
+            -Jx * ex
+            + (Jy - Jz) * wy * wz
+            + Jxy * (ey - wx * wz)
+            + Jzx * (ez + wx * wy)
+            + Jyz * (wy**2 - wz**2),
+            -Jy * ey
+            + (Jz - Jx) * wz * wx
+            + Jyz * (ez - wy * wx)
+            + Jxy * (ex + wy * wz)
+            + Jzx * (wz**2 - wx**2),
+            -Jz * ez
+            + (Jx - Jy) * wx * wy
+            + Jzx * (ex - wz * wy)
+            + Jyz * (ey + wz * wx)
+            + Jxy * (wx**2 - wy**2),
+        ]
+    )
 
 
 def inertia_couple_fixed(R, M_body) -> np.ndarray:
@@ -160,7 +189,14 @@ def link_motion(robot, q, v, a) -> LinkMotion:
     for j in chain.joints:
         i = j.index
         if j.parent < 0:
-            Rp, pp, wp, ep, vp, ap = np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+            Rp, pp, wp, ep, vp, ap = (
+                np.eye(3),
+                np.zeros(3),
+                np.zeros(3),
+                np.zeros(3),
+                np.zeros(3),
+                np.zeros(3),
+            )
         else:
             k = j.parent
             Rp, pp, wp, ep, vp, ap = R[k], p[k], w[k], e[k], vo[k], ao[k]
@@ -172,7 +208,13 @@ def link_motion(robot, q, v, a) -> LinkMotion:
             r = r + u * th[i]
             w[i], e[i] = wp, ep
             vo[i] = vp + np.cross(wp, r) + u * thd[i]
-            ao[i] = ap + np.cross(ep, r) + np.cross(wp, np.cross(wp, r)) + u * thdd[i] + 2 * np.cross(wp, u * thd[i])
+            ao[i] = (
+                ap
+                + np.cross(ep, r)
+                + np.cross(wp, np.cross(wp, r))
+                + u * thdd[i]
+                + 2 * np.cross(wp, u * thd[i])
+            )
         else:
             R[i] = R0 @ rot_axis(j.axis, th[i])
             w[i] = wp + u * thd[i]
@@ -206,7 +248,9 @@ def link_inertia_loads(robot, q, v, a) -> LinkInertiaLoads:
         i = j.index
         F[i] = inertia_force(j.mass, mo.a_com[i])
         Rt = mo.R[i].T
-        M[i] = inertia_couple_fixed(mo.R[i], inertia_couple(j.inertia, Rt @ mo.omega[i], Rt @ mo.eps[i]))
+        M[i] = inertia_couple_fixed(
+            mo.R[i], inertia_couple(j.inertia, Rt @ mo.omega[i], Rt @ mo.eps[i])
+        )
     return LinkInertiaLoads(F, M, mo)
 
 
@@ -223,7 +267,7 @@ def dalembert_torques(robot, q, v, a, gravity: bool = True) -> np.ndarray:
     f = loads.F + np.array([j.mass * g for j in chain.joints])
     mom = np.cross(mo.com, f) + loads.M
     fs, ms = f.copy(), mom.copy()
-    for j in reversed(chain.joints):          # children come after their parents
+    for j in reversed(chain.joints):  # children come after their parents
         if j.parent >= 0:
             fs[j.parent] += fs[j.index]
             ms[j.parent] += ms[j.index]
@@ -233,7 +277,7 @@ def dalembert_torques(robot, q, v, a, gravity: bool = True) -> np.ndarray:
         u = mo.axis[i]
         if j.kind == PRISMATIC:
             raw[i] = -u @ fs[i]
-        else:                                   # moment about the joint origin: m − p × f
+        else:  # moment about the joint origin: m − p × f
             raw[i] = -u @ (ms[i] - np.cross(mo.p[i], fs[i]))
     tau = np.zeros(robot.nv)
     for j in chain.joints:
@@ -269,7 +313,9 @@ def joint_frame(p1, p2) -> np.ndarray:
     c = np.cross(u1, u2)
     s = np.linalg.norm(c)
     if s < 1e-9:
-        raise ParameterError(f"joint axes p1 and p2 are parallel (|p1 × p2| = {s:.3g}): (8-85) has no third axis")
+        raise ParameterError(
+            f"joint axes p1 and p2 are parallel (|p1 × p2| = {s:.3g}): (8-85) has no third axis"
+        )
     return np.column_stack([u1, u2, c / s])
 
 
@@ -292,8 +338,10 @@ def _check_axes(axes) -> np.ndarray:
     """``axes`` (3, 3) with three independent columns (a :func:`joint_frame`), else ParameterError."""
     A = _vec(axes, "axes", (3, 3))
     if abs(np.linalg.det(A)) < 1e-12 * max(1.0, float(np.abs(A).max()) ** 3):
-        raise ParameterError(f"axes are not independent (det = {np.linalg.det(A):.3g}): no decomposition of M "
-                             "along them; build them with joint_frame(p1, p2)")
+        raise ParameterError(
+            f"axes are not independent (det = {np.linalg.det(A):.3g}): no decomposition of M "
+            "along them; build them with joint_frame(p1, p2)"
+        )
     return A
 
 

@@ -63,7 +63,6 @@ verified before it is executed, written atomically (deriving and generating the 
 
 from __future__ import annotations
 
-import math
 import os
 import threading
 import time
@@ -74,8 +73,8 @@ import numpy as np
 
 from .. import cache
 from ..chain import CONTINUOUS, PRISMATIC, REVOLUTE
-from ..errors import InertiaError, UnsupportedModelError
 from ..codegen.graph import Graph, emit_python, snap
+from ..errors import InertiaError, UnsupportedModelError
 
 #: bump when the generated code changes (part of the cache key)
 GENERATOR_VERSION = "2"
@@ -86,7 +85,6 @@ SINGULAR_RCOND = 1e-12
 #: within the loader's physical bounds stay in the float range)
 STATE_BOUND = 1e100
 _FAST_BOUND = (STATE_BOUND * 1e-160) ** 2
-
 
 
 # ====================================================================== model description
@@ -102,9 +100,11 @@ class ChainInfo:
 
     name: str
     chain: object
-    coord: tuple      # per joint: index of its generalized coordinate (0..n-1)
-    factor: tuple     # per joint: dθ_k / dv_coord
-    source: tuple     # per joint: joint index whose velocity input drives it (itself or its mimic source)
+    coord: tuple  # per joint: index of its generalized coordinate (0..n-1)
+    factor: tuple  # per joint: dθ_k / dv_coord
+    source: (
+        tuple  # per joint: joint index whose velocity input drives it (itself or its mimic source)
+    )
 
     @property
     def joints(self):
@@ -143,7 +143,8 @@ def _check_inertias(chain) -> None:
         scale = max(float(np.max(np.abs(ev))), 1e-300)
         if ev[0] < -1e-9 * scale:
             raise InertiaError(
-                f"{label} has an inertia tensor that is not positive (semi)definite: eigenvalues {ev.tolist()} kg m^2")
+                f"{label} has an inertia tensor that is not positive (semi)definite: eigenvalues {ev.tolist()} kg m^2"
+            )
         if m == 0 and np.max(np.abs(Ic)) > 0:
             raise InertiaError(f"{label} has zero mass but a non-zero rotational inertia")
     if not chain.joints:
@@ -172,10 +173,14 @@ def chain_info(obj, name: str | None = None) -> ChainInfo:
     chain = getattr(obj, "chain", None) if not isinstance(obj, Chain) else obj
     if chain is None:
         if not isinstance(obj, pin.Model):
-            raise UnsupportedModelError(f"Lagrange dynamics need a Robot, a Chain, a pin.Model or a catalog name, "
-                                        f"got {type(obj).__name__}")
+            raise UnsupportedModelError(
+                f"Lagrange dynamics need a Robot, a Chain, a pin.Model or a catalog name, "
+                f"got {type(obj).__name__}"
+            )
         # the tool frame does not matter to dynamics: the base frame keeps trees unambiguous
-        chain = Chain.from_model(obj, tool=obj.frames[0].name, name=name or getattr(obj, "name", "") or "model")
+        chain = Chain.from_model(
+            obj, tool=obj.frames[0].name, name=name or getattr(obj, "name", "") or "model"
+        )
     _check_inertias(chain)
     coord, factor, source = [], [], []
     vindex = {i: chain.joints[i].idx_v for i in chain.independent}
@@ -184,8 +189,13 @@ def chain_info(obj, name: str | None = None) -> ChainInfo:
         coord.append(vindex[src])
         factor.append(j.mimic.multiplier if j.is_mimic else 1.0)
         source.append(src)
-    return ChainInfo(name=name or chain.name, chain=chain, coord=tuple(coord), factor=tuple(factor),
-                     source=tuple(source))
+    return ChainInfo(
+        name=name or chain.name,
+        chain=chain,
+        coord=tuple(coord),
+        factor=tuple(factor),
+        source=tuple(source),
+    )
 
 
 # ====================================================================== symbolic derivation
@@ -213,9 +223,11 @@ def _rot_T(axis, s, c, w, g: Graph):
 
 
 def _cross_c(u, v, g: Graph):
-    return [g.add(g.mul(u[1], v[2]), g.mul(-1.0, g.mul(u[2], v[1]))),
-            g.add(g.mul(u[2], v[0]), g.mul(-1.0, g.mul(u[0], v[2]))),
-            g.add(g.mul(u[0], v[1]), g.mul(-1.0, g.mul(u[1], v[0])))]
+    return [
+        g.add(g.mul(u[1], v[2]), g.mul(-1.0, g.mul(u[2], v[1]))),
+        g.add(g.mul(u[2], v[0]), g.mul(-1.0, g.mul(u[0], v[2]))),
+        g.add(g.mul(u[0], v[1]), g.mul(-1.0, g.mul(u[1], v[0]))),
+    ]
 
 
 def _matT_vec(R, w, g: Graph):
@@ -269,10 +281,10 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
             s[k], c[k] = g.input("s", k), g.input("c", k)
         else:
             qv[k] = g.input("q", k)
-    ind = [k for k in range(nj) if info.source[k] == k]          # independent joints, v order
-    qd = [g.input("qd", k) for k in ind]                          # qd[i]: generalized velocity i
+    ind = [k for k in range(nj) if info.source[k] == k]  # independent joints, v order
+    qd = [g.input("qd", k) for k in ind]  # qd[i]: generalized velocity i
     qdd = [g.input("qdd", k) for k in ind]
-    thd = [g.mul(info.factor[k], qd[info.coord[k]]) for k in range(nj)]   # θ̇_k
+    thd = [g.mul(info.factor[k], qd[info.coord[k]]) for k in range(nj)]  # θ̇_k
     grav = [snap(x) for x in info.gravity]
 
     w = [None] * nj  # angular velocity of link k, link frame
@@ -312,10 +324,16 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
             cm = [snap(x) for x in j.com]
             vc = [g.add(vk[i], x) for i, x in enumerate(_cross_c(wk, cm, g))]
             I = j.inertia
-            quad = g.sum([g.mul(snap(I[0, 0]), g.mul(wk[0], wk[0])), g.mul(snap(I[1, 1]), g.mul(wk[1], wk[1])),
-                          g.mul(snap(I[2, 2]), g.mul(wk[2], wk[2])),
-                          g.mul(2 * snap(I[0, 1]), g.mul(wk[0], wk[1])), g.mul(2 * snap(I[0, 2]), g.mul(wk[0], wk[2])),
-                          g.mul(2 * snap(I[1, 2]), g.mul(wk[1], wk[2]))])
+            quad = g.sum(
+                [
+                    g.mul(snap(I[0, 0]), g.mul(wk[0], wk[0])),
+                    g.mul(snap(I[1, 1]), g.mul(wk[1], wk[1])),
+                    g.mul(snap(I[2, 2]), g.mul(wk[2], wk[2])),
+                    g.mul(2 * snap(I[0, 1]), g.mul(wk[0], wk[1])),
+                    g.mul(2 * snap(I[0, 2]), g.mul(wk[0], wk[2])),
+                    g.mul(2 * snap(I[1, 2]), g.mul(wk[1], wk[2])),
+                ]
+            )
             T_terms.append(g.add(g.mul(0.5 * m, _dot(vc, vc, g)), g.mul(0.5, quad)))  # (8-24)
             V_terms.append(g.mul(-m, g.add(hk, _dot(gk, cm, g))))  # (8-106)
     T = g.sum(T_terms)
@@ -378,10 +396,27 @@ def derive(model_or_robot, name: str | None = None, coriolis_matrix: bool = True
         Mflat = [M[a][b] for a in range(n) for b in range(n)]
         Mdot = g.forward(Mflat, qseed)
         dp = [g.forward(p, coord_seed(i)) for i in range(n)]  # dp[j][i] = ∂p_i/∂q_j
-        Cmat = [[g.mul(0.5, g.sum([Mdot[a * n + b], dp[b][a], g.mul(-1.0, dp[a][b])])) for b in range(n)]
-                for a in range(n)]
-    d = Derivation(info=info, graph=g, T=T, V=V, p=p, dTdq=dTdq, g=gvec, M=M, Cqd=Cqd, tau=tau, Cmat=Cmat,
-                   inputs={"s": s, "c": c, "q": qv, "qd": qd, "qdd": qdd})
+        Cmat = [
+            [
+                g.mul(0.5, g.sum([Mdot[a * n + b], dp[b][a], g.mul(-1.0, dp[a][b])]))
+                for b in range(n)
+            ]
+            for a in range(n)
+        ]
+    d = Derivation(
+        info=info,
+        graph=g,
+        T=T,
+        V=V,
+        p=p,
+        dTdq=dTdq,
+        g=gvec,
+        M=M,
+        Cqd=Cqd,
+        tau=tau,
+        Cmat=Cmat,
+        inputs={"s": s, "c": c, "q": qv, "qd": qd, "qdd": qdd},
+    )
     d.seconds = time.perf_counter() - t0
     return d
 
@@ -400,7 +435,11 @@ def _outputs(d: Derivation) -> dict:
         "momentum": (("q", "qd"), d.p, (n,)),
     }
     if d.Cmat is not None:
-        out["coriolis_matrix"] = (("q", "qd"), [d.Cmat[a][b] for a in range(n) for b in range(n)], (n, n))
+        out["coriolis_matrix"] = (
+            ("q", "qd"),
+            [d.Cmat[a][b] for a in range(n) for b in range(n)],
+            (n, n),
+        )
     return out
 
 
@@ -443,7 +482,7 @@ def generate_python(d: Derivation) -> str:
 
 # ====================================================================== cache
 _LOCK = threading.Lock()
-_MEMO: dict[str, object] = {}   # key -> generated module (holds no Robot)
+_MEMO: dict[str, object] = {}  # key -> generated module (holds no Robot)
 
 
 def generated_module(model_or_robot, name: str | None = None, use_cache: bool = True):
@@ -473,7 +512,9 @@ def _check_pd(mod, info: ChainInfo) -> None:
     """M(q) must be positive definite: at θ = 0 and at two random configurations."""
     chain = info.chain
     rng = np.random.default_rng(12345)
-    Q = chain.angles(chain.configuration(np.vstack([np.zeros(info.n), rng.uniform(-np.pi, np.pi, (2, info.n))])))
+    Q = chain.angles(
+        chain.configuration(np.vstack([np.zeros(info.n), rng.uniform(-np.pi, np.pi, (2, info.n))]))
+    )
     for th in Q:
         M = mod.mass_matrix_1(th)
         ev = np.linalg.eigvalsh(M)
@@ -482,7 +523,8 @@ def _check_pd(mod, info: ChainInfo) -> None:
             raise InertiaError(
                 f"{info.name}: the mass matrix is not positive definite at θ = {np.round(th, 3).tolist()} "
                 f"(eigenvalues {ev.tolist()}); joint {info.joints[weak].name!r} moves (almost) no mass or "
-                "inertia — a massless chain or zero inertia has no forward dynamics")
+                "inertia — a massless chain or zero inertia has no forward dynamics"
+            )
 
 
 # ====================================================================== user-facing object
@@ -495,16 +537,26 @@ class LagrangeDynamics:
     generalized coordinates, so they compare with ``pin.crba``/``rnea``/``aba`` directly.  SI
     units: rad (m for prismatic joints), N m (N).  Thread-safe."""
 
-    def __init__(self, model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy"):
+    def __init__(
+        self,
+        model_or_robot,
+        name: str | None = None,
+        use_cache: bool = True,
+        backend: str = "numpy",
+    ):
         self.info = chain_info(model_or_robot, name)
         chain = self.chain = self.info.chain
         self.n, self.nq = self.info.n, chain.nq
         self.joint_names = [chain.joints[i].name for i in chain.independent]
         self.module, self.source = generated_module(self.info, use_cache=use_cache)
         # θ = q and θ̇ = q̇ when every joint is a plain revolute / prismatic joint in q order
-        self._plain_q = all(j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints)
+        self._plain_q = all(
+            j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints
+        )
         self._plain_v = not chain.has_mimic
-        self._cos = np.array([j.idx_q for j in chain.joints if j.kind == CONTINUOUS and not j.is_mimic], dtype=int)
+        self._cos = np.array(
+            [j.idx_q for j in chain.joints if j.kind == CONTINUOUS and not j.is_mimic], dtype=int
+        )
         self._vsel = np.array(self.info.coord)
         self._vscale = np.array(self.info.factor)
         self.backend = backend
@@ -521,8 +573,10 @@ class LagrangeDynamics:
         return d.graph, _outputs(d), self.info.njoints
 
     def __repr__(self) -> str:
-        return (f"LagrangeDynamics({self.info.name!r}, nq={self.nq}, nv={self.n}, backend={self.backend!r}, "
-                f"from {self.source})")
+        return (
+            f"LagrangeDynamics({self.info.name!r}, nq={self.nq}, nv={self.n}, backend={self.backend!r}, "
+            f"from {self.source})"
+        )
 
     # -- robot layout -> the generated code's joint positions and rates
     def _theta(self, q):
@@ -531,7 +585,7 @@ class LagrangeDynamics:
         if self._cos.size:
             c, s = q[..., self._cos], q[..., self._cos + 1]
             if np.any(np.abs(c * c + s * s - 1.0) > 2e-6):
-                self.chain.check_unit(q)      # raises, naming the joint
+                self.chain.check_unit(q)  # raises, naming the joint
         return self.chain.angles(q)
 
     def _rates(self, v):
@@ -542,18 +596,24 @@ class LagrangeDynamics:
         a = np.asarray(x, dtype=float)
         size, names = (self.nq, self.chain.q_names) if what == "q" else (self.n, self.joint_names)
         if a.ndim not in (1, 2) or a.shape[-1] != size:
-            raise ValueError(f"{self.info.name}: {what} must have shape ({size},) or (N, {size}), got {a.shape}")
+            raise ValueError(
+                f"{self.info.name}: {what} must have shape ({size},) or (N, {size}), got {a.shape}"
+            )
         if not np.all(np.isfinite(a)):
             bad = np.argwhere(~np.isfinite(a))[0]
             j = int(bad[-1])
-            raise ValueError(f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]}; "
-                             "states must be finite")
+            raise ValueError(
+                f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]}; "
+                "states must be finite"
+            )
         if a.size and np.max(np.abs(a)) > STATE_BOUND:
             bad = np.argwhere(np.abs(a) > STATE_BOUND)[0]
             j = int(bad[-1])
-            raise ValueError(f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]:.3g}; states and "
-                             f"torques must be within +-{STATE_BOUND:.0e} (their squares and products with the "
-                             "inertias must stay in the float range)")
+            raise ValueError(
+                f"{self.info.name}: {what}[{j}] (joint {names[j]!r}) is {a[tuple(bad)]:.3g}; states and "
+                f"torques must be within +-{STATE_BOUND:.0e} (their squares and products with the "
+                "inertias must stay in the float range)"
+            )
         return a
 
     def _call(self, fname, q, *rates):
@@ -561,7 +621,7 @@ class LagrangeDynamics:
         tot = 0.0
         ok = type(q) is np.ndarray and q.shape == (self.nq,) and q.dtype == np.float64
         if ok:
-            s = q * 1e-160                    # squares of the scaled entries cannot overflow
+            s = q * 1e-160  # squares of the scaled entries cannot overflow
             tot = s.dot(s)
             for a in rates:
                 if type(a) is not np.ndarray or a.shape != (self.n,) or a.dtype != np.float64:
@@ -569,8 +629,10 @@ class LagrangeDynamics:
                     break
                 s = a * 1e-160
                 tot += s.dot(s)
-        if ok and tot < _FAST_BOUND:          # finite (NaN compares False) and every entry within the bound
-            arrs = (self._theta(q),) + (rates if self._plain_v else tuple(self._rates(a) for a in rates))
+        if ok and tot < _FAST_BOUND:  # finite (NaN compares False) and every entry within the bound
+            arrs = (self._theta(q),) + (
+                rates if self._plain_v else tuple(self._rates(a) for a in rates)
+            )
             if self._c is not None:
                 return self._c.one(fname, arrs)
             return getattr(self.module, fname + "_1")(*arrs)
@@ -647,8 +709,10 @@ class LagrangeDynamics:
         else:
             a = np.linalg.solve(M, rhs[..., None])[..., 0]
         if not np.all(np.isfinite(a)):
-            raise ValueError(f"{self.info.name}: forward dynamics overflows for tau = {np.asarray(tau).tolist()} "
-                             "(accelerations beyond the float range); use torques of a physical size")
+            raise ValueError(
+                f"{self.info.name}: forward dynamics overflows for tau = {np.asarray(tau).tolist()} "
+                "(accelerations beyond the float range); use torques of a physical size"
+            )
         return a
 
     @staticmethod
@@ -663,7 +727,9 @@ class LagrangeDynamics:
         from ..errors import SingularMassMatrixError
 
         q = np.asarray(q, dtype=float)
-        Ms, Qs = (M[None], q[None]) if M.ndim == 2 else (M, np.broadcast_to(q, (M.shape[0], self.nq)))
+        Ms, Qs = (
+            (M[None], q[None]) if M.ndim == 2 else (M, np.broadcast_to(q, (M.shape[0], self.nq)))
+        )
         ev_all = np.linalg.eigvalsh(Ms)
         rc = ev_all[:, 0] / np.maximum(ev_all[:, -1], 1e-300)
         k = int(np.argmin(rc))
@@ -675,7 +741,11 @@ class LagrangeDynamics:
             f"{self.info.name}: the mass matrix is singular at q = {Qs[k].tolist()}{where}: condition number "
             f"{cond:.3g} (limit {1 / SINGULAR_RCOND:.0e}); joint {joint!r} moves (almost) no mass or inertia "
             "there, so its acceleration is not determined. Give the links beyond it mass or rotational inertia "
-            "about that joint's axis, or avoid this configuration", q=Qs[k].copy(), cond=cond, joint=joint)
+            "about that joint's axis, or avoid this configuration",
+            q=Qs[k].copy(),
+            cond=cond,
+            joint=joint,
+        )
 
 
 def _tri_solve(L, b):
@@ -683,7 +753,9 @@ def _tri_solve(L, b):
     return np.linalg.solve(L.T, np.linalg.solve(L, b))
 
 
-def load(model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy") -> LagrangeDynamics:
+def load(
+    model_or_robot, name: str | None = None, use_cache: bool = True, backend: str = "numpy"
+) -> LagrangeDynamics:
     """:class:`LagrangeDynamics` of a Robot / Chain / pin.Model / catalog name / URDF path
     (generated code cached on disk, :mod:`anthroarm.cache`)."""
     return LagrangeDynamics(model_or_robot, name=name, use_cache=use_cache, backend=backend)
@@ -705,7 +777,9 @@ def _simp(e, simplify: bool, max_ops: int):
     return e3 if sp.count_ops(e3) <= sp.count_ops(e2) else e2
 
 
-def sympy_matrices(d: Derivation, which=("T", "V", "M", "Cqd", "g"), simplify: bool = True, max_ops: int = 300) -> dict:
+def sympy_matrices(
+    d: Derivation, which=("T", "V", "M", "Cqd", "g"), simplify: bool = True, max_ops: int = 300
+) -> dict:
     """The derived quantities as sympy expressions in q_k, \\dot q_k (s_k -> sin q_k ...).
 
     ``simplify``: expand + trigsimp every entry whose operation count is at most
@@ -731,7 +805,9 @@ def sympy_matrices(d: Derivation, which=("T", "V", "M", "Cqd", "g"), simplify: b
             flat = g.to_sympy([d.Cmat[a][b] for a in range(n) for b in range(n)])
             out["C"] = sp.Matrix(n, n, [_simp(e, simplify, max_ops) for e in flat])
         else:
-            raise ValueError(f"unknown quantity {w!r}; choose from T, V, M, Cqd, C, g, tau, p, dTdq")
+            raise ValueError(
+                f"unknown quantity {w!r}; choose from T, V, M, Cqd, C, g, tau, p, dTdq"
+            )
     return out
 
 
@@ -752,19 +828,37 @@ def christoffel(M, q):
 
     n = M.shape[0]
     dM = [M.diff(q[k]) for k in range(n)]
-    return [[[sp.Rational(1, 2) * (dM[k][i, j] + dM[j][i, k] - dM[i][j, k]) for k in range(n)] for j in range(n)]
-            for i in range(n)]
+    return [
+        [
+            [sp.Rational(1, 2) * (dM[k][i, j] + dM[j][i, k] - dM[i][j, k]) for k in range(n)]
+            for j in range(n)
+        ]
+        for i in range(n)
+    ]
 
 
-def latex(d: Derivation, simplify: bool = True, max_ops: int = 300, which=("T", "V", "M", "Cqd", "g")) -> str:
+def latex(
+    d: Derivation, simplify: bool = True, max_ops: int = 300, which=("T", "V", "M", "Cqd", "g")
+) -> str:
     """LaTeX of the Lagrange equations ``τ = M(q) q̈ + C(q,q̇) q̇ + g(q)`` with each quantity
     written out (see :func:`sympy_matrices` for ``simplify``/``max_ops``)."""
     import sympy as sp
 
     mats = sympy_matrices(d, which=which, simplify=simplify, max_ops=max_ops)
-    names = {"T": "T", "V": "V", "M": "M(q)", "Cqd": r"C(q,\dot q)\,\dot q", "C": r"C(q,\dot q)", "g": "g(q)",
-             "tau": r"\tau", "p": r"\partial T/\partial\dot q", "dTdq": r"\partial T/\partial q"}
+    names = {
+        "T": "T",
+        "V": "V",
+        "M": "M(q)",
+        "Cqd": r"C(q,\dot q)\,\dot q",
+        "C": r"C(q,\dot q)",
+        "g": "g(q)",
+        "tau": r"\tau",
+        "p": r"\partial T/\partial\dot q",
+        "dTdq": r"\partial T/\partial q",
+    }
     parts = [r"\tau = M(q)\,\ddot q + C(q,\dot q)\,\dot q + g(q)"]
     for k, v in mats.items():
         parts.append(f"{names[k]} = {sp.latex(v)}")
-    return r"\begin{aligned}" + r"\\ ".join(p.replace("=", "&=", 1) for p in parts) + r"\end{aligned}"
+    return (
+        r"\begin{aligned}" + r"\\ ".join(p.replace("=", "&=", 1) for p in parts) + r"\end{aligned}"
+    )

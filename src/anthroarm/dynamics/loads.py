@@ -71,7 +71,9 @@ def _vector3(x, what: str, n: int | None = None) -> np.ndarray:
     if not np.all(np.isfinite(a)):
         raise ParameterError(f"{what} must be finite, got {a[~np.isfinite(a)][0]}")
     if a.size and np.max(np.abs(a)) > LOAD_BOUND:
-        raise ParameterError(f"{what} has an entry beyond +-{LOAD_BOUND:.0e} (N, N m or m): {np.max(np.abs(a)):.3g}")
+        raise ParameterError(
+            f"{what} has an entry beyond +-{LOAD_BOUND:.0e} (N, N m or m): {np.max(np.abs(a)):.3g}"
+        )
     if n is not None and a.ndim == 2 and a.shape[0] != n:
         raise ParameterError(f"{what} has {a.shape[0]} rows but the trajectory has {n} samples")
     return a
@@ -92,7 +94,9 @@ class Wrench:
 
     def __post_init__(self):
         if self.reference not in _REFERENCES:
-            raise ParameterError(f"Wrench reference must be one of {sorted(_REFERENCES)}, got {self.reference!r}")
+            raise ParameterError(
+                f"Wrench reference must be one of {sorted(_REFERENCES)}, got {self.reference!r}"
+            )
         object.__setattr__(self, "force", _vector3(self.force, "Wrench force (N)"))
         object.__setattr__(self, "moment", _vector3(self.moment, "Wrench moment (N m)"))
 
@@ -125,37 +129,56 @@ class HeldObject:
         try:
             m = float(self.mass)
         except (TypeError, ValueError):
-            raise InertiaError(f"held object: mass must be a number (kg), got {self.mass!r}") from None
+            raise InertiaError(
+                f"held object: mass must be a number (kg), got {self.mass!r}"
+            ) from None
         if not (np.isfinite(m) and 0.0 < m <= LOAD_BOUND):
-            raise InertiaError(f"held object: mass must be finite and in (0, {LOAD_BOUND:.0e}] kg, got {self.mass}")
+            raise InertiaError(
+                f"held object: mass must be finite and in (0, {LOAD_BOUND:.0e}] kg, got {self.mass}"
+            )
         c = np.asarray(self.com, dtype=float)
         if c.shape != (3,) or not np.all(np.isfinite(c)) or np.max(np.abs(c)) > 1e3:
-            raise InertiaError(f"held object: com must be a finite (3,) vector in m (|c| <= 1e3), got {self.com!r}")
+            raise InertiaError(
+                f"held object: com must be a finite (3,) vector in m (|c| <= 1e3), got {self.com!r}"
+            )
         Ic = np.asarray(self.inertia, dtype=float)
         if Ic.shape != (3, 3) or not np.all(np.isfinite(Ic)):
-            raise InertiaError(f"held object: inertia must be a finite (3, 3) matrix in kg m^2, got {self.inertia!r}")
+            raise InertiaError(
+                f"held object: inertia must be a finite (3, 3) matrix in kg m^2, got {self.inertia!r}"
+            )
         if not np.allclose(Ic, Ic.T, rtol=0.0, atol=1e-12 * max(1.0, np.max(np.abs(Ic)))):
             raise InertiaError("held object: inertia must be symmetric")
         ev = np.linalg.eigvalsh(Ic)
         tol = 1e-12 * max(1.0, float(np.max(np.abs(ev))))
         if ev[0] < -tol or ev[0] + ev[1] < ev[2] - tol:
-            raise InertiaError(f"held object: inertia is not physical (principal moments {ev} kg m^2 must be >= 0 "
-                               "and satisfy the triangle inequality)")
+            raise InertiaError(
+                f"held object: inertia is not physical (principal moments {ev} kg m^2 must be >= 0 "
+                "and satisfy the triangle inequality)"
+            )
         object.__setattr__(self, "mass", m)
         object.__setattr__(self, "com", c)
         object.__setattr__(self, "inertia", 0.5 * (Ic + Ic.T))
 
     @classmethod
-    def cylinder(cls, mass: float, radius: float, height: float, com=(0.0, 0.0, 0.0), frame: str | None = None):
+    def cylinder(
+        cls,
+        mass: float,
+        radius: float,
+        height: float,
+        com=(0.0, 0.0, 0.0),
+        frame: str | None = None,
+    ):
         """A solid cylinder (a full cup) whose axis is the frame's z axis: I = diag(m(3r²+h²)/12,
         m(3r²+h²)/12, m r²/2) about its centre of mass."""
-        mass = cls(mass).mass                          # the mass checks of a point mass
+        mass = cls(mass).mass  # the mass checks of a point mass
         try:
             r, h = float(radius), float(height)
         except (TypeError, ValueError):
             r = h = float("nan")
         if not (r >= 0 and h >= 0 and np.isfinite(r) and np.isfinite(h)):
-            raise InertiaError(f"held object: radius and height must be finite and >= 0 m, got {radius!r}, {height!r}")
+            raise InertiaError(
+                f"held object: radius and height must be finite and >= 0 m, got {radius!r}, {height!r}"
+            )
         radius, height = r, h
         a = mass * (3 * radius**2 + height**2) / 12.0
         return cls(mass, np.asarray(com, float), np.diag([a, a, mass * radius**2 / 2.0]), frame)
@@ -188,7 +211,7 @@ class HeldObject:
         v, w = V[:, :3], V[:, 3:]
         a, al = A[:, :3], A[:, 3:]
         c, Ic, m = self.com, self.inertia, self.mass
-        gF = np.einsum("nji,j->ni", R, np.asarray(gravity, float))       # Rᵀ g
+        gF = np.einsum("nji,j->ni", R, np.asarray(gravity, float))  # Rᵀ g
         wc = np.cross(w, np.broadcast_to(c, w.shape))
         ac = a + np.cross(w, v) + np.cross(al, np.broadcast_to(c, al.shape)) + np.cross(w, wc)
         f = m * (ac - gF)
@@ -210,13 +233,19 @@ def _check_rates(robot, q, qd, qdd):
         try:
             a = np.atleast_2d(np.asarray(x, dtype=float))
         except (TypeError, ValueError):
-            raise ParameterError(f"{robot.name}: {name} must be numbers (rad/s, rad/s^2), got {x!r}") from None
+            raise ParameterError(
+                f"{robot.name}: {name} must be numbers (rad/s, rad/s^2), got {x!r}"
+            ) from None
         if a.shape != (len(q), robot.nv):
-            raise ParameterError(f"{robot.name}: {name} must have shape ({len(q)}, {robot.nv}) like q, got "
-                             f"{np.shape(x)}")
+            raise ParameterError(
+                f"{robot.name}: {name} must have shape ({len(q)}, {robot.nv}) like q, got "
+                f"{np.shape(x)}"
+            )
         if not np.all(np.isfinite(a)):
             j = int(np.argwhere(~np.isfinite(a))[0][-1])
-            raise ParameterError(f"{robot.name}: {name} for joint {robot.joint_names[j]!r} is not finite")
+            raise ParameterError(
+                f"{robot.name}: {name} for joint {robot.joint_names[j]!r} is not finite"
+            )
         out.append(a)
     return single, out
 
@@ -229,7 +258,9 @@ def generalized_forces(robot, q, loads, qd=None, qdd=None) -> np.ndarray:
     when they are omitted: zero velocity and acceleration).  Returns (nv,) or (N, nv)."""
     q_in = robot.check_q(q, "q")
     zeros = np.zeros(q_in.shape[:-1] + (robot.nv,))
-    single, (Q2, V2, A2) = _check_rates(robot, q_in, zeros if qd is None else qd, zeros if qdd is None else qdd)
+    single, (Q2, V2, A2) = _check_rates(
+        robot, q_in, zeros if qd is None else qd, zeros if qdd is None else qdd
+    )
     out = _loads_q(robot, Q2, V2, A2, loads)
     return out[0] if single else out
 
@@ -250,7 +281,7 @@ def _loads_q(robot, q, qd, qdd, loads) -> np.ndarray:
     Q = np.zeros((len(q), robot.nv))
     for load in _as_loads(loads):
         w, J = load.values(robot, q, qd, qdd)
-        Q += np.einsum("nki,nk->ni", J, w)                  # Jᵀ w, Eq. (8-5)
+        Q += np.einsum("nki,nk->ni", J, w)  # Jᵀ w, Eq. (8-5)
     return Q
 
 
@@ -272,7 +303,9 @@ class InverseDynamicsResult:
     engine: str
 
 
-def inverse_dynamics(robot, q, qd, qdd, loads=None, *, engine: str = "lagrange", dynamics=None) -> InverseDynamicsResult:
+def inverse_dynamics(
+    robot, q, qd, qdd, loads=None, *, engine: str = "lagrange", dynamics=None
+) -> InverseDynamicsResult:
     """τ = M(q) q̈ + C(q, q̇) q̇ + g(q) − Σ Jᵀ w along a trajectory (module docstring).
 
     Parameters
@@ -301,8 +334,15 @@ def inverse_dynamics(robot, q, qd, qdd, loads=None, *, engine: str = "lagrange",
         raise ParameterError(f"engine must be 'lagrange' or 'pinocchio', got {engine!r}")
     qext = _loads_q(robot, Q, V, A, loads)
     tau = free - qext
-    res = InverseDynamicsResult(tau=tau, tau_free=free, q_ext=qext, qd=V, power=tau * V,
-                                joint_names=list(robot.joint_names), engine=engine)
+    res = InverseDynamicsResult(
+        tau=tau,
+        tau_free=free,
+        q_ext=qext,
+        qd=V,
+        power=tau * V,
+        joint_names=list(robot.joint_names),
+        engine=engine,
+    )
     if single:
         for k in ("tau", "tau_free", "q_ext", "qd", "power"):
             setattr(res, k, getattr(res, k)[0])

@@ -91,8 +91,20 @@ def _tau_fn(tau, n):
     return lambda t, q, qd: arr
 
 
-def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=0.0, method: str = "rk4",
-             engine: str = "lagrange", rtol: float = 1e-10, atol: float = 1e-10, pin_model=None) -> SimResult:
+def simulate(
+    system,
+    q0,
+    qd0,
+    t_end: float,
+    dt: float = 1e-3,
+    tau=None,
+    damping=0.0,
+    method: str = "rk4",
+    engine: str = "lagrange",
+    rtol: float = 1e-10,
+    atol: float = 1e-10,
+    pin_model=None,
+) -> SimResult:
     """Integrate the equations of motion from (q0, q̇0) over [0, t_end].
 
     ``system``: Robot, pin.Model or :class:`~.lagrange.LagrangeDynamics`.  ``tau``: None, a
@@ -124,8 +136,10 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     chain = dyn.chain if dyn is not None else getattr(system, "chain", None)
     nq = chain.nq if chain is not None else n
     if chain is None and engine == "pin" and model.nq != model.nv:
-        raise ValueError(f"engine='pin' with nq = {model.nq} != nv = {model.nv} needs a Robot (its chain maps "
-                         "continuous joints' angles to (cos, sin)), not a bare pin.Model")
+        raise ValueError(
+            f"engine='pin' with nq = {model.nq} != nv = {model.nv} needs a Robot (its chain maps "
+            "continuous joints' angles to (cos, sin)), not a bare pin.Model"
+        )
     q0 = np.asarray(q0, dtype=float)
     qd0 = np.asarray(qd0, dtype=float)
     for name, a, size in (("q0", q0, nq), ("qd0", qd0, n)):
@@ -133,7 +147,7 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
             raise ValueError(f"{name} must have shape ({size},), got {a.shape}")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"{name} contains NaN/inf: {a.tolist()}")
-    if nq != n:   # continuous joints: integrate the independent joints' angles
+    if nq != n:  # continuous joints: integrate the independent joints' angles
         chain.check_unit(q0, "q0")
         to_q = chain.configuration
         x_q0 = chain.angles(q0)[list(chain.independent)]
@@ -149,26 +163,32 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
     nfev = [0]
 
     if engine == "lagrange":
+
         def accel(q, qd, u):
             return dyn.forward(q, qd, u)
 
         def energies(q, qd):
             return dyn.kinetic_energy(q, qd), dyn.potential_energy(q)
     else:
+
         def accel(q, qd, u):
             return pin.aba(model, data, q, qd, u).copy()
 
         def energies(q, qd):
-            return pin.computeKineticEnergy(model, data, q, qd), pin.computePotentialEnergy(model, data, q)
+            return pin.computeKineticEnergy(model, data, q, qd), pin.computePotentialEnergy(
+                model, data, q
+            )
 
     def rhs(t, x):
         nfev[0] += 1
-        q, qd = to_q(x[:n]), x[n:2 * n]
+        q, qd = to_q(x[:n]), x[n : 2 * n]
         if not np.all(np.isfinite(x)):
             raise FloatingPointError(f"the state became non-finite at t = {t:.6g} s")
         u = np.asarray(taufn(t, q, qd), dtype=float)
         if u.shape != (n,) or not np.all(np.isfinite(u)):
-            raise FloatingPointError(f"tau(t, q, qd) returned {u.tolist()} at t = {t:.6g} s (need {n} finite values)")
+            raise FloatingPointError(
+                f"tau(t, q, qd) returned {u.tolist()} at t = {t:.6g} s (need {n} finite values)"
+            )
         qdd = accel(q, qd, u - xi * qd)
         return np.concatenate([qd, qdd, [qd @ (xi * qd), u @ qd]])
 
@@ -201,7 +221,10 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
 
         try:
             sol = solve_ivp(rhs, (0.0, t[-1]), x0, method=method, t_eval=t, rtol=rtol, atol=atol)
-        except (FloatingPointError, SingularMassMatrixError) as exc:  # solve_ivp keeps no partial output
+        except (
+            FloatingPointError,
+            SingularMassMatrixError,
+        ) as exc:  # solve_ivp keeps no partial output
             X, t = x0[None], t[:1]
             status = f"{'diverged' if isinstance(exc, FloatingPointError) else 'singular'}: {exc}"
         else:
@@ -209,16 +232,33 @@ def simulate(system, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=
                 status = f"solve_ivp failed: {sol.message}"
             X = sol.y.T
             t = sol.t
-    q, qd = to_q(X[:, :n]), X[:, n:2 * n]
+    q, qd = to_q(X[:, :n]), X[:, n : 2 * n]
     TV = np.array([energies(a, b) for a, b in zip(q, qd)])
-    return SimResult(t=t, q=q, qd=qd, T=TV[:, 0], V=TV[:, 1], dissipated=X[:, 2 * n], work=X[:, 2 * n + 1],
-                     method=method, engine=engine, nfev=nfev[0], status=status)
+    return SimResult(
+        t=t,
+        q=q,
+        qd=qd,
+        T=TV[:, 0],
+        V=TV[:, 1],
+        dissipated=X[:, 2 * n],
+        work=X[:, 2 * n + 1],
+        method=method,
+        engine=engine,
+        nfev=nfev[0],
+        status=status,
+    )
 
 
-def compare_with_pinocchio(robot, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=0.0,
-                           method: str = "rk4") -> dict:
+def compare_with_pinocchio(
+    robot, q0, qd0, t_end: float, dt: float = 1e-3, tau=None, damping=0.0, method: str = "rk4"
+) -> dict:
     """Integrate with the generated Lagrange code and with ``pin.aba`` (same integrator);
     returns both results and the largest differences in q (rad) and q̇ (rad/s)."""
     a = simulate(robot, q0, qd0, t_end, dt, tau, damping, method, engine="lagrange")
     b = simulate(robot, q0, qd0, t_end, dt, tau, damping, method, engine="pin")
-    return dict(lagrange=a, pin=b, max_dq=float(np.max(np.abs(a.q - b.q))), max_dqd=float(np.max(np.abs(a.qd - b.qd))))
+    return dict(
+        lagrange=a,
+        pin=b,
+        max_dq=float(np.max(np.abs(a.q - b.q))),
+        max_dqd=float(np.max(np.abs(a.qd - b.qd))),
+    )

@@ -17,7 +17,9 @@ def number(value, name: str, unit: str = "") -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise EMGError(f"{name} must be a number{' in ' + unit if unit else ''}, got {value!r}") from None
+        raise EMGError(
+            f"{name} must be a number{' in ' + unit if unit else ''}, got {value!r}"
+        ) from None
     if not math.isfinite(v):
         raise EMGError(f"{name} must be finite{' (' + unit + ')' if unit else ''}, got {value!r}")
     return v
@@ -27,7 +29,9 @@ def positive(value, name: str, unit: str = "") -> float:
     """``value`` as a finite float > 0, else :class:`~anthroarm.errors.EMGError` naming it."""
     v = number(value, name, unit)
     if not v > 0:
-        raise EMGError(f"{name} must be finite and > 0{' (' + unit + ')' if unit else ''}, got {value!r}")
+        raise EMGError(
+            f"{name} must be finite and > 0{' (' + unit + ')' if unit else ''}, got {value!r}"
+        )
     return v
 
 
@@ -35,7 +39,9 @@ def nonnegative(value, name: str, unit: str = "") -> float:
     """``value`` as a finite float >= 0, else :class:`~anthroarm.errors.EMGError` naming it."""
     v = number(value, name, unit)
     if not v >= 0:
-        raise EMGError(f"{name} must be finite and >= 0{' (' + unit + ')' if unit else ''}, got {value!r}")
+        raise EMGError(
+            f"{name} must be finite and >= 0{' (' + unit + ')' if unit else ''}, got {value!r}"
+        )
     return v
 
 
@@ -54,7 +60,9 @@ def signal(x, name: str = "emg", n_channels: int | None = None, min_samples: int
     try:
         a = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
-        raise EMGError(f"{name} must be a numeric array (channels, samples), got {type(x).__name__}") from None
+        raise EMGError(
+            f"{name} must be a numeric array (channels, samples), got {type(x).__name__}"
+        ) from None
     if a.ndim == 1 and (n_channels is None or n_channels == 1):
         a = a[None, :]
     if a.ndim != 2:
@@ -67,9 +75,13 @@ def signal(x, name: str = "emg", n_channels: int | None = None, min_samples: int
         raise EMGError(f"{name} needs at least {min_samples} samples per channel, got {a.shape[1]}")
     if not np.all(np.isfinite(a)):
         bad = np.argwhere(~np.isfinite(a))[0]
-        raise EMGError(f"{name} contains NaN/inf (first at channel {bad[0]}, sample {bad[1]}): "
-                       "fill or cut the gap before processing")
+        raise EMGError(
+            f"{name} contains NaN/inf (first at channel {bad[0]}, sample {bad[1]}): "
+            "fill or cut the gap before processing"
+        )
     if a.size and np.max(np.abs(a)) > MAX_VOLTS:
-        raise EMGError(f"{name} has values up to {np.max(np.abs(a)):.3g}, beyond {MAX_VOLTS:.0e} V: "
-                       "not a voltage (wrong units?)")
+        raise EMGError(
+            f"{name} has values up to {np.max(np.abs(a)):.3g}, beyond {MAX_VOLTS:.0e} V: "
+            "not a voltage (wrong units?)"
+        )
     return a

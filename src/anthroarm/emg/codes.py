@@ -95,20 +95,31 @@ class CodeMachine:
         Length of the switch pulse of the left/right vibrator (s).
     """
 
-    def __init__(self, frame_s: float, debounce_s: float = 0.05, cocontraction_s: float = 0.15,
-                 modes=MODES, start_mode: int = 0, vibrate_s: float = 0.3):
+    def __init__(
+        self,
+        frame_s: float,
+        debounce_s: float = 0.05,
+        cocontraction_s: float = 0.15,
+        modes=MODES,
+        start_mode: int = 0,
+        vibrate_s: float = 0.3,
+    ):
         self.frame_s = positive(frame_s, "frame_s", "s")
         self.n_db = max(1, int(round(nonnegative(debounce_s, "debounce_s", "s") / self.frame_s)))
         self.n_cc = int(round(nonnegative(cocontraction_s, "cocontraction_s", "s") / self.frame_s))
         self.n_vib = max(1, int(round(positive(vibrate_s, "vibrate_s", "s") / self.frame_s)))
         if isinstance(modes, str):
-            raise EMGError(f"modes is a sequence of mode names, e.g. ('elbow', 'wrist', 'fingers'), got the "
-                           f"string {modes!r}")
+            raise EMGError(
+                f"modes is a sequence of mode names, e.g. ('elbow', 'wrist', 'fingers'), got the "
+                f"string {modes!r}"
+            )
         self.modes = tuple(str(m) for m in modes)
         if len(self.modes) < 1:
             raise EMGError("modes needs at least one joint name")
         if not (isinstance(start_mode, (int, np.integer)) and 0 <= start_mode < len(self.modes)):
-            raise EMGError(f"start_mode must be an index 0..{len(self.modes) - 1}, got {start_mode!r}")
+            raise EMGError(
+                f"start_mode must be an index 0..{len(self.modes) - 1}, got {start_mode!r}"
+            )
         self.start_mode = int(start_mode)
         vib = [VIBRATOR_OF_MODE.get(m) for m in self.modes]
         self._vib_col = np.array([-1 if v is None else VIBRATORS.index(v) for v in vib])
@@ -116,29 +127,33 @@ class CodeMachine:
 
     def reset(self) -> None:
         """Back to rest: code 00, the start mode, no lock-out, no pulse, frame 0."""
-        self._frame = 0              # global index of the next frame
-        self._raw = REST             # raw code of the current run
-        self._raw_start = 0          # global frame where the current raw run began
-        self._code = REST            # accepted code
+        self._frame = 0  # global index of the next frame
+        self._raw = REST  # raw code of the current run
+        self._raw_start = 0  # global frame where the current raw run began
+        self._code = REST  # accepted code
         self._mode = self.start_mode
         self._locked = False
-        self._hold = False           # the accepted 11 is a slow one (no switch)
-        self._onset = 0              # raw start of the single-muscle activity that left rest
-        self._vib_until = 0          # global frame (exclusive) until which a switch pulse lasts
+        self._hold = False  # the accepted 11 is a slow one (no switch)
+        self._onset = 0  # raw start of the single-muscle activity that left rest
+        self._vib_until = 0  # global frame (exclusive) until which a switch pulse lasts
         self._vib_mode = self.start_mode
 
     def run(self, raw_codes) -> CodeTrace:
         """Feed raw codes (frames,) int 0..3 (``ProcessedEMG.code``); returns the
         :class:`CodeTrace` of these frames and keeps the state for the next block."""
         r = np.asarray(raw_codes)
-        if r.ndim != 1 or (r.size and (not np.issubdtype(r.dtype, np.integer) or r.min() < 0 or r.max() > 3)):
-            raise EMGError(f"raw_codes must be a 1-D integer array of codes 0..3, got shape {r.shape}, "
-                           f"dtype {r.dtype}")
+        if r.ndim != 1 or (
+            r.size and (not np.issubdtype(r.dtype, np.integer) or r.min() < 0 or r.max() > 3)
+        ):
+            raise EMGError(
+                f"raw_codes must be a 1-D integer array of codes 0..3, got shape {r.shape}, "
+                f"dtype {r.dtype}"
+            )
         m, g0 = r.size, self._frame
         state0 = (self._code, self._mode, self._locked)
         hold0 = self._hold
         vib0 = (self._vib_until, self._vib_mode)
-        events = []                                     # (global frame, code, mode, locked, switched, hold)
+        events = []  # (global frame, code, mode, locked, switched, hold)
         if m:
             change = np.flatnonzero(r[1:] != r[:-1]) + 1
             starts = np.concatenate([[0], change])
@@ -152,7 +167,7 @@ class CodeMachine:
                     self._raw, self._raw_start = c, start
                 if c == self._code or g0 + int(e) - start < self.n_db:
                     continue
-                a = start + self.n_db - 1               # frame on which the run has lasted n_db frames
+                a = start + self.n_db - 1  # frame on which the run has lasted n_db frames
                 switched = hold = False
                 if c == BOTH:
                     if self._code == REST or start - self._onset <= self.n_cc:
@@ -173,10 +188,14 @@ class CodeMachine:
     def _trace(self, m, g0, state0, hold0, vib0, events) -> CodeTrace:
         frames = g0 + np.arange(m)
         ev_f = np.array([e[0] for e in events], dtype=np.int64)
-        table = np.array([state0] + [(e[1], e[2], e[3]) for e in events], dtype=np.int64).reshape(-1, 3)
-        k = np.searchsorted(ev_f, frames, side="right")      # 0 = before the first event
+        table = np.array([state0] + [(e[1], e[2], e[3]) for e in events], dtype=np.int64).reshape(
+            -1, 3
+        )
+        k = np.searchsorted(ev_f, frames, side="right")  # 0 = before the first event
         code, mode, locked = table[k, 0], table[k, 1], table[k, 2].astype(bool)
-        command = np.where(locked, 0, np.where(code == FLEXOR, 1, np.where(code == EXTENSOR, -1, 0))).astype(np.int8)
+        command = np.where(
+            locked, 0, np.where(code == FLEXOR, 1, np.where(code == EXTENSOR, -1, 0))
+        ).astype(np.int8)
         switched = np.zeros(m, dtype=bool)
         hold = np.zeros(m, dtype=bool)
         for f, *_, sw, hd in events:
@@ -189,13 +208,21 @@ class CodeMachine:
         pulses += [(f, f + self.n_vib, md) for f, _, md, _, sw, _ in events if sw]
         for i, (f0, f1, md) in enumerate(pulses):
             if i + 1 < len(pulses):
-                f1 = min(f1, pulses[i + 1][0])         # a new switch ends the previous pulse
+                f1 = min(f1, pulses[i + 1][0])  # a new switch ends the previous pulse
             col = self._vib_col[md]
             lo, hi = max(f0, g0) - g0, min(f1, g0 + m) - g0
             if col >= 0 and hi > lo:
                 vib[lo:hi, col] = True
-        return CodeTrace(code=code.astype(np.int8), mode=mode.astype(np.int8), command=command, switched=switched,
-                         hold=hold, vibrators=vib, modes=self.modes, frame_s=self.frame_s)
+        return CodeTrace(
+            code=code.astype(np.int8),
+            mode=mode.astype(np.int8),
+            command=command,
+            switched=switched,
+            hold=hold,
+            vibrators=vib,
+            modes=self.modes,
+            frame_s=self.frame_s,
+        )
 
 
 def vibrators_with_grasp(trace: CodeTrace, grasped) -> np.ndarray:
@@ -207,4 +234,3 @@ def vibrators_with_grasp(trace: CodeTrace, grasped) -> np.ndarray:
     v = trace.vibrators.copy()
     v[:, VIBRATORS.index("middle")] = g
     return v
-

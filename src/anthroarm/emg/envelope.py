@@ -49,8 +49,10 @@ def window_samples(window_s: float, fs: float) -> int:
     if n < 1:
         raise EMGError(f"envelope window {w:g} s is shorter than one sample at {f:g} Hz")
     if n > MAX_WINDOW_SAMPLES:
-        raise EMGError(f"window {w:g} s at {f:g} Hz is {n:.3g} samples, more than {MAX_WINDOW_SAMPLES:.0e}: "
-                       "is fs in Hz?")
+        raise EMGError(
+            f"window {w:g} s at {f:g} Hz is {n:.3g} samples, more than {MAX_WINDOW_SAMPLES:.0e}: "
+            "is fs in Hz?"
+        )
     return n
 
 
@@ -68,14 +70,16 @@ def moving_rms(x, fs: float, window_s: float = 0.1) -> np.ndarray:
     return running_rms(a, w, np.zeros((a.shape[0], w)), np.arange(a.shape[1]))[0]
 
 
-def running_rms(y: np.ndarray, w: int, tail: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def running_rms(
+    y: np.ndarray, w: int, tail: np.ndarray, idx: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The moving RMS of a stream block: ``y`` (channels, n) the new samples, ``tail``
     (channels, w) the previous ``w`` squared samples (zeros at the start), ``idx`` the sample
     indices (in ``y``) where the RMS is wanted.  Returns (RMS at ``idx``, the new tail)."""
     sq = np.concatenate([tail, y * y], axis=1)
     c = np.cumsum(sq, axis=1)
-    s = c[:, w + idx] - c[:, idx]        # sum of the w squares ending at each idx
-    np.maximum(s, 0.0, out=s)            # rounding of the running sum never makes a negative power
+    s = c[:, w + idx] - c[:, idx]  # sum of the w squares ending at each idx
+    np.maximum(s, 0.0, out=s)  # rounding of the running sum never makes a negative power
     return np.sqrt(s / w), sq[:, -w:]
 
 

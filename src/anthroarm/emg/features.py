@@ -34,7 +34,9 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     a = signal(x, "emg", min_samples=8)
     fs = positive(fs, "sampling rate fs", "Hz")
     n = min(a.shape[1], max(8, int(round(positive(segment_s, "segment_s", "s") * fs))))
-    f, p = sps.welch(a, fs=fs, window="hann", nperseg=n, noverlap=n // 2, detrend="constant", axis=-1)
+    f, p = sps.welch(
+        a, fs=fs, window="hann", nperseg=n, noverlap=n // 2, detrend="constant", axis=-1
+    )
     return f, p
 
 
@@ -46,8 +48,10 @@ def _spectrum_arrays(freqs, psd) -> tuple[np.ndarray, np.ndarray]:
     except (TypeError, ValueError):
         raise EMGError("freqs and psd must be numeric arrays (the output of spectrum())") from None
     if f.ndim != 1 or p.ndim != 2 or p.shape[-1] != f.size:
-        raise EMGError(f"psd (channels, n_freqs) must have one bin per entry of freqs (n_freqs,), got shapes "
-                       f"{p.shape} and {f.shape}")
+        raise EMGError(
+            f"psd (channels, n_freqs) must have one bin per entry of freqs (n_freqs,), got shapes "
+            f"{p.shape} and {f.shape}"
+        )
     if not (np.all(np.isfinite(f)) and np.all(np.isfinite(p))):
         raise EMGError("freqs or psd contains NaN/inf")
     return f, p
@@ -66,7 +70,9 @@ def _weights(freqs, psd, band):
         f, p = f[keep], p[:, keep]
     tot = p.sum(axis=-1)
     if np.any(tot <= 0):
-        raise EMGError("the spectrum has no power (a silent channel): no frequency descriptor exists")
+        raise EMGError(
+            "the spectrum has no power (a silent channel): no frequency descriptor exists"
+        )
     return f, p, tot
 
 
@@ -114,13 +120,13 @@ def band_powers(freqs, psd, bands) -> np.ndarray:
 class SpectralFeatures:
     """FFT descriptors of a recording, one entry per channel (Hz, V²)."""
 
-    freqs: np.ndarray        #: (n_freqs,) Hz
-    psd: np.ndarray          #: (channels, n_freqs) V²/Hz
-    mean_hz: np.ndarray      #: spectral centroid
-    median_hz: np.ndarray    #: median frequency
-    peak_hz: np.ndarray      #: frequency of the PSD maximum
-    power: np.ndarray        #: total power (variance), V²
-    band_power: np.ndarray | None = None   #: (channels, n_bands) V² over the given bands
+    freqs: np.ndarray  #: (n_freqs,) Hz
+    psd: np.ndarray  #: (channels, n_freqs) V²/Hz
+    mean_hz: np.ndarray  #: spectral centroid
+    median_hz: np.ndarray  #: median frequency
+    peak_hz: np.ndarray  #: frequency of the PSD maximum
+    power: np.ndarray  #: total power (variance), V²
+    band_power: np.ndarray | None = None  #: (channels, n_bands) V² over the given bands
 
 
 def spectral_features(x, fs: float, bands=None, segment_s: float = 0.25) -> SpectralFeatures:
@@ -130,6 +136,12 @@ def spectral_features(x, fs: float, bands=None, segment_s: float = 0.25) -> Spec
     if bands is not None and hasattr(bands, "edges"):
         bands = bands.edges
     df = f[1] - f[0]
-    return SpectralFeatures(freqs=f, psd=p, mean_hz=mean_frequency(f, p), median_hz=median_frequency(f, p),
-                            peak_hz=peak_frequency(f, p), power=p.sum(axis=-1) * df,
-                            band_power=None if bands is None else band_powers(f, p, bands))
+    return SpectralFeatures(
+        freqs=f,
+        psd=p,
+        mean_hz=mean_frequency(f, p),
+        median_hz=median_frequency(f, p),
+        peak_hz=peak_frequency(f, p),
+        power=p.sum(axis=-1) * df,
+        band_power=None if bands is None else band_powers(f, p, bands),
+    )

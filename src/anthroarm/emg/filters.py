@@ -54,7 +54,9 @@ MAX_BANDWIDTH_OCTAVES = 10.0
 def _bandwidth(bandwidth_octaves) -> float:
     b = positive(bandwidth_octaves, "bandwidth_octaves", "octaves")
     if b > MAX_BANDWIDTH_OCTAVES:
-        raise EMGError(f"bandwidth_octaves {b:g} is wider than {MAX_BANDWIDTH_OCTAVES:g} octaves: not a bank band")
+        raise EMGError(
+            f"bandwidth_octaves {b:g} is wider than {MAX_BANDWIDTH_OCTAVES:g} octaves: not a bank band"
+        )
     return b
 
 
@@ -66,7 +68,10 @@ def check_sampling_rate(fs, highest_edge_hz: float, what: str) -> float:
     if not fs > need:
         raise SamplingRateError(
             f"sampling rate {fs:g} Hz is not above twice the highest edge of {what} "
-            f"({highest_edge_hz:.4g} Hz): use fs > {need:.4g} Hz or lower the band", fs=fs, required=need)
+            f"({highest_edge_hz:.4g} Hz): use fs > {need:.4g} Hz or lower the band",
+            fs=fs,
+            required=need,
+        )
     return fs
 
 
@@ -78,7 +83,9 @@ def _unwarp(w, fs):
     return fs / np.pi * np.arctan(np.asarray(w, dtype=float) / (2.0 * fs))
 
 
-def band_edges(centre_hz: float, fs: float, bandwidth_octaves: float = BANK_BANDWIDTH_OCTAVES) -> tuple[float, float]:
+def band_edges(
+    centre_hz: float, fs: float, bandwidth_octaves: float = BANK_BANDWIDTH_OCTAVES
+) -> tuple[float, float]:
     r"""The −3 dB edges (Hz) of a bank band centred at ``centre_hz``.
 
     Nominal edges :math:`f_c 2^{\pm b/2}` (``b`` = ``bandwidth_octaves``) taken in the
@@ -152,10 +159,14 @@ class FilterBank:
         except (TypeError, ValueError):
             c = np.zeros((0, 0))
         if c.ndim != 1 or c.size == 0 or not np.all(np.isfinite(c)) or np.any(c <= 0):
-            raise EMGError(f"centres_hz must be a non-empty list of finite frequencies > 0 (Hz), got "
-                           f"{self.centres_hz!r}")
+            raise EMGError(
+                f"centres_hz must be a non-empty list of finite frequencies > 0 (Hz), got "
+                f"{self.centres_hz!r}"
+            )
         b = _bandwidth(self.bandwidth_octaves)
-        check_sampling_rate(self.fs, c.max() * 2.0 ** (b / 2), f"the band centred at {c.max():g} Hz")
+        check_sampling_rate(
+            self.fs, c.max() * 2.0 ** (b / 2), f"the band centred at {c.max():g} Hz"
+        )
         edges = np.array([band_edges(f, self.fs, b) for f in c])
         sos = np.stack([bandpass_sos(lo, hi, self.fs, self.order) for lo, hi in edges])
         object.__setattr__(self, "centres_hz", tuple(float(f) for f in c))

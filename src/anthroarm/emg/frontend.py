@@ -81,11 +81,15 @@ class DifferentialAmplifier:
         a = signal(v_plus, "v_plus")
         b = signal(v_minus, "v_minus")
         if a.shape != b.shape:
-            raise EMGError(f"v_plus and v_minus must have the same shape, got {a.shape} and {b.shape}")
+            raise EMGError(
+                f"v_plus and v_minus must have the same shape, got {a.shape} and {b.shape}"
+            )
         with np.errstate(over="ignore", invalid="ignore"):
             out = self.gain * (a - b) + self.common_mode_gain * 0.5 * (a + b)
         if not np.all(np.isfinite(out)):
-            raise EMGError(f"gain {self.gain:g} times the input overflows the float range: lower the gain")
+            raise EMGError(
+                f"gain {self.gain:g} times the input overflows the float range: lower the gain"
+            )
         if self.rail is None:
             return AmplifierOutput(out, np.zeros(out.shape[0], dtype=int), "ok")
         clipped = np.abs(out) > self.rail

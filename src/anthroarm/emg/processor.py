@@ -59,18 +59,26 @@ class Thresholds:
             on = np.broadcast_to(np.asarray(self.on_pp, dtype=float), (n_channels,)).copy()
             off = np.broadcast_to(np.asarray(self.off_pp, dtype=float), (n_channels,)).copy()
         except (TypeError, ValueError):
-            raise ThresholdError(f"thresholds must be a number or one per channel ({n_channels}), "
-                                 f"got on_pp={self.on_pp!r}, off_pp={self.off_pp!r}") from None
+            raise ThresholdError(
+                f"thresholds must be a number or one per channel ({n_channels}), "
+                f"got on_pp={self.on_pp!r}, off_pp={self.off_pp!r}"
+            ) from None
         for name, v in (("on_pp", on), ("off_pp", off)):
             if not np.all(np.isfinite(v)) or np.any(v <= 0):
-                raise ThresholdError(f"{name} must be finite and > 0 (V peak-to-peak), got {v.tolist()}")
+                raise ThresholdError(
+                    f"{name} must be finite and > 0 (V peak-to-peak), got {v.tolist()}"
+                )
         if np.any(off > on):
             i = int(np.argmax(off > on))
-            raise ThresholdError(f"channel {i}: off-threshold {off[i]:.3g} V is above the on-threshold "
-                                 f"{on[i]:.3g} V (hysteresis needs off <= on)")
+            raise ThresholdError(
+                f"channel {i}: off-threshold {off[i]:.3g} V is above the on-threshold "
+                f"{on[i]:.3g} V (hysteresis needs off <= on)"
+            )
         return on, off
 
-    def check(self, n_channels: int, max_input_pp: float = float("inf"), noise_pp: float = 0.0) -> None:
+    def check(
+        self, n_channels: int, max_input_pp: float = float("inf"), noise_pp: float = 0.0
+    ) -> None:
         """Refuse thresholds that can never switch (:class:`~anthroarm.errors.ThresholdError`):
         an on-threshold at or above ``max_input_pp`` (the largest input the front end passes
         unclipped, V p-p) can never switch on; an off-threshold at or below ``noise_pp`` (the
@@ -78,13 +86,17 @@ class Thresholds:
         on, off = self.arrays(n_channels)
         if np.any(on >= max_input_pp):
             i = int(np.argmax(on >= max_input_pp))
-            raise ThresholdError(f"channel {i}: on-threshold {on[i] * 1e6:.4g} µV p-p is at or above the largest "
-                                 f"input the amplifier passes unclipped ({max_input_pp * 1e6:.4g} µV p-p = 2 rail / "
-                                 "gain): it can never switch on; lower it or the gain")
+            raise ThresholdError(
+                f"channel {i}: on-threshold {on[i] * 1e6:.4g} µV p-p is at or above the largest "
+                f"input the amplifier passes unclipped ({max_input_pp * 1e6:.4g} µV p-p = 2 rail / "
+                "gain): it can never switch on; lower it or the gain"
+            )
         if np.any(off <= noise_pp):
             i = int(np.argmax(off <= noise_pp))
-            raise ThresholdError(f"channel {i}: off-threshold {off[i] * 1e6:.4g} µV p-p is at or below the noise "
-                                 f"floor ({noise_pp * 1e6:.4g} µV p-p): it can never switch off; raise it")
+            raise ThresholdError(
+                f"channel {i}: off-threshold {off[i] * 1e6:.4g} µV p-p is at or below the noise "
+                f"floor ({noise_pp * 1e6:.4g} µV p-p): it can never switch off; raise it"
+            )
 
 
 @dataclass(frozen=True)
@@ -138,10 +150,22 @@ class EMGProcessor:
         baseline noise (V RMS) for :meth:`Thresholds.check`.
     """
 
-    def __init__(self, fs: float, n_channels: int = 2, *, band=CONDITIONING_BAND, notch_hz: float | None = None,
-                 envelope: str = "rms", window_s: float = 0.1, cutoff_hz: float = 5.0, frame_s: float = 0.005,
-                 thresholds: Thresholds | None = None, gain: float = 1.0, max_input_pp: float = float("inf"),
-                 noise_rms: float | None = None):
+    def __init__(
+        self,
+        fs: float,
+        n_channels: int = 2,
+        *,
+        band=CONDITIONING_BAND,
+        notch_hz: float | None = None,
+        envelope: str = "rms",
+        window_s: float = 0.1,
+        cutoff_hz: float = 5.0,
+        frame_s: float = 0.005,
+        thresholds: Thresholds | None = None,
+        gain: float = 1.0,
+        max_input_pp: float = float("inf"),
+        noise_rms: float | None = None,
+    ):
         if not (isinstance(n_channels, (int, np.integer)) and n_channels >= 1):
             raise EMGError(f"n_channels must be an integer >= 1, got {n_channels!r}")
         self.n_channels = int(n_channels)
@@ -168,9 +192,17 @@ class EMGProcessor:
         self.gain = positive(gain, "gain", "V/V")
         self.thresholds = thresholds if thresholds is not None else Thresholds()
         if not isinstance(self.thresholds, Thresholds):
-            raise ThresholdError(f"thresholds must be a Thresholds(on_pp, off_pp), got {thresholds!r}")
-        noise_pp = 0.0 if noise_rms is None else PP_PER_RMS * nonnegative(noise_rms, "noise_rms", "V")
-        mx = float("inf") if max_input_pp == float("inf") else positive(max_input_pp, "max_input_pp", "V")
+            raise ThresholdError(
+                f"thresholds must be a Thresholds(on_pp, off_pp), got {thresholds!r}"
+            )
+        noise_pp = (
+            0.0 if noise_rms is None else PP_PER_RMS * nonnegative(noise_rms, "noise_rms", "V")
+        )
+        mx = (
+            float("inf")
+            if max_input_pp == float("inf")
+            else positive(max_input_pp, "max_input_pp", "V")
+        )
         # no accepted signal exceeds MAX_VOLTS at the processor, 2 MAX_VOLTS / gain p-p at the electrodes
         reach = min(mx, 2.0 * MAX_VOLTS / self.gain)
         self.thresholds.check(self.n_channels, reach, noise_pp)
@@ -185,11 +217,11 @@ class EMGProcessor:
         n = self.n_channels
         self._zi = np.zeros((self.sos.shape[0], n, 2))
         if self.envelope == "rms":
-            self._tail = np.zeros((n, self.window))      # last `window` squared samples
+            self._tail = np.zeros((n, self.window))  # last `window` squared samples
         else:
             self._zi_env = np.zeros((self.env_sos.shape[0], n, 2))
         self._state = np.zeros(n, dtype=bool)
-        self._count = 0                                    # samples seen so far
+        self._count = 0  # samples seen so far
 
     def process(self, emg, reset: bool = True) -> ProcessedEMG:
         """Run the chain on ``emg`` (channels, samples) volts; ``reset=False`` continues the
@@ -199,7 +231,7 @@ class EMGProcessor:
             self.reset()
         y, self._zi = sps.sosfilt(self.sos, x, axis=-1, zi=self._zi)
         n = x.shape[1]
-        first = (-self._count - 1) % self.hop            # index of the first frame's last sample
+        first = (-self._count - 1) % self.hop  # index of the first frame's last sample
         idx = np.arange(first, n, self.hop)
         if self.envelope == "rms":
             e, self._tail = running_rms(y, self.window, self._tail, idx)
@@ -210,8 +242,17 @@ class EMGProcessor:
         t = (self._count + idx + 1) / self.fs
         self._count += n
         code = (2 * active[0] + active[1]).astype(np.int8) if self.n_channels == 2 else None
-        return ProcessedEMG(filtered=y / self.gain, envelope_pp=e * (self._pp / self.gain), active=active, code=code,
-                            t_frames=t, on_pp=self.on, off_pp=self.off, fs=self.fs, frame_s=self.frame_s)
+        return ProcessedEMG(
+            filtered=y / self.gain,
+            envelope_pp=e * (self._pp / self.gain),
+            active=active,
+            code=code,
+            t_frames=t,
+            on_pp=self.on,
+            off_pp=self.off,
+            fs=self.fs,
+            frame_s=self.frame_s,
+        )
 
     def _schmitt(self, e: np.ndarray) -> np.ndarray:
         """Vectorised hysteresis: on at >= on, off at <= off, else hold the previous state."""
@@ -246,8 +287,15 @@ class Calibration:
     status: str
 
 
-def calibrate_thresholds(rest, fs: float, *, k: float = 5.0, off_fraction: float = 0.5, settle_s: float = 0.3,
-                         **processor_kw) -> Calibration:
+def calibrate_thresholds(
+    rest,
+    fs: float,
+    *,
+    k: float = 5.0,
+    off_fraction: float = 0.5,
+    settle_s: float = 0.3,
+    **processor_kw,
+) -> Calibration:
     """On/off thresholds from a recording of the relaxed muscles (``rest``, (channels, samples)
     V at the electrodes), through the same chain as ``EMGProcessor(fs, **processor_kw)``.
 
@@ -272,8 +320,10 @@ def calibrate_thresholds(rest, fs: float, *, k: float = 5.0, off_fraction: float
     out = EMGProcessor(fs, **kw).process(x)
     keep = out.t_frames > settle
     if out.t_frames[keep].size == 0 or out.t_frames[-1] - settle < 1.0 - 1e-9:
-        raise EMGError(f"the rest recording must last at least {settle + 1.0:g} s "
-                       f"({settle:g} s to settle + 1 s), got {x.shape[1] / out.fs:g} s")
+        raise EMGError(
+            f"the rest recording must last at least {settle + 1.0:g} s "
+            f"({settle:g} s to settle + 1 s), got {x.shape[1] / out.fs:g} s"
+        )
     e = out.envelope_pp[:, keep]
     mean, sd = e.mean(axis=1), e.std(axis=1)
     on = mean + kk * sd
@@ -281,7 +331,12 @@ def calibrate_thresholds(rest, fs: float, *, k: float = 5.0, off_fraction: float
     off = np.where(off > 0, off, 0.5 * on)
     if not np.all(on > 0):
         raise EMGError("the rest recording is silent (envelope 0): record with the electrodes on")
-    bad = [f"channel {c}: on-threshold {on[c] * 1e6:.3g} µV p-p is above the book's {BOOK_SENSITIVITY_PP * 1e6:g} µV "
-           "sensitivity (rest noise too high: check the electrodes)" for c in range(on.size)
-           if on[c] > BOOK_SENSITIVITY_PP]
-    return Calibration(Thresholds(tuple(on.tolist()), tuple(off.tolist())), mean, sd, "; ".join(bad) or "ok")
+    bad = [
+        f"channel {c}: on-threshold {on[c] * 1e6:.3g} µV p-p is above the book's {BOOK_SENSITIVITY_PP * 1e6:g} µV "
+        "sensitivity (rest noise too high: check the electrodes)"
+        for c in range(on.size)
+        if on[c] > BOOK_SENSITIVITY_PP
+    ]
+    return Calibration(
+        Thresholds(tuple(on.tolist()), tuple(off.tolist())), mean, sd, "; ".join(bad) or "ok"
+    )

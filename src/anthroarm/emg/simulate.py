@@ -47,8 +47,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import EMGError, ParameterError, UnsupportedModelError
 from ..control.servo import PositionServo
+from ..errors import EMGError, ParameterError, UnsupportedModelError
 from .codes import VIBRATORS, CodeMachine, CodeTrace, vibrators_with_grasp
 from .processor import EMGProcessor, ProcessedEMG
 
@@ -67,7 +67,9 @@ def prosthesis_motor(i: float = 200.0, eta: float = 0.7):
     sheets, an assumption; no-load speed V/k_m = 1000 rad/s ≈ 9550 r/min."""
     from ..control.motor import DCMotor
 
-    return DCMotor(R=5.0, k_m=6e-3, J_m=6e-8, i=float(i), eta=float(eta), V_nom=6.0, name="16 mm coreless")
+    return DCMotor(
+        R=5.0, k_m=6e-3, J_m=6e-8, i=float(i), eta=float(eta), V_nom=6.0, name="16 mm coreless"
+    )
 
 
 def joint_servo(motor, J_L: float, omega_n_min: float = 20.0):
@@ -75,7 +77,9 @@ def joint_servo(motor, J_L: float, omega_n_min: float = 20.0):
     load inertia ``J_L`` (kg·m²), amplifier limited to ``motor.V_nom``: ω_n is the larger of
     ``omega_n_min`` and 1.05 × the motor's own damping limit (below it no tachogenerator gain
     gives ζ = 1)."""
-    bare = PositionServo.from_motor(motor, J_L, k_a=1.0, k_p=1.0)      # k_s = 0: the motor's damping only
+    bare = PositionServo.from_motor(
+        motor, J_L, k_a=1.0, k_p=1.0
+    )  # k_s = 0: the motor's damping only
     omega_n = max(float(omega_n_min), 1.05 * bare.Kv / (2.0 * bare.J0))
     return PositionServo.tuned(motor, J_L, omega_n=omega_n, zeta=1.0, V_max=motor.V_nom)
 
@@ -102,8 +106,19 @@ class HandModel:
     still: float = 0.05
 
     def __post_init__(self):
-        vals = {k: getattr(self, k) for k in ("J_L", "lower", "upper", "contact_stiffness", "contact_damping",
-                                              "max_lead", "grasp_torque", "still")}
+        vals = {
+            k: getattr(self, k)
+            for k in (
+                "J_L",
+                "lower",
+                "upper",
+                "contact_stiffness",
+                "contact_damping",
+                "max_lead",
+                "grasp_torque",
+                "still",
+            )
+        }
         for k, v in vals.items():
             if not (isinstance(v, (int, float, np.floating, np.integer)) and np.isfinite(v)):
                 raise ParameterError(f"HandModel.{k} must be a finite number, got {v!r}")
@@ -114,18 +129,28 @@ class HandModel:
             if vals[k] < 0:
                 raise ParameterError(f"HandModel.{k} must be >= 0, got {vals[k]!r}")
         if not self.lower < self.upper:
-            raise ParameterError(f"HandModel: lower ({self.lower}) must be below upper ({self.upper}) rad")
+            raise ParameterError(
+                f"HandModel: lower ({self.lower}) must be below upper ({self.upper}) rad"
+            )
         oa = self.object_angle
-        if oa is not None and not (isinstance(oa, (int, float, np.floating)) and self.lower <= oa <= self.upper):
-            raise ParameterError(f"HandModel.object_angle must be None or in [lower, upper] = "
-                                 f"[{self.lower}, {self.upper}] rad, got {oa!r}")
+        if oa is not None and not (
+            isinstance(oa, (int, float, np.floating)) and self.lower <= oa <= self.upper
+        ):
+            raise ParameterError(
+                f"HandModel.object_angle must be None or in [lower, upper] = "
+                f"[{self.lower}, {self.upper}] rad, got {oa!r}"
+            )
 
     def contact_torque(self, theta, omega):
         """Load torque of the object on the closing fingers (N·m, ≥ 0)."""
         if self.object_angle is None:
             return np.zeros_like(np.asarray(theta, dtype=float))
         pen = np.asarray(theta, dtype=float) - self.object_angle
-        return np.where(pen > 0, np.maximum(self.contact_stiffness * pen + self.contact_damping * omega, 0.0), 0.0)
+        return np.where(
+            pen > 0,
+            np.maximum(self.contact_stiffness * pen + self.contact_damping * omega, 0.0),
+            0.0,
+        )
 
 
 @dataclass
@@ -170,20 +195,31 @@ class PoweredHandResult:
 
         if fig is None:
             fig = plt.figure(figsize=(9, 9.5))
-        ax = fig.subplots(5, 1, sharex=True, gridspec_kw=dict(height_ratios=[1.2, 1.2, 0.7, 0.8, 1.5]))
+        ax = fig.subplots(
+            5, 1, sharex=True, gridspec_kw=dict(height_ratios=[1.2, 1.2, 0.7, 0.8, 1.5])
+        )
         names = ("flexor", "extensor")
         for c in range(self.emg.shape[0]):
-            ax[0].plot(self.t_emg, self.emg[c] * 1e6, lw=0.4, alpha=0.8,
-                       label=names[c] if c < 2 else f"ch {c}")
+            ax[0].plot(
+                self.t_emg,
+                self.emg[c] * 1e6,
+                lw=0.4,
+                alpha=0.8,
+                label=names[c] if c < 2 else f"ch {c}",
+            )
         ax[0].set_ylabel("EMG [µV]")
         ax[0].legend(fontsize=7, loc="upper right")
         p = self.processed
         for c in range(p.envelope_pp.shape[0]):
-            line, = ax[1].plot(self.t, p.envelope_pp[c] * 1e6, label=f"{names[c] if c < 2 else c} envelope")
+            (line,) = ax[1].plot(
+                self.t, p.envelope_pp[c] * 1e6, label=f"{names[c] if c < 2 else c} envelope"
+            )
             ax[1].axhline(p.on_pp[c] * 1e6, color=line.get_color(), ls="--", lw=0.8)
             ax[1].axhline(p.off_pp[c] * 1e6, color=line.get_color(), ls=":", lw=0.8)
         ax[1].set_ylabel("p-p [µV]")
-        ax[1].legend(fontsize=7, loc="upper right", title="-- on, ··· off threshold", title_fontsize=7)
+        ax[1].legend(
+            fontsize=7, loc="upper right", title="-- on, ··· off threshold", title_fontsize=7
+        )
         ax[2].step(self.t, p.code, where="post", color="0.6", lw=0.8, label="raw")
         ax[2].step(self.t, self.trace.code, where="post", color="k", label="debounced")
         ax[2].set_yticks([0, 1, 2, 3], ["00", "01", "10", "11"])
@@ -191,17 +227,26 @@ class PoweredHandResult:
         ax[2].legend(fontsize=7, loc="upper right")
         ax[3].step(self.t, self.trace.mode, where="post", label="mode")
         ax[3].step(self.t, self.trace.command, where="post", label="command")
-        ax[3].set_yticks(range(-1, len(self.modes)), ["−1"] + [f"{i}: {m}" if i else f"0: {m}"
-                                                               for i, m in enumerate(self.modes)])
+        ax[3].set_yticks(
+            range(-1, len(self.modes)),
+            ["−1"] + [f"{i}: {m}" if i else f"0: {m}" for i, m in enumerate(self.modes)],
+        )
         for k, col in enumerate(VIBRATORS):
             on = self.vibrators[:, k]
             if on.any():
-                ax[3].fill_between(self.t, -1, len(self.modes) - 1, where=on, step="post", alpha=0.15,
-                                   label=f"{col} vibrator")
+                ax[3].fill_between(
+                    self.t,
+                    -1,
+                    len(self.modes) - 1,
+                    where=on,
+                    step="post",
+                    alpha=0.15,
+                    label=f"{col} vibrator",
+                )
         ax[3].set_ylabel("mode / command")
         ax[3].legend(fontsize=7, loc="upper right", ncol=2)
         for j, m in enumerate(self.modes):
-            line, = ax[4].plot(self.t, self.angle[:, j], label=f"{m} ({self.joint_names[j]})")
+            (line,) = ax[4].plot(self.t, self.angle[:, j], label=f"{m} ({self.joint_names[j]})")
             ax[4].plot(self.t, self.setpoint[:, j], ls="--", lw=0.8, color=line.get_color())
         ax[4].set_ylabel("angle [rad]")
         ax[4].set_xlabel("t [s]")
@@ -216,18 +261,20 @@ class PoweredHandResult:
         from ..viewer import Viewer
 
         v = Viewer(self.robot)
-        Q = self.q[::max(1, int(every))]
+        Q = self.q[:: max(1, int(every))]
         v.play(Q, dt=self.trace.frame_s * max(1, int(every)), loop=True, trace=False)
         return v
 
 
-def _setpoints(trace: CodeTrace, j: int, speed: float, lo: float, hi: float, start: float) -> np.ndarray:
+def _setpoints(
+    trace: CodeTrace, j: int, speed: float, lo: float, hi: float, start: float
+) -> np.ndarray:
     """The set-point of mode ``j`` per frame: it moves at ``speed`` while ``trace`` commands
     this mode, clipped to [lo, hi]."""
     step = speed * trace.frame_s * trace.command * (trace.mode == j)
     out = np.empty(step.size)
     s, last = start, 0
-    for k in np.flatnonzero(step):            # only frames that move; the rest hold
+    for k in np.flatnonzero(step):  # only frames that move; the rest hold
         out[last:k] = s
         s = min(max(s + step[k], lo), hi)
         last = k
@@ -235,9 +282,20 @@ def _setpoints(trace: CodeTrace, j: int, speed: float, lo: float, hi: float, sta
     return out
 
 
-def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, processor: EMGProcessor | None = None,
-                          machine: CodeMachine | None = None, servos: dict | None = None, speeds: dict | None = None,
-                          hand: HandModel | None = None, dt: float = 1e-3) -> PoweredHandResult:
+def simulate_powered_hand(
+    robot,
+    emg,
+    fs: float,
+    joints: dict,
+    *,
+    q0=None,
+    processor: EMGProcessor | None = None,
+    machine: CodeMachine | None = None,
+    servos: dict | None = None,
+    speeds: dict | None = None,
+    hand: HandModel | None = None,
+    dt: float = 1e-3,
+) -> PoweredHandResult:
     """Run EMG → codes → servos → arm and hand (see the module text).
 
     Parameters
@@ -284,47 +342,71 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
 
     robot = robot if isinstance(robot, Robot) else load(robot)
     if not isinstance(joints, dict) or not joints:
-        raise ParameterError("joints maps each mode name to a joint name of the robot or None, e.g. "
-                             "{'elbow': 'elbow_flexion', 'wrist': 'forearm_rotation', 'fingers': None}")
+        raise ParameterError(
+            "joints maps each mode name to a joint name of the robot or None, e.g. "
+            "{'elbow': 'elbow_flexion', 'wrist': 'forearm_rotation', 'fingers': None}"
+        )
     modes = tuple(joints)
     if sum(v is None for v in joints.values()) > 1:
         raise ParameterError("at most one mode can be the built-in hand (None)")
     processor = processor if processor is not None else EMGProcessor(fs, 2)
     if processor.n_channels != 2 or abs(processor.fs - float(fs)) > 1e-9 * float(fs):
-        raise EMGError(f"the processor must take 2 channels at fs = {fs} Hz (has {processor.n_channels} at "
-                       f"{processor.fs} Hz)")
+        raise EMGError(
+            f"the processor must take 2 channels at fs = {fs} Hz (has {processor.n_channels} at "
+            f"{processor.fs} Hz)"
+        )
     machine = machine if machine is not None else CodeMachine(processor.frame_s, modes=modes)
     if machine.modes != modes:
-        raise ParameterError(f"the machine's modes {machine.modes} differ from the joints' modes {modes}")
+        raise ParameterError(
+            f"the machine's modes {machine.modes} differ from the joints' modes {modes}"
+        )
     hand = hand if hand is not None else HandModel()
     if not isinstance(hand, HandModel):
         raise ParameterError(f"hand must be a HandModel, got {type(hand).__name__}")
     speeds = {m: DEFAULT_SPEED for m in modes} | dict(speeds or {})
     for m, v in speeds.items():
-        if m not in modes or not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v) and v > 0):
-            raise ParameterError(f"speeds: mode {m!r} must be one of {modes} with a finite speed > 0 rad/s, got {v!r}")
+        if m not in modes or not (
+            isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v) and v > 0
+        ):
+            raise ParameterError(
+                f"speeds: mode {m!r} must be one of {modes} with a finite speed > 0 rad/s, got {v!r}"
+            )
     for m, sv in (servos or {}).items():
         if m not in modes or not isinstance(sv, PositionServo):
-            raise ParameterError(f"servos: mode {m!r} must be one of {modes} with a PositionServo, got {sv!r}")
-    if not (isinstance(dt, (int, float, np.integer, np.floating)) and np.isfinite(dt) and 0 < dt <= processor.frame_s):
-        raise ParameterError(f"dt must be a finite step > 0 s and at most one control frame ({processor.frame_s:g} s), "
-                             f"got {dt!r}")
+            raise ParameterError(
+                f"servos: mode {m!r} must be one of {modes} with a PositionServo, got {sv!r}"
+            )
+    if not (
+        isinstance(dt, (int, float, np.integer, np.floating))
+        and np.isfinite(dt)
+        and 0 < dt <= processor.frame_s
+    ):
+        raise ParameterError(
+            f"dt must be a finite step > 0 s and at most one control frame ({processor.frame_s:g} s), "
+            f"got {dt!r}"
+        )
 
     chain = robot.chain
     names = {}
     for m, v in joints.items():
         seq = () if v is None else ((v,) if isinstance(v, str) else tuple(v))
         if v is not None and (not seq or not all(isinstance(n, str) for n in seq)):
-            raise ParameterError(f"joints[{m!r}] must be a joint name, a list of joint names or None, got {v!r}")
+            raise ParameterError(
+                f"joints[{m!r}] must be a joint name, a list of joint names or None, got {v!r}"
+            )
         names[m] = seq
-    drives = [(m, chain.joint(n)) for m in modes for n in names[m]]      # (mode, joint), mode order
+    drives = [(m, chain.joint(n)) for m in modes for n in names[m]]  # (mode, joint), mode order
     seen = [jt.name for _, jt in drives]
     if len(set(seen)) != len(seen):
-        raise ParameterError(f"a joint is driven by two modes: {sorted(n for n in set(seen) if seen.count(n) > 1)}")
+        raise ParameterError(
+            f"a joint is driven by two modes: {sorted(n for n in set(seen) if seen.count(n) > 1)}"
+        )
     for m, jt in drives:
         if jt.kind == "continuous" or jt.is_mimic:
-            raise UnsupportedModelError(f"joint {jt.name!r} ({m}) is {jt.kind}{' mimic' if jt.is_mimic else ''}; "
-                                        "a driven joint must be a revolute or prismatic joint with its own q")
+            raise UnsupportedModelError(
+                f"joint {jt.name!r} ({m}) is {jt.kind}{' mimic' if jt.is_mimic else ''}; "
+                "a driven joint must be a revolute or prismatic joint with its own q"
+            )
     if q0 is None:
         q0 = np.zeros(robot.nq)
         for jt in chain.joints:
@@ -340,19 +422,23 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
 
     # ---- signal chain
     x = np.asarray(emg, dtype=float)
-    proc = processor.process(x)                 # reset=True: the run starts from rest
-    machine.reset()                              # so does the state machine (a reused one kept its mode)
+    proc = processor.process(x)  # reset=True: the run starts from rest
+    machine.reset()  # so does the state machine (a reused one kept its mode)
     trace = machine.run(proc.code)
     t = proc.t_frames
     n_f = t.size
     if n_f < 2:
         raise EMGError(f"the EMG is shorter than two control frames ({processor.frame_s} s each)")
     if drives and t[-1] / dt > MAX_STEPS:
-        raise ParameterError(f"{t[-1]:g} s of EMG at dt = {dt:g} s is {t[-1] / dt:.3g} integration steps, more than "
-                             f"{MAX_STEPS:.0e}: raise dt or cut the recording")
+        raise ParameterError(
+            f"{t[-1]:g} s of EMG at dt = {dt:g} s is {t[-1] / dt:.3g} integration steps, more than "
+            f"{MAX_STEPS:.0e}: raise dt or cut the recording"
+        )
 
     # ---- the arm: driven joints free, the others locked at q0
-    locked = {jt.name: float(q0[jt.idx_q]) for jt in chain.joints if jt.nq == 1 and jt.name not in seen}
+    locked = {
+        jt.name: float(q0[jt.idx_q]) for jt in chain.joints if jt.nq == 1 and jt.name not in seen
+    }
     setpoint = np.zeros((n_f, len(modes)))
     angle = np.zeros((n_f, len(modes)))
     q_out = np.repeat(q0[None, :], n_f, axis=0)
@@ -364,24 +450,31 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
         M0 = pin.crba(red.model, red.model.createData(), rq0)
         col = [red.chain.joint(jt.name).idx_v for _, jt in drives]
         g0 = pin.computeGeneralizedGravity(red.model, red.model.createData(), rq0)
-        per_ratio = prosthesis_motor(1.0).stall_torque()             # N m of stall torque per unit of i
+        per_ratio = prosthesis_motor(1.0).stall_torque()  # N m of stall torque per unit of i
         srv = []
         for (m, jt), c in zip(drives, col):
             given = (servos or {}).get(m)
             # the gearbox: the mode's default ratio, raised (in steps of 50) until the stall torque is
             # at least twice the gravity load at q0 (a sizing margin, an assumption)
-            i = max(DEFAULT_RATIOS.get(m, 200.0), 50.0 * np.ceil(2.0 * abs(float(g0[c])) / per_ratio / 50.0))
+            i = max(
+                DEFAULT_RATIOS.get(m, 200.0),
+                50.0 * np.ceil(2.0 * abs(float(g0[c])) / per_ratio / 50.0),
+            )
             srv.append(given or joint_servo(prosthesis_motor(i), float(M0[c, c])))
             per_joint[jt.name] = srv[-1]
-            used.setdefault(m, srv[-1])                              # a mode's first joint
+            used.setdefault(m, srv[-1])  # a mode's first joint
         model = red.model.copy()
         for c, sv in zip(col, srv):
-            model.armature[c] += sv.J0 - sv.J_L                      # reflected motor inertia, eta i^2 J_m
+            model.armature[c] += sv.J0 - sv.J_L  # reflected motor inertia, eta i^2 J_m
         # the servos have settled at q0: each set-point starts at q0 + M_L / K_s, Eq. (9-8),
         # with M_L the gravity torque Pinocchio gives there
-        start = [float(q0[jt.idx_q]) + float(g0[c]) / sv.Ks for (_, jt), c, sv in zip(drives, col, srv)]
-        sp = [_setpoints(trace, modes.index(m), speeds[m], jt.lower, jt.upper, s0)
-              for (m, jt), s0 in zip(drives, start)]
+        start = [
+            float(q0[jt.idx_q]) + float(g0[c]) / sv.Ks for (_, jt), c, sv in zip(drives, col, srv)
+        ]
+        sp = [
+            _setpoints(trace, modes.index(m), speeds[m], jt.lower, jt.upper, s0)
+            for (m, jt), s0 in zip(drives, start)
+        ]
 
         def tau(tt, q, qd):
             k = min(max(int(np.searchsorted(t, tt, side="right")) - 1, -1), n_f - 1)
@@ -392,13 +485,15 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
                 out[c] = sv.J0 * sv.rhs(np.array([q[c], qd[c]]), ti, 0.0)[1]
             return out
 
-        sim = simulate(red, rq0, np.zeros(red.nv), float(t[-1]), dt=dt, tau=tau, engine="pin", pin_model=model)
+        sim = simulate(
+            red, rq0, np.zeros(red.nv), float(t[-1]), dt=dt, tau=tau, engine="pin", pin_model=model
+        )
         status = sim.status
         first = set()
         for (m, jt), c, spi in zip(drives, col, sp):
             a = np.interp(t, sim.t, sim.q[:, c])
             q_out[:, jt.idx_q] = a
-            if m not in first:                                       # the mode's columns: its first joint
+            if m not in first:  # the mode's columns: its first joint
                 first.add(m)
                 j = modes.index(m)
                 angle[:, j], setpoint[:, j] = a, spi
@@ -410,7 +505,9 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
     if hand_modes:
         m = hand_modes[0]
         j = modes.index(m)
-        hs = (servos or {}).get(m) or joint_servo(prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), hand.J_L)
+        hs = (servos or {}).get(m) or joint_servo(
+            prosthesis_motor(DEFAULT_RATIOS.get(m, 200.0)), hand.J_L
+        )
         used[m] = hs
         cmd = trace.command * (trace.mode == j)
         v = speeds[m]
@@ -428,18 +525,41 @@ def simulate_powered_hand(robot, emg, fs: float, joints: dict, *, q0=None, proce
             return [d[0], d[1], rate]
 
         th0 = float(hand.lower)
-        sol = solve_ivp(rhs, (0.0, float(t[-1])), [th0, 0.0, th0], t_eval=t, max_step=processor.frame_s,
-                        rtol=1e-6, atol=1e-9)
+        sol = solve_ivp(
+            rhs,
+            (0.0, float(t[-1])),
+            [th0, 0.0, th0],
+            t_eval=t,
+            max_step=processor.frame_s,
+            rtol=1e-6,
+            atol=1e-9,
+        )
         if not sol.success:
             status = f"hand: {sol.message}"
         th, om, ti = sol.y
         angle[:, j], setpoint[:, j] = th, np.clip(ti, hand.lower, hand.upper)
         load_est = hs.estimate_load_torque(hs.k_p * (ti - th))
-        grasped = ((load_est >= hand.grasp_torque) & (np.abs(om) < hand.still)) | (th >= hand.upper - 0.02)
+        grasped = ((load_est >= hand.grasp_torque) & (np.abs(om) < hand.still)) | (
+            th >= hand.upper - 0.02
+        )
     vib = vibrators_with_grasp(trace, grasped)
-    return PoweredHandResult(t=t, processed=proc, trace=trace, modes=modes,
-                             joint_names=tuple(n if n is not None else "hand" for n in joints.values()),
-                             setpoint=setpoint, angle=angle, q=q_out, grasped=grasped, load_estimate=load_est,
-                             vibrators=vib, emg=x, t_emg=np.arange(x.shape[1]) / fs,
-                             robot=robot, servos=used, joint_servos=per_joint, hand=hand if hand_modes else None,
-                             status=status)
+    return PoweredHandResult(
+        t=t,
+        processed=proc,
+        trace=trace,
+        modes=modes,
+        joint_names=tuple(n if n is not None else "hand" for n in joints.values()),
+        setpoint=setpoint,
+        angle=angle,
+        q=q_out,
+        grasped=grasped,
+        load_estimate=load_est,
+        vibrators=vib,
+        emg=x,
+        t_emg=np.arange(x.shape[1]) / fs,
+        robot=robot,
+        servos=used,
+        joint_servos=per_joint,
+        hand=hand if hand_modes else None,
+        status=status,
+    )

@@ -49,11 +49,15 @@ def _band(band, fs: float) -> tuple[float, float]:
     except (TypeError, ValueError):
         raise EMGError(f"band must be (low, high) in Hz, got {band!r}") from None
     if not (0 <= lo < hi < fs / 2):
-        raise EMGError(f"band must satisfy 0 <= low < high < fs/2 = {fs / 2:g} Hz, got ({lo:g}, {hi:g})")
+        raise EMGError(
+            f"band must satisfy 0 <= low < high < fs/2 = {fs / 2:g} Hz, got ({lo:g}, {hi:g})"
+        )
     return lo, hi
 
 
-def band_limited_noise(n_samples: int, fs: float, band=EMG_BAND, n_channels: int = 1, rng=None) -> np.ndarray:
+def band_limited_noise(
+    n_samples: int, fs: float, band=EMG_BAND, n_channels: int = 1, rng=None
+) -> np.ndarray:
     """Gaussian noise with a flat spectrum inside ``band`` (Hz) and none outside (FFT brick-wall),
     scaled to unit sample variance per channel; shape (n_channels, n_samples).  ``band[1]``
     must be below fs/2; at most :data:`MAX_SAMPLES` samples in all."""
@@ -85,14 +89,18 @@ def activation(t, bursts, ramp_s: float = 0.05) -> np.ndarray:
     try:
         bursts = list(bursts)
     except TypeError:
-        raise EMGError(f"bursts is a list of (onset_s, duration_s, level), got {bursts!r}") from None
+        raise EMGError(
+            f"bursts is a list of (onset_s, duration_s, level), got {bursts!r}"
+        ) from None
     for b in bursts:
         try:
             t0, dur, level = (float(v) for v in b)
         except (TypeError, ValueError):
             raise EMGError(f"a burst is (onset_s, duration_s, level), got {b!r}") from None
         if not (np.isfinite(t0) and np.isfinite(dur) and dur > 0 and 0 <= level <= 1):
-            raise EMGError(f"a burst needs a finite onset, duration > 0 and a level in [0, 1], got {b!r}")
+            raise EMGError(
+                f"a burst needs a finite onset, duration > 0 and a level in [0, 1], got {b!r}"
+            )
         rr = min(r, dur / 2)
         up = np.clip((t - t0) / rr, 0.0, 1.0)
         down = np.clip((t0 + dur - t) / rr, 0.0, 1.0)
@@ -118,8 +126,16 @@ class SyntheticEMG:
     fs: float
 
 
-def synthesize(duration_s: float, fs: float, bursts, pp=TYPICAL_PP, band=EMG_BAND, noise_rms: float = 1e-6,
-               ramp_s: float = 0.05, rng=None) -> SyntheticEMG:
+def synthesize(
+    duration_s: float,
+    fs: float,
+    bursts,
+    pp=TYPICAL_PP,
+    band=EMG_BAND,
+    noise_rms: float = 1e-6,
+    ramp_s: float = 0.05,
+    rng=None,
+) -> SyntheticEMG:
     """Generate EMG: one channel per entry of ``bursts`` (each a list of
     ``(onset_s, duration_s, level)``), full-activation amplitude ``pp`` (V sine-equivalent
     peak-to-peak, scalar or one per channel; e.g. :data:`HEALTHY_PP`, :data:`AMPUTEE_PP`),
@@ -132,13 +148,17 @@ def synthesize(duration_s: float, fs: float, bursts, pp=TYPICAL_PP, band=EMG_BAN
         raise EMGError("bursts is a list with one list of (onset_s, duration_s, level) per channel")
     n_ch = len(bursts)
     if not 16 <= dur * fs * n_ch <= MAX_SAMPLES:
-        raise EMGError(f"duration_s * fs * channels = {dur * fs * n_ch:.3g} samples; the generator makes "
-                       f"16..{MAX_SAMPLES:.0e}")
+        raise EMGError(
+            f"duration_s * fs * channels = {dur * fs * n_ch:.3g} samples; the generator makes "
+            f"16..{MAX_SAMPLES:.0e}"
+        )
     n = int(round(dur * fs))
     try:
         p = np.broadcast_to(np.asarray(pp, dtype=float), (n_ch,)).copy()
     except (TypeError, ValueError):
-        raise EMGError(f"pp is one amplitude (V peak-to-peak) or one per channel ({n_ch}), got {pp!r}") from None
+        raise EMGError(
+            f"pp is one amplitude (V peak-to-peak) or one per channel ({n_ch}), got {pp!r}"
+        ) from None
     if not np.all(np.isfinite(p)) or np.any(p <= 0):
         raise EMGError(f"pp must be finite and > 0 (V peak-to-peak), got {p.tolist()}")
     nr = nonnegative(noise_rms, "noise_rms", "V")
@@ -153,7 +173,9 @@ def synthesize(duration_s: float, fs: float, bursts, pp=TYPICAL_PP, band=EMG_BAN
     return SyntheticEMG(t=t, emg=x, activation=act, envelope_rms=env, pp=p, noise_rms=nr, fs=fs)
 
 
-def electrode_potentials(emg, fs: float, mains_pp: float = 0.0, mains_hz: float = 50.0, offset_v: float = 0.0):
+def electrode_potentials(
+    emg, fs: float, mains_pp: float = 0.0, mains_hz: float = 50.0, offset_v: float = 0.0
+):
     """The two electrode potentials of a bipolar pair recording ``emg`` (V): the differential
     EMG split symmetrically, plus a **common-mode** mains hum of ``mains_pp`` volts
     peak-to-peak at ``mains_hz`` and a common DC ``offset_v`` (the interference the book's
@@ -165,6 +187,8 @@ def electrode_potentials(emg, fs: float, mains_pp: float = 0.0, mains_hz: float 
     f0 = positive(mains_hz, "mains_hz", "Hz")
     cm = 0.5 * amp * np.sin(2 * np.pi * f0 * t) + number(offset_v, "offset_v", "V")
     if not np.all(np.isfinite(cm)) or amp + abs(float(offset_v)) > MAX_VOLTS:
-        raise EMGError(f"mains_pp {mains_pp!r} V and offset_v {offset_v!r} V are beyond {MAX_VOLTS:.0e} V: "
-                       "not a voltage (wrong units?)")
+        raise EMGError(
+            f"mains_pp {mains_pp!r} V and offset_v {offset_v!r} V are beyond {MAX_VOLTS:.0e} V: "
+            "not a voltage (wrong units?)"
+        )
     return cm + 0.5 * x, cm - 0.5 * x

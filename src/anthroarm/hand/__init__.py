@@ -17,9 +17,29 @@ Modules: :mod:`~anthroarm.hand.fingers` (fingers, palm, pad normals, span, from
 """
 
 from .fingers import Finger, Hand
-from .grasp import NORMAL_TOL, POSITION_TOL, GraspResult, check_span, grasp_errors, grasp_tasks, solve_grasp
+from .grasp import (
+    NORMAL_TOL,
+    POSITION_TOL,
+    GraspResult,
+    check_span,
+    grasp_errors,
+    grasp_tasks,
+    solve_grasp,
+)
 from .objects import Cylinder, Sphere
 from .overlays import show_grasp
 
-__all__ = ["Hand", "Finger", "Sphere", "Cylinder", "solve_grasp", "GraspResult", "grasp_tasks", "grasp_errors",
-           "check_span", "show_grasp", "POSITION_TOL", "NORMAL_TOL"]
+__all__ = [
+    "Hand",
+    "Finger",
+    "Sphere",
+    "Cylinder",
+    "solve_grasp",
+    "GraspResult",
+    "grasp_tasks",
+    "grasp_errors",
+    "check_span",
+    "show_grasp",
+    "POSITION_TOL",
+    "NORMAL_TOL",
+]

@@ -26,13 +26,14 @@ from .grasp import NORMAL_TOL, POSITION_TOL, grasp_errors
 from .objects import Cylinder
 from .problems import reachable_grasps
 
-GLASS_HEIGHT = 0.18   # m, the drawn glass (the fingertips lie within ±9 cm of its centre)
+GLASS_HEIGHT = 0.18  # m, the drawn glass (the fingertips lie within ±9 cm of its centre)
 
 
 def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
     """(robot, hand, q, glass) of the picture (see the module docstring).  ``RuntimeError`` if no
     draw gives a grasp that passes the checks."""
     import anthroarm as aa
+
     from ..ik.qp import IKConfiguration
     from ..ik.qp.tasks.posture import comfortable_posture
 
@@ -48,7 +49,13 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
                 Tw = np.eye(4)
                 Tw[:3, :3] = pin.rpy.rpyToMatrix(0.0, 0.0, yaw) @ flip
                 Tw[:3, 3] = center
-                res = aa.ik.solve(robot, Tw @ np.linalg.inv(pb.T_palm_obj), frame=h.palm, q0=comfort, max_time=0.02)
+                res = aa.ik.solve(
+                    robot,
+                    Tw @ np.linalg.inv(pb.T_palm_obj),
+                    frame=h.palm,
+                    q0=comfort,
+                    max_time=0.02,
+                )
                 if not (res.success and robot.within_limits(res.q)):
                     continue
                 q = pb.witness.copy()
@@ -69,8 +76,8 @@ def readme_picture(png, size=(960, 640)) -> Path:
     """Screenshot of :func:`cup_grasp` in the viewer, written to ``png``."""
     from ..ik.qp import IKConfiguration
     from ..viewer import Viewer
-    from .overlays import show_grasp
     from ..viewer.browser import screenshot
+    from .overlays import show_grasp
 
     robot, h, q, glass = cup_grasp()
     _, _, contacts, _ = grasp_errors(h, IKConfiguration(robot, q), glass)

@@ -59,7 +59,7 @@ class Finger:
     joints: tuple
     v_indices: tuple
     pad_axis: np.ndarray
-    length: float          # L: sum of the offsets from the first joint to the tip (m)
+    length: float  # L: sum of the offsets from the first joint to the tip (m)
 
     @property
     def name(self) -> str:
@@ -73,9 +73,12 @@ def _pad_axis(chain, frame, distal) -> np.ndarray | None:
     if n < 1e-9 * max(1.0, float(np.linalg.norm(frame.translation))):
         return None
     lo, hi = j.lower, j.upper
-    if j.is_mimic:                       # a follower's range is its source's, scaled
+    if j.is_mimic:  # a follower's range is its source's, scaled
         src = chain.joints[j.mimic.source]
-        a, b = j.mimic.multiplier * src.lower + j.mimic.offset, j.mimic.multiplier * src.upper + j.mimic.offset
+        a, b = (
+            j.mimic.multiplier * src.lower + j.mimic.offset,
+            j.mimic.multiplier * src.upper + j.mimic.offset,
+        )
         lo, hi = min(a, b), max(a, b)
     s = 1.0 if not (np.isfinite(lo) and np.isfinite(hi)) or hi >= -lo else -1.0
     return s * (frame.rotation.T @ (v / n))
@@ -110,12 +113,16 @@ class Hand:
         all_tips = tuple(robot.tips)
         tips = all_tips if tips is None else tuple(tips)
         if len(tips) < 2:
-            raise FingertipError(f"{robot.name}: a hand needs at least two fingertips, got {list(tips)}; "
-                                 f"tips of the tree: {', '.join(all_tips)}")
+            raise FingertipError(
+                f"{robot.name}: a hand needs at least two fingertips, got {list(tips)}; "
+                f"tips of the tree: {', '.join(all_tips)}"
+            )
         for t in tips:
             if not isinstance(t, str) or t not in all_tips:
-                raise FingertipError(f"{robot.name}: {t!r} is not a fingertip (a tip of the kinematic tree); "
-                                     f"fingertips: {', '.join(all_tips)}")
+                raise FingertipError(
+                    f"{robot.name}: {t!r} is not a fingertip (a tip of the kinematic tree); "
+                    f"fingertips: {', '.join(all_tips)}"
+                )
         if len(set(tips)) != len(tips):
             raise FingertipError(f"{robot.name}: fingertips repeated in {list(tips)}")
         default = tips is all_tips
@@ -132,38 +139,51 @@ class Hand:
             # at the end of the longest path: the fingertip
             best: dict = {}
             for t, p in zip(tips, paths):
-                own = frozenset(chain.joints[i].idx_v for i in p[common:] if not chain.joints[i].is_mimic)
-                drivers = own or frozenset(chain.joints[chain.joints[i].mimic.source].idx_v
-                                           for i in p[common:] if chain.joints[i].is_mimic)
+                own = frozenset(
+                    chain.joints[i].idx_v for i in p[common:] if not chain.joints[i].is_mimic
+                )
+                drivers = own or frozenset(
+                    chain.joints[chain.joints[i].mimic.source].idx_v
+                    for i in p[common:]
+                    if chain.joints[i].is_mimic
+                )
                 if drivers not in best or len(p) > len(best[drivers][1]):
                     best[drivers] = (t, p)
             tips = tuple(t for t, _ in best.values())
             paths = [p for _, p in best.values()]
             if len(tips) < 2:
-                raise FingertipError(f"{robot.name}: fewer than two tips move on joints of their own "
-                                     f"({', '.join(all_tips)}): not a hand")
+                raise FingertipError(
+                    f"{robot.name}: fewer than two tips move on joints of their own "
+                    f"({', '.join(all_tips)}): not a hand"
+                )
             common = _common(paths)
         self.arm_joints = tuple(paths[0][:common])
         last = self.arm_joints[-1] if self.arm_joints else -1
         pad_axes = dict(pad_axes or {})
         unknown = set(pad_axes) - set(tips)
         if unknown:
-            raise FingertipError(f"{robot.name}: pad_axes for frames that are not fingertips: {sorted(unknown)}; "
-                                 f"fingertips: {', '.join(tips)}")
+            raise FingertipError(
+                f"{robot.name}: pad_axes for frames that are not fingertips: {sorted(unknown)}; "
+                f"fingertips: {', '.join(tips)}"
+            )
         fingers = []
         for t, p in zip(tips, paths):
             own = tuple(p[common:])
             if not own:
-                raise FingertipError(f"{robot.name}: tip {t!r} has no joint of its own (it does not move "
-                                     f"relative to the palm): not a fingertip")
+                raise FingertipError(
+                    f"{robot.name}: tip {t!r} has no joint of its own (it does not move "
+                    f"relative to the palm): not a fingertip"
+                )
             f = chain.frame(t)
             if t in pad_axes:
                 axis = unit_vector(pad_axes[t], f"pad axis of {t!r}")
             else:
                 axis = _pad_axis(chain, f, f.joint)
                 if axis is None:
-                    raise FingertipError(f"{robot.name}: fingertip {t!r} lies on its distal joint's axis, so the "
-                                         f"pad normal convention does not apply; give pad_axes={{{t!r}: (x, y, z)}}")
+                    raise FingertipError(
+                        f"{robot.name}: fingertip {t!r} lies on its distal joint's axis, so the "
+                        f"pad normal convention does not apply; give pad_axes={{{t!r}: (x, y, z)}}"
+                    )
             length = float(np.linalg.norm(f.translation))
             for i in own[1:]:
                 length += float(np.linalg.norm(chain.joints[i].translation))
@@ -195,8 +215,10 @@ class Hand:
         for f in self.fingers:
             if f.tip == tip:
                 return f
-        raise FingertipError(f"{self.robot.name}: {tip!r} is not a fingertip of this hand; fingertips: "
-                             f"{', '.join(self.tips)}")
+        raise FingertipError(
+            f"{self.robot.name}: {tip!r} is not a fingertip of this hand; fingertips: "
+            f"{', '.join(self.tips)}"
+        )
 
     @cached_property
     def arm_v_indices(self) -> tuple:
@@ -236,7 +258,9 @@ class Hand:
         for i, fi in enumerate(self.fingers):
             for j in range(i + 1, len(self.fingers)):
                 fj = self.fingers[j]
-                best = max(best, float(np.linalg.norm(origins[i] - origins[j])) + fi.length + fj.length)
+                best = max(
+                    best, float(np.linalg.norm(origins[i] - origins[j])) + fi.length + fj.length
+                )
         return best
 
     # ------------------------------------------------------------------ poses
@@ -265,12 +289,16 @@ class Hand:
             j = chain.joint(name)
             val = float(val)
             if not np.isfinite(val):
-                raise ValueError(f"{self.robot.name}: joint {name!r} value must be finite, got {val}")
+                raise ValueError(
+                    f"{self.robot.name}: joint {name!r} value must be finite, got {val}"
+                )
             if j.is_mimic:
                 mimic[name] = val
                 continue
             if j.nq != 1:
-                raise ValueError(f"{self.robot.name}: set continuous joint {name!r} through q (cos, sin)")
+                raise ValueError(
+                    f"{self.robot.name}: set continuous joint {name!r} through q (cos, sin)"
+                )
             q[j.idx_q] = val
         theta = chain.angles(q)
         for name, val in mimic.items():
@@ -281,5 +309,6 @@ class Hand:
                 raise CouplingError(
                     f"{self.robot.name}: joint {name!r} is coupled to {src.name!r} "
                     f"({name} = {j.mimic.multiplier:g}·{src.name} + {j.mimic.offset:g}); with {src.name} = "
-                    f"{theta[src.index]:.6g} it is {want:.6g}, not {val:.6g}")
+                    f"{theta[src.index]:.6g} it is {want:.6g}, not {val:.6g}"
+                )
         return q

@@ -99,14 +99,18 @@ class GraspResult:
     info: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
-        return (f"GraspResult(status={self.status!r}, iterations={self.iterations}, "
-                f"max position error={1e3 * float(np.max(self.position_errors)):.3g} mm, "
-                f"max normal error={math.degrees(float(np.max(self.normal_errors))):.3g} deg)")
+        return (
+            f"GraspResult(status={self.status!r}, iterations={self.iterations}, "
+            f"max position error={1e3 * float(np.max(self.position_errors)):.3g} mm, "
+            f"max normal error={math.degrees(float(np.max(self.normal_errors))):.3g} deg)"
+        )
 
 
 def _as_object(obj):
     if not isinstance(obj, (Sphere, Cylinder)):
-        raise GraspError(f"the grasped object is a hand.Sphere or hand.Cylinder, got {type(obj).__name__}")
+        raise GraspError(
+            f"the grasped object is a hand.Sphere or hand.Cylinder, got {type(obj).__name__}"
+        )
     return obj
 
 
@@ -136,29 +140,59 @@ def grasp_errors(hand: Hand, conf, obj, points=None):
     return pe, ne, cp, on_side
 
 
-def grasp_tasks(robot, hand: Hand, obj, points=None, *, position_cost: float = 1.0, normal_cost: float = 0.1,
-                lm_damping: float = 1e-3) -> list:
+def grasp_tasks(
+    robot,
+    hand: Hand,
+    obj,
+    points=None,
+    *,
+    position_cost: float = 1.0,
+    normal_cost: float = 0.1,
+    lm_damping: float = 1e-3,
+) -> list:
     """The QP tasks of a grasp (see the module docstring): per fingertip a surface-contact task
     (``points=None``) or a position task to its point plus a contact-normal task along −m."""
     tasks = []
     for k, f in enumerate(hand.fingers):
         if points is None:
-            tasks.append(SurfaceContactTask(robot, f.tip_id, obj, axis=f.pad_axis, distance_cost=position_cost,
-                                            normal_cost=normal_cost, lm_damping=lm_damping))
+            tasks.append(
+                SurfaceContactTask(
+                    robot,
+                    f.tip_id,
+                    obj,
+                    axis=f.pad_axis,
+                    distance_cost=position_cost,
+                    normal_cost=normal_cost,
+                    lm_damping=lm_damping,
+                )
+            )
         else:
-            tasks.append(qp.PositionTask(robot, f.tip_id, cost=position_cost, lm_damping=lm_damping,
-                                         target=points[k]))
-            tasks.append(ContactNormalTask(robot, f.tip_id, axis=f.pad_axis, cost=normal_cost,
-                                           lm_damping=lm_damping, target=-obj.normal(points[k])))
+            tasks.append(
+                qp.PositionTask(
+                    robot, f.tip_id, cost=position_cost, lm_damping=lm_damping, target=points[k]
+                )
+            )
+            tasks.append(
+                ContactNormalTask(
+                    robot,
+                    f.tip_id,
+                    axis=f.pad_axis,
+                    cost=normal_cost,
+                    lm_damping=lm_damping,
+                    target=-obj.normal(points[k]),
+                )
+            )
     return tasks
 
 
 def check_span(hand: Hand, obj) -> None:
     """:class:`~anthroarm.errors.GraspError` when the object's size exceeds the hand's span."""
     if obj.size > hand.span:
-        raise GraspError(f"{hand.robot.name}: the {obj.kind} is {1e3 * obj.size:.1f} mm across, larger than the "
-                         f"hand's span {1e3 * hand.span:.1f} mm (the largest possible distance between two "
-                         f"fingertips {hand.tips}): no fingertip grasp exists")
+        raise GraspError(
+            f"{hand.robot.name}: the {obj.kind} is {1e3 * obj.size:.1f} mm across, larger than the "
+            f"hand's span {1e3 * hand.span:.1f} mm (the largest possible distance between two "
+            f"fingertips {hand.tips}): no fingertip grasp exists"
+        )
 
 
 def _kabsch(P, Q, w):
@@ -188,8 +222,17 @@ def _fit_palm(hand: Hand, data, points, obj) -> np.ndarray:
     return T
 
 
-def palm_approach(hand: Hand, points, obj, q, rng=None, seed_arm: bool = False, rounds: int = 3,
-                  solver: str = "daqp", step_fn=None) -> np.ndarray:
+def palm_approach(
+    hand: Hand,
+    points,
+    obj,
+    q,
+    rng=None,
+    seed_arm: bool = False,
+    rounds: int = 3,
+    solver: str = "daqp",
+    step_fn=None,
+) -> np.ndarray:
     """A start for a grasp with given contact ``points``: the arm joints of ``q`` moved so that the
     palm sits where a hand shape fits the contacts, the finger joints shaped for them.
 
@@ -216,10 +259,20 @@ def palm_approach(hand: Hand, points, obj, q, rng=None, seed_arm: bool = False, 
         T = _fit_palm(hand, data, points, obj)
         if k == rounds - 1:
             break
-        X = data.oMf[hand.palm_id].homogeneous @ np.linalg.inv(T)     # world → current palm placement
+        X = data.oMf[hand.palm_id].homogeneous @ np.linalg.inv(T)  # world → current palm placement
         pts = points @ X[:3, :3].T + X[:3, 3]
-        res = solve_grasp(robot, obj.transformed(X), pts, hand=hand, q0=cur, move_arm=False, restarts=0,
-                          max_iterations=30, solver=solver, step_fn=step_fn)
+        res = solve_grasp(
+            robot,
+            obj.transformed(X),
+            pts,
+            hand=hand,
+            q0=cur,
+            move_arm=False,
+            restarts=0,
+            max_iterations=30,
+            solver=solver,
+            step_fn=step_fn,
+        )
         cur[fq] = res.q[fq]
     q_start = cur
     if seed_arm:
@@ -227,17 +280,36 @@ def palm_approach(hand: Hand, points, obj, q, rng=None, seed_arm: bool = False, 
         q_start[aq] = robot.random_q(rng=rng)[aq]
     res = ik.solve(robot, T, q0=q_start, frame=hand.palm, tol_pos=1e-4, tol_rot=1e-3, max_time=0.01)
     if res.q is not None and np.isfinite(res.q).all() and robot.within_limits(res.q):
-        cur[aq] = res.q[aq]          # the palm pose, or the nearest the arm reaches: a start
+        cur[aq] = res.q[aq]  # the palm pose, or the nearest the arm reaches: a start
     else:
         cur[aq] = np.asarray(q, dtype=float)[aq]
     return cur
 
 
-def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=None, q0=None, couplings=(),
-                max_iterations: int = 300, max_step: float = 0.2, position_cost: float = 1.0,
-                normal_cost: float = 0.1, lm_damping: float = 1e-3, posture_cost: float = 0.0,
-                position_tol: float = POSITION_TOL, normal_tol: float = NORMAL_TOL, solver: str = "daqp",
-                tasks=(), restarts: int = 25, seed=0, move_arm: bool = True, step_fn=None) -> GraspResult:
+def solve_grasp(
+    robot,
+    obj,
+    contacts=None,
+    *,
+    hand: Hand | None = None,
+    tips=None,
+    q0=None,
+    couplings=(),
+    max_iterations: int = 300,
+    max_step: float = 0.2,
+    position_cost: float = 1.0,
+    normal_cost: float = 0.1,
+    lm_damping: float = 1e-3,
+    posture_cost: float = 0.0,
+    position_tol: float = POSITION_TOL,
+    normal_tol: float = NORMAL_TOL,
+    solver: str = "daqp",
+    tasks=(),
+    restarts: int = 25,
+    seed=0,
+    move_arm: bool = True,
+    step_fn=None,
+) -> GraspResult:
     """Grasp ``obj`` (a :class:`~anthroarm.hand.objects.Sphere` or
     :class:`~anthroarm.hand.objects.Cylinder`, world frame) with the fingertips of ``robot``.
 
@@ -304,13 +376,19 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     if contacts is not None:
         pts = np.asarray(contacts, dtype=float)
         if pts.shape != (n, 3) or not np.isfinite(pts).all():
-            raise GraspError(f"contacts must be a finite ({n}, 3) array, one point (m) per fingertip "
-                             f"{hand.tips}, got shape {np.shape(contacts)}")
+            raise GraspError(
+                f"contacts must be a finite ({n}, 3) array, one point (m) per fingertip "
+                f"{hand.tips}, got shape {np.shape(contacts)}"
+            )
         points = np.array([obj.project(p) for p in pts])
     for nm, val in (("max_iterations", max_iterations), ("restarts", restarts)):
         if isinstance(val, bool) or not (isinstance(val, (int, np.integer)) and val >= 0):
             raise ValueError(f"{nm} must be a whole number >= 0, got {val!r}")
-    for nm, val in (("max_step", max_step), ("position_tol", position_tol), ("normal_tol", normal_tol)):
+    for nm, val in (
+        ("max_step", max_step),
+        ("position_tol", position_tol),
+        ("normal_tol", normal_tol),
+    ):
         if not (math.isfinite(val) and val > 0):
             raise ValueError(f"{nm} must be finite and > 0, got {val!r}")
     if q0 is None:
@@ -323,42 +401,77 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
     for c in couplings:
         e = c.compute_error(conf)
         if not np.all(np.abs(e) <= 1e-6):
-            raise CouplingError(f"{robot.name}: the start configuration breaks the coupling {c!r} "
-                                f"(residual {float(np.max(np.abs(e))):.3g}); give a q0 that satisfies it")
-    all_tasks = grasp_tasks(robot, hand, obj, points, position_cost=position_cost, normal_cost=normal_cost,
-                            lm_damping=lm_damping) + list(tasks)
+            raise CouplingError(
+                f"{robot.name}: the start configuration breaks the coupling {c!r} "
+                f"(residual {float(np.max(np.abs(e))):.3g}); give a q0 that satisfies it"
+            )
+    all_tasks = grasp_tasks(
+        robot,
+        hand,
+        obj,
+        points,
+        position_cost=position_cost,
+        normal_cost=normal_cost,
+        lm_damping=lm_damping,
+    ) + list(tasks)
     if posture_cost:
         all_tasks.append(qp.PostureTask(robot, cost=posture_cost, target=conf.q))
     lower, upper = None, None
-    if not move_arm and hand.arm_joints:      # the arm's joints held at q0: a box of zero width
+    if not move_arm and hand.arm_joints:  # the arm's joints held at q0: a box of zero width
         lower, upper = np.array(robot.chain.lower), np.array(robot.chain.upper)
         for i in hand.arm_joints:
             j = robot.chain.joints[i]
             if not j.is_mimic and j.nq == 1:
                 lower[j.idx_q] = upper[j.idx_q] = conf.q[j.idx_q]
-    limits = [qp.ConfigurationLimit(robot, lower=lower, upper=upper), qp.VelocityLimit(robot, v_max=np.full(robot.nv, float(max_step)))]
+    limits = [
+        qp.ConfigurationLimit(robot, lower=lower, upper=upper),
+        qp.VelocityLimit(robot, v_max=np.full(robot.nv, float(max_step))),
+    ]
     rng = np.random.default_rng(seed)
     fq = hand.finger_q_indices
     best = None
     total = 0
-    conf_q0 = conf.q.copy()
     approach = points is not None and move_arm and bool(hand.arm_v_indices)
-    aq = hand.arm_q_indices
     for attempt in range(int(restarts) + 1):
         if attempt:
-            start = best[0].copy()               # arm where the best attempt left it, fingers anew
-            if approach and attempt % 2 == 1:    # or, every other time, a finer approach (a new arm branch
-                start = palm_approach(hand, points, obj, start, rng=rng, seed_arm=attempt > 1, solver=solver,
-                                      rounds=6, step_fn=step_fn)     # after the first restart)
+            start = best[0].copy()  # arm where the best attempt left it, fingers anew
+            if (
+                approach and attempt % 2 == 1
+            ):  # or, every other time, a finer approach (a new arm branch
+                start = palm_approach(
+                    hand,
+                    points,
+                    obj,
+                    start,
+                    rng=rng,
+                    seed_arm=attempt > 1,
+                    solver=solver,
+                    rounds=6,
+                    step_fn=step_fn,
+                )  # after the first restart)
             else:
                 start[fq] = robot.random_q(rng=rng)[fq]
             conf.update(start)
             if posture_cost:
                 all_tasks[-1].set_target(conf.q)
         elif approach:
-            conf.update(palm_approach(hand, points, obj, conf.q, rng=rng, solver=solver, step_fn=step_fn))
-        out = _descend(conf, hand, obj, points, all_tasks, limits, couplings, solver, max_iterations,
-                       position_tol, normal_tol, step_fn)
+            conf.update(
+                palm_approach(hand, points, obj, conf.q, rng=rng, solver=solver, step_fn=step_fn)
+            )
+        out = _descend(
+            conf,
+            hand,
+            obj,
+            points,
+            all_tasks,
+            limits,
+            couplings,
+            solver,
+            max_iterations,
+            position_tol,
+            normal_tol,
+            step_fn,
+        )
         total += out[2]
         score = max(out[3].max() / position_tol, out[4].max() / normal_tol)
         if best is None or out[1] == "success" or score < best[-1]:
@@ -366,12 +479,35 @@ def solve_grasp(robot, obj, contacts=None, *, hand: Hand | None = None, tips=Non
         if out[1] == "success" or out[1].startswith("qp_"):
             break
     q, status, _, pe, ne, cp, within, info, _ = best
-    return GraspResult(q, status == "success", status, total, time.perf_counter() - t0, hand.tips, pe, ne, cp,
-                       within, dict(info, attempts=attempt + 1))
+    return GraspResult(
+        q,
+        status == "success",
+        status,
+        total,
+        time.perf_counter() - t0,
+        hand.tips,
+        pe,
+        ne,
+        cp,
+        within,
+        dict(info, attempts=attempt + 1),
+    )
 
 
-def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iterations, position_tol, normal_tol,
-             step_fn=None):
+def _descend(
+    conf,
+    hand,
+    obj,
+    points,
+    tasks,
+    limits,
+    couplings,
+    solver,
+    max_iterations,
+    position_tol,
+    normal_tol,
+    step_fn=None,
+):
     """QP iterations from ``conf`` until the criteria hold, the step vanishes, the error stops
     improving (by 1 % over 25 iterations: ``"stalled"``) or ``max_iterations``."""
     status = "max_iterations"
@@ -392,8 +528,17 @@ def _descend(conf, hand, obj, points, tasks, limits, couplings, solver, max_iter
         if it >= max_iterations:
             break
         if step_fn is None:
-            res = qp.step(conf, None, tasks, 1.0, limits=limits, solver=solver, damping=1e-9,
-                          constraints=couplings, full=True)
+            res = qp.step(
+                conf,
+                None,
+                tasks,
+                1.0,
+                limits=limits,
+                solver=solver,
+                damping=1e-9,
+                constraints=couplings,
+                full=True,
+            )
         else:
             res = step_fn(conf, tasks, limits, couplings, solver)
         if not res.ok:

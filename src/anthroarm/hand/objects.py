@@ -119,14 +119,18 @@ class Cylinder:
         if length is not None:
             length = float(length)
             if not (np.isfinite(length) and length > 0):
-                raise GraspError(f"Cylinder length must be finite and > 0 (m) or None, got {length}")
+                raise GraspError(
+                    f"Cylinder length must be finite and > 0 (m) or None, got {length}"
+                )
         self.length = length
         self._P = np.eye(3) - np.outer(self.axis, self.axis)
         self._perp = _perpendicular(self.axis)
 
     def __repr__(self) -> str:
-        return (f"Cylinder(center={np.round(self.center, 4).tolist()}, axis={np.round(self.axis, 4).tolist()}, "
-                f"radius={self.radius:g}, length={self.length})")
+        return (
+            f"Cylinder(center={np.round(self.center, 4).tolist()}, axis={np.round(self.axis, 4).tolist()}, "
+            f"radius={self.radius:g}, length={self.length})"
+        )
 
     @property
     def size(self) -> float:
@@ -165,11 +169,17 @@ class Cylinder:
     def transformed(self, T) -> "Cylinder":
         """The cylinder moved by the rigid transform ``T`` (4×4)."""
         T = np.asarray(T, dtype=float)
-        return Cylinder(T[:3, :3] @ self.center + T[:3, 3], T[:3, :3] @ self.axis, self.radius, self.length)
+        return Cylinder(
+            T[:3, :3] @ self.center + T[:3, 3], T[:3, :3] @ self.axis, self.radius, self.length
+        )
 
     def point(self, angle: float, height: float = 0.0) -> np.ndarray:
         """Surface point at ``angle`` (rad, about the axis from a fixed perpendicular ``e₁``;
         ``e₂ = u × e₁``) and axial ``height`` (m) from the centre."""
         e1 = self._perp
         e2 = np.cross(self.axis, e1)
-        return self.center + height * self.axis + self.radius * (np.cos(angle) * e1 + np.sin(angle) * e2)
+        return (
+            self.center
+            + height * self.axis
+            + self.radius * (np.cos(angle) * e1 + np.sin(angle) * e2)
+        )

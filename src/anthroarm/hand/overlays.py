@@ -30,8 +30,17 @@ def object_transform(obj) -> np.ndarray:
     return T
 
 
-def show_grasp(viewer, obj, contacts, *, length: float | None = None, name: str = "grasp",
-               color: int = 0xD9D2C0, opacity: float = 0.85, arrow: float = 0.035) -> None:
+def show_grasp(
+    viewer,
+    obj,
+    contacts,
+    *,
+    length: float | None = None,
+    name: str = "grasp",
+    color: int = 0xD9D2C0,
+    opacity: float = 0.85,
+    arrow: float = 0.035,
+) -> None:
     """Draw ``obj`` (Sphere or Cylinder), the ``contacts`` (n, 3) and −m at each.
 
     ``length`` (m) is the drawn cylinder's length (default: the cylinder's own, else 4 radii);
@@ -40,16 +49,24 @@ def show_grasp(viewer, obj, contacts, *, length: float | None = None, name: str 
     import meshcat.geometry as mg
 
     if not isinstance(obj, (Sphere, Cylinder)):
-        raise TypeError(f"show_grasp draws a hand.Sphere or hand.Cylinder, got {type(obj).__name__}")
+        raise TypeError(
+            f"show_grasp draws a hand.Sphere or hand.Cylinder, got {type(obj).__name__}"
+        )
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 3)
     viewer.show_points(contacts, colors=(0.1, 0.65, 0.2), name=f"{name}_points")
-    viewer.show_arrows(contacts, -arrow * np.array([obj.normal(c) for c in contacts]), colors=(0.9, 0.2, 0.1),
-                       name=f"{name}_normals")
+    viewer.show_arrows(
+        contacts,
+        -arrow * np.array([obj.normal(c) for c in contacts]),
+        colors=(0.9, 0.2, 0.1),
+        name=f"{name}_normals",
+    )
     if isinstance(obj, Cylinder):
         h = length or obj.length or 4.0 * obj.radius
         geom = mg.Cylinder(h, obj.radius)
     else:
         geom = mg.Sphere(obj.radius)
     node = viewer.scene[viewer.root.removeprefix("/meshcat/") + f"/overlays/{name}_object"]
-    node.set_object(geom, mg.MeshLambertMaterial(color=color, opacity=opacity, transparent=opacity < 1.0))
+    node.set_object(
+        geom, mg.MeshLambertMaterial(color=color, opacity=opacity, transparent=opacity < 1.0)
+    )
     node.set_transform(object_transform(obj))

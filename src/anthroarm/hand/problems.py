@@ -84,8 +84,14 @@ def open_hand(robot, hand: Hand, q=None) -> np.ndarray:
             j = chain.joints[i]
             if j.is_mimic or j.nq != 1:
                 continue
-            flex_positive = not (np.isfinite(j.lower) and np.isfinite(j.upper)) or j.upper >= -j.lower
-            q[j.idx_q] = min(max(0.0, j.lower), j.upper) if flex_positive else max(min(0.0, j.upper), j.lower)
+            flex_positive = (
+                not (np.isfinite(j.lower) and np.isfinite(j.upper)) or j.upper >= -j.lower
+            )
+            q[j.idx_q] = (
+                min(max(0.0, j.lower), j.upper)
+                if flex_positive
+                else max(min(0.0, j.upper), j.lower)
+            )
     return q
 
 
@@ -100,7 +106,9 @@ def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
     w = np.ones(len(centres)) if weights is None else np.asarray(weights, dtype=float)
     w = w / w.sum()
     c = w @ centres
-    axis = np.linalg.svd((centres - c) * np.sqrt(w)[:, None])[2][0] if kind == "cylinder" else across
+    axis = (
+        np.linalg.svd((centres - c) * np.sqrt(w)[:, None])[2][0] if kind == "cylinder" else across
+    )
     T_palm_obj = np.eye(4)
     T_palm_obj[:3, :3] = _frame(axis)
     T_palm_obj[:3, 3] = c
@@ -109,9 +117,19 @@ def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
     return T_palm_obj, obj
 
 
-def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand | None = None,
-                     radius=(0.015, 0.04), arm_margin: float = 0.2, max_draws: int | None = None,
-                     solver: str = "daqp", per_hand: int = 1, rounds: int = 6) -> list[GraspProblem]:
+def reachable_grasps(
+    robot,
+    n: int,
+    kind: str = "cylinder",
+    rng=None,
+    hand: Hand | None = None,
+    radius=(0.015, 0.04),
+    arm_margin: float = 0.2,
+    max_draws: int | None = None,
+    solver: str = "daqp",
+    per_hand: int = 1,
+    rounds: int = 6,
+) -> list[GraspProblem]:
     """``n`` reachable grasp problems (see the module docstring).
 
     Parameters
@@ -171,8 +189,18 @@ def reachable_grasps(robot, n: int, kind: str = "cylinder", rng=None, hand: Hand
             T_palm_obj, obj = _fit_object(hand, model, data, q_h, Mp0, r, kind, across, w)
             if obj.size > hand.span:
                 break
-            res = solve_grasp(robot, obj, hand=hand, q0=q_h, move_arm=False, solver=solver, restarts=0,
-                              max_iterations=40, position_tol=2e-4, normal_tol=np.radians(1.0))
+            res = solve_grasp(
+                robot,
+                obj,
+                hand=hand,
+                q0=q_h,
+                move_arm=False,
+                solver=solver,
+                restarts=0,
+                max_iterations=40,
+                position_tol=2e-4,
+                normal_tol=np.radians(1.0),
+            )
             if res.success:
                 break
             q_h = res.q

@@ -7,8 +7,15 @@
 """
 
 from . import qp
+from .closed_form import (
+    AnalyticBatchResult,
+    AnalyticIKResult,
+    ClosedForm,
+    analytic,
+    analytic_batch,
+    closed_form_info,
+    has_analytic,
+)
+from .qp.tasks.swivel import swivel_angle
 from .result import IKBatchResult, IKResult
 from .solve import solve
-from .closed_form import (AnalyticBatchResult, AnalyticIKResult, ClosedForm, analytic, analytic_batch,
-                          closed_form_info, has_analytic)
-from .qp.tasks.swivel import swivel_angle

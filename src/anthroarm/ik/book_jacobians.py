@@ -92,14 +92,14 @@ def chain_derivatives(robot, q, second: bool = False):
     T = _product(G) @ tool
     dT = np.empty((n, 4, 4))
     for i in range(n):
-        dT[i] = _product(G[:i] + [F[i][1]] + G[i + 1:]) @ tool
+        dT[i] = _product(G[:i] + [F[i][1]] + G[i + 1 :]) @ tool
     if not second:
         return T, dT
     d2T = np.empty((n, n, 4, 4))
     for i in range(n):
         for k in range(n):
             if i == k:
-                d2T[i, k] = _product(G[:i] + [F[i][2]] + G[i + 1:]) @ tool
+                d2T[i, k] = _product(G[:i] + [F[i][2]] + G[i + 1 :]) @ tool
             else:
                 mats = list(G)
                 mats[i], mats[k] = F[i][1], F[k][1]
@@ -154,7 +154,7 @@ def hand_frame_jacobian(robot, q) -> np.ndarray:
     T = np.eye(4)
     axes, origins, kinds = [], [], []
     for js, (G, _, _) in zip(spec.joints, F):
-        Fj = T @ np.asarray(js.origin, float)   # joint frame before its own motion
+        Fj = T @ np.asarray(js.origin, float)  # joint frame before its own motion
         a = np.asarray(js.axis, float) / np.linalg.norm(js.axis)
         axes.append(Fj[:3, :3] @ a)
         origins.append(Fj[:3, 3])
@@ -167,8 +167,8 @@ def hand_frame_jacobian(robot, q) -> np.ndarray:
         if kind == "prismatic":
             cols.append(np.concatenate([u, np.zeros(3)]))
         else:
-            cols.append(np.concatenate([np.cross(u, O7 - O), u]))   # (7-90), (7-91)
+            cols.append(np.concatenate([np.cross(u, O7 - O), u]))  # (7-90), (7-91)
     Jw = np.array(cols).T
     B = np.zeros((6, 6))
-    B[:3, :3] = B[3:, 3:] = C17.T                                    # (7-94), block-diagonal
+    B[:3, :3] = B[3:, 3:] = C17.T  # (7-94), block-diagonal
     return B @ Jw

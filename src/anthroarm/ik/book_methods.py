@@ -45,7 +45,9 @@ class PositionTask:
         self.fid = robot.frame_id(frame)
         self.target = np.asarray(target, float)
         if self.target.shape != (len(self.rows),) or not np.isfinite(self.target).all():
-            raise ValueError(f"target must be finite with shape ({len(self.rows)},), got {target!r}")
+            raise ValueError(
+                f"target must be finite with shape ({len(self.rows)},), got {target!r}"
+            )
 
     def value(self, q):
         return self.robot.fk(q, self.fid)[self.rows, 3]
@@ -60,9 +62,13 @@ class PositionTask:
         import pinocchio as pin
 
         r = self.robot
-        pin.computeJointJacobiansTimeVariation(r.model, r.data, np.asarray(q, float), np.asarray(qd, float))
+        pin.computeJointJacobiansTimeVariation(
+            r.model, r.data, np.asarray(q, float), np.asarray(qd, float)
+        )
         pin.updateFramePlacements(r.model, r.data)
-        dJ = pin.getFrameJacobianTimeVariation(r.model, r.data, self.fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        dJ = pin.getFrameJacobianTimeVariation(
+            r.model, r.data, self.fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        )
         return dJ[self.rows]
 
 
@@ -86,7 +92,9 @@ class PoseTask:
         import pinocchio as pin
 
         T = self.value(q)
-        return np.concatenate([self.target[:3, 3] - T[:3, 3], pin.log3(self.target[:3, :3] @ T[:3, :3].T)])
+        return np.concatenate(
+            [self.target[:3, 3] - T[:3, 3], pin.log3(self.target[:3, :3] @ T[:3, :3].T)]
+        )
 
     def jacobian(self, q):
         return self.robot.jacobian(q, self.fid)
@@ -113,13 +121,17 @@ class IterResult:
 def _check_q0(q0, n=None):
     q = np.asarray(q0, float).copy()
     if q.ndim != 1 or not np.isfinite(q).all() or (n is not None and q.shape[0] != n):
-        raise ValueError(f"q0 must be a finite vector{'' if n is None else f' of length {n}'}, got {q0!r}")
+        raise ValueError(
+            f"q0 must be a finite vector{'' if n is None else f' of length {n}'}, got {q0!r}"
+        )
     return q
 
 
 def _finish(q, its, errs, tol, status, steps=()):
     ok = errs[-1] <= tol
-    return IterResult(q, np.array(its), np.array(errs), bool(ok), "converged" if ok else status, list(steps))
+    return IterResult(
+        q, np.array(its), np.array(errs), bool(ok), "converged" if ok else status, list(steps)
+    )
 
 
 # ---------------------------------------------------------------------------- Newton / feedback compensation
@@ -162,8 +174,18 @@ class TrackingResult:
     success: bool
 
 
-def feedback_compensation(task, reference, q0, qd0, dt: float, num: int, *, eps: float = 1e-9,
-                          max_corrections: int = 20, K: str = "exact") -> TrackingResult:
+def feedback_compensation(
+    task,
+    reference,
+    q0,
+    qd0,
+    dt: float,
+    num: int,
+    *,
+    eps: float = 1e-9,
+    max_corrections: int = 20,
+    K: str = "exact",
+) -> TrackingResult:
     """Track r*(t) by the feedback-compensation method, Fig. 7-11 / Eqs. (7-52)–(7-57).
 
     ``reference(t) -> (r*, ṙ*, r̈*)``.  For k = 0 … num−1: q̈ = J⁻¹(r̈* − K q̇) (7-52), predict
@@ -194,8 +216,8 @@ def feedback_compensation(task, reference, q0, qd0, dt: float, num: int, *, eps:
         t = k * dt
         _, _, rdd = reference(t)
         J = task.jacobian(q)
-        qdd = np.linalg.solve(J, np.asarray(rdd, float) - Kmat(q, qd) @ qd)          # (7-52)
-        q = q + qd * dt + 0.5 * qdd * dt * dt                                        # (7-53)
+        qdd = np.linalg.solve(J, np.asarray(rdd, float) - Kmat(q, qd) @ qd)  # (7-52)
+        q = q + qd * dt + 0.5 * qdd * dt * dt  # (7-53)
         qd = qd + qdd * dt
         t1 = t + dt
         e = dR(q, qd, t1)
@@ -204,8 +226,8 @@ def feedback_compensation(task, reference, q0, qd0, dt: float, num: int, *, eps:
         while np.linalg.norm(e) > eps and c < max_corrections:
             J = task.jacobian(q)
             P = np.block([[J, np.zeros_like(J)], [Kmat(q, qd), J]])
-            dQ = np.linalg.solve(P, e)                                               # (7-55)
-            q, qd = q + dQ[:n], qd + dQ[n:]                                          # (7-57)
+            dQ = np.linalg.solve(P, e)  # (7-55)
+            q, qd = q + dQ[:n], qd + dQ[n:]  # (7-57)
             e = dR(q, qd, t1)
             c += 1
         ts.append(t1)
@@ -214,8 +236,15 @@ def feedback_compensation(task, reference, q0, qd0, dt: float, num: int, *, eps:
         errs.append(float(np.linalg.norm(e)))
         corr.append(c)
     errs = np.array(errs)
-    return TrackingResult(np.array(ts), np.array(Q), np.array(QD), errs, np.array(pred), np.array(corr),
-                          bool((errs <= eps).all()))
+    return TrackingResult(
+        np.array(ts),
+        np.array(Q),
+        np.array(QD),
+        errs,
+        np.array(pred),
+        np.array(corr),
+        bool((errs <= eps).all()),
+    )
 
 
 # ---------------------------------------------------------------------------- optimisation
@@ -232,7 +261,9 @@ def steepest_descent(task, q0, *, tol: float = 1e-10, max_iter: int = 10000) -> 
     return _descent(task, q0, tol=tol, max_iter=max_iter, conjugate=False)
 
 
-def conjugate_direction(task, q0, *, tol: float = 1e-10, max_iter: int = 10000, restart: int | None = None) -> IterResult:
+def conjugate_direction(
+    task, q0, *, tol: float = 1e-10, max_iter: int = 10000, restart: int | None = None
+) -> IterResult:
     """Fletcher–Reeves conjugate directions (7-83) with the ω1 step of (7-82).
 
     p_0 = −∇f, p_k = −∇f_k + (|∇f_k|² / |∇f_{k−1}|²) p_{k−1}; restarted with −∇f every
@@ -253,16 +284,16 @@ def _descent(task, q0, *, tol, max_iter, conjugate, restart=None, residual=None)
     for _ in range(max_iter):
         if errs[-1] <= tol:
             break
-        g = -2.0 * J.T @ e                                         # ∇f (7-73)
+        g = -2.0 * J.T @ e  # ∇f (7-73)
         if not np.any(g):
             return _finish(q, its, errs, tol, "stalled", steps)
         if conjugate and p is not None and k_since < restart:
-            p = -g + (g @ g) / (g_prev @ g_prev) * p              # (7-83)
+            p = -g + (g @ g) / (g_prev @ g_prev) * p  # (7-83)
             if p @ g >= 0:
                 p, k_since = -g, 0
         else:
             p, k_since = -g, 0
-        w = _omega1(J @ p, e)                                       # (7-82)
+        w = _omega1(J @ p, e)  # (7-82)
         if w <= 0:
             p, k_since = -g, 0
             w = _omega1(J @ p, e)
@@ -292,8 +323,16 @@ def joint_limit_constraints(robot, margin: float = 0.0):
     return out
 
 
-def penalty_minimize(task, q0, constraints, *, mu: float = 1e4, method: str = "fr", tol: float = 1e-12,
-                     max_iter: int = 5000) -> IterResult:
+def penalty_minimize(
+    task,
+    q0,
+    constraints,
+    *,
+    mu: float = 1e4,
+    method: str = "fr",
+    tol: float = 1e-12,
+    max_iter: int = 5000,
+) -> IterResult:
     """Exterior penalty (7-84)–(7-86): minimise φ(Q, μ) = δRᵀδR + μ Σ min(0, g_i(Q))².
 
     ``constraints`` is a list of (g, grad_g) callables (g(q) ≥ 0 wanted).  The stacked residual
@@ -311,13 +350,15 @@ def penalty_minimize(task, q0, constraints, *, mu: float = 1e4, method: str = "f
         rows_e, rows_J = [e], [J]
         for g, dg in constraints:
             v = g(q)
-            if v < 0:                                                # u_i = 1 when g_i < 0 (7-86)
+            if v < 0:  # u_i = 1 when g_i < 0 (7-86)
                 # ρ = −√μ g, ρ(q + dq) ≈ ρ − √μ ∇g·dq: Jacobian row +√μ ∇g in the δr convention
                 rows_e.append(np.array([-sm * v]))
                 rows_J.append(sm * np.asarray(dg(q), float)[None, :])
         return np.concatenate(rows_e), np.vstack(rows_J)
 
-    return _descent(task, q0, tol=tol, max_iter=max_iter, conjugate=(method == "fr"), residual=residual)
+    return _descent(
+        task, q0, tol=tol, max_iter=max_iter, conjugate=(method == "fr"), residual=residual
+    )
 
 
 # ---------------------------------------------------------------------------- gradual approach

@@ -38,7 +38,9 @@ from ..errors import ParameterError
 from .closed_form import analytic_batch, require_form
 
 #: corner offsets (i, j, k) of M0 … M7 in the book's labelling
-CORNERS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1], [1, 1, 1]])
+CORNERS = np.array(
+    [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1], [1, 1, 1]]
+)
 
 
 def trilinear_weights(m) -> np.ndarray:
@@ -48,8 +50,19 @@ def trilinear_weights(m) -> np.ndarray:
     t = 1.0 - m
     m1, m2, m3 = m[..., 0], m[..., 1], m[..., 2]
     t1, t2, t3 = t[..., 0], t[..., 1], t[..., 2]
-    return np.stack([t1 * t2 * t3, m1 * t2 * t3, t1 * m2 * t3, t1 * t2 * m3,
-                     m1 * m2 * t3, t1 * m2 * m3, m1 * t2 * m3, m1 * m2 * m3], -1)
+    return np.stack(
+        [
+            t1 * t2 * t3,
+            m1 * t2 * t3,
+            t1 * m2 * t3,
+            t1 * t2 * m3,
+            m1 * m2 * t3,
+            t1 * m2 * m3,
+            m1 * t2 * m3,
+            m1 * m2 * m3,
+        ],
+        -1,
+    )
 
 
 def nested_division(M, m) -> np.ndarray:
@@ -113,8 +126,19 @@ class CellTable:
     ``Q`` (nx, ny, nz, nq) rad (NaN where the lattice point has no IK solution on the branch),
     ``valid`` (nx, ny, nz), ``rotation`` (3, 3), ``model`` and ``params``."""
 
-    def __init__(self, model: str, params: dict, rotation, origin, D: float, Q, valid, *, point=None,
-                 pulses_per_rad=None):
+    def __init__(
+        self,
+        model: str,
+        params: dict,
+        rotation,
+        origin,
+        D: float,
+        Q,
+        valid,
+        *,
+        point=None,
+        pulses_per_rad=None,
+    ):
         self.model = model
         #: the point (m, tool frame) whose position the lattice holds; zero = the tool origin
         self.point = np.zeros(3) if point is None else _finite_vector(point, "point", 3)
@@ -133,15 +157,34 @@ class CellTable:
         self._hi = tuple(int(v) - 2 for v in self.shape)
         # per-cell usability: all 8 corners valid
         v = self.valid
-        self.cell_ok = (v[:-1, :-1, :-1] & v[1:, :-1, :-1] & v[:-1, 1:, :-1] & v[:-1, :-1, 1:]
-                        & v[1:, 1:, :-1] & v[:-1, 1:, 1:] & v[1:, :-1, 1:] & v[1:, 1:, 1:])
+        self.cell_ok = (
+            v[:-1, :-1, :-1]
+            & v[1:, :-1, :-1]
+            & v[:-1, 1:, :-1]
+            & v[:-1, :-1, 1:]
+            & v[1:, 1:, :-1]
+            & v[:-1, 1:, 1:]
+            & v[1:, :-1, 1:]
+            & v[1:, 1:, 1:]
+        )
         if pulses_per_rad is not None:
             self._set_pulses(pulses_per_rad)
 
     # ------------------------------------------------------------------ build
     @classmethod
-    def build(cls, robot, rotation, D: float, bounds, *, q_ref=None, branch: str | None = None,
-              progress: bool = True, swivel: float = 0.0, point=None) -> "CellTable":
+    def build(
+        cls,
+        robot,
+        rotation,
+        D: float,
+        bounds,
+        *,
+        q_ref=None,
+        branch: str | None = None,
+        progress: bool = True,
+        swivel: float = 0.0,
+        point=None,
+    ) -> "CellTable":
         """Exact IK at every lattice point of the box ``bounds = (lo(3), hi(3))`` (m); the
         lattice is anchored at the base origin (points are integer multiples of ``D``).
 
@@ -158,13 +201,24 @@ class CellTable:
             D = float(D)
             lo, hi = (np.asarray(b, float) for b in bounds)
         except (TypeError, ValueError):
-            raise ParameterError(f"rotation (3x3), D (m) and bounds (lo(3), hi(3)) must be numbers, got "
-                                 f"{rotation!r}, {D!r}, {bounds!r}") from None
-        if R.shape != (3, 3) or not np.isfinite(R).all() or np.abs(R.T @ R - np.eye(3)).max() > 1e-9:
+            raise ParameterError(
+                f"rotation (3x3), D (m) and bounds (lo(3), hi(3)) must be numbers, got "
+                f"{rotation!r}, {D!r}, {bounds!r}"
+            ) from None
+        if (
+            R.shape != (3, 3)
+            or not np.isfinite(R).all()
+            or np.abs(R.T @ R - np.eye(3)).max() > 1e-9
+        ):
             raise ParameterError(f"rotation must be a 3x3 rotation matrix, got {R!r}")
         if not (np.isfinite(D) and D > 0):
             raise ParameterError(f"cell size D must be > 0 (m), got {D}")
-        if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi <= lo).any():
+        if (
+            lo.shape != (3,)
+            or hi.shape != (3,)
+            or not (np.isfinite(lo).all() and np.isfinite(hi).all())
+            or (hi <= lo).any()
+        ):
             raise ParameterError(f"bounds must be (lo(3), hi(3)) with lo < hi, got {bounds!r}")
         point = np.zeros(3) if point is None else _finite_vector(point, "point", 3)
         i0, shape = lattice(lo, hi, D)
@@ -221,7 +275,7 @@ class CellTable:
         """Joint vector (nq,) at position ``p`` (3,) m by Eq. (7-32).  Raises
         :class:`OutsideCellTableError` if the cell is not covered."""
         (i, j, k), w = self._cell(p)
-        return np.dot(w, self.Q[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq))
+        return np.dot(w, self.Q[i : i + 2, j : j + 2, k : k + 2].reshape(8, self.nq))
 
     def _cell(self, p):
         """The covered cell (i, j, k) of position ``p`` and the 8 weights of Eq. (7-32) in the
@@ -239,29 +293,43 @@ class CellTable:
             if idx[a] == hi[a] + 1 and r[a] <= hi[a] + 1 + 1e-12:
                 idx[a] = hi[a]
             if not 0 <= idx[a] <= hi[a]:
-                raise OutsideCellTableError(f"position {tuple(p)} m is outside the lattice {self.bounds}")
+                raise OutsideCellTableError(
+                    f"position {tuple(p)} m is outside the lattice {self.bounds}"
+                )
         i, j, k = idx
         if not self.cell_ok[i, j, k]:
-            raise OutsideCellTableError(f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the joint limits")
+            raise OutsideCellTableError(
+                f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the joint limits"
+            )
         m1, m2, m3 = r[0] - i, r[1] - j, r[2] - k
         t1, t2, t3 = 1.0 - m1, 1.0 - m2, 1.0 - m3
         # the 8 weights of (7-32) in the corner order of Q[i:i+2, j:j+2, k:k+2] (i slowest)
-        w = (t1 * t2 * t3, t1 * t2 * m3, t1 * m2 * t3, t1 * m2 * m3,
-             m1 * t2 * t3, m1 * t2 * m3, m1 * m2 * t3, m1 * m2 * m3)
+        w = (
+            t1 * t2 * t3,
+            t1 * t2 * m3,
+            t1 * m2 * t3,
+            t1 * m2 * m3,
+            m1 * t2 * t3,
+            m1 * t2 * m3,
+            m1 * m2 * t3,
+            m1 * m2 * m3,
+        )
         return (i, j, k), w
 
     def lookup_batch(self, P) -> CellLookup:
         """Vectorised Eq. (7-32) for positions ``P`` (N, 3) m."""
         P = np.asarray(P, float)
         if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
-            raise ParameterError(f"P must be finite positions (N, 3) in metres, got shape {P.shape}")
+            raise ParameterError(
+                f"P must be finite positions (N, 3) in metres, got shape {P.shape}"
+            )
         idx, m, inside = self._locate(P)
         idc = np.clip(idx, 0, np.array(self.shape) - 2)
         ok = inside & self.cell_ok[idc[:, 0], idc[:, 1], idc[:, 2]]
-        w = trilinear_weights(m)                              # (N, 8)
+        w = trilinear_weights(m)  # (N, 8)
         q = np.zeros((P.shape[0], self.nq))
         for c, (a, b, e) in enumerate(CORNERS):
-            q += w[:, c:c + 1] * self.Q[idc[:, 0] + a, idc[:, 1] + b, idc[:, 2] + e]
+            q += w[:, c : c + 1] * self.Q[idc[:, 0] + a, idc[:, 1] + b, idc[:, 2] + e]
         q[~ok] = np.nan
         return CellLookup(q, ok)
 
@@ -272,7 +340,7 @@ class CellTable:
 
         q = robot.check_q(q).copy()
         Rt = self.rotation
-        target = np.asarray(p, float) - Rt @ self.point       # the tool origin's position
+        target = np.asarray(p, float) - Rt @ self.point  # the tool origin's position
         for _ in range(steps):
             T = robot.fk(q)
             e = np.concatenate([target - T[:3, 3], pin.log3(Rt @ T[:3, :3].T)])
@@ -282,8 +350,11 @@ class CellTable:
 
     # ------------------------------------------------------------------ motor pulses (§9-3)
     def _set_pulses(self, pulses_per_rad) -> None:
-        k = _finite_vector([pulses_per_rad] * self.nq if np.ndim(pulses_per_rad) == 0 else pulses_per_rad,
-                           "pulses_per_rad", self.nq)
+        k = _finite_vector(
+            [pulses_per_rad] * self.nq if np.ndim(pulses_per_rad) == 0 else pulses_per_rad,
+            "pulses_per_rad",
+            self.nq,
+        )
         if (k <= 0).any():
             raise ParameterError(f"pulses_per_rad must be > 0 (pulses per joint radian), got {k}")
         Q = np.where(self.valid[..., None], self.Q, 0.0) * k
@@ -299,12 +370,23 @@ class CellTable:
         ``round(q · pulses_per_rad)`` at every lattice point.  ``pulses_per_rad``: a scalar or
         (nq,) motor pulses per joint radian (encoder counts per motor turn × gear ratio / 2π),
         finite and > 0; ValueError otherwise."""
-        return type(self)(self.model, self.params, self.rotation, self.origin, self.D, self.Q, self.valid,
-                          point=self.point, pulses_per_rad=pulses_per_rad)
+        return type(self)(
+            self.model,
+            self.params,
+            self.rotation,
+            self.origin,
+            self.D,
+            self.Q,
+            self.valid,
+            point=self.point,
+            pulses_per_rad=pulses_per_rad,
+        )
 
     def _require_pulses(self):
         if self.pulses is None:
-            raise ParameterError("this cell table stores no motor pulses: use table.with_pulses(pulses_per_rad)")
+            raise ParameterError(
+                "this cell table stores no motor pulses: use table.with_pulses(pulses_per_rad)"
+            )
 
     def lookup_pulses(self, p) -> np.ndarray:
         """Motor pulses (nq,) int64 from the origin to position ``p`` (3,) m: Eq. (7-32) on the
@@ -312,7 +394,7 @@ class CellTable:
         :class:`OutsideCellTableError` if the cell is not covered, ValueError without pulses."""
         self._require_pulses()
         (i, j, k), w = self._cell(p)
-        corners = self.pulses[i:i + 2, j:j + 2, k:k + 2].reshape(8, self.nq).astype(float)
+        corners = self.pulses[i : i + 2, j : j + 2, k : k + 2].reshape(8, self.nq).astype(float)
         return np.rint(np.dot(w, corners)).astype(np.int64)
 
     def relative_pulses(self, p_from, p_to) -> np.ndarray:
@@ -328,7 +410,9 @@ class CellTable:
         except (TypeError, ValueError):
             p = np.zeros(0)
         if p.ndim not in (1, 2) or p.shape[-1] != self.nq or not np.isfinite(p).all():
-            raise ParameterError(f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got {pulses!r}")
+            raise ParameterError(
+                f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got {pulses!r}"
+            )
         return p / self.pulses_per_rad
 
     @property
@@ -345,10 +429,18 @@ class CellTable:
         extra = {"point": [float(v) for v in self.point]}
         if self.pulses_per_rad is not None:
             extra["pulses_per_rad"] = [float(v) for v in self.pulses_per_rad]
-        meta = json.dumps({"model": self.model, "params": self.params, "D": self.D, "format": 1, **extra})
+        meta = json.dumps(
+            {"model": self.model, "params": self.params, "D": self.D, "format": 1, **extra}
+        )
         with open(tmp, "wb") as fh:
-            np.savez(fh, Q=self.Q, valid=self.valid, origin=self.origin, rotation=self.rotation,
-                     meta=np.array(meta))
+            np.savez(
+                fh,
+                Q=self.Q,
+                valid=self.valid,
+                origin=self.origin,
+                rotation=self.rotation,
+                meta=np.array(meta),
+            )
         os.replace(tmp, path)
         return path
 
@@ -359,13 +451,28 @@ class CellTable:
         try:
             with np.load(path, allow_pickle=False) as z:
                 meta = json.loads(str(z["meta"]))
-                return cls(meta["model"], meta["params"], z["rotation"], z["origin"], meta["D"], z["Q"], z["valid"],
-                           point=meta.get("point"), pulses_per_rad=meta.get("pulses_per_rad"))
+                return cls(
+                    meta["model"],
+                    meta["params"],
+                    z["rotation"],
+                    z["origin"],
+                    meta["D"],
+                    z["Q"],
+                    z["valid"],
+                    point=meta.get("point"),
+                    pulses_per_rad=meta.get("pulses_per_rad"),
+                )
         except (KeyError, json.JSONDecodeError, OSError, ValueError) as exc:
             if isinstance(exc, FileNotFoundError):
                 raise
-            raise ValueError(f"{path}: not a cell table written by CellTable.save ({exc})") from None
+            raise ValueError(
+                f"{path}: not a cell table written by CellTable.save ({exc})"
+            ) from None
 
     def matches(self, robot) -> bool:
         """True if ``robot`` is the model and parameters this table was built for."""
-        return robot.spec is not None and robot.spec.name == self.model and dict(robot.spec.params) == self.params
+        return (
+            robot.spec is not None
+            and robot.spec.name == self.model
+            and dict(robot.spec.params) == self.params
+        )

@@ -20,10 +20,10 @@ def rows(models, samples, rng) -> list[CheckRow]:
     import anthroarm as aa
 
     out = []
-    for name in (aa.models.names() if models is None else models):
+    for name in aa.models.names() if models is None else models:
         try:
             robot = aa.load(name)
-        except Exception:                 # noqa: BLE001 - not a catalog arm: its rows come from elsewhere
+        except Exception:  # noqa: BLE001 - not a catalog arm: its rows come from elsewhere
             continue
         form = closed_form_info(robot)
         if form is None or form.family not in (SRS, PLANAR):
@@ -41,6 +41,15 @@ def rows(models, samples, rng) -> list[CheckRow]:
         worst = float(err.max()) if len(err) else float("inf")
         if not res.valid.any(1).all():
             worst = float("inf")
-        out.append(CheckRow(name, "analytic IK: FK(IK(T)) = T, all branches", worst, 1e-10, samples,
-                            oracle="pinocchio FK", note=f"{res.valid.sum(1).mean():.2f} solutions/pose"))
+        out.append(
+            CheckRow(
+                name,
+                "analytic IK: FK(IK(T)) = T, all branches",
+                worst,
+                1e-10,
+                samples,
+                oracle="pinocchio FK",
+                note=f"{res.valid.sum(1).mean():.2f} solutions/pose",
+            )
+        )
     return out

@@ -63,8 +63,16 @@ TWO_INTERSECTING = "two_intersecting"
 GEN_SIX_DOF = "gen_six_dof"
 NOT_6R = "not_6r"
 #: the 6R classes, in the order they are tried (simplest solution first)
-CLASSES = (SPHERICAL_TWO_PARALLEL, SPHERICAL_TWO_INTERSECTING, THREE_PARALLEL_TWO_INTERSECTING,
-           SPHERICAL, THREE_PARALLEL, TWO_PARALLEL, TWO_INTERSECTING, GEN_SIX_DOF)
+CLASSES = (
+    SPHERICAL_TWO_PARALLEL,
+    SPHERICAL_TWO_INTERSECTING,
+    THREE_PARALLEL_TWO_INTERSECTING,
+    SPHERICAL,
+    THREE_PARALLEL,
+    TWO_PARALLEL,
+    TWO_INTERSECTING,
+    GEN_SIX_DOF,
+)
 #: classes with a closed form (no search)
 CLOSED_FORM_CLASSES = CLASSES[:5]
 
@@ -145,7 +153,8 @@ def kinematics(robot, frame=None) -> Kinematics:
         if jt.is_mimic:
             raise UnsupportedModelError(
                 f"{chain.name}: joint {jt.name!r} mimics another joint; the subproblem "
-                "decomposition needs independent joints: use aa.ik.solve")
+                "decomposition needs independent joints: use aa.ik.solve"
+            )
         Rp, pp = world[jt.parent]
         R = Rp @ jt.rotation
         p = Rp @ jt.translation + pp
@@ -159,8 +168,9 @@ def kinematics(robot, frame=None) -> Kinematics:
     R_tool, p_tool = Rj @ fr.rotation, Rj @ fr.translation + pj
     pts = np.array(pts).reshape(-1, 3)
     P = np.diff(np.vstack([np.zeros(3), pts, p_tool]), axis=0)
-    return Kinematics(np.array(H).reshape(-1, 3), pts, P, R_tool, p_tool, tuple(path),
-                      tuple(kinds), tuple(names))
+    return Kinematics(
+        np.array(H).reshape(-1, 3), pts, P, R_tool, p_tool, tuple(path), tuple(kinds), tuple(names)
+    )
 
 
 def _relations(H, pts, tol, angle_tol):
@@ -175,8 +185,8 @@ def _relations(H, pts, tol, angle_tol):
     inter = ~par & (np.nan_to_num(dist, nan=np.inf) <= tol)
     tri = np.full(max(n - 2, 0), np.nan)
     for i in range(n - 2):
-        hs, ps = H[i:i + 3], pts[i:i + 3]
-        if par[i] or par[i + 1]:          # (i, i+2 may be parallel: both lines through the centre)
+        hs, ps = H[i : i + 3], pts[i : i + 3]
+        if par[i] or par[i + 1]:  # (i, i+2 may be parallel: both lines through the centre)
             continue
         # least-squares common point x of the three lines: Σ (I − h hᵀ)(x − p) = 0
         M = sum(np.eye(3) - np.outer(h, h) for h in hs)
@@ -211,13 +221,19 @@ def classify(robot, frame=None, tol: float = 1e-6, angle_tol: float = 1e-6) -> C
     consecutive axes, the measured values and the IK-Geo class (IK-Geo Table I; see the module
     docstring).  Joints of kind ``"continuous"`` count as revolute."""
     for name, v in (("tol", tol), ("angle_tol", angle_tol)):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
-                or not np.isfinite(v) or v <= 0:
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, (int, float, np.floating, np.integer))
+            or not np.isfinite(v)
+            or v <= 0
+        ):
             raise ParameterError(f"classify: {name} must be a finite number > 0, got {v!r}")
     return classify_kinematics(kinematics(robot, frame), tol, angle_tol)
 
 
-def classify_kinematics(kin: Kinematics, tol: float = 1e-6, angle_tol: float = 1e-6) -> Classification:
+def classify_kinematics(
+    kin: Kinematics, tol: float = 1e-6, angle_tol: float = 1e-6
+) -> Classification:
     """:func:`classify` of given :class:`Kinematics` (e.g. the first six joints of a 7-joint
     arm whose last joint is held fixed)."""
     sin, par, dist, inter, tri, sph, three = _relations(kin.H, kin.points, tol, angle_tol)
@@ -226,36 +242,70 @@ def classify_kinematics(kin: Kinematics, tol: float = 1e-6, angle_tol: float = 1
     acc_d, acc_a = dl[dl <= tol], sin[sin <= angle_tol]
     rej_d, rej_a = dl[dl > tol], sin[sin > angle_tol]
     worst = (float(acc_d.max()) if acc_d.size else 0.0, float(acc_a.max()) if acc_a.size else 0.0)
-    nearest = (float(rej_d.min()) if rej_d.size else np.inf, float(rej_a.min()) if rej_a.size else np.inf)
+    nearest = (
+        float(rej_d.min()) if rej_d.size else np.inf,
+        float(rej_a.min()) if rej_a.size else np.inf,
+    )
 
     def idx(mask):
         return tuple(int(i) for i in np.flatnonzero(mask))
 
-    common = dict(parallel=tuple((i, i + 1) for i in idx(par)),
-                  intersecting=tuple((i, i + 1) for i in idx(inter)),
-                  spherical=idx(sph), three_parallel=idx(three), sin_angle=sin, distance=dist,
-                  triple_distance=tri, tol=float(tol), angle_tol=float(angle_tol),
-                  worst_accepted=worst, nearest_rejected=nearest,
-                  kinematics=kin)
+    common = dict(
+        parallel=tuple((i, i + 1) for i in idx(par)),
+        intersecting=tuple((i, i + 1) for i in idx(inter)),
+        spherical=idx(sph),
+        three_parallel=idx(three),
+        sin_angle=sin,
+        distance=dist,
+        triple_distance=tri,
+        tol=float(tol),
+        angle_tol=float(angle_tol),
+        worst_accepted=worst,
+        nearest_rejected=nearest,
+        kinematics=kin,
+    )
     revolute = all(k in (REVOLUTE, CONTINUOUS) for k in kin.kinds)
     if kin.n != 6 or not revolute:
-        why = (f"{kin.n} joints from the base to the frame, not 6" if kin.n != 6 else
-               "not every joint is revolute: " + ", ".join(
-                   f"{nm} ({k})" for nm, k in zip(kin.names, kin.kinds) if k not in (REVOLUTE, CONTINUOUS)))
+        why = (
+            f"{kin.n} joints from the base to the frame, not 6"
+            if kin.n != 6
+            else "not every joint is revolute: "
+            + ", ".join(
+                f"{nm} ({k})"
+                for nm, k in zip(kin.names, kin.kinds)
+                if k not in (REVOLUTE, CONTINUOUS)
+            )
+        )
         return Classification(NOT_6R, False, (), reason=why, **common)
     fwd = _classes_6r(par, inter, sph, three)
     # reversed chain: joint i ↔ joint 5 − i; pairs (i, i+1) ↔ (4 − i, 5 − i); triples i ↔ 3 − i
     rev = _classes_6r(par[::-1], inter[::-1], sph[::-1], three[::-1])
-    ranked = sorted([(CLASSES.index(c), False, c) for c in fwd] + [(CLASSES.index(c), True, c) for c in rev])
+    ranked = sorted(
+        [(CLASSES.index(c), False, c) for c in fwd] + [(CLASSES.index(c), True, c) for c in rev]
+    )
     compatible = tuple((c, r) for _, r, c in ranked)
     name, is_rev = compatible[0]
     return Classification(name, is_rev, compatible, **common)
 
 
-__all__ = ["Classification", "Kinematics", "classify", "classify_kinematics", "kinematics", "CLASSES", "CLOSED_FORM_CLASSES",
-           "NOT_6R", "SPHERICAL_TWO_PARALLEL", "SPHERICAL_TWO_INTERSECTING",
-           "THREE_PARALLEL_TWO_INTERSECTING", "SPHERICAL", "THREE_PARALLEL", "TWO_PARALLEL",
-           "TWO_INTERSECTING", "GEN_SIX_DOF"]
+__all__ = [
+    "Classification",
+    "Kinematics",
+    "classify",
+    "classify_kinematics",
+    "kinematics",
+    "CLASSES",
+    "CLOSED_FORM_CLASSES",
+    "NOT_6R",
+    "SPHERICAL_TWO_PARALLEL",
+    "SPHERICAL_TWO_INTERSECTING",
+    "THREE_PARALLEL_TWO_INTERSECTING",
+    "SPHERICAL",
+    "THREE_PARALLEL",
+    "TWO_PARALLEL",
+    "TWO_INTERSECTING",
+    "GEN_SIX_DOF",
+]
 
 
 # ----------------------------------------------------------------------------- first solver
@@ -279,8 +329,13 @@ def _solve_spherical_two_parallel(kin: Kinematics, T) -> tuple[np.ndarray, np.nd
     T = np.asarray(T, dtype=float)
     single = T.ndim == 2
     T = T[None] if single else T
-    q, valid, exact = solve_class(SPHERICAL_TWO_PARALLEL, kin.H, _spherical_wrist_P(kin),
-                                  T[:, :3, :3] @ kin.R_tool.T, T[:, :3, 3])
+    q, valid, exact = solve_class(
+        SPHERICAL_TWO_PARALLEL,
+        kin.H,
+        _spherical_wrist_P(kin),
+        T[:, :3, :3] @ kin.R_tool.T,
+        T[:, :3, 3],
+    )
     if single:
         return q[0], valid[0], exact[0]
     return q, valid, exact

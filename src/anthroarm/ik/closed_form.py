@@ -162,7 +162,7 @@ class AnalyticBatchResult:
     model: str = ""
 
     def __post_init__(self):
-        for a in (self.solutions, self.valid, self.residuals):   # what `singular` reads later
+        for a in (self.solutions, self.valid, self.residuals):  # what `singular` reads later
             if a is not None:
                 a.flags.writeable = False
 
@@ -174,7 +174,7 @@ class AnalyticBatchResult:
 
     def __getstate__(self):
         """Pickled with :attr:`singular` evaluated (its lazy maker is a closure)."""
-        self.singular                                      # noqa: B018 - evaluated into __dict__
+        self.singular  # noqa: B018 - evaluated into __dict__
         state = self.__dict__.copy()
         state["_singular_of"] = None
         return state
@@ -193,7 +193,9 @@ class AnalyticBatchResult:
             branches=[b for b, ok in zip(self.branches, v) if ok],
             reason=self.reasons[i],
             swivel=None if self.swivel is None else self.swivel[i][v].copy(),
-            residuals=np.zeros(int(v.sum())) if self.residuals is None else self.residuals[i][v].copy(),
+            residuals=np.zeros(int(v.sum()))
+            if self.residuals is None
+            else self.residuals[i][v].copy(),
             _singular=sing,
             model=self.model,
         )
@@ -238,7 +240,7 @@ class ClosedForm:
 
 def _cost(cls: str) -> float:
     if cls == _geo.C.GEN_SIX_DOF:
-        return 3e5                       # the 2-D search
+        return 3e5  # the 2-D search
     return 2e3 if cls in _geo.SEARCHED else 3.0
 
 
@@ -286,13 +288,17 @@ def _arm_of(robot):
         return "no joint moves the frame"
     keep = set(path) | {j.index for j in ch.joints if j.is_mimic and j.mimic.source in path}
     try:
-        model, _ = reduce_model(robot.model, robot.name, active=[ch.joints[j].name for j in sorted(keep)])
+        model, _ = reduce_model(
+            robot.model, robot.name, active=[ch.joints[j].name for j in sorted(keep)]
+        )
         arm = Robot(model, name=robot.name, tool=robot.tool)
     except Exception as exc:  # noqa: BLE001 - UnsupportedModelError (a mimic pair cut), a model without frames
         return f"the arm on the path to the tool could not be cut out of the tree: {exc}"
     full = robot.model
     starts = [full.joints[full.getJointId(model.names[j])].idx_q for j in range(1, model.njoints)]
-    q_idx = np.concatenate([np.arange(i, i + model.joints[j].nq) for j, i in enumerate(starts, 1)]).astype(int)
+    q_idx = np.concatenate(
+        [np.arange(i, i + model.joints[j].nq) for j, i in enumerate(starts, 1)]
+    ).astype(int)
     pos = {ch.joints[j].name: k for k, j in enumerate(ch.independent)}
     th_idx = np.array([pos[arm.chain.joints[j].name] for j in arm.chain.independent], dtype=int)
     q_rest = comfortable_posture(robot)
@@ -304,11 +310,11 @@ def _arm_of(robot):
 
 @dataclass(frozen=True)
 class _Solver:
-    kind: str                            # "geo", "srs", "planar"
+    kind: str  # "geo", "srs", "planar"
     plan: object
     form: ClosedForm
-    plain: bool                          # q is the joint angles themselves (no continuous joint)
-    arm: _Arm | None = None              # a tree: the closed form is the arm's (its own _Solver)
+    plain: bool  # q is the joint angles themselves (no continuous joint)
+    arm: _Arm | None = None  # a tree: the closed form is the arm's (its own _Solver)
 
     @functools.cached_property
     def one_call(self) -> _OneCall | None:
@@ -328,9 +334,19 @@ class _Solver:
         cf, ci = self.plan.packed
         n = int(ci[2])
         w = n if self.plain else self.plan.chain.nq
-        call = _jit.entry_point(_geo.pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, w + 4)))
-        return _OneCall(cf, ci, _by_mask(self.plan.labels, w, w), self.plan.param_joint is not None, call,
-                        _SingularOf(self.plan, self.plain), self.kind, (8, w + 4))
+        call = _jit.entry_point(
+            _geo.pose_solutions, cf, ci, np.eye(4), 0.0, 1.0, 1.0, np.empty((8, w + 4))
+        )
+        return _OneCall(
+            cf,
+            ci,
+            _by_mask(self.plan.labels, w, w),
+            self.plan.param_joint is not None,
+            call,
+            _SingularOf(self.plan, self.plain),
+            self.kind,
+            (8, w + 4),
+        )
 
 
 def _by_mask(labels, width: int, residual: int, swivel: int | None = None) -> tuple:
@@ -342,7 +358,14 @@ def _by_mask(labels, width: int, residual: int, swivel: int | None = None) -> tu
     for mask in range(1 << B):
         lab = [labels[b] for b in range(B) if mask >> b & 1]
         rows = slice(0, len(lab))
-        out.append((lab, (rows, slice(0, width)), (rows, residual), None if swivel is None else (rows, swivel)))
+        out.append(
+            (
+                lab,
+                (rows, slice(0, width)),
+                (rows, residual),
+                None if swivel is None else (rows, swivel),
+            )
+        )
     return tuple(out)
 
 
@@ -355,16 +378,18 @@ class _OneCall(NamedTuple):
     row: θ (7), the FK residual in column 9, the swivel angle in column 11) or
     :func:`.families.planar_pose_solutions` (position only; a row: θ (2), the residual)."""
 
-    cf: np.ndarray                       # the plan's packed constants
+    cf: np.ndarray  # the plan's packed constants
     ci: np.ndarray
-    by_mask: tuple                       # :func:`_by_mask` of the plan's labels and ``out``'s columns
-    holds_param: bool                    # a 7th joint is held (``param=``)
-    call: object                         # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
+    by_mask: tuple  # :func:`_by_mask` of the plan's labels and ``out``'s columns
+    holds_param: bool  # a 7th joint is held (``param=``)
+    call: object  # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
     #                                      the caller checks T)
-    singular: _SingularOf | None         # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
-    kind: str                            # of the :class:`_Solver`: "geo", "srs" (``angle`` is the swivel
+    singular: (
+        _SingularOf | None
+    )  # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
+    kind: str  # of the :class:`_Solver`: "geo", "srs" (``angle`` is the swivel
     #                                      angle), "planar" (position only)
-    shape: tuple                         # of ``out``
+    shape: tuple  # of ``out``
 
 
 class _SingularOf:
@@ -379,8 +404,14 @@ class _SingularOf:
 
     def __call__(self, solutions: np.ndarray) -> str | None:
         plan, K = self.plan, len(solutions)
-        th = solutions if self.plain else plan.chain.angles(solutions)[:, list(plan.chain.independent)]
-        return _singular_text(float(_geo.jacobian_volumes(plan, th[None], np.ones((1, K), bool)).min()))
+        th = (
+            solutions
+            if self.plain
+            else plan.chain.angles(solutions)[:, list(plan.chain.independent)]
+        )
+        return _singular_text(
+            float(_geo.jacobian_volumes(plan, th[None], np.ones((1, K), bool)).min())
+        )
 
 
 #: id(robot) → (its chain, its tool, its :class:`_Solver` or None, the solver's
@@ -399,7 +430,12 @@ def _solver(robot):
     out = _new_solver(robot)
     if hit is None:
         weakref.finalize(robot, _SOLVERS.pop, id(robot), None)
-    _SOLVERS[id(robot)] = (robot.chain, robot.tool, out, None if out is None or out.arm is not None else _PENDING)
+    _SOLVERS[id(robot)] = (
+        robot.chain,
+        robot.tool,
+        out,
+        None if out is None or out.arm is not None else _PENDING,
+    )
     return out
 
 
@@ -418,11 +454,15 @@ def _new_solver(robot):
     if arm is not None:
         inner = _solver(arm.robot) if isinstance(arm, _Arm) else None
         return None if inner is None else _Solver(inner.kind, inner.plan, inner.form, False, arm)
-    plain = robot.nq == len(ch.independent) and all(ch.joints[j].kind != "continuous" for j in ch.independent)
+    plain = robot.nq == len(ch.independent) and all(
+        ch.joints[j].kind != "continuous" for j in ch.independent
+    )
     out = None
     pl = _fam.planar_plan(robot)
     if pl is not None:
-        out = _Solver("planar", pl, ClosedForm(PLANAR, 2, 2, position_only=True, cost_us=2.0), plain)
+        out = _Solver(
+            "planar", pl, ClosedForm(PLANAR, 2, 2, position_only=True, cost_us=2.0), plain
+        )
     if out is None:
         sp = _fam.srs_plan(robot)
         if sp is not None:
@@ -430,8 +470,18 @@ def _new_solver(robot):
     if out is None:
         gp = _geo.plan_for(robot)
         if gp is not None:
-            out = _Solver("geo", gp, ClosedForm(gp.cls, len(gp.fk_axes), _geo.n_branches(gp.cls),
-                                                param=gp.param_joint is not None, cost_us=_cost(gp.cls)), plain)
+            out = _Solver(
+                "geo",
+                gp,
+                ClosedForm(
+                    gp.cls,
+                    len(gp.fk_axes),
+                    _geo.n_branches(gp.cls),
+                    param=gp.param_joint is not None,
+                    cost_us=_cost(gp.cls),
+                ),
+                plain,
+            )
     return out
 
 
@@ -456,16 +506,24 @@ def _retooled(robot, frame):
     if hit is None or hit[0] is not robot.chain:
         hit = _RETOOLED[robot] = (robot.chain, {})
     if f.index not in hit[1]:
-        other = Robot(robot.model, name=robot.name, tool=f.name, info=robot.info, spec=robot.spec,
-                      locked=robot.locked)
+        other = Robot(
+            robot.model,
+            name=robot.name,
+            tool=f.name,
+            info=robot.info,
+            spec=robot.spec,
+            locked=robot.locked,
+        )
         hit[1][f.index] = other if other.tool_id == f.index else None
     return hit[1][f.index]
 
 
 def _unnamed(robot, frame) -> str:
     f = robot.chain.frame(frame)
-    return (f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame {robot.chain.frame(f.name).index}; "
-            "the closed form solves for a frame known by its name: use aa.ik.solve(robot, T, frame=...)")
+    return (
+        f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame {robot.chain.frame(f.name).index}; "
+        "the closed form solves for a frame known by its name: use aa.ik.solve(robot, T, frame=...)"
+    )
 
 
 def _frame_robot(robot, frame):
@@ -516,21 +574,32 @@ def analytic_cost(robot, frame=None) -> float:
 def _why_not(robot) -> str:
     on_path = len(robot.chain.path(robot.tool_id))
     if not on_path:
-        return f"{robot.name}: no joint moves the frame {robot.tool!r}: there is nothing to solve for"
+        return (
+            f"{robot.name}: no joint moves the frame {robot.tool!r}: there is nothing to solve for"
+        )
     arm = _arm_of(robot)
     sub = arm.robot if isinstance(arm, _Arm) else robot
     c = _geo.classification(sub)
-    why = ("its chain could not be read" if c is None else
-           f"its kinematic class is {c.name}" + (f" ({c.reason})" if c.reason else ""))
+    why = (
+        "its chain could not be read"
+        if c is None
+        else f"its kinematic class is {c.name}" + (f" ({c.reason})" if c.reason else "")
+    )
     if isinstance(arm, str):
         why += f"; {arm}"
     srs = _fam.srs_reason(sub)
-    return (f"{robot.name}: no closed form for this geometry at the tool {robot.tool!r}: {why}"
-            + (f"; not an SRS arm: {srs}" if srs and on_path == 7 else "")
-            + ("; lock joints on the path (aa.load(..., locked=[...])) to leave 6 or 7" if on_path > 7 else "")
-            + f". Closed forms exist for 6R arms of the classes {', '.join(_geo.SOLVED)} (and 7-joint arms whose "
-            "first six are one, with the last joint held), SRS 7R arms by swivel angle, and planar 2R arms; "
-            "use aa.ik.solve(robot, T) for a numerical solution")
+    return (
+        f"{robot.name}: no closed form for this geometry at the tool {robot.tool!r}: {why}"
+        + (f"; not an SRS arm: {srs}" if srs and on_path == 7 else "")
+        + (
+            "; lock joints on the path (aa.load(..., locked=[...])) to leave 6 or 7"
+            if on_path > 7
+            else ""
+        )
+        + f". Closed forms exist for 6R arms of the classes {', '.join(_geo.SOLVED)} (and 7-joint arms whose "
+        "first six are one, with the last joint held), SRS 7R arms by swivel angle, and planar 2R arms; "
+        "use aa.ik.solve(robot, T) for a numerical solution"
+    )
 
 
 def _require(robot) -> _Solver:
@@ -547,14 +616,18 @@ def _q_rest(robot, arm, q_rest) -> np.ndarray | None:
         return None if arm is None else arm.q_rest
     q = robot.check_q(q_rest, name="q_rest")
     if q.ndim != 1:
-        raise ValueError(f"{robot.name}: q_rest is one configuration, shape ({robot.nq},), got shape {q.shape}")
+        raise ValueError(
+            f"{robot.name}: q_rest is one configuration, shape ({robot.nq},), got shape {q.shape}"
+        )
     if arm is not None:
         off = np.setdiff1d(np.arange(robot.nq), arm.q_idx)
         bad = off[(q[off] < robot.lower[off]) | (q[off] > robot.upper[off])]
         if len(bad):
             names = robot.chain.q_names
-            raise ValueError(f"{robot.name}: q_rest puts {', '.join(names[i] for i in bad)} outside the joint limits "
-                             "(the solutions keep its joints off the tool's path, and every solution is inside them)")
+            raise ValueError(
+                f"{robot.name}: q_rest puts {', '.join(names[i] for i in bad)} outside the joint limits "
+                "(the solutions keep its joints off the tool's path, and every solution is inside them)"
+            )
     return q
 
 
@@ -563,7 +636,11 @@ def _on_robot(arm: _Arm, res, q_rest):
     robot, the joints off the path at ``q_rest``."""
     if isinstance(res, AnalyticBatchResult):
         return replace(res, solutions=arm.configurations(res.solutions, q_rest, res.valid))
-    sing = functools.partial(_singular_from, res._singular, res.solutions) if callable(res._singular) else res._singular
+    sing = (
+        functools.partial(_singular_from, res._singular, res.solutions)
+        if callable(res._singular)
+        else res._singular
+    )
     return replace(res, solutions=arm.configurations(res.solutions, q_rest), _singular=sing)
 
 
@@ -578,7 +655,9 @@ def require_form(robot, frame=None) -> ClosedForm:
 
 
 # ---------------------------------------------------------------------------- input checks
-def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=True) -> tuple[np.ndarray, bool]:
+def _check_poses(
+    T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=True
+) -> tuple[np.ndarray, bool]:
     """Return (N, 4, 4) and whether the input was a single pose.  ValueError on bad input:
     the shape, a value that is not finite, and (``rigid``) the last row and the rotation part
     (``rigid=False``: the caller's compiled solver checks those, :class:`.geometric.BadPoseError`)."""
@@ -592,26 +671,35 @@ def _check_poses(T, name="T", tol_orthonormal=1e-6, position_only=False, rigid=T
     elif arr.ndim == 2 and arr.shape == (4, 4):
         arr = arr[None]
     elif not (arr.ndim == 3 and arr.shape[1:] == (4, 4)):
-        raise ValueError(f"{name} must be a 4x4 homogeneous pose or a batch (N, 4, 4), got shape {arr.shape}")
+        raise ValueError(
+            f"{name} must be a 4x4 homogeneous pose or a batch (N, 4, 4), got shape {arr.shape}"
+        )
     if arr.shape[0] == 0:
-        return arr, single                   # an empty batch: an empty result
+        return arr, single  # an empty batch: an empty result
     if not np.isfinite(arr).all():
         idx = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
-        raise ValueError(f"{name}{list(idx) if not single else list(idx[1:])} is {arr[idx]} (not finite)")
+        raise ValueError(
+            f"{name}{list(idx) if not single else list(idx[1:])} is {arr[idx]} (not finite)"
+        )
     if not rigid:
         return arr, single
     if np.abs(arr[:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max() > 1e-12:
         raise ValueError(f"{name}: the last row of a homogeneous pose must be [0, 0, 0, 1]")
     R = arr[:, :3, :3]
     err = np.abs(np.einsum("nji,njk->nik", R, R) - np.eye(3)).max(axis=(1, 2))
-    det = np.linalg.det(R) if len(R) < 64 else np.einsum("ni,ni->n", R[:, :, 0], np.cross(R[:, :, 1], R[:, :, 2]))
+    det = (
+        np.linalg.det(R)
+        if len(R) < 64
+        else np.einsum("ni,ni->n", R[:, :, 0], np.cross(R[:, :, 1], R[:, :, 2]))
+    )
     bad = (err > tol_orthonormal) | (det < 0)
     if not position_only and bad.any():
         i = int(np.argmax(bad))
         where = "" if single else f"[{i}]"
         raise ValueError(
             f"{name}{where}: the rotation part is not a rotation matrix (max |R^T R - I| = {err[i]:.3g}, "
-            f"det = {det[i]:.6g}); orthonormalise it first (e.g. nearest rotation by SVD)")
+            f"det = {det[i]:.6g}); orthonormalise it first (e.g. nearest rotation by SVD)"
+        )
     return arr, single
 
 
@@ -624,6 +712,7 @@ def _detail_bad_pose(Ts, i, single, tol_orthonormal):
 
 # ---------------------------------------------------------------------------- helpers
 
+
 def _fk_residual(robot, Qw, Ts, position_only):
     """max |FK(q) − T| (3×4 entries, or position) of candidates Qw (N, B, nq) against Ts (N, 4, 4),
     +inf for a non-finite candidate.  Few candidates: Pinocchio's FK (one C++ call each, the
@@ -633,7 +722,9 @@ def _fk_residual(robot, Qw, Ts, position_only):
     N, B = Qw.shape[:2]
     finite = np.isfinite(Qw).all(-1)
     if N * B > 64:
-        Tf = robot.chain.serial(robot.tool).fk(np.where(finite[..., None], Qw, 0.0).reshape(N * B, -1))
+        Tf = robot.chain.serial(robot.tool).fk(
+            np.where(finite[..., None], Qw, 0.0).reshape(N * B, -1)
+        )
         Tf = Tf.reshape(N, B, 4, 4)
         d = np.abs(Tf[..., :3, 3] - Ts[:, None, :3, 3]).max(-1)
         if not position_only:
@@ -662,31 +753,47 @@ def _swivel_array(swivel, N, grid_1d=False):
     (1, S) -> a grid per pose; None -> :data:`DEFAULT_SWIVEL` for every pose."""
     if swivel is None:
         return np.broadcast_to(DEFAULT_SWIVEL[None, :], (N, DEFAULT_SWIVEL.size)).copy()
-    if type(swivel) is float and abs(swivel) < WRAP_MAX:      # the usual one angle: no numpy checks
+    if type(swivel) is float and abs(swivel) < WRAP_MAX:  # the usual one angle: no numpy checks
         sw = np.empty((N, 1))
         sw.fill(swivel)
         return sw
     sw = np.asarray(swivel, dtype=float)
     if not (np.abs(sw) < WRAP_MAX).all():
-        raise ValueError(f"swivel must be finite angles (rad) of magnitude below {WRAP_MAX:g}, got {swivel!r}")
+        raise ValueError(
+            f"swivel must be finite angles (rad) of magnitude below {WRAP_MAX:g}, got {swivel!r}"
+        )
     if sw.ndim == 0:
         return np.full((N, 1), float(sw))
     if sw.ndim == 1 and grid_1d:
         sw = sw[None, :]
     elif sw.ndim == 1:
         if sw.shape[0] != N:
-            raise ValueError(f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
-                             f"got {sw.shape[0]} (pass shape (1, S) for a grid shared by all poses)")
+            raise ValueError(
+                f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
+                f"got {sw.shape[0]} (pass shape (1, S) for a grid shared by all poses)"
+            )
         return sw[:, None].copy()
     if sw.ndim == 2 and sw.shape[0] in (1, N) and sw.shape[1] >= 1:
         return np.broadcast_to(sw, (N, sw.shape[1])).copy()
-    raise ValueError(f"swivel must be a scalar, shape (N,), (1, S) or (N, S) with N = {N}, got {sw.shape}")
+    raise ValueError(
+        f"swivel must be a scalar, shape (N,), (1, S) or (N, S) with N = {N}, got {sw.shape}"
+    )
 
 
 # ---------------------------------------------------------------------------- batches
-def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-                   tol_orthonormal: float = 1e-6, param=None, q_rest=None, frame=None,
-                   _single_grid: bool = False) -> AnalyticBatchResult:
+def analytic_batch(
+    robot,
+    T,
+    *,
+    swivel=None,
+    position_only: bool | None = None,
+    tol: float = 1e-9,
+    tol_orthonormal: float = 1e-6,
+    param=None,
+    q_rest=None,
+    frame=None,
+    _single_grid: bool = False,
+) -> AnalyticBatchResult:
     """Closed-form IK of N poses ``T`` (N, 4, 4) on every branch (see the module docstring).
 
     Candidates are wrapped into the joint limits (multiples of 2π), rejected if outside, and
@@ -706,33 +813,61 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
     _check_tol("tol_orthonormal", tol_orthonormal)
     other = _frame_robot(robot, frame)
     if other is not robot:
-        return analytic_batch(other, T, swivel=swivel, position_only=position_only, tol=tol,
-                              tol_orthonormal=tol_orthonormal, param=param, q_rest=q_rest, _single_grid=_single_grid)
+        return analytic_batch(
+            other,
+            T,
+            swivel=swivel,
+            position_only=position_only,
+            tol=tol,
+            tol_orthonormal=tol_orthonormal,
+            param=param,
+            q_rest=q_rest,
+            _single_grid=_single_grid,
+        )
     s = _require(robot)
     if s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
-        return _on_robot(s.arm, analytic_batch(s.arm.robot, T, swivel=swivel, position_only=position_only, tol=tol,
-                                               tol_orthonormal=tol_orthonormal, param=param,
-                                               _single_grid=_single_grid), rest)
+        return _on_robot(
+            s.arm,
+            analytic_batch(
+                s.arm.robot,
+                T,
+                swivel=swivel,
+                position_only=position_only,
+                tol=tol,
+                tol_orthonormal=tol_orthonormal,
+                param=param,
+                _single_grid=_single_grid,
+            ),
+            rest,
+        )
     if q_rest is not None:
         _q_rest(robot, None, q_rest)
     if s.kind != "srs" and swivel is not None:
-        raise ValueError(f"{robot.name}: swivel= applies to a redundant SRS arm's family of solutions; this arm "
-                         f"({s.form.family}) has finitely many solutions" +
-                         ("; its held last joint is param=" if s.form.param else ""))
+        raise ValueError(
+            f"{robot.name}: swivel= applies to a redundant SRS arm's family of solutions; this arm "
+            f"({s.form.family}) has finitely many solutions"
+            + ("; its held last joint is param=" if s.form.param else "")
+        )
     if s.kind != "geo" or not s.form.param:
         if param is not None:
-            raise ValueError(f"{robot.name}: param= is the value of the held last joint of a 7-joint arm solved "
-                             f"by its geometry; this arm ({s.form.family}) has none" +
-                             ("; use swivel=" if s.kind == "srs" else ""))
+            raise ValueError(
+                f"{robot.name}: param= is the value of the held last joint of a 7-joint arm solved "
+                f"by its geometry; this arm ({s.form.family}) has none"
+                + ("; use swivel=" if s.kind == "srs" else "")
+            )
     if s.kind == "planar":
         return _planar_batch(robot, s, T, position_only, tol)
     if position_only:
-        raise ValueError(f"{robot.name}: a {s.form.family} arm is solved for the full pose (position and "
-                         "rotation); for a position alone use aa.ik.solve(robot, p, position_only=True)")
+        raise ValueError(
+            f"{robot.name}: a {s.form.family} arm is solved for the full pose (position and "
+            "rotation); for a position alone use aa.ik.solve(robot, p, position_only=True)"
+        )
     closed = s.kind == "geo" and s.plan.cls in _geo.CLOSED
     # a closed class and the SRS family check the rotations in their compiled call
-    Ts, single = _check_poses(T, tol_orthonormal=tol_orthonormal, rigid=not (closed or s.kind == "srs"))
+    Ts, single = _check_poses(
+        T, tol_orthonormal=tol_orthonormal, rigid=not (closed or s.kind == "srs")
+    )
     N = Ts.shape[0]
     if s.kind == "srs":
         grid = _swivel_array(swivel, N, grid_1d=single or _single_grid)
@@ -740,15 +875,19 @@ def analytic_batch(robot, T, *, swivel=None, position_only: bool | None = None, 
         if N == 0:
             return _empty(robot, labels, swivel=True)
         try:
-            th, cand, exact, inside, res, ok = _fam.srs_verified(s.plan, Ts, grid, tol, tol_orthonormal)
+            th, cand, exact, inside, res, ok = _fam.srs_verified(
+                s.plan, Ts, grid, tol, tol_orthonormal
+            )
         except _geo.BadPoseError as exc:
             _detail_bad_pose(Ts, exc.index, single, tol_orthonormal)
             raise
         sw = np.repeat(grid, len(s.plan.labels), axis=1)
-        return _finish(robot, s, Ts, th, cand, exact, inside, res, ok, labels, tol, False, swivel=sw)
+        return _finish(
+            robot, s, Ts, th, cand, exact, inside, res, ok, labels, tol, False, swivel=sw
+        )
     gp = s.plan
     if gp.param_joint is not None:
-        if param is None:                 # a grid over the held joint's range
+        if param is None:  # a grid over the held joint's range
             k = gp.order.tolist().index(gp.param_joint)
             lo, hi = (max(gp.lower[k], -np.pi), min(gp.upper[k], np.pi))
             param = (np.linspace(lo, hi, PARAM_GRID + 1)[:-1] + 0.5 * (hi - lo) / PARAM_GRID)[None]
@@ -788,9 +927,15 @@ def _grid_labels(labels, S, what):
 
 def _empty(robot, labels, swivel=False):
     B = len(labels)
-    return AnalyticBatchResult(np.zeros((0, B, robot.nq)), np.zeros((0, B), bool), labels, [],
-                               swivel=np.zeros((0, B)) if swivel else None, residuals=np.zeros((0, B)),
-                               model=robot.name)
+    return AnalyticBatchResult(
+        np.zeros((0, B, robot.nq)),
+        np.zeros((0, B), bool),
+        labels,
+        [],
+        swivel=np.zeros((0, B)) if swivel else None,
+        residuals=np.zeros((0, B)),
+        model=robot.name,
+    )
 
 
 def _planar_batch(robot, s, T, position_only, tol):
@@ -802,58 +947,95 @@ def _planar_batch(robot, s, T, position_only, tol):
     labels = list(s.plan.labels)
     if N == 0:
         return _empty(robot, labels)
-    th, cand, exact, inside, res, ok = _fam.planar_verified(s.plan, np.ascontiguousarray(Ts[:, :3, 3]), tol)
-    if not po:                          # the rotation too: Pinocchio's residuals, solutions marked again
+    th, cand, exact, inside, res, ok = _fam.planar_verified(
+        s.plan, np.ascontiguousarray(Ts[:, :3, 3]), tol
+    )
+    if not po:  # the rotation too: Pinocchio's residuals, solutions marked again
         Q = s.plan.chain.configuration(np.where(cand[..., None], th, 0.0))
         res = np.where(cand, _fk_residual(robot, Q, Ts, False), np.inf)
         ok = None
     return _finish(robot, s, Ts, th, cand, exact, inside, res, ok, labels, tol, po)
 
 
-def _finish(robot, s, Ts, th, cand, exact, inside, res, valid, labels, tol, position_only, swivel=None, conf=None):
+def _finish(
+    robot,
+    s,
+    Ts,
+    th,
+    cand,
+    exact,
+    inside,
+    res,
+    valid,
+    labels,
+    tol,
+    position_only,
+    swivel=None,
+    conf=None,
+):
     """From the compiled solver's branches to the result: configurations (``conf``, where the
     compiled call made them), polish of near-exact candidates, duplicates, the rescue of poses
     whose candidates lie on a limit, reasons."""
     N, B = cand.shape
     ch = robot.chain
-    Q = th if s.plain else conf if conf is not None else ch.configuration(th)   # NaN below where no solution
+    Q = (
+        th if s.plain else conf if conf is not None else ch.configuration(th)
+    )  # NaN below where no solution
     res = np.array(res, dtype=float)
     near = cand & exact & inside & (res > tol) & (res <= POLISH_MAX)
     polished = bool(near.any()) and s.plain
     if polished:
         Q = np.array(Q)
         for i, b in zip(*np.nonzero(near)):
-            Q[i, b], res[i, b] = _refine(robot, Q[i, b], Ts[i], robot.lower, robot.upper, position_only)
+            Q[i, b], res[i, b] = _refine(
+                robot, Q[i, b], Ts[i], robot.lower, robot.upper, position_only
+            )
     if valid is None or polished:
         valid = _geo.mark_solutions(Q if polished else th, cand, inside, res, tol, s.form.branches)
     else:
         valid = np.array(valid)
-    none = ~valid.any(1)                                            # poses without a solution
+    none = ~valid.any(1)  # poses without a solution
     if s.kind != "srs" and s.plain and none.any():
         todo = np.flatnonzero(none & (cand & (exact | (res <= POLISH_MAX)) & ~inside).any(1))
         if todo.size:
             Q = np.array(Q)
             for i in todo:
-                for b, q, r in _rescue(robot, Q[i], cand[i] & (exact[i] | (res[i] <= POLISH_MAX)) & ~inside[i],
-                                       Ts[i], tol, position_only):
+                for b, q, r in _rescue(
+                    robot,
+                    Q[i],
+                    cand[i] & (exact[i] | (res[i] <= POLISH_MAX)) & ~inside[i],
+                    Ts[i],
+                    tol,
+                    position_only,
+                ):
                     Q[i, b], valid[i, b], res[i, b], inside[i, b] = q, True, r, True
     reasons = [None] * N
     for i in np.flatnonzero(~valid.any(1)) if none.any() else ():
-        reasons[i] = _reason(robot, s, Ts[i], cand[i], exact[i], inside[i], res[i], tol, position_only)
+        reasons[i] = _reason(
+            robot, s, Ts[i], cand[i], exact[i], inside[i], res[i], tol, position_only
+        )
     singular_of = None
     if s.kind == "geo":
-        TH = Q if polished else th                                  # polished: a plain arm, Q = θ
+        TH = Q if polished else th  # polished: a plain arm, Q = θ
         plan = s.plan
 
         def singular_of(rows):
             vol = _geo.jacobian_volumes(plan, TH[rows], valid[rows]).min(1)
             return [_singular_text(float(v)) for v in vol]
+
     # Q and res are this call's own arrays (the compiled call's, or copies): NaN in place where
     # no solution (a new 8·n·N array would cost more than the rest of this function)
     _geo.blank_unsolved(Q, res, valid)
-    return AnalyticBatchResult(solutions=Q, valid=valid, branches=labels, reasons=reasons,
-                               swivel=None if swivel is None else np.where(valid, swivel, np.nan), residuals=res,
-                               _singular_of=singular_of, model=robot.name)
+    return AnalyticBatchResult(
+        solutions=Q,
+        valid=valid,
+        branches=labels,
+        reasons=reasons,
+        swivel=None if swivel is None else np.where(valid, swivel, np.nan),
+        residuals=res,
+        _singular_of=singular_of,
+        model=robot.name,
+    )
 
 
 #: an FK residual (m / unitless) up to which a pose without a solution is reported as a near miss
@@ -867,31 +1049,50 @@ def _reason(robot, s, T, cand, exact, inside, res, tol, position_only) -> str:
     if s.kind == "planar":
         off = abs(float(s.plan.h1 @ (T[:3, 3] - s.plan.p_tool)))
         if off > tol:
-            return (f"outside the workspace: the target is {off:.3g} m off the plane of motion of the "
-                    "mechanism (normal to its parallel axes)")
+            return (
+                f"outside the workspace: the target is {off:.3g} m off the plane of motion of the "
+                "mechanism (normal to its parallel axes)"
+            )
     if not (cand & exact).any():
         best = float(np.min(res)) if np.isfinite(res).any() else float("inf")
         if best <= NEAR_MISS:
-            return (f"not reached to tol = {tol:g}: the best candidate leaves an FK residual of {best:.3g} "
-                    "(the pose is not a rigid transform to that precision — a single-precision pose, a rotation "
-                    "orthonormal only to ~1e-8 — or lies that close to the workspace boundary); pass a larger tol "
-                    "to accept it")
-        return (f"outside the workspace: no branch of the {fam} closed form reaches this pose (its "
-                f"subproblems have least-squares answers only; best FK residual {best:.3g})")
+            return (
+                f"not reached to tol = {tol:g}: the best candidate leaves an FK residual of {best:.3g} "
+                "(the pose is not a rigid transform to that precision — a single-precision pose, a rotation "
+                "orthonormal only to ~1e-8 — or lies that close to the workspace boundary); pass a larger tol "
+                "to accept it"
+            )
+        return (
+            f"outside the workspace: no branch of the {fam} closed form reaches this pose (its "
+            f"subproblems have least-squares answers only; best FK residual {best:.3g})"
+        )
     if not (cand & exact & inside).any():
-        ch = robot.chain             # limits of the joints solved for (θ, not q: a continuous joint is cos, sin in q)
+        ch = (
+            robot.chain
+        )  # limits of the joints solved for (θ, not q: a continuous joint is cos, sin in q)
         joints = [ch.joints[j] for j in ch.independent]
-        return (f"all {int((cand & exact).sum())} closed-form solutions violate the joint limits ("
-                + ", ".join(f"{j.name} continuous" if j.kind == "continuous"
-                            else f"{j.name} [{j.lower:.4g}, {j.upper:.4g}]" for j in joints) + ")")
+        return (
+            f"all {int((cand & exact).sum())} closed-form solutions violate the joint limits ("
+            + ", ".join(
+                f"{j.name} continuous"
+                if j.kind == "continuous"
+                else f"{j.name} [{j.lower:.4g}, {j.upper:.4g}]"
+                for j in joints
+            )
+            + ")"
+        )
     worst = float(np.min(np.where(cand & exact & inside, res, np.inf)))
-    text = (f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); the pose is at a "
-            "singularity or not reachable with this orientation")
+    text = (
+        f"no candidate passed the FK check (best residual {worst:.3g} > tol {tol:g}); the pose is at a "
+        "singularity or not reachable with this orientation"
+    )
     if s.kind == "geo":
         c = s.plan.classification
         if max(c.worst_accepted) > 0:
-            text += (f", or the arm is {fam} only within the classification tolerance (axes up to "
-                     f"{c.worst_accepted[0]:.3g} m / sine {c.worst_accepted[1]:.3g} from the exact relation)")
+            text += (
+                f", or the arm is {fam} only within the classification tolerance (axes up to "
+                f"{c.worst_accepted[0]:.3g} m / sine {c.worst_accepted[1]:.3g} from the exact relation)"
+            )
     return text
 
 
@@ -912,7 +1113,7 @@ def _rescue(robot, Q, which, T, tol, position_only):
         if q is None:
             continue
         q, res = _refine(robot, np.clip(q, lo, hi), T, lo, hi, position_only, polish=False)
-        if res > 1e-6:                     # not a near-solution: skip the polish
+        if res > 1e-6:  # not a near-solution: skip the polish
             continue
         q, res = _refine(robot, q, T, lo, hi, position_only)
         if res <= tol and all(np.abs(q - k[1]).max() >= 1e-9 for k in out):
@@ -921,8 +1122,19 @@ def _rescue(robot, Q, which, T, tol, position_only):
 
 
 # ---------------------------------------------------------------------------- one pose
-def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: float = 1e-9,
-             tol_orthonormal: float = 1e-6, method: str = "robust", param=None, q_rest=None, frame=None):
+def analytic(
+    robot,
+    T,
+    *,
+    swivel=None,
+    position_only: bool | None = None,
+    tol: float = 1e-9,
+    tol_orthonormal: float = 1e-6,
+    method: str = "robust",
+    param=None,
+    q_rest=None,
+    frame=None,
+):
     """Every closed-form IK solution of ``robot`` at pose ``T`` inside the joint limits.
 
     ``T``: 4×4 pose of ``robot.tool`` (m) — or a batch (N, 4, 4), which returns an
@@ -943,16 +1155,25 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     module docstring."""
     hit = _SOLVERS.get(id(robot))
     if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
-        _solver(robot)                            # the cache entry: a first call, or a new chain or tool
+        _solver(robot)  # the cache entry: a first call, or a new chain or tool
         hit = _SOLVERS[id(robot)]
     if type(T) is np.ndarray:
         arr, usual = T, T.shape == (4, 4) and T.dtype is _F64
     else:
         arr = _c_order(T)
         usual = type(arr) is np.ndarray and arr.shape == (4, 4) and arr.dtype is _F64
-    if usual and frame is None and q_rest is None and not position_only and method == "robust" and type(tol) is float \
-            and type(tol_orthonormal) is float and 0.0 < tol < _INF and 0.0 < tol_orthonormal < _INF:
-        flags = arr.flags                         # what the compiled calls take without a copy
+    if (
+        usual
+        and frame is None
+        and q_rest is None
+        and not position_only
+        and method == "robust"
+        and type(tol) is float
+        and type(tol_orthonormal) is float
+        and 0.0 < tol < _INF
+        and 0.0 < tol_orthonormal < _INF
+    ):
+        flags = arr.flags  # what the compiled calls take without a copy
         usual = flags.c_contiguous and flags.aligned
     else:
         usual = False
@@ -966,8 +1187,16 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
         cf, ci, by_mask, holds_param, call, singular, kind, shape = one
         srs = kind == "srs"
         if srs:
-            angle = swivel if param is None and type(swivel) is float and -WRAP_MAX < swivel < WRAP_MAX else None
-        elif swivel is None and (param is None) != holds_param and (position_only is None or kind != "planar"):
+            angle = (
+                swivel
+                if param is None and type(swivel) is float and -WRAP_MAX < swivel < WRAP_MAX
+                else None
+            )
+        elif (
+            swivel is None
+            and (param is None) != holds_param
+            and (position_only is None or kind != "planar")
+        ):
             angle = 0.0 if param is None else _held_angle(param)
         else:
             angle = None
@@ -978,24 +1207,47 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
                 branches, rows, res, sw = by_mask[mask]
                 # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the
                 # path of every single pose, where keywords cost a third of the result's construction
-                return AnalyticIKResult(out[rows], branches[:], None, None if sw is None else out[sw], out[res],
-                                        singular, robot.name)
+                return AnalyticIKResult(
+                    out[rows],
+                    branches[:],
+                    None,
+                    None if sw is None else out[sw],
+                    out[res],
+                    singular,
+                    robot.name,
+                )
     arr = _c_order(arr)
     _check_tol("tol", tol)
     _check_tol("tol_orthonormal", tol_orthonormal)
     if frame is not None:
         other = _frame_robot(robot, frame)
         if other is not robot:
-            return analytic(other, T, swivel=swivel, position_only=position_only, tol=tol,
-                            tol_orthonormal=tol_orthonormal, method=method, param=param, q_rest=q_rest)
+            return analytic(
+                other,
+                T,
+                swivel=swivel,
+                position_only=position_only,
+                tol=tol,
+                tol_orthonormal=tol_orthonormal,
+                method=method,
+                param=param,
+                q_rest=q_rest,
+            )
     if method != "robust":
         if method != "book":
             raise ValueError(f"method must be 'robust' or 'book', got {method!r}")
         spec = getattr(robot, "spec", None)
-        if spec is None or spec.name not in _models.BOOK_PROCEDURES or robot.nq != 6 or robot.tool != spec.tool_name:
-            raise ValueError("method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) is the book's procedure for the "
-                             f"prosthetic arm of Fig. 7-2 (catalog {', '.join(_models.BOOK_PROCEDURES)}; all 6 "
-                             "joints, its tool) only")
+        if (
+            spec is None
+            or spec.name not in _models.BOOK_PROCEDURES
+            or robot.nq != 6
+            or robot.tool != spec.tool_name
+        ):
+            raise ValueError(
+                "method='book' (Cramer's rule, Eqs. (7-20)-(7-22)) is the book's procedure for the "
+                f"prosthetic arm of Fig. 7-2 (catalog {', '.join(_models.BOOK_PROCEDURES)}; all 6 "
+                "joints, its tool) only"
+            )
         Ts, single = _check_poses(arr, tol_orthonormal=tol_orthonormal)
         if not single:
             raise ValueError("method='book' takes one pose")
@@ -1003,20 +1255,52 @@ def analytic(robot, T, *, swivel=None, position_only: bool | None = None, tol: f
     s = hit[2]
     if s is not None and s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
-        return _on_robot(s.arm, analytic(s.arm.robot, T, swivel=swivel, position_only=position_only, tol=tol,
-                                         tol_orthonormal=tol_orthonormal, param=param), rest)
+        return _on_robot(
+            s.arm,
+            analytic(
+                s.arm.robot,
+                T,
+                swivel=swivel,
+                position_only=position_only,
+                tol=tol,
+                tol_orthonormal=tol_orthonormal,
+                param=param,
+            ),
+            rest,
+        )
     if q_rest is not None:
         _q_rest(robot, None, q_rest)
-    if not tried and s is not None and s.kind != "geo" and param is None and arr.dtype == np.float64 and (
-            arr.shape == (4, 4) or (s.kind == "planar" and arr.shape == (3,))):
+    if (
+        not tried
+        and s is not None
+        and s.kind != "geo"
+        and param is None
+        and arr.dtype == np.float64
+        and (arr.shape == (4, 4) or (s.kind == "planar" and arr.shape == (3,)))
+    ):
         fast = _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal)
         if fast is not None:
             return fast
     if arr.ndim == 3:
-        return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                              tol_orthonormal=tol_orthonormal, param=param)
-    return analytic_batch(robot, arr, swivel=swivel, position_only=position_only, tol=tol,
-                          tol_orthonormal=tol_orthonormal, param=param, _single_grid=True)[0]
+        return analytic_batch(
+            robot,
+            arr,
+            swivel=swivel,
+            position_only=position_only,
+            tol=tol,
+            tol_orthonormal=tol_orthonormal,
+            param=param,
+        )
+    return analytic_batch(
+        robot,
+        arr,
+        swivel=swivel,
+        position_only=position_only,
+        tol=tol,
+        tol_orthonormal=tol_orthonormal,
+        param=param,
+        _single_grid=True,
+    )[0]
 
 
 def nearest_solver(robot, frame=None):
@@ -1034,7 +1318,11 @@ def nearest_solver(robot, frame=None):
         return None
     cf, ci = s.plan.packed
     inner = functools.partial(_geo.solve_nearest, cf, ci)
-    return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+    return (
+        inner
+        if s.arm is None
+        else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+    )
 
 
 def nearest_swivel_solver(robot, frame=None):
@@ -1047,7 +1335,11 @@ def nearest_swivel_solver(robot, frame=None):
     if s is None or s.kind != "srs":
         return None
     inner = functools.partial(_fam.srs_nearest, s.plan)
-    return inner if s.arm is None else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+    return (
+        inner
+        if s.arm is None
+        else functools.partial(_nearest_on_arm, inner, s.arm.th_idx, s.arm.th_rest)
+    )
 
 
 def _nearest_on_arm(inner, th_idx, th_rest, T, ref, *args):
@@ -1077,8 +1369,15 @@ def _srs_single(robot, s, arr, swivel, tol, tol_orthonormal):
         return None
     q, res, rows, angles = got
     labels = s.plan.labels if len(grid) == 1 else _grid_labels(s.plan.labels, len(grid), "swivel")
-    return AnalyticIKResult(q if s.plain else s.plan.chain.configuration(q), [labels[r] for r in rows], None, angles,
-                            res, None, robot.name)
+    return AnalyticIKResult(
+        q if s.plain else s.plan.chain.configuration(q),
+        [labels[r] for r in rows],
+        None,
+        angles,
+        res,
+        None,
+        robot.name,
+    )
 
 
 def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
@@ -1091,7 +1390,7 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
         return None if position_only else _srs_single(robot, s, arr, swivel, tol, tol_orthonormal)
     if position_only is False:
         return None
-    if arr.shape == (3,):                    # a position: the pose the planar kernel reads it from
+    if arr.shape == (3,):  # a position: the pose the planar kernel reads it from
         pose = np.eye(4)
         pose[:3, 3] = arr
     else:
@@ -1100,12 +1399,16 @@ def _family_single(robot, s, arr, swivel, position_only, tol, tol_orthonormal):
     out = np.empty((2, 4))
     mask = _fam.planar_pose_solutions(cf, ci, pose, 0.0, float(tol), float(tol_orthonormal), out)
     if mask <= 0:
-        return None                          # none, a malformed target, a candidate to polish: the batch path
+        return None  # none, a malformed target, a candidate to polish: the batch path
     labels = s.plan.labels
     k = [b for b in range(len(labels)) if mask >> b & 1]
-    q = out[:len(k), :2]
-    return AnalyticIKResult(solutions=q if s.plain else s.plan.chain.configuration(q),
-                            branches=[labels[b] for b in k], residuals=out[:len(k), 2], model=robot.name)
+    q = out[: len(k), :2]
+    return AnalyticIKResult(
+        solutions=q if s.plain else s.plan.chain.configuration(q),
+        branches=[labels[b] for b in k],
+        residuals=out[: len(k), 2],
+        model=robot.name,
+    )
 
 
 def _held_angle(param) -> float | None:
@@ -1123,14 +1426,23 @@ def _singular_text(volume: float) -> str | None:
     solution (:func:`.geometric.jacobian_volumes`) means, in words."""
     if volume > _geo.SINGULAR_TOL:
         return None
-    return (f"a singular configuration (normalised |det J| = {volume:.2g}: aligned wrist axes, a stretched "
-            "elbow or the wrist centre on the first axis): solutions coincide in pairs or form a one-parameter "
-            "family, one member is returned per branch")
+    return (
+        f"a singular configuration (normalised |det J| = {volume:.2g}: aligned wrist axes, a stretched "
+        "elbow or the wrist centre on the first axis): solutions coincide in pairs or form a one-parameter "
+        "family, one member is returned per branch"
+    )
 
 
 # ---------------------------------------------------------------------------- the book's procedure
-def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float = 0.130,
-                              *, det_tol: float = 1e-9, printed_m2: bool = False):
+def prosthetic_book_procedure(
+    T,
+    L1: float = 0.340,
+    L2: float = 0.260,
+    L3: float = 0.130,
+    *,
+    det_tol: float = 1e-9,
+    printed_m2: bool = False,
+):
     """The book's prosthetic-arm IK exactly as printed (corrected), Eqs. (7-17)–(7-31), Fig. 7-3.
 
     Elbow by Cramer's rule (7-20)/(7-21) (coefficient A with m3, not the printed m2) and the
@@ -1153,8 +1465,10 @@ def prosthetic_book_procedure(T, L1: float = 0.340, L2: float = 0.260, L3: float
     Delta = m3 * x - m1 * z + L3 * (m1 * n3 - m3 * n1)
     scale = max(1.0, abs(x) + abs(y) + abs(z))
     if abs(Delta) <= det_tol * scale:
-        return [], (f"elbow determinant Δ = m3·x − m1·z + L3(m1·n3 − m3·n1) = {Delta:.3g} ≈ 0: "
-                    "Cramer's rule (7-20)/(7-21) cannot solve the elbow (use the robust solver)")
+        return [], (
+            f"elbow determinant Δ = m3·x − m1·z + L3(m1·n3 − m3·n1) = {Delta:.3g} ≈ 0: "
+            "Cramer's rule (7-20)/(7-21) cannot solve the elbow (use the robust solver)"
+        )
     A = ((m2 if printed_m2 else m3) * K0 - L3 * m3 * nC - mC * (z - L3 * n3)) / Delta
     B = (m2 * z - m3 * y + L3 * (m3 * n2 - m2 * n3)) / Delta
     Cc = (mC * (x - L3 * n1) + L3 * m1 * nC - m1 * K0) / Delta
@@ -1203,11 +1517,16 @@ def _book_result(robot, T, prm, tol):
     ok = inside & (res <= tol)
     labels = ["elbow_root=+", "elbow_root=-"]
     if not ok.any():
-        why = ("the book's asin-based θ3/θ6 (7-27)/(7-30) give no FK-consistent solution inside the limits "
-               f"(residuals {', '.join(f'{r:.3g}' for r in res)}); use method='robust'")
-        return AnalyticIKResult(np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model=robot.name)
-    return AnalyticIKResult(Qw[ok], [lb for lb, k in zip(labels, ok) if k], None, residuals=res[ok],
-                            model=robot.name)
+        why = (
+            "the book's asin-based θ3/θ6 (7-27)/(7-30) give no FK-consistent solution inside the limits "
+            f"(residuals {', '.join(f'{r:.3g}' for r in res)}); use method='robust'"
+        )
+        return AnalyticIKResult(
+            np.zeros((0, robot.nq)), [], why, residuals=np.zeros(0), model=robot.name
+        )
+    return AnalyticIKResult(
+        Qw[ok], [lb for lb, k in zip(labels, ok) if k], None, residuals=res[ok], model=robot.name
+    )
 
 
 # ---------------------------------------------------------------------------- poses on the limits
@@ -1250,7 +1569,7 @@ def _slide_into_limits(q, J, lo, hi):
     def outside(v):
         return float(np.maximum(lo - v, v - hi).clip(0.0).max())
 
-    for _ in range(2):                         # at most two families (shoulder and elbow) at once
+    for _ in range(2):  # at most two families (shoulder and elbow) at once
         if outside(q) <= LIMIT_SLACK:
             return q
         moved = False
@@ -1304,10 +1623,9 @@ def _refine(robot, q, T, lo, hi, position_only, polish=True):
     if polish and bool((hi > lo).all()):
         from scipy.optimize import least_squares
 
-        sol = least_squares(err, q, bounds=(lo, hi), method="trf", xtol=1e-15, ftol=1e-15,
-                            gtol=1e-15, max_nfev=60)
+        sol = least_squares(
+            err, q, bounds=(lo, hi), method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=60
+        )
         if np.isfinite(sol.x).all():
             q = np.clip(sol.x, lo, hi)
     return q, float(np.abs(err(q)).max())
-
-

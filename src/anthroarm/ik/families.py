@@ -57,12 +57,49 @@ import numpy as np
 from ..jit import kernel, local, local2, local_flags, view2, view3
 from ..threads import run_rows
 from . import classify as C
-from .geometric import (BRANCH_ROW, COS, EXACT, EXISTS, NO_REF, POLISH_MAX, SIN, BadPoseError, _angles, _common_point,
-                        _fk_residuals, _mark_solutions, _pose_status, _target_errors, _wrist,
-                        into_limit_rows, into_limits, local_frames, nearest_first)
+from .geometric import (
+    BRANCH_ROW,
+    COS,
+    EXACT,
+    EXISTS,
+    NO_REF,
+    POLISH_MAX,
+    SIN,
+    BadPoseError,
+    _angles,
+    _common_point,
+    _fk_residuals,
+    _mark_solutions,
+    _pose_status,
+    _target_errors,
+    _wrist,
+    into_limit_rows,
+    into_limits,
+    local_frames,
+    nearest_first,
+)
 from .subproblems import TOL, sp1_cs, sp1_one, sp2_cs, sp3_cs, sp3_one
-from .vec3 import (add, atan2, cross, dot, mat, mm, mtv, mv, neg, norm, rot, rot_cs, rotate, rows7, scale, sub, transpose,
-                   vec, wrap)
+from .vec3 import (
+    add,
+    atan2,
+    cross,
+    dot,
+    mat,
+    mm,
+    mtv,
+    mv,
+    neg,
+    norm,
+    rot,
+    rot_cs,
+    rotate,
+    rows7,
+    scale,
+    sub,
+    transpose,
+    vec,
+    wrap,
+)
 
 #: shoulder routes of the SRS arm (index stored in the plan)
 SRS_ROUTES = ("sp2", "general")
@@ -109,7 +146,7 @@ class SRSPlan:
     swivel_frames: tuple | None
     chain: object
     tool: str
-    in_order: bool = False         # path order is robot.chain.independent order
+    in_order: bool = False  # path order is robot.chain.independent order
 
     @functools.cached_property
     def fk_frames(self) -> np.ndarray:
@@ -121,9 +158,22 @@ class SRSPlan:
         """The plan's constants as the compiled drivers take them (:func:`_srs_unpack`): one
         float array (H, S, E0, W0, R_tool, p_tool, :attr:`fk_frames`, limits in path order) and
         one int array (route, then ``order``)."""
-        cf = np.concatenate([np.asarray(a, dtype=float).ravel() for a in (
-            self.H, self.S, self.E0, self.W0, self.R_tool, self.p_tool, self.fk_frames, self.lower_path,
-            self.upper_path)])
+        cf = np.concatenate(
+            [
+                np.asarray(a, dtype=float).ravel()
+                for a in (
+                    self.H,
+                    self.S,
+                    self.E0,
+                    self.W0,
+                    self.R_tool,
+                    self.p_tool,
+                    self.fk_frames,
+                    self.lower_path,
+                    self.upper_path,
+                )
+            ]
+        )
         return cf, np.array([self.route, *self.order], dtype=np.int64)
 
 
@@ -153,9 +203,22 @@ class PlanarPlan:
         """The plan's constants as the compiled drivers take them (:func:`_planar_unpack`): one
         float array (h1, h2, o1, o2, p_tool, the FK check's axes and points (2, 3), limits in
         path order) and one int array (``order``)."""
-        cf = np.concatenate([np.asarray(a, dtype=float).ravel() for a in (
-            self.h1, self.h2, self.o1, self.o2, self.p_tool, self.fk_axes, self.fk_points, self.lower_path,
-            self.upper_path)])
+        cf = np.concatenate(
+            [
+                np.asarray(a, dtype=float).ravel()
+                for a in (
+                    self.h1,
+                    self.h2,
+                    self.o1,
+                    self.o2,
+                    self.p_tool,
+                    self.fk_axes,
+                    self.fk_points,
+                    self.lower_path,
+                    self.upper_path,
+                )
+            ]
+        )
         return cf, np.array(self.order, dtype=np.int64)
 
 
@@ -210,9 +273,18 @@ def _kinematics(robot, n):
         return None, "joints off the tool path (a solution would not be a configuration)"
     path = list(kin.joints)
     order = np.array([path.index(j) for j in ch.independent])
-    lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in path])
-    hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in path])
-    return (kin, np.ascontiguousarray(lo, dtype=float), np.ascontiguousarray(hi, dtype=float), order), None
+    lo = np.array(
+        [-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in path]
+    )
+    hi = np.array(
+        [np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in path]
+    )
+    return (
+        kin,
+        np.ascontiguousarray(lo, dtype=float),
+        np.ascontiguousarray(hi, dtype=float),
+        order,
+    ), None
 
 
 def _line_distance(h, o, x):
@@ -244,6 +316,7 @@ def _build_srs(robot):
     frames, E0 = None, None
     try:
         from .qp.tasks.swivel import swivel_frames
+
         frames = swivel_frames(robot)
     except Exception:  # noqa: BLE001 - no human-like layout: the elbow point is chosen below
         frames = None
@@ -252,26 +325,61 @@ def _build_srs(robot):
         Sf, Ef, Wf = (np.asarray(robot.fk(q0, f))[:3, 3] for f in frames)
         path = list(kin.joints)
         jE = robot.chain.frame(frames[1]).joint
-        ok = (np.linalg.norm(Sf - S) <= GEOM_TOL and np.linalg.norm(Wf - W0) <= GEOM_TOL
-              and _line_distance(H[3], O[3], Ef) <= GEOM_TOL and jE in path and path.index(jE) == 3)
+        ok = (
+            np.linalg.norm(Sf - S) <= GEOM_TOL
+            and np.linalg.norm(Wf - W0) <= GEOM_TOL
+            and _line_distance(H[3], O[3], Ef) <= GEOM_TOL
+            and jE in path
+            and path.index(jE) == 3
+        )
         if not ok:
-            return None, ("the swivel frames " + ", ".join(frames) + " are not at the shoulder centre, on the "
-                          "elbow axis and at the wrist centre: the swivel angle is not this decomposition's")
+            return None, (
+                "the swivel frames "
+                + ", ".join(frames)
+                + " are not at the shoulder centre, on the "
+                "elbow axis and at the wrist centre: the swivel angle is not this decomposition's"
+            )
         E0 = Ef
-    if E0 is None:                       # the point of axis 4 nearest the shoulder centre
+    if E0 is None:  # the point of axis 4 nearest the shoulder centre
         E0 = O[3] + ((S - O[3]) @ H[3]) * H[3]
     a, b = np.linalg.norm(E0 - S), np.linalg.norm(W0 - E0)
     if a <= GEOM_TOL or b <= GEOM_TOL:
         return None, "the elbow point coincides with the shoulder or wrist centre"
-    if min(np.linalg.norm(np.cross(H[3], (E0 - S) / a)), np.linalg.norm(np.cross(H[3], (W0 - E0) / b))) <= ANGLE_TOL:
-        return None, "the elbow axis lies along the upper arm or the forearm (the elbow does not bend)"
+    if (
+        min(
+            np.linalg.norm(np.cross(H[3], (E0 - S) / a)),
+            np.linalg.norm(np.cross(H[3], (W0 - E0) / b)),
+        )
+        <= ANGLE_TOL
+    ):
+        return (
+            None,
+            "the elbow axis lies along the upper arm or the forearm (the elbow does not bend)",
+        )
     route = 0 if np.linalg.norm(np.cross(H[2], (E0 - S) / a)) <= ANGLE_TOL else 1
     M = np.eye(4)
     M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
-    f = lambda x: np.ascontiguousarray(x, dtype=float)      # noqa: E731
-    plan = SRSPlan(f(H), f(S), f(E0), f(W0), f(kin.R_tool), f(kin.p_tool), route, order, lo, hi, f(H), f(O), M,
-                   srs_branch_labels(SRS_ROUTES[route]), frames, robot.chain, robot.tool,
-                   bool((order == np.arange(7)).all()))
+    f = lambda x: np.ascontiguousarray(x, dtype=float)  # noqa: E731
+    plan = SRSPlan(
+        f(H),
+        f(S),
+        f(E0),
+        f(W0),
+        f(kin.R_tool),
+        f(kin.p_tool),
+        route,
+        order,
+        lo,
+        hi,
+        f(H),
+        f(O),
+        M,
+        srs_branch_labels(SRS_ROUTES[route]),
+        frames,
+        robot.chain,
+        robot.tool,
+        bool((order == np.arange(7)).all()),
+    )
     return plan, None
 
 
@@ -290,9 +398,23 @@ def _build_planar(robot):
         return None, "the two axes coincide"
     if _line_distance(h2, O[1], pt) <= GEOM_TOL:
         return None, "the tool point lies on the second axis"
-    f = lambda x: np.ascontiguousarray(x, dtype=float)      # noqa: E731
-    return PlanarPlan(f(h1), f(h2), f(O[0]), f(O[1]), f(pt), order, lo, hi, f(H), f(O), PLANAR_LABELS,
-                      robot.chain, robot.tool, bool((order == np.arange(2)).all())), None
+    f = lambda x: np.ascontiguousarray(x, dtype=float)  # noqa: E731
+    return PlanarPlan(
+        f(h1),
+        f(h2),
+        f(O[0]),
+        f(O[1]),
+        f(pt),
+        order,
+        lo,
+        hi,
+        f(H),
+        f(O),
+        PLANAR_LABELS,
+        robot.chain,
+        robot.tool,
+        bool((order == np.arange(2)).all()),
+    ), None
 
 
 # ----------------------------------------------------------------------------- SRS kernels
@@ -323,22 +445,32 @@ def _align(a0, b0, a1, b1):
     z1 = cross(a1, b1)
     z1 = scale(z1, 1.0 / norm(z1))
     y1 = cross(z1, x1)
-    F0 = (x0, y0, z0)                    # the rows of F0ᵀ; R = x1 x0ᵀ + y1 y0ᵀ + z1 z0ᵀ
-    return ((x1[0] * F0[0][0] + y1[0] * F0[1][0] + z1[0] * F0[2][0],
-             x1[0] * F0[0][1] + y1[0] * F0[1][1] + z1[0] * F0[2][1],
-             x1[0] * F0[0][2] + y1[0] * F0[1][2] + z1[0] * F0[2][2]),
-            (x1[1] * F0[0][0] + y1[1] * F0[1][0] + z1[1] * F0[2][0],
-             x1[1] * F0[0][1] + y1[1] * F0[1][1] + z1[1] * F0[2][1],
-             x1[1] * F0[0][2] + y1[1] * F0[1][2] + z1[1] * F0[2][2]),
-            (x1[2] * F0[0][0] + y1[2] * F0[1][0] + z1[2] * F0[2][0],
-             x1[2] * F0[0][1] + y1[2] * F0[1][1] + z1[2] * F0[2][1],
-             x1[2] * F0[0][2] + y1[2] * F0[1][2] + z1[2] * F0[2][2]))
+    F0 = (x0, y0, z0)  # the rows of F0ᵀ; R = x1 x0ᵀ + y1 y0ᵀ + z1 z0ᵀ
+    return (
+        (
+            x1[0] * F0[0][0] + y1[0] * F0[1][0] + z1[0] * F0[2][0],
+            x1[0] * F0[0][1] + y1[0] * F0[1][1] + z1[0] * F0[2][1],
+            x1[0] * F0[0][2] + y1[0] * F0[1][2] + z1[0] * F0[2][2],
+        ),
+        (
+            x1[1] * F0[0][0] + y1[1] * F0[1][0] + z1[1] * F0[2][0],
+            x1[1] * F0[0][1] + y1[1] * F0[1][1] + z1[1] * F0[2][1],
+            x1[1] * F0[0][2] + y1[1] * F0[1][2] + z1[1] * F0[2][2],
+        ),
+        (
+            x1[2] * F0[0][0] + y1[2] * F0[1][0] + z1[2] * F0[2][0],
+            x1[2] * F0[0][1] + y1[2] * F0[1][1] + z1[2] * F0[2][1],
+            x1[2] * F0[0][2] + y1[2] * F0[1][2] + z1[2] * F0[2][2],
+        ),
+    )
 
 
 @kernel
 def _rot3(h, a1, a2, a3):
     """rot(h1, q1) rot(h2, q2) rot(h3, q3) of three rotations (cos, sin)."""
-    return mm(mm(rot_cs(h[0], a1[0], a1[1]), rot_cs(h[1], a2[0], a2[1])), rot_cs(h[2], a3[0], a3[1]))
+    return mm(
+        mm(rot_cs(h[0], a1[0], a1[1]), rot_cs(h[1], a2[0], a2[1])), rot_cs(h[2], a3[0], a3[1])
+    )
 
 
 @kernel
@@ -389,7 +521,9 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
             src = h[3] if straight else f
             dst = aE if straight else fore
             if route == 0:
-                c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, n12, ea, eb, _ = sp2_cs(up, e0, neg(h[0]), h[1], TOL)
+                c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, n12, ea, eb, _ = sp2_cs(
+                    up, e0, neg(h[0]), h[1], TOL
+                )
                 for j in range(2):
                     if j >= n12:
                         continue
@@ -399,32 +533,55 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                     R04 = mm(mm(R02, rot_cs(h[2], c3, s3)), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, (c3, s3),
-                           ex4 and (ea if j == 0 else eb) and e3)
+                    _wrist(
+                        (h[4], h[4], h[4], h[4], h[5], h[6]),
+                        R04,
+                        Rg,
+                        B6,
+                        b,
+                        a1,
+                        a2,
+                        (c3, s3),
+                        ex4 and (ea if j == 0 else eb) and e3,
+                    )
             else:
                 R03 = _align(e0, src, up, dst)
                 ident = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
                 for j in range(2):
                     Bs[j, EXISTS] = 0.0
                 zero = (1.0, 0.0)
-                _wrist((h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Bs, 0, zero, zero, zero, True)
+                _wrist(
+                    (h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Bs, 0, zero, zero, zero, True
+                )
                 for j in range(2):
                     if Bs[j, EXISTS] == 0.0:
                         continue
-                    a1, a2, a3 = ((Bs[j, COS + 3], Bs[j, SIN + 3]), (Bs[j, COS + 4], Bs[j, SIN + 4]),
-                                  (Bs[j, COS + 5], Bs[j, SIN + 5]))
+                    a1, a2, a3 = (
+                        (Bs[j, COS + 3], Bs[j, SIN + 3]),
+                        (Bs[j, COS + 4], Bs[j, SIN + 4]),
+                        (Bs[j, COS + 5], Bs[j, SIN + 5]),
+                    )
                     R04 = mm(_rot3(h, a1, a2, a3), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
-                    _wrist((h[4], h[4], h[4], h[4], h[5], h[6]), R04, Rg, B6, b, a1, a2, a3,
-                           ex4 and Bs[j, EXACT] != 0.0)
-    _angles(B6)                                       # the angles from their rotations, vectorised
+                    _wrist(
+                        (h[4], h[4], h[4], h[4], h[5], h[6]),
+                        R04,
+                        Rg,
+                        B6,
+                        b,
+                        a1,
+                        a2,
+                        a3,
+                        ex4 and Bs[j, EXACT] != 0.0,
+                    )
+    _angles(B6)  # the angles from their rotations, vectorised
     for b in range(8):
         if B6[b, EXISTS] != 0.0:
             for j in range(7):
                 if j == 3:
                     Q[b, j], QC[b, j], QS[b, j] = atan2(q4b[b, 1], q4b[b, 0]), q4b[b, 0], q4b[b, 1]
-                else:                                 # the wrist's joints are 4, 5, 6 of B6's row
+                else:  # the wrist's joints are 4, 5, 6 of B6's row
                     k = j if j < 3 else j - 1
                     Q[b, j], QC[b, j], QS[b, j] = B6[b, k], B6[b, COS + k], B6[b, SIN + k]
             V[b], E[b] = True, B6[b, EXACT] != 0.0
@@ -434,14 +591,24 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
             V[b], E[b] = False, False
 
 
-
 @kernel(inline=True)
 def _srs_unpack(cf, ci):
     """The constants of :attr:`SRSPlan.packed`: (route, H (7, 3), S, E0, W0 (3,), R_tool
     (3, 3), p_tool (3,), the FK frames A (8, 12), lo, hi (7,), order (7,)) — views of ``cf``,
     ``ci``, compiled into each caller (:func:`anthroarm.jit.kernel`)."""
-    return (ci[0], view2(cf, 7, 3), cf[21:24], cf[24:27], cf[27:30], view2(cf[30:], 3, 3), cf[39:42],
-            view2(cf[42:], 8, 12), cf[138:145], cf[145:152], ci[1:8])
+    return (
+        ci[0],
+        view2(cf, 7, 3),
+        cf[21:24],
+        cf[24:27],
+        cf[27:30],
+        view2(cf[30:], 3, 3),
+        cf[39:42],
+        view2(cf[42:], 8, 12),
+        cf[138:145],
+        cf[145:152],
+        ci[1:8],
+    )
 
 
 @kernel(counted=False)
@@ -473,11 +640,34 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
         R, p = mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3])
         Rg = mm(R, transpose(Rt))
         W = add(mv(Rg, sub(W0v, pt)), p)
-        c4a, s4a, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL)
+        c4a, s4a, c4b, s4b, n4, e4a, e4b, _ = sp3_cs(
+            sub(W0v, E0v), sub(Sv, E0v), h[3], norm(sub(W, Sv)), TOL
+        )
         for k in range(ns):
             rows = slice(8 * k, 8 * k + 8)
-            _srs_one(route, h, Sv, E0v, W0v, Rg, W, swivel[i, k], (c4a, s4a), (c4b, s4b), n4, e4a, e4b,
-                     Qi[rows], QC, QS, Vi[rows], Ei[rows], B6, Bs, q4b)
+            _srs_one(
+                route,
+                h,
+                Sv,
+                E0v,
+                W0v,
+                Rg,
+                W,
+                swivel[i, k],
+                (c4a, s4a),
+                (c4b, s4b),
+                n4,
+                e4a,
+                e4b,
+                Qi[rows],
+                QC,
+                QS,
+                Vi[rows],
+                Ei[rows],
+                B6,
+                Bs,
+                q4b,
+            )
             into_limit_rows(Qi[rows], QC, QS, Vi[rows], Ei[rows], 7, lo, hi, INi[rows], CHK)
             _fk_residuals(A, Qi[rows], QC, QS, CHK, 7, Ti, RESi[rows], Sfk)
             _mark_solutions(Qi[rows], Vi[rows], INi[rows], RESi[rows], tol, 8, OKi[rows])
@@ -508,7 +698,7 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     for k in range(len(swivel)):
         sw[0, 0] = swivel[k]
         if _srs_verified(cf, ci, Tb, sw, tol, tol_orthonormal, Q1, V1, E1, IN1, RES1, OK1) >= 0:
-            return -1                                  # a malformed pose, or an angle not finite
+            return -1  # a malformed pose, or an angle not finite
         for b in range(8):
             if V[b] and E[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
                 return -2
@@ -560,7 +750,12 @@ def srs_nearest(plan: SRSPlan, T, ref, swivel, first: bool):
 def _one_pose(plan: SRSPlan, T, swivel, first: bool, tol: float, tol_orthonormal: float, ref):
     """:func:`_srs_nearest` of ``plan``: (K, its rows (8 S, 12)).  ``T``: a C-order float 4×4
     array (ValueError otherwise: the kernel reads 16 entries)."""
-    if not (isinstance(T, np.ndarray) and T.shape == (4, 4) and T.dtype == np.float64 and T.flags.c_contiguous):
+    if not (
+        isinstance(T, np.ndarray)
+        and T.shape == (4, 4)
+        and T.dtype == np.float64
+        and T.flags.c_contiguous
+    ):
         raise ValueError("T must be a C-order float64 4x4 array")
     out = np.empty((8 * len(swivel), 12))
     cf, ci = plan.packed
@@ -587,11 +782,15 @@ def _swivel_array(swivel, N, check=True):
         sw = np.full((N, 1), float(sw))
     elif sw.ndim == 1:
         if len(sw) != N:
-            raise ValueError(f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
-                             f"got {len(sw)}")
+            raise ValueError(
+                f"swivel: a 1-D array gives one angle per pose and must have length N = {N}, "
+                f"got {len(sw)}"
+            )
         sw = sw.reshape(N, 1)
     elif sw.ndim != 2 or sw.shape[0] != N:
-        raise ValueError(f"swivel must be a scalar, (N,) or (N, S) with N = {N}, got shape {sw.shape}")
+        raise ValueError(
+            f"swivel must be a scalar, (N,) or (N, S) with N = {N}, got shape {sw.shape}"
+        )
     if check and not np.all(np.isfinite(sw)):
         raise ValueError("swivel must be finite angles (rad)")
     return sw if sw.flags.c_contiguous else np.ascontiguousarray(sw)
@@ -612,7 +811,7 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     if T.ndim != 3 or T.shape[1:] != (4, 4):
         raise ValueError(f"T must have shape (N, 4, 4), got {T.shape}")
     N = len(T)
-    sw = _swivel_array(swivel, N, check=False)             # finiteness: checked by the kernel
+    sw = _swivel_array(swivel, N, check=False)  # finiteness: checked by the kernel
     B = 8 * sw.shape[1]
     Q, V, E = np.empty((N, B, 7)), np.empty((N, B), bool), np.empty((N, B), bool)
     IN, RES, OK = np.empty((N, B), bool), np.empty((N, B)), np.empty((N, B), bool)
@@ -620,9 +819,21 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
 
     cf, ci = plan.packed
 
-    def rows(a, b):                                          # a slice of poses, on one core
-        k = _srs_verified(cf, ci, T[a:b], sw[a:b], tol, tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b],
-                          OK[a:b])
+    def rows(a, b):  # a slice of poses, on one core
+        k = _srs_verified(
+            cf,
+            ci,
+            T[a:b],
+            sw[a:b],
+            tol,
+            tol_orthonormal,
+            Q[a:b],
+            V[a:b],
+            E[a:b],
+            IN[a:b],
+            RES[a:b],
+            OK[a:b],
+        )
         if k >= b - a:
             bad_swivel.append(a + k - (b - a))
         elif k >= 0:
@@ -632,8 +843,11 @@ def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: f
     if bad_swivel:
         raise ValueError(f"swivel[{min(bad_swivel)}] is not finite (rad)")
     if bad_pose:
-        raise BadPoseError(min(bad_pose), f"T[{min(bad_pose)}] is not a valid pose (finite, last row [0, 0, 0, 1], "
-                                          f"rotation part a rotation to {tol_orthonormal:g})")
+        raise BadPoseError(
+            min(bad_pose),
+            f"T[{min(bad_pose)}] is not a valid pose (finite, last row [0, 0, 0, 1], "
+            f"rotation part a rotation to {tol_orthonormal:g})",
+        )
     # E is already False wherever V is (the kernel's rule)
     return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES, OK
 
@@ -650,6 +864,7 @@ def srs_points(plan: SRSPlan, T, swivel):
     L = np.linalg.norm(W - plan.S, axis=1)
     n = (W - plan.S) / L[:, None]
     from .qp.tasks.swivel import swivel_basis
+
     u, v = swivel_basis(n)
     c = np.clip((a * a - b * b + L * L) / (2 * L), -a, a)
     r = np.sqrt(np.maximum(a * a - c * c, 0))
@@ -678,8 +893,17 @@ def _fk_position_residual(kH, kO, p_tool, q, n, p):
 def _planar_unpack(cf):
     """The constants of :attr:`PlanarPlan.packed`: (h1, h2, o1, o2, p_tool (3-tuples), the FK
     check's axes and points (2, 3), lo, hi (2,)) — views of ``cf``, compiled into each caller."""
-    return (vec(cf[0:3]), vec(cf[3:6]), vec(cf[6:9]), vec(cf[9:12]), vec(cf[12:15]), view2(cf[15:], 2, 3),
-            view2(cf[21:], 2, 3), cf[27:29], cf[29:31])
+    return (
+        vec(cf[0:3]),
+        vec(cf[3:6]),
+        vec(cf[6:9]),
+        vec(cf[9:12]),
+        vec(cf[12:15]),
+        view2(cf[15:], 2, 3),
+        view2(cf[21:], 2, 3),
+        cf[27:29],
+        cf[29:31],
+    )
 
 
 @kernel(inline=True)
@@ -692,7 +916,7 @@ def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
     for b in range(2):
         Q[b, 0], Q[b, 1] = math.nan, math.nan
         V[b], E[b], IN[b], RES[b] = False, False, False, math.inf
-    if abs(dot(h1, sub(p, pt))) <= tol:               # else off the plane of motion: no candidate
+    if abs(dot(h1, sub(p, pt))) <= tol:  # else off the plane of motion: no candidate
         po = sub(p, o1)
         ta, tb, cnt, ea, eb, _ = sp3_one(p1, p2, h2, norm(po), TOL)
         for b in range(cnt):
@@ -717,7 +941,9 @@ def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
         for j in range(3):
             if not math.isfinite(P[i, j]):
                 return i
-        _planar_pose(plan, (P[i, 0], P[i, 1], P[i, 2]), tol, Q[i], V[i], E[i], IN[i], RES[i], OK[i], q)
+        _planar_pose(
+            plan, (P[i, 0], P[i, 1], P[i, 2]), tol, Q[i], V[i], E[i], IN[i], RES[i], OK[i], q
+        )
     return -1
 
 
@@ -730,7 +956,7 @@ def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
     pose or a candidate to polish — the general path answers).  ``angle`` and
     ``tol_orthonormal`` are not read (the signature of :func:`.geometric.pose_solutions`).
     ``cf``, ``ci``: :attr:`PlanarPlan.packed`."""
-    if 0 < _pose_status(T, math.inf) < 3:           # not finite, or not its last row (the rotation: unread)
+    if 0 < _pose_status(T, math.inf) < 3:  # not finite, or not its last row (the rotation: unread)
         return -1
     Q, RES, q = local2(2, 2), local(2), local(2)
     V, E, IN, OK = local_flags(2), local_flags(2), local_flags(2), local_flags(2)
@@ -767,6 +993,19 @@ def planar_verified(plan: PlanarPlan, P, tol: float = 1e-9):
     return (Q if plan.in_order else Q[..., plan.order]), V, E, IN, RES, OK
 
 
-__all__ = ["PLANAR_BRANCHES", "PLANAR_LABELS", "PlanarPlan", "SRSPlan", "SRS_BRANCHES", "SRS_ROUTES",
-           "planar_plan", "planar_reason", "planar_verified", "srs_branch_labels", "srs_plan", "srs_points",
-           "srs_reason", "srs_verified"]
+__all__ = [
+    "PLANAR_BRANCHES",
+    "PLANAR_LABELS",
+    "PlanarPlan",
+    "SRSPlan",
+    "SRS_BRANCHES",
+    "SRS_ROUTES",
+    "planar_plan",
+    "planar_reason",
+    "planar_verified",
+    "srs_branch_labels",
+    "srs_plan",
+    "srs_points",
+    "srs_reason",
+    "srs_verified",
+]

@@ -45,11 +45,14 @@ def _product(g, chain, frame, path, bounds, states, joints=None):
     R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
     p = [0.0, 0.0, 0.0]
 
-    def place(R, p, rot, tr):     # (R, p) ∘ (rot, tr), constant rot/tr
+    def place(R, p, rot, tr):  # (R, p) ∘ (rot, tr), constant rot/tr
         rot = [[snap(x) for x in row] for row in np.asarray(rot, float)]
         tr = [snap(x) for x in np.asarray(tr, float)]
         p = [g.sum([p[i]] + [g.mul(tr[k], R[i][k]) for k in range(3)]) for i in range(3)]
-        R = [[g.sum([g.mul(rot[k][c], R[i][k]) for k in range(3)]) for c in range(3)] for i in range(3)]
+        R = [
+            [g.sum([g.mul(rot[k][c], R[i][k]) for k in range(3)]) for c in range(3)]
+            for i in range(3)
+        ]
         return R, p
 
     for pos, i in enumerate(path):
@@ -60,25 +63,38 @@ def _product(g, chain, frame, path, bounds, states, joints=None):
         ax = [snap(x) for x in j.axis]
         if j.kind == "prismatic":
             q = g.input("q", pos)
-            p = [g.add(p[r], g.mul(q, g.sum([g.mul(ax[k], R[r][k]) for k in range(3)]))) for r in range(3)]
+            p = [
+                g.add(p[r], g.mul(q, g.sum([g.mul(ax[k], R[r][k]) for k in range(3)])))
+                for r in range(3)
+            ]
         else:
             c, s = g.input("c", pos), g.input("s", pos)
             k = int(np.argmax(np.abs(ax)))
             if abs(ax[k]) == 1.0 and sum(abs(x) for x in ax) == 1.0:
                 sg = ax[k]
-                a, b = [(1, 2), (2, 0), (0, 1)][k]   # a rotation about e_k mixes columns a, b
+                a, b = [(1, 2), (2, 0), (0, 1)][k]  # a rotation about e_k mixes columns a, b
                 Rn = [row[:] for row in R]
                 for r in range(3):
                     Rn[r][a] = g.add(g.mul(R[r][a], c), g.mul(sg, g.mul(R[r][b], s)))
                     Rn[r][b] = g.add(g.mul(R[r][b], c), g.mul(-sg, g.mul(R[r][a], s)))
                 R = Rn
-            else:                                    # Rodrigues: I + s K + (1 − c) K²
+            else:  # Rodrigues: I + s K + (1 − c) K²
                 K = np.array([[0.0, -ax[2], ax[1]], [ax[2], 0.0, -ax[0]], [-ax[1], ax[0], 0.0]])
                 K2 = K @ K
                 omc = g.add(1.0, g.mul(-1.0, c))
-                Rq = [[g.sum([float(r == cc), g.mul(snap(K[r, cc]), s), g.mul(snap(K2[r, cc]), omc)])
-                       for cc in range(3)] for r in range(3)]
-                R = [[g.sum([g.mul(R[r][k], Rq[k][cc]) for k in range(3)]) for cc in range(3)] for r in range(3)]
+                Rq = [
+                    [
+                        g.sum(
+                            [float(r == cc), g.mul(snap(K[r, cc]), s), g.mul(snap(K2[r, cc]), omc)]
+                        )
+                        for cc in range(3)
+                    ]
+                    for r in range(3)
+                ]
+                R = [
+                    [g.sum([g.mul(R[r][k], Rq[k][cc]) for k in range(3)]) for cc in range(3)]
+                    for r in range(3)
+                ]
         if pos + 1 in bounds[1:-1]:
             states.append([v for row in R for v in row] + p)
     return place(R, p, fr.rotation, fr.translation)

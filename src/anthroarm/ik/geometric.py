@@ -80,12 +80,41 @@ from . import classify as C
 from . import subproblems as sp
 from .search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search  # noqa: F401 - re-exported
 from .subproblems import TOL, TOL_QUARTIC, sp1_cs, sp2_cs, sp3_cs, sp4_cs, sp5_one, sp6_one
-from .vec3 import (add, angle_cs, atan2, cross, dot, mat, mm, mtm, mtv, mv, neg, norm, perpendicular, rot_cs, rotate_cs,
-                   rows6, rows7, sub, transpose, vec, wrap)
+from .vec3 import (
+    add,
+    angle_cs,
+    atan2,
+    cross,
+    dot,
+    mat,
+    mm,
+    mtm,
+    mtv,
+    mv,
+    neg,
+    norm,
+    perpendicular,
+    rot_cs,
+    rotate_cs,
+    rows6,
+    rows7,
+    sub,
+    transpose,
+    vec,
+    wrap,
+)
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
-SOLVED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
-          C.SPHERICAL, C.THREE_PARALLEL, C.TWO_PARALLEL, C.TWO_INTERSECTING, C.GEN_SIX_DOF)
+SOLVED = (
+    C.SPHERICAL_TWO_PARALLEL,
+    C.SPHERICAL_TWO_INTERSECTING,
+    C.THREE_PARALLEL_TWO_INTERSECTING,
+    C.SPHERICAL,
+    C.THREE_PARALLEL,
+    C.TWO_PARALLEL,
+    C.TWO_INTERSECTING,
+    C.GEN_SIX_DOF,
+)
 #: the classes of :data:`SOLVED` solved by a search (1-D over one joint angle; 2-D for
 #: ``gen_six_dof``)
 SEARCHED = (C.TWO_PARALLEL, C.TWO_INTERSECTING, C.GEN_SIX_DOF)
@@ -132,10 +161,10 @@ class GeoPlan:
     H: np.ndarray
     P: np.ndarray
     R_tool: np.ndarray
-    order: np.ndarray          # independent joint k is solver joint order[k]
+    order: np.ndarray  # independent joint k is solver joint order[k]
     lower: np.ndarray
     upper: np.ndarray
-    classification: object     # the anthroarm.ik.classify.Classification
+    classification: object  # the anthroarm.ik.classify.Classification
     chain: object
     tool: str
     labels: tuple
@@ -173,13 +202,36 @@ class GeoPlan:
         pa = np.zeros(3) if self.param_axis is None else self.param_axis
         pp = np.zeros(3) if self.param_point is None else self.param_point
         frames = local_frames(self.fk_axes, self.fk_points, self.fk_M)
-        cf = np.concatenate([a.ravel() for a in (self.H, self.P, self.R_tool, pa, pp, self.fk_M, frames,
-                                                 self.lower_path, self.upper_path)]).astype(float)
+        cf = np.concatenate(
+            [
+                a.ravel()
+                for a in (
+                    self.H,
+                    self.P,
+                    self.R_tool,
+                    pa,
+                    pp,
+                    self.fk_M,
+                    frames,
+                    self.lower_path,
+                    self.upper_path,
+                )
+            ]
+        ).astype(float)
         n, nq = len(self.fk_axes), self.chain.nq
-        if nq > 2 * n:                   # the compiled calls' scratch (local arrays) holds 2 entries a joint
+        if nq > 2 * n:  # the compiled calls' scratch (local arrays) holds 2 entries a joint
             raise ValueError(f"{self.chain.name}: nq = {nq} > 2 × {n} joints on the path")
-        ci = np.array([CLOSED.index(self.cls) if self.cls in CLOSED else -1, int(self.reversed), n, *self.order, nq,
-                       *self.chain._configuration_index.ravel()], dtype=np.int64)
+        ci = np.array(
+            [
+                CLOSED.index(self.cls) if self.cls in CLOSED else -1,
+                int(self.reversed),
+                n,
+                *self.order,
+                nq,
+                *self.chain._configuration_index.ravel(),
+            ],
+            dtype=np.int64,
+        )
         return cf, ci
 
 
@@ -196,10 +248,16 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     1–2: p12 = 0; intersecting 5–6: p56 = 0).  ``H`` (6, 3), ``points`` (6, 3) one point of
     each axis, ``p_tool`` (3,) the tool position at q = 0 (base frame, m)."""
     o = np.array(points, dtype=float)
-    groups = {C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)], C.SPHERICAL: [(3, 4, 5)],
-              C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
-              C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)], C.THREE_PARALLEL: [],
-              C.TWO_PARALLEL: [], C.TWO_INTERSECTING: [(4, 5)], C.GEN_SIX_DOF: []}[cls]
+    groups = {
+        C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)],
+        C.SPHERICAL: [(3, 4, 5)],
+        C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
+        C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)],
+        C.THREE_PARALLEL: [],
+        C.TWO_PARALLEL: [],
+        C.TWO_INTERSECTING: [(4, 5)],
+        C.GEN_SIX_DOF: [],
+    }[cls]
     for g in groups:
         c = _common_point(H[list(g)], o[list(g)])
         for i in g:
@@ -210,7 +268,7 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
 def _reversed(kin: C.Kinematics):
     """(H, points, R_tool, p_tool) of the arm read from the tool at q = 0 (module docstring)."""
     Rt, pt = kin.R_tool, kin.p_tool
-    H = -(kin.H[::-1] @ Rt)                       # rows: −R_toolᵀ h
+    H = -(kin.H[::-1] @ Rt)  # rows: −R_toolᵀ h
     pts = (kin.points[::-1] - pt) @ Rt
     return H, pts, Rt.T, -Rt.T @ pt
 
@@ -235,7 +293,7 @@ def classification(robot):
     a mimic joint on the path)."""
     try:
         return C.classify(robot)
-    except Exception:            # noqa: BLE001 - UnsupportedModelError (mimic) and kin: no class
+    except Exception:  # noqa: BLE001 - UnsupportedModelError (mimic) and kin: no class
         return None
 
 
@@ -246,21 +304,42 @@ def _build(robot) -> GeoPlan | None:
     ch = robot.chain
     kin = c.kinematics
     if sorted(kin.joints) != sorted(ch.independent):
-        return None                      # joints off the tool path: a solution is not a configuration
+        return None  # joints off the tool path: a solution is not a configuration
     param = None
-    if c.name == C.NOT_6R and kin.n == 7 and all(k in ("revolute", "continuous") for k in kin.kinds):
+    if (
+        c.name == C.NOT_6R
+        and kin.n == 7
+        and all(k in ("revolute", "continuous") for k in kin.kinds)
+    ):
         # a redundant 7R arm: hold the last joint as the family parameter; the first six joints
         # with the tool at q = 0 are a 6R arm (their relations do not depend on the last joint)
         param = 6
-        c6 = C.classify_kinematics(C.Kinematics(kin.H[:6], kin.points[:6], kin.P[:6], kin.R_tool, kin.p_tool,
-                                                kin.joints[:6], kin.kinds[:6], kin.names[:6]),
-                                   c.tol, c.angle_tol)
+        c6 = C.classify_kinematics(
+            C.Kinematics(
+                kin.H[:6],
+                kin.points[:6],
+                kin.P[:6],
+                kin.R_tool,
+                kin.p_tool,
+                kin.joints[:6],
+                kin.kinds[:6],
+                kin.names[:6],
+            ),
+            c.tol,
+            c.angle_tol,
+        )
         kin6, compatible = c6.kinematics, c6.compatible
     else:
         kin6, compatible = kin, c.compatible
     # a 7-joint arm: not by the 2-D search (seconds per pose for a grid of the held joint)
-    pick = next(((n, r) for n, r in compatible if n in SOLVED and not (param is not None and n == C.GEN_SIX_DOF)),
-                None)
+    pick = next(
+        (
+            (n, r)
+            for n, r in compatible
+            if n in SOLVED and not (param is not None and n == C.GEN_SIX_DOF)
+        ),
+        None,
+    )
     if pick is None:
         return None
     cls, rev = pick
@@ -268,21 +347,50 @@ def _build(robot) -> GeoPlan | None:
         H, pts, R_tool, p_tool = _reversed(kin6)
     else:
         H, pts, R_tool, p_tool = kin6.H, kin6.points, kin6.R_tool, kin6.p_tool
-    path = kin.joints                    # solve() turns a reversed solution back to this order
+    path = kin.joints  # solve() turns a reversed solution back to this order
     P = ik_geo_P(cls, H, pts, p_tool)
     order = np.array([path.index(j) for j in ch.independent])
-    lo = np.array([-np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower for j in ch.independent])
-    hi = np.array([np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper for j in ch.independent])
+    lo = np.array(
+        [
+            -np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].lower
+            for j in ch.independent
+        ]
+    )
+    hi = np.array(
+        [
+            np.inf if ch.joints[j].kind == "continuous" else ch.joints[j].upper
+            for j in ch.independent
+        ]
+    )
     M = np.eye(4)
     M[:3, :3], M[:3, 3] = kin.R_tool, kin.p_tool
-    inv = np.argsort(order)                      # path position -> independent joint
-    extra = dict(fk_axes=np.ascontiguousarray(kin.H, dtype=float), fk_points=np.ascontiguousarray(kin.points, dtype=float),
-                 fk_M=M, lower_path=np.ascontiguousarray(lo[inv]), upper_path=np.ascontiguousarray(hi[inv]),
-                 plain=robot.nq == len(ch.independent) and all(ch.joints[j].kind != "continuous" for j in ch.independent))
+    inv = np.argsort(order)  # path position -> independent joint
+    extra = dict(
+        fk_axes=np.ascontiguousarray(kin.H, dtype=float),
+        fk_points=np.ascontiguousarray(kin.points, dtype=float),
+        fk_M=M,
+        lower_path=np.ascontiguousarray(lo[inv]),
+        upper_path=np.ascontiguousarray(hi[inv]),
+        plain=robot.nq == len(ch.independent)
+        and all(ch.joints[j].kind != "continuous" for j in ch.independent),
+    )
     if param is not None:
         extra.update(param_joint=param, param_axis=kin.H[param], param_point=kin.points[param], M=M)
-    return GeoPlan(cls, rev, np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(R_tool, dtype=float), order, lo, hi, c, ch, robot.tool,
-                   branch_labels(cls), **extra)
+    return GeoPlan(
+        cls,
+        rev,
+        np.ascontiguousarray(H, dtype=float),
+        np.ascontiguousarray(P, dtype=float),
+        np.ascontiguousarray(R_tool, dtype=float),
+        order,
+        lo,
+        hi,
+        c,
+        ch,
+        robot.tool,
+        branch_labels(cls),
+        **extra,
+    )
 
 
 # ----------------------------------------------------------------------------- the closed classes
@@ -352,7 +460,9 @@ def _wrist_reads(h, R):
 @kernel
 def _back3(h, a1, a2, a3, v):
     """R03ᵀ v = rot(h3, −q3) rot(h2, −q2) rot(h1, −q1) v of the rotations (cos, sin) a1, a2, a3."""
-    return rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], a2[0], -a2[1], rotate_cs(h[0], a1[0], -a1[1], v)))
+    return rotate_cs(
+        h[2], a3[0], -a3[1], rotate_cs(h[1], a2[0], -a2[1], rotate_cs(h[0], a1[0], -a1[1], v))
+    )
 
 
 @kernel
@@ -373,22 +483,34 @@ def _wrist_of(h, u, w, B, b, a1, a2, a3, ex):
         # rot(h6, q6) = rot(h5, −q5) rot(h4, −q4) R36 applied to x ⟂ h6 (never singular)
         c4, s4, e4, _ = sp1_cs(rotate_cs(h5, c, s, h6), u, h4, TOL)
         c6, s6, e6, _ = sp1_cs(x, rotate_cs(h5, c, -s, rotate_cs(h4, c4, -s4, w)), h6, TOL)
-        _put(B, b + j, a1, a2, a3, (c4, s4), (c, s), (c6, s6), True, ex and (ea if j == 0 else eb) and e4 and e6)
+        _put(
+            B,
+            b + j,
+            a1,
+            a2,
+            a3,
+            (c4, s4),
+            (c, s),
+            (c6, s6),
+            True,
+            ex and (ea if j == 0 else eb) and e4 and e6,
+        )
 
 
 @kernel
 def _spherical_two_parallel(h, P, R06, p, B):
     """q1 SP4, q3 SP3, q2 SP1, the wrist (spherical wrist, axes 2 ∥ 3)."""
-    wrist = sub(sub(p, mv(R06, P[6])), P[0])                         # p_16 (wrist centre − p01)
-    c1a, s1a, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(h[1], wrist, neg(h[0]), dot(h[1], add(add(P[1], P[2]), P[3])),
-                                                 TOL)
+    wrist = sub(sub(p, mv(R06, P[6])), P[0])  # p_16 (wrist centre − p01)
+    c1a, s1a, c1b, s1b, n1, e1a, e1b, _ = sp4_cs(
+        h[1], wrist, neg(h[0]), dot(h[1], add(add(P[1], P[2]), P[3])), TOL
+    )
     u0, w0 = _wrist_reads(h, R06)
     for i1 in range(2):
         if i1 >= n1:
             _none(B, 4 * i1, 4 * i1 + 4)
             continue
         a1 = (c1a, s1a) if i1 == 0 else (c1b, s1b)
-        v = sub(rotate_cs(neg(h[0]), a1[0], a1[1], wrist), P[1])       # R01ᵀ p_16 − p12
+        v = sub(rotate_cs(neg(h[0]), a1[0], a1[1], wrist), P[1])  # R01ᵀ p_16 − p12
         u1, w1 = rotate_cs(h[0], a1[0], -a1[1], u0), rotate_cs(h[0], a1[0], -a1[1], w0)
         c3a, s3a, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(neg(P[3]), P[2], h[2], norm(v), TOL)
         for i3 in range(2):
@@ -399,7 +521,7 @@ def _spherical_two_parallel(h, P, R06, p, B):
             a3 = (c3a, s3a) if i3 == 0 else (c3b, s3b)
             c2, s2, e2, _ = sp1_cs(add(P[2], rotate_cs(h[2], a3[0], a3[1], P[3])), v, h[1], TOL)
             ex = (e1a if i1 == 0 else e1b) and (e3a if i3 == 0 else e3b) and e2
-            u = rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], c2, -s2, u1))    # R03ᵀ R06 h6
+            u = rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], c2, -s2, u1))  # R03ᵀ R06 h6
             w = rotate_cs(h[2], a3[0], -a3[1], rotate_cs(h[1], c2, -s2, w1))
             _wrist_of(h, u, w, B, b, a1, (c2, s2), a3, ex)
 
@@ -407,7 +529,7 @@ def _spherical_two_parallel(h, P, R06, p, B):
 @kernel
 def _spherical_two_intersecting(h, P, R06, p, B):
     """q3 SP3, (q1, q2) SP2, the wrist (spherical wrist, axes 1 × 2)."""
-    p16 = sub(sub(p, mv(R06, P[6])), P[0])                           # from the 1–2 intersection
+    p16 = sub(sub(p, mv(R06, P[6])), P[0])  # from the 1–2 intersection
     u0, w0 = _wrist_reads(h, R06)
     c3a, s3a, c3b, s3b, n3, e3a, e3b, _ = sp3_cs(P[3], neg(P[2]), h[2], norm(p16), TOL)
     for i3 in range(2):
@@ -416,15 +538,25 @@ def _spherical_two_intersecting(h, P, R06, p, B):
             continue
         a3 = (c3a, s3a) if i3 == 0 else (c3b, s3b)
         c1a, s1a, c2a, s2a, c1b, s1b, c2b, s2b, n12, ea, eb, _ = sp2_cs(
-            p16, add(P[2], rotate_cs(h[2], a3[0], a3[1], P[3])), neg(h[0]), h[1], TOL)
+            p16, add(P[2], rotate_cs(h[2], a3[0], a3[1], P[3])), neg(h[0]), h[1], TOL
+        )
         for j in range(2):
             b = 4 * i3 + 2 * j
             if j >= n12:
                 _none(B, b, b + 2)
                 continue
             a1, a2 = ((c1a, s1a), (c2a, s2a)) if j == 0 else ((c1b, s1b), (c2b, s2b))
-            _wrist_of(h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, b, a1, a2, a3,
-                      (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb))
+            _wrist_of(
+                h,
+                _back3(h, a1, a2, a3, u0),
+                _back3(h, a1, a2, a3, w0),
+                B,
+                b,
+                a1,
+                a2,
+                a3,
+                (e3a if i3 == 0 else e3b) and (ea if j == 0 else eb),
+            )
 
 
 @kernel
@@ -438,10 +570,17 @@ def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, B, b):
     c5, s5 = a5
     # q6 (0 where it is free: h6 ∥ h2, the wrist aligned with the parallel axes), then θ14 from
     # rot(h2, θ14) = R01ᵀ R06 rot(h6, −q6) rot(h5, −q5) applied to x ⟂ h2 (never singular)
-    c6, s6, e6, _ = sp1_cs(rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL)
+    c6, s6, e6, _ = sp1_cs(
+        rotate_cs(neg(h[4]), c5, s5, h[1]), mtv(R06, mv(R01, h[1])), neg(h[5]), TOL
+    )
     x = perpendicular(h[1])
-    c14, s14, e14, _ = sp1_cs(x, mtv(R01, mv(R06, rotate_cs(h[5], c6, -s6, rotate_cs(h[4], c5, -s5, x)))), h[1], TOL)
-    d_in = sub(sub(mtv(R01, p06), P[1]), rotate_cs(h[1], c14, s14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))))
+    c14, s14, e14, _ = sp1_cs(
+        x, mtv(R01, mv(R06, rotate_cs(h[5], c6, -s6, rotate_cs(h[4], c5, -s5, x)))), h[1], TOL
+    )
+    d_in = sub(
+        sub(mtv(R01, p06), P[1]),
+        rotate_cs(h[1], c14, s14, add(P[4], rotate_cs(h[4], c5, s5, P[5]))),
+    )
     ca, sa, cb, sb, n3, ea, eb, _ = sp3_cs(neg(P[3]), P[2], h[1], norm(d_in), TOL)
     for j in range(2):
         if j >= n3:
@@ -452,8 +591,18 @@ def _three_parallel_tail(h, P, R06, p06, a1, a5, ex, B, b):
         # q4 = θ14 − q2 − q3: its rotation is e^{iθ14} e^{−i(q2 + q3)}
         c23, s23 = c2 * c3 - s2 * s3, s2 * c3 + c2 * s3
         c4, s4 = c14 * c23 + s14 * s23, s14 * c23 - c14 * s23
-        _put(B, b + j, a1, (c2, s2), (c3, s3n * s3), (c4, s4n * s4), a5, (c6, s6), True,
-             ex and e14 and e6 and (ea if j == 0 else eb) and e2)
+        _put(
+            B,
+            b + j,
+            a1,
+            (c2, s2),
+            (c3, s3n * s3),
+            (c4, s4n * s4),
+            a5,
+            (c6, s6),
+            True,
+            ex and e14 and e6 and (ea if j == 0 else eb) and e2,
+        )
 
 
 @kernel
@@ -469,15 +618,25 @@ def _three_parallel_two_intersecting(h, P, R06, p, B):
             _none(B, 4 * i1, 4 * i1 + 4)
             continue
         a1 = (c1a, s1a) if i1 == 0 else (c1b, s1b)
-        c5a, s5a, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(h[1], h[5], h[4], dot(h[1], rotate_cs(
-            neg(h[0]), a1[0], a1[1], R06h6)), TOL)
+        c5a, s5a, c5b, s5b, n5, e5a, e5b, _ = sp4_cs(
+            h[1], h[5], h[4], dot(h[1], rotate_cs(neg(h[0]), a1[0], a1[1], R06h6)), TOL
+        )
         for i5 in range(2):
             b = 4 * i1 + 2 * i5
             if i5 >= n5:
                 _none(B, b, b + 2)
                 continue
-            _three_parallel_tail(h, P, R06, p06, a1, (c5a, s5a) if i5 == 0 else (c5b, s5b),
-                                 (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b), B, b)
+            _three_parallel_tail(
+                h,
+                P,
+                R06,
+                p06,
+                a1,
+                (c5a, s5a) if i5 == 0 else (c5b, s5b),
+                (e1a if i1 == 0 else e1b) and (e5a if i5 == 0 else e5b),
+                B,
+                b,
+            )
 
 
 @kernel
@@ -486,9 +645,15 @@ def _three_parallel(h, P, R06, p, B):
     and of h6; a quartic, up to 4), then :func:`_three_parallel_tail`."""
     p06 = sub(sub(p, mv(R06, P[6])), P[0])
     t = local2(4, 2)
-    cnt, _ = sp6_one((h[1], h[1], h[1], h[1]), (neg(h[0]), h[4], neg(h[0]), h[4]),
-                     (p06, neg(P[5]), mv(R06, h[5]), neg(h[5])),
-                     dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4])), 0.0, TOL_QUARTIC, t)
+    cnt, _ = sp6_one(
+        (h[1], h[1], h[1], h[1]),
+        (neg(h[0]), h[4], neg(h[0]), h[4]),
+        (p06, neg(P[5]), mv(R06, h[5]), neg(h[5])),
+        dot(h[1], add(add(add(P[1], P[2]), P[3]), P[4])),
+        0.0,
+        TOL_QUARTIC,
+        t,
+    )
     for j in range(4):
         if j >= cnt:
             _none(B, 2 * j, 2 * j + 2)
@@ -509,12 +674,19 @@ def _spherical(h, P, R06, p, B):
             _none(B, 2 * j, 2 * j + 2)
             continue
         a1, a2, a3 = angle_cs(t[j, 0]), angle_cs(t[j, 1]), angle_cs(t[j, 2])
-        _wrist_of(h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, 2 * j, a1, a2, a3, True)
+        _wrist_of(
+            h, _back3(h, a1, a2, a3, u0), _back3(h, a1, a2, a3, w0), B, 2 * j, a1, a2, a3, True
+        )
 
 
 #: the compiled class solvers, by their index in :data:`CLOSED`
-CLOSED = (C.SPHERICAL_TWO_PARALLEL, C.SPHERICAL_TWO_INTERSECTING, C.THREE_PARALLEL_TWO_INTERSECTING,
-          C.SPHERICAL, C.THREE_PARALLEL)
+CLOSED = (
+    C.SPHERICAL_TWO_PARALLEL,
+    C.SPHERICAL_TWO_INTERSECTING,
+    C.THREE_PARALLEL_TWO_INTERSECTING,
+    C.SPHERICAL,
+    C.THREE_PARALLEL,
+)
 
 
 @kernel
@@ -586,7 +758,7 @@ def into_limit_cs(x, c, s, lo, hi, exists):
     cosine, its sine, whether it is inside) — (c, s) kept where the angle returned is x moved
     by whole turns (the same rotation), cos and sin of the angle returned where it was put
     onto a limit (it is then the limit) and the branch ``exists``."""
-    if -math.pi < x <= math.pi and lo <= x <= hi:       # the usual case: already the angle returned
+    if -math.pi < x <= math.pi and lo <= x <= hi:  # the usual case: already the angle returned
         return x, c, s, True
     q, ok = into_limit(x, lo, hi)
     if exists and q != x and (q == lo or q == hi):
@@ -603,7 +775,9 @@ def into_limit_rows(Q, QC, QS, V, E, n, lo, hi, IN, CHK):
     for b in range(len(V)):
         inside = True
         for j in range(n):
-            Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(Q[b, j], QC[b, j], QS[b, j], lo[j], hi[j], V[b])
+            Q[b, j], QC[b, j], QS[b, j], ok = into_limit_cs(
+                Q[b, j], QC[b, j], QS[b, j], lo[j], hi[j], V[b]
+            )
             inside = inside and ok
         IN[b] = inside
         CHK[b] = V[b] and (inside or not E[b])
@@ -633,7 +807,9 @@ def wrap_into_limits(Q, lo, hi):
     shape = Q.shape
     Q2 = np.ascontiguousarray(Q.reshape(-1, shape[-1]))
     inside = np.empty(len(Q2), dtype=bool)
-    _into_limits_rows(Q2, np.ascontiguousarray(lo, dtype=float), np.ascontiguousarray(hi, dtype=float), inside)
+    _into_limits_rows(
+        Q2, np.ascontiguousarray(lo, dtype=float), np.ascontiguousarray(hi, dtype=float), inside
+    )
     return Q2.reshape(shape), inside.reshape(shape[:-1])
 
 
@@ -644,7 +820,12 @@ def _pose_status(T, tol_orthonormal):
         for j in range(4):
             if not math.isfinite(T[i, j]):
                 return 1
-    if abs(T[3, 0]) > 1e-12 or abs(T[3, 1]) > 1e-12 or abs(T[3, 2]) > 1e-12 or abs(T[3, 3] - 1.0) > 1e-12:
+    if (
+        abs(T[3, 0]) > 1e-12
+        or abs(T[3, 1]) > 1e-12
+        or abs(T[3, 2]) > 1e-12
+        or abs(T[3, 3] - 1.0) > 1e-12
+    ):
         return 2
     R = mat(T)
     RtR = mtm(R, R)
@@ -687,17 +868,21 @@ def local_frames(axes, points, M) -> np.ndarray:
 @kernel
 def _frame(A, i):
     """Row i of A (:func:`local_frames`) as (R, t)."""
-    return (((A[i, 0], A[i, 1], A[i, 2]), (A[i, 3], A[i, 4], A[i, 5]), (A[i, 6], A[i, 7], A[i, 8])),
-            (A[i, 9], A[i, 10], A[i, 11]))
+    return (
+        ((A[i, 0], A[i, 1], A[i, 2]), (A[i, 3], A[i, 4], A[i, 5]), (A[i, 6], A[i, 7], A[i, 8])),
+        (A[i, 9], A[i, 10], A[i, 11]),
+    )
 
 
 @kernel
 def _joint_step(R, t, A, i, c, s):
     """(R, t) · Rz(q) · A_i, a partial product of :func:`local_frames` taken one joint further,
     from c = cos q and s = sin q: the first two columns of R turned by q, then A_i."""
-    Rq = ((R[0][0] * c + R[0][1] * s, R[0][1] * c - R[0][0] * s, R[0][2]),
-          (R[1][0] * c + R[1][1] * s, R[1][1] * c - R[1][0] * s, R[1][2]),
-          (R[2][0] * c + R[2][1] * s, R[2][1] * c - R[2][0] * s, R[2][2]))
+    Rq = (
+        (R[0][0] * c + R[0][1] * s, R[0][1] * c - R[0][0] * s, R[0][2]),
+        (R[1][0] * c + R[1][1] * s, R[1][1] * c - R[1][0] * s, R[1][2]),
+        (R[2][0] * c + R[2][1] * s, R[2][1] * c - R[2][0] * s, R[2][2]),
+    )
     B, a = _frame(A, i)
     return mm(Rq, B), add(mv(Rq, a), t)
 
@@ -730,8 +915,10 @@ def _target_errors(A, q, n, T):
     R, x = _chain_fk(A, q, n)
     W = mtm(R, mat(T))
     v = (W[2][1] - W[1][2], W[0][2] - W[2][0], W[1][0] - W[0][1])
-    return (norm((T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2])),
-            math.atan2(0.5 * norm(v), 0.5 * (W[0][0] + W[1][1] + W[2][2] - 1.0)))
+    return (
+        norm((T[0, 3] - x[0], T[1, 3] - x[1], T[2, 3] - x[2])),
+        math.atan2(0.5 * norm(v), 0.5 * (W[0][0] + W[1][1] + W[2][2] - 1.0)),
+    )
 
 
 @kernel
@@ -787,7 +974,7 @@ def _polish_chain(A, q, n, T, lo, hi, tol, J, F):
         x = min(max(q[j], lo[j]), hi[j])
         moved = moved or x != q[j]
         q[j] = x
-    if moved:                                    # put onto a limit: the residual of the angles returned
+    if moved:  # put onto a limit: the residual of the angles returned
         R, x = _chain_fk(A, q, n)
         res = _pose_error(R, x, T)
     return res
@@ -837,9 +1024,22 @@ def _unpack(cf, ci):
     caller (:func:`anthroarm.jit.kernel`)."""
     n = ci[2]
     o = 70 + 12 * (n + 1)
-    return (ci[0], ci[1] == 1, n, view2(cf, 6, 3), view2(cf[18:], 7, 3), view2(cf[39:], 3, 3),
-            (cf[48], cf[49], cf[50]), (cf[51], cf[52], cf[53]), view2(cf[54:], 4, 4),
-            view2(cf[70:], n + 1, 12), cf[o:o + n], cf[o + n:o + 2 * n], ci[3:3 + n], view2(ci[4 + n:], n, 2))
+    return (
+        ci[0],
+        ci[1] == 1,
+        n,
+        view2(cf, 6, 3),
+        view2(cf[18:], 7, 3),
+        view2(cf[39:], 3, 3),
+        (cf[48], cf[49], cf[50]),
+        (cf[51], cf[52], cf[53]),
+        view2(cf[54:], 4, 4),
+        view2(cf[70:], n + 1, 12),
+        cf[o : o + n],
+        cf[o + n : o + 2 * n],
+        ci[3 : 3 + n],
+        view2(ci[4 + n :], n, 2),
+    )
 
 
 @kernel(counted=False)
@@ -858,8 +1058,21 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     J, F = local2(6, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
-        if not _verify_pose(plan, T[i], param[i], tol, tol_orthonormal, Q[i], V[i], E[i], IN[i], RES[i], OK[i],
-                            CONF[i], (B6, q, QC, QS, S, J, F, CHK)):
+        if not _verify_pose(
+            plan,
+            T[i],
+            param[i],
+            tol,
+            tol_orthonormal,
+            Q[i],
+            V[i],
+            E[i],
+            IN[i],
+            RES[i],
+            OK[i],
+            CONF[i],
+            (B6, q, QC, QS, S, J, F, CHK),
+        ):
             return i
     return -1
 
@@ -871,8 +1084,23 @@ def _pose_plan(cf, ci):
     (class index, reversed, n, h, P, R_tool, MR, Mp, the held joint's axis and point, A, lo,
     hi, order, index).  Compiled into each caller."""
     cls, rev, n, H, P, R_tool, p_axis, p_point, M, A, lo, hi, order, index = _unpack(cf, ci)
-    return (cls, rev, n, rows6(H), rows7(P), mat(R_tool), mat(M[:3, :3]), vec(M[:3, 3]), p_axis, p_point, A, lo, hi,
-            order, index)
+    return (
+        cls,
+        rev,
+        n,
+        rows6(H),
+        rows7(P),
+        mat(R_tool),
+        mat(M[:3, :3]),
+        vec(M[:3, 3]),
+        p_axis,
+        p_point,
+        A,
+        lo,
+        hi,
+        order,
+        index,
+    )
 
 
 @kernel(inline=True)
@@ -911,7 +1139,7 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
     for b in range(8):
         V[b], E[b] = B6[b, EXISTS] != 0.0, B6[b, EXACT] != 0.0
         for j in range(n):
-            jj = 5 - j if rev else j                  # a reversed chain's joints come last first
+            jj = 5 - j if rev else j  # a reversed chain's joints come last first
             x = (B6[b, jj], B6[b, COS + jj], B6[b, SIN + jj]) if j < 6 else (t7, a7[0], a7[1])
             Q[b, j], QC[b, j], QS[b, j] = x
     into_limit_rows(Q, QC, QS, V, E, n, lo, hi, IN, CHK)
@@ -1003,9 +1231,11 @@ def _mark_solutions(Q, V, IN, RES, tol, group, OK):
         a = b - b % group
         while ok and a < b:
             if OK[a]:
-                ok = False                       # a duplicate of a unless some joint differs
+                ok = False  # a duplicate of a unless some joint differs
                 for j in range(Q.shape[1]):
-                    d = abs(Q[b, j] - Q[a, j])   # differs by 1e-9 rad, and (below a turn: no wrap) as a rotation
+                    d = abs(
+                        Q[b, j] - Q[a, j]
+                    )  # differs by 1e-9 rad, and (below a turn: no wrap) as a rotation
                     if d >= 1e-9 and (d <= 2.0 * math.pi - 1e-9 or abs(wrap(d)) >= 1e-9):
                         ok = True
                         break
@@ -1037,8 +1267,15 @@ def mark_solutions(Q, V, IN, RES, tol: float, group: int) -> np.ndarray:
     IN (inside the limits) and FK residuals RES (N, B): residual ≤ ``tol``, duplicates within
     1e-9 rad inside each ``group`` of consecutive branches dropped (compiled)."""
     OK = np.empty(V.shape, bool)
-    _mark_loop(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(V), np.ascontiguousarray(IN),
-               np.ascontiguousarray(RES, dtype=float), float(tol), int(group), OK)
+    _mark_loop(
+        np.ascontiguousarray(Q, dtype=float),
+        np.ascontiguousarray(V),
+        np.ascontiguousarray(IN),
+        np.ascontiguousarray(RES, dtype=float),
+        float(tol),
+        int(group),
+        OK,
+    )
     return OK
 
 
@@ -1064,7 +1301,7 @@ def class_pose(plan: GeoPlan, T, param=None):
     of the first six joints (T · M⁻¹ e^{−ξ7 v} M, ``param`` = v (N,)) for a 7-joint arm."""
     if plan.param_joint is not None:
         v = np.broadcast_to(np.asarray(param, dtype=float), (len(T),))
-        Rv = sp.rot(np.broadcast_to(plan.param_axis, (len(T), 3)), -v)            # e^{−ξ7 v}
+        Rv = sp.rot(np.broadcast_to(plan.param_axis, (len(T), 3)), -v)  # e^{−ξ7 v}
         E = np.broadcast_to(np.eye(4), (len(T), 4, 4)).copy()
         E[:, :3, :3] = Rv
         E[:, :3, 3] = plan.param_point - np.einsum("nij,j->ni", Rv, plan.param_point)
@@ -1092,7 +1329,9 @@ def solve(plan: GeoPlan, T, param=None):
     if plan.reversed:
         q = q[..., ::-1]
     if plan.param_joint is not None:
-        q = np.concatenate([q, np.broadcast_to(np.angle(np.exp(1j * v))[:, None, None], q.shape[:2] + (1,))], -1)
+        q = np.concatenate(
+            [q, np.broadcast_to(np.angle(np.exp(1j * v))[:, None, None], q.shape[:2] + (1,))], -1
+        )
     return q[..., plan.order], valid, exact
 
 
@@ -1129,8 +1368,16 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     V, E, IN, OK = local_flags(8), local_flags(8), local_flags(8), local_flags(8)
     CONF = view2(local(112), 8, w if w != n else 0)
     QC, QS = view2(local(56), 8, n), view2(local(56), 8, n)
-    scratch = (local2(8, BRANCH_ROW), local(7), QC, QS, view2(local(96), n + 1, 12),
-               local2(6, 6), local(6), local_flags(8))
+    scratch = (
+        local2(8, BRANCH_ROW),
+        local(7),
+        QC,
+        QS,
+        view2(local(96), n + 1, 12),
+        local2(6, 6),
+        local(6),
+        local_flags(8),
+    )
     if not _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
         return -1
     K, mask = 0, 0
@@ -1164,7 +1411,7 @@ def pose_solutions(cf, ci, T, param, tol, tol_orthonormal, out):
     return _verified_one(cf, ci, T, param, tol, tol_orthonormal, local(1)[:0], out)
 
 
-NO_REF = np.zeros(0)   # "no reference" of the one-pose kernels (an empty array)
+NO_REF = np.zeros(0)  # "no reference" of the one-pose kernels (an empty array)
 
 
 class BadPoseError(ValueError):
@@ -1200,7 +1447,11 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     ``anthroarm.ik.closed_form`` checks before it calls."""
     T = np.ascontiguousarray(T, dtype=float)
     N, n = len(T), len(plan.fk_axes)
-    pv = _ZERO1 if param is None else np.ascontiguousarray(np.broadcast_to(np.asarray(param, float), (N,)))
+    pv = (
+        _ZERO1
+        if param is None
+        else np.ascontiguousarray(np.broadcast_to(np.asarray(param, float), (N,)))
+    )
     if param is None and N > 1:
         pv = np.zeros(N)
     Q, V, E = np.empty((N, 8, n)), np.empty((N, 8), bool), np.empty((N, 8), bool)
@@ -1210,16 +1461,32 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     first_bad = []
 
     def rows(a, b):
-        k = _verified(cf, ci, T[a:b], pv[a:b], tol, tol_orthonormal, Q[a:b], V[a:b], E[a:b], IN[a:b], RES[a:b],
-                      OK[a:b], CONF[a:b])
+        k = _verified(
+            cf,
+            ci,
+            T[a:b],
+            pv[a:b],
+            tol,
+            tol_orthonormal,
+            Q[a:b],
+            V[a:b],
+            E[a:b],
+            IN[a:b],
+            RES[a:b],
+            OK[a:b],
+            CONF[a:b],
+        )
         if k >= 0:
             first_bad.append(a + k)
 
     run_rows(rows, N)
     bad = min(first_bad) if first_bad else -1
     if bad >= 0:
-        raise BadPoseError(bad, f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a "
-                                f"rotation to {tol_orthonormal:g})")
+        raise BadPoseError(
+            bad,
+            f"T[{bad}] is not a valid pose (finite, last row [0, 0, 0, 1], rotation part a "
+            f"rotation to {tol_orthonormal:g})",
+        )
     if not plan.order_is_path:
         Q = Q[..., plan.order]
     return Q, OK, V, E & V, IN, RES, (Q if plan.plain else CONF)
@@ -1264,27 +1531,38 @@ def check_rows(robot, samples: int, rng) -> list:
         pin.framesForwardKinematics(model, data, q)
         T[i] = data.oMf[fid].homogeneous
     k7 = None if plan.param_joint is None else plan.order.tolist().index(plan.param_joint)
-    param = None if k7 is None else plan.chain.angles(Q)[:, k7]        # the sampled last joint
+    param = None if k7 is None else plan.chain.angles(Q)[:, k7]  # the sampled last joint
     th, valid, exact = solve(plan, T, param)
     worst, nb = 0.0, int(exact.sum())
     for i, k in zip(*np.nonzero(exact)):
         pin.framesForwardKinematics(model, data, plan.chain.configuration(th[i, k]))
         worst = max(worst, float(np.abs(data.oMf[fid].homogeneous[:3] - T[i, :3]).max()))
     if not exact.any(1).all():
-        worst = float("inf")                   # a pose made by FK must have a branch
+        worst = float("inf")  # a pose made by FK must have a branch
     tag = f"{plan.cls}{' (reversed chain)' if plan.reversed else ''}"
     # an arm of its class only within the classification tolerance (rounded URDF angles): the raw
     # class solution is off by about that much (aa.ik.analytic polishes it before its FK check)
     off = max(plan.classification.worst_accepted)
     tol = max(1e-9, 10.0 * off)
-    note = f"{tag}; {nb} branches" + (f"; axes {off:.2g} off the class: raw class solutions" if off else "")
-    rows = [CheckRow(robot.name, "closed form by geometry: FK(IK(T)) = T, all branches", worst, tol, n,
-                     "pinocchio FK", note)]
+    note = f"{tag}; {nb} branches" + (
+        f"; axes {off:.2g} off the class: raw class solutions" if off else ""
+    )
+    rows = [
+        CheckRow(
+            robot.name,
+            "closed form by geometry: FK(IK(T)) = T, all branches",
+            worst,
+            tol,
+            n,
+            "pinocchio FK",
+            note,
+        )
+    ]
     try:
         import ik_geo
     except ImportError:
         return rows
-    if not hasattr(ik_geo, "Robot"):           # a folder named ik_geo on sys.path, not IK-Geo
+    if not hasattr(ik_geo, "Robot"):  # a folder named ik_geo on sys.path, not IK-Geo
         return rows
     geo = getattr(ik_geo.Robot, plan.cls)(plan.H.tolist(), plan.P.tolist())
     diff = 0
@@ -1292,9 +1570,33 @@ def check_rows(robot, samples: int, rng) -> list:
     for i in range(n):
         theirs = sum(1 for _, ls in geo.get_ik(R06[i].T.tolist(), p06[i].tolist()) if not ls)
         diff = max(diff, abs(theirs - int(exact[i].sum())))
-    rows.append(CheckRow(robot.name, "closed form by geometry: branches = IK-Geo's", float(diff), 0.0, n,
-                         "ik-geo (Rust)", f"{tag}; max |ours - ik-geo| exact solutions per pose"))
+    rows.append(
+        CheckRow(
+            robot.name,
+            "closed form by geometry: branches = IK-Geo's",
+            float(diff),
+            0.0,
+            n,
+            "ik-geo (Rust)",
+            f"{tag}; max |ours - ik-geo| exact solutions per pose",
+        )
+    )
     return rows
 
 
-__all__ = ["CLOSED", "GeoPlan", "solve_nearest", "solve_verified", "SEARCHED", "SOLVED", "branch_labels", "n_branches", "check_rows", "class_pose", "ik_geo_P", "plan_for", "solve", "solve_class"]
+__all__ = [
+    "CLOSED",
+    "GeoPlan",
+    "solve_nearest",
+    "solve_verified",
+    "SEARCHED",
+    "SOLVED",
+    "branch_labels",
+    "n_branches",
+    "check_rows",
+    "class_pose",
+    "ik_geo_P",
+    "plan_for",
+    "solve",
+    "solve_class",
+]

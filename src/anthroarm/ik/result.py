@@ -18,7 +18,7 @@ STATUSES = {
     "success": "the target is reached within tol_pos / tol_rot and every joint is within its limits",
     "out_of_reach": "the target lies farther from the base than the arm can reach; q is the closest pose found",
     "not_converged": "no configuration within the limits reached the tolerance before max_time / max_restarts; "
-                     "q is the closest pose found",
+    "q is the closest pose found",
 }
 
 
@@ -70,10 +70,16 @@ class IKResult:
     def as_dict(self) -> dict:
         """JSON-friendly dict (lists instead of arrays)."""
         return {
-            "q": [float(x) for x in self.q], "success": bool(self.success), "status": self.status,
-            "pos_err": float(self.pos_err), "rot_err": float(self.rot_err),
-            "iterations": int(self.iterations), "restarts": int(self.restarts),
-            "message": self.message, "mode": self.mode, "seed": self.seed,
+            "q": [float(x) for x in self.q],
+            "success": bool(self.success),
+            "status": self.status,
+            "pos_err": float(self.pos_err),
+            "rot_err": float(self.rot_err),
+            "iterations": int(self.iterations),
+            "restarts": int(self.restarts),
+            "message": self.message,
+            "mode": self.mode,
+            "seed": self.seed,
         }
 
 
@@ -83,12 +89,12 @@ class IKBatchResult:
 
     ``result[i]`` is the :class:`IKResult` of target ``i``; ``len(result) == N``."""
 
-    q: np.ndarray            # (N, nq)
-    success: np.ndarray      # (N,) bool
-    status: list             # N strings
-    pos_err: np.ndarray      # (N,)
-    rot_err: np.ndarray      # (N,)
-    iterations: np.ndarray   # (N,) int
+    q: np.ndarray  # (N, nq)
+    success: np.ndarray  # (N,) bool
+    status: list  # N strings
+    pos_err: np.ndarray  # (N,)
+    rot_err: np.ndarray  # (N,)
+    iterations: np.ndarray  # (N,) int
     restarts: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     messages: list = field(default_factory=list)
     mode: str = "pose"
@@ -97,10 +103,17 @@ class IKBatchResult:
         return len(self.q)
 
     def __getitem__(self, i) -> IKResult:
-        return IKResult(self.q[i].copy(), bool(self.success[i]), self.status[i], float(self.pos_err[i]),
-                        float(self.rot_err[i]), int(self.iterations[i]),
-                        int(self.restarts[i]) if len(self.restarts) else 0,
-                        self.messages[i] if self.messages else "", self.mode)
+        return IKResult(
+            self.q[i].copy(),
+            bool(self.success[i]),
+            self.status[i],
+            float(self.pos_err[i]),
+            float(self.rot_err[i]),
+            int(self.iterations[i]),
+            int(self.restarts[i]) if len(self.restarts) else 0,
+            self.messages[i] if self.messages else "",
+            self.mode,
+        )
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))

@@ -74,7 +74,25 @@ import numpy as np
 
 from ..jit import kernel
 from .subproblems import TOL, TOL_QUARTIC, sp1_one, sp5_one, sp6_one
-from .vec3 import add, cross, dot, mm, mtv, mv, neg, norm, rot, rotate, rows6, rows7, scale, sub, transpose, vec, wrap
+from .vec3 import (
+    add,
+    cross,
+    dot,
+    mm,
+    mtv,
+    mv,
+    neg,
+    norm,
+    rot,
+    rotate,
+    rows6,
+    rows7,
+    scale,
+    sub,
+    transpose,
+    vec,
+    wrap,
+)
 
 #: samples of the searched joint over [−π, π] (IK-Geo's reference implementation uses 200)
 SEARCH_GRID = 256
@@ -184,8 +202,8 @@ def polish(h, PP, R06, p, q, iters, J, F):
         R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
         o = PP[0]
         for i in range(6):
-            J[3, i], J[4, i], J[5, i] = mv(R, h[i])          # the joint's axis (base frame)
-            J[0, i], J[1, i], J[2, i] = o                    # a point of it, crossed below
+            J[3, i], J[4, i], J[5, i] = mv(R, h[i])  # the joint's axis (base frame)
+            J[0, i], J[1, i], J[2, i] = o  # a point of it, crossed below
             R = mm(R, rot(h[i], q[i]))
             o = add(o, mv(R, PP[i + 1]))
         for i in range(6):
@@ -198,7 +216,7 @@ def polish(h, PP, R06, p, q, iters, J, F):
         F[4] = 0.5 * (W[0][2] - W[2][0])
         F[5] = 0.5 * (W[1][0] - W[0][1])
         if abs(solve6(J, F)) <= 1e-12:
-            break                                            # the same q (and J) at every later step
+            break  # the same q (and J) at every later step
         for i in range(6):
             q[i] += F[i]
     err = pose_error(h, PP, R06, p, q)
@@ -250,8 +268,10 @@ def _tp_parts(h, PP, R06, p16, q1, t6, t4):
     R34, R56 = rot(h4, t4), rot(h[5], t6)
     t23, e23, _ = sp1_one(mv(R34, h5), mv(R16, mtv(R56, h5)), h2, TOL)
     R13 = rot(h2, t23)
-    v = sub(sub(sub(sub(mv(Rt1, p16), PP[1]), mv(R13, PP[3])), mv(R13, mv(R34, PP[4]))),
-            mv(R16, mtv(R56, PP[5])))
+    v = sub(
+        sub(sub(sub(mv(Rt1, p16), PP[1]), mv(R13, PP[3])), mv(R13, mv(R34, PP[4]))),
+        mv(R16, mtv(R56, PP[5])),
+    )
     return t23, e23, v, R16, R34, R56
 
 
@@ -265,10 +285,17 @@ def _inner(cls, h, PP, R06, p16, x, th, e, t2):
         h2 = h[1]
         Rt1 = rot(h[0], -x)
         R16 = mm(Rt1, R06)
-        h1 = mtv(R16, h2)                                         # R06ᵀ R01 h2
+        h1 = mtv(R16, h2)  # R06ᵀ R01 h2
         d1 = dot(h2, mv(Rt1, p16)) - dot(h2, add(add(PP[1], PP[2]), PP[3]))
-        cnt, _ = sp6_one((h1, h2, h1, h2), (neg(h[5]), h[3], neg(h[5]), h[3]),
-                         (PP[5], PP[4], h[4], neg(h[4])), d1, 0.0, TOL_QUARTIC, t2)
+        cnt, _ = sp6_one(
+            (h1, h2, h1, h2),
+            (neg(h[5]), h[3], neg(h[5]), h[3]),
+            (PP[5], PP[4], h[4], neg(h[4])),
+            d1,
+            0.0,
+            TOL_QUARTIC,
+            t2,
+        )
         d23 = norm(PP[2])
         for r in range(cnt):
             _, _, v, _, _, _ = _tp_parts(h, PP, R06, p16, x, t2[r, 0], t2[r, 1])
@@ -321,7 +348,10 @@ def _nearest(RS, CS, i, r):
     of the wrapped difference): (its index, the distance; inf where there is none)."""
     best, k = math.inf, 0
     for t in range(CS[i]):
-        d = max(abs(wrap(RS[i, t, 0] - r[0])), max(abs(wrap(RS[i, t, 1] - r[1])), abs(wrap(RS[i, t, 2] - r[2]))))
+        d = max(
+            abs(wrap(RS[i, t, 0] - r[0])),
+            max(abs(wrap(RS[i, t, 1] - r[1])), abs(wrap(RS[i, t, 2] - r[2]))),
+        )
         if d < best:
             best, k = d, t
     return k, best
@@ -361,10 +391,17 @@ def _interpolated_root(cls, h, PP, R06, p16, x, xl, xr, rl, rr, th, e, t2):
     cnt = _inner(cls, h, PP, R06, p16, x, th, e, t2)
     t = (x - xl) / (xr - xl if xr != xl else 1.0)
     t = min(max(t, 0.0), 1.0)
-    ref = (rl[0] + t * wrap(rr[0] - rl[0]), rl[1] + t * wrap(rr[1] - rl[1]), rl[2] + t * wrap(rr[2] - rl[2]))
+    ref = (
+        rl[0] + t * wrap(rr[0] - rl[0]),
+        rl[1] + t * wrap(rr[1] - rl[1]),
+        rl[2] + t * wrap(rr[2] - rl[2]),
+    )
     best, k = math.inf, 0
     for r in range(cnt):
-        d = max(abs(wrap(th[r, 0] - ref[0])), max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))))
+        d = max(
+            abs(wrap(th[r, 0] - ref[0])),
+            max(abs(wrap(th[r, 1] - ref[1])), abs(wrap(th[r, 2] - ref[2]))),
+        )
         if d < best:
             best, k = d, r
     return k, best, ref
@@ -401,7 +438,9 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
 
 
 @kernel
-def _brackets(cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+def _brackets(
+    cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n
+):
     """The brackets of sample interval ``g`` of X, RS, ES, CS (roots followed by
     :func:`_interval`: S1, DM): every followed root (closer than :data:`_MATCH`) whose error
     changes sign is refined (:func:`_refine`) and its branch pushed.  Where the number of roots
@@ -414,8 +453,23 @@ def _brackets(cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out,
             r1 = (RS[g + 1, s1, 0], RS[g + 1, s1, 1], RS[g + 1, s1, 2])
             if CS[g] != CS[g + 1] and _nearest(RS, CS, g, r1)[0] != s:
                 continue
-            if _refine(cls, h, PP, R06, p16, X[g], X[g + 1], ES[g, s], ES[g + 1, s1],
-                       (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]), r1, th, e, t2, out):
+            if _refine(
+                cls,
+                h,
+                PP,
+                R06,
+                p16,
+                X[g],
+                X[g + 1],
+                ES[g, s],
+                ES[g + 1, s1],
+                (RS[g, s, 0], RS[g, s, 1], RS[g, s, 2]),
+                r1,
+                th,
+                e,
+                t2,
+                out,
+            ):
                 n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
     return n
 
@@ -463,7 +517,35 @@ def _low(xa, xb, xc, fa, fb, fc):
 
 
 @kernel
-def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+def _dip(
+    cls,
+    h,
+    PP,
+    R06,
+    p,
+    p16,
+    xa,
+    xb,
+    xc,
+    ea,
+    eb,
+    ec,
+    ra,
+    rb,
+    rc,
+    th,
+    e,
+    t2,
+    out,
+    q,
+    q2,
+    J,
+    F,
+    Q,
+    V,
+    E,
+    n,
+):
     """A dip of the error along a followed root: |e| at ``xb`` below its value at ``xa`` < xb
     and ``xc`` > xb, all three of one sign (``ea``, ``eb``, ``ec``; followed inner roots ``ra``,
     ``rb``, ``rc``).  |e| is minimised over [xa, xc] along the root by successive parabolic
@@ -479,7 +561,7 @@ def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2,
     gold = 0.381966011250105
     for it in range(_DIP_ITERS):
         if xc - xa <= _DIP_TOL or not _low(xa, xb, xc, fa, fb, fc):
-            break                                                # no zero can hide in [xa, xc] any more
+            break  # no zero can hide in [xa, xc] any more
         # the vertex of the parabola through (a, fa), (b, fb), (c, fc)
         u1, u2 = (xb - xa) * (fb - fc), (xb - xc) * (fb - fa)
         den = 2.0 * (u1 - u2)
@@ -488,14 +570,14 @@ def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2,
             xu = xb - ((xb - xa) * u1 - (xb - xc) * u2) / den
             m = 0.05 * min(xb - xa, xc - xb)
             ok = xa + m < xu < xc - m and abs(xu - xb) > 0.25 * _DIP_TOL and it % 4 != 3
-        if not ok:                                               # golden section of the larger side
+        if not ok:  # golden section of the larger side
             xu = xb + gold * (xc - xb) if xc - xb > xb - xa else xb - gold * (xb - xa)
         if xu < xb:
             eu, ru = _follow(cls, h, PP, R06, p16, xu, xa, xb, ra, rb, th, e, t2)
         else:
             eu, ru = _follow(cls, h, PP, R06, p16, xu, xb, xc, rb, rc, th, e, t2)
         if not math.isfinite(eu):
-            return n                                             # the root is lost (a fold): not a dip
+            return n  # the root is lost (a fold): not a dip
         fu = sg * eu
         if fu <= 0.0:
             # a sign change: a root on either side of xu (one where fu is exactly 0)
@@ -525,8 +607,41 @@ def _dip(cls, h, PP, R06, p, p16, xa, xb, xc, ea, eb, ec, ra, rb, rc, th, e, t2,
 
 
 @kernel
-def _dips(cls, h, PP, R06, p, p16, RS0, ES0, CS0, i0, x0, RS1, ES1, CS1, i1, x1, RS2, ES2, CS2, i2, x2,
-          th, e, t2, out, q, q2, J, F, Q, V, E, n):
+def _dips(
+    cls,
+    h,
+    PP,
+    R06,
+    p,
+    p16,
+    RS0,
+    ES0,
+    CS0,
+    i0,
+    x0,
+    RS1,
+    ES1,
+    CS1,
+    i1,
+    x1,
+    RS2,
+    ES2,
+    CS2,
+    i2,
+    x2,
+    th,
+    e,
+    t2,
+    out,
+    q,
+    q2,
+    J,
+    F,
+    Q,
+    V,
+    E,
+    n,
+):
     """Every dip of the error at sample ``i1`` of RS1, ES1, CS1 (angle ``x1``) between its
     neighbours, sample ``i0`` of RS0, … (angle ``x0`` < x1) and sample ``i2`` of RS2, … (angle
     ``x2`` > x1): a root there followed to both (nearest, closer than :data:`_MATCH`) whose |e|
@@ -542,11 +657,39 @@ def _dips(cls, h, PP, R06, p, p16, RS0, ES0, CS0, i0, x0, RS1, ES1, CS1, i1, x1,
         ea, ec = ES0[i0, k0], ES2[i2, k2]
         sg = 1.0 if eb > 0.0 else -1.0
         fa, fb, fc = sg * ea, sg * eb, sg * ec
-        if not (fa > 0.0 and fc > 0.0 and fb <= fa and fb <= fc) or not _low(x0, x1, x2, fa, fb, fc):
+        if not (fa > 0.0 and fc > 0.0 and fb <= fa and fb <= fc) or not _low(
+            x0, x1, x2, fa, fb, fc
+        ):
             continue
-        n = _dip(cls, h, PP, R06, p, p16, x0, x1, x2, ea, eb, ec,
-                 (RS0[i0, k0, 0], RS0[i0, k0, 1], RS0[i0, k0, 2]), rb, (RS2[i2, k2, 0], RS2[i2, k2, 1], RS2[i2, k2, 2]),
-                 th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        n = _dip(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            x0,
+            x1,
+            x2,
+            ea,
+            eb,
+            ec,
+            (RS0[i0, k0, 0], RS0[i0, k0, 1], RS0[i0, k0, 2]),
+            rb,
+            (RS2[i2, k2, 0], RS2[i2, k2, 1], RS2[i2, k2, 2]),
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
     return n
 
 
@@ -561,8 +704,45 @@ def _copy_sample(RS, ES, CS, i, RD, ED, CD, j):
 
 
 @kernel
-def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR, NE, NC, NX, S1, DM, FM, SX, SR,
-          ns, th, e, t2, out, q, q2, J, F, Q, V, E, n):
+def _look(
+    cls,
+    h,
+    PP,
+    R06,
+    p,
+    p16,
+    xa,
+    xb,
+    u,
+    deeper,
+    X2,
+    RS2,
+    ES2,
+    CS2,
+    FL,
+    NR,
+    NE,
+    NC,
+    NX,
+    S1,
+    DM,
+    FM,
+    SX,
+    SR,
+    ns,
+    th,
+    e,
+    t2,
+    out,
+    q,
+    q2,
+    J,
+    F,
+    Q,
+    V,
+    E,
+    n,
+):
     """A finer look at the interval [xa, xb]: its samples X2 = xa + (xb − xa) ``u`` (roots RS2,
     errors ES2, counts CS2), the brackets and dips of them, the dips at both ends (with the
     samples next to the interval: slot 0 (left, angle NX[0]) and 1 (right, NX[1]) of NR, NE,
@@ -585,11 +765,69 @@ def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR,
                 fast = fast or DM[s] > _JUMP
         FL[g2] = fast
         if not fast:
-            n = _brackets(cls, h, PP, R06, p, p16, X2, RS2, ES2, CS2, g2, S1, DM, th, e, t2, out, q, q2, J, F,
-                          Q, V, E, n)
+            n = _brackets(
+                cls,
+                h,
+                PP,
+                R06,
+                p,
+                p16,
+                X2,
+                RS2,
+                ES2,
+                CS2,
+                g2,
+                S1,
+                DM,
+                th,
+                e,
+                t2,
+                out,
+                q,
+                q2,
+                J,
+                F,
+                Q,
+                V,
+                E,
+                n,
+            )
         if g2 > 0 and not FL[g2 - 1] and not fast:
-            n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, g2 - 1, X2[g2 - 1], RS2, ES2, CS2, g2, X2[g2],
-                      RS2, ES2, CS2, g2 + 1, X2[g2 + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+            n = _dips(
+                cls,
+                h,
+                PP,
+                R06,
+                p,
+                p16,
+                RS2,
+                ES2,
+                CS2,
+                g2 - 1,
+                X2[g2 - 1],
+                RS2,
+                ES2,
+                CS2,
+                g2,
+                X2[g2],
+                RS2,
+                ES2,
+                CS2,
+                g2 + 1,
+                X2[g2 + 1],
+                th,
+                e,
+                t2,
+                out,
+                q,
+                q2,
+                J,
+                F,
+                Q,
+                V,
+                E,
+                n,
+            )
         if CS2[g2] != CS2[g2 + 1]:
             # fold seeds: on the side with more roots, those with a small error, and all those
             # nearest to no root of the other side (the pair that meets at the fold) where
@@ -599,7 +837,9 @@ def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR,
             for j in range(4):
                 FM[j] = True
             for t in range(CS2[other]):
-                k, _ = _nearest(RS2, CS2, side, (RS2[other, t, 0], RS2[other, t, 1], RS2[other, t, 2]))
+                k, _ = _nearest(
+                    RS2, CS2, side, (RS2[other, t, 0], RS2[other, t, 1], RS2[other, t, 2])
+                )
                 FM[k] = False
             pos = neg_ = False
             for j in range(CS2[side]):
@@ -609,15 +849,85 @@ def _look(cls, h, PP, R06, p, p16, xa, xb, u, deeper, X2, RS2, ES2, CS2, FL, NR,
             for j in range(CS2[side]):
                 if (abs(ES2[side, j]) < _SEED or (FM[j] and pos and neg_)) and ns < _MAX_SEEDS:
                     SX[ns] = X2[side]
-                    SR[ns, 0], SR[ns, 1], SR[ns, 2] = RS2[side, j, 0], RS2[side, j, 1], RS2[side, j, 2]
+                    SR[ns, 0], SR[ns, 1], SR[ns, 2] = (
+                        RS2[side, j, 0],
+                        RS2[side, j, 1],
+                        RS2[side, j, 2],
+                    )
                     ns += 1
     # the ends of the finer look, between its next samples and the samples beyond it
     if not FL[0]:
-        n = _dips(cls, h, PP, R06, p, p16, NR, NE, NC, 0, NX[0], RS2, ES2, CS2, 0, X2[0],
-                  RS2, ES2, CS2, 1, X2[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        n = _dips(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            NR,
+            NE,
+            NC,
+            0,
+            NX[0],
+            RS2,
+            ES2,
+            CS2,
+            0,
+            X2[0],
+            RS2,
+            ES2,
+            CS2,
+            1,
+            X2[1],
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
     if not FL[L2 - 2]:
-        n = _dips(cls, h, PP, R06, p, p16, RS2, ES2, CS2, L2 - 2, X2[L2 - 2], RS2, ES2, CS2, L2 - 1, X2[L2 - 1],
-                  NR, NE, NC, 1, NX[1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        n = _dips(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            RS2,
+            ES2,
+            CS2,
+            L2 - 2,
+            X2[L2 - 2],
+            RS2,
+            ES2,
+            CS2,
+            L2 - 1,
+            X2[L2 - 1],
+            NR,
+            NE,
+            NC,
+            1,
+            NX[1],
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
     return n, ns
 
 
@@ -643,16 +953,75 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     for g in range(grid):
         fine[g] = _interval(RS, CS, g, S1, DM)
         if fine[g]:
-            continue                                              # its brackets come from the finer look
-        n = _brackets(cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n)
+            continue  # its brackets come from the finer look
+        n = _brackets(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            X,
+            RS,
+            ES,
+            CS,
+            g,
+            S1,
+            DM,
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
     # dips at the samples between two plain intervals (sample 0 ≡ L − 1: its left neighbour is L − 2)
     for g in range(grid):
         gl = g - 1 if g > 0 else grid - 1
         if fine[gl] or fine[g]:
             continue
         il, xl = (g - 1, X[g - 1]) if g > 0 else (L - 2, X[L - 2] - 2.0 * math.pi)
-        n = _dips(cls, h, PP, R06, p, p16, RS, ES, CS, il, xl, RS, ES, CS, g, X[g],
-                  RS, ES, CS, g + 1, X[g + 1], th, e, t2, out, q, q2, J, F, Q, V, E, n)
+        n = _dips(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            RS,
+            ES,
+            CS,
+            il,
+            xl,
+            RS,
+            ES,
+            CS,
+            g,
+            X[g],
+            RS,
+            ES,
+            CS,
+            g + 1,
+            X[g + 1],
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
     # the finer looks: 2 _SUB + 1 points crowded quadratically towards both ends, at up to
     # _DEPTH levels (level d + 1 looks again at the flagged intervals of level d, depth first)
     L2 = 2 * _SUB + 1
@@ -678,9 +1047,45 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
         _copy_sample(RS, ES, CS, il, NR[0], NE[0], NC[0], 0)
         _copy_sample(RS, ES, CS, ir, NR[0], NE[0], NC[0], 1)
         NX[0, 0], NX[0, 1] = xl, xr
-        n, ns = _look(cls, h, PP, R06, p, p16, X[g], X[g + 1], u, _DEPTH > 1, XL[0], RSL[0], ESL[0], CSL[0],
-                      FL[0], NR[0], NE[0], NC[0], NX[0], S1, DM, FM, SX, SR, ns, th, e, t2, out, q, q2, J, F,
-                      Q, V, E, n)
+        n, ns = _look(
+            cls,
+            h,
+            PP,
+            R06,
+            p,
+            p16,
+            X[g],
+            X[g + 1],
+            u,
+            _DEPTH > 1,
+            XL[0],
+            RSL[0],
+            ESL[0],
+            CSL[0],
+            FL[0],
+            NR[0],
+            NE[0],
+            NC[0],
+            NX[0],
+            S1,
+            DM,
+            FM,
+            SX,
+            SR,
+            ns,
+            th,
+            e,
+            t2,
+            out,
+            q,
+            q2,
+            J,
+            F,
+            Q,
+            V,
+            E,
+            n,
+        )
         d = 0
         pos[0] = 0
         while d >= 0:
@@ -688,7 +1093,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
             while k < L2 - 1 and not FL[d, k]:
                 k += 1
             if k >= L2 - 1:
-                d -= 1                                            # every flagged interval of level d done
+                d -= 1  # every flagged interval of level d done
                 continue
             pos[d] = k + 1
             if k > 0:
@@ -704,9 +1109,45 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                 _copy_sample(NR[d], NE[d], NC[d], 1, NR[d + 1], NE[d + 1], NC[d + 1], 1)
                 NX[d + 1, 1] = NX[d, 1]
             d += 1
-            n, ns = _look(cls, h, PP, R06, p, p16, XL[d - 1, k], XL[d - 1, k + 1], u, d + 1 < _DEPTH, XL[d],
-                          RSL[d], ESL[d], CSL[d], FL[d], NR[d], NE[d], NC[d], NX[d], S1, DM, FM, SX, SR, ns,
-                          th, e, t2, out, q, q2, J, F, Q, V, E, n)
+            n, ns = _look(
+                cls,
+                h,
+                PP,
+                R06,
+                p,
+                p16,
+                XL[d - 1, k],
+                XL[d - 1, k + 1],
+                u,
+                d + 1 < _DEPTH,
+                XL[d],
+                RSL[d],
+                ESL[d],
+                CSL[d],
+                FL[d],
+                NR[d],
+                NE[d],
+                NC[d],
+                NX[d],
+                S1,
+                DM,
+                FM,
+                SX,
+                SR,
+                ns,
+                th,
+                e,
+                t2,
+                out,
+                q,
+                q2,
+                J,
+                F,
+                Q,
+                V,
+                E,
+                n,
+            )
             pos[d] = 0
     for k in range(ns):
         _assemble(cls, h, PP, R06, p16, SX[k], SR[k, 0], SR[k, 1], SR[k, 2], q)
@@ -718,7 +1159,9 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
 # ----------------------------------------------------------------------------- 2-D search
 @kernel
 def _r05(h, q1, q2, t):
-    return mm(mm(mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], t[0])), rot(h[3], t[1])), rot(h[4], t[2]))
+    return mm(
+        mm(mm(mm(rot(h[0], q1), rot(h[1], q2)), rot(h[2], t[0])), rot(h[3], t[1])), rot(h[4], t[2])
+    )
 
 
 @kernel
@@ -730,7 +1173,11 @@ def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
     R06h6 = mv(R06, h6)
     # a unit vector ⟂ h6 (h6 × the axis of its smallest component)
     a0, a1, a2 = abs(h6[0]), abs(h6[1]), abs(h6[2])
-    ax = (1.0, 0.0, 0.0) if a0 <= a1 and a0 <= a2 else ((0.0, 1.0, 0.0) if a1 <= a2 else (0.0, 0.0, 1.0))
+    ax = (
+        (1.0, 0.0, 0.0)
+        if a0 <= a1 and a0 <= a2
+        else ((0.0, 1.0, 0.0) if a1 <= a2 else (0.0, 0.0, 1.0))
+    )
     u = cross(h6, ax)
     u = scale(u, 1.0 / norm(u))
     G2 = grid * grid
@@ -819,5 +1266,15 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
     return q, valid, exact & valid
 
 
-__all__ = ["CLASSES", "SEARCH_BRANCHES", "SEARCH_GRID", "SEARCH_GRID_2D", "SEARCH_TOL", "fk_geo", "polish",
-           "pose_error", "solve6", "solve_search"]
+__all__ = [
+    "CLASSES",
+    "SEARCH_BRANCHES",
+    "SEARCH_GRID",
+    "SEARCH_GRID_2D",
+    "SEARCH_TOL",
+    "fk_geo",
+    "polish",
+    "pose_error",
+    "solve6",
+    "solve_search",
+]

@@ -196,7 +196,7 @@ def sp1_cs(p1, p2, k, tol):
     :func:`sp1`."""
     kxp = cross(k, p1)
     x0 = dot(kxp, p2)
-    x1 = -dot(cross(k, kxp), p2)                      # x = Aᵀ p2, A = [k × p1, −k × (k × p1)]
+    x1 = -dot(cross(k, kxp), p2)  # x = Aᵀ p2, A = [k × p1, −k × (k × p1)]
     n1, n2 = norm(p1), norm(p2)
     sing = norm(kxp) <= 1e-12 * max(1.0, n1) or norm(cross(k, p2)) <= 1e-12 * max(1.0, n2)
     c, s = (1.0, 0.0) if sing else unit_cs(x0, x1)
@@ -226,11 +226,11 @@ def sp4_cs(h, p, k, d, tol):
     Eqs. (4)–(6), see :func:`sp4`."""
     kxp = cross(k, p)
     a0 = dot(h, kxp)
-    a1 = -dot(h, cross(k, kxp))                       # hᵀA
+    a1 = -dot(h, cross(k, kxp))  # hᵀA
     b = d - dot(h, k) * dot(k, p)
     na = math.sqrt(a0 * a0 + a1 * a1)
     ab = abs(b)
-    margin = na - ab                                  # > 0: two roots; residual of the LS root
+    margin = na - ab  # > 0: two roots; residual of the LS root
     sing = na <= 1e-12 * max(1.0, norm(p))
     # two roots wherever the plane cuts the circle (as IK-Geo's sp_4): a near-tangent pair is
     # kept as two roots, not merged into one whose error grows like √margin in the angle
@@ -257,7 +257,8 @@ def _sp1_loop(p1, p2, k, tol, theta, exact, sing):
 def _sp4_loop(h, p, k, d, tol, theta, count, exact, sing):
     for i in range(len(h)):
         theta[i, 0], theta[i, 1], count[i], exact[i, 0], exact[i, 1], sing[i] = sp4_one(
-            vec(h[i]), vec(p[i]), vec(k[i]), d[i], tol)
+            vec(h[i]), vec(p[i]), vec(k[i]), d[i], tol
+        )
 
 
 def sp1(p1, p2, k, tol: float = TOL) -> Solutions:
@@ -300,10 +301,16 @@ def sp4(h, p, k, d, tol: float = TOL) -> Solutions:
     ``h``, ``k``: unit ``(3,)``/``(N, 3)``; ``p``: ``(3,)``/``(N, 3)``; ``d``: scalar/``(N,)``
     (length unit).  m = 1, S = 2."""
     tol = _tol(tol)
-    (h, p, k, d), batched = _inputs({"h": (h, "axis"), "p": (p, "vec"), "k": (k, "axis"),
-                                     "d": (d, "scalar")})
+    (h, p, k, d), batched = _inputs(
+        {"h": (h, "axis"), "p": (p, "vec"), "k": (k, "axis"), "d": (d, "scalar")}
+    )
     n = len(h)
-    theta, count, exact, sing = np.empty((n, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    theta, count, exact, sing = (
+        np.empty((n, 2)),
+        np.empty(n, np.int64),
+        np.empty((n, 2), bool),
+        np.empty(n, bool),
+    )
     _sp4_loop(h, p, k, d, tol, theta, count, exact, sing)
     return _two_roots(theta, count, exact, sing, batched)
 
@@ -320,7 +327,9 @@ def sp3_cs(p1, p2, k, d, tol):
     else:
         h, dd, safe = scale(p2, 1.0 / n2), (dot(p1, p1) + n2 * n2 - d * d) / (2.0 * n2), n2
     # a distance residual δ changes the SP4 height by ≈ δ (2d + δ) / (2‖p2‖)
-    ca, sa, cb, sb, cnt, ea, eb, sing = sp4_cs(h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15))
+    ca, sa, cb, sb, cnt, ea, eb, sing = sp4_cs(
+        h, p1, k, dd, max(tol * (d + 0.5 * tol) / safe, 1e-15)
+    )
     if sing or zero:
         ea = abs(norm(sub(rotate_cs(k, ca, sa, p1), p2)) - d) <= tol
         if cnt == 2:
@@ -340,7 +349,8 @@ def sp3_one(p1, p2, k, d, tol):
 def _sp3_loop(p1, p2, k, d, tol, theta, count, exact, sing):
     for i in range(len(p1)):
         theta[i, 0], theta[i, 1], count[i], exact[i, 0], exact[i, 1], sing[i] = sp3_one(
-            vec(p1[i]), vec(p2[i]), vec(k[i]), d[i], tol)
+            vec(p1[i]), vec(p2[i]), vec(k[i]), d[i], tol
+        )
 
 
 def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
@@ -355,12 +365,18 @@ def sp3(p1, p2, k, d, tol: float = TOL) -> Solutions:
     ``p1``, ``p2``: ``(3,)``/``(N, 3)``; ``k``: unit axis; ``d`` ≥ 0: scalar/``(N,)``.
     m = 1, S = 2."""
     tol = _tol(tol)
-    (p1, p2, k, d), batched = _inputs({"p1": (p1, "vec"), "p2": (p2, "vec"), "k": (k, "axis"),
-                                       "d": (d, "scalar")})
+    (p1, p2, k, d), batched = _inputs(
+        {"p1": (p1, "vec"), "p2": (p2, "vec"), "k": (k, "axis"), "d": (d, "scalar")}
+    )
     if np.any(d < 0):
         raise ParameterError("d: the sphere radius must be >= 0")
     n = len(p1)
-    theta, count, exact, sing = np.empty((n, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    theta, count, exact, sing = (
+        np.empty((n, 2)),
+        np.empty(n, np.int64),
+        np.empty((n, 2), bool),
+        np.empty(n, bool),
+    )
     _sp3_loop(p1, p2, k, d, tol, theta, count, exact, sing)
     return _two_roots(theta, count, exact, sing, batched)
 
@@ -384,15 +400,21 @@ def sp2_cs(p1, p2, k1, k2, tol):
     zero = n1 <= 1e-300 or n2 <= 1e-300
     u1 = scale(p1, 1.0 / n1) if n1 > 1e-300 else p1
     u2 = scale(p2, 1.0 / n2) if n2 > 1e-300 else p2
-    ca, sa, cb, sb, cnt, ea, eb, sing1 = sp4_cs(k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300))
+    ca, sa, cb, sb, cnt, ea, eb, sing1 = sp4_cs(
+        k2, u1, k1, dot(k2, u2), tol / max(max(n1, n2), 1e-300)
+    )
     k2u2 = cross(k2, u2)
     k2k2u2 = cross(k2, k2u2)
     sing2 = norm(k2u2) <= 1e-12
     sing = sing1 or sing2 or zero
-    c2a, s2a, xa = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, ca, sa, sing2, tol, sing, ea, n1, n2)
+    c2a, s2a, xa = _sp2_second(
+        k1, k2, p1, p2, u1, k2u2, k2k2u2, ca, sa, sing2, tol, sing, ea, n1, n2
+    )
     c2b, s2b, xb = math.nan, math.nan, False
     if cnt == 2:
-        c2b, s2b, xb = _sp2_second(k1, k2, p1, p2, u1, k2u2, k2k2u2, cb, sb, sing2, tol, sing, eb, n1, n2)
+        c2b, s2b, xb = _sp2_second(
+            k1, k2, p1, p2, u1, k2u2, k2k2u2, cb, sb, sing2, tol, sing, eb, n1, n2
+        )
     return ca, sa, c2a, s2a, cb, sb, c2b, s2b, cnt, xa, xb, sing
 
 
@@ -407,8 +429,16 @@ def sp2_one(p1, p2, k1, k2, tol):
 @kernel
 def _sp2_loop(p1, p2, k1, k2, tol, theta, count, exact, sing):
     for i in range(len(p1)):
-        (theta[i, 0, 0], theta[i, 0, 1], theta[i, 1, 0], theta[i, 1, 1], count[i], exact[i, 0], exact[i, 1],
-         sing[i]) = sp2_one(vec(p1[i]), vec(p2[i]), vec(k1[i]), vec(k2[i]), tol)
+        (
+            theta[i, 0, 0],
+            theta[i, 0, 1],
+            theta[i, 1, 0],
+            theta[i, 1, 1],
+            count[i],
+            exact[i, 0],
+            exact[i, 1],
+            sing[i],
+        ) = sp2_one(vec(p1[i]), vec(p2[i]), vec(k1[i]), vec(k2[i]), tol)
 
 
 def sp2(p1, p2, k1, k2, tol: float = TOL) -> Solutions:
@@ -424,10 +454,16 @@ def sp2(p1, p2, k1, k2, tol: float = TOL) -> Solutions:
 
     ``p1``, ``p2``: ``(3,)``/``(N, 3)``; ``k1``, ``k2``: unit axes.  m = 2 (θ1, θ2), S = 2."""
     tol = _tol(tol)
-    (p1, p2, k1, k2), batched = _inputs({"p1": (p1, "vec"), "p2": (p2, "vec"), "k1": (k1, "axis"),
-                                         "k2": (k2, "axis")})
+    (p1, p2, k1, k2), batched = _inputs(
+        {"p1": (p1, "vec"), "p2": (p2, "vec"), "k1": (k1, "axis"), "k2": (k2, "axis")}
+    )
     n = len(p1)
-    theta, count, exact, sing = np.empty((n, 2, 2)), np.empty(n, np.int64), np.empty((n, 2), bool), np.empty(n, bool)
+    theta, count, exact, sing = (
+        np.empty((n, 2, 2)),
+        np.empty(n, np.int64),
+        np.empty((n, 2), bool),
+        np.empty(n, bool),
+    )
     _sp2_loop(p1, p2, k1, k2, tol, theta, count, exact, sing)
     valid = np.arange(2)[None, :] < count[:, None]
     return _finish(theta, valid, exact, sing, batched)
@@ -463,7 +499,7 @@ def _refine_root(a, n, lo, hi, flo):
             hi = x
         xn = x - f / g if g != 0.0 else lo - 1.0
         if not (lo < xn < hi) or abs(2.0 * f) > abs(dxold * g):
-            xn = 0.5 * (lo + hi)                        # bisection: Newton leaves the bracket or stalls
+            xn = 0.5 * (lo + hi)  # bisection: Newton leaves the bracket or stalls
         dxold = dx
         dx = xn - x
         if xn == x or abs(dx) <= 4.4e-16 * abs(x) or hi - lo <= 4.4e-16 * max(abs(lo), abs(hi)):
@@ -487,7 +523,7 @@ def _bracket_roots(a, n, crit, cmul, m, out, omul):
     (even ``cmul``) and vanishes there to rounding (``abs(p(c)) ≤ 4 (n + 1) ε Σ abs(aᵢ) abs(c)ⁱ``,
     a triple or higher root)."""
     a0 = a[0]
-    bound = 0.0                                         # Fujiwara's bound on abs(root)
+    bound = 0.0  # Fujiwara's bound on abs(root)
     for i in range(1, n + 1):
         t = abs(a[i] / a0)
         if i == n:
@@ -510,11 +546,11 @@ def _bracket_roots(a, n, crit, cmul, m, out, omul):
             s, ax = 0.0, abs(cx)
             for i in range(n + 1):
                 s = s * ax + abs(a[i])
-            if cmul[j] % 2 == 0:                        # p monotone across c: a root of
-                root = abs(cv) <= 4.0 * (n + 1) * 2.220446049250313e-16 * s    # odd multiplicity?
+            if cmul[j] % 2 == 0:  # p monotone across c: a root of
+                root = abs(cv) <= 4.0 * (n + 1) * 2.220446049250313e-16 * s  # odd multiplicity?
             elif cv == 0.0:
                 root = True
-            else:                                       # an extremum: tangent within 1e-6?
+            else:  # an extremum: tangent within 1e-6?
                 p2 = 0.0
                 for i in range(n - 1):
                     p2 = p2 * cx + a[i] * (n - i) * (n - i - 1)
@@ -557,13 +593,13 @@ def real_roots(c, x, real):
     s = big if big > 0.0 else 1.0
     first = 0
     while first < 4 and abs(c[first] / s) <= (1e-10 if first == 0 else 1e-14):
-        first += 1                                    # lower degree (rare)
+        first += 1  # lower degree (rare)
     deg = 4 - first
     for i in range(4):
         x[i], real[i] = 0.0, False
     if deg == 0:
         return
-    D = local2(4, 5)                                  # D[k]: k-th derivative, degree deg − k
+    D = local2(4, 5)  # D[k]: k-th derivative, degree deg − k
     R = local2(4, 4)
     M = local_ints2(4, 4)
     for k in range(4):
@@ -597,10 +633,12 @@ def _solve3(J, F):
     det = dot(J[0], cross(J[1], J[2]))
     if abs(det) <= 1e-12:
         return (0.0, 0.0, 0.0), False
-    c0, c1, c2 = cross(J[1], J[2]), cross(J[2], J[0]), cross(J[0], J[1])   # rows of adj(J)ᵀ
-    return ((c0[0] * F[0] + c1[0] * F[1] + c2[0] * F[2]) / det,
-            (c0[1] * F[0] + c1[1] * F[1] + c2[1] * F[2]) / det,
-            (c0[2] * F[0] + c1[2] * F[1] + c2[2] * F[2]) / det), True
+    c0, c1, c2 = cross(J[1], J[2]), cross(J[2], J[0]), cross(J[0], J[1])  # rows of adj(J)ᵀ
+    return (
+        (c0[0] * F[0] + c1[0] * F[1] + c2[0] * F[2]) / det,
+        (c0[1] * F[0] + c1[1] * F[1] + c2[1] * F[2]) / det,
+        (c0[2] * F[0] + c1[2] * F[1] + c2[2] * F[2]) / det,
+    ), True
 
 
 @kernel
@@ -649,8 +687,11 @@ def _circle_polynomials(o, k, p, k2, delta):
     beta = dot(o, kxk2) / nk2
     cen = add(o, scale(k, dot(k, p)))
     f = 4.0 * beta * beta
-    return (-2.0 * alpha, r2 + dot(cen, cen) + 2.0 * alpha * delta), \
-        (-f, 2.0 * delta * f, (-delta * delta + r2 * nk2) * f), bad
+    return (
+        (-2.0 * alpha, r2 + dot(cen, cen) + 2.0 * alpha * delta),
+        (-f, 2.0 * delta * f, (-delta * delta + r2 * nk2) * f),
+        bad,
+    )
 
 
 @kernel
@@ -675,7 +716,7 @@ def _sp5_newton(p0, p1, p2, p3, k1, k2, k3, t, stop):
         r1 = rotate(k1, t[0], p1)
         r3 = rotate(k3, t[2], p3)
         w = rotate(k2, t[1], add(p2, r3))
-        F = sub(add(p0, r1), w)                        # _sp5_residual at t
+        F = sub(add(p0, r1), w)  # _sp5_residual at t
         res = norm(F)
         if it == SP5_NEWTON or res <= stop:
             break
@@ -692,8 +733,8 @@ def _sp5_newton(p0, p1, p2, p3, k1, k2, k3, t, stop):
 def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
     """SP5 of one problem (tuples): writes the solutions into ``out_theta`` (4, 3) (valid rows
     first) and returns (count, singular); see :func:`sp5`."""
-    c1 = add(p0, scale(k1, dot(k1, p1)))                # centre of circle 1
-    c3 = add(p2, scale(k3, dot(k3, p3)))                # centre of circle 3
+    c1 = add(p0, scale(k1, dot(k1, p1)))  # centre of circle 1
+    c3 = add(p2, scale(k3, dot(k3, p3)))  # centre of circle 3
     d1, d3 = dot(k2, c1), dot(k2, c3)
     P1, R1, bad1 = _circle_polynomials(p0, k1, p1, k2, d1)
     P3, R3, bad3 = _circle_polynomials(p2, k3, p3, k2, d3)
@@ -703,20 +744,24 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
             out_theta[j, c] = math.nan
     if sing:
         return 0, True
-    a, b = P1[0] - P3[0], P1[1] - P3[1]                # P13 = a z + b
-    sq = (a * a, 2.0 * a * b, b * b)                   # P13²
+    a, b = P1[0] - P3[0], P1[1] - P3[1]  # P13 = a z + b
+    sq = (a * a, 2.0 * a * b, b * b)  # P13²
     rhs = (R3[0] - R1[0] - sq[0], R3[1] - R1[1] - sq[1], R3[2] - R1[2] - sq[2])
-    eq = local(5)                                      # rhs² − 4 P13² R1
+    eq = local(5)  # rhs² − 4 P13² R1
     eq[0] = rhs[0] * rhs[0] - 4.0 * sq[0] * R1[0]
     eq[1] = 2.0 * rhs[0] * rhs[1] - 4.0 * (sq[0] * R1[1] + sq[1] * R1[0])
-    eq[2] = rhs[1] * rhs[1] + 2.0 * rhs[0] * rhs[2] - 4.0 * (sq[0] * R1[2] + sq[1] * R1[1] + sq[2] * R1[0])
+    eq[2] = (
+        rhs[1] * rhs[1]
+        + 2.0 * rhs[0] * rhs[2]
+        - 4.0 * (sq[0] * R1[2] + sq[1] * R1[1] + sq[2] * R1[0])
+    )
     eq[3] = 2.0 * rhs[1] * rhs[2] - 4.0 * (sq[1] * R1[2] + sq[2] * R1[1])
     eq[4] = rhs[2] * rhs[2] - 4.0 * sq[2] * R1[2]
     z, real = local(4), local_flags(4)
     real_roots(eq, z, real)
     k1p1, k3p3 = cross(k1, p1), cross(k3, p3)
     kk1p1, kk3p3 = cross(k1, k1p1), cross(k3, k3p3)
-    a1 = (dot(k1p1, k2), -dot(kk1p1, k2))              # A1ᵀ k2
+    a1 = (dot(k1p1, k2), -dot(kk1p1, k2))  # A1ᵀ k2
     a3 = (dot(k3p3, k2), -dot(kk3p3, k2))
     na1 = max(a1[0] * a1[0] + a1[1] * a1[1], 1e-300)
     na3 = max(a3[0] * a3[0] + a3[1] * a3[1], 1e-300)
@@ -728,7 +773,7 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
     stop = min(1e-13 * scl, 1e-3 * tol)
     for r in range(4):
         if not real[r] or (r > 0 and z[r] == z[r - 1]):
-            continue                                   # a double root: the same candidates
+            continue  # a double root: the same candidates
         e1, e3 = z[r] - d1, z[r] - d3
         s1 = math.sqrt(max(na1 - e1 * e1, 0.0))
         s3 = math.sqrt(max(na3 - e3 * e3, 0.0))
@@ -736,7 +781,7 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
             sg1 = 1.0 if g < 2 else -1.0
             sg3 = 1.0 if g % 2 == 0 else -1.0
             if (sg1 < 0.0 and s1 == 0.0) or (sg3 < 0.0 and s3 == 0.0):
-                continue                               # the same point as sign +1
+                continue  # the same point as sign +1
             # the SP4 points at height z (IK-Geo Eqs. (4)-(6)): x = (sin θ, cos θ) unnormalised
             x10, x11 = a1[0] * e1 + sg1 * a1[1] * s1, a1[1] * e1 - sg1 * a1[0] * s1
             x30, x31 = a3[0] * e3 + sg3 * a3[1] * s3, a3[1] * e3 - sg3 * a3[0] * s3
@@ -744,13 +789,13 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
             if n1 > 0.0:
                 x10, x11 = x10 / n1, x11 / n1
             else:
-                x10, x11 = 0.0, 1.0                    # atan2(0, 0) = 0
+                x10, x11 = 0.0, 1.0  # atan2(0, 0) = 0
             if n3 > 0.0:
                 x30, x31 = x30 / n3, x31 / n3
             else:
                 x30, x31 = 0.0, 1.0
-            v1 = add(c1, sub(scale(k1p1, x10), scale(kk1p1, x11)))      # p0 + rot(k1, θ1) p1
-            v3 = add(c3, sub(scale(k3p3, x30), scale(kk3p3, x31)))      # p2 + rot(k3, θ3) p3
+            v1 = add(c1, sub(scale(k1p1, x10), scale(kk1p1, x11)))  # p0 + rot(k1, θ1) p1
+            v3 = add(c3, sub(scale(k3p3, x30), scale(kk3p3, x31)))  # p2 + rot(k3, θ3) p3
             # residual after θ2 by SP1 (rot(k2, θ2) v3 nearest v1): heights h and radii ρ about
             # k2 (the spurious sign pairs of the squared quartic have ‖v1‖ ≠ ‖v3‖)
             h1, h3 = dot(k2, v1), dot(k2, v3)
@@ -760,7 +805,7 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
                 continue
             t1, t3 = math.atan2(x10, x11), math.atan2(x30, x31)
             k2v3 = cross(k2, v3)
-            t2 = math.atan2(dot(k2v3, v1), -dot(cross(k2, k2v3), v1))     # SP1: rot(k2, θ2) v3 = v1
+            t2 = math.atan2(dot(k2v3, v1), -dot(cross(k2, k2v3), v1))  # SP1: rot(k2, θ2) v3 = v1
             t, rs = _sp5_newton(p0, p1, p2, p3, k1, k2, k3, (t1, t2, t3), stop)
             i = 4 * r + g
             theta[i, 0], theta[i, 1], theta[i, 2] = t
@@ -772,8 +817,17 @@ def sp5_one(p0, p1, p2, p3, k1, k2, k3, tol, out_theta):
 @kernel
 def _sp5_loop(p0, p1, p2, p3, k1, k2, k3, tol, theta, count, sing):
     for i in range(len(p0)):
-        count[i], sing[i] = sp5_one(vec(p0[i]), vec(p1[i]), vec(p2[i]), vec(p3[i]), vec(k1[i]), vec(k2[i]),
-                                    vec(k3[i]), tol, theta[i])
+        count[i], sing[i] = sp5_one(
+            vec(p0[i]),
+            vec(p1[i]),
+            vec(p2[i]),
+            vec(p3[i]),
+            vec(k1[i]),
+            vec(k2[i]),
+            vec(k3[i]),
+            tol,
+            theta[i],
+        )
 
 
 def sp5(p0, p1, p2, p3, k1, k2, k3, tol: float = TOL_QUARTIC) -> Solutions:
@@ -796,9 +850,17 @@ def sp5(p0, p1, p2, p3, k1, k2, k3, tol: float = TOL_QUARTIC) -> Solutions:
 
     Vectors ``(3,)``/``(N, 3)``; ``k1``, ``k2``, ``k3`` unit axes.  m = 3, S = 4."""
     tol = _tol(tol)
-    (p0, p1, p2, p3, k1, k2, k3), batched = _inputs({
-        "p0": (p0, "vec"), "p1": (p1, "vec"), "p2": (p2, "vec"), "p3": (p3, "vec"),
-        "k1": (k1, "axis"), "k2": (k2, "axis"), "k3": (k3, "axis")})
+    (p0, p1, p2, p3, k1, k2, k3), batched = _inputs(
+        {
+            "p0": (p0, "vec"),
+            "p1": (p1, "vec"),
+            "p2": (p2, "vec"),
+            "p3": (p3, "vec"),
+            "k1": (k1, "axis"),
+            "k2": (k2, "axis"),
+            "k3": (k3, "axis"),
+        }
+    )
     n = len(p0)
     theta, count, sing = np.empty((n, 4, 3)), np.empty(n, np.int64), np.empty(n, bool)
     _sp5_loop(p0, p1, p2, p3, k1, k2, k3, tol, theta, count, sing)
@@ -819,8 +881,14 @@ def _sp6_residual(H, K, P, d1, d2, t0, t1):
 @kernel
 def _conic(xm0, xm1, n00, n01, n10, n11):
     """‖xm + N ξ‖² = 1 (xm (2,), N 2×2) as a ξ1² + b ξ1ξ2 + c ξ2² + d ξ1 + e ξ2 + f = 0."""
-    return (n00 * n00 + n10 * n10, 2.0 * (n00 * n01 + n10 * n11), n01 * n01 + n11 * n11,
-            2.0 * (xm0 * n00 + xm1 * n10), 2.0 * (xm0 * n01 + xm1 * n11), xm0 * xm0 + xm1 * xm1 - 1.0)
+    return (
+        n00 * n00 + n10 * n10,
+        2.0 * (n00 * n01 + n10 * n11),
+        n01 * n01 + n11 * n11,
+        2.0 * (xm0 * n00 + xm1 * n10),
+        2.0 * (xm0 * n01 + xm1 * n11),
+        xm0 * xm0 + xm1 * xm1 - 1.0,
+    )
 
 
 @kernel
@@ -857,14 +925,14 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         nw += Vt[1, i] * Vt[1, i]
     nw = math.sqrt(nw)
     if n0 * nw <= 1e-12 * max(1.0, amax) ** 2:
-        return 0, True                                 # the two equations are not independent
+        return 0, True  # the two equations are not independent
     for i in range(4):
         Vt[1, i] /= nw
     y0 = b0 / n0
     y1 = (b1 - l10 * y0) / nw
     xm = local(4)
     for i in range(4):
-        xm[i] = Vt[0, i] * y0 + Vt[1, i] * y1          # minimum-norm solution of A x = b
+        xm[i] = Vt[0, i] * y0 + Vt[1, i] * y1  # minimum-norm solution of A x = b
     # the null space of A: the columns of I − E Eᵀ of largest norm, one after the other
     for r in (2, 3):
         best, kb = -1.0, 0
@@ -890,21 +958,79 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
     b1 = b1_
     # resultant in ξ2 of the two conics (eliminating ξ1)
     z = local(5)
-    z[4] = (f * a * dd1 ** 2 + a ** 2 * fq ** 2 - d * a * dd1 * fq + a1 ** 2 * f ** 2 - 2 * a * fq * a1 * f
-            - d * dd1 * a1 * f + a1 * d ** 2 * fq)
-    z[3] = (e1 * d ** 2 * a1 - fq * dd1 * a * b_ - 2 * a * fq * a1 * e - f * a1 * b1 * d + 2 * dd1 * b1 * a * f
-            + 2 * e1 * fq * a ** 2 + dd1 ** 2 * a * e - e1 * dd1 * a * d - 2 * a * e1 * a1 * f - f * a1 * dd1 * b_
-            + 2 * f * e * a1 ** 2 - fq * b1 * a * d - e * a1 * dd1 * d + 2 * fq * b_ * a1 * d)
-    z[2] = (e1 ** 2 * a ** 2 + 2 * c1 * fq * a ** 2 - e * a1 * dd1 * b_ + fq * a1 * b_ ** 2 - e * a1 * b1 * d
-            - fq * b1 * a * b_ - 2 * a * e1 * a1 * e + 2 * dd1 * b1 * a * e - c1 * dd1 * a * d - 2 * a * c1 * a1 * f
-            + b1 ** 2 * a * f + 2 * e1 * b_ * a1 * d + e ** 2 * a1 ** 2 - c * a1 * dd1 * d - e1 * b1 * a * d
-            + 2 * f * c * a1 ** 2 - f * a1 * b1 * b_ + c1 * d ** 2 * a1 + dd1 ** 2 * a * c - e1 * dd1 * a * b_
-            - 2 * a * fq * a1 * c)
-    z[1] = (-2 * a * a1 * c * e1 + e1 * a1 * b_ ** 2 + 2 * c1 * b_ * a1 * d - c * a1 * b1 * d + b1 ** 2 * a * e
-            - e1 * b1 * a * b_ - 2 * a * c1 * a1 * e - e * a1 * b1 * b_ - c1 * b1 * a * d + 2 * e1 * c1 * a ** 2
-            + 2 * e * c * a1 ** 2 - c * a1 * dd1 * b_ + 2 * dd1 * b1 * a * c - c1 * dd1 * a * b_)
-    z[0] = (a ** 2 * c1 ** 2 - 2 * a * c1 * a1 * c + a1 ** 2 * c ** 2 - b_ * a * b1 * c1 - b_ * b1 * a1 * c
-            + b_ ** 2 * a1 * c1 + c * a * b1 ** 2)
+    z[4] = (
+        f * a * dd1**2
+        + a**2 * fq**2
+        - d * a * dd1 * fq
+        + a1**2 * f**2
+        - 2 * a * fq * a1 * f
+        - d * dd1 * a1 * f
+        + a1 * d**2 * fq
+    )
+    z[3] = (
+        e1 * d**2 * a1
+        - fq * dd1 * a * b_
+        - 2 * a * fq * a1 * e
+        - f * a1 * b1 * d
+        + 2 * dd1 * b1 * a * f
+        + 2 * e1 * fq * a**2
+        + dd1**2 * a * e
+        - e1 * dd1 * a * d
+        - 2 * a * e1 * a1 * f
+        - f * a1 * dd1 * b_
+        + 2 * f * e * a1**2
+        - fq * b1 * a * d
+        - e * a1 * dd1 * d
+        + 2 * fq * b_ * a1 * d
+    )
+    z[2] = (
+        e1**2 * a**2
+        + 2 * c1 * fq * a**2
+        - e * a1 * dd1 * b_
+        + fq * a1 * b_**2
+        - e * a1 * b1 * d
+        - fq * b1 * a * b_
+        - 2 * a * e1 * a1 * e
+        + 2 * dd1 * b1 * a * e
+        - c1 * dd1 * a * d
+        - 2 * a * c1 * a1 * f
+        + b1**2 * a * f
+        + 2 * e1 * b_ * a1 * d
+        + e**2 * a1**2
+        - c * a1 * dd1 * d
+        - e1 * b1 * a * d
+        + 2 * f * c * a1**2
+        - f * a1 * b1 * b_
+        + c1 * d**2 * a1
+        + dd1**2 * a * c
+        - e1 * dd1 * a * b_
+        - 2 * a * fq * a1 * c
+    )
+    z[1] = (
+        -2 * a * a1 * c * e1
+        + e1 * a1 * b_**2
+        + 2 * c1 * b_ * a1 * d
+        - c * a1 * b1 * d
+        + b1**2 * a * e
+        - e1 * b1 * a * b_
+        - 2 * a * c1 * a1 * e
+        - e * a1 * b1 * b_
+        - c1 * b1 * a * d
+        + 2 * e1 * c1 * a**2
+        + 2 * e * c * a1**2
+        - c * a1 * dd1 * b_
+        + 2 * dd1 * b1 * a * c
+        - c1 * dd1 * a * b_
+    )
+    z[0] = (
+        a**2 * c1**2
+        - 2 * a * c1 * a1 * c
+        + a1**2 * c**2
+        - b_ * a * b1 * c1
+        - b_ * b1 * a1 * c
+        + b_**2 * a1 * c1
+        + c * a * b1**2
+    )
     xi2s, real = local(4), local_flags(4)
     real_roots(z, xi2s, real)
     theta, ok, res = local2(4, 2), local_flags(4), local(4)
@@ -918,7 +1044,10 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         den = a * b1 * xi2 + a * dd1 - a1 * b_ * xi2 - a1 * d
         if abs(den) <= 1e-300:
             continue
-        xi1 = -(a * fq + a * c1 * xi2 ** 2 - a1 * c * xi2 ** 2 + a * e1 * xi2 - a1 * e * xi2 - a1 * f) / den
+        xi1 = (
+            -(a * fq + a * c1 * xi2**2 - a1 * c * xi2**2 + a * e1 * xi2 - a1 * e * xi2 - a1 * f)
+            / den
+        )
         x = local(4)
         for i in range(4):
             x[i] = xm[i] + Vt[2, i] * xi1 + Vt[3, i] * xi2
@@ -928,7 +1057,7 @@ def sp6_one(H, K, P, d1, d2, tol, out_theta):
         F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
         if max(abs(F0), abs(F1)) > 1e-2 * scl:
             continue
-        for _ in range(3):                             # Newton polish on the two equations
+        for _ in range(3):  # Newton polish on the two equations
             F0, F1 = _sp6_residual(H, K, P, d1, d2, t0, t1)
             g = local(4)
             for q in range(4):
@@ -981,11 +1110,16 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
         if a.ndim not in (2, 3) or a.shape[-2:] != (4, 3):
             raise ParameterError(f"{name}: expected shape (4, 3) or (N, 4, 3), got {a.shape}")
         arrs[name] = a
-    spec = {f"{name}{i + 1}": (arrs[name][..., i, :], "axis" if name != "p" else "vec")
-            for name in ("h", "k", "p") for i in range(4)}
+    spec = {
+        f"{name}{i + 1}": (arrs[name][..., i, :], "axis" if name != "p" else "vec")
+        for name in ("h", "k", "p")
+        for i in range(4)
+    }
     spec.update({"d1": (d1, "scalar"), "d2": (d2, "scalar")})
     vals, batched = _inputs(spec)
-    H, K, P = (np.ascontiguousarray(np.stack(vals[4 * j:4 * j + 4], 1)) for j in range(3))    # (N, 4, 3)
+    H, K, P = (
+        np.ascontiguousarray(np.stack(vals[4 * j : 4 * j + 4], 1)) for j in range(3)
+    )  # (N, 4, 3)
     d1, d2 = vals[12], vals[13]
     n = len(d1)
     theta, count, sing = np.empty((n, 4, 2)), np.empty(n, np.int64), np.empty(n, bool)
@@ -994,6 +1128,27 @@ def sp6(h, k, p, d1, d2, tol: float = TOL_QUARTIC) -> Solutions:
     return _finish(theta, valid, valid.copy(), sing, batched)
 
 
-__all__ = ["Solutions", "rot", "sp1", "sp2", "sp3", "sp4", "sp5", "sp6", "sp1_one", "sp2_one", "sp3_one",
-           "sp4_one", "sp5_one", "sp6_one", "unit_cs", "sp1_cs", "sp2_cs", "sp3_cs", "sp4_cs", "real_roots", "TOL",
-           "TOL_QUARTIC"]
+__all__ = [
+    "Solutions",
+    "rot",
+    "sp1",
+    "sp2",
+    "sp3",
+    "sp4",
+    "sp5",
+    "sp6",
+    "sp1_one",
+    "sp2_one",
+    "sp3_one",
+    "sp4_one",
+    "sp5_one",
+    "sp6_one",
+    "unit_cs",
+    "sp1_cs",
+    "sp2_cs",
+    "sp3_cs",
+    "sp4_cs",
+    "real_roots",
+    "TOL",
+    "TOL_QUARTIC",
+]

@@ -40,9 +40,11 @@ def rows7(A):
 @kernel
 def mat(a):
     """The row tuples of a 3×3 array."""
-    return ((float(a[0, 0]), float(a[0, 1]), float(a[0, 2])),
-            (float(a[1, 0]), float(a[1, 1]), float(a[1, 2])),
-            (float(a[2, 0]), float(a[2, 1]), float(a[2, 2])))
+    return (
+        (float(a[0, 0]), float(a[0, 1]), float(a[0, 2])),
+        (float(a[1, 0]), float(a[1, 1]), float(a[1, 2])),
+        (float(a[2, 0]), float(a[2, 1]), float(a[2, 2])),
+    )
 
 
 @kernel
@@ -85,11 +87,11 @@ def perpendicular(k):
     """A unit vector ⟂ k (k a unit axis): k × e_i for the axis e_i least aligned with k."""
     ax, ay, az = abs(k[0]), abs(k[1]), abs(k[2])
     if ax <= ay and ax <= az:
-        v = (0.0, k[2], -k[1])                        # k × e_x
+        v = (0.0, k[2], -k[1])  # k × e_x
     elif ay <= az:
-        v = (-k[2], 0.0, k[0])                        # k × e_y
+        v = (-k[2], 0.0, k[0])  # k × e_y
     else:
-        v = (k[1], -k[0], 0.0)                        # k × e_z
+        v = (k[1], -k[0], 0.0)  # k × e_z
     return scale(v, 1.0 / norm(v))
 
 
@@ -98,8 +100,11 @@ def rotate_cs(k, c, s, p):
     """rot(k, θ) p from c = cos θ, s = sin θ (Rodrigues; k a unit axis)."""
     kxp = cross(k, p)
     w = dot(k, p) * (1.0 - c)
-    return (p[0] * c + kxp[0] * s + k[0] * w, p[1] * c + kxp[1] * s + k[1] * w,
-            p[2] * c + kxp[2] * s + k[2] * w)
+    return (
+        p[0] * c + kxp[0] * s + k[0] * w,
+        p[1] * c + kxp[1] * s + k[1] * w,
+        p[2] * c + kxp[2] * s + k[2] * w,
+    )
 
 
 @kernel
@@ -120,9 +125,11 @@ def rot_cs(k, c, s):
     """The matrix rot(k, θ) = I + s [k]× + (1 − c) [k]×² from c = cos θ, s = sin θ."""
     v = 1.0 - c
     x, y, z = k
-    return ((c + x * x * v, x * y * v - z * s, x * z * v + y * s),
-            (x * y * v + z * s, c + y * y * v, y * z * v - x * s),
-            (x * z * v - y * s, y * z * v + x * s, c + z * z * v))
+    return (
+        (c + x * x * v, x * y * v - z * s, x * z * v + y * s),
+        (x * y * v + z * s, c + y * y * v, y * z * v - x * s),
+        (x * z * v - y * s, y * z * v + x * s, c + z * z * v),
+    )
 
 
 @kernel
@@ -139,9 +146,11 @@ def mv(R, v):
 @kernel
 def mtv(R, v):
     """Rᵀ v."""
-    return (R[0][0] * v[0] + R[1][0] * v[1] + R[2][0] * v[2],
-            R[0][1] * v[0] + R[1][1] * v[1] + R[2][1] * v[2],
-            R[0][2] * v[0] + R[1][2] * v[1] + R[2][2] * v[2])
+    return (
+        R[0][0] * v[0] + R[1][0] * v[1] + R[2][0] * v[2],
+        R[0][1] * v[0] + R[1][1] * v[1] + R[2][1] * v[2],
+        R[0][2] * v[0] + R[1][2] * v[1] + R[2][2] * v[2],
+    )
 
 
 @kernel
@@ -153,9 +162,11 @@ def transpose(R):
 def mm(A, B):
     """A B."""
     Bt = transpose(B)
-    return ((dot(A[0], Bt[0]), dot(A[0], Bt[1]), dot(A[0], Bt[2])),
-            (dot(A[1], Bt[0]), dot(A[1], Bt[1]), dot(A[1], Bt[2])),
-            (dot(A[2], Bt[0]), dot(A[2], Bt[1]), dot(A[2], Bt[2])))
+    return (
+        (dot(A[0], Bt[0]), dot(A[0], Bt[1]), dot(A[0], Bt[2])),
+        (dot(A[1], Bt[0]), dot(A[1], Bt[1]), dot(A[1], Bt[2])),
+        (dot(A[2], Bt[0]), dot(A[2], Bt[1]), dot(A[2], Bt[2])),
+    )
 
 
 @kernel
@@ -172,16 +183,26 @@ def wrap(x):
         return x
     if not abs(x) < WRAP_MAX:
         return math.nan
-    y = x - 2.0 * math.pi * math.floor((x + math.pi) / (2.0 * math.pi))      # in [−π, π)
+    y = x - 2.0 * math.pi * math.floor((x + math.pi) / (2.0 * math.pi))  # in [−π, π)
     return math.pi if y <= -math.pi else y
 
 
 # Cephes atan (S. L. Moshier, *Methods and Programs for Mathematical Functions*, 1989; the
 # Cephes Math Library, atan.c): atan(u) = u + u z P(z) / Q(z), z = u², |u| ≤ 0.66
-_ATAN_P = (-8.750608600031904122785e-01, -1.615753718733365076637e+01, -7.500855792314704667340e+01,
-           -1.228866684490136173410e+02, -6.485021904942025371773e+01)
-_ATAN_Q = (2.485846490142306297962e+01, 1.650270098316988542046e+02, 4.328810604912902668951e+02,
-           4.853903996359136964868e+02, 1.945506571482613964425e+02)
+_ATAN_P = (
+    -8.750608600031904122785e-01,
+    -1.615753718733365076637e01,
+    -7.500855792314704667340e01,
+    -1.228866684490136173410e02,
+    -6.485021904942025371773e01,
+)
+_ATAN_Q = (
+    2.485846490142306297962e01,
+    1.650270098316988542046e02,
+    4.328810604912902668951e02,
+    4.853903996359136964868e02,
+    1.945506571482613964425e02,
+)
 #: π/4 as the nearest double and the rest: k π/4 = k HI + k LO (k = 0…4; k HI rounds to the
 #: double nearest 3π/4 at k = 3)
 _QUARTER_PI_HI = 0.7853981633974483
@@ -202,7 +223,7 @@ def atan2(y, x):
     swap = ay > ax
     num, den = (ax, ay) if swap else (ay, ax)
     ratio = num / den
-    t = ratio if den != 0.0 else num * 0.0          # 0 at (0, 0); NaN stays NaN
+    t = ratio if den != 0.0 else num * 0.0  # 0 at (0, 0); NaN stays NaN
     t = 1.0 if ax == ay == math.inf else t
     big = t > 0.66
     reduced = (t - 1.0) / (t + 1.0)
@@ -225,5 +246,28 @@ def as_array(t) -> np.ndarray:
     return np.array(t, dtype=float)
 
 
-__all__ = ["add", "angle_cs", "as_array", "atan2", "cross", "dot", "mat", "mm", "mtm", "mtv", "mv", "neg", "norm", "perpendicular", "rot",
-           "rot_cs", "rotate", "rotate_cs", "scale", "sub", "transpose", "vec", "wrap"]
+__all__ = [
+    "add",
+    "angle_cs",
+    "as_array",
+    "atan2",
+    "cross",
+    "dot",
+    "mat",
+    "mm",
+    "mtm",
+    "mtv",
+    "mv",
+    "neg",
+    "norm",
+    "perpendicular",
+    "rot",
+    "rot_cs",
+    "rotate",
+    "rotate_cs",
+    "scale",
+    "sub",
+    "transpose",
+    "vec",
+    "wrap",
+]

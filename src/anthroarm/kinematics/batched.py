@@ -38,6 +38,7 @@ def _clean(M: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------- structure-of-arrays algebra
 # A "scalar" is a Python float (constant) or a length-N array.
 
+
 def _axpy(acc, coef, x):
     """acc + coef * x, skipping zeros and unit coefficients."""
     if coef == 0.0:
@@ -80,10 +81,15 @@ def _rotate_general(R, a, c, s):
     """R @ exp([a]× q) for a unit axis a (Rodrigues), batch c, s."""
     x, y, z = a
     C = 1.0 - c
-    E = [[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-         [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-         [z * x * C - y * s, z * y * C + x * s, c + z * z * C]]
-    return [[R[i][0] * E[0][j] + R[i][1] * E[1][j] + R[i][2] * E[2][j] for j in range(3)] for i in range(3)]
+    E = [
+        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
+    ]
+    return [
+        [R[i][0] * E[0][j] + R[i][1] * E[1][j] + R[i][2] * E[2][j] for j in range(3)]
+        for i in range(3)
+    ]
 
 
 def _position(qT, coord):
@@ -104,8 +110,21 @@ class SerialChain:
     ``continuous``).  ``v_index[j]`` is the column of J that joint j's rate adds to, with the
     factor ``v_scale[j]`` (the mimic multiplier, else 1)."""
 
-    def __init__(self, R0s, p0s, axes, kinds, tool_R, tool_p, q_index=None, v_index=None, nq=None, nv=None,
-                 coords=None, v_scale=None):
+    def __init__(
+        self,
+        R0s,
+        p0s,
+        axes,
+        kinds,
+        tool_R,
+        tool_p,
+        q_index=None,
+        v_index=None,
+        nq=None,
+        nv=None,
+        coords=None,
+        v_scale=None,
+    ):
         self.R0 = [_clean(R) for R in R0s]
         self.p0 = [np.array(p, float) for p in p0s]
         self.axes = [np.array(a, float) / np.linalg.norm(a) for a in axes]
@@ -141,15 +160,29 @@ class SerialChain:
             kinds.append("P" if j.kind == PRISMATIC else "R")
             if j.is_mimic:
                 src = chain.joints[j.mimic.source]
-                coords.append(("mimic", src.idx_q, j.mimic.multiplier, j.mimic.offset, src.kind == CONTINUOUS))
+                coords.append(
+                    ("mimic", src.idx_q, j.mimic.multiplier, j.mimic.offset, src.kind == CONTINUOUS)
+                )
                 vi.append(src.idx_v)
                 vs.append(j.mimic.multiplier)
             else:
                 coords.append(("cs", j.idx_q) if j.kind == CONTINUOUS else ("q", j.idx_q))
                 vi.append(j.idx_v)
                 vs.append(1.0)
-        return cls(R0s, p0s, axes, kinds, f.rotation, f.translation, [c[1] for c in coords], vi,
-                   chain.nq, chain.nv, coords, vs)
+        return cls(
+            R0s,
+            p0s,
+            axes,
+            kinds,
+            f.rotation,
+            f.translation,
+            [c[1] for c in coords],
+            vi,
+            chain.nq,
+            chain.nv,
+            coords,
+            vs,
+        )
 
     @classmethod
     def of(cls, robot, frame=None) -> "SerialChain":
@@ -164,16 +197,27 @@ class SerialChain:
 
         S = [np.eye(4)] + [dh_static(r) for r in rows]
         T_tool = S[-1] @ (np.eye(4) if tool is None else np.asarray(tool, float))
-        return cls([s[:3, :3] for s in S[:-1]], [s[:3, 3] for s in S[:-1]], [(0, 0, 1.0)] * len(rows),
-                   ["R" if r.kind == "R" else "P" for r in rows], T_tool[:3, :3], T_tool[:3, 3])
+        return cls(
+            [s[:3, :3] for s in S[:-1]],
+            [s[:3, 3] for s in S[:-1]],
+            [(0, 0, 1.0)] * len(rows),
+            ["R" if r.kind == "R" else "P" for r in rows],
+            T_tool[:3, :3],
+            T_tool[:3, 3],
+        )
 
     @classmethod
     def from_spec(cls, spec) -> "SerialChain":
         """Chain of a catalog :class:`~anthroarm.models.spec.ChainSpec` (joint origins and axes
         as tabulated; for the §6-3 arm this is Eq. (6-31)–(6-33))."""
-        return cls([j.origin[:3, :3] for j in spec.joints], [j.origin[:3, 3] for j in spec.joints],
-                   [j.axis for j in spec.joints], ["R" if j.type == "revolute" else "P" for j in spec.joints],
-                   spec.tool_origin[:3, :3], spec.tool_origin[:3, 3])
+        return cls(
+            [j.origin[:3, :3] for j in spec.joints],
+            [j.origin[:3, 3] for j in spec.joints],
+            [j.axis for j in spec.joints],
+            ["R" if j.type == "revolute" else "P" for j in spec.joints],
+            spec.tool_origin[:3, :3],
+            spec.tool_origin[:3, 3],
+        )
 
     # ------------------------------------------------------------ evaluation
     def _batch(self, q):
@@ -191,7 +235,9 @@ class SerialChain:
         R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
         p = [0.0, 0.0, 0.0]
         joints = []
-        for R0, p0, a, kind, coord, ax in zip(self.R0, self.p0, self.axes, self.kinds, self.coords, self._axis_index):
+        for R0, p0, a, kind, coord, ax in zip(
+            self.R0, self.p0, self.axes, self.kinds, self.coords, self._axis_index
+        ):
             dp = _vec_const(R, p0)
             p = [_axpy(p[i], 1.0, dp[i]) for i in range(3)]
             R = _mat_const(R, R0)
@@ -246,13 +292,19 @@ class SerialChain:
         for (kind, w, pj), col, k in zip(joints, self.v_index, self.v_scale):
             if kind == "R":
                 d = [p[i] - pj[i] for i in range(3)]
-                cols = (w[1] * d[2] - w[2] * d[1], w[2] * d[0] - w[0] * d[2], w[0] * d[1] - w[1] * d[0],
-                        w[0], w[1], w[2])
+                cols = (
+                    w[1] * d[2] - w[2] * d[1],
+                    w[2] * d[0] - w[0] * d[2],
+                    w[0] * d[1] - w[1] * d[0],
+                    w[0],
+                    w[1],
+                    w[2],
+                )
             else:
                 cols = (w[0], w[1], w[2], 0.0, 0.0, 0.0)
             for i, x in enumerate(cols):
                 if k == 1.0:
-                    J[:, i, col] += x     # += : a mimic joint adds to its source's column
+                    J[:, i, col] += x  # += : a mimic joint adds to its source's column
                 elif not (isinstance(x, float) and x == 0.0):
                     J[:, i, col] += k * x
         T = self._pose(R, p, N)

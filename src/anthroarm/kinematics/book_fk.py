@@ -110,14 +110,34 @@ def human_arm7_rotations(q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     CE[:, 1] = np.stack([s1 * s2, c1, -s1 * c2], -1)
     CE[:, 2] = np.stack([-c1 * s2, s1, c1 * c2], -1)
     W1 = np.stack([c2 * c3, s1 * s2 * c3 + c1 * s3, -c1 * s2 * c3 + s1 * s3], -1)
-    W2 = np.stack([-c2 * s3 * c4 + s2 * s4, -s1 * s2 * s3 * c4 + c1 * c3 * c4 - s1 * c2 * s4,
-                   c1 * s2 * s3 * c4 + s1 * c3 * c4 + c1 * c2 * s4], -1)
-    W3 = np.stack([c2 * s3 * s4 + s2 * c4, s1 * s2 * s3 * s4 - c1 * c3 * s4 - s1 * c2 * c4,
-                   -c1 * s2 * s3 * s4 - s1 * c3 * s4 + c1 * c2 * c4], -1)
+    W2 = np.stack(
+        [
+            -c2 * s3 * c4 + s2 * s4,
+            -s1 * s2 * s3 * c4 + c1 * c3 * c4 - s1 * c2 * s4,
+            c1 * s2 * s3 * c4 + s1 * c3 * c4 + c1 * c2 * s4,
+        ],
+        -1,
+    )
+    W3 = np.stack(
+        [
+            c2 * s3 * s4 + s2 * c4,
+            s1 * s2 * s3 * s4 - c1 * c3 * s4 - s1 * c2 * c4,
+            -c1 * s2 * s3 * s4 - s1 * c3 * s4 + c1 * c2 * c4,
+        ],
+        -1,
+    )
     CW = np.stack([W1, W2, W3], axis=-1)
     H1 = W1 * (c5 * c6)[:, None] + W2 * (s5 * c6)[:, None] - W3 * s6[:, None]
-    H2 = W1 * (c5 * s6 * s7 - s5 * c7)[:, None] + W2 * (s5 * s6 * s7 + c5 * c7)[:, None] + W3 * (c6 * s7)[:, None]
-    H3 = W1 * (c5 * s6 * c7 + s5 * s7)[:, None] + W2 * (s5 * s6 * c7 - c5 * s7)[:, None] + W3 * (c6 * c7)[:, None]
+    H2 = (
+        W1 * (c5 * s6 * s7 - s5 * c7)[:, None]
+        + W2 * (s5 * s6 * s7 + c5 * c7)[:, None]
+        + W3 * (c6 * s7)[:, None]
+    )
+    H3 = (
+        W1 * (c5 * s6 * c7 + s5 * s7)[:, None]
+        + W2 * (s5 * s6 * c7 - c5 * s7)[:, None]
+        + W3 * (c6 * c7)[:, None]
+    )
     CH = np.stack([H1, H2, H3], axis=-1)
     if single:
         return CE[0], CW[0], CH[0]
@@ -233,13 +253,28 @@ def _human_arm7_length_jacobian(q, p):
 
 #: book model name -> its printed forms (functions are looked up when called)
 PRINTED: dict[str, tuple[PrintedForm, ...]] = {
-    "sixr_arm": (PrintedForm("(6-16)/(6-17)", lambda q, p: sixr_hand_pose(q, p["s0"], p["h2"], p["s3"], p["P"])),),
-    "unimate5": (PrintedForm("(6-21)-(6-23)", lambda q, p: unimate_hand_pose(q, p["s0"], p["h2"], p["P"])),),
-    "rrprr5": (PrintedForm("002 (4-52)-(4-54)", lambda q, p: rrprr_hand_pose(q, p["s0"], p["h2"], p["p"])),),
-    "human_arm7": (PrintedForm("(6-34)-(6-39)", lambda q, p: human_arm7_hand_pose(q, p["l1"], p["l2"], p["l3"]),
-                               lambda q, p: human_arm7_jacobian(q, p["l1"], p["l2"], p["l3"]),
-                               _human_arm7_length_jacobian),),
-    "planar2r": (PrintedForm("Fig. 7-14 (y, z)", lambda q, p: planar2r_tip_pose(q, p["l1"], p["l2"])),),
+    "sixr_arm": (
+        PrintedForm(
+            "(6-16)/(6-17)", lambda q, p: sixr_hand_pose(q, p["s0"], p["h2"], p["s3"], p["P"])
+        ),
+    ),
+    "unimate5": (
+        PrintedForm("(6-21)-(6-23)", lambda q, p: unimate_hand_pose(q, p["s0"], p["h2"], p["P"])),
+    ),
+    "rrprr5": (
+        PrintedForm("002 (4-52)-(4-54)", lambda q, p: rrprr_hand_pose(q, p["s0"], p["h2"], p["p"])),
+    ),
+    "human_arm7": (
+        PrintedForm(
+            "(6-34)-(6-39)",
+            lambda q, p: human_arm7_hand_pose(q, p["l1"], p["l2"], p["l3"]),
+            lambda q, p: human_arm7_jacobian(q, p["l1"], p["l2"], p["l3"]),
+            _human_arm7_length_jacobian,
+        ),
+    ),
+    "planar2r": (
+        PrintedForm("Fig. 7-14 (y, z)", lambda q, p: planar2r_tip_pose(q, p["l1"], p["l2"])),
+    ),
 }
 
 

@@ -40,7 +40,12 @@ def _pose_err(Ta, Tb, scale) -> float:
 
 
 def _jac_err(Ja, Jb, scale) -> float:
-    return float(max(np.abs(Ja[..., :3, :] - Jb[..., :3, :]).max() / scale, np.abs(Ja[..., 3:, :] - Jb[..., 3:, :]).max()))
+    return float(
+        max(
+            np.abs(Ja[..., :3, :] - Jb[..., :3, :]).max() / scale,
+            np.abs(Ja[..., 3:, :] - Jb[..., 3:, :]).max(),
+        )
+    )
 
 
 def _pinocchio(robot, Q):
@@ -63,7 +68,13 @@ def _book_forms(robot):
     out = []
     if spec.dh is not None:
         dh, tool = spec.dh, spec.tool_dh
-        out.append(("fk H-D chain (6-12)-(6-14)", lambda q: dh_fk(dh, q, tool), lambda q: dh_jacobian(dh, q, tool)))
+        out.append(
+            (
+                "fk H-D chain (6-12)-(6-14)",
+                lambda q: dh_fk(dh, q, tool),
+                lambda q: dh_jacobian(dh, q, tool),
+            )
+        )
     p = spec.params
     for f in printed_forms(robot):
         jac = (lambda q, f=f: f.jacobian(q, p)) if f.jacobian is not None else None
@@ -73,10 +84,12 @@ def _book_forms(robot):
 
 def _yourdfpy_row(robot, Q, scale) -> CheckRow:
     if robot.info is None:
-        return CheckRow.unsupported(robot.name, "fk yourdfpy (all links)", "loaded from a pin.Model: no URDF")
+        return CheckRow.unsupported(
+            robot.name, "fk yourdfpy (all links)", "loaded from a pin.Model: no URDF"
+        )
     u = robot.urdf
     model, data = robot.model, robot.model.createData()
-    links = {}   # link name -> its body frame (a joint frame may share the name: z1)
+    links = {}  # link name -> its body frame (a joint frame may share the name: z1)
     for fid, f in enumerate(model.frames):
         if f.type == pin.FrameType.BODY and f.name in u.link_map:
             links.setdefault(f.name, fid)
@@ -86,7 +99,9 @@ def _yourdfpy_row(robot, Q, scale) -> CheckRow:
         u.update_cfg(robot.yourdfpy_cfg(q))
         pin.framesForwardKinematics(model, data, q)
         for n, fid in links.items():
-            err = max(err, _pose_err(u.get_transform(n, u.base_link), data.oMf[fid].homogeneous, scale))
+            err = max(
+                err, _pose_err(u.get_transform(n, u.base_link), data.oMf[fid].homogeneous, scale)
+            )
     note = f"{len(names)} links" + ("; mimic joints modelled by both" if robot.has_mimic else "")
     return CheckRow(robot.name, "fk yourdfpy (all links)", err, TOL, len(Q), "pinocchio", note)
 
@@ -100,10 +115,29 @@ def rows(robot, samples, rng) -> list[CheckRow]:
     for quantity, fk, jac in _book_forms(robot):
         out.append(CheckRow(name, quantity, _pose_err(fk(Q), T_pin, scale), TOL, samples))
         if jac is not None:
-            out.append(CheckRow(name, quantity.replace("fk", "jacobian", 1) + " LWA", _jac_err(jac(Q), J_pin, scale),
-                                TOL, samples))
-    out.append(CheckRow(name, "fk batched chain robot.fk(Q)", _pose_err(robot.fk(Q), T_pin, scale), TOL, samples))
-    out.append(CheckRow(name, "jacobian batched chain LWA", _jac_err(robot.jacobian(Q), J_pin, scale), TOL, samples))
+            out.append(
+                CheckRow(
+                    name,
+                    quantity.replace("fk", "jacobian", 1) + " LWA",
+                    _jac_err(jac(Q), J_pin, scale),
+                    TOL,
+                    samples,
+                )
+            )
+    out.append(
+        CheckRow(
+            name, "fk batched chain robot.fk(Q)", _pose_err(robot.fk(Q), T_pin, scale), TOL, samples
+        )
+    )
+    out.append(
+        CheckRow(
+            name,
+            "jacobian batched chain LWA",
+            _jac_err(robot.jacobian(Q), J_pin, scale),
+            TOL,
+            samples,
+        )
+    )
     out.append(_yourdfpy_row(robot, Q, scale))
     return out
 
@@ -113,8 +147,13 @@ def error_rows(robot, samples, rng) -> list[CheckRow]:
     n = max(1, min(int(samples), 5))
     name, scale = robot.name, robot.length_scale
     Q = robot.random_q(n, rng)
-    e_jl = max(np.abs(ep.length_jacobian(robot, q, mode="components")
-                      - ep.length_jacobian_fd(robot, q, mode="components")).max() for q in Q)
+    e_jl = max(
+        np.abs(
+            ep.length_jacobian(robot, q, mode="components")
+            - ep.length_jacobian_fd(robot, q, mode="components")
+        ).max()
+        for q in Q
+    )
     out = [CheckRow(name, "J_L (6-118) vs FD of perturbed placements", float(e_jl), 1e-10, n)]
     chain = ep.PerturbedChain(robot, mode="components")
     dL = 0.01 * scale * rng.standard_normal((n, len(chain.params)))
@@ -128,10 +167,15 @@ def error_rows(robot, samples, rng) -> list[CheckRow]:
         pin.framesForwardKinematics(m, d_, q)
         M = d_.oMf[robot.tool_id]
         err = max(err, np.abs(x[i] - M.translation).max() / scale, np.abs(R[i] - M.rotation).max())
-    out.append(CheckRow(name, "perturbed FK T(q, L+dL) vs pin on the perturbed model", float(err), TOL, n))
+    out.append(
+        CheckRow(name, "perturbed FK T(q, L+dL) vs pin on the perturbed model", float(err), TOL, n)
+    )
     for f in printed_forms(robot):
         p = book_spec(robot).params
         if f.length_jacobian is not None:
-            e = max(np.abs(f.length_jacobian(q, p) - ep.length_jacobian_fd(robot, q)[:3]).max() for q in Q)
+            e = max(
+                np.abs(f.length_jacobian(q, p) - ep.length_jacobian_fd(robot, q)[:3]).max()
+                for q in Q
+            )
             out.append(CheckRow(name, "(6-119) vs FD of perturbed placements", float(e), 1e-10, n))
     return out

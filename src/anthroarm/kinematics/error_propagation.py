@@ -53,7 +53,9 @@ class LinkParameter:
     nominal: float
 
 
-def link_parameters(robot, frame=None, mode: str = "length", tol: float = 1e-12) -> list[LinkParameter]:
+def link_parameters(
+    robot, frame=None, mode: str = "length", tol: float = 1e-12
+) -> list[LinkParameter]:
     """The link dimensions that move ``frame`` (default: the tool), in base-to-tip order, read
     from ``robot.chain``: the placement of every joint on the path (mimic joints included) and
     the frame's placement in its joint.
@@ -66,7 +68,10 @@ def link_parameters(robot, frame=None, mode: str = "length", tol: float = 1e-12)
         raise ValueError(f"mode must be 'length' or 'components', got {mode!r}")
     chain = robot.chain
     f = chain.frame(robot.frame_id(frame))
-    items = [("joint", i + 1, chain.joints[i].name, chain.joints[i].translation) for i in chain.path(f.index)]
+    items = [
+        ("joint", i + 1, chain.joints[i].name, chain.joints[i].translation)
+        for i in chain.path(f.index)
+    ]
     items.append(("frame", f.index, f.name, f.translation))
     out = []
     for kind, idx, name, t in items:
@@ -87,7 +92,11 @@ def _params(robot, frame, params, mode):
 
 def _parent_joint(chain, p: LinkParameter) -> int:
     """Pinocchio id of the joint whose frame ``p`` is expressed in (0: the base)."""
-    return chain.joints[p.index - 1].parent + 1 if p.kind == "joint" else chain.frames[p.index].joint + 1
+    return (
+        chain.joints[p.index - 1].parent + 1
+        if p.kind == "joint"
+        else chain.frames[p.index].joint + 1
+    )
 
 
 # ----------------------------------------------------------------------------- Jacobians
@@ -121,7 +130,9 @@ def _perturbed_model(model: pin.Model, p: LinkParameter, delta: float) -> pin.Mo
     return m
 
 
-def length_jacobian_fd(robot, q, frame=None, params=None, mode: str = "length", h: float = 1e-3) -> np.ndarray:
+def length_jacobian_fd(
+    robot, q, frame=None, params=None, mode: str = "length", h: float = 1e-3
+) -> np.ndarray:
     """J_L by central finite differences over Pinocchio models whose joint / frame placements
     are perturbed by ±h (m) along each parameter (the oracle for :func:`length_jacobian`).
     The pose is affine in each placement translation, so the differences are exact up to
@@ -177,7 +188,9 @@ def _vec(x, n: int, name: str) -> np.ndarray:
     return a
 
 
-def propagate(robot, q, dq=None, dL=None, frame=None, params=None, mode: str = "length") -> ErrorPropagation:
+def propagate(
+    robot, q, dq=None, dL=None, frame=None, params=None, mode: str = "length"
+) -> ErrorPropagation:
     """First-order pose error of ``frame`` at ``q``, Eq. (6-118): Δx = J_q Δq + J_L ΔL."""
     q = robot.check_q(q)
     ps = _params(robot, frame, params, mode)
@@ -215,7 +228,9 @@ class PerturbedChain:
         if dL.shape != (N, len(self.params)):
             raise ValueError(f"dL must have shape ({N}, {len(self.params)}), got {dL.shape}")
         if not np.all(np.isfinite(dL)):
-            raise ValueError(f"dL has a NaN or infinite value: {dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}")
+            raise ValueError(
+                f"dL has a NaN or infinite value: {dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}"
+            )
         chain = self.robot.chain
         theta = chain.angles(q)
         if dq is not None:
@@ -227,7 +242,7 @@ class PerturbedChain:
         dt = {}
         for k, p in enumerate(self.params):
             key = (p.kind, p.index)
-            dt[key] = dt.get(key, 0.0) + dL[:, k:k + 1] * p.direction
+            dt[key] = dt.get(key, 0.0) + dL[:, k : k + 1] * p.direction
         R = np.broadcast_to(np.eye(3), (N, 3, 3)).copy()
         x = np.zeros((N, 3))
         for j in self.joints:
@@ -248,7 +263,9 @@ def _log3_batch(R: np.ndarray) -> np.ndarray:
     """Rotation vectors of a batch of rotations (angles < π)."""
     c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
     th = np.arccos(c)
-    w = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], -1)
+    w = 0.5 * np.stack(
+        [R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], -1
+    )
     s = np.sin(th)
     k = np.where(s > 1e-12, th / np.where(s > 1e-12, s, 1.0), 1.0)
     return w * k[:, None]
@@ -281,9 +298,20 @@ def _draw(rng, dist: str, scale: np.ndarray, n: int) -> np.ndarray:
     raise ValueError(f"distribution must be 'normal' or 'uniform', got {dist!r}")
 
 
-def monte_carlo(robot, q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, rng=None, frame=None, params=None,
-                mode: str = "length", distribution: str = "normal", batch: int = 2000,
-                progress: bool = True) -> MonteCarloResult:
+def monte_carlo(
+    robot,
+    q,
+    sigma_q=0.0,
+    sigma_L=0.0,
+    n: int = 10000,
+    rng=None,
+    frame=None,
+    params=None,
+    mode: str = "length",
+    distribution: str = "normal",
+    batch: int = 2000,
+    progress: bool = True,
+) -> MonteCarloResult:
     """Sample joint errors Δq and link errors ΔL, evaluate the exact perturbed FK in batches
     (:class:`PerturbedChain`, with a tqdm progress bar), and compare the spread with the
     first-order prediction J Σ Jᵀ of Eq. (6-118).
@@ -300,7 +328,9 @@ def monte_carlo(robot, q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, rng=None, fr
     sq = _vec(sigma_q, robot.nv, "sigma_q")
     sL = _vec(sigma_L, len(ps), "sigma_L")
     if np.any(sq < 0) or np.any(sL < 0):
-        raise ValueError(f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}")
+        raise ValueError(
+            f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}"
+        )
     rng = np.random.default_rng(rng)
     R0, x0 = chain.pose(q[None])
     out = np.empty((n, 6))
@@ -308,20 +338,27 @@ def monte_carlo(robot, q, sigma_q=0.0, sigma_L=0.0, n: int = 10000, rng=None, fr
     if progress:
         from tqdm.auto import tqdm
 
-        starts = tqdm(starts, total=(n + batch - 1) // batch, desc="monte carlo", unit="batch", leave=False)
+        starts = tqdm(
+            starts, total=(n + batch - 1) // batch, desc="monte carlo", unit="batch", leave=False
+        )
     for a in starts:
         m = min(batch, n - a)
         dq = _draw(rng, distribution, sq, m)
         dL = _draw(rng, distribution, sL, m)
         R, x = chain.pose(np.broadcast_to(q, (m, q.size)), dL, dq)
-        out[a:a + m, :3] = x - x0
-        out[a:a + m, 3:] = _log3_batch(R @ R0[0].T)
+        out[a : a + m, :3] = x - x0
+        out[a : a + m, 3:] = _log3_batch(R @ R0[0].T)
     var_factor = 1.0 if distribution == "normal" else 1.0 / 3.0
     J = np.hstack([robot.jacobian(q, frame), length_jacobian(robot, q, frame, ps)])
     Sigma = np.diag(np.concatenate([sq, sL]) ** 2 * var_factor)
     dp = np.linalg.norm(out[:, :3], axis=1)
     return MonteCarloResult(
-        dx=out, mean=out.mean(0), cov=np.cov(out.T) if n > 1 else np.zeros((6, 6)), linear_cov=J @ Sigma @ J.T,
-        rms_position=float(np.sqrt(np.mean(dp**2))), p95_position=float(np.percentile(dp, 95)),
-        max_position=float(dp.max()), params=ps,
+        dx=out,
+        mean=out.mean(0),
+        cov=np.cov(out.T) if n > 1 else np.zeros((6, 6)),
+        linear_cov=J @ Sigma @ J.T,
+        rms_position=float(np.sqrt(np.mean(dp**2))),
+        p95_position=float(np.percentile(dp, 95)),
+        max_position=float(dp.max()),
+        params=ps,
     )

@@ -95,7 +95,9 @@ def _q(loop: VectorLoop, q) -> np.ndarray:
     try:
         q = np.asarray(q, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}") from None
+        raise ParameterError(
+            f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}"
+        ) from None
     if q.shape != (loop.nq,) or not np.isfinite(q).all():
         raise ParameterError(f"{loop.name}: q must be {loop.nq} finite joint values, got {q!r}")
     return q
@@ -162,15 +164,19 @@ def loop_spec(loop: VectorLoop, limits=None):
     sits at the sum of the constant vectors since joint n−1, rpy = 0, axis w (or u for a
     slide); the tool frame ``grip`` at G with the ground axes (so a = R_tool a₀).  ``limits``:
     optional (lower, upper) per joint (default ±π, slides 0–1 m)."""
-    from ..spatial.rotations import homogeneous
     from ..models.spec import ChainSpec, JointSpec, rod_link
+    from ..spatial.rotations import homogeneous
 
     if loop.nq == 0:
-        raise ParameterError(f"{loop.name}: the loop has no joint ('R' or 'L' item): nothing to build")
+        raise ParameterError(
+            f"{loop.name}: the loop has no joint ('R' or 'L' item): nothing to build"
+        )
     joints, acc, n = [], np.zeros(3), 0
     lim = list(limits) if limits is not None else None
     if lim is not None and len(lim) != loop.nq:
-        raise ParameterError(f"{loop.name}: limits needs one (lower, upper) per joint ({loop.nq}), got {len(lim)}")
+        raise ParameterError(
+            f"{loop.name}: limits needs one (lower, upper) per joint ({loop.nq}), got {len(lim)}"
+        )
     for kind, v in loop.items:
         if kind == "C":
             acc = acc + v
@@ -178,13 +184,26 @@ def loop_spec(loop: VectorLoop, limits=None):
         lo, hi = lim[n] if lim is not None else ((-np.pi, np.pi) if kind == "R" else (0.0, 1.0))
         if joints:
             joints[-1].link = rod_link(joints[-1].link.name, acc)
-        joints.append(JointSpec(f"joint{n + 1}", "revolute" if kind == "R" else "prismatic",
-                                homogeneous(r=acc), axis=tuple(v), lower=lo, upper=hi,
-                                link=rod_link(f"link{n + 1}", np.zeros(3))))
+        joints.append(
+            JointSpec(
+                f"joint{n + 1}",
+                "revolute" if kind == "R" else "prismatic",
+                homogeneous(r=acc),
+                axis=tuple(v),
+                lower=lo,
+                upper=hi,
+                link=rod_link(f"link{n + 1}", np.zeros(3)),
+            )
+        )
         acc, n = np.zeros(3), n + 1
     tool = acc + loop.G
     joints[-1].link = rod_link(joints[-1].link.name, tool)
-    return ChainSpec(name=loop.name, description=f"{loop.name}: orthogonal manipulator in vector-loop form (book §6-4)",
-                     joints=joints, tool_name="grip", tool_origin=homogeneous(r=tool),
-                     source="book 000 l.4047-4209 (§6-4, Eqs. (6-48)-(6-65))",
-                     inertia_source="not printed: default rods (models.spec.rod_link)")
+    return ChainSpec(
+        name=loop.name,
+        description=f"{loop.name}: orthogonal manipulator in vector-loop form (book §6-4)",
+        joints=joints,
+        tool_name="grip",
+        tool_origin=homogeneous(r=tool),
+        source="book 000 l.4047-4209 (§6-4, Eqs. (6-48)-(6-65))",
+        inertia_source="not printed: default rods (models.spec.rod_link)",
+    )

@@ -41,7 +41,9 @@ def finite_scalar(name: str, x) -> float:
     ``name`` when x is not a finite real scalar (:func:`anthroarm.spatial.rotations.as_scalar`
     with the name first)."""
     if _not_a_number(x):
-        raise ParameterError(f"{name} must be a finite real number, got {type(x).__name__} {_short(x)}")
+        raise ParameterError(
+            f"{name} must be a finite real number, got {type(x).__name__} {_short(x)}"
+        )
     try:
         return as_scalar(x, name)
     except (TypeError, ValueError) as exc:
@@ -65,17 +67,27 @@ def finite_array(name: str, x, shape=None) -> np.ndarray:
     ``shape`` may contain ``None`` for "any size" in that position (checked from the end)."""
     want = "" if shape is None else f" of shape {tuple('N' if s is None else s for s in shape)}"
     if _not_a_number(x):
-        raise ParameterError(f"{name} must be a real array{want}, got {type(x).__name__} {_short(x)}")
+        raise ParameterError(
+            f"{name} must be a real array{want}, got {type(x).__name__} {_short(x)}"
+        )
     try:
         a = np.array(x, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"{name} must be a real array{want}, got {_short(x)}") from None
-    if (isinstance(x, np.ndarray) and x.dtype.kind in "USb") or (isinstance(x, (list, tuple)) and _has_strings(x)):
+    if (isinstance(x, np.ndarray) and x.dtype.kind in "USb") or (
+        isinstance(x, (list, tuple)) and _has_strings(x)
+    ):
         raise ParameterError(f"{name} must be a real array{want}, got {_short(x)}")
     if shape is not None:
-        tail = a.shape[len(a.shape) - len(shape):] if len(a.shape) >= len(shape) else None
-        if tail is None or len(a.shape) != len(shape) or any(s is not None and s != t for s, t in zip(shape, tail)):
-            raise ParameterError(f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}")
+        tail = a.shape[len(a.shape) - len(shape) :] if len(a.shape) >= len(shape) else None
+        if (
+            tail is None
+            or len(a.shape) != len(shape)
+            or any(s is not None and s != t for s, t in zip(shape, tail))
+        ):
+            raise ParameterError(
+                f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}"
+            )
     if not np.all(np.isfinite(a)):
         raise ParameterError(f"{name} must be finite, got {_short(x)}")
     return a
@@ -109,7 +121,9 @@ def unit_axis(name: str, u) -> np.ndarray:
     except ValueError as exc:
         if isinstance(exc, ParameterError):
             raise
-        raise ParameterError(f"{exc} ({name} must be a unit 3-vector, |{name}| = 1 within {UNIT_TOL:g})") from None
+        raise ParameterError(
+            f"{exc} ({name} must be a unit 3-vector, |{name}| = 1 within {UNIT_TOL:g})"
+        ) from None
     return a / float(np.linalg.norm(a))
 
 
@@ -131,8 +145,9 @@ def Wdot(thetadot, thetaddot, u) -> np.ndarray:
     """Angular-acceleration matrix for a fixed axis, Eq. (6-92) / 002 (4-28):
     thetaddot [P_u] + thetadot^2 [P_u]^2, so that r_ddot = Wdot @ r for r fixed in the body."""
     P = skew(u)
-    return (np.asarray(thetaddot, dtype=float)[..., None, None] * P
-            + np.asarray(thetadot, dtype=float)[..., None, None] ** 2 * (P @ P))
+    return np.asarray(thetaddot, dtype=float)[..., None, None] * P + np.asarray(
+        thetadot, dtype=float
+    )[..., None, None] ** 2 * (P @ P)
 
 
 def wrap(a):
@@ -164,12 +179,19 @@ def assembly_status(assembled, dead, x, disc, x_name: str, dead_reason: str, eq:
     names the book's equation of the assembly condition, e.g. " (4-31)"."""
     st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
     if np.ndim(x) == 0:
-        reason = {"ok": "ok", "dead_point": dead_reason,
-                  "cannot_assemble": f"cannot assemble at {x_name} = {float(x):.6g}: "
-                                     f"E^2 + F^2 - G^2 = {float(disc):.6g} < 0{eq}"}[str(st)]
+        reason = {
+            "ok": "ok",
+            "dead_point": dead_reason,
+            "cannot_assemble": f"cannot assemble at {x_name} = {float(x):.6g}: "
+            f"E^2 + F^2 - G^2 = {float(disc):.6g} < 0{eq}",
+        }[str(st)]
     else:
         na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-        reason = "ok" if na == nd == 0 else f"{na} of {np.size(x)} cannot assemble{eq}, {nd} at a branch point"
+        reason = (
+            "ok"
+            if na == nd == 0
+            else f"{na} of {np.size(x)} cannot assemble{eq}, {nd} at a branch point"
+        )
     return st, reason
 
 
@@ -215,9 +237,13 @@ def pow2_scale(*xs) -> float:
     Dividing by a power of two is exact (for normal numbers), so formulas evaluated on
     ``x / pow2_scale(...)`` and scaled back give the same bits as the unscaled ones wherever those
     do not overflow, and finite answers where the squares of the raw lengths would overflow."""
-    m = max((float(np.max(np.abs(np.asarray(x, dtype=float)), initial=0.0)) for x in xs), default=0.0)
+    m = max(
+        (float(np.max(np.abs(np.asarray(x, dtype=float)), initial=0.0)) for x in xs), default=0.0
+    )
     if not np.isfinite(m):
-        raise ParameterError(f"a length or coordinate is beyond the float range ({m}); inputs must be finite")
+        raise ParameterError(
+            f"a length or coordinate is beyond the float range ({m}); inputs must be finite"
+        )
     if m == 0.0:
         return 1.0
     return float(np.ldexp(1.0, np.frexp(m)[1] - 1))
@@ -239,7 +265,9 @@ def representable(name: str, x, why: str):
     the float range (``why`` says which inputs make it so)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ParameterError(f"{name} cannot be represented in floating point ({why}); use other units or smaller rates")
+        raise ParameterError(
+            f"{name} cannot be represented in floating point ({why}); use other units or smaller rates"
+        )
     return x
 
 

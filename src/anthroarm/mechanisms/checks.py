@@ -47,8 +47,10 @@ class _Acc:
         self.rows[k] = (max(e, err), n + 1, note)
 
     def out(self):
-        return [CheckRow(model=m, quantity=q, max_abs_err=e, tol=TOL, samples=n, oracle=o, note=note)
-                for (m, q, o), (e, n, note) in self.rows.items()]
+        return [
+            CheckRow(model=m, quantity=q, max_abs_err=e, tol=TOL, samples=n, oracle=o, note=note)
+            for (m, q, o), (e, n, note) in self.rows.items()
+        ]
 
 
 def _maxabs(x):
@@ -67,7 +69,9 @@ def _fourbar_rows(acc, n, rng):
     done = 0
     while done < n:
         r2, r3, r4 = rng.uniform(0.3, 1.0), rng.uniform(1.5, 3.0), rng.uniform(1.5, 3.0)
-        r1 = rng.uniform(max(abs(r3 - r4) + r2, 1.0) + 0.2, min(r3 + r4 - r2, 4.0))  # crank-rocker-ish
+        r1 = rng.uniform(
+            max(abs(r3 - r4) + r2, 1.0) + 0.2, min(r3 + r4 - r2, 4.0)
+        )  # crank-rocker-ish
         th2, w2, a2 = rng.uniform(-np.pi, np.pi), rng.uniform(0.5, 1.5), rng.uniform(-1, 1)
         br = int(rng.choice([1, -1]))
         s = fourbar(r1, r2, r3, r4, th2, w2, a2, br)
@@ -77,19 +81,52 @@ def _fourbar_rows(acc, n, rng):
         L = r1 + r2 + r3 + r4
         acc.add(m, "loop closure / length", s.residual / L, "math")
         c = fourbar_cartesian([r1, 0.0], r2, r3, r4, th2, w2, a2, br)
-        acc.add(m, "complex (5-12)-(5-22) vs Cartesian §5-3: angles, rates", _maxabs(
-            [wrap(c.theta3 - s.theta3), wrap(c.theta4 - s.theta4), c.omega3 - s.omega3, c.omega4 - s.omega4,
-             c.alpha3 - s.alpha3, c.alpha4 - s.alpha4]), "math")
+        acc.add(
+            m,
+            "complex (5-12)-(5-22) vs Cartesian §5-3: angles, rates",
+            _maxabs(
+                [
+                    wrap(c.theta3 - s.theta3),
+                    wrap(c.theta4 - s.theta4),
+                    c.omega3 - s.omega3,
+                    c.omega4 - s.omega4,
+                    c.alpha3 - s.alpha3,
+                    c.alpha4 - s.alpha4,
+                ]
+            ),
+            "math",
+        )
         loop = ClosedLoop(fourbar_spec(r1, r2, r3, r4))
         q0 = np.array([th2, s.theta3 - th2 + 0.05, s.theta4 - 0.05])
         st = loop.solve([th2], [w2], [a2], q0=q0)
-        acc.add(m, "pin closure residual (RigidConstraintModel)", loop.residual_pin(st.q) / L, "pinocchio")
-        acc.add(m, "theta3, theta4", _maxabs([wrap(st.q[0] + st.q[1] - s.theta3), wrap(st.q[2] - s.theta4)]), "pinocchio")
-        acc.add(m, "omega3, omega4", _rel([st.v[0] + st.v[1], st.v[2]], [s.omega3, s.omega4], w2), "pinocchio")
-        acc.add(m, "alpha3, alpha4", _rel([st.a[0] + st.a[1], st.a[2]], [s.alpha3, s.alpha4], w2**2 + abs(a2)), "pinocchio")
+        acc.add(
+            m,
+            "pin closure residual (RigidConstraintModel)",
+            loop.residual_pin(st.q) / L,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta3, theta4",
+            _maxabs([wrap(st.q[0] + st.q[1] - s.theta3), wrap(st.q[2] - s.theta4)]),
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "omega3, omega4",
+            _rel([st.v[0] + st.v[1], st.v[2]], [s.omega3, s.omega4], w2),
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "alpha3, alpha4",
+            _rel([st.a[0] + st.a[1], st.a[2]], [s.alpha3, s.alpha4], w2**2 + abs(a2)),
+            "pinocchio",
+        )
 
         def traj(t):
             return fourbar(r1, r2, r3, r4, th2 + w2 * t + 0.5 * a2 * t * t, w2 + a2 * t, a2, br)
+
         d1 = fd_derivative(lambda t: np.array([traj(t).theta3, traj(t).theta4]), angular=True)
         d2 = fd_derivative(lambda t: np.array([traj(t).omega3, traj(t).omega4]))
         acc.add(m, "omega3, omega4", _rel(d1, [s.omega3, s.omega4], w2), "finite-diff")
@@ -107,9 +144,14 @@ def _rssr_rows(acc, n, rng):
     tries = 0
     while done < n and tries < 200:
         tries += 1
-        g = RSSRGeometry(a0=rng.normal(0, 0.1, 3), ua=_rand_unit(rng), a1=rng.normal(0, 0.1, 3) + [0.5, 0, 0],
-                         b0=rng.normal(0, 0.1, 3) + [2.0, 0, 0.5], ub=_rand_unit(rng),
-                         b1=rng.normal(0, 0.1, 3) + [2.0, 0, 1.5])
+        g = RSSRGeometry(
+            a0=rng.normal(0, 0.1, 3),
+            ua=_rand_unit(rng),
+            a1=rng.normal(0, 0.1, 3) + [0.5, 0, 0],
+            b0=rng.normal(0, 0.1, 3) + [2.0, 0, 0.5],
+            ub=_rand_unit(rng),
+            b1=rng.normal(0, 0.1, 3) + [2.0, 0, 1.5],
+        )
         ct = rssr_crank_test(g, samples=720)
         if not ct.is_crank or ct.min_discriminant < 1e-3 * g.length_scale**4:
             continue
@@ -125,12 +167,26 @@ def _rssr_rows(acc, n, rng):
         Q, ok = loop.track(np.linspace(0.0, al, 1 + int(np.ceil(abs(al) / 0.1)))[:, None])
         st = loop.solve([al], [w], [a], q0=Q[-1])
         ib = loop.joint_q_index("rocker")
-        acc.add(m, "pin closure residual (RigidConstraintModel)", loop.residual_pin(st.q) / L, "pinocchio")
-        acc.add(m, "beta (branch by continuity from a1, b1)", abs(wrap(st.q[ib] - s.beta)) if st.ok else np.inf, "pinocchio")
+        acc.add(
+            m,
+            "pin closure residual (RigidConstraintModel)",
+            loop.residual_pin(st.q) / L,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "beta (branch by continuity from a1, b1)",
+            abs(wrap(st.q[ib] - s.beta)) if st.ok else np.inf,
+            "pinocchio",
+        )
         acc.add(m, "betadot", _rel(st.v[ib], s.betadot, w), "pinocchio")
         acc.add(m, "betaddot", _rel(st.a[ib], s.betaddot, w**2 + abs(a)), "pinocchio")
-        d1 = fd_derivative(lambda t: rssr_position(g, al + w * t + 0.5 * a * t * t, br).beta, angular=True)
-        d2 = fd_derivative(lambda t: rssr(g, al + w * t + 0.5 * a * t * t, w + a * t, a, br).betadot)
+        d1 = fd_derivative(
+            lambda t: rssr_position(g, al + w * t + 0.5 * a * t * t, br).beta, angular=True
+        )
+        d2 = fd_derivative(
+            lambda t: rssr(g, al + w * t + 0.5 * a * t * t, w + a * t, a, br).betadot
+        )
         acc.add(m, "betadot", _rel(d1, s.betadot, w), "finite-diff")
         acc.add(m, "betaddot", _rel(d2, s.betaddot, w**2 + abs(a)), "finite-diff")
 
@@ -143,9 +199,14 @@ def _rrss_rows(acc, n, rng):
         tries += 1
         u0 = np.array([0.0, 0.0, 1.0]) + rng.normal(0, 0.2, 3)
         u1 = np.array([0.0, 1.0, 1.0]) + rng.normal(0, 0.3, 3)
-        g = RRSSGeometry(a0=rng.normal(0, 0.1, 3), u0=u0 / np.linalg.norm(u0), a1=[1.0, 0, 0] + rng.normal(0, 0.1, 3),
-                         u1=u1 / np.linalg.norm(u1), b0=[1.0, 1.0, 5.0] + rng.normal(0, 0.3, 3),
-                         b1=[2.0, 0.5, -0.5] + rng.normal(0, 0.2, 3))
+        g = RRSSGeometry(
+            a0=rng.normal(0, 0.1, 3),
+            u0=u0 / np.linalg.norm(u0),
+            a1=[1.0, 0, 0] + rng.normal(0, 0.1, 3),
+            u1=u1 / np.linalg.norm(u1),
+            b0=[1.0, 1.0, 5.0] + rng.normal(0, 0.3, 3),
+            b1=[2.0, 0.5, -0.5] + rng.normal(0, 0.2, 3),
+        )
         br = rrss_branch_through(g)
         th = rng.uniform(-1.2, 1.2)
         w, a = rng.uniform(0.5, 1.5), rng.uniform(-1, 1)
@@ -154,33 +215,83 @@ def _rrss_rows(acc, n, rng):
         if not np.all(np.asarray(sp.status) == "ok"):
             continue
         s = rrss(g, th, w, a, br)
-        den = abs(np.dot(s.b - g.b0, np.cross(s.u_a, s.b - s.a))) / (g.bar_length * np.linalg.norm(s.b - s.a))
+        den = abs(np.dot(s.b - g.b0, np.cross(s.u_a, s.b - s.a))) / (
+            g.bar_length * np.linalg.norm(s.b - s.a)
+        )
         if den < 0.2:
             continue
         done += 1
         L = g.length_scale
         acc.add(m, "loop closure / length", s.residual / L, "math")
         nw = rrss_newton(g, th, w, a, steps=6)
-        acc.add(m, "002 Newton (rotation vector) vs closed form (6-99)/(6-105)/(6-111)", _maxabs(
-            [wrap(nw.theta2 - s.theta2), (nw.theta2dot - s.theta2dot) / w, (nw.theta2ddot - s.theta2ddot) / (w**2 + abs(a)),
-             *((nw.b - s.b) / L)]) if nw.status == "ok" else np.inf, "math")
+        acc.add(
+            m,
+            "002 Newton (rotation vector) vs closed form (6-99)/(6-105)/(6-111)",
+            _maxabs(
+                [
+                    wrap(nw.theta2 - s.theta2),
+                    (nw.theta2dot - s.theta2dot) / w,
+                    (nw.theta2ddot - s.theta2ddot) / (w**2 + abs(a)),
+                    *((nw.b - s.b) / L),
+                ]
+            )
+            if nw.status == "ok"
+            else np.inf,
+            "math",
+        )
         loop = ClosedLoop(rrss_spec(g))
         Q, ok = loop.track(path[:, None])
         st = loop.solve([th], [w], [a], q0=Q[-1])
         i2 = loop.joint_q_index("r2")
-        acc.add(m, "pin closure residual (RigidConstraintModel)", loop.residual_pin(st.q) / L, "pinocchio")
-        acc.add(m, "theta2, b", max(abs(wrap(st.q[i2] - s.theta2)), _maxabs(loop.frame_position(st.q, "b_R2") - s.b) / L)
-                if st.ok else np.inf, "pinocchio")
-        acc.add(m, "theta2dot, bdot", _rel(np.r_[st.v[i2], loop.frame_velocity(st.q, st.v, "b_R2") / L],
-                                           np.r_[s.theta2dot, s.bdot / L], w), "pinocchio")
-        acc.add(m, "theta2ddot, bddot (classical)", _rel(np.r_[st.a[i2], loop.frame_acceleration(st.q, st.v, st.a, "b_R2") / L],
-                                                         np.r_[s.theta2ddot, s.bddot / L], w**2 + abs(a)), "pinocchio")
+        acc.add(
+            m,
+            "pin closure residual (RigidConstraintModel)",
+            loop.residual_pin(st.q) / L,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2, b",
+            max(
+                abs(wrap(st.q[i2] - s.theta2)), _maxabs(loop.frame_position(st.q, "b_R2") - s.b) / L
+            )
+            if st.ok
+            else np.inf,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2dot, bdot",
+            _rel(
+                np.r_[st.v[i2], loop.frame_velocity(st.q, st.v, "b_R2") / L],
+                np.r_[s.theta2dot, s.bdot / L],
+                w,
+            ),
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2ddot, bddot (classical)",
+            _rel(
+                np.r_[st.a[i2], loop.frame_acceleration(st.q, st.v, st.a, "b_R2") / L],
+                np.r_[s.theta2ddot, s.bddot / L],
+                w**2 + abs(a),
+            ),
+            "pinocchio",
+        )
+
         def traj(t):
             return rrss(g, th + w * t + 0.5 * a * t * t, w + a * t, a, br)
+
         d1 = fd_derivative(lambda t: np.r_[traj(t).theta2, traj(t).b / L], angular=False)
         d2 = fd_derivative(lambda t: np.r_[traj(t).theta2dot, traj(t).bdot / L])
         acc.add(m, "theta2dot, bdot", _rel(d1, np.r_[s.theta2dot, s.bdot / L], w), "finite-diff")
-        acc.add(m, "theta2ddot, bddot (classical)", _rel(d2, np.r_[s.theta2ddot, s.bddot / L], w**2 + abs(a)), "finite-diff")
+        acc.add(
+            m,
+            "theta2ddot, bddot (classical)",
+            _rel(d2, np.r_[s.theta2ddot, s.bddot / L], w**2 + abs(a)),
+            "finite-diff",
+        )
 
 
 def _thumb_rows(acc, n, rng):
@@ -189,28 +300,75 @@ def _thumb_rows(acc, n, rng):
     loop = ClosedLoop(thumb_spec(g))
     L = g.length_scale
     i2, i3 = loop.joint_q_index("r2"), loop.joint_q_index("r3")
-    for th in rng.uniform(0.15, 0.5, n):      # theta1 in ~[9, 29] deg: f2 is matched; the literal upper
+    for th in rng.uniform(0.15, 0.5, n):  # theta1 in ~[9, 29] deg: f2 is matched; the literal upper
         # four-bar is close to its toggle below ~5 deg (rates of tens of rad/s)
         w, a = rng.uniform(0.5, 1.5), rng.uniform(-1, 1)
         s = thumb(g, th, w, a)
-        acc.add(m, "loop closure / length", s.residual / L, "math", note="Ch.4 geometry, theta1 in [9, 29] deg")
+        acc.add(
+            m,
+            "loop closure / length",
+            s.residual / L,
+            "math",
+            note="Ch.4 geometry, theta1 in [9, 29] deg",
+        )
         Q, ok = loop.track(np.linspace(0.0, th, 9)[:, None])
         st = loop.solve([th], [w], [a], q0=Q[-1])
-        acc.add(m, "pin closure residual (RigidConstraintModel)", loop.residual_pin(st.q) / L, "pinocchio")
-        acc.add(m, "theta2, theta3, fingertip S", max(abs(wrap(st.q[i2] - s.theta2)), abs(wrap(st.q[i3] - s.theta3)),
-                _maxabs(loop.frame_position(st.q, "S") - s.S) / L) if st.ok else np.inf, "pinocchio")
-        acc.add(m, "theta2dot, theta3dot, Sdot", _rel(np.r_[st.v[i2], st.v[i3], loop.frame_velocity(st.q, st.v, "S") / L],
-                                                      np.r_[s.theta2dot, s.theta3dot, s.Sdot / L], w), "pinocchio")
-        acc.add(m, "theta2ddot, theta3ddot, Sddot (classical)",
-                _rel(np.r_[st.a[i2], st.a[i3], loop.frame_acceleration(st.q, st.v, st.a, "S") / L],
-                     np.r_[s.theta2ddot, s.theta3ddot, s.Sddot / L], w**2 + abs(a)), "pinocchio")
+        acc.add(
+            m,
+            "pin closure residual (RigidConstraintModel)",
+            loop.residual_pin(st.q) / L,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2, theta3, fingertip S",
+            max(
+                abs(wrap(st.q[i2] - s.theta2)),
+                abs(wrap(st.q[i3] - s.theta3)),
+                _maxabs(loop.frame_position(st.q, "S") - s.S) / L,
+            )
+            if st.ok
+            else np.inf,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2dot, theta3dot, Sdot",
+            _rel(
+                np.r_[st.v[i2], st.v[i3], loop.frame_velocity(st.q, st.v, "S") / L],
+                np.r_[s.theta2dot, s.theta3dot, s.Sdot / L],
+                w,
+            ),
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "theta2ddot, theta3ddot, Sddot (classical)",
+            _rel(
+                np.r_[st.a[i2], st.a[i3], loop.frame_acceleration(st.q, st.v, st.a, "S") / L],
+                np.r_[s.theta2ddot, s.theta3ddot, s.Sddot / L],
+                w**2 + abs(a),
+            ),
+            "pinocchio",
+        )
+
         def traj(t):
             return thumb(g, th + w * t + 0.5 * a * t * t, w + a * t, a)
+
         d1 = fd_derivative(lambda t: np.r_[traj(t).theta2, traj(t).theta3, traj(t).S / L])
         d2 = fd_derivative(lambda t: np.r_[traj(t).theta2dot, traj(t).theta3dot, traj(t).Sdot / L])
-        acc.add(m, "theta2dot, theta3dot, Sdot", _rel(d1, np.r_[s.theta2dot, s.theta3dot, s.Sdot / L], w), "finite-diff")
-        acc.add(m, "theta2ddot, theta3ddot, Sddot (classical)",
-                _rel(d2, np.r_[s.theta2ddot, s.theta3ddot, s.Sddot / L], w**2 + abs(a)), "finite-diff")
+        acc.add(
+            m,
+            "theta2dot, theta3dot, Sdot",
+            _rel(d1, np.r_[s.theta2dot, s.theta3dot, s.Sdot / L], w),
+            "finite-diff",
+        )
+        acc.add(
+            m,
+            "theta2ddot, theta3ddot, Sddot (classical)",
+            _rel(d2, np.r_[s.theta2ddot, s.theta3ddot, s.Sddot / L], w**2 + abs(a)),
+            "finite-diff",
+        )
 
 
 def _finger_rows(acc, n, rng):
@@ -223,57 +381,128 @@ def _finger_rows(acc, n, rng):
         ph = p0 + u * (p1 - p0)
         w, a = rng.uniform(0.5, 1.5), rng.uniform(-1, 1)
         s = finger(g, ph, w, a)
-        acc.add(m, "loop closure / length", s.residual / L, "math", note="our bar lengths (fitted to Ch.3 f(x))")
+        acc.add(
+            m,
+            "loop closure / length",
+            s.residual / L,
+            "math",
+            note="our bar lengths (fitted to Ch.3 f(x))",
+        )
         Q, ok = loop.track(np.linspace(0.0, ph - p0, 7)[:, None])
         st = loop.solve([ph - p0], [w], [a], q0=Q[-1])
-        acc.add(m, "pin closure residual (RigidConstraintModel)", loop.residual_pin(st.q) / L, "pinocchio")
-        acc.add(m, "fingertip P8", _maxabs(loop.frame_position(st.q, "P8")[:2] - s.tip) / L if st.ok else np.inf, "pinocchio")
-        acc.add(m, "fingertip velocity", _rel(loop.frame_velocity(st.q, st.v, "P8")[:2] / L, s.velocities["P8"] / L, w),
-                "pinocchio")
-        acc.add(m, "fingertip acceleration (classical)", _rel(loop.frame_acceleration(st.q, st.v, st.a, "P8")[:2] / L,
-                                                              s.accelerations["P8"] / L, w**2 + abs(a)), "pinocchio")
+        acc.add(
+            m,
+            "pin closure residual (RigidConstraintModel)",
+            loop.residual_pin(st.q) / L,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "fingertip P8",
+            _maxabs(loop.frame_position(st.q, "P8")[:2] - s.tip) / L if st.ok else np.inf,
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "fingertip velocity",
+            _rel(loop.frame_velocity(st.q, st.v, "P8")[:2] / L, s.velocities["P8"] / L, w),
+            "pinocchio",
+        )
+        acc.add(
+            m,
+            "fingertip acceleration (classical)",
+            _rel(
+                loop.frame_acceleration(st.q, st.v, st.a, "P8")[:2] / L,
+                s.accelerations["P8"] / L,
+                w**2 + abs(a),
+            ),
+            "pinocchio",
+        )
+
         def traj(t):
             return finger(g, ph + w * t + 0.5 * a * t * t, w + a * t, a)
-        h = 2.5e-4     # the DIP rate grows fast near the end of the range: small steps
+
+        h = 2.5e-4  # the DIP rate grows fast near the end of the range: small steps
         d1 = fd_derivative(lambda t: traj(t).tip / L, h)
         d2 = fd_derivative(lambda t: traj(t).velocities["P8"] / L, h)
         acc.add(m, "fingertip velocity", _rel(d1, s.velocities["P8"] / L, w), "finite-diff")
-        acc.add(m, "fingertip acceleration (classical)", _rel(d2, s.accelerations["P8"] / L, w**2 + abs(a)), "finite-diff")
+        acc.add(
+            m,
+            "fingertip acceleration (classical)",
+            _rel(d2, s.accelerations["P8"] / L, w**2 + abs(a)),
+            "finite-diff",
+        )
 
 
 # ---------------------------------------------------------------------------------------------
 # relative motion (002 §4-1) and the RCCC mechanism (§5-6): rows of their own, checked against
 # Pinocchio chains; ``n`` samples each (capped separately, these are cheap)
 def _relative_rows(n, rng):
-    from .relative_motion import (RelativeMotionGeometry, pinocchio_model, relative_acceleration,
-                                              relative_position, relative_velocity)
+    from .relative_motion import (
+        RelativeMotionGeometry,
+        pinocchio_model,
+        relative_acceleration,
+        relative_position,
+        relative_velocity,
+    )
 
     e = np.zeros(3)
     for _ in range(n):
         u0, u1 = _rand_unit(rng), _rand_unit(rng)
-        g = RelativeMotionGeometry(u0, rng.normal(size=3), u1, rng.normal(size=3), rng.normal(size=3))
+        g = RelativeMotionGeometry(
+            u0, rng.normal(size=3), u1, rng.normal(size=3), rng.normal(size=3)
+        )
         x = rng.normal(size=9)
         th, thd, thdd, ph, phd, phdd, s, sd, sdd = x
         model, fid = pinocchio_model(g)
         data = model.createData()
-        pin.forwardKinematics(model, data, np.array([th, s, ph]), np.array([thd, sd, phd]), np.array([thdd, sdd, phdd]))
+        pin.forwardKinematics(
+            model,
+            data,
+            np.array([th, s, ph]),
+            np.array([thd, sd, phd]),
+            np.array([thdd, sdd, phdd]),
+        )
         pin.updateFramePlacements(model, data)
         scale = max(1.0, np.abs(np.r_[g.p0, g.p1, g.q1]).max())
-        e[0] = max(e[0], np.abs(relative_position(g, th, ph, s).q - data.oMf[fid].translation).max() / scale)
-        e[1] = max(e[1], np.abs(relative_velocity(g, th, thd, ph, phd, s, sd).total
-                                - pin.getFrameVelocity(model, data, fid, LWA).linear).max() / scale)
-        e[2] = max(e[2], np.abs(relative_acceleration(g, th, thd, thdd, ph, phd, phdd, s, sd, sdd).total
-                                - pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear).max() / scale)
+        e[0] = max(
+            e[0],
+            np.abs(relative_position(g, th, ph, s).q - data.oMf[fid].translation).max() / scale,
+        )
+        e[1] = max(
+            e[1],
+            np.abs(
+                relative_velocity(g, th, thd, ph, phd, s, sd).total
+                - pin.getFrameVelocity(model, data, fid, LWA).linear
+            ).max()
+            / scale,
+        )
+        e[2] = max(
+            e[2],
+            np.abs(
+                relative_acceleration(g, th, thd, thdd, ph, phd, phdd, s, sd, sdd).total
+                - pin.getFrameClassicalAcceleration(model, data, fid, LWA).linear
+            ).max()
+            / scale,
+        )
     return [
         CheckRow("relative_motion", "position 002 (4-6) vs pin FK (rel.)", float(e[0]), 1e-10, n),
-        CheckRow("relative_motion", "velocity 002 (4-11) vs frame velocity (rel.)", float(e[1]), 1e-10, n),
-        CheckRow("relative_motion", "acceleration 002 (4-17) vs classical acc (rel.)", float(e[2]), 1e-10, n),
+        CheckRow(
+            "relative_motion", "velocity 002 (4-11) vs frame velocity (rel.)", float(e[1]), 1e-10, n
+        ),
+        CheckRow(
+            "relative_motion",
+            "acceleration 002 (4-17) vs classical acc (rel.)",
+            float(e[2]),
+            1e-10,
+            n,
+        ),
     ]
 
 
 def _rccc_rows(n, rng):
-    from .rccc import RCCCGeometry, pinocchio_chain, rccc_acceleration, rccc_position, rccc_velocity
     from ..spatial.dual import Dual
+    from .rccc import RCCCGeometry, pinocchio_chain, rccc_acceleration, rccc_position, rccc_velocity
 
     e = np.zeros(4)
     count = checked = fd_checked = 0  # assembled geometries, branches with rates, FD comparisons
@@ -308,7 +537,9 @@ def _rccc_rows(n, rng):
             h = 1e-6
             rp, rm = rccc_position(g, th1 + h), rccc_position(g, th1 - h)
             v1 = rccc_velocity(g, sol, 1.0).rates
-            if rp.ok and rm.ok and np.abs(v1).max() < 100.0:  # away from dead points (FD is meaningless there)
+            if (
+                rp.ok and rm.ok and np.abs(v1).max() < 100.0
+            ):  # away from dead points (FD is meaningless there)
                 dq = (rp.solutions[sol.branch].q - rm.solutions[sol.branch].q) / (2 * h)
                 e[3] = max(e[3], np.abs(dq - v1).max() / max(1.0, np.abs(v1).max()))
                 fd_checked += 1
@@ -318,10 +549,21 @@ def _rccc_rows(n, rng):
     e[3] = e[3] if fd_checked else np.nan
     note = f"{checked} branches of {count} assembled geometries"
     return [
-        CheckRow("rccc", "loop closure (5-152) log6 (rel.)", float(e[0]), 1e-10, checked, note=note),
+        CheckRow(
+            "rccc", "loop closure (5-152) log6 (rel.)", float(e[0]), 1e-10, checked, note=note
+        ),
         CheckRow("rccc", "cut-frame velocity = 0 (rel.)", float(e[1]), 1e-10, checked, note=note),
-        CheckRow("rccc", "cut-frame classical acc = 0 (rel.)", float(e[2]), 1e-10, checked, note=note),
-        CheckRow("rccc", "joint rates vs finite differences (rel.)", float(e[3]), 1e-6, fd_checked, "finite differences"),
+        CheckRow(
+            "rccc", "cut-frame classical acc = 0 (rel.)", float(e[2]), 1e-10, checked, note=note
+        ),
+        CheckRow(
+            "rccc",
+            "joint rates vs finite differences (rel.)",
+            float(e[3]),
+            1e-6,
+            fd_checked,
+            "finite differences",
+        ),
     ]
 
 

@@ -99,13 +99,17 @@ class LoopSpec:
         def joint_xml(name, jtype, parent, child, T, axis):
             rpy = [float(x) for x in pin.rpy.matrixToRpy(np.asarray(T[:3, :3], dtype=float))]
             xyz = [float(x) for x in T[:3, 3]]
-            s = (f'  <joint name="{name}" type="{jtype}">\n'
-                 f'    <parent link="{parent}"/>\n    <child link="{child}"/>\n'
-                 f'    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="{rpy[0]!r} {rpy[1]!r} {rpy[2]!r}"/>\n')
+            s = (
+                f'  <joint name="{name}" type="{jtype}">\n'
+                f'    <parent link="{parent}"/>\n    <child link="{child}"/>\n'
+                f'    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="{rpy[0]!r} {rpy[1]!r} {rpy[2]!r}"/>\n'
+            )
             if jtype in ("revolute", "prismatic"):
                 a = [float(x) for x in axis]
-                s += (f'    <axis xyz="{a[0]!r} {a[1]!r} {a[2]!r}"/>\n'
-                      '    <limit lower="-1e3" upper="1e3" effort="1" velocity="1"/>\n')
+                s += (
+                    f'    <axis xyz="{a[0]!r} {a[1]!r} {a[2]!r}"/>\n'
+                    '    <limit lower="-1e3" upper="1e3" effort="1" velocity="1"/>\n'
+                )
             return s + "  </joint>"
 
         for j in self.joints:
@@ -114,14 +118,22 @@ class LoopSpec:
                 bx, by = f"{j.name}__bx", f"{j.name}__by"
                 for n in (bx, by, j.child):
                     add_link(n)
-                jl.append(joint_xml(f"{j.name}_x", "revolute", j.parent, bx, np.asarray(j.origin), (1, 0, 0)))
+                jl.append(
+                    joint_xml(
+                        f"{j.name}_x", "revolute", j.parent, bx, np.asarray(j.origin), (1, 0, 0)
+                    )
+                )
                 jl.append(joint_xml(f"{j.name}_y", "revolute", bx, by, np.eye(4), (0, 1, 0)))
                 jl.append(joint_xml(f"{j.name}_z", "revolute", by, j.child, np.eye(4), (0, 0, 1)))
             elif j.type in ("revolute", "prismatic", "fixed"):
                 add_link(j.child)
-                jl.append(joint_xml(j.name, j.type, j.parent, j.child, np.asarray(j.origin), j.axis))
+                jl.append(
+                    joint_xml(j.name, j.type, j.parent, j.child, np.asarray(j.origin), j.axis)
+                )
             else:
-                raise ValueError(f"joint {j.name}: unknown type {j.type!r} (revolute, prismatic, fixed, ball)")
+                raise ValueError(
+                    f"joint {j.name}: unknown type {j.type!r} (revolute, prismatic, fixed, ball)"
+                )
         for name, parent, T in self.sites:
             add_link(name)
             jl.append(joint_xml(f"{name}__site", "fixed", parent, name, np.asarray(T), None))
@@ -163,13 +175,21 @@ class ClosedLoop:
         try:
             self.model = pin.buildModelFromXML(self.urdf)
         except Exception as exc:  # C++ exceptions surface as RuntimeError/ValueError
-            raise AnthroarmError(f"{spec.name}: Pinocchio cannot build the spanning tree: {exc}") from None
+            raise AnthroarmError(
+                f"{spec.name}: Pinocchio cannot build the spanning tree: {exc}"
+            ) from None
         self.data = self.model.createData()
         for n in spec.inputs:
             if not self.model.existJointName(n):
-                raise ValueError(f"{spec.name}: input joint {n!r} is not in the tree ({list(self.model.names)[1:]})")
-        self.input_idx = np.array([self.model.joints[self.model.getJointId(n)].idx_v for n in spec.inputs], dtype=int)
-        self.free_idx = np.array([i for i in range(self.model.nv) if i not in set(self.input_idx)], dtype=int)
+                raise ValueError(
+                    f"{spec.name}: input joint {n!r} is not in the tree ({list(self.model.names)[1:]})"
+                )
+        self.input_idx = np.array(
+            [self.model.joints[self.model.getJointId(n)].idx_v for n in spec.inputs], dtype=int
+        )
+        self.free_idx = np.array(
+            [i for i in range(self.model.nv) if i not in set(self.input_idx)], dtype=int
+        )
         self._fid = {}
         for c in spec.closures:
             for f in (c.frame_a, c.frame_b):
@@ -210,7 +230,9 @@ class ClosedLoop:
     def frame_acceleration(self, q, v, a, name: str) -> np.ndarray:
         """*Classical* linear acceleration (m/s^2) of the frame origin, world-aligned."""
         self._fk(np.asarray(q, float), np.asarray(v, float), np.asarray(a, float))
-        return pin.getFrameClassicalAcceleration(self.model, self.data, self.frame_id(name), LWA).linear.copy()
+        return pin.getFrameClassicalAcceleration(
+            self.model, self.data, self.frame_id(name), LWA
+        ).linear.copy()
 
     # ------------------------------------------------------------------ closure residual / Jacobian
     def residual(self, q) -> np.ndarray:
@@ -254,8 +276,9 @@ class ClosedLoop:
         pin.updateFramePlacements(self.model, self.data)
         rows = []
         for c in self.spec.closures:
-            D = (pin.getFrameJacobian(self.model, self.data, self._fid[c.frame_a], LWA)
-                 - pin.getFrameJacobian(self.model, self.data, self._fid[c.frame_b], LWA))
+            D = pin.getFrameJacobian(
+                self.model, self.data, self._fid[c.frame_a], LWA
+            ) - pin.getFrameJacobian(self.model, self.data, self._fid[c.frame_b], LWA)
             rows.append(D[list(c.components)] if c.kind == "point" else D)
         return np.vstack(rows)
 
@@ -277,10 +300,20 @@ class ClosedLoop:
     def _build_pin_constraints(self):
         cons = []
         for c in self.spec.closures:
-            fa, fb = self.model.frames[self._fid[c.frame_a]], self.model.frames[self._fid[c.frame_b]]
+            fa, fb = (
+                self.model.frames[self._fid[c.frame_a]],
+                self.model.frames[self._fid[c.frame_b]],
+            )
             ctype = pin.ContactType.CONTACT_3D if c.kind == "point" else pin.ContactType.CONTACT_6D
-            cm = pin.RigidConstraintModel(ctype, self.model, fa.parentJoint, fa.placement,
-                                          fb.parentJoint, fb.placement, pin.ReferenceFrame.LOCAL)
+            cm = pin.RigidConstraintModel(
+                ctype,
+                self.model,
+                fa.parentJoint,
+                fa.placement,
+                fb.parentJoint,
+                fb.placement,
+                pin.ReferenceFrame.LOCAL,
+            )
             cons.append((c, cm, cm.createData()))
         return cons
 
@@ -293,10 +326,16 @@ class ClosedLoop:
             cm.calc(self.model, self.data, cd)
             M = cd.c1Mc2
             if c.kind == "point":
-                dp = self.data.oMf[self._fid[c.frame_a]].rotation @ M.translation   # world components
+                dp = (
+                    self.data.oMf[self._fid[c.frame_a]].rotation @ M.translation
+                )  # world components
                 worst = max(worst, float(np.linalg.norm(dp[list(c.components)])))
             else:
-                worst = max(worst, float(np.linalg.norm(M.translation)), float(np.linalg.norm(pin.log3(M.rotation))))
+                worst = max(
+                    worst,
+                    float(np.linalg.norm(M.translation)),
+                    float(np.linalg.norm(pin.log3(M.rotation))),
+                )
         return worst
 
     # ------------------------------------------------------------------ solvers
@@ -304,9 +343,13 @@ class ClosedLoop:
         if isinstance(x, dict):
             unknown = set(x) - set(self.spec.inputs)
             if unknown:
-                raise ValueError(f"{self.spec.name}: {what} names unknown inputs {sorted(unknown)} (inputs: {list(self.spec.inputs)})")
+                raise ValueError(
+                    f"{self.spec.name}: {what} names unknown inputs {sorted(unknown)} (inputs: {list(self.spec.inputs)})"
+                )
             x = [x.get(n, 0.0) for n in self.spec.inputs]
-        return finite_array(what, np.atleast_1d(np.asarray(x, dtype=float)), (len(self.spec.inputs),))
+        return finite_array(
+            what, np.atleast_1d(np.asarray(x, dtype=float)), (len(self.spec.inputs),)
+        )
 
     def solve_position(self, inputs, q0=None, tol: float = 1e-13, max_iter: int = 60):
         """Newton (least-norm, with backtracking) on the closure residual with the inputs fixed.
@@ -314,7 +357,11 @@ class ClosedLoop:
         ``q0``: initial tree configuration (selects the assembly branch); default zeros.
         Returns (q, residual_norm, iterations, converged).  ``tol`` is relative to
         ``spec.length_scale``."""
-        q = np.zeros(self.model.nq) if q0 is None else finite_array("q0", q0, (self.model.nq,)).copy()
+        q = (
+            np.zeros(self.model.nq)
+            if q0 is None
+            else finite_array("q0", q0, (self.model.nq,)).copy()
+        )
         q[self.input_idx] = self._inputs(inputs, "inputs")
         scale = self.spec.length_scale
         self._fk(q)
@@ -365,8 +412,15 @@ class ClosedLoop:
         a[self.free_idx] = np.linalg.lstsq(J[:, self.free_idx], rhs, rcond=1e-12)[0]
         return a, float(np.linalg.norm(J @ a + gamma))
 
-    def solve(self, inputs, input_velocities=None, input_accelerations=None, q0=None,
-              tol: float = 1e-13, consistency_tol: float = 1e-9) -> LoopState:
+    def solve(
+        self,
+        inputs,
+        input_velocities=None,
+        input_accelerations=None,
+        q0=None,
+        tol: float = 1e-13,
+        consistency_tol: float = 1e-9,
+    ) -> LoopState:
         """Positions, velocities and accelerations of the whole tree for the given inputs."""
         nin = len(self.spec.inputs)
         iv = np.zeros(nin) if input_velocities is None else input_velocities
@@ -374,24 +428,41 @@ class ClosedLoop:
         q, res, it, conv = self.solve_position(inputs, q0, tol=tol)
         if not conv:
             z = np.zeros(self.model.nv)
-            return LoopState(q, z, z.copy(), res, it, "not_converged",
-                             f"Newton did not close the loop (|residual| = {res:.3e}): the inputs may be outside "
-                             "the assembly range, or q0 is too far from a solution")
+            return LoopState(
+                q,
+                z,
+                z.copy(),
+                res,
+                it,
+                "not_converged",
+                f"Newton did not close the loop (|residual| = {res:.3e}): the inputs may be outside "
+                "the assembly range, or q0 is too far from a solution",
+            )
         v, ev = self.solve_velocity(q, iv)
         a, ea = self.solve_acceleration(q, v, ia)
         scale = self.spec.length_scale
         vnorm = 1.0 + float(np.linalg.norm(self._inputs(iv, "input_velocities")))
         if ev > consistency_tol * scale * vnorm or ea > consistency_tol * scale * vnorm**2:
-            return LoopState(q, v, a, res, it, "singular",
-                             f"closure Jacobian is singular here (velocity inconsistency {ev:.3e}): dead point / branch point")
+            return LoopState(
+                q,
+                v,
+                a,
+                res,
+                it,
+                "singular",
+                f"closure Jacobian is singular here (velocity inconsistency {ev:.3e}): dead point / branch point",
+            )
         return LoopState(q, v, a, res, it, "ok", "ok")
 
     def track(self, input_path, q0=None, tol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
         """Continuation: solve for each row of ``input_path`` (K x n_inputs) starting from the
         previous solution moved along the tangent (the velocity solution).  Keep the steps small
         compared with the distance between assembly branches.  Returns (Q (K x nq), converged (K,))."""
-        P = finite_array("input_path", np.asarray(input_path, float).reshape(len(input_path), -1),
-                         (None, len(self.spec.inputs)))
+        P = finite_array(
+            "input_path",
+            np.asarray(input_path, float).reshape(len(input_path), -1),
+            (None, len(self.spec.inputs)),
+        )
         Q = np.zeros((len(P), self.model.nq))
         ok = np.zeros(len(P), dtype=bool)
         q = None if q0 is None else np.asarray(q0, float)
@@ -401,7 +472,7 @@ class ClosedLoop:
             if q is not None and x_prev is not None:
                 # tangent predictor: q + dq/dx (x - x_prev), from the velocity solution
                 v, _ = self.solve_velocity(q, x - x_prev)
-                guess = q + v          # revolute/prismatic trees: nq == nv, q integrates additively
+                guess = q + v  # revolute/prismatic trees: nq == nv, q integrates additively
             qk, _, _, conv = self.solve_position(x, guess, tol=tol)
             Q[k], ok[k] = qk, conv
             if conv:

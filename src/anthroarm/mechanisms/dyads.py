@@ -69,7 +69,11 @@ class DyadState:
 
 
 def _pt(name, x):
-    return finite_array(name, x, (None,) * (np.ndim(x) - 1) + (2,)) if np.ndim(x) >= 1 else finite_array(name, x, (2,))
+    return (
+        finite_array(name, x, (None,) * (np.ndim(x) - 1) + (2,))
+        if np.ndim(x) >= 1
+        else finite_array(name, x, (2,))
+    )
 
 
 def _cross_k(w, r):
@@ -77,7 +81,9 @@ def _cross_k(w, r):
     return np.stack([-w * r[..., 1], w * r[..., 0]], -1)
 
 
-def rigid_body_point(P1, P1dot, P1ddot, length, theta, thetadot=0.0, thetaddot=0.0, phi=0.0) -> RigidBodyPoint:
+def rigid_body_point(
+    P1, P1dot, P1ddot, length, theta, thetadot=0.0, thetaddot=0.0, phi=0.0
+) -> RigidBodyPoint:
     """A point at ``length`` from P1 on a rigid body turning with angle theta, offset by the
     fixed included angle ``phi`` (Eqs. (6-66)/(6-67): P = P1 + L (cos(theta + phi), sin(theta + phi))).
 
@@ -93,12 +99,15 @@ def rigid_body_point(P1, P1dot, P1ddot, length, theta, thetadot=0.0, thetaddot=0
     ang = th + ph
     r = L * np.stack([np.cos(ang), np.sin(ang)], -1)
     with np.errstate(over="ignore", invalid="ignore"):
-        P = P1 + r                                                    # (6-66)/(6-67)
-        V = P1dot + _cross_k(w, r)                                     # (6-68)
-        A = P1ddot + _cross_k(al, r) - (w**2)[..., None] * r           # (6-69)
+        P = P1 + r  # (6-66)/(6-67)
+        V = P1dot + _cross_k(w, r)  # (6-68)
+        A = P1ddot + _cross_k(al, r) - (w**2)[..., None] * r  # (6-69)
     why = f"length {L:.3g} m, thetadot up to {np.max(np.abs(w)):.3g} rad/s"
-    return RigidBodyPoint(representable("position", P, why), representable("velocity", V, why),
-                          representable("acceleration", A, why))
+    return RigidBodyPoint(
+        representable("position", P, why),
+        representable("velocity", V, why),
+        representable("acceleration", A, why),
+    )
 
 
 def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadState:
@@ -124,36 +133,39 @@ def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadS
     # every length / L (a power of two: exact), so no square overflows or underflows
     L = pow2_scale(r1, r2, dv)
     n1, n2, dvn = r1 / L, r2 / L, dv / L
-    distn = np.hypot(dvn[..., 0], dvn[..., 1])                         # (6-70), d / L
+    distn = np.hypot(dvn[..., 0], dvn[..., 1])  # (6-70), d / L
     dist = distn * L
-    phi = np.arctan2(dv[..., 1], dv[..., 0])                           # (6-73)
+    phi = np.arctan2(dv[..., 1], dv[..., 0])  # (6-73)
     tiny = 1e-14 * (n1 + n2)
     safe = np.where(distn > tiny, distn, 1.0)
-    k = np.where(distn > tiny, (n1 * n1 + distn * distn - n2 * n2) / (2 * n1 * safe),
-                 np.where(abs(n1 - n2) <= tiny, 1.0, 2.0))
-    assembled = np.abs(k) <= 1 + ASSEMBLY_TOL                          # (6-71)/(6-72)
-    th1 = phi + branch * np.arccos(np.clip(k, -1.0, 1.0))              # (6-74)/(6-75)
+    k = np.where(
+        distn > tiny,
+        (n1 * n1 + distn * distn - n2 * n2) / (2 * n1 * safe),
+        np.where(abs(n1 - n2) <= tiny, 1.0, 2.0),
+    )
+    assembled = np.abs(k) <= 1 + ASSEMBLY_TOL  # (6-71)/(6-72)
+    th1 = phi + branch * np.arccos(np.clip(k, -1.0, 1.0))  # (6-74)/(6-75)
     r = r1 * np.stack([np.cos(th1), np.sin(th1)], -1)
     P3 = representable("P3", P1 + r, "the points are too far apart")  # (6-76)
-    rn = n1 * np.stack([np.cos(th1), np.sin(th1)], -1)                 # (P3 - P1) / L
-    qn = rn - dvn                                                      # (P3 - P2) / L
-    th2 = np.arctan2(qn[..., 1], qn[..., 0])                           # (6-77)
-    a, b = rn[..., 0], rn[..., 1]                                      # a, b, c, d of (6-83) / L
+    rn = n1 * np.stack([np.cos(th1), np.sin(th1)], -1)  # (P3 - P1) / L
+    qn = rn - dvn  # (P3 - P2) / L
+    th2 = np.arctan2(qn[..., 1], qn[..., 0])  # (6-77)
+    a, b = rn[..., 0], rn[..., 1]  # a, b, c, d of (6-83) / L
     c, dd = qn[..., 0], qn[..., 1]
-    D = b * c - a * dd                                                 # D / L^2
+    D = b * c - a * dd  # D / L^2
     dead = assembled & (np.abs(D) < DEAD_POINT_TOL * n1 * n2)
     good = assembled & ~dead
     Ds = np.where(good, D, 1.0) * L
     with np.errstate(over="ignore", invalid="ignore"):
         X, Y = P2dot[..., 0] - P1dot[..., 0], P2dot[..., 1] - P1dot[..., 1]
-        w1 = np.where(good, -(X * c + Y * dd) / Ds, 0.0)              # (6-83)
-        w2 = np.where(good, -(X * a + Y * b) / Ds, 0.0)               # (6-84)
+        w1 = np.where(good, -(X * c + Y * dd) / Ds, 0.0)  # (6-83)
+        w2 = np.where(good, -(X * a + Y * b) / Ds, 0.0)  # (6-84)
         E = (P2ddot[..., 0] - P1ddot[..., 0]) + L * (w1**2 * a - w2**2 * c)
         F = (P2ddot[..., 1] - P1ddot[..., 1]) + L * (w1**2 * b - w2**2 * dd)
-        a1 = np.where(good, -(E * c + F * dd) / Ds, 0.0)              # (6-86), corrected to theta''
-        a2 = np.where(good, -(E * a + F * b) / Ds, 0.0)               # (6-87), corrected to theta''
-        V = P1dot + _cross_k(w1, r)                                    # (6-78)
-        A = P1ddot + _cross_k(a1, r) - (w1**2)[..., None] * r          # (6-85)
+        a1 = np.where(good, -(E * c + F * dd) / Ds, 0.0)  # (6-86), corrected to theta''
+        a2 = np.where(good, -(E * a + F * b) / Ds, 0.0)  # (6-87), corrected to theta''
+        V = P1dot + _cross_k(w1, r)  # (6-78)
+        A = P1ddot + _cross_k(a1, r) - (w1**2)[..., None] * r  # (6-85)
     why = "rates of the points too large for these lengths"
     w1, w2 = representable("omega1", w1, why), representable("omega2", w2, why)
     a1, a2 = representable("alpha1", a1, why), representable("alpha2", a2, why)
@@ -161,15 +173,34 @@ def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadS
     st = np.where(~assembled, "cannot_assemble", np.where(dead, "dead_point", "ok"))
     if np.ndim(dist) == 0:
         if not assembled:
-            reason = (f"dyad does not exist: d = {float(dist):.6g} outside [|r1 - r2|, r1 + r2] = "
-                      f"[{abs(r1 - r2):.6g}, {r1 + r2:.6g}] (6-71)/(6-72)")
+            reason = (
+                f"dyad does not exist: d = {float(dist):.6g} outside [|r1 - r2|, r1 + r2] = "
+                f"[{abs(r1 - r2):.6g}, {r1 + r2:.6g}] (6-71)/(6-72)"
+            )
         elif dead:
-            reason = "dead point: the two links are collinear (D = 0); rates unbounded, reported as 0"
+            reason = (
+                "dead point: the two links are collinear (D = 0); rates unbounded, reported as 0"
+            )
         else:
             reason = "ok"
     else:
         na, nd = int(np.sum(~assembled)), int(np.sum(dead))
-        reason = "ok" if na == nd == 0 else f"{na} of {dist.size} cannot assemble, {nd} at a dead point"
-    return DyadState(P3=P3, P3dot=V, P3ddot=A, theta1=out(th1), theta2=out(th2), omega1=out(w1), omega2=out(w2),
-                     alpha1=out(a1), alpha2=out(a2), d=out(dist), assembled=out(assembled), dead_point=out(dead),
-                     status=out(st), reason=reason)
+        reason = (
+            "ok" if na == nd == 0 else f"{na} of {dist.size} cannot assemble, {nd} at a dead point"
+        )
+    return DyadState(
+        P3=P3,
+        P3dot=V,
+        P3ddot=A,
+        theta1=out(th1),
+        theta2=out(th2),
+        omega1=out(w1),
+        omega2=out(w2),
+        alpha1=out(a1),
+        alpha2=out(a2),
+        d=out(dist),
+        assembled=out(assembled),
+        dead_point=out(dead),
+        status=out(st),
+        reason=reason,
+    )

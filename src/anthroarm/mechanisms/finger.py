@@ -50,8 +50,8 @@ class FingerGeometry:
 
     P1: np.ndarray
     P4: np.ndarray
-    R: tuple                 #: (R1, R2, R3, R4, R5, R6, R7, R8)
-    alpha: tuple             #: (alpha1, alpha2, alpha3)
+    R: tuple  #: (R1, R2, R3, R4, R5, R6, R7, R8)
+    alpha: tuple  #: (alpha1, alpha2, alpha3)
     branches: tuple = (1, 1)
     phi_range: tuple = (0.0, 1.0)
 
@@ -62,11 +62,17 @@ class FingerGeometry:
         if np.any(R <= 0):
             raise ValueError(f"bar lengths R1..R8 must be positive, got {R.tolist()}")
         object.__setattr__(self, "R", tuple(float(x) for x in R))
-        object.__setattr__(self, "alpha", tuple(float(x) for x in finite_array("alpha", self.alpha, (3,))))
+        object.__setattr__(
+            self, "alpha", tuple(float(x) for x in finite_array("alpha", self.alpha, (3,)))
+        )
         for b in self.branches:
             if b not in (1, -1):
                 raise ValueError(f"branches must be +1/-1, got {self.branches!r}")
-        object.__setattr__(self, "phi_range", tuple(float(x) for x in finite_array("phi_range", self.phi_range, (2,))))
+        object.__setattr__(
+            self,
+            "phi_range",
+            tuple(float(x) for x in finite_array("phi_range", self.phi_range, (2,))),
+        )
 
     @property
     def length_scale(self) -> float:
@@ -82,17 +88,41 @@ class FingerGeometry:
         def ang(v):
             return float(np.arctan2(v[1], v[0]))
 
-        R = (np.linalg.norm(P2 - P1), np.linalg.norm(P5 - P1), np.linalg.norm(P3 - P2), np.linalg.norm(P3 - P4),
-             np.linalg.norm(P6 - P2), np.linalg.norm(P7 - P6), np.linalg.norm(P7 - P5), np.linalg.norm(P8 - P6))
-        alpha = (ang(P5 - P1) - ang(P2 - P1), ang(P6 - P2) - ang(P3 - P2), ang(P8 - P6) - ang(P7 - P6))
+        R = (
+            np.linalg.norm(P2 - P1),
+            np.linalg.norm(P5 - P1),
+            np.linalg.norm(P3 - P2),
+            np.linalg.norm(P3 - P4),
+            np.linalg.norm(P6 - P2),
+            np.linalg.norm(P7 - P6),
+            np.linalg.norm(P7 - P5),
+            np.linalg.norm(P8 - P6),
+        )
+        alpha = (
+            ang(P5 - P1) - ang(P2 - P1),
+            ang(P6 - P2) - ang(P3 - P2),
+            ang(P8 - P6) - ang(P7 - P6),
+        )
         phi0 = ang(P2 - P1)
         if branches is None:
             z = np.zeros(2)
-            b1 = min((1, -1), key=lambda s: np.linalg.norm(dyad(P2, z, z, P4, z, z, R[2], R[3], s).P3 - P3))
-            b2 = min((1, -1), key=lambda s: np.linalg.norm(dyad(P6, z, z, P5, z, z, R[5], R[6], s).P3 - P7))
+            b1 = min(
+                (1, -1),
+                key=lambda s: np.linalg.norm(dyad(P2, z, z, P4, z, z, R[2], R[3], s).P3 - P3),
+            )
+            b2 = min(
+                (1, -1),
+                key=lambda s: np.linalg.norm(dyad(P6, z, z, P5, z, z, R[5], R[6], s).P3 - P7),
+            )
             branches = (b1, b2)
-        return cls(P1=P1, P4=P4, R=tuple(float(r) for r in R), alpha=alpha, branches=tuple(branches),
-                   phi_range=(phi0, float(phi_end)))
+        return cls(
+            P1=P1,
+            P4=P4,
+            R=tuple(float(r) for r in R),
+            alpha=alpha,
+            branches=tuple(branches),
+            phi_range=(phi0, float(phi_end)),
+        )
 
     @classmethod
     def default(cls) -> "FingerGeometry":
@@ -103,8 +133,14 @@ class FingerGeometry:
 
 # the assembled initial pose found by design_finger() (mm): P1 .. P8, and the end of the driver range
 _DEFAULT_POSE = (
-    (69.6723, -4.5266), (35.5935, 24.8611), (39.5627, 24.3651), (59.5686, 5.3915),
-    (89.2201, 30.3717), (16.6609, 41.1876), (15.721, 37.2996), (0.0001, 55.5549),
+    (69.6723, -4.5266),
+    (35.5935, 24.8611),
+    (39.5627, 24.3651),
+    (59.5686, 5.3915),
+    (89.2201, 30.3717),
+    (16.6609, 41.1876),
+    (15.721, 37.2996),
+    (0.0001, 55.5549),
 )
 _DEFAULT_PHI_END = 2.206381854910214
 
@@ -137,20 +173,34 @@ class FingerState:
 
 def finger(geom: FingerGeometry, phi1, phi1dot=0.0, phi1ddot=0.0) -> FingerState:
     """Fig. 6-14 pipeline (see the module docstring), vectorised over phi1 (rad)."""
-    ph, w, al = np.broadcast_arrays(finite_array("phi1", phi1), finite_array("phi1dot", phi1dot),
-                                    finite_array("phi1ddot", phi1ddot))
+    ph, w, al = np.broadcast_arrays(
+        finite_array("phi1", phi1),
+        finite_array("phi1dot", phi1dot),
+        finite_array("phi1ddot", phi1ddot),
+    )
     R1, R2, R3, R4, R5, R6, R7, R8 = geom.R
     a1, a2, a3 = geom.alpha
     z = np.zeros(ph.shape + (2,))
     P1 = np.broadcast_to(geom.P1, z.shape)
     P4 = np.broadcast_to(geom.P4, z.shape)
-    p2 = rigid_body_point(P1, z, z, R1, ph, w, al)                       # (6-66)
-    p5 = rigid_body_point(P1, z, z, R2, ph, w, al, a1)                   # (6-67)
-    d1 = dyad(p2.position, p2.velocity, p2.acceleration, P4, z, z, R3, R4, geom.branches[0])   # (6-70)-(6-87)
+    p2 = rigid_body_point(P1, z, z, R1, ph, w, al)  # (6-66)
+    p5 = rigid_body_point(P1, z, z, R2, ph, w, al, a1)  # (6-67)
+    d1 = dyad(
+        p2.position, p2.velocity, p2.acceleration, P4, z, z, R3, R4, geom.branches[0]
+    )  # (6-70)-(6-87)
     th2, w2, al2 = (np.asarray(x, float) for x in (d1.theta1, d1.omega1, d1.alpha1))
     p6 = rigid_body_point(p2.position, p2.velocity, p2.acceleration, R5, th2, w2, al2, a2)
-    d2 = dyad(p6.position, p6.velocity, p6.acceleration, p5.position, p5.velocity, p5.acceleration, R6, R7,
-              geom.branches[1])
+    d2 = dyad(
+        p6.position,
+        p6.velocity,
+        p6.acceleration,
+        p5.position,
+        p5.velocity,
+        p5.acceleration,
+        R6,
+        R7,
+        geom.branches[1],
+    )
     th3, w3, al3 = (np.asarray(x, float) for x in (d2.theta1, d2.omega1, d2.alpha1))
     p8 = rigid_body_point(p6.position, p6.velocity, p6.acceleration, R8, th3, w3, al3, a3)
     mid, dist = th2 + a2, th3 + a3
@@ -160,19 +210,63 @@ def finger(geom: FingerGeometry, phi1, phi1dot=0.0, phi1ddot=0.0) -> FingerState
     st1, st2 = np.asarray(d1.status), np.asarray(d2.status)
     bad = np.where(st1 != "ok", st1, st2)
     if bad.ndim == 0:
-        reason = "ok" if bad == "ok" else (f"PIP dyad: {d1.reason}" if st1 != "ok" else f"DIP dyad: {d2.reason}")
+        reason = (
+            "ok"
+            if bad == "ok"
+            else (f"PIP dyad: {d1.reason}" if st1 != "ok" else f"DIP dyad: {d2.reason}")
+        )
     else:
         nb = int(np.sum(bad != "ok"))
-        reason = "ok" if nb == 0 else f"{nb} of {bad.size} configurations: " + ", ".join(sorted(set(bad[bad != 'ok'].tolist())))
-    res = np.maximum(np.abs(np.linalg.norm(d1.P3 - P4, axis=-1) - R4),
-                     np.abs(np.linalg.norm(d2.P3 - p5.position, axis=-1) - R7))
-    pts = {"P1": P1, "P2": p2.position, "P3": d1.P3, "P4": P4, "P5": p5.position, "P6": p6.position,
-           "P7": d2.P3, "P8": p8.position}
-    vel = {"P2": p2.velocity, "P3": d1.P3dot, "P5": p5.velocity, "P6": p6.velocity, "P7": d2.P3dot, "P8": p8.velocity}
-    acc = {"P2": p2.acceleration, "P3": d1.P3ddot, "P5": p5.acceleration, "P6": p6.acceleration,
-           "P7": d2.P3ddot, "P8": p8.acceleration}
-    return FingerState(phi1=out(ph), points=pts, velocities=vel, accelerations=acc, q=q, qdot=qd, qddot=qdd,
-                       theta2=out(th2), theta3=out(th3), status=out(bad), reason=reason, residual=out(res))
+        reason = (
+            "ok"
+            if nb == 0
+            else f"{nb} of {bad.size} configurations: "
+            + ", ".join(sorted(set(bad[bad != "ok"].tolist())))
+        )
+    res = np.maximum(
+        np.abs(np.linalg.norm(d1.P3 - P4, axis=-1) - R4),
+        np.abs(np.linalg.norm(d2.P3 - p5.position, axis=-1) - R7),
+    )
+    pts = {
+        "P1": P1,
+        "P2": p2.position,
+        "P3": d1.P3,
+        "P4": P4,
+        "P5": p5.position,
+        "P6": p6.position,
+        "P7": d2.P3,
+        "P8": p8.position,
+    }
+    vel = {
+        "P2": p2.velocity,
+        "P3": d1.P3dot,
+        "P5": p5.velocity,
+        "P6": p6.velocity,
+        "P7": d2.P3dot,
+        "P8": p8.velocity,
+    }
+    acc = {
+        "P2": p2.acceleration,
+        "P3": d1.P3ddot,
+        "P5": p5.acceleration,
+        "P6": p6.acceleration,
+        "P7": d2.P3ddot,
+        "P8": p8.acceleration,
+    }
+    return FingerState(
+        phi1=out(ph),
+        points=pts,
+        velocities=vel,
+        accelerations=acc,
+        q=q,
+        qdot=qd,
+        qddot=qdd,
+        theta2=out(th2),
+        theta3=out(th3),
+        status=out(bad),
+        reason=reason,
+        residual=out(res),
+    )
 
 
 def finger_spec(geom: FingerGeometry):
@@ -185,17 +279,27 @@ def finger_spec(geom: FingerGeometry):
     p = {k: np.r_[np.asarray(v, float), 0.0] for k, v in s.points.items()}
     return LoopSpec(
         name="finger",
-        joints=(TreeJoint("mcp", "ground", "proximal", origin=origin(p["P1"])),
-                TreeJoint("pip", "proximal", "middle", origin=origin(p["P2"] - p["P1"])),
-                TreeJoint("dip", "middle", "distal", origin=origin(p["P6"] - p["P2"])),
-                TreeJoint("bar1", "ground", "bar1_link", origin=origin(p["P4"])),
-                TreeJoint("bar2", "proximal", "bar2_link", origin=origin(p["P5"] - p["P1"]))),
-        closures=(Closure("P3_middle", "P3_bar1", components=(0, 1)), Closure("P7_distal", "P7_bar2", components=(0, 1))),
+        joints=(
+            TreeJoint("mcp", "ground", "proximal", origin=origin(p["P1"])),
+            TreeJoint("pip", "proximal", "middle", origin=origin(p["P2"] - p["P1"])),
+            TreeJoint("dip", "middle", "distal", origin=origin(p["P6"] - p["P2"])),
+            TreeJoint("bar1", "ground", "bar1_link", origin=origin(p["P4"])),
+            TreeJoint("bar2", "proximal", "bar2_link", origin=origin(p["P5"] - p["P1"])),
+        ),
+        closures=(
+            Closure("P3_middle", "P3_bar1", components=(0, 1)),
+            Closure("P7_distal", "P7_bar2", components=(0, 1)),
+        ),
         inputs=("mcp",),
-        sites=(("P3_middle", "middle", origin(p["P3"] - p["P2"])), ("P3_bar1", "bar1_link", origin(p["P3"] - p["P4"])),
-               ("P7_distal", "distal", origin(p["P7"] - p["P6"])), ("P7_bar2", "bar2_link", origin(p["P7"] - p["P5"])),
-               ("P8", "distal", origin(p["P8"] - p["P6"]))),
-        length_scale=geom.length_scale)
+        sites=(
+            ("P3_middle", "middle", origin(p["P3"] - p["P2"])),
+            ("P3_bar1", "bar1_link", origin(p["P3"] - p["P4"])),
+            ("P7_distal", "distal", origin(p["P7"] - p["P6"])),
+            ("P7_bar2", "bar2_link", origin(p["P7"] - p["P5"])),
+            ("P8", "distal", origin(p["P8"] - p["P6"])),
+        ),
+        length_scale=geom.length_scale,
+    )
 
 
 def _design_build(x):
@@ -232,7 +336,11 @@ def _design_residual(x, samples: int = 41):
     for A, B, C in (("P2", "P3", "P4"), ("P6", "P7", "P5")):
         u = P[A] - P[B]
         v = P[C] - P[B]
-        sn = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]) / np.linalg.norm(u, axis=1) / np.linalg.norm(v, axis=1)
+        sn = (
+            np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+            / np.linalg.norm(u, axis=1)
+            / np.linalg.norm(v, axis=1)
+        )
         r.append(10 * np.clip(0.5 - sn, 0, None) + 100 * ~ok)
     # human-like: PIP and DIP flex in the MCP's sense, PIP <= 100 deg, DIP <= 80 deg
     sgn = np.sign(g.phi_range[1] - g.phi_range[0])
@@ -254,14 +362,35 @@ def design_finger(x0=None, samples: int = 41, max_nfev: int = 4000):
 
     x0 = np.array(_DESIGN_X0 if x0 is None else x0, float)
     lo, hi = np.array(_DESIGN_BOUNDS[0], float), np.array(_DESIGN_BOUNDS[1], float)
-    res = least_squares(_design_residual, np.clip(x0, lo, hi), args=(samples,), x_scale="jac", max_nfev=max_nfev,
-                        bounds=(lo, hi))
+    res = least_squares(
+        _design_residual,
+        np.clip(x0, lo, hi),
+        args=(samples,),
+        x_scale="jac",
+        max_nfev=max_nfev,
+        bounds=(lo, hi),
+    )
     g, pose = _design_build(res.x)
     return g, res, pose
 
 
 # start of the fit: the best of a random multi-start (bounded: lever arms 4-20 mm, bar pivots within
 # 30 mm of the MCP, driver span up to 92 deg)
-_DESIGN_X0 = [70.104, -4.049, 2.437, -2.62, 6.357, 23.273, -1.796, -1.354, 29.689, 1.908, 4.597, -0.198]
-_DESIGN_BOUNDS = ([-150, -150, -np.pi, -np.pi, 4, -30, -30, -np.pi, 5, -np.pi, 4, -1.6],
-                  [150, 150, np.pi, np.pi, 20, 30, 30, np.pi, 40, np.pi, 15, 1.6])
+_DESIGN_X0 = [
+    70.104,
+    -4.049,
+    2.437,
+    -2.62,
+    6.357,
+    23.273,
+    -1.796,
+    -1.354,
+    29.689,
+    1.908,
+    4.597,
+    -0.198,
+]
+_DESIGN_BOUNDS = (
+    [-150, -150, -np.pi, -np.pi, 4, -30, -30, -np.pi, 5, -np.pi, 4, -1.6],
+    [150, 150, np.pi, np.pi, 20, 30, 30, np.pi, 40, np.pi, 15, 1.6],
+)

@@ -56,10 +56,19 @@ ASSEMBLY_TOL = 1e-12
 MAX_LENGTH_RATIO = 1e150
 
 __all__ = [
-    "FourBarState", "CouplerPoint", "FourBarRange",
-    "fourbar", "fourbar_position", "fourbar_velocity", "fourbar_acceleration",
-    "fourbar_cartesian", "coupler_point", "fourbar_points", "fourbar_input_range",
-    "fourbar_grashof", "transmission_angle",
+    "FourBarState",
+    "CouplerPoint",
+    "FourBarRange",
+    "fourbar",
+    "fourbar_position",
+    "fourbar_velocity",
+    "fourbar_acceleration",
+    "fourbar_cartesian",
+    "coupler_point",
+    "fourbar_points",
+    "fourbar_input_range",
+    "fourbar_grashof",
+    "transmission_angle",
 ]
 
 
@@ -79,13 +88,13 @@ class FourBarState:
     theta2: object
     theta3: object
     theta4: object
-    d: object               #: crank-tip to rocker-pivot distance, Eq. (5-13)
-    theta_d: object         #: its direction, Eq. (5-14)
-    assembled: object       #: the loop closes
-    dead_point: object      #: coupler and rocker collinear (sin(th3 - th4) = 0)
-    status: object          #: "ok" | "dead_point" | "cannot_assemble"
+    d: object  #: crank-tip to rocker-pivot distance, Eq. (5-13)
+    theta_d: object  #: its direction, Eq. (5-14)
+    assembled: object  #: the loop closes
+    dead_point: object  #: coupler and rocker collinear (sin(th3 - th4) = 0)
+    status: object  #: "ok" | "dead_point" | "cannot_assemble"
     reason: str
-    residual: object        #: |loop closure error|, same unit as the lengths
+    residual: object  #: |loop closure error|, same unit as the lengths
     ground_angle: float = 0.0
     omega2: object = 0.0
     omega3: object = 0.0
@@ -102,7 +111,9 @@ class FourBarState:
     @property
     def transmission_angle(self):
         """Angle between coupler and rocker in [0, pi] (pi/2 is best; 0 or pi = dead point)."""
-        mu = np.abs(np.mod(np.asarray(self.theta3) - np.asarray(self.theta4) + np.pi, 2 * np.pi) - np.pi)
+        mu = np.abs(
+            np.mod(np.asarray(self.theta3) - np.asarray(self.theta4) + np.pi, 2 * np.pi) - np.pi
+        )
         return out(np.pi - mu)
 
 
@@ -136,10 +147,17 @@ class FourBarRange:
 
 
 def _lengths(r1, r2, r3, r4):
-    r = (positive_length("r1", r1), positive_length("r2", r2), positive_length("r3", r3), positive_length("r4", r4))
+    r = (
+        positive_length("r1", r1),
+        positive_length("r2", r2),
+        positive_length("r3", r3),
+        positive_length("r4", r4),
+    )
     if max(r) > MAX_LENGTH_RATIO * min(r):
-        raise ValueError(f"link lengths {list(r)} differ by a factor above {MAX_LENGTH_RATIO:.0e}: the squares of "
-                         "their ratios are not representable; such a linkage cannot be computed in floating point")
+        raise ValueError(
+            f"link lengths {list(r)} differ by a factor above {MAX_LENGTH_RATIO:.0e}: the squares of "
+            "their ratios are not representable; such a linkage cannot be computed in floating point"
+        )
     return r
 
 
@@ -159,8 +177,10 @@ def _reason(assembled, dead, d, r3, r4) -> str:
     dead = np.asarray(dead)
     if assembled.ndim == 0:
         if not assembled:
-            return (f"cannot assemble: crank-tip to rocker-pivot distance d = {float(d):.6g} is outside "
-                    f"[|r3 - r4|, r3 + r4] = [{abs(r3 - r4):.6g}, {r3 + r4:.6g}]")
+            return (
+                f"cannot assemble: crank-tip to rocker-pivot distance d = {float(d):.6g} is outside "
+                f"[|r3 - r4|, r3 + r4] = [{abs(r3 - r4):.6g}, {r3 + r4:.6g}]"
+            )
         if dead:
             return "dead point: coupler and rocker are collinear (transmission angle 0 or pi); rates are unbounded and reported as 0"
         return "ok"
@@ -183,12 +203,28 @@ def _finish(r1, r2, r3, r4, branch, th2, th3, th4, d, thd, k, ground_angle, gx, 
     ry = (r2 / L) * np.sin(th2) + (r3 / L) * np.sin(th3) - gy / L - (r4 / L) * np.sin(th4)
     res = L * np.hypot(rx, ry)
     return FourBarState(
-        r1=r1, r2=r2, r3=r3, r4=r4, branch=branch,
-        theta2=out(th2), theta3=out(th3), theta4=out(th4), d=out(d), theta_d=out(thd),
-        assembled=out(assembled), dead_point=out(dead), status=_status(assembled, dead),
-        reason=_reason(assembled, dead, d, r3, r4), residual=out(res), ground_angle=float(ground_angle),
-        omega2=out(np.zeros_like(th2)), omega3=out(np.zeros_like(th2)), omega4=out(np.zeros_like(th2)),
-        alpha2=out(np.zeros_like(th2)), alpha3=out(np.zeros_like(th2)), alpha4=out(np.zeros_like(th2)),
+        r1=r1,
+        r2=r2,
+        r3=r3,
+        r4=r4,
+        branch=branch,
+        theta2=out(th2),
+        theta3=out(th3),
+        theta4=out(th4),
+        d=out(d),
+        theta_d=out(thd),
+        assembled=out(assembled),
+        dead_point=out(dead),
+        status=_status(assembled, dead),
+        reason=_reason(assembled, dead, d, r3, r4),
+        residual=out(res),
+        ground_angle=float(ground_angle),
+        omega2=out(np.zeros_like(th2)),
+        omega3=out(np.zeros_like(th2)),
+        omega4=out(np.zeros_like(th2)),
+        alpha2=out(np.zeros_like(th2)),
+        alpha3=out(np.zeros_like(th2)),
+        alpha4=out(np.zeros_like(th2)),
     )
 
 
@@ -196,13 +232,17 @@ def _representable(name: str, x, why: str):
     """``x`` (computed with overflow warnings off) or ``ValueError`` when it holds inf/NaN."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
-        raise ValueError(f"{name} is beyond the float range ({why}); use smaller rates or other units")
+        raise ValueError(
+            f"{name} is beyond the float range ({why}); use smaller rates or other units"
+        )
     return x
 
 
 def _rate_scale(*rates):
     """Elementwise max(|w2|, |w3|, |w4|, sqrt|a2|) (1 where all are 0): rates / scale are <= 1."""
-    om = np.maximum.reduce([np.abs(np.asarray(r, dtype=float)) for r in rates[:-1]] + [np.sqrt(np.abs(rates[-1]))])
+    om = np.maximum.reduce(
+        [np.abs(np.asarray(r, dtype=float)) for r in rates[:-1]] + [np.sqrt(np.abs(rates[-1]))]
+    )
     return np.where(om > 0, om, 1.0)
 
 
@@ -228,14 +268,16 @@ def fourbar_position(r1, r2, r3, r4, theta2, branch: int = 1) -> FourBarState:
     r1, r2, r3, r4 = _lengths(r1, r2, r3, r4)
     branch = _branch(branch)
     th2 = finite_array("theta2", theta2)
-    L = max(r1, r2, r3, r4)                                 # lengths / L: no square overflows
+    L = max(r1, r2, r3, r4)  # lengths / L: no square overflows
     n1, n2, n3, n4 = r1 / L, r2 / L, r3 / L, r4 / L
-    zd = n1 - n2 * np.exp(1j * th2)                         # d e^{i th_d} = r1 - r2 e^{i th2}  (5-12)
-    dn = np.abs(zd)                                         # (5-13), d / L
-    thd = np.angle(zd)                                      # (5-14) with atan2
+    zd = n1 - n2 * np.exp(1j * th2)  # d e^{i th_d} = r1 - r2 e^{i th2}  (5-12)
+    dn = np.abs(zd)  # (5-13), d / L
+    thd = np.angle(zd)  # (5-14) with atan2
     k = _cosine(n3, n4, dn, n1 + n2 + n3 + n4)
-    th3 = thd + branch * np.arccos(np.clip(k, -1.0, 1.0))   # (5-16), both branches
-    th4 = np.arctan2(n3 * np.sin(th3) - dn * np.sin(thd), n3 * np.cos(th3) - dn * np.cos(thd))  # (5-17) corr.
+    th3 = thd + branch * np.arccos(np.clip(k, -1.0, 1.0))  # (5-16), both branches
+    th4 = np.arctan2(
+        n3 * np.sin(th3) - dn * np.sin(thd), n3 * np.cos(th3) - dn * np.cos(thd)
+    )  # (5-17) corr.
     return _finish(r1, r2, r3, r4, branch, th2, th3, th4, dn * L, thd, k, 0.0, r1, 0.0)
 
 
@@ -276,14 +318,24 @@ def fourbar_acceleration(state: FourBarState, alpha2=0.0) -> FourBarState:
     th2, th3, th4 = (np.asarray(x, dtype=float) for x in (state.theta2, state.theta3, state.theta4))
     w2, w3, w4 = (np.asarray(x, dtype=float) for x in (state.omega2, state.omega3, state.omega4))
     L = max(state.r1, state.r2, state.r3, state.r4)
-    r2, r3, r4 = state.r2 / L, state.r3 / L, state.r4 / L     # lengths / L and rates / om (<= 1)
+    r2, r3, r4 = state.r2 / L, state.r3 / L, state.r4 / L  # lengths / L and rates / om (<= 1)
     om = _rate_scale(w2, w3, w4, a2)
     w2, w3, w4, a2n = w2 / om, w3 / om, w4 / om, (a2 / om) / om
     # the complex method works in the ground frame (r1 on +x): rotate absolute angles back
     g = state.ground_angle
     t2, t3, t4 = th2 - g, th3 - g, th4 - g
-    A = r2 * a2n * np.sin(t2) + r2 * w2**2 * np.cos(t2) + r3 * w3**2 * np.cos(t3) - r4 * w4**2 * np.cos(t4)
-    B = -r2 * a2n * np.cos(t2) + r2 * w2**2 * np.sin(t2) + r3 * w3**2 * np.sin(t3) - r4 * w4**2 * np.sin(t4)
+    A = (
+        r2 * a2n * np.sin(t2)
+        + r2 * w2**2 * np.cos(t2)
+        + r3 * w3**2 * np.cos(t3)
+        - r4 * w4**2 * np.cos(t4)
+    )
+    B = (
+        -r2 * a2n * np.cos(t2)
+        + r2 * w2**2 * np.sin(t2)
+        + r3 * w3**2 * np.sin(t3)
+        - r4 * w4**2 * np.sin(t4)
+    )
     good = _rates_mask(state)
     den = np.where(good, np.sin(th3 - th4), 1.0)
     with np.errstate(over="ignore", invalid="ignore"):
@@ -298,14 +350,19 @@ def fourbar(r1, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch: int = 1) -> 
     """Position, velocity and acceleration in one call (complex method, Eqs. (5-12)-(5-22) corrected).
 
     ``theta2``, ``omega2``, ``alpha2`` broadcast against each other (rad, rad/s, rad/s^2)."""
-    th2, w2, a2 = np.broadcast_arrays(finite_array("theta2", theta2), finite_array("omega2", omega2),
-                                      finite_array("alpha2", alpha2))
+    th2, w2, a2 = np.broadcast_arrays(
+        finite_array("theta2", theta2),
+        finite_array("omega2", omega2),
+        finite_array("alpha2", alpha2),
+    )
     s = fourbar_position(r1, r2, r3, r4, th2, branch)
     s = fourbar_velocity(s, w2)
     return fourbar_acceleration(s, a2)
 
 
-def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch: int = 1) -> FourBarState:
+def fourbar_cartesian(
+    ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch: int = 1
+) -> FourBarState:
     """The same four-bar by Cartesian vectors, book §5-3 (Fig. 5-5), with a general ground vector.
 
     ``ground`` = r1 = (r1x, r1y), the vector from the crank pivot O2 to the rocker pivot O4.
@@ -324,9 +381,12 @@ def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch
         raise ValueError(f"ground vector must be non-zero, got {g.tolist()}")
     _, r2, r3, r4 = _lengths(r1, r2, r3, r4)
     branch = _branch(branch)
-    th2, w2, a2 = np.broadcast_arrays(finite_array("theta2", theta2), finite_array("omega2", omega2),
-                                      finite_array("alpha2", alpha2))
-    L = max(r1, r2, r3, r4)                     # every vector / L: no product overflows
+    th2, w2, a2 = np.broadcast_arrays(
+        finite_array("theta2", theta2),
+        finite_array("omega2", omega2),
+        finite_array("alpha2", alpha2),
+    )
+    L = max(r1, r2, r3, r4)  # every vector / L: no product overflows
     gn, n2, n3, n4 = g / L, r2 / L, r3 / L, r4 / L
     r2x, r2y = n2 * np.cos(th2), n2 * np.sin(th2)
     dx, dy = gn[0] - r2x, gn[1] - r2y
@@ -337,7 +397,9 @@ def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch
     r3x, r3y = n3 * np.cos(th3), n3 * np.sin(th3)
     r4x, r4y = r3x - dx, r3y - dy
     th4 = np.arctan2(r4y, r4x)
-    s = _finish(r1, r2, r3, r4, branch, th2, th3, th4, dn * L, thd, k, np.arctan2(g[1], g[0]), g[0], g[1])
+    s = _finish(
+        r1, r2, r3, r4, branch, th2, th3, th4, dn * L, thd, k, np.arctan2(g[1], g[0]), g[0], g[1]
+    )
     # r4 from the closed form has length r4 only when assembled; use the unit direction times r4
     r4x, r4y = n4 * np.cos(th4), n4 * np.sin(th4)
     good = _rates_mask(s)
@@ -347,7 +409,7 @@ def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch
         w4 = np.where(good, w2 * ((r2x * r3y - r3x * r2y) / den), 0.0)
     why = f"omega2 = {np.max(np.abs(w2)):.3g} rad/s near a dead point"
     w3, w4 = _representable("omega3", w3, why), _representable("omega4", w4, why)
-    om = _rate_scale(w2, w3, w4, a2)             # rates / om <= 1: no square overflows
+    om = _rate_scale(w2, w3, w4, a2)  # rates / om <= 1: no square overflows
     v2, v3, v4, a2n = w2 / om, w3 / om, w4 / om, (a2 / om) / om
     A = r2y * a2n + r2x * v2**2 + r3x * v3**2 - r4x * v4**2
     B = -r2x * a2n + r2y * v2**2 + r3y * v3**2 - r4y * v4**2
@@ -356,8 +418,15 @@ def fourbar_cartesian(ground, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch
         a4 = np.where(good, om * (om * (-(A * r3x + B * r3y) / den)), 0.0)
     why = f"rates up to {np.max(om):.3g} rad/s give accelerations of order their square"
     a3, a4 = _representable("alpha3", a3, why), _representable("alpha4", a4, why)
-    return replace(s, omega2=out(w2), omega3=out(w3), omega4=out(w4),
-                   alpha2=out(a2), alpha3=out(a3), alpha4=out(a4))
+    return replace(
+        s,
+        omega2=out(w2),
+        omega3=out(w3),
+        omega4=out(w4),
+        alpha2=out(a2),
+        alpha3=out(a3),
+        alpha4=out(a4),
+    )
 
 
 def coupler_point(state: FourBarState, p, gamma=0.0) -> CouplerPoint:
@@ -381,7 +450,11 @@ def coupler_point(state: FourBarState, p, gamma=0.0) -> CouplerPoint:
     def xy(name, c):
         return _representable(name, np.stack([c.real, c.imag], -1), "lengths times rates squared")
 
-    return CouplerPoint(xy("coupler point", z), xy("coupler point velocity", zd), xy("coupler point acceleration", zdd))
+    return CouplerPoint(
+        xy("coupler point", z),
+        xy("coupler point velocity", zd),
+        xy("coupler point acceleration", zdd),
+    )
 
 
 def fourbar_points(state: FourBarState) -> dict:
@@ -406,7 +479,7 @@ def fourbar_input_range(r1, r2, r3, r4) -> FourBarRange:
     cos th2 in [(r1^2 + r2^2 - (r3 + r4)^2)/(2 r1 r2), (r1^2 + r2^2 - (r3 - r4)^2)/(2 r1 r2)].
     The input is a crank (``full_turn``) when that interval contains [-1, 1]."""
     r1, r2, r3, r4 = _lengths(r1, r2, r3, r4)
-    L = max(r1, r2, r3, r4)                     # scale-free: lengths / L
+    L = max(r1, r2, r3, r4)  # scale-free: lengths / L
     r1, r2, r3, r4 = r1 / L, r2 / L, r3 / L, r4 / L
     cmin = (r1 * r1 + r2 * r2 - (r3 + r4) ** 2) / (2 * r1 * r2)
     cmax = (r1 * r1 + r2 * r2 - (r3 - r4) ** 2) / (2 * r1 * r2)
@@ -414,7 +487,7 @@ def fourbar_input_range(r1, r2, r3, r4) -> FourBarRange:
         return FourBarRange(True, ((-np.pi, np.pi),))
     if cmin > 1.0 or cmax < -1.0:
         return FourBarRange(False, ())
-    a = float(np.arccos(min(cmax, 1.0)))   # smallest |th2|
+    a = float(np.arccos(min(cmax, 1.0)))  # smallest |th2|
     b = float(np.arccos(max(cmin, -1.0)))  # largest |th2|
     if a == 0.0:
         return FourBarRange(False, ((-b, b),))
@@ -427,7 +500,7 @@ def fourbar_grashof(r1, r2, r3, r4) -> str:
     """Grashof class: "crank-rocker", "double-crank", "double-rocker", "rocker-crank",
     "change-point" (s + l = p + q) or "triple-rocker" (non-Grashof)."""
     r = _lengths(r1, r2, r3, r4)
-    r = tuple(x / max(r) for x in r)            # scale-free (no overflow of the sums)
+    r = tuple(x / max(r) for x in r)  # scale-free (no overflow of the sums)
     s, l_ = min(r), max(r)
     pq = sum(r) - s - l_
     tol = 1e-12 * sum(r)

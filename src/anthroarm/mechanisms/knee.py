@@ -43,8 +43,17 @@ PARALLEL_TOL = 1e-9
 #: the most samples :func:`icr_path` takes (1e5 flexion steps: far below a µrad)
 MAX_PATH_SAMPLES = 100_000
 
-__all__ = ["KneeGeometry", "KneeState", "default_knee", "knee_pose", "knee_flexion", "icr_path",
-           "stability_margin", "PARALLEL_TOL", "MAX_PATH_SAMPLES"]
+__all__ = [
+    "KneeGeometry",
+    "KneeState",
+    "default_knee",
+    "knee_pose",
+    "knee_flexion",
+    "icr_path",
+    "stability_margin",
+    "PARALLEL_TOL",
+    "MAX_PATH_SAMPLES",
+]
 
 
 @dataclass(frozen=True)
@@ -61,19 +70,31 @@ class KneeGeometry:
 
     def __post_init__(self):
         for name in ("prox_ant", "prox_post", "dist_ant", "dist_post", "ankle"):
-            object.__setattr__(self, name, finite_array(name, getattr(self, name), (2,)).astype(float))
-        pairs = {"anterior link": (self.prox_ant, self.dist_ant), "posterior link": (self.prox_post, self.dist_post),
-                 "thigh part": (self.prox_ant, self.prox_post), "shank part": (self.dist_ant, self.dist_post)}
+            object.__setattr__(
+                self, name, finite_array(name, getattr(self, name), (2,)).astype(float)
+            )
+        pairs = {
+            "anterior link": (self.prox_ant, self.dist_ant),
+            "posterior link": (self.prox_post, self.dist_post),
+            "thigh part": (self.prox_ant, self.prox_post),
+            "shank part": (self.dist_ant, self.dist_post),
+        }
         for what, (a, b) in pairs.items():
             if not np.hypot(*(b - a)) > 0.0:
-                raise ParameterError(f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} coincide)")
+                raise ParameterError(
+                    f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} coincide)"
+                )
 
     @property
     def lengths(self) -> tuple[float, float, float, float]:
         """(ground r1, anterior r2, distal r3, posterior r4), m: the four-bar of §5-3."""
         d = np.hypot
-        return (float(d(*(self.prox_post - self.prox_ant))), float(d(*(self.dist_ant - self.prox_ant))),
-                float(d(*(self.dist_post - self.dist_ant))), float(d(*(self.dist_post - self.prox_post))))
+        return (
+            float(d(*(self.prox_post - self.prox_ant))),
+            float(d(*(self.dist_ant - self.prox_ant))),
+            float(d(*(self.dist_post - self.dist_ant))),
+            float(d(*(self.dist_post - self.prox_post))),
+        )
 
 
 def default_knee() -> KneeGeometry:
@@ -81,8 +102,13 @@ def default_knee() -> KneeGeometry:
     proximally so that the ICR at extension sits about 9 cm above the distal pivots and behind
     the anterior link, the usual layout of polycentric knees (Radcliffe 1994, Fig. 5).
     Ankle 0.42 m below the knee."""
-    return KneeGeometry(prox_ant=(0.008, 0.030), prox_post=(-0.016, 0.030), dist_ant=(0.020, -0.010),
-                        dist_post=(-0.020, -0.015), ankle=(0.0, -0.42))
+    return KneeGeometry(
+        prox_ant=(0.008, 0.030),
+        prox_post=(-0.016, 0.030),
+        dist_ant=(0.020, -0.010),
+        dist_post=(-0.020, -0.015),
+        ankle=(0.0, -0.42),
+    )
 
 
 @dataclass(frozen=True)
@@ -135,15 +161,15 @@ def knee_pose(knee: KneeGeometry, theta2) -> KneeState:
     status = np.array(np.broadcast_to(np.asarray(s.status, dtype=object), th2.shape), dtype=object)
     A = knee.prox_ant + r2 * np.stack([np.cos(th2), np.sin(th2)], -1)
     B = A + r3 * np.stack([np.cos(th3), np.sin(th3)], -1)
-    u = np.stack([np.cos(th2), np.sin(th2)], -1)                 # anterior link direction
-    w = np.stack([np.cos(th4), np.sin(th4)], -1)                 # posterior link direction
+    u = np.stack([np.cos(th2), np.sin(th2)], -1)  # anterior link direction
+    w = np.stack([np.cos(th4), np.sin(th4)], -1)  # posterior link direction
     cross = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
     parallel = np.abs(cross) < PARALLEL_TOL
     status = np.where((status == "ok") & parallel, "parallel_links", status)
     ok = status == "ok"
     safe = np.where(ok, cross, 1.0)
     d = knee.prox_post - knee.prox_ant
-    t = (d[0] * w[:, 1] - d[1] * w[:, 0]) / safe                 # prox_ant + t u = prox_post + s w
+    t = (d[0] * w[:, 1] - d[1] * w[:, 0]) / safe  # prox_ant + t u = prox_post + s w
     icr = knee.prox_ant + t[:, None] * u
     # shank rotation relative to its extension pose: the coupler turned by th3 - th3_ext
     phi = np.where(ok, np.angle(np.exp(1j * (th3 - th3_ext))), 0.0)
@@ -164,7 +190,9 @@ def knee_flexion(knee: KneeGeometry, flexion) -> KneeState:
     cannot reach gets status "cannot_assemble" (numbers 0)."""
     target = np.atleast_1d(finite_array("flexion", flexion)).astype(float)
     if target.ndim != 1 or target.size == 0:
-        raise ParameterError(f"flexion must be one angle or a non-empty 1-D array (rad), got shape {target.shape}")
+        raise ParameterError(
+            f"flexion must be one angle or a non-empty 1-D array (rad), got shape {target.shape}"
+        )
     _, th2_ext, _ = _branch(knee)
     # sample the crank around the extension angle, keep the assembled run that contains it
     grid = th2_ext + np.linspace(-np.pi, np.pi, 4001)
@@ -175,23 +203,23 @@ def knee_flexion(knee: KneeGeometry, flexion) -> KneeState:
         lo -= 1
     while hi < len(grid) - 1 and s.ok[hi + 1]:
         hi += 1
-    f = s.flexion[lo:hi + 1]
-    g = grid[lo:hi + 1]
+    f = s.flexion[lo : hi + 1]
+    g = grid[lo : hi + 1]
     d = np.diff(f)
     mono = np.all(d > 0) or np.all(d < 0)
-    if not mono:                      # keep the monotonic run through the extension pose
+    if not mono:  # keep the monotonic run through the extension pose
         sign = np.sign(d[min(i0 - lo, len(d) - 1)])
         a = b = i0 - lo
         while a > 0 and np.sign(d[a - 1]) == sign:
             a -= 1
         while b < len(d) and np.sign(d[b]) == sign:
             b += 1
-        f, g = f[a:b + 1], g[a:b + 1]
+        f, g = f[a : b + 1], g[a : b + 1]
     order = np.argsort(f)
     f, g = f[order], g[order]
     th2 = np.interp(target, f, g)
     inside = (target >= f[0] - 1e-12) & (target <= f[-1] + 1e-12)
-    for _ in range(60):               # Newton-free refinement: secant on the sampled bracket
+    for _ in range(60):  # Newton-free refinement: secant on the sampled bracket
         st = knee_pose(knee, th2)
         err = np.where(inside & st.ok, st.flexion - target, 0.0)
         if np.abs(err).max(initial=0.0) < 1e-13:
@@ -208,8 +236,17 @@ def knee_flexion(knee: KneeGeometry, flexion) -> KneeState:
     z = ~ok
     for arr in (st.icr, st.icr_shank, st.dist_ant, st.dist_post, st.ankle):
         arr[z] = 0.0
-    return KneeState(np.where(ok, th2, 0.0), np.where(ok, st.flexion, 0.0), st.icr, st.icr_shank, st.dist_ant,
-                     st.dist_post, st.ankle, status.astype(str), ok)
+    return KneeState(
+        np.where(ok, th2, 0.0),
+        np.where(ok, st.flexion, 0.0),
+        st.icr,
+        st.icr_shank,
+        st.dist_ant,
+        st.dist_post,
+        st.ankle,
+        status.astype(str),
+        ok,
+    )
 
 
 def icr_path(knee: KneeGeometry, max_flexion: float = np.radians(120.0), n: int = 121) -> KneeState:
@@ -238,4 +275,3 @@ def stability_margin(knee: KneeGeometry, hip) -> float:
     p = st.icr[0] - hip
     # anterior is +x: the ICR is posterior when it lies on the -x side of the line (line points down)
     return float((p[0] * line[1] - p[1] * line[0]) / n)
-

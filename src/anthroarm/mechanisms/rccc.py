@@ -50,7 +50,9 @@ def _dual(x, name: str) -> Dual:
         try:
             a, b = x
         except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a Dual or an (angle, length) pair, got {x!r}") from None
+            raise ValueError(
+                f"{name} must be a Dual or an (angle, length) pair, got {x!r}"
+            ) from None
         d = Dual(float(a), float(b))
     if np.shape(d.real) != () or not (np.isfinite(d.real) and np.isfinite(d.dual)):
         raise ValueError(f"{name} must be a finite scalar dual angle, got {d!r}")
@@ -79,7 +81,14 @@ class RCCCGeometry:
     @property
     def scale(self) -> float:
         """Link size (m) for relative tolerances: the largest of |aᵢⱼ|, |s₁| and 1e-3."""
-        return max(abs(self.alpha12.dual), abs(self.alpha23.dual), abs(self.alpha34.dual), abs(self.alpha41.dual), abs(self.s1), 1e-3)
+        return max(
+            abs(self.alpha12.dual),
+            abs(self.alpha23.dual),
+            abs(self.alpha34.dual),
+            abs(self.alpha41.dual),
+            abs(self.s1),
+            1e-3,
+        )
 
 
 @dataclass
@@ -96,8 +105,17 @@ class RCCCSolution:
     @property
     def q(self) -> np.ndarray:
         """Joint vector of :func:`pinocchio_chain`: (θ₁, θ₄, s₄, θ₃, s₃, θ₂, s₂)."""
-        return np.array([self.theta1.real, self.theta4.real, self.theta4.dual, self.theta3.real,
-                         self.theta3.dual, self.theta2.real, self.theta2.dual])
+        return np.array(
+            [
+                self.theta1.real,
+                self.theta4.real,
+                self.theta4.dual,
+                self.theta3.real,
+                self.theta3.dual,
+                self.theta2.real,
+                self.theta2.dual,
+            ]
+        )
 
 
 @dataclass
@@ -118,7 +136,13 @@ class RCCCResult:
 # ----------------------------------------------------------------------------- matrices
 def loop_matrices(g: RCCCGeometry, th1: Dual, th2: Dual, th3: Dual, th4: Dual) -> tuple[Dual, Dual]:
     """(Ĉ, D̂) of Eq. (5-153) as dual matrix products (passive basic matrices (5-146)/(5-149))."""
-    C = D.screw_x(g.alpha12) @ D.screw_z(th1) @ D.screw_x(g.alpha41) @ D.screw_z(th4) @ D.screw_x(g.alpha34)
+    C = (
+        D.screw_x(g.alpha12)
+        @ D.screw_z(th1)
+        @ D.screw_x(g.alpha41)
+        @ D.screw_z(th4)
+        @ D.screw_x(g.alpha34)
+    )
     Dm = (D.screw_z(th3) @ D.screw_x(g.alpha23) @ D.screw_z(th2)).T
     return C, Dm
 
@@ -127,7 +151,14 @@ def c_elements(alpha12, alpha41, alpha34, theta1, theta4) -> Dual:
     """The nine elements of Ĉ = α̂₁₂ θ̂₁ α̂₄₁ θ̂₄ α̂₃₄ in closed form, recomputed (book §5-6 lists
     them after (5-153); c₁₂, c₂₂, c₂₃, c₃₁, c₃₂, c₃₃ are misprinted there).  Dual arguments."""
     a12, a41, a34, t1, t4 = (D.Dual.lift(x) for x in (alpha12, alpha41, alpha34, theta1, theta4))
-    c12, s12, c41, s41, c34, s34 = D.cos(a12), D.sin(a12), D.cos(a41), D.sin(a41), D.cos(a34), D.sin(a34)
+    c12, s12, c41, s41, c34, s34 = (
+        D.cos(a12),
+        D.sin(a12),
+        D.cos(a41),
+        D.sin(a41),
+        D.cos(a34),
+        D.sin(a34),
+    )
     ct1, st1, ct4, st4 = D.cos(t1), D.sin(t1), D.cos(t4), D.sin(t4)
     u = ct1 * st4 + c41 * st1 * ct4
     v = ct4 * (c12 * c41 * ct1 - s12 * s41) - c12 * st1 * st4
@@ -136,10 +167,21 @@ def c_elements(alpha12, alpha41, alpha34, theta1, theta4) -> Dual:
     y = c41 * c12 - s41 * s12 * ct1
     e = [
         [ct1 * ct4 - c41 * st1 * st4, c34 * u - s34 * s41 * st1, s34 * u + c34 * s41 * st1],
-        [-c12 * st1 * ct4 + st4 * (s41 * s12 - c41 * c12 * ct1), c34 * v - s34 * w, s34 * v + c34 * w],
-        [s12 * st1 * ct4 + st4 * (s41 * c12 + c41 * s12 * ct1), c34 * x - s34 * y, s34 * x + c34 * y],
+        [
+            -c12 * st1 * ct4 + st4 * (s41 * s12 - c41 * c12 * ct1),
+            c34 * v - s34 * w,
+            s34 * v + c34 * w,
+        ],
+        [
+            s12 * st1 * ct4 + st4 * (s41 * c12 + c41 * s12 * ct1),
+            c34 * x - s34 * y,
+            s34 * x + c34 * y,
+        ],
     ]
-    return Dual(np.array([[float(z.real) for z in r] for r in e]), np.array([[float(z.dual) for z in r] for r in e]))
+    return Dual(
+        np.array([[float(z.real) for z in r] for r in e]),
+        np.array([[float(z.dual) for z in r] for r in e]),
+    )
 
 
 def d_elements(alpha23, theta2, theta3) -> Dual:
@@ -152,7 +194,10 @@ def d_elements(alpha23, theta2, theta3) -> Dual:
         [s2 * c3 + ca * c2 * s3, -s2 * s3 + ca * c2 * c3, -sa * c2],
         [sa * s3, sa * c3, ca],
     ]
-    return Dual(np.array([[float(z.real) for z in r] for r in e]), np.array([[float(z.dual) for z in r] for r in e]))
+    return Dual(
+        np.array([[float(z.real) for z in r] for r in e]),
+        np.array([[float(z.dual) for z in r] for r in e]),
+    )
 
 
 def _X(a: Dual) -> pin.SE3:
@@ -167,8 +212,16 @@ def _Z(t: Dual) -> pin.SE3:
 def loop_se3(g: RCCCGeometry, sol: RCCCSolution) -> pin.SE3:
     """The active loop product X(α̂₁₂)Z(θ̂₁)X(α̂₄₁)Z(θ̂₄)X(α̂₃₄)Z(θ̂₃)X(α̂₂₃)Z(θ̂₂) (= I when closed)."""
     M = pin.SE3.Identity()
-    for f in (_X(g.alpha12), _Z(sol.theta1), _X(g.alpha41), _Z(sol.theta4), _X(g.alpha34), _Z(sol.theta3),
-              _X(g.alpha23), _Z(sol.theta2)):
+    for f in (
+        _X(g.alpha12),
+        _Z(sol.theta1),
+        _X(g.alpha41),
+        _Z(sol.theta4),
+        _X(g.alpha34),
+        _Z(sol.theta3),
+        _X(g.alpha23),
+        _Z(sol.theta2),
+    ):
         M = M * f
     return M
 
@@ -189,7 +242,14 @@ def rccc_position(g: RCCCGeometry, theta1: float, tol: float = DEAD_TOL) -> RCCC
     th1 = Dual(th1_real, g.s1)
     a12, a23, a34, a41 = g.alpha12, g.alpha23, g.alpha34, g.alpha41
     # c33 = A cos θ4 + B sin θ4 + C  (corrected element, dual)
-    s12, c12, s41, c41, s34, c34 = D.sin(a12), D.cos(a12), D.sin(a41), D.cos(a41), D.sin(a34), D.cos(a34)
+    s12, c12, s41, c41, s34, c34 = (
+        D.sin(a12),
+        D.cos(a12),
+        D.sin(a41),
+        D.cos(a41),
+        D.sin(a34),
+        D.cos(a34),
+    )
     ct1, st1 = D.cos(th1), D.sin(th1)
     A = -s34 * (s41 * c12 + c41 * s12 * ct1)
     B = s34 * s12 * st1
@@ -198,13 +258,23 @@ def rccc_position(g: RCCCGeometry, theta1: float, tol: float = DEAD_TOL) -> RCCC
     a, b, d = float(A.real), float(B.real), float(Dd.real)
     rho = float(np.hypot(a, b))
     if rho < tol:
-        return RCCCResult("degenerate", [], f"the input-output equation does not depend on θ4 at θ1 = {th1_real:.6g} "
-                                            f"(|A|, |B| = {abs(a):.2e}, {abs(b):.2e}; sin α34 or sin α12 ≈ 0)")
+        return RCCCResult(
+            "degenerate",
+            [],
+            f"the input-output equation does not depend on θ4 at θ1 = {th1_real:.6g} "
+            f"(|A|, |B| = {abs(a):.2e}, {abs(b):.2e}; sin α34 or sin α12 ≈ 0)",
+        )
     if abs(float(np.sin(a23.real))) < tol:
-        return RCCCResult("degenerate", [], f"sin α23 = {np.sin(a23.real):.2e}: θ2 and θ3 are not determined")
+        return RCCCResult(
+            "degenerate", [], f"sin α23 = {np.sin(a23.real):.2e}: θ2 and θ3 are not determined"
+        )
     ratio = d / rho
     if abs(ratio) > 1.0 + tol:
-        return RCCCResult("cannot assemble", [], f"no real θ4 at θ1 = {th1_real:.6g}: |cos α23 − C| / √(A² + B²) = {abs(ratio):.6g} > 1")
+        return RCCCResult(
+            "cannot assemble",
+            [],
+            f"no real θ4 at θ1 = {th1_real:.6g}: |cos α23 − C| / √(A² + B²) = {abs(ratio):.6g} > 1",
+        )
     phi0 = float(np.arctan2(b, a))
     delta = float(np.arccos(np.clip(ratio, -1.0, 1.0)))
     dead = abs(abs(ratio) - 1.0) <= tol or delta < 1e-7 or np.pi - delta < 1e-7
@@ -214,15 +284,25 @@ def rccc_position(g: RCCCGeometry, theta1: float, tol: float = DEAD_TOL) -> RCCC
         c4, s4 = np.cos(t4), np.sin(t4)
         den = b * c4 - a * s4
         if dead or abs(den) < tol * max(1.0, rho):
-            return RCCCResult("dead point", [], f"θ1 = {th1_real:.6g} is a dead point: the two branches meet at θ4 = {t4:.6g} "
-                                                f"and the slide s4 is not determined (∂c33/∂θ4 = {den:.2e})")
+            return RCCCResult(
+                "dead point",
+                [],
+                f"θ1 = {th1_real:.6g} is a dead point: the two branches meet at θ4 = {t4:.6g} "
+                f"and the slide s4 is not determined (∂c33/∂θ4 = {den:.2e})",
+            )
         s4_ = (float(Dd.dual) - float(A.dual) * c4 - float(B.dual) * s4) / den
         th4 = Dual(t4, s4_)
         Cm = c_elements(a12, a41, a34, th1, th4)
         sa = D.sin(a23)
         th2 = D.atan2(Cm[0, 2] / sa, -Cm[1, 2] / sa)
         th3 = D.atan2(Cm[2, 0] / sa, Cm[2, 1] / sa)
-        sol = RCCCSolution(branch, th1, Dual(float(th2.real), float(th2.dual)), Dual(float(th3.real), float(th3.dual)), th4)
+        sol = RCCCSolution(
+            branch,
+            th1,
+            Dual(float(th2.real), float(th2.dual)),
+            Dual(float(th3.real), float(th3.dual)),
+            th4,
+        )
         sol.closure_residual = closure_residual(g, sol)
         sols.append(sol)
     return RCCCResult("ok", sols, "")
@@ -261,12 +341,17 @@ _NAMES = ["theta1", "theta4", "s4", "theta3", "s3", "theta2", "s2"]
 def _solve(J: np.ndarray, rhs: np.ndarray, tol: float) -> tuple[str, np.ndarray, str]:
     sv = np.linalg.svd(J, compute_uv=False)
     if sv[-1] < tol * sv[0]:
-        return "dead point", np.zeros(6), f"closure Jacobian is singular (σ_min/σ_max = {sv[-1] / sv[0]:.2e})"
+        return (
+            "dead point",
+            np.zeros(6),
+            f"closure Jacobian is singular (σ_min/σ_max = {sv[-1] / sv[0]:.2e})",
+        )
     return "ok", np.linalg.solve(J, rhs), ""
 
 
-def rccc_velocity(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: float = DEAD_TOL,
-                  _screws=None) -> RCCCRates:
+def rccc_velocity(
+    g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: float = DEAD_TOL, _screws=None
+) -> RCCCRates:
     """Joint rates from Σ Jⱼ q̇ⱼ = 0 (loop closure differentiated once), input θ̇₁ (rad/s)."""
     w1 = as_scalar(theta1_dot, "theta1_dot")
     S = _joint_screws(g, sol) if _screws is None else _screws
@@ -275,8 +360,14 @@ def rccc_velocity(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, tol: fl
     return RCCCRates(st, np.concatenate([[w1], x]), msg)
 
 
-def rccc_acceleration(g: RCCCGeometry, sol: RCCCSolution, theta1_dot: float, theta1_ddot: float,
-                      velocity: RCCCRates | None = None, tol: float = DEAD_TOL) -> RCCCRates:
+def rccc_acceleration(
+    g: RCCCGeometry,
+    sol: RCCCSolution,
+    theta1_dot: float,
+    theta1_ddot: float,
+    velocity: RCCCRates | None = None,
+    tol: float = DEAD_TOL,
+) -> RCCCRates:
     """Joint accelerations from Σ Jⱼ q̈ⱼ + Σⱼ [Vⱼ₋, Jⱼ] q̇ⱼ = 0, where Vⱼ₋ is the base-frame
     twist of the link carrying joint j (sum of the upstream Jᵢ q̇ᵢ)."""
     a1 = as_scalar(theta1_ddot, "theta1_ddot")
@@ -302,7 +393,12 @@ def pinocchio_chain(g: RCCCGeometry) -> tuple[pin.Model, int]:
     X(α̂₃₄), X(α̂₂₃).  Returns (model, frame id of the cut end).  When the loop is closed the
     end frame sits at the identity with zero velocity and zero classical acceleration."""
     model = pin.Model()
-    placements = [_X(g.alpha12), pin.SE3(np.eye(3), np.array([0.0, 0.0, g.s1])) * _X(g.alpha41), _X(g.alpha34), _X(g.alpha23)]
+    placements = [
+        _X(g.alpha12),
+        pin.SE3(np.eye(3), np.array([0.0, 0.0, g.s1])) * _X(g.alpha41),
+        _X(g.alpha34),
+        _X(g.alpha23),
+    ]
     parent = 0
     inertia = pin.Inertia.FromSphere(1.0, 0.05)
     for k, M in enumerate(placements):

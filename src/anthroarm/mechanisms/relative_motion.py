@@ -104,11 +104,24 @@ def relative_position(g: RelativeMotionGeometry, theta, phi, s) -> RelativePosit
     return RelativePosition(q, p, u, q1p, p1p)
 
 
-def relative_velocity(g: RelativeMotionGeometry, theta, theta_dot, phi, phi_dot, s, s_dot,
-                      p0_dot=(0.0, 0.0, 0.0), position: RelativePosition | None = None) -> RelativeVelocity:
+def relative_velocity(
+    g: RelativeMotionGeometry,
+    theta,
+    theta_dot,
+    phi,
+    phi_dot,
+    s,
+    s_dot,
+    p0_dot=(0.0, 0.0, 0.0),
+    position: RelativePosition | None = None,
+) -> RelativeVelocity:
     """q̇ = ṗ₀ + [W_{θ̇,u₀}](q − p₀) + [W_{φ̇,u}](q − p) + ṡ u, Eq. (4-7)–(4-11)."""
     pos = position or relative_position(g, theta, phi, s)
-    thd, phd, sd = as_angle(theta_dot, "theta_dot"), as_angle(phi_dot, "phi_dot"), as_angle(s_dot, "s_dot")
+    thd, phd, sd = (
+        as_angle(theta_dot, "theta_dot"),
+        as_angle(phi_dot, "phi_dot"),
+        as_angle(s_dot, "s_dot"),
+    )
     p0d = as_vector3(p0_dot, "p0_dot")
     W0 = thd[..., None, None] * skew(g.u0)
     Wu = phd[..., None, None] * skew(pos.u)
@@ -117,9 +130,20 @@ def relative_velocity(g: RelativeMotionGeometry, theta, theta_dot, phi, phi_dot,
     return RelativeVelocity(transport + relative, transport, relative)
 
 
-def relative_acceleration(g: RelativeMotionGeometry, theta, theta_dot, theta_ddot, phi, phi_dot, phi_ddot,
-                          s, s_dot, s_ddot, p0_ddot=(0.0, 0.0, 0.0),
-                          position: RelativePosition | None = None) -> RelativeAcceleration:
+def relative_acceleration(
+    g: RelativeMotionGeometry,
+    theta,
+    theta_dot,
+    theta_ddot,
+    phi,
+    phi_dot,
+    phi_ddot,
+    s,
+    s_dot,
+    s_ddot,
+    p0_ddot=(0.0, 0.0, 0.0),
+    position: RelativePosition | None = None,
+) -> RelativeAcceleration:
     """q̈ = transport (4-13) + relative (4-14) + Coriolis (4-15)/(4-16), total (4-17)."""
     pos = position or relative_position(g, theta, phi, s)
     thd, thdd = as_angle(theta_dot, "theta_dot"), as_angle(theta_ddot, "theta_ddot")
@@ -146,9 +170,13 @@ def pinocchio_model(g: RelativeMotionGeometry) -> tuple[pin.Model, int]:
     I = pin.Inertia.FromSphere(1.0, 0.05)
     j1 = model.addJoint(0, pin.JointModelRevoluteUnaligned(g.u0), pin.SE3(np.eye(3), g.p0), "theta")
     model.appendBodyToJoint(j1, I, pin.SE3.Identity())
-    j2 = model.addJoint(j1, pin.JointModelPrismaticUnaligned(g.u1), pin.SE3(np.eye(3), g.p1 - g.p0), "s")
+    j2 = model.addJoint(
+        j1, pin.JointModelPrismaticUnaligned(g.u1), pin.SE3(np.eye(3), g.p1 - g.p0), "s"
+    )
     model.appendBodyToJoint(j2, I, pin.SE3.Identity())
     j3 = model.addJoint(j2, pin.JointModelRevoluteUnaligned(g.u1), pin.SE3.Identity(), "phi")
     model.appendBodyToJoint(j3, I, pin.SE3.Identity())
-    fid = model.addFrame(pin.Frame("q", j3, 0, pin.SE3(np.eye(3), g.q1 - g.p1), pin.FrameType.OP_FRAME))
+    fid = model.addFrame(
+        pin.Frame("q", j3, 0, pin.SE3(np.eye(3), g.q1 - g.p1), pin.FrameType.OP_FRAME)
+    )
     return model, fid

@@ -37,12 +37,37 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ._util import Wdot, assembly_status, difference, finite_array, finite_scalar, norm, out, point3, pow2_scale, representable_fields, rot, skew, unit_axis
+from ._util import (
+    Wdot,
+    assembly_status,
+    difference,
+    finite_array,
+    finite_scalar,
+    norm,
+    out,
+    point3,
+    pow2_scale,
+    representable_fields,
+    rot,
+    skew,
+    unit_axis,
+)
 
 DEAD_POINT_TOL = 1e-7
 
-__all__ = ["RRSSGeometry", "RRSSState", "RRSSPoint", "rrss", "rrss_position", "rrss_efg", "rrss_branch_through",
-           "rrss_point", "rrss_newton", "rrss_track", "rrss_constraints"]
+__all__ = [
+    "RRSSGeometry",
+    "RRSSState",
+    "RRSSPoint",
+    "rrss",
+    "rrss_position",
+    "rrss_efg",
+    "rrss_branch_through",
+    "rrss_point",
+    "rrss_newton",
+    "rrss_track",
+    "rrss_constraints",
+]
 
 
 @dataclass(frozen=True)
@@ -65,9 +90,11 @@ class RRSSGeometry:
         if self.bar_length == 0.0:
             raise ValueError(f"b1 and b0 coincide ({self.b1.tolist()}): zero-length S-S bar")
         d = difference("b1 - a1", self.b1, self.a1)
-        d = d / pow2_scale(d)                  # exact; no overflow of the projection
+        d = d / pow2_scale(d)  # exact; no overflow of the projection
         if np.linalg.norm(d - self.u1 * (self.u1 @ d)) == 0.0:
-            raise ValueError(f"b1 = {self.b1.tolist()} lies on the hinge axis u1: theta2 cannot move it")
+            raise ValueError(
+                f"b1 = {self.b1.tolist()} lies on the hinge axis u1: theta2 cannot move it"
+            )
 
     @property
     def bar_length(self) -> float:
@@ -75,8 +102,11 @@ class RRSSGeometry:
 
     @property
     def length_scale(self) -> float:
-        return float(norm("a1 - a0", difference("a1 - a0", self.a1, self.a0))
-                     + norm("b1 - a1", difference("b1 - a1", self.b1, self.a1)) + self.bar_length)
+        return float(
+            norm("a1 - a0", difference("a1 - a0", self.a1, self.a0))
+            + norm("b1 - a1", difference("b1 - a1", self.b1, self.a1))
+            + self.bar_length
+        )
 
 
 @dataclass(frozen=True)
@@ -99,14 +129,14 @@ class RRSSState:
     addot: np.ndarray
     bddot: np.ndarray
     R2: np.ndarray
-    omega2: np.ndarray        #: world angular velocity of R2 (rad/s)
-    omegadot2: np.ndarray     #: world angular acceleration of R2 (rad/s^2)
+    omega2: np.ndarray  #: world angular velocity of R2 (rad/s)
+    omegadot2: np.ndarray  #: world angular acceleration of R2 (rad/s^2)
     branch: int
     assembled: object
     dead_point: object
     status: object
     reason: str
-    residual: object          #: | |b - b0| - |b1 - b0| |, m
+    residual: object  #: | |b - b0| - |b1 - b0| |, m
     iterations: int = 0
 
     @property
@@ -135,9 +165,9 @@ def rrss_efg(geom: RRSSGeometry, theta1):
     """E, F, G of (6-98) and a, b', u_a of (6-93)-(6-95), vectorised over theta1."""
     th1 = finite_array("theta1", theta1)
     R1 = rot(th1, geom.u0)
-    a = _vec(R1, geom.a1 - geom.a0) + geom.a0                     # (6-93)
-    bp = _vec(R1, geom.b1 - geom.a0) + geom.a0                    # (6-94)
-    ua = _vec(R1, np.broadcast_to(geom.u1, R1.shape[:-1]))        # (6-95)
+    a = _vec(R1, geom.a1 - geom.a0) + geom.a0  # (6-93)
+    bp = _vec(R1, geom.b1 - geom.a0) + geom.a0  # (6-94)
+    ua = _vec(R1, np.broadcast_to(geom.u1, R1.shape[:-1]))  # (6-95)
     c = a - geom.b0
     e = bp - a
     ue = _dot(ua, e)
@@ -168,50 +198,87 @@ def rrss(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, branch: int 
     ``branch`` +1 takes the "+" root of (6-99)."""
     if branch not in (1, -1):
         raise ValueError(f"branch must be +1 or -1, got {branch!r}")
-    th1, w1, al1 = np.broadcast_arrays(finite_array("theta1", theta1), finite_array("theta1dot", theta1dot),
-                                       finite_array("theta1ddot", theta1ddot))
+    th1, w1, al1 = np.broadcast_arrays(
+        finite_array("theta1", theta1),
+        finite_array("theta1dot", theta1dot),
+        finite_array("theta1ddot", theta1ddot),
+    )
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         E, F, G, a, bp, ua = rrss_efg(geom, th1)
         disc = E * E + F * F - G * G
-        L = np.float64(geom.length_scale)     # numpy: overflow is inf (checked below), not OverflowError
+        L = np.float64(
+            geom.length_scale
+        )  # numpy: overflow is inf (checked below), not OverflowError
         assembled = disc >= -1e-12 * L**4
-        th2 = _half_angle(E, F, G, branch, np.sqrt(np.clip(disc, 0.0, None)))   # (6-99)
+        th2 = _half_angle(E, F, G, branch, np.sqrt(np.clip(disc, 0.0, None)))  # (6-99)
         R2rel = _rot_batch(th2, ua)
-        b = _vec(R2rel, bp - a) + a                                               # (6-96)
+        b = _vec(R2rel, bp - a) + a  # (6-96)
         R1 = rot(th1, geom.u0)
         u0 = geom.u0
         rb0, rba, rba0 = b - geom.b0, b - a, b - geom.a0
         den = _dot(rb0, np.cross(ua, rba))
-        dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.bar_length * np.linalg.norm(geom.b1 - geom.a1))
+        dead = assembled & (
+            np.abs(den) < DEAD_POINT_TOL * geom.bar_length * np.linalg.norm(geom.b1 - geom.a1)
+        )
         good = assembled & ~dead
         dens = np.where(good, den, 1.0)
-        w2 = np.where(good, -w1 * _dot(rb0, np.cross(u0, rba0)) / dens, 0.0)      # (6-105)
+        w2 = np.where(good, -w1 * _dot(rb0, np.cross(u0, rba0)) / dens, 0.0)  # (6-105)
         om1 = w1[..., None] * u0
-        adot = np.cross(om1, a - geom.a0)                                         # (6-106)
-        bdot = np.cross(om1, rba0) + w2[..., None] * np.cross(ua, rba)            # (6-103)/(6-104)
-        b_e = _vec(Wdot(w1, al1, u0), rba0)                                       # transport
-        b_c = 2 * np.cross(om1, w2[..., None] * np.cross(ua, rba))                # Coriolis
+        adot = np.cross(om1, a - geom.a0)  # (6-106)
+        bdot = np.cross(om1, rba0) + w2[..., None] * np.cross(ua, rba)  # (6-103)/(6-104)
+        b_e = _vec(Wdot(w1, al1, u0), rba0)  # transport
+        b_c = 2 * np.cross(om1, w2[..., None] * np.cross(ua, rba))  # Coriolis
         cen = (w2**2)[..., None] * np.cross(ua, np.cross(ua, rba))
-        al2 = np.where(good, -(_dot(rb0, b_e + cen + b_c) + _dot(bdot, bdot)) / dens, 0.0)   # (6-111)
-        addot = _vec(Wdot(w1, al1, u0), a - geom.a0)                              # (6-112)
-        bddot = b_e + al2[..., None] * np.cross(ua, rba) + cen + b_c              # (6-110)
+        al2 = np.where(
+            good, -(_dot(rb0, b_e + cen + b_c) + _dot(bdot, bdot)) / dens, 0.0
+        )  # (6-111)
+        addot = _vec(Wdot(w1, al1, u0), a - geom.a0)  # (6-112)
+        bddot = b_e + al2[..., None] * np.cross(ua, rba) + cen + b_c  # (6-110)
         om2 = om1 + w2[..., None] * ua
         uadot = np.cross(om1, ua)
         omd2 = al1[..., None] * u0 + al2[..., None] * ua + w2[..., None] * uadot
         st, reason = assembly_status(
-            assembled, dead, th1, disc, "theta1",
-            "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0")
+            assembled,
+            dead,
+            th1,
+            disc,
+            "theta1",
+            "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0",
+        )
         if not np.all(good):
             z = ~good[..., None]
             bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
             om2, omd2 = np.where(z, 0.0, om2), np.where(z, 0.0, omd2)
         res = np.abs(np.linalg.norm(rb0, axis=-1) - geom.bar_length)
-    st_ = RRSSState(theta1=out(th1), theta2=out(th2), theta1dot=out(w1), theta2dot=out(w2), theta1ddot=out(al1),
-                     theta2ddot=out(al2), a=a, u_a=ua, b=b, adot=adot, bdot=bdot, addot=addot, bddot=bddot,
-                     R2=R2rel @ R1, omega2=om2, omegadot2=omd2, branch=int(branch), assembled=out(assembled),
-                     dead_point=out(dead), status=out(st), reason=reason, residual=out(res))
-    return representable_fields(st_, f"length scale {geom.length_scale:.3g} m, theta1dot up to "
-                                f"{np.max(np.abs(w1)):.3g} rad/s, theta1ddot up to {np.max(np.abs(al1)):.3g} rad/s^2")
+    st_ = RRSSState(
+        theta1=out(th1),
+        theta2=out(th2),
+        theta1dot=out(w1),
+        theta2dot=out(w2),
+        theta1ddot=out(al1),
+        theta2ddot=out(al2),
+        a=a,
+        u_a=ua,
+        b=b,
+        adot=adot,
+        bdot=bdot,
+        addot=addot,
+        bddot=bddot,
+        R2=R2rel @ R1,
+        omega2=om2,
+        omegadot2=omd2,
+        branch=int(branch),
+        assembled=out(assembled),
+        dead_point=out(dead),
+        status=out(st),
+        reason=reason,
+        residual=out(res),
+    )
+    return representable_fields(
+        st_,
+        f"length scale {geom.length_scale:.3g} m, theta1dot up to "
+        f"{np.max(np.abs(w1)):.3g} rad/s, theta1ddot up to {np.max(np.abs(al1)):.3g} rad/s^2",
+    )
 
 
 def _rot_batch(theta, u):
@@ -225,7 +292,10 @@ def _rot_batch(theta, u):
 def rrss_branch_through(geom: RRSSGeometry, theta1: float = 0.0, theta2: float = 0.0) -> int:
     """The branch sign whose solution passes through (theta1, theta2) — by default the reference
     configuration (b = b1 at theta1 = 0), "the sign comes from the initial state" (6-99)."""
-    err = [abs(np.angle(np.exp(1j * (rrss_position(geom, theta1, s).theta2 - theta2)))) for s in (1, -1)]
+    err = [
+        abs(np.angle(np.exp(1j * (rrss_position(geom, theta1, s).theta2 - theta2))))
+        for s in (1, -1)
+    ]
     return 1 if err[0] <= err[1] else -1
 
 
@@ -243,8 +313,12 @@ def rrss_point(geom: RRSSGeometry, state: RRSSState, P1) -> RRSSPoint:
     om1 = w1[..., None] * u0
     rP0, rPa = P - geom.a0, P - state.a
     V = np.cross(om1, rP0) + w2[..., None] * np.cross(ua, rPa)
-    A = (_vec(Wdot(w1, al1, u0), rP0) + al2[..., None] * np.cross(ua, rPa)
-         + (w2**2)[..., None] * np.cross(ua, np.cross(ua, rPa)) + 2 * np.cross(om1, w2[..., None] * np.cross(ua, rPa)))
+    A = (
+        _vec(Wdot(w1, al1, u0), rP0)
+        + al2[..., None] * np.cross(ua, rPa)
+        + (w2**2)[..., None] * np.cross(ua, np.cross(ua, rPa))
+        + 2 * np.cross(om1, w2[..., None] * np.cross(ua, rPa))
+    )
     return RRSSPoint(P, V, A)
 
 
@@ -268,14 +342,16 @@ def rrss_constraints(geom: RRSSGeometry, x, theta1: float) -> np.ndarray:
     u0, d1 = geom.u0, geom.a1 - geom.a0
     d = a - geom.a0
     n = rot(theta1, u0) @ np.cross(u0, d1)
-    return np.array([
-        u0 @ d - u0 @ d1,
-        ua @ d - geom.u1 @ d1,
-        u0 @ ua - u0 @ geom.u1,
-        np.cross(d, ua) @ u0 - np.cross(d1, geom.u1) @ u0,
-        ((b - geom.b0) @ (b - geom.b0) - geom.bar_length ** 2) / (2 * geom.bar_length),
-        d @ n / max(np.linalg.norm(d1), 1e-300),
-    ])
+    return np.array(
+        [
+            u0 @ d - u0 @ d1,
+            ua @ d - geom.u1 @ d1,
+            u0 @ ua - u0 @ geom.u1,
+            np.cross(d, ua) @ u0 - np.cross(d1, geom.u1) @ u0,
+            ((b - geom.b0) @ (b - geom.b0) - geom.bar_length**2) / (2 * geom.bar_length),
+            d @ n / max(np.linalg.norm(d1), 1e-300),
+        ]
+    )
 
 
 def _G(geom, x, theta1):
@@ -288,14 +364,16 @@ def _G(geom, x, theta1):
     nd1 = max(np.linalg.norm(d1), 1e-300)
     L = geom.bar_length
     z = np.zeros(3)
-    G = np.array([
-        np.r_[u0, z],
-        np.r_[ua, np.cross(ua, d)],
-        np.r_[z, np.cross(ua, u0)],
-        np.r_[np.cross(ua, u0), np.cross(ua, np.cross(u0, d))],
-        np.r_[(b - geom.b0) / L, np.cross(b - a, b - geom.b0) / L],
-        np.r_[n / nd1, z],
-    ])
+    G = np.array(
+        [
+            np.r_[u0, z],
+            np.r_[ua, np.cross(ua, d)],
+            np.r_[z, np.cross(ua, u0)],
+            np.r_[np.cross(ua, u0), np.cross(ua, np.cross(u0, d))],
+            np.r_[(b - geom.b0) / L, np.cross(b - a, b - geom.b0) / L],
+            np.r_[n / nd1, z],
+        ]
+    )
     g_th = np.zeros(6)
     g_th[5] = d @ np.cross(u0, n) / nd1
     return G, g_th, (R, a, b, ua, d, n, nd1)
@@ -334,14 +412,16 @@ def _rates(geom, x, theta1, w1, al1):
     b0dd = np.cross(om, np.cross(om, b - a))
     ua0dd = np.cross(om, np.cross(om, ua))
     ndot = w1 * np.cross(u0, n)
-    quad = np.array([
-        0.0,
-        ua0dd @ d + 2 * uad @ pd,
-        u0 @ ua0dd,
-        np.cross(ua0dd, u0) @ d + 2 * np.cross(uad, u0) @ pd,
-        ((b - geom.b0) @ b0dd + bd @ bd) / L,
-        (2 * pd @ ndot + w1**2 * d @ np.cross(u0, np.cross(u0, n))) / nd1,
-    ])
+    quad = np.array(
+        [
+            0.0,
+            ua0dd @ d + 2 * uad @ pd,
+            u0 @ ua0dd,
+            np.cross(ua0dd, u0) @ d + 2 * np.cross(uad, u0) @ pd,
+            ((b - geom.b0) @ b0dd + bd @ bd) / L,
+            (2 * pd @ ndot + w1**2 * d @ np.cross(u0, np.cross(u0, n))) / nd1,
+        ]
+    )
     acc = np.linalg.solve(G, -quad - g_th * al1)
     return pd, om, acc[:3], acc[3:]
 
@@ -363,14 +443,42 @@ def _state_from_x(geom, x, th1, w1, al1, iters, status, reason, rates):
     bddot = pdd + np.cross(omd, b - a) + np.cross(om, np.cross(om, b - a))
     res = abs(np.linalg.norm(b - geom.b0) - geom.bar_length)
     assembled = status in ("ok", "dead_point")
-    return RRSSState(theta1=float(th1), theta2=th2, theta1dot=float(w1), theta2dot=w2, theta1ddot=float(al1),
-                     theta2ddot=al2, a=a, u_a=ua, b=b, adot=pd, bdot=bdot, addot=pdd, bddot=bddot, R2=R,
-                     omega2=om, omegadot2=omd, branch=0, assembled=assembled, dead_point=status == "dead_point",
-                     status=status, reason=reason, residual=float(res), iterations=iters)
+    return RRSSState(
+        theta1=float(th1),
+        theta2=th2,
+        theta1dot=float(w1),
+        theta2dot=w2,
+        theta1ddot=float(al1),
+        theta2ddot=al2,
+        a=a,
+        u_a=ua,
+        b=b,
+        adot=pd,
+        bdot=bdot,
+        addot=pdd,
+        bddot=bddot,
+        R2=R,
+        omega2=om,
+        omegadot2=omd,
+        branch=0,
+        assembled=assembled,
+        dead_point=status == "dead_point",
+        status=status,
+        reason=reason,
+        residual=float(res),
+        iterations=iters,
+    )
 
 
-def rrss_track(geom: RRSSGeometry, theta1_path, theta1dot=0.0, theta1ddot=0.0, x0=None,
-               tol: float = 1e-14, max_halvings: int = 12) -> list:
+def rrss_track(
+    geom: RRSSGeometry,
+    theta1_path,
+    theta1dot=0.0,
+    theta1ddot=0.0,
+    x0=None,
+    tol: float = 1e-14,
+    max_halvings: int = 12,
+) -> list:
     """Newton-Raphson with continuation along ``theta1_path`` (002 §4-3: "use the previous
     position's solution as the initial estimate").
 
@@ -392,8 +500,10 @@ def rrss_track(geom: RRSSGeometry, theta1_path, theta1dot=0.0, theta1ddot=0.0, x
         if lost is None:
             x, ok, iters = _march(geom, x, th_prev, th, tol_abs, max_halvings)
             if not ok:
-                lost = (f"branch lost between theta1 = {th_prev:.6g} and {th:.6g}: Newton fails even for tiny steps "
-                        "(dead point or assembly limit)")
+                lost = (
+                    f"branch lost between theta1 = {th_prev:.6g} and {th:.6g}: Newton fails even for tiny steps "
+                    "(dead point or assembly limit)"
+                )
             else:
                 th_prev = th
         if lost is not None:
@@ -401,8 +511,19 @@ def rrss_track(geom: RRSSGeometry, theta1_path, theta1dot=0.0, theta1ddot=0.0, x
             continue
         r = _rates(geom, x, th, w1, al1)
         if r is None:
-            states.append(_state_from_x(geom, x, th, w1, al1, iters, "dead_point",
-                                        "dead point: the constraint Jacobian is singular; rates reported as 0", None))
+            states.append(
+                _state_from_x(
+                    geom,
+                    x,
+                    th,
+                    w1,
+                    al1,
+                    iters,
+                    "dead_point",
+                    "dead point: the constraint Jacobian is singular; rates reported as 0",
+                    None,
+                )
+            )
         else:
             states.append(_state_from_x(geom, x, th, w1, al1, iters, "ok", "ok", r))
     return states
@@ -426,7 +547,9 @@ def _march(geom, x, th_from, th_to, tol, max_halvings):
             xp[3:] += np.linalg.solve(R @ pin.Jexp3(x[3:]), om) * step
         xn, _, it, ok = _newton(geom, xp, t + step, tol)
         total += it
-        if ok and np.linalg.norm(xn[3:] - x[3:]) < 0.5 + 2 * abs(step):   # guard against branch jumps
+        if ok and np.linalg.norm(xn[3:] - x[3:]) < 0.5 + 2 * abs(
+            step
+        ):  # guard against branch jumps
             x, t = xn, t + step
             if halvings:
                 h, halvings = h * 2, halvings - 1
@@ -438,8 +561,9 @@ def _march(geom, x, th_from, th_to, tol, max_halvings):
     return x, True, total
 
 
-def rrss_newton(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, steps: int = 8,
-                tol: float = 1e-14) -> RRSSState:
+def rrss_newton(
+    geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, steps: int = 8, tol: float = 1e-14
+) -> RRSSState:
     """One configuration by continuation from the reference pose (theta1 = 0) in ``steps``
     equal steps, then velocity and acceleration (002 (4-48)/(4-49) and their derivative)."""
     th = finite_scalar("theta1", theta1)

@@ -31,12 +31,32 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._util import assembly_status, finite_array, norm, out, point3, positive_length, representable_fields, rot, skew, unit_axis
+from ._util import (
+    assembly_status,
+    finite_array,
+    norm,
+    out,
+    point3,
+    positive_length,
+    representable_fields,
+    rot,
+    skew,
+    unit_axis,
+)
 
 DEAD_POINT_TOL = 1e-7
 
-__all__ = ["RSSRGeometry", "RSSRState", "RSSRCrankTest", "rssr_position", "rssr", "rssr_crank_test",
-           "rssr_branch_through", "rssr_efg", "rssr_polar"]
+__all__ = [
+    "RSSRGeometry",
+    "RSSRState",
+    "RSSRCrankTest",
+    "rssr_position",
+    "rssr",
+    "rssr_crank_test",
+    "rssr_branch_through",
+    "rssr_efg",
+    "rssr_polar",
+]
 
 
 def _diff(p, q):
@@ -81,7 +101,7 @@ class RSSRGeometry:
     @property
     def crank_radius(self) -> float:
         d = _diff(self.a1, self.a0)
-        s = _pow2(d)       # d / 2^k: no overflow of the projection
+        s = _pow2(d)  # d / 2^k: no overflow of the projection
         return float(s * norm("crank radius", d / s - self.ua * (self.ua @ (d / s))))
 
     @property
@@ -121,7 +141,7 @@ class RSSRState:
     dead_point: object
     status: object
     reason: str
-    residual: object        #: | |a - b| - |a1 - b1| |, m
+    residual: object  #: | |a - b| - |a1 - b1| |, m
 
     @property
     def ok(self):
@@ -150,14 +170,14 @@ def rssr_efg(geom: RSSRGeometry, alpha):
     """E, F, G of (4-21) and the crank sphere centre a(alpha) (4-19), vectorised over alpha."""
     al = finite_array("alpha", alpha)
     Ra = rot(al, geom.ua)
-    a = np.einsum("...ij,j->...i", Ra, geom.a1 - geom.a0) + geom.a0          # (4-19)
+    a = np.einsum("...ij,j->...i", Ra, geom.a1 - geom.a0) + geom.a0  # (4-19)
     c = a - geom.b0
     d = geom.b1 - geom.b0
     P = skew(geom.ub)
     Q = np.outer(geom.ub, geom.ub)
     E = c @ ((np.eye(3) - Q) @ d)
     F = c @ (P @ d)
-    L2 = np.float64(geom.coupler_length) ** 2        # numpy: inf on overflow, not OverflowError
+    L2 = np.float64(geom.coupler_length) ** 2  # numpy: inf on overflow, not OverflowError
     G = c @ (Q @ d) + 0.5 * (L2 - np.einsum("...i,...i", c, c) - d @ d)
     return E, F, G, a
 
@@ -185,45 +205,84 @@ def rssr(geom: RSSRGeometry, alpha, alphadot=0.0, alphaddot=0.0, branch: int = 1
     beta'' = [(a - b)^T (a'' - beta'^2 [P_ub]^2 (b - b0)) + |a' - b'|^2] / ((a - b)^T [P_ub](b - b0))   (4-30)
     with a' = alpha' [P_ua](a - a0) (4-24), a'' = [E_{alpha',alpha'',ua}](a - a0) (4-28)."""
     s = _check_branch(branch)
-    al, ad, add = np.broadcast_arrays(finite_array("alpha", alpha), finite_array("alphadot", alphadot),
-                                      finite_array("alphaddot", alphaddot))
+    al, ad, add = np.broadcast_arrays(
+        finite_array("alpha", alpha),
+        finite_array("alphadot", alphadot),
+        finite_array("alphaddot", alphaddot),
+    )
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         E, F, G, a = rssr_efg(geom, al)
         disc = E * E + F * F - G * G
-        scale2 = np.float64(geom.rocker_radius * (geom.coupler_length + geom.crank_radius + geom.rocker_radius)) ** 2
+        scale2 = (
+            np.float64(
+                geom.rocker_radius * (geom.coupler_length + geom.crank_radius + geom.rocker_radius)
+            )
+            ** 2
+        )
         assembled = disc >= -1e-12 * scale2
         root = np.sqrt(np.clip(disc, 0.0, None))
         beta = _beta(E, F, G, s, root)
         Rb = rot(beta, geom.ub)
-        b = np.einsum("...ij,j->...i", Rb, geom.b1 - geom.b0) + geom.b0            # (4-20)
+        b = np.einsum("...ij,j->...i", Rb, geom.b1 - geom.b0) + geom.b0  # (4-20)
         Pa, Pb = skew(geom.ua), skew(geom.ub)
         ra, rb = a - geom.a0, b - geom.b0
         ab = a - b
-        adot = ad[..., None] * (ra @ Pa.T)                                          # (4-24)
-        addot = add[..., None] * (ra @ Pa.T) + (ad**2)[..., None] * (ra @ (Pa @ Pa).T)   # (4-28)
+        adot = ad[..., None] * (ra @ Pa.T)  # (4-24)
+        addot = add[..., None] * (ra @ Pa.T) + (ad**2)[..., None] * (ra @ (Pa @ Pa).T)  # (4-28)
         den = np.einsum("...i,...i", ab, rb @ Pb.T)
         dead = assembled & (np.abs(den) < DEAD_POINT_TOL * geom.coupler_length * geom.rocker_radius)
         good = assembled & ~dead
         dens = np.where(good, den, 1.0)
-        bd = np.where(good, np.einsum("...i,...i", adot, ab) / dens, 0.0)           # (4-26)
-        bdot = bd[..., None] * (rb @ Pb.T)                                          # (4-25)
+        bd = np.where(good, np.einsum("...i,...i", adot, ab) / dens, 0.0)  # (4-26)
+        bdot = bd[..., None] * (rb @ Pb.T)  # (4-25)
         rel = adot - bdot
-        num = np.einsum("...i,...i", ab, addot - (bd**2)[..., None] * (rb @ (Pb @ Pb).T)) + np.einsum("...i,...i", rel, rel)
-        bdd = np.where(good, num / dens, 0.0)                                       # (4-30)
-        bddot = bdd[..., None] * (rb @ Pb.T) + (bd**2)[..., None] * (rb @ (Pb @ Pb).T)   # (4-29)
+        num = np.einsum(
+            "...i,...i", ab, addot - (bd**2)[..., None] * (rb @ (Pb @ Pb).T)
+        ) + np.einsum("...i,...i", rel, rel)
+        bdd = np.where(good, num / dens, 0.0)  # (4-30)
+        bddot = bdd[..., None] * (rb @ Pb.T) + (bd**2)[..., None] * (rb @ (Pb @ Pb).T)  # (4-29)
         res = np.abs(np.linalg.norm(ab, axis=-1) - geom.coupler_length)
         st, reason = assembly_status(
-            assembled, dead, al, disc, "alpha",
-            "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0", " (4-31)")
-        if not np.all(good):   # keep the rates of bad entries exactly zero
+            assembled,
+            dead,
+            al,
+            disc,
+            "alpha",
+            "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0",
+            " (4-31)",
+        )
+        if not np.all(good):  # keep the rates of bad entries exactly zero
             z = ~good[..., None]
             bdot, bddot = np.where(z, 0.0, bdot), np.where(z, 0.0, bddot)
-    st_ = RSSRState(alpha=out(al), beta=out(beta), alphadot=out(ad), betadot=out(bd), alphaddot=out(add),
-                     betaddot=out(bdd), a=a, b=b, adot=adot, bdot=bdot, addot=addot, bddot=bddot,
-                     E=out(E), F=out(F), G=out(G), discriminant=out(disc), branch=s, assembled=out(assembled),
-                     dead_point=out(dead), status=out(st), reason=reason, residual=out(res))
-    return representable_fields(st_, f"length scale {geom.length_scale:.3g} m, alphadot up to "
-                                f"{np.max(np.abs(ad)):.3g} rad/s, alphaddot up to {np.max(np.abs(add)):.3g} rad/s^2")
+    st_ = RSSRState(
+        alpha=out(al),
+        beta=out(beta),
+        alphadot=out(ad),
+        betadot=out(bd),
+        alphaddot=out(add),
+        betaddot=out(bdd),
+        a=a,
+        b=b,
+        adot=adot,
+        bdot=bdot,
+        addot=addot,
+        bddot=bddot,
+        E=out(E),
+        F=out(F),
+        G=out(G),
+        discriminant=out(disc),
+        branch=s,
+        assembled=out(assembled),
+        dead_point=out(dead),
+        status=out(st),
+        reason=reason,
+        residual=out(res),
+    )
+    return representable_fields(
+        st_,
+        f"length scale {geom.length_scale:.3g} m, alphadot up to "
+        f"{np.max(np.abs(ad)):.3g} rad/s, alphaddot up to {np.max(np.abs(add)):.3g} rad/s^2",
+    )
 
 
 def rssr_branch_through(geom: RSSRGeometry, alpha0: float = 0.0, beta0: float = 0.0) -> int:
@@ -243,7 +302,9 @@ def rssr_crank_test(geom: RSSRGeometry, samples: int = 3600) -> RSSRCrankTest:
     from scipy.optimize import minimize_scalar
 
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 8:
-        raise ValueError(f"samples must be an integer >= 8 (points over the turn of the input), got {samples!r}")
+        raise ValueError(
+            f"samples must be an integer >= 8 (points over the turn of the input), got {samples!r}"
+        )
     al = np.linspace(-np.pi, np.pi, int(samples), endpoint=False)
     E, F, G, _ = rssr_efg(geom, al)
     disc = E * E + F * F - G * G
@@ -254,7 +315,9 @@ def rssr_crank_test(geom: RSSRGeometry, samples: int = 3600) -> RSSRCrankTest:
         e, fq, g, _ = rssr_efg(geom, x)
         return float(e * e + fq * fq - g * g)
 
-    r = minimize_scalar(f, bounds=(al[i] - h, al[i] + h), method="bounded", options={"xatol": 1e-12})
+    r = minimize_scalar(
+        f, bounds=(al[i] - h, al[i] + h), method="bounded", options={"xatol": 1e-12}
+    )
     mn, amin = (float(r.fun), float(r.x)) if r.fun < disc[i] else (float(disc[i]), float(al[i]))
     ok = disc >= 0
     intervals = []
@@ -272,12 +335,17 @@ def rssr_crank_test(geom: RSSRGeometry, samples: int = 3600) -> RSSRCrankTest:
                 k = j + 1
             else:
                 k += 1
-        if len(intervals) > 1 and ok[0] and ok[-1]:   # wraps around +/-pi
+        if len(intervals) > 1 and ok[0] and ok[-1]:  # wraps around +/-pi
             first, last = intervals[0], intervals[-1]
             intervals = [(last[0], first[1] + 2 * np.pi)] + intervals[1:-1]
     kind = "crank" if mn >= 0 else ("rocker" if ok.any() else "cannot_assemble")
-    return RSSRCrankTest(is_crank=mn >= 0, kind=kind, min_discriminant=mn, alpha_at_min=amin,
-                         intervals=tuple(intervals))
+    return RSSRCrankTest(
+        is_crank=mn >= 0,
+        kind=kind,
+        min_discriminant=mn,
+        alpha_at_min=amin,
+        intervals=tuple(intervals),
+    )
 
 
 def rssr_polar(r2, r3, r4, C, theta2, phi2, branch: int = 1):

@@ -81,7 +81,11 @@ class ThumbGeometry:
             object.__setattr__(self, n, finite_array(n, getattr(self, n), (2,)))
         object.__setattr__(self, "R3", positive_length("R3", self.R3))
         object.__setattr__(self, "beta", finite_scalar("beta", self.beta))
-        for n, v in (("R2 = |P0|", self.R2), ("R4 = |F0 - P0|", self.R4), ("R5 = |F0 - C|", self.R5)):
+        for n, v in (
+            ("R2 = |P0|", self.R2),
+            ("R4 = |F0 - P0|", self.R4),
+            ("R5 = |F0 - C|", self.R5),
+        ):
             if v == 0.0:
                 raise ValueError(f"{n} is zero")
 
@@ -126,15 +130,35 @@ class ThumbGeometry:
     def book(cls) -> "ThumbGeometry":
         """The Chapter 4 §4-5 thumb (see the module docstring for every reading we had to make)."""
         u1 = np.array([np.sqrt(3) / 2, np.sqrt(3) / 4, -0.25])
-        g = RRSSGeometry(a0=[0, 0, 0], u0=[0, 0, -1], a1=np.array([0, 30.0, 0]) * MM, u1=u1,
-                         b0=np.array([-2.229, -4.316, -48.326]) * MM, b1=np.array([15.913, 15.462, -40.15]) * MM)
-        pac, xf, yf, xc, alpha, beta = np.deg2rad(157.098), -42.132 * MM, 17.918 * MM, 14.758 * MM, np.deg2rad(159.913), np.deg2rad(49.365)
+        g = RRSSGeometry(
+            a0=[0, 0, 0],
+            u0=[0, 0, -1],
+            a1=np.array([0, 30.0, 0]) * MM,
+            u1=u1,
+            b0=np.array([-2.229, -4.316, -48.326]) * MM,
+            b1=np.array([15.913, 15.462, -40.15]) * MM,
+        )
+        pac, xf, yf, xc, alpha, beta = (
+            np.deg2rad(157.098),
+            -42.132 * MM,
+            17.918 * MM,
+            14.758 * MM,
+            np.deg2rad(159.913),
+            np.deg2rad(49.365),
+        )
         back = g.a0 - g.a1
         back = back - u1 * (u1 @ back)
         back /= np.linalg.norm(back)
-        ex = rot(alpha - pac, u1) @ back       # A->C: R1's line turned by alpha - PAC about u1
-        return cls(rrss=g, ex=ex, P0=45 * MM * np.array([np.cos(pac), np.sin(pac)]), F0=np.array([xf, yf]),
-                   C=np.array([xc, 0.0]), R3=35 * MM, beta=beta)
+        ex = rot(alpha - pac, u1) @ back  # A->C: R1's line turned by alpha - PAC about u1
+        return cls(
+            rrss=g,
+            ex=ex,
+            P0=45 * MM * np.array([np.cos(pac), np.sin(pac)]),
+            F0=np.array([xf, yf]),
+            C=np.array([xc, 0.0]),
+            R3=35 * MM,
+            beta=beta,
+        )
 
 
 @dataclass(frozen=True)
@@ -164,17 +188,26 @@ class ThumbState:
     rrss: RRSSState
     status: object
     reason: str
-    residual: object    #: largest closure error of the two loops (m)
+    residual: object  #: largest closure error of the two loops (m)
 
 
 def _dyad_branch(geom: ThumbGeometry) -> int:
     z = np.zeros(2)
-    d = [np.linalg.norm(dyad(geom.P0, z, z, geom.C, z, z, geom.R4, geom.R5, s).P3 - geom.F0) for s in (1, -1)]
+    d = [
+        np.linalg.norm(dyad(geom.P0, z, z, geom.C, z, z, geom.R4, geom.R5, s).P3 - geom.F0)
+        for s in (1, -1)
+    ]
     return 1 if d[0] <= d[1] else -1
 
 
-def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branch: int | None = None,
-          dyad_branch: int | None = None) -> ThumbState:
+def thumb(
+    geom: ThumbGeometry,
+    theta1,
+    theta1dot=0.0,
+    theta1ddot=0.0,
+    rrss_branch: int | None = None,
+    dyad_branch: int | None = None,
+) -> ThumbState:
     """Thumb kinematics for driver angle(s) theta1 (rad, scalar or array) and rates, Fig. 6-17 pipeline.
 
     Branches default to the ones through the initial pose (theta1 = 0: theta2 = theta3 = 0).
@@ -182,8 +215,11 @@ def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branc
     T = R(theta1, u0) [ex ey u1] ((6-115); the book's x'y'z' frame differs by a constant in-plane
     rotation); (6-116) S' = T S_r' + W(theta1', u0)(S - a0),
     S'' = T S_r'' + Wdot(theta1', theta1'', u0)(S - a0) + 2 W(theta1', u0) T S_r'."""
-    th1, w1, al1 = np.broadcast_arrays(finite_array("theta1", theta1), finite_array("theta1dot", theta1dot),
-                                       finite_array("theta1ddot", theta1ddot))
+    th1, w1, al1 = np.broadcast_arrays(
+        finite_array("theta1", theta1),
+        finite_array("theta1dot", theta1dot),
+        finite_array("theta1ddot", theta1ddot),
+    )
     g = geom.rrss
     rb = rrss_branch_through(g) if rrss_branch is None else rrss_branch
     db = _dyad_branch(geom) if dyad_branch is None else dyad_branch
@@ -193,8 +229,10 @@ def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branc
     th2, w2, al2 = (np.asarray(x, float) for x in (r.theta2, r.theta2dot, r.theta2ddot))
     # planar four-bar relative to R1 (Fig. 6-16): crank R2 about A (origin), a' = c' = 0
     ang0 = float(np.arctan2(geom.P0[1], geom.P0[0]))
-    P = rigid_body_point(z, z, z, geom.R2, ang0 + th2, w2, al2)                    # (6-66)-(6-69)
-    dy = dyad(P.position, P.velocity, P.acceleration, C, z, z, geom.R4, geom.R5, db)   # (6-70)-(6-87)
+    P = rigid_body_point(z, z, z, geom.R2, ang0 + th2, w2, al2)  # (6-66)-(6-69)
+    dy = dyad(
+        P.position, P.velocity, P.acceleration, C, z, z, geom.R4, geom.R5, db
+    )  # (6-70)-(6-87)
     phi0 = float(np.arctan2(*(geom.F0 - geom.P0)[::-1]))
     t31, w31, a31 = (np.asarray(x, float) for x in (dy.theta1, dy.omega1, dy.alpha1))
     S = rigid_body_point(P.position, P.velocity, P.acceleration, geom.R3, t31, w31, a31, geom.beta)
@@ -207,7 +245,9 @@ def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branc
     Wm, Wd = W(w1, g.u0), Wdot(w1, al1, g.u0)
 
     def lift(v):
-        return np.einsum("...ij,...j->...i", T, np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], -1))
+        return np.einsum(
+            "...ij,...j->...i", T, np.concatenate([v, np.zeros(v.shape[:-1] + (1,))], -1)
+        )
 
     def mv(M, v):
         return np.einsum("...ij,...j->...i", M, v)
@@ -222,19 +262,46 @@ def thumb(geom: ThumbGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, rrss_branc
     Pddot = lift(P.acceleration) + mv(Wd, Pw - g.a0) + 2 * mv(Wm, Pd_r)
     F_w = lift(dy.P3) + a
     rs, ds = np.asarray(r.status), np.asarray(dy.status)
-    status = np.where(rs == "cannot_assemble", rs, np.where(ds == "cannot_assemble", ds,
-                      np.where(rs != "ok", rs, ds)))
+    status = np.where(
+        rs == "cannot_assemble",
+        rs,
+        np.where(ds == "cannot_assemble", ds, np.where(rs != "ok", rs, ds)),
+    )
     if status.ndim == 0:
         st = str(status)
-        reason = "ok" if st == "ok" else (f"RRSS: {r.reason}" if str(rs) == st else f"upper four-bar: {dy.reason}")
+        reason = (
+            "ok"
+            if st == "ok"
+            else (f"RRSS: {r.reason}" if str(rs) == st else f"upper four-bar: {dy.reason}")
+        )
     else:
         nb = int(np.sum(status != "ok"))
         reason = "ok" if nb == 0 else f"RRSS: {r.reason}; upper four-bar: {dy.reason}"
     res = np.maximum(np.asarray(r.residual), np.abs(np.linalg.norm(dy.P3 - C, axis=-1) - geom.R5))
-    return ThumbState(theta1=out(th1), theta2=out(th2), theta3=out(th3), theta1dot=out(w1), theta2dot=out(w2),
-                      theta3dot=out(w3), theta1ddot=out(al1), theta2ddot=out(al2), theta3ddot=out(al3), a=a, P=Pw,
-                      Pdot=Pdot, Pddot=Pddot, S=S_w, Sdot=Sdot, Sddot=Sddot, S_r=S.position, F=F_w, rrss=r,
-                      status=out(status), reason=reason, residual=out(res))
+    return ThumbState(
+        theta1=out(th1),
+        theta2=out(th2),
+        theta3=out(th3),
+        theta1dot=out(w1),
+        theta2dot=out(w2),
+        theta3dot=out(w3),
+        theta1ddot=out(al1),
+        theta2ddot=out(al2),
+        theta3ddot=out(al3),
+        a=a,
+        P=Pw,
+        Pdot=Pdot,
+        Pddot=Pddot,
+        S=S_w,
+        Sdot=Sdot,
+        Sddot=Sddot,
+        S_r=S.position,
+        F=F_w,
+        rrss=r,
+        status=out(status),
+        reason=reason,
+        residual=out(res),
+    )
 
 
 def thumb_spec(geom: ThumbGeometry):
@@ -253,17 +320,24 @@ def thumb_spec(geom: ThumbGeometry):
     Pw, Fw, Cw, Sw = (geom.to_world(x) for x in (geom.P0, geom.F0, geom.C, geom.S0))
     return LoopSpec(
         name="thumb",
-        joints=(TreeJoint("r1", "ground", "R1", origin=origin(g.a0, R0)),
-                TreeJoint("r2", "R1", "R2", origin=origin(R0.T @ (g.a1 - g.a0), R0.T @ Ru)),
-                TreeJoint("r3", "R2", "R3", origin=origin(Ru.T @ (Pw - g.a1))),
-                TreeJoint("rocker", "R1", "rocker_link", origin=origin(R0.T @ (Cw - g.a0), R0.T @ Ru)),
-                TreeJoint("ball_b0", "ground", "bar", "ball", origin=origin(g.b0, Rbar))),
+        joints=(
+            TreeJoint("r1", "ground", "R1", origin=origin(g.a0, R0)),
+            TreeJoint("r2", "R1", "R2", origin=origin(R0.T @ (g.a1 - g.a0), R0.T @ Ru)),
+            TreeJoint("r3", "R2", "R3", origin=origin(Ru.T @ (Pw - g.a1))),
+            TreeJoint("rocker", "R1", "rocker_link", origin=origin(R0.T @ (Cw - g.a0), R0.T @ Ru)),
+            TreeJoint("ball_b0", "ground", "bar", "ball", origin=origin(g.b0, Rbar)),
+        ),
         closures=(Closure("b_R2", "b_bar"), Closure("F_R3", "F_rocker")),
         inputs=("r1",),
-        sites=(("b_R2", "R2", origin(Ru.T @ (g.b1 - g.a1))), ("b_bar", "bar", origin(Rbar.T @ (g.b1 - g.b0))),
-               ("F_R3", "R3", origin(Ru.T @ (Fw - Pw))), ("F_rocker", "rocker_link", origin(Ru.T @ (Fw - Cw))),
-               ("S", "R3", origin(Ru.T @ (Sw - Pw)))),
-        length_scale=geom.length_scale)
+        sites=(
+            ("b_R2", "R2", origin(Ru.T @ (g.b1 - g.a1))),
+            ("b_bar", "bar", origin(Rbar.T @ (g.b1 - g.b0))),
+            ("F_R3", "R3", origin(Ru.T @ (Fw - Pw))),
+            ("F_rocker", "rocker_link", origin(Ru.T @ (Fw - Cw))),
+            ("S", "R3", origin(Ru.T @ (Sw - Pw))),
+        ),
+        length_scale=geom.length_scale,
+    )
 
 
 __all__.append("thumb_spec")

@@ -17,12 +17,12 @@ from pathlib import Path
 from ..errors import ParameterError, UnknownModelError
 from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
 from .care_robot import care_robot
-from .templates import TEMPLATES
 from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .human_upper_limb import human_upper_limb
 from .prosthetic_hand import prosthetic_hand
 from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
+from .templates import TEMPLATES
 
 BOOK_MODELS = {
     "prosthetic_arm": prosthetic_arm,
@@ -33,7 +33,7 @@ BOOK_MODELS = {
     "planar2r": planar2r,
     "human_upper_limb": human_upper_limb,
     "care_robot": care_robot,
-    "prosthetic_hand": prosthetic_hand,   # Fig. 2-8/2-9 linkages; plain URDF with fitted mimic joints
+    "prosthetic_hand": prosthetic_hand,  # Fig. 2-8/2-9 linkages; plain URDF with fitted mimic joints
     **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
 }
 
@@ -68,9 +68,11 @@ def book_names() -> list[str]:
 
 
 def _unknown(name) -> UnknownModelError:
-    return UnknownModelError(f"unknown model {name!r}; the catalog has: {', '.join(names())}; "
-                             f"example-robot-data has: {', '.join(n for n in erd_names() if n not in ERD_ARMS)}; "
-                             "or give a URDF path")
+    return UnknownModelError(
+        f"unknown model {name!r}; the catalog has: {', '.join(names())}; "
+        f"example-robot-data has: {', '.join(n for n in erd_names() if n not in ERD_ARMS)}; "
+        "or give a URDF path"
+    )
 
 
 def spec(name: str, **params) -> ChainSpec:
@@ -83,7 +85,9 @@ def spec(name: str, **params) -> ChainSpec:
         import inspect
 
         sig = inspect.signature(BOOK_MODELS[name])
-        raise ParameterError(f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})") from None
+        raise ParameterError(
+            f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})"
+        ) from None
 
 
 def urdf_text(name: str, **params) -> str:
@@ -111,8 +115,10 @@ def urdf_path(name: str) -> Path:
 
     folder = cache.folder("urdf")
     if folder is None:
-        raise FileNotFoundError(f"{p} does not exist (not a source checkout) and {cache.status()}; "
-                                f"use anthroarm.models.urdf_text({name!r})")
+        raise FileNotFoundError(
+            f"{p} does not exist (not a source checkout) and {cache.status()}; "
+            f"use anthroarm.models.urdf_text({name!r})"
+        )
     p, text = folder / f"{name}.urdf", urdf_text(name)
     if not p.is_file() or p.read_text(encoding="utf-8") != text:
         atomic_write_text(p, text)
@@ -134,8 +140,30 @@ def write_urdfs(out_dir=None) -> list[Path]:
 
 
 __all__ = [
-    "BOOK_MODELS", "ERD_ARMS", "ErdArm", "ChainSpec", "DHRow", "JointSpec", "LinkSpec",
-    "dh_matrix", "from_dh", "to_urdf", "names", "book_names", "spec", "urdf_text", "urdf_path",
-    "write_urdfs", "erd_names", "erd_urdf_path", "human_arm7", "prosthetic_arm", "sixr_arm", "unimate5", "rrprr5", "planar2r",
-    "segment_parameters", "care_robot",
+    "BOOK_MODELS",
+    "ERD_ARMS",
+    "ErdArm",
+    "ChainSpec",
+    "DHRow",
+    "JointSpec",
+    "LinkSpec",
+    "dh_matrix",
+    "from_dh",
+    "to_urdf",
+    "names",
+    "book_names",
+    "spec",
+    "urdf_text",
+    "urdf_path",
+    "write_urdfs",
+    "erd_names",
+    "erd_urdf_path",
+    "human_arm7",
+    "prosthetic_arm",
+    "sixr_arm",
+    "unimate5",
+    "rrprr5",
+    "planar2r",
+    "segment_parameters",
+    "care_robot",
 ]

@@ -28,8 +28,10 @@ def _lengths(model: str, **values) -> None:
             except (TypeError, ValueError):
                 ok = False
         if not ok:
-            raise ParameterError(f"{model}: {name} must be a finite length >= 0 (m), e.g. {name}=0.3; "
-                                 f"got {type(v).__name__} {v!r}")
+            raise ParameterError(
+                f"{model}: {name} must be a finite length >= 0 (m), e.g. {name}=0.3; "
+                f"got {type(v).__name__} {v!r}"
+            )
 
 
 def _stroke(model: str, name: str, stroke) -> tuple[float, float]:
@@ -39,9 +41,13 @@ def _stroke(model: str, name: str, stroke) -> tuple[float, float]:
             raise TypeError("a string")
         lo, hi = (float(x) for x in stroke)
     except (TypeError, ValueError):
-        raise ParameterError(f"{model}: {name} must be a pair (lower, upper) in m, got {stroke!r}") from None
+        raise ParameterError(
+            f"{model}: {name} must be a pair (lower, upper) in m, got {stroke!r}"
+        ) from None
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise ParameterError(f"{model}: {name} must be finite with lower < upper (m), got {stroke!r}")
+        raise ParameterError(
+            f"{model}: {name} must be finite with lower < upper (m), got {stroke!r}"
+        )
     return lo, hi
 
 
@@ -66,8 +72,14 @@ def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> C
         DHRow("R", 90 * deg, s=L2, lower=-90 * deg, upper=90 * deg),
         DHRow("R", -90 * deg, lower=-90 * deg, upper=90 * deg),
     ]
-    names = ["shoulder_rotation", "shoulder_elevation", "humeral_rotation", "elbow_flexion",
-             "forearm_rotation", "wrist_flexion"]
+    names = [
+        "shoulder_rotation",
+        "shoulder_elevation",
+        "humeral_rotation",
+        "elbow_flexion",
+        "forearm_rotation",
+        "wrist_flexion",
+    ]
     return from_dh(
         "prosthetic_arm",
         "Anthropomorphic 6R prosthetic arm (book Ch.7 Fig. 7-2, Table 7.1); tool = palm centre C.",
@@ -157,10 +169,16 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
     """Two-link planar mechanism of Fig. 7-14 (l. 5637/5645): two parallel hinges about x,
     links of 1 m, y = l1 cos θ1 + l2 cos(θ1+θ2), z = l1 sin θ1 + l2 sin(θ1+θ2)."""
     _lengths("planar2r", l1=l1, l2=l2)
-    j1 = JointSpec("joint1", "revolute", homogeneous(), axis=(1.0, 0, 0),
-                   link=rod_link("link1", [0, l1, 0]))
-    j2 = JointSpec("joint2", "revolute", homogeneous(r=[0, l1, 0]), axis=(1.0, 0, 0),
-                   link=rod_link("link2", [0, l2, 0]))
+    j1 = JointSpec(
+        "joint1", "revolute", homogeneous(), axis=(1.0, 0, 0), link=rod_link("link1", [0, l1, 0])
+    )
+    j2 = JointSpec(
+        "joint2",
+        "revolute",
+        homogeneous(r=[0, l1, 0]),
+        axis=(1.0, 0, 0),
+        link=rod_link("link2", [0, l2, 0]),
+    )
     from .spec import DEFAULT_JOINT_MASS, DEFAULT_LINEAR_DENSITY, DEFAULT_LINK_RADIUS
 
     return ChainSpec(

@@ -47,8 +47,10 @@ class MelodyCode:
 @functools.cache
 def melody_codes() -> tuple[MelodyCode, ...]:
     """The 36 rows of Table 9.6 in the printed order (No. 1–36)."""
-    return tuple(MelodyCode(int(r["no"]), r["display"], r["output_zh"], r["output_en"])
-                 for r in _rows("table_9_6_melody.csv"))
+    return tuple(
+        MelodyCode(int(r["no"]), r["display"], r["output_zh"], r["output_en"])
+        for r in _rows("table_9_6_melody.csv")
+    )
 
 
 def melody_lookup(display: str) -> MelodyCode:
@@ -63,8 +65,10 @@ def melody_lookup(display: str) -> MelodyCode:
     for row in melody_codes():
         if row.display == key:
             return row
-    raise UnknownCodeError(f"display code {display!r} is not in Table 9.6; printed codes: "
-                           f"{', '.join(r.display for r in melody_codes())}")
+    raise UnknownCodeError(
+        f"display code {display!r} is not in Table 9.6; printed codes: "
+        f"{', '.join(r.display for r in melody_codes())}"
+    )
 
 
 @dataclass(frozen=True)
@@ -84,9 +88,17 @@ class RangeOfMotion:
 def lower_limb_rom() -> tuple[RangeOfMotion, ...]:
     """Table 2.4, the ranges of motion of the human lower limb, row by row as printed.  The
     knee-extension cell is blank in the print (``range_deg`` None)."""
-    return tuple(RangeOfMotion(r["joint"], r["joint_zh"], r["motion"], r["motion_zh"],
-                               float(r["range_deg"]) if r["range_deg"] else None, r["printed"])
-                 for r in _rows("table_2_4_lower_limb_rom.csv"))
+    return tuple(
+        RangeOfMotion(
+            r["joint"],
+            r["joint_zh"],
+            r["motion"],
+            r["motion_zh"],
+            float(r["range_deg"]) if r["range_deg"] else None,
+            r["printed"],
+        )
+        for r in _rows("table_2_4_lower_limb_rom.csv")
+    )
 
 
 def lower_limb_limits() -> dict[str, tuple[float, float]]:
@@ -99,7 +111,10 @@ def lower_limb_limits() -> dict[str, tuple[float, float]]:
     knee_ext = rom[("knee", "extension")] or 0.0
     return {
         "hip_flexion": (-d(rom[("hip", "extension")]), d(rom[("hip", "flexion")])),
-        "hip_rotation": (-d(rom[("hip", "internal_external_rotation")]), d(rom[("hip", "internal_external_rotation")])),
+        "hip_rotation": (
+            -d(rom[("hip", "internal_external_rotation")]),
+            d(rom[("hip", "internal_external_rotation")]),
+        ),
         "knee_flexion": (-d(knee_ext) if knee_ext else 0.0, d(rom[("knee", "flexion")])),
         "ankle_flexion": (-d(rom[("ankle", "plantarflexion")]), d(rom[("ankle", "dorsiflexion")])),
     }
@@ -127,5 +142,15 @@ def robot_forms() -> tuple[RobotForm, ...]:
     return tuple(RobotForm(**r) for r in _rows("table_2_3_robot_forms.csv"))
 
 
-__all__ = ["MELODY_CODES_3_NOTES", "MELODY_CODES_4_NOTES", "MelodyCode", "melody_codes", "melody_lookup",
-           "RangeOfMotion", "lower_limb_rom", "lower_limb_limits", "RobotForm", "robot_forms"]
+__all__ = [
+    "MELODY_CODES_3_NOTES",
+    "MELODY_CODES_4_NOTES",
+    "MelodyCode",
+    "melody_codes",
+    "melody_lookup",
+    "RangeOfMotion",
+    "lower_limb_rom",
+    "lower_limb_limits",
+    "RobotForm",
+    "robot_forms",
+]

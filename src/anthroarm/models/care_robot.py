@@ -90,16 +90,24 @@ def pulses_per_rad(encoder_counts: float = ENCODER_COUNTS, gear_ratio: float = G
     try:
         c, g = float(encoder_counts), float(gear_ratio)
     except (TypeError, ValueError):
-        raise ParameterError(f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, "
-                             f"{gear_ratio!r}") from None
+        raise ParameterError(
+            f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, {gear_ratio!r}"
+        ) from None
     if not (np.isfinite(c) and np.isfinite(g) and c > 0 and g > 0):
         raise ParameterError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
     return c * g / (2.0 * np.pi)
 
 
-def cell_table(robot=None, *, rotation=R_FORWARD, bounds=CELL_BOUNDS, D: float = CELL_D,
-               branch: str = CELL_BRANCH, encoder_counts: float = ENCODER_COUNTS,
-               gear_ratio: float = GEAR_RATIO):
+def cell_table(
+    robot=None,
+    *,
+    rotation=R_FORWARD,
+    bounds=CELL_BOUNDS,
+    D: float = CELL_D,
+    branch: str = CELL_BRANCH,
+    encoder_counts: float = ENCODER_COUNTS,
+    gear_ratio: float = GEAR_RATIO,
+):
     """The care robot's spatial cell table of §9-3 (l. 7589) with the motor pulses stored.
 
     The lattice holds **wrist-centre** positions ("手腕的位置坐标") every ``D`` = 10 cm in x, y,
@@ -141,16 +149,21 @@ def cell_table(robot=None, *, rotation=R_FORWARD, bounds=CELL_BOUNDS, D: float =
 
         robot = load("care_robot")
     if robot.spec is None or robot.spec.name != "care_robot":
-        raise ParameterError("cell_table needs the catalog care_robot (aa.load('care_robot', ...)): the wrist "
-                             f"offset P and the table's IK branch are its own; got {robot.name!r}"
-                             + (" without its parameter table (loaded from a URDF?)" if robot.spec is None else ""))
+        raise ParameterError(
+            "cell_table needs the catalog care_robot (aa.load('care_robot', ...)): the wrist "
+            f"offset P and the table's IK branch are its own; got {robot.name!r}"
+            + (" without its parameter table (loaded from a URDF?)" if robot.spec is None else "")
+        )
     P = float(robot.spec.params["P"])
-    table = CellTable.build(robot, rotation, D, bounds, branch=branch, progress=False,
-                            point=(0.0, 0.0, -P))
+    table = CellTable.build(
+        robot, rotation, D, bounds, branch=branch, progress=False, point=(0.0, 0.0, -P)
+    )
     return table.with_pulses(pulses_per_rad(encoder_counts, gear_ratio))
 
 
-def care_robot(s0: float = 0.115, h2: float = 0.295, s3: float = 0.280, P: float = 0.186) -> ChainSpec:
+def care_robot(
+    s0: float = 0.115, h2: float = 0.295, s3: float = 0.280, P: float = 0.186
+) -> ChainSpec:
     """Care manipulator of §9-3, Table 9.5, on the assumed layout of the 6R arm of Fig. 6-3.
 
     Parameters
@@ -167,7 +180,7 @@ def care_robot(s0: float = 0.115, h2: float = 0.295, s3: float = 0.280, P: float
         for what is printed and what is assumed (the layout: Fig. 9-28 is lost).
     """
     _lengths("care_robot", s0=s0, h2=h2, s3=s3, P=P)
-    rows = sixr_arm(s0=s0, h2=h2, s3=s3, P=P).dh           # the one H-D table of Fig. 6-3
+    rows = sixr_arm(s0=s0, h2=h2, s3=s3, P=P).dh  # the one H-D table of Fig. 6-3
     spec = from_dh(
         "care_robot",
         "Bedridden-patient care manipulator (book §9-3, Table 9.5) on the assumed 6R layout of "
@@ -175,18 +188,24 @@ def care_robot(s0: float = 0.115, h2: float = 0.295, s3: float = 0.280, P: float
         rows,
         homogeneous(r=[0, 0, P]),
         source="book 000 l.7556-7617 (Table 9.5: lengths 115/295/280/186 mm, printed total 856 but "
-               "the parts sum to 876; masses 2.38/1.82/1.16/0.57 kg = 5.93); joint layout assumed "
-               "(6R of Fig. 6-3), ranges assumed +-180 deg",
+        "the parts sum to 876; masses 2.38/1.82/1.16/0.57 kg = 5.93); joint layout assumed "
+        "(6R of Fig. 6-3), ranges assumed +-180 deg",
         joint_names=["waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw"],
         params={"s0": s0, "h2": h2, "s3": s3, "P": P},
         tool_name="grip",
         inertia_source="Table 9.5 segment masses (base 2.38, upper arm 1.82, forearm 1.16, finger-palm "
-                       "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
-                       f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)",
+        "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
+        f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)",
     )
     m = {k: v[1] for k, v in TABLE_9_5.items()}
-    masses = [m["base"], m["upper_arm"], HOUSING_MASS, m["forearm"] - HOUSING_MASS, HOUSING_MASS,
-              m["finger_palm"] - HOUSING_MASS]
+    masses = [
+        m["base"],
+        m["upper_arm"],
+        HOUSING_MASS,
+        m["forearm"] - HOUSING_MASS,
+        HOUSING_MASS,
+        m["finger_palm"] - HOUSING_MASS,
+    ]
     for j, mass in zip(spec.joints, masses):
         j.link = rod_link(j.link.name, j.link.segment, mass=mass, joint_mass=0.0)
         # coreless DC motors through a worm reduction: slow joints (rad/s) -- an assumption
@@ -194,6 +213,21 @@ def care_robot(s0: float = 0.115, h2: float = 0.295, s3: float = 0.280, P: float
     return spec
 
 
-__all__ = ["care_robot", "cell_table", "pulses_per_rad", "ENCODER_COUNTS", "GEAR_RATIO", "R_FORWARD",
-           "CELL_BOUNDS", "CELL_BRANCH", "TABLE_9_5", "CELL_D", "CELL_ACCURACY", "HOUSING_MASS", "DOF_PRINTED",
-           "MOTORS_PRINTED", "table_9_5_length_sum_mm", "table_9_5_mass_sum_kg"]
+__all__ = [
+    "care_robot",
+    "cell_table",
+    "pulses_per_rad",
+    "ENCODER_COUNTS",
+    "GEAR_RATIO",
+    "R_FORWARD",
+    "CELL_BOUNDS",
+    "CELL_BRANCH",
+    "TABLE_9_5",
+    "CELL_D",
+    "CELL_ACCURACY",
+    "HOUSING_MASS",
+    "DOF_PRINTED",
+    "MOTORS_PRINTED",
+    "table_9_5_length_sum_mm",
+    "table_9_5_mass_sum_kg",
+]

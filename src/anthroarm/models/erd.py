@@ -21,7 +21,9 @@ class ErdArm:
     tool: str
     description: str
     active: tuple[str, ...] | None = None  # None: every joint of the URDF
-    locked_values: dict = field(default_factory=dict)  # joint -> value for locked joints (default 0)
+    locked_values: dict = field(
+        default_factory=dict
+    )  # joint -> value for locked joints (default 0)
 
     def urdf_path(self) -> Path:
         from example_robot_data import getModelPath
@@ -61,8 +63,13 @@ ERD_ARMS: dict[str, ErdArm] = {
                 "sub-chain; the rest of the body, the clavicle included, is locked at zero."
             ),
             active=(
-                "right_shoulder_Z", "right_shoulder_X", "right_shoulder_Y",
-                "right_elbow_Z", "right_elbow_Y", "right_wrist_Z", "right_wrist_X",
+                "right_shoulder_Z",
+                "right_shoulder_X",
+                "right_shoulder_Y",
+                "right_elbow_Z",
+                "right_elbow_Y",
+                "right_wrist_Z",
+                "right_wrist_X",
             ),
         ),
     ]

@@ -97,10 +97,18 @@ HAND_DENSITY = 1160.0
 VIRTUAL_MASS = 0.0005
 
 #: joint ranges (degrees) per joint kind: AAOS (Greene & Heckman 1994); abduction ±20 ours
-FINGER_ROM_DEG = {"mcp_abduction": (-20.0, 20.0), "mcp_flexion": (-45.0, 90.0), "pip": (0.0, 100.0),
-                  "dip": (-10.0, 90.0)}
-THUMB_ROM_DEG = {"cmc_abduction": (0.0, 70.0), "cmc_flexion": (-20.0, 15.0), "mcp": (0.0, 50.0),
-                 "ip": (-20.0, 80.0)}
+FINGER_ROM_DEG = {
+    "mcp_abduction": (-20.0, 20.0),
+    "mcp_flexion": (-45.0, 90.0),
+    "pip": (0.0, 100.0),
+    "dip": (-10.0, 90.0),
+}
+THUMB_ROM_DEG = {
+    "cmc_abduction": (0.0, 70.0),
+    "cmc_flexion": (-20.0, 15.0),
+    "mcp": (0.0, 50.0),
+    "ip": (-20.0, 80.0),
+}
 
 #: θ_DIP / θ_PIP of the physiological coupling, 2/3 after Rijpkema & Girard 1991
 DIP_PIP_RATIO = 2.0 / 3.0
@@ -116,8 +124,16 @@ HL_PER_STATURE = (0.085, 0.14)
 HB_PER_HL = (0.30, 0.65)
 
 #: comfortable (relaxed) hand posture, degrees: a lightly curled hand
-RELAXED_DEG = {"mcp_abduction": 0.0, "mcp_flexion": 20.0, "pip": 30.0, "dip": 20.0,
-               "cmc_abduction": 20.0, "cmc_flexion": 0.0, "mcp": 10.0, "ip": 10.0}
+RELAXED_DEG = {
+    "mcp_abduction": 0.0,
+    "mcp_flexion": 20.0,
+    "pip": 30.0,
+    "dip": 20.0,
+    "cmc_abduction": 20.0,
+    "cmc_flexion": 0.0,
+    "mcp": 10.0,
+    "ip": 10.0,
+}
 
 
 def joint_names(digit: str) -> tuple[str, str, str, str]:
@@ -149,18 +165,26 @@ def parse_coupling(dip_coupling) -> float | None:
         try:
             r = float(Fraction(t))
         except (ValueError, ZeroDivisionError):
-            raise ParameterError(f"dip_coupling must be 'none', a ratio such as '2/3' or a number, got {dip_coupling!r}") from None
+            raise ParameterError(
+                f"dip_coupling must be 'none', a ratio such as '2/3' or a number, got {dip_coupling!r}"
+            ) from None
     elif isinstance(dip_coupling, Real) and not isinstance(dip_coupling, bool):
         r = float(dip_coupling)
     else:
-        raise ParameterError(f"dip_coupling must be None, 'none', '2/3' or a number, got {dip_coupling!r}")
+        raise ParameterError(
+            f"dip_coupling must be None, 'none', '2/3' or a number, got {dip_coupling!r}"
+        )
     if not (np.isfinite(r) and 0.0 < r <= 1.5):
         raise ParameterError(f"dip_coupling ratio must lie in (0, 1.5] (DIP/PIP), got {r}")
     return r
 
 
-def hand_dimensions(hand_length: float, hand_breadth: float, forearm_length: float | None = None,
-                    stature: float | None = None) -> dict:
+def hand_dimensions(
+    hand_length: float,
+    hand_breadth: float,
+    forearm_length: float | None = None,
+    stature: float | None = None,
+) -> dict:
     """Validated hand length and breadth (m) and the Buchholz (1992) segment lengths (m).
 
     Raises :class:`~anthroarm.errors.AnthropometryError` for a non-finite or non-positive value,
@@ -176,17 +200,31 @@ def hand_dimensions(hand_length: float, hand_breadth: float, forearm_length: flo
     if forearm_length is not None and HL >= forearm_length:
         raise AnthropometryError(
             f"hand_length {HL:.4g} m is not shorter than the forearm ({forearm_length:.4g} m): outside human "
-            "proportions (a hand is about 0.7 forearm lengths)", "hand_length", HL)
-    if stature is not None and not (HL_PER_STATURE[0] * stature <= HL <= HL_PER_STATURE[1] * stature):
+            "proportions (a hand is about 0.7 forearm lengths)",
+            "hand_length",
+            HL,
+        )
+    if stature is not None and not (
+        HL_PER_STATURE[0] * stature <= HL <= HL_PER_STATURE[1] * stature
+    ):
         raise AnthropometryError(
             f"hand_length {HL:.4g} m is {HL / stature:.3g} × the stature {stature} m; human hands lie within "
-            f"{HL_PER_STATURE[0]}…{HL_PER_STATURE[1]} × stature", "hand_length", HL)
+            f"{HL_PER_STATURE[0]}…{HL_PER_STATURE[1]} × stature",
+            "hand_length",
+            HL,
+        )
     if not (HB_PER_HL[0] * HL <= HB <= HB_PER_HL[1] * HL):
         raise AnthropometryError(
             f"hand_breadth {HB:.4g} m is {HB / HL:.3g} × the hand length; human hands lie within "
-            f"{HB_PER_HL[0]}…{HB_PER_HL[1]} × hand length", "hand_breadth", HB)
-    return {"hand_length": HL, "hand_breadth": HB,
-            "segments": {d: tuple(c * HL for c in BUCHHOLZ_1992[d]) for d in DIGITS}}
+            f"{HB_PER_HL[0]}…{HB_PER_HL[1]} × hand length",
+            "hand_breadth",
+            HB,
+        )
+    return {
+        "hand_length": HL,
+        "hand_breadth": HB,
+        "segments": {d: tuple(c * HL for c in BUCHHOLZ_1992[d]) for d in DIGITS},
+    }
 
 
 def _thumb_rotation() -> np.ndarray:
@@ -199,9 +237,9 @@ def _thumb_rotation() -> np.ndarray:
     z = -d
     x = np.array([0.0, 1.0, 0.0]) - z * z[1]
     x /= np.linalg.norm(x)
-    y = np.cross(z, x)                       # the flexion direction: ulnar (-x of the hand)
+    y = np.cross(z, x)  # the flexion direction: ulnar (-x of the hand)
     c, s = np.cos(THUMB_PRONATION), np.sin(THUMB_PRONATION)
-    x, y = c * x - s * y, s * x + c * y      # turn about z: flexion now also goes palmar (+y)
+    x, y = c * x - s * y, s * x + c * y  # turn about z: flexion now also goes palmar (+y)
     return np.column_stack([x, y, z])
 
 
@@ -213,8 +251,15 @@ def _phalanx_link(name, length, radius, rgba=(0.93, 0.78, 0.68, 1.0)) -> LinkSpe
     i_ax = m * radius**2 / 2.0
     I = np.diag([i_perp, i_perp, i_ax])
     seg = np.array([0.0, 0.0, -length])
-    return LinkSpec(name=name, mass=m, com=seg / 2, inertia=I, segment=seg, radius=radius,
-                    shapes=capsule(np.zeros(3), seg, radius, material="skin", rgba=rgba))
+    return LinkSpec(
+        name=name,
+        mass=m,
+        com=seg / 2,
+        inertia=I,
+        segment=seg,
+        radius=radius,
+        shapes=capsule(np.zeros(3), seg, radius, material="skin", rgba=rgba),
+    )
 
 
 def _virtual_link(name, radius) -> LinkSpec:
@@ -227,10 +272,14 @@ def digit_bases(dims: dict, l_hand: float) -> dict:
     module docstring for the layout."""
     HB = dims["hand_breadth"]
     seg = dims["segments"]
-    z_shift = l_hand - seg["middle"][0]      # wrist joint centre -> crease offset that puts MCP III at l_hand
+    z_shift = (
+        l_hand - seg["middle"][0]
+    )  # wrist joint centre -> crease offset that puts MCP III at l_hand
     x_of = {"index": HB / 4, "middle": 0.0, "ring": -HB / 4, "little": -HB / 2}
     out = {f: homogeneous(r=[x_of[f], 0.0, -(seg[f][0] + z_shift)]) for f in FINGERS}
-    out["thumb"] = homogeneous(_thumb_rotation(), [0.22 * HB, 0.12 * HB, -(seg["thumb"][0] + z_shift)])
+    out["thumb"] = homogeneous(
+        _thumb_rotation(), [0.22 * HB, 0.12 * HB, -(seg["thumb"][0] + z_shift)]
+    )
     return out
 
 
@@ -249,12 +298,21 @@ def hand_chain(dims: dict, l_hand: float, parent: str = "hand", dip_coupling: fl
         radius = (1.15 if d == "thumb" else 1.0) * r_f
         radii = (radius, radius * 0.925, radius * 0.85)
         rom = THUMB_ROM_DEG if d == "thumb" else FINGER_ROM_DEG
-        kinds = tuple(n[len(d) + 1:] for n in names)
-        links = [_virtual_link(f"{d}_base_link", radii[0]),
-                 _phalanx_link(f"{d}_{'metacarpal' if d == 'thumb' else 'proximal'}", lengths[0], radii[0]),
-                 _phalanx_link(f"{d}_{'proximal' if d == 'thumb' else 'middle'}", lengths[1], radii[1]),
-                 _phalanx_link(f"{d}_distal", lengths[2], radii[2])]
-        origins = [bases[d], homogeneous(), homogeneous(r=[0, 0, -lengths[0]]), homogeneous(r=[0, 0, -lengths[1]])]
+        kinds = tuple(n[len(d) + 1 :] for n in names)
+        links = [
+            _virtual_link(f"{d}_base_link", radii[0]),
+            _phalanx_link(
+                f"{d}_{'metacarpal' if d == 'thumb' else 'proximal'}", lengths[0], radii[0]
+            ),
+            _phalanx_link(f"{d}_{'proximal' if d == 'thumb' else 'middle'}", lengths[1], radii[1]),
+            _phalanx_link(f"{d}_distal", lengths[2], radii[2]),
+        ]
+        origins = [
+            bases[d],
+            homogeneous(),
+            homogeneous(r=[0, 0, -lengths[0]]),
+            homogeneous(r=[0, 0, -lengths[1]]),
+        ]
         # base abduction about -y: toward +x (the thumb side) for fingers 2-5, palmar for the thumb
         axes = [(0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (1.0, 0.0, 0.0), (1.0, 0.0, 0.0)]
         for k, (n, kind) in enumerate(zip(names, kinds)):
@@ -262,9 +320,21 @@ def hand_chain(dims: dict, l_hand: float, parent: str = "hand", dip_coupling: fl
             mimic = None
             if k == 3 and d != "thumb" and dip_coupling is not None:
                 mimic = (names[2], float(dip_coupling), 0.0)
-            joints.append(JointSpec(n, "revolute", origins[k], axis=axes[k], lower=lo * deg, upper=hi * deg,
-                                    effort=2.0, velocity=5.0, link=links[k],
-                                    parent=parent if k == 0 else links[k - 1].name, mimic=mimic))
+            joints.append(
+                JointSpec(
+                    n,
+                    "revolute",
+                    origins[k],
+                    axis=axes[k],
+                    lower=lo * deg,
+                    upper=hi * deg,
+                    effort=2.0,
+                    velocity=5.0,
+                    link=links[k],
+                    parent=parent if k == 0 else links[k - 1].name,
+                    mimic=mimic,
+                )
+            )
             comfort[n] = RELAXED_DEG[kind] * deg
             mass += links[k].mass
         frames.append((f"{d}_tip", links[3].name, homogeneous(r=[0, 0, -lengths[2]])))
@@ -277,16 +347,30 @@ def palm_link(dims: dict, l_hand: float, mass: float, name: str = "hand") -> Lin
     carrying ``mass`` kg; inertia of the solid box about its centre."""
     HB = dims["hand_breadth"]
     if not mass > 0:
-        raise AnthropometryError(f"the fingers ({-mass:.3g} kg more than the hand) leave no mass for the palm: "
-                                 "the hand is too long or broad for the body mass", "hand_length",
-                                 dims["hand_length"])
+        raise AnthropometryError(
+            f"the fingers ({-mass:.3g} kg more than the hand) leave no mass for the palm: "
+            "the hand is too long or broad for the body mass",
+            "hand_length",
+            dims["hand_length"],
+        )
     a, b, c = HB, 0.3 * HB, l_hand
     I = mass / 12.0 * np.diag([b**2 + c**2, a**2 + c**2, a**2 + b**2])
-    centre = np.array([-HB / 8, 0.0, -l_hand / 2])   # the MCP row spans x in [-HB/2, HB/4]
-    box = Shape("box", (a, b, c), homogeneous(r=centre), material="skin", rgba=(0.93, 0.78, 0.68, 1.0))
-    wrist = Shape("sphere", (0.3 * HB,), homogeneous(), material="joint", rgba=(0.85, 0.45, 0.2, 1.0))
-    return LinkSpec(name=name, mass=mass, com=centre, inertia=I, segment=np.array([0.0, 0.0, -l_hand]),
-                    radius=0.3 * HB, shapes=(wrist, box))
+    centre = np.array([-HB / 8, 0.0, -l_hand / 2])  # the MCP row spans x in [-HB/2, HB/4]
+    box = Shape(
+        "box", (a, b, c), homogeneous(r=centre), material="skin", rgba=(0.93, 0.78, 0.68, 1.0)
+    )
+    wrist = Shape(
+        "sphere", (0.3 * HB,), homogeneous(), material="joint", rgba=(0.85, 0.45, 0.2, 1.0)
+    )
+    return LinkSpec(
+        name=name,
+        mass=mass,
+        com=centre,
+        inertia=I,
+        segment=np.array([0.0, 0.0, -l_hand]),
+        radius=0.3 * HB,
+        shapes=(wrist, box),
+    )
 
 
 def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
@@ -301,11 +385,15 @@ def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
     from ..errors import CouplingError
 
     if not isinstance(angles, Mapping):
-        raise ParameterError(f"{spec.name}: angles must be a dict joint name -> rad, got {type(angles).__name__}")
+        raise ParameterError(
+            f"{spec.name}: angles must be a dict joint name -> rad, got {type(angles).__name__}"
+        )
     by_name = {j.name: j for j in spec.joints}
     unknown = [n for n in angles if n not in by_name]
     if unknown:
-        raise ParameterError(f"{spec.name}: unknown joint(s) {unknown}; joints: {', '.join(by_name)}")
+        raise ParameterError(
+            f"{spec.name}: unknown joint(s) {unknown}; joints: {', '.join(by_name)}"
+        )
     vals = {}
     for n, v in angles.items():
         if isinstance(v, bool) or not isinstance(v, Real) or not np.isfinite(float(v)):
@@ -322,7 +410,8 @@ def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
             if abs(vals[j.name] - expected) > tol:
                 err = CouplingError(
                     f"{spec.name}: {j.name} = {vals[j.name]:.6g} rad contradicts its coupling "
-                    f"{j.name} = {mult:.6g} × {src} + {off:.6g} = {expected:.6g} rad; give {src} only")
+                    f"{j.name} = {mult:.6g} × {src} + {off:.6g} = {expected:.6g} rad; give {src} only"
+                )
                 err.joint, err.expected, err.given = j.name, expected, vals[j.name]
                 raise err
     return np.array(q)
@@ -349,11 +438,15 @@ def mechanism_of(spec):
         children[p] = children.get(p, 0) + 1
 
     def connector(link):
-        return (link.mass <= VIRTUAL_MASS * 1.0001 or link.segment is None or np.linalg.norm(link.segment) < 1e-12) \
-            and children.get(link.name, 0) == 1
-    merged_into = {}   # connector link -> the link the group started from
+        return (
+            link.mass <= VIRTUAL_MASS * 1.0001
+            or link.segment is None
+            or np.linalg.norm(link.segment) < 1e-12
+        ) and children.get(link.name, 0) == 1
+
+    merged_into = {}  # connector link -> the link the group started from
     m = Mechanism(spec.name, ground=spec.base_link)
-    groups = []   # (start link, end link, n rotations)
+    groups = []  # (start link, end link, n rotations)
     for j, p in zip(joints, parents):
         start = merged_into.get(p, p)
         if p in merged_into:

@@ -88,20 +88,34 @@ def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "mal
     _NUM = (int, float, np.floating, np.integer)
     for pname, v, unit in (("height", height, "m"), ("mass", mass, "kg")):
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, _NUM):
-            raise AnthropometryError(f"body height and mass must be numbers (m, kg): {pname} got "
-                                     f"{type(v).__name__} {v!r}", pname, v)
-    if not (0.5 <= height <= 2.6):   # also False for NaN
-        raise AnthropometryError(f"body height {height} m is outside 0.5…2.6 m (height= in m, e.g. 1.75)",
-                                 "height", height)
+            raise AnthropometryError(
+                f"body height and mass must be numbers (m, kg): {pname} got "
+                f"{type(v).__name__} {v!r}",
+                pname,
+                v,
+            )
+    if not (0.5 <= height <= 2.6):  # also False for NaN
+        raise AnthropometryError(
+            f"body height {height} m is outside 0.5…2.6 m (height= in m, e.g. 1.75)",
+            "height",
+            height,
+        )
     if not (10.0 <= mass <= 300.0):
-        raise AnthropometryError(f"body mass {mass} kg is outside 10…300 kg (mass= in kg, e.g. 75)", "mass", mass)
+        raise AnthropometryError(
+            f"body mass {mass} kg is outside 10…300 kg (mass= in kg, e.g. 75)", "mass", mass
+        )
     tab = DE_LEVA_1996[sex]
     k = height * 1000.0 / tab["stature"]
     out = {}
     for seg in ("upperarm", "forearm", "hand"):
         L_mm, mf, cf, radii = tab[seg]
         L = L_mm * k / 1000.0
-        out[seg] = {"length": L, "mass": mf * mass, "com": cf * L, "radii": tuple(r * L for r in radii)}
+        out[seg] = {
+            "length": L,
+            "mass": mf * mass,
+            "com": cf * L,
+            "radii": tuple(r * L for r in radii),
+        }
     return out
 
 
@@ -111,7 +125,7 @@ def segment_parameters(height: float = 1.75, mass: float = 75.0, sex: str = "mal
 #: upper arm −20…20°, lower arm 60…100°, wrist 0°).
 HUMAN_ARM7_COMFORT = {
     "shoulder_flexion": 20 * deg,
-    "shoulder_abduction": -15 * deg,   # negative = abduction for this right arm
+    "shoulder_abduction": -15 * deg,  # negative = abduction for this right arm
     "shoulder_rotation": 0.0,
     "elbow_flexion": 80 * deg,
     "forearm_pronation": 0.0,
@@ -133,8 +147,18 @@ HUMAN_ARM7_COMFORT = {
 #: ~57 mm, metacarpal breadth ~60 mm for a 1.75 m man: segment lengths 283, 270, 87 mm), not
 #: measured on a person.  Read by :func:`anthroarm.motion.markers.default_marker_set`.
 HUMAN_ARM_LANDMARKS = {
-    "AC": ("base_link", (0.106, 0.0, 0.159), 1.0, "acromion (on the trunk: fixed, used for scaling)"),
-    "UA": ("upper_arm", (0.160, 0.0, -0.50), 1.0, "lateral upper arm, mid-shaft (technical marker)"),
+    "AC": (
+        "base_link",
+        (0.106, 0.0, 0.159),
+        1.0,
+        "acromion (on the trunk: fixed, used for scaling)",
+    ),
+    "UA": (
+        "upper_arm",
+        (0.160, 0.0, -0.50),
+        1.0,
+        "lateral upper arm, mid-shaft (technical marker)",
+    ),
     "EL": ("upper_arm", (0.113, 0.0, -1.0), 1.0, "lateral epicondyle of the humerus"),
     "EM": ("upper_arm", (-0.134, 0.0, -1.0), 1.0, "medial epicondyle of the humerus"),
     "FA": ("forearm", (0.0, -0.130, -0.50), 1.0, "dorsal forearm, mid-shaft (technical marker)"),
@@ -157,19 +181,31 @@ def _segment_lengths(segment_lengths) -> dict:
     """``segment_lengths`` keyed by the de Leva segment names (a link's name is accepted for its
     segment); bad keys or values raise :class:`~anthroarm.errors.ParameterError`."""
     if not isinstance(segment_lengths, dict):
-        raise ParameterError(f"segment_lengths is a dict segment -> length (m) with keys {list(SEGMENT_LINKS)}, "
-                             f"got {segment_lengths!r}")
+        raise ParameterError(
+            f"segment_lengths is a dict segment -> length (m) with keys {list(SEGMENT_LINKS)}, "
+            f"got {segment_lengths!r}"
+        )
     by_link = {link: key for key, link in SEGMENT_LINKS.items()}
     lengths = {}
     for name, L in segment_lengths.items():
         key = by_link.get(name, name)
         if key not in SEGMENT_LINKS:
-            raise ParameterError(f"segment_lengths: unknown segment {name!r}; known: {list(SEGMENT_LINKS)} "
-                                 f"(or the links {list(by_link)})")
+            raise ParameterError(
+                f"segment_lengths: unknown segment {name!r}; known: {list(SEGMENT_LINKS)} "
+                f"(or the links {list(by_link)})"
+            )
         if key in lengths:
-            raise ParameterError(f"segment_lengths: {key!r} given twice (as {key!r} and {SEGMENT_LINKS[key]!r})")
-        if isinstance(L, bool) or not isinstance(L, (int, float, np.floating, np.integer)) or not (0.02 <= L <= 1.0):
-            raise ParameterError(f"segment_lengths[{name!r}] must be a length in 0.02 ... 1.0 m, got {L!r}")
+            raise ParameterError(
+                f"segment_lengths: {key!r} given twice (as {key!r} and {SEGMENT_LINKS[key]!r})"
+            )
+        if (
+            isinstance(L, bool)
+            or not isinstance(L, (int, float, np.floating, np.integer))
+            or not (0.02 <= L <= 1.0)
+        ):
+            raise ParameterError(
+                f"segment_lengths[{name!r}] must be a length in 0.02 ... 1.0 m, got {L!r}"
+            )
         lengths[key] = float(L)
     return lengths
 
@@ -186,7 +222,9 @@ def _measured_lengths(seg: dict, lengths: dict) -> dict:
     return out
 
 
-def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segment_lengths: dict | None = None) -> ChainSpec:
+def human_arm7(
+    height: float = 1.75, mass: float = 75.0, sex: str = "male", segment_lengths: dict | None = None
+) -> ChainSpec:
     """The §6-3 7-DOF arm (right arm) scaled to a person of ``height`` m and ``mass`` kg.
 
     ``segment_lengths`` (optional): measured lengths in m of ``"upperarm"`` (shoulder to elbow
@@ -212,30 +250,86 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segm
         p = seg[key]
         r_sag, r_trans, r_long = p["radii"]
         return rod_link(
-            name, s, mass=p["mass"], radius=radius, joint_mass=0.0,
-            com_fraction=p["com"] / p["length"], radii_of_gyration=(r_sag, r_trans, r_long),
+            name,
+            s,
+            mass=p["mass"],
+            radius=radius,
+            joint_mass=0.0,
+            com_fraction=p["com"] / p["length"],
+            radii_of_gyration=(r_sag, r_trans, r_long),
         )
 
     joints = [
-        JointSpec("shoulder_flexion", "revolute", homogeneous(), axis=X, link=virtual("shoulder_link1"),
-                  lower=lim["shoulder_flexion"][0], upper=lim["shoulder_flexion"][1], effort=80.0),
-        JointSpec("shoulder_abduction", "revolute", homogeneous(), axis=Y, link=virtual("shoulder_link2"),
-                  lower=lim["shoulder_abduction"][0], upper=lim["shoulder_abduction"][1], effort=80.0),
-        JointSpec("shoulder_rotation", "revolute", homogeneous(), axis=Z,
-                  link=anthropo("upper_arm", [0, 0, -l1], "upperarm", 0.045),
-                  lower=lim["shoulder_rotation"][0], upper=lim["shoulder_rotation"][1], effort=40.0),
-        JointSpec("elbow_flexion", "revolute", homogeneous(r=[0, 0, -l1]), axis=X,
-                  link=rod_link("elbow_link", [0, 0, 0], mass=0.0, joint_mass=tiny, radius=0.04),
-                  lower=lim["elbow_flexion"][0], upper=lim["elbow_flexion"][1], effort=60.0),
-        JointSpec("forearm_pronation", "revolute", homogeneous(), axis=Z,
-                  link=anthropo("forearm", [0, 0, -l2], "forearm", 0.035),
-                  lower=lim["forearm_pronation"][0], upper=lim["forearm_pronation"][1], effort=10.0),
-        JointSpec("wrist_deviation", "revolute", homogeneous(r=[0, 0, -l2]), axis=Y,
-                  link=virtual("wrist_link"),
-                  lower=lim["wrist_deviation"][0], upper=lim["wrist_deviation"][1], effort=10.0),
-        JointSpec("wrist_flexion", "revolute", homogeneous(), axis=X,
-                  link=anthropo("hand", [0, 0, -l3], "hand", 0.03),
-                  lower=lim["wrist_flexion"][0], upper=lim["wrist_flexion"][1], effort=10.0),
+        JointSpec(
+            "shoulder_flexion",
+            "revolute",
+            homogeneous(),
+            axis=X,
+            link=virtual("shoulder_link1"),
+            lower=lim["shoulder_flexion"][0],
+            upper=lim["shoulder_flexion"][1],
+            effort=80.0,
+        ),
+        JointSpec(
+            "shoulder_abduction",
+            "revolute",
+            homogeneous(),
+            axis=Y,
+            link=virtual("shoulder_link2"),
+            lower=lim["shoulder_abduction"][0],
+            upper=lim["shoulder_abduction"][1],
+            effort=80.0,
+        ),
+        JointSpec(
+            "shoulder_rotation",
+            "revolute",
+            homogeneous(),
+            axis=Z,
+            link=anthropo("upper_arm", [0, 0, -l1], "upperarm", 0.045),
+            lower=lim["shoulder_rotation"][0],
+            upper=lim["shoulder_rotation"][1],
+            effort=40.0,
+        ),
+        JointSpec(
+            "elbow_flexion",
+            "revolute",
+            homogeneous(r=[0, 0, -l1]),
+            axis=X,
+            link=rod_link("elbow_link", [0, 0, 0], mass=0.0, joint_mass=tiny, radius=0.04),
+            lower=lim["elbow_flexion"][0],
+            upper=lim["elbow_flexion"][1],
+            effort=60.0,
+        ),
+        JointSpec(
+            "forearm_pronation",
+            "revolute",
+            homogeneous(),
+            axis=Z,
+            link=anthropo("forearm", [0, 0, -l2], "forearm", 0.035),
+            lower=lim["forearm_pronation"][0],
+            upper=lim["forearm_pronation"][1],
+            effort=10.0,
+        ),
+        JointSpec(
+            "wrist_deviation",
+            "revolute",
+            homogeneous(r=[0, 0, -l2]),
+            axis=Y,
+            link=virtual("wrist_link"),
+            lower=lim["wrist_deviation"][0],
+            upper=lim["wrist_deviation"][1],
+            effort=10.0,
+        ),
+        JointSpec(
+            "wrist_flexion",
+            "revolute",
+            homogeneous(),
+            axis=X,
+            link=anthropo("hand", [0, 0, -l3], "hand", 0.03),
+            lower=lim["wrist_flexion"][0],
+            upper=lim["wrist_flexion"][1],
+            effort=10.0,
+        ),
     ]
     return ChainSpec(
         name="human_arm7",
@@ -248,7 +342,11 @@ def human_arm7(height: float = 1.75, mass: float = 75.0, sex: str = "male", segm
         tool_origin=homogeneous(r=[0, 0, -l3]),
         source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
         inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg"
-        + ("" if segment_lengths is None else f"; measured segment lengths {sorted(segment_lengths)}"),
+        + (
+            ""
+            if segment_lengths is None
+            else f"; measured segment lengths {sorted(segment_lengths)}"
+        ),
         params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},
         person=True,
         comfort=dict(HUMAN_ARM7_COMFORT),

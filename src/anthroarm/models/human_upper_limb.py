@@ -26,8 +26,15 @@ Load a fingertip as the tool with ``aa.load("human_upper_limb", tool="index_tip"
 from __future__ import annotations
 
 from ..spatial.rotations import homogeneous
-from .hand import (BREADTH_RATIO, BUCHHOLZ_1992, _number, hand_chain, hand_dimensions, palm_link,
-                   parse_coupling)
+from .hand import (
+    BREADTH_RATIO,
+    BUCHHOLZ_1992,
+    _number,
+    hand_chain,
+    hand_dimensions,
+    palm_link,
+    parse_coupling,
+)
 from .human import human_arm7, segment_parameters
 from .spec import ChainSpec
 
@@ -35,8 +42,14 @@ from .spec import ChainSpec
 FRAMES = ("hand_point", "palm", "thumb_tip", "index_tip", "middle_tip", "ring_tip", "little_tip")
 
 
-def human_upper_limb(height: float = 1.75, mass: float = 75.0, sex: str = "male", hand_length: float | None = None,
-                     hand_breadth: float | None = None, dip_coupling: str = "none") -> ChainSpec:
+def human_upper_limb(
+    height: float = 1.75,
+    mass: float = 75.0,
+    sex: str = "male",
+    hand_length: float | None = None,
+    hand_breadth: float | None = None,
+    dip_coupling: str = "none",
+) -> ChainSpec:
     """The Fig. 2-2 upper limb (27 joints; right arm and hand) of a person of ``height`` m and ``mass`` kg.
 
     Parameters
@@ -68,31 +81,57 @@ def human_upper_limb(height: float = 1.75, mass: float = 75.0, sex: str = "male"
     HL = _number("hand_length", HL)
     HB = BREADTH_RATIO * HL if hand_breadth is None else hand_breadth
     dims = hand_dimensions(HL, HB, forearm_length=l_forearm, stature=float(height))
-    l_hand = BUCHHOLZ_1992["middle"][0] * dims["hand_length"]     # wrist -> MCP III; = de Leva's at the default
-    joints, frames, comfort, finger_mass = hand_chain(dims, l_hand, parent="hand", dip_coupling=ratio)
+    l_hand = (
+        BUCHHOLZ_1992["middle"][0] * dims["hand_length"]
+    )  # wrist -> MCP III; = de Leva's at the default
+    joints, frames, comfort, finger_mass = hand_chain(
+        dims, l_hand, parent="hand", dip_coupling=ratio
+    )
     arm_joints = list(arm.joints)
     wrist = arm_joints[-1]
     palm = palm_link(dims, l_hand, seg["hand"]["mass"] - finger_mass, name="hand")
-    arm_joints[-1] = type(wrist)(wrist.name, wrist.type, wrist.origin, axis=wrist.axis, lower=wrist.lower,
-                                 upper=wrist.upper, effort=wrist.effort, velocity=wrist.velocity, link=palm)
+    arm_joints[-1] = type(wrist)(
+        wrist.name,
+        wrist.type,
+        wrist.origin,
+        axis=wrist.axis,
+        lower=wrist.lower,
+        upper=wrist.upper,
+        effort=wrist.effort,
+        velocity=wrist.velocity,
+        link=palm,
+    )
     frames = [("palm", "hand", homogeneous(r=[0.0, 0.0, -l_hand / 2]))] + frames
-    params = {"height": height, "mass": mass, "sex": sex, "hand_length": dims["hand_length"],
-              "hand_breadth": dims["hand_breadth"], "dip_coupling": "none" if ratio is None else ratio,
-              **{k: arm.params[k] for k in ("l1", "l2")}, "l3": l_hand}
+    params = {
+        "height": height,
+        "mass": mass,
+        "sex": sex,
+        "hand_length": dims["hand_length"],
+        "hand_breadth": dims["hand_breadth"],
+        "dip_coupling": "none" if ratio is None else ratio,
+        **{k: arm.params[k] for k in ("l1", "l2")},
+        "l3": l_hand,
+    }
     return ChainSpec(
         name="human_upper_limb",
-        description=("Human upper limb of book Fig. 2-2 (F = 27): the 7-DOF §6-3 right arm (shoulder x-y-z, elbow x, "
-                     "wrist z-y-x, hanging along -z; y forward, x to the right) and a five-digit hand with 4 joints per "
-                     "digit (20 finger DOF); tool = hand point H; fingertip frames thumb_tip ... little_tip."),
+        description=(
+            "Human upper limb of book Fig. 2-2 (F = 27): the 7-DOF §6-3 right arm (shoulder x-y-z, elbow x, "
+            "wrist z-y-x, hanging along -z; y forward, x to the right) and a five-digit hand with 4 joints per "
+            "digit (20 finger DOF); tool = hand point H; fingertip frames thumb_tip ... little_tip."
+        ),
         joints=arm_joints + joints,
         tool_name="hand_point",
         tool_origin=homogeneous(r=[0.0, 0.0, -l_hand]),
         tool_parent="hand",
         frames=tuple(frames),
-        source=("book 000 l.540-552 (Fig. 2-2, F = 27, fingers 20), l.3927-3989 (§6-3 arm); limits Table 2.2 "
-                "l.527-534 (arm), AAOS 1994 (fingers); finger lengths Buchholz, Armstrong & Goldstein 1992"),
-        inertia_source=(f"arm: de Leva (1996) Table 4, {sex}, height {height} m, mass {mass} kg; phalanges: solid "
-                        "cylinders of 1160 kg/m3 (Dempster 1955); palm: de Leva hand mass minus the phalanges, as a box"),
+        source=(
+            "book 000 l.540-552 (Fig. 2-2, F = 27, fingers 20), l.3927-3989 (§6-3 arm); limits Table 2.2 "
+            "l.527-534 (arm), AAOS 1994 (fingers); finger lengths Buchholz, Armstrong & Goldstein 1992"
+        ),
+        inertia_source=(
+            f"arm: de Leva (1996) Table 4, {sex}, height {height} m, mass {mass} kg; phalanges: solid "
+            "cylinders of 1160 kg/m3 (Dempster 1955); palm: de Leva hand mass minus the phalanges, as a box"
+        ),
         params=params,
         person=True,
         comfort={**(arm.comfort or {}), **comfort},

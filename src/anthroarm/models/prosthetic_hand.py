@@ -53,7 +53,16 @@ from ..mechanisms.finger import FingerGeometry, finger, finger_spec
 from ..mechanisms.rrss import RRSSGeometry
 from ..mechanisms.thumb import ThumbGeometry, thumb, thumb_spec
 from ..spatial.rotations import homogeneous, rot_axis
-from .hand import BREADTH_RATIO, BUCHHOLZ_1992, DIGITS, FINGERS, Q_ORDER, THUMB_REST_DIRECTION, digit_bases, hand_dimensions
+from .hand import (
+    BREADTH_RATIO,
+    BUCHHOLZ_1992,
+    DIGITS,
+    FINGERS,
+    Q_ORDER,
+    THUMB_REST_DIRECTION,
+    digit_bases,
+    hand_dimensions,
+)
 from .human import segment_parameters
 from .spec import ChainSpec, JointSpec, LinkSpec, Shape, capsule
 
@@ -73,16 +82,29 @@ def _finger_length(d: str) -> float:
 def scaled_finger(geom: FingerGeometry, s: float) -> FingerGeometry:
     """The six-bar ``geom`` with every length multiplied by ``s`` (angles, branches and driver
     range unchanged: the fingertip path is the scaled path)."""
-    return FingerGeometry(P1=geom.P1 * s, P4=geom.P4 * s, R=tuple(r * s for r in geom.R), alpha=geom.alpha,
-                          branches=geom.branches, phi_range=geom.phi_range)
+    return FingerGeometry(
+        P1=geom.P1 * s,
+        P4=geom.P4 * s,
+        R=tuple(r * s for r in geom.R),
+        alpha=geom.alpha,
+        branches=geom.branches,
+        phi_range=geom.phi_range,
+    )
 
 
 def scaled_thumb(geom: ThumbGeometry, s: float) -> ThumbGeometry:
     """The thumb ``geom`` with every length multiplied by ``s``."""
     g = geom.rrss
     r = RRSSGeometry(a0=g.a0 * s, u0=g.u0, a1=g.a1 * s, u1=g.u1, b0=g.b0 * s, b1=g.b1 * s)
-    return ThumbGeometry(rrss=r, ex=geom.ex, P0=geom.P0 * s, F0=geom.F0 * s, C=geom.C * s, R3=geom.R3 * s,
-                         beta=geom.beta)
+    return ThumbGeometry(
+        rrss=r,
+        ex=geom.ex,
+        P0=geom.P0 * s,
+        F0=geom.F0 * s,
+        C=geom.C * s,
+        R3=geom.R3 * s,
+        beta=geom.beta,
+    )
 
 
 def _frame_from(e, m):
@@ -133,8 +155,12 @@ class ProstheticHand:
 
 def default_hand(scale: float = 1.0) -> ProstheticHand:
     """The hand described in the module docstring, every length times ``scale``."""
-    if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)) \
-            or not np.isfinite(scale) or not (0.3 <= scale <= 3.0):
+    if (
+        isinstance(scale, bool)
+        or not isinstance(scale, (int, float, np.floating, np.integer))
+        or not np.isfinite(scale)
+        or not (0.3 <= scale <= 3.0)
+    ):
         raise ParameterError(f"prosthetic_hand: scale must be a number in 0.3…3, got {scale!r}")
     s = float(scale)
     # the palm of the default adult hand of models.hand (HL = de Leva hand / 0.446, HB = 0.45 HL)
@@ -144,7 +170,7 @@ def default_hand(scale: float = 1.0) -> ProstheticHand:
     bases = digit_bases(dims, l_palm)
     g0 = FingerGeometry.default()
     fingers, mounts = {}, {}
-    target = np.column_stack([[0, 0, -1.0], [0, 1.0, 0], [1.0, 0, 0]])     # (-z, +y, +x) of the palm
+    target = np.column_stack([[0, 0, -1.0], [0, 1.0, 0], [1.0, 0, 0]])  # (-z, +y, +x) of the palm
     for d in FINGERS:
         g = scaled_finger(g0, s * _finger_length(d) / _finger_length("index"))
         fingers[d] = g
@@ -161,13 +187,19 @@ def default_hand(scale: float = 1.0) -> ProstheticHand:
     d_t = THUMB_REST_DIRECTION
     R = _frame_from(d_t, [-1.0, 1.0, 0.0]) @ _frame_from(e, m).T
     mounts["thumb"] = homogeneous(R, bases["thumb"][:3, 3] * s - R @ th.rrss.a0)
-    return ProstheticHand(fingers=fingers, thumb=th, mounts=mounts, palm_size=(dims["hand_breadth"] * s, l_palm * s),
-                          scale=s)
+    return ProstheticHand(
+        fingers=fingers,
+        thumb=th,
+        mounts=mounts,
+        palm_size=(dims["hand_breadth"] * s, l_palm * s),
+        scale=s,
+    )
 
 
 def _prefixed(spec: LoopSpec, digit: str, mount: np.ndarray, tip_site: str) -> tuple:
     """Joints, closures, inputs and sites of one mechanism renamed ``{digit}_...`` on the palm
     (a passive joint hanging on the palm: ``{digit}_{driver}_...``)."""
+
     def link(n):
         return "palm" if n == spec.root else f"{digit}_{n}"
 
@@ -181,12 +213,23 @@ def _prefixed(spec: LoopSpec, digit: str, mount: np.ndarray, tip_site: str) -> t
             return f"{digit}_{spec.inputs[0]}_{j.name}"
         return f"{digit}_{j.name}"
 
-    joints = tuple(TreeJoint(joint(j), link(j.parent), link(j.child), j.type,
-                             mount @ j.origin if j.parent == spec.root else j.origin, j.axis) for j in spec.joints)
+    joints = tuple(
+        TreeJoint(
+            joint(j),
+            link(j.parent),
+            link(j.child),
+            j.type,
+            mount @ j.origin if j.parent == spec.root else j.origin,
+            j.axis,
+        )
+        for j in spec.joints
+    )
     # a planar loop's closure compares world x, y; mounted on the palm its plane is another one:
     # compare all three components (the out-of-plane row is redundant: least-norm Newton)
-    closures = tuple(replace(c, frame_a=site(c.frame_a), frame_b=site(c.frame_b), components=(0, 1, 2))
-                     for c in spec.closures)
+    closures = tuple(
+        replace(c, frame_a=site(c.frame_a), frame_b=site(c.frame_b), components=(0, 1, 2))
+        for c in spec.closures
+    )
     sites = tuple((site(n), link(p), T) for n, p, T in spec.sites)
     return joints, closures, tuple(f"{digit}_{n}" for n in spec.inputs), sites
 
@@ -199,12 +242,23 @@ def loop_spec(hand: ProstheticHand | None = None) -> LoopSpec:
     :data:`anthroarm.models.hand.Q_ORDER`); fingertip sites ``{digit}_tip``.  q = 0 is every
     mechanism's start pose."""
     hand = hand or default_hand()
-    parts = [_prefixed(thumb_spec(hand.thumb), "thumb", hand.mounts["thumb"], "S") if d == "thumb"
-             else _prefixed(finger_spec(hand.fingers[d]), d, hand.mounts[d], "P8") for d in Q_ORDER]
-    return LoopSpec(name="prosthetic_hand", joints=sum((p[0] for p in parts), ()),
-                    closures=sum((p[1] for p in parts), ()), inputs=sum((p[2] for p in parts), ()),
-                    sites=sum((p[3] for p in parts), ()), root="palm",
-                    length_scale=float(sum(hand.fingers[d].length_scale for d in FINGERS) + hand.thumb.length_scale))
+    parts = [
+        _prefixed(thumb_spec(hand.thumb), "thumb", hand.mounts["thumb"], "S")
+        if d == "thumb"
+        else _prefixed(finger_spec(hand.fingers[d]), d, hand.mounts[d], "P8")
+        for d in Q_ORDER
+    ]
+    return LoopSpec(
+        name="prosthetic_hand",
+        joints=sum((p[0] for p in parts), ()),
+        closures=sum((p[1] for p in parts), ()),
+        inputs=sum((p[2] for p in parts), ()),
+        sites=sum((p[3] for p in parts), ()),
+        root="palm",
+        length_scale=float(
+            sum(hand.fingers[d].length_scale for d in FINGERS) + hand.thumb.length_scale
+        ),
+    )
 
 
 def closed_loop(hand: ProstheticHand | None = None) -> ClosedLoop:
@@ -235,22 +289,30 @@ def _drivers(loop: ClosedLoop, drivers) -> np.ndarray:
     if isinstance(drivers, dict):
         unknown = sorted(set(drivers) - set(names))
         if unknown:
-            raise ParameterError(f"prosthetic_hand: unknown driver(s) {unknown}; drivers: {', '.join(names)}")
+            raise ParameterError(
+                f"prosthetic_hand: unknown driver(s) {unknown}; drivers: {', '.join(names)}"
+            )
         vals = [drivers.get(n, 0.0) for n in names]
     else:
         vals = drivers
     try:
         x = np.atleast_1d(np.array(vals, dtype=float))
     except (TypeError, ValueError):
-        raise ParameterError(f"prosthetic_hand: drivers must be numbers (rad), got {drivers!r}") from None
+        raise ParameterError(
+            f"prosthetic_hand: drivers must be numbers (rad), got {drivers!r}"
+        ) from None
     if x.shape != (len(names),):
-        raise ParameterError(f"prosthetic_hand: {len(names)} drivers ({', '.join(names)}), got shape {x.shape}")
+        raise ParameterError(
+            f"prosthetic_hand: {len(names)} drivers ({', '.join(names)}), got shape {x.shape}"
+        )
     if not np.all(np.isfinite(x)):
         raise ParameterError(f"prosthetic_hand: drivers must be finite (rad), got {x.tolist()}")
     return x
 
 
-def solve(loop: ClosedLoop, drivers, hand: ProstheticHand | None = None, steps: int = 12) -> HandState:
+def solve(
+    loop: ClosedLoop, drivers, hand: ProstheticHand | None = None, steps: int = 12
+) -> HandState:
     """Close every loop of the hand at the driver values (dict name -> rad, or the 5 values in
     ``loop.spec.inputs`` order), by continuation from the start pose q = 0 (the assembly
     branch of the mechanism solvers), and read the fingertips by Pinocchio FK.
@@ -263,14 +325,21 @@ def solve(loop: ClosedLoop, drivers, hand: ProstheticHand | None = None, steps: 
     for d, v, n in zip(digits, x, loop.spec.inputs):
         lo, hi = hand.driver_range(d)
         if not (lo - 1e-12 <= v <= hi + 1e-12):
-            return HandState(np.zeros(loop.model.nq), {}, float("nan"), "out_of_range",
-                             f"{n} = {v:.6g} rad is outside its range [{lo:.6g}, {hi:.6g}] rad")
+            return HandState(
+                np.zeros(loop.model.nq),
+                {},
+                float("nan"),
+                "out_of_range",
+                f"{n} = {v:.6g} rad is outside its range [{lo:.6g}, {hi:.6g}] rad",
+            )
     path = np.linspace(0.0, 1.0, max(2, int(steps)))[:, None] * x[None, :]
     Q, ok = loop.track(path, q0=np.zeros(loop.model.nq))
     q = Q[-1]
     res = float(np.max(np.abs(loop.residual(q))))
     if not ok[-1]:
-        return HandState(q, {}, res, "not_converged", f"the closure did not converge (|residual| {res:.3e} m)")
+        return HandState(
+            q, {}, res, "not_converged", f"the closure did not converge (|residual| {res:.3e} m)"
+        )
     tips = {d: loop.frame_position(q, f"{d}_tip") for d in DIGITS}
     return HandState(q, tips, res, "ok", "ok")
 
@@ -283,9 +352,13 @@ def closure_status(loop: ClosedLoop, q, tol: float = 1e-9) -> tuple[float, str]:
     try:
         q = np.asarray(q, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(f"prosthetic_hand: q must be {loop.model.nq} joint values (rad), got {q!r}") from None
+        raise ParameterError(
+            f"prosthetic_hand: q must be {loop.model.nq} joint values (rad), got {q!r}"
+        ) from None
     if q.shape != (loop.model.nq,) or not np.all(np.isfinite(q)):
-        raise ParameterError(f"prosthetic_hand: q must be {loop.model.nq} finite joint values (rad), got shape {q.shape}")
+        raise ParameterError(
+            f"prosthetic_hand: q must be {loop.model.nq} finite joint values (rad), got shape {q.shape}"
+        )
     gap = loop.residual_pin(q)
     return gap, ("ok" if gap <= tol else "inconsistent")
 
@@ -315,12 +388,16 @@ def _fit(scale: float, samples: int) -> MimicFit:
         d = n_in.split("_")[0]
         lo, hi = hand.driver_range(d)
         t = np.linspace(0.0, 1.0, samples)
-        u = lo + (hi - lo) * t if d == "thumb" else hi + (lo - hi) * t     # start at the start pose (0)
+        u = (
+            lo + (hi - lo) * t if d == "thumb" else hi + (lo - hi) * t
+        )  # start at the start pose (0)
         path = np.zeros((samples, nin))
         path[:, k] = u
         Q, ok = loop.track(path, q0=np.zeros(loop.model.nq))
         if not np.all(ok):
-            raise RuntimeError(f"prosthetic_hand: the {d} loop did not close over its range")  # pragma: no cover
+            raise RuntimeError(
+                f"prosthetic_hand: the {d} loop did not close over its range"
+            )  # pragma: no cover
         own = [i for i, n in enumerate(names) if n.startswith(d + "_") and n != n_in]
         A = np.column_stack([u, np.ones_like(u)])
         Qfit = np.zeros_like(Q)
@@ -342,8 +419,12 @@ def mimic_fit(scale: float = 1.0, samples: int = 41) -> MimicFit:
     its driver's range (``samples`` exact closed-loop solutions), with the largest joint and
     fingertip errors of the approximation.  Multipliers and offsets are rounded to 1e-10 so
     the URDF text is reproducible."""
-    default_hand(scale)    # validates scale
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 3 <= samples <= 10_000:
+    default_hand(scale)  # validates scale
+    if (
+        isinstance(samples, bool)
+        or not isinstance(samples, (int, np.integer))
+        or not 3 <= samples <= 10_000
+    ):
         raise ParameterError(f"samples must be an integer in 3…10000, got {samples!r}")
     return _fit(float(scale), int(samples))
 
@@ -357,7 +438,9 @@ def _cyl_link(name, seg, radius, rgba, material):
     i_perp = m * (3 * radius**2 + max(L, 2 * radius) ** 2) / 12.0
     I = i_perp * (np.eye(3) - np.outer(u, u)) + m * radius**2 / 2.0 * np.outer(u, u)
     shapes = capsule(np.zeros(3), seg, radius, material=material, rgba=rgba) if L > 1e-12 else ()
-    return LinkSpec(name=name, mass=m, com=seg / 2, inertia=I, segment=seg, radius=radius, shapes=shapes)
+    return LinkSpec(
+        name=name, mass=m, com=seg / 2, inertia=I, segment=seg, radius=radius, shapes=shapes
+    )
 
 
 def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
@@ -381,12 +464,14 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
     skin, metal = (0.93, 0.78, 0.68, 1.0), (0.6, 0.62, 0.66, 1.0)
     joints = []
     expanded = []
-    for j in spec.joints:      # a ball joint is three revolute joints about x, y, z (as LoopSpec.urdf)
+    for j in spec.joints:  # a ball joint is three revolute joints about x, y, z (as LoopSpec.urdf)
         if j.type == "ball":
             bx, by = f"{j.name}__bx", f"{j.name}__by"
-            expanded += [(f"{j.name}_x", j.parent, bx, np.asarray(j.origin), (1.0, 0, 0)),
-                         (f"{j.name}_y", bx, by, np.eye(4), (0, 1.0, 0)),
-                         (f"{j.name}_z", by, j.child, np.eye(4), (0, 0, 1.0))]
+            expanded += [
+                (f"{j.name}_x", j.parent, bx, np.asarray(j.origin), (1.0, 0, 0)),
+                (f"{j.name}_y", bx, by, np.eye(4), (0, 1.0, 0)),
+                (f"{j.name}_z", by, j.child, np.eye(4), (0, 0, 1.0)),
+            ]
         else:
             expanded.append((j.name, j.parent, j.child, np.asarray(j.origin), tuple(j.axis)))
     inputs = set(spec.inputs)
@@ -394,8 +479,13 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         segs = offsets.get(child, [])
         seg = max(segs, key=np.linalg.norm) if segs else np.zeros(3)
         is_bar = "bar" in child or "rocker" in child
-        link = _cyl_link(child, seg, r * (0.5 if is_bar else 1.0), metal if is_bar else skin,
-                         "bar" if is_bar else "skin")
+        link = _cyl_link(
+            child,
+            seg,
+            r * (0.5 if is_bar else 1.0),
+            metal if is_bar else skin,
+            "bar" if is_bar else "skin",
+        )
         digit = name.split("_")[0]
         if name in inputs:
             lo, hi = hand.driver_range(digit)
@@ -409,16 +499,41 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         if mimic is not None and abs(mimic[1]) < 1e-9:
             # a joint that does not move with its driver (the S-S bar's spin: least-norm keeps it
             # constant) is fixed at its value
-            joints.append(JointSpec(name, "fixed", origin @ homogeneous(rot_axis(axis, mimic[2])), axis=axis,
-                                    link=link, parent=parent))
+            joints.append(
+                JointSpec(
+                    name,
+                    "fixed",
+                    origin @ homogeneous(rot_axis(axis, mimic[2])),
+                    axis=axis,
+                    link=link,
+                    parent=parent,
+                )
+            )
             continue
-        joints.append(JointSpec(name, "revolute", origin, axis=axis, lower=lo, upper=hi, effort=1.0, velocity=3.0,
-                                link=link, parent=parent, mimic=mimic))
+        joints.append(
+            JointSpec(
+                name,
+                "revolute",
+                origin,
+                axis=axis,
+                lower=lo,
+                upper=hi,
+                effort=1.0,
+                velocity=3.0,
+                link=link,
+                parent=parent,
+                mimic=mimic,
+            )
+        )
     B, L = hand.palm_size
     mp = DENSITY * 0.5 * B * 0.3 * B * L
-    box = Shape("box", (B, 0.3 * B, L), homogeneous(r=[-B / 8, 0.0, -L / 2]), material="skin", rgba=skin)
+    box = Shape(
+        "box", (B, 0.3 * B, L), homogeneous(r=[-B / 8, 0.0, -L / 2]), material="skin", rgba=skin
+    )
     palm_I = mp / 12.0 * np.diag([(0.3 * B) ** 2 + L**2, B**2 + L**2, B**2 + (0.3 * B) ** 2])
-    palm = LinkSpec(name="palm", mass=mp, com=np.array([-B / 8, 0.0, -L / 2]), inertia=palm_I, shapes=(box,))
+    palm = LinkSpec(
+        name="palm", mass=mp, com=np.array([-B / 8, 0.0, -L / 2]), inertia=palm_I, shapes=(box,)
+    )
     palm_mount = JointSpec("palm_mount", "fixed", homogeneous(), link=palm, parent="world")
     tips = {n: (p, T) for n, p, T in spec.sites if n.endswith("_tip")}
     frames = tuple((f"{d}_tip", *tips[f"{d}_tip"]) for d in DIGITS if d != "index")
@@ -427,20 +542,26 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
     err = ", ".join(f"{d} {1000 * fit.tip_error[d]:.2f} mm" for d in DIGITS)
     return ChainSpec(
         name="prosthetic_hand",
-        description=("Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + four-bar "
-                     "thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 drivers "
-                     f"(largest fingertip error of the approximation: {err}); exact model: "
-                     "anthroarm.models.prosthetic_hand.closed_loop()"),
+        description=(
+            "Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + four-bar "
+            "thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 drivers "
+            f"(largest fingertip error of the approximation: {err}); exact model: "
+            "anthroarm.models.prosthetic_hand.closed_loop()"
+        ),
         joints=[palm_mount] + joints,
         tool_name="index_tip",
         tool_origin=tips["index_tip"][1],
         tool_parent=tips["index_tip"][0],
         base_link="world",
         frames=frames,
-        source=("book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry (l.2037-2133); "
-                "finger dimensions fitted to the Chapter 3 curve f(x) (mechanisms.finger), scaled by Buchholz 1992"),
-        inertia_source=(f"not in the book: polyamide ({DENSITY:g} kg/m3) cylinders of radius {r:g} m; "
-                        "palm a half-filled box"),
+        source=(
+            "book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry (l.2037-2133); "
+            "finger dimensions fitted to the Chapter 3 curve f(x) (mechanisms.finger), scaled by Buchholz 1992"
+        ),
+        inertia_source=(
+            f"not in the book: polyamide ({DENSITY:g} kg/m3) cylinders of radius {r:g} m; "
+            "palm a half-filled box"
+        ),
         params={"scale": hand.scale},
     )
 
@@ -478,5 +599,11 @@ def robot(scale: float = 1.0, tool: str = "index_tip"):
 
     spec = prosthetic_hand(scale)
     info = parse_urdf_bytes(urdf_text(scale).encode(), Path("<generated>/prosthetic_hand.urdf"))
-    return _make(build_model(info), name="prosthetic_hand", info=info, spec=spec, description=spec.description,
-                 tool=tool)
+    return _make(
+        build_model(info),
+        name="prosthetic_hand",
+        info=info,
+        spec=spec,
+        description=spec.description,
+        tool=tool,
+    )

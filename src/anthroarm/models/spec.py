@@ -185,9 +185,15 @@ def dh_static(row: DHRow) -> np.ndarray:
     return dh_matrix(row, 0.0)
 
 
-def rod_link(name: str, segment, mass: float | None = None, radius: float = DEFAULT_LINK_RADIUS,
-             joint_mass: float = DEFAULT_JOINT_MASS, com_fraction: float = 0.5,
-             radii_of_gyration: tuple | None = None) -> LinkSpec:
+def rod_link(
+    name: str,
+    segment,
+    mass: float | None = None,
+    radius: float = DEFAULT_LINK_RADIUS,
+    joint_mass: float = DEFAULT_JOINT_MASS,
+    com_fraction: float = 0.5,
+    radii_of_gyration: tuple | None = None,
+) -> LinkSpec:
     """A link modelled as a uniform solid cylinder along ``segment`` plus a point-ish sphere
     (radius ``radius``) of ``joint_mass`` at the link origin.
 
@@ -211,11 +217,14 @@ def rod_link(name: str, segment, mass: float | None = None, radius: float = DEFA
             e1 = np.cross(u, [0, 1.0, 0])
         e1 /= np.linalg.norm(e1)
         e2 = np.cross(u, e1)
-        I_rod = m_rod * (k1**2 * np.outer(e1, e1) + k2**2 * np.outer(e2, e2) + ka**2 * np.outer(u, u))
+        I_rod = m_rod * (
+            k1**2 * np.outer(e1, e1) + k2**2 * np.outer(e2, e2) + ka**2 * np.outer(u, u)
+        )
     m_j = float(joint_mass)
     I_j = 0.4 * m_j * radius**2 * np.eye(3)
     m = m_rod + m_j
     com = (m_rod * c_rod) / m if m > 0 else np.zeros(3)
+
     # parallel-axis theorem to the common com
     def shift(mass, c):
         d = c - com
@@ -225,9 +234,19 @@ def rod_link(name: str, segment, mass: float | None = None, radius: float = DEFA
     return LinkSpec(name=name, mass=m, com=com, inertia=0.5 * (I + I.T), segment=seg, radius=radius)
 
 
-def from_dh(name: str, description: str, rows: list[DHRow], tool: np.ndarray, *, source: str,
-            joint_names=None, link_masses=None, params=None, tool_name="tool",
-            inertia_source: str | None = None) -> ChainSpec:
+def from_dh(
+    name: str,
+    description: str,
+    rows: list[DHRow],
+    tool: np.ndarray,
+    *,
+    source: str,
+    joint_names=None,
+    link_masses=None,
+    params=None,
+    tool_name="tool",
+    inertia_source: str | None = None,
+) -> ChainSpec:
     """Build a :class:`ChainSpec` from an H-D table (Eq. (6-12)) and the tool pose in the last
     DH frame.  Joint j's origin in link j−1 is the static part S_{j−1} of row j−1 (S_0 = I)."""
     n = len(rows)
@@ -298,9 +317,11 @@ def _shape(s: Shape, indent: str) -> str:
         geom = f'<sphere radius="{_num(s.size[0])}"/>'
     else:
         raise ParameterError(f"shape kind must be box, cylinder or sphere, got {s.kind!r}")
-    return (f"{indent}<visual>\n{_origin(np.asarray(s.origin, float), indent + '  ')}"
-            f"{indent}  <geometry>{geom}</geometry>\n"
-            f"{indent}  <material name=\"{s.material}\"><color rgba=\"{_vec(s.rgba)}\"/></material>\n{indent}</visual>\n")
+    return (
+        f"{indent}<visual>\n{_origin(np.asarray(s.origin, float), indent + '  ')}"
+        f"{indent}  <geometry>{geom}</geometry>\n"
+        f'{indent}  <material name="{s.material}"><color rgba="{_vec(s.rgba)}"/></material>\n{indent}</visual>\n'
+    )
 
 
 def _visuals(link: LinkSpec, indent: str) -> str:
@@ -309,9 +330,9 @@ def _visuals(link: LinkSpec, indent: str) -> str:
     out = []
     # sphere at the joint centre
     out.append(
-        f"{indent}<visual>\n{indent}  <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n"
-        f"{indent}  <geometry><sphere radius=\"{_num(1.3 * link.radius)}\"/></geometry>\n"
-        f"{indent}  <material name=\"joint\"><color rgba=\"0.85 0.45 0.2 1\"/></material>\n{indent}</visual>\n"
+        f'{indent}<visual>\n{indent}  <origin xyz="0 0 0" rpy="0 0 0"/>\n'
+        f'{indent}  <geometry><sphere radius="{_num(1.3 * link.radius)}"/></geometry>\n'
+        f'{indent}  <material name="joint"><color rgba="0.85 0.45 0.2 1"/></material>\n{indent}</visual>\n'
     )
     L = float(np.linalg.norm(link.segment))
     if L > 1e-9:
@@ -319,8 +340,8 @@ def _visuals(link: LinkSpec, indent: str) -> str:
         T = homogeneous(rotation_between([0.0, 0.0, 1.0], link.segment), link.segment / 2)
         out.append(
             f"{indent}<visual>\n{_origin(T, indent + '  ')}"
-            f"{indent}  <geometry><cylinder radius=\"{_num(link.radius)}\" length=\"{_num(L)}\"/></geometry>\n"
-            f"{indent}  <material name=\"link\"><color rgba=\"0.75 0.78 0.82 1\"/></material>\n{indent}</visual>\n"
+            f'{indent}  <geometry><cylinder radius="{_num(link.radius)}" length="{_num(L)}"/></geometry>\n'
+            f'{indent}  <material name="link"><color rgba="0.75 0.78 0.82 1"/></material>\n{indent}</visual>\n'
         )
     return "".join(out)
 
@@ -330,10 +351,10 @@ def _inertial(link: LinkSpec, indent: str) -> str:
         return ""
     I = link.inertia
     return (
-        f"{indent}<inertial>\n{indent}  <origin xyz=\"{_vec(link.com)}\" rpy=\"0 0 0\"/>\n"
-        f"{indent}  <mass value=\"{_num(link.mass)}\"/>\n"
-        f"{indent}  <inertia ixx=\"{_num(I[0, 0])}\" ixy=\"{_num(I[0, 1])}\" ixz=\"{_num(I[0, 2])}\" "
-        f"iyy=\"{_num(I[1, 1])}\" iyz=\"{_num(I[1, 2])}\" izz=\"{_num(I[2, 2])}\"/>\n{indent}</inertial>\n"
+        f'{indent}<inertial>\n{indent}  <origin xyz="{_vec(link.com)}" rpy="0 0 0"/>\n'
+        f'{indent}  <mass value="{_num(link.mass)}"/>\n'
+        f'{indent}  <inertia ixx="{_num(I[0, 0])}" ixy="{_num(I[0, 1])}" ixz="{_num(I[0, 2])}" '
+        f'iyy="{_num(I[1, 1])}" iyz="{_num(I[1, 2])}" izz="{_num(I[2, 2])}"/>\n{indent}</inertial>\n'
     )
 
 
@@ -341,9 +362,13 @@ def to_urdf(spec: ChainSpec) -> str:
     """URDF text of a chain.  Deterministic: the same spec always gives the same bytes."""
     lines = ['<?xml version="1.0"?>\n']
     lines.append("<!-- Generated by anthroarm.models from its parameter table; do not edit.\n")
-    lines.append(f"     {spec.description}\n     Source: {spec.source}\n     Inertia: {spec.inertia_source}\n")
+    lines.append(
+        f"     {spec.description}\n     Source: {spec.source}\n     Inertia: {spec.inertia_source}\n"
+    )
     if spec.params:
-        lines.append("     Parameters: " + ", ".join(f"{k}={v}" for k, v in spec.params.items()) + "\n")
+        lines.append(
+            "     Parameters: " + ", ".join(f"{k}={v}" for k, v in spec.params.items()) + "\n"
+        )
     lines.append("-->\n")
     lines.append(f'<robot name="{spec.name}">\n')
     lines.append(f'  <link name="{spec.base_link}"/>\n')
@@ -361,7 +386,9 @@ def to_urdf(spec: ChainSpec) -> str:
         )
         if j.mimic is not None:
             src, mult, off = j.mimic
-            lines.append(f'    <mimic joint="{src}" multiplier="{_num(mult)}" offset="{_num(off)}"/>\n')
+            lines.append(
+                f'    <mimic joint="{src}" multiplier="{_num(mult)}" offset="{_num(off)}"/>\n'
+            )
         lines.append("  </joint>\n")
         lines.append(f'  <link name="{link.name}">\n')
         lines.append(_inertial(link, "    "))
@@ -369,7 +396,9 @@ def to_urdf(spec: ChainSpec) -> str:
         lines.append("  </link>\n")
         parent = link.name
     lines.append(f'  <joint name="{spec.tool_name}_joint" type="fixed">\n')
-    lines.append(f'    <parent link="{spec.tool_parent or parent}"/>\n    <child link="{spec.tool_name}"/>\n')
+    lines.append(
+        f'    <parent link="{spec.tool_parent or parent}"/>\n    <child link="{spec.tool_name}"/>\n'
+    )
     lines.append(_origin(spec.tool_origin, "    "))
     lines.append("  </joint>\n")
     lines.append(f'  <link name="{spec.tool_name}"/>\n')

@@ -24,17 +24,46 @@ from .activities import Activity, ActivityTrajectory, Keyframe, activity, activi
 from .c3d import read_c3d, write_c3d
 from .csv_io import JointTrajectory, read_joint_csv, write_joint_csv
 from .marker_ik import STATUSES, MarkerIK, MarkerIKResult, marker_ik, match_markers
-from .markers import (HUMAN_ARM_LANDMARKS, BoundMarkers, Marker, MarkerSet, default_marker_set, human_arm_markers,
-                      segment_length)
-from .timing import keyframe_trajectory, minimum_jerk
+from .markers import (
+    HUMAN_ARM_LANDMARKS,
+    BoundMarkers,
+    Marker,
+    MarkerSet,
+    default_marker_set,
+    human_arm_markers,
+    segment_length,
+)
 from .scaling import ScalingResult, scale_from_static
+from .timing import keyframe_trajectory, minimum_jerk
 from .trial import MarkerTrajectories
 
 __all__ = [
-    "MarkerTrajectories", "read_c3d", "write_c3d", "JointTrajectory", "read_joint_csv", "write_joint_csv",
-    "Marker", "MarkerSet", "BoundMarkers", "HUMAN_ARM_LANDMARKS", "default_marker_set", "human_arm_markers",
+    "MarkerTrajectories",
+    "read_c3d",
+    "write_c3d",
+    "JointTrajectory",
+    "read_joint_csv",
+    "write_joint_csv",
+    "Marker",
+    "MarkerSet",
+    "BoundMarkers",
+    "HUMAN_ARM_LANDMARKS",
+    "default_marker_set",
+    "human_arm_markers",
     "segment_length",
-    "MarkerIK", "MarkerIKResult", "marker_ik", "match_markers", "STATUSES",
-    "activities", "Activity", "ActivityTrajectory", "Keyframe", "activity", "activity_trajectory",
-    "minimum_jerk", "keyframe_trajectory", "ScalingResult", "scale_from_static",
+    "MarkerIK",
+    "MarkerIKResult",
+    "marker_ik",
+    "match_markers",
+    "STATUSES",
+    "activities",
+    "Activity",
+    "ActivityTrajectory",
+    "Keyframe",
+    "activity",
+    "activity_trajectory",
+    "minimum_jerk",
+    "keyframe_trajectory",
+    "ScalingResult",
+    "scale_from_static",
 ]

@@ -49,9 +49,16 @@ MAX_SAMPLES = 1e7
 
 #: stature fractions (Drillis & Contini 1966, Winter 2009 Fig. 4.1) and this module's estimates
 BODY_PROPORTIONS = {
-    "shoulder_height": 0.818, "chin_height": 0.870, "mouth_height": 0.890, "eye_height": 0.936,
-    "vertex_height": 1.000, "shoulder_width": 0.259, "face_front": 0.055, "head_back": 0.055,
-    "sitting_shoulder": 0.34, "back_depth": 0.07,
+    "shoulder_height": 0.818,
+    "chin_height": 0.870,
+    "mouth_height": 0.890,
+    "eye_height": 0.936,
+    "vertex_height": 1.000,
+    "shoulder_width": 0.259,
+    "face_front": 0.055,
+    "head_back": 0.055,
+    "sitting_shoulder": 0.34,
+    "back_depth": 0.07,
 }
 
 
@@ -175,99 +182,175 @@ def _lap(B: Body, seat_height) -> tuple:
     return (-0.02, 0.22, max(-0.85 * B.arm, -(B.f("sitting_shoulder") - 0.10)))
 
 
-def _hand_to_mouth(B, *, move=1.0, hold=1.0, seat_height=0.45, table_height=0.72, object_mass=0.0, **_):
-    m = B.mouth + [0.0, 0.07, -0.02]               # the grip of a cup or spoon, in front of the mouth
-    return [Keyframe("rest", _lap(B, seat_height)), Keyframe("mouth", tuple(m), move, hold),
-            Keyframe("rest_again", _lap(B, seat_height), move)], object_mass
+def _hand_to_mouth(
+    B, *, move=1.0, hold=1.0, seat_height=0.45, table_height=0.72, object_mass=0.0, **_
+):
+    m = B.mouth + [0.0, 0.07, -0.02]  # the grip of a cup or spoon, in front of the mouth
+    return [
+        Keyframe("rest", _lap(B, seat_height)),
+        Keyframe("mouth", tuple(m), move, hold),
+        Keyframe("rest_again", _lap(B, seat_height), move),
+    ], object_mass
 
 
-def _eating(B, *, move=1.0, hold=0.5, seat_height=0.45, table_height=0.72, object_mass=0.05, repeats=2, **_):
+def _eating(
+    B, *, move=1.0, hold=0.5, seat_height=0.45, table_height=0.72, object_mass=0.05, repeats=2, **_
+):
     zt = B.seated_table(table_height, seat_height)
     plate = (-0.05, 0.35, zt + 0.05)
     m = tuple(B.mouth + [0.0, 0.07, -0.02])
     kf = [Keyframe("plate", plate, hold=0.5, holding=True)]
     for i in range(int(repeats)):
-        kf += [Keyframe(f"mouth{i + 1}", m, move, hold, True), Keyframe(f"plate{i + 1}", plate, move, 0.5, True)]
+        kf += [
+            Keyframe(f"mouth{i + 1}", m, move, hold, True),
+            Keyframe(f"plate{i + 1}", plate, move, 0.5, True),
+        ]
     return kf, object_mass
 
 
 def _comb_hair(B, *, move=1.0, hold=0.0, strokes=2, object_mass=0.05, **_):
-    top = (B.midline_x + 0.04 * B.height, 0.03 * B.height, B.above_shoulder("vertex_height") - 0.02 * B.height)
-    back = (B.midline_x + 0.05 * B.height, -B.f("head_back"), B.above_shoulder("eye_height") - 0.02 * B.height)
-    kf = [Keyframe("rest", _rest(B), holding=True), Keyframe("head_front_top", top, 1.5 * move, 0.0, True)]
+    top = (
+        B.midline_x + 0.04 * B.height,
+        0.03 * B.height,
+        B.above_shoulder("vertex_height") - 0.02 * B.height,
+    )
+    back = (
+        B.midline_x + 0.05 * B.height,
+        -B.f("head_back"),
+        B.above_shoulder("eye_height") - 0.02 * B.height,
+    )
+    kf = [
+        Keyframe("rest", _rest(B), holding=True),
+        Keyframe("head_front_top", top, 1.5 * move, 0.0, True),
+    ]
     for i in range(int(strokes)):
-        kf += [Keyframe(f"head_back{i + 1}", back, move, hold, True), Keyframe(f"head_top{i + 1}", top, move, 0.0, True)]
+        kf += [
+            Keyframe(f"head_back{i + 1}", back, move, hold, True),
+            Keyframe(f"head_top{i + 1}", top, move, 0.0, True),
+        ]
     kf.append(Keyframe("rest_again", _rest(B), 1.5 * move, 0.0, True))
     return kf, object_mass
 
 
-def _reach_shelf(B, *, move=1.2, hold=0.5, reach_fraction=0.85, shelf_height=None, object_mass=0.0, **_):
+def _reach_shelf(
+    B, *, move=1.2, hold=0.5, reach_fraction=0.85, shelf_height=None, object_mass=0.0, **_
+):
     z = 0.0 if shelf_height is None else B.standing(shelf_height)
-    shelf = (0.02, reach_fraction * np.sqrt(max(B.arm ** 2 - z ** 2, 0.0)), z)
-    return [Keyframe("rest", _rest(B)), Keyframe("shelf", shelf, move, hold),
-            Keyframe("rest_again", _rest(B), move)], object_mass
+    shelf = (0.02, reach_fraction * np.sqrt(max(B.arm**2 - z**2, 0.0)), z)
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("shelf", shelf, move, hold),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
 def _opposite_shoulder(B, *, move=1.0, hold=0.5, object_mass=0.0, **_):
     target = (-B.f("shoulder_width") + 0.03, 0.04, 0.02)
-    return [Keyframe("rest", _rest(B)), Keyframe("opposite_shoulder", target, move, hold),
-            Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("opposite_shoulder", target, move, hold),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
-def _lift_to_table(B, *, move=1.2, hold=0.5, seat_height=0.45, table_height=0.72, object_mass=1.0, **_):
+def _lift_to_table(
+    B, *, move=1.2, hold=0.5, seat_height=0.45, table_height=0.72, object_mass=1.0, **_
+):
     zt = B.seated_table(table_height, seat_height)
-    start = (0.12, 0.15, -0.80 * B.arm)              # the object beside the chair, low
+    start = (0.12, 0.15, -0.80 * B.arm)  # the object beside the chair, low
     table = (-0.02, 0.38, zt + 0.06)
-    return [Keyframe("rest", _rest(B)), Keyframe("grasp_low", start, move, 0.3, True),
-            Keyframe("on_table", table, move, hold, False), Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("grasp_low", start, move, 0.3, True),
+        Keyframe("on_table", table, move, hold, False),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
 def _pour(B, *, move=1.2, hold=1.0, seat_height=0.45, table_height=0.72, object_mass=1.0, **_):
     zt = B.seated_table(table_height, seat_height)
     jug = (0.05, 0.35, zt + 0.08)
     over_cup = (-0.12, 0.36, zt + 0.22)
-    return [Keyframe("lap", _lap(B, seat_height)), Keyframe("grasp_jug", jug, move, 0.3, True),
-            Keyframe("over_cup", over_cup, move, hold, True), Keyframe("jug_down", jug, move, 0.3, False),
-            Keyframe("lap_again", _lap(B, seat_height), move)], object_mass
+    return [
+        Keyframe("lap", _lap(B, seat_height)),
+        Keyframe("grasp_jug", jug, move, 0.3, True),
+        Keyframe("over_cup", over_cup, move, hold, True),
+        Keyframe("jug_down", jug, move, 0.3, False),
+        Keyframe("lap_again", _lap(B, seat_height), move),
+    ], object_mass
 
 
 def _dressing(B, *, move=1.2, hold=0.5, object_mass=0.0, **_):
     opp = (-B.f("shoulder_width") + 0.03, 0.04, 0.02)
     neck = (B.midline_x + 0.03, -0.03, 0.05)
-    return [Keyframe("rest", _rest(B)), Keyframe("opposite_shoulder", opp, move, hold),
-            Keyframe("back_of_neck", neck, move, hold), Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("opposite_shoulder", opp, move, hold),
+        Keyframe("back_of_neck", neck, move, hold),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
 def _wash_face(B, *, move=1.0, hold=0.5, object_mass=0.0, **_):
     face = B.mouth + [0.0, 0.05, 0.03]
     left = face + [-0.05, 0.0, 0.02]
     right = face + [0.05, 0.0, 0.02]
-    return [Keyframe("rest", _rest(B)), Keyframe("face", tuple(face), move, hold), Keyframe("left_cheek", tuple(left), 0.5),
-            Keyframe("right_cheek", tuple(right), 0.5), Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("face", tuple(face), move, hold),
+        Keyframe("left_cheek", tuple(left), 0.5),
+        Keyframe("right_cheek", tuple(right), 0.5),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
 def _open_door(B, *, move=1.2, hold=0.5, handle_height=1.0, pull=0.15, object_mass=0.0, **_):
     z = B.standing(handle_height)
-    handle = (0.10, 0.65 * np.sqrt(max(B.arm ** 2 - z ** 2, 0.0)), z)
+    handle = (0.10, 0.65 * np.sqrt(max(B.arm**2 - z**2, 0.0)), z)
     pulled = (handle[0], handle[1] - pull, z)
-    return [Keyframe("rest", _rest(B)), Keyframe("handle", handle, move, hold),
-            Keyframe("pull", pulled, move, hold), Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("handle", handle, move, hold),
+        Keyframe("pull", pulled, move, hold),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
-def _writing(B, *, move=1.0, seat_height=0.45, table_height=0.72, stroke=0.08, strokes=3, object_mass=0.02, **_):
+def _writing(
+    B,
+    *,
+    move=1.0,
+    seat_height=0.45,
+    table_height=0.72,
+    stroke=0.08,
+    strokes=3,
+    object_mass=0.02,
+    **_,
+):
     zt = B.seated_table(table_height, seat_height)
     p0 = np.array([0.0, 0.33, zt + 0.04])
     kf = [Keyframe("paper", tuple(p0), holding=True)]
     for i in range(int(strokes)):
-        kf.append(Keyframe(f"stroke{i + 1}", tuple(p0 + [-(i + 1) * stroke / strokes, 0.0, 0.0]), 0.6, 0.2, True))
+        kf.append(
+            Keyframe(
+                f"stroke{i + 1}",
+                tuple(p0 + [-(i + 1) * stroke / strokes, 0.0, 0.0]),
+                0.6,
+                0.2,
+                True,
+            )
+        )
     kf.append(Keyframe("paper_again", tuple(p0), move, 0.0, True))
     return kf, object_mass
 
 
 def _toileting(B, *, move=1.2, hold=0.5, object_mass=0.0, **_):
     behind = (0.0, -B.f("back_depth") - 0.03, -0.85 * B.arm)
-    return [Keyframe("rest", _rest(B)), Keyframe("behind_hip", behind, move, hold),
-            Keyframe("rest_again", _rest(B), move)], object_mass
+    return [
+        Keyframe("rest", _rest(B)),
+        Keyframe("behind_hip", behind, move, hold),
+        Keyframe("rest_again", _rest(B), move),
+    ], object_mass
 
 
 _MAGERMANS = "Magermans et al. 2005, Clin. Biomech. 20(6) 591-599"
@@ -275,22 +358,58 @@ _MURRAY = "Murray & Johnson 2004, Clin. Biomech. 19(6) 586-594"
 
 #: name -> (title, builder, source, Table 9.2 row)
 ACTIVITIES = {
-    "hand_to_mouth": ("hand to mouth (drinking), seated", _hand_to_mouth, f"{_MURRAY}; issue 17", ""),
-    "comb_hair": ("combing hair (hand to the top and back of the head)", _comb_hair, _MAGERMANS, ""),
+    "hand_to_mouth": (
+        "hand to mouth (drinking), seated",
+        _hand_to_mouth,
+        f"{_MURRAY}; issue 17",
+        "",
+    ),
+    "comb_hair": (
+        "combing hair (hand to the top and back of the head)",
+        _comb_hair,
+        _MAGERMANS,
+        "",
+    ),
     "reach_shelf": ("reach to a shelf at shoulder height", _reach_shelf, "issue 17", ""),
-    "reach_opposite_shoulder": ("reach to the opposite shoulder", _opposite_shoulder,
-                                f"{_MAGERMANS} (contralateral axilla)", ""),
-    "lift_to_table": ("lift a 1 kg object from beside the chair to the table", _lift_to_table, f"{_MURRAY}; issue 17", ""),
+    "reach_opposite_shoulder": (
+        "reach to the opposite shoulder",
+        _opposite_shoulder,
+        f"{_MAGERMANS} (contralateral axilla)",
+        "",
+    ),
+    "lift_to_table": (
+        "lift a 1 kg object from beside the chair to the table",
+        _lift_to_table,
+        f"{_MURRAY}; issue 17",
+        "",
+    ),
     "pour": ("pour from a 1 kg jug into a cup, seated", _pour, f"{_MURRAY}; issue 17", ""),
     "eating": ("eating with a spoon: plate to mouth, twice", _eating, _MAGERMANS, "饮食 eating"),
-    "dressing": ("dressing: hand to the opposite shoulder and behind the neck", _dressing, "book Table 9.2",
-                 "穿脱衣服 dressing"),
+    "dressing": (
+        "dressing: hand to the opposite shoulder and behind the neck",
+        _dressing,
+        "book Table 9.2",
+        "穿脱衣服 dressing",
+    ),
     "wash_face": ("washing the face", _wash_face, "book Table 9.2", "洗脸 washing the face"),
-    "open_door": ("opening a door: reach the handle at 1 m and pull", _open_door, "book Table 9.2",
-                  "一般动作 general (opening doors)"),
-    "writing": ("writing at a table, seated", _writing, "book Table 9.2", "桌面动作 desk work (writing)"),
-    "toileting": ("hygiene: hand behind the hip (perineal care)", _toileting, f"book Table 9.2; {_MAGERMANS}",
-                  "卫生动作 hygiene (toilet)"),
+    "open_door": (
+        "opening a door: reach the handle at 1 m and pull",
+        _open_door,
+        "book Table 9.2",
+        "一般动作 general (opening doors)",
+    ),
+    "writing": (
+        "writing at a table, seated",
+        _writing,
+        "book Table 9.2",
+        "桌面动作 desk work (writing)",
+    ),
+    "toileting": (
+        "hygiene: hand behind the hip (perineal care)",
+        _toileting,
+        f"book Table 9.2; {_MAGERMANS}",
+        "卫生动作 hygiene (toilet)",
+    ),
 }
 
 
@@ -305,7 +424,11 @@ def _person(robot, height):
         height = params.get("height")
         if height is None:
             raise ActivityError(f"{robot.name} does not say the person's height: pass height= (m)")
-    if not (isinstance(height, (int, float, np.floating)) and np.isfinite(height) and 0.5 <= height <= 2.6):
+    if not (
+        isinstance(height, (int, float, np.floating))
+        and np.isfinite(height)
+        and 0.5 <= height <= 2.6
+    ):
         raise ActivityError(f"height must be a number of metres in 0.5 ... 2.6, got {height!r}")
     arm = float(np.linalg.norm(robot.fk(robot.neutral())[:3, 3]))
     return Body(float(height), arm, dict(BODY_PROPORTIONS))
@@ -329,7 +452,11 @@ def activity(name: str, robot, *, height: float | None = None, **params) -> Acti
     for k, v in params.items():
         if v is None:
             continue
-        if not (isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool) and np.isfinite(v)):
+        if not (
+            isinstance(v, (int, float, np.floating, np.integer))
+            and not isinstance(v, bool)
+            and np.isfinite(v)
+        ):
             raise ActivityError(f"activity {name!r}: parameter {k}={v!r} must be a finite number")
         if k in ("move", "repeats", "strokes") and v <= 0:
             raise ActivityError(f"activity {name!r}: {k} must be > 0, got {v}")
@@ -337,11 +464,28 @@ def activity(name: str, robot, *, height: float | None = None, **params) -> Acti
             raise ActivityError(f"activity {name!r}: {k} must be >= 0, got {v}")
     B = _person(robot, height)
     keyframes, mass = builder(B, **params)
-    return Activity(name, title, keyframes, float(mass), source, book, {"height": B.height, "arm": B.arm, **params})
+    return Activity(
+        name,
+        title,
+        keyframes,
+        float(mass),
+        source,
+        book,
+        {"height": B.height, "arm": B.arm, **params},
+    )
 
 
-def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False, tol: float = 1e-3,
-                        height: float | None = None, q_start=None, **params) -> ActivityTrajectory:
+def activity_trajectory(
+    robot,
+    act,
+    *,
+    rate: float = 100.0,
+    strict: bool = False,
+    tol: float = 1e-3,
+    height: float | None = None,
+    q_start=None,
+    **params,
+) -> ActivityTrajectory:
     """Joint trajectory of an activity (an :class:`Activity` or a library name, built with
     :func:`activity` and ``params``) for ``robot``, sampled at ``rate`` Hz.
 
@@ -361,23 +505,37 @@ def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False
         raise ActivityError(f"expected an Activity or a name, got {type(act).__name__}")
     if not act.keyframes:
         raise ActivityError(f"activity {act.name!r} has no keyframes")
-    if not (isinstance(rate, (int, float, np.floating, np.integer)) and np.isfinite(rate) and rate > 0):
+    if not (
+        isinstance(rate, (int, float, np.floating, np.integer)) and np.isfinite(rate) and rate > 0
+    ):
         raise ActivityError(f"rate must be a positive number of samples per second, got {rate!r}")
     for kf in act.keyframes:
         try:
-            ok = (np.asarray(kf.position, float).shape == (3,) and np.isfinite(kf.position).all()
-                  and np.isfinite(kf.move) and kf.move > 0 and np.isfinite(kf.hold) and kf.hold >= 0)
+            ok = (
+                np.asarray(kf.position, float).shape == (3,)
+                and np.isfinite(kf.position).all()
+                and np.isfinite(kf.move)
+                and kf.move > 0
+                and np.isfinite(kf.hold)
+                and kf.hold >= 0
+            )
         except (TypeError, ValueError):
             ok = False
         if not ok:
-            raise ActivityError(f"activity {act.name!r}: keyframe {kf.name!r} needs a target of 3 finite numbers (m), "
-                                f"move > 0 s and hold >= 0 s; got {kf.position!r}, {kf.move!r}, {kf.hold!r}",
-                                keyframe=kf.name)
+            raise ActivityError(
+                f"activity {act.name!r}: keyframe {kf.name!r} needs a target of 3 finite numbers (m), "
+                f"move > 0 s and hold >= 0 s; got {kf.position!r}, {kf.move!r}, {kf.hold!r}",
+                keyframe=kf.name,
+            )
     total = sum(kf.move for kf in act.keyframes[1:]) + sum(kf.hold for kf in act.keyframes)
     if total * rate > MAX_SAMPLES:
-        raise ActivityError(f"activity {act.name!r}: {total:g} s at {rate:g} Hz is more than {MAX_SAMPLES:g} samples; "
-                            "lower the rate or the durations")
-    q_prev = comfortable_posture(robot) if q_start is None else robot.check_q(q_start, name="q_start")
+        raise ActivityError(
+            f"activity {act.name!r}: {total:g} s at {rate:g} Hz is more than {MAX_SAMPLES:g} samples; "
+            "lower the rate or the durations"
+        )
+    q_prev = (
+        comfortable_posture(robot) if q_start is None else robot.check_q(q_start, name="q_start")
+    )
     Qk, status, err = [], [], []
     for kf in act.keyframes:
         p = np.asarray(kf.position, float)
@@ -385,9 +543,12 @@ def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False
         e = float(np.linalg.norm(robot.fk(res.q)[:3, 3] - p))
         ok = e <= tol
         if not ok and strict:
-            raise ActivityError(f"activity {act.name!r}: keyframe {kf.name!r} at {np.round(p, 3).tolist()} m is out "
-                                f"of the arm's reach (closest hand position {e * 1000:.0f} mm away; {res.status})",
-                                keyframe=kf.name, distance=e)
+            raise ActivityError(
+                f"activity {act.name!r}: keyframe {kf.name!r} at {np.round(p, 3).tolist()} m is out "
+                f"of the arm's reach (closest hand position {e * 1000:.0f} mm away; {res.status})",
+                keyframe=kf.name,
+                distance=e,
+            )
         Qk.append(res.q)
         status.append("ok" if ok else "unreachable")
         err.append(e)
@@ -405,5 +566,19 @@ def activity_trajectory(robot, act, *, rate: float = 100.0, strict: bool = False
         if fl:
             holding |= (t >= start) & (t < end)
     hand = robot.fk(q)[:, :3, 3]
-    return ActivityTrajectory(act, t, q, qd, qdd, hand, holding, act.object_mass, tuple(kf.name for kf in act.keyframes),
-                              arrival, Qk, tuple(status), np.array(err), tuple(robot.chain.q_names))
+    return ActivityTrajectory(
+        act,
+        t,
+        q,
+        qd,
+        qdd,
+        hand,
+        holding,
+        act.object_mass,
+        tuple(kf.name for kf in act.keyframes),
+        arrival,
+        Qk,
+        tuple(status),
+        np.array(err),
+        tuple(robot.chain.q_names),
+    )

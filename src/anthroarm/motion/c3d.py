@@ -24,8 +24,19 @@ from ..errors import C3DError
 from .trial import MarkerTrajectories
 
 #: metres per unit of the C3D POINT:UNITS values anthroarm understands
-UNITS = {"mm": 1e-3, "millimeter": 1e-3, "millimeters": 1e-3, "millimetre": 1e-3, "millimetres": 1e-3,
-         "cm": 1e-2, "m": 1.0, "meter": 1.0, "meters": 1.0, "metre": 1.0, "metres": 1.0}
+UNITS = {
+    "mm": 1e-3,
+    "millimeter": 1e-3,
+    "millimeters": 1e-3,
+    "millimetre": 1e-3,
+    "millimetres": 1e-3,
+    "cm": 1e-2,
+    "m": 1.0,
+    "meter": 1.0,
+    "meters": 1.0,
+    "metre": 1.0,
+    "metres": 1.0,
+}
 
 
 def _param(c, group: str, name: str, default=None):
@@ -51,15 +62,23 @@ def _check_structure(p: Path) -> int | None:
             raise C3DError("not a C3D file (no C3D header: the second byte is not 0x50)", p)
         start = (head[0] - 1) * 512
         if head[0] < 2 or start + 4 > size:
-            raise C3DError(f"damaged C3D header: parameter section at block {head[0]} is outside the file", p)
+            raise C3DError(
+                f"damaged C3D header: parameter section at block {head[0]} is outside the file", p
+            )
         fh.seek(start)
         sec = fh.read(4)
         n_blocks, proc = sec[2], sec[3]
         if proc not in (84, 85, 86):
-            raise C3DError(f"damaged C3D parameter section: processor type {proc} (84 Intel, 85 DEC, 86 MIPS)", p)
+            raise C3DError(
+                f"damaged C3D parameter section: processor type {proc} (84 Intel, 85 DEC, 86 MIPS)",
+                p,
+            )
         if n_blocks < 1 or start + 512 * n_blocks > size:
-            raise C3DError(f"damaged or truncated C3D file: the parameter section ({n_blocks} blocks) does not fit in "
-                           f"the file ({size} bytes)", p)
+            raise C3DError(
+                f"damaged or truncated C3D file: the parameter section ({n_blocks} blocks) does not fit in "
+                f"the file ({size} bytes)",
+                p,
+            )
         fh.seek(start)
         sec = fh.read(512 * n_blocks)
     i16 = ">h" if proc == 86 else "<h"
@@ -67,13 +86,13 @@ def _check_structure(p: Path) -> int | None:
     groups, params = set(), set()
     i = 4
     while i + 2 <= len(sec):
-        nchar, gid = struct.unpack("bb", sec[i:i + 2])
+        nchar, gid = struct.unpack("bb", sec[i : i + 2])
         if nchar == 0:
             break
         off_at = i + 2 + abs(nchar)
         if gid == 0 or off_at + 3 > len(sec):
             raise C3DError(f"damaged C3D parameter section at byte {start + i}: group id {gid}", p)
-        nxt = struct.unpack(i16, sec[off_at:off_at + 2])[0]
+        nxt = struct.unpack(i16, sec[off_at : off_at + 2])[0]
         j = off_at + 2
         if gid < 0:
             if -gid in groups:
@@ -81,23 +100,35 @@ def _check_structure(p: Path) -> int | None:
             groups.add(-gid)
         else:
             params.add(gid)
-            typ, ndim = struct.unpack("bB", sec[j:j + 2])
-            dims = sec[j + 2:j + 2 + ndim]
+            typ, ndim = struct.unpack("bB", sec[j : j + 2])
+            dims = sec[j + 2 : j + 2 + ndim]
             if typ not in (-1, 1, 2, 4) or ndim > 7 or len(dims) < ndim:
-                raise C3DError(f"damaged C3D parameter section at byte {start + i}: data type {typ}, {ndim} "
-                               "dimensions", p)
+                raise C3DError(
+                    f"damaged C3D parameter section at byte {start + i}: data type {typ}, {ndim} "
+                    "dimensions",
+                    p,
+                )
             j += 2 + ndim + abs(typ) * int(np.prod([int(d) for d in dims]))
         if j >= len(sec):
-            raise C3DError(f"damaged C3D parameter section at byte {start + i}: a record runs past the section", p)
-        j += 1 + sec[j]                                  # the description
+            raise C3DError(
+                f"damaged C3D parameter section at byte {start + i}: a record runs past the section",
+                p,
+            )
+        j += 1 + sec[j]  # the description
         if j > len(sec) or (nxt != 0 and (nxt < 2 or j > off_at + nxt)):
-            raise C3DError(f"damaged C3D parameter section at byte {start + i}: a record overlaps the next one", p)
+            raise C3DError(
+                f"damaged C3D parameter section at byte {start + i}: a record overlaps the next one",
+                p,
+            )
         if nxt == 0:
             break
         i = off_at + nxt
     if params - groups:
-        raise C3DError(f"damaged C3D parameter section: parameters of undeclared groups {sorted(params - groups)}", p)
-    first, last = (struct.unpack(u16, head[k:k + 2])[0] for k in (6, 8))
+        raise C3DError(
+            f"damaged C3D parameter section: parameters of undeclared groups {sorted(params - groups)}",
+            p,
+        )
+    first, last = (struct.unpack(u16, head[k : k + 2])[0] for k in (6, 8))
     return last - first + 1 if 0 < first <= last < 65535 else None
 
 
@@ -129,13 +160,15 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     if pts.ndim != 3 or pts.shape[0] < 3:
         raise C3DError(f"no POINT data (points array of shape {pts.shape})", p)
     if announced is not None and pts.shape[2] < announced:
-        raise C3DError(f"truncated file: its header announces {announced} frames, it holds {pts.shape[2]}", p)
+        raise C3DError(
+            f"truncated file: its header announces {announced} frames, it holds {pts.shape[2]}", p
+        )
     labels = list(_param(c, "POINT", "LABELS", []) or [])
     k = 2
     while len(labels) < pts.shape[1] and _param(c, "POINT", f"LABELS{k}") is not None:
         labels += list(_param(c, "POINT", f"LABELS{k}"))
         k += 1
-    labels = [str(s).strip() for s in labels[:pts.shape[1]]]
+    labels = [str(s).strip() for s in labels[: pts.shape[1]]]
     if len(labels) < pts.shape[1]:
         labels += [f"point{i + 1}" for i in range(len(labels), pts.shape[1])]
     units = _param(c, "POINT", "UNITS", ["mm"])
@@ -146,7 +179,7 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     rate = float(np.asarray(rate, dtype=float).ravel()[0]) if np.size(rate) else 0.0
     if not (np.isfinite(rate) and rate > 0):
         raise C3DError(f"POINT:RATE is {rate!r}: the frame rate must be positive (Hz)", p)
-    P = np.moveaxis(pts[:3], 0, -1).transpose(1, 0, 2) * UNITS[unit]      # (N, M, 3)
+    P = np.moveaxis(pts[:3], 0, -1).transpose(1, 0, 2) * UNITS[unit]  # (N, M, 3)
     missing = ~np.isfinite(P).all(axis=2)
     if zero_is_missing:
         missing |= np.all(P == 0.0, axis=2)
@@ -174,7 +207,10 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
         raise C3DError(f"folder {p.parent} does not exist", p)
     long = [n for n in trial.names if len(n.encode("utf-8")) > 255]
     if long:
-        raise C3DError(f"marker labels longer than 255 bytes cannot be stored in POINT:LABELS: {long[0][:40]!r}...", p)
+        raise C3DError(
+            f"marker labels longer than 255 bytes cannot be stored in POINT:LABELS: {long[0][:40]!r}...",
+            p,
+        )
     c = ezc3d.c3d()
     c["parameters"]["POINT"]["RATE"]["value"] = [trial.rate]
     c["parameters"]["POINT"]["LABELS"]["value"] = list(trial.names)
@@ -182,7 +218,7 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
     N, M, _ = trial.positions.shape
     pts = np.ones((4, M, N))
     pts[:3] = trial.positions.transpose(2, 1, 0) / UNITS[units]
-    missing = ~trial.visible.T                              # (M, N)
+    missing = ~trial.visible.T  # (M, N)
     pts[:3, missing] = np.nan
     c["data"]["points"] = pts
     res = np.zeros((1, M, N))
@@ -194,7 +230,10 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
         os.replace(tmp, p)
     except Exception as exc:
         tmp.unlink(missing_ok=True)
-        what = f"cannot write the file ({exc.strerror})" if isinstance(exc, OSError) and exc.strerror else \
-            f"ezc3d cannot write the file ({exc})"
+        what = (
+            f"cannot write the file ({exc.strerror})"
+            if isinstance(exc, OSError) and exc.strerror
+            else f"ezc3d cannot write the file ({exc})"
+        )
         raise C3DError(what, p) from None
     return p

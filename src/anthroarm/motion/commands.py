@@ -19,24 +19,48 @@ import sys
 def add_parser(sub):
     """Register ``ik-markers`` on the CLI's subparsers (``anthroarm.cli.build_parser``)."""
     p = sub.add_parser(
-        "ik-markers", help="marker-based IK of a C3D trial: joint angles per frame to CSV",
+        "ik-markers",
+        help="marker-based IK of a C3D trial: joint angles per frame to CSV",
         description="Frame-by-frame marker IK (weighted least squares of marker errors within the joint limits, "
-                    "warm-started, gaps handled by weights) of a C3D trial on a person's arm model; writes t, the "
-                    "joint angles (rad) and per-frame RMS / max marker error and status to CSV.",
+        "warm-started, gaps handled by weights) of a C3D trial on a person's arm model; writes t, the "
+        "joint angles (rad) and per-frame RMS / max marker error and status to CSV.",
         epilog="example: anthroarm ik-markers trial.c3d --out angles.csv --height 1.62 --mass 55 --sex female "
-               "--static static.c3d")
+        "--static static.c3d",
+    )
     p.add_argument("trial", help="C3D file of the trial (POINT:UNITS mm, cm or m)")
-    p.add_argument("--out", required=True, metavar="FILE.csv", help="joint angles, written atomically")
+    p.add_argument(
+        "--out", required=True, metavar="FILE.csv", help="joint angles, written atomically"
+    )
     p.add_argument("--model", default="human_arm7", help="arm model (default human_arm7)")
-    p.add_argument("--height", type=float, default=None,
-                   help="body height, m (a person's arm model: human_arm7, human_upper_limb; default 1.75)")
-    p.add_argument("--mass", type=float, default=None, help="body mass, kg (a person's arm model; default 75)")
+    p.add_argument(
+        "--height",
+        type=float,
+        default=None,
+        help="body height, m (a person's arm model: human_arm7, human_upper_limb; default 1.75)",
+    )
+    p.add_argument(
+        "--mass", type=float, default=None, help="body mass, kg (a person's arm model; default 75)"
+    )
     p.add_argument("--sex", default=None, choices=["male", "female"])
-    p.add_argument("--static", default=None, metavar="STATIC.c3d",
-                   help="static trial: scale the segments to it before the IK")
-    p.add_argument("--markers", default=None, metavar="SET.json", help="marker set (default: the ISB human-arm set)")
-    p.add_argument("--rename", action="append", default=[], metavar="LABEL=MARKER",
-                   help="map a trial label to a marker of the set (repeatable)")
+    p.add_argument(
+        "--static",
+        default=None,
+        metavar="STATIC.c3d",
+        help="static trial: scale the segments to it before the IK",
+    )
+    p.add_argument(
+        "--markers",
+        default=None,
+        metavar="SET.json",
+        help="marker set (default: the ISB human-arm set)",
+    )
+    p.add_argument(
+        "--rename",
+        action="append",
+        default=[],
+        metavar="LABEL=MARKER",
+        help="map a trial label to a marker of the set (repeatable)",
+    )
     p.add_argument("--solver", default="daqp", help="QP backend (default daqp)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_ik_markers)
@@ -61,7 +85,9 @@ def cmd_ik_markers(a) -> int:
     out = Path(a.out)
     if out.is_dir() or not out.parent.is_dir():
         raise UserError(f"--out {a.out}: give a file name in an existing folder")
-    person = {k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None}
+    person = {
+        k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None
+    }
     trial = read_c3d(a.trial)
     robot = aa.load(a.model, **person)
     markers = MarkerSet.read_json(a.markers) if a.markers else None
@@ -69,22 +95,34 @@ def cmd_ik_markers(a) -> int:
     if a.static:
         sc = scale_from_static(robot, read_c3d(a.static), markers, rename=rename)
         if sc.status != "ok":
-            raise UserError(f"--static {a.static}: the static trial does not fit {a.model} ({sc.status}: RMS marker "
-                            f"error {sc.rms * 1e3:.1f} mm, scale factors "
-                            f"{ {k: round(v, 2) for k, v in sc.scales.items()} }); check the markers' labels (--rename) "
-                            "and that it is a static trial of this person")
+            raise UserError(
+                f"--static {a.static}: the static trial does not fit {a.model} ({sc.status}: RMS marker "
+                f"error {sc.rms * 1e3:.1f} mm, scale factors "
+                f"{ {k: round(v, 2) for k, v in sc.scales.items()} }); check the markers' labels (--rename) "
+                "and that it is a static trial of this person"
+            )
         robot = aa.load(a.model, **sc.load_kwargs(robot))
         markers = sc.marker_set
         info["segment_lengths_m"] = {k: round(v, 4) for k, v in sc.segment_lengths.items()}
         info["static_rms_m"] = sc.rms
     bar = _progress(trial.n_frames, "marker IK", not a.no_progress)
     try:
-        res = marker_ik(robot, trial, markers, rename=rename, solver=a.solver,
-                        progress=lambda n, N: bar.update(n - bar.n))
+        res = marker_ik(
+            robot,
+            trial,
+            markers,
+            rename=rename,
+            solver=a.solver,
+            progress=lambda n, N: bar.update(n - bar.n),
+        )
     finally:
         bar.close()
-    write_joint_csv(a.out, res, comment=f"source: {trial.source} ({trial.n_frames} frames at {trial.rate:g} Hz); "
-                                        f"model {robot.name}; marker set {res.info['marker_set']}")
+    write_joint_csv(
+        a.out,
+        res,
+        comment=f"source: {trial.source} ({trial.n_frames} frames at {trial.rate:g} Hz); "
+        f"model {robot.name}; marker set {res.info['marker_set']}",
+    )
     summary = {"out": a.out, **res.summary(), **info}
     print(json.dumps(summary))
     if res.counts()["ok"] == 0:

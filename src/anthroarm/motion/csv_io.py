@@ -55,25 +55,40 @@ def write_joint_csv(path, t, q=None, names=None, *, comment: str = "") -> Path:
         q, names = res.q, res.joint_names
         if isinstance(res, MarkerIKResult):
             code = np.array([STATUSES.index(s) for s in res.status])
-            extra = (("rms_m", "max_error_m", "n_markers", "status"),
-                     np.column_stack([res.rms, res.max_error, res.n_markers, code]))
+            extra = (
+                ("rms_m", "max_error_m", "n_markers", "status"),
+                np.column_stack([res.rms, res.max_error, res.n_markers, code]),
+            )
     t = np.asarray(t, float)
     q = np.asarray(q, float)
     names = tuple(names or ())
     if q.ndim != 2 or t.shape != (q.shape[0],) or len(names) != q.shape[1]:
-        raise MotionDataError(f"write_joint_csv: t (N,), q (N, n) and n names, got {t.shape}, {q.shape}, {len(names)}")
+        raise MotionDataError(
+            f"write_joint_csv: t (N,), q (N, n) and n names, got {t.shape}, {q.shape}, {len(names)}"
+        )
     if not (np.isfinite(t).all() and np.isfinite(q).all()):
         raise MotionDataError("write_joint_csv: t and q must be finite", path)
-    bad = [n for n in names
-           if not str(n).strip() or any(c in str(n) for c in ',\n\r"') or str(n).lstrip().startswith("#")]
+    bad = [
+        n
+        for n in names
+        if not str(n).strip()
+        or any(c in str(n) for c in ',\n\r"')
+        or str(n).lstrip().startswith("#")
+    ]
     if bad:
-        raise MotionDataError(f"write_joint_csv: joint names {bad} cannot be CSV column names (empty, a comma, a quote, "
-                              "a line break or a leading #)", path)
+        raise MotionDataError(
+            f"write_joint_csv: joint names {bad} cannot be CSV column names (empty, a comma, a quote, "
+            "a line break or a leading #)",
+            path,
+        )
     buf = io.StringIO()
     buf.write("# anthroarm joint trajectory: t in s, joint angles in rad (prismatic joints in m)\n")
     if extra is not None:
-        buf.write("# rms_m, max_error_m: marker errors in m (nan: skipped frame); status: "
-                  + ", ".join(f"{i} {s}" for i, s in enumerate(STATUSES)) + "\n")
+        buf.write(
+            "# rms_m, max_error_m: marker errors in m (nan: skipped frame); status: "
+            + ", ".join(f"{i} {s}" for i, s in enumerate(STATUSES))
+            + "\n"
+        )
     for line in comment.splitlines():
         buf.write(f"# {line}\n")
     header = ["t", *names] + (list(extra[0]) if extra is not None else [])
@@ -82,8 +97,8 @@ def write_joint_csv(path, t, q=None, names=None, *, comment: str = "") -> Path:
     data = np.hstack(cols)
     nint = 2 if extra is not None else 0
     for row in data:
-        vals = [repr(float(x)) for x in row[:len(row) - nint]]
-        vals += [str(int(x)) for x in row[len(row) - nint:]]
+        vals = [repr(float(x)) for x in row[: len(row) - nint]]
+        vals += [str(int(x)) for x in row[len(row) - nint :]]
         buf.write(",".join(vals) + "\n")
     p = Path(path)
     atomic_write_text(p, buf.getvalue())
@@ -106,7 +121,11 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
         raise MotionDataError("joint-trajectory CSV not found", p) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise MotionDataError(f"cannot read the file as text ({exc})", p) from None
-    rows = [(i + 1, ln) for i, ln in enumerate(text.splitlines()) if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = [
+        (i + 1, ln)
+        for i, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not rows:
         raise MotionDataError("no header line", p)
     header = [h.strip() for h in rows[0][1].split(",")]
@@ -133,16 +152,23 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     for r, (lineno, ln) in enumerate(rows[1:]):
         cells = ln.split(",")
         if len(cells) != len(header):
-            raise MotionDataError(f"line {lineno}: {len(cells)} values, the header has {len(header)}", p)
+            raise MotionDataError(
+                f"line {lineno}: {len(cells)} values, the header has {len(header)}", p
+            )
         for c, cell in enumerate(cells):
             s = cell.strip()
             try:
                 x = float(s) if s else np.nan
             except ValueError:
-                raise MotionDataError(f"line {lineno}, column {header[c]!r}: {s!r} is not a number", p) from None
-            if abs(x) > MAX_VALUE:           # inf, or no angle (rad), length (m) or time (s)
-                raise MotionDataError(f"line {lineno}, column {header[c]!r}: {s!r} is beyond {MAX_VALUE:g} (not a "
-                                      "joint value in rad or m, nor a time in s); leave a gap empty or write nan", p)
+                raise MotionDataError(
+                    f"line {lineno}, column {header[c]!r}: {s!r} is not a number", p
+                ) from None
+            if abs(x) > MAX_VALUE:  # inf, or no angle (rad), length (m) or time (s)
+                raise MotionDataError(
+                    f"line {lineno}, column {header[c]!r}: {s!r} is beyond {MAX_VALUE:g} (not a "
+                    "joint value in rad or m, nor a time in s); leave a gap empty or write nan",
+                    p,
+                )
             vals[r, c] = x
     t = vals[:, tcol]
     if not np.isfinite(t).all():
@@ -151,7 +177,11 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     if np.any(np.diff(t) <= 0):
         bad = rows[2 + int(np.flatnonzero(np.diff(t) <= 0)[0])][0]
         raise MotionDataError(f"line {bad}: times must increase", p)
-    q = np.column_stack([vals[:, joints[n][0]] * joints[n][1] for n in names]) if len(t) else np.zeros((0, len(names)))
+    q = (
+        np.column_stack([vals[:, joints[n][0]] * joints[n][1] for n in names])
+        if len(t)
+        else np.zeros((0, len(names)))
+    )
     valid = np.isfinite(q).all(axis=1)
     if not valid.any():
         raise MotionDataError("no row with every joint value", p)

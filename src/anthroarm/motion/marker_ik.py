@@ -118,12 +118,15 @@ class MarkerIKResult:
         skipped: the dict is printed as strict JSON), ms per frame."""
         solved = self.status != "skipped"
         r = self.rms[solved]
-        return {"frames": len(self), **self.counts(),
-                "rms_median_m": float(np.median(r)) if r.size else None,
-                "rms_max_m": float(np.max(r)) if r.size else None,
-                "max_error_m": float(np.max(self.max_error[solved])) if r.size else None,
-                "ms_per_frame": 1e3 * self.seconds / max(len(self), 1),
-                "missing_markers": list(self.missing_markers)}
+        return {
+            "frames": len(self),
+            **self.counts(),
+            "rms_median_m": float(np.median(r)) if r.size else None,
+            "rms_max_m": float(np.max(r)) if r.size else None,
+            "max_error_m": float(np.max(self.max_error[solved])) if r.size else None,
+            "ms_per_frame": 1e3 * self.seconds / max(len(self), 1),
+            "missing_markers": list(self.missing_markers),
+        }
 
 
 def match_markers(trial_names, marker_set: MarkerSet, rename: dict | None = None) -> np.ndarray:
@@ -135,8 +138,10 @@ def match_markers(trial_names, marker_set: MarkerSet, rename: dict | None = None
     rename = dict(rename or {})
     unknown = sorted(str(v) for v in rename.values() if v not in marker_set.names)
     if unknown:
-        raise MarkerSetError(f"rename maps trial labels to {unknown}, which are not markers of {marker_set.name!r} "
-                             f"({', '.join(marker_set.names)})")
+        raise MarkerSetError(
+            f"rename maps trial labels to {unknown}, which are not markers of {marker_set.name!r} "
+            f"({', '.join(marker_set.names)})"
+        )
     cols = {}
     for i, lab in enumerate(trial_names):
         for key in (rename.get(lab, lab), lab.split(":")[-1].strip()):
@@ -176,18 +181,36 @@ class MarkerIK:
         Check that the set constrains every joint (:meth:`BoundMarkers.check_constrains`).
     """
 
-    def __init__(self, robot, marker_set: MarkerSet | None = None, *, solver: str = "daqp", max_iter: int = 20,
-                 first_iter: int = 200, tol: float = 1e-6, regularization: float = 1e-4, check: bool = True,
-                 seeds: int = 24, seed_iter: int = 25, max_rms: float = 0.02):
+    def __init__(
+        self,
+        robot,
+        marker_set: MarkerSet | None = None,
+        *,
+        solver: str = "daqp",
+        max_iter: int = 20,
+        first_iter: int = 200,
+        tol: float = 1e-6,
+        regularization: float = 1e-4,
+        check: bool = True,
+        seeds: int = 24,
+        seed_iter: int = 25,
+        max_rms: float = 0.02,
+    ):
         self.robot = robot
         self.marker_set = default_marker_set(robot) if marker_set is None else marker_set
         if not isinstance(self.marker_set, MarkerSet):
-            raise MarkerSetError(f"marker_set must be a MarkerSet, got {type(self.marker_set).__name__}")
+            raise MarkerSetError(
+                f"marker_set must be a MarkerSet, got {type(self.marker_set).__name__}"
+            )
         self.bound = BoundMarkers(robot, self.marker_set)
         if check:
             self.bound.check_constrains()
-        for nm, v, least in (("max_iter", max_iter, 1), ("first_iter", first_iter, 1), ("seed_iter", seed_iter, 1),
-                             ("seeds", seeds, 0)):
+        for nm, v, least in (
+            ("max_iter", max_iter, 1),
+            ("first_iter", first_iter, 1),
+            ("seed_iter", seed_iter, 1),
+            ("seeds", seeds, 0),
+        ):
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < least:
                 raise ParameterError(f"{nm} must be a whole number >= {least}, got {v!r}")
         for nm, v in (("tol", tol), ("regularization", regularization), ("max_rms", max_rms)):
@@ -196,8 +219,10 @@ class MarkerIK:
         self.solver, self.max_iter, self.first_iter = solver, int(max_iter), int(first_iter)
         self.tol, self.regularization = float(tol), float(regularization)
         self.seed_iter, self.max_rms = int(seed_iter), float(max_rms)
-        self.seed_q = robot.random_q(int(seeds), rng=0, margin=0.05) if seeds else np.zeros((0, robot.nq))
-        qp.make_backend(solver, robot.nv, 0)      # SolverNotAvailableError now, not mid-trial
+        self.seed_q = (
+            robot.random_q(int(seeds), rng=0, margin=0.05) if seeds else np.zeros((0, robot.nq))
+        )
+        qp.make_backend(solver, robot.nv, 0)  # SolverNotAvailableError now, not mid-trial
         self._rank_cache: dict = {}
 
     # ------------------------------------------------------------------ one frame
@@ -245,8 +270,9 @@ class MarkerIK:
         ev = np.linalg.eigvalsh(WJ.T @ WJ)
         return bool(ev[0] > 1e-10 * max(ev[-1], 1e-300))
 
-    def solve(self, trial, *, q0=None, rename: dict | None = None, progress=None,
-              rate: float = 100.0) -> MarkerIKResult:
+    def solve(
+        self, trial, *, q0=None, rename: dict | None = None, progress=None, rate: float = 100.0
+    ) -> MarkerIKResult:
         """Solve every frame of ``trial`` (:class:`~anthroarm.motion.trial.MarkerTrajectories`,
         or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0`` seeds the first frame
         (default: the comfortable posture).  ``progress(n_done, n_total)`` is called every 50
@@ -261,9 +287,11 @@ class MarkerIK:
         if isinstance(trial, MarkerTrajectories):
             cols = match_markers(trial.names, self.marker_set, rename)
             if not (cols >= 0).any():
-                raise MarkerSetError(f"{trial.source}: none of the markers {list(names)} of set "
-                                     f"{self.marker_set.name!r} is in the trial (labels: {', '.join(trial.names)}); "
-                                     "pass rename={trial label: marker name}")
+                raise MarkerSetError(
+                    f"{trial.source}: none of the markers {list(names)} of set "
+                    f"{self.marker_set.name!r} is in the trial (labels: {', '.join(trial.names)}); "
+                    "pass rename={trial label: marker name}"
+                )
             N = trial.n_frames
             P = np.full((N, len(names), 3), np.nan)
             P[:, cols >= 0] = trial.positions[:, cols[cols >= 0]]
@@ -274,8 +302,10 @@ class MarkerIK:
             except (TypeError, ValueError):
                 raise MotionDataError("marker positions must be numbers (m)") from None
             if P.ndim != 3 or P.shape[1:] != (len(names), 3):
-                raise MotionDataError(f"marker positions must have shape (frames, {len(names)}, 3) in the order "
-                                      f"{list(names)}, got {P.shape}")
+                raise MotionDataError(
+                    f"marker positions must have shape (frames, {len(names)}, 3) in the order "
+                    f"{list(names)}, got {P.shape}"
+                )
             check_coordinates(P, names)
             P[~np.isfinite(P).all(axis=2)] = np.nan
             N = P.shape[0]
@@ -292,10 +322,13 @@ class MarkerIK:
                 raise UnconstrainedJointError(
                     f"markers {list(missing)} are not in the trial; without them joints {free} have no marker "
                     "below them (rename the trial's labels with rename={label: marker} or use another set)",
-                    joints=free)
+                    joints=free,
+                )
 
         q_seed = qp.comfortable_posture(robot) if q0 is None else robot.check_q(q0, name="q0")
-        q_seed = np.clip(q_seed, robot.lower, robot.upper) if not robot.chain.has_continuous else q_seed
+        q_seed = (
+            np.clip(q_seed, robot.lower, robot.upper) if not robot.chain.has_continuous else q_seed
+        )
         conf = qp.IKConfiguration(robot, q_seed)
         task = MarkerTask(robot, self.bound.joint, self.bound.local, self.marker_set.weights)
         reg = qp.PostureTask(robot, cost=self.regularization, target=q_seed)
@@ -322,7 +355,9 @@ class MarkerIK:
             task.set_target(P[n], vis)
             extra = 0
             if fresh:
-                extra = self._best_start(conf, task, reg, tasks, limits, vis, q_seed if n == 0 else conf.q)
+                extra = self._best_start(
+                    conf, task, reg, tasks, limits, vis, q_seed if n == 0 else conf.q
+                )
             reg.target = conf.q.copy()
             it_max = self.first_iter if fresh else self.max_iter
             converged, it = self._iterate(conf, tasks, limits, it_max)
@@ -347,14 +382,36 @@ class MarkerIK:
         seconds = _time.process_time() - t0
         if progress is not None:
             progress(N, N)
-        return MarkerIKResult(q=Q, time=t, rms=rms, max_error=mx, n_markers=nvis, iterations=iters,
-                              status=status.astype(str), marker_error=merr, marker_names=names,
-                              joint_names=tuple(robot.chain.q_names), missing_markers=missing, seconds=seconds,
-                              info={"solver": self.solver, "marker_set": self.marker_set.name})
+        return MarkerIKResult(
+            q=Q,
+            time=t,
+            rms=rms,
+            max_error=mx,
+            n_markers=nvis,
+            iterations=iters,
+            status=status.astype(str),
+            marker_error=merr,
+            marker_names=names,
+            joint_names=tuple(robot.chain.q_names),
+            missing_markers=missing,
+            seconds=seconds,
+            info={"solver": self.solver, "marker_set": self.marker_set.name},
+        )
 
 
-def marker_ik(robot, trial, marker_set: MarkerSet | None = None, *, q0=None, rename: dict | None = None,
-              progress=None, rate: float = 100.0, **options) -> MarkerIKResult:
+def marker_ik(
+    robot,
+    trial,
+    marker_set: MarkerSet | None = None,
+    *,
+    q0=None,
+    rename: dict | None = None,
+    progress=None,
+    rate: float = 100.0,
+    **options,
+) -> MarkerIKResult:
     """Marker IK of a whole trial: ``MarkerIK(robot, marker_set, **options).solve(trial, ...)``
     (see :class:`MarkerIK` for the options and the module docstring for the method)."""
-    return MarkerIK(robot, marker_set, **options).solve(trial, q0=q0, rename=rename, progress=progress, rate=rate)
+    return MarkerIK(robot, marker_set, **options).solve(
+        trial, q0=q0, rename=rename, progress=progress, rate=rate
+    )

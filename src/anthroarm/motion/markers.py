@@ -40,8 +40,6 @@ class Marker:
     weight: float = 1.0
 
 
-
-
 class MarkerSet:
     """An ordered set of markers with unique names.
 
@@ -66,19 +64,30 @@ class MarkerSet:
         seen = set()
         for m in self.markers:
             if not isinstance(m, Marker):
-                raise MarkerSetError(f"marker set {self.name!r}: entries must be Marker objects, got {m!r}")
+                raise MarkerSetError(
+                    f"marker set {self.name!r}: entries must be Marker objects, got {m!r}"
+                )
             if not isinstance(m.name, str) or not m.name:
-                raise MarkerSetError(f"marker set {self.name!r}: a marker name must be a non-empty str, got {m.name!r}")
+                raise MarkerSetError(
+                    f"marker set {self.name!r}: a marker name must be a non-empty str, got {m.name!r}"
+                )
             if m.name in seen:
                 raise MarkerSetError(f"marker set {self.name!r}: duplicate marker name {m.name!r}")
             seen.add(m.name)
             p = np.asarray(m.position, dtype=float) if _numeric(m.position) else None
             if p is None or p.shape != (3,) or not np.isfinite(p).all():
-                raise MarkerSetError(f"marker {m.name!r}: position must be 3 finite numbers (m, in frame "
-                                     f"{m.body!r}), got {m.position!r}")
-            if not (isinstance(m.weight, (int, float, np.floating, np.integer)) and np.isfinite(m.weight)
-                    and m.weight >= 0):
-                raise MarkerSetError(f"marker {m.name!r}: weight must be a finite number >= 0, got {m.weight!r}")
+                raise MarkerSetError(
+                    f"marker {m.name!r}: position must be 3 finite numbers (m, in frame "
+                    f"{m.body!r}), got {m.position!r}"
+                )
+            if not (
+                isinstance(m.weight, (int, float, np.floating, np.integer))
+                and np.isfinite(m.weight)
+                and m.weight >= 0
+            ):
+                raise MarkerSetError(
+                    f"marker {m.name!r}: weight must be a finite number >= 0, got {m.weight!r}"
+                )
 
     def __len__(self) -> int:
         return len(self.markers)
@@ -113,7 +122,9 @@ class MarkerSet:
         """From ``{name: (body, (x, y, z))}``, ``{name: (body, (x, y, z), weight)}`` or
         ``{name: {"body": ..., "position": [...], "weight": ...}}`` (m)."""
         if not isinstance(d, dict):
-            raise MarkerSetError(f"a marker set dict maps names to (body, position[, weight]), got {type(d).__name__}")
+            raise MarkerSetError(
+                f"a marker set dict maps names to (body, position[, weight]), got {type(d).__name__}"
+            )
         out = []
         for k, v in d.items():
             try:
@@ -122,13 +133,21 @@ class MarkerSet:
                 else:
                     out.append(Marker(k, v[0], tuple(v[1]), v[2] if len(v) > 2 else 1.0))
             except (KeyError, IndexError, TypeError) as exc:
-                raise MarkerSetError(f"marker {k!r}: expected (body, (x, y, z)[, weight]) or a dict with body, "
-                                     f"position[, weight]; got {v!r} ({exc})") from None
+                raise MarkerSetError(
+                    f"marker {k!r}: expected (body, (x, y, z)[, weight]) or a dict with body, "
+                    f"position[, weight]; got {v!r} ({exc})"
+                ) from None
         return cls(out, name=name)
 
     def to_dict(self) -> dict:
-        return {m.name: {"body": m.body, "position": [float(x) for x in m.position], "weight": float(m.weight)}
-                for m in self.markers}
+        return {
+            m.name: {
+                "body": m.body,
+                "position": [float(x) for x in m.position],
+                "weight": float(m.weight),
+            }
+            for m in self.markers
+        }
 
     @classmethod
     def read_json(cls, path) -> "MarkerSet":
@@ -149,14 +168,18 @@ class MarkerSet:
         """Write the set as JSON (atomically)."""
         from .._io import atomic_write_text
 
-        atomic_write_text(path, json.dumps({"name": self.name, "markers": self.to_dict()}, indent=2) + "\n")
+        atomic_write_text(
+            path, json.dumps({"name": self.name, "markers": self.to_dict()}, indent=2) + "\n"
+        )
 
     def subset(self, names) -> "MarkerSet":
         """The markers named in ``names`` (in this set's order)."""
         names = set(names)
         unknown = names - set(self.names)
         if unknown:
-            raise MarkerSetError(f"markers {sorted(unknown)} are not in {self.name!r} ({', '.join(self.names)})")
+            raise MarkerSetError(
+                f"markers {sorted(unknown)} are not in {self.name!r} ({', '.join(self.names)})"
+            )
         return MarkerSet([m for m in self.markers if m.name in names], name=self.name)
 
     # ------------------------------------------------------------------ robot
@@ -204,8 +227,10 @@ class BoundMarkers:
             try:
                 f = chain.frame(m.body)
             except UnknownFrameError:
-                raise MarkerSetError(f"marker {m.name!r}: body {m.body!r} is not a frame of {robot.name}; frames: "
-                                     f"{', '.join(f.name for f in chain.frames)}") from None
+                raise MarkerSetError(
+                    f"marker {m.name!r}: body {m.body!r} is not a frame of {robot.name}; frames: "
+                    f"{', '.join(f.name for f in chain.frames)}"
+                ) from None
             self.joint[k] = f.joint
             self.local[k] = f.rotation @ np.asarray(m.position, float) + f.translation
         self.downstream = moved_by(chain, self.joint).T
@@ -253,9 +278,11 @@ class BoundMarkers:
             if j < 0:
                 continue
             Mi = data.oMi[int(j) + 1]
-            Jj = pin.getJointJacobian(model, data, int(j) + 1, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            Jj = pin.getJointJacobian(
+                model, data, int(j) + 1, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            )
             r = Mi.rotation @ self.local[k]
-            J[3 * k:3 * k + 3] = Jj[:3] + np.cross(Jj[3:].T, r).T
+            J[3 * k : 3 * k + 3] = Jj[:3] + np.cross(Jj[3:].T, r).T
         return J
 
     def check_constrains(self, q=None, rtol: float = 1e-8) -> None:
@@ -267,7 +294,9 @@ class BoundMarkers:
         if free:
             raise UnconstrainedJointError(
                 f"marker set {self.marker_set.name!r} does not constrain joints {free} of {self.robot.name}: "
-                "no marker on a body they move; add markers below them", joints=free)
+                "no marker on a body they move; add markers below them",
+                joints=free,
+            )
         if q is None:
             from ..ik.qp.tasks.posture import comfortable_posture
 
@@ -276,16 +305,20 @@ class BoundMarkers:
         _, s, Vt = np.linalg.svd(J)
         nv = self.robot.nv
         s_full = np.zeros(nv)
-        s_full[:len(s)] = s[:nv]
+        s_full[: len(s)] = s[:nv]
         weak = s_full <= rtol * max(s_full.max(), 1e-300)
         if weak.any():
             chain = self.robot.chain
             names = {j.idx_v: j.name for j in chain.joints if not j.is_mimic}
-            joints = sorted({names[int(np.argmax(np.abs(Vt[i])))] for i in np.flatnonzero(weak) if i < len(Vt)})
+            joints = sorted(
+                {names[int(np.argmax(np.abs(Vt[i])))] for i in np.flatnonzero(weak) if i < len(Vt)}
+            )
             raise UnconstrainedJointError(
                 f"marker set {self.marker_set.name!r} leaves {int(weak.sum())} direction(s) of {self.robot.name}'s "
                 f"joints undetermined at the reference posture (marker Jacobian rank {nv - int(weak.sum())} < {nv}); "
-                f"mostly joints {joints}: add markers off their axes", joints=joints)
+                f"mostly joints {joints}: add markers off their axes",
+                joints=joints,
+            )
 
 
 def segment_length(robot, body: str) -> float:
@@ -297,26 +330,41 @@ def segment_length(robot, body: str) -> float:
     chain = robot.chain
     f = chain.frame(body)
     if f.joint < 0:
-        raise MarkerSetError(f"{body!r} is fixed to the base of {robot.name}: it has no segment length")
+        raise MarkerSetError(
+            f"{body!r} is fixed to the base of {robot.name}: it has no segment length"
+        )
     tool = chain.frame(chain.tool)
     if tool.joint == f.joint and np.linalg.norm(tool.translation) > 0:
         return float(np.linalg.norm(tool.translation))
     ends = []
     for k in chain.children(f.joint):
         t = np.linalg.norm(chain.joints[k].translation)
-        if t == 0:      # a co-located virtual joint: follow it to the next offset on the chain
-            t = next((d for d in (np.linalg.norm(chain.joints[kk].translation) for kk in chain.children(k)) if d > 0), 0.0)
+        if t == 0:  # a co-located virtual joint: follow it to the next offset on the chain
+            t = next(
+                (
+                    d
+                    for d in (
+                        np.linalg.norm(chain.joints[kk].translation) for kk in chain.children(k)
+                    )
+                    if d > 0
+                ),
+                0.0,
+            )
         if t > 0:
             ends.append((float(t), chain.joints[k].name))
     if ends:
         if max(e for e, _ in ends) - min(e for e, _ in ends) > 1e-9:
-            raise MarkerSetError(f"{body!r} of {robot.name} branches to joints at different distances "
-                                 f"({', '.join(f'{n} {e:.4f} m' for e, n in ends)}): its segment length is ambiguous; "
-                                 "give the marker positions in m (MarkerSet)")
+            raise MarkerSetError(
+                f"{body!r} of {robot.name} branches to joints at different distances "
+                f"({', '.join(f'{n} {e:.4f} m' for e, n in ends)}): its segment length is ambiguous; "
+                "give the marker positions in m (MarkerSet)"
+            )
         return ends[0][0]
     offs = [np.linalg.norm(g.translation) for g in chain.frames if g.joint == f.joint]
     if not offs or max(offs) == 0:
-        raise MarkerSetError(f"{body!r} of {robot.name}: no joint or frame below it to measure a length")
+        raise MarkerSetError(
+            f"{body!r} of {robot.name}: no joint or frame below it to measure a length"
+        )
     return float(max(offs))
 
 
@@ -336,8 +384,10 @@ def human_arm_markers(robot, landmarks: dict | None = None) -> MarkerSet:
             if scale_body not in lengths:
                 lengths[scale_body] = segment_length(robot, scale_body)
         except UnknownFrameError as exc:
-            raise MarkerSetError(f"the human-arm marker set needs the links {sorted({b for b, *_ in table.values()})} "
-                                 f"({exc}): give your own MarkerSet") from None
+            raise MarkerSetError(
+                f"the human-arm marker set needs the links {sorted({b for b, *_ in table.values()})} "
+                f"({exc}): give your own MarkerSet"
+            ) from None
         out.append(Marker(name, body, tuple(float(v) * lengths[scale_body] for v in frac), w))
     return MarkerSet(out, name="human_arm_isb10")
 
@@ -348,6 +398,8 @@ def default_marker_set(robot) -> MarkerSet:
     (:class:`~anthroarm.errors.MarkerSetError`: give a :class:`MarkerSet`)."""
     spec = getattr(robot, "spec", None)
     if spec is None or not getattr(spec, "person", False):
-        raise MarkerSetError(f"{robot.name} is not a person's arm model: it has no default marker set; "
-                             "give one (MarkerSet.from_dict / read_json)")
+        raise MarkerSetError(
+            f"{robot.name} is not a person's arm model: it has no default marker set; "
+            "give one (MarkerSet.from_dict / read_json)"
+        )
     return human_arm_markers(robot)

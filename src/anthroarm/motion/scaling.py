@@ -98,7 +98,9 @@ def _static_positions(trial, marker_set, rename):
         if P.ndim == 2:
             P = P[None]
         if P.ndim != 3 or P.shape[1:] != (len(marker_set), 3):
-            raise MotionDataError(f"static marker positions must have shape (frames, {len(marker_set)}, 3), got {P.shape}")
+            raise MotionDataError(
+                f"static marker positions must have shape (frames, {len(marker_set)}, 3), got {P.shape}"
+            )
         check_coordinates(P, marker_set.names)
     P[~np.isfinite(P).all(axis=2)] = np.nan
     seen = np.isfinite(P).all(axis=2).any(axis=0)
@@ -108,8 +110,16 @@ def _static_positions(trial, marker_set, rename):
     return m, seen
 
 
-def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=None, rename: dict | None = None,
-                      bounds=(0.5, 2.0), max_rms: float = 0.02) -> ScalingResult:
+def scale_from_static(
+    robot,
+    trial,
+    marker_set: MarkerSet | None = None,
+    *,
+    q0=None,
+    rename: dict | None = None,
+    bounds=(0.5, 2.0),
+    max_rms: float = 0.02,
+) -> ScalingResult:
     """Segment scale factors of ``robot`` from a static trial (see the module docstring).
 
     ``trial``: :class:`~anthroarm.motion.trial.MarkerTrajectories` (a C3D read with
@@ -127,15 +137,19 @@ def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=N
     except (TypeError, ValueError):
         ok = False
     if not ok:
-        raise ParameterError(f"bounds must be two numbers 0 < low < 1 < high and max_rms a positive number (m), got "
-                             f"{bounds!r}, {max_rms!r}")
+        raise ParameterError(
+            f"bounds must be two numbers 0 < low < 1 < high and max_rms a positive number (m), got "
+            f"{bounds!r}, {max_rms!r}"
+        )
     ms = default_marker_set(robot) if marker_set is None else marker_set
     bound = ms.bind(robot)
     mbar, seen = _static_positions(trial, ms, rename)
     chain = robot.chain
     use = seen & (bound.joint >= 0)
     if not use.any():
-        raise MarkerSetError(f"no marker of {ms.name!r} on a moving body is visible in the static trial")
+        raise MarkerSetError(
+            f"no marker of {ms.name!r} on a moving body is visible in the static trial"
+        )
     # bodies to scale: those carrying a used marker and having a length
     bodies = []
     for j in sorted(set(bound.joint[use].tolist())):
@@ -148,10 +162,16 @@ def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=N
             bodies.append((j, frame.name, L))
     # identifiability: a visible marker on the body's descendants (or the body itself, off-origin)
     for j, name, _L in bodies:
-        below = [k for k in np.flatnonzero(use) if j in chain.path(bound._frame_of(k))
-                 and (bound.joint[k] != j or np.linalg.norm(bound.local[k]) > 0)]
+        below = [
+            k
+            for k in np.flatnonzero(use)
+            if j in chain.path(bound._frame_of(k))
+            and (bound.joint[k] != j or np.linalg.norm(bound.local[k]) > 0)
+        ]
         if not below:
-            raise MarkerSetError(f"the length of {name!r} cannot be found: no visible marker on it or below it")
+            raise MarkerSetError(
+                f"the length of {name!r} cannot be found: no visible marker on it or below it"
+            )
     model0 = robot.model
     scaled_joint = {j: [c for c in chain.children(j)] for j, _, _ in bodies}
     body_index = {j: i for i, (j, _, _) in enumerate(bodies)}
@@ -192,9 +212,14 @@ def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=N
     qs = comfortable_posture(robot) if q0 is None else robot.check_q(q0, name="q0")
     x0 = np.concatenate([np.clip(qs, robot.lower, robot.upper), np.zeros(len(bodies))])
     best = None
-    seeds = [x0] + [np.concatenate([robot.random_q(rng=i, margin=0.05), np.zeros(len(bodies))]) for i in range(4)]
+    seeds = [x0] + [
+        np.concatenate([robot.random_q(rng=i, margin=0.05), np.zeros(len(bodies))])
+        for i in range(4)
+    ]
     for xs in seeds:
-        sol = least_squares(fun, xs, bounds=(lo, hi), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+        sol = least_squares(
+            fun, xs, bounds=(lo, hi), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12
+        )
         if best is None or sol.cost < best.cost:
             best = sol
         if np.sqrt(2 * sol.cost / max(use.sum(), 1)) < 0.01:
@@ -219,10 +244,28 @@ def scale_from_static(robot, trial, marker_set: MarkerSet | None = None, *, q0=N
             pos = np.asarray(m.position, float) * fac
         new_markers.append(type(m)(m.name, m.body, tuple(float(v) for v in pos), m.weight))
     err = {n: float(e) for n, e in zip(np.array(ms.names)[use], d)}
-    rms = float(np.sqrt(np.mean(d ** 2)))
-    at_bound = [name for name, f in scales.items() if not bounds[0] * (1 + 1e-6) < f < bounds[1] * (1 - 1e-6)]
+    rms = float(np.sqrt(np.mean(d**2)))
+    at_bound = [
+        name
+        for name, f in scales.items()
+        if not bounds[0] * (1 + 1e-6) < f < bounds[1] * (1 - 1e-6)
+    ]
     status = "large_error" if not rms <= max_rms else "at_bound" if at_bound else "ok"
-    return ScalingResult(scales, lengths, seg, x[:nq].copy(), rms, float(d.max()), err,
-                         MarkerSet(new_markers, name=f"{ms.name} (scaled)"), status,
-                         info={"cost": float(best.cost), "nfev": int(best.nfev), "status": int(best.status),
-                               "markers_used": [n for n, u in zip(ms.names, use) if u], "at_bound": at_bound})
+    return ScalingResult(
+        scales,
+        lengths,
+        seg,
+        x[:nq].copy(),
+        rms,
+        float(d.max()),
+        err,
+        MarkerSet(new_markers, name=f"{ms.name} (scaled)"),
+        status,
+        info={
+            "cost": float(best.cost),
+            "nfev": int(best.nfev),
+            "status": int(best.status),
+            "markers_used": [n for n, u in zip(ms.names, use) if u],
+            "at_bound": at_bound,
+        },
+    )

@@ -57,7 +57,11 @@ def keyframe_trajectory(Q, durations, holds=None, rate: float = 100.0):
     K = Q.shape[0]
     dur = np.asarray(durations, float)
     hold = np.zeros(K) if holds is None else np.asarray(holds, float)
-    if dur.shape != (K,) or hold.shape != (K,) or not (np.isfinite(dur).all() and np.isfinite(hold).all()):
+    if (
+        dur.shape != (K,)
+        or hold.shape != (K,)
+        or not (np.isfinite(dur).all() and np.isfinite(hold).all())
+    ):
         raise ValueError(f"durations and holds must be {K} finite numbers (s)")
     if np.any(dur[1:] <= 0) or np.any(hold < 0):
         raise ValueError("durations must be > 0 s and holds >= 0 s")
@@ -65,7 +69,7 @@ def keyframe_trajectory(Q, durations, holds=None, rate: float = 100.0):
         raise ValueError(f"rate must be a positive number (Hz), got {rate!r}")
     # breakpoints: [hold 0] [move 1] [hold 1] [move 2] ...
     arrival = np.zeros(K)
-    segs = []                       # (t_start, t_end, q_from, q_to)
+    segs = []  # (t_start, t_end, q_from, q_to)
     tc = 0.0
     for k in range(K):
         if k > 0:
@@ -82,7 +86,7 @@ def keyframe_trajectory(Q, durations, holds=None, rate: float = 100.0):
     qd = np.zeros_like(q)
     qdd = np.zeros_like(q)
     q[:] = Q[0]
-    for (a, b, x0, x1) in segs:
+    for a, b, x0, x1 in segs:
         sel = (t >= a) & (t <= b)
         if not sel.any():
             continue

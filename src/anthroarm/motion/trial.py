@@ -26,8 +26,11 @@ def check_coordinates(P: np.ndarray, names, path=None) -> None:
     big = np.isfinite(P) & (np.abs(np.nan_to_num(P)) > MAX_COORDINATE)
     if big.any():
         n, k, _ = np.argwhere(big)[0]
-        raise MotionDataError(f"marker {names[k]!r} in frame {n} is at {P[n, k].tolist()} m, beyond "
-                              f"{MAX_COORDINATE:g} m: not a position in a lab (wrong units?)", path)
+        raise MotionDataError(
+            f"marker {names[k]!r} in frame {n} is at {P[n, k].tolist()} m, beyond "
+            f"{MAX_COORDINATE:g} m: not a position in a lab (wrong units?)",
+            path,
+        )
 
 
 @dataclass
@@ -60,18 +63,26 @@ class MarkerTrajectories:
         except (TypeError, ValueError):
             raise MotionDataError("marker positions must be numbers (m)", self._path()) from None
         if P.ndim != 3 or P.shape[2] != 3 or P.shape[1] != len(self.names):
-            raise MotionDataError(f"marker positions must have shape (frames, {len(self.names)} markers, 3), "
-                                  f"got {P.shape}", self._path())
+            raise MotionDataError(
+                f"marker positions must have shape (frames, {len(self.names)} markers, 3), "
+                f"got {P.shape}",
+                self._path(),
+            )
         if len(set(self.names)) != len(self.names):
             dup = sorted({n for n in self.names if self.names.count(n) > 1})
             raise MotionDataError(f"duplicate marker labels {dup}", self._path())
-        if not (isinstance(self.rate, (int, float, np.floating, np.integer)) and np.isfinite(self.rate)
-                and self.rate > 0):
-            raise MotionDataError(f"frame rate must be a positive number (Hz), got {self.rate!r}", self._path())
+        if not (
+            isinstance(self.rate, (int, float, np.floating, np.integer))
+            and np.isfinite(self.rate)
+            and self.rate > 0
+        ):
+            raise MotionDataError(
+                f"frame rate must be a positive number (Hz), got {self.rate!r}", self._path()
+            )
         self.rate = float(self.rate)
         check_coordinates(P, self.names, self._path())
         bad = ~np.isfinite(P).all(axis=2)
-        P[bad] = np.nan             # a marker is seen in all three coordinates or missing
+        P[bad] = np.nan  # a marker is seen in all three coordinates or missing
         self.positions = P
 
     def _path(self):
@@ -81,8 +92,10 @@ class MarkerTrajectories:
         return self.positions.shape[0]
 
     def __repr__(self) -> str:
-        return (f"MarkerTrajectories({len(self)} frames at {self.rate:g} Hz, {len(self.names)} markers, "
-                f"{self.visible.mean() * 100:.1f} % visible, source={self.source!r})")
+        return (
+            f"MarkerTrajectories({len(self)} frames at {self.rate:g} Hz, {len(self.names)} markers, "
+            f"{self.visible.mean() * 100:.1f} % visible, source={self.source!r})"
+        )
 
     @property
     def n_frames(self) -> int:
@@ -101,5 +114,7 @@ class MarkerTrajectories:
     def marker(self, name: str) -> np.ndarray:
         """(N, 3) trajectory of one marker (m, NaN where missing)."""
         if name not in self.names:
-            raise MotionDataError(f"no marker {name!r}; markers: {', '.join(self.names)}", self._path())
+            raise MotionDataError(
+                f"no marker {name!r}; markers: {', '.join(self.names)}", self._path()
+            )
         return self.positions[:, self.names.index(name)]

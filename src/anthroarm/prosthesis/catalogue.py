@@ -36,13 +36,32 @@ from pathlib import Path
 
 from ..errors import CatalogueError
 
-RPM = 2.0 * math.pi / 60.0          # rad/s per rpm
+RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
 
-MOTOR_COLUMNS = ("name", "series", "diameter_mm", "nominal_voltage_V", "terminal_resistance_ohm",
-                 "torque_constant_mNm_per_A", "rotor_inertia_gcm2", "max_continuous_torque_mNm",
-                 "max_speed_rpm", "mass_g")
-GEARBOX_COLUMNS = ("name", "series", "motor_diameters_mm", "stages", "ratio", "efficiency",
-                   "max_continuous_torque_Nm", "max_intermittent_torque_Nm", "max_input_speed_rpm", "mass_g")
+MOTOR_COLUMNS = (
+    "name",
+    "series",
+    "diameter_mm",
+    "nominal_voltage_V",
+    "terminal_resistance_ohm",
+    "torque_constant_mNm_per_A",
+    "rotor_inertia_gcm2",
+    "max_continuous_torque_mNm",
+    "max_speed_rpm",
+    "mass_g",
+)
+GEARBOX_COLUMNS = (
+    "name",
+    "series",
+    "motor_diameters_mm",
+    "stages",
+    "ratio",
+    "efficiency",
+    "max_continuous_torque_Nm",
+    "max_intermittent_torque_Nm",
+    "max_input_speed_rpm",
+    "mass_g",
+)
 
 
 @dataclass(frozen=True)
@@ -71,8 +90,16 @@ class Motor:
 
         i, eta = (1.0, 1.0) if gearbox is None else (gearbox.ratio, gearbox.efficiency)
         name = self.name if gearbox is None else f"{self.name} + {gearbox.name}"
-        return DCMotor(R=self.R, k_m=self.k_m, J_m=self.J_m, i=i, eta=eta, V_nom=self.V_nom,
-                       tau_cont=self.tau_cont, name=name)
+        return DCMotor(
+            R=self.R,
+            k_m=self.k_m,
+            J_m=self.J_m,
+            i=i,
+            eta=eta,
+            V_nom=self.V_nom,
+            tau_cont=self.tau_cont,
+            name=name,
+        )
 
 
 @dataclass(frozen=True)
@@ -123,14 +150,18 @@ def _rows(path, columns):
     """(line number, dict) per data row; checks the header."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8-sig")      # a spreadsheet may write a BOM
+        text = path.read_text(encoding="utf-8-sig")  # a spreadsheet may write a BOM
     except FileNotFoundError:
         raise CatalogueError("file not found", path) from None
     except IsADirectoryError:
         raise CatalogueError("is a folder, not a CSV file", path) from None
     except UnicodeDecodeError:
         raise CatalogueError("not a UTF-8 text file", path) from None
-    numbered = [(k + 1, line) for k, line in enumerate(text.splitlines()) if line.strip() and not line.lstrip().startswith("#")]
+    numbered = [
+        (k + 1, line)
+        for k, line in enumerate(text.splitlines())
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
     if not numbered:
         raise CatalogueError("no header line (the file is empty or only comments)", path)
     reader = csv.reader(io.StringIO("\n".join(line for _, line in numbered)))
@@ -138,14 +169,20 @@ def _rows(path, columns):
     header = [h.strip() for h in lines[0]]
     missing = [c for c in columns if c not in header]
     if missing:
-        raise CatalogueError(f"missing column(s) {missing}; the header has {header}; required: {list(columns)}",
-                             path, numbered[0][0], missing[0])
+        raise CatalogueError(
+            f"missing column(s) {missing}; the header has {header}; required: {list(columns)}",
+            path,
+            numbered[0][0],
+            missing[0],
+        )
     if len(set(header)) != len(header):
         raise CatalogueError(f"duplicate column names in the header {header}", path, numbered[0][0])
     out = []
     for (lineno, _), fields in zip(numbered[1:], lines[1:]):
         if len(fields) != len(header):
-            raise CatalogueError(f"{len(fields)} fields, the header has {len(header)}", path, lineno)
+            raise CatalogueError(
+                f"{len(fields)} fields, the header has {len(header)}", path, lineno
+            )
         out.append((lineno, dict(zip(header, (f.strip() for f in fields)))))
     if not out:
         raise CatalogueError("no rows (a catalogue needs at least one product)", path)
@@ -168,7 +205,9 @@ def _number(row, col, path, lineno, *, positive=True, upper=UPPER) -> float:
     if positive and v <= 0.0:
         raise CatalogueError(f"{col} = {v:g} must be > 0 (a physical constant)", path, lineno, col)
     if v > upper:
-        raise CatalogueError(f"{col} = {v:g} must be <= {upper:g} (in the column's unit; a typo?)", path, lineno, col)
+        raise CatalogueError(
+            f"{col} = {v:g} must be <= {upper:g} (in the column's unit; a typo?)", path, lineno, col
+        )
     return v
 
 
@@ -177,7 +216,9 @@ def _name(row, path, lineno, seen) -> str:
     if not name:
         raise CatalogueError("empty name", path, lineno, "name")
     if name in seen:
-        raise CatalogueError(f"duplicate name {name!r} (also on line {seen[name]})", path, lineno, "name")
+        raise CatalogueError(
+            f"duplicate name {name!r} (also on line {seen[name]})", path, lineno, "name"
+        )
     seen[name] = lineno
     return name
 
@@ -189,11 +230,20 @@ def load_motors(path=None) -> tuple:
     out = []
     for lineno, r in _rows(path, MOTOR_COLUMNS):
         n = lambda c, **kw: _number(r, c, path, lineno, **kw)  # noqa: E731
-        out.append(Motor(name=_name(r, path, lineno, seen), series=r["series"], diameter=n("diameter_mm") * 1e-3,
-                         V_nom=n("nominal_voltage_V"), R=n("terminal_resistance_ohm"),
-                         k_m=n("torque_constant_mNm_per_A") * 1e-3, J_m=n("rotor_inertia_gcm2") * 1e-7,
-                         tau_cont=n("max_continuous_torque_mNm") * 1e-3, max_speed=n("max_speed_rpm") * RPM,
-                         mass=n("mass_g") * 1e-3))
+        out.append(
+            Motor(
+                name=_name(r, path, lineno, seen),
+                series=r["series"],
+                diameter=n("diameter_mm") * 1e-3,
+                V_nom=n("nominal_voltage_V"),
+                R=n("terminal_resistance_ohm"),
+                k_m=n("torque_constant_mNm_per_A") * 1e-3,
+                J_m=n("rotor_inertia_gcm2") * 1e-7,
+                tau_cont=n("max_continuous_torque_mNm") * 1e-3,
+                max_speed=n("max_speed_rpm") * RPM,
+                mass=n("mass_g") * 1e-3,
+            )
+        )
     return tuple(out)
 
 
@@ -209,23 +259,48 @@ def load_gearboxes(path=None) -> tuple:
             try:
                 d = float(part)
             except ValueError:
-                raise CatalogueError(f"motor_diameters_mm = {r['motor_diameters_mm']!r} is not a ';'-separated list "
-                                     "of numbers", path, lineno, "motor_diameters_mm") from None
+                raise CatalogueError(
+                    f"motor_diameters_mm = {r['motor_diameters_mm']!r} is not a ';'-separated list "
+                    "of numbers",
+                    path,
+                    lineno,
+                    "motor_diameters_mm",
+                ) from None
             if not (math.isfinite(d) and 0 < d <= UPPER):
-                raise CatalogueError(f"motor_diameters_mm has {part!r}; diameters must be > 0 mm", path, lineno,
-                                     "motor_diameters_mm")
+                raise CatalogueError(
+                    f"motor_diameters_mm has {part!r}; diameters must be > 0 mm",
+                    path,
+                    lineno,
+                    "motor_diameters_mm",
+                )
             diams.append(d * 1e-3)
         stages = n("stages")
         if stages != int(stages):
-            raise CatalogueError(f"stages = {stages:g} must be a whole number", path, lineno, "stages")
+            raise CatalogueError(
+                f"stages = {stages:g} must be a whole number", path, lineno, "stages"
+            )
         tc, tm = n("max_continuous_torque_Nm"), n("max_intermittent_torque_Nm")
         if tm < tc:
-            raise CatalogueError(f"max_intermittent_torque_Nm = {tm:g} is below max_continuous_torque_Nm = {tc:g}",
-                                 path, lineno, "max_intermittent_torque_Nm")
-        out.append(Gearbox(name=_name(r, path, lineno, seen), series=r["series"], motor_diameters=tuple(diams),
-                           stages=int(stages), ratio=n("ratio"), efficiency=n("efficiency", upper=1.0),
-                           tau_cont=tc, tau_max=tm, max_input_speed=n("max_input_speed_rpm") * RPM,
-                           mass=n("mass_g") * 1e-3))
+            raise CatalogueError(
+                f"max_intermittent_torque_Nm = {tm:g} is below max_continuous_torque_Nm = {tc:g}",
+                path,
+                lineno,
+                "max_intermittent_torque_Nm",
+            )
+        out.append(
+            Gearbox(
+                name=_name(r, path, lineno, seen),
+                series=r["series"],
+                motor_diameters=tuple(diams),
+                stages=int(stages),
+                ratio=n("ratio"),
+                efficiency=n("efficiency", upper=1.0),
+                tau_cont=tc,
+                tau_max=tm,
+                max_input_speed=n("max_input_speed_rpm") * RPM,
+                mass=n("mass_g") * 1e-3,
+            )
+        )
     return tuple(out)
 
 
@@ -236,8 +311,11 @@ def load(motors=None, gearboxes=None) -> Catalogue:
     gp = Path(gearboxes) if gearboxes is not None else gp
     cat = Catalogue(load_motors(mp), load_gearboxes(gp), str(mp), str(gp))
     if not cat.combinations():
-        raise CatalogueError(f"no gearbox of {gp} mounts on any motor of {mp} (compare diameter_mm with "
-                             "motor_diameters_mm)", gp)
+        raise CatalogueError(
+            f"no gearbox of {gp} mounts on any motor of {mp} (compare diameter_mm with "
+            "motor_diameters_mm)",
+            gp,
+        )
     return cat
 
 

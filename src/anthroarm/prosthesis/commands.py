@@ -19,28 +19,59 @@ from pathlib import Path
 def add_parser(sub):
     """Register ``size`` on the CLI's subparsers (``anthroarm.cli.build_parser``)."""
     p = sub.add_parser(
-        "size", help="size a prosthesis's motors for a person's activities and write an HTML report",
+        "size",
+        help="size a prosthesis's motors for a person's activities and write an HTML report",
         description="From a person (height, mass, sex) and a set of activities to joint torques with a held "
-                    "object (Eq. (8-5)), their envelope, the lightest catalogue motor + gearbox per joint (servo "
-                    "model of Eq. (9-1)), the book's weight rules, and a self-contained HTML report.",
+        "object (Eq. (8-5)), their envelope, the lightest catalogue motor + gearbox per joint (servo "
+        "model of Eq. (9-1)), the book's weight rules, and a self-contained HTML report.",
         epilog="example: anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 "
-               "--out report.html")
-    p.add_argument("--model", default="human_arm7",
-                   help="a catalog model built from a person's height, mass and sex (default human_arm7)")
+        "--out report.html",
+    )
+    p.add_argument(
+        "--model",
+        default="human_arm7",
+        help="a catalog model built from a person's height, mass and sex (default human_arm7)",
+    )
     p.add_argument("--height", type=float, default=1.75, help="body height, m (default 1.75)")
     p.add_argument("--mass", type=float, default=70.0, help="body mass, kg (default 70)")
     p.add_argument("--sex", default="male", choices=["male", "female"])
-    p.add_argument("--activities", default="adl", metavar="adl|FILE[,FILE...]",
-                   help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
-                        "and joint-name columns, rad)")
-    p.add_argument("--payload", type=float, default=None,
-                   help="mass held in the hand all the time, kg (adl: at least this, the library's objects while "
-                        "they are held; default: the library's objects only; files: default 0)")
-    p.add_argument("--margin", type=float, default=0.2, help="demand margin, fraction (default 0.2 = 20 %%)")
-    p.add_argument("--motors", default=None, metavar="CSV", help="motor catalogue (default: the shipped example)")
-    p.add_argument("--gearboxes", default=None, metavar="CSV", help="gearbox catalogue (default: the shipped example)")
-    p.add_argument("--out", default="report.html", metavar="FILE.html", help="the report (written atomically)")
-    p.add_argument("--no-viewer", action="store_true", help="leave the 3-D animation out of the report (smaller file)")
+    p.add_argument(
+        "--activities",
+        default="adl",
+        metavar="adl|FILE[,FILE...]",
+        help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
+        "and joint-name columns, rad)",
+    )
+    p.add_argument(
+        "--payload",
+        type=float,
+        default=None,
+        help="mass held in the hand all the time, kg (adl: at least this, the library's objects while "
+        "they are held; default: the library's objects only; files: default 0)",
+    )
+    p.add_argument(
+        "--margin", type=float, default=0.2, help="demand margin, fraction (default 0.2 = 20 %%)"
+    )
+    p.add_argument(
+        "--motors",
+        default=None,
+        metavar="CSV",
+        help="motor catalogue (default: the shipped example)",
+    )
+    p.add_argument(
+        "--gearboxes",
+        default=None,
+        metavar="CSV",
+        help="gearbox catalogue (default: the shipped example)",
+    )
+    p.add_argument(
+        "--out", default="report.html", metavar="FILE.html", help="the report (written atomically)"
+    )
+    p.add_argument(
+        "--no-viewer",
+        action="store_true",
+        help="leave the 3-D animation out of the report (smaller file)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.set_defaults(func=cmd_size)
     return p
@@ -56,17 +87,21 @@ def _read_trajectory(path: Path, robot) -> dict:
     if not path.is_file():
         raise ActivityError(f"{path}: no such trajectory file")
     if path.suffix.lower() == ".npz":
-        not_npz = ActivityError(f"{path}: not a NumPy .npz archive of numeric arrays (np.savez(path, t=..., q=...))")
+        not_npz = ActivityError(
+            f"{path}: not a NumPy .npz archive of numeric arrays (np.savez(path, t=..., q=...))"
+        )
         try:
             z = np.load(path, allow_pickle=False)
         except (OSError, ValueError, EOFError, zipfile.BadZipFile):
             raise not_npz from None
-        if not isinstance(z, np.lib.npyio.NpzFile):        # a single .npy array under an .npz name
+        if not isinstance(z, np.lib.npyio.NpzFile):  # a single .npy array under an .npz name
             raise not_npz
         with z:
             if "t" not in z.files or "q" not in z.files:
-                raise ActivityError(f"{path}: an .npz trajectory needs arrays 't' (N,) and 'q' (N, {robot.nq}); "
-                                    f"it has {sorted(z.files)}")
+                raise ActivityError(
+                    f"{path}: an .npz trajectory needs arrays 't' (N,) and 'q' (N, {robot.nq}); "
+                    f"it has {sorted(z.files)}"
+                )
             try:
                 t, q = z["t"], z["q"]
             except (OSError, ValueError, EOFError, zipfile.BadZipFile):
@@ -74,13 +109,19 @@ def _read_trajectory(path: Path, robot) -> dict:
         try:
             return dict(name=path.stem, t=np.asarray(t, float), q=np.asarray(q, float))
         except (TypeError, ValueError):
-            raise ActivityError(f"{path}: 't' and 'q' must be numbers (s, rad), got {t.dtype} and {q.dtype}") from None
+            raise ActivityError(
+                f"{path}: 't' and 'q' must be numbers (s, rad), got {t.dtype} and {q.dtype}"
+            ) from None
     if path.suffix.lower() == ".csv":
         try:
             text = path.read_text(encoding="utf-8-sig")
         except UnicodeDecodeError:
             raise ActivityError(f"{path}: not a UTF-8 text file") from None
-        lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines()) if ln.strip() and not ln.startswith("#")]
+        lines = [
+            (k + 1, ln)
+            for k, ln in enumerate(text.splitlines())
+            if ln.strip() and not ln.startswith("#")
+        ]
         if not lines:
             raise ActivityError(f"{path}: empty trajectory file")
         header = [h.strip() for h in lines[0][1].split(",")]
@@ -92,11 +133,15 @@ def _read_trajectory(path: Path, robot) -> dict:
         for lineno, ln in lines[1:]:
             fields = ln.split(",")
             if len(fields) != len(header):
-                raise ActivityError(f"{path}, line {lineno}: {len(fields)} values, the header has {len(header)}")
+                raise ActivityError(
+                    f"{path}, line {lineno}: {len(fields)} values, the header has {len(header)}"
+                )
             try:
                 rows.append([float(x) for x in fields])
             except ValueError:
-                raise ActivityError(f"{path}, line {lineno}: a value is not a number: {ln.strip()!r}") from None
+                raise ActivityError(
+                    f"{path}, line {lineno}: a value is not a number: {ln.strip()!r}"
+                ) from None
         if not rows:
             raise ActivityError(f"{path}: a header but no samples")
         data = np.array(rows, dtype=float)
@@ -123,11 +168,16 @@ def _person_params(a) -> dict:
     from ..cli import UserError
 
     builder = models.BOOK_MODELS.get(a.model)
-    person = [n for n, b in models.BOOK_MODELS.items()
-              if {"height", "mass", "sex"} <= set(inspect.signature(b).parameters)]
+    person = [
+        n
+        for n, b in models.BOOK_MODELS.items()
+        if {"height", "mass", "sex"} <= set(inspect.signature(b).parameters)
+    ]
     if builder is None or a.model not in person:
-        raise UserError(f"--model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
-                        f"person models: {', '.join(sorted(person))}")
+        raise UserError(
+            f"--model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
+            f"person models: {', '.join(sorted(person))}"
+        )
     return dict(height=a.height, mass=a.mass, sex=a.sex)
 
 
@@ -141,12 +191,17 @@ def cmd_size(a) -> int:
     if out.suffix.lower() not in (".html", ".htm"):
         raise UserError(f"--out {a.out}: the report is an HTML file (.html)")
     if out.is_dir():
-        raise UserError(f"--out {a.out} is a folder; give a file name such as {out / 'report.html'}")
+        raise UserError(
+            f"--out {a.out} is a folder; give a file name such as {out / 'report.html'}"
+        )
     if not out.parent.is_dir():
         raise UserError(f"--out {a.out}: folder {out.parent} does not exist")
-    for what, v, lo, hi in (("height", a.height, 0.5, 2.5), ("mass", a.mass, 10.0, 300.0),
-                            ("payload", 0.0 if a.payload is None else a.payload, 0.0, 50.0),
-                            ("margin", a.margin, 0.0, 10.0)):
+    for what, v, lo, hi in (
+        ("height", a.height, 0.5, 2.5),
+        ("mass", a.mass, 10.0, 300.0),
+        ("payload", 0.0 if a.payload is None else a.payload, 0.0, 50.0),
+        ("margin", a.margin, 0.0, 10.0),
+    ):
         if not (np.isfinite(v) and lo <= v <= hi):
             raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
     cat = catalogue.load(a.motors, a.gearboxes)
@@ -159,16 +214,29 @@ def cmd_size(a) -> int:
         bar.update(1)
 
     try:
-        st = study.run(robot, acts, payload=a.payload or 0.0, catalogue=cat, margin=a.margin,
-                       person=dict(height=a.height, mass=a.mass, sex=a.sex), progress=progress)
+        st = study.run(
+            robot,
+            acts,
+            payload=a.payload or 0.0,
+            catalogue=cat,
+            margin=a.margin,
+            person=dict(height=a.height, mass=a.mass, sex=a.sex),
+            progress=progress,
+        )
         bar.set_postfix_str("report")
         report.write(st, out, viewer=not a.no_viewer)
     finally:
         bar.close()
-    summary = dict(out=str(out), drive_mass_kg=round(st.sizing.drive_mass, 4),
-                   joints={r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
-                           for r in st.sizing.rows()},
-                   unfit=st.sizing.unfit, skipped=[x.name for x in st.envelope.skipped],
-                   rules={r.source: r.ok for r in st.rules})
+    summary = dict(
+        out=str(out),
+        drive_mass_kg=round(st.sizing.drive_mass, 4),
+        joints={
+            r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
+            for r in st.sizing.rows()
+        },
+        unfit=st.sizing.unfit,
+        skipped=[x.name for x in st.envelope.skipped],
+        rules={r.source: r.ok for r in st.rules},
+    )
     print(json.dumps(summary), file=sys.stdout)
     return 0

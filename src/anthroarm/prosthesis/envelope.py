@@ -69,7 +69,9 @@ def derivatives(t, q):
 def _check_time(t, n: int, name: str) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or len(t) != n:
-        raise ActivityError(f"activity {name!r}: t must have one time per sample ({n}), got shape {t.shape}")
+        raise ActivityError(
+            f"activity {name!r}: t must have one time per sample ({n}), got shape {t.shape}"
+        )
     if n < 4:
         raise ActivityError(f"activity {name!r}: needs at least 4 samples, got {n}")
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
@@ -90,8 +92,19 @@ def held_object(mass: float = 1.0, frame: str | None = None):
     return HeldObject.cylinder(mass, CUP_RADIUS, CUP_HEIGHT, frame=frame)
 
 
-def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, payload=0.0, dynamics=None,
-                     limit_tol: float = 1e-6) -> ActivityTorques:
+def activity_torques(
+    robot,
+    name: str,
+    t,
+    q,
+    qd=None,
+    qdd=None,
+    loads=None,
+    *,
+    payload=0.0,
+    dynamics=None,
+    limit_tol: float = 1e-6,
+) -> ActivityTorques:
     """Joint torques, speeds and powers of one activity.
 
     Parameters
@@ -134,22 +147,28 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, p
     t = _check_time(t, len(q), name)
     if qd is None or qdd is None:
         if robot.nq != robot.nv:
-            raise ActivityError(f"activity {name!r}: give qd and qdd for a robot with continuous joints (nq != nv)")
+            raise ActivityError(
+                f"activity {name!r}: give qd and qdd for a robot with continuous joints (nq != nv)"
+            )
         d1, d2 = derivatives(t, q)
         qd = d1 if qd is None else qd
         qdd = d2 if qdd is None else qdd
     try:
         mass = np.asarray(payload, dtype=float)
     except (TypeError, ValueError):
-        raise ActivityError(f"activity {name!r}: payload must be a mass in kg, got {payload!r}") from None
+        raise ActivityError(
+            f"activity {name!r}: payload must be a mass in kg, got {payload!r}"
+        ) from None
     mass = np.full(len(t), float(mass)) if mass.ndim == 0 else mass
     if mass.shape != (len(t),) or not np.all(np.isfinite(mass)) or np.any(mass < 0):
-        raise ActivityError(f"activity {name!r}: payload must be a mass >= 0 kg, one or one per sample ({len(t)})")
+        raise ActivityError(
+            f"activity {name!r}: payload must be a mass >= 0 kg, one or one per sample ({len(t)})"
+        )
     try:
         res = inverse_dynamics(robot, q, qd, qdd, loads, dynamics=dynamics)
         tau = res.tau
         if np.any(mass > 0):
-            unit = generalized_forces(robot, q, held_object(1.0), res.qd, qdd)     # Eq. (8-5), 1 kg
+            unit = generalized_forces(robot, q, held_object(1.0), res.qd, qdd)  # Eq. (8-5), 1 kg
             tau = tau - mass[:, None] * unit
     except ValueError as exc:
         raise ActivityError(f"activity {name!r}: {exc}") from None
@@ -160,11 +179,25 @@ def activity_torques(robot, name: str, t, q, qd=None, qdd=None, loads=None, *, p
         lo = q[k] < robot.lower - limit_tol
         j = int(np.argmax(lo | (q[k] > robot.upper + limit_tol)))
         status = "outside_limits"
-        reason = (f"sample {k} (t = {t[k]:.3f} s): joint {robot.chain.q_names[j]!r} at {np.degrees(q[k, j]):.1f} deg is "
-                  f"outside [{np.degrees(robot.lower[j]):.1f}, {np.degrees(robot.upper[j]):.1f}] deg")
-    return ActivityTorques(name=name, t=t, q=q, qd=res.qd, qdd=np.asarray(qdd, float), tau=tau,
-                           tau_free=res.tau_free, power=tau * res.qd, joint_names=list(robot.joint_names),
-                           status=status, reason=reason, payload=float(np.max(mass)), mass_in_hand=np.array(mass))
+        reason = (
+            f"sample {k} (t = {t[k]:.3f} s): joint {robot.chain.q_names[j]!r} at {np.degrees(q[k, j]):.1f} deg is "
+            f"outside [{np.degrees(robot.lower[j]):.1f}, {np.degrees(robot.upper[j]):.1f}] deg"
+        )
+    return ActivityTorques(
+        name=name,
+        t=t,
+        q=q,
+        qd=res.qd,
+        qdd=np.asarray(qdd, float),
+        tau=tau,
+        tau_free=res.tau_free,
+        power=tau * res.qd,
+        joint_names=list(robot.joint_names),
+        status=status,
+        reason=reason,
+        payload=float(np.max(mass)),
+        mass_in_hand=np.array(mass),
+    )
 
 
 def _rms(t, x):
@@ -191,9 +224,16 @@ class Envelope:
 
     def rows(self) -> list[dict]:
         """One dict per joint (SI units) for tables."""
-        return [dict(joint=n, peak_torque=float(self.peak_torque[j]), rms_torque=float(self.rms_torque[j]),
-                     peak_speed=float(self.peak_speed[j]), peak_power=float(self.peak_power[j]))
-                for j, n in enumerate(self.joint_names)]
+        return [
+            dict(
+                joint=n,
+                peak_torque=float(self.peak_torque[j]),
+                rms_torque=float(self.rms_torque[j]),
+                peak_speed=float(self.peak_speed[j]),
+                peak_power=float(self.peak_power[j]),
+            )
+            for j, n in enumerate(self.joint_names)
+        ]
 
 
 def envelope(activities) -> Envelope:
@@ -211,7 +251,9 @@ def envelope(activities) -> Envelope:
     names = ok[0].joint_names
     for a in ok[1:]:
         if a.joint_names != names:
-            raise ActivityError(f"activity {a.name!r} has joints {a.joint_names}, the first one {names}")
+            raise ActivityError(
+                f"activity {a.name!r} has joints {a.joint_names}, the first one {names}"
+            )
     peak_t = np.max([np.max(np.abs(a.tau), axis=0) for a in ok], axis=0)
     rms_t = np.max([_rms(a.t, a.tau) for a in ok], axis=0)
     peak_w = np.max([np.max(np.abs(a.qd), axis=0) for a in ok], axis=0)

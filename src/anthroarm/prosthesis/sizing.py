@@ -101,12 +101,21 @@ class SizingResult:
         out = []
         for js in self.joints:
             c = js.choice
-            out.append(dict(joint=js.joint, status=js.status, motor=c.motor.name if c else "",
-                            gearbox=c.gearbox.name if c else "", ratio=c.gearbox.ratio if c else float("nan"),
-                            mass=c.mass if c else float("nan"),
-                            limiting=c.limiting if c else (js.closest.limiting if js.closest else ""),
-                            utilisation=c.worst if c else (js.closest.worst if js.closest else float("nan")),
-                            reason=js.reason))
+            out.append(
+                dict(
+                    joint=js.joint,
+                    status=js.status,
+                    motor=c.motor.name if c else "",
+                    gearbox=c.gearbox.name if c else "",
+                    ratio=c.gearbox.ratio if c else float("nan"),
+                    mass=c.mass if c else float("nan"),
+                    limiting=c.limiting if c else (js.closest.limiting if js.closest else ""),
+                    utilisation=c.worst
+                    if c
+                    else (js.closest.worst if js.closest else float("nan")),
+                    reason=js.reason,
+                )
+            )
         return out
 
 
@@ -126,7 +135,7 @@ def _utilisation(motor, gearbox, demands, scale: float) -> dict:
             tau, w, a = scale * tau, scale * w, scale * a
             try:
                 worse("voltage", np.max(np.abs(dc.voltage(tau, w, a))) / motor.V_nom)
-            except ControlError:                  # the motor model refuses a torque beyond float range
+            except ControlError:  # the motor model refuses a torque beyond float range
                 worse("voltage", np.inf)
             try:
                 worse("thermal", dc.thermal_check(t, tau, w, a).ratio)
@@ -153,10 +162,12 @@ def size_joint(envelope, joint, catalogue, margin: float = 0.2) -> JointSizing:
         best = min(ok, key=lambda c: (c.mass, c.worst))
         return JointSizing(name, "ok", best, closest, "", len(cands))
     lim = closest.limiting
-    reason = (f"none of {len(cands)} motor+gearbox pairs covers {name} with a {margin:.0%} margin "
-              f"(peak {envelope.peak_torque[j]:.2f} N m, RMS {envelope.rms_torque[j]:.2f} N m, "
-              f"{envelope.peak_speed[j]:.2f} rad/s); closest: {closest.name}, at {closest.utilisation[lim]:.2f}x "
-              f"the {_LIMIT_TEXT[lim]}")
+    reason = (
+        f"none of {len(cands)} motor+gearbox pairs covers {name} with a {margin:.0%} margin "
+        f"(peak {envelope.peak_torque[j]:.2f} N m, RMS {envelope.rms_torque[j]:.2f} N m, "
+        f"{envelope.peak_speed[j]:.2f} rad/s); closest: {closest.name}, at {closest.utilisation[lim]:.2f}x "
+        f"the {_LIMIT_TEXT[lim]}"
+    )
     return JointSizing(name, "none", None, closest, reason, len(cands))
 
 

@@ -46,8 +46,16 @@ def _payload(payload) -> float:
     return m
 
 
-def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: float = 0.2, person=None,
-        progress=None) -> Study:
+def run(
+    robot,
+    activities,
+    *,
+    payload: float = 0.5,
+    catalogue=None,
+    margin: float = 0.2,
+    person=None,
+    progress=None,
+) -> Study:
     """Run the loop (module docstring) on ``robot`` (the person's arm model).
 
     Parameters
@@ -88,7 +96,9 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
     acts = []
     for spec in activities:
         if not isinstance(spec, dict):
-            raise ActivityError(f"an activity is a dict with 't' (s) and 'q' (rad), got {type(spec).__name__}")
+            raise ActivityError(
+                f"an activity is a dict with 't' (s) and 'q' (rad), got {type(spec).__name__}"
+            )
         name = str(spec.get("name", f"activity {len(acts) + 1}"))
         if progress is not None:
             progress("activity", name)
@@ -98,26 +108,60 @@ def run(robot, activities, *, payload: float = 0.5, catalogue=None, margin: floa
             t = np.asarray(spec.get("t", np.zeros(0)), float)
             q = np.asarray(spec.get("q", np.zeros((0, robot.nq))), float)
             z = np.zeros((len(q), robot.nv))
-            acts.append(env_mod.ActivityTorques(name, t, q, z, z, z, z, z, list(robot.joint_names), status,
-                                                str(spec.get("reason", "")), float(np.max(m, initial=0.0))))
+            acts.append(
+                env_mod.ActivityTorques(
+                    name,
+                    t,
+                    q,
+                    z,
+                    z,
+                    z,
+                    z,
+                    z,
+                    list(robot.joint_names),
+                    status,
+                    str(spec.get("reason", "")),
+                    float(np.max(m, initial=0.0)),
+                )
+            )
             continue
         missing = [k for k in ("t", "q") if k not in spec]
         if missing:
-            raise ActivityError(f"activity {name!r} has no {' and no '.join(repr(k) for k in missing)} "
-                                "(times in s, joint positions in rad)")
-        acts.append(env_mod.activity_torques(robot, name, spec["t"], spec["q"], spec.get("qd"), spec.get("qdd"),
-                                             payload=m, dynamics=dyn))
+            raise ActivityError(
+                f"activity {name!r} has no {' and no '.join(repr(k) for k in missing)} "
+                "(times in s, joint positions in rad)"
+            )
+        acts.append(
+            env_mod.activity_torques(
+                robot,
+                name,
+                spec["t"],
+                spec["q"],
+                spec.get("qd"),
+                spec.get("qdd"),
+                payload=m,
+                dynamics=dyn,
+            )
+        )
     timings["dynamics"] = time.perf_counter() - t0
     env = env_mod.envelope(acts)
     t0 = time.perf_counter()
-    res = sizing.size(env, cat, margin, progress=None if progress is None else (lambda j: progress("joint", j)))
+    res = sizing.size(
+        env, cat, margin, progress=None if progress is None else (lambda j: progress("joint", j))
+    )
     timings["sizing"] = time.perf_counter() - t0
     rules = weight_rules.check(res.drive_mass, person.get("mass"), robot.nv, len(res.unfit))
     return Study(robot, person, acts, env, res, rules, payload, cat, timings)
 
 
-def adl_activities(robot, payload: float | None = None, names=None, *, rate: float = 100.0,
-                   height: float | None = None) -> list[dict]:
+def adl_activities(
+    robot,
+    payload: float | None = None,
+    names=None,
+    *,
+    rate: float = 100.0,
+    height: float | None = None,
+) -> list[dict]:
     """The daily-living activities of :mod:`anthroarm.motion.activities` (all of them, or
     ``names``) for ``robot``, as activity dicts for :func:`run`.
 
@@ -130,13 +174,21 @@ def adl_activities(robot, payload: float | None = None, names=None, *, rate: flo
 
     payload = None if payload is None else _payload(payload)
     out = []
-    for name in (adl.names() if names is None else list(names)):
+    for name in adl.names() if names is None else list(names):
         tr = adl.activity_trajectory(robot, name, rate=rate, height=height)
         mass = tr.payload if payload is None else np.maximum(tr.payload, payload)
-        spec = dict(name=name, t=tr.t, q=tr.q, qd=tr.qd, qdd=tr.qdd, payload=mass, title=tr.activity.title)
+        spec = dict(
+            name=name, t=tr.t, q=tr.q, qd=tr.qd, qdd=tr.qdd, payload=mass, title=tr.activity.title
+        )
         if not tr.reachable:
-            bad = [(n, e) for n, s, e in zip(tr.keyframe_names, tr.keyframe_status, tr.keyframe_error) if s != "ok"]
+            bad = [
+                (n, e)
+                for n, s, e in zip(tr.keyframe_names, tr.keyframe_status, tr.keyframe_error)
+                if s != "ok"
+            ]
             spec["status"] = "unreachable"
-            spec["reason"] = "; ".join(f"keyframe {n!r} out of reach ({e * 1000:.0f} mm short)" for n, e in bad)
+            spec["reason"] = "; ".join(
+                f"keyframe {n!r} out of reach ({e * 1000:.0f} mm short)" for n, e in bad
+            )
         out.append(spec)
     return out

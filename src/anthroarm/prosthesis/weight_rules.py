@@ -24,10 +24,10 @@ import numpy as np
 
 from ..errors import ParameterError
 
-DRIVE_SHARE = (0.50, 0.60)        # L274
-ARMS_FRACTION = 0.126             # both arms / body mass, L7298
-MAX_FULL_ARM_MASS = 2.0           # kg, L7445
-MIN_DOF = 7                       # L7441
+DRIVE_SHARE = (0.50, 0.60)  # L274
+ARMS_FRACTION = 0.126  # both arms / body mass, L7298
+MAX_FULL_ARM_MASS = 2.0  # kg, L7445
+MIN_DOF = 7  # L7441
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,9 @@ def prosthesis_mass_range(drive_mass: float) -> tuple[float, float]:
     return drive_mass / DRIVE_SHARE[1], drive_mass / DRIVE_SHARE[0]
 
 
-def check(drive_mass: float, body_mass: float | None, dof: int, unsized_joints: int = 0) -> list[RuleCheck]:
+def check(
+    drive_mass: float, body_mass: float | None, dof: int, unsized_joints: int = 0
+) -> list[RuleCheck]:
     """The rules of the module docstring for a drive of ``drive_mass`` kg on an arm with ``dof``
     joints, for a person of ``body_mass`` kg (``None``: unknown, the 12.6 % rule is left out).
     ``unsized_joints`` > 0 (joints without a motor) makes the masses lower bounds (said in the
@@ -59,22 +61,59 @@ def check(drive_mass: float, body_mass: float | None, dof: int, unsized_joints: 
         body = float("nan") if body_mass is None else float(body_mass)
     except (TypeError, ValueError):
         drive = body = float("nan")
-    if not (np.isfinite(drive) and drive >= 0 and (body_mass is None or (np.isfinite(body) and body > 0))):
-        raise ParameterError(f"weight rules need drive_mass >= 0 kg and body_mass > 0 kg (or None), got "
-                             f"{drive_mass!r}, {body_mass!r}")
+    if not (
+        np.isfinite(drive)
+        and drive >= 0
+        and (body_mass is None or (np.isfinite(body) and body > 0))
+    ):
+        raise ParameterError(
+            f"weight rules need drive_mass >= 0 kg and body_mass > 0 kg (or None), got "
+            f"{drive_mass!r}, {body_mass!r}"
+        )
     drive_mass = drive
     lo, hi = prosthesis_mass_range(drive_mass)
     partial = f" (lower bound: {unsized_joints} joint(s) without a motor)" if unsized_joints else ""
     rows = [
-        RuleCheck("drive (motors + gearboxes) is 50-60 % of the prosthesis", "L274", lo, hi, "kg", None,
-                  f"implied prosthesis mass {lo:.2f}-{hi:.2f} kg from a drive of {drive_mass:.3f} kg{partial}"),
-        RuleCheck("full-arm prosthesis not more than 2 kg", "L7445", lo, MAX_FULL_ARM_MASS, "kg",
-                  bool(lo <= MAX_FULL_ARM_MASS), f"lightest implied mass (drive / 0.6){partial}"),
-        RuleCheck("at least 7 DOF (shoulder 3, elbow 1, forearm 2, hand 1)", "L7441", float(dof), float(MIN_DOF),
-                  "DOF", bool(dof >= MIN_DOF), "joints of the sized arm model (a hand's grip is not in it)"),
+        RuleCheck(
+            "drive (motors + gearboxes) is 50-60 % of the prosthesis",
+            "L274",
+            lo,
+            hi,
+            "kg",
+            None,
+            f"implied prosthesis mass {lo:.2f}-{hi:.2f} kg from a drive of {drive_mass:.3f} kg{partial}",
+        ),
+        RuleCheck(
+            "full-arm prosthesis not more than 2 kg",
+            "L7445",
+            lo,
+            MAX_FULL_ARM_MASS,
+            "kg",
+            bool(lo <= MAX_FULL_ARM_MASS),
+            f"lightest implied mass (drive / 0.6){partial}",
+        ),
+        RuleCheck(
+            "at least 7 DOF (shoulder 3, elbow 1, forearm 2, hand 1)",
+            "L7441",
+            float(dof),
+            float(MIN_DOF),
+            "DOF",
+            bool(dof >= MIN_DOF),
+            "joints of the sized arm model (a hand's grip is not in it)",
+        ),
     ]
     if body_mass is not None:
         one_arm = ARMS_FRACTION / 2 * body
-        rows.insert(2, RuleCheck("not heavier than the person's own arm (both arms 12.6 % of the body; book: 4-5 kg)",
-                                 "L7298", lo, one_arm, "kg", bool(lo <= one_arm), f"6.3 % of {body:g} kg{partial}"))
+        rows.insert(
+            2,
+            RuleCheck(
+                "not heavier than the person's own arm (both arms 12.6 % of the body; book: 4-5 kg)",
+                "L7298",
+                lo,
+                one_arm,
+                "kg",
+                bool(lo <= one_arm),
+                f"6.3 % of {body:g} kg{partial}",
+            ),
+        )
     return rows

@@ -39,7 +39,12 @@ def _spatial_rows(n, rng, CheckRow):
     for w, t in zip(W, th):
         p, s = rng.normal(size=3), rng.normal()
         tw = screw_twist(t, s, w, p)
-        e_exp6 = max(e_exp6, np.abs(screw_matrix(t, s, w, p) - pin.exp6(pin.Motion(tw[:3], tw[3:])).homogeneous).max())
+        e_exp6 = max(
+            e_exp6,
+            np.abs(
+                screw_matrix(t, s, w, p) - pin.exp6(pin.Motion(tw[:3], tw[3:])).homogeneous
+            ).max(),
+        )
         M = pin.SE3(pin.exp3(rng.normal(size=3)), rng.normal(size=3))
         L = D.Line.from_point_direction(rng.normal(size=3), rng.normal(size=3))
         L2 = D.transform_line(D.dual_matrix_from_se3(M.rotation, M.translation), L)
@@ -51,7 +56,11 @@ def _spatial_rows(n, rng, CheckRow):
         mot = rotated_vector_motion(w, t, thd, thdd, R, Rd, Rdd)
         model = pin.Model()
         j = model.addJoint(0, pin.JointModelRevoluteUnaligned(w), pin.SE3.Identity(), "r")
-        for name, jm in (("x", pin.JointModelPX()), ("y", pin.JointModelPY()), ("z", pin.JointModelPZ())):
+        for name, jm in (
+            ("x", pin.JointModelPX()),
+            ("y", pin.JointModelPY()),
+            ("z", pin.JointModelPZ()),
+        ):
             j = model.addJoint(j, jm, pin.SE3.Identity(), name)
         data = model.createData()
         pin.forwardKinematics(model, data, np.r_[t, R], np.r_[thd, Rd], np.r_[thdd, Rdd])
@@ -60,8 +69,16 @@ def _spatial_rows(n, rng, CheckRow):
         a = rng.uniform(-np.pi, np.pi, 3)
         a[1] = rng.uniform(0.05, np.pi - 0.05)
         C = euler_zxz(*a)
-        ref = pin.exp3(np.array([0, 0, a[0]])) @ pin.exp3(np.array([a[1], 0, 0])) @ pin.exp3(np.array([0, 0, a[2]]))
-        e_euler = max(e_euler, np.abs(C - ref).max(), np.abs(euler_zxz(*euler_zxz_inverse(C).angles) - C).max())
+        ref = (
+            pin.exp3(np.array([0, 0, a[0]]))
+            @ pin.exp3(np.array([a[1], 0, 0]))
+            @ pin.exp3(np.array([0, 0, a[2]]))
+        )
+        e_euler = max(
+            e_euler,
+            np.abs(C - ref).max(),
+            np.abs(euler_zxz(*euler_zxz_inverse(C).angles) - C).max(),
+        )
         b = rng.uniform(-1.5, 1.5)
         H = hand_matrix(a[0], b, a[2])
         e_hand = max(e_hand, np.abs(hand_angles(H).angles - np.array([a[0], b, a[2]])).max())
@@ -70,8 +87,17 @@ def _spatial_rows(n, rng, CheckRow):
         CheckRow("spatial", "screw matrix 002 (4-6) vs exp6", float(e_exp6), 1e-12, n),
         CheckRow("spatial", "dual matrix (5-145) on a line vs SE3.actInv", float(e_line), 1e-11, n),
         CheckRow("spatial", "rotated vector acc (5-130) vs classical acc", float(e_acc), 1e-11, n),
-        CheckRow("spatial", "Euler z-x-z (5-80) vs exp3, inverse", float(e_euler), 1e-10, n, "pinocchio+round trip"),
-        CheckRow("spatial", "hand angles (6-44)/(6-47) round trip", float(e_hand), 1e-10, n, "round trip"),
+        CheckRow(
+            "spatial",
+            "Euler z-x-z (5-80) vs exp3, inverse",
+            float(e_euler),
+            1e-10,
+            n,
+            "pinocchio+round trip",
+        ),
+        CheckRow(
+            "spatial", "hand angles (6-44)/(6-47) round trip", float(e_hand), 1e-10, n, "round trip"
+        ),
     ]
 
 

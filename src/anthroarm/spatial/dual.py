@@ -36,7 +36,9 @@ class Dual:
     __array_priority__ = 100  # so that ndarray * Dual defers to Dual.__rmul__
 
     def __init__(self, real, dual=0.0):
-        if isinstance(real, (float, int, np.floating, np.integer)) and isinstance(dual, (float, int, np.floating, np.integer)):
+        if isinstance(real, (float, int, np.floating, np.integer)) and isinstance(
+            dual, (float, int, np.floating, np.integer)
+        ):
             self.real, self.dual = float(real), float(dual)  # scalar fast path
             ok = math.isfinite(self.real) and math.isfinite(self.dual)
         else:
@@ -44,7 +46,9 @@ class Dual:
             self.dual = np.asarray(dual, dtype=float)
             ok = bool(np.isfinite(self.real).all() and np.isfinite(self.dual).all())
         if not ok:
-            raise ValueError(f"dual number with a NaN or infinite part: {np.asarray(real).tolist()} + ε{np.asarray(dual).tolist()}")
+            raise ValueError(
+                f"dual number with a NaN or infinite part: {np.asarray(real).tolist()} + ε{np.asarray(dual).tolist()}"
+            )
 
     # -- helpers
     @staticmethod
@@ -56,7 +60,11 @@ class Dual:
     def pitch(self):
         """P_a = a*/a, Eq. (5-132) (inf for a pure dual number)."""
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(np.asarray(self.real) != 0, np.asarray(self.dual) / np.where(np.asarray(self.real) != 0, self.real, 1.0), np.inf)
+            return np.where(
+                np.asarray(self.real) != 0,
+                np.asarray(self.dual) / np.where(np.asarray(self.real) != 0, self.real, 1.0),
+                np.inf,
+            )
 
     @property
     def shape(self):
@@ -64,7 +72,9 @@ class Dual:
 
     @property
     def T(self) -> "Dual":
-        return Dual(np.swapaxes(np.asarray(self.real), -1, -2), np.swapaxes(np.asarray(self.dual), -1, -2))
+        return Dual(
+            np.swapaxes(np.asarray(self.real), -1, -2), np.swapaxes(np.asarray(self.dual), -1, -2)
+        )
 
     def __getitem__(self, idx) -> "Dual":
         r, d = np.broadcast_arrays(np.asarray(self.real), np.asarray(self.dual))
@@ -108,8 +118,10 @@ class Dual:
         if np.any(np.asarray(o.real) == 0):
             from ..errors import DualDivisionError
 
-            raise DualDivisionError(f"division by a dual number with zero real part: {o!r} (a pure dual "
-                                    "number a = 0 + eps b has no inverse)")
+            raise DualDivisionError(
+                f"division by a dual number with zero real part: {o!r} (a pure dual "
+                "number a = 0 + eps b has no inverse)"
+            )
         return Dual(self.real / o.real, self.dual / o.real - self.real * o.dual / o.real**2)
 
     def __rtruediv__(self, o):
@@ -118,7 +130,11 @@ class Dual:
     def __pow__(self, n):
         if not isinstance(n, (int, np.integer)):
             return exp(log(self) * n)
-        return Dual(self.real**n, n * self.real ** (n - 1) * self.dual) if n != 0 else Dual(np.ones_like(np.asarray(self.real)), np.zeros_like(np.asarray(self.dual)))
+        return (
+            Dual(self.real**n, n * self.real ** (n - 1) * self.dual)
+            if n != 0
+            else Dual(np.ones_like(np.asarray(self.real)), np.zeros_like(np.asarray(self.dual)))
+        )
 
     def __matmul__(self, o):
         o = Dual.lift(o)
@@ -135,7 +151,10 @@ class Dual:
 
     def isclose(self, o, atol: float = 1e-12) -> bool:
         o = Dual.lift(o)
-        return bool(np.allclose(self.real, o.real, atol=atol, rtol=0) and np.allclose(self.dual, o.dual, atol=atol, rtol=0))
+        return bool(
+            np.allclose(self.real, o.real, atol=atol, rtol=0)
+            and np.allclose(self.dual, o.dual, atol=atol, rtol=0)
+        )
 
     def conj(self) -> "Dual":
         """a − ε a*."""
@@ -151,8 +170,10 @@ def _f(x, f, df, name: str = "f"):
         re, du = f(x.real), x.dual * df(x.real)
     for part, v in (("real", re), ("dual", du)):
         if not np.all(np.isfinite(v)):
-            raise ValueError(f"{name}({x!r}): the {part} part is beyond the float range "
-                             f"(largest float {np.finfo(float).max:.6g})")
+            raise ValueError(
+                f"{name}({x!r}): the {part} part is beyond the float range "
+                f"(largest float {np.finfo(float).max:.6g})"
+            )
     return Dual(re, du)
 
 
@@ -260,7 +281,9 @@ class Line:
         u = check_unit_axis(self.u, "line direction u")
         m = as_vector3(self.moment, "line moment")
         if abs(float(u @ m)) > 1e-9 * max(1.0, float(np.linalg.norm(m))):
-            raise ValueError(f"not a line: direction {u.tolist()} and moment {m.tolist()} are not perpendicular (u·m = {float(u @ m):.3e})")
+            raise ValueError(
+                f"not a line: direction {u.tolist()} and moment {m.tolist()} are not perpendicular (u·m = {float(u @ m):.3e})"
+            )
         object.__setattr__(self, "u", u)
         object.__setattr__(self, "moment", m)
 
@@ -406,7 +429,9 @@ def check_dual_orthogonal(A: Dual, tol: float = 1e-9) -> Dual:
     M = A @ A.T
     err = max(float(np.abs(M.real - np.eye(3)).max()), float(np.abs(M.dual).max()))
     if err > tol:
-        raise ValueError(f"dual matrix is not dual-orthogonal: max |Â Âᵀ − I| = {err:.3e} (dual part {np.asarray(A.dual).tolist()})")
+        raise ValueError(
+            f"dual matrix is not dual-orthogonal: max |Â Âᵀ − I| = {err:.3e} (dual part {np.asarray(A.dual).tolist()})"
+        )
     return A
 
 

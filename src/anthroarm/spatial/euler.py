@@ -45,8 +45,17 @@ def euler_zxz_partial(theta, alpha) -> np.ndarray:
 def euler_zxz(theta, alpha, delta) -> np.ndarray:
     """C^{(θ,α,δ)} = C_z(θ) C_x(α) C_z(δ), Eq. (5-80) (element (3,2) corrected to sin α cos δ;
     the print has sin δ cos δ, see docs/errata.md).  Active, new → old; vectorised."""
-    theta, alpha, delta = (as_angle(a, n) for a, n in ((theta, "theta"), (alpha, "alpha"), (delta, "delta")))
-    ct, st, ca, sa, cd, sd = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha), np.cos(delta), np.sin(delta)
+    theta, alpha, delta = (
+        as_angle(a, n) for a, n in ((theta, "theta"), (alpha, "alpha"), (delta, "delta"))
+    )
+    ct, st, ca, sa, cd, sd = (
+        np.cos(theta),
+        np.sin(theta),
+        np.cos(alpha),
+        np.sin(alpha),
+        np.cos(delta),
+        np.sin(delta),
+    )
     ct, st, ca, sa, cd, sd = np.broadcast_arrays(ct, st, ca, sa, cd, sd)
     return np.stack(
         [
@@ -72,8 +81,11 @@ def euler_zxz_inverse(C, tol: float = SINGULAR_TOL) -> EulerAngles:
     if sa < tol:
         theta = float(np.arctan2(C[1, 0], C[0, 0]))  # C = Cz(θ + δ) (α = 0) or Cz(θ − δ)Cx(π)
         which = "θ + δ" if C[2, 2] > 0 else "θ − δ"
-        return EulerAngles(np.array([theta, alpha, 0.0]), True,
-                           f"gimbal lock: sin α = {sa:.2e}; only {which} = {theta:.6g} rad is defined (δ set to 0)")
+        return EulerAngles(
+            np.array([theta, alpha, 0.0]),
+            True,
+            f"gimbal lock: sin α = {sa:.2e}; only {which} = {theta:.6g} rad is defined (δ set to 0)",
+        )
     theta = float(np.arctan2(C[0, 2], -C[1, 2]))
     delta = float(np.arctan2(C[2, 0], C[2, 1]))
     return EulerAngles(np.array([theta, alpha, delta]), False, "ok")
@@ -98,8 +110,11 @@ def euler_xyx_inverse(R, tol: float = SINGULAR_TOL) -> EulerAngles:
     if sp < tol:
         theta = float(np.arctan2(R[2, 1], R[1, 1]))
         which = "θ + φ" if R[0, 0] > 0 else "θ − φ"
-        return EulerAngles(np.array([theta, psi, 0.0]), True,
-                           f"gimbal lock: sin ψ = {sp:.2e}; only {which} = {theta:.6g} rad is defined (φ set to 0)")
+        return EulerAngles(
+            np.array([theta, psi, 0.0]),
+            True,
+            f"gimbal lock: sin ψ = {sp:.2e}; only {which} = {theta:.6g} rad is defined (φ set to 0)",
+        )
     theta = float(np.arctan2(R[1, 0], -R[2, 0]))
     phi = float(np.arctan2(R[0, 1], R[0, 2]))
     return EulerAngles(np.array([theta, psi, phi]), False, "ok")

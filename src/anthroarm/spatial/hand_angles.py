@@ -35,7 +35,9 @@ def hand_matrix(alpha, beta, gamma) -> np.ndarray:
 def hand_pointing(alpha, beta) -> np.ndarray:
     """Unit pointing direction of the hand, −z_H = (cα cβ, sα cβ, −sβ)."""
     a, b = as_angle(alpha, "alpha"), as_angle(beta, "beta")
-    return np.stack([np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), -np.sin(b) * np.ones_like(a)], -1)
+    return np.stack(
+        [np.cos(a) * np.cos(b), np.sin(a) * np.cos(b), -np.sin(b) * np.ones_like(a)], -1
+    )
 
 
 def hand_angles(C, tol: float = SINGULAR_TOL) -> EulerAngles:
@@ -53,8 +55,11 @@ def hand_angles(C, tol: float = SINGULAR_TOL) -> EulerAngles:
         # with γ = 0, C_y(α) = Bᵀ C C_x(β)
         M = (rot_z(-np.pi / 2) @ rot_x(np.pi / 2)).T @ C @ rot_x(beta)
         alpha = float(np.arctan2(M[0, 2], M[0, 0]))
-        return EulerAngles(np.array([alpha, beta, 0.0]), True,
-                           f"hand points vertically (cos β = {cb:.2e}): α and γ are coupled; γ set to 0")
+        return EulerAngles(
+            np.array([alpha, beta, 0.0]),
+            True,
+            f"hand points vertically (cos β = {cb:.2e}): α and γ are coupled; γ set to 0",
+        )
     alpha = float(np.arctan2(-C[1, 2], -C[0, 2]))
     gamma = float(np.arctan2(-C[2, 0], C[2, 1]))
     return EulerAngles(np.array([alpha, beta, gamma]), False, "ok")

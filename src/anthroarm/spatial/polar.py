@@ -76,7 +76,10 @@ def polar_motion(r, r_dot, r_ddot, theta, theta_dot, theta_ddot) -> PolarMotion:
     """The derivatives (5-10)/(5-11) of r(t) e^{iθ(t)} split into radial, tangential,
     centripetal and Coriolis terms (m, m/s, m/s²)."""
     r, rd, rdd = (as_angle(x, n) for x, n in ((r, "r"), (r_dot, "r_dot"), (r_ddot, "r_ddot")))
-    th, thd, thdd = (as_angle(x, n) for x, n in ((theta, "theta"), (theta_dot, "theta_dot"), (theta_ddot, "theta_ddot")))
+    th, thd, thdd = (
+        as_angle(x, n)
+        for x, n in ((theta, "theta"), (theta_dot, "theta_dot"), (theta_ddot, "theta_ddot"))
+    )
     e = np.exp(1j * th)
     ie = 1j * e
     rv, tv = rd * e, r * thd * ie
@@ -88,7 +91,14 @@ def spherical_to_xyz(r_p, theta, phi) -> np.ndarray:
     """r_p(e^{iθ} sin φ + j cos φ), Eq. (5-23), as (x, y, z): θ azimuth in the xy-plane, φ polar
     angle from +z (j is the unit vector along z, not a quaternion unit)."""
     r_p, th, ph = as_angle(r_p, "r_p"), as_angle(theta, "theta"), as_angle(phi, "phi")
-    return np.stack([r_p * np.sin(ph) * np.cos(th), r_p * np.sin(ph) * np.sin(th), r_p * np.cos(ph) * np.ones_like(th)], -1)
+    return np.stack(
+        [
+            r_p * np.sin(ph) * np.cos(th),
+            r_p * np.sin(ph) * np.sin(th),
+            r_p * np.cos(ph) * np.ones_like(th),
+        ],
+        -1,
+    )
 
 
 def xyz_to_spherical(p) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

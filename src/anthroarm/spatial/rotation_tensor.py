@@ -20,7 +20,15 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from .rotations import as_angle, as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
+from .rotations import (
+    as_angle,
+    as_scalar,
+    as_vector3,
+    check_rotation,
+    check_unit_axis,
+    skew,
+    unskew,
+)
 
 
 # ----------------------------------------------------------------------------- component tensors
@@ -44,7 +52,14 @@ def axis_from_angles(alpha, beta) -> np.ndarray:
     """Axis w = E^{kβ}(E^{jα}(k)) = (cos β sin α, sin β sin α, cos α), Eq. (5-100)/(5-101):
     α is the polar angle from k, β the azimuth."""
     alpha, beta = as_angle(alpha, "alpha"), as_angle(beta, "beta")
-    return np.stack([np.cos(beta) * np.sin(alpha), np.sin(beta) * np.sin(alpha), np.cos(alpha) * np.ones_like(beta)], -1)
+    return np.stack(
+        [
+            np.cos(beta) * np.sin(alpha),
+            np.sin(beta) * np.sin(alpha),
+            np.cos(alpha) * np.ones_like(beta),
+        ],
+        -1,
+    )
 
 
 def rotation_tensor(w, theta) -> np.ndarray:
@@ -84,7 +99,11 @@ def rotation_tensor_acc(w, theta, theta_dot, theta_ddot, w_dot=None, w_ddot=None
     second derivative of (5-122): J̈₁(1 − c) + J̈₃ s + 2θ̇(J̇₁ s + J̇₃ c) + θ̈(−J₂ s + J₃ c)
     − θ̇²(J₂ c + J₃ s), using J̇₂ = −J̇₁."""
     w = check_unit_axis(w, "axis w")
-    th, thd, thdd = as_scalar(theta, "theta"), as_scalar(theta_dot, "theta_dot"), as_scalar(theta_ddot, "theta_ddot")
+    th, thd, thdd = (
+        as_scalar(theta, "theta"),
+        as_scalar(theta_dot, "theta_dot"),
+        as_scalar(theta_ddot, "theta_ddot"),
+    )
     c, s = np.cos(th), np.sin(th)
     j1 = np.outer(w, w)
     j2, j3 = np.eye(3) - j1, skew(w)
@@ -119,7 +138,9 @@ class RotatedVectorMotion:
     relative: np.ndarray
 
 
-def rotated_vector_motion(w, theta, theta_dot, theta_ddot, R, R_dot=(0.0, 0.0, 0.0), R_ddot=(0.0, 0.0, 0.0)) -> RotatedVectorMotion:
+def rotated_vector_motion(
+    w, theta, theta_dot, theta_ddot, R, R_dot=(0.0, 0.0, 0.0), R_ddot=(0.0, 0.0, 0.0)
+) -> RotatedVectorMotion:
     """Position, velocity (5-126) and acceleration (5-130) of R′ = E^{wθ}(R) for a fixed
     axis w, with R(t) given in the rotating frame (Ṙ, R̈ are its rates there).  Vectorised over
     a batch of θ, θ̇, θ̈, R, Ṙ, R̈ of a common leading shape."""
@@ -142,13 +163,24 @@ def rotated_vector_motion(w, theta, theta_dot, theta_ddot, R, R_dot=(0.0, 0.0, 0
         cent = EE(-(thd**2) * j2R)
         cor = EE(2.0 * thd * np.cross(w, Rd))
         rel = EE(np.broadcast_to(Rdd, tang.shape))
-        res = RotatedVectorMotion(EE(np.broadcast_to(R, rot_v.shape)), rot_v + str_v, rot_v, str_v,
-                                  tang + cent + cor + rel, tang, cent, cor, rel)
-    for f in fields(res):   # a rate whose square overflows: a ValueError naming the term
+        res = RotatedVectorMotion(
+            EE(np.broadcast_to(R, rot_v.shape)),
+            rot_v + str_v,
+            rot_v,
+            str_v,
+            tang + cent + cor + rel,
+            tang,
+            cent,
+            cor,
+            rel,
+        )
+    for f in fields(res):  # a rate whose square overflows: a ValueError naming the term
         if not np.all(np.isfinite(getattr(res, f.name))):
-            raise ValueError(f"{f.name} of the rotated vector cannot be represented in floating point "
-                             f"(theta_dot = {np.max(np.abs(thd)):.3g}, theta_ddot = {np.max(np.abs(thdd)):.3g}, "
-                             f"|R| = {np.max(np.abs(R)):.3g}); use smaller rates or other units")
+            raise ValueError(
+                f"{f.name} of the rotated vector cannot be represented in floating point "
+                f"(theta_dot = {np.max(np.abs(thd)):.3g}, theta_ddot = {np.max(np.abs(thdd)):.3g}, "
+                f"|R| = {np.max(np.abs(R)):.3g}); use smaller rates or other units"
+            )
     return res
 
 

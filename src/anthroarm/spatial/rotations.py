@@ -67,7 +67,9 @@ def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
     use :func:`unit_axis` to normalise a direction explicitly."""
     a = as_vector3(u, name)
     # a component above 2 cannot belong to a unit vector (and its square might overflow)
-    n = np.where(np.max(np.abs(a), axis=-1) > 2.0, np.inf, np.linalg.norm(np.clip(a, -2.0, 2.0), axis=-1))
+    n = np.where(
+        np.max(np.abs(a), axis=-1) > 2.0, np.inf, np.linalg.norm(np.clip(a, -2.0, 2.0), axis=-1)
+    )
     if np.any(n < 1e-12):
         raise ValueError(f"{name} has zero length: {a.tolist()}")
     if np.any(np.abs(n - 1.0) > tol):
@@ -82,8 +84,8 @@ def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
 def unit_axis(u, name: str = "axis") -> np.ndarray:
     """Normalise a direction (shape (..., 3)); ``ValueError`` for a zero-length one."""
     a = as_vector3(u, name)
-    m = np.max(np.abs(a), axis=-1, keepdims=True)     # divide by the largest component first:
-    if np.any(m < 1e-300):                            # no square overflows or underflows
+    m = np.max(np.abs(a), axis=-1, keepdims=True)  # divide by the largest component first:
+    if np.any(m < 1e-300):  # no square overflows or underflows
         raise ValueError(f"{name} has zero length: {a.tolist()}")
     a = a / m
     n = np.linalg.norm(a, axis=-1, keepdims=True)
@@ -104,9 +106,11 @@ def check_rotation(R, name: str = "rotation", tol: float = ORTHO_TOL) -> np.ndar
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} has a NaN or infinite element: {a.tolist()}")
     big = np.abs(a).max(axis=(-2, -1))
-    if np.any(big > 2.0):   # entries of a rotation lie in [-1, 1]; R R^T would overflow at ~1e154
-        raise ValueError(f"{name} is not orthogonal: it has an element of magnitude {float(np.max(big)):.6g} "
-                         f"(the entries of a rotation lie in [-1, 1])")
+    if np.any(big > 2.0):  # entries of a rotation lie in [-1, 1]; R R^T would overflow at ~1e154
+        raise ValueError(
+            f"{name} is not orthogonal: it has an element of magnitude {float(np.max(big)):.6g} "
+            f"(the entries of a rotation lie in [-1, 1])"
+        )
     err = np.abs(a @ np.swapaxes(a, -1, -2) - np.eye(3)).max(axis=(-2, -1))
     if np.any(err > tol):
         i = int(np.argmax(err)) if a.ndim > 2 else 0
@@ -116,7 +120,9 @@ def check_rotation(R, name: str = "rotation", tol: float = ORTHO_TOL) -> np.ndar
         )
     det = np.linalg.det(a)
     if np.any(det < 0):
-        raise ValueError(f"{name} is a reflection (det = {float(np.min(det)):.6g}), not a rotation: {a.tolist()}")
+        raise ValueError(
+            f"{name} is a reflection (det = {float(np.min(det)):.6g}), not a rotation: {a.tolist()}"
+        )
     return a
 
 
@@ -126,15 +132,21 @@ def skew(v) -> np.ndarray:
     a = as_vector3(v, "vector")
     x, y, z = a[..., 0], a[..., 1], a[..., 2]
     o = np.zeros_like(x)
-    return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
+    return np.stack(
+        [np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2
+    )
 
 
 def unskew(W) -> np.ndarray:
     """Vector w of a skew matrix W = [w]× (the antisymmetric part is used)."""
     W = np.asarray(W, dtype=float)
     if W.shape[-2:] != (3, 3) or not np.all(np.isfinite(W)):
-        raise ValueError(f"W must be a finite (..., 3, 3) matrix, got shape {W.shape}: {W.tolist()}")
-    return 0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1)
+        raise ValueError(
+            f"W must be a finite (..., 3, 3) matrix, got shape {W.shape}: {W.tolist()}"
+        )
+    return 0.5 * np.stack(
+        [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1
+    )
 
 
 # ----------------------------------------------------------------------------- elementary rotations
@@ -146,19 +158,25 @@ def _cs(angle, name="angle"):
 def rot_x(angle) -> np.ndarray:
     """C_x(angle), Eq. (5-70) (= E^{iθ}, Eq. (5-98)): active rotation about x."""
     c, s, one, o = _cs(angle)
-    return np.stack([np.stack([one, o, o], -1), np.stack([o, c, -s], -1), np.stack([o, s, c], -1)], -2)
+    return np.stack(
+        [np.stack([one, o, o], -1), np.stack([o, c, -s], -1), np.stack([o, s, c], -1)], -2
+    )
 
 
 def rot_y(angle) -> np.ndarray:
     """C_y(angle), Eq. (5-71) (= E^{jθ}, Eq. (5-99)): active rotation about y."""
     c, s, one, o = _cs(angle)
-    return np.stack([np.stack([c, o, s], -1), np.stack([o, one, o], -1), np.stack([-s, o, c], -1)], -2)
+    return np.stack(
+        [np.stack([c, o, s], -1), np.stack([o, one, o], -1), np.stack([-s, o, c], -1)], -2
+    )
 
 
 def rot_z(angle) -> np.ndarray:
     """C_z(angle), Eq. (5-72) (= E^{kθ}, Eq. (5-94)–(5-97)): active rotation about z."""
     c, s, one, o = _cs(angle)
-    return np.stack([np.stack([c, -s, o], -1), np.stack([s, c, o], -1), np.stack([o, o, one], -1)], -2)
+    return np.stack(
+        [np.stack([c, -s, o], -1), np.stack([s, c, o], -1), np.stack([o, o, one], -1)], -2
+    )
 
 
 def rot(axis: str, angle) -> np.ndarray:
@@ -188,7 +206,9 @@ def rotation_between(a, b) -> np.ndarray:
     a = unit_axis(a, "direction a")
     b = unit_axis(b, "direction b")
     if a.ndim != 1 or b.ndim != 1:
-        raise ValueError(f"rotation_between takes two (3,) directions, got shapes {a.shape} and {b.shape}")
+        raise ValueError(
+            f"rotation_between takes two (3,) directions, got shapes {a.shape} and {b.shape}"
+        )
     v = np.cross(a, b)
     c = float(a @ b)
     if np.linalg.norm(v) < 1e-12:

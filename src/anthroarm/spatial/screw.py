@@ -21,7 +21,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotations import as_angle, as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
+from .rotations import (
+    as_angle,
+    as_scalar,
+    as_vector3,
+    check_rotation,
+    check_unit_axis,
+    skew,
+    unskew,
+)
 
 
 def P(u) -> np.ndarray:
@@ -75,7 +83,9 @@ def screw_parameters(T, tol: float = 1e-10) -> tuple[float, float, np.ndarray, n
 
     T = np.asarray(T, float)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise ValueError(f"T must be a finite 4x4 matrix, got {T.tolist() if T.size <= 16 else T.shape}")
+        raise ValueError(
+            f"T must be a finite 4x4 matrix, got {T.tolist() if T.size <= 16 else T.shape}"
+        )
     R = check_rotation(T[:3, :3], "T[:3,:3]")
     t = T[:3, 3]
     u, phi = axis_angle(R)
@@ -102,7 +112,7 @@ def acceleration_matrix(phi_dot, phi_ddot, u, u_dot=None) -> np.ndarray:
     ``u_dot`` (default 0: fixed axis) gives the [Ṗ_u] term."""
     Pu = P(u)
     phi_dot, phi_ddot = as_scalar(phi_dot, "phi_dot"), as_scalar(phi_ddot, "phi_ddot")
-    E = phi_ddot * Pu + phi_dot ** 2 * (Pu @ Pu)
+    E = phi_ddot * Pu + phi_dot**2 * (Pu @ Pu)
     if u_dot is not None:
         E = E + phi_dot * skew(as_vector3(u_dot, "u_dot"))
     return E

@@ -35,8 +35,17 @@ class LineMotionResult:
     final_rot_err: float
 
 
-def straight_line_move(robot, q_start, T_goal, duration: float, dt: float, *, closed_loop: bool = False,
-                       k: float = 20.0, jacobian: str = "book") -> LineMotionResult:
+def straight_line_move(
+    robot,
+    q_start,
+    T_goal,
+    duration: float,
+    dt: float,
+    *,
+    closed_loop: bool = False,
+    k: float = 20.0,
+    jacobian: str = "book",
+) -> LineMotionResult:
     """Move the tool on a straight line to ``T_goal`` in ``duration`` s by resolved rate (7-89)/(7-95)/(7-96).
 
     ``jacobian="book"`` uses the hand-frame Jacobian (7-94) built from joint axes and lever arms;
@@ -56,8 +65,8 @@ def straight_line_move(robot, q_start, T_goal, duration: float, dt: float, *, cl
     Ti = robot.fk(q)
     pi, pf = Ti[:3, 3].copy(), Tg[:3, 3]
     Ri, Rf = Ti[:3, :3].copy(), Tg[:3, :3]
-    v_w = (pf - pi) / duration                                   # base-frame, constant (7-95)
-    w_w = pin.log3(Rf @ Ri.T) / duration                         # base-frame geodesic rate
+    v_w = (pf - pi) / duration  # base-frame, constant (7-95)
+    w_w = pin.log3(Rf @ Ri.T) / duration  # base-frame geodesic rate
     n = int(round(duration / dt))
     ts, Q, P, E = [0.0], [q.copy()], [pi.copy()], [0.0]
     for i in range(n):
@@ -71,10 +80,16 @@ def straight_line_move(robot, q_start, T_goal, duration: float, dt: float, *, cl
             R_ref = Ri @ pin.exp3(s * pin.log3(Ri.T @ Rf))
             v = v + k * (p_ref - T[:3, 3])
             w = w + k * pin.log3(R_ref @ C17.T)
-        sdot = np.concatenate([C17.T @ v, C17.T @ w])          # hand-frame twist (7-87)
-        J = hand_frame_jacobian(robot, q) if jacobian == "book" else robot.jacobian(q, reference="LOCAL")
-        qd = np.linalg.solve(J, sdot) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ sdot   # (7-89)
-        q = q + qd * dt                                          # (7-96), Euler
+        sdot = np.concatenate([C17.T @ v, C17.T @ w])  # hand-frame twist (7-87)
+        J = (
+            hand_frame_jacobian(robot, q)
+            if jacobian == "book"
+            else robot.jacobian(q, reference="LOCAL")
+        )
+        qd = (
+            np.linalg.solve(J, sdot) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ sdot
+        )  # (7-89)
+        q = q + qd * dt  # (7-96), Euler
         tn = (i + 1) * dt
         pn = robot.fk(q)[:3, 3]
         ts.append(tn)
@@ -86,6 +101,12 @@ def straight_line_move(robot, q_start, T_goal, duration: float, dt: float, *, cl
     rel = P - pi
     dev = np.linalg.norm(rel - np.outer(rel @ u, u), axis=1).max()
     Tend = robot.fk(q)
-    return LineMotionResult(np.array(ts), np.array(Q), P, np.array(E), float(dev),
-                            float(np.linalg.norm(Tend[:3, 3] - pf)),
-                            float(np.linalg.norm(pin.log3(Rf @ Tend[:3, :3].T))))
+    return LineMotionResult(
+        np.array(ts),
+        np.array(Q),
+        P,
+        np.array(E),
+        float(dev),
+        float(np.linalg.norm(Tend[:3, 3] - pf)),
+        float(np.linalg.norm(pin.log3(Rf @ Tend[:3, :3].T))),
+    )

@@ -26,12 +26,16 @@ class ViaPointTrajectory:
         t = np.asarray(times, float)
         Q = np.asarray(Q, float)
         if t.ndim != 1 or t.size < 2 or not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
-            raise ValueError(f"times must be a strictly increasing 1-D array of >= 2 finite values, got {times!r}")
+            raise ValueError(
+                f"times must be a strictly increasing 1-D array of >= 2 finite values, got {times!r}"
+            )
         if Q.ndim != 2 or Q.shape[0] != t.size or not np.isfinite(Q).all():
             raise ValueError(f"Q must be finite with shape ({t.size}, nq), got shape {Q.shape}")
         self.times, self.Q = t, Q
-        bc = ([(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))],
-              [(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))])
+        bc = (
+            [(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))],
+            [(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))],
+        )
         self._spl = make_interp_spline(t, Q, k=5, bc_type=bc)
 
     @property
@@ -45,7 +49,11 @@ class ViaPointTrajectory:
         t = np.asarray(t, float)
         if not np.isfinite(t).all():
             raise ValueError(f"t must be finite times (s), got {t.tolist()}")
-        if isinstance(derivative, bool) or not isinstance(derivative, (int, np.integer)) or not 0 <= derivative <= 5:
+        if (
+            isinstance(derivative, bool)
+            or not isinstance(derivative, (int, np.integer))
+            or not 0 <= derivative <= 5
+        ):
             raise ValueError(f"derivative must be an integer in 0 ... 5, got {derivative!r}")
         tc = np.clip(t, self.times[0], self.times[-1])
         out = self._spl(tc, nu=derivative)
@@ -55,7 +63,9 @@ class ViaPointTrajectory:
         return out
 
 
-def joint_via_trajectory(robot, poses, times, *, q_start=None, swivel=0.0) -> tuple[ViaPointTrajectory, np.ndarray]:
+def joint_via_trajectory(
+    robot, poses, times, *, q_start=None, swivel=0.0
+) -> tuple[ViaPointTrajectory, np.ndarray]:
     """Solve the closed-form IK at each via pose (4×4, m) and fit :class:`ViaPointTrajectory`.
 
     At each via point the solution nearest (max-norm) to the previous one is taken (the first is
@@ -66,7 +76,7 @@ def joint_via_trajectory(robot, poses, times, *, q_start=None, swivel=0.0) -> tu
     poses = np.asarray(poses, float)
     prev = robot.neutral() if q_start is None else robot.check_q(q_start, "q_start")
     form = closed_form_info(robot)
-    kw = {"swivel": swivel} if form is not None and form.swivel else {}   # redundant arm: one swivel
+    kw = {"swivel": swivel} if form is not None and form.swivel else {}  # redundant arm: one swivel
     Q = []
     for k, T in enumerate(poses):
         res = analytic(robot, T, **kw)

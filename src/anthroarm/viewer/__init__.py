@@ -13,9 +13,26 @@ playback, static HTML export, Jupyter cells; ``Viewer.scene`` is the underlying 
 :mod:`~anthroarm.viewer.browser` takes headless-Chromium screenshots (tests, docs).
 """
 
-from .viewer import Scene, Viewer, arrow_mesh, colormap_rgb, limit_color, limit_proximity, manipulability
+from .viewer import (
+    Scene,
+    Viewer,
+    arrow_mesh,
+    colormap_rgb,
+    limit_color,
+    limit_proximity,
+    manipulability,
+)
 
-__all__ = ["Scene", "Viewer", "arrow_mesh", "colormap_rgb", "limit_color", "limit_proximity", "manipulability", "show"]
+__all__ = [
+    "Scene",
+    "Viewer",
+    "arrow_mesh",
+    "colormap_rgb",
+    "limit_color",
+    "limit_proximity",
+    "manipulability",
+    "show",
+]
 
 
 def show(robot, q=None, **kwargs) -> Viewer:

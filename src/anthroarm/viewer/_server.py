@@ -44,8 +44,16 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _store import MESHCAT_DIST, SceneStore, page_html  # noqa: E402
 
 HOST = "127.0.0.1"
-MESHCAT_COMMANDS = {"set_transform", "set_object", "delete", "set_property", "set_animation",
-                    "anthroarm_batch", "anthroarm_color", "anthroarm_ui"}
+MESHCAT_COMMANDS = {
+    "set_transform",
+    "set_object",
+    "delete",
+    "set_property",
+    "set_animation",
+    "anthroarm_batch",
+    "anthroarm_color",
+    "anthroarm_ui",
+}
 #: the kinds of HTML overlay the page builds (``anthroarm_ui``)
 UI_KINDS = {"legend", "note", "teach"}
 #: Longest ``wait`` (s) and most browser tabs a ``wait`` may ask for.
@@ -108,7 +116,7 @@ class WebSocket(tornado.websocket.WebSocketHandler):
         self.bridge = bridge
 
     def get(self, *args, **kwargs):
-        if _refuse_foreign_host(self):   # before the upgrade: no websocket for a foreign Host
+        if _refuse_foreign_host(self):  # before the upgrade: no websocket for a foreign Host
             return None
         if self.request.headers.get("Upgrade", "").lower() != "websocket":
             self.redirect("/static/")
@@ -137,12 +145,14 @@ class Bridge:
         self.store = SceneStore()
         self.clients: set[WebSocket] = set()
         self.parent_pid = parent_pid
-        app = tornado.web.Application([
-            (r"/static/", PageHandler, {"bridge": self}),
-            (r"/static/index.html", PageHandler, {"bridge": self}),
-            (r"/static/(.*)", StaticNoCache, {"path": MESHCAT_DIST}),
-            (r"/", WebSocket, {"bridge": self}),
-        ])
+        app = tornado.web.Application(
+            [
+                (r"/static/", PageHandler, {"bridge": self}),
+                (r"/static/index.html", PageHandler, {"bridge": self}),
+                (r"/static/(.*)", StaticNoCache, {"path": MESHCAT_DIST}),
+                (r"/", WebSocket, {"bridge": self}),
+            ]
+        )
         if port is not None:
             try:
                 app.listen(port, address=HOST)
@@ -184,7 +194,9 @@ class Bridge:
         if len(self.clients) >= n:
             self._reply(b"ok")
         elif self.loop.time() >= deadline:
-            self._reply(f"error: {len(self.clients)} of {n} browser tabs connected before the timeout".encode())
+            self._reply(
+                f"error: {len(self.clients)} of {n} browser tabs connected before the timeout".encode()
+            )
         else:
             self.loop.call_later(0.05, lambda: self._wait_clients(n, deadline))
 
@@ -206,8 +218,10 @@ class Bridge:
 
     def _dispatch(self, frames) -> bytes | None:
         if not frames or not hmac.compare_digest(frames[0], self.secret):
-            return (b"error: refused: the request does not start with this viewer's secret "
-                    b"(only the process that started the server can drive it)")
+            return (
+                b"error: refused: the request does not start with this viewer's secret "
+                b"(only the process that started the server can drive it)"
+            )
         frames = frames[1:]
         if not frames:
             return b"error: no command after the secret"
@@ -242,7 +256,9 @@ class Bridge:
             return b"ok"
         if cmd == "wait":
             if nargs > 2:
-                return f"error: wait takes at most 2 arguments (tabs, seconds), got {nargs}".encode()
+                return (
+                    f"error: wait takes at most 2 arguments (tabs, seconds), got {nargs}".encode()
+                )
             n = _int_arg(frames[1], "tabs", 1, MAX_TABS) if nargs >= 1 and frames[1] else 1
             seconds = _seconds_arg(frames[2]) if nargs >= 2 and frames[2] else 30.0
             self._wait_clients(n, self.loop.time() + seconds)
@@ -287,8 +303,14 @@ def _check_command(cmd, top: bool) -> None:
             _check_command(c, top=False)
     elif kind == "set_transform":
         m = cmd.get("matrix")
-        if not (isinstance(m, list) and len(m) == 16
-                and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in m)):
+        if not (
+            isinstance(m, list)
+            and len(m) == 16
+            and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                for x in m
+            )
+        ):
             raise ValueError("set_transform: matrix must be 16 finite numbers")
     elif kind == "set_property":
         if not isinstance(cmd.get("property"), str):
@@ -302,7 +324,9 @@ def _check_command(cmd, top: bool) -> None:
             raise ValueError(f"anthroarm_ui: spec must be a map with kind in {sorted(UI_KINDS)}")
     elif kind == "anthroarm_color":
         c = cmd.get("color")
-        if not (isinstance(c, list) and len(c) in (3, 4) and all(isinstance(x, (int, float)) for x in c)):
+        if not (
+            isinstance(c, list) and len(c) in (3, 4) and all(isinstance(x, (int, float)) for x in c)
+        ):
             raise ValueError("anthroarm_color: color must be 3 or 4 numbers")
 
 

@@ -31,7 +31,9 @@ import os
 
 import umsgpack
 
-MESHCAT_DIST = os.path.join(os.path.dirname(os.path.abspath(__import__("meshcat").__file__)), "viewer", "dist")
+MESHCAT_DIST = os.path.join(
+    os.path.dirname(os.path.abspath(__import__("meshcat").__file__)), "viewer", "dist"
+)
 MAIN_JS = os.path.join(MESHCAT_DIST, "main.min.js")
 
 #: JavaScript installed right after ``new MeshCat.Viewer(...)``: the two extra commands.
@@ -230,7 +232,9 @@ _REPLAY = """(function () {{
 }})();"""
 
 
-def page_html(commands: list[bytes] | None = None, *, live: bool = False, title: str = "anthroarm viewer") -> str:
+def page_html(
+    commands: list[bytes] | None = None, *, live: bool = False, title: str = "anthroarm viewer"
+) -> str:
     """The viewer page.
 
     ``live=True``: the page served by the server (loads ``main.min.js`` from the server and
@@ -249,7 +253,9 @@ def page_html(commands: list[bytes] | None = None, *, live: bool = False, title:
     if commands:
         enc = [base64.b64encode(c).decode("ascii") for c in commands]
         replay = _REPLAY.format(cmds=json.dumps(enc))
-    return _PAGE.format(title=title, main_js=main_js, patch=JS_PATCH, replay=replay, connect=connect)
+    return _PAGE.format(
+        title=title, main_js=main_js, patch=JS_PATCH, replay=replay, connect=connect
+    )
 
 
 def split_path(path: str) -> tuple[str, ...]:

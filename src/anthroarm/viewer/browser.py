@@ -33,10 +33,20 @@ import numpy as np
 
 #: Flags that make headless Chromium render WebGL in software, offline and quietly.
 CHROMIUM_FLAGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--hide-scrollbars",
-    "--disable-default-apps", "--disable-extensions", "--mute-audio",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+    "--hide-scrollbars",
+    "--disable-default-apps",
+    "--disable-extensions",
+    "--mute-audio",
 ]
 
 
@@ -64,11 +74,23 @@ def screenshot(url, png, size=(800, 600), budget_ms: int = 6000, timeout: float 
     png = Path(png)
     png.unlink(missing_ok=True)
     prof = tempfile.mkdtemp(prefix="anthroarm-chromium-")
-    cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}", f"--screenshot={png}",
-           f"--window-size={int(size[0])},{int(size[1])}", f"--virtual-time-budget={int(budget_ms)}", url]
+    cmd = [
+        exe,
+        *CHROMIUM_FLAGS,
+        f"--user-data-dir={prof}",
+        f"--screenshot={png}",
+        f"--window-size={int(size[0])},{int(size[1])}",
+        f"--virtual-time-budget={int(budget_ms)}",
+        url,
+    ]
     # own process group: the renderer/GPU children are stopped with the browser
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
-                            start_new_session=True)
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     err = b""
     try:
         _, err = proc.communicate(timeout=timeout)
@@ -79,7 +101,9 @@ def screenshot(url, png, size=(800, 600), budget_ms: int = 6000, timeout: float 
         remove_profile(prof)
     if not png.is_file():
         tail = (err or b"").decode("utf-8", "replace").strip().splitlines()[-3:]
-        raise RuntimeError(f"chromium wrote no screenshot (exit {proc.returncode}): {' | '.join(tail)}")
+        raise RuntimeError(
+            f"chromium wrote no screenshot (exit {proc.returncode}): {' | '.join(tail)}"
+        )
     return png
 
 
@@ -106,11 +130,21 @@ def live_tab(url, size=(800, 600)):
         url = Path(url).resolve().as_uri()
     prof = tempfile.mkdtemp(prefix="anthroarm-chromium-")
     try:
-        proc = subprocess.Popen([exe, *CHROMIUM_FLAGS, f"--user-data-dir={prof}",
-                                 f"--window-size={int(size[0])},{int(size[1])}", "--remote-debugging-port=0",
-                                 "--remote-debugging-address=127.0.0.1", url],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
-                                start_new_session=True)
+        proc = subprocess.Popen(
+            [
+                exe,
+                *CHROMIUM_FLAGS,
+                f"--user-data-dir={prof}",
+                f"--window-size={int(size[0])},{int(size[1])}",
+                "--remote-debugging-port=0",
+                "--remote-debugging-address=127.0.0.1",
+                url,
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
     except BaseException:
         remove_profile(prof)
         raise
@@ -150,7 +184,10 @@ class DevTools:
         while page is None:
             with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=10) as r:
                 targets = json.loads(r.read().decode())
-            page = next((t for t in targets if t.get("type") == "page" and t.get("webSocketDebuggerUrl")), None)
+            page = next(
+                (t for t in targets if t.get("type") == "page" and t.get("webSocketDebuggerUrl")),
+                None,
+            )
             if page is None:
                 if time.monotonic() > deadline:
                     raise RuntimeError("chromium shows no page to drive")
@@ -159,7 +196,9 @@ class DevTools:
         self._loop = asyncio.new_event_loop()
 
         async def connect():
-            return await websocket_connect(page["webSocketDebuggerUrl"], max_message_size=64 * 2**20)
+            return await websocket_connect(
+                page["webSocketDebuggerUrl"], max_message_size=64 * 2**20
+            )
 
         self._conn = self._loop.run_until_complete(asyncio.wait_for(connect(), self.timeout))
         self._id = 0
@@ -170,6 +209,7 @@ class DevTools:
 
         self._id += 1
         mid = self._id
+
         async def read():
             return await self._conn.read_message()
 
@@ -186,9 +226,13 @@ class DevTools:
 
     def evaluate(self, expression: str):
         """The JSON value of a JavaScript expression in the page (RuntimeError if it throws)."""
-        r = self.call("Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True)
+        r = self.call(
+            "Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True
+        )
         if "exceptionDetails" in r:
-            raise RuntimeError(f"the page threw: {r['exceptionDetails'].get('exception', {}).get('description', r['exceptionDetails'])}")
+            raise RuntimeError(
+                f"the page threw: {r['exceptionDetails'].get('exception', {}).get('description', r['exceptionDetails'])}"
+            )
         return r.get("result", {}).get("value")
 
     def wait_for(self, expression: str, timeout: float = 30.0):
@@ -208,12 +252,34 @@ class DevTools:
         x0, y0 = (float(c) for c in start)
         x1, y1 = (float(c) for c in end)
         self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x0, y=y0)
-        self.call("Input.dispatchMouseEvent", type="mousePressed", x=x0, y=y0, button="left", buttons=1, clickCount=1)
+        self.call(
+            "Input.dispatchMouseEvent",
+            type="mousePressed",
+            x=x0,
+            y=y0,
+            button="left",
+            buttons=1,
+            clickCount=1,
+        )
         for k in range(1, steps + 1):
             t = k / steps
-            self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x0 + t * (x1 - x0), y=y0 + t * (y1 - y0),
-                      button="left", buttons=1)
-        self.call("Input.dispatchMouseEvent", type="mouseReleased", x=x1, y=y1, button="left", buttons=1, clickCount=1)
+            self.call(
+                "Input.dispatchMouseEvent",
+                type="mouseMoved",
+                x=x0 + t * (x1 - x0),
+                y=y0 + t * (y1 - y0),
+                button="left",
+                buttons=1,
+            )
+        self.call(
+            "Input.dispatchMouseEvent",
+            type="mouseReleased",
+            x=x1,
+            y=y1,
+            button="left",
+            buttons=1,
+            clickCount=1,
+        )
 
     def close(self) -> None:
         with contextlib.suppress(Exception):

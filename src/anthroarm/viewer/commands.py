@@ -22,17 +22,26 @@ def add_parser(sub):
         "teach",
         help="joint sliders that move a model in the browser (like RTB's teach), or the same page as HTML",
         description="Show a catalog model, an example-robot-data robot or a URDF file with one slider per joint "
-                    "(degrees within the joint limits, continuous joints ±180°, mimic joints follow) on a meshcat "
-                    "page served on 127.0.0.1, or write it as a self-contained HTML file.  Angles of --q are "
-                    "radians unless --deg.",
+        "(degrees within the joint limits, continuous joints ±180°, mimic joints follow) on a meshcat "
+        "page served on 127.0.0.1, or write it as a self-contained HTML file.  Angles of --q are "
+        "radians unless --deg.",
         epilog="examples:\n  anthroarm teach human_arm7\n  anthroarm teach panda --html panda_teach.html",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     cli._add_model_arguments(p)
-    p.add_argument("--q", nargs="+", type=float, metavar="Q", help="starting joint values, one per joint")
+    p.add_argument(
+        "--q", nargs="+", type=float, metavar="Q", help="starting joint values, one per joint"
+    )
     p.add_argument("--deg", action="store_true", help="--q is in degrees")
-    p.add_argument("--limits", action="store_true", help="colour links by joint-limit proximity (at the start)")
-    p.add_argument("--style", choices=["auto", "generated", "urdf"], default="auto", help="visuals (default auto)")
+    p.add_argument(
+        "--limits", action="store_true", help="colour links by joint-limit proximity (at the start)"
+    )
+    p.add_argument(
+        "--style",
+        choices=["auto", "generated", "urdf"],
+        default="auto",
+        help="visuals (default auto)",
+    )
     cli._add_live_options(p)
     p.set_defaults(func=cmd_teach)
     return p
@@ -44,7 +53,9 @@ def cmd_teach(a) -> int:
 
     out = cli._check_html_path(a.html)
     cli._check_port_early(a)
-    robot = cli._load_model(a.model, cli._parse_params(a.param, a.model, a), a.tool, cli._parse_locked(a.locked))
+    robot = cli._load_model(
+        a.model, cli._parse_params(a.param, a.model, a), a.tool, cli._parse_locked(a.locked)
+    )
     q = cli._parse_q(robot, a.q, a.deg)
     v = Viewer(robot, live=out is None, port=a.port, style=a.style, q=q)
     if a.limits:

@@ -37,11 +37,13 @@ REACH_POSTURES_DEG = {
 @dataclass
 class DemoResult:
     robot: object
-    Q: np.ndarray                 # (N, nq) joint trajectory, rad
-    dt: float                     # s between rows
-    targets: list                 # [(name, 4x4 target pose)]
-    errors: list = field(default_factory=list)  # [(name, position error m, rotation error rad)] at each hold end
-    method: str = ""              # "qp/<solver>"
+    Q: np.ndarray  # (N, nq) joint trajectory, rad
+    dt: float  # s between rows
+    targets: list  # [(name, 4x4 target pose)]
+    errors: list = field(
+        default_factory=list
+    )  # [(name, position error m, rotation error rad)] at each hold end
+    method: str = ""  # "qp/<solver>"
 
 
 @contextlib.contextmanager
@@ -82,7 +84,9 @@ def interpolate_pose(T0: np.ndarray, T1: np.ndarray, s: float) -> np.ndarray:
 def pose_error(robot, q, T) -> tuple[float, float]:
     """(position error m, rotation angle error rad) of the tool at ``q`` against ``T``."""
     F = robot.fk(q)
-    return float(np.linalg.norm(F[:3, 3] - T[:3, 3])), float(np.linalg.norm(pin.log3(F[:3, :3].T @ T[:3, :3])))
+    return float(np.linalg.norm(F[:3, 3] - T[:3, 3])), float(
+        np.linalg.norm(pin.log3(F[:3, :3].T @ T[:3, :3]))
+    )
 
 
 # ----------------------------------------------------------------------------- IK stepper
@@ -94,7 +98,9 @@ class QPStepper:
 
         self.qp = qp
         self.conf = qp.IKConfiguration(robot, q0)
-        self.ee = qp.FrameTask(robot, position_cost=1.0, orientation_cost=orientation_cost, lm_damping=1e-3)
+        self.ee = qp.FrameTask(
+            robot, position_cost=1.0, orientation_cost=orientation_cost, lm_damping=1e-3
+        )
         self.post = qp.PostureTask(robot, cost=1e-3)
         self.post.set_target(np.clip(robot.neutral(), robot.lower, robot.upper))
         self.solver = solver
@@ -108,8 +114,16 @@ class QPStepper:
 
 
 # ----------------------------------------------------------------------------- the demo
-def reach_demo(robot=None, postures_deg=None, move_time: float = 1.4, hold_time: float = 0.5, dt: float = 0.02,
-               method: str = "qp", solver: str = "osqp", progress=None) -> DemoResult:
+def reach_demo(
+    robot=None,
+    postures_deg=None,
+    move_time: float = 1.4,
+    hold_time: float = 0.5,
+    dt: float = 0.02,
+    method: str = "qp",
+    solver: str = "osqp",
+    progress=None,
+) -> DemoResult:
     """Simulate the human arm reaching for each posture's hand pose in turn, by QP
     differential IK (``method`` "qp"; "auto" is the same).
 
@@ -120,7 +134,9 @@ def reach_demo(robot=None, postures_deg=None, move_time: float = 1.4, hold_time:
     robot = robot if robot is not None else load("human_arm7")
     postures = postures_deg if postures_deg is not None else REACH_POSTURES_DEG
     if method not in ("qp", "auto"):
-        raise ValueError(f"method must be 'qp' (QP differential IK, anthroarm.ik.qp), got {method!r}")
+        raise ValueError(
+            f"method must be 'qp' (QP differential IK, anthroarm.ik.qp), got {method!r}"
+        )
     if not (dt > 0 and move_time > 0 and hold_time >= 0):
         raise ValueError("dt and move_time must be > 0 and hold_time >= 0")
     targets = []

@@ -55,8 +55,10 @@ def _check_port(port) -> int | None:
     if port is None:
         return None
     if isinstance(port, bool) or not isinstance(port, numbers.Integral):
-        raise ParameterError(f"port must be an integer in 1..65535 (or None for the first free port from 7000), "
-                             f"got {port!r} of type {type(port).__name__}")
+        raise ParameterError(
+            f"port must be an integer in 1..65535 (or None for the first free port from 7000), "
+            f"got {port!r} of type {type(port).__name__}"
+        )
     if not 1 <= int(port) <= 65535:
         raise ParameterError(f"port must be an integer in 1..65535, got {port!r}")
     return int(port)
@@ -65,7 +67,9 @@ def _check_port(port) -> int | None:
 def _check_seconds(value, name: str = "timeout") -> float:
     """A finite number of seconds in (0, MAX_WAIT]; ParameterError (TypeError/ValueError) otherwise."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError(f"{name} must be a number of seconds, got {value!r} of type {type(value).__name__}")
+        raise ParameterError(
+            f"{name} must be a number of seconds, got {value!r} of type {type(value).__name__}"
+        )
     v = float(value)
     if not (math.isfinite(v) and 0 < v <= MAX_WAIT):
         raise ParameterError(f"{name} must be finite, > 0 and <= {MAX_WAIT:g} s, got {value!r}")
@@ -74,7 +78,9 @@ def _check_seconds(value, name: str = "timeout") -> float:
 
 def _check_tabs(n) -> int:
     if isinstance(n, bool) or not isinstance(n, numbers.Integral):
-        raise ParameterError(f"n (browser tabs) must be an integer in 1..{MAX_TABS}, got {n!r} of type {type(n).__name__}")
+        raise ParameterError(
+            f"n (browser tabs) must be an integer in 1..{MAX_TABS}, got {n!r} of type {type(n).__name__}"
+        )
     if not 1 <= int(n) <= MAX_TABS:
         raise ParameterError(f"n (browser tabs) must be an integer in 1..{MAX_TABS}, got {n!r}")
     return int(n)
@@ -123,8 +129,13 @@ class ServerProcess:
         if port is not None:
             args += ["--port", str(port)]
         self.secret = secrets.token_hex(32).encode("ascii")
-        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.PIPE,
-                                     start_new_session=True)
+        self.proc = subprocess.Popen(
+            args,
+            stdout=subprocess.PIPE,
+            stderr=self._log,
+            stdin=subprocess.PIPE,
+            start_new_session=True,
+        )
         self._finalizer = weakref.finalize(self, _stop, self.proc, self._log)
         atexit.register(self._finalizer)
         try:  # the secret travels through the pipe: not in argv or the environment (ps, /proc)
@@ -253,5 +264,7 @@ class ServerProcess:
 
 
 def _in_use_message(port) -> str:
-    return (f"port {port} on 127.0.0.1 is already in use (another viewer or program); "
-            f"choose a free one with --port / port=, or leave it unset to pick the first free port from 7000")
+    return (
+        f"port {port} on 127.0.0.1 is already in use (another viewer or program); "
+        f"choose a free one with --port / port=, or leave it unset to pick the first free port from 7000"
+    )

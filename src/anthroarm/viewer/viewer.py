@@ -32,12 +32,20 @@ from meshcat.commands import SetObject, SetProperty
 from meshcat.path import Path as MeshcatPath
 from meshcat.visualizer import Visualizer
 
+from .._io import atomic_write_text
 from ..errors import ParameterError, ViewerError
 from ..spatial.rotations import homogeneous, rotation_between
-from .._io import atomic_write_text
 from ._store import SceneStore
-
-from .visuals import LINK_RGB, MESH_TRIANGLES, Body, Piece, _y_to, cylinder_between, rgb_hex, robot_bodies
+from .visuals import (
+    LINK_RGB,
+    MESH_TRIANGLES,
+    Body,
+    Piece,
+    _y_to,
+    cylinder_between,
+    rgb_hex,
+    robot_bodies,
+)
 
 ROOT = "/meshcat/anthroarm"
 #: Colour of a joint at its limit (joint-limit proximity).
@@ -51,10 +59,16 @@ def _safe(name: str) -> str:
 
 
 def _set_transform(path: str, T: np.ndarray) -> dict:
-    return {"type": "set_transform", "path": path, "matrix": np.asarray(T, float).T.ravel().tolist()}
+    return {
+        "type": "set_transform",
+        "path": path,
+        "matrix": np.asarray(T, float).T.ravel().tolist(),
+    }
 
 
-def _set_object(path: str, geometry, rgb=(0.7, 0.7, 0.7), opacity: float = 1.0, material=None) -> dict:
+def _set_object(
+    path: str, geometry, rgb=(0.7, 0.7, 0.7), opacity: float = 1.0, material=None
+) -> dict:
     if material is None:
         kw = {"color": rgb_hex(rgb)}
         if opacity < 1.0:
@@ -91,9 +105,17 @@ def _check_background(background):
     """``None`` or ((r, g, b), (r, g, b)) with 0..255 components -> two lists of ints."""
     if background is None:
         return None
-    if isinstance(background, (str, bytes)) or not hasattr(background, "__len__") or len(background) != 2:
-        raise ParameterError(f"background must be ((r, g, b), (r, g, b)) in 0..255 (top, bottom), got {background!r}")
-    return _rgb255(background[0], "background top colour"), _rgb255(background[1], "background bottom colour")
+    if (
+        isinstance(background, (str, bytes))
+        or not hasattr(background, "__len__")
+        or len(background) != 2
+    ):
+        raise ParameterError(
+            f"background must be ((r, g, b), (r, g, b)) in 0..255 (top, bottom), got {background!r}"
+        )
+    return _rgb255(background[0], "background top colour"), _rgb255(
+        background[1], "background bottom colour"
+    )
 
 
 def limit_proximity(q, lower, upper) -> np.ndarray:
@@ -143,11 +165,15 @@ def colormap_rgb(values, colormap: str = "viridis", vmin=None, vmax=None):
 
     v = np.asarray(values, dtype=float)
     if v.ndim != 1 or not np.all(np.isfinite(v)):
-        raise ParameterError(f"values must be a 1-D array of finite numbers, got shape {v.shape}"
-                             + ("" if v.ndim != 1 else " with NaN or inf"))
+        raise ParameterError(
+            f"values must be a 1-D array of finite numbers, got shape {v.shape}"
+            + ("" if v.ndim != 1 else " with NaN or inf")
+        )
     if not isinstance(colormap, str) or colormap not in colormaps:
-        raise ParameterError(f"colormap must be a matplotlib colour map name (viridis, viridis_r, plasma, "
-                             f"coolwarm, ...), got {colormap!r}")
+        raise ParameterError(
+            f"colormap must be a matplotlib colour map name (viridis, viridis_r, plasma, "
+            f"coolwarm, ...), got {colormap!r}"
+        )
     lo = float(v.min()) if vmin is None and v.size else (0.0 if vmin is None else float(vmin))
     hi = float(v.max()) if vmax is None and v.size else (1.0 if vmax is None else float(vmax))
     if not (math.isfinite(lo) and math.isfinite(hi) and hi >= lo):
@@ -165,8 +191,10 @@ def _rgb01(value, n: int, what: str) -> np.ndarray:
     if c.shape == (3,):
         c = np.tile(c, (n, 1))
     if c.shape != (n, 3) or not np.all(np.isfinite(c)) or np.any((c < 0) | (c > 1)):
-        raise ParameterError(f"{what} must be one colour (r, g, b) or ({n}, 3) colours, components in 0..1, "
-                             f"got shape {np.shape(value)}")
+        raise ParameterError(
+            f"{what} must be one colour (r, g, b) or ({n}, 3) colours, components in 0..1, "
+            f"got shape {np.shape(value)}"
+        )
     return c
 
 
@@ -174,11 +202,15 @@ def _points3(points, what: str, min_rows: int = 1) -> np.ndarray:
     try:
         P = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(f"{what} must be an (N, 3) array of numbers (m, base frame), got {type(points).__name__}") from None
+        raise ParameterError(
+            f"{what} must be an (N, 3) array of numbers (m, base frame), got {type(points).__name__}"
+        ) from None
     if P.shape == (3,):
         P = P[None]
     if P.ndim != 2 or P.shape[1] != 3 or len(P) < min_rows:
-        raise ParameterError(f"{what} must be an (N>={min_rows}, 3) array (m, base frame), got shape {P.shape}")
+        raise ParameterError(
+            f"{what} must be an (N>={min_rows}, 3) array (m, base frame), got shape {P.shape}"
+        )
     if not np.all(np.isfinite(P)):
         bad = int(np.argmax(~np.isfinite(P).all(axis=1)))
         raise ParameterError(f"{what} contain NaN or inf (row {bad})")
@@ -217,8 +249,8 @@ def arrow_mesh(origins, vectors, radius, colors, head_length=None, segments: int
         R = rotation_between((0.0, 0.0, 1.0), d)
         ex, ey = R[:, 0], R[:, 1]
         hl = min(head_length if head_length is not None else 3.5 * radius, 0.5 * L)
-        rim = ring[:, :1] * ex + ring[:, 1:] * ey          # (s, 3) unit radial directions
-        a, b = o, o + (L - hl) * d                          # shaft
+        rim = ring[:, :1] * ex + ring[:, 1:] * ey  # (s, 3) unit radial directions
+        a, b = o, o + (L - hl) * d  # shaft
         tip = o + v
         # shaft: 2s vertices with radial normals
         vs = np.concatenate([a + radius * rim, b + radius * rim])
@@ -235,7 +267,9 @@ def arrow_mesh(origins, vectors, radius, colors, head_length=None, segments: int
         base = count
         k = np.arange(segments)
         k1 = (k + 1) % segments
-        f_shaft = np.concatenate([np.stack([k, k1, segments + k1], 1), np.stack([k, segments + k1, segments + k], 1)])
+        f_shaft = np.concatenate(
+            [np.stack([k, k1, segments + k1], 1), np.stack([k, segments + k1, segments + k], 1)]
+        )
         f_cone = np.stack([k, k1, segments + k], 1) + 2 * segments
         f_base = np.stack([np.full(segments, segments), k1, k], 1) + 4 * segments
         faces.append(np.concatenate([f_shaft, f_cone, f_base]) + base)
@@ -246,7 +280,9 @@ def arrow_mesh(origins, vectors, radius, colors, head_length=None, segments: int
         count += len(vv)
     if not verts:
         return None
-    return _ShadedMesh(np.concatenate(verts), np.concatenate(faces), np.concatenate(norms), np.concatenate(cols))
+    return _ShadedMesh(
+        np.concatenate(verts), np.concatenate(faces), np.concatenate(norms), np.concatenate(cols)
+    )
 
 
 class _SceneWindow:
@@ -274,8 +310,10 @@ class _SceneWindow:
         return self._viewer.static_html()
 
     def get_image(self):
-        raise ViewerError("image capture is not supported by the anthroarm viewer; use "
-                          "anthroarm.viewer.browser.screenshot on export_html()")
+        raise ViewerError(
+            "image capture is not supported by the anthroarm viewer; use "
+            "anthroarm.viewer.browser.screenshot on export_html()"
+        )
 
     def close(self) -> None:
         self._viewer.close()
@@ -300,15 +338,20 @@ class Scene(Visualizer):
         keeps looking at the orbit target, the world origin (where the Viewer puts the centre
         of the robot's reach)."""
         x, y, z = (float(c) for c in _points3(position, "camera position")[0])
-        self.window.send(SetProperty("position", [x, z, -y], MeshcatPath(("Cameras", "default", "rotated", "<object>"))))
+        self.window.send(
+            SetProperty(
+                "position", [x, z, -y], MeshcatPath(("Cameras", "default", "rotated", "<object>"))
+            )
+        )
 
     def __repr__(self) -> str:
         return f"<anthroarm Scene at {self.path.lower()} of {self.window._viewer!r}>"
 
 
-
 def _box_corners(lo, hi) -> np.ndarray:
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])], float)
+    return np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])], float
+    )
 
 
 def local_corners(g) -> np.ndarray | None:
@@ -340,17 +383,21 @@ def colormap_legend(title: str, colormap: str, vmin: float, vmax: float, n: int 
 
     stops = np.asarray(colormaps[colormap](np.linspace(0.0, 1.0, n)))[:, :3]
     ticks = [f"{v:.3g}" for v in (vmin, 0.5 * (vmin + vmax), vmax)]
-    return {"kind": "legend", "title": str(title), "stops": [[round(float(c), 4) for c in rgb] for rgb in stops],
-            "ticks": ticks}
+    return {
+        "kind": "legend",
+        "title": str(title),
+        "stops": [[round(float(c), 4) for c in rgb] for rgb in stops],
+        "ticks": ticks,
+    }
 
 
 def nice_length(x: float) -> float:
     """The largest of 1, 2, 5 × 10^k metres not above ``x`` (> 0): grid spacings, scale bars."""
     k = math.floor(math.log10(x))
     for m in (5.0, 2.0, 1.0):
-        if m * 10.0 ** k <= x * (1 + 1e-9):
-            return m * 10.0 ** k
-    return 10.0 ** k  # pragma: no cover - unreachable
+        if m * 10.0**k <= x * (1 + 1e-9):
+            return m * 10.0**k
+    return 10.0**k  # pragma: no cover - unreachable
 
 
 def format_length(x: float) -> str:
@@ -361,7 +408,9 @@ def format_length(x: float) -> str:
     return f"{x * 1000:.3g} mm"
 
 
-def framing_distance(corners, direction, fill: float = 0.85, fov_deg: float = 75.0, aspect: float = 4 / 3) -> float:
+def framing_distance(
+    corners, direction, fill: float = 0.85, fov_deg: float = 75.0, aspect: float = 4 / 3
+) -> float:
     """Camera distance from the orbit target (the origin) along the unit ``direction`` at which
     every point of ``corners`` (K, 3; relative to the target) projects inside ``fill`` of the
     vertical field of view ``fov_deg`` and of the horizontal one (width / height = ``aspect``);
@@ -417,15 +466,29 @@ class Viewer:
         file stays small (Franka Panda: 15.0 MB → 1.49 MB).  ``None`` sends the files as they are.
     """
 
-    def __init__(self, robot, *, live: bool = False, port: int | None = None, style: str = "auto",
-                 q=None, name: str | None = None, background=None, grid: bool = True, axes: bool = True,
-                 scale_bar: bool = True, mesh_triangles: int | None = MESH_TRIANGLES):
+    def __init__(
+        self,
+        robot,
+        *,
+        live: bool = False,
+        port: int | None = None,
+        style: str = "auto",
+        q=None,
+        name: str | None = None,
+        background=None,
+        grid: bool = True,
+        axes: bool = True,
+        scale_bar: bool = True,
+        mesh_triangles: int | None = MESH_TRIANGLES,
+    ):
         from ..robot import Robot, load
 
         if isinstance(robot, (str, Path)):
             robot = load(robot)
         if not isinstance(robot, Robot):
-            raise ParameterError(f"Viewer takes a Robot (aa.load(...)) or a model name / URDF path, got {type(robot).__name__}")
+            raise ParameterError(
+                f"Viewer takes a Robot (aa.load(...)) or a model name / URDF path, got {type(robot).__name__}"
+            )
         background = _check_background(background)
         self.robot = robot
         self.store = SceneStore()
@@ -435,7 +498,9 @@ class Viewer:
 
             port = _check_port(port)  # a bad port is a ParameterError before any work
         self.root = f"{ROOT}/{_safe(name or robot.name)}"
-        self.bodies: list[Body] = robot_bodies(robot, style, mesh_triangles)   # MeshError etc. before a server starts
+        self.bodies: list[Body] = robot_bodies(
+            robot, style, mesh_triangles
+        )  # MeshError etc. before a server starts
         if live:
             from .server import ServerProcess
 
@@ -446,7 +511,7 @@ class Viewer:
         self._joint_lower = np.array([j.lower for j in joints])
         self._joint_upper = np.array([j.upper for j in joints])
         self._limits_on = False
-        self._joint_rgb: list | None = None   # show_joint_values: one colour per chain joint
+        self._joint_rgb: list | None = None  # show_joint_values: one colour per chain joint
         self._teaching = False
         self._animating = False
         self._colors: dict[str, tuple] = {}
@@ -493,10 +558,12 @@ class Viewer:
                 pts.extend(np.array(data.oMf[f].translation) for f in tips)
             return np.asarray(pts + [np.zeros(3)])
 
-        reach = points(robot.random_q(128, rng=0))        # the workspace: sizes and the floor
+        reach = points(robot.random_q(128, rng=0))  # the workspace: sizes and the floor
         lo, hi = reach.min(0), reach.max(0)
         mid = 0.5 * (lo + hi)
-        self.radius = float(max(np.linalg.norm(reach - mid, axis=1).max(), 0.1 * robot.length_scale, 1e-3))
+        self.radius = float(
+            max(np.linalg.norm(reach - mid, axis=1).max(), 0.1 * robot.length_scale, 1e-3)
+        )
         # the framing: the robot as first displayed (its drawn pieces, joints and tips)
         pose = np.vstack([points(self.q[None]), self._piece_corners(self.q)])
         blo, bhi = pose.min(0), pose.max(0)
@@ -505,13 +572,19 @@ class Viewer:
         self._frame_box = _box_corners(blo, bhi) - self.center
         cmds = [_set_transform(self.root, homogeneous(r=-self.center))]
         self.floor = floor = min(0.0, float(lo[2])) - 0.01  # base frame
-        cmds.append(_set_property("/Grid", "visible", False))     # meshcat's 20 m grid: ours fits the robot
+        cmds.append(
+            _set_property("/Grid", "visible", False)
+        )  # meshcat's 20 m grid: ours fits the robot
         cmds.append(_set_property("/Axes", "visible", False))
         # a translucent floor disc under the reach (always drawn; robust in software WebGL)
         rf = 0.9 * self.radius
         disc = mg.Cylinder(0.004 * rf, rf)
         cmds.append(_set_object(f"{self.root}/floor", disc, (0.80, 0.83, 0.88), 0.4))
-        cmds.append(_set_transform(f"{self.root}/floor", homogeneous(_y_to([0, 0, 1]), [mid[0], mid[1], floor])))
+        cmds.append(
+            _set_transform(
+                f"{self.root}/floor", homogeneous(_y_to([0, 0, 1]), [mid[0], mid[1], floor])
+            )
+        )
         if background is None:
             cmds.append(_set_property("/Background", "visible", False))
         else:
@@ -532,8 +605,15 @@ class Viewer:
         pin.framesForwardKinematics(model, data, q)
         out = [np.zeros((0, 3))]
         for b in self.bodies:
-            M = np.eye(4) if b.joint is None and b.frame is None else (
-                data.oMi[b.joint + 1].homogeneous if b.joint is not None else data.oMf[b.frame].homogeneous)
+            M = (
+                np.eye(4)
+                if b.joint is None and b.frame is None
+                else (
+                    data.oMi[b.joint + 1].homogeneous
+                    if b.joint is not None
+                    else data.oMf[b.frame].homogeneous
+                )
+            )
             for pc in b.pieces:
                 c = local_corners(pc.geometry)
                 if c is not None:
@@ -550,22 +630,39 @@ class Viewer:
         n1 = np.ceil((mid[:2] + rf) / sp).astype(int)
         xs, ys = sp * np.arange(n0[0], n1[0] + 1), sp * np.arange(n0[1], n1[1] + 1)
         z = self.floor + 0.002 * rf
-        segs = [[(x, ys[0], z), (x, ys[-1], z)] for x in xs] + [[(xs[0], y, z), (xs[-1], y, z)] for y in ys]
+        segs = [[(x, ys[0], z), (x, ys[-1], z)] for x in xs] + [
+            [(xs[0], y, z), (xs[-1], y, z)] for y in ys
+        ]
         P = np.asarray(segs, np.float32).reshape(-1, 3)
-        grid = mg.LineSegments(mg.PointsGeometry(P.T), mg.LineBasicMaterial(color=0x7d8899, opacity=0.6, transparent=True))
+        grid = mg.LineSegments(
+            mg.PointsGeometry(P.T),
+            mg.LineBasicMaterial(color=0x7D8899, opacity=0.6, transparent=True),
+        )
         cmds = [_set_object(f"{self.root}/grid", grid)]
         size = 0.15 * self.radius
         for k, piece in enumerate(self._triad(size, 0.04 * size)):
             path = f"{self.root}/axes/{k}"
-            cmds += [_set_object(path, piece.geometry, piece.rgb), _set_transform(path, piece.offset)]
+            cmds += [
+                _set_object(path, piece.geometry, piece.rgb),
+                _set_transform(path, piece.offset),
+            ]
         # the scale bar: `spacing` long, alternating dark and light fifths, at the grid's front-left
-        corner = self._frame_box.max(0)[:2] + self.center[:2]    # on the camera's side of the robot, on grid lines
-        a = np.array([sp * (np.floor(corner[0] / sp) - 1), sp * np.floor(corner[1] / sp), z + 0.006 * rf])
+        corner = (
+            self._frame_box.max(0)[:2] + self.center[:2]
+        )  # on the camera's side of the robot, on grid lines
+        a = np.array(
+            [sp * (np.floor(corner[0] / sp) - 1), sp * np.floor(corner[1] / sp), z + 0.006 * rf]
+        )
         for k in range(5):
             p0, p1 = a + [k * sp / 5, 0, 0], a + [(k + 1) * sp / 5, 0, 0]
-            for piece in cylinder_between(p0, p1, 0.012 * rf, (0.1, 0.1, 0.12) if k % 2 == 0 else (0.97, 0.97, 0.97)):
+            for piece in cylinder_between(
+                p0, p1, 0.012 * rf, (0.1, 0.1, 0.12) if k % 2 == 0 else (0.97, 0.97, 0.97)
+            ):
                 path = f"{self.root}/scale/{k}"
-                cmds += [_set_object(path, piece.geometry, piece.rgb), _set_transform(path, piece.offset)]
+                cmds += [
+                    _set_object(path, piece.geometry, piece.rgb),
+                    _set_transform(path, piece.offset),
+                ]
         self._send(cmds)
 
     def _ui(self, path: str, spec: dict) -> dict:
@@ -584,14 +681,27 @@ class Viewer:
         cmds = [_set_property(f"{self.root}/scale", "visible", bool(visible))]
         note = f"{self.root}/ui/scale"
         if visible:
-            cmds.append(self._ui(note, {"kind": "note", "text": f"scale bar and grid squares: {format_length(self.spacing)}"}))
+            cmds.append(
+                self._ui(
+                    note,
+                    {
+                        "kind": "note",
+                        "text": f"scale bar and grid squares: {format_length(self.spacing)}",
+                    },
+                )
+            )
         else:
             cmds.append(_delete(note))
         self._send(cmds)
 
     # ------------------------------------------------------------------ scene settings
-    def set_camera(self, direction=(0.9, 1.0, 0.45), distance: float | None = None, fill: float = 0.85,
-                   fit: str = "pose") -> None:
+    def set_camera(
+        self,
+        direction=(0.9, 1.0, 0.45),
+        distance: float | None = None,
+        fill: float = 0.85,
+        fit: str = "pose",
+    ) -> None:
         """Look at the robot from ``direction`` (base-frame axes) at ``distance`` m.
 
         The default distance frames ``fit``: ``"pose"``, the box around the robot as displayed
@@ -606,7 +716,7 @@ class Viewer:
         d = d / np.linalg.norm(d)
         if not (0.1 <= float(fill) <= 1.0):
             raise ValueError(f"fill must be in [0.1, 1], got {fill!r}")
-        if fit == "pose":   # the robot as displayed now, about the fixed orbit target
+        if fit == "pose":  # the robot as displayed now, about the fixed orbit target
             c = self._piece_corners(self.q)
             box = _box_corners(c.min(0), c.max(0)) - self.center if len(c) else self._frame_box
         else:
@@ -640,17 +750,25 @@ class Viewer:
         """(path, Pinocchio joint id or None, frame id or None) of every moving body; rebuilt
         when the overlays change."""
         if self._movers is None:
-            self._movers = [(self._bpath(b, prefix), None if b.joint is None else b.joint + 1, b.frame)
-                            for b, prefix in self._all_bodies() if b.joint is not None or b.frame is not None]
+            self._movers = [
+                (self._bpath(b, prefix), None if b.joint is None else b.joint + 1, b.frame)
+                for b, prefix in self._all_bodies()
+                if b.joint is not None or b.frame is not None
+            ]
         return self._movers
 
     def _pose_commands(self, q) -> list[dict]:
         model, data = self.robot.model, self.robot.data
         pin.framesForwardKinematics(model, data, q)
         oMi, oMf = data.oMi, data.oMf
-        return [{"type": "set_transform", "path": path,
-                 "matrix": (oMi[j] if j is not None else oMf[f]).homogeneous.T.ravel().tolist()}
-                for path, j, f in self._moving()]
+        return [
+            {
+                "type": "set_transform",
+                "path": path,
+                "matrix": (oMi[j] if j is not None else oMf[f]).homogeneous.T.ravel().tolist(),
+            }
+            for path, j, f in self._moving()
+        ]
 
     def _color_commands(self, q) -> list[dict]:
         """Recolour links and joint centres: with :meth:`show_limits`, links by the largest
@@ -659,8 +777,12 @@ class Viewer:
         unbounded joints are never coloured); with :meth:`show_joint_values`, each body's links
         by the value of the joint that moves it.  Only colours that changed since the last call
         are sent (None: the original colours)."""
-        if not self._limits_on and self._joint_rgb is None and not any(c is not None for c in self._colors.values()):
-            return []          # nothing coloured, nothing to restore: the common case of display()
+        if (
+            not self._limits_on
+            and self._joint_rgb is None
+            and not any(c is not None for c in self._colors.values())
+        ):
+            return []  # nothing coloured, nothing to restore: the common case of display()
         prox = None
         if self._limits_on:
             prox = limit_proximity(self.robot.chain.angles(q), self._joint_lower, self._joint_upper)
@@ -683,9 +805,15 @@ class Viewer:
                     groups.append(("joint", [b.limit_joint]))
                 for group, idx in groups:
                     base = next(p.rgb for p in b.pieces if p.group == group)
-                    want[f"{bp}/{group}"] = tuple(round(c, 3) for c in limit_color(float(prox[idx].max()), base))
+                    want[f"{bp}/{group}"] = tuple(
+                        round(c, 3) for c in limit_color(float(prox[idx].max()), base)
+                    )
             elif self._joint_rgb is not None and link_group in has:
-                j = b.joint if b.joint is not None else (frames[b.frame].joint if b.frame is not None else -1)
+                j = (
+                    b.joint
+                    if b.joint is not None
+                    else (frames[b.frame].joint if b.frame is not None else -1)
+                )
                 if j >= 0:
                     want[f"{bp}/{link_group}"] = self._joint_rgb[j]
         cmds = []
@@ -709,14 +837,21 @@ class Viewer:
         every changed link colour) in one message."""
         q = self.robot.check_q(q, "q")
         if q.ndim != 1:
-            raise ValueError(f"{self.robot.name}: display takes one configuration ({self.robot.nq},), got {q.shape}; use play() for a trajectory")
+            raise ValueError(
+                f"{self.robot.name}: display takes one configuration ({self.robot.nq},), got {q.shape}; use play() for a trajectory"
+            )
         self.q = q.copy()
         stop = [self._stop_command()] if self._animating else []
         self._animating = False
         self._send(stop + self._pose_commands(q) + self._color_commands(q))
 
     def _stop_command(self) -> dict:
-        return {"type": "set_animation", "path": "", "animations": [], "options": {"play": False, "repetitions": 1}}
+        return {
+            "type": "set_animation",
+            "path": "",
+            "animations": [],
+            "options": {"play": False, "repetitions": 1},
+        }
 
     def stop(self) -> None:
         """Stop and forget the animation set by :meth:`play` (``display`` does this too)."""
@@ -728,23 +863,35 @@ class Viewer:
         with a colour legend; joints without limits (continuous joints) are skipped.
         ``on=False`` restores the colours and removes the legend."""
         self._limits_on = bool(on)
-        if self._limits_on and self._joint_rgb is not None:   # one colouring at a time
+        if self._limits_on and self._joint_rgb is not None:  # one colouring at a time
             self._joint_rgb = None
             self._send([_delete(f"{self.root}/ui/joint_values")])
         legend = f"{self.root}/ui/limits"
         if self._limits_on:
             x = np.linspace(0.0, 1.0, 11)
-            spec = {"kind": "legend", "title": "joint-limit proximity (0: mid-range, 1: at a limit)",
-                    "stops": [list(limit_color(v)) for v in x], "ticks": ["0", "0.5", "1"]}
+            spec = {
+                "kind": "legend",
+                "title": "joint-limit proximity (0: mid-range, 1: at a limit)",
+                "stops": [list(limit_color(v)) for v in x],
+                "ticks": ["0", "0.5", "1"],
+            }
             cmds = [self._ui(legend, spec)]
         else:
             cmds = [_delete(legend)]
-        if self._teaching:   # the sliders recolour as they move (or stop doing so)
+        if self._teaching:  # the sliders recolour as they move (or stop doing so)
             cmds.append(self._ui(f"{self.root}/ui/teach", self._teach_spec()))
         self._send(self._color_commands(self.q) + cmds)
 
-    def show_joint_values(self, values, label: str = "joint torque |τ| (N·m)", *, colormap: str = "plasma",
-                          vmin=None, vmax=None, absolute: bool = True) -> dict:
+    def show_joint_values(
+        self,
+        values,
+        label: str = "joint torque |τ| (N·m)",
+        *,
+        colormap: str = "plasma",
+        vmin=None,
+        vmax=None,
+        absolute: bool = True,
+    ) -> dict:
         """Colour each body's links by a value of the joint that moves it (joint torques from
         :mod:`anthroarm.dynamics`, loads, effort ratios ...), with a colour legend.
 
@@ -785,16 +932,25 @@ class Viewer:
         chain = self.robot.chain
         v = np.asarray(values, dtype=float) if np.ndim(values) else np.array([np.nan])
         if v.ndim == 1 and len(v) == self.robot.nv and len(v) != len(chain.joints):
-            v = np.array([v[(chain.joints[j.mimic.source] if j.mimic else j).idx_v] for j in chain.joints])
+            v = np.array(
+                [v[(chain.joints[j.mimic.source] if j.mimic else j).idx_v] for j in chain.joints]
+            )
         if v.shape != (len(chain.joints),):
-            raise ParameterError(f"values must have one number per joint ({len(chain.joints)}) or per velocity "
-                                 f"({self.robot.nv}), got shape {np.shape(values)}")
+            raise ParameterError(
+                f"values must have one number per joint ({len(chain.joints)}) or per velocity "
+                f"({self.robot.nv}), got shape {np.shape(values)}"
+            )
         v = np.abs(v) if absolute else v
         rgb, lo, hi = colormap_rgb(v, colormap, vmin, vmax)
         self._limits_on = False
         self._joint_rgb = [tuple(round(float(c), 3) for c in row) for row in rgb]
-        self._send(self._color_commands(self.q) + [_delete(f"{self.root}/ui/limits"),
-                                                  self._ui(legend, colormap_legend(label, colormap, lo, hi))])
+        self._send(
+            self._color_commands(self.q)
+            + [
+                _delete(f"{self.root}/ui/limits"),
+                self._ui(legend, colormap_legend(label, colormap, lo, hi)),
+            ]
+        )
         return {"values": v, "colors": rgb, "vmin": lo, "vmax": hi}
 
     # ------------------------------------------------------------------ overlays
@@ -832,7 +988,11 @@ class Viewer:
             for j in robot.chain.joints:
                 bodies.append(Body(j.name, self._triad(size), joint=j.index))
         else:
-            names = [robot.tool] if frames is None else ([frames] if isinstance(frames, str) else list(frames))
+            names = (
+                [robot.tool]
+                if frames is None
+                else ([frames] if isinstance(frames, str) else list(frames))
+            )
             for f in names:
                 bodies.append(Body(str(f), self._triad(size), frame=robot.frame_id(f)))
         key = _safe(name)
@@ -842,7 +1002,9 @@ class Viewer:
         self._send(self._body_objects(bodies, f"overlays/{key}"))
         self.display(self.q)
 
-    def show_target(self, T, name: str = "target", size: float | None = None, rgb=(0.95, 0.55, 0.05)) -> None:
+    def show_target(
+        self, T, name: str = "target", size: float | None = None, rgb=(0.95, 0.55, 0.05)
+    ) -> None:
         """An IK target: a translucent ball and a triad at ``T`` (4×4 pose, or a 3-vector
         position), in the robot's base frame, metres."""
         T = np.asarray(T, float)
@@ -852,14 +1014,26 @@ class Viewer:
             raise ValueError(f"target must be a finite 4x4 pose or a 3-vector, got shape {T.shape}")
         size = size if size is not None else 0.1 * self.radius
         path = self._overlay_path(name)
-        cmds = [_delete(path), _set_transform(path, T),
-                _set_object(f"{path}/ball", mg.Sphere(0.35 * size), rgb, 0.45)]
+        cmds = [
+            _delete(path),
+            _set_transform(path, T),
+            _set_object(f"{path}/ball", mg.Sphere(0.35 * size), rgb, 0.45),
+        ]
         for k, p in enumerate(self._triad(size, 0.05 * size)):
-            cmds += [_set_object(f"{path}/triad/{k}", p.geometry, p.rgb), _set_transform(f"{path}/triad/{k}", p.offset)]
+            cmds += [
+                _set_object(f"{path}/triad/{k}", p.geometry, p.rgb),
+                _set_transform(f"{path}/triad/{k}", p.offset),
+            ]
         self._send(cmds)
 
-    def show_trace(self, points, name: str = "trace", rgb=(0.80, 0.25, 0.60), radius: float | None = None,
-                   configurations: bool | None = None) -> np.ndarray:
+    def show_trace(
+        self,
+        points,
+        name: str = "trace",
+        rgb=(0.80, 0.25, 0.60),
+        radius: float | None = None,
+        configurations: bool | None = None,
+    ) -> np.ndarray:
         """A polyline through ``points`` (N, 3) in the base frame, or through the tool positions
         of a joint trajectory (N, nq) (``configurations=True``; guessed from the shape when
         None).  Drawn as thin cylinders so it is visible at any zoom.  Returns the (N, 3) points."""
@@ -869,7 +1043,9 @@ class Viewer:
         if configurations:
             P = self.robot.fk(self.robot.check_q(P, "trajectory"))[:, :3, 3]
         if P.ndim != 2 or P.shape[1] != 3 or len(P) < 2:
-            raise ValueError(f"trace needs (N>=2, 3) points or (N, {self.robot.nq}) configurations, got shape {P.shape}")
+            raise ValueError(
+                f"trace needs (N>=2, 3) points or (N, {self.robot.nq}) configurations, got shape {P.shape}"
+            )
         if not np.all(np.isfinite(P)):
             raise ValueError("trace points contain NaN or inf")
         r = radius if radius is not None else 0.005 * self.radius
@@ -880,12 +1056,21 @@ class Viewer:
         Pk = P[idx]
         for k in range(len(Pk) - 1):
             for p in cylinder_between(Pk[k], Pk[k + 1], r, rgb, "trace"):
-                cmds += [_set_object(f"{path}/{k}", p.geometry, p.rgb), _set_transform(f"{path}/{k}", p.offset)]
+                cmds += [
+                    _set_object(f"{path}/{k}", p.geometry, p.rgb),
+                    _set_transform(f"{path}/{k}", p.offset),
+                ]
         self._send(cmds)
         return P
 
-    def show_workspace(self, n: int = 4000, rng=0, frame=None, name: str = "workspace",
-                       point_size: float | None = None) -> dict:
+    def show_workspace(
+        self,
+        n: int = 4000,
+        rng=0,
+        frame=None,
+        name: str = "workspace",
+        point_size: float | None = None,
+    ) -> dict:
         """The reachable workspace of ``frame`` (default tool) as a point cloud of ``n`` random
         configurations inside the limits, coloured by translational manipulability
         (:func:`manipulability`; viridis, yellow = most dexterous), with its colour legend.
@@ -897,12 +1082,31 @@ class Viewer:
         w = manipulability(self.robot, Q, frame)
         top = float(w.max()) if w.size and w.max() > 0 else 1.0
         unit = f"m{'²³'[min(3, self.robot.nv) - 2]}" if self.robot.nv >= 2 else "m"
-        self.show_points(P, values=w, colormap="viridis", vmin=0.0, vmax=top, size=point_size, name=name,
-                         label=f"manipulability ({unit}; yellow = most dexterous)")
+        self.show_points(
+            P,
+            values=w,
+            colormap="viridis",
+            vmin=0.0,
+            vmax=top,
+            size=point_size,
+            name=name,
+            label=f"manipulability ({unit}; yellow = most dexterous)",
+        )
         return {"points": P, "manipulability": w}
 
-    def show_points(self, points, colors=None, *, values=None, colormap: str = "viridis", vmin=None, vmax=None,
-                    size: float | None = None, name: str = "points", label: str | None = None) -> dict:
+    def show_points(
+        self,
+        points,
+        colors=None,
+        *,
+        values=None,
+        colormap: str = "viridis",
+        vmin=None,
+        vmax=None,
+        size: float | None = None,
+        name: str = "points",
+        label: str | None = None,
+    ) -> dict:
         """A 3-D point cloud (reachability and comfort maps, markers, sampled positions).
 
         Parameters
@@ -944,7 +1148,9 @@ class Viewer:
                 raise ParameterError("give colors or values (with a colormap), not both")
             v = np.asarray(values, dtype=float) if np.ndim(values) else np.array([np.nan])
             if v.shape != (len(P),):
-                raise ParameterError(f"values must have one number per point ({len(P)}), got shape {np.shape(values)}")
+                raise ParameterError(
+                    f"values must have one number per point ({len(P)}), got shape {np.shape(values)}"
+                )
             C, lo, hi = colormap_rgb(v, colormap, vmin, vmax)
         else:
             C = _rgb01((0.95, 0.55, 0.05) if colors is None else colors, len(P), "colors")
@@ -953,11 +1159,20 @@ class Viewer:
         path = self._overlay_path(name)
         self._send([_delete(path), _set_object(path, cloud)])
         if values is not None:
-            self._send([self._ui(f"{path}/legend", colormap_legend(label or name, colormap, lo, hi))])
+            self._send(
+                [self._ui(f"{path}/legend", colormap_legend(label or name, colormap, lo, hi))]
+            )
         return {"points": P, "colors": C, "vmin": lo, "vmax": hi}
 
-    def show_map(self, result, var: str | None = None, *, colormap: str | None = None, size: float | None = None,
-                 name: str | None = None) -> dict:
+    def show_map(
+        self,
+        result,
+        var: str | None = None,
+        *,
+        colormap: str | None = None,
+        size: float | None = None,
+        name: str | None = None,
+    ) -> dict:
         """A voxel map of :mod:`anthroarm.batch` as a 3-D point cloud with its colour legend: one
         point at the centre of every reached voxel, coloured by its value.
 
@@ -991,25 +1206,49 @@ class Viewer:
         job = getattr(result, "job", None)
         variables = getattr(result, "variables", None)
         if not isinstance(variables, dict):
-            raise ParameterError(f"show_map takes an anthroarm.batch result (reachability_map, comfort_map), "
-                                 f"got {type(result).__name__}")
+            raise ParameterError(
+                f"show_map takes an anthroarm.batch result (reachability_map, comfort_map), "
+                f"got {type(result).__name__}"
+            )
         var = var or _MAPS.get(job)
         if var is None or var not in variables or tuple(result.dims(var)) != ("x", "y", "z"):
-            raise ParameterError(f"{job}: no voxel map {var!r} to draw; voxel maps: "
-                                 f"{[k for k in variables if tuple(result.dims(k)) == ('x', 'y', 'z')]}")
+            raise ParameterError(
+                f"{job}: no voxel map {var!r} to draw; voxel maps: "
+                f"{[k for k in variables if tuple(result.dims(k)) == ('x', 'y', 'z')]}"
+            )
         P, vals = occupied_points(result, var)
         if len(P) == 0:
             raise ParameterError(f"{job}: the map {var!r} has no reached voxel to draw")
         voxel = float(result.attrs.get("voxel", 0.0)) or None
         cmap = colormap or ("viridis_r" if var == "discomfort" else "viridis")
-        note = " (configurations per voxel)" if var == "counts" else " (0 = comfortable)" if var == "discomfort" else ""
-        out = self.show_points(P, values=np.asarray(vals, float), colormap=cmap, size=size or voxel,
-                               name=name or job or var, label=f"{job}: {var}{note}")
+        note = (
+            " (configurations per voxel)"
+            if var == "counts"
+            else " (0 = comfortable)"
+            if var == "discomfort"
+            else ""
+        )
+        out = self.show_points(
+            P,
+            values=np.asarray(vals, float),
+            colormap=cmap,
+            size=size or voxel,
+            name=name or job or var,
+            label=f"{job}: {var}{note}",
+        )
         out["values"] = np.asarray(vals, float)
         return out
 
-    def show_arrows(self, origins, directions, colors=None, *, scale: float = 1.0, radius: float | None = None,
-                    name: str = "arrows") -> np.ndarray:
+    def show_arrows(
+        self,
+        origins,
+        directions,
+        colors=None,
+        *,
+        scale: float = 1.0,
+        radius: float | None = None,
+        name: str = "arrows",
+    ) -> np.ndarray:
         """Arrows (contact normals, forces, velocities) from ``origins`` along ``directions``.
 
         Parameters
@@ -1042,7 +1281,9 @@ class Viewer:
         O = _points3(origins, "origins")
         D = _points3(directions, "directions")
         if D.shape != O.shape:
-            raise ParameterError(f"origins and directions must have the same shape, got {O.shape} and {D.shape}")
+            raise ParameterError(
+                f"origins and directions must have the same shape, got {O.shape} and {D.shape}"
+            )
         scale = self._length(scale, 1.0, "scale")
         r = self._length(radius, 0.006 * self.radius, "radius")
         C = _rgb01((0.85, 0.10, 0.10) if colors is None else colors, len(O), "colors")
@@ -1097,53 +1338,116 @@ class Viewer:
         joints, sliders = [], []
         for j in chain.joints:
             m = j.mimic
-            joints.append({"parent": int(j.parent), "kind": j.kind, "axis": [float(a) for a in j.axis],
-                           "placement": [float(x) for x in j.placement.ravel()],
-                           "src": -1 if m is None else int(m.source),
-                           "mult": 1.0 if m is None else float(m.multiplier), "off": 0.0 if m is None else float(m.offset)})
+            joints.append(
+                {
+                    "parent": int(j.parent),
+                    "kind": j.kind,
+                    "axis": [float(a) for a in j.axis],
+                    "placement": [float(x) for x in j.placement.ravel()],
+                    "src": -1 if m is None else int(m.source),
+                    "mult": 1.0 if m is None else float(m.multiplier),
+                    "off": 0.0 if m is None else float(m.offset),
+                }
+            )
             if m is not None:
                 continue
             if j.kind == "prismatic":
-                lo, hi = (j.lower, j.upper) if np.isfinite(j.lower) and np.isfinite(j.upper) else (
-                    -0.5 * self.robot.length_scale, 0.5 * self.robot.length_scale)
+                lo, hi = (
+                    (j.lower, j.upper)
+                    if np.isfinite(j.lower) and np.isfinite(j.upper)
+                    else (-0.5 * self.robot.length_scale, 0.5 * self.robot.length_scale)
+                )
                 scale, unit, lo, hi, value = 1e-3, "mm", 1e3 * lo, 1e3 * hi, 1e3 * theta[j.index]
             else:
-                lo, hi = (j.lower, j.upper) if (j.kind != "continuous" and np.isfinite(j.lower)
-                                                and np.isfinite(j.upper) and j.upper - j.lower <= 2 * math.pi + 1e-9) \
+                lo, hi = (
+                    (j.lower, j.upper)
+                    if (
+                        j.kind != "continuous"
+                        and np.isfinite(j.lower)
+                        and np.isfinite(j.upper)
+                        and j.upper - j.lower <= 2 * math.pi + 1e-9
+                    )
                     else (-math.pi, math.pi)
-                scale, unit, lo, hi, value = math.pi / 180, "°", math.degrees(lo), math.degrees(hi), math.degrees(theta[j.index])
+                )
+                scale, unit, lo, hi, value = (
+                    math.pi / 180,
+                    "°",
+                    math.degrees(lo),
+                    math.degrees(hi),
+                    math.degrees(theta[j.index]),
+                )
             # on the slider's own grid (min + k·step, step 0.1): the browser snaps a value to it
             lo, hi = math.ceil(lo * 10 - 1e-6) / 10, math.floor(hi * 10 + 1e-6) / 10
             value = min(max(round(value * 10) / 10, lo), hi)
-            sliders.append({"joint": int(j.index), "name": j.name, "min": lo, "max": hi,
-                            "step": 0.1, "value": value, "unit": unit, "scale": scale, "digits": 1})
-            theta[j.index] = value * scale   # the page starts where its sliders are
+            sliders.append(
+                {
+                    "joint": int(j.index),
+                    "name": j.name,
+                    "min": lo,
+                    "max": hi,
+                    "step": 0.1,
+                    "value": value,
+                    "unit": unit,
+                    "scale": scale,
+                    "digits": 1,
+                }
+            )
+            theta[j.index] = value * scale  # the page starts where its sliders are
         movers = []
         for path, jid, fid in self._moving():
             if jid is not None:
                 movers.append({"path": path, "joint": jid - 1})
             else:
                 f = chain.frames[fid]
-                movers.append({"path": path, "joint": int(f.joint), "offset": [float(x) for x in f.placement.ravel()]})
+                movers.append(
+                    {
+                        "path": path,
+                        "joint": int(f.joint),
+                        "offset": [float(x) for x in f.placement.ravel()],
+                    }
+                )
         tool = chain.frames[self.robot.tool_id]
         limits = None
-        if self._limits_on:   # the page recolours like _color_commands: same groups, same blend
+        if self._limits_on:  # the page recolours like _color_commands: same groups, same blend
             groups = []
             for b in self.bodies:
                 has = {pc.group for pc in b.pieces}
                 link_group = "links" if "links" in has else "mesh"
-                for group, idx in ((link_group, b.link_joints), ("joint", [b.limit_joint] if b.limit_joint is not None else [])):
+                for group, idx in (
+                    (link_group, b.link_joints),
+                    ("joint", [b.limit_joint] if b.limit_joint is not None else []),
+                ):
                     if idx and group in has:
                         base = next(pc.rgb for pc in b.pieces if pc.group == group)
-                        groups.append({"path": f"{self._bpath(b)}/{group}", "joints": [int(i) for i in idx],
-                                       "base": [float(c) for c in base]})
-            fin = lambda x: float(x) if np.isfinite(x) else None   # noqa: E731 - msgpack has no inf
-            limits = {"lower": [fin(x) for x in self._joint_lower], "upper": [fin(x) for x in self._joint_upper],
-                      "warn": LIMIT_WARN, "red": list(LIMIT_RGB), "groups": groups}
-        return {"kind": "teach", "title": f"{self.robot.name}: joints", "theta": [float(t) for t in theta],
-                "joints": joints, "sliders": sliders, "movers": movers,
-                "tool": {"name": tool.name, "joint": int(tool.joint), "offset": [float(x) for x in tool.placement.ravel()]},
-                "limits": limits}
+                        groups.append(
+                            {
+                                "path": f"{self._bpath(b)}/{group}",
+                                "joints": [int(i) for i in idx],
+                                "base": [float(c) for c in base],
+                            }
+                        )
+            fin = lambda x: float(x) if np.isfinite(x) else None  # noqa: E731 - msgpack has no inf
+            limits = {
+                "lower": [fin(x) for x in self._joint_lower],
+                "upper": [fin(x) for x in self._joint_upper],
+                "warn": LIMIT_WARN,
+                "red": list(LIMIT_RGB),
+                "groups": groups,
+            }
+        return {
+            "kind": "teach",
+            "title": f"{self.robot.name}: joints",
+            "theta": [float(t) for t in theta],
+            "joints": joints,
+            "sliders": sliders,
+            "movers": movers,
+            "tool": {
+                "name": tool.name,
+                "joint": int(tool.joint),
+                "offset": [float(x) for x in tool.placement.ravel()],
+            },
+            "limits": limits,
+        }
 
     # ------------------------------------------------------------------ animation
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
@@ -1151,7 +1455,9 @@ class Viewer:
         animation (also stored in :meth:`static_html`).  ``trace`` draws the tool path."""
         Q = self.robot.check_q(Q, "Q")
         if Q.ndim != 2 or len(Q) < 2:
-            raise ValueError(f"play needs a trajectory of shape (N>=2, {self.robot.nq}), got {Q.shape}")
+            raise ValueError(
+                f"play needs a trajectory of shape (N>=2, {self.robot.nq}), got {Q.shape}"
+            )
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError(f"dt must be positive and finite, got {dt}")
         if trace:
@@ -1165,12 +1471,26 @@ class Viewer:
                 pos, rot = tracks.setdefault(cmd["path"], ([], []))
                 pos.append({"time": k, "value": M[:3, 3].tolist()})
                 rot.append({"time": k, "value": [float(c) for c in quat]})
-        anims = [{"path": path, "clip": {"fps": fps, "name": "default", "tracks": [
-            {"name": ".position", "type": "vector3", "keys": pos},
-            {"name": ".quaternion", "type": "quaternion", "keys": rot}]}}
-            for path, (pos, rot) in tracks.items()]
-        cmd = {"type": "set_animation", "path": "", "animations": anims,
-               "options": {"play": True, "repetitions": float("inf") if loop else 1}}
+        anims = [
+            {
+                "path": path,
+                "clip": {
+                    "fps": fps,
+                    "name": "default",
+                    "tracks": [
+                        {"name": ".position", "type": "vector3", "keys": pos},
+                        {"name": ".quaternion", "type": "quaternion", "keys": rot},
+                    ],
+                },
+            }
+            for path, (pos, rot) in tracks.items()
+        ]
+        cmd = {
+            "type": "set_animation",
+            "path": "",
+            "animations": anims,
+            "options": {"play": True, "repetitions": float("inf") if loop else 1},
+        }
         self.display(Q[0])
         self._send([cmd])
         self._animating = True
@@ -1213,7 +1533,9 @@ class Viewer:
     def open(self) -> "Viewer":
         """Open the live scene in the default web browser."""
         if self.server is None:
-            raise RuntimeError("this viewer is not live; create it with live=True, or use export_html()")
+            raise RuntimeError(
+                "this viewer is not live; create it with live=True, or use export_html()"
+            )
         import webbrowser
 
         webbrowser.open(self.url, new=2)
@@ -1232,8 +1554,10 @@ class Viewer:
             src = f'src="{self.url}"'
         else:
             src = f'srcdoc="{_html.escape(self.static_html(), quote=True)}"'
-        return (f'<div style="height: {int(height)}px; width: 100%; overflow: hidden; resize: both">'
-                f'<iframe {src} style="width: 100%; height: 100%; border: none"></iframe></div>')
+        return (
+            f'<div style="height: {int(height)}px; width: 100%; overflow: hidden; resize: both">'
+            f'<iframe {src} style="width: 100%; height: 100%; border: none"></iframe></div>'
+        )
 
     def jupyter_cell(self, height: int = 420):
         """Inline view for Jupyter: the live page when live, else a static snapshot that works

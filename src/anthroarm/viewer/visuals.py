@@ -95,7 +95,9 @@ def cylinder_between(a, b, radius, rgb, group="links", opacity=1.0) -> list[Piec
     L = float(np.linalg.norm(b - a))
     if L < 1e-9:
         return []
-    return [Piece(mg.Cylinder(L, radius), rgb, homogeneous(_y_to(b - a), (a + b) / 2), group, opacity)]
+    return [
+        Piece(mg.Cylinder(L, radius), rgb, homogeneous(_y_to(b - a), (a + b) / 2), group, opacity)
+    ]
 
 
 def capsule(a, b, radius, rgb=LINK_RGB, group="links") -> list[Piece]:
@@ -103,7 +105,10 @@ def capsule(a, b, radius, rgb=LINK_RGB, group="links") -> list[Piece]:
     out = cylinder_between(a, b, radius, rgb, group)
     if not out:
         return []
-    return out + [Piece(mg.Sphere(radius), rgb, homogeneous(r=a), group), Piece(mg.Sphere(radius), rgb, homogeneous(r=b), group)]
+    return out + [
+        Piece(mg.Sphere(radius), rgb, homogeneous(r=a), group),
+        Piece(mg.Sphere(radius), rgb, homogeneous(r=b), group),
+    ]
 
 
 # ---------------------------------------------------------------------- generated skeleton
@@ -144,10 +149,17 @@ def skeleton_bodies(robot) -> list[Body]:
     for t in ends[-1]:
         for a, b in _segments(t, np.array([0.0, 0.0, 1.0])):
             base += capsule(a, b, r)
-    if robot.spec is not None and robot.spec.person:   # the limb of a person
+    if robot.spec is not None and robot.spec.person:  # the limb of a person
         base += _torso(robot, r)
     else:
-        base.append(Piece(mg.Cylinder(0.6 * r, 2.2 * r), TORSO_RGB, homogeneous(_y_to([0, 0, 1]), [0, 0, -0.3 * r]), "base"))
+        base.append(
+            Piece(
+                mg.Cylinder(0.6 * r, 2.2 * r),
+                TORSO_RGB,
+                homogeneous(_y_to([0, 0, 1]), [0, 0, -0.3 * r]),
+                "base",
+            )
+        )
     bodies: list[Body] = [Body("base", base)]
     by_joint: dict[int, Body] = {-1: bodies[0]}
 
@@ -172,8 +184,12 @@ def skeleton_bodies(robot) -> list[Body]:
         own = j.index if _bounded(j) else None
         link_joints = pending.get(j.parent, []) + ([own] if own is not None else [])
         if not any(p.group == "links" for p in pieces):
-            pending[j.index] = link_joints  # nothing to colour here: hand the joint on to the next link
-        body = by_joint[j.index] = Body(j.name, pieces, joint=j.index, limit_joint=own, link_joints=link_joints)
+            pending[j.index] = (
+                link_joints  # nothing to colour here: hand the joint on to the next link
+            )
+        body = by_joint[j.index] = Body(
+            j.name, pieces, joint=j.index, limit_joint=own, link_joints=link_joints
+        )
         bodies.append(body)
     return bodies
 
@@ -199,10 +215,26 @@ def _torso(robot, r) -> list[Piece]:
     scale with the arm's length L (shoulder to midline ≈ 0.3 L ≈ 0.19 m for a 1.75 m man)."""
     L = robot.length_scale
     w = 0.3 * L
-    pieces = [Piece(mg.Ellipsoid([0.9 * w, 0.5 * w, 0.5 * L]), TORSO_RGB, homogeneous(r=[-w, 0.0, -0.42 * L]), "torso")]
-    pieces += capsule([-0.12 * w, 0.0, -0.03 * L], [-1.88 * w, 0.0, -0.03 * L], 0.8 * r, TORSO_RGB, "torso")
+    pieces = [
+        Piece(
+            mg.Ellipsoid([0.9 * w, 0.5 * w, 0.5 * L]),
+            TORSO_RGB,
+            homogeneous(r=[-w, 0.0, -0.42 * L]),
+            "torso",
+        )
+    ]
+    pieces += capsule(
+        [-0.12 * w, 0.0, -0.03 * L], [-1.88 * w, 0.0, -0.03 * L], 0.8 * r, TORSO_RGB, "torso"
+    )
     pieces += cylinder_between([-w, 0.0, 0.0], [-w, 0.0, 0.12 * L], 0.22 * w, SKIN_RGB, "torso")
-    pieces.append(Piece(mg.Ellipsoid([0.33 * w, 0.38 * w, 0.45 * w]), SKIN_RGB, homogeneous(r=[-w, 0.02 * L, 0.25 * L]), "torso"))
+    pieces.append(
+        Piece(
+            mg.Ellipsoid([0.33 * w, 0.38 * w, 0.45 * w]),
+            SKIN_RGB,
+            homogeneous(r=[-w, 0.02 * L, 0.25 * L]),
+            "torso",
+        )
+    )
     return pieces
 
 
@@ -229,15 +261,19 @@ def urdf_bodies(robot, max_triangles: int | None = None) -> list[Body]:
     from ..urdf_io import resolve_uri
 
     info = robot.info
-    root = etree.fromstring(info.text.encode(), etree.XMLParser(resolve_entities=False, no_network=True,
-                                                                load_dtd=False, remove_comments=True))
+    root = etree.fromstring(
+        info.text.encode(),
+        etree.XMLParser(
+            resolve_entities=False, no_network=True, load_dtd=False, remove_comments=True
+        ),
+    )
     named_colors = {}
     for m in root.findall("material"):
         c = m.find("color")
         if c is not None and m.get("name"):
             named_colors[m.get("name")] = _floats(c.get("rgba"), 4, (0.7, 0.7, 0.7, 1))
     links = {}
-    for f in robot.chain.frames:          # the link's body frame (a joint may share its name)
+    for f in robot.chain.frames:  # the link's body frame (a joint may share its name)
         if f.is_body:
             links.setdefault(f.name, f)
     bodies: list[Body] = []
@@ -268,8 +304,11 @@ def urdf_bodies(robot, max_triangles: int | None = None) -> list[Body]:
                 path = info.meshes.get(uri) or resolve_uri(uri, info.path, info.package_dirs)
                 path = Path(path)
                 if not path.is_file():
-                    raise MeshNotFoundError(info.path, f"link {name!r}: mesh {uri!r} resolved to {path}, which does not "
-                                                       f"exist; pass package_dirs={{...}} to aa.load")
+                    raise MeshNotFoundError(
+                        info.path,
+                        f"link {name!r}: mesh {uri!r} resolved to {path}, which does not "
+                        f"exist; pass package_dirs={{...}} to aa.load",
+                    )
                 scale = _floats(shape.get("scale"), 3, (1, 1, 1))
                 if path not in mesh_cache:
                     mesh_cache[path] = load_mesh(path, link=name, max_triangles=max_triangles)
@@ -285,9 +324,15 @@ def urdf_bodies(robot, max_triangles: int | None = None) -> list[Body]:
                 geom = mg.Sphere(float(shape.get("radius", 0.05)))
             else:
                 continue
-            pieces.append(Piece(geom, tuple(rgba[:3]), offset, "mesh", float(rgba[3]) if len(rgba) > 3 else 1.0))
+            pieces.append(
+                Piece(
+                    geom, tuple(rgba[:3]), offset, "mesh", float(rgba[3]) if len(rgba) > 3 else 1.0
+                )
+            )
         if pieces:
-            bodies.append(Body(name, pieces, frame=frame.index, **_limit_kw(robot.chain, frame.joint)))
+            bodies.append(
+                Body(name, pieces, frame=frame.index, **_limit_kw(robot.chain, frame.joint))
+            )
     return bodies
 
 
@@ -313,7 +358,9 @@ def geometry_bodies(robot, max_triangles: int | None = None) -> list[Body]:
     by_joint: dict[int, list[Piece]] = {}
     mesh_cache: dict[Path, object] = {}
     for go in robot.visual_model.geometryObjects:
-        by_joint.setdefault(int(go.parentJoint) - 1, []).extend(_geometry_pieces(go, mesh_cache, max_triangles))
+        by_joint.setdefault(int(go.parentJoint) - 1, []).extend(
+            _geometry_pieces(go, mesh_cache, max_triangles)
+        )
     bodies = []
     for j, pieces in sorted(by_joint.items()):
         if not pieces:
@@ -337,7 +384,7 @@ def _geometry_pieces(go, mesh_cache, max_triangles=None) -> list[Piece]:
     M = np.asarray(go.placement.homogeneous)
     rgba = np.asarray(go.meshColor, float)
     rgb, opacity = tuple(rgba[:3]), float(rgba[3])
-    z_to_y = homogeneous(_y_to([0, 0, 1]))   # coal's round shapes are along z, meshcat's along y
+    z_to_y = homogeneous(_y_to([0, 0, 1]))  # coal's round shapes are along z, meshcat's along y
     path = Path(go.meshPath) if go.meshPath else None
     if path is not None and path.is_file():
         if path not in mesh_cache:
@@ -352,11 +399,16 @@ def _geometry_pieces(go, mesh_cache, max_triangles=None) -> list[Piece]:
         geom, offset = mg.Ellipsoid(np.asarray(g.radii, float)), M
     elif kind == "Cylinder":
         geom, offset = mg.Cylinder(2 * g.halfLength, g.radius), M @ z_to_y
-    elif kind == "Cone":   # apex at +z
-        geom, offset = mg.Cylinder(2 * g.halfLength, radiusTop=0.0, radiusBottom=g.radius), M @ z_to_y
+    elif kind == "Cone":  # apex at +z
+        geom, offset = (
+            mg.Cylinder(2 * g.halfLength, radiusTop=0.0, radiusBottom=g.radius),
+            M @ z_to_y,
+        )
     elif kind == "Capsule":
         h = float(g.halfLength)
-        pieces = capsule([0, 0, -h], [0, 0, h], float(g.radius), rgb, "mesh") or [Piece(mg.Sphere(float(g.radius)), rgb, np.eye(4), "mesh")]
+        pieces = capsule([0, 0, -h], [0, 0, h], float(g.radius), rgb, "mesh") or [
+            Piece(mg.Sphere(float(g.radius)), rgb, np.eye(4), "mesh")
+        ]
         for pc in pieces:
             pc.offset, pc.opacity = M @ pc.offset, opacity
         return pieces
@@ -366,9 +418,11 @@ def _geometry_pieces(go, mesh_cache, max_triangles=None) -> list[Piece]:
     elif kind in _UNBOUNDED_SHAPES:
         return []
     else:
-        raise ViewerError(f"visual geometry {go.name!r} is a {kind} with no mesh file ({go.meshPath!r}); "
-                          "the viewer draws mesh files, triangle meshes, boxes, spheres, ellipsoids, "
-                          "cylinders, cones and capsules")
+        raise ViewerError(
+            f"visual geometry {go.name!r} is a {kind} with no mesh file ({go.meshPath!r}); "
+            "the viewer draws mesh files, triangle meshes, boxes, spheres, ellipsoids, "
+            "cylinders, cones and capsules"
+        )
     return [Piece(geom, rgb, offset, "mesh", opacity)]
 
 
@@ -398,8 +452,12 @@ def load_mesh(path, link: str | None = None, max_triangles: int | None = None):
     if not stat.S_ISREG(st.st_mode):
         raise MeshError(path, "is not a regular file", link)
     if st.st_size > MAX_MESH_BYTES:
-        raise MeshError(path, f"is {st.st_size} bytes, larger than the viewer's bound of {MAX_MESH_BYTES} bytes "
-                              f"(anthroarm.viewer.visuals.MAX_MESH_BYTES); decimate the mesh", link)
+        raise MeshError(
+            path,
+            f"is {st.st_size} bytes, larger than the viewer's bound of {MAX_MESH_BYTES} bytes "
+            f"(anthroarm.viewer.visuals.MAX_MESH_BYTES); decimate the mesh",
+            link,
+        )
     try:
         with open(path, "rb") as f:
             data = f.read(MAX_MESH_BYTES + 1)
@@ -425,7 +483,9 @@ def load_mesh(path, link: str | None = None, max_triangles: int | None = None):
             geom, fmt = _stl_geometry(body), "stl"
         if max_triangles is None:
             return geom
-        return _packed(body, fmt, _check_budget(max_triangles), (str(path), st.st_mtime_ns, st.st_size))
+        return _packed(
+            body, fmt, _check_budget(max_triangles), (str(path), st.st_mtime_ns, st.st_size)
+        )
     except _NotAMesh as exc:
         raise MeshError(path, str(exc), link) from None
 
@@ -445,7 +505,9 @@ class PackedMesh(mg.Geometry):
     def __init__(self, grid: np.ndarray, faces: np.ndarray, placement: np.ndarray):
         super().__init__()
         self.grid = np.ascontiguousarray(grid, dtype=np.uint16)
-        self.faces = np.ascontiguousarray(faces, dtype=np.uint16 if len(self.grid) <= 65536 else np.uint32)
+        self.faces = np.ascontiguousarray(
+            faces, dtype=np.uint16 if len(self.grid) <= 65536 else np.uint32
+        )
         self.placement = np.asarray(placement, float)
 
     @property
@@ -458,20 +520,37 @@ class PackedMesh(mg.Geometry):
 
         def attr(a, size):
             code, name = (20, "Uint16Array") if a.dtype == np.uint16 else (22, "Uint32Array")
-            return {"itemSize": size, "type": name, "array": umsgpack.Ext(code, a.tobytes()), "normalized": False}
+            return {
+                "itemSize": size,
+                "type": name,
+                "array": umsgpack.Ext(code, a.tobytes()),
+                "normalized": False,
+            }
 
-        return {"uuid": self.uuid, "type": "BufferGeometry",
-                "data": {"attributes": {"position": attr(self.grid, 3)}, "index": attr(self.faces.ravel(), 1)}}
+        return {
+            "uuid": self.uuid,
+            "type": "BufferGeometry",
+            "data": {
+                "attributes": {"position": attr(self.grid, 3)},
+                "index": attr(self.faces.ravel(), 1),
+            },
+        }
 
 
 def _check_budget(max_triangles) -> int:
     import numbers
 
-    if isinstance(max_triangles, bool) or not isinstance(max_triangles, numbers.Integral) or int(max_triangles) < 12:
+    if (
+        isinstance(max_triangles, bool)
+        or not isinstance(max_triangles, numbers.Integral)
+        or int(max_triangles) < 12
+    ):
         from ..errors import ParameterError
 
-        raise ParameterError(f"max_triangles (mesh_triangles) must be an integer >= 12 or None (the mesh files "
-                             f"as they are), got {max_triangles!r}")
+        raise ParameterError(
+            f"max_triangles (mesh_triangles) must be an integer >= 12 or None (the mesh files "
+            f"as they are), got {max_triangles!r}"
+        )
     return int(max_triangles)
 
 
@@ -485,7 +564,9 @@ def _cluster(V: np.ndarray, F: np.ndarray, n: int, count_only: bool = False):
     flat = (key[:, 0] * n + key[:, 1]) * n + key[:, 2]
     if count_only:
         G = flat[F]
-        return int(np.count_nonzero((G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2])))
+        return int(
+            np.count_nonzero((G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2]))
+        )
     _, inv = np.unique(flat, return_inverse=True)
     inv = inv.ravel()
     cnt = np.bincount(inv)
@@ -493,7 +574,9 @@ def _cluster(V: np.ndarray, F: np.ndarray, n: int, count_only: bool = False):
     G = inv[F]
     G = G[(G[:, 0] != G[:, 1]) & (G[:, 1] != G[:, 2]) & (G[:, 0] != G[:, 2])]
     if len(G):
-        r = np.argmin(G, 1)   # rotate each triangle to start at its smallest index: repeats become equal rows
+        r = np.argmin(
+            G, 1
+        )  # rotate each triangle to start at its smallest index: repeats become equal rows
         G = np.unique(np.stack([G[np.arange(len(G)), (r + k) % 3] for k in range(3)], 1), axis=0)
     used = np.unique(G)
     remap = np.full(len(W), -1, np.int64)
@@ -511,7 +594,7 @@ def pack_mesh(vertices, faces, max_triangles: int = MESH_TRIANGLES) -> PackedMes
     W, G = _cluster(V, F, 65535)
     if len(G) > max_triangles:
         lo, hi = 2, 4096
-        while lo < hi:           # the finest grid whose surviving triangles fit (they grow with n)
+        while lo < hi:  # the finest grid whose surviving triangles fit (they grow with n)
             mid = (lo + hi + 1) // 2
             if _cluster(V, F, mid, count_only=True) <= max_triangles:
                 lo = mid
@@ -546,10 +629,16 @@ def _packed(body, fmt: str, max_triangles: int, key) -> PackedMesh:
         m = trimesh.load(io.BytesIO(data), file_type=fmt, force="mesh")
         V, F = np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
     except Exception as exc:  # noqa: BLE001 - trimesh/pycollada raise anything
-        raise _NotAMesh(f"cannot be parsed for the viewer ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+        raise _NotAMesh(
+            f"cannot be parsed for the viewer ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})"
+        ) from None
     if len(F) and not np.all(np.isfinite(V)):
         raise _NotAMesh("has non-finite vertex coordinates")
-    packed = pack_mesh(V, F, max_triangles) if len(F) else PackedMesh(np.zeros((1, 3)), np.zeros((0, 3)), np.eye(4))
+    packed = (
+        pack_mesh(V, F, max_triangles)
+        if len(F)
+        else PackedMesh(np.zeros((1, 3)), np.zeros((0, 3)), np.eye(4))
+    )
     if len(_PACKED) >= 64:
         _PACKED.pop(next(iter(_PACKED)))
     _PACKED[k] = packed
@@ -561,8 +650,8 @@ class _NotAMesh(Exception):
 
 
 def _stl_geometry(data: bytes):
-    from meshcat.geometry import threejs_type
     import umsgpack
+    from meshcat.geometry import threejs_type
 
     _, extcode = threejs_type(np.uint8)
     return mg.MeshGeometry(umsgpack.Ext(extcode, bytes(data)), "stl")
@@ -580,24 +669,32 @@ def _check_stl(data: bytes) -> None:
             rec = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
             bad = ~np.isfinite(rec["v"]).all(axis=1)
             if bad.any():
-                raise _NotAMesh(f"is a binary STL with non-finite vertex coordinates (triangle {int(np.argmax(bad))})")
+                raise _NotAMesh(
+                    f"is a binary STL with non-finite vertex coordinates (triangle {int(np.argmax(bad))})"
+                )
             return
     if data.lstrip()[:5].lower() == b"solid":
         _check_ascii_stl(data)
         return
     if n >= 84:
         count = int.from_bytes(data[80:84], "little")
-        raise _NotAMesh(f"is not an STL file: as a binary STL its header promises {count} triangles "
-                        f"({84 + 50 * count} bytes) but the file has {n} bytes (truncated, or not a mesh), "
-                        "and it is not an ASCII STL ('solid ... endsolid')")
-    raise _NotAMesh(f"is not an STL file ({n} bytes: shorter than a binary STL header, and not an ASCII STL)")
+        raise _NotAMesh(
+            f"is not an STL file: as a binary STL its header promises {count} triangles "
+            f"({84 + 50 * count} bytes) but the file has {n} bytes (truncated, or not a mesh), "
+            "and it is not an ASCII STL ('solid ... endsolid')"
+        )
+    raise _NotAMesh(
+        f"is not an STL file ({n} bytes: shorter than a binary STL header, and not an ASCII STL)"
+    )
 
 
 def _check_ascii_stl(data: bytes) -> None:
     try:
         text = data.decode("ascii")
     except UnicodeDecodeError as exc:
-        raise _NotAMesh(f"starts like an ASCII STL but has a non-ASCII byte at offset {exc.start}") from None
+        raise _NotAMesh(
+            f"starts like an ASCII STL but has a non-ASCII byte at offset {exc.start}"
+        ) from None
     facets = 0
     in_loop = 0
     for lineno, line in enumerate(text.splitlines(), 1):
@@ -611,13 +708,17 @@ def _check_ascii_stl(data: bytes) -> None:
             except ValueError:
                 xyz = []
             if len(xyz) != 3 or not all(map(np.isfinite, xyz)):
-                raise _NotAMesh(f"is an ASCII STL with a bad vertex at line {lineno}: {line.strip()[:60]!r}")
+                raise _NotAMesh(
+                    f"is an ASCII STL with a bad vertex at line {lineno}: {line.strip()[:60]!r}"
+                )
             in_loop += 1
         elif key == "outer":
             in_loop = 0
         elif key == "endloop":
             if in_loop != 3:
-                raise _NotAMesh(f"is an ASCII STL with a facet of {in_loop} vertices at line {lineno} (3 expected)")
+                raise _NotAMesh(
+                    f"is an ASCII STL with a facet of {in_loop} vertices at line {lineno} (3 expected)"
+                )
             facets += 1
     if not re.search(r"^\s*endsolid\b", text, re.MULTILINE | re.IGNORECASE):
         raise _NotAMesh("is an ASCII STL without 'endsolid' (truncated)")
@@ -627,8 +728,10 @@ def _utf8(data: bytes, what: str) -> str:
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise _NotAMesh(f"is not UTF-8 text (a {what} file is text): byte {data[exc.start]:#04x} at offset "
-                        f"{exc.start}") from None
+        raise _NotAMesh(
+            f"is not UTF-8 text (a {what} file is text): byte {data[exc.start]:#04x} at offset "
+            f"{exc.start}"
+        ) from None
 
 
 def _check_obj(data: bytes) -> str:
@@ -646,7 +749,9 @@ def _check_obj(data: bytes) -> str:
             except ValueError:
                 xyz = []
             if len(xyz) != 3 or not all(map(np.isfinite, xyz)):
-                raise _NotAMesh(f"is an OBJ with a bad vertex at line {lineno}: {line.strip()[:60]!r}")
+                raise _NotAMesh(
+                    f"is an OBJ with a bad vertex at line {lineno}: {line.strip()[:60]!r}"
+                )
             nv += 1
         elif parts[0] == "f":
             if len(parts) < 4:
@@ -655,10 +760,14 @@ def _check_obj(data: bytes) -> str:
                 try:
                     i = int(tok.split("/")[0])
                 except ValueError:
-                    raise _NotAMesh(f"is an OBJ with a bad face at line {lineno}: {line.strip()[:60]!r}") from None
+                    raise _NotAMesh(
+                        f"is an OBJ with a bad face at line {lineno}: {line.strip()[:60]!r}"
+                    ) from None
                 if not (1 <= i <= nv or -nv <= i <= -1):
-                    raise _NotAMesh(f"is an OBJ whose face at line {lineno} refers to vertex {i}, but {nv} "
-                                    "vertices are defined before it (truncated, or not a mesh)")
+                    raise _NotAMesh(
+                        f"is an OBJ whose face at line {lineno} refers to vertex {i}, but {nv} "
+                        "vertices are defined before it (truncated, or not a mesh)"
+                    )
             faces += 1
     if faces == 0:
         raise _NotAMesh(f"is not an OBJ mesh: no faces ({nv} vertices)")
@@ -669,15 +778,19 @@ def _check_dae(data: bytes) -> str:
     """COLLADA XML without a DTD, with at least one <geometry>; returned as text."""
     from lxml import etree
 
-    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False)
+    parser = etree.XMLParser(
+        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False
+    )
     try:
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
         raise _NotAMesh(f"is not well-formed XML (a COLLADA .dae file is XML): {exc}") from None
     tree = root.getroottree()
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
-        raise _NotAMesh("declares a DTD (<!DOCTYPE ...>); refused: entity declarations can expand without bound "
-                        "or pull in other files")
+        raise _NotAMesh(
+            "declares a DTD (<!DOCTYPE ...>); refused: entity declarations can expand without bound "
+            "or pull in other files"
+        )
     name = etree.QName(root).localname if isinstance(root.tag, str) else str(root.tag)
     if name != "COLLADA":
         raise _NotAMesh(f"is XML but not COLLADA (root element <{name}>)")
@@ -692,8 +805,10 @@ def _check_dae(data: bytes) -> str:
 def _via_trimesh(data: bytes, ext: str) -> bytes:
     """Any other format trimesh reads, as a binary STL."""
     if not ext:
-        raise _NotAMesh("has no file extension; the viewer reads .stl, .obj, .dae and the formats trimesh "
-                        "reads (.ply, .glb, .off, ...)")
+        raise _NotAMesh(
+            "has no file extension; the viewer reads .stl, .obj, .dae and the formats trimesh "
+            "reads (.ply, .glb, .off, ...)"
+        )
     import io
 
     import trimesh
@@ -704,7 +819,9 @@ def _via_trimesh(data: bytes, ext: str) -> bytes:
         finite = bool(np.isfinite(np.asarray(mesh.vertices)).all())
         out = mesh.export(file_type="stl") if faces and finite else b""
     except Exception as exc:  # noqa: BLE001 - trimesh raises anything (NotImplementedError, KeyError, ...)
-        raise _NotAMesh(f"cannot be read as a {ext} mesh ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})") from None
+        raise _NotAMesh(
+            f"cannot be read as a {ext} mesh ({type(exc).__name__}: {' '.join(str(exc).split())[:200]})"
+        ) from None
     if not faces:
         raise _NotAMesh(f"is a {ext} file without triangles")
     if not finite:
@@ -727,17 +844,23 @@ def robot_bodies(robot, style: str = "auto", max_triangles: int | None = None) -
     if style not in STYLES:
         raise ValueError(f"style must be one of {', '.join(map(repr, STYLES))}, got {style!r}")
     if style == "urdf" and robot.info is None:
-        raise ViewerError(f"{robot.name} has no URDF (it was loaded from a pin.Model): use style='auto'")
+        raise ViewerError(
+            f"{robot.name} has no URDF (it was loaded from a pin.Model): use style='auto'"
+        )
     if style == "visual_model" and robot.visual_model is None:
-        raise ViewerError(f"{robot.name} has no visual_model: pass visual_model= to aa.load, or use style='auto'")
-    designed = robot.spec is not None and any(j.link is not None and j.link.shapes is not None for j in robot.spec.joints)
+        raise ViewerError(
+            f"{robot.name} has no visual_model: pass visual_model= to aa.load, or use style='auto'"
+        )
+    designed = robot.spec is not None and any(
+        j.link is not None and j.link.shapes is not None for j in robot.spec.joints
+    )
     if style == "generated" or (style == "auto" and robot.spec is not None and not designed):
         return skeleton_bodies(robot)
     bodies = []
     if style in ("auto", "urdf") and robot.info is not None:
         bodies = urdf_bodies(robot, max_triangles)
-        if bodies and designed and robot.spec.person:   # the limb of a person: the torso for context
+        if bodies and designed and robot.spec.person:  # the limb of a person: the torso for context
             bodies.insert(0, Body("torso", _torso(robot, link_radius(robot))))
     elif style in ("auto", "visual_model") and robot.visual_model is not None:
         bodies = geometry_bodies(robot, max_triangles)
-    return bodies or skeleton_bodies(robot)   # no visual geometry at all: the skeleton
+    return bodies or skeleton_bodies(robot)  # no visual geometry at all: the skeleton

@@ -9,16 +9,44 @@ n-D: :func:`fletcher_reeves` (4-26)–(4-47), :func:`steepest_descent`, :func:`s
 """
 
 from .conjugate_gradient import fletcher_reeves, numerical_gradient, steepest_descent
-from .golden import GOLDEN, bracket_minimum, golden_points_needed, golden_section, unimodality_violation
-from .quadratic import (line_minimize, quadratic_coefficients, quadratic_interpolation, quadratic_step,
-                        quadratic_step_equal)
+from .golden import (
+    GOLDEN,
+    bracket_minimum,
+    golden_points_needed,
+    golden_section,
+    unimodality_violation,
+)
+from .quadratic import (
+    line_minimize,
+    quadratic_coefficients,
+    quadratic_interpolation,
+    quadratic_step,
+    quadratic_step_equal,
+)
 from .result import OptimizeResult
 from .simplex import simplex_book
 from .sumt import bounds_to_ineq, find_feasible, sumt_exterior, sumt_interior, sumt_mixed, violation
 
 __all__ = [
-    "GOLDEN", "OptimizeResult", "bounds_to_ineq", "bracket_minimum", "find_feasible", "fletcher_reeves",
-    "golden_points_needed", "golden_section", "line_minimize", "numerical_gradient", "quadratic_coefficients",
-    "quadratic_interpolation", "quadratic_step", "quadratic_step_equal", "simplex_book", "steepest_descent",
-    "sumt_exterior", "sumt_interior", "sumt_mixed", "unimodality_violation", "violation",
+    "GOLDEN",
+    "OptimizeResult",
+    "bounds_to_ineq",
+    "bracket_minimum",
+    "find_feasible",
+    "fletcher_reeves",
+    "golden_points_needed",
+    "golden_section",
+    "line_minimize",
+    "numerical_gradient",
+    "quadratic_coefficients",
+    "quadratic_interpolation",
+    "quadratic_step",
+    "quadratic_step_equal",
+    "simplex_book",
+    "steepest_descent",
+    "sumt_exterior",
+    "sumt_interior",
+    "sumt_mixed",
+    "unimodality_violation",
+    "violation",
 ]

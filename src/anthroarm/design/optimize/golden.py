@@ -52,8 +52,9 @@ def unimodality_violation(xs, fs, rtol: float = 1e-10):
     return None
 
 
-def golden_section(f, a: float, b: float, eps: float = 1e-6, n: int | None = None,
-                   scan: int = 11) -> OptimizeResult:
+def golden_section(
+    f, a: float, b: float, eps: float = 1e-6, n: int | None = None, scan: int = 11
+) -> OptimizeResult:
     """Minimise ``f`` on [a, b] by the book's golden section (4-14).
 
     ``n`` points (default from (4-13) for ``eps``); stops after n points or when the interval is
@@ -87,11 +88,11 @@ def golden_section(f, a: float, b: float, eps: float = 1e-6, n: int | None = Non
     k = 2
     hist = []
     while True:
-        if f2 > f1:                                # drop the right part (4-14)
+        if f2 > f1:  # drop the right part (4-14)
             hi = x2
             x2, f2 = x1, f1
             new = "x1"
-        else:                                      # drop the left part
+        else:  # drop the left part
             lo = x1
             x1, f1 = x2, f2
             new = "x2"
@@ -99,7 +100,7 @@ def golden_section(f, a: float, b: float, eps: float = 1e-6, n: int | None = Non
         if k >= n_pts or hi - lo <= eps:
             break
         if new == "x1":
-            x1 = hi - GOLDEN * (hi - lo)           # = a1 + 0.382 (b1 - a1)
+            x1 = hi - GOLDEN * (hi - lo)  # = a1 + 0.382 (b1 - a1)
             f1 = ev(x1)
         else:
             x2 = lo + GOLDEN * (hi - lo)
@@ -116,16 +117,33 @@ def golden_section(f, a: float, b: float, eps: float = 1e-6, n: int | None = Non
     if f.best is None:
         raise f.never_finite()
     if f.saw_nan:
-        return f.result(xm, np.inf, "nan", "the objective returned NaN (x, fun: the best finite sample)",
-                        k, f.n, hist, info)
+        return f.result(
+            xm,
+            np.inf,
+            "nan",
+            "the objective returned NaN (x, fun: the best finite sample)",
+            k,
+            f.n,
+            hist,
+            info,
+        )
     bad = unimodality_violation(xs, fs)
     if bad is not None:
-        return f.result(xm, fm, "not_unimodal",
-                        f"f is not unimodal on [{a:g}, {b:g}]: a second valley near x = {bad:.6g}; "
-                        "narrow the interval (best sampled point in info['best_sampled'])",
-                        k, f.n, hist, info)
+        return f.result(
+            xm,
+            fm,
+            "not_unimodal",
+            f"f is not unimodal on [{a:g}, {b:g}]: a second valley near x = {bad:.6g}; "
+            "narrow the interval (best sampled point in info['best_sampled'])",
+            k,
+            f.n,
+            hist,
+            info,
+        )
     status = "converged" if hi - lo <= eps else "n_points"
-    return f.result(xm, fm, status, f"interval [{lo:.6g}, {hi:.6g}] after {k} points", k, f.n, hist, info)
+    return f.result(
+        xm, fm, status, f"interval [{lo:.6g}, {hi:.6g}] after {k} points", k, f.n, hist, info
+    )
 
 
 def bracket_minimum(f, x0: float = 0.0, h: float = 1e-2, grow: float = 2.0, maxiter: int = 60):
@@ -147,23 +165,26 @@ def bracket_minimum(f, x0: float = 0.0, h: float = 1e-2, grow: float = 2.0, maxi
 
     def f(x):
         if not math.isfinite(x):
-            raise ValueError(f"bracket_minimum stepped beyond the float range from x0 = {x0!r} (h = {h!r})")
+            raise ValueError(
+                f"bracket_minimum stepped beyond the float range from x0 = {x0!r} (h = {h!r})"
+            )
         v = float(f_user(x))
         return math.inf if math.isnan(v) else v
 
     def checked(a1, a2, a3, f1, f2, f3):
         if not math.isfinite(f2):
-            raise ObjectiveError(f"the objective is not finite at the bracketed point: f({a2!r}) = {f2}",
-                                 a2, f2)
+            raise ObjectiveError(
+                f"the objective is not finite at the bracketed point: f({a2!r}) = {f2}", a2, f2
+            )
         return (a1, a2, a3, f1, f2, f3)
 
     xa, fa = x0, f(x0)
     xb, fb = x0 + h, f(x0 + h)
-    if fb > fa:                                    # retreat: search the other way
+    if fb > fa:  # retreat: search the other way
         h = -h
         xb, fb = x0 + h, f(x0 + h)
-        if fb > fa:                                # x0 is already bracketed
-            return checked(x0 + h, x0, x0 - h, fb, fa, f(x0 - h))   # h < 0 here
+        if fb > fa:  # x0 is already bracketed
+            return checked(x0 + h, x0, x0 - h, fb, fa, f(x0 - h))  # h < 0 here
     for _ in range(maxiter):
         h *= grow
         xc, fc = xb + h, f(xb + h)

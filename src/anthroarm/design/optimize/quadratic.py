@@ -40,7 +40,9 @@ def quadratic_step(a1, a2, a3, f1, f2, f3) -> float:
     k1 = (f3 - f1) / (a3 - a1)
     k2 = ((f2 - f1) / (a2 - a1) - k1) / (a2 - a3)
     if not k2 > 0:
-        raise ValueError(f"the parabola through the points has no minimum (C = k2 = {k2:g} <= 0), (4-19)")
+        raise ValueError(
+            f"the parabola through the points has no minimum (C = k2 = {k2:g} <= 0), (4-19)"
+        )
     return 0.5 * (a1 + a3 - k1 / k2)
 
 
@@ -54,7 +56,9 @@ def quadratic_step_equal(h, f1, f2, f3) -> float:
         raise ValueError("(4-24) f1 + f3 > 2 f2 fails: the three values have no parabolic minimum")
     a = (4 * f2 - 3 * f1 - f3) / (4 * f2 - 2 * f3 - 2 * f1) * h
     if not math.isfinite(a):
-        raise ValueError(f"alpha* = ... * h is beyond the float range (h = {h!r}, values {f1!r}, {f2!r}, {f3!r})")
+        raise ValueError(
+            f"alpha* = ... * h is beyond the float range (h = {h!r}, values {f1!r}, {f2!r}, {f3!r})"
+        )
     return a
 
 
@@ -88,13 +92,21 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
         if not (f2 <= f1 and f2 <= f3):
             br = bracket_minimum(f, a, (b - a) / 10)
             if br is None:
-                return f.result(a1 if f1 < f3 else a3, min(f1, f3), "no_minimum",
-                                "f keeps decreasing: no bracket of a minimum", 0, f.n)
+                return f.result(
+                    a1 if f1 < f3 else a3,
+                    min(f1, f3),
+                    "no_minimum",
+                    "f keeps decreasing: no bracket of a minimum",
+                    0,
+                    f.n,
+                )
             a1, a2, a3, f1, f2, f3 = br
     else:
         raise ValueError("bracket must be (a, b) or (a1, a2, a3)")
     if f.saw_nan:
-        return f.result(a2, np.inf, "nan", "the objective returned NaN (x, fun: the best finite point)", 0, f.n)
+        return f.result(
+            a2, np.inf, "nan", "the objective returned NaN (x, fun: the best finite point)", 0, f.n
+        )
     if not (f2 <= f1 and f2 <= f3):
         return f.result(a2, f2, "no_minimum", "the three points do not bracket a minimum", 0, f.n)
     prev = a2
@@ -102,11 +114,13 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
     for it in range(1, maxiter + 1):
         try:
             x = quadratic_step(a1, a2, a3, f1, f2, f3)
-        except ValueError:                          # flat / collinear values: the middle point is the answer
-            return f.result(a2, f2, "converged", "the three values are equal: flat bracket", it, f.n, hist)
+        except ValueError:  # flat / collinear values: the middle point is the answer
+            return f.result(
+                a2, f2, "converged", "the three values are equal: flat bracket", it, f.n, hist
+            )
         if not a1 <= x <= a3:
             x = a2
-        if x == a2:                                 # vertex on the middle point: nudge to keep three distinct points
+        if x == a2:  # vertex on the middle point: nudge to keep three distinct points
             x = a2 + 1e-3 * ((a3 - a2) if a3 - a2 > a2 - a1 else (a1 - a2))
         fx = f(x)
         if x > a2:
@@ -121,14 +135,37 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
                 a1, f1 = x, fx
         hist.append(a2)
         if f.saw_nan:
-            return f.result(a2, np.inf, "nan", "the objective returned NaN (x, fun: the best finite point)",
-                            it, f.n, hist)
+            return f.result(
+                a2,
+                np.inf,
+                "nan",
+                "the objective returned NaN (x, fun: the best finite point)",
+                it,
+                f.n,
+                hist,
+            )
         if abs(x - prev) < eps * (abs(x) + 1.0) or (a3 - a1) < eps * (abs(a2) + 1.0):
-            return f.result(a2, f2, "converged", f"|alpha* - previous| < {eps:g}", it, f.n, hist,
-                            {"bracket": (a1, a2, a3)})
+            return f.result(
+                a2,
+                f2,
+                "converged",
+                f"|alpha* - previous| < {eps:g}",
+                it,
+                f.n,
+                hist,
+                {"bracket": (a1, a2, a3)},
+            )
         prev = x
-    return f.result(a2, f2, "maxiter", f"no convergence in {maxiter} steps", maxiter, f.n, hist,
-                    {"bracket": (a1, a2, a3)})
+    return f.result(
+        a2,
+        f2,
+        "maxiter",
+        f"no convergence in {maxiter} steps",
+        maxiter,
+        f.n,
+        hist,
+        {"bracket": (a1, a2, a3)},
+    )
 
 
 def line_minimize(phi, h0: float = 1e-2, eps: float = 1e-10):

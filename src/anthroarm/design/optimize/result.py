@@ -43,8 +43,10 @@ class OptimizeResult:
 
     def __repr__(self) -> str:
         x = np.array2string(np.asarray(self.x, dtype=float), precision=6)
-        return (f"OptimizeResult(status={self.status!r}, x={x}, fun={self.fun:.6g}, nit={self.nit}, "
-                f"nfev={self.nfev}, message={self.message!r})")
+        return (
+            f"OptimizeResult(status={self.status!r}, x={x}, fun={self.fun:.6g}, nit={self.nit}, "
+            f"nfev={self.nfev}, message={self.message!r})"
+        )
 
 
 class Counted:
@@ -58,7 +60,7 @@ class Counted:
         self.f = f
         self.n = 0
         self.saw_nan = False
-        self.best = None            # (x, f(x)) with the lowest finite f(x) seen
+        self.best = None  # (x, f(x)) with the lowest finite f(x) seen
         self.last = (None, np.nan)  # last point evaluated and its raw value
 
     def __call__(self, x):
@@ -77,10 +79,17 @@ class Counted:
     def never_finite(self) -> ObjectiveError:
         x, v = self.last
         xs = np.array2string(np.asarray(x, dtype=float), precision=6) if x is not None else "?"
-        return ObjectiveError(f"the objective never returned a finite value ({self.n} evaluations; "
-                              f"f = {v} at x = {xs})", x, v, self.n)
+        return ObjectiveError(
+            f"the objective never returned a finite value ({self.n} evaluations; "
+            f"f = {v} at x = {xs})",
+            x,
+            v,
+            self.n,
+        )
 
-    def result(self, x, fun, status, message="", nit=0, nfev=None, history=None, info=None) -> OptimizeResult:
+    def result(
+        self, x, fun, status, message="", nit=0, nfev=None, history=None, info=None
+    ) -> OptimizeResult:
         """The :class:`OptimizeResult` of a run.  A non-finite ``fun`` (the objective was NaN or
         inf there), or status ``"nan"``, reports the best finite point and value seen instead; if there is none the run
         has nothing to report and :class:`~anthroarm.errors.ObjectiveError` is raised."""
@@ -90,8 +99,16 @@ class Counted:
                 raise self.never_finite()
             x = self.best[0].reshape(np.shape(x)) if np.ndim(x) else float(self.best[0])
             fun = self.best[1]
-        return OptimizeResult(x, fun, status, message, nit, self.n if nfev is None else nfev,
-                              [] if history is None else history, {} if info is None else info)
+        return OptimizeResult(
+            x,
+            fun,
+            status,
+            message,
+            nit,
+            self.n if nfev is None else nfev,
+            [] if history is None else history,
+            {} if info is None else info,
+        )
 
 
 #: largest magnitude accepted for a starting point, a step or a bound: squares and sums of
@@ -118,7 +135,9 @@ def finite_interval(a, b):
     if not a < b:
         raise ValueError(f"need a < b for the search interval, got [{a}, {b}]")
     if max(abs(a), abs(b)) > MAX_COORD:
-        raise ValueError(f"interval ends must lie within +-{MAX_COORD:g}, got [{a}, {b}] (rescale the problem)")
+        raise ValueError(
+            f"interval ends must lie within +-{MAX_COORD:g}, got [{a}, {b}] (rescale the problem)"
+        )
     return a, b
 
 
@@ -131,7 +150,9 @@ def positive(name: str, value, allow_zero: bool = False) -> float:
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a number, got {type(value).__name__}") from None
     if not ((v > 0 or (allow_zero and v == 0)) and np.isfinite(v)):
-        raise ValueError(f"{name} must be finite and {'>=' if allow_zero else '>'} 0, got {value!r}")
+        raise ValueError(
+            f"{name} must be finite and {'>=' if allow_zero else '>'} 0, got {value!r}"
+        )
     return v
 
 

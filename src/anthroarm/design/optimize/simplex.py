@@ -22,9 +22,19 @@ import numpy as np
 from .result import MAX_COORD, Counted, OptimizeResult, as_vector, count, positive
 
 
-def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: float = 1e-14,
-                 eps2: float | None = None, maxiter: int = 5000, expand_if: str = "G",
-                 initial_simplex=None, xtol: float = 0.0) -> OptimizeResult:
+def simplex_book(
+    f,
+    x0,
+    step=1.0,
+    lam: float = 0.25,
+    mu: float = 1.5,
+    eps1: float = 1e-14,
+    eps2: float | None = None,
+    maxiter: int = 5000,
+    expand_if: str = "G",
+    initial_simplex=None,
+    xtol: float = 0.0,
+) -> OptimizeResult:
     """Minimise ``f`` by the book's simplex variant.
 
     ``step`` (scalar or per-axis) builds the initial simplex ``x0 + step·e_i`` unless
@@ -42,7 +52,9 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
     xtol = positive("xtol", xtol, allow_zero=True)
     maxiter = count("maxiter", maxiter)
     if not (0 < lam < 1) or lam == 0.5:
-        raise ValueError(f"compression factor must satisfy 0 < lam < 1, lam != 0.5 (4-60); got {lam!r}")
+        raise ValueError(
+            f"compression factor must satisfy 0 < lam < 1, lam != 0.5 (4-60); got {lam!r}"
+        )
     if not mu > 1:
         raise ValueError(f"expansion factor must be > 1 (4-61); got {mu!r}")
     if expand_if not in ("G", "L"):
@@ -53,16 +65,22 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
         n = x0.size
         st = np.broadcast_to(np.asarray(step, dtype=float), (n,))
         if np.any(st == 0) or not np.all(np.isfinite(st)) or np.any(np.abs(st) > MAX_COORD):
-            raise ValueError(f"simplex step must be finite, non-zero and within +-{MAX_COORD:g}, got {step!r}")
+            raise ValueError(
+                f"simplex step must be finite, non-zero and within +-{MAX_COORD:g}, got {step!r}"
+            )
         X = np.vstack([x0] + [x0 + st[i] * np.eye(n)[i] for i in range(n)])
     else:
         X = np.array(initial_simplex, dtype=float)
         n = X.shape[1]
         if X.shape != (n + 1, n) or not np.all(np.isfinite(X)) or np.any(np.abs(X) > MAX_COORD):
-            raise ValueError(f"initial_simplex must be a finite (n+1, n) array within +-{MAX_COORD:g}, "
-                             f"got shape {X.shape}")
+            raise ValueError(
+                f"initial_simplex must be a finite (n+1, n) array within +-{MAX_COORD:g}, "
+                f"got shape {X.shape}"
+            )
     if np.linalg.matrix_rank(X[1:] - X[0]) < n:
-        raise ValueError("simplex edges X_i - X_0 are linearly dependent: the search would stay in a subspace")
+        raise ValueError(
+            "simplex edges X_i - X_0 are linearly dependent: the search would stay in a subspace"
+        )
     S = np.array([fc(x) for x in X])
     hist = []
     status, msg = "maxiter", f"no convergence in {maxiter} iterations"
@@ -70,39 +88,46 @@ def simplex_book(f, x0, step=1.0, lam: float = 0.25, mu: float = 1.5, eps1: floa
     for it in range(1, maxiter + 1):
         order = np.argsort(S, kind="stable")
         X, S = X[order], S[order]
-        L, G, H = 0, n - 1, n                          # best, second worst, worst
+        L, G, H = 0, n - 1, n  # best, second worst, worst
         hist.append(X[L].copy())
         if np.isfinite(S[L]):
             spread = np.sum((S - S[L]) ** 2) if np.all(np.isfinite(S)) else np.inf
-            if spread < eps1:                          # (4-63)
+            if spread < eps1:  # (4-63)
                 status, msg = "converged", f"sum (S_i - S_L)^2 < {eps1:g} (4-63)"
                 break
-            if eps2 is not None and S[L] != 0 and np.isfinite(S[H]) and abs((S[H] - S[L]) / S[L]) < eps2:
+            if (
+                eps2 is not None
+                and S[L] != 0
+                and np.isfinite(S[H])
+                and abs((S[H] - S[L]) / S[L]) < eps2
+            ):
                 status, msg = "converged", f"|(S_H - S_L)/S_L| < {eps2:g} (4-64)"
                 break
         if xtol > 0 and np.max(np.linalg.norm(X - X[L], axis=1)) < xtol:
             status, msg = "converged", f"simplex diameter < {xtol:g}"
             break
-        XF = (X.sum(axis=0) - X[H]) / n                 # (4-55)
-        XR = 2 * XF - X[H]                             # (4-56)-(4-58)
+        XF = (X.sum(axis=0) - X[H]) / n  # (4-55)
+        XR = 2 * XF - X[H]  # (4-56)-(4-58)
         SR = fc(XR)
-        if SR >= S[G]:                                 # step 3: compress
+        if SR >= S[G]:  # step 3: compress
             XS = (1 - lam) * X[H] + lam * XR
             SS = fc(XS)
-        else:                                          # step 4: expand
+        else:  # step 4: expand
             if expand_if == "G" or SR < S[L]:
                 XB = (1 - mu) * X[H] + mu * XR
                 SB = fc(XB)
                 XS, SS = (XB, SB) if SB < SR else (XR, SR)
             else:
                 XS, SS = XR, SR
-        if SS < S[G]:                                  # step 5
+        if SS < S[G]:  # step 5
             X[H], S[H] = XS, SS
-        else:                                          # step 6: shrink towards X_L (4-62)
+        else:  # step 6: shrink towards X_L (4-62)
             X[1:] = 0.5 * (X[1:] + X[L])
             S[1:] = [fc(x) for x in X[1:]]
     order = np.argsort(S, kind="stable")
     X, S = X[order], S[order]
     if fc.saw_nan and not np.isfinite(S[0]):
         status, msg = "nan", "the objective returned NaN (x, fun: the best finite point)"
-    return fc.result(X[0].copy(), float(S[0]), status, msg, it, fc.n, hist, {"simplex": X, "values": S})
+    return fc.result(
+        X[0].copy(), float(S[0]), status, msg, it, fc.n, hist, {"simplex": X, "values": S}
+    )

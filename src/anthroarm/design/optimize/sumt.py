@@ -52,8 +52,10 @@ def _check_bounds(bounds):
         hi = np.inf if hi is None else float(hi)
         for name, v in (("lower", lo), ("upper", hi)):
             if np.isnan(v) or (np.isfinite(v) and abs(v) > MAX_COORD):
-                raise ValueError(f"bound {i}: the {name} bound must be a number within +-{MAX_COORD:g} "
-                                 f"or +-inf (no bound), got {v!r}")
+                raise ValueError(
+                    f"bound {i}: the {name} bound must be a number within +-{MAX_COORD:g} "
+                    f"or +-inf (no bound), got {v!r}"
+                )
         out.append((lo, hi))
     return out
 
@@ -107,7 +109,12 @@ def _finite_f(f, x, what: str) -> float:
 def _check_params(max_stages, eps1, eps2, scale, **factors):
     for name, v in factors.items():
         positive(name, v)
-    return count("max_stages", max_stages), positive("eps1", eps1), positive("eps2", eps2), positive("scale", scale)
+    return (
+        count("max_stages", max_stages),
+        positive("eps1", eps1),
+        positive("eps2", eps2),
+        positive("scale", scale),
+    )
 
 
 def _prepare(f, x0, ineq, eq, bounds):
@@ -117,13 +124,17 @@ def _prepare(f, x0, ineq, eq, bounds):
             raise ValueError(f"bounds has {len(bounds)} entries for {x0.size} variables")
         empty = _empty_bound(_check_bounds(bounds))
         if empty:
-            return None, OptimizeResult(x0, _finite_f(f, x0, "the starting point"), "infeasible_bounds", empty, nfev=1)
+            return None, OptimizeResult(
+                x0, _finite_f(f, x0, "the starting point"), "infeasible_bounds", empty, nfev=1
+            )
     return (x0, _combine(ineq, bounds)), None
 
 
 def _default_inner(phi, x, scale):
     step = 0.1 * np.maximum(np.abs(x), scale)
-    return simplex_book(phi, x, step=step, eps1=1e-20, xtol=1e-10 * (1 + np.linalg.norm(x)), maxiter=4000)
+    return simplex_book(
+        phi, x, step=step, eps1=1e-20, xtol=1e-10 * (1 + np.linalg.norm(x)), maxiter=4000
+    )
 
 
 def _barrier_inner(phi, x, scale, g):
@@ -131,12 +142,18 @@ def _barrier_inner(phi, x, scale, g):
     (edge = half the smallest constraint value) and the search restarts from its result until it
     stops improving — a collapsed simplex cannot follow the narrow curved valley along an active
     constraint otherwise."""
+
     def step_at(z):
-        return min(0.1 * float(np.max(np.maximum(np.abs(z), scale))), max(0.5 * float(np.min(_vec(g, z))), 1e-12))
+        return min(
+            0.1 * float(np.max(np.maximum(np.abs(z), scale))),
+            max(0.5 * float(np.min(_vec(g, z))), 1e-12),
+        )
 
     best, nfev = None, 0
     for _ in range(4):
-        r = simplex_book(phi, x, step=step_at(x), eps1=1e-20, xtol=1e-12 * (1 + np.linalg.norm(x)), maxiter=4000)
+        r = simplex_book(
+            phi, x, step=step_at(x), eps1=1e-20, xtol=1e-12 * (1 + np.linalg.norm(x)), maxiter=4000
+        )
         nfev += r.nfev
         if best is not None and r.fun >= best.fun - 1e-15 * abs(best.fun):
             if r.fun < best.fun:
@@ -148,9 +165,16 @@ def _barrier_inner(phi, x, scale, g):
 
 
 def _nan_result(f, x, stage, nfev, hist) -> OptimizeResult:
-    return OptimizeResult(x, _finite_f(f, x, f"the best finite point of stage {stage}"), "nan",
-                          f"the objective or a constraint returned NaN in stage {stage} "
-                          "(x, fun: the best finite point)", stage, nfev, hist)
+    return OptimizeResult(
+        x,
+        _finite_f(f, x, f"the best finite point of stage {stage}"),
+        "nan",
+        f"the objective or a constraint returned NaN in stage {stage} "
+        "(x, fun: the best finite point)",
+        stage,
+        nfev,
+        hist,
+    )
 
 
 def violation(x, ineq=None, eq=None) -> float:
@@ -162,6 +186,7 @@ def violation(x, ineq=None, eq=None) -> float:
 def find_feasible(x0, ineq, margin: float = 1e-6, inner=None):
     """Phase 1 for the interior method: minimise ``Σ min(0, g_u − margin)²`` from x0.
     Returns a strictly feasible point or None."""
+
     def pen(x):
         return float(np.sum(np.minimum(0.0, _vec(ineq, x) - margin) ** 2))
 
@@ -176,7 +201,9 @@ def find_feasible(x0, ineq, margin: float = 1e-6, inner=None):
     return x if np.all(_vec(ineq, x) > 0) else None
 
 
-def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale) -> OptimizeResult:
+def _barrier_method(
+    name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale
+) -> OptimizeResult:
     """The stage loop shared by the interior (4-66) and mixed (4-78) methods: barrier
     ``r Σ 1/g_u`` on the inequalities, plus ``r^{−1/2} Σ h_v²`` when there are equalities;
     r shrinks by ``c`` per stage until (4-67) and (4-68) hold."""
@@ -192,9 +219,13 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
     if not np.all(_vec(g, x) > 0):
         xf = find_feasible(x, g)
         if xf is None:
-            return OptimizeResult(x, _finite_f(f, x, "the starting point"), "infeasible",
-                                  "no strictly feasible starting point found: the constraints may be inconsistent",
-                                  info={"violation": violation(x, g, eq)})
+            return OptimizeResult(
+                x,
+                _finite_f(f, x, "the starting point"),
+                "infeasible",
+                "no strictly feasible starting point found: the constraints may be inconsistent",
+                info={"violation": violation(x, g, eq)},
+            )
         x = xf
     inner = inner or (lambda p, z: _barrier_inner(p, z, scale, g))
     r = float(r0)
@@ -203,13 +234,14 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
     status, msg = "maxiter", f"no convergence in {max_stages} stages"
     k = 0
     for k in range(1, max_stages + 1):
+
         def phi(z, r=r):
             gz = _vec(g, z)
             if np.any(gz <= 0):
                 return np.inf
-            val = float(f(z)) + r * float(np.sum(1.0 / gz))                      # (4-66)
+            val = float(f(z)) + r * float(np.sum(1.0 / gz))  # (4-66)
             if eq is not None:
-                val += r**-0.5 * float(np.sum(_vec(eq, z) ** 2))                # (4-78)
+                val += r**-0.5 * float(np.sum(_vec(eq, z) ** 2))  # (4-78)
             return val
 
         res = inner(phi, x)
@@ -222,7 +254,7 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
         if phi_prev is not None:
             dx = np.linalg.norm(x - x_prev)
             dphi = abs((ph - phi_prev) / phi_prev) if phi_prev != 0 else abs(ph - phi_prev)
-            if dx < eps1 and dphi < eps2:                                         # (4-67), (4-68)
+            if dx < eps1 and dphi < eps2:  # (4-67), (4-68)
                 status, msg = "converged", "(4-67) and (4-68) hold"
                 break
         phi_prev, x_prev = ph, x.copy()
@@ -230,23 +262,56 @@ def _barrier_method(name, f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages
     Q = violation(x, g, eq)
     if eq is not None and status == "converged" and Q > 1e-4 * (1 + np.linalg.norm(x)):
         status, msg = "infeasible", f"equality constraints violated by {Q:.3g} at the end"
-    return OptimizeResult(x, _finite_f(f, x, "the result"), status, msg, k, nfev, hist,
-                          {"r": r, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
+    return OptimizeResult(
+        x,
+        _finite_f(f, x, "the result"),
+        status,
+        msg,
+        k,
+        nfev,
+        hist,
+        {"r": r, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)},
+    )
 
 
-def sumt_interior(f, x0, ineq, bounds=None, r0: float = 1.0, c: float = 0.1, eps1: float = 1e-7,
-                  eps2: float = 1e-7, max_stages: int = 40, inner=None, scale: float = 1.0) -> OptimizeResult:
+def sumt_interior(
+    f,
+    x0,
+    ineq,
+    bounds=None,
+    r0: float = 1.0,
+    c: float = 0.1,
+    eps1: float = 1e-7,
+    eps2: float = 1e-7,
+    max_stages: int = 40,
+    inner=None,
+    scale: float = 1.0,
+) -> OptimizeResult:
     """Interior penalty (barrier) method, Eq. (4-66)–(4-68).
 
     ``ineq(x)`` returns the g_u (feasible ≥ 0).  If ``x0`` is not strictly feasible a phase-1
     search (:func:`find_feasible`) looks for one; if none is found the status is ``"infeasible"``.
     ``info``: the final r, the constraint values and the largest violation."""
-    return _barrier_method("sumt_interior", f, x0, ineq, None, bounds, r0, c, eps1, eps2, max_stages, inner, scale)
+    return _barrier_method(
+        "sumt_interior", f, x0, ineq, None, bounds, r0, c, eps1, eps2, max_stages, inner, scale
+    )
 
 
-def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: float = 10.0,
-                  eps1: float = 1e-6, eps2: float = 1e-7, R: float = 1e8, max_stages: int = 40,
-                  inner=None, scale: float = 1.0) -> OptimizeResult:
+def sumt_exterior(
+    f,
+    x0,
+    ineq=None,
+    eq=None,
+    bounds=None,
+    M0: float = 1.0,
+    c: float = 10.0,
+    eps1: float = 1e-6,
+    eps2: float = 1e-7,
+    R: float = 1e8,
+    max_stages: int = 40,
+    inner=None,
+    scale: float = 1.0,
+) -> OptimizeResult:
     """Exterior penalty method, Eq. (4-69)–(4-75), any starting point.
 
     Converged when the largest violation Q ≤ ``eps1`` (4-74).  When M exceeds the control value
@@ -267,8 +332,11 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
     k = 0
     Q = violation(x, g, eq)
     for k in range(1, max_stages + 1):
+
         def phi(z, M=M):
-            pen = np.sum(np.minimum(0.0, _vec(g, z)) ** 2) + np.sum(_vec(eq, z) ** 2)   # (4-72)/(4-73)
+            pen = np.sum(np.minimum(0.0, _vec(g, z)) ** 2) + np.sum(
+                _vec(eq, z) ** 2
+            )  # (4-72)/(4-73)
             return float(f(z)) + M * float(pen)
 
         res = inner(phi, x)
@@ -278,23 +346,51 @@ def sumt_exterior(f, x0, ineq=None, eq=None, bounds=None, M0: float = 1.0, c: fl
         if res.status == "nan":
             return _nan_result(f, x, k, nfev, hist)
         Q = violation(x, g, eq)
-        if Q <= eps1:                                          # (4-74)
+        if Q <= eps1:  # (4-74)
             status, msg = "converged", f"largest violation Q = {Q:.3g} <= {eps1:g} (4-74)"
             break
-        if M > R and x_prev is not None and np.linalg.norm(x - x_prev) <= eps2 * (1 + np.linalg.norm(x)):
-            status = "infeasible"                               # (4-75) holds but Q does not
-            msg = (f"X* stopped moving at M = {M:.3g} with violation Q = {Q:.3g} > {eps1:g}: "
-                   "the constraints cannot all be satisfied")
+        if (
+            M > R
+            and x_prev is not None
+            and np.linalg.norm(x - x_prev) <= eps2 * (1 + np.linalg.norm(x))
+        ):
+            status = "infeasible"  # (4-75) holds but Q does not
+            msg = (
+                f"X* stopped moving at M = {M:.3g} with violation Q = {Q:.3g} > {eps1:g}: "
+                "the constraints cannot all be satisfied"
+            )
             break
         x_prev = x.copy()
         M *= c
-    return OptimizeResult(x, _finite_f(f, x, "the result"), status, msg, k, nfev, hist,
-                          {"M": M, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)})
+    return OptimizeResult(
+        x,
+        _finite_f(f, x, "the result"),
+        status,
+        msg,
+        k,
+        nfev,
+        hist,
+        {"M": M, "violation": Q, "g": _vec(g, x), "h": _vec(eq, x)},
+    )
 
 
-def sumt_mixed(f, x0, ineq, eq=None, bounds=None, r0: float = 1.0, c: float = 0.1, eps1: float = 1e-7,
-               eps2: float = 1e-7, max_stages: int = 40, inner=None, scale: float = 1.0) -> OptimizeResult:
+def sumt_mixed(
+    f,
+    x0,
+    ineq,
+    eq=None,
+    bounds=None,
+    r0: float = 1.0,
+    c: float = 0.1,
+    eps1: float = 1e-7,
+    eps2: float = 1e-7,
+    max_stages: int = 40,
+    inner=None,
+    scale: float = 1.0,
+) -> OptimizeResult:
     """Mixed method, Eq. (4-78): barrier on the inequalities, ``r^{−1/2}`` penalty on the
     equalities.  X⁽⁰⁾ must satisfy the inequalities strictly (phase 1 is tried otherwise).
     Status ``"infeasible"`` when the stages converge with the equalities still violated."""
-    return _barrier_method("sumt_mixed", f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale)
+    return _barrier_method(
+        "sumt_mixed", f, x0, ineq, eq, bounds, r0, c, eps1, eps2, max_stages, inner, scale
+    )

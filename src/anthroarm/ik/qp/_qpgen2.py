@@ -23,8 +23,8 @@ import numpy as np
 
 SUPPORTED = ("0.1.14",)
 
-_FUNC = None        # the ctypes function, False when unavailable
-_SELFTESTED = {}    # n -> bool
+_FUNC = None  # the ctypes function, False when unavailable
+_SELFTESTED = {}  # n -> bool
 
 
 def _function():
@@ -63,7 +63,7 @@ class BoxQP:
         self.x = np.zeros(n)
         self._lagr = np.zeros(m)
         self._obj = np.zeros(1)
-        self._C = np.asfortranarray(np.hstack([np.eye(n), -np.eye(n)]))   # column j = constraint j
+        self._C = np.asfortranarray(np.hstack([np.eye(n), -np.eye(n)]))  # column j = constraint j
         self._iact = np.zeros(m, np.int32)
         self._nact = np.zeros(1, np.int32)
         self._iter = np.zeros(2, np.int32)
@@ -76,11 +76,26 @@ class BoxQP:
             p = lambda a: a.ctypes.data  # noqa: E731
             if not (B.flags.c_contiguous and B.dtype == np.float64 and B.shape == (2 * self.n,)):
                 raise ValueError("B must be a contiguous float64 array of shape (2n,)")
-            self._args = (p(self._G), p(self._av), self.n, p(self.x), p(self._lagr), p(self._obj), p(self._C), p(B),
-                          2 * self.n, 0, p(self._iact), p(self._nact), p(self._iter), p(self._work), 0)
+            self._args = (
+                p(self._G),
+                p(self._av),
+                self.n,
+                p(self.x),
+                p(self._lagr),
+                p(self._obj),
+                p(self._C),
+                p(B),
+                2 * self.n,
+                0,
+                p(self._iact),
+                p(self._nact),
+                p(self._iter),
+                p(self._work),
+                0,
+            )
             self._B = B
-        np.copyto(self._G, H)                 # H is symmetric: C or Fortran order alike
-        np.negative(c, out=self._av)          # quadprog minimises ½xᵀGx − aᵀx
+        np.copyto(self._G, H)  # H is symmetric: C or Fortran order alike
+        np.negative(c, out=self._av)  # quadprog minimises ½xᵀGx − aᵀx
         return self._f(*self._args), self.x
 
 
@@ -105,7 +120,7 @@ def _selftest(n: int, f) -> bool:
         J = rng.normal(size=(n + 2, n))
         H = J.T @ J + 1e-3 * np.eye(n)
         c = rng.normal(size=n)
-        B = np.concatenate([-rng.random(n) * 0.3 - 0.01, -rng.random(n) * 0.3 - 0.01])   # 0 inside
+        B = np.concatenate([-rng.random(n) * 0.3 - 0.01, -rng.random(n) * 0.3 - 0.01])  # 0 inside
         rc, x = box.solve(H, c, B.copy() if k % 2 else B)
         try:
             ref = quadprog.solve_qp(H, -c, box._C, B, 0)[0]

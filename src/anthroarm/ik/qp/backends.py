@@ -81,10 +81,12 @@ def polish_box(ws, z, sol, LLT, eye):
     llt = LLT(ws.H)
     x = llt.solve(ws.c)
     np.negative(x, out=x)
-    if z.dot(z) != 0.0:          # some multiplier nonzero (cheaper than z.any())
+    if z.dot(z) != 0.0:  # some multiplier nonzero (cheaper than z.any())
         # the rule entry by entry in Python: cheaper than six array operations at n ≈ 7
         act, lower = [], []
-        for i, (xi, zi, li, hi_) in enumerate(zip(sol.x.tolist(), z.tolist(), ws.lo.tolist(), ws.hi.tolist())):
+        for i, (xi, zi, li, hi_) in enumerate(
+            zip(sol.x.tolist(), z.tolist(), ws.lo.tolist(), ws.hi.tolist())
+        ):
             if xi - li < -zi:
                 act.append(i)
                 lower.append(li)
@@ -94,7 +96,7 @@ def polish_box(ws, z, sol, LLT, eye):
         if len(act) == 1:
             i = act[0]
             b = lower[0] if lower[0] is not None else float(ws.hi[i])
-            y = llt.solve(eye[i])                   # column i of H⁻¹
+            y = llt.solve(eye[i])  # column i of H⁻¹
             mu = (b - float(x[i])) / float(y[i])
             if (mu < -1e-8) if lower[0] is not None else (mu > 1e-8):
                 return None
@@ -103,7 +105,7 @@ def polish_box(ws, z, sol, LLT, eye):
         elif act:
             low = np.array([v is not None for v in lower])
             bA = np.where(low, ws.lo[act], ws.hi[act])
-            Y = llt.solve(eye[:, act])              # H⁻¹ E_A, (n, k)
+            Y = llt.solve(eye[:, act])  # H⁻¹ E_A, (n, k)
             mu = np.linalg.solve(Y[act], bA - x[act])
             if (mu[low] < -1e-8).any() or (mu[~low] > 1e-8).any():
                 return None
@@ -216,8 +218,10 @@ class Backend:
         tol = 1e-9
         if np.maximum.reduce(lo - xp) > tol or np.maximum.reduce(xp - hi) > tol:
             return None
-        if has_act and (np.minimum.reduce(np.where(act_lo, g, 0.0)) < -1e-8
-                        or np.maximum.reduce(np.where(act_hi, g, 0.0)) > 1e-8):
+        if has_act and (
+            np.minimum.reduce(np.where(act_lo, g, 0.0)) < -1e-8
+            or np.maximum.reduce(np.where(act_hi, g, 0.0)) > 1e-8
+        ):
             return None
         return xp
 
@@ -239,11 +243,21 @@ class OSQPBackend(Backend):
     name = "osqp"
     # rho 10: on 300 steps of a panda tracking QP the answer is within 1e-10 of quadprog at a
     # median 30 warm-started ADMM iterations at eps 1e-11 (with the default rho 0.1 it was 3e-6 off)
-    SETTINGS = dict(verbose=False, eps_abs=1e-11, eps_rel=1e-11, eps_prim_inf=1e-9, eps_dual_inf=1e-9, rho=10.0,
-                    polishing=False, max_iter=4000, warm_starting=True, adaptive_rho=True,
-                    check_termination=5)
-    EPS_BOX = 1e-9      # ADMM tolerance of box-only QPs, followed by the exact polish
-    EPS_TIGHT = 1e-11   # without a polish certificate
+    SETTINGS = dict(
+        verbose=False,
+        eps_abs=1e-11,
+        eps_rel=1e-11,
+        eps_prim_inf=1e-9,
+        eps_dual_inf=1e-9,
+        rho=10.0,
+        polishing=False,
+        max_iter=4000,
+        warm_starting=True,
+        adaptive_rho=True,
+        check_termination=5,
+    )
+    EPS_BOX = 1e-9  # ADMM tolerance of box-only QPs, followed by the exact polish
+    EPS_TIGHT = 1e-11  # without a polish certificate
 
     def __init__(self, n: int, n_eq: int = 0, **settings):
         super().__init__(n, n_eq)
@@ -254,7 +268,7 @@ class OSQPBackend(Backend):
         # upper-triangular pattern of H in CSC order (column by column, rows 0..j)
         cols = np.concatenate([np.full(j + 1, j) for j in range(n)])
         rows = np.concatenate([np.arange(j + 1) for j in range(n)])
-        self._tri = rows * n + cols          # flat indices into H (row-major) of the CSC entries
+        self._tri = rows * n + cols  # flat indices into H (row-major) of the CSC entries
         P = sp.csc_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
         # A = [I; Aeq] with a dense pattern for the equality block; Ax in CSC order is
         # vstack([1, Aeq[:, j]]) column by column
@@ -271,16 +285,31 @@ class OSQPBackend(Backend):
         self._LLT = LLT
         self._eye = np.eye(n)
         # box-only QPs are polished: ADMM can stop earlier (unless the caller set eps itself)
-        self._loose = n_eq == 0 and LLT is not None and "eps_abs" not in settings and "eps_rel" not in settings
+        self._loose = (
+            n_eq == 0
+            and LLT is not None
+            and "eps_abs" not in settings
+            and "eps_rel" not in settings
+        )
         if self._loose:
             self.settings.update(eps_abs=self.EPS_BOX, eps_rel=self.EPS_BOX)
         self.solver = osqp.OSQP()
-        self.solver.setup(P, np.zeros(n), A, -np.full(n + n_eq, BIG), np.full(n + n_eq, BIG), **self.settings)
+        self.solver.setup(
+            P, np.zeros(n), A, -np.full(n + n_eq, BIG), np.full(n + n_eq, BIG), **self.settings
+        )
         ext = getattr(self.solver, "_solver", None)
-        self._ext = ext if all(hasattr(ext, a) for a in ("update_data_vec", "update_data_mat", "solve", "info",
-                                                          "solution")) else None
+        self._ext = (
+            ext
+            if all(
+                hasattr(ext, a)
+                for a in ("update_data_vec", "update_data_mat", "solve", "info", "solution")
+            )
+            else None
+        )
         self._solved = osqp.SolverStatus.OSQP_SOLVED
-        if self._loose and self._ext is None:  # pragma: no cover - other osqp versions: no polish path
+        if (
+            self._loose and self._ext is None
+        ):  # pragma: no cover - other osqp versions: no polish path
             self.solver.update_settings(eps_abs=self.EPS_TIGHT, eps_rel=self.EPS_TIGHT)
             self._loose = False
 
@@ -289,8 +318,10 @@ class OSQPBackend(Backend):
         if n_eq != self.n_eq:
             raise ValueError(f"OSQPBackend built for {self.n_eq} equality rows, got {n_eq}")
         lo_f, hi_f = _finite(lo), _finite(hi)
-        if self._loose:      # box-only with the polish: the same path as a step
-            return self.solve_ws(_BoxQP(np.ascontiguousarray(H, dtype=float), np.asarray(c, dtype=float), lo_f, hi_f))
+        if self._loose:  # box-only with the polish: the same path as a step
+            return self.solve_ws(
+                _BoxQP(np.ascontiguousarray(H, dtype=float), np.asarray(c, dtype=float), lo_f, hi_f)
+            )
         if n_eq:
             l = np.concatenate([lo_f, b])
             u = np.concatenate([hi_f, b])
@@ -334,7 +365,6 @@ class OSQPBackend(Backend):
         self.solver.warm_start(x=np.zeros(self.n), y=np.zeros(self.n + self.n_eq))
         return None, "failed"
 
-
     def solve_ws(self, ws, A=None, b=None):
         ext = self._ext
         if A is not None or ext is None:
@@ -363,7 +393,7 @@ class OSQPBackend(Backend):
                 return x, "optimal"
         if info.status_val == self._solved:
             self._raw_info = (info, False)
-            return self._finish_box(sol.x, ws.lo, ws.hi)     # fresh array
+            return self._finish_box(sol.x, ws.lo, ws.hi)  # fresh array
         return self._status(info, sol.x, sol.y, ws.H, ws.c, ws.lo, ws.hi, None, None)
 
     def _info_from(self, raw):
@@ -415,7 +445,7 @@ class DaqpBackend(Backend):
         if A is not None:
             return self.solve(ws.H, ws.c, ws.lo, ws.hi, A, b)
         x, _, flag, info = self._daqp.solve(ws.H, ws.c, self._A0, ws.hi, ws.lo, self._sense)
-        self._raw_info = (flag, info)          # last_info is built when read
+        self._raw_info = (flag, info)  # last_info is built when read
         if flag > 0:
             return self._clip_box(x, ws.lo, ws.hi)
         return None, "infeasible" if flag == -1 else "failed"
@@ -478,12 +508,12 @@ class QuadprogBackend(Backend):
             rc, x = direct.solve(ws.H, ws.c, ws.B)
             if rc == 0:
                 self.last_info = {}
-                return self._clip_box(x, ws.lo, ws.hi)        # a fresh array (x is the buffer)
-            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)   # errors handled there
+                return self._clip_box(x, ws.lo, ws.hi)  # a fresh array (x is the buffer)
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)  # errors handled there
         try:
             x = self._qp.solve_qp(ws.H, np.negative(ws.c, out=ws.nc), self._C, ws.B, 0)[0]
         except ValueError:
-            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)   # error handling there
+            return self.solve(ws.H, ws.c, ws.lo, ws.hi, None, None)  # error handling there
         self.last_info = {}
         return self._finish_box(x, ws.lo, ws.hi)
 
@@ -510,7 +540,7 @@ class ProxqpBackend(Backend):
 
         self._proxqp = proxqp
         self._eye = np.eye(n)
-        self._Q = None          # persistent box-QP workspace (created on the first solve_ws)
+        self._Q = None  # persistent box-QP workspace (created on the first solve_ws)
         self._solved = proxqp.QPSolverOutput.PROXQP_SOLVED
         try:
             from eigenpy import LLT
@@ -540,7 +570,7 @@ class ProxqpBackend(Backend):
                 self._raw_info = r.info
                 return x, "optimal"
         else:
-            self._Q = None      # start afresh next time
+            self._Q = None  # start afresh next time
         return self.solve(ws.H, ws.c, ws.lo, ws.hi)
 
     def _info_from(self, info):
@@ -553,8 +583,18 @@ class ProxqpBackend(Backend):
     def solve(self, H, c, lo, hi, A=None, b=None):
         proxqp = self._proxqp
         Aeq, beq = (None, None) if A is None or not len(A) else (A, b)
-        r = proxqp.dense.solve(H, c, Aeq, beq, self._eye, _finite(lo), _finite(hi), eps_abs=1e-10, eps_rel=0.0,
-                               verbose=False)
+        r = proxqp.dense.solve(
+            H,
+            c,
+            Aeq,
+            beq,
+            self._eye,
+            _finite(lo),
+            _finite(hi),
+            eps_abs=1e-10,
+            eps_rel=0.0,
+            verbose=False,
+        )
         st = r.info.status
         S = proxqp.QPSolverOutput
         self.last_info = {"status": str(st), "iter": r.info.iter}
@@ -592,7 +632,12 @@ class QpsolversBackend(Backend):
         return self._finish(np.array(x), lo, hi, A, b, "optimal")
 
 
-_DIRECT_CLASSES = {"osqp": OSQPBackend, "daqp": DaqpBackend, "quadprog": QuadprogBackend, "proxqp": ProxqpBackend}
+_DIRECT_CLASSES = {
+    "osqp": OSQPBackend,
+    "daqp": DaqpBackend,
+    "quadprog": QuadprogBackend,
+    "proxqp": ProxqpBackend,
+}
 
 
 def make_backend(solver: str, n: int, n_eq: int = 0) -> Backend:
@@ -603,11 +648,15 @@ def make_backend(solver: str, n: int, n_eq: int = 0) -> Backend:
     is accepted too.  An unknown or uninstalled solver raises
     :class:`~anthroarm.errors.SolverNotAvailableError` listing the installed ones."""
     if not isinstance(solver, str):
-        raise SolverNotAvailableError(f"solver must be a string, got {solver!r}; installed: {', '.join(available_solvers())}")
+        raise SolverNotAvailableError(
+            f"solver must be a string, got {solver!r}; installed: {', '.join(available_solvers())}"
+        )
     avail = available_solvers()
     if solver in _DIRECT_CLASSES and solver in avail:
         return _DIRECT_CLASSES[solver](n, n_eq)
     name = solver.split(":", 1)[1] if solver.startswith("qpsolvers:") else solver
     if f"qpsolvers:{name}" in avail:
         return QpsolversBackend(n, n_eq, name)
-    raise SolverNotAvailableError(f"QP solver {solver!r} is not installed; installed solvers: {', '.join(avail)}")
+    raise SolverNotAvailableError(
+        f"QP solver {solver!r} is not installed; installed solvers: {', '.join(avail)}"
+    )

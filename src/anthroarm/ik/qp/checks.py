@@ -26,7 +26,7 @@ def rows(models, samples, rng) -> list[CheckRow]:
 
     out = []
     n = max(3, min(int(samples), 20))
-    for name in (aa.models.names() if models is None else models):
+    for name in aa.models.names() if models is None else models:
         robot = aa.load(name)
         Q = robot.random_q(n, rng)
         worst = 0.0
@@ -39,18 +39,35 @@ def rows(models, samples, rng) -> list[CheckRow]:
                 break
             pin.framesForwardKinematics(robot.model, d, res.q)
             M = d.oMf[robot.tool_id]
-            worst = max(worst, float(np.linalg.norm(M.translation - T[:3, 3])),
-                        float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))))
-        out.append(CheckRow(name, "aa.ik.solve: FK(solve(T)) = T within limits", worst, 1e-6, n,
-                            oracle="pinocchio FK", note="pos (m) / rot (rad), worst of both"))
+            worst = max(
+                worst,
+                float(np.linalg.norm(M.translation - T[:3, 3])),
+                float(np.linalg.norm(pin.log3(M.rotation.T @ T[:3, :3]))),
+            )
+        out.append(
+            CheckRow(
+                name,
+                "aa.ik.solve: FK(solve(T)) = T within limits",
+                worst,
+                1e-6,
+                n,
+                oracle="pinocchio FK",
+                note="pos (m) / rot (rad), worst of both",
+            )
+        )
         # QP step vs its closed form (limits far away: box of ±10 rad)
         werr = 0.0
         big = qp.Limit()
         big.box = lambda conf, dt: (np.full(robot.nv, -10.0), np.full(robot.nv, 10.0))
         for q, q2 in zip(Q[:3], Q[1:4]):
             conf = qp.IKConfiguration(robot, q)
-            ee = qp.FrameTask(robot, position_cost=[1.0, 0.5, 2.0], orientation_cost=0.3, lm_damping=1e-2,
-                              target=robot.fk(pin.interpolate(robot.model, q, q2, 0.05)))
+            ee = qp.FrameTask(
+                robot,
+                position_cost=[1.0, 0.5, 2.0],
+                orientation_cost=0.3,
+                lm_damping=1e-2,
+                target=robot.fk(pin.interpolate(robot.model, q, q2, 0.05)),
+            )
             post = qp.PostureTask(robot, cost=0.1, target=q2)
             dq = qp.step(conf, None, [ee, post], 1.0, limits=[big], solver="osqp", damping=1e-6)
             H = 1e-6 * np.eye(robot.nv)
@@ -60,8 +77,17 @@ def rows(models, samples, rng) -> list[CheckRow]:
                 w = np.broadcast_to(t.cost, e.shape)
                 mu = t.lm_damping * float((w * e) @ (w * e))
                 H += J.T @ (w[:, None] ** 2 * J) + mu * np.eye(robot.nv)
-                c += t.gain * J.T @ (w ** 2 * e)
+                c += t.gain * J.T @ (w**2 * e)
             werr = max(werr, float(np.abs(dq - np.linalg.solve(H, -c)).max()))
-        out.append(CheckRow(name, "qp.step (OSQP) = damped least squares, inactive limits", werr, 1e-8, 3,
-                            oracle="numpy closed form", note="frame + posture task"))
+        out.append(
+            CheckRow(
+                name,
+                "qp.step (OSQP) = damped least squares, inactive limits",
+                werr,
+                1e-8,
+                3,
+                oracle="numpy closed form",
+                note="frame + posture task",
+            )
+        )
     return out

@@ -82,7 +82,9 @@ class IKConfiguration:
             if q.shape != (self.nq,) or not np.isfinite(q).all():
                 self.robot.check_q(q if q.ndim == 1 else q, name="q")  # raises with the joint name
                 if q.shape != (self.nq,):
-                    raise ValueError(f"{self.robot.name}: q must have shape ({self.nq},), got {q.shape}")
+                    raise ValueError(
+                        f"{self.robot.name}: q must have shape ({self.nq},), got {q.shape}"
+                    )
             if self._unit:
                 self.robot.chain.check_unit(q)
             self.q = q.copy()
@@ -94,7 +96,9 @@ class IKConfiguration:
         """World pose of frame ``frame_id`` (SE(3), m)."""
         M = self._placements.get(frame_id)
         if M is None:
-            M = self._placements[frame_id] = pin.updateFramePlacement(self.model, self.data, frame_id)
+            M = self._placements[frame_id] = pin.updateFramePlacement(
+                self.model, self.data, frame_id
+            )
         return M
 
     def frame_jacobian(self, frame_id: int, reference=LOCAL) -> np.ndarray:
@@ -120,8 +124,10 @@ class IKConfiguration:
         """``update(integrate(v, dt))``."""
         v = np.asarray(v, dtype=float)
         if v.shape != (self.nv,) or not math.isfinite(v.dot(v)):
-            raise ValueError(f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}")
-        if dt.__class__ is float:             # dt as an array: v·dt array-wise costs less
+            raise ValueError(
+                f"{self.robot.name}: v must be a finite array of shape ({self.nv},), got {v!r}"
+            )
+        if dt.__class__ is float:  # dt as an array: v·dt array-wise costs less
             if dt != self._dt:
                 if not math.isfinite(dt):
                     raise ValueError(f"dt must be a finite time step (s), got {dt}")
@@ -132,7 +138,7 @@ class IKConfiguration:
             if not np.all(np.isfinite(dt)):
                 raise ValueError(f"dt must be a finite time step (s), got {dt!r}")
             dq = v * dt
-        self.q = pin.integrate(self.model, self.q, dq)   # finite q + finite step: no re-check
+        self.q = pin.integrate(self.model, self.q, dq)  # finite q + finite step: no re-check
         pin.computeJointJacobians(self.model, self.data, self.q)
         self._placements.clear()
         self._jacobians.clear()

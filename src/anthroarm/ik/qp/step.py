@@ -74,14 +74,30 @@ class _Workspace:
     objective into ``H``, ``c`` in place (``Hc`` holds both, so one dot product checks them for
     NaN/inf), the limits write ``B = [lo; −hi]`` (the quadprog form), and ``hi``."""
 
-    __slots__ = ("n", "Hc", "H", "c", "Hd", "B", "Bm", "lo", "mhi", "hi", "box2", "tmp2", "nc", "dt", "dtv")
+    __slots__ = (
+        "n",
+        "Hc",
+        "H",
+        "c",
+        "Hd",
+        "B",
+        "Bm",
+        "lo",
+        "mhi",
+        "hi",
+        "box2",
+        "tmp2",
+        "nc",
+        "dt",
+        "dtv",
+    )
 
     def __init__(self, n: int):
         self.n = n
         self.Hc = np.zeros(n * n + n)
         self.H = self.Hc[: n * n].reshape(n, n)
-        self.c = self.Hc[n * n:]
-        self.Hd = np.einsum("ii->i", self.H)        # writable view of diag(H)
+        self.c = self.Hc[n * n :]
+        self.Hd = np.einsum("ii->i", self.H)  # writable view of diag(H)
         self.B = np.zeros(2 * n)
         self.Bm = self.B.reshape(2, n)
         self.lo = self.B[:n]
@@ -89,8 +105,8 @@ class _Workspace:
         self.hi = np.zeros(n)
         self.box2 = np.zeros((2, n))
         self.tmp2 = np.zeros((2, n))
-        self.nc = np.zeros(n)                        # scratch for backends (e.g. −c)
-        self.dt = None                               # dt held in dtv (nv,)
+        self.nc = np.zeros(n)  # scratch for backends (e.g. −c)
+        self.dt = None  # dt held in dtv (nv,)
         self.dtv = np.zeros(n)
 
 
@@ -108,15 +124,24 @@ def _robot_state(robot) -> dict:
     on the Robot itself, so that threads never share them and nothing outlives the Robot."""
     local = robot.__dict__.get("_qp_local")
     if local is None:
-        local = robot.__dict__.setdefault("_qp_local", threading.local())   # atomic: one wins
+        local = robot.__dict__.setdefault("_qp_local", threading.local())  # atomic: one wins
     st = getattr(local, "state", None)
     if st is None:
         st = local.state = {"backends": {}}
     return st
 
 
-def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", damping: float = 1e-12,
-         constraints=(), full: bool = False):
+def step(
+    robot,
+    q,
+    tasks,
+    dt: float,
+    limits="default",
+    solver: str = "osqp",
+    damping: float = 1e-12,
+    constraints=(),
+    full: bool = False,
+):
     """Joint velocity v (nv,) of one differential-IK step from ``q``: a tangent vector
     (``pin.integrate(model, q, v dt)`` applies it; see :meth:`IKConfiguration.integrate_inplace`).
 
@@ -158,17 +183,19 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
             conf = st["conf"] = IKConfiguration(robot, q)
         else:
             conf.update(q)
-    if not (dt.__class__ is float and 0.0 < dt < math.inf):   # the common case in one test
+    if not (dt.__class__ is float and 0.0 < dt < math.inf):  # the common case in one test
         if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     nv = conf.nv
     if limits.__class__ is str:
         if limits != "default":
-            raise ValueError(f"limits must be 'default', None or a list of Limit objects, got {limits!r}")
+            raise ValueError(
+                f"limits must be 'default', None or a list of Limit objects, got {limits!r}"
+            )
         limits = st.get("default_limits")
         if limits is None:
             limits = st["default_limits"] = default_limits(rb)
-        stateful = False               # configuration and velocity limits keep no state
+        stateful = False  # configuration and velocity limits keep no state
     elif limits is None:
         limits, stateful = (), False
     else:
@@ -182,12 +209,14 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     first = True
     diag = float(damping) if damping else 0.0
     if not (math.isfinite(diag) and diag >= 0.0):
-        raise ValueError(f"damping must be a finite number >= 0 (a negative damping makes the QP "
-                         f"non-convex), got {damping!r}")
+        raise ValueError(
+            f"damping must be a finite number >= 0 (a negative damping makes the QP "
+            f"non-convex), got {damping!r}"
+        )
     for t in tasks:
         try:
             acc = t._accumulate
-        except AttributeError:          # a duck-typed task with compute_qp_objective only
+        except AttributeError:  # a duck-typed task with compute_qp_objective only
             acc = Task._accumulate.__get__(t)
         diag += acc(conf, ws, first)
         first = False
@@ -202,7 +231,7 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
         A = np.vstack([t.compute_jacobian(conf) for t in constraints])
         b = np.concatenate([-t.gain * t.compute_error(conf) for t in constraints])
     n_eq = 0 if A is None else len(A)
-    last = st.get("last")                  # (solver, n_eq, backend) of the previous step
+    last = st.get("last")  # (solver, n_eq, backend) of the previous step
     if last is not None and last[0] is solver and last[1] == n_eq:
         backend = last[2]
     else:
@@ -220,7 +249,7 @@ def step(robot, q, tasks, dt: float, limits="default", solver: str = "osqp", dam
     if x is None:
         v = np.zeros(nv)
     else:
-        if ws.dt != dt:                 # dt as an array: x / dt array-wise costs less
+        if ws.dt != dt:  # dt as an array: x / dt array-wise costs less
             ws.dtv.fill(dt)
             ws.dt = dt
         v = np.divide(x, ws.dtv, out=x)

@@ -11,15 +11,17 @@ from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
 from . import ckernel
-from .kernel import MAX_ITER, STALL, attempt as py_attempt, clock, damped_step, damping
-from .nullspace import Swivel, posture, swivel as swivel_phase
+from .kernel import MAX_ITER, STALL, clock, damped_step, damping
+from .kernel import attempt as py_attempt
+from .nullspace import Swivel, posture
+from .nullspace import swivel as swivel_phase
 from .seeds import SWIVEL_GRID, SWIVEL_GRID_COARSE, TableSeeds, analytic_seeds
-from .targets import ORIENTATION, POSE, Target, parse
+from .targets import ORIENTATION, Target, parse
 from .workspace import workspace
 
-ANALYTIC_AFTER = 8     # analytic="auto": closed-form seeds join after this many failed attempts
-LOCKSTEP_MIN = 8       # batches at least this large iterate all targets together
-LOCKSTEP_ATTEMPTS = 10 # attempts per target in lockstep; the rest go to the one-target solver
+ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
+LOCKSTEP_MIN = 8  # batches at least this large iterate all targets together
+LOCKSTEP_ATTEMPTS = 10  # attempts per target in lockstep; the rest go to the one-target solver
 
 
 class Problem:
@@ -29,7 +31,18 @@ class Problem:
     (None: none), the closed-form policy, and the attempt kernel (:func:`.kernel.attempt` or
     its compiled form :func:`.ckernel.attempt`)."""
 
-    __slots__ = ("robot", "ws", "max_time", "max_restarts", "rng", "_gen", "th_ref", "swivel", "analytic", "_attempt")
+    __slots__ = (
+        "robot",
+        "ws",
+        "max_time",
+        "max_restarts",
+        "rng",
+        "_gen",
+        "th_ref",
+        "swivel",
+        "analytic",
+        "_attempt",
+    )
 
     def __init__(self, robot, ws, max_time, max_restarts, rng, th_ref, swivel, analytic):
         self.robot, self.ws, self.max_time, self.max_restarts = robot, ws, max_time, max_restarts
@@ -51,17 +64,38 @@ class Problem:
         solves need no restart)."""
         if self._gen is None:
             r = self.rng
-            self._gen = r if isinstance(r, np.random.Generator) else np.random.default_rng(0 if r is None else r)
+            self._gen = (
+                r
+                if isinstance(r, np.random.Generator)
+                else np.random.default_rng(0 if r is None else r)
+            )
         sh = self.ws.sh
         return sh.lo_s + (sh.hi_s - sh.lo_s) * self._gen.random(sh.n)
 
     def closed_form_first(self, seed) -> bool:
-        return self.analytic is True or (self.analytic == "auto" and seed is None and self.ws.sh.closed_form_first)
+        return self.analytic is True or (
+            self.analytic == "auto" and seed is None and self.ws.sh.closed_form_first
+        )
 
 
-def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_time: float = 0.05,
-          *, mode: str | None = None, max_restarts: int | None = None, rng=None, posture="auto",
-          swivel: float | None = None, swivel_frames=None, analytic="auto", warm_start: bool = False):
+def solve(
+    robot,
+    T,
+    q0=None,
+    frame=None,
+    tol_pos: float = 1e-6,
+    tol_rot: float = 1e-6,
+    max_time: float = 0.05,
+    *,
+    mode: str | None = None,
+    max_restarts: int | None = None,
+    rng=None,
+    posture="auto",
+    swivel: float | None = None,
+    swivel_frames=None,
+    analytic="auto",
+    warm_start: bool = False,
+):
     """Inverse kinematics of ``robot`` for target ``T`` (see :mod:`anthroarm.ik.solve`).
 
     Parameters
@@ -113,16 +147,27 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         mode, batch, targets = "pose", False, [as_rigid(T, "T")]
     else:
         mode, batch, targets = parse(T, mode)
-    if not (type(tol_pos) is float and type(tol_rot) is float and type(max_time) is float   # the usual call
-            and 0.0 < tol_pos < math.inf and 0.0 < tol_rot < math.inf and 0.0 < max_time < math.inf):
+    if not (
+        type(tol_pos) is float
+        and type(tol_rot) is float
+        and type(max_time) is float  # the usual call
+        and 0.0 < tol_pos < math.inf
+        and 0.0 < tol_rot < math.inf
+        and 0.0 < max_time < math.inf
+    ):
         for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
             if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a positive finite number, got {v!r}")
     if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
         raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
-    if not (rng is None or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
-            or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)):
-        raise TypeError(f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}")
+    if not (
+        rng is None
+        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
+        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
+    ):
+        raise TypeError(
+            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
+        )
     if analytic not in ("auto", True, False):
         raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
     Q0 = None
@@ -138,7 +183,9 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
     elif posture is None:
         th_ref = None
     else:
-        th_ref = np.minimum(np.maximum(sh.theta(robot.check_q(posture, name="posture")), sh.lo), sh.hi)
+        th_ref = np.minimum(
+            np.maximum(sh.theta(robot.check_q(posture, name="posture")), sh.lo), sh.hi
+        )
     sw = None
     if swivel is not None:
         swivel = float(swivel)
@@ -146,11 +193,19 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
             raise ValueError(f"swivel must be finite, got {swivel}")
         sw = Swivel([robot.frame_id(f) for f in _swivel_frames(robot, swivel_frames)], swivel)
     redundant = sh.dof > (6 if mode == "pose" else 3)
-    pb = Problem(robot, ws, float(max_time), max_restarts, rng, th_ref if redundant and sw is None else None,
-                 sw if redundant else None, analytic)
+    pb = Problem(
+        robot,
+        ws,
+        float(max_time),
+        max_restarts,
+        rng,
+        th_ref if redundant and sw is None else None,
+        sw if redundant else None,
+        analytic,
+    )
     tp, tr = float(tol_pos), float(tol_rot)
-    ws.table()      # the one-time seed tables and compiled kernel: built here, before any clock
-    if mode == "pose":                         # starts, so the first call is not charged for them
+    ws.table()  # the one-time seed tables and compiled kernel: built here, before any clock
+    if mode == "pose":  # starts, so the first call is not charged for them
         ws.aligned()
     if ws.cbuf is None:
         ckernel.ready(ws)
@@ -158,12 +213,18 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
     seeds = [None if Q0 is None else (Q0[i] if Q0.ndim == 2 else Q0) for i in range(len(tgs))]
-    if not warm_start and len(tgs) >= LOCKSTEP_MIN and not (pb.closed_form_first(Q0) and mode == "pose"):
+    if (
+        not warm_start
+        and len(tgs) >= LOCKSTEP_MIN
+        and not (pb.closed_form_first(Q0) and mode == "pose")
+    ):
         results = solve_lockstep(pb, tgs, seeds)
     else:
         results, prev = [], None
         for tg, seed in zip(tgs, seeds):
-            r = solve_one(pb, tg, prev if (warm_start and prev is not None and Q0 is None) else seed)
+            r = solve_one(
+                pb, tg, prev if (warm_start and prev is not None and Q0 is None) else seed
+            )
             results.append(r)
             prev = r.q
     results = [_result(sh, r, s) for r, s in zip(results, seeds)]
@@ -171,10 +232,13 @@ def solve(robot, T, q0=None, frame=None, tol_pos: float = 1e-6, tol_rot: float =
         q=np.array([r.q for r in results]).reshape(len(results), sh.nq),
         success=np.array([r.success for r in results], dtype=bool),
         status=[r.status for r in results],
-        pos_err=np.array([r.pos_err for r in results]), rot_err=np.array([r.rot_err for r in results]),
+        pos_err=np.array([r.pos_err for r in results]),
+        rot_err=np.array([r.rot_err for r in results]),
         iterations=np.array([r.iterations for r in results], dtype=int),
         restarts=np.array([r.restarts for r in results], dtype=int),
-        messages=[r.message for r in results], mode=mode)
+        messages=[r.message for r in results],
+        mode=mode,
+    )
 
 
 def _result(sh, r, seed):
@@ -183,7 +247,7 @@ def _result(sh, r, seed):
     th = r.q
     if seed is not None and not sh.all_on_path:
         th = np.where(sh.on_path, th, seed)
-    r.q = th if sh.to_q is None else sh.to_q(th)   # θ is a fresh array of this call
+    r.q = th if sh.to_q is None else sh.to_q(th)  # θ is a fresh array of this call
     return r
 
 
@@ -204,22 +268,38 @@ def solve_one(pb: Problem, tg: Target, seed):
     if tg.kind != ORIENTATION:
         dist = math.sqrt(tg.ps.dot(tg.ps))
         if dist > sh.reach + tg.tol_p:
-            out_of_reach = (f"target is {dist:.4g} m from the base origin but the chain reaches at most "
-                            f"{sh.reach:.4g} m (sum of its link offsets)")
+            out_of_reach = (
+                f"target is {dist:.4g} m from the base origin but the chain reaches at most "
+                f"{sh.reach:.4g} m (sum of its link offsets)"
+            )
     ana, ana_i, note = None, 0, ""
     if not out_of_reach and pb.closed_form_first(seed):
         ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
         # without a posture objective any member of a swivel family will do: a coarse grid first
         grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
         anyone = th_ref is None and sw is None
-        ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, grid, anyone)
+        ana, note, err = analytic_seeds(
+            pb.robot, ws, tg, ref, sw.target if sw else None, grid, anyone
+        )
         if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
-            ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID, anyone)
+            ana, note, err = analytic_seeds(
+                pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID, anyone
+            )
         if err is not None and anyone and tg.ok(err[0] * err[0], err[1] * err[1]):
             # the closed form's nearest solution, checked by the FK of its compiled call: the answer
-            return IKResult(ana[0], True, "success", err[0], err[1], 0, 0, "converged from an analytic seed",
-                            tg.mode, "analytic")
-    table = None      # seed-table entries, nearest first (made when needed)
+            return IKResult(
+                ana[0],
+                True,
+                "success",
+                err[0],
+                err[1],
+                0,
+                0,
+                "converged from an analytic seed",
+                tg.mode,
+                "analytic",
+            )
+    table = None  # seed-table entries, nearest first (made when needed)
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
     while True:
@@ -243,8 +323,18 @@ def solve_one(pb: Problem, tg: Target, seed):
             total_it += it
             attempts += 1
             if ths is not None:
-                return IKResult(ths, True, "success", math.sqrt(pe2), math.sqrt(re2), total_it, restarts,
-                                "converged from an analytic seed", tg.mode, tag)
+                return IKResult(
+                    ths,
+                    True,
+                    "success",
+                    math.sqrt(pe2),
+                    math.sqrt(re2),
+                    total_it,
+                    restarts,
+                    "converged from an analytic seed",
+                    tg.mode,
+                    tag,
+                )
         ths, ok, it, pe2, re2, bq, bE = pb.attempt(ws, tg, th, deadline)
         total_it += it
         attempts += 1
@@ -267,8 +357,15 @@ def solve_one(pb: Problem, tg: Target, seed):
             return IKResult(ths, True, "success", pe, re, total_it, restarts, msg, tg.mode, tag)
         if out_of_reach and attempts >= 3:
             break
-        if pb.analytic == "auto" and ana is None and not out_of_reach and attempts >= ANALYTIC_AFTER:
-            ana, note, _ = analytic_seeds(pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID)
+        if (
+            pb.analytic == "auto"
+            and ana is None
+            and not out_of_reach
+            and attempts >= ANALYTIC_AFTER
+        ):
+            ana, note, _ = analytic_seeds(
+                pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID
+            )
         if clock() > deadline or (pb.max_restarts is not None and restarts >= pb.max_restarts):
             break
     th = best_q if best_q is not None else th
@@ -277,11 +374,15 @@ def solve_one(pb: Problem, tg: Target, seed):
         status, why = "out_of_reach", out_of_reach
     else:
         status = "not_converged"
-        why = (f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
-               f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, "
-               f"{(clock() - t0) * 1e3:.1f} ms CPU (max_time {max_time * 1e3:g} ms); the target is probably "
-               "outside the joint-limited workspace")
-    msg = f"{why}; closest pose found: pos_err {pe:.3g} m, rot_err {re:.3g} rad" + (f"; {note}" if note else "")
+        why = (
+            f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
+            f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, "
+            f"{(clock() - t0) * 1e3:.1f} ms CPU (max_time {max_time * 1e3:g} ms); the target is probably "
+            "outside the joint-limited workspace"
+        )
+    msg = f"{why}; closest pose found: pos_err {pe:.3g} m, rot_err {re:.3g} rad" + (
+        f"; {note}" if note else ""
+    )
     return IKResult(th, False, status, pe, re, total_it, restarts, msg, tg.mode, tag)
 
 
@@ -302,9 +403,17 @@ def _settle_swivel(pb, tg, ths, pe, re, msg):
         for cand in S:
             pe_c, re_c = tg.errors(ws, cand)
             if tg.ok(pe_c * pe_c, re_c * re_c):
-                return cand, pe_c, re_c, "analytic", "converged from an analytic seed at the requested swivel angle"
-    msg += (f"; swivel angle off by {off:.3g} rad: not reachable along this solution's self-motion within the "
-            f"joint limits{tried} (the hand pose is exact)")
+                return (
+                    cand,
+                    pe_c,
+                    re_c,
+                    "analytic",
+                    "converged from an analytic seed at the requested swivel angle",
+                )
+    msg += (
+        f"; swivel angle off by {off:.3g} rad: not reachable along this solution's self-motion within the "
+        f"joint limits{tried} (the hand pose is exact)"
+    )
     return ths, pe, re, "", msg
 
 
@@ -341,10 +450,14 @@ def solve_lockstep(pb: Problem, tgs, seeds):
     best = np.full(N, np.inf)
     stall = np.zeros(N, dtype=int)
     converged = np.zeros(N, dtype=bool)
-    max_attempts = LOCKSTEP_ATTEMPTS if pb.max_restarts is None else min(LOCKSTEP_ATTEMPTS, int(pb.max_restarts) + 1)
+    max_attempts = (
+        LOCKSTEP_ATTEMPTS
+        if pb.max_restarts is None
+        else min(LOCKSTEP_ATTEMPTS, int(pb.max_restarts) + 1)
+    )
     active = np.arange(N)
     while active.size:
-        for k in active:                      # Pinocchio: one call per target
+        for k in active:  # Pinocchio: one call per target
             tg = tgs[k]
             E[k], EE[k], PE2[k], RE2[k] = tg.residual(ws, Th[k])
             OK[k] = tg.ok(PE2[k], RE2[k])
@@ -366,7 +479,7 @@ def solve_lockstep(pb: Problem, tgs, seeds):
         if ended.any():
             ek = active[ended]
             retry = ek[attempts[ek] < max_attempts]
-            for k in retry:                   # next seed: the next table entry, then random
+            for k in retry:  # next seed: the next table entry, then random
                 if tables[k] is None:
                     tables[k] = TableSeeds(ws, tgs[k], pb.th_ref)
                 th = tables[k].next()
@@ -375,11 +488,11 @@ def solve_lockstep(pb: Problem, tgs, seeds):
             att_it[retry] = 0
             stall[retry] = 0
             best[retry] = np.inf
-            stepping = active[~ended]          # retried targets are evaluated first, next round
+            stepping = active[~ended]  # retried targets are evaluated first, next round
             active = np.concatenate([stepping, retry])
         if stepping.size:
             Tn = damped_step(ws, Th[stepping], J[stepping], E[stepping], damping(EE[stepping]))
-            if Tn is None:                    # a singular system: hand those targets over
+            if Tn is None:  # a singular system: hand those targets over
                 active = np.setdiff1d(active, stepping)
                 continue
             Th[stepping] = Tn
@@ -389,8 +502,20 @@ def solve_lockstep(pb: Problem, tgs, seeds):
         tg = tgs[k]
         if converged[k] and pb.th_ref is None and pb.swivel is None:
             tag = ("q0" if seeds[k] is not None else "table") if restarts == 0 else "restart"
-            results.append(IKResult(Th[k].copy(), True, "success", math.sqrt(PE2[k]), math.sqrt(RE2[k]),
-                                    int(its[k]), restarts, f"converged from {_article(tag)} {tag} seed (batch)", tg.mode, tag))
+            results.append(
+                IKResult(
+                    Th[k].copy(),
+                    True,
+                    "success",
+                    math.sqrt(PE2[k]),
+                    math.sqrt(RE2[k]),
+                    int(its[k]),
+                    restarts,
+                    f"converged from {_article(tag)} {tag} seed (batch)",
+                    tg.mode,
+                    tag,
+                )
+            )
             continue
         # a redundant arm's null-space phase, or stalled LOCKSTEP_ATTEMPTS times: the one-target solver
         r = solve_one(pb, tg, Th[k] if converged[k] else seeds[k])

@@ -44,10 +44,10 @@ except ImportError:  # numpy < 2
     except ImportError:  # pragma: no cover - a NumPy without the ufunc: the public wrapper
         uclip = np.clip
 
-LAMBDA0 = 1e-10   # floor of the damping (keeps JJᵀ + λI positive definite at singularities)
-K_DAMP = 0.01     # λ grows with the squared error: large errors -> short, gradient-like steps
-MAX_ITER = 60     # iterations per attempt (before the stall test ends it earlier)
-STALL = 3         # an attempt ends after STALL iterations without a 10 % error decrease
+LAMBDA0 = 1e-10  # floor of the damping (keeps JJᵀ + λI positive definite at singularities)
+K_DAMP = 0.01  # λ grows with the squared error: large errors -> short, gradient-like steps
+MAX_ITER = 60  # iterations per attempt (before the stall test ends it earlier)
+STALL = 3  # an attempt ends after STALL iterations without a 10 % error decrease
 
 #: The budget ``max_time`` is CPU time of the calling thread: on a busy machine a wall-clock
 #: budget turns into failures that depend on the load; with a CPU-time budget (and the fixed
@@ -74,8 +74,8 @@ def solve_damped(ws, J, e, lam, step=True):
         m = len(J)
         if m <= ws.n or not step:
             A, AF, Ad = ws.lin[m]
-            J.dot(J.T, out=A)             # the method: np.dot goes through a Python dispatcher
-            Ad += lam                     # the diagonal of A (a view)
+            J.dot(J.T, out=A)  # the method: np.dot goes through a Python dispatcher
+            Ad += lam  # the diagonal of A (a view)
             x, info = dposv(AF, e, overwrite_a=1)[1:]
             return None if info else (x.dot(J) if step else x)
         A, AF, Ad = ws.lin[ws.n]
@@ -109,7 +109,7 @@ def damped_step(ws, th, J, e, lam):
     lo, hi = ws.lo, ws.hi
     tn = th + dq
     tc = uclip(tn, lo, hi)
-    if tc.tobytes() != tn.tobytes():   # (byte comparison: ~20× cheaper than (tc != tn).any())
+    if tc.tobytes() != tn.tobytes():  # (byte comparison: ~20× cheaper than (tc != tn).any())
         # active set: the joints the step pushes past a limit stay where they are, the others
         # take the step recomputed without them, then it is clipped
         dq = solve_damped(ws, J * (tc == tn)[..., None, :], e, lam)
@@ -143,7 +143,9 @@ def attempt(ws, tg, th, deadline):
             stall += 1
             if stall >= STALL:
                 break
-        if not it & 7 and clock() > deadline:  # every 8th iteration (~0.1 ms): the CPU clock costs ~1 µs
+        if (
+            not it & 7 and clock() > deadline
+        ):  # every 8th iteration (~0.1 ms): the CPU clock costs ~1 µs
             break
         tn = damped_step(ws, th, jacobian(ws), e, LAMBDA0 + K_DAMP * E)
         if tn is None:

@@ -20,9 +20,9 @@ from scipy.linalg.lapack import dpotrs
 from ..qp.tasks.swivel import swivel_from_points
 from .kernel import clock, damping, solve_damped, uclip
 
-NULL_TOL = 1e-4   # posture / swivel secondary step norm (rad) under which it has settled
-NULL_EXTRA = 60   # extra iterations allowed for the secondary objective
-NULL_STEP = 1.0   # longest null-space step (rad)
+NULL_TOL = 1e-4  # posture / swivel secondary step norm (rad) under which it has settled
+NULL_EXTRA = 60  # extra iterations allowed for the secondary objective
+NULL_STEP = 1.0  # longest null-space step (rad)
 SECANT_RANGE = (0.1, 10.0)  # accepted curvature estimates of the secant null-space step
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -52,7 +52,7 @@ def posture(ws, tg, th, th_ref, deadline):
     good = None
     gpe2 = gre2 = math.inf
     it = 0
-    p_prev = None     # last null-space direction (unnormalised) and its g, s
+    p_prev = None  # last null-space direction (unnormalised) and its g, s
     g_prev = s_prev = 0.0
     h = 1.0
     residual, jacobian = tg.residual, tg.jacobian
@@ -68,16 +68,16 @@ def posture(ws, tg, th, th_ref, deadline):
         lam = damping(E)
         frozen = None
         while True:
-            x = solve_damped(ws, J, e, lam, step=False)     # AF now holds the Cholesky factor
+            x = solve_damped(ws, J, e, lam, step=False)  # AF now holds the Cholesky factor
             if x is None:
                 return good, gpe2, gre2, it
             dq = x.dot(J)
-            z = th_ref - th        # N (θ_ref − θ − Δθ) = N (θ_ref − θ) + O(λ): Δθ lies in the row space
+            z = th_ref - th  # N (θ_ref − θ − Δθ) = N (θ_ref − θ) + O(λ): Δθ lies in the row space
             if wrap is not None:
                 z[wrap] = (z[wrap] + math.pi) % (2.0 * math.pi) - math.pi
             if frozen is not None:
                 z[frozen] = 0.0
-            p = z - dpotrs(AF, J.dot(z))[0].dot(J)     # N z: projection on the null space
+            p = z - dpotrs(AF, J.dot(z))[0].dot(J)  # N z: projection on the null space
             g = math.sqrt(p.dot(p))
             if one_dim and frozen is None and g > 0.0:
                 # secant step along t = p/g: g = tᵀ(θ_ref − θ) is minus the derivative of the cost
@@ -96,36 +96,42 @@ def posture(ws, tg, th, th_ref, deadline):
             else:
                 s = 0.0
                 n2 = g
-                tn = th + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))  # long moves leave the linearisation
+                tn = (
+                    th + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))
+                )  # long moves leave the linearisation
             tc = uclip(tn, lo, hi)
             if frozen is not None or tc.tobytes() == tn.tobytes():
                 break
-            out = (tc != tn) & ((th == lo) | (th == hi))   # at a limit and pushed past it
+            out = (tc != tn) & ((th == lo) | (th == hi))  # at a limit and pushed past it
             if not out.any():
                 # the null-space move crosses a limit: shorten it so that the first joint to
                 # cross stops on its limit (clipping the whole step would spoil the pose)
                 step = tn - th - dq
                 base = th + dq
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    sig = np.where(step > 0.0, (hi - base) / step, np.where(step < 0.0, (lo - base) / step, np.inf))
+                    sig = np.where(
+                        step > 0.0,
+                        (hi - base) / step,
+                        np.where(step < 0.0, (lo - base) / step, np.inf),
+                    )
                 sig = min(max(float(sig.min()), 0.0), 1.0)
                 tn = base + sig * step
                 s *= sig
                 n2 *= sig
                 tc = uclip(tn, lo, hi)
                 break
-            frozen = out                       # active set: freeze, recompute once
+            frozen = out  # active set: freeze, recompute once
             J = J * ~out
         if ok and n2 < NULL_TOL:
             break
         if s != 0.0:
             clipped = tc.tobytes() != tn.tobytes()
-            s_prev = p.dot(tc - th) / g if clipped else s   # the move made along t = p/g
+            s_prev = p.dot(tc - th) / g if clipped else s  # the move made along t = p/g
             if ok and clipped and abs(s_prev) < 0.1 * n2:
-                break   # a joint limit blocks the self-motion: constrained optimum
-            p_prev, g_prev = (p if g > 0.0 else -p), g     # p_prev oriented like t
+                break  # a joint limit blocks the self-motion: constrained optimum
+            p_prev, g_prev = (p if g > 0.0 else -p), g  # p_prev oriented like t
         else:
-            p_prev = None                      # the secant memory is void after a frozen step
+            p_prev = None  # the secant memory is void after a frozen step
         th = tc
     else:
         pe, re = tg.errors(ws, th)
@@ -157,7 +163,7 @@ class Swivel:
             j += g @ pin.getFrameJacobian(model, data, i, LWA)[:3]
         d = self.target - phi
         d = math.atan2(math.sin(d), math.cos(d))
-        nj = j - J.T @ dpotrs(cfac, J @ j)[0]          # N jᵀ
+        nj = j - J.T @ dpotrs(cfac, J @ j)[0]  # N jᵀ
         den = float(j @ nj) + 1e-9
         return nj * ((d - float(j @ dq1)) / den)
 

@@ -25,13 +25,13 @@ from ..geometric import NO_REF
 from ..vec3 import WRAP_MAX
 from .targets import POSE
 
-SEED_TABLE = 2048       # configurations in the per-(robot, frame) seed table
+SEED_TABLE = 2048  # configurations in the per-(robot, frame) seed table
 SEED_TABLE_RNG = 20231  # its fixed RNG seed (the table, and so every answer, is reproducible)
 SEED_ROT_WEIGHT = 0.25  # w / reach in the seed distance ‖Δp‖² + w²‖ΔR‖²_F
 SEED_POSTURE_WEIGHT = 0.05  # w_q / reach: + w_q²‖θ − θ_ref‖² in that distance for posture problems
-TABLE_SEEDS = 8   # nearest table entries tried before uniform random restarts
-ALIGN_RANGE = np.pi   # first / last joints spanning at least a half turn are aligned (see Aligned; so101: median 10 % faster)
-ALIGN_WEIGHT = 0.25         # w / reach of the last joint's axis direction in the aligned table's distance
+TABLE_SEEDS = 8  # nearest table entries tried before uniform random restarts
+ALIGN_RANGE = np.pi  # first / last joints spanning at least a half turn are aligned (see Aligned; so101: median 10 % faster)
+ALIGN_WEIGHT = 0.25  # w / reach of the last joint's axis direction in the aligned table's distance
 #: swivel angles (rad) of a redundant arm's closed-form seeds: 16 (human_arm7, 100 random poses:
 #: the answer misses the member of the family nearest the comfortable posture on 2, median solve
 #: 0.24 ms; 24 angles: 2 and 0.28 ms; 12: 4 and 0.21 ms; 8: 7 and 0.20 ms)
@@ -67,8 +67,12 @@ def build_table(sh, data):
     G[:, 3, 3] = c
     Gpos = np.column_stack((-2.0 * P, c))
     Th.setflags(write=False)
-    return (Th, np.ascontiguousarray(G.reshape(K, 16).T), np.ascontiguousarray(Gpos.T),
-            np.ascontiguousarray(-H[:, :, :3].reshape(K, 9).T))
+    return (
+        Th,
+        np.ascontiguousarray(G.reshape(K, 16).T),
+        np.ascontiguousarray(Gpos.T),
+        np.ascontiguousarray(-H[:, :, :3].reshape(K, 9).T),
+    )
 
 
 def posture_penalty(sh, Th, th_ref):
@@ -97,8 +101,27 @@ class Aligned:
     (``Joint.axis``, joint frame).  An alignment outside a joint's range is wrapped by 2π or
     clipped."""
 
-    __slots__ = ("iq1", "iqn", "c1", "B", "Bc1", "an", "un", "vn", "AUV", "Fi", "G", "phi", "U", "V", "w", "lo1",
-                 "hi1", "lon", "hin")
+    __slots__ = (
+        "iq1",
+        "iqn",
+        "c1",
+        "B",
+        "Bc1",
+        "an",
+        "un",
+        "vn",
+        "AUV",
+        "Fi",
+        "G",
+        "phi",
+        "U",
+        "V",
+        "w",
+        "lo1",
+        "hi1",
+        "lon",
+        "hin",
+    )
 
     @classmethod
     def make(cls, sh, data, Th):
@@ -118,14 +141,16 @@ class Aligned:
         M1 = data.oMi[J1.index + 1]
         a1 = M1.rotation @ J1.axis
         self.c1 = M1.translation.copy()
-        self.B = np.array((*_perp(a1), a1))            # rows: world -> first-axis basis
+        self.B = np.array((*_perp(a1), a1))  # rows: world -> first-axis basis
         anl = np.asarray(Jn.axis)
         un, vn = _perp(anl)
         self.an, self.un, self.vn = anl, un, vn
         f = chain.frame(sh.fid)
         self.Fi = pin.SE3(f.rotation, f.translation).inverse()
         self.iq1, self.iqn = i1, i_n
-        self.lo1, self.hi1, self.lon, self.hin = (float(x) for x in (sh.lo[i1], sh.hi[i1], sh.lo[i_n], sh.hi[i_n]))
+        self.lo1, self.hi1, self.lon, self.hin = (
+            float(x) for x in (sh.lo[i1], sh.hi[i1], sh.lo[i_n], sh.hi[i_n])
+        )
         self.w = ALIGN_WEIGHT * max(sh.reach, 1e-3)
         self.AUV = np.column_stack((anl, un, vn))
         self.Bc1 = self.B @ self.c1
@@ -143,20 +168,34 @@ class Aligned:
             self.V.append(v)
         # score = |f|² − 2 f·x (+ |x|², the same for every entry), as one product G·(x, 1)
         f5 = feats[:, :5]
-        self.G = np.ascontiguousarray(np.column_stack((-2.0 * f5, (f5 * f5).sum(1))).T)   # (6, K)
-        self.phi = self.phi.tolist()   # plain floats: scalar arithmetic in seed() is cheaper
+        self.G = np.ascontiguousarray(np.column_stack((-2.0 * f5, (f5 * f5).sum(1))).T)  # (6, K)
+        self.phi = self.phi.tolist()  # plain floats: scalar arithmetic in seed() is cheaper
         return self
 
     def _canon(self, p, R):
         """Features (ρ, h, w z'), 1 of a joint-n frame (world position ``p``, rotation ``R``), its
         azimuth φ, and its uₙ, vₙ directions in the canonical frame (plain floats: 3-vectors
         cost less in Python than in NumPy)."""
-        (dx, dy, dh), (z, u, v) = (self.B.dot(p) - self.Bc1).tolist(), self.B.dot(R).dot(self.AUV).T.tolist()
+        (dx, dy, dh), (z, u, v) = (
+            (self.B.dot(p) - self.Bc1).tolist(),
+            self.B.dot(R).dot(self.AUV).T.tolist(),
+        )
         phi = math.atan2(dy, dx)
         co, si = math.cos(phi), math.sin(phi)
         w = self.w
-        return ((math.hypot(dx, dy), dh, w * (co * z[0] + si * z[1]), w * (co * z[1] - si * z[0]), w * z[2], 1.0), phi,
-                (co * u[0] + si * u[1], co * u[1] - si * u[0], u[2]), (co * v[0] + si * v[1], co * v[1] - si * v[0], v[2]))
+        return (
+            (
+                math.hypot(dx, dy),
+                dh,
+                w * (co * z[0] + si * z[1]),
+                w * (co * z[1] - si * z[0]),
+                w * z[2],
+                1.0,
+            ),
+            phi,
+            (co * u[0] + si * u[1], co * u[1] - si * u[0], u[2]),
+            (co * v[0] + si * v[1], co * v[1] - si * v[0], v[2]),
+        )
 
     def query(self, Ms):
         """(scores (K,), φ*, u*) of target ``Ms``: u* the canonical uₙ direction of its joint-n frame."""
@@ -170,7 +209,9 @@ class Aligned:
         i = self.iq1
         th[i] = _wrap(float(th[i]) + phi - self.phi[k], self.lo1, self.hi1)
         U, V = self.U[k], self.V[k]
-        d = math.atan2(V[0] * u[0] + V[1] * u[1] + V[2] * u[2], U[0] * u[0] + U[1] * u[1] + U[2] * u[2])
+        d = math.atan2(
+            V[0] * u[0] + V[1] * u[1] + V[2] * u[2], U[0] * u[0] + U[1] * u[1] + U[2] * u[2]
+        )
         i = self.iqn
         th[i] = _wrap(float(th[i]) + d, self.lon, self.hin)
         return th
@@ -263,14 +304,18 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
     none = np.zeros((0, sh.n))
     if tg.kind != POSE or not sh.has_closed_form:
         return none, "", None
-    angles = swivel if swivel is not None else grid     # the swivel angles of an SRS arm (None: default)
+    angles = (
+        swivel if swivel is not None else grid
+    )  # the swivel angles of an SRS arm (None: default)
     kw = {"swivel": angles} if sh.swivel_family and angles is not None else {}
     T = tg.H
     if sh.nearest_swivel is not None and th_ref is not None:
-        g = np.atleast_1d(np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float))
+        g = np.atleast_1d(
+            np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float)
+        )
         if (np.abs(g) < WRAP_MAX).all():
             one = sh.nearest_swivel(T, th_ref, g, any_solution)
-            if one is not None:                # one compiled call, nearest first
+            if one is not None:  # one compiled call, nearest first
                 return one[0], "", one[1:]
     try:
         prm, table = None, None
@@ -282,21 +327,21 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
             p = prm
             while True:
                 one = sh.nearest(T, ref, 0.0 if p is None else p)
-                if one is not None:            # one compiled call, nearest first
+                if one is not None:  # one compiled call, nearest first
                     return one[0], "", (None if one[1] is None else one[1:])
                 th = None if table is None else table.next()
                 if th is None:
                     break
-                p = float(th[sh.held])         # the held joint of the next-nearest table entry
+                p = float(th[sh.held])  # the held joint of the next-nearest table entry
         res = closed_form.analytic(robot, T, param=prm, frame=sh.fid) if prm is not None else None
         if res is None or not len(res):
             res = closed_form.analytic(robot, T, frame=sh.fid, **kw)
         S = sh.theta(np.asarray(res.solutions, dtype=float).reshape(-1, sh.nq))
-    except (ValueError, ArithmeticError, UnsupportedModelError) as exc:   # a seed source only
+    except (ValueError, ArithmeticError, UnsupportedModelError) as exc:  # a seed source only
         return none, f"analytic seed failed: {exc}", None
     if len(S) > 1:
         D = S - th_ref
         k = int((D * D).sum(1).argmin())
-        if k:                                  # nearest first (the order of the others matters little)
+        if k:  # nearest first (the order of the others matters little)
             S[[0, k]] = S[[k, 0]]
     return S, "", None

@@ -37,8 +37,23 @@ class Target:
     :meth:`anthroarm.ik.solve.seeds.build_table`).  A pose ``tgt`` is a rigid 4×4 float array
     (:func:`~anthroarm.ik.qp.targets.as_rigid`, not copied) or a ``pin.SE3``."""
 
-    __slots__ = ("kind", "mode", "m", "H", "_Ms", "ps", "Rs", "tol_p", "tol_r", "tp2", "tr2", "tsum", "x", "ref",
-                 "rows")
+    __slots__ = (
+        "kind",
+        "mode",
+        "m",
+        "H",
+        "_Ms",
+        "ps",
+        "Rs",
+        "tol_p",
+        "tol_r",
+        "tp2",
+        "tr2",
+        "tsum",
+        "x",
+        "ref",
+        "rows",
+    )
 
     def __init__(self, mode, tgt, tol_p, tol_r):
         self.mode = mode
@@ -137,7 +152,9 @@ def parse(T, mode):
         out = []
         for i, a in enumerate(arr if batch else [arr]):
             H = as_rigid(a, f"T[{i}]" if batch else "T")
-            out.append(H if m == "pose" else (H[:3, 3].copy() if m == "position" else H[:3, :3].copy()))
+            out.append(
+                H if m == "pose" else (H[:3, 3].copy() if m == "position" else H[:3, :3].copy())
+            )
         return m, batch, out
     if sh == (3,):
         if mode not in (None, "position"):
@@ -147,9 +164,17 @@ def parse(T, mode):
         if mode not in (None, "orientation"):
             raise ValueError(f"a 3x3 target is a rotation; mode={mode!r} needs a 4x4 pose")
         batch = arr.ndim == 3
-        return "orientation", batch, [as_rotation(a, f"T[{i}]" if batch else "T") for i, a in
-                                      enumerate(arr if batch else [arr])]
+        return (
+            "orientation",
+            batch,
+            [
+                as_rotation(a, f"T[{i}]" if batch else "T")
+                for i, a in enumerate(arr if batch else [arr])
+            ],
+        )
     if arr.ndim == 2 and sh[1] == 3 and mode in (None, "position"):
         return "position", True, [as_position(a, f"T[{i}]") for i, a in enumerate(arr)]
-    raise ValueError(f"target T must be a 4x4 pose, a position (3,), a rotation (3, 3), or a batch of them "
-                     f"with a leading axis; got shape {sh}" + (f" (mode={mode!r})" if mode else ""))
+    raise ValueError(
+        f"target T must be a 4x4 pose, a position (3,), a rotation (3, 3), or a batch of them "
+        f"with a leading axis; got shape {sh}" + (f" (mode={mode!r})" if mode else "")
+    )

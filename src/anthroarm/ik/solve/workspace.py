@@ -22,11 +22,11 @@ import numpy as np
 import pinocchio as pin
 
 from ...chain import CONTINUOUS, PRISMATIC
-from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from .. import closed_form
+from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from . import seeds
 
-_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # Robot -> {frame id: Shared}
+_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # Robot -> {frame id: Shared}
 
 
 class Shared:
@@ -65,7 +65,7 @@ class Shared:
         for i in chain.path(fid):
             j = chain.joints[i]
             self.on_path[v_of[j.mimic.source if j.is_mimic else i]] = True
-        self.dof = int(self.on_path.sum())   # joints that move the frame
+        self.dof = int(self.on_path.sum())  # joints that move the frame
         self.reach = chain.reach(fid)
         self.ref = self.theta(comfortable_posture(robot))
         self.ref.setflags(write=False)
@@ -76,17 +76,23 @@ class Shared:
         info = closed_form.closed_form_info(robot, fid)
         self.has_closed_form = info is not None
         self.swivel_family = bool(info is not None and info.swivel)
-        self.held = closed_form.held_joint(robot, fid)     # θ index of a 7-joint arm's held joint
+        self.held = closed_form.held_joint(robot, fid)  # θ index of a 7-joint arm's held joint
         self.closed_form_first = seeds.closed_form_cheap(robot, fid)
-        self.nearest = closed_form.nearest_solver(robot, fid)   # closed-form seeds in one call, or None
-        self.nearest_swivel = closed_form.nearest_swivel_solver(robot, fid)   # the same for an SRS arm
+        self.nearest = closed_form.nearest_solver(
+            robot, fid
+        )  # closed-form seeds in one call, or None
+        self.nearest_swivel = closed_form.nearest_swivel_solver(
+            robot, fid
+        )  # the same for an SRS arm
         self.all_on_path = bool(self.on_path.all())
         self.local = threading.local()
         self._lock = threading.Lock()
         self._table = None
         self._aligned = None
         self._penalty = {}
-        self.ckernel = None   # the compiled attempt kernel (ckernel.kernel_for), False if unavailable
+        self.ckernel = (
+            None  # the compiled attempt kernel (ckernel.kernel_for), False if unavailable
+        )
 
     def theta(self, q) -> np.ndarray:
         """θ (n,) or (N, n) of a configuration q in Pinocchio's layout (a copy)."""
@@ -138,7 +144,9 @@ class _Configuration:
     def __init__(self, chain):
         self.chain, self.nq = chain, chain.nq
         ind = [chain.joints[i] for i in chain.independent]
-        self.lin = [(j.idx_q, v) for v, j in enumerate(ind) if j.kind != CONTINUOUS]    # (q index, θ index)
+        self.lin = [
+            (j.idx_q, v) for v, j in enumerate(ind) if j.kind != CONTINUOUS
+        ]  # (q index, θ index)
         self.cont = [(j.idx_q, v) for v, j in enumerate(ind) if j.kind == CONTINUOUS]
 
     def __call__(self, th):
@@ -163,11 +171,18 @@ class Workspace:
 
     def __init__(self, sh: Shared):
         self.sh = sh
-        self.model, self.fid, self.n, self.lo, self.hi, self.to_q = sh.model, sh.fid, sh.n, sh.lo, sh.hi, sh.to_q
+        self.model, self.fid, self.n, self.lo, self.hi, self.to_q = (
+            sh.model,
+            sh.fid,
+            sh.n,
+            sh.lo,
+            sh.hi,
+            sh.to_q,
+        )
         self.data = sh.model.createData()
-        self.cbuf = None    # the compiled kernel's buffers (ckernel.ready)
-        self.lin = {}   # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
-        for m in {3, 6, min(sh.n, 6)}:      # and n × n for an arm with fewer joints than the task
+        self.cbuf = None  # the compiled kernel's buffers (ckernel.ready)
+        self.lin = {}  # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
+        for m in {3, 6, min(sh.n, 6)}:  # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
             self.lin[m] = (A, A.T, A.reshape(-1)[:: m + 1])
 
@@ -181,7 +196,9 @@ class Workspace:
         return self.sh.posture_penalty(self.data, q_ref)
 
     def fk(self, th) -> pin.SE3:
-        pin.framesForwardKinematics(self.model, self.data, th if self.to_q is None else self.to_q(th))
+        pin.framesForwardKinematics(
+            self.model, self.data, th if self.to_q is None else self.to_q(th)
+        )
         return self.data.oMf[self.fid]
 
 

@@ -21,7 +21,7 @@ class Limit:
     (acceleration) record the velocity that was applied."""
 
     priority: float = 1.5
-    _box_finite = False   # set by _box_into when the box it returned is finite everywhere
+    _box_finite = False  # set by _box_into when the box it returned is finite everywhere
 
     def box(self, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - interface
         raise NotImplementedError
@@ -96,9 +96,9 @@ def combine_into(limits, conf, dt: float, ws) -> None:
         finite = finite or lim._box_finite
     else:
         if not first:
-            if not finite:     # a finite box in the intersection bounds B below already
+            if not finite:  # a finite box in the intersection bounds B below already
                 np.maximum(B, -BIG, out=B)
-            if B[B.argmax()] <= 0.0:           # 0 inside the box (False for NaN: argmax finds it)
+            if B[B.argmax()] <= 0.0:  # 0 inside the box (False for NaN: argmax finds it)
                 np.negative(ws.mhi, out=ws.hi)
                 return
     lo, hi = combine(limits, conf, dt)

@@ -33,12 +33,16 @@ class ConfigurationLimit(Limit):
         self.lower = np.array(chain.lower if lower is None else lower, dtype=float)
         self.upper = np.array(chain.upper if upper is None else upper, dtype=float)
         if self.lower.shape != (robot.nq,) or self.upper.shape != (robot.nq,):
-            raise ValueError(f"lower/upper must have shape ({robot.nq},) (q entries {list(chain.q_names)})")
+            raise ValueError(
+                f"lower/upper must have shape ({robot.nq},) (q entries {list(chain.q_names)})"
+            )
         if np.isnan(self.lower).any() or np.isnan(self.upper).any():
             raise ValueError("lower/upper limits contain NaN (use inf for a side without a limit)")
         if np.any(self.lower > self.upper):
-            raise ValueError("lower limit above upper limit for joints "
-                             f"{[n for n, a, b in zip(chain.q_names, self.lower, self.upper) if a > b]}")
+            raise ValueError(
+                "lower limit above upper limit for joints "
+                f"{[n for n, a, b in zip(chain.q_names, self.lower, self.upper) if a > b]}"
+            )
         # map every velocity index of a joint with a range to its configuration index; the
         # others (continuous joints) have no position limit here
         qidx = np.full(robot.nv, -1)
@@ -51,21 +55,23 @@ class ConfigurationLimit(Limit):
         self._lo = np.where(self._fin_lo, self.lower[self._qidx], -np.inf)
         self._hi = np.where(self._fin_hi, self.upper[self._qidx], np.inf)
         self._identity = bool(np.all(self._qidx == np.arange(robot.nv))) and robot.nq == robot.nv
-        self._L2 = np.stack([self._lo, -self._hi])     # [q_min; −q_max] for _box_into
+        self._L2 = np.stack([self._lo, -self._hi])  # [q_min; −q_max] for _box_into
         self._sign2 = np.array([[1.0], [-1.0]])
-        self._scaled_for = None                        # gain of the cached gain·_L2, gain·_sign2
+        self._scaled_for = None  # gain of the cached gain·_L2, gain·_sign2
 
     def box(self, conf, dt):
         q = conf.q if self._identity else conf.q[self._qidx]
         # inf - q stays inf: unbounded joints give an unbounded side
         lo = self.gain * (self._lo - q)
         hi = self.gain * (self._hi - q)
-        if np.maximum.reduce(lo) > 0.0 or np.minimum.reduce(hi) < 0.0:  # a joint is outside its range
+        if (
+            np.maximum.reduce(lo) > 0.0 or np.minimum.reduce(hi) < 0.0
+        ):  # a joint is outside its range
             above = q > self._hi
             below = q < self._lo
             # outside the range: ask for the whole way back (gain 1), landing a hair inside so
             # that rounding in q + Δq cannot leave it outside; velocity limits cap the speed
-            with np.errstate(invalid="ignore"):   # inf − inf on unbounded joints, masked out
+            with np.errstate(invalid="ignore"):  # inf − inf on unbounded joints, masked out
                 hi = np.where(above, (self._hi - q) - 1e-12 * (1.0 + np.abs(self._hi)), hi)
                 lo = np.where(below, (self._lo - q) + 1e-12 * (1.0 + np.abs(self._lo)), lo)
         return lo, hi

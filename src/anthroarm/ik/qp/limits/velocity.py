@@ -15,15 +15,20 @@ class VelocityLimit(Limit):
     priority = 0
 
     def __init__(self, robot, v_max=None):
-        v = np.array(robot.chain.velocity_limit if v_max is None else np.broadcast_to(v_max, (robot.nv,)), dtype=float)
+        v = np.array(
+            robot.chain.velocity_limit if v_max is None else np.broadcast_to(v_max, (robot.nv,)),
+            dtype=float,
+        )
         if v.shape != (robot.nv,):
             raise ValueError(f"v_max must have shape ({robot.nv},), got {v.shape}")
         if np.isnan(v).any():
             raise ValueError("v_max contains NaN")
         if v_max is not None and np.any(v < 0):
-            raise ValueError(f"v_max must be >= 0 (0 or inf: no limit on that joint), got {np.asarray(v_max).tolist()}")
+            raise ValueError(
+                f"v_max must be >= 0 (0 or inf: no limit on that joint), got {np.asarray(v_max).tolist()}"
+            )
         self.v_max = np.where(np.isfinite(v) & (v > 0), v, np.inf)
-        self.v_max.setflags(write=False)   # replace it (lim.v_max = ...) rather than edit it
+        self.v_max.setflags(write=False)  # replace it (lim.v_max = ...) rather than edit it
         self._cached = (None, None, None)  # (v_max, dt, [−v dt; −v dt]) of the last _box_into
 
     def box(self, conf, dt):

@@ -115,9 +115,14 @@ class FrameAxesTask(Task):
     ``UnknownFrameError`` listing the frames), a cost that is a scalar or a 3-vector, and an
     optional target passed to the subclass's ``set_target``."""
 
-    def __init__(self, robot, frame=None, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0, target=None):
-        super().__init__(cost=np.broadcast_to(np.asarray(cost, dtype=float), (3,)).copy(), gain=gain,
-                         lm_damping=lm_damping)
+    def __init__(
+        self, robot, frame=None, cost=1.0, gain: float = 1.0, lm_damping: float = 0.0, target=None
+    ):
+        super().__init__(
+            cost=np.broadcast_to(np.asarray(cost, dtype=float), (3,)).copy(),
+            gain=gain,
+            lm_damping=lm_damping,
+        )
         self.frame_id = robot.frame_id(frame)
         self.frame = robot.chain.frame(self.frame_id).name
         self.target = None
@@ -129,6 +134,7 @@ class FrameAxesTask(Task):
 
     def _require_target(self):
         if self.target is None:
-            raise ValueError(f"{type(self).__name__}({self.frame!r}): no target set (call set_target)")
+            raise ValueError(
+                f"{type(self).__name__}({self.frame!r}): no target set (call set_target)"
+            )
         return self.target
-

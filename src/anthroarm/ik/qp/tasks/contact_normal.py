@@ -61,10 +61,20 @@ class ContactNormalTask(FrameAxesTask):
         Target direction in world axes (normalised).
     """
 
-    def __init__(self, robot, frame=None, axis=(0.0, 0.0, 1.0), cost=1.0, gain: float = 1.0,
-                 lm_damping: float = 0.0, target=None):
+    def __init__(
+        self,
+        robot,
+        frame=None,
+        axis=(0.0, 0.0, 1.0),
+        cost=1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+        target=None,
+    ):
         self.axis = unit_vector(axis, "ContactNormalTask axis")
-        super().__init__(robot, frame=frame, cost=cost, gain=gain, lm_damping=lm_damping, target=target)
+        super().__init__(
+            robot, frame=frame, cost=cost, gain=gain, lm_damping=lm_damping, target=target
+        )
 
     def __repr__(self) -> str:
         return f"ContactNormalTask({self.frame!r}, axis={self.axis.tolist()}, cost={self.cost.tolist()})"

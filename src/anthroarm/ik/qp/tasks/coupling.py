@@ -26,21 +26,33 @@ def _joint_index(robot, name: str) -> int:
         raise ValueError(f"{robot.name}: unknown joint {name!r}; joints: {', '.join(names)}")
     j = chain.joint(name)
     if j.nv != 1:
-        raise ValueError(f"{robot.name}: joint {name!r} is a mimic joint (it has no velocity of its own: "
-                         f"Pinocchio moves it with {chain.joints[j.mimic.source].name!r}); couple that joint instead")
+        raise ValueError(
+            f"{robot.name}: joint {name!r} is a mimic joint (it has no velocity of its own: "
+            f"Pinocchio moves it with {chain.joints[j.mimic.source].name!r}); couple that joint instead"
+        )
     return j.idx_v
 
 
 class JointCouplingTask(Task):
     """Σ ratios[j] q[joints[j]] = offset, as a soft task (cost) or a hard constraint."""
 
-    def __init__(self, robot, joints, ratios, offset: float = 0.0, cost=1.0, gain: float = 1.0,
-                 lm_damping: float = 0.0):
+    def __init__(
+        self,
+        robot,
+        joints,
+        ratios,
+        offset: float = 0.0,
+        cost=1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+    ):
         super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
         joints = list(joints)
         ratios = np.asarray(ratios, dtype=float)
         if len(joints) != len(ratios) or len(joints) == 0:
-            raise ValueError(f"need one ratio per joint, got {len(joints)} joints and {len(ratios)} ratios")
+            raise ValueError(
+                f"need one ratio per joint, got {len(joints)} joints and {len(ratios)} ratios"
+            )
         if not np.isfinite(ratios).all() or not np.isfinite(offset):
             raise ValueError("ratios and offset must be finite")
         self.joints = joints
@@ -55,7 +67,9 @@ class JointCouplingTask(Task):
         return f"JointCouplingTask({terms} = {self.offset:g}, cost={self.cost})"
 
     @classmethod
-    def mimic(cls, robot, joint: str, mimicked: str, multiplier: float = 1.0, offset: float = 0.0, **kw):
+    def mimic(
+        cls, robot, joint: str, mimicked: str, multiplier: float = 1.0, offset: float = 0.0, **kw
+    ):
         """q_joint = multiplier · q_mimicked + offset (URDF ``<mimic>`` semantics)."""
         return cls(robot, [joint, mimicked], [1.0, -float(multiplier)], offset=offset, **kw)
 

@@ -22,7 +22,9 @@ class DampingTask(Task):
 
     def compute_qp_objective(self, conf):  # the returned H is a fresh array (may be modified)
         w = self.cost
-        return np.diag(np.broadcast_to(np.asarray(w, float) ** 2, (conf.nv,)).astype(float)), np.zeros(conf.nv)
+        return np.diag(
+            np.broadcast_to(np.asarray(w, float) ** 2, (conf.nv,)).astype(float)
+        ), np.zeros(conf.nv)
 
     def _accumulate(self, conf, ws, first):
         # H += diag(w²), c unchanged

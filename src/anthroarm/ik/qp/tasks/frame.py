@@ -23,15 +23,23 @@ from .base import Task
 class FrameTask(Task):
     """Pose task on ``frame`` (name or id; default the robot's tool)."""
 
-    def __init__(self, robot, frame=None, position_cost=1.0, orientation_cost=1.0, gain: float = 1.0,
-                 lm_damping: float = 0.0, target=None):
+    def __init__(
+        self,
+        robot,
+        frame=None,
+        position_cost=1.0,
+        orientation_cost=1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+        target=None,
+    ):
         pc = np.broadcast_to(np.asarray(position_cost, dtype=float), (3,))
         oc = np.broadcast_to(np.asarray(orientation_cost, dtype=float), (3,))
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
         self.frame_id = robot.frame_id(frame)
         self.frame = robot.chain.frame(self.frame_id).name
         self._nv = robot.nv
-        self._w_cost = None           # the cost array and gain the cached weights belong to
+        self._w_cost = None  # the cost array and gain the cached weights belong to
         self._w_gain = None
         self._weights()
         self.target: pin.SE3 | None = None
@@ -79,7 +87,7 @@ class FrameTask(Task):
             self._wcol = w[:, None].copy()
             self._wg = w * self.gain
             uniform = bool(np.all(w == w[0]))
-            self._w1 = float(w[0]) if uniform else None          # scalar weight, or None
+            self._w1 = float(w[0]) if uniform else None  # scalar weight, or None
             self._nwg1 = -float(w[0]) * self.gain if uniform else None
             self._nwg = -self._wg
             WJ = np.empty((6, self._nv))
@@ -93,7 +101,7 @@ class FrameTask(Task):
         if T_t is None:
             self._require_target()
         self._weights()
-        X = conf.frame_placement(self.frame_id).actInv(T_t)          # T_b⁻¹ T_t
+        X = conf.frame_placement(self.frame_id).actInv(T_t)  # T_b⁻¹ T_t
         e = pin.log6(X).vector
         WJ = self._wcol * (pin.Jlog6(X.inverse()) @ conf.frame_jacobian(self.frame_id, LOCAL))
         We = self._wg * e
@@ -115,7 +123,7 @@ class FrameTask(Task):
             self._weights()
         model, data, fid = conf.model, conf.data, self.frame_id
         # kinematics are current (IKConfiguration.update / integrate_inplace computed them)
-        X = pin.updateFramePlacement(model, data, fid).actInv(T_t)          # T_b⁻¹ T_t
+        X = pin.updateFramePlacement(model, data, fid).actInv(T_t)  # T_b⁻¹ T_t
         WJ, WJt, Ht, ct = self._buf
         pin.Jlog6(X.inverse()).dot(pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ)
         w = self._w1
@@ -127,8 +135,8 @@ class FrameTask(Task):
             if w != 1.0:
                 np.multiply(WJ, w, out=WJ)
             if self._nwg1 == -1.0:
-                nWe = (-pin.log6(X)).vector           # −αW e with αW = 1 (negation is exact)
+                nWe = (-pin.log6(X)).vector  # −αW e with αW = 1 (negation is exact)
             else:
                 e = pin.log6(X).vector
-                nWe = np.multiply(e, self._nwg1, out=e)   # −αW e
+                nWe = np.multiply(e, self._nwg1, out=e)  # −αW e
         return self._add_weighted_least_squares(ws, first, WJ, WJt, nWe, Ht, ct)

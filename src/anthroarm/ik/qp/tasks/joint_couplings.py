@@ -55,9 +55,9 @@ class JointCouplingsTask(Task):
         if type(self) is not JointCouplingsTask:
             return Task._accumulate(self, conf, ws, first)
         if self._key is None or self._key[0] is not self.cost or self._key[1] != self.gain:
-            W2 = self.cost ** 2
+            W2 = self.cost**2
             self._H = self.A.T @ (W2[:, None] * self.A)
-            self._AtW2a = self.A.T * (W2 * self.gain)               # α AᵀW², (nv, K)
+            self._AtW2a = self.A.T * (W2 * self.gain)  # α AᵀW², (nv, K)
             self._key = (self.cost, self.gain)
         e = self.A @ self._theta(conf) - self.b
         if first:

@@ -34,7 +34,7 @@ def moved_by(chain, joints) -> np.ndarray:
         while i >= 0:
             jt = chain.joints[i]
             src = chain.joints[jt.mimic.source] if jt.is_mimic else jt
-            out[k, src.idx_v:src.idx_v + src.nv] = True
+            out[k, src.idx_v : src.idx_v + src.nv] = True
             i = jt.parent
     return out
 
@@ -54,7 +54,9 @@ class MarkerTask(Task):
         w_k ≥ 0 (default 1); the rows of marker k get cost √w_k.
     """
 
-    def __init__(self, robot, joints, local, weights=None, gain: float = 1.0, lm_damping: float = 0.0):
+    def __init__(
+        self, robot, joints, local, weights=None, gain: float = 1.0, lm_damping: float = 0.0
+    ):
         joints = np.asarray(joints, dtype=int)
         local = np.asarray(local, dtype=float)
         M = joints.shape[0]
@@ -72,14 +74,18 @@ class MarkerTask(Task):
         self.target = np.zeros((M, 3))
         self.visible = np.ones(M, dtype=bool)
         self._bodies = [int(b) for b in np.unique(joints) if b >= 0]
-        self._gidx = np.array([self._bodies.index(int(j)) if j >= 0 else 0 for j in joints], dtype=int)
+        self._gidx = np.array(
+            [self._bodies.index(int(j)) if j >= 0 else 0 for j in joints], dtype=int
+        )
         self._fixed = np.flatnonzero(joints < 0)
         self._mask = moved_by(robot.chain, joints).astype(float)
-        self._R = np.zeros((max(len(self._bodies), 1), 3, 3))     # one slot when every marker is on the base
+        self._R = np.zeros(
+            (max(len(self._bodies), 1), 3, 3)
+        )  # one slot when every marker is on the base
         self._o = np.zeros((max(len(self._bodies), 1), 3))
         self._p = np.zeros((M, 3))
         self._J = np.zeros((M, 3, self.nv))
-        self._for = (None, b"")          # (configuration, its q's bytes) the cache below was computed for
+        self._for = (None, b"")  # (configuration, its q's bytes) the cache below was computed for
 
     def set_target(self, positions, visible=None) -> None:
         """Measured positions (M, 3), m, world frame.  Rows that are NaN, or False in
@@ -98,7 +104,7 @@ class MarkerTask(Task):
         # one pass: the bodies' placements, then every marker at once from the world-frame joint
         # Jacobian of computeJointJacobians (data.J: column v = (v_O; ω) of joint v's motion, v_O
         # the velocity of the point at the world origin), J_k = mask_k · (v_O + ω × p_k)
-        key = conf.q.tobytes()      # by value: a q changed in place and update() must not hit the cache
+        key = conf.q.tobytes()  # by value: a q changed in place and update() must not hit the cache
         if self._for[0] is conf and self._for[1] == key:
             return
         data = conf.data

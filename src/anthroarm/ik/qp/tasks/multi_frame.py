@@ -38,8 +38,16 @@ class MultiFrameTask(Task):
     targets : sequence of 4×4 or pin.SE3, optional
     """
 
-    def __init__(self, robot, frames, position_cost=1.0, orientation_cost=1.0, gain: float = 1.0,
-                 lm_damping: float = 0.0, targets=None):
+    def __init__(
+        self,
+        robot,
+        frames,
+        position_cost=1.0,
+        orientation_cost=1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+        targets=None,
+    ):
         frames = list(frames)
         if not frames:
             raise ValueError("MultiFrameTask needs at least one frame")
@@ -52,11 +60,18 @@ class MultiFrameTask(Task):
             try:
                 return np.broadcast_to(c, (K, 3))
             except ValueError:
-                raise ValueError(f"MultiFrameTask {what} must be a scalar, a 3-vector or one per frame "
-                                 f"((K,) or (K, 3) with K = {K}), got shape {c.shape}") from None
+                raise ValueError(
+                    f"MultiFrameTask {what} must be a scalar, a 3-vector or one per frame "
+                    f"((K,) or (K, 3) with K = {K}), got shape {c.shape}"
+                ) from None
 
-        pc, oc = per_frame(position_cost, "position_cost"), per_frame(orientation_cost, "orientation_cost")
-        super().__init__(cost=np.concatenate([pc, oc], axis=1).ravel(), gain=gain, lm_damping=lm_damping)
+        pc, oc = (
+            per_frame(position_cost, "position_cost"),
+            per_frame(orientation_cost, "orientation_cost"),
+        )
+        super().__init__(
+            cost=np.concatenate([pc, oc], axis=1).ravel(), gain=gain, lm_damping=lm_damping
+        )
         self.frame_ids = [robot.frame_id(f) for f in frames]
         self.frames = [robot.chain.frame(i).name for i in self.frame_ids]
         self._target_names = [f"MultiFrameTask target of {f!r}" for f in self.frames]
@@ -94,18 +109,25 @@ class MultiFrameTask(Task):
     def _require_targets(self):
         for k, T in enumerate(self.targets):
             if T is None:
-                raise ValueError(f"MultiFrameTask: no target for frame {self.frames[k]!r} (call set_target)")
+                raise ValueError(
+                    f"MultiFrameTask: no target for frame {self.frames[k]!r} (call set_target)"
+                )
         return self.targets
 
     def compute_error(self, conf) -> np.ndarray:
         Ts = self._require_targets()
-        return np.concatenate([pin.log6(conf.frame_placement(f).actInv(T)).vector
-                               for f, T in zip(self.frame_ids, Ts)])
+        return np.concatenate(
+            [pin.log6(conf.frame_placement(f).actInv(T)).vector for f, T in zip(self.frame_ids, Ts)]
+        )
 
     def compute_jacobian(self, conf) -> np.ndarray:
         Ts = self._require_targets()
-        return np.vstack([-pin.Jlog6(T.actInv(conf.frame_placement(f))) @ conf.frame_jacobian(f, LOCAL)
-                          for f, T in zip(self.frame_ids, Ts)])
+        return np.vstack(
+            [
+                -pin.Jlog6(T.actInv(conf.frame_placement(f))) @ conf.frame_jacobian(f, LOCAL)
+                for f, T in zip(self.frame_ids, Ts)
+            ]
+        )
 
     def _accumulate(self, conf, ws, first):
         # the objective in place: stacked W Jlog6 ᵇJ in one buffer, one product for H and one for c
@@ -119,9 +141,11 @@ class MultiFrameTask(Task):
         model, data = conf.model, conf.data
         WJ, WJt, e, Ht, ct = self._buf
         for k, (fid, T_t) in enumerate(zip(self.frame_ids, Ts)):
-            X = pin.updateFramePlacement(model, data, fid).actInv(T_t)       # T_b⁻¹ T_t
-            pin.Jlog6(X.inverse()).dot(pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ[6 * k:6 * k + 6])
-            e[6 * k:6 * k + 6] = pin.log6(X).vector
+            X = pin.updateFramePlacement(model, data, fid).actInv(T_t)  # T_b⁻¹ T_t
+            pin.Jlog6(X.inverse()).dot(
+                pin.getFrameJacobian(model, data, fid, LOCAL), out=WJ[6 * k : 6 * k + 6]
+            )
+            e[6 * k : 6 * k + 6] = pin.log6(X).vector
         np.multiply(WJ, self._wcol, out=WJ)
-        nWe = np.multiply(e, self._nwg, out=e)                                # −αW e
+        nWe = np.multiply(e, self._nwg, out=e)  # −αW e
         return self._add_weighted_least_squares(ws, first, WJ, WJt, nWe, Ht, ct)

@@ -36,4 +36,6 @@ class OrientationTask(FrameAxesTask):
 
     def compute_jacobian(self, conf) -> np.ndarray:
         R = conf.frame_placement(self.frame_id).rotation
-        return -pin.Jlog3(self._require_target().T @ R) @ conf.frame_jacobian(self.frame_id, LOCAL)[3:]
+        return (
+            -pin.Jlog3(self._require_target().T @ R) @ conf.frame_jacobian(self.frame_id, LOCAL)[3:]
+        )

@@ -22,11 +22,14 @@ import pinocchio as pin
 
 from .base import Task
 
+
 def has_comfortable_posture(robot) -> bool:
     """True when the robot's model carries a comfortable posture for every joint
     (``robot.spec.comfort``, e.g. the §6-3 human arm; see :mod:`anthroarm.models.human`)."""
     comfort = getattr(robot.spec, "comfort", None)
-    return bool(comfort) and all(robot.chain.joints[i].name in comfort for i in robot.chain.independent)
+    return bool(comfort) and all(
+        robot.chain.joints[i].name in comfort for i in robot.chain.independent
+    )
 
 
 def comfortable_posture(robot) -> np.ndarray:
@@ -53,9 +56,11 @@ class PostureTask(Task):
         super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
         self.model = robot.model
         self.robot = robot
-        self._H = np.diag(np.broadcast_to(np.asarray(self.cost, float) ** 2, (robot.nv,)).astype(float))
+        self._H = np.diag(
+            np.broadcast_to(np.asarray(self.cost, float) ** 2, (robot.nv,)).astype(float)
+        )
         self._H.setflags(write=False)
-        self._s_for = (None, None, None)   # (cost, gain, α w² per joint) of _accumulate
+        self._s_for = (None, None, None)  # (cost, gain, α w² per joint) of _accumulate
         self.set_target(comfortable_posture(robot) if target is None else target)
 
     def set_target(self, q_ref) -> None:

@@ -19,8 +19,17 @@ from .base import Task
 
 
 class RelativeFrameTask(Task):
-    def __init__(self, robot, frame, root, position_cost=1.0, orientation_cost=1.0, gain: float = 1.0,
-                 lm_damping: float = 0.0, target=None):
+    def __init__(
+        self,
+        robot,
+        frame,
+        root,
+        position_cost=1.0,
+        orientation_cost=1.0,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+        target=None,
+    ):
         pc = np.broadcast_to(np.asarray(position_cost, dtype=float), (3,))
         oc = np.broadcast_to(np.asarray(orientation_cost, dtype=float), (3,))
         super().__init__(cost=np.concatenate([pc, oc]), gain=gain, lm_damping=lm_damping)
@@ -51,5 +60,7 @@ class RelativeFrameTask(Task):
     def compute_jacobian(self, conf):
         T_rt = self._require_target()
         T_rf = conf.transform(self.frame_id, self.root_id)
-        J_rel = conf.frame_jacobian(self.frame_id, LOCAL) - T_rf.inverse().action @ conf.frame_jacobian(self.root_id, LOCAL)
+        J_rel = conf.frame_jacobian(
+            self.frame_id, LOCAL
+        ) - T_rf.inverse().action @ conf.frame_jacobian(self.root_id, LOCAL)
         return -pin.Jlog6(T_rt.actInv(T_rf)) @ J_rel

@@ -47,13 +47,27 @@ class SurfaceContactTask(Task):
         Weight of the three normal rows ([cost] per unit).
     """
 
-    def __init__(self, robot, frame, surface, axis=(0.0, 0.0, 1.0), distance_cost: float = 1.0,
-                 normal_cost: float = 0.1, gain: float = 1.0, lm_damping: float = 0.0):
-        super().__init__(cost=np.array([distance_cost, normal_cost, normal_cost, normal_cost], dtype=float),
-                         gain=gain, lm_damping=lm_damping)
+    def __init__(
+        self,
+        robot,
+        frame,
+        surface,
+        axis=(0.0, 0.0, 1.0),
+        distance_cost: float = 1.0,
+        normal_cost: float = 0.1,
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+    ):
+        super().__init__(
+            cost=np.array([distance_cost, normal_cost, normal_cost, normal_cost], dtype=float),
+            gain=gain,
+            lm_damping=lm_damping,
+        )
         for attr in ("distance", "normal", "normal_jacobian"):
             if not callable(getattr(surface, attr, None)):
-                raise TypeError(f"SurfaceContactTask: surface must have a {attr}(p) method, got {surface!r}")
+                raise TypeError(
+                    f"SurfaceContactTask: surface must have a {attr}(p) method, got {surface!r}"
+                )
         self.frame_id = robot.frame_id(frame)
         self.frame = robot.chain.frame(self.frame_id).name
         self.surface = surface

@@ -31,10 +31,11 @@ from .base import Task
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
+
 def _joint_origins(chain) -> dict:
     """World position (m) of every joint origin at θ = 0, from the chain's placements."""
     T = {-1: np.eye(4)}
-    for j in chain.joints:                 # parents come first (Pinocchio's order)
+    for j in chain.joints:  # parents come first (Pinocchio's order)
         T[j.index] = T[j.parent] @ j.placement
     return {i: M[:3, 3] for i, M in T.items() if i >= 0}
 
@@ -52,7 +53,10 @@ def human_layout(chain, frame=None) -> tuple[str, str, str] | None:
     scale = 1.0 + max((float(np.linalg.norm(p)) for p in origins.values()), default=0.0)
     groups: list[list] = []
     for j in path:
-        if groups and np.linalg.norm(origins[j.index] - origins[groups[-1][0].index]) <= 1e-9 * scale:
+        if (
+            groups
+            and np.linalg.norm(origins[j.index] - origins[groups[-1][0].index]) <= 1e-9 * scale
+        ):
             groups[-1].append(j)
         else:
             groups.append([j])
@@ -60,7 +64,7 @@ def human_layout(chain, frame=None) -> tuple[str, str, str] | None:
         return None
     names = tuple(g[0].name for g in groups)
     if not all(chain.frame(n).joint == g[0].index for n, g in zip(names, groups)):
-        return None                        # a joint frame named differently from its joint
+        return None  # a joint frame named differently from its joint
     return names
 
 
@@ -77,10 +81,12 @@ def swivel_frames(robot, frames=None) -> tuple[str, str, str]:
         return tuple(frames)
     names = human_layout(robot.chain)
     if names is None:
-        raise ValueError(f"{robot.name}: no human-like (shoulder, elbow, wrist) layout on the path to "
-                         f"{robot.chain.tool!r} (three co-located shoulder joints, then elbow and wrist joints "
-                         "with common origins); pass frames=(shoulder, elbow, wrist) from "
-                         f"{', '.join(robot.frame_names)}")
+        raise ValueError(
+            f"{robot.name}: no human-like (shoulder, elbow, wrist) layout on the path to "
+            f"{robot.chain.tool!r} (three co-located shoulder joints, then elbow and wrist joints "
+            "with common origins); pass frames=(shoulder, elbow, wrist) from "
+            f"{', '.join(robot.frame_names)}"
+        )
     return names
 
 
@@ -100,8 +106,10 @@ def swivel_from_points(S, E, W, ref=(0.0, 0.0, -1.0)):
     b = float(r @ p - (r @ u) * (u @ p))
     n2 = a * a + b * b
     if n2 < 1e-24:
-        raise ValueError("swivel angle undefined: the elbow (or the reference direction) lies on the "
-                         "shoulder-wrist axis (straight arm)")
+        raise ValueError(
+            "swivel angle undefined: the elbow (or the reference direction) lies on the "
+            "shoulder-wrist axis (straight arm)"
+        )
     phi = float(np.arctan2(a, b))
     da_dp = np.cross(u, r)
     db_dp = r - (r @ u) * u
@@ -166,8 +174,16 @@ class SwivelTask(Task):
     ``frames=(shoulder, elbow, wrist)``, by default the human-like layout found in
     ``robot.chain`` (:func:`swivel_frames`)."""
 
-    def __init__(self, robot, target: float = 0.0, cost: float = 1.0, frames=None, ref=(0.0, 0.0, -1.0),
-                 gain: float = 1.0, lm_damping: float = 0.0):
+    def __init__(
+        self,
+        robot,
+        target: float = 0.0,
+        cost: float = 1.0,
+        frames=None,
+        ref=(0.0, 0.0, -1.0),
+        gain: float = 1.0,
+        lm_damping: float = 0.0,
+    ):
         super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
         names = swivel_frames(robot, frames)
         self.frame_ids = tuple(robot.frame_id(f) for f in names)
