@@ -109,11 +109,14 @@ class Graph:
 
     # ------------------------------------------------------------------ construction
     def _new(self, key: tuple) -> Node:
-        i = self._index.get(key)
+        # the index must tell a constant (float) from a node id (int): ("mul", 2.0, 7) is 2·x7,
+        # ("mul", 2, 7) is x2·x7, and the two tuples are equal, with equal hashes, in Python
+        ikey = (key, type(key[1]) is float)
+        i = self._index.get(ikey)
         if i is None:
             i = len(self.ops)
             self.ops.append(key)
-            self._index[key] = i
+            self._index[ikey] = i
         return Node(self, i)
 
     def input(self, kind: str, k: int) -> Node:

@@ -76,8 +76,9 @@ from ..chain import CONTINUOUS, PRISMATIC, REVOLUTE
 from ..codegen.graph import Graph, emit_python, snap
 from ..errors import InertiaError, UnsupportedModelError
 
-#: bump when the generated code changes (part of the cache key)
-GENERATOR_VERSION = "2"
+#: bump when the generated code changes (part of the cache key); "3": code generated before the
+#: graph told a constant 2.0 from node id 2 (issue 30, wrong C q̇ and τ) is never loaded again
+GENERATOR_VERSION = "3"
 #: forward dynamics refuses M(q) whose reciprocal condition number (estimated from the Cholesky
 #: pivots) is below this: :class:`~anthroarm.errors.SingularMassMatrixError`
 SINGULAR_RCOND = 1e-12
