@@ -50,6 +50,9 @@ MODES = ("elbow", "wrist", "fingers")
 VIBRATOR_OF_MODE = {"elbow": "left", "wrist": "right", "fingers": None}
 #: the columns of ``CodeTrace.vibrators``
 VIBRATORS = ("left", "right", "middle")
+#: the longest debounce, co-contraction or vibrator time in frames (2**40 frames of 1 ms are
+#: 35 years; frame indices are int64, so sums of them never overflow)
+MAX_FRAMES = float(2**40)
 
 
 @dataclass(frozen=True)
@@ -105,18 +108,27 @@ class CodeMachine:
         vibrate_s: float = 0.3,
     ):
         self.frame_s = positive(frame_s, "frame_s", "s")
-        self.n_db = max(1, int(round(nonnegative(debounce_s, "debounce_s", "s") / self.frame_s)))
-        self.n_cc = int(round(nonnegative(cocontraction_s, "cocontraction_s", "s") / self.frame_s))
-        self.n_vib = max(1, int(round(positive(vibrate_s, "vibrate_s", "s") / self.frame_s)))
-        if isinstance(modes, str):
+        self.n_db = max(1, self._frames(nonnegative(debounce_s, "debounce_s", "s"), "debounce_s"))
+        self.n_cc = self._frames(
+            nonnegative(cocontraction_s, "cocontraction_s", "s"), "cocontraction_s"
+        )
+        self.n_vib = max(1, self._frames(positive(vibrate_s, "vibrate_s", "s"), "vibrate_s"))
+        try:
+            if isinstance(modes, (str, bytes)):
+                raise TypeError
+            self.modes = tuple(str(m) for m in modes)
+        except TypeError:
             raise EMGError(
-                f"modes is a sequence of mode names, e.g. ('elbow', 'wrist', 'fingers'), got the "
-                f"string {modes!r}"
-            )
-        self.modes = tuple(str(m) for m in modes)
+                f"modes is a sequence of mode names, e.g. ('elbow', 'wrist', 'fingers'), got "
+                f"{type(modes).__name__} {modes!r}"
+            ) from None
         if len(self.modes) < 1:
             raise EMGError("modes needs at least one joint name")
-        if not (isinstance(start_mode, (int, np.integer)) and 0 <= start_mode < len(self.modes)):
+        if not (
+            isinstance(start_mode, (int, np.integer))
+            and not isinstance(start_mode, bool)
+            and 0 <= start_mode < len(self.modes)
+        ):
             raise EMGError(
                 f"start_mode must be an index 0..{len(self.modes) - 1}, got {start_mode!r}"
             )
@@ -124,6 +136,18 @@ class CodeMachine:
         vib = [VIBRATOR_OF_MODE.get(m) for m in self.modes]
         self._vib_col = np.array([-1 if v is None else VIBRATORS.index(v) for v in vib])
         self.reset()
+
+    def _frames(self, seconds: float, name: str) -> int:
+        """``seconds`` as a whole number of frames, at most :data:`MAX_FRAMES` (else
+        :class:`~anthroarm.errors.EMGError`: a ratio that overflows a float or the frame
+        counters is a unit mistake, not a setting)."""
+        ratio = seconds / self.frame_s
+        if not ratio <= MAX_FRAMES:  # also catches inf (a subnormal frame_s)
+            raise EMGError(
+                f"{name} = {seconds:g} s is {ratio:.3g} frames of frame_s = {self.frame_s:g} s, "
+                f"more than {MAX_FRAMES:.3g}: are both in seconds?"
+            )
+        return int(round(ratio))
 
     def reset(self) -> None:
         """Back to rest: code 00, the start mode, no lock-out, no pulse, frame 0."""
@@ -141,7 +165,13 @@ class CodeMachine:
     def run(self, raw_codes) -> CodeTrace:
         """Feed raw codes (frames,) int 0..3 (``ProcessedEMG.code``); returns the
         :class:`CodeTrace` of these frames and keeps the state for the next block."""
-        r = np.asarray(raw_codes)
+        try:
+            r = np.asarray(raw_codes)
+        except (TypeError, ValueError):
+            raise EMGError(
+                f"raw_codes must be a 1-D integer array of codes 0..3, got {type(raw_codes).__name__}"
+                " (ragged?)"
+            ) from None
         if r.ndim != 1 or (
             r.size and (not np.issubdtype(r.dtype, np.integer) or r.min() < 0 or r.max() > 3)
         ):

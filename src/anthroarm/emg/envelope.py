@@ -65,7 +65,7 @@ def moving_rms(x, fs: float, window_s: float = 0.1) -> np.ndarray:
     """Causal moving RMS (V) of ``x`` (channels, samples) over ``window_s`` seconds (see the
     module text; default 100 ms, an assumption within the 100–125 ms controller delay that
     Farrell & Weir 2007, *IEEE TNSRE* 15:111, found best for myoelectric prostheses)."""
-    a = signal(x, "emg")
+    a = signal(x, "emg", bytes_per_value=56.0)
     w = window_samples(window_s, fs)
     return running_rms(a, w, np.zeros((a.shape[0], w)), np.arange(a.shape[1]))[0]
 
@@ -87,7 +87,7 @@ def lowpass_envelope(x, fs: float, cutoff_hz: float = 5.0, order: int = 2) -> np
     """Linear envelope (V, mean rectified value): :math:`|x|` through a causal Butterworth
     low-pass at ``cutoff_hz`` (default 5 Hz, an assumption: 3–10 Hz is the usual range,
     De Luca 1997).  ``fs`` must exceed twice the cutoff."""
-    a = signal(x, "emg")
+    a = signal(x, "emg", bytes_per_value=32.0)
     return sps.sosfilt(lowpass_sos(fs, cutoff_hz, order), np.abs(a), axis=-1)
 
 

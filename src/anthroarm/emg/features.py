@@ -31,7 +31,7 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     """One-sided PSD of every channel: ``(freqs_hz, psd)`` with ``psd`` (channels, n_freqs) in
     V²/Hz (Welch, Hann window, segments of ``segment_s`` seconds, 50 % overlap; the segment is
     the whole record when shorter).  Parseval: ``psd.sum(-1) * df`` is the variance."""
-    a = signal(x, "emg", min_samples=8)
+    a = signal(x, "emg", min_samples=8, bytes_per_value=40.0)
     fs = positive(fs, "sampling rate fs", "Hz")
     n = min(a.shape[1], max(8, int(round(positive(segment_s, "segment_s", "s") * fs))))
     f, p = sps.welch(

@@ -75,14 +75,6 @@ def check_sampling_rate(fs, highest_edge_hz: float, what: str) -> float:
     return fs
 
 
-def _prewarp(f, fs):
-    return 2.0 * fs * np.tan(np.pi * np.asarray(f, dtype=float) / fs)
-
-
-def _unwarp(w, fs):
-    return fs / np.pi * np.arctan(np.asarray(w, dtype=float) / (2.0 * fs))
-
-
 def band_edges(
     centre_hz: float, fs: float, bandwidth_octaves: float = BANK_BANDWIDTH_OCTAVES
 ) -> tuple[float, float]:
@@ -95,8 +87,12 @@ def band_edges(
     fc = positive(centre_hz, "band centre", "Hz")
     b = _bandwidth(bandwidth_octaves)
     check_sampling_rate(fs, fc * 2.0 ** (b / 2), f"the band centred at {fc:g} Hz")
-    wc = _prewarp(fc, fs)
-    lo, hi = _unwarp(wc * 2.0 ** (-b / 2), fs), _unwarp(wc * 2.0 ** (b / 2), fs)
+    fs = float(fs)
+    # the pre-warped axis in units of 2 fs (tan, arctan of f/fs), so that no product with fs
+    # overflows at extreme rates: fs = 1e308 gives the edges, not NaN
+    tc = np.tan(np.pi * (fc / fs))
+    lo = fs / np.pi * np.arctan(tc * 2.0 ** (-b / 2))
+    hi = fs / np.pi * np.arctan(tc * 2.0 ** (b / 2))
     return float(lo), float(hi)
 
 
@@ -179,7 +175,7 @@ class FilterBank:
         rest); returns (channels, n_bands, samples) volts."""
         from ._checks import signal
 
-        a = signal(x, "emg")
+        a = signal(x, "emg", bytes_per_value=8.0 + 16.0 * len(self.sos))
         return np.stack([sps.sosfilt(s, a, axis=-1) for s in self.sos], axis=1)
 
     def gains(self, freqs_hz) -> np.ndarray:

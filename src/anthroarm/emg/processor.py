@@ -34,13 +34,15 @@ import numpy as np
 from scipy import signal as sps
 
 from ..errors import EMGError, ThresholdError
-from ._checks import MAX_VOLTS, nonnegative, number, positive, signal
+from ._checks import MAX_VOLTS, budget, count, nonnegative, number, positive, signal
 from .envelope import PP_PER_MAV, PP_PER_RMS, lowpass_sos, running_rms, window_samples
 from .filters import CONDITIONING_BAND, bandpass_sos, check_sampling_rate, notch_sos
 
 #: code values of an antagonist pair, flexor bit first as printed ("10" is the flexor)
 REST, EXTENSOR, FLEXOR, BOTH = 0, 1, 2, 3
 CODE_NAMES = ("00", "01", "10", "11")
+#: the most channels one processor takes (its filter states are per channel)
+MAX_CHANNELS = 1024
 
 
 @dataclass(frozen=True)
@@ -166,9 +168,7 @@ class EMGProcessor:
         max_input_pp: float = float("inf"),
         noise_rms: float | None = None,
     ):
-        if not (isinstance(n_channels, (int, np.integer)) and n_channels >= 1):
-            raise EMGError(f"n_channels must be an integer >= 1, got {n_channels!r}")
-        self.n_channels = int(n_channels)
+        self.n_channels = count(n_channels, "n_channels", 1, MAX_CHANNELS)
         try:
             lo, hi = (float(b) for b in band)
         except (TypeError, ValueError):
@@ -183,6 +183,7 @@ class EMGProcessor:
         self.envelope = envelope
         if envelope == "rms":
             self.window = window_samples(window_s, self.fs)
+            budget(self.n_channels * self.window, 16.0, "the moving-RMS window of every channel")
             self._pp = PP_PER_RMS
         else:
             self.env_sos = lowpass_sos(self.fs, cutoff_hz)
@@ -226,7 +227,7 @@ class EMGProcessor:
     def process(self, emg, reset: bool = True) -> ProcessedEMG:
         """Run the chain on ``emg`` (channels, samples) volts; ``reset=False`` continues the
         stream of the previous call (blocks of any length, frames aligned to the stream)."""
-        x = signal(emg, "emg", self.n_channels)
+        x = signal(emg, "emg", self.n_channels, bytes_per_value=40.0)
         if reset:
             self.reset()
         y, self._zi = sps.sosfilt(self.sos, x, axis=-1, zi=self._zi)
@@ -309,7 +310,7 @@ def calibrate_thresholds(
     (hysteresis, an assumption).  The first ``settle_s`` seconds (the filters'
     and the window's start-up) are left out; at least one second must remain.  The status
     compares the on-threshold with the book's sensitivity (:data:`BOOK_SENSITIVITY_PP`)."""
-    x = signal(rest, "rest", processor_kw.get("n_channels"))
+    x = signal(rest, "rest", processor_kw.get("n_channels"), bytes_per_value=40.0)
     kk = positive(k, "k (standard deviations)")
     frac = number(off_fraction, "off_fraction")
     if not 0.0 <= frac <= 1.0:

@@ -49,6 +49,7 @@ import numpy as np
 
 from ..control.servo import PositionServo
 from ..errors import EMGError, ParameterError, UnsupportedModelError
+from ._checks import signal
 from .codes import VIBRATORS, CodeMachine, CodeTrace, vibrators_with_grasp
 from .processor import EMGProcessor, ProcessedEMG
 
@@ -421,7 +422,7 @@ def simulate_powered_hand(
         raise ParameterError(f"q0 must be one configuration ({robot.nq},), got {q0.shape}")
 
     # ---- signal chain
-    x = np.asarray(emg, dtype=float)
+    x = signal(emg, "emg", 2, bytes_per_value=40.0)  # complex, gaps, budget: refused here
     proc = processor.process(x)  # reset=True: the run starts from rest
     machine.reset()  # so does the state machine (a reused one kept its mode)
     trace = machine.run(proc.code)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import EMGError
-from ._checks import MAX_VOLTS, count, nonnegative, number, positive, signal
+from ._checks import MAX_VOLTS, MEMORY_BUDGET, count, nonnegative, number, positive, signal
 from .envelope import PP_PER_RMS
 
 #: healthy EMG, 1–3 mV peak-to-peak (V), book §9-2
@@ -38,9 +38,11 @@ AMPUTEE_PP = 50e-6
 AMPUTEE_TRAINED_PP = 100e-6
 #: the band of the main spectral power (Hz), book §9-2
 EMG_BAND = (30.0, 300.0)
-#: the most samples (all channels together) the generator makes (a guard against a mistyped
-#: duration or channel count: 1e8 float64 samples are 0.8 GB)
-MAX_SAMPLES = 100_000_000
+#: the most samples (all channels together) the generator makes: its working memory is about 64
+#: bytes a sample (noise, its spectrum, activation, envelope, output), so this keeps it within
+#: :data:`~anthroarm.emg._checks.MEMORY_BUDGET` (2 GiB); a mistyped duration, rate or channel
+#: count (10**8 samples) is refused instead of exhausting the memory
+MAX_SAMPLES = MEMORY_BUDGET // 64
 
 
 def _band(band, fs: float) -> tuple[float, float]:
@@ -71,7 +73,14 @@ def band_limited_noise(
     spec[:, (f < lo) | (f > hi)] = 0.0
     x = np.fft.irfft(spec, n=int(n_samples), axis=-1)
     x -= x.mean(axis=-1, keepdims=True)
-    return x / x.std(axis=-1, keepdims=True)
+    sd = x.std(axis=-1, keepdims=True)
+    if not np.all(sd > 0):
+        raise EMGError(
+            f"the band {lo:g}-{hi:g} Hz holds no frequency bin of {n_samples} samples at "
+            f"{fs:g} Hz (bin spacing {fs / n_samples:.3g} Hz): make the record longer or the band "
+            "wider"
+        )
+    return x / sd
 
 
 def activation(t, bursts, ramp_s: float = 0.05) -> np.ndarray:
@@ -102,8 +111,9 @@ def activation(t, bursts, ramp_s: float = 0.05) -> np.ndarray:
                 f"a burst needs a finite onset, duration > 0 and a level in [0, 1], got {b!r}"
             )
         rr = min(r, dur / 2)
-        up = np.clip((t - t0) / rr, 0.0, 1.0)
-        down = np.clip((t0 + dur - t) / rr, 0.0, 1.0)
+        with np.errstate(over="ignore"):  # ±inf clips to 0 or 1, the right limit
+            up = np.clip((t - t0) / rr, 0.0, 1.0)
+            down = np.clip((t0 + dur - t) / rr, 0.0, 1.0)
         a += level * 0.5 * (1 - np.cos(np.pi * np.minimum(up, down)))
     return np.minimum(a, 1.0)
 
@@ -180,12 +190,19 @@ def electrode_potentials(
     EMG split symmetrically, plus a **common-mode** mains hum of ``mains_pp`` volts
     peak-to-peak at ``mains_hz`` and a common DC ``offset_v`` (the interference the book's
     differential front end must reject, §9-2 三).  Returns ``(v_plus, v_minus)``."""
-    x = signal(emg, "emg")
+    x = signal(emg, "emg", bytes_per_value=32.0)
     fs = positive(fs, "sampling rate fs", "Hz")
     t = np.arange(x.shape[1]) / fs
     amp = nonnegative(mains_pp, "mains_pp", "V")
     f0 = positive(mains_hz, "mains_hz", "Hz")
-    cm = 0.5 * amp * np.sin(2 * np.pi * f0 * t) + number(offset_v, "offset_v", "V")
+    with np.errstate(over="ignore", invalid="ignore"):
+        phase = 2 * np.pi * f0 * t
+    if not np.all(np.isfinite(phase)):
+        raise EMGError(
+            f"mains_hz {mains_hz!r} Hz over {t[-1]:g} s overflows the phase: give Hz and an fs "
+            "in Hz"
+        )
+    cm = 0.5 * amp * np.sin(phase) + number(offset_v, "offset_v", "V")
     if not np.all(np.isfinite(cm)) or amp + abs(float(offset_v)) > MAX_VOLTS:
         raise EMGError(
             f"mains_pp {mains_pp!r} V and offset_v {offset_v!r} V are beyond {MAX_VOLTS:.0e} V: "
