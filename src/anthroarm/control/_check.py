@@ -1,18 +1,46 @@
-"""Input checks shared by the modules of :mod:`anthroarm.control` (one place for the messages)."""
+"""Input checks shared by the modules of :mod:`anthroarm.control` and :mod:`anthroarm.trajectory`
+(one place for the messages), and the budgets that bound what a call may allocate or loop over.
+
+**Budgets.**  A time step that is tiny against a duration (``dt = 1e-12`` over 2 s) or a count
+that is huge (``n = 10**12``) would ask for more memory than any machine has, or for a loop that
+never ends in practice.  Every sampled result is checked *before* it is computed:
+
+* :data:`MAX_VALUES` — the largest number of floats (samples × values per sample) a sampled
+  result may hold: 2**25 ≈ 3.4e7 floats, 268 MB as float64;
+* :data:`MAX_STEPS` — the largest number of integration or search steps one call may take:
+  5e6 (a few seconds to a minute of Python).
+
+A request beyond a budget is a :class:`~anthroarm.errors.ControlError` that says what it needs,
+what the budget is and what to change.
+"""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 from ..errors import ControlError
 from ..spatial.rotations import as_scalar
 
+#: the largest number of float values (samples × values per sample) of one sampled result
+MAX_VALUES = 2**25
+#: the largest number of integration or search steps of one call
+MAX_STEPS = 5_000_000
+
 
 def scalar(x, name: str) -> float:
     """``x`` as one finite float (:func:`anthroarm.spatial.rotations.as_scalar`), with a
-    :class:`~anthroarm.errors.ControlError` naming ``name`` otherwise."""
+    :class:`~anthroarm.errors.ControlError` naming ``name`` otherwise (also for an integer
+    beyond the float range and for a complex number)."""
+    if isinstance(x, (complex, np.complexfloating)):
+        raise ControlError(f"{name} must be a real number, got {x!r}")
     try:
         return as_scalar(x, name)
+    except OverflowError:
+        raise ControlError(
+            f"{name} must be finite, got an integer beyond the float range"
+        ) from None
     except ValueError as exc:
         raise ControlError(str(exc)) from None
 
@@ -35,10 +63,14 @@ def nonnegative(x, name: str) -> float:
 
 def array(x, name: str) -> np.ndarray:
     """A finite float array (any shape)."""
+    if np.iscomplexobj(x):
+        raise ControlError(f"{name} must be real numbers, got complex values")
     try:
         a = np.asarray(x, dtype=float)
+    except OverflowError:
+        raise ControlError(f"{name} has an integer beyond the float range") from None
     except (TypeError, ValueError):
-        raise ControlError(f"{name} must be numbers, got {x!r}") from None
+        raise ControlError(f"{name} must be numbers, got {_short(x)}") from None
     if not np.all(np.isfinite(a)):
         raise ControlError(f"{name} has a NaN or infinite element")
     return a
@@ -66,11 +98,72 @@ def on_grid(x, t: np.ndarray, name: str) -> np.ndarray:
     return a
 
 
-def count(x, name: str, minimum: int = 0) -> int:
-    """An integer (not a bool) >= ``minimum``."""
+def count(x, name: str, minimum: int = 0, maximum: int | None = None) -> int:
+    """An integer (not a bool) >= ``minimum`` (and <= ``maximum`` when given)."""
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < minimum:
-        raise ControlError(f"{name} must be an integer >= {minimum}, got {x!r}")
+        raise ControlError(f"{name} must be an integer >= {minimum}, got {_short(x)}")
+    if maximum is not None and x > maximum:
+        raise ControlError(f"{name} = {int(x)} is beyond the budget of {maximum}")
     return int(x)
+
+
+def _short(x) -> str:
+    r = repr(x)
+    return r if len(r) <= 80 else r[:77] + "..."
+
+
+def _fmt(n: float) -> str:
+    return f"{n:.3g}" if n >= 1e6 else f"{n:g}"
+
+
+def samples(n: float, width: int, what: str, remedy: str) -> int:
+    """``n`` samples of ``width`` values each, as an int, within :data:`MAX_VALUES`; otherwise
+    a :class:`~anthroarm.errors.ControlError` that says ``what`` needs them and the ``remedy``.
+    ``n`` may be a float (``duration / dt``, possibly inf)."""
+    width = max(1, int(width))
+    if not (n * width <= MAX_VALUES):  # also inf and NaN
+        raise ControlError(
+            f"{what} needs {_fmt(n)} samples"
+            + (f" of {width} values" if width > 1 else "")
+            + f"; the budget is {MAX_VALUES} values (anthroarm.control._check.MAX_VALUES): "
+            + remedy
+        )
+    return int(n)
+
+
+def steps(n: float, what: str, remedy: str) -> int:
+    """``n`` integration or search steps, as an int, within :data:`MAX_STEPS`; otherwise a
+    :class:`~anthroarm.errors.ControlError` naming ``what`` and the ``remedy``."""
+    if not (n <= MAX_STEPS):
+        raise ControlError(
+            f"{what} needs {_fmt(n)} steps; the budget is {MAX_STEPS} steps "
+            f"(anthroarm.control._check.MAX_STEPS): {remedy}"
+        )
+    return int(n)
+
+
+def n_per(duration: float, dt: float) -> float:
+    """``ceil(duration / dt)`` as a float (inf when the quotient overflows), at least 1."""
+    with np.errstate(over="ignore"):
+        q = duration / dt
+    return max(1.0, float(math.ceil(q))) if math.isfinite(q) else math.inf
+
+
+def broadcast(*pairs) -> tuple[np.ndarray, ...]:
+    """Broadcast ``(array, name)`` pairs against each other; a
+    :class:`~anthroarm.errors.ControlError` naming them and their shapes otherwise."""
+    try:
+        return tuple(np.broadcast_arrays(*(a for a, _ in pairs)))
+    except ValueError:
+        shapes = ", ".join(f"{nm} {np.shape(a)}" for a, nm in pairs)
+        raise ControlError(f"shapes that do not broadcast together: {shapes}") from None
+
+
+def finite(value, what: str, remedy: str = "the inputs are too large or too small"):
+    """``value`` when every element is finite, else a :class:`~anthroarm.errors.ControlError`."""
+    if not np.all(np.isfinite(value)):
+        raise ControlError(f"{what} is beyond the floating-point range: {remedy}")
+    return value
 
 
 def finite_result(func):

@@ -23,11 +23,13 @@ pulses, so
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ControlError
+from . import _check
 
 __all__ = ["DDAResult", "dda", "pulse_counts"]
 
@@ -72,25 +74,48 @@ class DDAResult:
         return np.where(any_, last, 0)
 
 
+#: the largest |count| accepted: beyond it ``j |Δ|`` of the accumulator could leave int64
+MAX_COUNT = 2**62
+
+
 def _counts(counts) -> np.ndarray:
-    a = np.asarray(counts)
+    """Signed pulse counts as int64, every one within ±:data:`MAX_COUNT`, checked on the exact
+    values (Python ints, or the array's own integer type) before any conversion can wrap."""
+    try:
+        a = np.asarray(counts)
+    except (TypeError, ValueError, OverflowError):
+        raise ControlError(f"counts must be integers, got {_check._short(counts)}") from None
     if a.ndim != 1 or a.size == 0:
         raise ControlError(
             f"counts must be a 1-D list of pulse counts (one per axis), got shape {a.shape}"
         )
-    if a.dtype.kind not in "iu":
-        try:
-            f = np.asarray(a, dtype=float)
-        except (TypeError, ValueError):
-            raise ControlError(f"counts must be integers, got {counts!r}") from None
-        if not np.all(np.isfinite(f)) or np.any(f != np.round(f)):
+    if a.dtype.kind in "iu":
+        lo, hi = int(a.min()), int(a.max())  # exact Python ints: no wrap-around
+    elif a.dtype.kind == "f" or (
+        a.dtype.kind == "O"
+        and all(isinstance(x, (int, float, np.integer, np.floating)) for x in a.tolist())
+        and not any(isinstance(x, bool) for x in a.tolist())
+    ):
+        vals = a.tolist()
+        fl = [float(v) for v in vals if not isinstance(v, (int, np.integer))]
+        if not all(math.isfinite(x) and x == math.floor(x) for x in fl):
             raise ControlError(
-                f"counts must be whole numbers of pulses, got {f.tolist()}; "
+                f"counts must be whole numbers of pulses, got {_check._short(vals)}; "
                 "round positions to pulses with pulse_counts()"
             )
-        if np.any(np.abs(f) > 2**62):
-            raise ControlError("a pulse count is beyond 2**62")
-        a = f.astype(np.int64)
+        ints = [int(v) for v in vals]
+        lo, hi = min(ints), max(ints)
+        a = np.array(ints, dtype=object)
+    else:
+        raise ControlError(
+            f"counts must be integers, got {a.dtype.name} values {_check._short(counts)}"
+        )
+    if hi > MAX_COUNT or lo < -MAX_COUNT:
+        big = hi if hi > MAX_COUNT else lo
+        raise ControlError(
+            f"counts: a pulse count of {big} is beyond ±2**62 (the DDA works in 64-bit "
+            "integers); split the move into shorter ones"
+        )
     return a.astype(np.int64)
 
 
@@ -135,8 +160,12 @@ def dda(counts, n_ticks: int | None = None) -> DDAResult:
             )
     if need == 0:
         return DDAResult(c, np.zeros((N, c.size), dtype=np.int8), N, "no motion")
-    if N > 50_000_000 // max(1, c.size):
-        raise ControlError(f"{N} ticks x {c.size} axes is too many pulses to tabulate")
+    _check.samples(
+        N,
+        c.size,
+        f"a DDA of {N} ticks over {c.size} axes",
+        "tabulate fewer ticks (n_ticks, or split the move into shorter ones)",
+    )
     j = np.arange(N + 1, dtype=np.int64)[:, None]
     emitted = (j * mag[None, :]) // N  # floor(j |Δ| / N): the accumulator's overflows
     pulses = (np.diff(emitted, axis=0) * np.sign(c)[None, :]).astype(np.int8)
@@ -157,21 +186,24 @@ def pulse_counts(q_from, q_to, resolution) -> np.ndarray:
     -------
     numpy.ndarray of int64
     """
-    a = np.asarray(q_from, dtype=float)
-    b = np.asarray(q_to, dtype=float)
-    r = np.asarray(resolution, dtype=float)
-    if a.shape != b.shape or a.ndim != 1:
+    a = _check.array(q_from, "q_from")
+    b = _check.array(q_to, "q_to")
+    r = _check.array(resolution, "resolution")
+    if a.shape != b.shape or a.ndim != 1 or a.size == 0:
         raise ControlError(
-            f"q_from and q_to must be 1-D of the same length, got {a.shape} and {b.shape}"
+            f"q_from and q_to must be 1-D of the same length (at least one axis), got "
+            f"{a.shape} and {b.shape}"
         )
-    if not (
-        np.all(np.isfinite(a))
-        and np.all(np.isfinite(b))
-        and np.all(np.isfinite(r))
-        and np.all(r > 0)
-    ):
-        raise ControlError("positions must be finite and the resolution finite and > 0")
-    steps = (b - a) / r
-    if np.any(np.abs(steps) > 2**62):
-        raise ControlError("the move is beyond 2**62 pulses")
+    if r.shape not in ((), a.shape):
+        raise ControlError(
+            f"resolution must be a scalar or one value per axis {a.shape}, got shape {r.shape}"
+        )
+    if not np.all(r > 0):
+        raise ControlError(f"resolution must be > 0, got {r.tolist()}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        steps = (b - a) / r
+    if not np.all(np.abs(steps) <= MAX_COUNT):  # also inf: the move overflowed
+        raise ControlError(
+            "the move is beyond 2**62 pulses on an axis (resolution too fine for the distance)"
+        )
     return np.round(steps).astype(np.int64)
