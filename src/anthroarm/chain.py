@@ -135,6 +135,7 @@ class Frame:
     is_body: bool  # a URDF link (Pinocchio BODY frame)
     is_joint: bool  # a joint frame (Pinocchio JOINT or FIXED_JOINT)
     parent_frame: int  # Pinocchio id of the frame it hangs from
+    kind: str = ""  # Pinocchio's frame type: "body", "op_frame", "joint", "fixed_joint", "sensor"
 
     @property
     def placement(self) -> np.ndarray:
@@ -295,6 +296,7 @@ class Chain:
                     f.type == pin.FrameType.BODY,
                     f.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT),
                     int(f.parentFrame),
+                    str(f.type.name).lower(),
                 )
             )
         tips = leaf_frames(joints, frames)
@@ -607,18 +609,46 @@ def _check_sampling(name: str, n, margin) -> tuple[int | None, float]:
 
 
 def leaf_frames(joints, frames) -> tuple[str, ...]:
-    """One frame per leaf of the tree.  A leaf link is a body frame from which no joint
-    (moving or fixed) hangs; leaf links fixed to the same moving joint are one tip (a UR's
-    ``ee_link`` and ``tool0``, a Kinova's end effector and finger tips), named by the one whose
-    name says tool / tcp / end effector / eef / hand if there is one, else the last.  Links
-    fixed to the base are no tips."""
+    """One frame per leaf of the tree, read from the joint tree: a serial chain has one tip.
+
+    A *leaf joint* is one no other joint hangs from (mimic joints count as joints).  Its tip is
+    chosen among its *leaf links*, the body and operational frames on it from which no joint
+    frame (moving or fixed) hangs: the one whose name says tool / tcp / end effector / eef / hand
+    if there is one, else the last added (highest Pinocchio frame id) — a UR's ``ee_link`` and
+    ``tool0`` are one tip, ``tool0``.  A leaf joint without leaf links is named by the last frame
+    on it that is not a joint frame (a sensor), else by its joint frame; one without any frame
+    has no tip.
+
+    A leaf link fixed by a fixed joint (a URDF ``type="fixed"``) to a joint that is no leaf is a
+    tip as well, one per such joint and chosen by the same rule: the URDF's author hung a frame
+    there (an SO-101's ``gripper_frame_link`` beside its moving jaw, Baxter's range sensors), so
+    that robot is a tree of tips.  Bodies of a model built in code hang from their joint's own
+    frame, so they are no tips but on a leaf joint.  Links fixed to the base are no tips, unless
+    nothing moves."""
     hangs = {f.parent_frame for f in frames if f.is_joint and f.parent_frame != f.index}
-    by_joint: dict[int, list] = {}
-    for f in frames:  # links fixed to the base do not move: no tip, unless nothing moves
-        if f.is_body and f.index not in hangs and f.index != 0 and (f.joint >= 0 or not joints):
-            by_joint.setdefault(f.joint, []).append(f)
+    by_id = {f.index: f for f in frames}
+    has_child = {j.parent for j in joints}
+    leaf_joints = [j.index for j in joints if j.index not in has_child] if joints else [-1]
+    leaf_set = set(leaf_joints)
+
+    def fixed_below(f) -> bool:  # hangs from a fixed joint's frame
+        p = by_id.get(f.parent_frame)
+        return p is not None and p.is_joint and p.kind != "joint"
+
+    groups: dict[int, list] = {}
+    for f in frames:
+        if not (f.is_body or f.kind == "op_frame") or f.index in hangs or f.index == 0:
+            continue
+        if f.joint in leaf_set or (f.joint >= 0 and fixed_below(f)):
+            groups.setdefault(f.joint, []).append(f)
+    for j in leaf_joints:  # a leaf joint without leaf links: a sensor, else its joint frame
+        if j not in groups:
+            on = [f for f in frames if f.joint == j and f.index != 0]
+            other = [f for f in on if not f.is_joint]
+            if other or on:
+                groups[j] = [(other or on)[-1]]
     out = []
-    for group in by_joint.values():
+    for group in sorted(groups.values(), key=lambda g: g[0].index):
         named = [f for f in group if _TOOL_NAME.search(f.name)]
         out.append((named or group)[-1].name)
     return tuple(out)
