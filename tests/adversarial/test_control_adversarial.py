@@ -112,3 +112,74 @@ def test_dda_huge_tick_count_names_the_budget():
 def test_pulse_counts_refuses_malformed_input(args):
     with pytest.raises(ControlError):
         dda_mod.pulse_counts(*args)
+
+
+# ====================================================================== control: interpolation
+UNIT_ARC = ([0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e200, 1e300])
+def test_arc_at_extreme_scales_is_the_scaled_unit_arc(scale):
+    """Radii of 1e-300 or 1e300 gave radius 0 or inf and a NaN sweep."""
+    ref = circle_through(*UNIT_ARC)
+    arc = circle_through(*(np.array(p) * scale for p in UNIT_ARC))
+    assert math.isfinite(arc.radius) and math.isfinite(arc.sweep)
+    assert arc.radius == pytest.approx(scale * ref.radius, rel=1e-12)
+    assert arc.sweep == pytest.approx(ref.sweep, rel=1e-12)
+    s = np.linspace(0.0, 1.0, 7)
+    np.testing.assert_allclose(arc.points(s) / scale, ref.points(s), atol=1e-12)
+
+
+def test_arc_far_from_the_origin_keeps_its_radius():
+    base = np.array([1e300, 0.0, 0.0])
+    arc = circle_through(*(base + 1e295 * np.array(p) for p in UNIT_ARC))
+    assert arc.radius == pytest.approx(1e295, rel=1e-9)
+    assert math.isfinite(arc.sweep) and 0.0 < arc.sweep < 2 * math.pi
+
+
+def test_nearly_collinear_arc_is_finite_and_passes_its_points():
+    p1, p2, p3 = np.zeros(3), np.array([1.0, 1e-150, 0.0]), np.array([2.0, 0.0, 0.0])
+    arc = circle_through(p1, p2, p3, tol=0.0)
+    assert math.isfinite(arc.radius) and math.isfinite(arc.sweep)
+    pts = arc.points(np.array([0.0, arc.via_angle / arc.sweep, 1.0]))
+    np.testing.assert_allclose(pts, [p1, p2, p3], atol=1e-12)
+    assert np.all(np.isfinite(arc.points(np.linspace(0, 1, 11))))
+
+
+def test_arc_whose_radius_overflows_is_degenerate():
+    p1, p2, p3 = np.zeros(3), np.array([1e300, 1e290, 0.0]), np.array([2e300, 0.0, 0.0])
+    with pytest.raises(DegenerateArcError, match="radius"):
+        circle_through(p1, p2, p3, tol=0.0)
+
+
+@pytest.mark.parametrize("tol", [math.nan, -1.0, math.inf, "x", 1.0])
+def test_arc_refuses_a_bad_tolerance(tol):
+    with pytest.raises(ControlError, match="tol"):
+        circle_through(*UNIT_ARC, tol=tol)
+
+
+def test_line_between_the_ends_of_the_float_range_is_finite():
+    mid = line_points([-1e308, 0.0, 0.0], [1e308, 0.0, 0.0], 0.5)
+    np.testing.assert_array_equal(mid, [0.0, 0.0, 0.0])
+
+
+def test_pose_with_a_bad_last_row_is_refused():
+    """A 4x4 pose with last row (5, 5, 5, 5) was silently replaced by (0, 0, 0, 1)."""
+    bad = np.eye(4)
+    bad[3] = 5.0
+    with pytest.raises(ControlError, match="last row"):
+        line_poses(bad, np.eye(4), 0.5)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: line_points([0, 0, 0], [1, 1, 1], "x"),
+        lambda: circle_through([0, 0, 0], "abc", [2, 0, 0]),
+        lambda: arc_poses(np.eye(4), "abc", np.eye(4), 0.5),
+    ],
+    ids=["s string", "point string", "via string"],
+)
+def test_interpolation_refuses_strings(call):
+    with pytest.raises(ControlError):
+        call()

@@ -16,18 +16,23 @@ Frames and units: points in m in one fixed (base) frame; poses are 4×4 homogene
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ControlError, DegenerateArcError
 from ..spatial.rotations import axis_angle, check_rotation, rot_axis
+from . import _check
 
 __all__ = ["Arc", "arc_poses", "circle_through", "line_points", "line_poses", "slerp"]
 
 
 def _s(s) -> np.ndarray:
-    a = np.asarray(s, dtype=float)
+    try:
+        a = np.asarray(s, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ControlError(f"s must be a finite scalar or 1-D array in [0, 1], got {s!r}") from None
     if a.ndim > 1 or not np.all(np.isfinite(a)):
         raise ControlError(f"s must be a finite scalar or 1-D array in [0, 1], got {s!r}")
     if np.any((a < -1e-12) | (a > 1 + 1e-12)):
@@ -36,16 +41,26 @@ def _s(s) -> np.ndarray:
 
 
 def _point(p, name) -> np.ndarray:
-    a = np.asarray(p, dtype=float)
+    try:
+        a = np.asarray(p, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ControlError(f"{name} must be a finite point of shape (3,), got {p!r}") from None
     if a.shape != (3,) or not np.all(np.isfinite(a)):
         raise ControlError(f"{name} must be a finite point of shape (3,), got {p!r}")
     return a
 
 
 def _pose(T, name) -> np.ndarray:
-    a = np.asarray(T, dtype=float)
+    try:
+        a = np.asarray(T, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ControlError(f"{name} must be a finite 4x4 pose, got {T!r}") from None
     if a.shape != (4, 4) or not np.all(np.isfinite(a)):
         raise ControlError(f"{name} must be a finite 4x4 pose, got shape {a.shape}")
+    if np.max(np.abs(a[3] - (0.0, 0.0, 0.0, 1.0))) > 1e-12:
+        raise ControlError(
+            f"{name} is not a homogeneous pose: its last row is {a[3].tolist()}, not [0, 0, 0, 1]"
+        )
     try:
         check_rotation(a[:3, :3], f"{name} rotation")
     except ValueError as exc:
@@ -78,11 +93,21 @@ def slerp(R0, R1, s) -> np.ndarray:
     return R0 @ rot_axis(n, _s(s) * phi)
 
 
+def _lerp(p0: np.ndarray, p1: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``p0 + s (p1 − p0)`` for ``s`` of shape (N,) or (), ``p`` of any shape; where the
+    difference overflows (ends near ±1e308) the same point as ``(1 − s) p0 + s p1``."""
+    s = s.reshape(s.shape + (1,) * p0.ndim)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = p0 + s * (p1 - p0)
+        if not np.all(np.isfinite(out)):
+            out = (1.0 - s) * p0 + s * p1
+    return _check.finite(out, "the interpolated point", "the ends are too large")
+
+
 def line_points(p0, p1, s) -> np.ndarray:
     """Points ``p0 + s (p1 − p0)`` of the straight segment (m), shape (3,) or (N, 3)."""
     p0, p1 = _point(p0, "p0"), _point(p1, "p1")
-    s = _s(s)
-    return p0 + s[..., None] * (p1 - p0)
+    return _lerp(p0, p1, _s(s))
 
 
 def line_poses(T0, T1, s) -> np.ndarray:
@@ -92,7 +117,7 @@ def line_poses(T0, T1, s) -> np.ndarray:
     s = _s(s)
     out = np.broadcast_to(np.eye(4), s.shape + (4, 4)).copy()
     out[..., :3, :3] = slerp(T0[:3, :3], T1[:3, :3], s)
-    out[..., :3, 3] = line_points(T0[:3, 3], T1[:3, 3], s)
+    out[..., :3, 3] = _lerp(T0[:3, 3], T1[:3, 3], s)
     return out
 
 
@@ -114,6 +139,9 @@ class Arc:
         Angle swept from ``p1`` to ``p3`` (passing ``p2``), rad, in (0, 2π).
     via_angle : float
         Angle of ``p2`` from ``p1``, rad, in (0, sweep).
+    start : numpy.ndarray, shape (3,), optional
+        ``p1``; the points are computed from it (``p1 + r((cos a − 1) e1 + sin a e2)``), which
+        stays accurate on a huge, nearly straight arc.  Default ``center + radius e1``.
     """
 
     center: np.ndarray
@@ -123,6 +151,7 @@ class Arc:
     e2: np.ndarray
     sweep: float
     via_angle: float
+    start: np.ndarray | None = None
 
     @property
     def length(self) -> float:
@@ -133,7 +162,12 @@ class Arc:
         """Points at the fraction ``s`` of the swept angle, ``c + r (cos sφ e1 + sin sφ e2)``
         (m), shape (3,) or (N, 3)."""
         a = _s(s)[..., None] * self.sweep
-        return self.center + self.radius * (np.cos(a) * self.e1 + np.sin(a) * self.e2)
+        if self.start is None:
+            return self.center + self.radius * (np.cos(a) * self.e1 + np.sin(a) * self.e2)
+        h = np.sin(0.5 * a)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = self.start + self.radius * (-2.0 * h * h * self.e1 + np.sin(a) * self.e2)
+        return _check.finite(out, "a point of the arc", "the arc is too large")
 
     def tangents(self, s) -> np.ndarray:
         """Unit tangents (direction of travel) at ``s``, shape (3,) or (N, 3)."""
@@ -165,8 +199,14 @@ def circle_through(p1, p2, p3, tol: float = 1e-9) -> Arc:
         Two points coincide or the three are collinear (no unique circle).
     """
     p1, p2, p3 = _point(p1, "p1"), _point(p2, "p2"), _point(p3, "p3")
-    # work in units of the largest coordinate difference, so no square overflows or underflows
-    d = np.concatenate([p1 - p3, p2 - p3, p2 - p1])
+    tol = _check.scalar(tol, "tol (relative collinearity tolerance)")
+    if not 0.0 <= tol < 1.0:
+        raise ControlError(f"tol (relative collinearity tolerance) must be in [0, 1), got {tol}")
+    # Everything is computed in units of the largest coordinate difference (a, b, the centre u
+    # relative to p3, the radius), so no square overflows or underflows whatever the scale;
+    # only the final radius and centre are scaled back, and checked.
+    with np.errstate(over="ignore", invalid="ignore"):
+        d = np.concatenate([p1 - p3, p2 - p3, p2 - p1])
     if not np.all(np.isfinite(d)):
         raise DegenerateArcError("the arc's points are too far apart for floating point")
     scale = float(np.max(np.abs(d)))
@@ -174,30 +214,48 @@ def circle_through(p1, p2, p3, tol: float = 1e-9) -> Arc:
         raise DegenerateArcError(f"the arc's three points coincide: {p1.tolist()}")
     a, b = (p1 - p3) / scale, (p2 - p3) / scale
     la, lb, lab = np.linalg.norm(a), np.linalg.norm(b), np.linalg.norm(b - a)
-    if min(la, lb, lab) <= tol * max(la, lb, lab):
+    if min(la, lb, lab) <= tol * max(la, lb, lab) or min(la, lb, lab) == 0.0:
         raise DegenerateArcError(
             f"two of the arc's points coincide: p1={p1.tolist()}, p2={p2.tolist()}, "
             f"p3={p3.tolist()}"
         )
     axb = np.cross(a, b)
     n2 = float(axb @ axb)
-    if np.sqrt(n2) <= tol * la * lb:
+    if n2 == 0.0 or np.sqrt(n2) <= tol * la * lb:
         raise DegenerateArcError(
             f"the arc's three points are collinear (no unique circle): p1={p1.tolist()}, "
             f"p2={p2.tolist()}, p3={p3.tolist()}; use a straight line"
         )
-    c = p3 + scale * (np.cross(la * la * b - lb * lb * a, axb) / (2.0 * n2))
-    r = float(np.linalg.norm(p1 - c))
+    with np.errstate(over="ignore", invalid="ignore"):
+        u = np.cross(la * la * b - lb * lb * a, axb) / (2.0 * n2)  # centre − p3, scaled
+        w = a - u  # p1 − centre, scaled
+        rs = float(np.linalg.norm(w))
+        r = scale * rs
+        c = p3 + scale * u
+    if not (math.isfinite(r) and r > 0.0 and np.all(np.isfinite(c))):
+        raise DegenerateArcError(
+            f"the arc's radius ({scale:g} x {rs:g} m) or centre is beyond the floating-point "
+            f"range: the points p1={p1.tolist()}, p2={p2.tolist()}, p3={p3.tolist()} are too "
+            "nearly collinear at this scale; use a straight line"
+        )
     n = np.cross(b - a, -b)  # (p2 − p1) × (p3 − p2) over scale²
     n = n / np.linalg.norm(n)
-    e1 = (p1 - c) / r
+    e1 = w / rs
     e2 = np.cross(n, e1)
 
-    def angle(p):
-        d = p - c
-        return float(np.mod(np.arctan2(d @ e2, d @ e1), 2 * np.pi))
+    def angle(q):
+        dq = q - u
+        return float(np.mod(np.arctan2(dq @ e2, dq @ e1), 2 * np.pi))
 
-    return Arc(center=c, radius=r, normal=n, e1=e1, e2=e2, sweep=angle(p3), via_angle=angle(p2))
+    sweep, via = angle(np.zeros(3)), angle(b)  # p3 and p2 in scaled units relative to p3
+    if not (0.0 < via < sweep <= 2 * np.pi and math.isfinite(r * sweep)):
+        raise DegenerateArcError(
+            f"the arc through p1={p1.tolist()}, p2={p2.tolist()}, p3={p3.tolist()} has no "
+            f"resolvable sweep (sweep {sweep}, via angle {via} rad); use a straight line"
+        )
+    return Arc(
+        center=c, radius=r, normal=n, e1=e1, e2=e2, sweep=sweep, via_angle=via, start=p1.copy()
+    )
 
 
 def arc_poses(T1, p2, T3, s) -> np.ndarray:
@@ -219,9 +277,8 @@ def arc_poses(T1, p2, T3, s) -> np.ndarray:
     numpy.ndarray, shape (4, 4) or (N, 4, 4)
     """
     T1, T3 = _pose(T1, "T1"), _pose(T3, "T3")
-    p2 = np.asarray(p2, dtype=float)
-    if p2.shape == (4, 4):
-        p2 = p2[:3, 3]
+    if np.shape(p2) == (4, 4):
+        p2 = _pose(p2, "p2")[:3, 3]
     arc = circle_through(T1[:3, 3], p2, T3[:3, 3])
     s = _s(s)
     out = np.broadcast_to(np.eye(4), s.shape + (4, 4)).copy()
