@@ -12,17 +12,34 @@ folder.  An exception removes it.  A writer killed with ``SIGKILL`` cannot, so i
 stay: it is hidden, no reader opens it (the cache counts and serves only its own entries), and
 the next :func:`atomic_write_text` to the same target deletes the temp files of writers whose
 process no longer exists.
+
+Reading files safely: :func:`read_bounded`, :func:`load_json_bounded` and
+:func:`check_regular_file` (for a path handed to a library that opens it itself) are the readers'
+side (C3D, joint CSV and marker-set JSON of :mod:`anthroarm.motion`; meant for every reader of a
+user's file: teach programs, catalogues, batch results).  They read **regular files only** (a folder, ``/dev/zero``, a FIFO or a socket is
+refused without being read: a FIFO is opened non-blocking, so a reader never waits for a writer),
+at most ``max_bytes`` (checked on the size before reading, and again on the bytes read, in case
+the file grows), and, for JSON, at most ``max_depth`` nested arrays/objects, checked on the text
+before :func:`json.loads` runs (a deep document would otherwise raise :class:`RecursionError`).
+Each takes ``error``, a callable ``error(problem) -> Exception`` that builds the caller's typed
+error (e.g. ``lambda problem: MotionDataError(problem, path)``): the problems it is given say what
+is wrong and name the bound, the caller's error names the file.
 """
 
 from __future__ import annotations
 
 import errno
 import glob
+import json
 import os
 import secrets
 import stat
 import threading
+from collections.abc import Callable
 from pathlib import Path
+
+#: the default nesting bound of :func:`load_json_bounded` (arrays and objects, counted together)
+MAX_JSON_DEPTH = 64
 
 
 def atomic_write_text(path, text: str | bytes) -> None:
@@ -122,3 +139,134 @@ def _remove_stale_temps(path: Path) -> None:
                 pass
         except (PermissionError, OverflowError, OSError):
             pass  # alive (another user's) or not a pid: leave it
+
+
+def read_bounded(
+    path,
+    max_bytes: int,
+    *,
+    error: Callable[[str], Exception],
+    what: str = "file",
+    encoding: str | None = "utf-8",
+) -> str | bytes:
+    """The content of the regular file ``path``: text decoded with ``encoding`` (bytes when
+    ``encoding`` is None).  Raises ``error(problem)`` when the file does not exist, is not a
+    regular file (a folder, a device such as ``/dev/zero``, a FIFO, a socket; a symlink is
+    followed), is larger than ``max_bytes``, cannot be read (the OS error's text) or decoded.
+    A FIFO is opened with ``O_NONBLOCK`` and refused without waiting for a writer.  ``what``
+    names the kind of file in the problems (``"C3D file"``: "C3D file not found")."""
+    p = Path(path)
+    try:
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        raise error(f"{what} not found") from None
+    except IsADirectoryError:
+        raise error("is a folder, not a file") from None
+    except OSError as exc:
+        raise error(f"cannot open the file ({exc.strerror or exc})") from None
+    try:
+        st = os.fstat(fd)
+        _check_regular(st, max_bytes, error, what)
+        chunks, left = [], max_bytes + 1
+        while left > 0:
+            b = os.read(fd, min(left, 1 << 20))
+            if not b:
+                break
+            chunks.append(b)
+            left -= len(b)
+    except OSError as exc:
+        raise error(f"cannot read the file ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
+    data = b"".join(chunks)
+    if len(data) > max_bytes:
+        raise error(f"the file grew beyond {max_bytes} bytes while being read (the bound)")
+    if encoding is None:
+        return data
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise error(f"not {encoding} text ({exc})") from None
+
+
+def check_regular_file(
+    path, max_bytes: int, *, error: Callable[[str], Exception], what: str = "file"
+) -> int:
+    """The size of the regular file ``path`` (bytes), for a reader that hands the path to a
+    library (ezc3d): ``error(problem)`` as :func:`read_bounded` for a missing file, a file that
+    is not a regular file, or one larger than ``max_bytes``.  Nothing is opened."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise error(f"{what} not found") from None
+    except OSError as exc:
+        raise error(f"cannot read the file ({exc.strerror or exc})") from None
+    _check_regular(st, max_bytes, error, what)
+    return st.st_size
+
+
+def _check_regular(st: os.stat_result, max_bytes: int, error, what: str) -> None:
+    if stat.S_ISDIR(st.st_mode):
+        raise error("is a folder, not a file")
+    if not stat.S_ISREG(st.st_mode):
+        kind = (
+            "a device"
+            if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode)
+            else "a FIFO"
+            if stat.S_ISFIFO(st.st_mode)
+            else "a socket"
+            if stat.S_ISSOCK(st.st_mode)
+            else "not a regular file"
+        )
+        raise error(f"is {kind}, not a regular file: give the path of a {what}")
+    if st.st_size > max_bytes:
+        raise error(f"the file has {st.st_size} bytes, more than the bound of {max_bytes} bytes")
+
+
+def json_depth(text: str) -> int:
+    """The deepest nesting of arrays and objects in the JSON ``text`` (brackets inside strings
+    are not counted), by one linear scan, without parsing."""
+    depth = deepest = 0
+    in_str = esc = False
+    for ch in text:
+        if in_str:
+            if esc:
+                esc = False
+            elif ch == "\\":
+                esc = True
+            elif ch == '"':
+                in_str = False
+        elif ch == '"':
+            in_str = True
+        elif ch in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in "]}":
+            depth -= 1
+    return deepest
+
+
+def load_json_bounded(
+    path,
+    max_bytes: int,
+    *,
+    error: Callable[[str], Exception],
+    what: str = "file",
+    max_depth: int = MAX_JSON_DEPTH,
+):
+    """The JSON document in the regular file ``path`` (UTF-8): :func:`read_bounded`, then the
+    nesting depth checked against ``max_depth`` (:func:`json_depth`) before :func:`json.loads`.
+    ``error(problem)`` also for a document nested deeper than ``max_depth`` and for text that is
+    not JSON (the decoder's message, with the line and column)."""
+    text = read_bounded(path, max_bytes, error=error, what=what)
+    opening = text.count("[") + text.count("{")  # no deeper than the brackets it has
+    d = json_depth(text) if opening > max_depth else opening
+    if d > max_depth:
+        raise error(
+            f"JSON nested {d} levels deep, more than the bound of {max_depth} "
+            "(arrays and objects inside each other)"
+        )
+    try:
+        return json.loads(text)
+    except ValueError as exc:  # JSONDecodeError, and ints beyond Python's digit limit
+        raise error(f"not a JSON {what} ({exc})") from None

@@ -8,6 +8,18 @@ invalid point; ezc3d reads its coordinates as NaN), when a coordinate is not fin
 ``zero_is_missing`` (default), when it is exactly (0, 0, 0), which several capture systems write
 for gaps.
 
+Frame counts are checked on the file's bytes, not taken from ezc3d: the frames the header and
+``POINT:FRAMES`` announce must be in the file (ezc3d returns the frames it finds, silently, and
+reads the zero padding of the last 512-byte block as frames when ``POINT:FRAMES`` says so).
+A file whose bytes end before the last announced frame, or whose header and ``POINT:FRAMES``
+disagree, holds fewer frames than it announces: a :class:`~anthroarm.errors.C3DError` naming both
+counts, or, with ``partial=True``, the frames it holds with ``meta["status"] == "truncated"``.
+In such a file the trailing frames of zero bytes in the last 512 bytes are the block padding,
+not frames, and are not counted.  (A file whose header and ``POINT:FRAMES`` agree on frames that
+its padding holds cannot be told from one that ends with frames of zeros: those frames are
+read, as missing samples with ``zero_is_missing``.)  Only regular files
+of at most :data:`MAX_C3D_BYTES` are read (:func:`anthroarm._io.check_regular_file`).
+
 :func:`write_c3d` writes a trial (in mm by default) to a temporary file in the target's folder
 and renames it into place, so a reader never sees half a file.
 """
@@ -20,8 +32,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .._io import check_regular_file
 from ..errors import C3DError
 from .trial import MarkerTrajectories
+
+#: the largest C3D file :func:`read_c3d` reads, bytes (1 GiB: ezc3d holds the whole file in
+#: memory, several times over as Python objects); a larger file is a C3DError naming the bound
+MAX_C3D_BYTES = 1 << 30
 
 #: metres per unit of the C3D POINT:UNITS values anthroarm understands
 UNITS = {
@@ -46,13 +63,16 @@ def _param(c, group: str, name: str, default=None):
         return default
 
 
-def _check_structure(p: Path) -> int | None:
+def _check_structure(p: Path) -> dict:
     """Walk the header and the parameter section of a C3D file (https://www.c3d.org, "The C3D
     File Format User Guide", ch. 2-3: 512-byte blocks; parameter records ``name length, group id,
     name, offset to the next record, [type, dimensions, data], description``) and raise
     :class:`~anthroarm.errors.C3DError` where it is inconsistent, before ezc3d reads it: ezc3d
     (1.7) crashes the interpreter (SIGSEGV) or never returns on some damaged parameter sections.
-    Returns the number of frames the header announces (None when it cannot say: 65535 or more)."""
+    Returns the layout the frame count is checked on (:func:`_frames_held`): ``size``, the
+    ``data_start`` byte, ``frame_bytes``, the frames the header announces (``header_frames``,
+    None when it cannot say: 65535 or more) and ``POINT:FRAMES`` (``point_frames``, None if
+    absent)."""
     import struct
 
     size = p.stat().st_size
@@ -84,6 +104,7 @@ def _check_structure(p: Path) -> int | None:
     i16 = ">h" if proc == 86 else "<h"
     u16 = ">H" if proc == 86 else "<H"
     groups, params = set(), set()
+    group_ids, scalars = {}, {}  # group name -> id; (group id, NAME) -> (type, data bytes)
     i = 4
     while i + 2 <= len(sec):
         nchar, gid = struct.unpack("bb", sec[i : i + 2])
@@ -98,6 +119,7 @@ def _check_structure(p: Path) -> int | None:
             if -gid in groups:
                 raise C3DError(f"damaged C3D parameter section: group id {-gid} appears twice", p)
             groups.add(-gid)
+            group_ids[sec[i + 2 : i + 2 + abs(nchar)].decode("latin-1").upper()] = -gid
         else:
             params.add(gid)
             typ, ndim = struct.unpack("bB", sec[j : j + 2])
@@ -107,6 +129,12 @@ def _check_structure(p: Path) -> int | None:
                     f"damaged C3D parameter section at byte {start + i}: data type {typ}, {ndim} "
                     "dimensions",
                     p,
+                )
+            if ndim == 0 and typ in (2, 4):
+                raw = sec[j + 2 : j + 2 + typ]
+                scalars[(gid, sec[i + 2 : i + 2 + abs(nchar)].decode("latin-1").upper())] = (
+                    typ,
+                    raw,
                 )
             j += 2 + ndim + abs(typ) * int(np.prod([int(d) for d in dims]))
         if j >= len(sec):
@@ -129,25 +157,78 @@ def _check_structure(p: Path) -> int | None:
             p,
         )
     first, last = (struct.unpack(u16, head[k : k + 2])[0] for k in (6, 8))
-    return last - first + 1 if 0 < first <= last < 65535 else None
+    n_points, n_analog, data_block = (struct.unpack(u16, head[k : k + 2])[0] for k in (2, 4, 16))
+    sign_byte = {84: 15, 85: 13, 86: 12}[proc]  # the sign bit of POINT's scale (IEEE LE, DEC, BE)
+    word = 4 if head[sign_byte] & 0x80 else 2  # a negative scale: float data
+    point = group_ids.get("POINT")
+    frames = scalars.get((point, "FRAMES"))
+    point_frames = None
+    if frames is not None and len(frames[1]) == frames[0]:
+        typ, raw = frames
+        if typ == 2:
+            point_frames = struct.unpack(u16, raw)[0]  # unsigned: files of 32768+ frames
+        else:
+            if proc == 85:  # DEC F-float: swap the 16-bit words, IEEE, divide by 4
+                raw = raw[2:4] + raw[0:2]
+            v = struct.unpack(">f" if proc == 86 else "<f", raw)[0] / (4.0 if proc == 85 else 1.0)
+            point_frames = int(v) if np.isfinite(v) and 0 <= v < 2**31 else None
+    return {
+        "size": size,
+        "data_start": (data_block - 1) * 512 if data_block >= 1 else None,
+        "frame_bytes": (4 * n_points + n_analog) * word,
+        "header_frames": last - first + 1 if 0 < first <= last < 65535 else None,
+        "point_frames": point_frames,
+    }
 
 
-def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
+def _frames_held(p: Path, layout: dict, announced: int) -> tuple[int, int]:
+    """(frames held, of them block padding): the complete frames of ``announced`` that the
+    file's bytes hold after the data start, less the trailing frames of zero bytes that lie in
+    the last 512 bytes of the file (the padding of its last block, which ezc3d reads as frames
+    when the file announces them)."""
+    ds, fb, size = layout["data_start"], layout["frame_bytes"], layout["size"]
+    if ds is None or fb <= 0 or ds > size:
+        return 0, 0
+    held = min(announced, (size - ds) // fb)
+    if held == 0:
+        return 0, 0
+    i0 = max(0, -(-(size - 511 - ds) // fb))  # the first frame starting in the last 511 bytes
+    if i0 >= held:
+        return held, 0
+    lo = ds + i0 * fb
+    with open(p, "rb") as fh:
+        fh.seek(lo)
+        tail = fh.read(ds + held * fb - lo)
+    k = held
+    while k > i0 and not any(tail[(k - 1 - i0) * fb : (k - i0) * fb]):
+        k -= 1
+    return k, held - k
+
+
+def read_c3d(path, *, zero_is_missing: bool = True, partial: bool = False) -> MarkerTrajectories:
     """Marker trajectories of a C3D file, in metres (world = the lab frame of the file).
+
+    ``meta`` of the result holds ``units``, ``status`` (``"complete"``, or ``"truncated"`` for a
+    partial read), ``frames_announced`` and ``frames_read``.  With ``partial=True`` a file that
+    holds fewer frames than it announces is read up to its last complete frame instead of
+    refused (block padding is never read as frames).
 
     Raises
     ------
     C3DError
-        No such file, not a C3D file ezc3d can read (a damaged header or parameter section is
-        found before ezc3d reads it), a truncated file (fewer frames than its header
-        announces), no POINT data, unknown ``POINT:UNITS`` (the message lists the known ones),
-        a non-positive rate, duplicate labels.
+        No such file, not a regular file (a folder, a device, a FIFO), larger than
+        :data:`MAX_C3D_BYTES`, not a C3D file ezc3d can read (a damaged header or parameter
+        section is found before ezc3d reads it), fewer frames than the header or
+        ``POINT:FRAMES`` announces (unless ``partial``: the message names both counts), no
+        POINT data, unknown ``POINT:UNITS`` (the message lists the known ones), a non-positive
+        rate, duplicate labels.
     """
     p = Path(path)
-    if not p.is_file():
-        raise C3DError("C3D file not found" if not p.exists() else "not a file", p)
+    check_regular_file(
+        p, MAX_C3D_BYTES, what="C3D file", error=lambda problem: C3DError(problem, p)
+    )
     try:
-        announced = _check_structure(p)
+        layout = _check_structure(p)
     except OSError as exc:
         raise C3DError(f"cannot read the file ({exc.strerror or exc})", p) from None
     try:
@@ -159,10 +240,41 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     pts = np.asarray(c["data"]["points"], dtype=float)
     if pts.ndim != 3 or pts.shape[0] < 3:
         raise C3DError(f"no POINT data (points array of shape {pts.shape})", p)
-    if announced is not None and pts.shape[2] < announced:
-        raise C3DError(
-            f"truncated file: its header announces {announced} frames, it holds {pts.shape[2]}", p
+    n_read = pts.shape[2]
+    claims = {k: layout[k] for k in ("header_frames", "point_frames") if layout[k] is not None}
+    announced = max([n_read, *claims.values()])
+    consistent = n_read == announced and all(v == announced for v in claims.values())
+    ds, fb = layout["data_start"], layout["frame_bytes"]
+    if fb <= 0:  # nothing per frame to count on
+        held, padding = n_read, 0
+    elif consistent and ds is not None and ds + announced * fb <= layout["size"]:
+        held, padding = announced, 0  # frames of zeros at the end of such a file are kept
+    else:
+        try:
+            held, padding = _frames_held(p, layout, announced)
+        except OSError as exc:
+            raise C3DError(f"cannot read the file ({exc.strerror or exc})", p) from None
+    status = "complete"
+    if held < announced or not consistent:
+        said = ", ".join(
+            f"{'the header' if k == 'header_frames' else 'POINT:FRAMES'} {v}"
+            for k, v in claims.items()
         )
+        pad = (
+            f" (the {padding} frame(s) of zero bytes after them are the padding of the last "
+            "512-byte block, not frames)"
+            if padding
+            else ""
+        )
+        if not partial:
+            raise C3DError(
+                f"truncated or damaged file: its header announces {announced} frames ({said}), "
+                f"the file holds {min(held, n_read)}{pad} (ezc3d reads {n_read}); "
+                f"read_c3d(..., partial=True) reads the frames it holds",
+                p,
+            )
+        status = "truncated"
+        pts = pts[:, :, : min(held, n_read)]
     labels = list(_param(c, "POINT", "LABELS", []) or [])
     k = 2
     while len(labels) < pts.shape[1] and _param(c, "POINT", f"LABELS{k}") is not None:
@@ -187,7 +299,13 @@ def read_c3d(path, *, zero_is_missing: bool = True) -> MarkerTrajectories:
     dup = sorted({s for s in labels if labels.count(s) > 1})
     if dup:
         raise C3DError(f"duplicate marker labels {dup}: rename them in the capture software", p)
-    return MarkerTrajectories(tuple(labels), P, rate=rate, source=str(p), meta={"units": unit})
+    meta = {
+        "units": unit,
+        "status": status,
+        "frames_announced": int(announced),
+        "frames_read": int(P.shape[0]),
+    }
+    return MarkerTrajectories(tuple(labels), P, rate=rate, source=str(p), meta=meta)
 
 
 def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:

@@ -2,12 +2,18 @@
 
     anthroarm ik-markers trial.c3d --out angles.csv [--height 1.62 --mass 55 --sex female]
                          [--static static.c3d] [--markers set.json] [--rename LABEL=MARKER ...]
+                         [--subject NAME]
 
 The arm is ``human_arm7`` scaled to the person (``--height/--mass/--sex``), or to a static
 trial (``--static``: :func:`anthroarm.motion.scaling.scale_from_static`); the marker set is the
 default ISB set or ``--markers`` (JSON, :meth:`~anthroarm.motion.markers.MarkerSet.read_json`).
 A progress bar on stderr (on a terminal) follows the frames; the last line printed is a JSON
 summary (frames per status, median and largest RMS marker error, ms per frame).
+
+``--out`` must not be one of the inputs (the trial, ``--static``, ``--markers``; compared as
+files: the same path written differently, a symlink or a hard link to it): that is refused
+before anything is read or written.  The CSV is written atomically after the solve
+(:func:`anthroarm._io.atomic_write_text`), so a failed run leaves an existing file as it was.
 """
 
 from __future__ import annotations
@@ -61,6 +67,12 @@ def add_parser(sub):
         metavar="LABEL=MARKER",
         help="map a trial label to a marker of the set (repeatable)",
     )
+    p.add_argument(
+        "--subject",
+        default=None,
+        metavar="NAME",
+        help="whose markers to use in a trial of several subjects (labels NAME:MARKER)",
+    )
     p.add_argument("--solver", default="daqp", help="QP backend (default daqp)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_ik_markers)
@@ -85,6 +97,12 @@ def cmd_ik_markers(a) -> int:
     out = Path(a.out)
     if out.is_dir() or not out.parent.is_dir():
         raise UserError(f"--out {a.out}: give a file name in an existing folder")
+    for flag, given in (("the trial", a.trial), ("--static", a.static), ("--markers", a.markers)):
+        if given is not None and _same_file(out, Path(given)):
+            raise UserError(
+                f"--out {a.out} is an input ({flag} {given}): it would be overwritten; "
+                "give another output file"
+            )
     person = {
         k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None
     }
@@ -93,7 +111,7 @@ def cmd_ik_markers(a) -> int:
     markers = MarkerSet.read_json(a.markers) if a.markers else None
     info = {}
     if a.static:
-        sc = scale_from_static(robot, read_c3d(a.static), markers, rename=rename)
+        sc = scale_from_static(robot, read_c3d(a.static), markers, rename=rename, subject=a.subject)
         if sc.status != "ok":
             raise UserError(
                 f"--static {a.static}: the static trial does not fit {a.model} ({sc.status}: RMS marker "
@@ -112,6 +130,7 @@ def cmd_ik_markers(a) -> int:
             trial,
             markers,
             rename=rename,
+            subject=a.subject,
             solver=a.solver,
             progress=lambda n, N: bar.update(n - bar.n),
         )
@@ -129,3 +148,14 @@ def cmd_ik_markers(a) -> int:
         print("anthroarm ik-markers: no frame solved with status ok", file=sys.stderr)
         return 1
     return 0
+
+
+def _same_file(a, b) -> bool:
+    """``a`` and ``b`` name the same file: the same inode (a hard link, a symlink, the same path
+    written differently) or, when one does not exist yet, the same resolved path."""
+    import os
+
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)

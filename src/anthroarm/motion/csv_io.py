@@ -9,7 +9,9 @@ number, so any CSV reader takes it.
 
 :func:`read_joint_csv` also accepts ``time`` / ``time_s`` for the time column and joint columns
 with a unit suffix (``_rad``, ``_deg``; degrees are converted), so spreadsheets from other tools
-load too.  An empty or ``nan`` cell is a gap; ``inf`` or a magnitude beyond 1e6 is an error.
+load too.  An empty or ``nan`` cell is a gap; ``inf`` or a magnitude beyond 1e6 is an error, so
+is a column named twice (``a`` and ``a_deg`` name the same joint).  Only a regular file of at
+most :data:`MAX_CSV_BYTES` is read (:func:`anthroarm._io.read_bounded`).
 A row whose joint values are not finite is a gap: it is marked invalid and holds the
 previous valid row (the next one before the first), never NaN.
 """
@@ -22,13 +24,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import atomic_write_text
+from .._io import atomic_write_text, read_bounded
 from ..errors import MotionDataError
 from .marker_ik import STATUSES, MarkerIKResult
 
 TIME_COLUMNS = ("t", "time", "time_s")
+_EXTRAS = ("rms_m", "max_error_m", "n_markers", "status")  # the marker-IK columns
 #: the largest magnitude :func:`read_joint_csv` takes in a cell (inf and beyond are errors)
 MAX_VALUE = 1e6
+#: the largest joint-trajectory CSV :func:`read_joint_csv` reads, bytes (64 MiB: about 500 000
+#: rows of 7 joints, 80 min at 100 Hz); a larger file is a MotionDataError naming the bound
+MAX_CSV_BYTES = 64 << 20
 
 
 @dataclass
@@ -111,16 +117,17 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     column except the time and the marker-IK extras is a joint.
 
     Raises :class:`~anthroarm.errors.MotionDataError` naming the file and the line: no such
-    file, no header, no time column, a missing joint, a value that is not a number or is
-    infinite or beyond :data:`MAX_VALUE`, a row of the wrong length, times that do not increase,
-    no valid row."""
+    file, not a regular file (a folder, a device, a FIFO), larger than :data:`MAX_CSV_BYTES`,
+    not UTF-8 text, no header, no time column, a column named twice, a missing joint, a value
+    that is not a number or is infinite or beyond :data:`MAX_VALUE`, a row of the wrong length,
+    times that do not increase, no valid row."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MotionDataError("joint-trajectory CSV not found", p) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MotionDataError(f"cannot read the file as text ({exc})", p) from None
+    text = read_bounded(
+        p,
+        MAX_CSV_BYTES,
+        what="joint-trajectory CSV",
+        error=lambda problem: MotionDataError(problem, p),
+    )
     rows = [
         (i + 1, ln)
         for i, ln in enumerate(text.splitlines())
@@ -128,20 +135,35 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     ]
     if not rows:
         raise MotionDataError("no header line", p)
-    header = [h.strip() for h in rows[0][1].split(",")]
-    tcol = next((header.index(c) for c in TIME_COLUMNS if c in header), None)
-    if tcol is None:
+    hline, hrow = rows[0]
+    header = [h.strip() for h in hrow.split(",")]
+    times = [h for h in header if h in TIME_COLUMNS]
+    if not times:
         raise MotionDataError(f"no time column (one of {list(TIME_COLUMNS)}); header: {header}", p)
-    joints = {}
+    if len(times) > 1:
+        raise MotionDataError(
+            f"line {hline}: time columns {times[0]!r} and {times[1]!r}: keep one", p
+        )
+    tcol = header.index(times[0])
+    joints, seen = {}, {}
     for i, h in enumerate(header):
-        if i == tcol or h in ("rms_m", "max_error_m", "n_markers", "status"):
+        if i == tcol:
             continue
+        key, scale = h, 1.0
         if h.endswith("_deg"):
-            joints[h[:-4]] = (i, np.pi / 180.0)
+            key, scale = h[:-4], np.pi / 180.0
         elif h.endswith("_rad"):
-            joints[h[:-4]] = (i, 1.0)
-        else:
-            joints[h] = (i, 1.0)
+            key = h[:-4]
+        if key in seen:
+            same = f"column {h!r} twice" if seen[key] == h else f"columns {seen[key]!r} and {h!r}"
+            raise MotionDataError(
+                f"line {hline}: {same} (the same {'joint' if key not in _EXTRAS else 'value'} "
+                f"{key!r}); keep one",
+                p,
+            )
+        seen[key] = h
+        if h not in _EXTRAS:
+            joints[key] = (i, scale)
     names = tuple(joints) if robot is None else tuple(robot.chain.q_names)
     missing = [n for n in names if n not in joints]
     if missing:

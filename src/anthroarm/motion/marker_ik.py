@@ -129,12 +129,26 @@ class MarkerIKResult:
         }
 
 
-def match_markers(trial_names, marker_set: MarkerSet, rename: dict | None = None) -> np.ndarray:
+def _split_label(label: str) -> tuple[str | None, str]:
+    """``"Subject1:EL"`` -> ``("Subject1", "EL")``; a label without a prefix -> ``(None, label)``."""
+    pre, sep, base = str(label).rpartition(":")
+    return (pre.strip() or None, base.strip()) if sep else (None, str(label).strip())
+
+
+def match_markers(
+    trial_names, marker_set: MarkerSet, rename: dict | None = None, *, subject: str | None = None
+) -> np.ndarray:
     """Column of each marker of ``marker_set`` in a trial with labels ``trial_names`` (−1 if
     absent).  A label matches a marker by exact name, after ``rename`` (trial label -> marker
-    name), or after stripping a subject prefix (``"Subject1:EL"`` -> ``"EL"``) and case.  A
-    ``rename`` target that is not a marker of the set is a :class:`~anthroarm.errors.MarkerSetError`
-    (a typo would otherwise leave the marker silently missing)."""
+    name), or after stripping a subject prefix (``"Subject1:EL"`` -> ``"EL"``) and case.
+
+    A trial may hold several subjects (labels ``"Subj1:RSHO"``, ``"Subj2:RSHO"``, as Vicon
+    Nexus writes them).  When the labels of more than one subject match markers of the set,
+    ``subject`` must say whose markers to use (labels without a prefix are used too);
+    otherwise a :class:`~anthroarm.errors.MarkerSetError` lists the subjects.  A ``subject``
+    that is not in the trial, or a ``rename`` target that is not a marker of the set, is a
+    :class:`~anthroarm.errors.MarkerSetError` too (a typo would otherwise leave markers silently
+    missing)."""
     rename = dict(rename or {})
     unknown = sorted(str(v) for v in rename.values() if v not in marker_set.names)
     if unknown:
@@ -142,11 +156,41 @@ def match_markers(trial_names, marker_set: MarkerSet, rename: dict | None = None
             f"rename maps trial labels to {unknown}, which are not markers of {marker_set.name!r} "
             f"({', '.join(marker_set.names)})"
         )
-    cols = {}
-    for i, lab in enumerate(trial_names):
-        for key in (rename.get(lab, lab), lab.split(":")[-1].strip()):
-            cols.setdefault(key, i)
-            cols.setdefault(key.upper(), i)
+    labels = [str(s) for s in trial_names]
+    split = [_split_label(lab) for lab in labels]
+    subjects = sorted({pre for pre, _ in split if pre is not None})
+    if subject is not None:
+        if not isinstance(subject, str) or subject.strip() not in subjects:
+            raise MarkerSetError(
+                f"subject {subject!r} is not in the trial; its subjects: "
+                f"{', '.join(subjects) if subjects else 'none (no label has a SUBJECT: prefix)'}"
+            )
+        subject = subject.strip()
+
+    def columns(keep) -> dict:
+        cols = {}
+        for i, (lab, (pre, base)) in enumerate(zip(labels, split)):
+            if keep(pre):
+                for key in (rename.get(lab, lab), base):
+                    cols.setdefault(key, i)
+                    cols.setdefault(key.upper(), i)
+        return cols
+
+    if subject is None and len(subjects) > 1:
+        found = {}
+        for sub in subjects:
+            cols = columns(lambda pre, sub=sub: pre == sub)
+            n = sum(1 for m in marker_set if m.name in cols or m.name.upper() in cols)
+            if n:
+                found[sub] = n
+        if len(found) > 1:
+            listed = ", ".join(f"{k} ({v} markers)" for k, v in found.items())
+            first = next(iter(found))
+            raise MarkerSetError(
+                f"the trial holds markers of {len(found)} subjects of set {marker_set.name!r}: "
+                f"{listed}; choose one: subject={first!r} (anthroarm ik-markers --subject {first})"
+            )
+    cols = columns(lambda pre: subject is None or pre in (None, subject))
     out = np.full(len(marker_set), -1, dtype=int)
     for k, m in enumerate(marker_set):
         out[k] = cols.get(m.name, cols.get(m.name.upper(), -1))
@@ -271,12 +315,20 @@ class MarkerIK:
         return bool(ev[0] > 1e-10 * max(ev[-1], 1e-300))
 
     def solve(
-        self, trial, *, q0=None, rename: dict | None = None, progress=None, rate: float = 100.0
+        self,
+        trial,
+        *,
+        q0=None,
+        rename: dict | None = None,
+        subject: str | None = None,
+        progress=None,
+        rate: float = 100.0,
     ) -> MarkerIKResult:
         """Solve every frame of ``trial`` (:class:`~anthroarm.motion.trial.MarkerTrajectories`,
         or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0`` seeds the first frame
         (default: the comfortable posture).  ``progress(n_done, n_total)`` is called every 50
-        frames (the CLI's progress bar).
+        frames (the CLI's progress bar).  ``rename`` and ``subject`` (whose markers to use in a
+        trial of several subjects) are those of :func:`match_markers`.
 
         Raises :class:`~anthroarm.errors.MarkerSetError` when no marker of the set is in the
         trial and :class:`~anthroarm.errors.UnconstrainedJointError` when the markers present
@@ -285,7 +337,7 @@ class MarkerIK:
         robot = self.robot
         names = self.marker_set.names
         if isinstance(trial, MarkerTrajectories):
-            cols = match_markers(trial.names, self.marker_set, rename)
+            cols = match_markers(trial.names, self.marker_set, rename, subject=subject)
             if not (cols >= 0).any():
                 raise MarkerSetError(
                     f"{trial.source}: none of the markers {list(names)} of set "
@@ -406,6 +458,7 @@ def marker_ik(
     *,
     q0=None,
     rename: dict | None = None,
+    subject: str | None = None,
     progress=None,
     rate: float = 100.0,
     **options,
@@ -413,5 +466,5 @@ def marker_ik(
     """Marker IK of a whole trial: ``MarkerIK(robot, marker_set, **options).solve(trial, ...)``
     (see :class:`MarkerIK` for the options and the module docstring for the method)."""
     return MarkerIK(robot, marker_set, **options).solve(
-        trial, q0=q0, rename=rename, progress=progress, rate=rate
+        trial, q0=q0, rename=rename, subject=subject, progress=progress, rate=rate
     )

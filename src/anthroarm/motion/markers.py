@@ -12,7 +12,8 @@ model knowledge and lives with the model (:data:`anthroarm.models.human.HUMAN_AR
 link, position as fractions of the link's segment length, weight); this module scales it to the
 robot's segment lengths read from ``robot.chain`` (:func:`segment_length`) and checks that the
 links exist as frames.  A lab with its own protocol supplies its own set
-(:meth:`MarkerSet.from_dict`, :meth:`MarkerSet.read_json`).
+(:meth:`MarkerSet.from_dict`, :meth:`MarkerSet.read_json`: a regular file of at most
+:data:`MAX_MARKER_SET_BYTES`, nested at most :data:`MAX_MARKER_SET_DEPTH` deep).
 """
 
 from __future__ import annotations
@@ -27,6 +28,13 @@ import pinocchio as pin
 from ..errors import MarkerSetError, UnconstrainedJointError, UnknownFrameError
 from ..ik.qp.tasks.marker import moved_by
 from ..models.human import HUMAN_ARM_LANDMARKS, HUMAN_ARM_TRUNK_SCALE_LINK
+
+#: the largest marker-set JSON file :meth:`MarkerSet.read_json` reads, bytes (1 MiB: thousands
+#: of markers); a larger file is a MarkerSetError naming the bound
+MAX_MARKER_SET_BYTES = 1 << 20
+#: the deepest nesting of arrays/objects a marker-set JSON file may have (a set needs 4); checked
+#: before parsing, so a deeply nested file is a MarkerSetError, not a RecursionError
+MAX_MARKER_SET_DEPTH = 16
 
 
 @dataclass(frozen=True)
@@ -52,8 +60,9 @@ class MarkerSet:
     Raises
     ------
     MarkerSetError
-        Empty set, duplicate names, a position that is not 3 finite numbers, a negative or
-        non-finite weight.
+        Empty set, duplicate names, a body that is not a frame name (a non-empty str: a
+        ``null`` body would otherwise mean the tool), a position that is not 3 finite numbers,
+        a negative or non-finite weight.
     """
 
     def __init__(self, markers, name: str = "markers"):
@@ -73,6 +82,11 @@ class MarkerSet:
                 )
             if m.name in seen:
                 raise MarkerSetError(f"marker set {self.name!r}: duplicate marker name {m.name!r}")
+            if not isinstance(m.body, str) or not m.body.strip():
+                raise MarkerSetError(
+                    f"marker {m.name!r}: body must be the name of a frame of the robot (a non-empty "
+                    f"str), got {m.body!r}"
+                )
             seen.add(m.name)
             p = np.asarray(m.position, dtype=float) if _numeric(m.position) else None
             if p is None or p.shape != (3,) or not np.isfinite(p).all():
@@ -152,17 +166,26 @@ class MarkerSet:
     @classmethod
     def read_json(cls, path) -> "MarkerSet":
         """A set written by :meth:`write_json` (or by hand: ``{"name": ..., "markers": {...}}``
-        with the entries of :meth:`from_dict`)."""
+        with the entries of :meth:`from_dict`).  A :class:`~anthroarm.errors.MarkerSetError`
+        naming the file for a missing file, one that is not a regular file, is larger than
+        :data:`MAX_MARKER_SET_BYTES`, nested deeper than :data:`MAX_MARKER_SET_DEPTH`, is not
+        JSON or not a valid set."""
+        from .._io import load_json_bounded
+
         p = Path(path)
-        try:
-            doc = json.loads(p.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise MarkerSetError(f"{p}: marker set file not found") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise MarkerSetError(f"{p}: not a JSON marker set ({exc})") from None
+        doc = load_json_bounded(
+            p,
+            MAX_MARKER_SET_BYTES,
+            max_depth=MAX_MARKER_SET_DEPTH,
+            what="marker set file",
+            error=lambda problem: MarkerSetError(f"{p}: {problem}"),
+        )
         if not isinstance(doc, dict) or not isinstance(doc.get("markers"), dict):
             raise MarkerSetError(f"{p}: expected an object with a 'markers' object")
-        return cls.from_dict(doc["markers"], name=str(doc.get("name", p.stem)))
+        try:
+            return cls.from_dict(doc["markers"], name=str(doc.get("name", p.stem)))
+        except MarkerSetError as exc:
+            raise MarkerSetError(f"{p}: {exc}") from None
 
     def write_json(self, path) -> None:
         """Write the set as JSON (atomically)."""

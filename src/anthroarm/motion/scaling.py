@@ -85,9 +85,9 @@ class ScalingResult:
         return out
 
 
-def _static_positions(trial, marker_set, rename):
+def _static_positions(trial, marker_set, rename, subject=None):
     if isinstance(trial, MarkerTrajectories):
-        cols = match_markers(trial.names, marker_set, rename)
+        cols = match_markers(trial.names, marker_set, rename, subject=subject)
         P = np.full((trial.n_frames, len(marker_set), 3), np.nan)
         P[:, cols >= 0] = trial.positions[:, cols[cols >= 0]]
     else:
@@ -117,6 +117,7 @@ def scale_from_static(
     *,
     q0=None,
     rename: dict | None = None,
+    subject: str | None = None,
     bounds=(0.5, 2.0),
     max_rms: float = 0.02,
 ) -> ScalingResult:
@@ -124,7 +125,8 @@ def scale_from_static(
 
     ``trial``: :class:`~anthroarm.motion.trial.MarkerTrajectories` (a C3D read with
     :func:`~anthroarm.motion.c3d.read_c3d`) or an array ``(frames, M, 3)`` / ``(M, 3)`` in the
-    marker set's order (m).  The result's ``status`` says whether the fit can be trusted
+    marker set's order (m); ``rename`` and ``subject`` (whose markers, in a trial of several
+    subjects) as in :func:`~anthroarm.motion.marker_ik.match_markers`.  The result's ``status`` says whether the fit can be trusted
     (RMS marker error at most ``max_rms`` m, no factor at a bound).  Raises
     :class:`~anthroarm.errors.MarkerSetError` when a body to be scaled has no visible marker at
     or below its distal end, :class:`~anthroarm.errors.ParameterError` for ``bounds`` that are
@@ -143,7 +145,7 @@ def scale_from_static(
         )
     ms = default_marker_set(robot) if marker_set is None else marker_set
     bound = ms.bind(robot)
-    mbar, seen = _static_positions(trial, ms, rename)
+    mbar, seen = _static_positions(trial, ms, rename, subject)
     chain = robot.chain
     use = seen & (bound.joint >= 0)
     if not use.any():
