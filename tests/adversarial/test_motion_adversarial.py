@@ -444,3 +444,46 @@ def test_io_readers_helper(tmp_path):
         read_bounded(tmp_path, 100, error=err)
     with pytest.raises(MotionDataError, match="report not found"):
         read_bounded(tmp_path / "none", 100, error=err, what="report")
+
+
+def test_csv_with_a_byte_order_mark_reads(tmp_path):
+    """Spreadsheets save UTF-8 CSV with a byte-order mark: it is not part of the first column's
+    name (it was: 'no time column', header ['\\ufefft', ...])."""
+    p = tmp_path / "excel.csv"
+    p.write_text("t,a_deg\n0,90\n0.01,45\n", encoding="utf-8-sig")
+    tr = read_joint_csv(p)
+    assert tr.names == ("a",) and np.allclose(tr.q[:, 0], [np.pi / 2, np.pi / 4])
+
+
+def test_marker_positions_and_weights_must_be_numbers(tmp_path):
+    """ "1" and true are not coordinates or weights (they were kept as given: position ('1', '2',
+    '3'), weight True)."""
+    for entry, what in (
+        ('{"body": "hand", "position": ["0.1", "0", "0"]}', "position"),
+        ('{"body": "hand", "position": [0.1, 0, 0], "weight": true}', "weight"),
+        ('{"body": "hand", "position": [true, 0, 0]}', "position"),
+    ):
+        p = tmp_path / "s.json"
+        p.write_text('{"markers": {"MC3": ' + entry + "}}")
+        with pytest.raises(MarkerSetError, match=f"'MC3': {what}") as ei:
+            MarkerSet.read_json(p)
+        assert str(p) in str(ei.value)
+
+
+@pytest.mark.parametrize("bad", [None, 5, ""])
+def test_readers_take_only_paths(bad):
+    """read_c3d(5), read_joint_csv(None): typed errors, not a TypeError from pathlib."""
+    for reader, error in (
+        (read_c3d, C3DError),
+        (read_joint_csv, MotionDataError),
+        (MarkerSet.read_json, MarkerSetError),
+    ):
+        with pytest.raises(error, match="path must be a file path"):
+            reader(bad)
+
+
+def test_cli_refuses_a_device_as_output_before_solving(tmp_path, arm, capsys):
+    trial = _small_trial(tmp_path, arm)
+    rc = main(["ik-markers", str(trial), "--out", "/dev/null", "--no-progress"])
+    cap = capsys.readouterr()
+    assert rc == 2 and "not a regular file" in cap.err and cap.out == ""  # no summary: not solved

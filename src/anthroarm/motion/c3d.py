@@ -223,6 +223,8 @@ def read_c3d(path, *, zero_is_missing: bool = True, partial: bool = False) -> Ma
         POINT data, unknown ``POINT:UNITS`` (the message lists the known ones), a non-positive
         rate, duplicate labels.
     """
+    if not isinstance(path, (str, os.PathLike)) or path == "":
+        raise C3DError(f"read_c3d: path must be a file path, got {type(path).__name__} {path!r}")
     p = Path(path)
     check_regular_file(
         p, MAX_C3D_BYTES, what="C3D file", error=lambda problem: C3DError(problem, p)

@@ -97,6 +97,10 @@ def cmd_ik_markers(a) -> int:
     out = Path(a.out)
     if out.is_dir() or not out.parent.is_dir():
         raise UserError(f"--out {a.out}: give a file name in an existing folder")
+    if out.exists() and not out.is_file():
+        raise UserError(
+            f"--out {a.out}: not a regular file (a device, FIFO or socket); give a file name"
+        )
     for flag, given in (("the trial", a.trial), ("--static", a.static), ("--markers", a.markers)):
         if given is not None and _same_file(out, Path(given)):
             raise UserError(

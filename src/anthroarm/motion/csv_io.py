@@ -19,6 +19,7 @@ previous valid row (the next one before the first), never NaN.
 from __future__ import annotations
 
 import io
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,11 +122,16 @@ def read_joint_csv(path, robot=None) -> JointTrajectory:
     not UTF-8 text, no header, no time column, a column named twice, a missing joint, a value
     that is not a number or is infinite or beyond :data:`MAX_VALUE`, a row of the wrong length,
     times that do not increase, no valid row."""
+    if not isinstance(path, (str, os.PathLike)) or path == "":
+        raise MotionDataError(
+            f"read_joint_csv: path must be a file path, got {type(path).__name__} {path!r}"
+        )
     p = Path(path)
     text = read_bounded(
         p,
         MAX_CSV_BYTES,
         what="joint-trajectory CSV",
+        encoding="utf-8-sig",  # a byte-order mark (spreadsheets write one) is not in the header
         error=lambda problem: MotionDataError(problem, p),
     )
     rows = [

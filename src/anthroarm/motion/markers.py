@@ -19,6 +19,7 @@ links exist as frames.  A lab with its own protocol supplies its own set
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -96,6 +97,7 @@ class MarkerSet:
                 )
             if not (
                 isinstance(m.weight, (int, float, np.floating, np.integer))
+                and not isinstance(m.weight, bool)
                 and np.isfinite(m.weight)
                 and m.weight >= 0
             ):
@@ -172,6 +174,10 @@ class MarkerSet:
         JSON or not a valid set."""
         from .._io import load_json_bounded
 
+        if not isinstance(path, (str, os.PathLike)) or path == "":
+            raise MarkerSetError(
+                f"read_json: path must be a file path, got {type(path).__name__} {path!r}"
+            )
         p = Path(path)
         doc = load_json_bounded(
             p,
@@ -218,10 +224,18 @@ class MarkerSet:
 
 
 def _numeric(x) -> bool:
+    """``x`` is a sequence of real numbers (not text, not booleans: "1" or true in a JSON file
+    is a mistake, not a coordinate)."""
+    if isinstance(x, np.ndarray):
+        return x.dtype.kind in "iuf"
+    if isinstance(x, (str, bytes)):
+        return False
     try:
-        np.asarray(x, dtype=float)
-        return True
-    except (TypeError, ValueError):
+        return all(
+            isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+            for v in x
+        )
+    except TypeError:  # not a sequence
         return False
 
 
