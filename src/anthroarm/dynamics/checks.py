@@ -13,7 +13,12 @@ reduced quantities (tests/dynamics/test_lagrange_any_robot.py checks them agains
 model without mimic joints), but its ``computeCoriolisMatrix`` is not consistent with them and
 ``aba`` and the energy functions refuse mimic joints: there C q̇ and the Christoffel matrix
 times q̇ are checked against ``nonLinearEffects − g``, forward dynamics against
-``crba⁻¹ (τ − nonLinearEffects)``, T against ½ q̇ᵀ crba q̇ and V against −m gᵀ ``centerOfMass``.
+``M⁻¹ (τ − nonLinearEffects)``, T against ½ q̇ᵀ M q̇ and V against −m gᵀ ``centerOfMass``, where
+M is built from ``rnea`` (column i = rnea(q, 0, e_i) − g), not ``crba``: Pinocchio 4.1's
+``crba`` is wrong on a mimic joint whose link carries two joints (both conventions) and, in its
+default LOCAL convention, depends on the reused pin.Data's past on other mimic trees
+(tests/dynamics/test_mimic_dynamics.py: FORK4, TREE5); its ``rnea`` agrees with the projection
+of the model without mimic relations on all of them.
 """
 
 from __future__ import annotations
@@ -50,11 +55,16 @@ def model_rows(robot, samples: int, rng) -> list:
     mimic = robot.chain.has_mimic
     if mimic:
         Cm = np.einsum("nij,nj->ni", Cm, Qd)
+    zero = np.zeros(n)
     for q, qd, qdd, ti in zip(Q, Qd, Qdd, tau_in):
-        Mp = pin.crba(m, d, q)
-        Mp = np.triu(Mp) + np.triu(Mp, 1).T
-        ref["M"].append(Mp)
         gp = pin.computeGeneralizedGravity(m, d, q).copy()
+        if mimic:  # M e_i = rnea(q, 0, e_i) - g: Pinocchio 4.1's crba is wrong on some mimic trees
+            Mp = np.column_stack([pin.rnea(m, d, q, zero, e) - gp for e in np.eye(n)])
+            Mp = 0.5 * (Mp + Mp.T)
+        else:
+            Mp = pin.crba(m, d, q)
+            Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        ref["M"].append(Mp)
         ref["g"].append(gp)
         if mimic:
             nle = pin.nonLinearEffects(m, d, q, qd).copy()
@@ -89,8 +99,9 @@ def model_rows(robot, samples: int, rng) -> list:
     if mimic:
         label["C"] = ("dyn C(q,qd) Christoffel matrix @ qd", "pin.nonLinearEffects - g (mimic)")
         label["Cqd"] = (label["Cqd"][0], "pin.nonLinearEffects - g (mimic)")
-        label["fd"] = (label["fd"][0], "solve(pin.crba, tau - nonLinearEffects) (mimic)")
-        label["T"] = (label["T"][0], "qd' pin.crba qd / 2 (mimic)")
+        label["M"] = (label["M"][0], "pin.rnea columns (mimic)")
+        label["fd"] = (label["fd"][0], "solve(M from pin.rnea, tau - nonLinearEffects) (mimic)")
+        label["T"] = (label["T"][0], "qd' (M from pin.rnea) qd / 2 (mimic)")
         label["V"] = (label["V"][0], "-mass g'pin.centerOfMass (mimic)")
     rows = []
     for k, (q_name, oracle) in label.items():
