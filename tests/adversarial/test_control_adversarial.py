@@ -183,3 +183,145 @@ def test_pose_with_a_bad_last_row_is_refused():
 def test_interpolation_refuses_strings(call):
     with pytest.raises(ControlError):
         call()
+
+
+# ============================================================================ teach: calls
+def test_mutually_recursive_subroutines_are_refused_with_the_cycle_named():
+    a = Program("a", (_step(0), Call("b")))
+    b = Program("b", (_step(1), Call("a")))
+    with within(5), pytest.raises(PlaybackError, match="a -> b -> a"):
+        play_subroutines({"a": a, "b": b}, ["a"])
+    with within(5), pytest.raises(PlaybackError, match="a -> b -> a"):
+        play_select({"a": a, "b": b}, "a")
+
+
+def test_self_calling_subroutine_without_steps_is_refused():
+    e = Program("e", (Call("e"),))
+    with within(5), pytest.raises(PlaybackError, match="e -> e"):
+        play_subroutines({"e": e}, ["e"])
+
+
+def test_exponential_call_tree_without_steps_stops():
+    """Forty subroutines, each calling the next twice and none with a step: 2**40 calls, no
+    step ever counted against max_steps (a hang)."""
+    lib = {f"s{k}": Program(f"s{k}", (Call(f"s{k + 1}"), Call(f"s{k + 1}"))) for k in range(40)}
+    lib["s40"] = Program("s40", ())
+    with within(10):
+        out = play_subroutines(lib, ["s0"])
+    assert out.status == "step limit"
+
+
+def test_call_depth_beyond_the_bound_is_refused():
+    lib = {f"s{k}": Program(f"s{k}", (Call(f"s{k + 1}"),)) for k in range(300)}
+    lib["s300"] = Program("s300", (_step(0),))
+    with within(5), pytest.raises(PlaybackError, match="deeper"):
+        play_subroutines(lib, ["s0"])
+
+
+def test_jump_sensor_with_no_values_is_named():
+    prog = Program("p", (_step(0, label="top"), Jump("top", "s")))
+    with pytest.raises(PlaybackError, match="'s'"):
+        play_jump(prog, {"s": []})
+
+
+def test_random_access_history_is_not_quadratic():
+    with within(8):
+        out = play_random_access({"a": _step(0)}, "a", lambda a, h: "a", max_steps=200_000)
+    assert out.status == "step limit" and len(out.executed) == 200_000
+
+
+# ============================================================================ teach: files
+def test_from_json_refuses_deep_nesting():
+    deep = '{"name": "x", "items": ' + "[" * 100_000 + "]" * 100_000 + "}"
+    with pytest.raises(ControlError, match="nest"):
+        Program.from_json(deep)
+
+
+def test_from_json_refuses_an_integer_with_too_many_digits():
+    text = json.dumps({"name": "x", "items": []})[:-1] + ', "n": ' + "9" * 5000 + "}"
+    with pytest.raises(ControlError):
+        Program.from_json(text)
+
+
+@pytest.mark.parametrize(
+    "item",
+    [{"kind": "jump", "label": 5}, {"kind": "call", "name": [1]}, {"kind": "step"}, 5],
+)
+def test_from_json_refuses_items_of_the_wrong_type(item):
+    with pytest.raises(ControlError):
+        Program.from_json(json.dumps({"name": "x", "items": [item]}))
+
+
+def test_load_refuses_what_is_not_a_small_regular_program_file(tmp_path):
+    with pytest.raises(ControlError, match="folder"):
+        Program.load(tmp_path)
+    with pytest.raises(ControlError, match="not found"):
+        Program.load(tmp_path / "missing.json")
+    binary = tmp_path / "bin.json"
+    binary.write_bytes(b"\x80\x81\xff")
+    with pytest.raises(ControlError, match="(?i)utf-8"):
+        Program.load(binary)
+    huge = tmp_path / "huge.json"
+    with open(huge, "wb") as f:
+        f.truncate(2**40)  # sparse: 1 TiB that must be refused before it is read
+    with within(5), pytest.raises(ControlError, match="bytes"):
+        Program.load(huge)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with within(5), pytest.raises(ControlError, match="regular file"):
+        Program.load(fifo)
+
+
+def test_save_load_round_trip_still_works(tmp_path):
+    p = Program("p", (_step(0, label="a"), Jump("a", "s"), _step(1), Call("q")))
+    p.save(tmp_path / "p.json")
+    assert Program.load(tmp_path / "p.json").to_json() == p.to_json()
+
+
+# ========================================================================= teach: programs
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: Program("x", 5),
+        lambda: Program(5, ()),
+        lambda: Jump(5),
+        lambda: Call(None),
+        lambda: record("x", [[0.0], [1.0]], "a"),
+        lambda: record("x", [[0.0], [1.0]], [1.0, 2.0, 3.0]),
+        lambda: Program.from_channels("x", 5, [[1.0]], [1.0]),
+        lambda: play_subroutines({"a": 5}, ["a"]),
+        lambda: play_select({"a": Program("a", ())}, lambda s: ["a"]),
+    ],
+    ids=[
+        "items int",
+        "name int",
+        "jump label int",
+        "call name None",
+        "times string",
+        "times length",
+        "sequence int",
+        "library value",
+        "selector unhashable",
+    ],
+)
+def test_teach_refuses_malformed_programs(call):
+    with pytest.raises(ControlError):
+        call()
+
+
+@pytest.mark.parametrize("dt", [1e-12, 5e-324])
+def test_trajectory_with_a_tiny_time_step_names_the_budget(dt):
+    """dt = 1e-12 over 2 s asked numpy for 14.6 TiB (MemoryError); 5e-324 an OverflowError."""
+    pb = play_fixed(record("x", [[0.0], [1.0]], 2.0))
+    t0 = time.perf_counter()
+    with pytest.raises(ControlError, match="budget") as err:
+        pb.trajectory(dt)
+    assert time.perf_counter() - t0 < 1.0
+    assert "dt" in str(err.value)
+
+
+def test_trajectory_between_huge_joint_values_is_finite():
+    pb = play_fixed(record("x", [[0.0], [1e308], [-1e308]], 1.0))
+    t, p = pb.trajectory(0.5)
+    assert np.all(np.isfinite(p))
+    np.testing.assert_allclose(p[:, 0], [0.0, 5e307, 1e308, 0.0, -1e308])

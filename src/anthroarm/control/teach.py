@@ -38,12 +38,30 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._io import atomic_write_text
+from .._io import atomic_write_text, read_bounded
 from ..errors import ControlError, PlaybackError
 from . import _check
-from .interpolation import arc_poses, circle_through, line_poses
+from ._teach_guard import (
+    ITEMS_PER_STEP,
+    MAX_CALL_DEPTH,
+    MAX_JSON_DEPTH,
+    MAX_PROGRAM_BYTES,
+    History,
+    check_call_graph,
+    check_calls,
+    hashable,
+    library_of,
+    parse_program_json,
+    sensor_signal,
+)
+from ._teach_guard import name as _name
+from .interpolation import _lerp, arc_poses, circle_through, line_poses
 
 __all__ = [
+    "ITEMS_PER_STEP",
+    "MAX_CALL_DEPTH",
+    "MAX_JSON_DEPTH",
+    "MAX_PROGRAM_BYTES",
     "Call",
     "ExecutedStep",
     "Jump",
@@ -149,6 +167,11 @@ class Jump:
     label: str
     sensor: str | None = None
 
+    def __post_init__(self):
+        _name(self.label, "a jump's label")
+        if self.sensor is not None:
+            _name(self.sensor, "a jump's sensor")
+
     def to_dict(self) -> dict:
         return {"kind": "jump", "label": self.label, "sensor": self.sensor}
 
@@ -158,6 +181,9 @@ class Call:
     """Run the subroutine ``name`` (a program of the library) and come back (子程序)."""
 
     name: str
+
+    def __post_init__(self):
+        _name(self.name, "a call's subroutine name")
 
     def to_dict(self) -> dict:
         return {"kind": "call", "name": self.name}
@@ -183,6 +209,14 @@ class Program:
     items: tuple = field(default_factory=tuple)
 
     def __post_init__(self):
+        _name(self.name, "a program's name")
+        if isinstance(self.items, (str, bytes, Mapping)) or not isinstance(
+            self.items, (Sequence, tuple, list)
+        ):
+            raise ControlError(
+                f"program {self.name!r}: items must be a sequence of Step, Jump and Call, got "
+                f"{type(self.items).__name__}"
+            )
         items = tuple(self.items)
         object.__setattr__(self, "items", items)
         labels: dict[str, int] = {}
@@ -264,11 +298,18 @@ class Program:
         -------
         Program
         """
+        if isinstance(sequence, (str, bytes)) or not isinstance(sequence, Sequence):
+            raise ControlError(
+                f"sequence must be a list of labels (one per step), got {type(sequence).__name__}"
+            )
+        for lb in sequence:
+            if lb is not None:
+                _name(lb, "a label of the sequence")
         pos = _check.array(position, "position")
         n = len(sequence)
         t = _check.array(time, "time")
         d = np.zeros(n) if dwell is None else _check.array(dwell, "dwell")
-        if pos.shape[:1] != (n,) or t.shape != (n,) or d.shape != (n,):
+        if pos.ndim == 0 or pos.shape[:1] != (n,) or t.shape != (n,) or d.shape != (n,):
             raise ControlError(
                 f"channels of different lengths: sequence {n}, position {pos.shape}, time {t.shape}, "
                 f"dwell {d.shape}"
@@ -293,18 +334,38 @@ class Program:
     def from_json(cls, text: str) -> Program:
         """Read a program written by :meth:`to_json`.
 
+        The text is bounded before it is parsed: at most :data:`MAX_PROGRAM_BYTES` characters
+        and :data:`MAX_JSON_DEPTH` nested arrays/objects (a deeper document would exhaust the
+        parser's recursion).
+
         Raises
         ------
         anthroarm.errors.ControlError
-            Text that is not such a program.
+            Text that is not such a program (the message says what is wrong).
         """
+        return cls._from_dict(parse_program_json(text))
+
+    @classmethod
+    def _from_dict(cls, d) -> Program:
+        if not isinstance(d, dict):
+            raise ControlError(f"not a stored program: a JSON {type(d).__name__}, not an object")
         try:
-            d = json.loads(text)
-            items = []
-            for it in d["items"]:
-                kind = it["kind"]
+            items = d["items"]
+            name = d["name"]
+        except KeyError as exc:
+            raise ControlError(f"not a stored program: no {exc.args[0]!r} entry") from None
+        if not isinstance(items, list):
+            raise ControlError(f"not a stored program: 'items' is a {type(items).__name__}")
+        out = []
+        for k, it in enumerate(items):
+            if not isinstance(it, dict):
+                raise ControlError(
+                    f"stored program item {k} is a {type(it).__name__}, not an object"
+                )
+            kind = it.get("kind")
+            try:
                 if kind == "step":
-                    items.append(
+                    out.append(
                         Step(
                             position=it["position"],
                             time=it["time"],
@@ -316,14 +377,20 @@ class Program:
                         )
                     )
                 elif kind == "jump":
-                    items.append(Jump(it["label"], it.get("sensor")))
+                    out.append(Jump(it["label"], it.get("sensor")))
                 elif kind == "call":
-                    items.append(Call(it["name"]))
+                    out.append(Call(it["name"]))
                 else:
-                    raise ControlError(f"unknown item kind {kind!r}")
-            return cls(str(d["name"]), tuple(items))
-        except (KeyError, TypeError, json.JSONDecodeError) as exc:
-            raise ControlError(f"not a stored program: {exc}") from None
+                    raise ControlError(
+                        f"unknown item kind {_check._short(kind)} (step, jump or call)"
+                    )
+            except KeyError as exc:
+                raise ControlError(
+                    f"stored program item {k} ({kind}) has no {exc.args[0]!r} entry"
+                ) from None
+            except ControlError as exc:
+                raise type(exc)(f"stored program item {k}: {exc}") from None
+        return cls(_name(name, "a stored program's name"), tuple(out))
 
     def save(self, path) -> None:
         """Store the program as JSON, atomically (a reader sees the old file or the new one)."""
@@ -331,9 +398,27 @@ class Program:
 
     @classmethod
     def load(cls, path) -> Program:
-        """Read a program stored by :meth:`save`."""
-        with open(path, encoding="utf-8") as f:
-            return cls.from_json(f.read())
+        """Read a program stored by :meth:`save`.
+
+        Only a regular file of at most :data:`MAX_PROGRAM_BYTES` bytes is read (a folder, a
+        FIFO or a device is refused without being read), in UTF-8, nested at most
+        :data:`MAX_JSON_DEPTH` deep.
+
+        Raises
+        ------
+        anthroarm.errors.ControlError
+            The file is missing, not a regular file, too large, not UTF-8 or not a program; the
+            message names the file.
+        """
+
+        def error(problem):
+            return ControlError(f"{path}: {problem}")
+
+        text = read_bounded(path, MAX_PROGRAM_BYTES, error=error, what="teach program")
+        try:
+            return cls.from_json(text)
+        except ControlError as exc:
+            raise type(exc)(f"{path}: {exc}") from None
 
 
 def record(name: str, positions, times, labels=None, **step_kwargs) -> Program:
@@ -357,7 +442,13 @@ def record(name: str, positions, times, labels=None, **step_kwargs) -> Program:
     Program
     """
     positions = list(positions)
-    t = np.broadcast_to(np.asarray(times, dtype=float), (len(positions),))
+    t = _check.array(times, "times (s)")
+    if t.ndim == 0:
+        t = np.full(len(positions), float(t))
+    elif t.shape != (len(positions),):
+        raise ControlError(
+            f"times must be one value or one per position ({len(positions)}), got shape {t.shape}"
+        )
     labels = [None] * len(positions) if labels is None else list(labels)
     if len(labels) != len(positions):
         raise ControlError(f"{len(labels)} labels for {len(positions)} positions")
@@ -429,12 +520,22 @@ class Playback:
         ex = [e.step for e in self.executed]
         if not ex:
             raise ControlError("nothing was played back")
+        durations = [st.time for st in ex[1:] if st.time > 0] + [
+            st.dwell for st in ex if st.dwell > 0
+        ]
+        total = 1.0 + sum(_check.n_per(d, dt) for d in durations)
+        _check.samples(
+            total,
+            ex[0].position.size,
+            f"trajectory(dt={dt:g} s) over {self.duration:g} s",
+            "give a larger dt (s)",
+        )
         ts, ps = [np.array([0.0])], [ex[0].position[None]]
         t0 = 0.0
 
         def segment(duration, positions_at):
             nonlocal t0
-            n = max(1, int(np.ceil(duration / dt)))
+            n = int(_check.n_per(duration, dt))
             s = np.arange(1, n + 1) / n
             ts.append(t0 + duration * s)
             ps.append(positions_at(s))
@@ -498,38 +599,13 @@ class Playback:
 def _move(a: Step, b: Step, s: np.ndarray) -> np.ndarray:
     """Positions from ``a`` to ``b`` at the fractions ``s`` with ``b``'s motion."""
     p, q = a.position, b.position
-    if b.motion == "joint":
-        return p[None] + s.reshape((-1,) + (1,) * p.ndim) * (q - p)[None]
+    if b.motion == "joint" or (b.motion == "line" and p.shape == (3,)):
+        return _lerp(p, q, s)
     if p.shape == (3,):
-        if b.motion == "line":
-            return p + s[:, None] * (q - p)
         return circle_through(p, b.via, q).points(s)
     if b.motion == "line":
         return line_poses(p, q, s)
     return arc_poses(p, b.via, q, s)
-
-
-def _sensor(sensors, name: str, cycle: int) -> bool:
-    if callable(sensors) and not isinstance(sensors, Mapping):
-        return bool(sensors(name, cycle))
-    if sensors is None or name not in sensors:
-        known = [] if sensors is None else sorted(sensors)
-        raise PlaybackError(f"sensor {name!r} has no signal; sensors: {known}")
-    v = sensors[name]
-    if callable(v):
-        return bool(v(cycle))
-    if isinstance(v, (list, tuple, np.ndarray)):
-        return bool(v[cycle % len(v)])
-    return bool(v)
-
-
-def _check_calls(program: Program, library: Mapping[str, Program]) -> None:
-    for k, it in enumerate(program.items):
-        if isinstance(it, Call) and it.name not in library:
-            raise PlaybackError(
-                f"program {program.name!r}: item {k} calls subroutine {it.name!r}, which does not "
-                f"exist; subroutines: {sorted(library)}"
-            )
 
 
 def _run(
@@ -541,19 +617,29 @@ def _run(
     cycles: int = 1,
     max_steps: int = 100_000,
 ) -> Playback:
-    """Execute items with a call stack; jumps test sensors; stop after ``max_steps`` steps."""
-    library = {} if library is None else dict(library)
+    """Execute items with a call stack; jumps test sensors; stop after ``max_steps`` steps or
+    ``ITEMS_PER_STEP * max_steps`` items (steps, jumps, calls)."""
+    if not isinstance(program, Program):
+        raise ControlError(f"program must be a Program, got {_check._short(program)}")
+    library = library_of(library, Program)
     cycles = _check.count(cycles, "cycles", 1)
     max_steps = _check.count(max_steps, "max_steps", 1)
     for prog in [program, *library.values()]:
-        _check_calls(prog, library)
+        check_calls(prog, library, Call)
+    check_call_graph(
+        program, library, lambda prog: [it.name for it in prog.items if isinstance(it, Call)]
+    )
     out: list[ExecutedStep] = []
+    items_left = ITEMS_PER_STEP * max_steps
     for cycle in range(int(cycles)):
         stack: list[tuple[Program, int]] = [(program, 0)]
         while stack:
             prog, k = stack.pop()
             if k >= len(prog.items):
                 continue
+            items_left -= 1
+            if items_left < 0:
+                return Playback(mode, tuple(out), "step limit")
             it = prog.items[k]
             if isinstance(it, Step):
                 out.append(ExecutedStep(prog.name, k, cycle, it))
@@ -561,13 +647,9 @@ def _run(
                     return Playback(mode, tuple(out), "step limit")
                 stack.append((prog, k + 1))
             elif isinstance(it, Jump):
-                on = True if it.sensor is None else _sensor(sensors, it.sensor, cycle)
+                on = True if it.sensor is None else sensor_signal(sensors, it.sensor, cycle)
                 stack.append((prog, prog._labels[it.label] if on else k + 1))
             else:
-                if len(stack) > 1000:
-                    raise PlaybackError(
-                        f"subroutine calls nested deeper than 1000 (recursion through {it.name!r})"
-                    )
                 stack.append((prog, k + 1))
                 stack.append((library[it.name], 0))
     return Playback(mode, tuple(out), "done")
@@ -611,8 +693,20 @@ def play_select(
     anthroarm.errors.PlaybackError
         The selected name is not a program (the message lists them).
     """
-    lib = dict(programs) if isinstance(programs, Mapping) else {p.name: p for p in programs}
+    if isinstance(programs, Mapping):
+        lib = library_of(programs, Program)
+    else:
+        progs = list(programs)
+        for p in progs:
+            if not isinstance(p, Program):
+                raise ControlError(f"programs must be Programs, got {_check._short(p)}")
+        lib = {p.name: p for p in progs}
     name = selector(sensors) if callable(selector) else selector
+    if not isinstance(name, str):
+        raise PlaybackError(
+            f"the selector must give a program name (a string), got {_check._short(name)}; "
+            f"programs: {sorted(lib)}"
+        )
     if name not in lib:
         raise PlaybackError(
             f"program {name!r} was selected but does not exist; programs: {sorted(lib)}"
@@ -648,7 +742,9 @@ def play_subroutines(
     anthroarm.errors.PlaybackError
         A name in ``order`` (or a :class:`Call`) that is not a subroutine.
     """
-    main = Program("main", tuple(Call(str(n)) for n in order))
+    if isinstance(order, (str, bytes)) or not isinstance(order, Sequence):
+        raise ControlError(f"order must be a list of subroutine names, got {_check._short(order)}")
+    main = Program("main", tuple(Call(_name(n, "a name of the order")) for n in order))
     return _run(main, "subroutine", library=subroutines, sensors=sensors, cycles=cycles)
 
 
@@ -666,7 +762,9 @@ def play_random_access(
         First address.
     next_address : callable
         ``next_address(current_address, history_of_addresses) -> address or None``; the robot's
-        decision from its sensors.
+        decision from its sensors.  The history is a read-only sequence of the addresses so
+        far (indexing, slicing, ``len``, iteration and ``==`` with a tuple work as on a tuple;
+        it is a view, not a copy, so a long playback stays linear in time).
     max_steps : int
         Stop (status ``"step limit"``) after this many steps.
 
@@ -681,7 +779,11 @@ def play_random_access(
     out: list[ExecutedStep] = []
     hist: list[str] = []
     addr = start
+    if not callable(next_address):
+        raise ControlError(f"next_address must be callable, got {_check._short(next_address)}")
     while addr is not None:
+        if not isinstance(addr, str) and not hashable(addr):
+            raise PlaybackError(f"address {_check._short(addr)} is not an address")
         if addr not in pts:
             raise PlaybackError(f"address {addr!r} does not exist; addresses: {sorted(pts)}")
         step = pts[addr]
@@ -691,5 +793,5 @@ def play_random_access(
         out.append(ExecutedStep(prog_name, len(out), 0, step))
         if len(out) >= max_steps:
             return Playback("random access", tuple(out), "step limit")
-        addr = next_address(addr, tuple(hist))
+        addr = next_address(addr, History(hist, len(hist)))
     return Playback("random access", tuple(out), "done")
