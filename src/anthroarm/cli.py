@@ -23,7 +23,39 @@ class UserError(Exception):
 
 class _Parser(argparse.ArgumentParser):
     """argparse with a one-line error (the usage is one ``--help`` away); subcommand parsers
-    are of the same class."""
+    are of the same class.  ``recorded`` holds the actions its options made, in order (what
+    the public ``add_argument`` returns, also through argument groups), so that the command
+    line can be pre-read and options checked for without argparse's private tables."""
+
+    def __init__(self, *args, **kwargs):
+        self.recorded = []  # before argparse's __init__, which adds -h through add_argument
+        super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args, **kwargs):
+        action = super().add_argument(*args, **kwargs)
+        self.recorded.append(action)
+        return action
+
+    def _recording(self, group):
+        add = group.add_argument
+
+        def add_argument(*args, **kwargs):
+            action = add(*args, **kwargs)
+            self.recorded.append(action)
+            return action
+
+        group.add_argument = add_argument
+        return group
+
+    def add_argument_group(self, *args, **kwargs):
+        return self._recording(super().add_argument_group(*args, **kwargs))
+
+    def add_mutually_exclusive_group(self, *args, **kwargs):
+        return self._recording(super().add_mutually_exclusive_group(*args, **kwargs))
+
+    def option_strings(self) -> set:
+        """Every option string (``--tool``, ``-h`` ...) this parser takes."""
+        return {s for a in self.recorded for s in a.option_strings}
 
     def error(self, message):
         self.exit(
@@ -153,7 +185,8 @@ def _add_model_param_options(p, model):
         f"parameters of {model}", f"{first} Also accepted as --param NAME=VALUE.".strip()
     )
     for name, default, kind, unit in params:
-        if f"--{name}" in p._option_string_actions:
+        taken = p.option_strings()
+        if f"--{name}" in taken:
             continue
         shown = (
             ",".join(f"{x:g}" for x in default)
@@ -171,9 +204,7 @@ def _add_model_param_options(p, model):
         )
         flags = [f"--{name}"] + (
             [f"--{name.replace('_', '-')}"]
-            if kind == "map"
-            and "_" in name
-            and f"--{name.replace('_', '-')}" not in p._option_string_actions
+            if kind == "map" and "_" in name and f"--{name.replace('_', '-')}" not in taken
             else []
         )
         g.add_argument(
@@ -196,7 +227,7 @@ def _prescan_model(sp, rest):
     with its required options not yet enforced and unknown options (a model's parameters) let
     through; None if there is none."""
     pre = _Prescan(add_help=False, prog=sp.prog)
-    for act in sp._actions:
+    for act in sp.recorded:
         if not act.option_strings:
             if act.dest == "model" and act.nargs is None:
                 pre.add_argument("model", nargs="?")

@@ -21,7 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 MIN_ROWS_PER_THREAD = 2048
 ENV = "ANTHROARM_THREADS"
 _LOCK = threading.Lock()
-_POOL: dict[str, ThreadPoolExecutor] = {}
+_POOL: dict = {}  # "pool": the ThreadPoolExecutor, "size": its max_workers
 
 
 def workers() -> int:
@@ -41,10 +41,11 @@ def workers() -> int:
 def _pool(n: int) -> ThreadPoolExecutor:
     with _LOCK:
         pool = _POOL.get("pool")
-        if pool is None or pool._max_workers < n:  # noqa: SLF001 - grow when $ANTHROARM_THREADS rises
+        if pool is None or _POOL["size"] < n:  # grow when $ANTHROARM_THREADS rises
             if pool is not None:
                 pool.shutdown(wait=False)
             pool = _POOL["pool"] = ThreadPoolExecutor(max_workers=n, thread_name_prefix="anthroarm")
+            _POOL["size"] = n
         return pool
 
 

@@ -36,13 +36,12 @@ import time
 import numpy as np
 from scipy.linalg.lapack import dposv
 
-try:  # the clip ufunc itself: ~0.2 µs against ~1.3 µs for np.clip's Python wrapper
-    from numpy._core.umath import clip as uclip
-except ImportError:  # numpy < 2
-    try:
-        from numpy.core.umath import clip as uclip
-    except ImportError:  # pragma: no cover - a NumPy without the ufunc: the public wrapper
-        uclip = np.clip
+
+def clip(x, lo, hi):
+    """x clipped to [lo, hi] elementwise: two ufunc calls (~0.4 µs for 7 joints), not
+    ``np.clip``'s Python wrapper (~1.3 µs) nor NumPy's private ``_core.umath.clip``."""
+    return np.minimum(np.maximum(x, lo), hi)
+
 
 LAMBDA0 = 1e-10  # floor of the damping (keeps JJᵀ + λI positive definite at singularities)
 K_DAMP = 0.01  # λ grows with the squared error: large errors -> short, gradient-like steps
@@ -108,13 +107,13 @@ def damped_step(ws, th, J, e, lam):
         return None
     lo, hi = ws.lo, ws.hi
     tn = th + dq
-    tc = uclip(tn, lo, hi)
+    tc = clip(tn, lo, hi)
     if tc.tobytes() != tn.tobytes():  # (byte comparison: ~20× cheaper than (tc != tn).any())
         # active set: the joints the step pushes past a limit stay where they are, the others
         # take the step recomputed without them, then it is clipped
         dq = solve_damped(ws, J * (tc == tn)[..., None, :], e, lam)
         if dq is not None:
-            tc = uclip(th + dq, lo, hi)
+            tc = clip(th + dq, lo, hi)
     return tc
 
 

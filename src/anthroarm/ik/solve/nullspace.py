@@ -18,7 +18,7 @@ import pinocchio as pin
 from scipy.linalg.lapack import dpotrs
 
 from ..qp.tasks.swivel import swivel_from_points
-from .kernel import clock, damping, solve_damped, uclip
+from .kernel import clip, clock, damping, solve_damped
 
 NULL_TOL = 1e-4  # posture / swivel secondary step norm (rad) under which it has settled
 NULL_EXTRA = 60  # extra iterations allowed for the secondary objective
@@ -99,7 +99,7 @@ def posture(ws, tg, th, th_ref, deadline):
                 tn = (
                     th + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))
                 )  # long moves leave the linearisation
-            tc = uclip(tn, lo, hi)
+            tc = clip(tn, lo, hi)
             if frozen is not None or tc.tobytes() == tn.tobytes():
                 break
             out = (tc != tn) & ((th == lo) | (th == hi))  # at a limit and pushed past it
@@ -118,7 +118,7 @@ def posture(ws, tg, th, th_ref, deadline):
                 tn = base + sig * step
                 s *= sig
                 n2 *= sig
-                tc = uclip(tn, lo, hi)
+                tc = clip(tn, lo, hi)
                 break
             frozen = out  # active set: freeze, recompute once
             J = J * ~out
@@ -203,7 +203,7 @@ def swivel(ws, tg, th, sw: Swivel, deadline):
             break
         if n2 > NULL_STEP:  # long null-space moves leave the linearisation: shorten them
             dq2 *= NULL_STEP / n2
-        th = uclip(th + dq + dq2, ws.lo, ws.hi)
+        th = clip(th + dq + dq2, ws.lo, ws.hi)
     else:
         pe, re = tg.errors(ws, th)
         if tg.ok(pe * pe, re * re):
