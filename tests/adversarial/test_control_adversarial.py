@@ -185,6 +185,51 @@ def test_interpolation_refuses_strings(call):
         call()
 
 
+# ============================================================================ control: servo
+@pytest.mark.parametrize(
+    "bad", [{"i": 1e200}, {"i": 1e308}, {"k_m": 1e308}, {"k_a": 1e308}, {"k_s": 1e308}]
+)
+def test_servo_with_coefficients_beyond_the_float_range_is_refused(bad):
+    """(9-5)'s coefficients overflowed: OverflowError from i**2, LinAlgError from poles()."""
+    with pytest.raises(ControlError, match="floating-point range"):
+        PositionServo(**{**SERVO, **bad})
+
+
+@pytest.mark.parametrize("omega_n", [1e200, 1e-200])
+def test_tuned_servo_at_extreme_frequencies_is_refused(omega_n):
+    motor = DCMotor(R=1.0, k_m=0.05, J_m=1e-6, i=50.0)
+    with pytest.raises(ControlError):
+        PositionServo.tuned(motor, 1e-3, omega_n, 0.7)
+
+
+def test_servo_step_response_with_a_trillion_samples_names_the_budget():
+    with within(5), pytest.raises(ControlError, match="budget"):
+        PositionServo(**SERVO).step_response(1.0, n=10**12)
+
+
+@pytest.mark.parametrize("dt", [1e6, 1e308])
+def test_saturating_servo_long_step_is_refused_before_it_runs(dt):
+    """RK4 sub-steps of 1/50 of the fastest time constant over dt = 1e6 s: a hang (and an
+    OverflowError for 1e308)."""
+    servo = PositionServo(**SERVO, V_max=10.0)
+    with within(5), pytest.raises(ControlError, match="budget"):
+        servo.advance([0.0, 0.0], dt, 1.0)
+    with within(5), pytest.raises(ControlError, match="budget"):
+        servo.simulate(np.array([0.0, dt]), 1.0)
+
+
+def test_linear_servo_huge_step_is_not_nan():
+    out = PositionServo(**SERVO).advance([0.0, 0.0], 1e308, 1.0)
+    np.testing.assert_allclose(out, [1.0, 0.0])  # a stable servo has settled
+
+
+@pytest.mark.parametrize("method", ["rhs", "voltage"])
+def test_servo_ode_refuses_strings(method):
+    servo = PositionServo(**SERVO)
+    with pytest.raises(ControlError):
+        getattr(servo, method)("ab", 0.0, 0.0)
+
+
 # ============================================================================ teach: calls
 def test_mutually_recursive_subroutines_are_refused_with_the_cycle_named():
     a = Program("a", (_step(0), Call("b")))

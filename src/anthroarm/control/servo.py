@@ -143,9 +143,26 @@ class PositionServo:
         s(self, "eta", eta)
         if self.V_max is not None:
             s(self, "V_max", _check.positive(self.V_max, "V_max (amplifier limit, V)"))
-        if self.J0 <= 0.0:
+        with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+            J0, Kv, Ks = self.J0, self.Kv, self.Ks
+            derived = (J0, Kv, Ks, Ks / J0 if J0 > 0 else 1.0, Kv / J0 if J0 > 0 else 1.0)
+        if not all(math.isfinite(v) for v in derived):
+            raise ControlError(
+                f"the servo's coefficients of Eq. (9-5) are beyond the floating-point range: "
+                f"J_0 = {J0:.3g}, K_v = {Kv:.3g}, K_s = {Ks:.3g} (and K_s/J_0, K_v/J_0) from "
+                f"k_m={self.k_m:g}, k={self.k:g}, J_m={self.J_m:g}, J_L={self.J_L:g}, "
+                f"i={self.i:g}, k_a={self.k_a:g}, k_p={self.k_p:g}, k_s={self.k_s:g}; "
+                "give parameters of a physical scale"
+            )
+        if J0 <= 0.0:
             raise ControlError(
                 "J_0 = eta i^2 J_m + J_L must be > 0 (give a motor or a load inertia)"
+            )
+        if Ks <= 0.0 or Ks / J0 <= 0.0:
+            raise ControlError(
+                f"the servo's stiffness K_s = eta i k_m k_a k_p = {Ks:.3g} (K_s/J_0 = "
+                f"{Ks / J0:.3g}) underflows the floating-point range: give parameters of a "
+                "physical scale"
             )
 
     # ------------------------------------------------------------------ construction
@@ -247,10 +264,16 @@ class PositionServo:
         zeta = _check.positive(zeta, "zeta (damping ratio)")
         base = cls.from_motor(motor, J_L, k_a=1.0, k_p=k_p)
         J0 = base.J0
-        k_a = J0 * omega_n**2 / (base.eta * base.i * base.k_m * k_p)
-        k_s = (2.0 * zeta * omega_n * J0 / (base.eta * base.i**2) - base.k) / (base.k_m * k_a)
+        with np.errstate(over="ignore", under="ignore"):
+            k_a = J0 * omega_n * omega_n / (base.eta * base.i * base.k_m * k_p)
+        if not (math.isfinite(k_a) and k_a > 0.0):
+            raise ControlError(
+                f"omega_n = {omega_n:g} rad/s needs an amplifier gain k_a = J_0 omega_n^2 / "
+                f"(eta i k_m k_p) = {k_a:.3g}, outside the floating-point range"
+            )
+        k_s = (2.0 * zeta * omega_n * J0 / (base.eta * base.i * base.i) - base.k) / (base.k_m * k_a)
         if k_s < 0.0:
-            zmin = base.eta * base.i**2 * base.k / (2.0 * omega_n * J0)
+            zmin = base.eta * base.i * base.i * base.k / (2.0 * omega_n * J0)
             raise ControlError(
                 f"the motor's own damping gives zeta >= {zmin:.6g} at omega_n = {omega_n:g} rad/s; "
                 f"asked for zeta = {zeta:g} (no tachogenerator gain can lower it)"
@@ -261,12 +284,12 @@ class PositionServo:
     @property
     def J0(self) -> float:
         """``J_0 = η i² J_m + J_L`` (kg·m²), Eq. (9-5)."""
-        return self.eta * self.i**2 * self.J_m + self.J_L
+        return self.eta * (self.i * self.i) * self.J_m + self.J_L
 
     @property
     def Kv(self) -> float:
         """``K_v = η i² (k + k_m k_a k_s)`` (N·m·s/rad), Eq. (9-5) as corrected."""
-        return self.eta * self.i**2 * (self.k + self.k_m * self.k_a * self.k_s)
+        return self.eta * (self.i * self.i) * (self.k + self.k_m * self.k_a * self.k_s)
 
     @property
     def Ks(self) -> float:
@@ -352,9 +375,13 @@ class PositionServo:
     def voltage(self, theta, omega, theta_i):
         """Motor voltage of Eq. (9-4), ``k_a k_p (θ_i − θ) − k_a k_s i θ̇`` (V), clipped to
         ``±V_max`` when set."""
-        V = self.k_a * self.k_p * (
-            np.asarray(theta_i) - theta
-        ) - self.k_a * self.k_s * self.i * np.asarray(omega)
+        theta = _check.array(theta, "theta (rad)")
+        omega = _check.array(omega, "omega (rad/s)")
+        theta_i = _check.array(theta_i, "theta_i (rad)")
+        theta, omega, theta_i = _check.broadcast(
+            (theta, "theta"), (omega, "omega"), (theta_i, "theta_i")
+        )
+        V = self.k_a * self.k_p * (theta_i - theta) - self.k_a * self.k_s * self.i * omega
         return V if self.V_max is None else np.clip(V, -self.V_max, self.V_max)
 
     def rhs(self, x, theta_i, M_L) -> np.ndarray:
@@ -373,6 +400,10 @@ class PositionServo:
         numpy.ndarray
             ``(θ̇, θ̈)``, same shape as ``x``.
         """
+        x = _check.array(x, "x (state)")
+        if x.ndim == 0 or x.shape[0] != 2:
+            raise ControlError(f"x must be (theta, omega), shape (2,) or (2, N), got {x.shape}")
+        M_L = _check.array(M_L, "M_L (N m)")
         theta, omega = x[0], x[1]
         V = self.voltage(theta, omega, theta_i)
         M_m = self.k_m * V - self.k * self.i * omega
@@ -380,9 +411,20 @@ class PositionServo:
 
     def _zoh(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         A, B, _, _ = self.state_space()
+        decay = float(-np.max(self.poles().real))  # the slowest mode's decay rate, 1/s
+        if decay > 0.0 and dt * decay > 800.0:
+            # every mode has decayed by more than e^-800 (below the smallest float): the state
+            # is the steady state of the held inputs, x = -A^-1 B u, exactly as far as floats go
+            return np.zeros((2, 2)), -np.linalg.solve(A, B)
         M = np.zeros((4, 4))
         M[:2, :2], M[:2, 2:] = A * dt, B * dt
-        E = scipy.linalg.expm(M)
+        with np.errstate(over="ignore", invalid="ignore"):
+            E = scipy.linalg.expm(M)
+        _check.finite(
+            E,
+            f"the servo's transition over dt = {dt:g} s",
+            "an undamped servo (K_v = 0) cannot be stepped over so long a time; give a shorter dt",
+        )
         return E[:2, :2], E[:2, 2:]
 
     def advance(self, x, dt: float, theta_i: float, M_L: float = 0.0) -> np.ndarray:
@@ -409,11 +451,24 @@ class PositionServo:
             raise ControlError(f"x must be (theta, omega), shape (2,), got {x.shape}")
         theta_i = _check.scalar(theta_i, "theta_i (rad)")
         M_L = _check.scalar(M_L, "M_L (N m)")
-        return self._advance(x, dt, theta_i, M_L, None)
+        if self.V_max is not None:
+            _check.steps(
+                self._substeps_float(dt),
+                f"advance(dt={dt:g} s) with the amplifier limit V_max (RK4 steps of 1/50 of "
+                "the fastest time constant)",
+                "give a shorter dt",
+            )
+        out = self._advance(x, dt, theta_i, M_L, None)
+        return _check.finite(out, "the servo's state", "the inputs are too large")
+
+    def _substeps_float(self, dt) -> float:
+        fastest = float(np.max(np.abs(self.poles())))
+        with np.errstate(over="ignore"):
+            n = np.ceil(np.asarray(dt, dtype=float) * fastest * 50.0)
+        return float(np.sum(np.maximum(n, 1.0)))
 
     def _substeps(self, dt: float) -> int:
-        fastest = float(np.max(np.abs(self.poles())))
-        return max(1, int(math.ceil(dt * fastest * 50.0)))
+        return int(self._substeps_float(dt))
 
     def _advance(self, x, dt, theta_i, M_L, zoh=None):
         """One step; ``zoh`` = (Ad, Bd) of this ``dt`` when the caller has them."""
@@ -455,9 +510,16 @@ class PositionServo:
         x = _check.array(x0, "x0")
         if x.shape != (2,):
             raise ControlError(f"x0 must be (theta, omega), shape (2,), got {x.shape}")
+        dts = np.diff(t)
+        if self.V_max is not None:
+            _check.steps(
+                self._substeps_float(dts),
+                f"simulate over {t[-1] - t[0]:g} s with the amplifier limit V_max (RK4 steps "
+                "of 1/50 of the fastest time constant)",
+                "simulate a shorter time",
+            )
         X = np.empty((t.size, 2))
         X[0] = x
-        dts = np.diff(t)
         uniform = np.allclose(dts, dts[0], rtol=1e-9, atol=0.0)
         zoh = self._zoh(float(dts[0])) if self.V_max is None and uniform else None
         for k, dt in enumerate(dts):
@@ -508,5 +570,6 @@ class PositionServo:
         """
         duration = _check.positive(duration, "duration (s)")
         n = _check.count(n, "n", 2)
+        _check.samples(n, 9, f"step_response(n={n})", "give a smaller n")
         t = np.linspace(0.0, duration, n)
         return self.simulate(t, theta_step, M_L_step)
