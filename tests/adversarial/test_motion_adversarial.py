@@ -487,3 +487,18 @@ def test_cli_refuses_a_device_as_output_before_solving(tmp_path, arm, capsys):
     rc = main(["ik-markers", str(trial), "--out", "/dev/null", "--no-progress"])
     cap = capsys.readouterr()
     assert rc == 2 and "not a regular file" in cap.err and cap.out == ""  # no summary: not solved
+
+
+@pytest.mark.parametrize("field", ["points", "data_start"])
+def test_c3d_header_disagreeing_with_its_parameters_is_refused(tmp_path, field):
+    """The frame count is checked on the bytes a frame takes and where the data start: a header
+    whose point count or data block disagrees with POINT:USED / POINT:DATA_START is damaged."""
+    good = _ezc3d_file(tmp_path / "g.c3d", 20, labels=("A", "B", "C"))
+    b = bytearray(good)
+    at = {"points": 2, "data_start": 16}[field]
+    b[at : at + 2] = struct.pack("<H", struct.unpack("<H", good[at : at + 2])[0] + 1)
+    bad = tmp_path / "bad.c3d"
+    bad.write_bytes(bytes(b))
+    with pytest.raises(C3DError, match="damaged C3D file: the header") as ei:
+        read_c3d(bad)
+    assert str(bad) in str(ei.value)

@@ -161,17 +161,34 @@ def _check_structure(p: Path) -> dict:
     sign_byte = {84: 15, 85: 13, 86: 12}[proc]  # the sign bit of POINT's scale (IEEE LE, DEC, BE)
     word = 4 if head[sign_byte] & 0x80 else 2  # a negative scale: float data
     point = group_ids.get("POINT")
-    frames = scalars.get((point, "FRAMES"))
-    point_frames = None
-    if frames is not None and len(frames[1]) == frames[0]:
-        typ, raw = frames
+
+    def scalar(name):
+        """POINT:name as a number (an int16 read unsigned), None if absent or not a scalar."""
+        rec = scalars.get((point, name))
+        if rec is None or len(rec[1]) != rec[0]:
+            return None
+        typ, raw = rec
         if typ == 2:
-            point_frames = struct.unpack(u16, raw)[0]  # unsigned: files of 32768+ frames
-        else:
-            if proc == 85:  # DEC F-float: swap the 16-bit words, IEEE, divide by 4
-                raw = raw[2:4] + raw[0:2]
-            v = struct.unpack(">f" if proc == 86 else "<f", raw)[0] / (4.0 if proc == 85 else 1.0)
-            point_frames = int(v) if np.isfinite(v) and 0 <= v < 2**31 else None
+            return struct.unpack(u16, raw)[0]  # unsigned: files of 32768+ frames
+        if proc == 85:  # DEC F-float: swap the 16-bit words, IEEE, divide by 4
+            raw = raw[2:4] + raw[0:2]
+        v = struct.unpack(">f" if proc == 86 else "<f", raw)[0] / (4.0 if proc == 85 else 1.0)
+        return int(v) if np.isfinite(v) and 0 <= v < 2**31 else None
+
+    point_frames = scalar("FRAMES")
+    used, param_start = scalar("USED"), scalar("DATA_START")
+    if used is not None and used != n_points:
+        raise C3DError(
+            f"damaged C3D file: the header says {n_points} points a frame, POINT:USED {used}", p
+        )
+    if data_block == 0 and param_start:
+        data_block = param_start
+    elif param_start is not None and param_start != data_block:
+        raise C3DError(
+            f"damaged C3D file: the header puts the data at block {data_block}, "
+            f"POINT:DATA_START at block {param_start}",
+            p,
+        )
     return {
         "size": size,
         "data_start": (data_block - 1) * 512 if data_block >= 1 else None,
