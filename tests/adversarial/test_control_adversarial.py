@@ -230,6 +230,30 @@ def test_servo_ode_refuses_strings(method):
         getattr(servo, method)("ab", 0.0, 0.0)
 
 
+# ============================================================================ control: motor
+def test_motor_whose_torque_speed_slope_underflows_is_refused():
+    """k_m = 1e-200: k_m²/R underflowed to 0, then ZeroDivisionError in the time constant."""
+    with pytest.raises(ControlError, match="k_m"):
+        DCMotor(R=1.0, k_m=1e-200, J_m=1.0)
+
+
+def test_motor_arrays_that_do_not_broadcast_are_named():
+    m = DCMotor(R=1.0, k_m=0.05, J_m=1e-6, i=50.0, V_nom=12.0)
+    with pytest.raises(ControlError, match="omega"):
+        m.motor_torque([1.0, 2.0, 3.0], [1.0, 2.0])
+
+
+def test_motor_replace_with_an_unknown_parameter_is_typed():
+    m = DCMotor(R=1.0, k_m=0.05, J_m=1e-6)
+    with pytest.raises(ParameterError, match="foo"):
+        m.replace(foo=1.0)
+
+
+def test_rms_at_the_ends_of_the_float_range_is_exact():
+    assert rms([0.0, 1.0], [1e200, 1e200]) == pytest.approx(1e200)
+    assert rms([-1e308, 1e308], [1.0, 1.0]) == pytest.approx(1.0)
+
+
 # ============================================================================ teach: calls
 def test_mutually_recursive_subroutines_are_refused_with_the_cycle_named():
     a = Program("a", (_step(0), Call("b")))

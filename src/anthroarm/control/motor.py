@@ -34,11 +34,12 @@ e.g. Pons, *Wearable Robots* (Wiley, 2008), §7, and the maxon "Key information"
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ControlError
+from ..errors import ControlError, ParameterError
 from . import _check
 
 __all__ = ["DCMotor", "ThermalCheck", "rms"]
@@ -87,7 +88,13 @@ def rms(t, x) -> float:
     """
     t = _check.time_grid(t)
     x = _check.on_grid(x, t, "x")
-    return float(np.sqrt(np.trapezoid(x * x, t) / (t[-1] - t[0])))
+    # in units of the largest |x| and |t|, so neither x² nor the time span overflows (the RMS
+    # does not depend on the time unit); the scale of x is put back at the end
+    xs, ts = float(np.max(np.abs(x))), float(np.max(np.abs(t)))
+    if xs == 0.0:
+        return 0.0
+    u, tau = x / xs, t / ts
+    return xs * float(np.sqrt(np.trapezoid(u * u, tau) / (tau[-1] - tau[0])))
 
 
 @dataclass(frozen=True)
@@ -151,9 +158,31 @@ class DCMotor:
             s(self, "V_nom", _check.positive(self.V_nom, "V_nom (supply voltage, V)"))
         if self.tau_cont is not None:
             s(self, "tau_cont", _check.positive(self.tau_cont, "tau_cont (continuous torque, N m)"))
+        if not isinstance(self.name, str):
+            raise ControlError(f"name must be a string, got {type(self.name).__name__}")
+        with np.errstate(over="ignore", under="ignore"):
+            derived = {
+                "k_m / R (the book's stall-torque coefficient)": self.stall_torque_coefficient,
+                "k_m^2 / R + b_m (the torque-speed slope)": self.torque_speed_slope,
+                "i^2 J_m (the reflected inertia)": self.reflected_inertia,
+            }
+        for what, v in derived.items():
+            if not math.isfinite(v) or (v <= 0.0 and "inertia" not in what):
+                raise ControlError(
+                    f"{what} = {v:.3g} is outside the floating-point range for R={self.R:g}, "
+                    f"k_m={self.k_m:g}, b_m={self.b_m:g}, i={self.i:g}, J_m={self.J_m:g}: give "
+                    "parameters of a physical scale"
+                )
 
     def replace(self, **changes) -> DCMotor:
         """A copy with some parameters changed (validated again), e.g. ``motor.replace(i=100)``."""
+        fields = {f.name for f in dataclasses.fields(self)}
+        unknown = sorted(set(changes) - fields)
+        if unknown:
+            raise ParameterError(
+                f"DCMotor has no parameter {', '.join(map(repr, unknown))}; parameters: "
+                f"{sorted(fields)}"
+            )
         return dataclasses.replace(self, **changes)
 
     # ------------------------------------------------------------------ book symbols of (9-1)
@@ -222,6 +251,7 @@ class DCMotor:
         """
         V = _check.array(V, "V (voltage, V)")
         w = _check.array(omega_m, "omega_m (motor speed, rad/s)")
+        V, w = _check.broadcast((V, "V"), (w, "omega_m"))
         return self.stall_torque_coefficient * V - self.torque_speed_slope * w
 
     @_check.finite_result
@@ -243,7 +273,8 @@ class DCMotor:
             Joint torque, N·m (broadcast shape of ``omega`` and ``V``).
         """
         w = _check.array(omega, "omega (joint speed, rad/s)")
-        tm = self.motor_torque(self._voltage(V), self.i * w)
+        V, w = _check.broadcast((self._voltage(V), "V"), (w, "omega"))
+        tm = self.motor_torque(V, self.i * w)
         motoring = tm * w >= 0.0
         return np.where(motoring, self.eta * self.i * tm, self.i / self.eta * tm)
 
@@ -275,10 +306,9 @@ class DCMotor:
             Joint speed, rad/s.
         """
         tau = _check.array(tau, "tau (joint torque, N m)")
+        tau, V = _check.broadcast((tau, "tau"), (self._voltage(V), "V"))
         tm = tau / (self.eta * self.i)
-        return (self.stall_torque_coefficient * self._voltage(V) - tm) / (
-            self.torque_speed_slope * self.i
-        )
+        return (self.stall_torque_coefficient * V - tm) / (self.torque_speed_slope * self.i)
 
     # ------------------------------------------------------------------ what a joint motion needs
     @_check.finite_result
@@ -303,6 +333,7 @@ class DCMotor:
         tau = _check.array(tau, "tau (joint torque, N m)")
         w = _check.array(omega, "omega (joint speed, rad/s)")
         a = _check.array(alpha, "alpha (joint acceleration, rad/s^2)")
+        tau, w, a = _check.broadcast((tau, "tau"), (w, "omega"), (a, "alpha"))
         gear = np.where(tau * w >= 0.0, tau / (self.eta * self.i), self.eta * tau / self.i)
         return self.J_m * self.i * a + self.b_m * self.i * w + gear
 
