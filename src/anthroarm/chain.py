@@ -40,9 +40,11 @@ from functools import cached_property
 import numpy as np
 
 from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, UnsupportedModelError
+from .joint_kinds import CONTINUOUS as CONTINUOUS
+from .joint_kinds import PRISMATIC as PRISMATIC
+from .joint_kinds import REVOLUTE as REVOLUTE
+from .kinematics.batched import SerialChain
 from .threads import run_rows
-
-REVOLUTE, PRISMATIC, CONTINUOUS = "revolute", "prismatic", "continuous"
 
 #: a joint limit this large (rad or m) means none (Pinocchio's default is ±DBL_MAX)
 NO_LIMIT = 1e100
@@ -575,8 +577,6 @@ class Chain:
         cache = self.__dict__.setdefault("_serial", {})
         s = cache.get(fid)
         if s is None:
-            from .kinematics.batched import SerialChain
-
             s = cache[fid] = SerialChain.from_chain(self, fid)
         return s
 

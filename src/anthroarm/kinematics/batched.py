@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..joint_kinds import CONTINUOUS, PRISMATIC
+
 _EPS = 1e-15
 
 
@@ -148,8 +150,6 @@ class SerialChain:
     def from_chain(cls, chain, frame=None) -> "SerialChain":
         """The path of a :class:`~anthroarm.chain.Chain` from the base to ``frame`` (default:
         the tool), continuous and mimic joints included."""
-        from ..chain import CONTINUOUS, PRISMATIC
-
         f = chain.frame(frame)
         R0s, p0s, axes, kinds, coords, vi, vs = [], [], [], [], [], [], []
         for i in chain.path(f.index):

@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-from .dh import _as_batch, finite_params
+from .dh import _as_batch, dh_frames, finite_params
 
 
 def _pose(x, y, z, l, m, n, u, v, w) -> np.ndarray:
@@ -192,6 +192,14 @@ def human_arm7_jacobian(q, l1: float, l2: float, l3: float) -> np.ndarray:
     return J[0] if single else J
 
 
+def human_arm7_length_jacobian(q) -> np.ndarray:
+    """The book's Eq. (6-119) for the §6-3 arm: the 3 × 3 matrix [−e_{·3}, −w_{·3}, −h_{·3}]
+    mapping (Δl₁, Δl₂, Δl₃) to (Δx_H, Δy_H, Δz_H), with C_E, C_W, C_H of (6-34)–(6-36).
+    (:mod:`.error_propagation` computes the same coefficients for any robot.)"""
+    CE, CW, CH = human_arm7_rotations(np.asarray(q, float))
+    return -np.stack([CE[..., :, 2], CW[..., :, 2], CH[..., :, 2]], axis=-1)
+
+
 def planar2r_tip(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
     """Fig. 7-14: tip (y, z) = (l1 cos θ1 + l2 cos(θ1+θ2), l1 sin θ1 + l2 sin(θ1+θ2)), shape (N, 2)."""
     q2, single = _as_batch(q, 2)
@@ -207,7 +215,6 @@ def prosthetic_arm_points(q, L1: float, L2: float, L3: float):
     E = L1 (c1 s2, s1 s2, −c2) (Eq. (7-17)); W = E + L2 z4; C = W + L3 z6 (Fig. 7-2), with the
     frames of Table 7.1 / Eq. (7-16), θ3 carrying the printed A23's hidden +90°."""
     from ..models.book import prosthetic_arm
-    from .dh import dh_frames
 
     L1, L2, L3 = finite_params(L1=L1, L2=L2, L3=L3)
     rows = prosthetic_arm(L1, L2, L3).dh
@@ -245,12 +252,6 @@ class PrintedForm:
     length_jacobian: Callable | None = None
 
 
-def _human_arm7_length_jacobian(q, p):
-    from .error_propagation import human_arm7_length_jacobian
-
-    return human_arm7_length_jacobian(q)
-
-
 #: book model name -> its printed forms (functions are looked up when called)
 PRINTED: dict[str, tuple[PrintedForm, ...]] = {
     "sixr_arm": (
@@ -269,7 +270,7 @@ PRINTED: dict[str, tuple[PrintedForm, ...]] = {
             "(6-34)-(6-39)",
             lambda q, p: human_arm7_hand_pose(q, p["l1"], p["l2"], p["l3"]),
             lambda q, p: human_arm7_jacobian(q, p["l1"], p["l2"], p["l3"]),
-            _human_arm7_length_jacobian,
+            lambda q, p: human_arm7_length_jacobian(q),
         ),
     ),
     "planar2r": (

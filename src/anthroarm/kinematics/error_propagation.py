@@ -21,8 +21,9 @@ downstream point by R_parent d δ without rotating anything, so the book's coeff
     ∂x/∂L_k = R_parent(k) d_k    (world axes),
 
 which for the §6-3 arm is (6-119): ∂P_H/∂l₁ = −e_{·3}, ∂P_H/∂l₂ = −w_{·3}, ∂P_H/∂l₃ = −h_{·3}
-(:func:`human_arm7_length_jacobian`).  :func:`length_jacobian_fd` checks it by central finite
-differences over copies of the Pinocchio model with perturbed placements.
+(:func:`~anthroarm.kinematics.book_fk.human_arm7_length_jacobian`, also importable from here).
+:func:`length_jacobian_fd` checks it by central finite differences over copies of the
+Pinocchio model with perturbed placements.
 
 Errors are reported as 6-vectors (Δp; Δφ) in world axes (LOCAL_WORLD_ALIGNED): Δp the frame
 origin displacement (m), Δφ the small rotation vector (rad); ΔL does not rotate anything.
@@ -36,6 +37,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..spatial.rotations import rot_axis
+from .book_fk import human_arm7_length_jacobian as human_arm7_length_jacobian  # (6-119)
 
 
 # ----------------------------------------------------------------------------- parameters
@@ -152,15 +154,6 @@ def length_jacobian_fd(
         J[:3, k] = (poses[0].translation - poses[1].translation) / (2 * h)
         J[3:, k] = pin.log3(poses[0].rotation @ poses[1].rotation.T) / (2 * h)
     return J
-
-
-def human_arm7_length_jacobian(q) -> np.ndarray:
-    """The book's Eq. (6-119) for the §6-3 arm: the 3 × 3 matrix [−e_{·3}, −w_{·3}, −h_{·3}]
-    mapping (Δl₁, Δl₂, Δl₃) to (Δx_H, Δy_H, Δz_H), with C_E, C_W, C_H of (6-34)–(6-36)."""
-    from .book_fk import human_arm7_rotations
-
-    CE, CW, CH = human_arm7_rotations(np.asarray(q, float))
-    return -np.stack([CE[..., :, 2], CW[..., :, 2], CH[..., :, 2]], axis=-1)
 
 
 @dataclass
