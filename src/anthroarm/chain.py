@@ -170,8 +170,9 @@ class Chain:
     @classmethod
     def from_model(cls, model, tool: str | None = None, name: str | None = None) -> "Chain":
         """Read a ``pin.Model``: joints, axes, placements, limits, inertias, mimic relations,
-        frames and tips.  ``tool=None`` picks the single tip (see :func:`leaf_frames`); a tree
-        with several tips raises :class:`UnknownFrameError` listing them."""
+        frames and tips.  ``tool=None`` picks the single tip (see :func:`leaf_frames`: a serial
+        chain has one); a tree with several tips raises :class:`AmbiguousToolError` listing
+        them, an unknown ``tool`` :class:`UnknownFrameError`."""
         import pinocchio as pin
 
         name = name or getattr(model, "name", "") or "model"
