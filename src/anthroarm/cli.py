@@ -986,7 +986,9 @@ def _add_cache(sub):
     p.add_argument(
         "action",
         choices=["info", "clear"],
-        help="info: folder, entries and size; clear: delete them",
+        help="info: folder, entries, size and whether it is used; clear: delete the cache's "
+        "own files (refused, exit status 2, if the folder is a link, another user's, or "
+        "writable by group or others)",
     )
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.set_defaults(func=cmd_cache)
@@ -996,7 +998,7 @@ def cmd_cache(a) -> int:
     from . import cache
 
     if a.action == "clear":
-        where = str(cache.root())
+        where = str(cache.configured())  # the folder asked for; clear() refuses an unsafe one
         n = cache.clear()
         print(
             json.dumps({"folder": where, "removed": n})

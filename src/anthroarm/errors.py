@@ -266,3 +266,22 @@ class UnknownCodeError(AnthroarmError, KeyError):
 
     def __str__(self) -> str:
         return str(self.args[0]) if self.args else ""
+
+
+class UnsafeCacheError(AnthroarmError, PermissionError):
+    """The disk cache folder (:mod:`anthroarm.cache`) is not safe to use: it is a symbolic
+    link, not a folder, owned by another user, or writable by group or others.  Raised by
+    operations that act on that folder on purpose (``anthroarm cache clear``); everyday use
+    warns with :class:`UnsafeCacheWarning` and runs without it.  ``path`` is the folder."""
+
+    def __init__(self, message: str, path=None):
+        self.path = None if path is None else str(path)
+        super().__init__(message)
+
+    def __str__(self) -> str:  # PermissionError would format (errno, strerror)
+        return str(self.args[0]) if self.args else ""
+
+
+class UnsafeCacheWarning(UserWarning):
+    """The disk cache folder is not safe to use (see :class:`UnsafeCacheError`); anthroarm runs
+    without it, keeping generated code in a private temporary folder for this process."""

@@ -219,6 +219,7 @@ def test_cli_view_html_on_a_full_disk(tmp_path, capsys):
 @pytest.mark.parametrize("fault", ["full", "read-only"])
 def test_cache_write_faults_store_nothing_and_say_why(tmp_path, monkeypatch, fault):
     with tmpfs(tmp_path / "fs") as d:
+        os.chmod(d, 0o700)  # a tmpfs root is 1777: the cache refuses a folder others can write
         monkeypatch.setenv("ANTHROARM_CACHE", str(d))
         assert cache.write("lagrange", "small.py", b"x = 1\n") is not None
         if fault == "full":
