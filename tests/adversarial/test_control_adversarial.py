@@ -254,6 +254,54 @@ def test_rms_at_the_ends_of_the_float_range_is_exact():
     assert rms([-1e308, 1e308], [1.0, 1.0]) == pytest.approx(1.0)
 
 
+# ======================================================================== control: bilateral
+def test_bilateral_tiny_max_step_names_the_budget():
+    t = np.linspace(0.0, 1.0, 11)
+    for max_step in (1e-12, 5e-324):
+        with within(5), pytest.raises(ControlError, match="budget"):
+            Bilateral().simulate("symmetric", t, np.sin(t), max_step=max_step)
+    with within(5), pytest.raises(ControlError, match="budget"):
+        Bilateral().simulate("symmetric", [0.0, 1e300], [0.0, 1.0])
+
+
+@pytest.mark.parametrize("path", [lambda tt: "x", lambda tt: tt], ids=["string", "one value"])
+def test_bilateral_bad_operator_path_is_named(path):
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ControlError, match="theta_h"):
+        Bilateral().simulate("symmetric", t, path)
+
+
+# ========================================================================== control: gripper
+def test_gripper_hostile_counts_and_resolutions():
+    with within(5), pytest.raises(ControlError, match="max_steps"):
+        gripper.tactile_search(lambda q: False, [0.0, 0.0], [1.0, 0.0], 1.0, 10**9)
+    with within(5), pytest.raises(ControlError, match="step"):
+        gripper.tactile_search(lambda q: False, [0.0, 0.0], [1.0, 0.0], 1e308, 3)
+    with within(5), pytest.raises(ControlError, match="resolution"):
+        gripper.correct_position(0.01, 0.02, 0.05, 1e-3, 5e-324)
+    with within(5), pytest.raises(ControlError, match="resolution"):
+        gripper.correct_attitude(0.1, 0.02, 0.05, 1e-3, 5e-324)
+    with within(5), pytest.raises(ControlError, match="max_corrections"):
+        gripper.correct_position(0.01, 0.02, 0.05, 1e-12, 1e-3, max_corrections=10**10)
+
+
+def test_slip_controller_hostile_numbers():
+    with pytest.raises(ControlError, match="grip_max"):
+        gripper.SlipController(0.0, 0.05, grip_max=-math.inf)
+    with pytest.raises(ControlError, match="grip_max"):
+        gripper.SlipController(0.0, 0.05, grip_max=10**400)
+    with pytest.raises(ControlError, match="pulses"):
+        gripper.SlipController(0.1, 1.0).update(10**400)
+    with pytest.raises(ControlError, match="n_jaws"):
+        gripper.simulate_slip(1.0, 0.5, gripper.SlipController(0.0, 0.05), 1e-3, n_jaws=10**400)
+
+
+def test_grasp_with_a_lead_whose_square_underflows_is_refused():
+    motor = DCMotor(R=2.0, k_m=0.02, J_m=1e-6, i=100.0, V_nom=24.0)
+    with pytest.raises(ControlError, match="lead"):
+        gripper.grasp(motor, "hard", gap=0.005, stiffness=1e4, lead=1e-300, duration=0.2, n=11)
+
+
 # ============================================================================ teach: calls
 def test_mutually_recursive_subroutines_are_refused_with_the_cycle_named():
     a = Program("a", (_step(0), Call("b")))

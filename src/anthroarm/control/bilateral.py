@@ -240,7 +240,25 @@ class Bilateral:
         if wall is not None and not isinstance(wall, Wall):
             raise ControlError(f"wall must be a Wall, got {type(wall).__name__}")
         if callable(theta_h):
-            path = theta_h
+
+            def path(tt):
+                try:
+                    out = theta_h(tt)
+                    th, wh = out
+                    th = np.asarray(th, dtype=float)
+                    wh = np.asarray(wh, dtype=float)
+                except (TypeError, ValueError, OverflowError):
+                    raise ControlError(
+                        "theta_h(t) must return (theta, theta_dot), two numbers or arrays of the "
+                        f"shape of t (rad, rad/s); got {_check._short(locals().get('out'))}"
+                    ) from None
+                try:
+                    return tuple(np.broadcast_arrays(th, wh, np.asarray(tt, dtype=float))[:2])
+                except ValueError:
+                    raise ControlError(
+                        f"theta_h(t) returned shapes {th.shape} and {wh.shape} for t of shape "
+                        f"{np.shape(tt)}"
+                    ) from None
         else:
             samples = _check.on_grid(theta_h, t, "theta_h (rad)")
             rate = np.gradient(samples, t)
@@ -248,6 +266,11 @@ class Bilateral:
             def path(tt):
                 return np.interp(tt, t, samples), np.interp(tt, t, rate)
 
+        _check.steps(
+            float(np.sum(np.maximum(1.0, np.ceil(np.diff(t) / max_step)))),
+            f"simulate over {t[-1] - t[0]:g} s with max_step = {max_step:g} s",
+            "give a larger max_step or a shorter time",
+        )
         th_t, wh_t = (np.broadcast_to(np.asarray(v, dtype=float), t.shape) for v in path(t))
         if not (np.all(np.isfinite(th_t)) and np.all(np.isfinite(wh_t))):
             raise ControlError("theta_h must be finite")

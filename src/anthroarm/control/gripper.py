@@ -100,7 +100,16 @@ def tactile_search(
         )
     d = d / np.linalg.norm(d)
     step = _check.positive(step, "step (m)")
-    max_steps = _check.count(max_steps, "max_steps")
+    max_steps = _check.count(max_steps, "max_steps", maximum=_check.MAX_STEPS)
+    if not callable(contact):
+        raise ControlError(f"contact must be callable, got {_check._short(contact)}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        far = p + float(max_steps) * step * d
+    if not np.all(np.isfinite(far)):
+        raise ControlError(
+            f"max_steps x step = {max_steps} x {step:g} m from {p.tolist()} leaves the "
+            "floating-point range"
+        )
     for k in range(max_steps + 1):
         q = p + k * step * d
         if contact(q):
@@ -131,13 +140,30 @@ class CorrectionResult:
     status: str
 
 
+def _increments(span: float, resolution: float, name: str) -> None:
+    """The closing increments of a jaw that travels ``span`` must be countable exactly."""
+    with np.errstate(over="ignore"):
+        n = span / resolution
+    if not n <= 2.0**53:
+        raise ControlError(
+            f"resolution = {resolution:g} m: the {name} of {span:g} m is {n:.3g} closing "
+            "increments, beyond what floating point counts exactly (2**53); give a coarser "
+            "resolution"
+        )
+
+
 def _touch_index(gap, resolution):
     """Closing increment (1-based) on which a contact with this gap closes."""
     return math.ceil(gap / resolution - 1e-12)
 
 
 def _correct(error, unit, gaps, resolution, max_corrections):
-    max_corrections = _check.count(max_corrections, "max_corrections")
+    max_corrections = _check.count(max_corrections, "max_corrections", maximum=_check.MAX_STEPS)
+    if error + unit == error or error - unit == error:
+        raise ControlError(
+            f"the correction step unit = {unit:g} is below the floating-point resolution of "
+            f"the error {error:g}: no correction would change it"
+        )
     hist = [error]
     for k in range(int(max_corrections) + 1):
         ga, gb = gaps(error)
@@ -194,6 +220,7 @@ def correct_position(
             f"the object (width {width}, offset {offset}) does not fit between jaws {opening} m apart"
         )
     half = 0.5 * (opening - width)
+    _increments(opening, resolution, "opening")
     return _correct(offset, unit, lambda d: (half + d, half - d), resolution, max_corrections)
 
 
@@ -240,6 +267,7 @@ def correct_attitude(
         raise ControlError(
             f"angle {angle} rad: the pad would already cut into the face (gap {gap} m)"
         )
+    _increments(gap + 0.5 * pad * abs(math.tan(angle)), resolution, "gap")
     return _correct(
         angle,
         unit,
@@ -353,12 +381,21 @@ def grasp(
     duration = _check.positive(duration, "duration (s)")
     v0 = _check.positive(approach_speed, "approach_speed (m/s)")
     F_set = _check.nonnegative(set_force, "set_force (N)")
-    m_eq = _check.positive(jaw_mass, "jaw_mass (kg)") + motor.reflected_inertia / lead**2
+    jaw_mass = _check.positive(jaw_mass, "jaw_mass (kg)")
+    with np.errstate(over="ignore", under="ignore"):
+        lead2 = lead * lead
+        m_eq = jaw_mass + (motor.reflected_inertia / lead2 if lead2 > 0.0 else math.inf)
+    if not math.isfinite(m_eq):
+        raise ControlError(
+            f"lead = {lead:g} m/rad makes the equivalent jaw mass jaw_mass + i^2 J_m / lead^2 "
+            "leave the floating-point range; give a physical lead"
+        )
     k_v, k_p, k_i, k_x = (
         _check.nonnegative(v, nm)
         for v, nm in ((k_v, "k_v"), (k_p, "k_p"), (k_i, "k_i"), (k_x, "k_x"))
     )
     n = _check.count(n, "n", 2)
+    _check.samples(n, 4, f"grasp(n={n})", "give a smaller n")
     Vmax = motor.V_nom
     V0 = float(motor.voltage(0.0, v0 / lead))
     if abs(V0) > Vmax:
@@ -454,13 +491,25 @@ class SlipController:
     def __post_init__(self):
         self.grip = _check.nonnegative(self.grip, "grip (N)")
         self.step = _check.positive(self.step, "step (N)")
-        if not (isinstance(self.grip_max, float) and math.isinf(self.grip_max)):
+        if not (
+            isinstance(self.grip_max, (float, np.floating)) and self.grip_max == math.inf
+        ):  # +inf (no cap) is the one non-finite value allowed
             self.grip_max = _check.positive(self.grip_max, "grip_max (N)")
 
     def update(self, pulses: int) -> float:
         """Take ``pulses`` new roller pulses (≥ 0) and return the new grip force, N."""
         pulses = _check.count(pulses, "pulses")
-        self.grip = min(self.grip + pulses * self.step, self.grip_max)
+        try:
+            grip = self.grip + float(pulses) * self.step
+        except OverflowError:
+            grip = math.inf
+        grip = min(grip, self.grip_max)
+        if not math.isfinite(grip):
+            raise ControlError(
+                f"pulses = {pulses} x step = {self.step:g} N takes the grip beyond the "
+                "floating-point range (set grip_max)"
+            )
+        self.grip = grip
         return self.grip
 
 
@@ -535,7 +584,7 @@ def simulate_slip(
     unit = _check.positive(unit, "unit (m)")
     g = _check.positive(g, "g (m/s^2)")
     max_slip = _check.positive(max_slip, "max_slip (m)")
-    n_jaws = _check.count(n_jaws, "n_jaws", 1)
+    n_jaws = _check.count(n_jaws, "n_jaws", 1, maximum=1000)
     if max_slip / unit > 1e7:
         raise ControlError(
             f"max_slip / unit = {max_slip / unit:.3g} pulses is too many to simulate (at most 1e7)"
