@@ -179,14 +179,12 @@ def test_check_rows_pass_on_mimic3(urdf_path):
 
 
 def test_anthroarm_check_on_mimic3_urdf(urdf_path):
-    """``crosscheck.run`` on the URDF path, as ``anthroarm check mimic3.urdf`` runs it: the
-    dynamics and kinematics rows pass."""
-    rows = crosscheck.run(
-        [str(urdf_path)],
-        samples=20,
-        providers=["anthroarm.dynamics.checks:model_rows", "anthroarm.kinematics.checks:rows"],
-    )
-    assert len(rows) >= 9
+    """``crosscheck.run`` on the URDF path, as ``anthroarm check mimic3.urdf`` runs it: every
+    row passes (all robot providers but the IK round trip, which runs against a wall-clock
+    budget and is not about this issue; it passes too, 5e-7 m against 1e-6)."""
+    provs = [p for p in crosscheck.ROBOT_PROVIDERS if p != "anthroarm.crosscheck:ik_rows"]
+    rows = crosscheck.run([str(urdf_path)], samples=20, providers=provs)
+    assert sum(r.quantity.startswith("dyn ") for r in rows) == 8 and len(rows) >= 13
     assert all(r.ok for r in rows), [(r.quantity, r.max_abs_err, r.note) for r in rows if not r.ok]
 
 
