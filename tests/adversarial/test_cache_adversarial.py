@@ -116,6 +116,16 @@ def test_clear_deletes_only_the_files_the_cache_writes(croot):
     assert not (croot / "numba" / "src_folder").exists()  # emptied, so removed
 
 
+def test_info_counts_no_file_behind_a_symbolic_link(croot, tmp_path):
+    u = user_folder(tmp_path)
+    cache.write("ik", "lm_" + "cd" * 12 + ".so", b"\x7fELF")
+    (croot / "lagrange").symlink_to(u)
+    (croot / "ik" / "linked.so").symlink_to(u / ENTRY)
+    got = cache.info()
+    assert got["by_folder"]["lagrange"] == (0, 0)
+    assert got["by_folder"]["ik"] == (1, 4 + len(f"sha256 {'0' * 64} 4\n"))  # entry + sidecar
+
+
 def test_clear_refuses_a_symlinked_cache_folder(croot, tmp_path):
     u = tmp_path / "project"
     plant(u / "lagrange", ENTRY, b"A = 1\n")
