@@ -24,11 +24,11 @@ from __future__ import annotations
 import importlib
 import json
 import math
-from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .check_rows import UNSUPPORTED, CheckRow  # CheckRow re-exported: aa.crosscheck.CheckRow
 from .errors import UnsupportedModelError
 
 #: providers run on every robot, ``rows(robot, samples, rng)``: dotted name -> what it checks
@@ -50,48 +50,7 @@ PROVIDERS: list[str] = [
 ]
 
 
-UNSUPPORTED = "unsupported"
 ERROR = "error"
-
-
-@dataclass
-class CheckRow:
-    """One line of the cross-check report.
-
-    ``max_abs_err`` is the largest error seen (positions relative to the model's length scale
-    when ``relative`` is set); ``ok`` is ``max_abs_err <= tol`` and finite."""
-
-    model: str
-    quantity: str
-    max_abs_err: float
-    tol: float
-    samples: int
-    oracle: str = "pinocchio"
-    note: str = ""
-
-    @classmethod
-    def unsupported(cls, model: str, quantity: str, reason: str) -> "CheckRow":
-        """A row for a check that cannot run on ``model``: it compares nothing and does not pass."""
-        return cls(
-            model, quantity, math.nan, 0.0, 0, "-", f"{UNSUPPORTED}: {' '.join(reason.split())}"
-        )
-
-    @property
-    def ok(self) -> bool:
-        return bool(math.isfinite(self.max_abs_err) and self.max_abs_err <= self.tol)
-
-    @property
-    def status(self) -> str:
-        """ "ok", "FAIL" or "unsupported"."""
-        if self.ok:
-            return "ok"
-        return UNSUPPORTED if self.note.startswith(UNSUPPORTED + ":") else "FAIL"
-
-    def as_dict(self) -> dict:
-        d = asdict(self)
-        d["ok"] = self.ok
-        d["status"] = self.status
-        return d
 
 
 def _load_provider(dotted: str):

@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..check_rows import CheckRow
+
 ROMAN = {1: "I", 2: "II", 3: "III", 4: "IV", 5: "V"}
 
 
@@ -346,7 +348,6 @@ def prosthetic_arm_bent_q(theta3, q123=(0.0, 0.0, 0.0)) -> np.ndarray:
 
 def reach_rows(models, samples, rng):
     """Cross-check provider: Eq. (2-3)/(2-4) against Pinocchio FK of ``prosthetic_arm``."""
-    from ..crosscheck import CheckRow
 
     if "prosthetic_arm" not in models:
         return []

@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..check_rows import CheckRow
+
 TOL = 1e-10
 
 
@@ -37,7 +39,6 @@ def model_rows(robot, samples: int, rng) -> list:
     """Rows for one Robot (see the module docstring)."""
     import pinocchio as pin
 
-    from ..crosscheck import CheckRow
     from .lagrange import load
 
     dyn = load(robot)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..crosscheck import CheckRow
+from ..check_rows import CheckRow
 from .closed_form import PLANAR, SRS, analytic_batch, closed_form_info
 from .qp.tasks.swivel import swivel_angle
 

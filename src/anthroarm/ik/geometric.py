@@ -74,6 +74,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..chain_kernels import put_joint
+from ..check_rows import CheckRow
 from ..jit import kernel, local, local2, local_flags, view2
 from ..threads import run_rows
 from . import classify as C
@@ -1517,8 +1518,6 @@ def check_rows(robot, samples: int, rng) -> list:
     of the 3×4 pose), and the number of exact branches per pose against IK-Geo's (PyPI
     ``ik-geo``, same H and P; the row is left out when it is not installed)."""
     import pinocchio as pin
-
-    from ..crosscheck import CheckRow
 
     plan = plan_for(robot)
     if plan is None:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ..crosscheck import CheckRow
+from ..check_rows import CheckRow
 from . import error_propagation as ep
 from .book_fk import book_spec, printed_forms
 from .dh import dh_fk, dh_jacobian

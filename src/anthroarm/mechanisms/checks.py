@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ..crosscheck import CheckRow
+from ..check_rows import CheckRow
 from ._util import fd_derivative, wrap
 from .closed_loop import ClosedLoop
 from .finger import FingerGeometry, finger, finger_spec

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ..check_rows import CheckRow
+
 LWA = pin.LOCAL_WORLD_ALIGNED
 
 
@@ -104,6 +106,5 @@ def _spatial_rows(n, rng, CheckRow):
 def rows(models, samples, rng) -> list:
     """Provider for :mod:`anthroarm.crosscheck` (``samples`` capped at 50 to keep it ~ a second;
     the rows need no model)."""
-    from ..crosscheck import CheckRow
 
     return _spatial_rows(max(1, min(int(samples), 50)), rng, CheckRow)

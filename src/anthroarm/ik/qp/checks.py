@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from ...crosscheck import CheckRow
+from ...check_rows import CheckRow
 
 
 def rows(models, samples, rng) -> list[CheckRow]:
