@@ -302,6 +302,29 @@ def test_grasp_with_a_lead_whose_square_underflows_is_refused():
         gripper.grasp(motor, "hard", gap=0.005, stiffness=1e4, lead=1e-300, duration=0.2, n=11)
 
 
+# ======================================================================= control: trajectory
+def test_via_point_trajectory_refuses_strings_with_a_typed_error():
+    from anthroarm.trajectory import ViaPointTrajectory
+
+    with pytest.raises(AnthroarmError):
+        ViaPointTrajectory("abc", [[0.0], [1.0]])
+    traj = ViaPointTrajectory([0.0, 1.0], [[0.0], [1.0]])
+    with pytest.raises(AnthroarmError):
+        traj("x")
+
+
+def test_straight_line_move_with_a_trillion_steps_names_the_budget():
+    import anthroarm as aa
+    from anthroarm.trajectory import straight_line_move
+
+    robot = aa.load("prosthetic_arm")
+    q = np.full(robot.model.nq, 0.3)
+    with within(10), pytest.raises(ControlError, match="budget"):
+        straight_line_move(robot, q, robot.fk(q), 2.0, 1e-12)
+    with pytest.raises(ControlError, match="dt"):
+        straight_line_move(robot, q, robot.fk(q), 2.0, "x")
+
+
 # ============================================================================ teach: calls
 def test_mutually_recursive_subroutines_are_refused_with_the_cycle_named():
     a = Program("a", (_step(0), Call("b")))

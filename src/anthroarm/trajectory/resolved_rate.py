@@ -19,6 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..control import _check
+from ..errors import ControlError
+
 
 @dataclass
 class LineMotionResult:
@@ -49,25 +52,37 @@ def straight_line_move(
     """Move the tool on a straight line to ``T_goal`` in ``duration`` s by resolved rate (7-89)/(7-95)/(7-96).
 
     ``jacobian="book"`` uses the hand-frame Jacobian (7-94) built from joint axes and lever arms;
-    ``"pinocchio"`` uses Pinocchio's LOCAL frame Jacobian (they are equal; tested)."""
+    ``"pinocchio"`` uses Pinocchio's LOCAL frame Jacobian (they are equal; tested).
+
+    Raises :class:`~anthroarm.errors.ControlError` (a ``ValueError``) for a bad pose,
+    ``duration``, ``dt``, ``k`` or ``jacobian``, for a move of more Euler steps than the step
+    budget (``duration / dt`` > :data:`anthroarm.control._check.MAX_STEPS`), and when the
+    Jacobian is singular on the way (7-89 needs its inverse)."""
     import pinocchio as pin
 
     from ..ik.book_jacobians import hand_frame_jacobian
 
     q = robot.check_q(q_start, "q_start").copy()
-    Tg = np.asarray(T_goal, float)
-    if Tg.shape != (4, 4) or not np.isfinite(Tg).all():
-        raise ValueError(f"T_goal must be a finite 4x4 pose, got shape {Tg.shape}")
-    if not (duration > 0 and dt > 0 and dt <= duration):
-        raise ValueError(f"need 0 < dt <= duration, got dt={dt}, duration={duration}")
+    Tg = _check.array(T_goal, "T_goal")
+    if Tg.shape != (4, 4):
+        raise ControlError(f"T_goal must be a finite 4x4 pose, got shape {Tg.shape}")
+    duration = _check.positive(duration, "duration (s)")
+    dt = _check.positive(dt, "dt (s)")
+    if dt > duration:
+        raise ControlError(f"need 0 < dt <= duration, got dt={dt}, duration={duration}")
+    k = _check.nonnegative(k, "k (1/s)")
     if jacobian not in ("book", "pinocchio"):
-        raise ValueError(f"jacobian must be 'book' or 'pinocchio', got {jacobian!r}")
+        raise ControlError(f"jacobian must be 'book' or 'pinocchio', got {jacobian!r}")
+    n = _check.steps(
+        round(duration / dt),
+        f"straight_line_move(duration={duration:g} s, dt={dt:g} s)",
+        "give a larger dt",
+    )
     Ti = robot.fk(q)
     pi, pf = Ti[:3, 3].copy(), Tg[:3, 3]
     Ri, Rf = Ti[:3, :3].copy(), Tg[:3, :3]
     v_w = (pf - pi) / duration  # base-frame, constant (7-95)
     w_w = pin.log3(Rf @ Ri.T) / duration  # base-frame geodesic rate
-    n = int(round(duration / dt))
     ts, Q, P, E = [0.0], [q.copy()], [pi.copy()], [0.0]
     for i in range(n):
         t = i * dt
@@ -86,9 +101,19 @@ def straight_line_move(
             if jacobian == "book"
             else robot.jacobian(q, reference="LOCAL")
         )
-        qd = (
-            np.linalg.solve(J, sdot) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ sdot
-        )  # (7-89)
+        try:
+            qd = (
+                np.linalg.solve(J, sdot) if J.shape[0] == J.shape[1] else np.linalg.pinv(J) @ sdot
+            )  # (7-89)
+        except np.linalg.LinAlgError:
+            raise ControlError(
+                f"the Jacobian is singular at t = {t:g} s (q = {q.tolist()}): resolved rate "
+                "(7-89) needs its inverse; plan the line away from the singularity"
+            ) from None
+        if not np.all(np.isfinite(qd)):
+            raise ControlError(
+                f"the joint rates left the floating-point range at t = {t:g} s (near a singularity)"
+            )
         q = q + qd * dt  # (7-96), Euler
         tn = (i + 1) * dt
         pn = robot.fk(q)[:3, 3]

@@ -14,6 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..control import _check
+from ..errors import ControlError
+
 
 class ViaPointTrajectory:
     """q(t) through ``Q[k]`` at ``times[k]`` (strictly increasing), zero velocity and acceleration
@@ -23,14 +26,16 @@ class ViaPointTrajectory:
     def __init__(self, times, Q):
         from scipy.interpolate import make_interp_spline
 
-        t = np.asarray(times, float)
-        Q = np.asarray(Q, float)
-        if t.ndim != 1 or t.size < 2 or not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
-            raise ValueError(
-                f"times must be a strictly increasing 1-D array of >= 2 finite values, got {times!r}"
-            )
-        if Q.ndim != 2 or Q.shape[0] != t.size or not np.isfinite(Q).all():
-            raise ValueError(f"Q must be finite with shape ({t.size}, nq), got shape {Q.shape}")
+        try:
+            t = _check.time_grid(times, "times")
+        except ControlError:
+            raise ControlError(
+                "times must be a strictly increasing 1-D array of >= 2 finite values, got "
+                f"{_check._short(times)}"
+            ) from None
+        Q = _check.array(Q, "Q (joint values at the via points)")
+        if Q.ndim != 2 or Q.shape[0] != t.size or Q.shape[1] == 0:
+            raise ControlError(f"Q must be finite with shape ({t.size}, nq), got shape {Q.shape}")
         self.times, self.Q = t, Q
         bc = (
             [(1, np.zeros(Q.shape[1])), (2, np.zeros(Q.shape[1]))],
@@ -44,17 +49,16 @@ class ViaPointTrajectory:
 
     def __call__(self, t, derivative: int = 0) -> np.ndarray:
         """q (derivative 0, rad or m), q̇ (1, per s), q̈ (2, per s²) … at time(s) ``t`` (s);
-        shape ``t.shape + (nq,)``.  ``ValueError`` for a NaN/inf time or a derivative order
+        shape ``t.shape + (nq,)``.  :class:`~anthroarm.errors.ControlError` (a ``ValueError``)
+        for a NaN/inf time, a string or a derivative order
         that is not an integer in 0 … 5 (the pieces are quintic)."""
-        t = np.asarray(t, float)
-        if not np.isfinite(t).all():
-            raise ValueError(f"t must be finite times (s), got {t.tolist()}")
+        t = _check.array(t, "t (s)")
         if (
             isinstance(derivative, bool)
             or not isinstance(derivative, (int, np.integer))
             or not 0 <= derivative <= 5
         ):
-            raise ValueError(f"derivative must be an integer in 0 ... 5, got {derivative!r}")
+            raise ControlError(f"derivative must be an integer in 0 ... 5, got {derivative!r}")
         tc = np.clip(t, self.times[0], self.times[-1])
         out = self._spl(tc, nu=derivative)
         if derivative > 0:
@@ -70,10 +74,13 @@ def joint_via_trajectory(
 
     At each via point the solution nearest (max-norm) to the previous one is taken (the first is
     nearest to ``q_start``, default the neutral configuration), so the trajectory stays on one
-    branch.  Returns (trajectory, Q).  ValueError names a via point without a solution."""
+    branch.  Returns (trajectory, Q).  :class:`~anthroarm.errors.ControlError` (a ``ValueError``)
+    names a via point without a solution."""
     from ..ik.closed_form import analytic, closed_form_info
 
-    poses = np.asarray(poses, float)
+    poses = _check.array(poses, "poses")
+    if poses.ndim != 3 or poses.shape[1:] != (4, 4):
+        raise ControlError(f"poses must be an array of 4x4 poses (N, 4, 4), got {poses.shape}")
     prev = robot.neutral() if q_start is None else robot.check_q(q_start, "q_start")
     form = closed_form_info(robot)
     kw = {"swivel": swivel} if form is not None and form.swivel else {}  # redundant arm: one swivel
@@ -81,7 +88,7 @@ def joint_via_trajectory(
     for k, T in enumerate(poses):
         res = analytic(robot, T, **kw)
         if not res.success:
-            raise ValueError(f"via point {k} has no IK solution: {res.reason}")
+            raise ControlError(f"via point {k} has no IK solution: {res.reason}")
         i = int(np.argmin(np.abs(res.solutions - prev).max(1)))
         prev = res.solutions[i]
         Q.append(prev)
