@@ -271,6 +271,12 @@ def test_bilateral_bad_operator_path_is_named(path):
         Bilateral().simulate("symmetric", t, path)
 
 
+def test_bilateral_static_feel_beyond_the_float_range_is_refused():
+    """k_f = G = 1e308 against 1e308 N m returned inf."""
+    with pytest.raises(ControlError, match="floating-point range"):
+        Bilateral(k_f=1e308, G=1e308).static_feel("force_feedback", 1e308)
+
+
 # ========================================================================== control: gripper
 def test_gripper_hostile_counts_and_resolutions():
     with within(5), pytest.raises(ControlError, match="max_steps"):

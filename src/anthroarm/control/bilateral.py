@@ -330,6 +330,7 @@ class Bilateral:
             tau_slave=np.asarray(tau_2, dtype=float),
         )
 
+    @_check.finite_result
     def static_feel(self, kind: str, tau_env) -> np.ndarray:
         """What the operator feels at rest against an environment torque ``tau_env`` (N·m), from
         the equilibrium of the module docstring's equations: ``(K_m/K_s) τ_e`` (symmetric),
