@@ -266,8 +266,10 @@ class Bilateral:
             def path(tt):
                 return np.interp(tt, t, samples), np.interp(tt, t, rate)
 
+        with np.errstate(over="ignore"):
+            n_sub = float(np.sum(np.maximum(1.0, np.ceil(np.diff(t) / max_step))))
         _check.steps(
-            float(np.sum(np.maximum(1.0, np.ceil(np.diff(t) / max_step)))),
+            n_sub,
             f"simulate over {t[-1] - t[0]:g} s with max_step = {max_step:g} s",
             "give a larger max_step or a shorter time",
         )
