@@ -21,6 +21,9 @@ from .workspace import workspace
 
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
 LOCKSTEP_MIN = 8  # batches at least this large iterate all targets together
+WARM_POSES = (
+    8  # poses of fixed configurations solved untimed before a first call (_warm_closed_form)
+)
 LOCKSTEP_ATTEMPTS = 10  # attempts per target in lockstep; the rest go to the one-target solver
 
 
@@ -209,6 +212,8 @@ def solve(
         ws.aligned()
     if ws.cbuf is None:
         ckernel.ready(ws)
+    if analytic is not False and sh.has_closed_form:
+        _warm_closed_form(pb, mode, tp, tr)
     if not batch:
         return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
     tgs = [Target(mode, t, tp, tr) for t in targets]
@@ -239,6 +244,33 @@ def solve(
         messages=[r.message for r in results],
         mode=mode,
     )
+
+
+def _warm_closed_form(pb: Problem, mode: str, tp: float, tr: float) -> None:
+    """Compile the closed form's kernels that these settings use (or load them from the disk
+    cache), once per (robot, frame, settings) and before any clock starts: one untimed solve of
+    the pose of the reference posture, closed form first, with no budget.  ``max_time`` is the
+    caller's budget for solving, never for compilation or cache loading: without this, the first
+    call of a process with an empty cache spent its 50 ms compiling and failed (issue 28)."""
+    sh = pb.ws.sh
+    key = (mode, pb.th_ref is not None, pb.swivel is not None)
+    if key in sh.warm:
+        return
+    # the reference posture's pose, poses of a few fixed configurations (the closed form's
+    # paths differ with the pose: solved at the first swivel angle or not, polished, rescued)
+    # and a pose out of reach
+    rng = np.random.default_rng(0)
+    thetas = [sh.ref] + [
+        sh.lo_s + (sh.hi_s - sh.lo_s) * rng.random(sh.n) for _ in range(WARM_POSES)
+    ]
+    poses = [pb.ws.fk(th).homogeneous for th in thetas]
+    far = poses[0].copy()
+    far[:3, 3] *= 4.0 * sh.reach / max(float(np.linalg.norm(far[:3, 3])), 1e-3)
+    warm = Problem(pb.robot, pb.ws, 60.0, 0, 0, pb.th_ref, pb.swivel, True)
+    for H in poses + [far]:
+        _, _, (tgt,) = parse(H, mode)
+        solve_one(warm, Target(mode, tgt, tp, tr), None)
+    sh.warm.add(key)
 
 
 def _result(sh, r, seed):

@@ -309,9 +309,14 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
     )  # the swivel angles of an SRS arm (None: default)
     kw = {"swivel": angles} if sh.swivel_family and angles is not None else {}
     T = tg.H
+    if th_ref is not None and not th_ref.flags.writeable:
+        # one array type for the compiled calls: Numba compiles a read-only array (the shared
+        # reference posture) apart from a writable one (a seed), so a first call of either kind
+        # would otherwise compile the same kernel again
+        th_ref = th_ref.copy()
     if sh.nearest_swivel is not None and th_ref is not None:
-        g = np.atleast_1d(
-            np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float)
+        g = np.array(  # a writable copy (see th_ref above)
+            closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float, ndmin=1
         )
         if (np.abs(g) < WRAP_MAX).all():
             one = sh.nearest_swivel(T, th_ref, g, any_solution)

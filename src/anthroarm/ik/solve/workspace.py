@@ -90,6 +90,9 @@ class Shared:
         self._table = None
         self._aligned = None
         self._penalty = {}
+        self.warm = (
+            set()
+        )  # the settings whose closed-form kernels are loaded (api._warm_closed_form)
         self.ckernel = (
             None  # the compiled attempt kernel (ckernel.kernel_for), False if unavailable
         )
