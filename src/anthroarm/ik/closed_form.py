@@ -982,7 +982,9 @@ def _finish(
         th if s.plain else conf if conf is not None else ch.configuration(th)
     )  # NaN below where no solution
     res = np.array(res, dtype=float)
-    near = cand & exact & inside & (res > tol) & (res <= POLISH_MAX)
+    # near-exact candidates inside the limits, exact or not: a subproblem's least-squares root
+    # at a singular pose (flagged inexact) is within √ε of a solution, which the polish finds
+    near = cand & inside & (res > tol) & (res <= POLISH_MAX)
     polished = bool(near.any()) and s.plain
     if polished:
         Q = np.array(Q)
@@ -1109,7 +1111,8 @@ def _rescue(robot, Q, which, T, tol, position_only):
     out = []
     for b in np.flatnonzero(which):
         J = np.asarray(robot.jacobian(Q[b]))
-        q = _slide_into_limits(Q[b], J[rows], lo, hi)
+        revolute = np.abs(J[3:]).max(0) > 0.0  # a prismatic joint turns nothing
+        q = _slide_into_limits(_turns_into_limits(Q[b], revolute, lo, hi), J[rows], lo, hi)
         if q is None:
             continue
         q, res = _refine(robot, np.clip(q, lo, hi), T, lo, hi, position_only, polish=False)
@@ -1554,6 +1557,19 @@ def _check_tol(name, value):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
 
 
+def _turns_into_limits(q, revolute, lo, hi):
+    """``q`` with each revolute joint turned by the multiple of 2π that brings it nearest its
+    limits (a copy).  A joint on a limit comes out of the closed form as often at the limit
+    ± 2π, which the exact wrap of the compiled call puts an ulp outside (−π/2 as 3π/2 − 2π)."""
+    q = np.array(q, dtype=float)
+    for i in np.flatnonzero(revolute):
+        k = np.arange(-2, 3)
+        x = q[i] + TWO_PI * k
+        out = np.maximum(lo[i] - x, x - hi[i]).clip(0.0)
+        q[i] = x[int(np.argmin(out))]
+    return q
+
+
 def _slide_into_limits(q, J, lo, hi):
     """Move ``q`` along its exact self-motions into the limits, or return None.
 
@@ -1628,4 +1644,46 @@ def _refine(robot, q, T, lo, hi, position_only, polish=True):
         )
         if np.isfinite(sol.x).all():
             q = np.clip(sol.x, lo, hi)
+        # the reflective method creeps towards a solution that lies on a bound (each step halves
+        # the distance) and its finite-difference Jacobian stops it near 1e-9: finish with
+        # Newton steps on Pinocchio's Jacobian, joints that would cross a limit held on it
+        qn = _newton_on_limits(model, data, fid, q, T, lo, hi, position_only)
+        if float(np.abs(err(qn)).max()) < float(np.abs(err(q)).max()):
+            q = qn
     return q, float(np.abs(err(q)).max())
+
+
+def _newton_on_limits(model, data, fid, q, T, lo, hi, position_only, iters: int = 40):
+    """Gauss–Newton steps δq = −J⁺ e on the pose error e = (p − p*, log₃(R R*ᵀ)) (world frame;
+    J: Pinocchio's frame Jacobian, LOCAL_WORLD_ALIGNED, rows of the position only where
+    ``position_only``), with an active set: a joint whose step would leave [lo, hi] is put on
+    that limit and held there for the following steps.  Quadratic convergence where the
+    solution lies on a limit, which the bounded least squares above only approaches; linear (the
+    error halves a step) at a singular configuration on a limit, hence up to ``iters`` steps."""
+    import pinocchio as pin
+
+    x = np.clip(np.array(q, dtype=float), lo, hi)
+    free = np.ones(x.size, dtype=bool)
+    rows = slice(0, 3) if position_only else slice(0, 6)
+    Rt, pt = T[:3, :3], T[:3, 3]
+    for _ in range(iters):
+        J = pin.computeFrameJacobian(model, data, x, fid, pin.LOCAL_WORLD_ALIGNED)[rows]
+        M = pin.updateFramePlacement(model, data, fid)  # after the Jacobian computed the joints
+        e = np.concatenate([M.translation - pt, pin.log3(M.rotation @ Rt.T)])[rows]
+        if float(np.abs(e).max()) < 1e-15 or not free.any():
+            break
+        while True:
+            dq = np.zeros(x.size)
+            dq[free] = -np.linalg.lstsq(J[:, free], e, rcond=1e-10)[0]
+            xn = x + dq
+            out = free & ((xn < lo) | (xn > hi))
+            if not out.any():
+                break
+            x[out] = np.clip(xn[out], lo[out], hi[out])  # onto the limit it would cross
+            free &= ~out
+            if not free.any():
+                break
+        if not np.isfinite(xn).all():
+            break
+        x = np.clip(xn, lo, hi)
+    return x
