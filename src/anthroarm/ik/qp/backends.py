@@ -657,6 +657,25 @@ def make_backend(solver: str, n: int, n_eq: int = 0) -> Backend:
     name = solver.split(":", 1)[1] if solver.startswith("qpsolvers:") else solver
     if f"qpsolvers:{name}" in avail:
         return QpsolversBackend(n, n_eq, name)
+    pip = PIP_NAMES.get(name)
     raise SolverNotAvailableError(
-        f"QP solver {solver!r} is not installed; installed solvers: {', '.join(avail)}"
+        f"QP solver {solver!r} is not installed; installed solvers: {', '.join(avail)}. "
+        + (f"Install it (pip install {pip}) or " if pip else "Either install it or ")
+        + "pass one of the installed ones (solver=..., --solver on the command line)"
     )
+
+
+#: the PyPI package of each QP backend a user may name (for the message of a missing one)
+PIP_NAMES = {
+    "osqp": "osqp",
+    "daqp": "daqp",
+    "quadprog": "quadprog",
+    "proxqp": "proxsuite",
+    "proxsuite": "proxsuite",
+    "clarabel": "clarabel",
+    "ecos": "ecos",
+    "highs": "highspy",
+    "piqp": "piqp",
+    "scs": "scs",
+    "cvxopt": "cvxopt",
+}
