@@ -19,7 +19,7 @@ import umsgpack
 import anthroarm as aa
 from anthroarm.errors import ViewerError
 from anthroarm.viewer import Viewer
-from anthroarm.viewer.visuals import PackedMesh, _placement
+from anthroarm.viewer.meshes import PackedMesh, mesh_placement
 
 
 def _user_urdf() -> str:
@@ -211,7 +211,7 @@ def piece_poses_match_omg(robot, v: Viewer, q):
     poses = []
     for b in v.bodies:
         M = sent[v._bpath(b)] if b.joint is not None else np.eye(4)
-        poses += [M @ p.offset @ np.linalg.inv(_placement(p.geometry)) for p in b.pieces]
+        poses += [M @ p.offset @ np.linalg.inv(mesh_placement(p.geometry)) for p in b.pieces]
     assert len(poses) == len(gm.geometryObjects)
     for k, go in enumerate(gm.geometryObjects):
         scale = np.diag([*go.meshScale, 1.0])

@@ -9,8 +9,17 @@
 :class:`Viewer` — poses (one message per update), overlays (frames, IK target, workspace
 coloured by manipulability, joint-limit colours, trace, point clouds, arrows), animation
 playback, static HTML export, Jupyter cells; ``Viewer.scene`` is the underlying meshcat scene
-(a meshcat ``Visualizer``, :class:`Scene`) for anything else.  :mod:`~anthroarm.viewer.server` runs the 127.0.0.1-only server process;
-:mod:`~anthroarm.viewer.browser` takes headless-Chromium screenshots (tests, docs).
+(a meshcat ``Visualizer``, :class:`Scene`) for anything else.
+
+The modules: :mod:`~anthroarm.viewer.viewer` (the :class:`Viewer`, composed of
+:mod:`~anthroarm.viewer.scene`, :mod:`~anthroarm.viewer.overlays`,
+:mod:`~anthroarm.viewer.teach`, :mod:`~anthroarm.viewer.export` and
+:mod:`~anthroarm.viewer.live`); what it draws: :mod:`~anthroarm.viewer.visuals` (a robot's
+bodies), :mod:`~anthroarm.viewer.shapes`, :mod:`~anthroarm.viewer.meshes`,
+:mod:`~anthroarm.viewer.colors`; how: :mod:`~anthroarm.viewer.messages` (the commands),
+:mod:`~anthroarm.viewer.checks` (argument checks); :mod:`~anthroarm.viewer.server` runs the
+127.0.0.1-only server process; :mod:`~anthroarm.viewer.browser` takes headless-Chromium
+screenshots (tests, docs); :mod:`~anthroarm.viewer.demo` is ``anthroarm demo``.
 """
 
 from .viewer import (

@@ -20,7 +20,7 @@ Two commands are added to meshcat's protocol (handled by the page's JavaScript p
                      ``textContent`` only; deleting ``path`` or a parent removes it.
 
 and after every ``set_object`` it computes smooth vertex normals for the meshes that came
-without any (:class:`~anthroarm.viewer.visuals.PackedMesh`, meshcat's ``TriangularMeshGeometry``).
+without any (:class:`~anthroarm.viewer.meshes.PackedMesh`, meshcat's ``TriangularMeshGeometry``).
 """
 
 from __future__ import annotations

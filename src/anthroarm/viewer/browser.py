@@ -18,7 +18,9 @@ never raises.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import json
 import os
 import shutil
 import signal
@@ -26,10 +28,15 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.request
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
+from tornado.websocket import websocket_connect
+
+from .demo import REACH_POSTURES_DEG, demo_viewer, reach_demo
 
 #: Flags that make headless Chromium render WebGL in software, offline and quietly.
 CHROMIUM_FLAGS = [
@@ -166,12 +173,6 @@ class DevTools:
     """
 
     def __init__(self, tab: Tab, timeout: float = 60.0):
-        import asyncio
-        import json
-        import urllib.request
-
-        from tornado.websocket import websocket_connect
-
         self.timeout = float(timeout)
         deadline = time.monotonic() + self.timeout
         port_file = Path(tab.profile) / "DevToolsActivePort"
@@ -205,8 +206,6 @@ class DevTools:
 
     def call(self, method: str, **params):
         """One DevTools command; its ``result`` (RuntimeError with the protocol's message on an error)."""
-        import asyncio
-
         self._id += 1
         mid = self._id
 
@@ -366,8 +365,7 @@ def remove_profile(path, attempts: int = 5) -> bool:
 
 
 def load_rgb(png) -> np.ndarray:
-    from PIL import Image
-
+    """The PNG as an (H, W, 3) int16 RGB array."""
     with Image.open(png) as im:
         return np.asarray(im.convert("RGB")).astype(np.int16)
 
@@ -399,8 +397,6 @@ def drawn_fraction(png, baseline_png, region=(0.0, 0.0, 1.0, 1.0), tol: int = 40
 def docs_screenshot(png, size=(960, 640)) -> Path:
     """The README picture: the §6-3 human arm reaching forward, the demo's targets and the
     hand's path, joint-limit colours on.  ``python -m anthroarm.viewer.browser docs/x.png``."""
-    from .demo import REACH_POSTURES_DEG, demo_viewer, reach_demo
-
     res = reach_demo()
     v = demo_viewer(res)
     v.stop()  # a still picture: the pose below, not the animation
@@ -413,6 +409,4 @@ def docs_screenshot(png, size=(960, 640)) -> Path:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
-
     print(docs_screenshot(sys.argv[1] if len(sys.argv) > 1 else "human_arm_viewer.png"))

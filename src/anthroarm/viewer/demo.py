@@ -11,6 +11,9 @@ PostureTask, the model's configuration and velocity limits, OSQP by default).
 
 >>> res = reach_demo()                 # DemoResult(Q (N, 7), dt, targets, errors, method)
 >>> v = Viewer(res.robot); v.play(res.Q, res.dt); v.export_html("demo.html")
+
+Function-local import (heavy, ~1 s: qpsolvers and OSQP, only paid for by a demo that runs):
+``anthroarm.ik.qp`` in :class:`QPStepper`.
 """
 
 from __future__ import annotations
@@ -22,6 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+
+from ..robot import load
+from .viewer import Viewer
 
 #: Postures (degrees; shoulder x, y, z, elbow x, wrist z, y, x) whose hand poses are the targets.
 REACH_POSTURES_DEG = {
@@ -129,8 +135,6 @@ def reach_demo(
 
     ``progress``: an optional callable ``progress(done, total)`` called once per target.
     Returns a :class:`DemoResult`; ``errors`` holds the pose error at the end of each hold."""
-    from ..robot import load
-
     robot = robot if robot is not None else load("human_arm7")
     postures = postures_deg if postures_deg is not None else REACH_POSTURES_DEG
     if method not in ("qp", "auto"):
@@ -164,8 +168,6 @@ def reach_demo(
 
 def demo_viewer(res: DemoResult, live: bool = False, port=None):
     """A Viewer playing the demo: targets as overlays, the hand's path traced, looping."""
-    from .viewer import Viewer
-
     v = Viewer(res.robot, live=live, port=port)
     for k, (name, T) in enumerate(res.targets):
         v.show_target(T, name=f"target_{k}", size=0.06)

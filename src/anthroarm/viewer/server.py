@@ -19,6 +19,7 @@ import math
 import numbers
 import os
 import secrets
+import selectors
 import socket
 import subprocess
 import sys
@@ -50,7 +51,7 @@ def port_is_free(port: int) -> bool:
         s.close()
 
 
-def _check_port(port) -> int | None:
+def check_port(port) -> int | None:
     """``None`` or an integer 1..65535 (a bool or a float is a TypeError, not port 1)."""
     if port is None:
         return None
@@ -120,10 +121,10 @@ class ServerProcess:
     context = zmq.Context.instance()
 
     def __init__(self, port: int | None = None, timeout: float = 20.0):
-        port = _check_port(port)
+        port = check_port(port)
         timeout = _check_seconds(timeout)
         if port is not None and not port_is_free(port):
-            raise ViewerPortInUseError(_in_use_message(port))
+            raise ViewerPortInUseError(in_use_message(port))
         self._log = tempfile.TemporaryFile(mode="w+")
         args = [sys.executable, "-u", _SERVER_SCRIPT, "--parent-pid", str(os.getpid())]
         if port is not None:
@@ -146,7 +147,7 @@ class ServerProcess:
         line = self._read_line(timeout)
         if line.startswith("error port_in_use"):
             self._finalizer()
-            raise ViewerPortInUseError(_in_use_message(port))
+            raise ViewerPortInUseError(in_use_message(port))
         if not line.startswith("ready "):
             self._finalizer()
             raise ViewerError(f"the viewer server did not start: {line or self._stderr_tail()}")
@@ -159,8 +160,6 @@ class ServerProcess:
 
     # ------------------------------------------------------------------ plumbing
     def _read_line(self, timeout: float) -> str:
-        import selectors
-
         sel = selectors.DefaultSelector()
         sel.register(self.proc.stdout, selectors.EVENT_READ)
         try:
@@ -263,8 +262,13 @@ class ServerProcess:
         self.close()
 
 
-def _in_use_message(port) -> str:
+def in_use_message(port) -> str:
+    """What to tell a user whose ``port`` is taken."""
     return (
         f"port {port} on 127.0.0.1 is already in use (another viewer or program); "
         f"choose a free one with --port / port=, or leave it unset to pick the first free port from 7000"
     )
+
+
+#: The old private name, still imported by ``anthroarm.cli`` (``_check_port_early``).
+_in_use_message = in_use_message
