@@ -216,6 +216,7 @@ class Robot:
         self.tool = self.chain.tool
         self.tool_id = self.chain.tool_frame
         self._local = threading.local()
+        self._derived: dict = {}  # key -> (chain, tool, value): see derived()
 
     @property
     def data(self) -> pin.Data:
@@ -224,6 +225,21 @@ class Robot:
         if d is None:
             d = self._local.data = self.model.createData()
         return d
+
+    def derived(self, key: str, make):
+        """What an algorithm derives from this robot once — a closed-form plan, a solver, a
+        workspace — made by ``make(robot)`` on first use and kept on the robot: dropped with it
+        (no module-level table outlives a robot) and made again when ``robot.chain`` or
+        ``robot.tool`` change.  ``key`` names the owner (``"ik.geometric.plan"``).
+
+        Thread-safe without a lock: two threads asking at once may both make it; the last one
+        made is kept and each caller gets a valid value (``make`` must be pure)."""
+        hit = self._derived.get(key)
+        if hit is not None and hit[0] is self.chain and hit[1] == self.tool:
+            return hit[2]
+        value = make(self)
+        self._derived[key] = (self.chain, self.tool, value)
+        return value
 
     # ------------------------------------------------------------------ identity
     def __repr__(self) -> str:

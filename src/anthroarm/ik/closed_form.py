@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import functools
 import math
-import weakref
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -414,37 +413,32 @@ class _SingularOf:
         )
 
 
-#: id(robot) → (its chain, its tool, its :class:`_Solver` or None, the solver's
-#: :attr:`_Solver.one_call` where :func:`analytic` may answer one pose by it (no tree; made on
-#: the first such pose, :data:`_PENDING` until then), else None); an entry leaves with its
-#: robot (``weakref.finalize``), and holds no reference to it
-_SOLVERS: dict = {}
 _PENDING = object()
 
 
+class _Entry:
+    """What :func:`analytic` keeps on a robot (:meth:`~anthroarm.robot.Robot.derived`): its
+    :class:`_Solver` at its tool or None, and the solver's :attr:`_Solver.one_call` where
+    :func:`analytic` may answer one pose by it (no tree; made on the first such pose,
+    :data:`_PENDING` until then), else None."""
+
+    __slots__ = ("solver", "one")
+
+    def __init__(self, robot):
+        self.solver = _new_solver(robot)
+        self.one = None if self.solver is None or self.solver.arm is not None else _PENDING
+
+
 def _solver(robot):
-    """The :class:`_Solver` of ``robot`` at its tool (cached per robot and chain), or None."""
-    hit = _SOLVERS.get(id(robot))
-    if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
-        return hit[2]
-    out = _new_solver(robot)
-    if hit is None:
-        weakref.finalize(robot, _SOLVERS.pop, id(robot), None)
-    _SOLVERS[id(robot)] = (
-        robot.chain,
-        robot.tool,
-        out,
-        None if out is None or out.arm is not None else _PENDING,
-    )
-    return out
+    """The :class:`_Solver` of ``robot`` at its tool (kept on the robot), or None."""
+    return robot.derived("ik.closed_form", _Entry).solver
 
 
-def _one_call_of(robot, hit) -> _OneCall | None:
-    """The :attr:`_Solver.one_call` of a :data:`_SOLVERS` entry ``hit`` still :data:`_PENDING`,
-    made (the one-pose kernel compiled or loaded) and kept in the entry."""
-    one = hit[2].one_call
-    _SOLVERS[id(robot)] = (*hit[:3], one)
-    return one
+def _one_call_of(entry: _Entry) -> _OneCall | None:
+    """The :attr:`_Solver.one_call` of an entry still :data:`_PENDING`, made (the one-pose
+    kernel compiled or loaded) and kept in the entry."""
+    entry.one = entry.solver.one_call
+    return entry.one
 
 
 def _new_solver(robot):
@@ -485,7 +479,8 @@ def _new_solver(robot):
     return out
 
 
-_RETOOLED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+def _no_others(robot) -> dict:
+    return {}
 
 
 def _retooled(robot, frame):
@@ -502,10 +497,8 @@ def _retooled(robot, frame):
         return robot
     from ..robot import Robot
 
-    hit = _RETOOLED.get(robot)
-    if hit is None or hit[0] is not robot.chain:
-        hit = _RETOOLED[robot] = (robot.chain, {})
-    if f.index not in hit[1]:
+    others = robot.derived("ik.closed_form.retooled", _no_others)  # frame id -> Robot or None
+    if f.index not in others:
         other = Robot(
             robot.model,
             name=robot.name,
@@ -514,8 +507,8 @@ def _retooled(robot, frame):
             spec=robot.spec,
             locked=robot.locked,
         )
-        hit[1][f.index] = other if other.tool_id == f.index else None
-    return hit[1][f.index]
+        others[f.index] = other if other.tool_id == f.index else None
+    return others[f.index]
 
 
 def _unnamed(robot, frame) -> str:
@@ -1156,10 +1149,7 @@ def analytic(
     ``param``) is one compiled call (≈ 3 µs from Python, limits and FK check included), as is
     one pose of an SRS arm at one swivel angle (≈ 3.5 µs) or of a planar 2R arm (≈ 2 µs); see the
     module docstring."""
-    hit = _SOLVERS.get(id(robot))
-    if hit is None or hit[0] is not robot.chain or hit[1] != robot.tool:
-        _solver(robot)  # the cache entry: a first call, or a new chain or tool
-        hit = _SOLVERS[id(robot)]
+    hit = robot.derived("ik.closed_form", _Entry)
     if type(T) is np.ndarray:
         arr, usual = T, T.shape == (4, 4) and T.dtype is _F64
     else:
@@ -1180,9 +1170,9 @@ def analytic(
         usual = flags.c_contiguous and flags.aligned
     else:
         usual = False
-    one, tried = hit[3], False
+    one, tried = hit.one, False
     if usual and one is _PENDING:
-        one = _one_call_of(robot, hit)
+        one = _one_call_of(hit)
     if usual and one is not None:
         # one pose of a closed class (no tree, no other frame), of an SRS arm at one swivel
         # angle or of a planar 2R arm (position only): one compiled call, when it has a
@@ -1255,7 +1245,7 @@ def analytic(
         if not single:
             raise ValueError("method='book' takes one pose")
         return _book_result(robot, Ts[0], spec.params, tol)
-    s = hit[2]
+    s = hit.solver
     if s is not None and s.arm is not None:
         rest = _q_rest(robot, s.arm, q_rest)
         return _on_robot(

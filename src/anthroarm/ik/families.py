@@ -49,7 +49,6 @@ from __future__ import annotations
 
 import functools
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -222,39 +221,27 @@ class PlanarPlan:
         return cf, np.array(self.order, dtype=np.int64)
 
 
-_SRS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_PLANAR: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def _cached(cache, robot, build):
-    hit = cache.get(robot)
-    if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
-        return hit[2], hit[3]
-    plan, why = build(robot)
-    cache[robot] = (robot.chain, robot.tool, plan, why)
-    return plan, why
-
-
 def srs_plan(robot) -> SRSPlan | None:
-    """The cached :class:`SRSPlan` of ``robot`` at its tool, or None (:func:`srs_reason` says
-    why).  Cached per robot, rebuilt when ``robot.chain`` or ``robot.tool`` change."""
-    return _cached(_SRS, robot, _build_srs)[0]
+    """The :class:`SRSPlan` of ``robot`` at its tool, or None (:func:`srs_reason` says why).
+    Kept on the robot (:meth:`~anthroarm.robot.Robot.derived`), rebuilt when ``robot.chain`` or
+    ``robot.tool`` change."""
+    return robot.derived("ik.families.srs", _build_srs)[0]
 
 
 def srs_reason(robot) -> str | None:
     """Why ``robot`` has no SRS plan (None when it has one)."""
-    return _cached(_SRS, robot, _build_srs)[1]
+    return robot.derived("ik.families.srs", _build_srs)[1]
 
 
 def planar_plan(robot) -> PlanarPlan | None:
     """The cached :class:`PlanarPlan` of ``robot`` at its tool, or None
     (:func:`planar_reason`)."""
-    return _cached(_PLANAR, robot, _build_planar)[0]
+    return robot.derived("ik.families.planar", _build_planar)[0]
 
 
 def planar_reason(robot) -> str | None:
     """Why ``robot`` has no planar-2R plan (None when it has one)."""
-    return _cached(_PLANAR, robot, _build_planar)[1]
+    return robot.derived("ik.families.planar", _build_planar)[1]
 
 
 def _kinematics(robot, n):

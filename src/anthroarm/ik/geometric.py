@@ -68,7 +68,6 @@ from __future__ import annotations
 
 import functools
 import math
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -274,19 +273,12 @@ def _reversed(kin: C.Kinematics):
     return H, pts, Rt.T, -Rt.T @ pt
 
 
-_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
 def plan_for(robot) -> GeoPlan | None:
-    """The cached :class:`GeoPlan` of ``robot`` for its tool, or None when its geometry has no
-    closed form here (not 6R on the path to the tool, a mimic joint, joints off that path, or
-    a class in :data:`anthroarm.ik.classify.CLASSES` other than :data:`SOLVED`)."""
-    hit = _PLANS.get(robot)
-    if hit is not None and hit[0] is robot.chain and hit[1] == robot.tool:
-        return hit[2]
-    plan = _build(robot)
-    _PLANS[robot] = (robot.chain, robot.tool, plan)
-    return plan
+    """The :class:`GeoPlan` of ``robot`` for its tool (kept on the robot:
+    :meth:`~anthroarm.robot.Robot.derived`), or None when its geometry has no closed form here
+    (not 6R on the path to the tool, a mimic joint, joints off that path, or a class in
+    :data:`anthroarm.ik.classify.CLASSES` other than :data:`SOLVED`)."""
+    return robot.derived("ik.geometric.plan", _build)
 
 
 def classification(robot):

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 import threading
-import weakref
 
 import numpy as np
 import pinocchio as pin
@@ -25,8 +24,6 @@ from ...chain import CONTINUOUS, PRISMATIC
 from .. import closed_form
 from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from . import seeds
-
-_SHARED: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # Robot -> {frame id: Shared}
 
 
 class Shared:
@@ -205,11 +202,13 @@ class Workspace:
         return self.data.oMf[self.fid]
 
 
+def _frames(robot) -> dict:
+    return {}
+
+
 def workspace(robot, fid: int) -> Workspace:
     """The calling thread's workspace for (robot, frame id ``fid``)."""
-    frames = _SHARED.get(robot)
-    if frames is None:
-        frames = _SHARED.setdefault(robot, {})
+    frames = robot.derived("ik.solve.shared", _frames)  # frame id -> Shared, kept on the robot
     sh = frames.get(fid)
     if sh is None:
         sh = frames.setdefault(fid, Shared(robot, fid))
