@@ -14,7 +14,7 @@ from meshcat.commands import SetObject
 
 from .colors import rgb_hex
 
-#: Where every Viewer draws: ``ROOT/<robot name>`` (:attr:`Viewer.root`).
+#: Where every Viewer draws: ``ROOT/<robot name>`` (``viewer.root``).
 ROOT = "/meshcat/anthroarm"
 
 

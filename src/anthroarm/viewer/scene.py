@@ -107,9 +107,10 @@ class SceneWindow:
 
 
 class Scene(Visualizer):
-    """meshcat's :class:`~meshcat.visualizer.Visualizer` API on the scene of a
-    :class:`Viewer` (:attr:`Viewer.scene`): ``scene["name"].set_object(geometry, material)``,
-    ``set_transform``, ``set_property``, ``delete``, plus :meth:`set_cam_pos`.  Paths start at ``/meshcat`` (absolute paths such as
+    """meshcat's :class:`~meshcat.visualizer.Visualizer` API on the scene of a :class:`Viewer`
+    (:attr:`Viewer.scene <anthroarm.viewer.scene.SceneMixin.scene>`):
+    ``scene["name"].set_object(geometry, material)``, ``set_transform``, ``set_property``,
+    ``delete``, plus :meth:`set_cam_pos`.  Paths start at ``/meshcat`` (absolute paths such as
     ``"/Grid"`` or ``"/Cameras/default"`` address meshcat's own nodes).  Everything sent
     through it is kept in the static HTML export and reaches a live browser."""
 

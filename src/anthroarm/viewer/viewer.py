@@ -83,7 +83,7 @@ class Viewer(SceneMixin, OverlaysMixin, TeachMixin, ExportMixin, LiveMixin):
 
     * scene (:class:`~anthroarm.viewer.scene.SceneMixin`): :meth:`display`, :meth:`set_camera`,
       :meth:`set_background`, :meth:`set_grid`, :meth:`set_axes`, :meth:`set_scale_bar`, and
-      :attr:`scene` (meshcat's own API);
+      :attr:`~anthroarm.viewer.scene.SceneMixin.scene` (meshcat's own API);
     * overlays (:class:`~anthroarm.viewer.overlays.OverlaysMixin`): :meth:`show_frames`,
       :meth:`show_target`, :meth:`show_trace`, :meth:`show_points`, :meth:`show_workspace`,
       :meth:`show_map`, :meth:`show_arrows`, :meth:`show_limits`, :meth:`show_joint_values`,
@@ -91,8 +91,9 @@ class Viewer(SceneMixin, OverlaysMixin, TeachMixin, ExportMixin, LiveMixin):
     * teach (:class:`~anthroarm.viewer.teach.TeachMixin`): :meth:`teach`;
     * export (:class:`~anthroarm.viewer.export.ExportMixin`): :meth:`play`, :meth:`stop`,
       :meth:`static_html`, :meth:`export_html`, :meth:`jupyter_cell`;
-    * live server (:class:`~anthroarm.viewer.live.LiveMixin`): :attr:`url`, :meth:`open`,
-      :meth:`wait`, :meth:`close` (also on leaving a ``with`` block).
+    * live server (:class:`~anthroarm.viewer.live.LiveMixin`):
+      :attr:`~anthroarm.viewer.live.LiveMixin.url`, :meth:`open`, :meth:`wait`, :meth:`close`
+      (also on leaving a ``with`` block).
 
     Parameters
     ----------
