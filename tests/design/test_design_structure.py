@@ -25,7 +25,7 @@ def test_table_2_1_classes():
 def test_mobility_upper_limb_book_27():
     # l. 542-546: n = 19, p = (0, 1, 2, 6, 11) -> 6*19 - 87 = 27
     assert S.spatial_mobility(19, (0, 1, 2, 6, 11)) == 27
-    m = S.human_upper_limb()
+    m = S.upper_limb_mechanism()
     assert m.n_moving == 19
     assert m.pair_counts() == {1: 0, 2: 1, 3: 2, 4: 6, 5: 11}
     assert m.mobility() == 27
@@ -38,7 +38,7 @@ def test_mobility_fingers_book_20():
     m = S.human_fingers()
     assert (m.n_moving, m.mobility(), m.loops) == (15, 20, 0)
     # the arm alone carries the rest: 27 - 20 = 7 = shoulder 3 + elbow 2 + wrist 2
-    assert S.human_upper_limb().mobility() - m.mobility() == 7
+    assert S.upper_limb_mechanism().mobility() - m.mobility() == 7
 
 
 def test_mobility_rrss_local_dof_and_planar_sixbar():
@@ -105,7 +105,18 @@ def test_reach_against_catalog_arm_fk():
     L1, L2, L3 = (robot.spec.params[k] for k in ("L1", "L2", "L3"))
     rng = np.random.default_rng(1)
     th = rng.uniform(0, np.pi / 2, 200)
-    q = S.prosthetic_arm_bent_q(th)
+    assert robot.spec.reach.lengths == (L1, L2, L3) and robot.spec.reach.bend == (3, 5)
+    q = S.bent_q(robot.spec.reach, robot.nq, th)
+    # elbow and wrist flexion bent by θ3, the forearm rotation between them 0
+    assert np.array_equal(q[:, [3, 5]], np.stack([th, th], 1)) and not q[:, [0, 1, 2, 4]].any()
+    assert S.bent_q(robot.spec.reach, 6, 0.3, (0.1, 0.2, 0.3)).tolist() == [
+        0.1,
+        0.2,
+        0.3,
+        0.3,
+        0.0,
+        0.3,
+    ]
     q[:, :3] = robot.random_q(200, rng)[:, :3]
     d = np.linalg.norm(robot.fk(q)[:, :3, 3], axis=1)
     np.testing.assert_allclose(d, S.reach_min(L1, L2, L3, th), atol=1e-12)
@@ -118,7 +129,9 @@ def test_reach_against_catalog_arm_fk():
 def test_reach_provider_rows():
     rows = S.reach_rows(["prosthetic_arm"], 20, np.random.default_rng(0))
     assert len(rows) == 2 and all(r.ok for r in rows)
-    assert S.reach_rows(["planar2r"], 20, np.random.default_rng(0)) == []
+    assert S.reach_rows(["planar2r"], 20, np.random.default_rng(0)) == []  # spec.reach is None
+    assert S.reach_rows(["panda"], 20, np.random.default_rng(0)) == []  # not a book model
+    assert aa.models.spec("planar2r").reach is None
 
 
 def printed_reach_min_2_4(l1, l2, l3, t):

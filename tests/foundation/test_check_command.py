@@ -13,7 +13,7 @@ from test_chain import USER_URDF
 
 import anthroarm as aa
 from anthroarm import cli, crosscheck
-from anthroarm.kinematics import book_fk
+from anthroarm.models import book as book_models
 
 #: the rows every robot gets (book models get more)
 GENERIC = {
@@ -128,14 +128,14 @@ def test_check_unknown_model_is_one_line_error():
 
 
 def test_check_fails_loudly(monkeypatch, capsys):
-    real = book_fk.sixr_hand_pose
+    real = book_models.sixr_hand_pose
 
     def wrong(q, *a):  # a planted 1 mm error in the hand height
         T = real(q, *a)
         T[..., 2, 3] += 1e-3
         return T
 
-    monkeypatch.setattr(book_fk, "sixr_hand_pose", wrong)
+    monkeypatch.setattr(book_models, "sixr_hand_pose", wrong)
     rc = cli.main(["check", "sixr_arm", "--samples", "5"])
     out = capsys.readouterr().out
     assert rc == 1

@@ -10,6 +10,7 @@ from anthroarm import crosscheck
 from anthroarm.kinematics import book_fk as cf
 from anthroarm.kinematics.batched import SerialChain
 from anthroarm.kinematics.dh import dh_fk, dh_jacobian, dh_transform
+from anthroarm.models import book as book_models
 from anthroarm.models.spec import DHRow, dh_matrix
 
 N = 300
@@ -180,14 +181,14 @@ def test_crosscheck_passes_and_detects_a_wrong_closed_form(monkeypatch):
     rows = crosscheck.run(["sixr_arm", "human_arm7"], samples=20)
     assert rows and all(r.ok for r in rows)
     # plant the printed (6-17) error: the check must flag it
-    real = cf.sixr_hand_pose
+    real = book_models.sixr_hand_pose  # the form the spec declares looks it up here
 
     def wrong(q, *a):
         T = real(q, *a)
         T[..., :3, 0] = _sixr_printed_uvw(np.atleast_2d(q))
         return T
 
-    monkeypatch.setattr(cf, "sixr_hand_pose", wrong)
+    monkeypatch.setattr(book_models, "sixr_hand_pose", wrong)
     rows = crosscheck.run(["sixr_arm"], samples=20)
     bad = [r for r in rows if not r.ok]
     assert [r.quantity for r in bad] == ["fk printed (6-16)/(6-17)"]

@@ -40,7 +40,7 @@ def test_mobility_is_the_books_27_and_20():
     m = mechanism_of(spec)
     assert m.loops == 0
     # Eq. (2-1) on the generated model's graph = the book's F = 27 (l. 544) = Fig. 2-2's graph
-    assert m.mobility() == 27 == structure.human_upper_limb().mobility()
+    assert m.mobility() == 27 == structure.upper_limb_mechanism().mobility()
     # the finger part: 5 two-axis base pairs (IV) + 10 hinges (V) on 15 phalanges: F = 20 (l. 548)
     counts = m.pair_counts()
     n_fingers = 15

@@ -11,6 +11,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.kinematics import error_propagation as EP
+from anthroarm.models.human import human_arm7_length_jacobian
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "foundation"))
 from test_chain import USER_URDF  # noqa: E402
@@ -47,7 +48,7 @@ def test_6_119_human_arm7_is_the_length_jacobian(robots):
     l1, l2, l3 = (r.spec.params[k] for k in ("l1", "l2", "l3"))
     assert np.allclose([p.nominal for p in ps], [l1, l2, l3])
     for q in r.random_q(5, np.random.default_rng(3)):
-        book = EP.human_arm7_length_jacobian(q)  # (6-119): [-e.3, -w.3, -h.3]
+        book = human_arm7_length_jacobian(q)  # (6-119): [-e.3, -w.3, -h.3]
         assert np.allclose(book, EP.length_jacobian_fd(r, q)[:3], atol=1e-10)
         # (6-119) is exact: P_H is linear in l_k
         dl = np.array([0.01, -0.02, 0.005])

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from ..ik.cells import MAX_LATTICE, lattice
+from ..models import PERSON_ARM
 from . import engine
 from .describe import RobotDescription, describe, robot_from
 from .errors import JobTooLargeError
@@ -330,7 +331,7 @@ def _population_task(robot, p):
 
 
 def population_reach(
-    model: str = "human_arm7",
+    model: str = PERSON_ARM,
     heights=(1.55, 1.65, 1.75, 1.85),
     masses=(60.0, 75.0),
     sexes=("female", "male"),

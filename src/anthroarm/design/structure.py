@@ -3,10 +3,12 @@
 * the kinematic-pair catalog of Table 2.1 (pair class = number of constraints k = 6 − f);
 * a mechanism graph (links, pairs, independent loops) and the spatial mobility formula
   Eq. (2-1) ``F = 6n − Σ_{k=1..5} k·p_k`` (the OCR prints the upper limit as ``s``);
-* the human upper-limb graph of Fig. 2-2 (F = 27) and its finger sub-graph (F = 20);
+* the human upper-limb graph of Fig. 2-2 (F = 27, :func:`upper_limb_mechanism`) and its finger
+  sub-graph (F = 20);
 * the arm-layout count Eq. (2-2) ``N = m^n`` and the enumeration of §2-3 that leaves the
   book's four forms (Fig. 2-3);
-* the reach of the R-P-R-P-R-P arm, Eq. (2-3) and Eq. (2-4).
+* the reach of the R-P-R-P-R-P arm, Eq. (2-3) and Eq. (2-4), checked on every catalog arm
+  whose spec declares the arm of Fig. 2-6 (``spec.reach``).
 
 Lengths are in metres (any consistent unit works: the formulas are homogeneous), angles in rad.
 """
@@ -218,8 +220,10 @@ def human_fingers() -> Mechanism:
     return m
 
 
-def human_upper_limb() -> Mechanism:
-    """Human upper-limb mechanism of Fig. 2-2 (l. 540–546), trunk as the frame.
+def upper_limb_mechanism() -> Mechanism:
+    """Human upper-limb mechanism of Fig. 2-2 (l. 540–546), trunk as the frame (the book's
+    graph; the catalog's 27-joint limb ``human_upper_limb`` has its own graph,
+    :func:`anthroarm.models.hand.mechanism_of`).
 
     Links: 1 humerus, 2 ulna, 3 radius, 4 palm, 5–19 phalanges (n = 19).  Pairs: shoulder S,
     humerus–ulna R (elbow flexion), humerus–radius S, ulna–radius class II, wrist (palm–radius)
@@ -334,38 +338,49 @@ def reach_min_fk(l1, l2, l3, theta3):
     return np.abs(l1 + l2 * np.exp(1j * t) + l3 * np.exp(2j * t))
 
 
-def prosthetic_arm_bent_q(theta3, q123=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Joint vector of the catalog ``prosthetic_arm`` (R-P-R-P-R-P) that realises the (2-4)
-    posture: elbow and wrist flexion both ``theta3``, forearm rotation 0 (the two swing axes
-    parallel), shoulder joints free."""
+def bent_q(reach, nq: int, theta3, q_shoulder=None) -> np.ndarray:
+    """Joint vector of the (2-4) posture of an arm whose spec declares ``reach``
+    (:class:`~anthroarm.models.spec.ReachPosture`): both swing joints ``reach.bend`` at
+    ``theta3`` (rad), the shoulder joints (those before ``reach.bend[0]``) at ``q_shoulder``
+    (default 0), every other joint 0.  Shape (nq,) for a scalar ``theta3``, else (N, nq)."""
+    i, k = reach.bend
     t = np.atleast_1d(np.asarray(theta3, dtype=float))
-    q = np.zeros((t.size, 6))
-    q[:, :3] = np.asarray(q123, dtype=float)
-    q[:, 3] = t
-    q[:, 5] = t
+    q = np.zeros((t.size, int(nq)))
+    if q_shoulder is not None:
+        q[:, :i] = np.asarray(q_shoulder, dtype=float)
+    q[:, i] = t
+    q[:, k] = t
     return q if np.ndim(theta3) else q[0]
 
 
 def reach_rows(models, samples, rng):
-    """Cross-check provider: Eq. (2-3)/(2-4) against Pinocchio FK of ``prosthetic_arm``."""
-
-    if "prosthetic_arm" not in models:
-        return []
+    """Cross-check provider: Eq. (2-3)/(2-4) against Pinocchio FK of every catalog model among
+    ``models`` whose spec declares the arm of Fig. 2-6 (``spec.reach``)."""
+    from .. import models as catalog
     from ..robot import load
 
-    robot = load("prosthetic_arm")
-    L1, L2, L3 = (robot.spec.params[k] for k in ("L1", "L2", "L3"))
-    n = max(int(samples), 1)
-    th = rng.uniform(0.0, np.deg2rad(90.0), n)  # wrist flexion limit is ±90°
-    q = prosthetic_arm_bent_q(th)
-    q[:, 0] = rng.uniform(robot.lower[0], robot.upper[0], n)
-    q[:, 1] = rng.uniform(robot.lower[1], robot.upper[1], n)
-    q[:, 2] = rng.uniform(robot.lower[2], robot.upper[2], n)
-    d = np.linalg.norm(robot.fk(q)[:, :3, 3], axis=1)
-    err_min = float(np.max(np.abs(d - reach_min(L1, L2, L3, th))))
-    d0 = np.linalg.norm(robot.fk(np.zeros(6))[:3, 3])
-    err_max = abs(float(d0 - reach_max(L1, L2, L3)))
-    return [
-        CheckRow("prosthetic_arm", "reach R_min (2-4) vs |fk|", err_min, 1e-9, n),
-        CheckRow("prosthetic_arm", "reach R_max (2-3) vs |fk(0)|", err_max, 1e-9, 1),
-    ]
+    rows = []
+    for name in models:
+        if name not in catalog.BOOK_MODELS:
+            continue
+        reach = catalog.spec(name).reach
+        if reach is None:
+            continue
+        robot = load(name)
+        L1, L2, L3 = reach.lengths
+        n = max(int(samples), 1)
+        i, k = reach.bend
+        hi = min(robot.upper[i], robot.upper[k], np.deg2rad(90.0))  # inside both joints' ranges
+        th = rng.uniform(0.0, hi, n)
+        q = bent_q(reach, robot.nq, th)
+        for j in range(i):
+            q[:, j] = rng.uniform(robot.lower[j], robot.upper[j], n)
+        d = np.linalg.norm(robot.fk(q)[:, :3, 3], axis=1)
+        err_min = float(np.max(np.abs(d - reach_min(L1, L2, L3, th))))
+        d0 = np.linalg.norm(robot.fk(np.zeros(robot.nq))[:3, 3])
+        err_max = abs(float(d0 - reach_max(L1, L2, L3)))
+        rows += [
+            CheckRow(name, "reach R_min (2-4) vs |fk|", err_min, 1e-9, n),
+            CheckRow(name, "reach R_max (2-3) vs |fk(0)|", err_max, 1e-9, 1),
+        ]
+    return rows

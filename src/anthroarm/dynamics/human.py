@@ -22,11 +22,13 @@ from .hand_model import minimum_jerk
 
 
 def human_arm(height: float = 1.75, mass: float = 75.0, sex: str = "male"):
-    """(robot, dynamics) of ``human_arm7`` for a person of the given height/mass/sex."""
+    """(robot, dynamics) of the catalog's arm of a person (:data:`anthroarm.models.PERSON_ARM`,
+    ``human_arm7``) for the given height/mass/sex."""
+    from ..models import PERSON_ARM
     from ..robot import load as load_robot
     from .lagrange import load
 
-    robot = load_robot("human_arm7", height=height, mass=mass, sex=sex)
+    robot = load_robot(PERSON_ARM, height=height, mass=mass, sex=sex)
     return robot, load(robot)
 
 

@@ -37,7 +37,7 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
     from ..ik.qp import IKConfiguration
     from ..ik.qp.tasks.posture import comfortable_posture
 
-    robot = aa.load("human_upper_limb") if robot is None else robot
+    robot = aa.load(aa.models.PERSON_ARM_WITH_HAND) if robot is None else robot
     h = Hand(robot)
     comfort = comfortable_posture(robot)
     aq = h.arm_q_indices

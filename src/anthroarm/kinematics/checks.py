@@ -6,9 +6,10 @@
   :class:`~anthroarm.kinematics.batched.SerialChain`) against Pinocchio one configuration at a
   time (``pin.framesForwardKinematics``, ``pin.computeFrameJacobian`` LOCAL_WORLD_ALIGNED);
 * yourdfpy's FK of every link against Pinocchio's, joints mapped by name (robots with a URDF);
-* for a book model as generated: the H-D chain Eq. (6-12)–(6-14) and the printed forms of
-  :data:`anthroarm.kinematics.book_fk.PRINTED` ((6-16)/(6-17), (6-21)–(6-23), 002
-  (4-52)–(4-54), the human arm (6-34)–(6-39) with its Jacobian, Fig. 7-14).
+* for a book model as generated: the H-D chain Eq. (6-12)–(6-14) and the printed forms its
+  spec declares (:func:`anthroarm.kinematics.book_fk.printed_forms`, defined in
+  :mod:`anthroarm.models.printed`: (6-16)/(6-17), (6-21)–(6-23), 002 (4-52)–(4-54), the human
+  arm (6-34)–(6-39) with its Jacobian, Fig. 7-14).
 
 :func:`error_rows`, for any robot: §6-6 J_L (6-118) against finite differences over
 Pinocchio models with perturbed placements, the batched perturbed FK

@@ -10,25 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial.rotations import as_scalar
-
-
-def _as_batch(q, n: int) -> tuple[np.ndarray, bool]:
-    q = np.asarray(q, dtype=float)
-    single = q.ndim == 1
-    q2 = q[None, :] if single else q
-    if q2.ndim != 2 or q2.shape[1] != n:
-        raise ValueError(f"q must have shape ({n},) or (N, {n}), got {q.shape}")
-    if not np.isfinite(q2).all():
-        j = int(np.argwhere(~np.isfinite(q2))[0, 1])
-        raise ValueError(f"q[{j}] is not finite")
-    return q2, single
-
-
-def finite_params(**values) -> list[float]:
-    """The named scalar parameters (link lengths in m, angles in rad) as floats; ``ValueError``
-    naming the first one that is not a finite number."""
-    return [as_scalar(v, name) for name, v in values.items()]
+# the checks of joint values and parameters, shared with the printed forms of the catalog
+from ..models.spec import as_batch as _as_batch
+from ..models.spec import finite_params as finite_params
 
 
 def dh_transform(theta, s, h, alpha) -> np.ndarray:

@@ -21,7 +21,8 @@ downstream point by R_parent d δ without rotating anything, so the book's coeff
     ∂x/∂L_k = R_parent(k) d_k    (world axes),
 
 which for the §6-3 arm is (6-119): ∂P_H/∂l₁ = −e_{·3}, ∂P_H/∂l₂ = −w_{·3}, ∂P_H/∂l₃ = −h_{·3}
-(:func:`~anthroarm.kinematics.book_fk.human_arm7_length_jacobian`, also importable from here).
+(:func:`~anthroarm.models.human.human_arm7_length_jacobian`, the arm's printed form, declared
+in its spec).
 :func:`length_jacobian_fd` checks it by central finite differences over copies of the
 Pinocchio model with perturbed placements.
 
@@ -37,7 +38,6 @@ import numpy as np
 import pinocchio as pin
 
 from ..spatial.rotations import rot_axis
-from .book_fk import human_arm7_length_jacobian as human_arm7_length_jacobian  # (6-119)
 
 
 # ----------------------------------------------------------------------------- parameters

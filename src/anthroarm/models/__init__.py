@@ -37,6 +37,12 @@ BOOK_MODELS = {
     **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
 }
 
+#: the catalog model of a person's arm, built from body height (m), mass (kg) and sex: what the
+#: analyses and applications that start from a person load unless told otherwise
+PERSON_ARM = "human_arm7"
+#: the same arm with a five-digit hand (the fingertips are frames of the model)
+PERSON_ARM_WITH_HAND = "human_upper_limb"
+
 #: units of the builder parameters that are not lengths in m (the catalog's convention; mass is
 #: kg everywhere): shown by ``anthroarm urdf MODEL --help``
 PARAM_UNITS: dict[str, dict[str, str]] = {
@@ -141,6 +147,8 @@ def write_urdfs(out_dir=None) -> list[Path]:
 
 __all__ = [
     "BOOK_MODELS",
+    "PERSON_ARM",
+    "PERSON_ARM_WITH_HAND",
     "ERD_ARMS",
     "ErdArm",
     "ChainSpec",

@@ -1,8 +1,17 @@
-"""The book's serial arms as parameter tables.
+"""The book's serial arms as parameter tables, with the book's printed closed forms of them.
 
-Each function returns a :class:`~anthroarm.models.spec.ChainSpec`; its keyword arguments are
+Each builder returns a :class:`~anthroarm.models.spec.ChainSpec`; its keyword arguments are
 the book's symbols (SI units).  Where the book prints no numbers the defaults are our choice,
 stated in the docstring and in the generated URDF's header.
+
+The printed closed forms of these arms' hand poses (corrected where recomputation proves a
+misprint, see ``docs/errata.md``) follow the builders, vectorised over a batch: each takes joint
+values ``q`` of shape ``(n,)`` or ``(N, n)`` (rad; m for prismatic joints) and link lengths in m,
+and returns the hand pose as a 4×4 homogeneous matrix (or a batch) in the book's base frame 0.
+In the book's notation the hand frame has its x axis b = (u, v, w), its z axis a = (l, m, n) and
+its origin at the hand point (x, y, z); y = a × b.  Each builder declares its arm's forms in
+``spec.printed`` (:class:`~anthroarm.models.spec.PrintedForm`), which ``anthroarm check``
+compares with Pinocchio.
 """
 
 from __future__ import annotations
@@ -11,7 +20,18 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..spatial.rotations import as_scalar, homogeneous
-from .spec import ChainSpec, DHRow, JointSpec, from_dh, rod_link
+from .spec import (
+    ChainSpec,
+    DHRow,
+    JointSpec,
+    PrintedForm,
+    ReachPosture,
+    as_batch,
+    dh_matrix,
+    finite_params,
+    from_dh,
+    rod_link,
+)
 
 deg = np.pi / 180.0
 
@@ -89,6 +109,9 @@ def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> C
         joint_names=names,
         params={"L1": L1, "L2": L2, "L3": L3},
         tool_name="palm",
+        # Fig. 2-6 is this arm (R-P-R-P-R-P): elbow and wrist flexion bend in one plane when
+        # the forearm rotation is 0
+        reach=ReachPosture((L1, L2, L3), (3, 5)),
     )
 
 
@@ -114,6 +137,7 @@ def sixr_arm(s0: float = 0.5, h2: float = 0.4, s3: float = 0.35, P: float = 0.1)
         source="book 000 l.3769-3847 (Fig. 6-3, Eq. (6-14)-(6-17)); lengths chosen by anthroarm",
         params={"s0": s0, "h2": h2, "s3": s3, "P": P},
         tool_name="hand",
+        printed=(PrintedForm("(6-16)/(6-17)", _sixr_pose),),
     )
 
 
@@ -144,6 +168,7 @@ def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0))
         joint_names=["waist", "shoulder", "boom", "wrist_pitch", "wrist_roll"],
         params={"s0": s0, "h2": h2, "P": P, "boom": list(boom)},
         tool_name="hand",
+        printed=(PrintedForm("(6-21)-(6-23)", _unimate_pose),),
     )
 
 
@@ -162,6 +187,7 @@ def rrprr5(s0: float = 0.4, h2: float = 0.08, p: float = 0.12, stroke=(0.2, 0.6)
         source="002 l.355-409 (Eq. (4-50)-(4-54)); lengths chosen by anthroarm",
         params={"s0": s0, "h2": h2, "p": p, "stroke": list(stroke)},
         tool_name="gripper",
+        printed=(PrintedForm("002 (4-52)-(4-54)", _rrprr_pose),),
     )
 
 
@@ -193,4 +219,141 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
             f"plus {DEFAULT_JOINT_MASS} kg at each joint"
         ),
         params={"l1": l1, "l2": l2},
+        printed=(PrintedForm("Fig. 7-14 (y, z)", _planar2r_pose),),
     )
+
+
+# ---------------------------------------------------------------- the book's printed closed forms
+
+
+def _pose(x, y, z, l, m, n, u, v, w) -> np.ndarray:
+    N = np.shape(x)[0]
+    T = np.zeros((N, 4, 4))
+    b = np.stack([u, v, w], axis=-1)
+    a = np.stack([l, m, n], axis=-1)
+    T[:, :3, 0] = b
+    T[:, :3, 2] = a
+    T[:, :3, 1] = np.cross(a, b)
+    T[:, :3, 3] = np.stack([x, y, z], axis=-1)
+    T[:, 3, 3] = 1.0
+    return T
+
+
+def sixr_hand_pose(q, s0: float, h2: float, s3: float, P: float) -> np.ndarray:
+    """6R arm of Fig. 6-3: hand position Eq. (6-16) and attitude Eq. (6-17).
+
+    (6-16) is printed correctly; in (6-17) the printed u, v, w carry θ5 where θ6 belongs
+    (errata): here u = [(C6C5C4 + S6S4)C23 + C6S5S23]C1 + (C6C5S4 − S6C4)S1, etc."""
+    q2, single = as_batch(q, 6)
+    s0, h2, s3, P = finite_params(s0=s0, h2=h2, s3=s3, P=P)
+    t1, t2, t3, t4, t5, t6 = q2.T
+    C1, S1, C2, S2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
+    C4, S4, C5, S5, C6, S6 = np.cos(t4), np.sin(t4), np.cos(t5), np.sin(t5), np.cos(t6), np.sin(t6)
+    C23, S23 = np.cos(t2 + t3), np.sin(t2 + t3)
+    r = P * S5 * C4 * C23 + (s3 - P * C5) * S23 + h2 * C2  # Eq. (6-16)
+    x = r * C1 + P * S5 * S4 * S1
+    y = r * S1 - P * S5 * S4 * C1
+    z = P * S5 * C4 * S23 - (s3 - P * C5) * C23 + h2 * S2 + s0
+    k = S5 * C4 * C23 - C5 * S23  # Eq. (6-17)
+    l = k * C1 + S5 * S4 * S1
+    m = k * S1 - S5 * S4 * C1
+    n = S5 * C4 * S23 + C5 * C23
+    g = (C6 * C5 * C4 + S6 * S4) * C23 + C6 * S5 * S23
+    f = C6 * C5 * S4 - S6 * C4
+    u = g * C1 + f * S1
+    v = g * S1 - f * C1
+    w = (C6 * C5 * C4 + S6 * S4) * S23 - C6 * S5 * C23
+    T = _pose(x, y, z, l, m, n, u, v, w)
+    return T[0] if single else T
+
+
+def unimate_hand_pose(q, s0: float, h2: float, P: float) -> np.ndarray:
+    """R-R-P-R-R arm: the Unimate of Fig. 6-4, Eq. (6-21)–(6-23), which is the same chain
+    as the 002 text's RRPRR manipulator, Eq. (4-52)–(4-54).  ``q = (θ1, θ2, s2, θ4, θ5)``.
+
+    Corrected misprints (errata): (6-23) v ends in −C5 S4 C1 (printed S1); (4-52) x has C2
+    where the 002 text prints C3; (4-54) v as (6-23)."""
+    q2, single = as_batch(q, 5)
+    s0, h2, P = finite_params(s0=s0, h2=h2, P=P)
+    t1, t2, s2, t4, t5 = q2.T
+    C1, S1, C2, S2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
+    C4, S4, C5, S5 = np.cos(t4), np.sin(t4), np.cos(t5), np.sin(t5)
+    k = S5 * C4 * C2 - C5 * S2
+    r = P * k + s2 * S2 + h2 * C2  # Eq. (6-21)
+    x = r * C1 + P * S5 * S4 * S1
+    y = r * S1 - P * S5 * S4 * C1
+    z = P * (S5 * C4 * S2 + C5 * C2) - s2 * C2 + h2 * S2 + s0
+    l = k * C1 + S5 * S4 * S1  # Eq. (6-22)
+    m = k * S1 - S5 * S4 * C1
+    n = S5 * C4 * S2 + C5 * C2
+    g = C5 * C4 * C2 + S5 * S2  # Eq. (6-23)
+    u = g * C1 + C5 * S4 * S1
+    v = g * S1 - C5 * S4 * C1
+    w = C5 * C4 * S2 - S5 * C2
+    T = _pose(x, y, z, l, m, n, u, v, w)
+    return T[0] if single else T
+
+
+#: the 002 text's (4-52)–(4-54) are the same formulas as (6-21)–(6-23)
+rrprr_hand_pose = unimate_hand_pose
+
+
+def planar2r_tip(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
+    """Fig. 7-14: tip (y, z) = (l1 cos θ1 + l2 cos(θ1+θ2), l1 sin θ1 + l2 sin(θ1+θ2)), shape (N, 2)."""
+    q2, single = as_batch(q, 2)
+    l1, l2 = finite_params(l1=l1, l2=l2)
+    t1, t12 = q2[:, 0], q2[:, 0] + q2[:, 1]
+    yz = np.stack([l1 * np.cos(t1) + l2 * np.cos(t12), l1 * np.sin(t1) + l2 * np.sin(t12)], -1)
+    return yz[0] if single else yz
+
+
+def planar2r_tip_pose(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
+    """Fig. 7-14 as a pose, (N, 4, 4): the printed tip (y, z) of :func:`planar2r_tip`; both
+    hinges turn about x, so the tip frame is Rx(θ1 + θ2)."""
+    q2, _ = as_batch(q, 2)
+    yz = np.atleast_2d(planar2r_tip(q2, l1, l2))
+    t = q2.sum(axis=-1)
+    T = np.zeros(t.shape + (4, 4))
+    T[:, 0, 0] = T[:, 3, 3] = 1.0
+    T[:, 1, 1] = T[:, 2, 2] = np.cos(t)
+    T[:, 2, 1], T[:, 1, 2] = np.sin(t), -np.sin(t)
+    T[:, 1, 3], T[:, 2, 3] = yz[:, 0], yz[:, 1]
+    return T
+
+
+def prosthetic_arm_points(q, L1: float, L2: float, L3: float):
+    """Elbow E, wrist W and palm centre C of the Ch. 7 prosthetic arm (m, base frame 0).
+
+    E = L1 (c1 s2, s1 s2, −c2) (Eq. (7-17)); W = E + L2 z4; C = W + L3 z6 (Fig. 7-2), with the
+    frames of Table 7.1 / Eq. (7-16) (the products of the rows' A matrices, Eq. (6-14)), θ3
+    carrying the printed A23's hidden +90°."""
+    q2, single = as_batch(q, 6)
+    L1, L2, L3 = finite_params(L1=L1, L2=L2, L3=L3)
+    F, frames = np.eye(4), []
+    for j, row in enumerate(prosthetic_arm(L1, L2, L3).dh):
+        F = F @ dh_matrix(row, q2[:, j])
+        frames.append(F)
+    E = frames[2][:, :3, 3]
+    W = frames[4][:, :3, 3]
+    C = W + L3 * frames[5][:, :3, 2]
+    return (E[0], W[0], C[0]) if single else (E, W, C)
+
+
+# the forms as the specs declare them: (q, spec.params) -> pose; the functions are looked up
+# when called
+
+
+def _sixr_pose(q, p):
+    return sixr_hand_pose(q, p["s0"], p["h2"], p["s3"], p["P"])
+
+
+def _unimate_pose(q, p):
+    return unimate_hand_pose(q, p["s0"], p["h2"], p["P"])
+
+
+def _rrprr_pose(q, p):
+    return rrprr_hand_pose(q, p["s0"], p["h2"], p["p"])
+
+
+def _planar2r_pose(q, p):
+    return planar2r_tip_pose(q, p["l1"], p["l2"])

@@ -49,7 +49,7 @@ import numpy as np
 
 from ..errors import AnthropometryError, ParameterError
 from ..spatial.rotations import homogeneous
-from .spec import ChainSpec, JointSpec, rod_link
+from .spec import ChainSpec, JointSpec, PrintedForm, as_batch, finite_params, rod_link
 
 deg = np.pi / 180.0
 
@@ -350,4 +350,133 @@ def human_arm7(
         params={"height": height, "mass": mass, "sex": sex, "l1": l1, "l2": l2, "l3": l3},
         person=True,
         comfort=dict(HUMAN_ARM7_COMFORT),
+        printed=(PrintedForm("(6-34)-(6-39)", _hand_pose, _jacobian, _length_jacobian),),
     )
+
+
+# ---------------------------------------------------------------- the book's printed closed forms
+# Eq. (6-34)-(6-39) and (6-119) of this arm, vectorised over a batch of configurations q of
+# shape (7,) or (N, 7) (rad); lengths l1, l2, l3 in m (the spec's params).
+
+
+def human_arm7_rotations(q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """C_E, C_W, C_H of the §6-3 arm, Eq. (6-34)–(6-36), each (N, 3, 3) (or (3, 3)).
+
+    C_E = Cx1 Cy2 (printed elementwise, (6-34)); C_W = Cx1 Cy2 Cz3 Cx4 (6-35); C_H = C_W Cz5
+    Cy6 Cx7 written column-wise with the columns W1, W2, W3 of C_W (6-36; the printed h21, h31
+    read s6c6 where s5c6 belongs)."""
+    q2, single = as_batch(q, 7)
+    c = np.cos(q2)
+    s = np.sin(q2)
+    c1, c2, c3, c4, c5, c6, c7 = c.T
+    s1, s2, s3, s4, s5, s6, s7 = s.T
+    N = q2.shape[0]
+    CE = np.empty((N, 3, 3))
+    CE[:, 0] = np.stack([c2, np.zeros(N), s2], -1)
+    CE[:, 1] = np.stack([s1 * s2, c1, -s1 * c2], -1)
+    CE[:, 2] = np.stack([-c1 * s2, s1, c1 * c2], -1)
+    W1 = np.stack([c2 * c3, s1 * s2 * c3 + c1 * s3, -c1 * s2 * c3 + s1 * s3], -1)
+    W2 = np.stack(
+        [
+            -c2 * s3 * c4 + s2 * s4,
+            -s1 * s2 * s3 * c4 + c1 * c3 * c4 - s1 * c2 * s4,
+            c1 * s2 * s3 * c4 + s1 * c3 * c4 + c1 * c2 * s4,
+        ],
+        -1,
+    )
+    W3 = np.stack(
+        [
+            c2 * s3 * s4 + s2 * c4,
+            s1 * s2 * s3 * s4 - c1 * c3 * s4 - s1 * c2 * c4,
+            -c1 * s2 * s3 * s4 - s1 * c3 * s4 + c1 * c2 * c4,
+        ],
+        -1,
+    )
+    CW = np.stack([W1, W2, W3], axis=-1)
+    H1 = W1 * (c5 * c6)[:, None] + W2 * (s5 * c6)[:, None] - W3 * s6[:, None]
+    H2 = (
+        W1 * (c5 * s6 * s7 - s5 * c7)[:, None]
+        + W2 * (s5 * s6 * s7 + c5 * c7)[:, None]
+        + W3 * (c6 * s7)[:, None]
+    )
+    H3 = (
+        W1 * (c5 * s6 * c7 + s5 * s7)[:, None]
+        + W2 * (s5 * s6 * c7 - c5 * s7)[:, None]
+        + W3 * (c6 * c7)[:, None]
+    )
+    CH = np.stack([H1, H2, H3], axis=-1)
+    if single:
+        return CE[0], CW[0], CH[0]
+    return CE, CW, CH
+
+
+def human_arm7_points(q, l1: float, l2: float, l3: float):
+    """Elbow, wrist and hand points P_E, P_W, P_H of the §6-3 arm, Eq. (6-37)–(6-39), in the
+    shoulder frame (m), and C_H.  Returns (PE, PW, PH, CH)."""
+    l1, l2, l3 = finite_params(l1=l1, l2=l2, l3=l3)
+    CE, CW, CH = human_arm7_rotations(q)
+    PE = -l1 * CE[..., :, 2]
+    PW = PE - l2 * CW[..., :, 2]
+    PH = PW - l3 * CH[..., :, 2]
+    return PE, PW, PH, CH
+
+
+def human_arm7_hand_pose(q, l1: float, l2: float, l3: float) -> np.ndarray:
+    """Hand pose of the §6-3 arm: orientation C_H (6-36) at the hand point P_H (6-39)."""
+    _, _, PH, CH = human_arm7_points(q, l1, l2, l3)
+    T = np.zeros(PH.shape[:-1] + (4, 4))
+    T[..., :3, :3] = CH
+    T[..., :3, 3] = PH
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def human_arm7_jacobian(q, l1: float, l2: float, l3: float) -> np.ndarray:
+    """Jacobian of the hand point of the §6-3 arm, LOCAL_WORLD_ALIGNED, rows (v; ω), (6, 7).
+
+    Joint axes from the printed rotations: x0; Cx1·y; C_E·z; C_E Cz3·x (= column 1 of C_W);
+    C_W·z; C_W Cz5·y; C_W Cz5 Cy6·x (= column 1 of C_H).  Shoulder joints turn about S,
+    the elbow about P_E and the wrist joints about P_W; column k is (a_k × (P_H − c_k); a_k)."""
+    q2, single = as_batch(q, 7)
+    PE, PW, PH, CH = human_arm7_points(q2, l1, l2, l3)
+    CE, CW, _ = human_arm7_rotations(q2)
+    N = q2.shape[0]
+    c1, s1 = np.cos(q2[:, 0]), np.sin(q2[:, 0])
+    c5, s5 = np.cos(q2[:, 4]), np.sin(q2[:, 4])
+    axes = np.empty((N, 7, 3))
+    axes[:, 0] = [1.0, 0.0, 0.0]
+    axes[:, 1] = np.stack([np.zeros(N), c1, s1], -1)  # Cx1 · e_y
+    axes[:, 2] = CE[:, :, 2]
+    axes[:, 3] = CW[:, :, 0]
+    axes[:, 4] = CW[:, :, 2]
+    axes[:, 5] = CW[:, :, 0] * (-s5)[:, None] + CW[:, :, 1] * c5[:, None]  # C_W Cz5 · e_y
+    axes[:, 6] = CH[:, :, 0]
+    centres = np.stack([np.zeros((N, 3))] * 3 + [PE] + [PW] * 3, axis=1)
+    J = np.empty((N, 6, 7))
+    J[:, :3, :] = np.cross(axes, PH[:, None, :] - centres).transpose(0, 2, 1)
+    J[:, 3:, :] = axes.transpose(0, 2, 1)
+    return J[0] if single else J
+
+
+def human_arm7_length_jacobian(q) -> np.ndarray:
+    """The book's Eq. (6-119) for the §6-3 arm: the 3 × 3 matrix [−e_{·3}, −w_{·3}, −h_{·3}]
+    mapping (Δl₁, Δl₂, Δl₃) to (Δx_H, Δy_H, Δz_H), with C_E, C_W, C_H of (6-34)–(6-36).
+    (:mod:`anthroarm.kinematics.error_propagation` computes the same coefficients for any
+    robot.)"""
+    CE, CW, CH = human_arm7_rotations(np.asarray(q, float))
+    return -np.stack([CE[..., :, 2], CW[..., :, 2], CH[..., :, 2]], axis=-1)
+
+
+# the forms as the spec declares them: (q, spec.params) -> ...; looked up when called
+
+
+def _hand_pose(q, p):
+    return human_arm7_hand_pose(q, p["l1"], p["l2"], p["l3"])
+
+
+def _jacobian(q, p):
+    return human_arm7_jacobian(q, p["l1"], p["l2"], p["l3"])
+
+
+def _length_jacobian(q, p):
+    return human_arm7_length_jacobian(q)

@@ -17,11 +17,12 @@ Units: metres, radians, kilograms.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
 from ..errors import ParameterError
-from ..spatial.rotations import homogeneous, rotation_between
+from ..spatial.rotations import as_scalar, homogeneous, rotation_between
 
 #: Default linear density (kg/m) and radius (m) of the book arms' links, which print no masses:
 #: an aluminium tube Ø50 × 3 mm with its fittings weighs about 1.5 kg/m.
@@ -129,6 +130,32 @@ class DHRow:
     upper: float = np.pi
 
 
+@dataclass(frozen=True)
+class PrintedForm:
+    """One printed closed form of a book model: ``pose(q, params)`` → (N, 4, 4) of the tool,
+    ``jacobian(q, params)`` → (N, 6, n) LOCAL_WORLD_ALIGNED or None, ``length_jacobian(q,
+    params)`` → (N, 3, 3) the §6-6 coefficients ∂P/∂l or None; ``params`` is the model's
+    ``spec.params`` (SI units).  The builder of the model declares its forms in
+    :attr:`ChainSpec.printed`; ``anthroarm check`` compares them with Pinocchio."""
+
+    equations: str
+    pose: Callable
+    jacobian: Callable | None = None
+    length_jacobian: Callable | None = None
+
+
+@dataclass(frozen=True)
+class ReachPosture:
+    """The three-link arm of Fig. 2-6 inside a catalog arm, for its reach Eq. (2-3)/(2-4):
+    ``lengths`` (l1, l2, l3) shoulder–elbow, elbow–wrist, wrist–tool (m), and ``bend``, the
+    indices in q of the two parallel swing joints that (2-4) bends by the same angle θ3.  The
+    joints before ``bend[0]`` (the shoulder) are free; every other joint is 0 in that posture,
+    and q = 0 stretches the arm to l1 + l2 + l3 (2-3)."""
+
+    lengths: tuple[float, float, float]
+    bend: tuple[int, int]
+
+
 @dataclass
 class ChainSpec:
     """A catalog arm: its joints (each carrying the link it moves), the tool frame placed by
@@ -136,7 +163,12 @@ class ChainSpec:
     with the tool pose ``tool_dh`` in the last DH frame.  ``params`` are the builder's
     arguments (SI units).  ``person``: the limb of a person (the viewer draws a torso around
     its shoulder); ``comfort``: its comfortable posture, joint name -> rad (the default
-    reference of posture objectives, see :func:`anthroarm.ik.qp.comfortable_posture`)."""
+    reference of posture objectives, see :func:`anthroarm.ik.qp.comfortable_posture`).
+
+    What the book knows about this arm beyond its table, declared by its builder so that no
+    algorithm has to recognise the arm by name: ``printed``, the book's printed closed forms
+    of its forward kinematics (:class:`PrintedForm`), and ``reach``, the three-link arm of the
+    reach formulas (:class:`ReachPosture`) or None."""
 
     name: str
     description: str
@@ -155,6 +187,10 @@ class ChainSpec:
     tool_parent: str | None = None
     #: extra fixed frames ``(name, parent link, 4×4 origin)``, e.g. the fingertips of a hand
     frames: tuple = ()
+    #: the book's printed closed forms of this arm (:class:`PrintedForm`)
+    printed: tuple = field(default=(), repr=False, compare=False)
+    #: the arm of the reach formulas (2-3)/(2-4), or None
+    reach: ReachPosture | None = None
 
     @property
     def nq(self) -> int:
@@ -162,22 +198,51 @@ class ChainSpec:
         return sum(1 for j in self.joints if j.mimic is None and j.type != "fixed")
 
 
-def dh_matrix(row: DHRow, q: float) -> np.ndarray:
-    """The book's A matrix, Eq. (6-12), of one row at joint value q."""
+def dh_matrix(row: DHRow, q) -> np.ndarray:
+    """The book's A matrix, Eq. (6-12), of one row at joint value q: shape (4, 4), or
+    ``np.shape(q) + (4, 4)`` for an array of joint values."""
+    q = np.asarray(q, dtype=float)
     if row.kind == "R":
         theta, s = q + row.offset, row.s
     else:
         theta, s = row.theta, q + row.offset
     ct, st = np.cos(theta), np.sin(theta)
     ca, sa = np.cos(row.alpha), np.sin(row.alpha)
-    return np.array(
-        [
-            [ct, -st * ca, st * sa, row.h * ct],
-            [st, ct * ca, -ct * sa, row.h * st],
-            [0.0, sa, ca, s],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
-    )
+    A = np.zeros(q.shape + (4, 4))
+    A[..., 0, 0] = ct
+    A[..., 0, 1] = -st * ca
+    A[..., 0, 2] = st * sa
+    A[..., 0, 3] = row.h * ct
+    A[..., 1, 0] = st
+    A[..., 1, 1] = ct * ca
+    A[..., 1, 2] = -ct * sa
+    A[..., 1, 3] = row.h * st
+    A[..., 2, 1] = sa
+    A[..., 2, 2] = ca
+    A[..., 2, 3] = s
+    A[..., 3, 3] = 1.0
+    return A
+
+
+def as_batch(q, n: int) -> tuple[np.ndarray, bool]:
+    """Joint values ``q`` of shape (n,) or (N, n) as a finite (N, n) float array, and whether
+    one configuration was given; ``ValueError`` naming the shape or the first joint that is not
+    finite."""
+    q = np.asarray(q, dtype=float)
+    single = q.ndim == 1
+    q2 = q[None, :] if single else q
+    if q2.ndim != 2 or q2.shape[1] != n:
+        raise ValueError(f"q must have shape ({n},) or (N, {n}), got {q.shape}")
+    if not np.isfinite(q2).all():
+        j = int(np.argwhere(~np.isfinite(q2))[0, 1])
+        raise ValueError(f"q[{j}] is not finite")
+    return q2, single
+
+
+def finite_params(**values) -> list[float]:
+    """The named scalar parameters (link lengths in m, angles in rad) as floats; ``ValueError``
+    naming the first one that is not a finite number."""
+    return [as_scalar(v, name) for name, v in values.items()]
 
 
 def dh_static(row: DHRow) -> np.ndarray:
@@ -246,9 +311,12 @@ def from_dh(
     params=None,
     tool_name="tool",
     inertia_source: str | None = None,
+    printed: tuple = (),
+    reach: ReachPosture | None = None,
 ) -> ChainSpec:
     """Build a :class:`ChainSpec` from an H-D table (Eq. (6-12)) and the tool pose in the last
-    DH frame.  Joint j's origin in link j−1 is the static part S_{j−1} of row j−1 (S_0 = I)."""
+    DH frame.  Joint j's origin in link j−1 is the static part S_{j−1} of row j−1 (S_0 = I);
+    ``printed`` and ``reach`` go to the spec as they are."""
     n = len(rows)
     joint_names = joint_names or [f"joint{j + 1}" for j in range(n)]
     statics = [dh_static(r) for r in rows]
@@ -285,6 +353,8 @@ def from_dh(
         dh=rows,
         tool_dh=tool,
         params=dict(params or {}),
+        printed=tuple(printed),
+        reach=reach,
     )
 
 
