@@ -1,5 +1,5 @@
 """First class-generic closed form from the subproblems: spherical wrist + two parallel axes
-(anthroarm.ik.classify._solve_spherical_two_parallel), on sixr_arm, kinova (continuous joints)
+(anthroarm.ik.geometric.drivers._solve_spherical_two_parallel), on sixr_arm, kinova (continuous joints)
 and a user-built PUMA-like URDF.
 
 Oracles: Pinocchio FK for every branch (inside the limits after a 2π wrap); PyPI ik-geo
@@ -14,6 +14,7 @@ from test_classify import puma_urdf  # same folder (pytest puts it on sys.path)
 
 import anthroarm as aa
 from anthroarm.ik import classify as C
+from anthroarm.ik.geometric.drivers import _solve_spherical_two_parallel, _spherical_wrist_P
 
 
 def _wrap_into_limits(q, lo, hi):
@@ -49,7 +50,7 @@ def test_every_branch_fk_verified(tmp_path):
             q = ch.configuration(theta)
             pin.framesForwardKinematics(model, data, q)
             T = data.oMf[fid].homogeneous.copy()
-            sol, valid, exact = C._solve_spherical_two_parallel(c.kinematics, T)
+            sol, valid, exact = _solve_spherical_two_parallel(c.kinematics, T)
             assert valid.all() and exact.all()  # reachable generic pose: 8 exact branches
             dist = np.abs(np.angle(np.exp(1j * (sol - theta)))).max(1)
             assert dist.min() < 1e-7  # the sampled posture is one of them
@@ -69,7 +70,7 @@ def test_unreachable_pose_is_least_squares_flagged():
     c = C.classify(robot)
     T = np.eye(4)
     T[:3, 3] = [10.0, 0, 0]  # far out of reach
-    sol, valid, exact = C._solve_spherical_two_parallel(c.kinematics, T)
+    sol, valid, exact = _solve_spherical_two_parallel(c.kinematics, T)
     assert valid.any() and not exact.any() and np.isfinite(sol[valid]).all()
 
 
@@ -77,7 +78,7 @@ def test_same_solutions_as_ik_geo():
     ik_geo = pytest.importorskip("ik_geo")
     robot = aa.load("sixr_arm")
     kin = C.classify(robot).kinematics
-    P = C._spherical_wrist_P(kin)
+    P = _spherical_wrist_P(kin)
     geo = ik_geo.Robot.spherical_two_parallel(kin.H.tolist(), P.tolist())
     rng = np.random.default_rng(5)
     for _ in range(30):
@@ -85,7 +86,7 @@ def test_same_solutions_as_ik_geo():
         T = robot.fk(theta)
         R06 = T[:3, :3] @ kin.R_tool.T  # ik-geo's tool is identity at q = 0
         theirs = np.array([s for s, ls in geo.get_ik(R06.T.tolist(), T[:3, 3].tolist()) if not ls])
-        ours, valid, exact = C._solve_spherical_two_parallel(kin, T)
+        ours, valid, exact = _solve_spherical_two_parallel(kin, T)
         ours = ours[exact]
         assert len(theirs) == len(ours) == 8
         d = np.abs(np.angle(np.exp(1j * (ours[:, None] - theirs[None])))).max(-1)

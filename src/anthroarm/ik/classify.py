@@ -306,36 +306,3 @@ __all__ = [
     "TWO_INTERSECTING",
     "GEN_SIX_DOF",
 ]
-
-
-# ----------------------------------------------------------------------------- first solver
-def _spherical_wrist_P(kin: Kinematics) -> np.ndarray:
-    """IK-Geo's offsets ``P`` (7, 3) of a 6R arm with a spherical wrist, joints 4, 5, 6 slid
-    along their axes to the wrist centre (p_45 = p_56 = 0; base frame, m, q = 0)."""
-    from .geometric import ik_geo_P
-
-    return ik_geo_P(SPHERICAL_TWO_PARALLEL, kin.H, kin.points, kin.p_tool)
-
-
-def _solve_spherical_two_parallel(kin: Kinematics, T) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every IK branch of a ``spherical_two_parallel`` 6R arm in the joint order of ``kin``
-    (the class solver of :mod:`anthroarm.ik.geometric`, kept for its callers).
-
-    ``T``: (4, 4) or (N, 4, 4) pose of the tool in the base frame (m).  Returns q (N, 8, 6)
-    joint angles in (−π, π], ``valid`` (N, 8) and ``exact`` (N, 8) (False: a least-squares
-    branch, the pose is out of reach).  No limit filtering and no FK check here."""
-    from .geometric import solve_class
-
-    T = np.asarray(T, dtype=float)
-    single = T.ndim == 2
-    T = T[None] if single else T
-    q, valid, exact = solve_class(
-        SPHERICAL_TWO_PARALLEL,
-        kin.H,
-        _spherical_wrist_P(kin),
-        T[:, :3, :3] @ kin.R_tool.T,
-        T[:, :3, 3],
-    )
-    if single:
-        return q[0], valid[0], exact[0]
-    return q, valid, exact
