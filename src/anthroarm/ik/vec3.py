@@ -214,7 +214,8 @@ def atan2(y, x):
     """atan2(y, x) (rad, in [−π, π]) as ``math.atan2`` — its values at zeros of either sign,
     infinities and NaN included — within 2 units in the last place, in branch-free arithmetic
     that a compiled kernel inlines and vectorises (the C library's atan2 is a call of ~20 ns
-    here, and the closed-form IK reads 48 angles a pose, :func:`anthroarm.ik.geometric._angles`).
+    here, and the closed-form IK reads 48 angles a pose,
+    :func:`anthroarm.ik.geometric.closed._angles`).
     Cephes' method: the ratio of the smaller to the larger of |x|, |y| in [0, 1], reduced to
     |u| ≤ 0.42 by u = (t − 1)/(t + 1) above 0.66 (atan t = π/4 + atan u), Cephes' rational
     approximation of atan on it, then the octant: |atan2| = k π/4 ± r (k = 0 … 4, the
