@@ -95,12 +95,56 @@ def chunk_seeds(seed, n: int) -> list[np.random.SeedSequence]:
     return ss.spawn(n)
 
 
+def iter_seeds(seed, n: int):
+    """The children of :func:`chunk_seeds` one at a time (the same seeds, in the same order;
+    a SeedSequence given is advanced as ``spawn(n)`` advances it), spawned in blocks of
+    :data:`SEED_BLOCK` as they are consumed: a job of 10**6 tasks never holds 10**6 seeds."""
+    ss = (
+        seed
+        if isinstance(seed, np.random.SeedSequence)
+        else np.random.SeedSequence(0 if seed is None else seed)
+    )
+    for a in range(0, n, SEED_BLOCK):
+        yield from ss.spawn(min(SEED_BLOCK, n - a))
+
+
+#: seeds spawned at a time by :func:`iter_seeds`
+SEED_BLOCK = 1024
+
+
 def chunks(n: int, size: int) -> list[tuple[int, int]]:
     """``[(start, stop), ...]`` covering ``range(n)`` in pieces of ``size`` (the last shorter)."""
+    return list(iter_chunks(n, size))
+
+
+def iter_chunks(n: int, size: int):
+    """The pieces of :func:`chunks`, one at a time (no list of 10**6 pairs for a long job)."""
     size = int(size)
     if size <= 0:
         raise ValueError(f"chunk_size must be a positive integer, got {size}")
-    return [(a, min(a + size, n)) for a in range(0, n, size)]
+    return ((a, min(a + size, n)) for a in range(0, n, size))
+
+
+def n_chunks(n: int, size: int) -> int:
+    """``len(chunks(n, size))`` without making the list."""
+    return -(-int(n) // int(size))
+
+
+class Tasks:
+    """A job's tasks, made lazily: ``len(tasks)`` is known up front, and iterating calls
+    ``make()`` for a fresh generator of ``(fn, description, payload)``.  :func:`run` keeps at
+    most :func:`window` of them alive on Dask (one locally), so the memory of a job does not
+    grow with its number of tasks (``n = 10**12`` configurations are ~10**6 tasks)."""
+
+    def __init__(self, n: int, make):
+        self.n = int(n)
+        self._make = make
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __iter__(self):
+        return iter(self._make())
 
 
 def window(client) -> int:
@@ -158,12 +202,14 @@ def _execute_on_worker(fn, desc, payload):
 def run(
     tasks, consume, *, client=None, progress: bool = True, desc: str = "batch", callback=None
 ) -> int:
-    """Run ``tasks`` (a sequence of ``(fn, robot_description, payload)``) and hand each result
-    to ``consume(index, part)``; returns the number of tasks.
+    """Run ``tasks`` (a sequence of ``(fn, robot_description, payload)``, or :class:`Tasks`
+    made as they are submitted) and hand each result to ``consume(index, part)``; returns the
+    number of tasks.
 
     ``callback(done, total)`` is called after each task (raise to cancel);
     ``progress`` shows a tqdm bar."""
-    tasks = list(tasks)
+    if not isinstance(tasks, Tasks):
+        tasks = list(tasks)
     total = len(tasks)
     bar = None
     if progress:

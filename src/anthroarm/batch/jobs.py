@@ -20,15 +20,15 @@ aligned in the base frame, coordinates are voxel centres (m); angles in rad.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..ik.cells import MAX_LATTICE, lattice
 from ..models import PERSON_ARM
 from . import engine
 from .describe import RobotDescription, describe, robot_from
-from .errors import JobTooLargeError
+from .errors import BatchParameterError, JobTooLargeError
+from .limits import MEMORY_BUDGET as MEMORY_BUDGET  # its old home
+from .limits import _check_memory, _positive_int, _voxel, _voxels_per_side
 from .result import BatchResult
 
 #: configurations per task of the map jobs: ~0.3 s of work per task.  Measured on a 1-worker
@@ -46,22 +46,6 @@ MC_CHUNK = 1 << 15
 IK_CHUNK = 256
 #: z slices of a cell table per task
 CELL_SLICES = 2
-#: bytes the *outputs* of one job may take (inputs are streamed in chunks)
-MEMORY_BUDGET = 4 * 2**30
-
-
-def _check_memory(nbytes: float, what: str, remedy: str) -> None:
-    if nbytes > MEMORY_BUDGET:
-        raise JobTooLargeError(
-            f"{what} would take {nbytes / 2**30:.1f} GiB (budget "
-            f"{MEMORY_BUDGET / 2**30:.0f} GiB, anthroarm.batch.jobs.MEMORY_BUDGET). Remedy: {remedy}"
-        )
-
-
-def _positive_int(x, name):
-    if not (isinstance(x, (int, np.integer)) and x > 0):
-        raise ValueError(f"{name} must be a positive integer, got {x!r}")
-    return int(x)
 
 
 def _robot_and_desc(robot, client):
@@ -85,12 +69,15 @@ class _LocalOnly:
 
 
 def _tasks(fn, desc, payloads):
-    return [(fn, desc, p) for p in payloads]
+    """:class:`~anthroarm.batch.engine.Tasks` of ``fn`` over ``payloads = (count, make)``
+    (``make()`` a fresh generator of the payloads): made as they are submitted."""
+    n, make = payloads
+    if isinstance(desc, _LocalOnly):
+        return engine.Tasks(n, lambda: ((_local_call, None, (fn, desc.robot, p)) for p in make()))
+    return engine.Tasks(n, lambda: ((fn, desc, p) for p in make()))
 
 
 def _run(tasks, consume, client, robot, progress, desc, callback):
-    if tasks and isinstance(tasks[0][1], _LocalOnly):
-        tasks = [(_local_call, None, (fn, robot, p)) for fn, _, p in tasks]
     engine.run(tasks, consume, client=client, progress=progress, desc=desc, callback=callback)
 
 
@@ -103,10 +90,8 @@ def _local_call(_, payload):
 def voxel_grid(robot, voxel: float, frame=None):
     """(lo (3,), shape (3,)) of the axis-aligned grid of cubes of side ``voxel`` (m) that
     contains every position ``frame`` can reach: ±(chain.reach + one voxel) about the base."""
-    voxel = float(voxel)
-    if not (np.isfinite(voxel) and voxel > 0):
-        raise ValueError(f"voxel must be a positive length in m, got {voxel}")
-    m = int(math.ceil(robot.chain.reach(frame) / voxel)) + 1
+    voxel = _voxel(voxel)
+    m = _voxels_per_side(robot.chain.reach(frame), voxel) + 1
     return np.full(3, -m * voxel), (2 * m,) * 3
 
 
@@ -157,17 +142,18 @@ def _map_setup(robot, n, voxel, frame, chunk_size, seed):
     chunk_size = _positive_int(chunk_size, "chunk_size")
     lo, shape = voxel_grid(robot, voxel, frame)
     _check_memory(
-        np.prod(shape) * 16.0,
+        np.prod(shape, dtype=float) * 16.0,
         f"a voxel grid of {shape} voxels",
         "use a coarser voxel (voxel= in m)",
     )
-    parts = engine.chunks(n, chunk_size)
-    seeds = engine.chunk_seeds(seed, len(parts))
-    payloads = [
-        dict(n=b - a, seed=s, frame=frame, lo=lo, voxel=float(voxel), shape=shape)
-        for (a, b), s in zip(parts, seeds)
-    ]
-    return n, lo, shape, payloads
+    voxel = float(voxel)
+    n_parts = engine.n_chunks(n, chunk_size)
+
+    def payloads():  # made as they are submitted: n = 10**12 is 10**6 tasks
+        for (a, b), s in zip(engine.iter_chunks(n, chunk_size), engine.iter_seeds(seed, n_parts)):
+            yield dict(n=b - a, seed=s, frame=frame, lo=lo, voxel=voxel, shape=shape)
+
+    return n, lo, shape, (n_parts, payloads)
 
 
 def reachability_map(
@@ -323,7 +309,13 @@ def _population_task(robot, p):
     pmin, pmax = np.full(3, np.inf), np.full(3, -np.inf)
     for _, xyz in _positions_blocks(robot, p):
         P = np.stack(xyz, 1)
-        ijk = np.floor(P / p["voxel"]).astype(np.int64) + _OFF
+        f = np.floor(P / p["voxel"])
+        if not np.all(np.abs(f) < _OFF):  # the codes hold ±2**20 voxels per axis
+            raise JobTooLargeError(
+                f"population: positions up to {np.max(np.abs(P)):.3g} m are more than {_OFF} "
+                f"voxels of {p['voxel']:g} m from the base. Remedy: use a coarser voxel"
+            )
+        ijk = f.astype(np.int64) + _OFF
         codes.append(np.unique((ijk[:, 0] * _B + ijk[:, 1]) * _B + ijk[:, 2]))
         rmax = max(rmax, float(np.sqrt(np.max(np.einsum("ij,ij->i", P, P)))))
         pmin, pmax = np.minimum(pmin, P.min(0)), np.maximum(pmax, P.max(0))
@@ -356,44 +348,43 @@ def population_reach(
     Every person's robot is shipped as (name, parameters) and rebuilt on the worker."""
     n = _positive_int(n, "n")
     chunk_size = _positive_int(chunk_size, "chunk_size")
-    voxel = float(voxel)
-    if not (np.isfinite(voxel) and voxel > 0):
-        raise ValueError(f"voxel must be a positive length in m, got {voxel}")
+    voxel = _voxel(voxel)
     heights, masses = np.asarray(heights, float).ravel(), np.asarray(masses, float).ravel()
     sexes = [str(s) for s in np.atleast_1d(sexes)]
     people = [(float(h), float(m), s) for h in heights for m in masses for s in sexes]
     if not people:
-        raise ValueError("the population is empty: give at least one height, mass and sex")
-    parts = engine.chunks(n, chunk_size)
-    seeds = engine.chunk_seeds(seed, len(people) * len(parts))
-    tasks = []
-    for k, (h, m, s) in enumerate(people):
-        d = RobotDescription("catalog", model, model, (("height", h), ("mass", m), ("sex", s)))
-        for j, (a, b) in enumerate(parts):
-            tasks.append(
-                (
-                    _population_task,
-                    d,
-                    dict(
-                        person=k, n=b - a, seed=seeds[k * len(parts) + j], frame=frame, voxel=voxel
-                    ),
-                )
-            )
-    robot_from(tasks[0][1])  # fail early, here, on a bad model name or parameter
+        raise BatchParameterError("the population is empty: give at least one height, mass and sex")
+    C = engine.n_chunks(n, chunk_size)
+    descs = [
+        RobotDescription("catalog", model, model, (("height", h), ("mass", m), ("sex", s)))
+        for h, m, s in people
+    ]
+
+    def make():  # made as they are submitted; seeds in the order of chunk_seeds(seed, P * C)
+        seeds = engine.iter_seeds(seed, len(people) * C)
+        for k, d in enumerate(descs):
+            for a, b in engine.iter_chunks(n, chunk_size):
+                p = dict(person=k, n=b - a, seed=next(seeds), frame=frame, voxel=voxel)
+                yield _population_task, d, p
+
+    tasks = engine.Tasks(len(people) * C, make)
+    first = robot_from(descs[0])  # fail early, here, on a bad model name or parameter
+    _voxels_per_side(first.chain.reach(frame), voxel)
     P = len(people)
     volume, rmax = np.zeros(P), np.zeros(P)
     lo, hi = np.full((P, 3), np.inf), np.full((P, 3), -np.inf)
-    pending = {k: len(parts) for k in range(P)}
+    pending = {k: C for k in range(P)}
     sets: dict = {}
 
     def consume(i, part):
         k, codes, r, pmin, pmax = part
-        sets.setdefault(k, []).append(codes)
+        # the union so far (order-independent; never more than the occupied voxels)
+        sets[k] = np.union1d(sets[k], codes) if k in sets else codes
         rmax[k] = max(rmax[k], r)
         lo[k], hi[k] = np.minimum(lo[k], pmin), np.maximum(hi[k], pmax)
         pending[k] -= 1
         if pending[k] == 0:  # this person is complete: keep the number, drop the voxel set
-            volume[k] = np.unique(np.concatenate(sets.pop(k))).size * voxel**3
+            volume[k] = sets.pop(k).size * voxel**3
 
     engine.run(
         tasks, consume, client=client, progress=progress, desc="population", callback=callback
@@ -480,11 +471,13 @@ def tolerance_monte_carlo(
     n = _positive_int(n, "n")
     chunk_size = _positive_int(chunk_size, "chunk_size")
     if distribution not in ("normal", "uniform"):
-        raise ValueError(f"distribution must be 'normal' or 'uniform', got {distribution!r}")
+        raise BatchParameterError(
+            f"distribution must be 'normal' or 'uniform', got {distribution!r}"
+        )
     ps = PerturbedChain(robot, frame, params, mode).params
     sq, sL = _vec(sigma_q, robot.nv, "sigma_q"), _vec(sigma_L, len(ps), "sigma_L")
     if np.any(sq < 0) or np.any(sL < 0):
-        raise ValueError(
+        raise BatchParameterError(
             f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}"
         )
     M = Q.shape[0]
@@ -493,24 +486,25 @@ def tolerance_monte_carlo(
         f"{M} configurations x {n} samples",
         "fewer samples n or fewer configurations per job",
     )
-    parts = engine.chunks(n, chunk_size)
-    C = len(parts)
-    seeds = engine.chunk_seeds(seed, M * C)
-    payloads = [
-        dict(
-            q=Q[i],
-            n=b - a,
-            seed=seeds[i * C + j],
-            frame=frame,
-            params=ps,
-            mode=mode,
-            distribution=distribution,
-            sigma_q=sq,
-            sigma_L=sL,
-        )
-        for i in range(M)
-        for j, (a, b) in enumerate(parts)
-    ]
+    C = engine.n_chunks(n, chunk_size)
+
+    def make():  # seeds in the order of chunk_seeds(seed, M * C)
+        seeds = engine.iter_seeds(seed, M * C)
+        for i in range(M):
+            for a, b in engine.iter_chunks(n, chunk_size):
+                yield dict(
+                    q=Q[i],
+                    n=b - a,
+                    seed=next(seeds),
+                    frame=frame,
+                    params=ps,
+                    mode=mode,
+                    distribution=distribution,
+                    sigma_q=sq,
+                    sigma_L=sL,
+                )
+
+    payloads = (M * C, make)
     store: dict = {}
     _run(
         _tasks(_mc_task, d, payloads),
@@ -603,24 +597,29 @@ def ik_dataset(
         or (T.ndim == 3 and T.shape[1:] != (4, 4))
         or (T.ndim == 2 and T.shape[1] != 3)
     ):
-        raise ValueError(f"T must be (N, 4, 4) poses or (N, 3) positions, got shape {T.shape}")
+        raise BatchParameterError(
+            f"T must be (N, 4, 4) poses or (N, 3) positions, got shape {T.shape}"
+        )
     N = T.shape[0]
     if q0 is not None:
         q0 = np.asarray(q0, float)
         if q0.shape != (N, robot.nq):
-            raise ValueError(f"q0 must have shape ({N}, {robot.nq}), got {q0.shape}")
+            raise BatchParameterError(f"q0 must have shape ({N}, {robot.nq}), got {q0.shape}")
     chunk_size = _positive_int(chunk_size, "chunk_size")
     _check_memory(
         N * (robot.nq + 4) * 8.0,
         f"IK results of {N} targets",
         "split the targets into several jobs",
     )
-    parts = engine.chunks(N, chunk_size)
+    parts = engine.chunks(N, chunk_size)  # N targets are in memory: so may N / 256 pairs be
     seeds = engine.chunk_seeds(seed, len(parts))
-    payloads = [
-        dict(T=T[a:b], q0=None if q0 is None else q0[a:b], seed=s, kw=dict(solve_kw))
-        for (a, b), s in zip(parts, seeds)
-    ]
+    payloads = (
+        len(parts),
+        lambda: (
+            dict(T=T[a:b], q0=None if q0 is None else q0[a:b], seed=s, kw=dict(solve_kw))
+            for (a, b), s in zip(parts, seeds)
+        ),
+    )
     q = np.full((N, robot.nq), np.nan)
     ok, pe, re, it = (
         np.zeros(N, bool),
@@ -716,11 +715,11 @@ def cell_table(
         and lo.shape == hi.shape == (3,)
         and np.all(np.isfinite(lo) & np.isfinite(hi) & (hi > lo))
     ):
-        raise ValueError(
+        raise BatchParameterError(
             f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, bounds={bounds!r}"
         )
     if robot.spec is None:
-        raise ValueError(
+        raise BatchParameterError(
             f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is None)"
         )
     i0, shape = lattice(lo, hi, D)  # the lattice of CellTable.build
@@ -729,7 +728,7 @@ def cell_table(
             f"lattice of {shape} points is too large. Remedy: increase D or shrink bounds"
         )
     chunk_size = _positive_int(chunk_size, "chunk_size")
-    payloads = []
+    payloads = []  # at most MAX_LATTICE points: a short list
     for k0, k1 in engine.chunks(shape[2], chunk_size):
         m = k1 - k0
         b = (
@@ -747,7 +746,8 @@ def cell_table(
         a, b = slabs[i]
         Q[:, :, a:b], valid[:, :, a:b] = part
 
-    _run(_tasks(_cell_task, d, payloads), consume, client, robot, progress, "cell table", callback)
+    tasks = _tasks(_cell_task, d, (len(payloads), lambda: payloads))
+    _run(tasks, consume, client, robot, progress, "cell table", callback)
     origin = i0 * D
     coords = {ax: origin[i] + D * np.arange(shape[i]) for i, ax in enumerate("xyz")}
     coords["joint"] = np.array(robot.chain.q_names)

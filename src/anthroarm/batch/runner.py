@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import engine
+from .errors import BatchParameterError
 from .jobs import (
     cell_table,
     comfort_map,
@@ -15,6 +16,7 @@ from .jobs import (
     reachability_map,
     tolerance_monte_carlo,
 )
+from .result import check_suffix
 
 JOBS = {
     "reach": reachability_map,
@@ -45,7 +47,14 @@ def run_job(
     atomically after the job finished (a job that fails or is interrupted — KeyboardInterrupt —
     writes nothing); ``plot``: a PNG of a slice (maps) or of the volumes (population)."""
     if job not in JOBS:
-        raise ValueError(f"unknown batch job {job!r}; choose one of {', '.join(JOBS)}")
+        raise BatchParameterError(f"unknown batch job {job!r}; choose one of {', '.join(JOBS)}")
+    if out is not None:  # before the job runs: an hour's result is not lost to a wrong suffix
+        check_suffix(out)
+    if plot is not None and Path(plot).suffix.lower() != ".png":
+        raise BatchParameterError(
+            f"{plot}: the plot is a PNG image; give a name ending in .png, e.g. "
+            f"{Path(plot).with_suffix('.png').name}"
+        )
     for path in (out, plot):
         if path is not None and not Path(path).parent.is_dir():
             raise FileNotFoundError(
