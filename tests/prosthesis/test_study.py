@@ -110,7 +110,7 @@ def test_cli_size_end_to_end(tmp_path, capsys):
     [
         (["--out", "x.txt"], "HTML"),
         (["--payload", "-1"], "payload"),
-        (["--activities", "nope.npz"], "no such"),
+        (["--activities", "nope.npz"], "not found"),
         (["--motors", "missing.csv"], "not found"),
         (["--model", "prosthetic_arm"], "person models: "),  # a book arm not scaled by a person
         (["--model", "ur5"], "person models"),

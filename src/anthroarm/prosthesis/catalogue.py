@@ -146,17 +146,38 @@ def default_paths() -> tuple[Path, Path]:
     return Path(str(base / "motors.csv")), Path(str(base / "gearboxes.csv"))
 
 
+#: the largest catalogue file read (bytes); a manufacturer's catalogue of a few hundred products
+#: is tens of kB
+MAX_FILE_BYTES = 16 * 2**20
+#: the most products of one file (the sizing tries every motor with every gearbox)
+MAX_ROWS = 10_000
+
+
+def _read(path) -> str:
+    """The text of the regular file ``path`` (at most :data:`MAX_FILE_BYTES`; ``/dev/zero``, a
+    folder or a FIFO is refused unread), else :class:`~anthroarm.errors.CatalogueError`."""
+    from .._io import read_bounded
+
+    data = read_bounded(
+        path,
+        MAX_FILE_BYTES,
+        error=lambda problem: CatalogueError(problem, path),
+        what="CSV catalogue",
+        encoding=None,
+    )
+    try:
+        text = data.decode("utf-8-sig")  # a spreadsheet may write a BOM
+    except UnicodeDecodeError:
+        raise CatalogueError("not a UTF-8 text file", path) from None
+    if "\x00" in text:
+        raise CatalogueError("holds NUL bytes: not a CSV text file", path)
+    return text
+
+
 def _rows(path, columns):
     """(line number, dict) per data row; checks the header."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")  # a spreadsheet may write a BOM
-    except FileNotFoundError:
-        raise CatalogueError("file not found", path) from None
-    except IsADirectoryError:
-        raise CatalogueError("is a folder, not a CSV file", path) from None
-    except UnicodeDecodeError:
-        raise CatalogueError("not a UTF-8 text file", path) from None
+    text = _read(path)
     numbered = [
         (k + 1, line)
         for k, line in enumerate(text.splitlines())
@@ -164,8 +185,15 @@ def _rows(path, columns):
     ]
     if not numbered:
         raise CatalogueError("no header line (the file is empty or only comments)", path)
+    if len(numbered) > MAX_ROWS + 1:
+        raise CatalogueError(
+            f"{len(numbered) - 1} rows, more than {MAX_ROWS} products (the bound of one file)", path
+        )
     reader = csv.reader(io.StringIO("\n".join(line for _, line in numbered)))
-    lines = list(reader)
+    try:
+        lines = list(reader)
+    except csv.Error as exc:  # a field beyond csv's size limit, a broken quote
+        raise CatalogueError(f"not a readable CSV file ({exc})", path) from None
     header = [h.strip() for h in lines[0]]
     missing = [c for c in columns if c not in header]
     if missing:
@@ -322,7 +350,7 @@ def load(motors=None, gearboxes=None) -> Catalogue:
 def source_note(path) -> str:
     """The ``#`` comment lines at the top of a catalogue file (its source), joined."""
     lines = []
-    for line in Path(path).read_text(encoding="utf-8-sig").splitlines():
+    for line in _read(path).splitlines():
         if not line.lstrip().startswith("#"):
             break
         lines.append(line.lstrip()[1:].strip())

@@ -77,15 +77,23 @@ def add_parser(sub):
     return p
 
 
+#: the largest trajectory file read (bytes): 10**6 samples of a 7-joint arm as CSV are ~150 MB
+MAX_TRAJECTORY_BYTES = 256 * 2**20
+
+
 def _read_trajectory(path: Path, robot) -> dict:
     import zipfile
 
     import numpy as np
 
+    from .._io import check_regular_file, read_bounded
     from ..errors import ActivityError
 
-    if not path.is_file():
-        raise ActivityError(f"{path}: no such trajectory file")
+    def bad(problem):
+        return ActivityError(f"{path}: {problem}")
+
+    # a regular file within the bound: /dev/zero, a folder or a FIFO is refused unread
+    check_regular_file(path, MAX_TRAJECTORY_BYTES, error=bad, what="trajectory file")
     if path.suffix.lower() == ".npz":
         not_npz = ActivityError(
             f"{path}: not a NumPy .npz archive of numeric arrays (np.savez(path, t=..., q=...))"
@@ -113,10 +121,9 @@ def _read_trajectory(path: Path, robot) -> dict:
                 f"{path}: 't' and 'q' must be numbers (s, rad), got {t.dtype} and {q.dtype}"
             ) from None
     if path.suffix.lower() == ".csv":
-        try:
-            text = path.read_text(encoding="utf-8-sig")
-        except UnicodeDecodeError:
-            raise ActivityError(f"{path}: not a UTF-8 text file") from None
+        text = read_bounded(
+            path, MAX_TRAJECTORY_BYTES, error=bad, what="trajectory file", encoding="utf-8-sig"
+        )
         lines = [
             (k + 1, ln)
             for k, ln in enumerate(text.splitlines())

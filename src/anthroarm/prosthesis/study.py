@@ -105,8 +105,20 @@ def run(
         m = spec.get("payload", payload)
         status = spec.get("status", "ok")
         if status != "ok":
-            t = np.asarray(spec.get("t", np.zeros(0)), float)
-            q = np.asarray(spec.get("q", np.zeros((0, robot.nq))), float)
+            try:
+                t = np.asarray(spec.get("t", np.zeros(0)), float)
+                q = np.asarray(spec.get("q", np.zeros((0, robot.nq))), float)
+                held = float(np.max(np.asarray(m, float), initial=0.0))
+            except (TypeError, ValueError):
+                raise ActivityError(
+                    f"activity {name!r} (status {status!r}): 't', 'q' and 'payload' must be "
+                    "numbers (s, rad, kg)"
+                ) from None
+            if not (np.isfinite(held) and held >= 0.0):
+                raise ActivityError(
+                    f"activity {name!r} (status {status!r}): payload must be a mass >= 0 kg, got "
+                    f"{m!r}"
+                )
             z = np.zeros((len(q), robot.nv))
             acts.append(
                 env_mod.ActivityTorques(
@@ -121,7 +133,7 @@ def run(
                     list(robot.joint_names),
                     status,
                     str(spec.get("reason", "")),
-                    float(np.max(m, initial=0.0)),
+                    held,
                 )
             )
             continue

@@ -57,10 +57,15 @@ def check(
     ``unsized_joints`` > 0 (joints without a motor) makes the masses lower bounds (said in the
     notes).  Bad masses raise :class:`~anthroarm.errors.ParameterError`."""
     try:
+        if isinstance(drive_mass, bool) or isinstance(body_mass, bool):
+            raise TypeError  # True is not a mass
         drive = float(drive_mass)
         body = float("nan") if body_mass is None else float(body_mass)
     except (TypeError, ValueError):
         drive = body = float("nan")
+    for name, v in (("dof", dof), ("unsized_joints", unsized_joints)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise ParameterError(f"weight rules need {name} as a whole number >= 0, got {v!r}")
     if not (
         np.isfinite(drive)
         and drive >= 0
