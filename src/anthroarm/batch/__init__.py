@@ -20,6 +20,8 @@ from .describe import RobotDescription, describe
 from .engine import chunk_seeds, close, connect
 from .errors import (
     BatchError,
+    BatchParameterError,
+    BatchResultError,
     JobTooLargeError,
     RobotDescriptionError,
     RobotRebuildError,
@@ -41,6 +43,8 @@ from .runner import JOBS, run_job
 
 __all__ = [
     "BatchError",
+    "BatchParameterError",
+    "BatchResultError",
     "BatchResult",
     "JOBS",
     "JobTooLargeError",

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import atomic_write_text
+from .._io import atomic_write_text, json_depth, read_bounded
+from .errors import BatchParameterError, BatchResultError
 
 FORMAT = "anthroarm.batch/1"
 
@@ -101,8 +102,6 @@ class BatchResult:
         """Write ``path`` (``.npz``) atomically: a reader sees the old file or the whole new one.
         A path not ending in ``.npz`` and an inconsistent result (:meth:`problem`) raise
         :class:`~anthroarm.batch.errors.BatchParameterError` before anything is written."""
-        from .errors import BatchParameterError
-
         path = check_suffix(path)
         problem = self.problem()
         if problem:
@@ -143,8 +142,6 @@ def check_suffix(path, what: str = "result file") -> Path:
     """``path`` as a Path; :class:`~anthroarm.batch.errors.BatchParameterError` unless it ends
     in ``.npz`` (a result is a zip of numpy arrays: ``r.txt`` would hold a zip under a text
     name)."""
-    from .errors import BatchParameterError
-
     p = Path(path)
     if p.suffix.lower() != SUFFIX:
         raise BatchParameterError(
@@ -163,8 +160,6 @@ def load(path, max_bytes: int = MAX_FILE_BYTES) -> BatchResult:
     a variable without its array, an array whose shape does not match its dimensions or its
     coordinates) raises :class:`~anthroarm.batch.errors.BatchResultError` naming the file and
     what is wrong."""
-    from .._io import read_bounded
-    from .errors import BatchResultError
 
     def bad(problem):
         return BatchResultError(problem, path)
@@ -214,8 +209,6 @@ def _entry_reader(z, bad):
 
 def _meta(raw, bad) -> dict:
     """The ``__meta__`` entry as the format's dict, else ``bad(problem)``."""
-    from .._io import json_depth
-
     if raw.dtype != np.uint8 or raw.ndim != 1:
         raise bad(f"__meta__ must be UTF-8 JSON bytes, got {raw.dtype} of shape {raw.shape}")
     try:

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from .._io import read_bounded
 from ..errors import CatalogueError
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -156,8 +157,6 @@ MAX_ROWS = 10_000
 def _read(path) -> str:
     """The text of the regular file ``path`` (at most :data:`MAX_FILE_BYTES`; ``/dev/zero``, a
     folder or a FIFO is refused unread), else :class:`~anthroarm.errors.CatalogueError`."""
-    from .._io import read_bounded
-
     data = read_bounded(
         path,
         MAX_FILE_BYTES,

@@ -15,6 +15,8 @@ import json
 import sys
 from pathlib import Path
 
+from .._io import check_regular_file, read_bounded
+
 
 def add_parser(sub):
     """Register ``size`` on the CLI's subparsers (``anthroarm.cli.build_parser``)."""
@@ -86,7 +88,6 @@ def _read_trajectory(path: Path, robot) -> dict:
 
     import numpy as np
 
-    from .._io import check_regular_file, read_bounded
     from ..errors import ActivityError
 
     def bad(problem):
