@@ -3,21 +3,27 @@ match the committed benchmark tables.
 
 * **Python blocks.**  Every fenced ```` ```python ```` block of ``README.md``, ``docs/*.md`` and
   ``docs/guide/*.md`` is run, a page's blocks in order in ONE fresh namespace per page (as a
-  reader pastes them into one session), in a subprocess per page with a temporary working
-  directory and ``ANTHROARM_CACHE`` unset (the default cache folder, as a user has it).  A
-  traceback names the page and the Markdown line.  A block preceded by the HTML comment
+  reader pastes them into one session; the README's blocks, sections apart, each in its own:
+  :data:`SELF_CONTAINED`), in a subprocess per page with a temporary working directory and
+  ``ANTHROARM_CACHE`` unset (the default cache folder, as a user has it).  A traceback names the
+  page and the Markdown line.  A block preceded by the HTML comment
   ``<!-- snippet: xfail REASON -->`` is expected to raise (a known bug in the library, named in
-  REASON); it must raise, and the page goes on after it.  A block that only shows output is
-  ```` ```text ````, a shell session ```` ```bash ````.
-* **Shell blocks.**  Every line of a ```` ```bash ```` block that starts with ``anthroarm`` is
-  run in a temporary folder, except the ones that open a live viewer and wait for the browser
-  (``anthroarm view`` / ``teach`` without ``--html``: those are checked for their flags with
-  ``--help``-free argument parsing only) and the long jobs listed in :data:`SLOW_COMMANDS`,
-  which are parsed, not run.
+  REASON): it must raise, and the page goes on after it; ``<!-- snippet: skip REASON -->`` is
+  not run (a block that needs a cluster).  A block that only shows output is ```` ```text ````,
+  a shell session ```` ```bash ````.
+* **Shell blocks.**  After the page's Python blocks, in the same folder (a command may read a
+  file a block wrote), every ``anthroarm ...`` line of its ```` ```bash ```` blocks is run, except
+  a live viewer (``view`` / ``teach`` without ``--html``, which serve until interrupted), the
+  long jobs of :data:`SLOW_COMMANDS` and a command an earlier page already ran: those are only
+  parsed by the CLI's own parser (an unknown flag fails).  Lines that install things or build
+  the site do not start with ``anthroarm`` and are not run.
 * **Quoted numbers.**  The numbers the pages quote from ``benchmarks/results/*.md`` that can be
-  tied mechanically (:data:`QUOTES`) equal the committed tables.
+  tied mechanically (:func:`quotes`: the viewer's poses/s and notebook size, the hand and grasp
+  step times, the EMG chain, marker IK) are rebuilt from the committed tables and looked up in
+  the pages.
 
-Run one page: ``pytest tests/docs/test_snippets.py -k grasp``.
+Run one page: ``pytest tests/docs/test_snippets.py -k grasp``.  The whole file: ~3.5 min on the
+shared 2-core machine under load, serially (most of it the pages' own work).
 """
 
 from __future__ import annotations
