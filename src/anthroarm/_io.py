@@ -38,6 +38,8 @@ import threading
 from collections.abc import Callable
 from pathlib import Path
 
+from .errors import ParameterError
+
 #: the default nesting bound of :func:`load_json_bounded` (arrays and objects, counted together)
 MAX_JSON_DEPTH = 64
 
@@ -51,8 +53,6 @@ def atomic_write_text(path, text: str | bytes) -> None:
     ``OSError(EINVAL)``: neither is replaced.  Both messages name the path and say what to
     give instead.  A ``path`` that is not a path, or ``text`` that is neither str nor bytes,
     raises :class:`~anthroarm.errors.ParameterError`."""
-    from .errors import ParameterError
-
     if not isinstance(path, (str, os.PathLike)) or (isinstance(path, str) and not path):
         raise ParameterError(
             f"atomic_write_text: path must be a file path (str or os.PathLike), "

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+import pinocchio as pin
 
 from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, UnsupportedModelError
 from .joint_kinds import CONTINUOUS as CONTINUOUS
@@ -45,6 +46,7 @@ from .joint_kinds import PRISMATIC as PRISMATIC
 from .joint_kinds import REVOLUTE as REVOLUTE
 from .kinematics.batched import SerialChain
 from .threads import run_rows
+from .urdf_io import MAX_MOVABLE_JOINTS
 
 #: a joint limit this large (rad or m) means none (Pinocchio's default is ±DBL_MAX)
 NO_LIMIT = 1e100
@@ -173,11 +175,7 @@ class Chain:
         frames and tips.  ``tool=None`` picks the single tip (see :func:`leaf_frames`: a serial
         chain has one); a tree with several tips raises :class:`AmbiguousToolError` listing
         them, an unknown ``tool`` :class:`UnknownFrameError`."""
-        import pinocchio as pin
-
         name = name or getattr(model, "name", "") or "model"
-        from .urdf_io import MAX_MOVABLE_JOINTS
-
         if model.njoints - 1 > MAX_MOVABLE_JOINTS:  # before createData: pin.Data grows as n³
             raise UnsupportedModelError(
                 f"{name}: {model.njoints - 1} joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model "

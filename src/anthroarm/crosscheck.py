@@ -27,9 +27,14 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
+from tqdm.auto import tqdm
 
+from . import ik
+from . import models as catalog
 from .check_rows import UNSUPPORTED, CheckRow  # CheckRow re-exported: aa.crosscheck.CheckRow
 from .errors import UnsupportedModelError
+from .robot import Robot, load
 
 #: providers run on every robot, ``rows(robot, samples, rng)``: dotted name -> what it checks
 ROBOT_PROVIDERS: dict[str, str] = {
@@ -62,9 +67,6 @@ def load_robots(models=None, tool: str | None = None, locked=None) -> list:
     """The robots of a check: ``models`` entries are catalog names, example-robot-data names,
     URDF paths or Robots (default: the catalog); ``tool=``/``locked=`` go to
     :func:`anthroarm.load` for every entry given by name or path."""
-    from . import models as catalog
-    from .robot import Robot, load
-
     entries = list(models) if models else catalog.names()
     kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
     return [e if isinstance(e, Robot) else load(e, **kw) for e in entries]
@@ -84,8 +86,6 @@ def run(
     ``models``: names, URDF paths or Robots (default: the whole catalog); ``providers``: dotted
     names to run instead of all (robot providers are those in :data:`ROBOT_PROVIDERS`);
     ``tool``/``locked``: passed to :func:`anthroarm.load` for every named model."""
-    from . import models as catalog
-
     robots = load_robots(models, tool, locked)
     if not models:
         names = catalog.names()
@@ -98,8 +98,6 @@ def run(
     jobs += [(p, None) for p in provs if p not in ROBOT_PROVIDERS]
     it = jobs
     if progress:
-        from tqdm.auto import tqdm
-
         it = tqdm(jobs, desc="cross-check", unit="check", leave=False)
     rows: list[CheckRow] = []
     for dotted, robot in it:
@@ -131,10 +129,6 @@ def ik_rows(robot, samples: int, rng) -> list[CheckRow]:
     Pinocchio FK of the tool → solve → Pinocchio FK of the answer.  The row reports the largest
     position (m) or rotation (rad) error; a failure or an answer outside the limits counts as
     an infinite error."""
-    import pinocchio as pin
-
-    from . import ik
-
     n = max(3, min(int(samples), 20))
     model, data, fid = robot.model, robot.model.createData(), robot.tool_id
     worst, solved = 0.0, 0

@@ -30,7 +30,7 @@ import pinocchio as pin
 
 from .chain import Chain
 from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
-from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf
+from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf, resolve_uri
 
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _REFERENCES = ("LOCAL", "WORLD", "LOCAL_WORLD_ALIGNED")
@@ -424,8 +424,6 @@ class Robot:
         )
 
     def _filename_handler(self, fname: str) -> str:
-        from .urdf_io import resolve_uri
-
         return str(resolve_uri(fname, self.info.path, self.info.package_dirs))
 
     def yourdfpy_cfg(self, q) -> dict:
@@ -494,7 +492,7 @@ def load(
     :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
     (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
-    from . import models
+    from . import models  # models imports this module (its builders make Robots)
 
     def no_params(what):
         if params:

@@ -23,7 +23,7 @@ LAYERS = [
     (
         "foundation",
         ["errors", "_io", "spatial", "codegen", "cache", "threads", "jit", "check_rows"]
-        + ["joint_kinds"],
+        + ["joint_kinds", "optional", "input_checks"],
     ),
 ]
 LEVEL = {m: i for i, (_, ms) in enumerate(LAYERS) for m in ms}

@@ -10,8 +10,8 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from .. import input_checks as _check
 from ..errors import ControlError, PlaybackError
-from . import _check
 
 #: the largest stored program :meth:`Program.load` / :meth:`Program.from_json` read, bytes
 MAX_PROGRAM_BYTES = 64 * 2**20
@@ -26,7 +26,7 @@ ITEMS_PER_STEP = 4
 
 def name(x, what: str) -> str:
     if not isinstance(x, str):
-        raise ControlError(f"{what} must be a string, got {type(x).__name__} {_check._short(x)}")
+        raise ControlError(f"{what} must be a string, got {type(x).__name__} {_check.short(x)}")
     return x
 
 
@@ -176,7 +176,7 @@ def library_of(library, program_type) -> dict:
         raise ControlError(f"the subroutines must be a mapping name -> Program, got {library!r}")
     for k, v in library.items():
         if not isinstance(v, program_type):
-            raise ControlError(f"subroutine {k!r} is not a Program: {_check._short(v)}")
+            raise ControlError(f"subroutine {k!r} is not a Program: {_check.short(v)}")
     return dict(library)
 
 

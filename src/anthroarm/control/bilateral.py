@@ -38,8 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from .. import input_checks as _check
 from ..errors import ControlError
-from . import _check
 
 __all__ = ["KINDS", "Bilateral", "BilateralResult", "Wall"]
 
@@ -250,7 +250,7 @@ class Bilateral:
                 except (TypeError, ValueError, OverflowError):
                     raise ControlError(
                         "theta_h(t) must return (theta, theta_dot), two numbers or arrays of the "
-                        f"shape of t (rad, rad/s); got {_check._short(locals().get('out'))}"
+                        f"shape of t (rad, rad/s); got {_check.short(locals().get('out'))}"
                     ) from None
                 try:
                     return tuple(np.broadcast_arrays(th, wh, np.asarray(tt, dtype=float))[:2])

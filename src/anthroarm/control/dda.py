@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import input_checks as _check
 from ..errors import ControlError
-from . import _check
 
 __all__ = ["DDAResult", "dda", "pulse_counts"]
 
@@ -84,7 +84,7 @@ def _counts(counts) -> np.ndarray:
     try:
         a = np.asarray(counts)
     except (TypeError, ValueError, OverflowError):
-        raise ControlError(f"counts must be integers, got {_check._short(counts)}") from None
+        raise ControlError(f"counts must be integers, got {_check.short(counts)}") from None
     if a.ndim != 1 or a.size == 0:
         raise ControlError(
             f"counts must be a 1-D list of pulse counts (one per axis), got shape {a.shape}"
@@ -100,7 +100,7 @@ def _counts(counts) -> np.ndarray:
         fl = [float(v) for v in vals if not isinstance(v, (int, np.integer))]
         if not all(math.isfinite(x) and x == math.floor(x) for x in fl):
             raise ControlError(
-                f"counts must be whole numbers of pulses, got {_check._short(vals)}; "
+                f"counts must be whole numbers of pulses, got {_check.short(vals)}; "
                 "round positions to pulses with pulse_counts()"
             )
         ints = [int(v) for v in vals]
@@ -108,7 +108,7 @@ def _counts(counts) -> np.ndarray:
         a = np.array(ints, dtype=object)
     else:
         raise ControlError(
-            f"counts must be integers, got {a.dtype.name} values {_check._short(counts)}"
+            f"counts must be integers, got {a.dtype.name} values {_check.short(counts)}"
         )
     if hi > MAX_COUNT or lo < -MAX_COUNT:
         big = hi if hi > MAX_COUNT else lo

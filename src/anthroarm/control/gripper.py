@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import input_checks as _check
 from ..errors import ControlError
-from . import _check
 from .motor import DCMotor
 
 __all__ = [
@@ -102,7 +102,7 @@ def tactile_search(
     step = _check.positive(step, "step (m)")
     max_steps = _check.count(max_steps, "max_steps", maximum=_check.MAX_STEPS)
     if not callable(contact):
-        raise ControlError(f"contact must be callable, got {_check._short(contact)}")
+        raise ControlError(f"contact must be callable, got {_check.short(contact)}")
     with np.errstate(over="ignore", invalid="ignore"):
         far = p + float(max_steps) * step * d
     if not np.all(np.isfinite(far)):

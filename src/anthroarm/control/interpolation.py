@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import input_checks as _check
 from ..errors import ControlError, DegenerateArcError
 from ..spatial.rotations import axis_angle, check_rotation, rot_axis
-from . import _check
 
 __all__ = ["Arc", "arc_poses", "circle_through", "line_points", "line_poses", "slerp"]
 

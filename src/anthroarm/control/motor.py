@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import input_checks as _check
 from ..errors import ControlError, ParameterError
-from . import _check
 
 __all__ = ["DCMotor", "ThermalCheck", "rms"]
 

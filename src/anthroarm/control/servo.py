@@ -38,8 +38,8 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
+from .. import input_checks as _check
 from ..errors import ControlError
-from . import _check
 from .motor import DCMotor
 
 __all__ = ["KGF_CM", "PositionServo", "ServoResponse"]

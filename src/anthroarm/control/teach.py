@@ -38,9 +38,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import input_checks as _check
 from .._io import atomic_write_text, read_bounded
 from ..errors import ControlError, PlaybackError
-from . import _check
+from ..ik import solve
 from ._teach_guard import (
     ITEMS_PER_STEP,
     MAX_CALL_DEPTH,
@@ -382,7 +383,7 @@ class Program:
                     out.append(Call(it["name"]))
                 else:
                     raise ControlError(
-                        f"unknown item kind {_check._short(kind)} (step, jump or call)"
+                        f"unknown item kind {_check.short(kind)} (step, jump or call)"
                     )
             except KeyError as exc:
                 raise ControlError(
@@ -577,8 +578,6 @@ class Playback:
         ok : numpy.ndarray of bool, shape (N,)
             Whether each solve met the IK tolerances.
         """
-        from ..ik import solve
-
         t, P = self.trajectory(dt)
         if P.shape[1:] != (4, 4):
             raise ControlError(
@@ -620,7 +619,7 @@ def _run(
     """Execute items with a call stack; jumps test sensors; stop after ``max_steps`` steps or
     ``ITEMS_PER_STEP * max_steps`` items (steps, jumps, calls)."""
     if not isinstance(program, Program):
-        raise ControlError(f"program must be a Program, got {_check._short(program)}")
+        raise ControlError(f"program must be a Program, got {_check.short(program)}")
     library = library_of(library, Program)
     cycles = _check.count(cycles, "cycles", 1)
     max_steps = _check.count(max_steps, "max_steps", 1)
@@ -699,12 +698,12 @@ def play_select(
         progs = list(programs)
         for p in progs:
             if not isinstance(p, Program):
-                raise ControlError(f"programs must be Programs, got {_check._short(p)}")
+                raise ControlError(f"programs must be Programs, got {_check.short(p)}")
         lib = {p.name: p for p in progs}
     name = selector(sensors) if callable(selector) else selector
     if not isinstance(name, str):
         raise PlaybackError(
-            f"the selector must give a program name (a string), got {_check._short(name)}; "
+            f"the selector must give a program name (a string), got {_check.short(name)}; "
             f"programs: {sorted(lib)}"
         )
     if name not in lib:
@@ -743,7 +742,7 @@ def play_subroutines(
         A name in ``order`` (or a :class:`Call`) that is not a subroutine.
     """
     if isinstance(order, (str, bytes)) or not isinstance(order, Sequence):
-        raise ControlError(f"order must be a list of subroutine names, got {_check._short(order)}")
+        raise ControlError(f"order must be a list of subroutine names, got {_check.short(order)}")
     main = Program("main", tuple(Call(_name(n, "a name of the order")) for n in order))
     return _run(main, "subroutine", library=subroutines, sensors=sensors, cycles=cycles)
 
@@ -780,10 +779,10 @@ def play_random_access(
     hist: list[str] = []
     addr = start
     if not callable(next_address):
-        raise ControlError(f"next_address must be callable, got {_check._short(next_address)}")
+        raise ControlError(f"next_address must be callable, got {_check.short(next_address)}")
     while addr is not None:
         if not isinstance(addr, str) and not hashable(addr):
-            raise PlaybackError(f"address {_check._short(addr)} is not an address")
+            raise PlaybackError(f"address {_check.short(addr)} is not an address")
         if addr not in pts:
             raise PlaybackError(f"address {addr!r} does not exist; addresses: {sorted(pts)}")
         step = pts[addr]

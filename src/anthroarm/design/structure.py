@@ -21,7 +21,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import models as catalog
 from ..check_rows import CheckRow
+from ..robot import load
 
 ROMAN = {1: "I", 2: "II", 3: "III", 4: "IV", 5: "V"}
 
@@ -356,9 +358,6 @@ def bent_q(reach, nq: int, theta3, q_shoulder=None) -> np.ndarray:
 def reach_rows(models, samples, rng):
     """Cross-check provider: Eq. (2-3)/(2-4) against Pinocchio FK of every catalog model among
     ``models`` whose spec declares the arm of Fig. 2-6 (``spec.reach``)."""
-    from .. import models as catalog
-    from ..robot import load
-
     rows = []
     for name in models:
         if name not in catalog.BOOK_MODELS:

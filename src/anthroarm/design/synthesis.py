@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..mechanisms.fourbar import coupler_point, fourbar_cartesian
+from .optimize import simplex_book
 
 
 @dataclass(frozen=True)
@@ -356,8 +357,6 @@ def design_finger_linkage(
     linkage that fails gets a large penalty).  ``span_limits`` bounds |Δα|; ``max_link`` (same
     unit as the curve) rejects linkages with a longer link or a pivot farther from the path
     origin — a finger must fit in a finger."""
-    from .optimize import simplex_book
-
     target = curve_targets(curve, x_range, n)
     size = float(np.ptp(target, axis=0).max()) or 1.0
     x0 = np.asarray(x0, dtype=float)

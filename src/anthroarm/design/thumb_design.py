@@ -39,6 +39,7 @@ import numpy as np
 
 from ..mechanisms.fourbar import fourbar_cartesian
 from ..mechanisms.rrss import RRSSGeometry, rrss_efg
+from . import optimize as O
 from .motion_curves import THUMB_F2, THUMB_F3
 
 D2R = np.pi / 180.0
@@ -298,8 +299,6 @@ def optimise(problem: ThumbProblem, method: str = "sumt_exterior", x0=None, **kw
     (book simplex on a fixed exterior penalty), ``"slsqp"`` (epigraph form min t s.t.
     t ≥ |f − F|_i, the bounds and the per-point transmission constraints)."""
     from scipy.optimize import minimize
-
-    from . import optimize as O
 
     x0 = problem.x_book.copy() if x0 is None else np.asarray(x0, dtype=float)
     t0 = time.perf_counter()

@@ -7,6 +7,7 @@ Modules (imported lazily, e.g. ``aa.dynamics.lagrange``):
 * :mod:`.equivalent_link` — §8-2 equivalent link J*, M* (8-19)–(8-29), energy/moment forms;
 * :mod:`.euler_chain` — §8-3 X–Y–X Euler-angle ball-joint chain (8-41)–(8-96);
 * :mod:`.hand_model` — §8-4 prosthetic-hand Lagrange model (8-97)–(8-112);
+* :mod:`.profiles` — the minimum-jerk rest-to-rest profile (numpy only, light to import);
 * :mod:`.simulate` — RK4 / solve_ivp with damping and energy bookkeeping;
 * :mod:`.human` — gravity-torque maps and reaching torques of ``human_arm7``;
 * :mod:`.loads` — external wrenches and held objects as generalised forces (8-5), τ = rnea − Jᵀw;
@@ -27,22 +28,21 @@ _SUBMODULES = {
     "checks",
     "ccode",
     "loads",
+    "profiles",
 }
 
 
 def __getattr__(name):
+    """Lazy submodules (PEP 562), and ``load``: the shortcut for
+    :func:`anthroarm.dynamics.lagrange.load`, loaded on first use like the submodules (importing
+    :mod:`.lagrange` costs ~50 ms, which ``import anthroarm.dynamics.profiles`` does not pay)."""
     if name in _SUBMODULES:
         mod = importlib.import_module(f".{name}", __name__)
         globals()[name] = mod
         return mod
+    if name == "load":
+        return importlib.import_module(".lagrange", __name__).load
     raise AttributeError(f"module 'anthroarm.dynamics' has no attribute {name!r}")
-
-
-def load(robot, **kw):
-    """Shortcut for :func:`anthroarm.dynamics.lagrange.load`."""
-    from .lagrange import load as _load
-
-    return _load(robot, **kw)
 
 
 __all__ = sorted(_SUBMODULES) + ["load"]

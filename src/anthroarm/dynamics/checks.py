@@ -24,8 +24,11 @@ of the model without mimic relations on all of them.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from ..check_rows import CheckRow
+from ..robot import load as load_robot
+from .lagrange import load
 
 TOL = 1e-10
 
@@ -37,10 +40,6 @@ def _rel(ours, ref) -> float:
 
 def model_rows(robot, samples: int, rng) -> list:
     """Rows for one Robot (see the module docstring)."""
-    import pinocchio as pin
-
-    from .lagrange import load
-
     dyn = load(robot)
     m, d = robot.model, robot.data
     n = robot.nv
@@ -122,8 +121,6 @@ def model_rows(robot, samples: int, rng) -> list:
 
 def rows(models: list[str], samples: int, rng) -> list:
     """Provider for :mod:`anthroarm.crosscheck` (every catalog arm)."""
-    from ..robot import load as load_robot
-
     out = []
     for name in models:
         out.extend(model_rows(load_robot(name), min(samples, 200), rng))

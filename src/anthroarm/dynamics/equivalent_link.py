@@ -25,8 +25,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InertiaError
+from ..mechanisms.fourbar import fourbar
 from ..spatial.rotations import as_scalar
 
 
@@ -107,8 +109,6 @@ class FourBarFinger:
 
     # ------------------------------------------------------------------ kinematics (ω = 1)
     def _state(self, phi):
-        from ..mechanisms.fourbar import fourbar
-
         phi = float(phi)
         if not np.isfinite(phi):
             raise ValueError(f"phi must be finite, got {phi}")
@@ -256,8 +256,6 @@ class FourBarFinger:
         """The linkage as a Pinocchio tree (cut at the coupler–rocker joint B): crank RZ at O2,
         coupler RZ at A (child of the crank), rocker RZ at O4; q = (θ2, θ3 − θ2, θ4); planar
         inertias about z; gravity in the plane."""
-        import pinocchio as pin
-
         model = pin.Model()
         model.gravity.linear = np.array([self.gravity[0], self.gravity[1], 0.0])
 

@@ -33,6 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import EulerSingularityError, InertiaError
 from ..spatial.euler import euler_xyx, euler_xyx_rate_matrix
@@ -345,8 +346,6 @@ class EulerChain:
     def pin_model(self):
         """The same chain with ``JointModelSpherical`` joints (recipe R2): joint k frame = link
         k's body axes at its first joint; joint k+1 at l_k; gravity (0, 0, −g)."""
-        import pinocchio as pin
-
         model = pin.Model()
         model.gravity.linear = np.array([0.0, 0.0, -self.g])
         parent = 0
@@ -363,8 +362,6 @@ class EulerChain:
 
     def to_pin_state(self, S, Sd, Sdd):
         """Map absolute Euler angles and rates to Pinocchio (q, v, a) of :meth:`pin_model`."""
-        import pinocchio as pin
-
         S, Sd, Sdd = self._state(S, "S"), self._state(Sd, "Sd"), self._state(Sdd, "Sdd")
         q, v, a = [], [], []
         Rp, wp, wdp = np.eye(3), np.zeros(3), np.zeros(3)

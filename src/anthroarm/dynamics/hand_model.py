@@ -30,9 +30,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InertiaError
 from ..spatial.rotations import rot
+from .lagrange import load
+from .profiles import minimum_jerk  # re-exported: aa.dynamics.hand_model.minimum_jerk
 
 #: Δ^x of (8-111): dE^{xθ}/dθ = Δ^x E^{xθ} (skew matrices of the unit axes, corrected Δ^i)
 DELTA = {
@@ -192,8 +195,6 @@ class HandModel:
         """The same hand as a ``pin.Model`` (recipe R1 of the notes): joint 1 at l[0], joint
         i+1 at l[i] in frame i, RX/RY/RZ joints, isotropic (or the given) inertia about the CoM,
         gravity +g ẑ (z down)."""
-        import pinocchio as pin
-
         model = pin.Model()
         model.name = self.name
         model.gravity.linear = np.array([0.0, 0.0, self.g])
@@ -220,8 +221,6 @@ class HandModel:
     def lagrange(self):
         """Generated Lagrange code (:mod:`.lagrange`) of :meth:`pin_model`."""
         if self._dyn is None:
-            from .lagrange import load
-
             self._dyn = load(self.pin_model(), name=self.name)
         return self._dyn
 
@@ -240,19 +239,6 @@ def default_hand(xi: float = 0.002) -> HandModel:
     l = np.vstack([np.zeros(3), np.column_stack([np.zeros(3), np.zeros(3), L])])
     r = np.column_stack([np.zeros(3), np.zeros(3), L / 2])
     return HandModel(axes=["j", "i", "i"], l=l, r=r, m=m, J=m * L**2 / 12, xi=xi, name="finger3")
-
-
-def minimum_jerk(q0, q1, T: float, t):
-    """Minimum-jerk point-to-point motion q(t), q̇(t), q̈(t) from q0 to q1 in T seconds."""
-    if not (np.isfinite(T) and T > 0):
-        raise ValueError(f"minimum-jerk duration must be finite and > 0 s, got {T!r}")
-    q0, q1 = np.asarray(q0, float), np.asarray(q1, float)
-    s = np.clip(np.asarray(t, float) / T, 0.0, 1.0)[..., None]
-    p = 10 * s**3 - 15 * s**4 + 6 * s**5
-    pd = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
-    pdd = (60 * s - 180 * s**2 + 120 * s**3) / T**2
-    d = q1 - q0
-    return q0 + p * d, pd * d, pdd * d
 
 
 def coriolis_over_grasp(

@@ -18,16 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..models import PERSON_ARM
+from ..robot import load as load_robot
 from .hand_model import minimum_jerk
+from .lagrange import load
 
 
 def human_arm(height: float = 1.75, mass: float = 75.0, sex: str = "male"):
     """(robot, dynamics) of the catalog's arm of a person (:data:`anthroarm.models.PERSON_ARM`,
     ``human_arm7``) for the given height/mass/sex."""
-    from ..models import PERSON_ARM
-    from ..robot import load as load_robot
-    from .lagrange import load
-
     robot = load_robot(PERSON_ARM, height=height, mass=mass, sex=sex)
     return robot, load(robot)
 

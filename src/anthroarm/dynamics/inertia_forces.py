@@ -43,6 +43,7 @@ import numpy as np
 from ..chain import PRISMATIC
 from ..errors import ParameterError
 from ..spatial.rotations import rot_axis
+from .euler_chain import passive
 
 __all__ = [
     "inertia_force",
@@ -325,8 +326,6 @@ def joint_frame_from_links(l1, e1, l2, e2) -> np.ndarray:
     of axis 2 in link β(p, 2) with ``e2``.  As printed, each fixed-frame axis is the row vector
     ``(l, m, n)(Φ Ψ Θ)`` with the passive matrices of Eq. (8-41)
     (:func:`anthroarm.dynamics.euler_chain.passive`); then :func:`joint_frame` adds p3 (8-85)."""
-    from .euler_chain import passive
-
     rows = []
     for name, lmn, e in (("l1", l1, e1), ("l2", l2, e2)):
         Th, Ps, Ph = passive(_vec(e, f"Euler angles of {name}'s link"))

@@ -70,11 +70,14 @@ import types
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 from .. import cache
-from ..chain import CONTINUOUS, PRISMATIC, REVOLUTE
+from ..chain import CONTINUOUS, PRISMATIC, REVOLUTE, Chain
 from ..codegen.graph import Graph, emit_python, snap
-from ..errors import InertiaError, UnsupportedModelError
+from ..errors import InertiaError, SingularMassMatrixError, UnsupportedModelError
+from ..robot import load as load_robot
+from .ccode import compiled
 from .lagrange_sympy import _simp, christoffel, latex, symbols, sympy_matrices  # noqa: F401
 
 #: bump when the generated code changes (part of the cache key); "3": code generated before the
@@ -162,15 +165,9 @@ def chain_info(obj, name: str | None = None) -> ChainInfo:
     Raises :class:`UnsupportedModelError` for joints the chain does not handle (free-flyer,
     spherical, planar, helical...) and :class:`InertiaError` for negative masses, indefinite
     inertia tensors and massless chains."""
-    import pinocchio as pin
-
-    from ..chain import Chain
-
     if isinstance(obj, ChainInfo):
         return obj
     if isinstance(obj, (str, os.PathLike)):
-        from ..robot import load as load_robot
-
         obj = load_robot(obj)
     chain = getattr(obj, "chain", None) if not isinstance(obj, Chain) else obj
     if chain is None:
@@ -564,8 +561,6 @@ class LagrangeDynamics:
         self.backend = backend
         self._c = None
         if backend == "c":
-            from .ccode import compiled
-
             self._c = compiled(self.info.key(), self._c_inputs)
         elif backend != "numpy":
             raise ValueError(f"backend must be 'numpy' or 'c', got {backend!r}")
@@ -726,8 +721,6 @@ class LagrangeDynamics:
         return bool(np.all(lo * lo > SINGULAR_RCOND * hi * hi))
 
     def _raise_singular(self, q, M, L):
-        from ..errors import SingularMassMatrixError
-
         q = np.asarray(q, dtype=float)
         Ms, Qs = (
             (M[None], q[None]) if M.ndim == 2 else (M, np.broadcast_to(q, (M.shape[0], self.nq)))

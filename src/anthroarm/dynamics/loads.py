@@ -55,6 +55,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InertiaError, ParameterError
+from .lagrange import load as load_dynamics
 
 _REFERENCES = {"LOCAL": pin.LOCAL, "LOCAL_WORLD_ALIGNED": pin.LOCAL_WORLD_ALIGNED}
 #: a held object above this mass (kg) or force/moment above this magnitude is refused
@@ -323,9 +324,7 @@ def inverse_dynamics(
     single, (Q, V, A) = _check_rates(robot, q, qd, qdd)
     if engine == "lagrange":
         if dynamics is None:
-            from .lagrange import load
-
-            dynamics = load(robot)
+            dynamics = load_dynamics(robot)
         free = dynamics.tau(Q, V, A)
     elif engine == "pinocchio":
         model, data = robot.model, robot.data

@@ -20,8 +20,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import SingularMassMatrixError
+from .lagrange import LagrangeDynamics, load
 
 
 @dataclass
@@ -72,8 +74,6 @@ class SimResult:
 
 
 def _as_dyn(system):
-    from .lagrange import LagrangeDynamics, load
-
     if isinstance(system, LagrangeDynamics):
         return system
     return load(system)
@@ -124,8 +124,6 @@ def simulate(
     circle); ``tau(t, q, qd)`` receives q in the robot's layout."""
     dyn = _as_dyn(system) if engine == "lagrange" else None
     if engine == "pin":
-        import pinocchio as pin
-
         model = pin_model if pin_model is not None else getattr(system, "model", system)
         data = model.createData()
         n = model.nv

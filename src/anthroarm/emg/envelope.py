@@ -28,6 +28,7 @@ from scipy import signal as sps
 
 from ..errors import EMGError
 from ._checks import count, positive, signal
+from .filters import check_sampling_rate
 
 #: sine-equivalent peak-to-peak per volt RMS
 PP_PER_RMS = 2.0 * math.sqrt(2.0)
@@ -94,8 +95,6 @@ def lowpass_envelope(x, fs: float, cutoff_hz: float = 5.0, order: int = 2) -> np
 def lowpass_sos(fs: float, cutoff_hz: float, order: int = 2) -> np.ndarray:
     """The Butterworth low-pass of the linear envelope as second-order sections; ``fs`` (Hz)
     must exceed twice ``cutoff_hz``."""
-    from .filters import check_sampling_rate
-
     fc = positive(cutoff_hz, "envelope cutoff", "Hz")
     fs = check_sampling_rate(fs, fc, f"the {fc:g} Hz envelope low-pass")
     order = count(order, "envelope filter order", 1, 8)

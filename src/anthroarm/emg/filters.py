@@ -37,7 +37,7 @@ import numpy as np
 from scipy import signal as sps
 
 from ..errors import EMGError, SamplingRateError
-from ._checks import positive
+from ._checks import positive, signal
 
 #: band-pass centre frequencies of Table 9.1, 方式1 (2 EMG channels), Hz
 BOOK_BANK_2CH = (40.0, 100.0, 160.0, 360.0)
@@ -173,8 +173,6 @@ class FilterBank:
     def apply(self, x) -> np.ndarray:
         """Filter ``x`` (channels, samples) volts through every band (causal ``sosfilt`` from
         rest); returns (channels, n_bands, samples) volts."""
-        from ._checks import signal
-
         a = signal(x, "emg", bytes_per_value=8.0 + 16.0 * len(self.sos))
         return np.stack([sps.sosfilt(s, a, axis=-1) for s in self.sos], axis=1)
 

@@ -46,9 +46,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
+from ..control.motor import DCMotor
 from ..control.servo import PositionServo
+from ..dynamics.simulate import simulate
 from ..errors import EMGError, ParameterError, UnsupportedModelError
+from ..robot import Robot, load
 from ._checks import signal
 from .codes import VIBRATORS, CodeMachine, CodeTrace, vibrators_with_grasp
 from .processor import EMGProcessor, ProcessedEMG
@@ -66,8 +70,6 @@ def prosthesis_motor(i: float = 200.0, eta: float = 0.7):
     (:class:`anthroarm.control.motor.DCMotor`): R = 5 Ω, k_m = 6 mN·m/A, J_m = 0.6 g·cm²,
     6 V (a prosthesis battery).  Illustrative values in the range of such motors' data
     sheets, an assumption; no-load speed V/k_m = 1000 rad/s ≈ 9550 r/min."""
-    from ..control.motor import DCMotor
-
     return DCMotor(
         R=5.0, k_m=6e-3, J_m=6e-8, i=float(i), eta=float(eta), V_nom=6.0, name="16 mm coreless"
     )
@@ -335,11 +337,7 @@ def simulate_powered_hand(
     -------
     PoweredHandResult
     """
-    import pinocchio as pin
     from scipy.integrate import solve_ivp
-
-    from ..dynamics.simulate import simulate
-    from ..robot import Robot, load
 
     robot = robot if isinstance(robot, Robot) else load(robot)
     if not isinstance(joints, dict) or not joints:

@@ -21,9 +21,14 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from .. import ik, models
+from ..ik.qp import IKConfiguration
+from ..ik.qp.tasks.posture import comfortable_posture
+from ..robot import load
 from .fingers import Hand
 from .grasp import NORMAL_TOL, POSITION_TOL, grasp_errors
 from .objects import Cylinder
+from .overlays import show_grasp
 from .problems import reachable_grasps
 
 GLASS_HEIGHT = 0.18  # m, the drawn glass (the fingertips lie within ±9 cm of its centre)
@@ -32,12 +37,7 @@ GLASS_HEIGHT = 0.18  # m, the drawn glass (the fingertips lie within ±9 cm of i
 def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
     """(robot, hand, q, glass) of the picture (see the module docstring).  ``RuntimeError`` if no
     draw gives a grasp that passes the checks."""
-    import anthroarm as aa
-
-    from ..ik.qp import IKConfiguration
-    from ..ik.qp.tasks.posture import comfortable_posture
-
-    robot = aa.load(aa.models.PERSON_ARM_WITH_HAND) if robot is None else robot
+    robot = load(models.PERSON_ARM_WITH_HAND) if robot is None else robot
     h = Hand(robot)
     comfort = comfortable_posture(robot)
     aq = h.arm_q_indices
@@ -49,7 +49,7 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
                 Tw = np.eye(4)
                 Tw[:3, :3] = pin.rpy.rpyToMatrix(0.0, 0.0, yaw) @ flip
                 Tw[:3, 3] = center
-                res = aa.ik.solve(
+                res = ik.solve(
                     robot,
                     Tw @ np.linalg.inv(pb.T_palm_obj),
                     frame=h.palm,
@@ -74,10 +74,8 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
 
 def readme_picture(png, size=(960, 640)) -> Path:
     """Screenshot of :func:`cup_grasp` in the viewer, written to ``png``."""
-    from ..ik.qp import IKConfiguration
-    from ..viewer import Viewer
+    from ..viewer import Viewer  # upward (faces): the picture is drawn by the viewer
     from ..viewer.browser import screenshot
-    from .overlays import show_grasp
 
     robot, h, q, glass = cup_grasp()
     _, _, contacts, _ = grasp_errors(h, IKConfiguration(robot, q), glass)

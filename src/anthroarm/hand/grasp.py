@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from .. import ik
 from ..errors import CouplingError, GraspError
 from ..ik import qp
 from ..ik.qp.tasks.contact_normal import ContactNormalTask
@@ -243,8 +244,6 @@ def palm_approach(
     The arm joints then come from :func:`anthroarm.ik.solve` on the palm frame (from ``q``, or
     from a random arm configuration with ``seed_arm``); where the fitted pose is out of reach,
     the nearest configuration it found inside the limits (else ``q``'s arm)."""
-    from .. import ik
-
     robot = hand.robot
     model = robot.model
     data = model.createData()

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from tqdm.auto import tqdm
 
 from ..spatial.rotations import rot_axis
 
@@ -329,8 +330,6 @@ def monte_carlo(
     out = np.empty((n, 6))
     starts = range(0, n, batch)
     if progress:
-        from tqdm.auto import tqdm
-
         starts = tqdm(
             starts, total=(n + batch - 1) // batch, desc="monte carlo", unit="batch", leave=False
         )

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..spatial.rotation_tensor import rotation_tensor
+from ..spatial.rotations import homogeneous
 
 I, J, K = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
 
@@ -164,8 +165,7 @@ def loop_spec(loop: VectorLoop, limits=None):
     sits at the sum of the constant vectors since joint n−1, rpy = 0, axis w (or u for a
     slide); the tool frame ``grip`` at G with the ground axes (so a = R_tool a₀).  ``limits``:
     optional (lower, upper) per joint (default ±π, slides 0–1 m)."""
-    from ..models.spec import ChainSpec, JointSpec, rod_link
-    from ..spatial.rotations import homogeneous
+    from ..models.spec import ChainSpec, JointSpec, rod_link  # models imports this module
 
     if loop.nq == 0:
         raise ParameterError(

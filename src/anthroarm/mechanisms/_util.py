@@ -18,10 +18,13 @@ All frames are world frames, right-handed, SI units.
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 import numpy as np
 
 from ..errors import ParameterError
 from ..spatial.rotations import UNIT_TOL, as_scalar, check_unit_axis, skew  # noqa: F401  (re-exported)
+from ..spatial.screw import rotation_matrix
 
 
 def _short(x, n: int = 80) -> str:
@@ -131,8 +134,6 @@ def rot(theta, u) -> np.ndarray:
     """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in theta.
 
     Delegates to :func:`anthroarm.spatial.screw.rotation_matrix` (002 line 185)."""
-    from ..spatial.screw import rotation_matrix
-
     return rotation_matrix(theta, u)
 
 
@@ -282,8 +283,6 @@ def representable_fields(state, why: str):
     """``state`` (a dataclass computed under ``np.errstate(over='ignore', invalid='ignore')``)
     unchanged, or :class:`~anthroarm.errors.ParameterError` naming the first numeric field that holds inf/NaN (its true
     value is beyond the float range; ``why`` names the inputs that make it so)."""
-    from dataclasses import fields
-
     for f in fields(state):
         v = getattr(state, f.name)
         if isinstance(v, (str, bool, np.bool_)) or v is None:

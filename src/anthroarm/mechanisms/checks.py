@@ -20,11 +20,20 @@ import numpy as np
 import pinocchio as pin
 
 from ..check_rows import CheckRow
+from ..spatial.dual import Dual
 from ._util import fd_derivative, wrap
 from .closed_loop import ClosedLoop
 from .finger import FingerGeometry, finger, finger_spec
 from .fourbar import fourbar, fourbar_cartesian
 from .pin_models import fourbar_spec, rrss_spec, rssr_spec
+from .rccc import RCCCGeometry, pinocchio_chain, rccc_acceleration, rccc_position, rccc_velocity
+from .relative_motion import (
+    RelativeMotionGeometry,
+    pinocchio_model,
+    relative_acceleration,
+    relative_position,
+    relative_velocity,
+)
 from .rrss import RRSSGeometry, rrss, rrss_branch_through, rrss_newton, rrss_position
 from .rssr import RSSRGeometry, rssr, rssr_branch_through, rssr_crank_test, rssr_position
 from .thumb import ThumbGeometry, thumb, thumb_spec
@@ -438,14 +447,6 @@ def _finger_rows(acc, n, rng):
 # relative motion (002 §4-1) and the RCCC mechanism (§5-6): rows of their own, checked against
 # Pinocchio chains; ``n`` samples each (capped separately, these are cheap)
 def _relative_rows(n, rng):
-    from .relative_motion import (
-        RelativeMotionGeometry,
-        pinocchio_model,
-        relative_acceleration,
-        relative_position,
-        relative_velocity,
-    )
-
     e = np.zeros(3)
     for _ in range(n):
         u0, u1 = _rand_unit(rng), _rand_unit(rng)
@@ -501,9 +502,6 @@ def _relative_rows(n, rng):
 
 
 def _rccc_rows(n, rng):
-    from ..spatial.dual import Dual
-    from .rccc import RCCCGeometry, pinocchio_chain, rccc_acceleration, rccc_position, rccc_velocity
-
     e = np.zeros(4)
     count = checked = fd_checked = 0  # assembled geometries, branches with rates, FD comparisons
     tries = 0

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._util import finite_array, out
+from .closed_loop import Closure, LoopSpec, TreeJoint, origin
 from .dyads import dyad, rigid_body_point
 
 MM = 1e-3
@@ -273,8 +274,6 @@ def finger_spec(geom: FingerGeometry):
     """Spanning tree + planar closures for :class:`ClosedLoop`, built at the pose phi1 = phi_start
     (q = 0 closes): palm -mcp(P1)- proximal -pip(P2)- middle -dip(P6)- distal; palm -bar1(P4);
     proximal -bar2(P5).  Closures at P3 (middle = bar1) and P7 (distal = bar2), x-y only."""
-    from .closed_loop import Closure, LoopSpec, TreeJoint, origin
-
     s = finger(geom, geom.phi_range[0])
     p = {k: np.r_[np.asarray(v, float), 0.0] for k, v in s.points.items()}
     return LoopSpec(

@@ -38,6 +38,7 @@ from ._util import (
     out,
     point3,
     positive_length,
+    pow2_scale,
     representable_fields,
     rot,
     skew,
@@ -65,8 +66,6 @@ def _diff(p, q):
 
 
 def _pow2(d):
-    from ._util import pow2_scale
-
     return pow2_scale(norm("a difference of the points", d))
 
 

@@ -35,7 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._util import W, Wdot, finite_array, finite_scalar, out, point3, positive_length, rot
+from .closed_loop import Closure, LoopSpec, TreeJoint, origin
 from .dyads import dyad, rigid_body_point
+from .pin_models import frame_with_z
 from .rrss import RRSSGeometry, RRSSState, rrss, rrss_branch_through
 
 MM = 1e-3
@@ -311,9 +313,6 @@ def thumb_spec(geom: ThumbGeometry):
     R1 -R(u1 at C)- rocker (site F_rocker); ground -ball(b0)- S-S bar (site b_bar); R2 site b_R2.
     Closures: b_R2 = b_bar and F_R3 = F_rocker (3-D points; the planar loop's out-of-plane rows
     are redundant and handled by the least-norm solver)."""
-    from .closed_loop import Closure, LoopSpec, TreeJoint, origin
-    from .pin_models import frame_with_z
-
     g = geom.rrss
     R0, Ru = frame_with_z(g.u0), frame_with_z(g.u1)
     Rbar = frame_with_z(g.b1 - g.b0)

@@ -37,11 +37,14 @@ activity is still built.
 
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import ik
 from ..errors import ActivityError
+from ..ik.qp import comfortable_posture
 from .timing import keyframe_trajectory
 
 #: the most samples :func:`activity_trajectory` makes (a bound on the memory a bad rate or duration takes)
@@ -443,7 +446,6 @@ def activity(name: str, robot, *, height: float | None = None, **params) -> Acti
     if name not in ACTIVITIES:
         raise ActivityError(f"unknown activity {name!r}; the library has: {', '.join(ACTIVITIES)}")
     title, builder, source, book = ACTIVITIES[name]
-    import inspect
 
     accepted = [p for p in inspect.signature(builder).parameters if p not in ("B", "_")]
     unknown = sorted(set(params) - set(accepted))
@@ -494,9 +496,6 @@ def activity_trajectory(
     comfortable posture); a keyframe whose hand error stays above ``tol`` (m) is
     ``"unreachable"`` (or raises :class:`~anthroarm.errors.ActivityError` with ``strict``).
     """
-    from .. import ik
-    from ..ik.qp import comfortable_posture
-
     if isinstance(act, str):
         act = activity(act, robot, height=height, **params)
     elif params or height is not None:

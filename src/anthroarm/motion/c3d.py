@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import os
 import secrets
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -73,8 +74,6 @@ def _check_structure(p: Path) -> dict:
     ``data_start`` byte, ``frame_bytes``, the frames the header announces (``header_frames``,
     None when it cannot say: 65535 or more) and ``POINT:FRAMES`` (``point_frames``, None if
     absent)."""
-    import struct
-
     size = p.stat().st_size
     with open(p, "rb") as fh:
         head = fh.read(512)

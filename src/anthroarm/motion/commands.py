@@ -19,7 +19,13 @@ before anything is read or written.  The CSV is written atomically after the sol
 from __future__ import annotations
 
 import json
+import os
 import sys
+from pathlib import Path
+
+from ..robot import load as load_robot
+from . import MarkerSet, marker_ik, read_c3d, scale_from_static
+from .csv_io import write_joint_csv
 
 
 def add_parser(sub):
@@ -80,11 +86,7 @@ def add_parser(sub):
 
 
 def cmd_ik_markers(a) -> int:
-    import anthroarm as aa
-
-    from ..cli import UserError, _progress
-    from . import MarkerSet, marker_ik, read_c3d, scale_from_static
-    from .csv_io import write_joint_csv
+    from ..cli import UserError, _progress  # upward (faces), and cli imports this module
 
     rename = {}
     for item in a.rename:
@@ -92,7 +94,6 @@ def cmd_ik_markers(a) -> int:
             raise UserError(f"--rename expects LABEL=MARKER, got {item!r}")
         k, v = item.split("=", 1)
         rename[k.strip()] = v.strip()
-    from pathlib import Path
 
     out = Path(a.out)
     if out.is_dir() or not out.parent.is_dir():
@@ -111,7 +112,7 @@ def cmd_ik_markers(a) -> int:
         k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None
     }
     trial = read_c3d(a.trial)
-    robot = aa.load(a.model, **person)
+    robot = load_robot(a.model, **person)
     markers = MarkerSet.read_json(a.markers) if a.markers else None
     info = {}
     if a.static:
@@ -123,7 +124,7 @@ def cmd_ik_markers(a) -> int:
                 f"{ {k: round(v, 2) for k, v in sc.scales.items()} }); check the markers' labels (--rename) "
                 "and that it is a static trial of this person"
             )
-        robot = aa.load(a.model, **sc.load_kwargs(robot))
+        robot = load_robot(a.model, **sc.load_kwargs(robot))
         markers = sc.marker_set
         info["segment_lengths_m"] = {k: round(v, 4) for k, v in sc.segment_lengths.items()}
         info["static_rms_m"] = sc.rms
@@ -157,8 +158,6 @@ def cmd_ik_markers(a) -> int:
 def _same_file(a, b) -> bool:
     """``a`` and ``b`` name the same file: the same inode (a hard link, a symlink, the same path
     written differently) or, when one does not exist yet, the same resolved path."""
-    import os
-
     try:
         return os.path.samefile(a, b)
     except OSError:

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MarkerSetError, MotionDataError, ParameterError
+from ..errors import MarkerSetError, MotionDataError, ParameterError, UnconstrainedJointError
 from ..ik import qp
 from ..ik.qp.tasks.marker import MarkerTask
 from .markers import BoundMarkers, MarkerSet, default_marker_set
@@ -369,8 +369,6 @@ class MarkerIK:
         if missing:
             free = self.bound.unconstrained_joints(cols >= 0)
             if free:
-                from ..errors import UnconstrainedJointError
-
                 raise UnconstrainedJointError(
                     f"markers {list(missing)} are not in the trial; without them joints {free} have no marker "
                     "below them (rename the trial's labels with rename={label: marker} or use another set)",

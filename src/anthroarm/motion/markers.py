@@ -26,8 +26,10 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from .._io import atomic_write_text, load_json_bounded
 from ..errors import MarkerSetError, UnconstrainedJointError, UnknownFrameError
 from ..ik.qp.tasks.marker import moved_by
+from ..ik.qp.tasks.posture import comfortable_posture
 from ..models.human import HUMAN_ARM_LANDMARKS, HUMAN_ARM_TRUNK_SCALE_LINK
 
 #: the largest marker-set JSON file :meth:`MarkerSet.read_json` reads, bytes (1 MiB: thousands
@@ -172,8 +174,6 @@ class MarkerSet:
         naming the file for a missing file, one that is not a regular file, is larger than
         :data:`MAX_MARKER_SET_BYTES`, nested deeper than :data:`MAX_MARKER_SET_DEPTH`, is not
         JSON or not a valid set."""
-        from .._io import load_json_bounded
-
         if not isinstance(path, (str, os.PathLike)) or path == "":
             raise MarkerSetError(
                 f"read_json: path must be a file path, got {type(path).__name__} {path!r}"
@@ -195,8 +195,6 @@ class MarkerSet:
 
     def write_json(self, path) -> None:
         """Write the set as JSON (atomically)."""
-        from .._io import atomic_write_text
-
         atomic_write_text(
             path, json.dumps({"name": self.name, "markers": self.to_dict()}, indent=2) + "\n"
         )
@@ -335,8 +333,6 @@ class BoundMarkers:
                 joints=free,
             )
         if q is None:
-            from ..ik.qp.tasks.posture import comfortable_posture
-
             q = comfortable_posture(self.robot)
         J = self.jacobian(q) * np.repeat(np.sqrt(self.marker_set.weights), 3)[:, None]
         _, s, Vt = np.linalg.svd(J)

@@ -32,6 +32,8 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import MarkerSetError, MotionDataError, ParameterError
+from ..ik.qp import comfortable_posture
+from ..models.human import SEGMENT_LINKS
 from .marker_ik import match_markers
 from .markers import MarkerSet, default_marker_set, segment_length
 from .trial import MarkerTrajectories, check_coordinates
@@ -209,8 +211,6 @@ def scale_from_static(
     def fun(x):
         return ((positions(x) - target) * w[:, None]).ravel()
 
-    from ..ik.qp import comfortable_posture
-
     qs = comfortable_posture(robot) if q0 is None else robot.check_q(q0, name="q0")
     x0 = np.concatenate([np.clip(qs, robot.lower, robot.upper), np.zeros(len(bodies))])
     best = None
@@ -231,7 +231,6 @@ def scale_from_static(
     d = np.linalg.norm(positions(x) - target, axis=1)
     scales = {name: float(s[i]) for i, (j, name, L) in enumerate(bodies)}
     lengths = {name: float(s[i] * L) for i, (j, name, L) in enumerate(bodies)}
-    from ..models.human import SEGMENT_LINKS
 
     seg = {key: lengths[link] for key, link in SEGMENT_LINKS.items() if link in lengths}
     new_markers = []

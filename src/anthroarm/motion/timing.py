@@ -17,15 +17,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..dynamics.profiles import minimum_jerk as _minimum_jerk
+
 
 def minimum_jerk(x0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, velocity and acceleration of the rest-to-rest minimum-jerk motion from ``x0``
     to ``x1`` (arrays of the same shape) in ``duration`` s, at times ``t`` (clipped to
     [0, duration]).  Returns arrays of shape ``t.shape + x0.shape``.  The formula is
-    :func:`anthroarm.dynamics.hand_model.minimum_jerk` (one source); this adds scalar
+    :func:`anthroarm.dynamics.profiles.minimum_jerk` (one source); this adds scalar
     coordinates."""
-    from ..dynamics.hand_model import minimum_jerk as _minimum_jerk
-
     x0 = np.asarray(x0, float)
     T = float(duration)
     if not (np.isfinite(T) and T > 0):

@@ -14,6 +14,11 @@ import numpy as np
 import pinocchio as pin
 
 from ..check_rows import CheckRow
+from . import dual as D
+from .euler import euler_zxz, euler_zxz_inverse
+from .hand_angles import hand_angles, hand_matrix
+from .rotation_tensor import rotated_vector_motion, rotation_tensor
+from .screw import screw_matrix, screw_twist
 
 LWA = pin.LOCAL_WORLD_ALIGNED
 
@@ -24,12 +29,6 @@ def _unit(rng, n):
 
 
 def _spatial_rows(n, rng, CheckRow):
-    from . import dual as D
-    from .euler import euler_zxz, euler_zxz_inverse
-    from .hand_angles import hand_angles, hand_matrix
-    from .rotation_tensor import rotated_vector_motion, rotation_tensor
-    from .screw import screw_matrix, screw_twist
-
     W = _unit(rng, n)
     th = rng.uniform(-np.pi, np.pi, n)
     e_exp3 = max(np.abs(rotation_tensor(w, t) - pin.exp3(t * w)).max() for w, t in zip(W, th))

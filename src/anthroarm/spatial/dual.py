@@ -25,8 +25,18 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
-from .rotations import as_scalar, as_vector3, check_rotation, check_unit_axis, skew, unskew
+from ..errors import DualDivisionError
+from .rotations import (
+    as_scalar,
+    as_vector3,
+    check_rotation,
+    check_unit_axis,
+    skew,
+    unit_axis,
+    unskew,
+)
 
 
 class Dual:
@@ -116,8 +126,6 @@ class Dual:
     def __truediv__(self, o):
         o = Dual.lift(o)
         if np.any(np.asarray(o.real) == 0):
-            from ..errors import DualDivisionError
-
             raise DualDivisionError(
                 f"division by a dual number with zero real part: {o!r} (a pure dual "
                 "number a = 0 + eps b has no inverse)"
@@ -290,8 +298,6 @@ class Line:
     @classmethod
     def from_point_direction(cls, point, direction) -> "Line":
         """The line through ``point`` along ``direction`` (normalised; zero → ValueError)."""
-        from .rotations import unit_axis
-
         u = unit_axis(direction, "line direction")
         r = as_vector3(point, "point")
         return cls(u, np.cross(r, u))
@@ -327,8 +333,6 @@ class Line:
 
     def as_motion(self):
         """The zero-pitch unit twist ``pin.Motion(linear=u_O, angular=u)`` of this line."""
-        import pinocchio as pin
-
         return pin.Motion(self.moment, self.u)
 
 

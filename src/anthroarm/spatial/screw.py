@@ -25,6 +25,7 @@ from .rotations import (
     as_angle,
     as_scalar,
     as_vector3,
+    axis_angle,
     check_rotation,
     check_unit_axis,
     skew,
@@ -79,8 +80,6 @@ def screw_parameters(T, tol: float = 1e-10) -> tuple[float, float, np.ndarray, n
     """Inverse of :func:`screw_matrix` (Chasles): (φ ∈ [0, π], s, u, p) with p the foot of the
     perpendicular from the origin to the axis.  A pure translation returns φ = 0, u = its
     direction and p = 0; the identity returns (0, 0, (0, 0, 1), 0)."""
-    from .rotations import axis_angle
-
     T = np.asarray(T, float)
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise ValueError(

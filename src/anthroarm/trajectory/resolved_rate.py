@@ -18,9 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
-from ..control import _check
+from .. import input_checks as _check
 from ..errors import ControlError
+from ..ik.book_jacobians import hand_frame_jacobian
 
 
 @dataclass
@@ -56,12 +58,8 @@ def straight_line_move(
 
     Raises :class:`~anthroarm.errors.ControlError` (a ``ValueError``) for a bad pose,
     ``duration``, ``dt``, ``k`` or ``jacobian``, for a move of more Euler steps than the step
-    budget (``duration / dt`` > :data:`anthroarm.control._check.MAX_STEPS`), and when the
+    budget (``duration / dt`` > :data:`anthroarm.input_checks.MAX_STEPS`), and when the
     Jacobian is singular on the way (7-89 needs its inverse)."""
-    import pinocchio as pin
-
-    from ..ik.book_jacobians import hand_frame_jacobian
-
     q = robot.check_q(q_start, "q_start").copy()
     Tg = _check.array(T_goal, "T_goal")
     if Tg.shape != (4, 4):

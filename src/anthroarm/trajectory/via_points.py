@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..control import _check
+from .. import input_checks as _check
 from ..errors import ControlError
+from ..ik.closed_form import analytic, closed_form_info
 
 
 class ViaPointTrajectory:
@@ -31,7 +32,7 @@ class ViaPointTrajectory:
         except ControlError:
             raise ControlError(
                 "times must be a strictly increasing 1-D array of >= 2 finite values, got "
-                f"{_check._short(times)}"
+                f"{_check.short(times)}"
             ) from None
         Q = _check.array(Q, "Q (joint values at the via points)")
         if Q.ndim != 2 or Q.shape[0] != t.size or Q.shape[1] == 0:
@@ -76,8 +77,6 @@ def joint_via_trajectory(
     nearest to ``q_start``, default the neutral configuration), so the trajectory stays on one
     branch.  Returns (trajectory, Q).  :class:`~anthroarm.errors.ControlError` (a ``ValueError``)
     names a via point without a solution."""
-    from ..ik.closed_form import analytic, closed_form_info
-
     poses = _check.array(poses, "poses")
     if poses.ndim != 3 or poses.shape[1:] != (4, 4):
         raise ControlError(f"poses must be an array of 4x4 poses (N, 4, 4), got {poses.shape}")

@@ -1,5 +1,7 @@
 """Input checks shared by the modules of :mod:`anthroarm.control` and :mod:`anthroarm.trajectory`
 (one place for the messages), and the budgets that bound what a call may allocate or loop over.
+A foundation module (it needs only :mod:`anthroarm.errors` and :mod:`anthroarm.spatial`), so
+that both packages import it by its public name.
 
 **Budgets.**  A time step that is tiny against a duration (``dt = 1e-12`` over 2 s) or a count
 that is huge (``n = 10**12``) would ask for more memory than any machine has, or for a loop that
@@ -16,12 +18,13 @@ what the budget is and what to change.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
-from ..errors import ControlError
-from ..spatial.rotations import as_scalar
+from .errors import ControlError
+from .spatial.rotations import as_scalar
 
 #: the largest number of float values (samples × values per sample) of one sampled result
 MAX_VALUES = 2**25
@@ -70,7 +73,7 @@ def array(x, name: str) -> np.ndarray:
     except OverflowError:
         raise ControlError(f"{name} has an integer beyond the float range") from None
     except (TypeError, ValueError):
-        raise ControlError(f"{name} must be numbers, got {_short(x)}") from None
+        raise ControlError(f"{name} must be numbers, got {short(x)}") from None
     if not np.all(np.isfinite(a)):
         raise ControlError(f"{name} has a NaN or infinite element")
     return a
@@ -101,13 +104,13 @@ def on_grid(x, t: np.ndarray, name: str) -> np.ndarray:
 def count(x, name: str, minimum: int = 0, maximum: int | None = None) -> int:
     """An integer (not a bool) >= ``minimum`` (and <= ``maximum`` when given)."""
     if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < minimum:
-        raise ControlError(f"{name} must be an integer >= {minimum}, got {_short(x)}")
+        raise ControlError(f"{name} must be an integer >= {minimum}, got {short(x)}")
     if maximum is not None and x > maximum:
         raise ControlError(f"{name} = {int(x)} is beyond the budget of {maximum}")
     return int(x)
 
 
-def _short(x) -> str:
+def short(x) -> str:
     r = repr(x)
     return r if len(r) <= 80 else r[:77] + "..."
 
@@ -125,7 +128,7 @@ def samples(n: float, width: int, what: str, remedy: str) -> int:
         raise ControlError(
             f"{what} needs {_fmt(n)} samples"
             + (f" of {width} values" if width > 1 else "")
-            + f"; the budget is {MAX_VALUES} values (anthroarm.control._check.MAX_VALUES): "
+            + f"; the budget is {MAX_VALUES} values (anthroarm.input_checks.MAX_VALUES): "
             + remedy
         )
     return int(n)
@@ -137,7 +140,7 @@ def steps(n: float, what: str, remedy: str) -> int:
     if not (n <= MAX_STEPS):
         raise ControlError(
             f"{what} needs {_fmt(n)} steps; the budget is {MAX_STEPS} steps "
-            f"(anthroarm.control._check.MAX_STEPS): {remedy}"
+            f"(anthroarm.input_checks.MAX_STEPS): {remedy}"
         )
     return int(n)
 
@@ -170,7 +173,6 @@ def finite_result(func):
     """Decorate a method whose array result must be finite: a result beyond the float range
     (inputs near 1e308) is a :class:`~anthroarm.errors.ControlError` naming the method, not an
     inf or NaN handed back."""
-    import functools
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
