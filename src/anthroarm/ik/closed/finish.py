@@ -7,7 +7,7 @@ A candidate is a solution when it is inside the limits and max |FK(q) − T| ≤
 3×4 pose entries (m / unitless; the position alone where ``position_only``); one inside the
 limits with a residual ≤ :data:`POLISH_MAX` is first polished (:func:`.limits.refine`); a pose
 without a solution whose exact candidates lie just outside the limits is rescued along its
-self-motions (:func:`.limits.rescue`) where its kind allows (:attr:`.kinds.ClosedFormKind.rescues`).
+self-motions (:func:`.limits.rescue`) where its kind allows (``kinds.ClosedFormKind.rescues``).
 """
 
 from __future__ import annotations

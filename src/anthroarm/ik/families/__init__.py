@@ -31,7 +31,7 @@ wrist (axes 5, 6, 7 meet at W), one solution family per elbow swivel angle φ:
   SP4, q5 and q7 by SP1 (2 roots).
 
 8 branches per φ, q4 root outermost, wrist root innermost: labels ``"q4=0,q1q2=0,q6=0"`` …
-(``q2`` in place of ``q1q2`` for the general shoulder route), see :attr:`SRSPlan.labels`.
+(``q2`` in place of ``q1q2`` for the general shoulder route), see ``SRSPlan.labels``.
 
 ``planar_2r`` — two parallel revolute axes, position only: q2 by SP3
 (‖rot(h2, q2)(p_t − o2) − (o1 − o2)‖ = ‖p − o1‖), q1 by SP1; 2 branches ``"q2=0"``, ``"q2=1"``.

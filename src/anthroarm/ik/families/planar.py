@@ -35,7 +35,7 @@ def _fk_position_residual(kH, kO, p_tool, q, n, p):
 
 @kernel(inline=True)
 def _planar_unpack(cf):
-    """The constants of :attr:`PlanarPlan.packed`: (h1, h2, o1, o2, p_tool (3-tuples), the FK
+    """The constants of ``PlanarPlan.packed``: (h1, h2, o1, o2, p_tool (3-tuples), the FK
     check's axes and points (2, 3), lo, hi (2,)) — views of ``cf``, compiled into each caller."""
     return (
         vec(cf[0:3]),
@@ -78,7 +78,7 @@ def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
 def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
     """Both branches of targets P (N, 3) (:func:`_planar_pose` of each): Q (N, 2, 2) path
     order, V, E, IN, RES, OK (N, 2); returns the index of the first non-finite target (−1 if
-    none).  ``cf``: :attr:`PlanarPlan.packed`."""
+    none).  ``cf``: ``PlanarPlan.packed``."""
     plan = _planar_unpack(cf)
     q = local(2)
     for i in range(len(P)):
@@ -99,7 +99,7 @@ def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
     residual, the branch — and the bit mask of their branches returned (≤ 0: none, a malformed
     pose or a candidate to polish — the general path answers).  ``angle`` and
     ``tol_orthonormal`` are not read (the signature of :func:`.geometric.pose_solutions`).
-    ``cf``, ``ci``: :attr:`PlanarPlan.packed`."""
+    ``cf``, ``ci``: ``PlanarPlan.packed``."""
     if 0 < _pose_status(T, math.inf) < 3:  # not finite, or not its last row (the rotation: unread)
         return -1
     Q, RES, q = local2(2, 2), local(2), local(2)

@@ -420,7 +420,7 @@ def _swivel_array(swivel, N, check=True):
 def srs_verified(plan: SRSPlan, T, swivel, tol: float = 1e-9, tol_orthonormal: float = 1e-6):
     """Every branch of the SRS arm of ``plan`` for tool poses ``T`` (N, 4, 4) (base frame, m)
     and elbow swivel angles ``swivel`` (N, S) rad (a scalar or (N,) means S = 1), in one
-    compiled call: rows ``8 k + b`` hold swivel angle k and branch b (:attr:`SRSPlan.labels`).
+    compiled call: rows ``8 k + b`` hold swivel angle k and branch b (``SRSPlan.labels``).
     Returns θ (N, 8S, 7) in ``robot.chain.independent`` order (rad, wrapped by 2π into the
     limits, NaN where the branch does not exist), candidate (N, 8S), exact (N, 8S), inside the
     limits (N, 8S), FK residual (N, 8S) (max entry of the 3×4 pose by the chain's product of

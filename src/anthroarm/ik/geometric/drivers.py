@@ -136,7 +136,7 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
 
 def solve_nearest(cf, ci, T, ref, param: float):
     """The solutions θ (K, n) (independent-joint order, rad) of one pose ``T`` (4, 4) of a
-    closed class (``cf``, ``ci``: :attr:`GeoPlan.packed`; default tolerances; ``param`` the held
+    closed class (``cf``, ``ci``: ``GeoPlan.packed``; default tolerances; ``param`` the held
     7th joint) with the one nearest ``ref`` (n,) first, and that one's position and rotation
     errors (m, rad; :func:`_target_errors`; None, None without a reference: an empty ``ref``)
     — or None where the pose has no solution, is malformed or has a candidate to polish.  The

@@ -123,7 +123,7 @@ class ClosedFormKind(ABC):
         return None
 
     def solve_one(self, robot, s, arr, swivel, position_only, tol, tol_orthonormal):
-        """One pose ``arr`` (4×4 C-order float64; a position (3,) where :attr:`position_only`) in
+        """One pose ``arr`` (4×4 C-order float64; a position (3,) where :attr:`~anthroarm.ik.closed.kinds.base.ClosedFormKind.position_only`) in
         one compiled call when it has a solution and nothing to polish — an
         :class:`~..results.AnalyticIKResult` with the same solutions, labels and order as
         :meth:`solve_batch` — else None (the batch path answers)."""
@@ -135,8 +135,8 @@ class ClosedFormKind(ABC):
     ):
         """Every branch of the poses ``T`` (an :class:`~..results.AnalyticBatchResult`), the
         arguments already checked against the kind's capabilities (``swivel`` only where
-        :attr:`swivel`, ``param`` only where a joint is held, ``position_only`` only where
-        :attr:`position_only`); ``single_grid``: a 1-D ``swivel``/``param`` is a grid."""
+        :attr:`~anthroarm.ik.closed.kinds.base.ClosedFormKind.swivel`, ``param`` only where a joint is held, ``position_only`` only where
+        :attr:`~anthroarm.ik.closed.kinds.base.ClosedFormKind.position_only`); ``single_grid``: a 1-D ``swivel``/``param`` is a grid."""
 
     def nearest(self, plan):
         """``f(T, ref, param)`` giving the solutions θ (K, n) nearest ``ref`` first with that

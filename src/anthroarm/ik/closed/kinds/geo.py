@@ -48,7 +48,7 @@ class SingularOf:
 
 
 def singular_rows(plan, TH, valid, rows) -> list:
-    """:attr:`AnalyticBatchResult.singular` of the poses ``rows`` of a batch (joint angles
+    """``AnalyticBatchResult.singular`` of the poses ``rows`` of a batch (joint angles
     ``TH`` (N, B, n), ``valid`` (N, B))."""
     vol = _geo.jacobian_volumes(plan, TH[rows], valid[rows]).min(1)
     return [singular_text(float(v)) for v in vol]

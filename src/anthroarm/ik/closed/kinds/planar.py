@@ -19,7 +19,7 @@ from ..poses import check_poses
 from ..results import AnalyticIKResult
 from .base import ClosedForm, ClosedFormKind, OneCall, by_mask
 
-#: the family name of the planar 2R arm (:attr:`ClosedForm.family`)
+#: the family name of the planar 2R arm (``ClosedForm.family``)
 PLANAR = "planar_2r"
 
 

@@ -23,7 +23,7 @@ from ..poses import check_poses, detail_bad_pose, swivel_array
 from ..results import AnalyticIKResult
 from .base import ClosedForm, ClosedFormKind, OneCall, by_mask
 
-#: the family name of the SRS 7R arm (:attr:`ClosedForm.family`)
+#: the family name of the SRS 7R arm (``ClosedForm.family``)
 SRS = "srs_7r"
 
 
