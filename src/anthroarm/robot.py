@@ -513,7 +513,7 @@ def load(
         if package_dirs is not None:
             raise ParameterError("package_dirs= applies to URDF files, not to a pin.Model")
         model, vis, col = src
-        return _make(
+        return make_robot(
             model,
             name=name or model.name or "robot",
             info=None,
@@ -539,7 +539,7 @@ def load(
         if params or not path.is_file() or path.read_text(encoding="utf-8") != text:
             # not the committed default file: keep the text only (yourdfpy reads from memory)
             info.path = Path(f"<generated>/{s}.urdf")
-        return _make(
+        return make_robot(
             build_model(info),
             name=name or s,
             info=info,
@@ -555,7 +555,7 @@ def load(
         info = read_urdf(arm.urdf_path(), package_dirs=package_dirs, check_meshes=check_meshes)
         if active is None and locked is None:
             active, locked = arm.active, arm.locked_values
-        return _make(
+        return make_robot(
             build_model(info),
             name=name or s,
             info=info,
@@ -569,7 +569,7 @@ def load(
         info = read_urdf(
             models.erd_urdf_path(s), package_dirs=package_dirs, check_meshes=check_meshes
         )
-        return _make(
+        return make_robot(
             build_model(info),
             name=name or s,
             info=info,
@@ -581,9 +581,12 @@ def load(
         raise models._unknown(s)
     no_params(f"the URDF file {s}")
     info = read_urdf(s, package_dirs=package_dirs, check_meshes=check_meshes)
-    return _make(build_model(info), name=name or Path(s).stem, info=info, **common)
+    return make_robot(build_model(info), name=name or Path(s).stem, info=info, **common)
 
 
-def _make(model, *, name, active=None, locked=None, **kw) -> Robot:
+def make_robot(model, *, name, active=None, locked=None, **kw) -> Robot:
+    """The :class:`Robot` of ``model`` (a ``pin.Model``) with only the joints ``active`` kept or
+    the joints ``locked`` frozen (:func:`reduce_model`); the other keywords go to
+    :class:`Robot`.  No validation of a source: :func:`load` is the way in for a user."""
     model, values = reduce_model(model, name, active, locked)
     return Robot(model, name=name, locked=values, **kw)

@@ -31,10 +31,6 @@ PACKAGE = "anthroarm"
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "batch/describe.py": 5,
-    "batch/engine.py": 2,
-    "batch/jobs.py": 6,
-    "batch/runner.py": 3,
     "cli.py": 36,
     "ik/book_methods.py": 2,
     "ik/cells.py": 2,
@@ -44,13 +40,8 @@ LOCAL_IMPORTS = {
     "ik/qp/checks.py": 2,
     "ik/qp/tasks/coupling.py": 1,
     "jit.py": 1,
-    "models/__init__.py": 4,
-    "models/book.py": 1,
     "models/care_robot.py": 2,
-    "models/erd.py": 1,
-    "models/hand.py": 2,
-    "models/prosthetic_hand.py": 5,
-    "models/templates.py": 2,
+    "models/hand.py": 1,
     "prosthesis/catalogue.py": 1,
     "prosthesis/commands.py": 10,
     "prosthesis/envelope.py": 3,
@@ -65,8 +56,6 @@ LOCAL_IMPORTS = {
     # a circle: chain -> kinematics.batched (the upward import of test_layers.KNOWN) and
     # models -> robot -> chain; gone when SerialChain moves down into the model layer
     "kinematics/batched.py": 1,
-    # a circle: models.templates -> kinematics.vector_loop (test_layers.KNOWN)
-    "kinematics/vector_loop.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would close a circle
     # (cli imports motion.commands) or load the viewer (meshcat, tornado) with the algorithm;
     # gone when the command and the viewer demo move into cli/ and viewer/
@@ -78,10 +67,7 @@ LOCAL_IMPORTS = {
 #: file -> private names (or names from private modules) imported from another package
 PRIVATE_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "batch/describe.py": 1,
-    "batch/jobs.py": 3,
     "cli.py": 1,
-    "models/prosthetic_hand.py": 1,
     "prosthesis/commands.py": 2,
     "viewer/overlays.py": 1,
     # anthroarm.cli._progress: with the upward import of the command above

@@ -19,6 +19,9 @@ import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
+from .. import models
+from ..robot import build_model, load, make_robot
+from ..urdf_io import parse_urdf_bytes
 from .errors import RobotDescriptionError, RobotRebuildError
 
 #: robots kept per process (a population job has one robot per person)
@@ -52,10 +55,6 @@ class RobotDescription:
 
     def build(self):
         """A fresh :class:`~anthroarm.robot.Robot` (no cache); raises RobotRebuildError."""
-        from .. import load
-        from ..robot import _make, build_model
-        from ..urdf_io import parse_urdf_bytes
-
         locked = dict(self.locked) or None
         try:
             if self.kind == "catalog":
@@ -66,7 +65,7 @@ class RobotDescription:
                 info = parse_urdf_bytes(
                     self.source.encode("utf-8"), f"<batch>/{self.name}.urdf", check_meshes=False
                 )
-                robot = _make(
+                robot = make_robot(
                     build_model(info), name=self.name, info=info, tool=self.tool, locked=locked
                 )
             else:
@@ -100,8 +99,6 @@ def describe(robot, **params) -> RobotDescription:
     if isinstance(robot, RobotDescription):
         return robot
     if isinstance(robot, str) or hasattr(robot, "__fspath__"):
-        from .. import load
-
         robot = load(robot, **params)
     elif params:
         raise TypeError(f"builder parameters {sorted(params)} go with a catalog name, not a Robot")
@@ -118,8 +115,6 @@ def describe(robot, **params) -> RobotDescription:
 
 
 def _describe(robot) -> RobotDescription:
-    from .. import models
-
     locked = tuple(sorted((str(k), float(v)) for k, v in robot.locked.items()))
     spec = robot.spec
     if spec is not None and spec.name in models.BOOK_MODELS:

@@ -26,10 +26,12 @@ after the job returns (atomically), so a cancelled job leaves no partial file.
 
 from __future__ import annotations
 
+import ctypes
 import itertools
 import uuid
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .describe import robot_from
 from .errors import SchedulerUnreachableError
@@ -175,8 +177,6 @@ def _relax_malloc_trim() -> None:
         return
     _trim_relaxed[0] = True
     try:
-        import ctypes
-
         libc = ctypes.CDLL("libc.so.6")
         libc.mallopt(-1, WORKER_TRIM_THRESHOLD)  # M_TRIM_THRESHOLD = -1
         # the nanny's environment variable also freezes the mmap threshold at 128 KiB (glibc
@@ -213,8 +213,6 @@ def run(
     total = len(tasks)
     bar = None
     if progress:
-        from tqdm.auto import tqdm
-
         bar = tqdm(total=total, desc=desc, unit="task", leave=False)
     try:
         if client is None:

@@ -22,7 +22,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..ik.cells import MAX_LATTICE, lattice
+from ..ik import solve
+from ..ik.cells import MAX_LATTICE, CellTable, lattice
+from ..ik.qp.tasks.posture import comfortable_posture
+from ..kinematics.error_propagation import (
+    PerturbedChain,
+    draw_errors,
+    length_jacobian,
+    log3_batch,
+    tolerance_vector,
+)
 from ..models import PERSON_ARM
 from . import engine
 from .describe import RobotDescription, describe, robot_from
@@ -224,8 +233,6 @@ def discomfort(robot, Q) -> np.ndarray:
     RULA's lowest-load bands, McAtamney & Corlett 1993), as the RMS over the independent joints
     of the deviation divided by the joint's range: 0 at the comfortable posture, dimensionless,
     at most 1.  A continuous joint's deviation is wrapped to (−π, π]."""
-    from ..ik.qp.tasks.posture import comfortable_posture
-
     chain = robot.chain
     ind = list(chain.independent)
     th_c = chain.angles(comfortable_posture(robot))[ind]
@@ -419,19 +426,17 @@ def population_reach(
 
 # ============================================================================ tolerance
 def _mc_task(robot, p):
-    from ..kinematics.error_propagation import PerturbedChain, _draw, _log3_batch
-
     chain = PerturbedChain(robot, p["frame"], p["params"], p["mode"])
     q = p["q"]
     R0, x0 = chain.pose(q[None])
     rng = np.random.default_rng(p["seed"])
     m = p["n"]
-    dq = _draw(rng, p["distribution"], p["sigma_q"], m)
-    dL = _draw(rng, p["distribution"], p["sigma_L"], m)
+    dq = draw_errors(rng, p["distribution"], p["sigma_q"], m)
+    dL = draw_errors(rng, p["distribution"], p["sigma_L"], m)
     R, x = chain.pose(np.broadcast_to(q, (m, q.size)), dL, dq)
     dx = np.empty((m, 6))
     dx[:, :3] = x - x0
-    dx[:, 3:] = _log3_batch(R @ R0[0].T)
+    dx[:, 3:] = log3_batch(R @ R0[0].T)
     return np.linalg.norm(dx[:, :3], axis=1), dx.sum(0), dx.T @ dx
 
 
@@ -464,8 +469,6 @@ def tolerance_monte_carlo(
     pose error (Δp m; Δφ rad, world axes), and ``linear_cov``: the first-order J Σ Jᵀ of
     Eq. (6-118).  With ``chunk_size >= n`` configuration i draws from
     ``chunk_seeds(seed, M)[i]`` exactly as ``monte_carlo(..., rng=that seed, batch=n)``."""
-    from ..kinematics.error_propagation import PerturbedChain, _vec, length_jacobian
-
     robot, d = _robot_and_desc(robot, client)
     Q = np.atleast_2d(robot.check_q(Q))
     n = _positive_int(n, "n")
@@ -475,7 +478,10 @@ def tolerance_monte_carlo(
             f"distribution must be 'normal' or 'uniform', got {distribution!r}"
         )
     ps = PerturbedChain(robot, frame, params, mode).params
-    sq, sL = _vec(sigma_q, robot.nv, "sigma_q"), _vec(sigma_L, len(ps), "sigma_L")
+    sq, sL = (
+        tolerance_vector(sigma_q, robot.nv, "sigma_q"),
+        tolerance_vector(sigma_L, len(ps), "sigma_L"),
+    )
     if np.any(sq < 0) or np.any(sL < 0):
         raise BatchParameterError(
             f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}"
@@ -564,8 +570,6 @@ def tolerance_monte_carlo(
 
 # ============================================================================ IK
 def _ik_task(robot, p):
-    from ..ik import solve
-
     r = solve(robot, p["T"], q0=p["q0"], rng=np.random.default_rng(p["seed"]), **p["kw"])
     return r.q, r.success, r.pos_err, r.rot_err, r.iterations
 
@@ -661,8 +665,6 @@ def ik_dataset(
 
 # ============================================================================ cell table
 def _cell_task(robot, p):
-    from ..ik.cells import CellTable
-
     t = CellTable.build(
         robot,
         p["rotation"],
@@ -773,8 +775,6 @@ def cell_table(
 
 def to_cell_table(result: BatchResult):
     """The :class:`~anthroarm.ik.cells.CellTable` of a :func:`cell_table` result."""
-    from ..ik.cells import CellTable
-
     a = result.attrs
     return CellTable(
         a["model"],

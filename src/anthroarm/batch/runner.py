@@ -4,8 +4,10 @@ only once the job has finished), close what was started.  ``anthroarm batch`` ca
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
+from .._io import atomic_write_text
 from . import engine
 from .errors import BatchParameterError
 from .jobs import (
@@ -16,6 +18,7 @@ from .jobs import (
     reachability_map,
     tolerance_monte_carlo,
 )
+from .plot import population_plot, slice_plot
 from .result import check_suffix
 
 JOBS = {
@@ -76,15 +79,10 @@ def run_job(
 
 
 def _save_plot(result, path) -> None:
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
-
-    from .._io import atomic_write_text
-    from .plot import population_plot, slice_plot
 
     if result.job in ("reachability_map", "comfort_map"):
         fig = slice_plot(result, axis="x")

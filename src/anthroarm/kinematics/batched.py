@@ -193,7 +193,7 @@ class SerialChain:
     def from_dh(cls, rows, tool=None) -> "SerialChain":
         """The book's H-D chain, Eq. (6-12)–(6-14): A_j(q) = Rz(q) S_j (R) or Tz(q) S_j (P),
         where S_j is the static part of row j; joint j sits at S_{j−1} with axis z."""
-        from ..models.spec import dh_static
+        from ..models.spec import dh_static  # models -> robot -> chain imports this module
 
         S = [np.eye(4)] + [dh_static(r) for r in rows]
         T_tool = S[-1] @ (np.eye(4) if tool is None else np.asarray(tool, float))

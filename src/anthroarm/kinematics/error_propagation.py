@@ -171,7 +171,9 @@ class ErrorPropagation:
         return self.dx[:3]
 
 
-def _vec(x, n: int, name: str) -> np.ndarray:
+def tolerance_vector(x, n: int, name: str) -> np.ndarray:
+    """``x`` as a finite vector of ``n`` values: ``None`` -> zeros, a scalar -> ``n`` copies;
+    raises :class:`ValueError` naming ``name`` for another shape or a NaN / infinite value."""
     a = np.zeros(n) if x is None else np.asarray(x, dtype=float)
     if a.ndim == 0:
         a = np.full(n, float(a))
@@ -188,8 +190,8 @@ def propagate(
     """First-order pose error of ``frame`` at ``q``, Eq. (6-118): Δx = J_q Δq + J_L ΔL."""
     q = robot.check_q(q)
     ps = _params(robot, frame, params, mode)
-    dq = _vec(dq, robot.nv, "dq")
-    dL = _vec(dL, len(ps), "dL")
+    dq = tolerance_vector(dq, robot.nv, "dq")
+    dL = tolerance_vector(dL, len(ps), "dL")
     Jq = robot.jacobian(q, frame)
     JL = length_jacobian(robot, q, frame, ps)
     return ErrorPropagation(Jq @ dq + JL @ dL, Jq, JL, ps)
@@ -253,7 +255,7 @@ class PerturbedChain:
         return R @ self.Rf, x
 
 
-def _log3_batch(R: np.ndarray) -> np.ndarray:
+def log3_batch(R: np.ndarray) -> np.ndarray:
     """Rotation vectors of a batch of rotations (angles < π)."""
     c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
     th = np.arccos(c)
@@ -284,7 +286,9 @@ class MonteCarloResult:
     params: list[LinkParameter] = field(default_factory=list)
 
 
-def _draw(rng, dist: str, scale: np.ndarray, n: int) -> np.ndarray:
+def draw_errors(rng, dist: str, scale: np.ndarray, n: int) -> np.ndarray:
+    """``n`` samples (n, len(scale)) of errors with per-column ``scale``: ``"normal"`` (scale =
+    standard deviation) or ``"uniform"`` (on ±scale), drawn from ``rng``."""
     if dist == "normal":
         return rng.normal(size=(n, scale.size)) * scale
     if dist == "uniform":
@@ -319,8 +323,8 @@ def monte_carlo(
         raise ValueError(f"n must be a positive integer, got {n!r}")
     chain = PerturbedChain(robot, frame, params, mode)
     ps = chain.params
-    sq = _vec(sigma_q, robot.nv, "sigma_q")
-    sL = _vec(sigma_L, len(ps), "sigma_L")
+    sq = tolerance_vector(sigma_q, robot.nv, "sigma_q")
+    sL = tolerance_vector(sigma_L, len(ps), "sigma_L")
     if np.any(sq < 0) or np.any(sL < 0):
         raise ValueError(
             f"tolerances must be non-negative, got sigma_q={sq.tolist()}, sigma_L={sL.tolist()}"
@@ -335,11 +339,11 @@ def monte_carlo(
         )
     for a in starts:
         m = min(batch, n - a)
-        dq = _draw(rng, distribution, sq, m)
-        dL = _draw(rng, distribution, sL, m)
+        dq = draw_errors(rng, distribution, sq, m)
+        dL = draw_errors(rng, distribution, sL, m)
         R, x = chain.pose(np.broadcast_to(q, (m, q.size)), dL, dq)
         out[a : a + m, :3] = x - x0
-        out[a : a + m, 3:] = _log3_batch(R @ R0[0].T)
+        out[a : a + m, 3:] = log3_batch(R @ R0[0].T)
     var_factor = 1.0 if distribution == "normal" else 1.0 / 3.0
     J = np.hstack([robot.jacobian(q, frame), length_jacobian(robot, q, frame, ps)])
     Sigma = np.diag(np.concatenate([sq, sL]) ** 2 * var_factor)

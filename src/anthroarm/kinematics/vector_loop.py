@@ -30,66 +30,15 @@ Frames and units: the ground frame, m and rad; joint values in loop order.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import ParameterError
+from ..models.spec import ChainSpec, JointSpec, rod_link
+from ..models.vector_loop import I, J, K, VectorLoop
 from ..spatial.rotation_tensor import rotation_tensor
 from ..spatial.rotations import homogeneous
 
-I, J, K = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
-
 __all__ = ["VectorLoop", "nested_pose", "product_pose", "pose_matrices", "loop_spec", "I", "J", "K"]
-
-
-def _vec3(v, what: str, unit: bool = False) -> np.ndarray:
-    try:
-        a = np.asarray(v, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{what} must be 3 finite numbers, got {v!r}") from None
-    if a.shape != (3,) or not np.isfinite(a).all():
-        raise ParameterError(f"{what} must be 3 finite numbers, got {v!r}")
-    if unit:
-        n = np.linalg.norm(a)
-        if abs(n - 1.0) > 1e-9:
-            raise ParameterError(f"{what} must be a unit vector, got {v!r} (norm {n:.6g})")
-    return a
-
-
-@dataclass(frozen=True)
-class VectorLoop:
-    """An orthogonal manipulator in vector-loop form (see the module docstring)."""
-
-    items: tuple
-    G: np.ndarray
-    a0: tuple = I
-    b0: tuple = K
-    name: str = "vector_loop"
-
-    def __post_init__(self):
-        items = []
-        for n, it in enumerate(self.items):
-            try:
-                kind, v = it
-            except (TypeError, ValueError):
-                raise ParameterError(f"loop item {n} must be (kind, vector), got {it!r}") from None
-            if kind not in ("C", "R", "L"):
-                raise ParameterError(f"loop item {n}: kind must be 'C', 'R' or 'L', got {kind!r}")
-            items.append((kind, _vec3(v, f"loop item {n} ({kind})", unit=kind != "C")))
-        object.__setattr__(self, "items", tuple(items))
-        object.__setattr__(self, "G", _vec3(self.G, "G"))
-        object.__setattr__(self, "a0", _vec3(self.a0, "a0", unit=True))
-        object.__setattr__(self, "b0", _vec3(self.b0, "b0", unit=True))
-
-    @property
-    def joints(self) -> tuple:
-        """The joint items ("R" or "L", axis), base to tip."""
-        return tuple(it for it in self.items if it[0] != "C")
-
-    @property
-    def nq(self) -> int:
-        return len(self.joints)
 
 
 def _q(loop: VectorLoop, q) -> np.ndarray:
@@ -165,8 +114,6 @@ def loop_spec(loop: VectorLoop, limits=None):
     sits at the sum of the constant vectors since joint n−1, rpy = 0, axis w (or u for a
     slide); the tool frame ``grip`` at G with the ground axes (so a = R_tool a₀).  ``limits``:
     optional (lower, upper) per joint (default ±π, slides 0–1 m)."""
-    from ..models.spec import ChainSpec, JointSpec, rod_link  # models imports this module
-
     if loop.nq == 0:
         raise ParameterError(
             f"{loop.name}: the loop has no joint ('R' or 'L' item): nothing to build"

@@ -12,8 +12,11 @@ equal the generator's output); :func:`write_urdfs` regenerates them.
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 
+from .. import cache
+from .._io import atomic_write_text
 from ..errors import ParameterError, UnknownModelError
 from .book import planar2r, prosthetic_arm, rrprr5, sixr_arm, unimate5
 from .care_robot import care_robot
@@ -21,7 +24,7 @@ from .erd import ERD_ARMS, ErdArm, erd_names, erd_urdf_path
 from .human import human_arm7, segment_parameters
 from .human_upper_limb import human_upper_limb
 from .prosthetic_hand import prosthetic_hand
-from .spec import ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
+from .spec import REPO_URDF_DIR, ChainSpec, DHRow, JointSpec, LinkSpec, dh_matrix, from_dh, to_urdf
 from .templates import TEMPLATES
 
 BOOK_MODELS = {
@@ -59,11 +62,6 @@ def param_unit(model: str, param: str) -> str:
     return PARAM_UNITS.get(model, {}).get(param, "kg" if param == "mass" else "m")
 
 
-#: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
-#: installed package does not need it: book models are loaded from the generator's text
-REPO_URDF_DIR = Path(__file__).resolve().parents[3] / "urdf"
-
-
 def names() -> list[str]:
     """Every catalog name: the book's models, then the example-robot-data arms."""
     return sorted(BOOK_MODELS) + sorted(ERD_ARMS)
@@ -88,8 +86,6 @@ def spec(name: str, **params) -> ChainSpec:
     try:
         return BOOK_MODELS[name](**params)
     except TypeError as exc:
-        import inspect
-
         sig = inspect.signature(BOOK_MODELS[name])
         raise ParameterError(
             f"{name}: bad parameters {params}; accepted: {list(sig.parameters)} ({exc})"
@@ -116,9 +112,6 @@ def urdf_path(name: str) -> Path:
     p = REPO_URDF_DIR / f"{name}.urdf"
     if p.is_file():
         return p
-    from .. import cache
-    from .._io import atomic_write_text
-
     folder = cache.folder("urdf")
     if folder is None:
         raise FileNotFoundError(
@@ -133,8 +126,6 @@ def urdf_path(name: str) -> Path:
 
 def write_urdfs(out_dir=None) -> list[Path]:
     """(Re)generate the URDFs of all book models with default parameters into ``out_dir``."""
-    from .._io import atomic_write_text
-
     out = Path(out_dir) if out_dir is not None else REPO_URDF_DIR
     out.mkdir(parents=True, exist_ok=True)
     paths = []

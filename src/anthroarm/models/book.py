@@ -21,6 +21,9 @@ import numpy as np
 from ..errors import ParameterError
 from ..spatial.rotations import as_scalar, homogeneous
 from .spec import (
+    DEFAULT_JOINT_MASS,
+    DEFAULT_LINEAR_DENSITY,
+    DEFAULT_LINK_RADIUS,
     ChainSpec,
     DHRow,
     JointSpec,
@@ -205,8 +208,6 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
         axis=(1.0, 0, 0),
         link=rod_link("link2", [0, l2, 0]),
     )
-    from .spec import DEFAULT_JOINT_MASS, DEFAULT_LINEAR_DENSITY, DEFAULT_LINK_RADIUS
-
     return ChainSpec(
         name="planar2r",
         description="Planar two-link mechanism with 1 m links (book Fig. 7-14, Table 7.3).",

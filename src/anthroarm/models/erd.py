@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
+from os.path import join
 from pathlib import Path
 
 
@@ -92,8 +93,6 @@ def erd_names() -> list[str]:
 def erd_urdf_path(name: str) -> Path:
     """Path of the URDF of an example-robot-data robot (the file its loader reads); the
     robot's own floating base, if its loader adds one, is not part of the URDF."""
-    from os.path import join
-
     from example_robot_data import getModelPath
 
     L = _erd_loaders()[name]

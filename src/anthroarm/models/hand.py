@@ -68,7 +68,7 @@ from numbers import Real
 
 import numpy as np
 
-from ..errors import AnthropometryError, ParameterError
+from ..errors import AnthropometryError, CouplingError, ParameterError
 from ..spatial.rotations import homogeneous
 from .spec import JointSpec, LinkSpec, Shape, capsule
 
@@ -382,8 +382,6 @@ def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
     ``expected`` and ``given``, rad); an unknown name or a
     non-finite value raises :class:`~anthroarm.errors.ParameterError`.  The q order is the
     order of ``spec.joints`` without the mimic joints, which is Pinocchio's for these trees."""
-    from ..errors import CouplingError
-
     if not isinstance(angles, Mapping):
         raise ParameterError(
             f"{spec.name}: angles must be a dict joint name -> rad, got {type(angles).__name__}"

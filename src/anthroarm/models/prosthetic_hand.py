@@ -47,12 +47,15 @@ from pathlib import Path
 
 import numpy as np
 
+from .._io import atomic_write_text
 from ..errors import ParameterError
 from ..mechanisms.closed_loop import ClosedLoop, LoopSpec, TreeJoint
 from ..mechanisms.finger import FingerGeometry, finger, finger_spec
 from ..mechanisms.rrss import RRSSGeometry
 from ..mechanisms.thumb import ThumbGeometry, thumb, thumb_spec
+from ..robot import build_model, make_robot
 from ..spatial.rotations import homogeneous, rot_axis
+from ..urdf_io import parse_urdf_bytes
 from .hand import (
     BREADTH_RATIO,
     BUCHHOLZ_1992,
@@ -64,7 +67,7 @@ from .hand import (
     hand_dimensions,
 )
 from .human import segment_parameters
-from .spec import ChainSpec, JointSpec, LinkSpec, Shape, capsule
+from .spec import REPO_URDF_DIR, ChainSpec, JointSpec, LinkSpec, Shape, capsule, to_urdf
 
 DEG = np.pi / 180.0
 #: driver range of the thumb (rad): θ1 ∈ [0, 30°], where the Chapter 3 coupling f2 is defined
@@ -569,16 +572,11 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
 def urdf_text(scale: float = 1.0) -> str:
     """The plain URDF of :func:`prosthetic_hand` (mimic approximations; ``urdf/prosthetic_hand.urdf``
     is the default, committed and tested equal to this text)."""
-    from .spec import to_urdf
-
     return to_urdf(prosthetic_hand(scale))
 
 
 def write_urdf(path=None, scale: float = 1.0) -> Path:
     """Write :func:`urdf_text` to ``path`` (default: ``urdf/prosthetic_hand.urdf`` of a source checkout)."""
-    from .._io import atomic_write_text
-    from . import REPO_URDF_DIR
-
     p = Path(path) if path is not None else REPO_URDF_DIR / "prosthetic_hand.urdf"
     atomic_write_text(p, urdf_text(scale))
     return p
@@ -594,12 +592,9 @@ def robot(scale: float = 1.0, tool: str = "index_tip"):
     −m gᵀ c, ``nonLinearEffects`` − g, M⁻¹(τ − ``nonLinearEffects``):
     :mod:`anthroarm.dynamics.checks` and ``tests/dynamics/test_lagrange.py``, which runs its
     catalog comparison on this hand too)."""
-    from ..robot import _make, build_model
-    from ..urdf_io import parse_urdf_bytes
-
     spec = prosthetic_hand(scale)
     info = parse_urdf_bytes(urdf_text(scale).encode(), Path("<generated>/prosthetic_hand.urdf"))
-    return _make(
+    return make_robot(
         build_model(info),
         name="prosthetic_hand",
         info=info,

@@ -17,12 +17,17 @@ Units: metres, radians, kilograms.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..spatial.rotations import as_scalar, homogeneous, rotation_between
+
+#: folder of the committed URDFs in a source checkout (``urdf/`` at the repository root); an
+#: installed package does not need it: book models are loaded from the generator's text
+REPO_URDF_DIR = Path(__file__).resolve().parents[3] / "urdf"
 
 #: Default linear density (kg/m) and radius (m) of the book arms' links, which print no masses:
 #: an aluminium tube Ø50 × 3 mm with its fittings weighs about 1.5 kg/m.

@@ -39,6 +39,7 @@ from .spec import (
     JointSpec,
     rod_link,
 )
+from .vector_loop import I, J, K, VectorLoop
 
 deg = np.pi / 180.0
 #: the book's usual maximum speeds (§2-4, l. 820-826): about 1000 mm/s and 180°/s
@@ -259,8 +260,6 @@ def unimate2600_loop(
         ``(VectorLoop, limits)``: the loop and the joint ranges for
         :func:`anthroarm.kinematics.vector_loop.loop_spec`.
     """
-    from ..kinematics.vector_loop import I, J, K, VectorLoop
-
     m = "unimate2600"
     c1, c2, c4, c5, g6 = (
         _length(m, n, v) for n, v in (("c1", c1), ("c2", c2), ("c4", c4), ("c5", c5), ("g6", g6))
@@ -304,8 +303,6 @@ def tensor6r_loop(
     E^{jθ₃}(C₅ⁱ + E^{iθ₄}(C₆ⁱ + E^{jθ₅}(C₇ⁱ + E^{iθ₆}(G₈ⁱ))))))``; attitude vectors a₀ ∥ i (the
     hand axis) and b₀ ∥ k (6-65).  In the initial state the arm is horizontal along +i.  No
     numbers are printed: the lengths (m) are ours.  Returns ``(VectorLoop, limits)``."""
-    from ..kinematics.vector_loop import I, J, K, VectorLoop
-
     m = "tensor6r"
     c = [
         _length(m, n, v)
