@@ -35,6 +35,7 @@ from importlib import resources
 from pathlib import Path
 
 from .._io import read_bounded
+from ..control.motor import DCMotor
 from ..errors import CatalogueError
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -87,8 +88,6 @@ class Motor:
         """This motor behind ``gearbox`` (or direct drive) as the servo model
         :class:`anthroarm.control.motor.DCMotor` (Eq. (9-1); no inductance, no viscous friction:
         the catalogue gives neither)."""
-        from ..control.motor import DCMotor
-
         i, eta = (1.0, 1.0) if gearbox is None else (gearbox.ratio, gearbox.efficiency)
         name = self.name if gearbox is None else f"{self.name} + {gearbox.name}"
         return DCMotor(

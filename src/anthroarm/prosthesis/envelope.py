@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..control.motor import rms
+from ..dynamics.loads import HeldObject, generalized_forces, inverse_dynamics
 from ..errors import ActivityError
 
 
@@ -87,8 +89,6 @@ CUP_RADIUS, CUP_HEIGHT = 0.04, 0.10
 def held_object(mass: float = 1.0, frame: str | None = None):
     """The held object of the reports: :data:`CUP_RADIUS`/:data:`CUP_HEIGHT` solid cylinder of
     ``mass`` kg at ``frame`` (default the tool), as :class:`anthroarm.dynamics.loads.HeldObject`."""
-    from ..dynamics.loads import HeldObject
-
     return HeldObject.cylinder(mass, CUP_RADIUS, CUP_HEIGHT, frame=frame)
 
 
@@ -136,8 +136,6 @@ def activity_torques(
     anthroarm.errors.ActivityError
         Malformed times or samples.
     """
-    from ..dynamics.loads import generalized_forces, inverse_dynamics
-
     try:
         q = robot.check_q(q, f"q of activity {name!r}")
     except ValueError as exc:
@@ -202,8 +200,6 @@ def activity_torques(
 
 def _rms(t, x):
     """RMS over the time span of each column (:func:`anthroarm.control.motor.rms`)."""
-    from ..control.motor import rms
-
     return np.array([rms(t, col) for col in np.asarray(x).T])
 
 

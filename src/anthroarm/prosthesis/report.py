@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import atomic_write_text
+from .catalogue import source_note
 from .envelope import CUP_HEIGHT, CUP_RADIUS
 
 _CSS = """
@@ -192,8 +193,6 @@ def _fmt_ok(ok):
 def render(study, *, viewer: bool = True, title: str | None = None) -> str:
     """The report's HTML text (see the module docstring); ``viewer=False`` leaves out the
     animation (and meshcat's JavaScript)."""
-    from .catalogue import source_note
-
     env, sz = study.envelope, study.sizing
     parts = [
         f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{_e(title or 'anthroarm prosthesis sizing')}"

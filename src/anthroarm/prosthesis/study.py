@@ -10,11 +10,17 @@ it already knows it is unusable, e.g. a target outside the arm's reach), in SI u
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..dynamics.lagrange import load as load_dynamics
 from ..errors import ActivityError
+from ..motion import activities as adl
+from . import catalogue as cat_mod
+from . import envelope as env_mod
+from . import sizing, weight_rules
 
 
 @dataclass
@@ -76,13 +82,6 @@ def run(
     progress : callable, optional
         ``progress(stage, name)`` before each activity and joint.
     """
-    import time
-
-    from ..dynamics.lagrange import load as load_dynamics
-    from . import catalogue as cat_mod
-    from . import envelope as env_mod
-    from . import sizing, weight_rules
-
     payload = _payload(payload)
     if person is None:
         p = dict(robot.spec.params) if robot.spec is not None else {}
@@ -182,8 +181,6 @@ def adl_activities(
     time: ``max(payload, object mass while holding)``.  An activity with a keyframe out of the
     arm's reach gets status "unreachable" and a reason naming the keyframe and the distance.
     ``height`` (m): place the targets for a person of this stature (default: the model's)."""
-    from ..motion import activities as adl
-
     payload = None if payload is None else _payload(payload)
     out = []
     for name in adl.names() if names is None else list(names):
