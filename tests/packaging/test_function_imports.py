@@ -32,13 +32,9 @@ PACKAGE = "anthroarm"
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
     "cli.py": 36,
-    "ik/book_methods.py": 2,
-    "ik/cells.py": 2,
-    "ik/checks.py": 1,
     "ik/qp/_qpgen2.py": 1,
     "ik/qp/backends.py": 5,
     "ik/qp/checks.py": 2,
-    "ik/qp/tasks/coupling.py": 1,
     "jit.py": 1,
     "models/care_robot.py": 2,
     "models/hand.py": 1,

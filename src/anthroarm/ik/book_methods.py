@@ -30,6 +30,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 
 # ---------------------------------------------------------------------------- tasks
@@ -59,8 +60,6 @@ class PositionTask:
         return self.robot.jacobian(q, self.fid)[self.rows]
 
     def jacobian_dot(self, q, qd):
-        import pinocchio as pin
-
         r = self.robot
         pin.computeJointJacobiansTimeVariation(
             r.model, r.data, np.asarray(q, float), np.asarray(qd, float)
@@ -89,8 +88,6 @@ class PoseTask:
         return self.robot.fk(q, self.fid)
 
     def error(self, q):
-        import pinocchio as pin
-
         T = self.value(q)
         return np.concatenate(
             [self.target[:3, 3] - T[:3, 3], pin.log3(self.target[:3, :3] @ T[:3, :3].T)]

@@ -33,6 +33,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
+from tqdm.auto import tqdm
 
 from ..errors import ParameterError
 from .closed_form import analytic_batch, require_form
@@ -235,8 +237,6 @@ class CellTable:
         gx, gy = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
         it = range(shape[2])
         if progress:
-            from tqdm.auto import tqdm
-
             it = tqdm(it, desc=f"cell table {name} D={D * 1000:g} mm", unit="slice")
         kw = {"swivel": swivel} if form.swivel else {}
         for k in it:
@@ -336,8 +336,6 @@ class CellTable:
     def refine(self, robot, p, q, steps: int = 1) -> np.ndarray:
         """``steps`` Newton steps on the full pose error (position ``p``, the table's rotation)
         from ``q``: Δq = J⁺ (p − p(q); log3(R* R(q)ᵀ)), J = Pinocchio LOCAL_WORLD_ALIGNED."""
-        import pinocchio as pin
-
         q = robot.check_q(q).copy()
         Rt = self.rotation
         target = np.asarray(p, float) - Rt @ self.point  # the tool origin's position

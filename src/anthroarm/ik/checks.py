@@ -11,18 +11,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import models as catalog
 from ..check_rows import CheckRow
+from ..robot import load
 from .closed_form import PLANAR, SRS, analytic_batch, closed_form_info
 from .qp.tasks.swivel import swivel_angle
 
 
 def rows(models, samples, rng) -> list[CheckRow]:
-    import anthroarm as aa
-
     out = []
-    for name in aa.models.names() if models is None else models:
+    for name in catalog.names() if models is None else models:
         try:
-            robot = aa.load(name)
+            robot = load(name)
         except Exception:  # noqa: BLE001 - not a catalog arm: its rows come from elsewhere
             continue
         form = closed_form_info(robot)

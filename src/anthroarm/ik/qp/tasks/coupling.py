@@ -14,6 +14,7 @@ exactly.
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from .base import Task
 
@@ -77,8 +78,6 @@ class JointCouplingTask(Task):
         if conf.nq == conf.nv:
             qt = conf.q
         else:  # joint coordinates in the tangent space (1-DOF joints of a Lie-group model)
-            import pinocchio as pin
-
             qt = pin.difference(conf.model, pin.neutral(conf.model), conf.q)
         return np.array([self._row[0] @ qt - self.offset])
 
