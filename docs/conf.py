@@ -61,6 +61,7 @@ GUIDE = [
     "control",
     "book_systems",
     "viewer",
+    "cli",
     *(["/batch"] if (DOCS / "batch.md").is_file() else []),
     "benchmarks",
 ]

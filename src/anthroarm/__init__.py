@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import importlib
 
-from . import errors, models
-from .robot import Robot, load
+from . import errors
 
 __version__ = "0.1.0"
 
@@ -35,7 +34,11 @@ _LAZY = {
     "motion",
     "hand",
     "prosthesis",
+    "models",
 }
+#: names loaded from a submodule on first use, like the subpackages: ``import anthroarm`` (and
+#: with it ``anthroarm --help``) loads neither numpy nor pinocchio until a model is needed
+_LAZY_NAMES = {"Robot": "robot", "load": "robot"}
 
 
 def __getattr__(name):  # lazy subpackages: `aa.ik.solve(...)` without importing everything up front
@@ -43,6 +46,10 @@ def __getattr__(name):  # lazy subpackages: `aa.ik.solve(...)` without importing
         mod = importlib.import_module(f".{name}", __name__)
         globals()[name] = mod
         return mod
+    if name in _LAZY_NAMES:
+        value = getattr(importlib.import_module(f".{_LAZY_NAMES[name]}", __name__), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'anthroarm' has no attribute {name!r}")
 
 

@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 import anthroarm as aa
+from anthroarm.cli.size_run import read_trajectory as _read_trajectory
 from anthroarm.errors import ActivityError, CatalogueError, InertiaError, ParameterError
 from anthroarm.prosthesis import catalogue as C
 from anthroarm.prosthesis import envelope, study, weight_rules
-from anthroarm.prosthesis.commands import _read_trajectory
 
 HEADER = ",".join(C.MOTOR_COLUMNS)
 ROW = "M1,RE,16,12,10,20,1,10,10000,40"

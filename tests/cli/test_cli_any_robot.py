@@ -14,6 +14,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm import cli
+from anthroarm.cli import runtime
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "foundation"))
 from test_chain import USER_URDF  # noqa: E402
@@ -71,14 +72,14 @@ def test_view_user_urdf_takes_a_continuous_joint_as_its_angle(tmp_path, user_urd
 def test_parse_q_maps_angles_to_cos_sin():
     r = aa.load("kinova")
     theta = np.deg2rad([170.0, 150.0, 60.0, -120.0, 90.0, 45.0])
-    q = cli._parse_q(r, np.rad2deg(theta).tolist(), deg=True)
+    q = runtime.parse_q(r, np.rad2deg(theta).tolist(), deg=True)
     assert q.shape == (r.nq,)
     # oracle: Pinocchio's FK at the same angles built joint by joint
     qp = []
     for j, t in zip((r.model.joints[i] for i in range(1, r.model.njoints)), theta):
         qp += [np.cos(t), np.sin(t)] if j.nq == 2 else [t]
     np.testing.assert_allclose(q, qp, atol=1e-15)
-    np.testing.assert_allclose(cli._joint_values(r, q), theta, atol=1e-12)
+    np.testing.assert_allclose(runtime.joint_values(r, q), theta, atol=1e-12)
 
 
 def test_ik_on_continuous_joints_prints_one_angle_per_joint(capsys):

@@ -27,10 +27,12 @@ SRC = Path(__file__).resolve().parents[2] / "src" / "anthroarm"
 
 #: file (relative to src/anthroarm) -> lines of code naming a catalog arm, still to go
 ALLOWED = {
-    "cli.py": 12,
-    "motion/commands.py": 2,
-    "prosthesis/commands.py": 2,
-    "viewer/commands.py": 1,
+    # examples in help texts (epilog) of the commands
+    "cli/batch.py": 1,
+    "cli/check.py": 1,
+    "cli/ik.py": 1,
+    "cli/urdf.py": 2,
+    "cli/view.py": 3,
     "viewer/demo.py": 1,
 }
 

@@ -8,7 +8,7 @@
    ``__getattr__`` (PEP 562: the lazy subpackages of ``anthroarm``, ``anthroarm.dynamics`` ...).
 2. No private name (one leading underscore: ``_x``, a module ``_util``) is imported from
    another top-level package of anthroarm (``from ..ik.geometric import _x`` in ``dynamics/``);
-   inside one package it is fine.  Top-level modules (``cli.py``, ``robot.py``) are packages of
+   inside one package it is fine.  Top-level modules (``robot.py``, ``chain.py``) are packages of
    their own here; ``anthroarm._io`` is a public foundation module despite its name.
 
 The files that still break a rule are listed below with their exact count: a count must not
@@ -31,16 +31,13 @@ PACKAGE = "anthroarm"
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "cli.py": 36,
     "ik/qp/_qpgen2.py": 1,
     "ik/qp/backends.py": 5,
     "ik/qp/checks.py": 2,
     "jit.py": 1,
     "models/care_robot.py": 2,
     "models/hand.py": 1,
-    "prosthesis/commands.py": 10,
     "prosthesis/report.py": 1,
-    "viewer/commands.py": 3,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
     # a circle: load() reads the catalog (models), whose builders make Robots (models imports
@@ -49,10 +46,8 @@ LOCAL_IMPORTS = {
     # a circle: chain -> kinematics.batched (the upward import of test_layers.KNOWN) and
     # models -> robot -> chain; gone when SerialChain moves down into the model layer
     "kinematics/batched.py": 1,
-    # upward imports (test_layers.KNOWN) of the faces: at the top they would close a circle
-    # (cli imports motion.commands) or load the viewer (meshcat, tornado) with the algorithm;
-    # gone when the command and the viewer demo move into cli/ and viewer/
-    "motion/commands.py": 1,
+    # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
+    # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
     "emg/simulate.py": 1,
     "hand/demo.py": 2,
 }
@@ -60,11 +55,7 @@ LOCAL_IMPORTS = {
 #: file -> private names (or names from private modules) imported from another package
 PRIVATE_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "cli.py": 1,
-    "prosthesis/commands.py": 2,
     "viewer/overlays.py": 1,
-    # anthroarm.cli._progress: with the upward import of the command above
-    "motion/commands.py": 1,
 }
 
 

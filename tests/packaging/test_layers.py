@@ -40,8 +40,6 @@ KNOWN = {
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.finger"),
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.rrss"),
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.thumb"),
-    ("anthroarm.motion.commands", "anthroarm.cli"),
-    ("anthroarm.prosthesis.commands", "anthroarm.cli"),
     ("anthroarm.prosthesis.report", "anthroarm.viewer"),
 }
 

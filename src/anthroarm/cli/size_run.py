@@ -1,95 +1,28 @@
-"""The ``anthroarm size`` command: a person → activities → joint demands → motors → an HTML report.
-
-    anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 --out report.html
-
-``--activities`` is ``adl`` (the daily-living activity library of :mod:`anthroarm.motion`, turned
-into joint trajectories for this person) or a comma-separated list of joint-trajectory files:
-``.npz`` with arrays ``t`` (N,) s and ``q`` (N, nq) rad, or ``.csv`` with a header ``t`` and the
-arm's joint names (rad; ``#`` lines are comments).  Progress bars (stderr, on a terminal) follow
-the activities and the joints; the last line printed is a JSON summary.
-"""
+"""``anthroarm size``: the run (the parser and the command's description: :mod:`.size`), and
+the joint-trajectory files ``--activities`` reads."""
 
 from __future__ import annotations
 
+import inspect
 import json
 import sys
+import zipfile
 from pathlib import Path
 
+import numpy as np
+
+from .. import models
 from .._io import check_regular_file, read_bounded
-
-
-def add_parser(sub):
-    """Register ``size`` on the CLI's subparsers (``anthroarm.cli.build_parser``)."""
-    p = sub.add_parser(
-        "size",
-        help="size a prosthesis's motors for a person's activities and write an HTML report",
-        description="From a person (height, mass, sex) and a set of activities to joint torques with a held "
-        "object (Eq. (8-5)), their envelope, the lightest catalogue motor + gearbox per joint (servo "
-        "model of Eq. (9-1)), the book's weight rules, and a self-contained HTML report.",
-        epilog="example: anthroarm size --height 1.75 --mass 70 --sex male --activities adl --payload 0.5 "
-        "--out report.html",
-    )
-    p.add_argument(
-        "--model",
-        default="human_arm7",
-        help="a catalog model built from a person's height, mass and sex (default human_arm7)",
-    )
-    p.add_argument("--height", type=float, default=1.75, help="body height, m (default 1.75)")
-    p.add_argument("--mass", type=float, default=70.0, help="body mass, kg (default 70)")
-    p.add_argument("--sex", default="male", choices=["male", "female"])
-    p.add_argument(
-        "--activities",
-        default="adl",
-        metavar="adl|FILE[,FILE...]",
-        help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
-        "and joint-name columns, rad)",
-    )
-    p.add_argument(
-        "--payload",
-        type=float,
-        default=None,
-        help="mass held in the hand all the time, kg (adl: at least this, the library's objects while "
-        "they are held; default: the library's objects only; files: default 0)",
-    )
-    p.add_argument(
-        "--margin", type=float, default=0.2, help="demand margin, fraction (default 0.2 = 20 %%)"
-    )
-    p.add_argument(
-        "--motors",
-        default=None,
-        metavar="CSV",
-        help="motor catalogue (default: the shipped example)",
-    )
-    p.add_argument(
-        "--gearboxes",
-        default=None,
-        metavar="CSV",
-        help="gearbox catalogue (default: the shipped example)",
-    )
-    p.add_argument(
-        "--out", default="report.html", metavar="FILE.html", help="the report (written atomically)"
-    )
-    p.add_argument(
-        "--no-viewer",
-        action="store_true",
-        help="leave the 3-D animation out of the report (smaller file)",
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress bars")
-    p.set_defaults(func=cmd_size)
-    return p
-
+from ..errors import ActivityError
+from ..prosthesis import catalogue, report, study
+from .common import UserError
+from .runtime import load_model, progress, resolve_model
 
 #: the largest trajectory file read (bytes): 10**6 samples of a 7-joint arm as CSV are ~150 MB
 MAX_TRAJECTORY_BYTES = 256 * 2**20
 
 
-def _read_trajectory(path: Path, robot) -> dict:
-    import zipfile
-
-    import numpy as np
-
-    from ..errors import ActivityError
-
+def read_trajectory(path: Path, robot) -> dict:
     def bad(problem):
         return ActivityError(f"{path}: {problem}")
 
@@ -159,22 +92,16 @@ def _read_trajectory(path: Path, robot) -> dict:
 
 
 def activities_from(spec: str, robot, payload: float) -> list[dict]:
-    """The activity dicts of :func:`.study.run` for ``--activities`` (module docstring)."""
+    """The activity dicts of :func:`anthroarm.prosthesis.study.run` for ``--activities``
+    (:mod:`.size`)."""
     if spec.strip().lower() == "adl":
-        from .study import adl_activities
-
-        return adl_activities(robot, payload)
-    return [_read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
+        return study.adl_activities(robot, payload)
+    return [read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
 
 
 def _person_params(a) -> dict:
     """height, mass and sex for a catalog model whose builder scales a person; anything else
     cannot be sized for a person: a one-line error naming the person models."""
-    import inspect
-
-    from .. import models
-    from ..cli import UserError
-
     builder = models.BOOK_MODELS.get(a.model)
     person = [
         n
@@ -183,18 +110,14 @@ def _person_params(a) -> dict:
     ]
     if builder is None or a.model not in person:
         raise UserError(
-            f"--model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
+            f"model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
             f"person models: {', '.join(sorted(person))}"
         )
     return dict(height=a.height, mass=a.mass, sex=a.sex)
 
 
-def cmd_size(a) -> int:
-    import numpy as np
-
-    from ..cli import UserError, _load_model, _progress
-    from . import catalogue, report, study
-
+def run(a) -> int:
+    resolve_model(a)
     out = Path(a.out)
     if out.suffix.lower() not in (".html", ".htm"):
         raise UserError(f"--out {a.out}: the report is an HTML file (.html)")
@@ -213,11 +136,11 @@ def cmd_size(a) -> int:
         if not (np.isfinite(v) and lo <= v <= hi):
             raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
     cat = catalogue.load(a.motors, a.gearboxes)
-    robot = _load_model(a.model, _person_params(a))
+    robot = load_model(a.model, _person_params(a))
     acts = activities_from(a.activities, robot, a.payload)
-    bar = _progress(len(acts) + robot.nv, "size", not a.no_progress)
+    bar = progress(len(acts) + robot.nv, "size", not a.no_progress)
 
-    def progress(stage, name):
+    def tick(stage, name):
         bar.set_postfix_str(f"{stage} {name}")
         bar.update(1)
 
@@ -229,7 +152,7 @@ def cmd_size(a) -> int:
             catalogue=cat,
             margin=a.margin,
             person=dict(height=a.height, mass=a.mass, sex=a.sex),
-            progress=progress,
+            progress=tick,
         )
         bar.set_postfix_str("report")
         report.write(st, out, viewer=not a.no_viewer)

@@ -1,0 +1,115 @@
+"""What the commands share when they run (loaded with the first command module, never by
+``--help``): loading a model the same way everywhere, joint values, progress bars."""
+
+from __future__ import annotations
+
+import difflib
+import sys
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from .. import models
+from ..errors import UnknownModelError
+from ..robot import load
+from .common import UserError, parse_locked
+from .params import parse_params
+
+__all__ = [
+    "default_model",
+    "joint_values",
+    "load_model",
+    "model_from_args",
+    "parse_params",
+    "parse_q",
+    "progress",
+    "resolve_model",
+]
+
+
+def suggestions(name: str) -> list[str]:
+    """Catalog and example-robot-data names close to a misspelled ``name`` (difflib)."""
+    known = dict.fromkeys([*models.names(), *models.erd_names()])
+    return difflib.get_close_matches(name, list(known), n=3, cutoff=0.6)
+
+
+def load_model(name, params=None, tool=None, locked=None):
+    """Load a catalog model, an example-robot-data robot or a URDF path (:func:`anthroarm.load`);
+    its typed errors (unknown name, a tree without a tool, bad keywords) print as one line, an
+    unknown name with the closest names ("did you mean")."""
+    kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
+    try:
+        return load(name, **kw, **(params or {}))
+    except UnknownModelError as exc:
+        close = suggestions(str(name)) if not Path(str(name)).suffix else []
+        if not close:
+            raise
+        hint = " or ".join(repr(c) for c in close)
+        raise UserError(f"unknown model {name!r}: did you mean {hint}? ({exc})") from None
+
+
+def default_model() -> str:
+    """The model of a command whose MODEL is optional: the catalog's arm of a person."""
+    return models.PERSON_ARM
+
+
+def resolve_model(a) -> None:
+    """``a.model`` of a command whose MODEL is optional: the positional, else the deprecated
+    ``--model``, else the catalog's arm of a person."""
+    alias = getattr(a, "model_alias", None)
+    if alias is not None:
+        if a.model is not None and a.model != alias:
+            raise UserError(f"two models given: {a.model} and --model {alias}; give one (MODEL)")
+        a.model = alias
+    if a.model is None:
+        a.model = default_model()
+
+
+def model_from_args(a, params=True):
+    """The robot of a command's ``MODEL``, ``--param``/``--NAME`` options, ``--tool``, ``--locked``."""
+    return load_model(
+        a.model,
+        parse_params(a.param, a.model, a) if params else None,
+        getattr(a, "tool", None),
+        parse_locked(getattr(a, "locked", None)),
+    )
+
+
+def parse_q(robot, values, deg: bool, what: str = "--q"):
+    """A configuration from one value per joint (rad or m; degrees with --deg; a continuous
+    joint takes its angle).  Values outside the limits are kept, with a warning."""
+    if values is None:
+        return robot.neutral()
+    names = robot.joint_names
+    if len(values) != len(names):
+        raise UserError(
+            f"{what} needs {len(names)} values for {robot.name} (joints: {', '.join(names)}), "
+            f"got {len(values)}"
+        )
+    theta = np.deg2rad(values) if deg else np.asarray(values, float)
+    q = robot.check_q(robot.chain.configuration(theta), what)
+    joints = [robot.chain.joints[i] for i in robot.chain.independent]
+    bad = [j.name for j, t in zip(joints, theta) if not j.lower - 1e-9 <= t <= j.upper + 1e-9]
+    if bad:
+        print(
+            f"anthroarm: warning: {what} is outside the joint limits of {', '.join(bad)}",
+            file=sys.stderr,
+        )
+    return q
+
+
+def joint_values(robot, q):
+    """One value per joint of ``robot.joint_names`` (a continuous joint: its angle)."""
+    return robot.angles(q)[list(robot.chain.independent)]
+
+
+def progress(total: int, desc: str, enabled: bool):
+    """A tqdm bar on stderr (only when stderr is a terminal and enabled)."""
+    return tqdm(
+        total=total,
+        desc=desc,
+        file=sys.stderr,
+        disable=not (enabled and sys.stderr.isatty()),
+        leave=False,
+    )
