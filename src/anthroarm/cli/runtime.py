@@ -41,12 +41,15 @@ def load_model(name, params=None, tool=None, locked=None):
     kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
     try:
         return load(name, **kw, **(params or {}))
-    except UnknownModelError as exc:
+    except UnknownModelError:
         close = suggestions(str(name)) if not Path(str(name)).suffix else []
         if not close:
             raise
         hint = " or ".join(repr(c) for c in close)
-        raise UserError(f"unknown model {name!r}: did you mean {hint}? ({exc})") from None
+        raise UserError(
+            f"unknown model {name!r}: did you mean {hint}? ('anthroarm models --all' lists "
+            "every name; a URDF file is given by its path)"
+        ) from None
 
 
 def default_model() -> str:
