@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from anthroarm import emg
+from anthroarm.emg import features
 from anthroarm.emg._checks import MEMORY_BUDGET
 from anthroarm.errors import EMGError
 
@@ -178,3 +179,12 @@ def test_mains_phase_overflow_is_named():
 def test_activation_at_extreme_times_has_no_warning():
     a = emg.activation(np.array([1e308, -1e308]), [(1e308, 1e308, 1.0)], ramp_s=1e-300)
     assert np.all((a >= 0) & (a <= 1))
+
+
+def test_spectrum_at_a_rate_at_the_end_of_the_float_range_is_refused():
+    """fs = 1e308 Hz overflowed Welch's scaling inside scipy (a warning and a spectrum of zeros)."""
+    x = np.random.default_rng(0).normal(size=(1, 512))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(EMGError, match="fs = 1e"):
+            features.spectrum(x, 1e308)

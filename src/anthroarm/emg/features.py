@@ -34,9 +34,18 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     a = signal(x, "emg", min_samples=8, bytes_per_value=40.0)
     fs = positive(fs, "sampling rate fs", "Hz")
     n = min(a.shape[1], max(8, int(round(positive(segment_s, "segment_s", "s") * fs))))
-    f, p = sps.welch(
-        a, fs=fs, window="hann", nperseg=n, noverlap=n // 2, detrend="constant", axis=-1
-    )
+    try:  # a rate at the end of the float range overflows Welch's scaling 1 / (fs Σw²)
+        with np.errstate(over="raise", under="ignore"):
+            f, p = sps.welch(
+                a, fs=fs, window="hann", nperseg=n, noverlap=n // 2, detrend="constant", axis=-1
+            )
+    except FloatingPointError:
+        raise EMGError(
+            f"sampling rate fs = {fs:g} Hz is beyond what a spectrum can be computed at "
+            "(its scaling overflows); give the rate in Hz"
+        ) from None
+    if not (np.isfinite(f).all() and np.isfinite(p).all()):
+        raise EMGError(f"the spectrum at fs = {fs:g} Hz is not finite; give the rate in Hz")
     return f, p
 
 
