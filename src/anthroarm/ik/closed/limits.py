@@ -158,6 +158,8 @@ def newton_on_limits(model, data, fid, q, T, lo, hi, position_only, iters: int =
     solution lies on a limit, which the bounded least squares above only approaches; linear (the
     error halves a step) at a singular configuration on a limit, hence up to ``iters`` steps."""
     x = np.clip(np.array(q, dtype=float), lo, hi)
+    if model.nq != model.nv:  # continuous joints: q holds (cos, sin), steps are in v
+        return x
     free = np.ones(x.size, dtype=bool)
     rows = slice(0, 3) if position_only else slice(0, 6)
     Rt, pt = T[:3, :3], T[:3, 3]

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ..closed.limits import refine
 from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
@@ -270,6 +271,12 @@ def _warm_closed_form(pb: Problem, mode: str, tp: float, tr: float) -> None:
     for H in poses + [far]:
         _, _, (tgt,) = parse(H, mode)
         solve_one(warm, Target(mode, tgt, tp, tr), None)
+    # the polish of a closed-form candidate at a singular pose (bounded least squares): its
+    # first use imports scipy.optimize (~1 s), which a first target needing it paid in its budget
+    robot = pb.robot
+    if robot.nq == robot.nv:  # the polish is for arms without continuous joints
+        q = sh.q(sh.ref)
+        refine(robot, q, robot.fk(q), robot.lower, robot.upper, False)
     sh.warm.add(key)
 
 
