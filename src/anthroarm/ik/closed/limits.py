@@ -59,12 +59,13 @@ def turns_into_limits(q, revolute, lo, hi):
     limits (a copy).  A joint on a limit comes out of the closed form as often at the limit
     ± 2π, which the exact wrap of the compiled call puts an ulp outside (−π/2 as 3π/2 − 2π)."""
     q = np.array(q, dtype=float)
-    for i in np.flatnonzero(revolute):
-        k = np.arange(-2, 3)
-        x = q[i] + TWO_PI * k
-        out = np.maximum(lo[i] - x, x - hi[i]).clip(0.0)
-        q[i] = x[int(np.argmin(out))]
-    return q
+    x = q[:, None] + _TURNS  # (n, 5): each joint turned by -2..2 turns
+    out = np.maximum(lo[:, None] - x, x - hi[:, None])
+    best = x[np.arange(q.size), out.argmin(1)]  # the least outside (or most inside) of each
+    return np.where(revolute & (out[:, 2] > 0.0), best, q)  # only joints outside move
+
+
+_TURNS = TWO_PI * np.arange(-2.0, 3.0)
 
 
 def slide_into_limits(q, J, lo, hi):
