@@ -37,7 +37,7 @@ ALIGN_WEIGHT = 0.25  # w / reach of the last joint's axis direction in the align
 #: 0.24 ms; 24 angles: 2 and 0.28 ms; 12: 4 and 0.21 ms; 8: 7 and 0.20 ms)
 SWIVEL_GRID = np.linspace(-np.pi, np.pi, 16, endpoint=False)
 #: the swivel angles tried first where any solution will do (no posture objective), 90° apart
-SWIVEL_GRID_COARSE = SWIVEL_GRID[::4]
+SWIVEL_GRID_COARSE = SWIVEL_GRID[::4].copy()  # C order: the compiled calls' one array type
 #: a closed form costing at most this (µs, ``ClosedForm.cost_us``) is tried first
 CHEAP_US = 50.0
 
@@ -315,8 +315,8 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
         # would otherwise compile the same kernel again
         th_ref = th_ref.copy()
     if sh.nearest_swivel is not None and th_ref is not None:
-        g = np.array(  # a writable copy (see th_ref above)
-            closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float, ndmin=1
+        g = np.atleast_1d(  # the grids are C-order module arrays: one type, no copy a call
+            np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float)
         )
         if (np.abs(g) < WRAP_MAX).all():
             one = sh.nearest_swivel(T, th_ref, g, any_solution)
