@@ -285,3 +285,14 @@ class UnsafeCacheError(AnthroarmError, PermissionError):
 class UnsafeCacheWarning(UserWarning):
     """The disk cache folder is not safe to use (see :class:`UnsafeCacheError`); anthroarm runs
     without it, keeping generated code in a private temporary folder for this process."""
+
+
+class CollisionError(AnthroarmError, ValueError):
+    """A collision model, obstacle or collision limit that cannot be used: a missing or corrupt
+    collision mesh (``link`` and ``path`` name it), a degenerate shape (radius or size <= 0,
+    non-finite pose), too many obstacles, a safety distance not below the detection distance."""
+
+    def __init__(self, message: str, link: str | None = None, path=None):
+        self.link = link
+        self.path = None if path is None else str(path)
+        super().__init__(message)

@@ -17,9 +17,9 @@ LAYERS = [
     (
         "algorithms",
         ["kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "motion", "control"]
-        + ["emg", "trajectory"],
+        + ["emg", "trajectory", "collision"],
     ),
-    ("model", ["models", "robot", "chain", "urdf_io", "chain_kernels"]),
+    ("model", ["models", "robot", "chain", "serial_chain", "urdf_io", "chain_kernels"]),
     (
         "foundation",
         ["errors", "_io", "spatial", "codegen", "cache", "threads", "jit", "check_rows"]
@@ -30,7 +30,6 @@ LEVEL = {m: i for i, (_, ms) in enumerate(LAYERS) for m in ms}
 
 #: (importer, imported) imports that still run upward: the debt of issue 29 item 1
 KNOWN = {
-    ("anthroarm.chain", "anthroarm.kinematics.batched"),
     ("anthroarm.emg.simulate", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer.browser"),
