@@ -296,3 +296,35 @@ class CollisionError(AnthroarmError, ValueError):
         self.link = link
         self.path = None if path is None else str(path)
         super().__init__(message)
+
+
+class OsimError(AnthroarmError, ValueError):
+    """An OpenSim model (``.osim``) that cannot be imported.  ``path`` names the file,
+    ``element`` the XML element at fault (``<SimmSpline>`` of ``knee_r/translation1``) and
+    ``line`` its line in the file (None when unknown)."""
+
+    def __init__(self, path, problem: str, element: str | None = None, line: int | None = None):
+        self.path = str(path)
+        self.problem = problem
+        self.element = element
+        self.line = line
+        where = ""
+        if element:
+            where += f" {element}"
+        if line is not None:
+            where += f" (line {line})"
+        super().__init__(f"{self.path}:{where}: {problem}" if where else f"{self.path}: {problem}")
+
+
+class OsimSecurityError(OsimError):
+    """The file uses a DTD / entity declarations (entity bombs, external entities), or is too
+    large to be a model."""
+
+
+class OsimUnsupportedError(OsimError):
+    """A valid OpenSim construct the import does not represent (a joint or function type, a
+    format version): the message names the remedy."""
+
+
+class OsimStrictError(OsimError):
+    """``strict=True`` and the import report lists a component as dropped or approximated."""
