@@ -44,7 +44,7 @@ from .errors import AmbiguousToolError, ParameterError, UnknownFrameError, Unsup
 from .joint_kinds import CONTINUOUS as CONTINUOUS
 from .joint_kinds import PRISMATIC as PRISMATIC
 from .joint_kinds import REVOLUTE as REVOLUTE
-from .kinematics.batched import SerialChain
+from .serial_chain import SerialChain
 from .threads import run_rows
 from .urdf_io import MAX_MOVABLE_JOINTS
 
@@ -571,7 +571,7 @@ class Chain:
 
     def serial(self, frame=None):
         """The batched FK/Jacobian evaluator of the path to ``frame``
-        (:class:`anthroarm.kinematics.batched.SerialChain`), built once per frame."""
+        (:class:`anthroarm.serial_chain.SerialChain`), built once per frame."""
         fid = self.frame(frame).index
         cache = self.__dict__.setdefault("_serial", {})
         s = cache.get(fid)

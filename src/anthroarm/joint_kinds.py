@@ -1,7 +1,7 @@
 """The kinds of joint every layer names (foundation: imports nothing).
 
 ``robot.chain`` (:class:`anthroarm.chain.Chain`) gives each joint one of these kinds and the
-batched kernel (:mod:`anthroarm.kinematics.batched`) reads them; both import them from here, so
+batched kernel (:mod:`anthroarm.serial_chain`) reads them; both import them from here, so
 neither imports the other to learn them.  :mod:`anthroarm.chain` re-exports them.
 """
 

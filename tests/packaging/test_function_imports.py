@@ -43,9 +43,6 @@ LOCAL_IMPORTS = {
     # a circle: load() reads the catalog (models), whose builders make Robots (models imports
     # robot); gone when load() moves above the catalog
     "robot.py": 1,
-    # a circle: chain -> kinematics.batched (the upward import of test_layers.KNOWN) and
-    # models -> robot -> chain; gone when SerialChain moves down into the model layer
-    "kinematics/batched.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
     "emg/simulate.py": 1,

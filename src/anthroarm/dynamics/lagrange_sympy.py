@@ -1,13 +1,12 @@
 """The sympy / LaTeX view of a Lagrange derivation (:func:`anthroarm.dynamics.lagrange.derive`):
 the derived quantities as ordinary sympy expressions, the Christoffel symbols of a sympy mass
-matrix, and the equations as LaTeX.  Re-exported by :mod:`anthroarm.dynamics.lagrange`."""
+matrix, and the equations as LaTeX.  Re-exported by :mod:`anthroarm.dynamics.lagrange`.
+
+The functions take a :class:`~anthroarm.dynamics.lagrange.Derivation` ``d`` (read through its
+attributes only): this module imports nothing of :mod:`~anthroarm.dynamics.lagrange`, which
+imports it."""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .lagrange import Derivation
 
 
 def _simp(e, simplify: bool, max_ops: int):
@@ -26,7 +25,7 @@ def _simp(e, simplify: bool, max_ops: int):
 
 
 def sympy_matrices(
-    d: Derivation, which=("T", "V", "M", "Cqd", "g"), simplify: bool = True, max_ops: int = 300
+    d, which=("T", "V", "M", "Cqd", "g"), simplify: bool = True, max_ops: int = 300
 ) -> dict:
     """The derived quantities as sympy expressions in q_k, \\dot q_k (s_k -> sin q_k ...).
 
@@ -85,9 +84,7 @@ def christoffel(M, q):
     ]
 
 
-def latex(
-    d: Derivation, simplify: bool = True, max_ops: int = 300, which=("T", "V", "M", "Cqd", "g")
-) -> str:
+def latex(d, simplify: bool = True, max_ops: int = 300, which=("T", "V", "M", "Cqd", "g")) -> str:
     """LaTeX of the Lagrange equations ``τ = M(q) q̈ + C(q,q̇) q̇ + g(q)`` with each quantity
     written out (see :func:`sympy_matrices` for ``simplify``/``max_ops``)."""
     import sympy as sp

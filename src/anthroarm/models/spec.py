@@ -134,6 +134,10 @@ class DHRow:
     lower: float = -np.pi
     upper: float = np.pi
 
+    def static(self) -> np.ndarray:
+        """Static part S of the row, (4, 4): ``A(q) = Rz(q) S`` (R) or ``A(q) = Tz(q) S`` (P)."""
+        return dh_matrix(self, 0.0)
+
 
 @dataclass(frozen=True)
 class PrintedForm:
