@@ -14,8 +14,9 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.design import structure
+from anthroarm.design.structure import mechanism_of
 from anthroarm.errors import AnthropometryError, CouplingError, ParameterError
-from anthroarm.models.hand import configuration, mechanism_of
+from anthroarm.models.hand import configuration
 
 deg = np.pi / 180
 

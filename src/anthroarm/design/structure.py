@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import models as catalog
 from ..check_rows import CheckRow
+from ..models import hand as hand_model
 from ..robot import load
 
 ROMAN = {1: "I", 2: "II", 3: "III", 4: "IV", 5: "V"}
@@ -225,7 +226,7 @@ def human_fingers() -> Mechanism:
 def upper_limb_mechanism() -> Mechanism:
     """Human upper-limb mechanism of Fig. 2-2 (l. 540–546), trunk as the frame (the book's
     graph; the catalog's 27-joint limb ``human_upper_limb`` has its own graph,
-    :func:`anthroarm.models.hand.mechanism_of`).
+    :func:`mechanism_of`).
 
     Links: 1 humerus, 2 ulna, 3 radius, 4 palm, 5–19 phalanges (n = 19).  Pairs: shoulder S,
     humerus–ulna R (elbow flexion), humerus–radius S, ulna–radius class II, wrist (palm–radius)
@@ -243,6 +244,60 @@ def upper_limb_mechanism() -> Mechanism:
         m.add_link(ln)
     for j in fingers.joints:
         m.add_joint(j.name, j.pair, j.a, j.b)
+    return m
+
+
+def mechanism_of(spec):
+    """The mechanism graph (:class:`Mechanism`) of a catalog model's tree spec (a
+    :class:`~anthroarm.models.spec.ChainSpec`, e.g. ``aa.models.spec("human_upper_limb")``): joints
+    whose child link is a zero-length connector (a base pair's middle link) are merged with the
+    joint that follows at the same point into one pair with 2 (``U``, IV级) or 3 (``S``, III级)
+    rotations; other revolute joints are ``R`` pairs.  Mimic joints count as the pair they are
+    (a coupling is not a pair: subtract it from Eq. (2-1) yourself).  Links are the spec's
+    links that are not connectors; the ground is ``spec.base_link``."""
+    joints = list(spec.joints)
+    # serial predecessor of every joint's parent (a joint with parent=None hangs on the previous link)
+    parents, prev = [], spec.base_link
+    for j in joints:
+        p = j.parent if j.parent is not None else prev
+        parents.append(p)
+        prev = j.link.name
+    children = {}
+    for p in parents:
+        children[p] = children.get(p, 0) + 1
+
+    def connector(link):
+        return (
+            link.mass <= hand_model.VIRTUAL_MASS * 1.0001
+            or link.segment is None
+            or np.linalg.norm(link.segment) < 1e-12
+        ) and children.get(link.name, 0) == 1
+
+    merged_into = {}  # connector link -> the link the group started from
+    m = Mechanism(spec.name, ground=spec.base_link)
+    groups = []  # (start link, end link, n rotations)
+    for j, p in zip(joints, parents):
+        start = merged_into.get(p, p)
+        if p in merged_into:
+            # extend the open group ending at p
+            for g in groups:
+                if g[1] == p:
+                    g[1], g[2] = j.link.name, g[2] + 1
+                    break
+        else:
+            groups.append([start, j.link.name, 1])
+        zero_origin_next = True
+        if connector(j.link):
+            nxt = [k for k, pp in zip(joints, parents) if pp == j.link.name]
+            zero_origin_next = bool(nxt) and np.allclose(nxt[0].origin[:3, 3], 0.0)
+        if connector(j.link) and zero_origin_next:
+            merged_into[j.link.name] = start
+    kind = {1: "R", 2: "U", 3: "S"}
+    for start, end, n in groups:
+        for ln in (start, end):
+            if ln not in m.links:
+                m.add_link(ln)
+        m.add_joint(f"{start}->{end}", kind[n], start, end)
     return m
 
 

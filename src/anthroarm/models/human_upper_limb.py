@@ -5,7 +5,7 @@ segments, Table 2.2 ranges, hanging along −z; y forward, x to the person's rig
 ``hand`` link (the palm) hang five digits of 4 joints each (:mod:`anthroarm.models.hand`:
 Buchholz et al. (1992) segment lengths, AAOS ranges, phalanx masses): 7 + 20 = 27 joints,
 the book's F = 27 of which 20 are the fingers' (``ch1-2.md`` §2.2; Eq. (2-1) on the graph
-from :func:`anthroarm.models.hand.mechanism_of`).
+from :func:`anthroarm.design.structure.mechanism_of`).
 
 With ``dip_coupling="2/3"`` the four DIP joints mimic their PIP (Rijpkema & Girard 1991):
 the graph still has F = 27 pairs' freedoms, the couplings remove 4, so nq = 23.
