@@ -36,7 +36,6 @@ LOCAL_IMPORTS = {
     "ik/qp/checks.py": 2,
     "jit.py": 1,
     "models/care_robot.py": 2,
-    "models/hand.py": 1,
     "prosthesis/report.py": 1,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
