@@ -7,6 +7,12 @@ import pytest
 
 matplotlib.use("Agg")
 os.environ.setdefault("MPLBACKEND", "Agg")
+# The suite tests the compiled kernels: each compiles (or loads) on first use, in the test's
+# thread (anthroarm.jit mode "compile"), so no test depends on when a background compilation
+# ends.  The default mode "auto" (the reference path while compiling in the background) is
+# tested by tests that start their own processes (tests/foundation/test_jit_modes.py,
+# tests/adversarial/test_cold_start.py).
+os.environ.setdefault("ANTHROARM_JIT", "compile")
 
 
 def _same_urdf_text(a: str, b: str, rtol: float = 1e-12) -> bool:

@@ -70,11 +70,11 @@ import warnings
 from pathlib import Path
 
 from ._io import atomic_write_text
-from .errors import UnsafeCacheError, UnsafeCacheWarning
+from .errors import ParameterError, UnsafeCacheError, UnsafeCacheWarning
 
 ENV = "ANTHROARM_CACHE"
 #: subfolders this module manages (``cache clear`` empties only these)
-SUBFOLDERS = ("lagrange", "ik", "urdf", "numba")
+SUBFOLDERS = ("lagrange", "ik", "urdf", "numba", "kernels")
 _SIDECAR = ".sha256"
 _LOCK = threading.Lock()
 _CC_IDS: dict[str, str] = {}
@@ -269,17 +269,43 @@ def compiler() -> str | None:
     return shutil.which(os.environ.get("CC", "cc"))
 
 
-class CompiledOnce:
-    """One family of compiled kernels, each built on first use and kept on its owner.
+#: ``$ANTHROARM_JIT``: who compiles (:mod:`anthroarm.jit`; the C kernels of
+#: :class:`CompiledOnce` follow it): ``auto`` in the background, ``compile`` on first use in the
+#: calling thread, ``reference`` never
+BUILD_MODES = ("auto", "compile", "reference")
 
-    :meth:`get` builds ``owner.<attr>`` once (``False`` after a failed build, so it is not
-    retried) and keeps the last failure for :meth:`status`; the environment variable ``switch``
-    set to 0/false/no/off disables the family, and callers then use ``fallback`` (named in the
-    status)."""
+
+def build_mode() -> str:
+    """``$ANTHROARM_JIT`` (:data:`BUILD_MODES`; ``auto`` if unset).  An unknown value raises
+    :class:`~anthroarm.errors.ParameterError`."""
+    m = os.environ.get("ANTHROARM_JIT", "auto").strip().lower() or "auto"
+    if m not in BUILD_MODES:
+        raise ParameterError(f"ANTHROARM_JIT={m!r}: give one of {', '.join(BUILD_MODES)}")
+    return m
+
+
+class _Pending:
+    """Marks a kernel whose build runs in a background thread."""
+
+
+PENDING = _Pending()
+
+
+class CompiledOnce:
+    """One family of compiled kernels, each built once and kept on its owner.
+
+    :meth:`get` returns ``owner.<attr>``: loaded from the disk cache at once where it is there;
+    else built — in a background thread in the ``auto`` :func:`build_mode` (callers use
+    ``fallback`` until it is done: nothing compiles on the caller's clock), in the calling
+    thread in ``compile``, never in ``reference``.  A failed build leaves ``False`` (not
+    retried) and its reason for :meth:`status`; the environment variable ``switch`` set to
+    0/false/no/off disables the family.  ``build(owner, compile)`` returns the kernel, or None
+    when ``compile`` is False and the cache does not hold it."""
 
     def __init__(self, switch: str, fallback: str, available: str):
         self.switch, self.fallback, self.available = switch, fallback, available
         self.reason: str | None = None
+        self.lock = threading.Lock()
 
     def enabled(self) -> bool:
         return os.environ.get(self.switch, "1").strip().lower() not in ("0", "false", "no", "off")
@@ -292,21 +318,38 @@ class CompiledOnce:
             return f"no C compiler ($CC or cc) found: {self.fallback}"
         return self.reason or self.available
 
+    def _build(self, owner, attr, build, what, compile_now):
+        try:
+            k = build(owner, compile_now)
+            self.reason = None
+        except (RuntimeError, OSError) as exc:
+            self.reason = f"compiled {what} unavailable ({exc}); {self.fallback}"
+            k = False
+        if k is not None:
+            setattr(owner, attr, k)
+        return k
+
     def get(self, owner, attr: str, build, what: str):
-        """``owner.<attr>``, built by ``build(owner)`` the first time; None where the family is
-        disabled or the build failed (``what`` names the kernel in the status)."""
+        """``owner.<attr>`` (see the class); None where the family is disabled, the build
+        failed or still runs (``what`` names the kernel in the status)."""
         if not self.enabled():
             return None
         k = getattr(owner, attr)
         if k is None:
-            try:
-                k = build(owner)
-                self.reason = None
-            except (RuntimeError, OSError) as exc:
-                self.reason = f"compiled {what} unavailable ({exc}); {self.fallback}"
-                k = False
-            setattr(owner, attr, k)
-        return k or None
+            with self.lock:
+                k = getattr(owner, attr)
+                if k is None:
+                    mode = build_mode()
+                    k = self._build(owner, attr, build, what, mode == "compile")
+                    if k is None and mode == "auto":
+                        setattr(owner, attr, PENDING)
+                        threading.Thread(
+                            target=self._build,
+                            args=(owner, attr, build, what, True),
+                            name=f"anthroarm-build-{attr}",
+                            daemon=True,
+                        ).start()
+        return k if k is not PENDING and k else None
 
 
 def compiler_id(cc: str) -> str:
@@ -456,14 +499,17 @@ class CompileError(RuntimeError):
     """The C compiler is missing or failed (message: the compiler's first 500 characters)."""
 
 
-def shared_library(sub: str, stem: str, source: str, flags: list[str]) -> tuple[Path, str]:
+def shared_library(
+    sub: str, stem: str, source: str, flags: list[str], compile: bool = True
+) -> tuple[Path, str] | None:
     """Path of a shared library compiled from C ``source`` with ``flags``: the cached
     ``<stem>_<key>.so`` if its bytes verify, its size on disk is theirs and it is whole
     (:func:`library_complete`), else compiled now and stored: a library that fails any of these
     is never returned, so never handed to ``dlopen``.  The key hashes the source, the compiler
     (:func:`compiler_id`) and the flags.  Without a writable cache folder
     the library is compiled into a private temporary folder.  Returns ``(path, origin)`` with
-    origin "cache" or "compiled"; raises :class:`CompileError`."""
+    origin "cache" or "compiled" (None with ``compile=False`` and no cached library); raises
+    :class:`CompileError`."""
     cc = compiler()
     if cc is None:
         raise CompileError("no C compiler ($CC or cc)")
@@ -480,6 +526,8 @@ def shared_library(sub: str, stem: str, source: str, flags: list[str]) -> tuple[
             if same and library_complete(data):
                 return d / name, "cache"
             _remove(d / name)  # never handed to dlopen: compiled again
+    if not compile:
+        return None
     so = _compile(cc, source, flags)
     path = write(sub, name, so)
     if path is None:

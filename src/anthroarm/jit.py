@@ -1,179 +1,278 @@
-"""Compiled scalar kernels: the Python source of a kernel, compiled by Numba.
+"""Compiled kernels: one Python source per formula, compiled by Numba off the caller's clock.
 
-A kernel written here once (plain Python on floats, tuples and small numpy arrays) is the one
-source of its formula: Numba compiles *that* source to machine code on first use
-(https://numba.readthedocs.io, ``numba.njit``), and ``py_func`` of the compiled object is
-the same function run by the Python interpreter (what the tests compare against where they
-want the interpreter's answer).  There is no second copy to keep in step.
+A kernel (``@kernel``) is plain Python on floats, tuples and small numpy arrays: the one source
+of its formula.  It runs two ways, with the same answers:
 
-Disk cache: the compiled code of every kernel is kept by Numba's per-function cache in the
-subfolder ``numba`` of anthroarm's cache (:func:`anthroarm.cache.root`; ``$ANTHROARM_CACHE``
-moves it), unless ``$NUMBA_CACHE_DIR`` is already set or Numba was imported before anthroarm.
-Numba keys each entry by the source file's path, modification time and size, the function's
-bytecode and signature, the target CPU and its own version, and recompiles when any of them
-changes.  A compiled kernel also holds the code of the kernels it calls, which may live in other
-modules (the class solvers call the subproblems of :mod:`anthroarm.ik.subproblems`), and Numba
-does not look at those; so the stamp of every entry here also holds the SHA-256 of the sources
-of all the kernel modules of its package (:func:`kernel_sources_digest`): an edited subproblem
-recompiles its callers instead of leaving them with the old code.  Like every entry of anthroarm's cache, each data file is *verified before it is
-loaded*: it is written atomically with the SHA-256 of its contents in front
-(:class:`VerifiedCacheFile`), and a file that does not match (truncated, edited, half-copied) or
-an index that cannot be read is dropped and the kernel compiled again — never loaded.  The
-first call of a kernel in a fresh cache compiles it (about a second per kernel family), later
-processes load it in milliseconds.  ``anthroarm cache clear`` empties it.
+- **compiled**: Numba (https://numba.readthedocs.io, ``numba.njit``) compiles that source to
+  machine code, kept in Numba's per-function disk cache (the subfolder ``numba`` of anthroarm's
+  cache, :func:`anthroarm.cache.root`; ``$ANTHROARM_CACHE`` moves it, unless
+  ``$NUMBA_CACHE_DIR`` is set or Numba was imported before anthroarm);
+- **reference**: the same source run by the Python interpreter (:func:`reference`), with
+  Numba's float semantics where the interpreter would raise (``error_model="numpy"``: a
+  domain error of :mod:`math` gives NaN, not ``ValueError``), and :func:`local` arrays made by
+  :func:`numpy.empty`.  About 400 times slower than compiled (~1.3 ms for one pose of a 6R arm),
+  but it needs no compilation.
+
+**Who compiles, and when** (``$ANTHROARM_JIT``):
+
+``auto`` (default)
+    A kernel called from Python runs compiled once the kernels of this version of the sources
+    are compiled in the cache — the *ready stamp* (:func:`ready_name`: the SHA-256 of the kernel
+    sources, Numba's and Python's versions and the CPU) with the SHA-256 of every file Numba
+    wrote.  Until then it runs its reference while **one background process**
+    (``python -m anthroarm.warmup``, started by the first kernel call of any process; a lock
+    file keeps it single) compiles every kernel through the public entry points and writes the
+    stamp.  Each process watches for the stamp (a daemon thread), verifies the files against it,
+    loads the compiled kernels it has used (still on that thread) and switches: no compilation
+    and no cache loading on the caller's clock.  A time budget (``aa.ik.solve(max_time=)``)
+    therefore never counts compilation.
+``compile``
+    Numba's own behaviour: a kernel compiles (or loads from the cache) on its first call, in the
+    calling thread.  The background process runs in this mode.
+``reference``
+    Never compile: every kernel runs its reference (a machine where LLVM cannot run, debugging).
+
+**Integrity.**  Numba keys each entry by the source file's path, modification time and size,
+the function's bytecode and signature, the target CPU and its own version.  A kernel also holds
+the code of the kernels it calls, which Numba does not look at; the ready stamp holds the digest
+of all kernel sources (:func:`kernel_sources_digest`), so an edited kernel makes a new stamp and
+everything is compiled again.  Numba's files are pickles: before a process uses compiled code it
+checks every file in the folder against the SHA-256 the stamp lists; a file that does not match
+(truncated, edited, planted, foreign) or is not listed is deleted and the kernels are compiled
+again in the background — never loaded.  ``anthroarm cache clear`` empties the folder.
 
 Kernels are compiled with ``nogil=True`` (threads run them in parallel; they hold no state) and
 ``error_model="numpy"`` (a division by zero gives inf/NaN as in numpy, checked by the kernel,
 instead of raising).
+
+**State.**  The registry of kernels and the mode of the process are module-level state by
+design (like the disk cache): compiled code is per process.  :data:`STATE` says which mode the
+process is in; it changes once, from reference to compiled, under a lock.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 from . import cache as _cache
 
 #: the cache subfolder of the compiled kernels
 CACHE_SUBFOLDER = "numba"
+#: the cache subfolder of the ready stamps
+STAMP_SUBFOLDER = "kernels"
 
-if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in __import__("sys").modules:
+if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
     os.environ["NUMBA_CACHE_DIR"] = str(_cache.root() / CACHE_SUBFOLDER)
 
 import functools  # noqa: E402
 import hashlib  # noqa: E402
-import pickle  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import platform  # noqa: E402
+import subprocess  # noqa: E402
+import threading  # noqa: E402
+import time  # noqa: E402
+import types as pytypes  # noqa: E402
+import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import llvmlite  # noqa: E402
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
+from llvmlite import binding as llvm  # noqa: E402
+from llvmlite import ir  # noqa: E402
 from numba import types  # noqa: E402
-from numba.core import caching, cgutils  # noqa: E402
-from numba.core.imputils import impl_ret_borrowed  # noqa: E402
-from numba.extending import intrinsic  # noqa: E402
-from numba.np.arrayobj import populate_array  # noqa: E402
+from numba.extending import intrinsic, typeof_impl  # noqa: E402
 
-OPTIONS = dict(nogil=True, error_model="numpy")
-_MAGIC = b"anthroarm-sha256\n"
+OPTIONS = dict(nogil=True, error_model="numpy", cache=True)
+MODES = _cache.BUILD_MODES
+#: seconds between two looks for the ready stamp by a waiting process
+POLL = 0.25
 
 
-class VerifiedCacheFile(caching.IndexDataCacheFile):
-    """Numba's index and data files of one kernel, each data file prefixed by the SHA-256 of
-    its payload and checked before it is unpickled; a damaged index reads as empty."""
+def mode() -> str:
+    """The mode asked by ``$ANTHROARM_JIT`` (:func:`anthroarm.cache.build_mode`)."""
+    return _cache.build_mode()
 
-    def _load_index(self):
+
+# --------------------------------------------------------------------------- the reference
+def _nan_on_error(f):
+    """``f`` of :mod:`math` returning what Numba's compiled call returns where CPython raises:
+    NaN for a domain error, ±inf for an overflow or a pole."""
+
+    @functools.wraps(f)
+    def g(*args):
         try:
-            return super()._load_index()
-        except Exception:  # noqa: BLE001 - truncated/edited index: compile again
-            return {}
+            return f(*args)
+        except ValueError:
+            return math.nan
+        except (OverflowError, ZeroDivisionError):
+            return math.inf
 
-    def _save_data(self, name, data):
-        payload = self._dump(data)
-        with self._open_for_write(self._data_path(name)) as f:  # temp file + os.replace
-            f.write(_MAGIC + hashlib.sha256(payload).digest() + payload)
-
-    def _load_data(self, name):
-        path = self._data_path(name)
-        with open(path, "rb") as f:
-            raw = f.read()
-        head = len(_MAGIC) + 32
-        if (
-            not raw.startswith(_MAGIC)
-            or hashlib.sha256(raw[head:]).digest() != raw[len(_MAGIC) : head]
-        ):
-            try:
-                os.remove(path)
-            except OSError:
-                pass
-            return None  # not verified: compiled again, never loaded
-        return pickle.loads(raw[head:])
+    return g
 
 
-def _package_root(func) -> str:
-    """The folder of the top-level package that defines ``func`` (its own folder for a module
-    outside a package)."""
-    import sys
+#: :mod:`math` as compiled kernels see it (``error_model="numpy"``)
+MATH = pytypes.SimpleNamespace(
+    **{
+        k: (_nan_on_error(v) if callable(v) and not isinstance(v, type) else v)
+        for k, v in vars(math).items()
+        if not k.startswith("__")
+    }
+)
 
-    mod = sys.modules.get(func.__module__.split(".")[0])
-    path = getattr(mod, "__path__", None)
-    if path:
-        return str(Path(list(path)[0]).resolve())
-    return str(Path(func.__code__.co_filename).resolve().parent)
+
+def _float_floor(x):
+    return math.nan if math.isnan(x) else (math.floor(x) if math.isfinite(x) else x)
+
+
+MATH.floor = _float_floor
+MATH.ceil = lambda x: math.nan if math.isnan(x) else (math.ceil(x) if math.isfinite(x) else x)
 
 
 @functools.lru_cache(maxsize=None)
-def kernel_sources_digest(root: str) -> str:
-    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
-    kernels (their text holds ``@kernel``), with their paths relative to ``root``; read once per
-    process and folder."""
-    base = Path(root)
-    h = hashlib.sha256()
-    for p in sorted(base.rglob("*.py")):
-        try:
-            text = p.read_bytes()
-        except OSError:
-            continue
-        if b"@kernel" in text:
-            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
-    return h.hexdigest()
+def _reference_of(kernel) -> pytypes.FunctionType:
+    f = kernel.py_func
+    glob: dict = {}
+    ref = pytypes.FunctionType(f.__code__, glob, f.__name__, f.__defaults__, f.__closure__)
+    ref.__doc__, ref.__qualname__, ref.__module__ = f.__doc__, f.__qualname__, f.__module__
+    glob.update(f.__globals__)
+    for k, v in f.__globals__.items():
+        if v is math:
+            glob[k] = MATH
+        elif isinstance(v, Kernel) and v is not kernel:
+            glob[k] = v  # its __call__ runs its reference until the process switches
+        elif id(v) in _PY_FORMS:
+            glob[k] = _PY_FORMS[id(v)]
+    glob[f.__name__] = ref if f.__globals__.get(f.__name__) is kernel else glob.get(f.__name__)
+    return ref
 
 
-class VerifiedCache(caching.FunctionCache):
-    """Numba's per-function cache on :class:`VerifiedCacheFile`; an entry that verifies but
-    cannot be rebuilt (another build of the same version) is compiled again as well.  The
-    source stamp is Numba's (the function's file) and :func:`kernel_sources_digest` (the
-    kernels it may call)."""
-
-    def __init__(self, py_func):
-        super().__init__(py_func)
-        stamp = (
-            self._impl.locator.get_source_stamp(),
-            kernel_sources_digest(_package_root(py_func)),
-        )
-        self._cache_file = VerifiedCacheFile(
-            cache_path=self._cache_path, filename_base=self._impl.filename_base, source_stamp=stamp
-        )
-
-    def load_overload(self, sig, target_context):
-        try:
-            return super().load_overload(sig, target_context)
-        except Exception:  # noqa: BLE001 - any unreadable entry: compile again
-            return None
+def reference(kernel) -> pytypes.FunctionType:
+    """The reference of ``kernel``: its source run by the interpreter, with :data:`MATH` for
+    :mod:`math` and :func:`numpy.empty` for :func:`local` arrays (see the module docstring)."""
+    return _reference_of(kernel)
 
 
-def kernel(func=None, *, counted: bool = True, inline: bool = False):
-    """Compile ``func`` with Numba (:data:`OPTIONS`, the verified disk cache); the result is
-    called like ``func``, and its ``py_func`` is ``func`` itself.
+# --------------------------------------------------------------------------- kernels
+class Kernel:
+    """A compiled kernel: Numba's dispatcher (:attr:`dispatcher`) for the kernels that call it
+    (Numba types it as that dispatcher), and, called from Python, whichever of compiled code or
+    :func:`reference` the process runs (:data:`STATE`).  ``py_func`` is the source function."""
 
-    ``@kernel(counted=False)`` compiles an entry point without Numba's reference counting
-    (``_nrt=False``): every array it or a kernel it calls touches is an argument or a
-    :func:`local` array, so no array is allocated on the heap, and the atomic reference counts
-    of each view (a large part of a call on small inputs) are not made.  A heap allocation in
-    any kernel it calls fails to compile.  Numba keeps one compiled body of a kernel per
-    argument types, whichever entry point compiled it first, so a kernel that such an entry
-    point calls must not return an array (a view returned uncounted to a counting caller would
-    be released once too often): a kernel that returns views is ``inline=True`` (compiled
-    into each caller's body, ``numba.njit(inline="always")``)."""
+    __slots__ = ("dispatcher", "py_func", "fn", "seen", "__name__", "__qualname__", "__dict__")
+
+    def __init__(self, dispatcher):
+        self.dispatcher = dispatcher
+        self.py_func = dispatcher.py_func
+        self.__name__ = self.py_func.__name__
+        self.__qualname__ = self.py_func.__qualname__
+        self.__doc__ = self.py_func.__doc__
+        self.seen = None  # the Numba types of its first call from Python (loaded at the switch)
+        self.fn = self._first
+
+    def __call__(self, *args):
+        return self.fn(*args)
+
+    def _first(self, *args):
+        start()
+        if self.fn == self._first:  # reference mode: remember what the switch must load
+            self.fn = reference(self)
+        if self.seen is None and STATE.compiled is False:
+            self.seen = tuple(numba.typeof(a) for a in args)
+        return self.fn(*args)
+
+    @property
+    def signatures(self):
+        return self.dispatcher.signatures
+
+    def __repr__(self):
+        return f"<kernel {self.py_func.__module__}.{self.__qualname__}>"
+
+
+@typeof_impl.register(Kernel)
+def _typeof_kernel(val, c):
+    return numba.typeof(val.dispatcher)
+
+
+class Entry:
+    """The compiled body of a kernel for fixed argument types (:func:`entry_point`), or its
+    reference until the process switches to compiled code."""
+
+    __slots__ = ("kernel", "sig", "fn")
+
+    def __init__(self, kernel, sig):
+        self.kernel, self.sig = kernel, sig
+        self.fn = self._body()
+
+    def _body(self):
+        if STATE.compiled:
+            return self.kernel.dispatcher.compile(self.sig)
+        return reference(self.kernel)
+
+    def __call__(self, *args):
+        return self.fn(*args)
+
+
+def kernel(func=None, *, inline: bool = False):
+    """Make ``func`` a :class:`Kernel` (Numba :data:`OPTIONS`, its disk cache); called like
+    ``func``.  ``inline=True`` compiles it into each caller's body
+    (``numba.njit(inline="always")``)."""
 
     def wrap(f):
-        options = OPTIONS if counted else dict(OPTIONS, _nrt=False)
-        if inline:
-            options = dict(options, inline="always")
-        dispatcher = numba.njit(**options)(f)
-        dispatcher._cache = VerifiedCache(f)  # numba.njit(cache=True) with our cache file
-        return dispatcher
+        options = dict(OPTIONS, inline="always") if inline else OPTIONS
+        k = Kernel(numba.njit(**options)(f))
+        STATE.kernels.append(k)
+        return k
 
     return wrap if func is None else wrap(func)
 
 
-def entry_point(dispatcher, *args):
-    """The compiled body of kernel ``dispatcher`` for the Numba types of ``args`` (example
-    arguments; compiled, or loaded from the disk cache, now if it is not yet), as a function
-    called with arguments of exactly those types.  It skips the dispatcher's resolution of the
-    argument types on every call (about 40 ns an array argument) — and its checks: an array of
-    another dtype, dimension, layout or alignment, or of a size the kernel does not expect, is
-    undefined behaviour.  For a hot call whose caller has checked its arguments (the one-pose
-    closed-form IK, :func:`anthroarm.ik.closed_form.analytic`)."""
-    return dispatcher.compile(tuple(numba.typeof(a) for a in args))
+def entry_point(k: Kernel, *args) -> Entry:
+    """The body of kernel ``k`` for the Numba types of ``args`` (example arguments), called
+    with arguments of exactly those types: compiled (``dispatcher.compile``, which skips the
+    dispatcher's resolution of the argument types on every call, about 40 ns an array
+    argument, and its checks: an array of another dtype, dimension, layout or alignment is
+    undefined behaviour) once the process runs compiled code, its reference until then.  For a
+    hot call whose caller has checked its arguments (the one-pose closed-form IK,
+    :func:`anthroarm.ik.closed_form.analytic`)."""
+    start()
+    e = Entry(k, tuple(numba.typeof(a) for a in args))
+    with STATE.lock:
+        STATE.entries.append(e)
+    return e
+
+
+# --------------------------------------------------------------------------- local arrays
+def _array_value(context, builder, arrty, data, shape, strides, meminfo=None, parent=None):
+    """The LLVM value of a Numba array of type ``arrty`` (Numba's array data model, read through
+    ``context.data_model_manager``; llvmlite's ``insert_value``)."""
+    model = context.data_model_manager[arrty]
+    llty = context.get_value_type(arrty)
+    intp = context.get_value_type(types.intp)
+    pos = model.get_field_position
+    val = ir.Constant(llty, ir.Undefined)
+    elem = llty.elements
+    val = builder.insert_value(
+        val,
+        meminfo if meminfo is not None else ir.Constant(elem[pos("meminfo")], None),
+        pos("meminfo"),
+    )
+    val = builder.insert_value(
+        val, parent if parent is not None else ir.Constant(elem[pos("parent")], None), pos("parent")
+    )
+    itemsize = context.get_abi_sizeof(context.get_data_type(arrty.dtype))
+    nitems = ir.Constant(intp, 1)
+    for n in shape:
+        nitems = builder.mul(nitems, n)
+    val = builder.insert_value(val, nitems, pos("nitems"))
+    val = builder.insert_value(val, ir.Constant(intp, itemsize), pos("itemsize"))
+    val = builder.insert_value(val, data, pos("data"))
+    for i, (n, s) in enumerate(zip(shape, strides)):
+        val = builder.insert_value(val, n, [pos("shape"), i])
+        val = builder.insert_value(val, s, [pos("strides"), i])
+    return val
 
 
 def _local_array(dtype, ndim: int):
@@ -188,20 +287,20 @@ def _local_array(dtype, ndim: int):
         arrty = types.Array(dtype, ndim, "C")
 
         def codegen(context, builder, sig, args):
-            ary = context.make_array(arrty)(context, builder)
+            intp = context.get_value_type(types.intp)
             llty = context.get_data_type(dtype)
             size = context.get_abi_sizeof(llty)
-            intp = functools.partial(context.get_constant, types.intp)
+            with builder.goto_entry_block():
+                data = builder.alloca(llty, size=ir.Constant(intp, int(np.prod(shape))))
             strides = [size * int(np.prod(shape[i + 1 :])) for i in range(ndim)]
-            populate_array(
-                ary,
-                data=cgutils.alloca_once(builder, llty, size=int(np.prod(shape))),
-                shape=[intp(n) for n in shape],
-                strides=[intp(s) for s in strides],
-                itemsize=intp(size),
-                meminfo=None,
+            return _array_value(
+                context,
+                builder,
+                arrty,
+                data,
+                [ir.Constant(intp, n) for n in shape],
+                [ir.Constant(intp, s) for s in strides],
             )
-            return ary._getvalue()
 
         return arrty(*sizes), codegen
 
@@ -213,7 +312,7 @@ def _local_array(dtype, ndim: int):
 def _view_array(ndim: int):
     """A Numba intrinsic ``f(a, *shape)`` (``ndim`` integer sizes): the first prod(shape) entries
     of the C-order array ``a`` (in memory order) as a C-order array of that shape (same data,
-    dtype and owner; :data:`view2`)."""
+    dtype and owner, whose reference count it takes; :data:`view2`)."""
 
     def typer(typingctx, arr, sizes):
         if not (isinstance(arr, types.Array) and arr.layout == "C") or not all(
@@ -223,24 +322,29 @@ def _view_array(ndim: int):
         outty = arr.copy(ndim=ndim, layout="C")
 
         def codegen(context, builder, sig, args):
-            src = context.make_array(sig.args[0])(context, builder, args[0])
+            src_model = context.data_model_manager[sig.args[0]]
+            field = src_model.get_field_position
+            src = args[0]
             shape = [
                 context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:])
             ]
-            strides = [src.itemsize]
+            itemsize = builder.extract_value(src, field("itemsize"))
+            strides = [itemsize]
             for n in shape[:0:-1]:
                 strides.insert(0, builder.mul(strides[0], n))
-            out = context.make_array(outty)(context, builder)
-            populate_array(
-                out,
-                data=src.data,
-                shape=shape,
-                strides=strides,
-                itemsize=src.itemsize,
-                meminfo=src.meminfo,
-                parent=src.parent,
+            out = _array_value(
+                context,
+                builder,
+                outty,
+                builder.extract_value(src, field("data")),
+                shape,
+                strides,
+                meminfo=builder.extract_value(src, field("meminfo")),
+                parent=builder.extract_value(src, field("parent")),
             )
-            return impl_ret_borrowed(context, builder, outty, out._getvalue())
+            if context.enable_nrt:  # a borrowed view returned: it holds a reference
+                context.nrt.incref(builder, outty, out)
+            return out
 
         return outty(arr, *sizes), codegen
 
@@ -266,12 +370,291 @@ local2 = _local_array(types.float64, 2)
 local_flags = _local_array(types.boolean, 1)
 local_ints2 = _local_array(types.int64, 2)
 
+#: what the reference runs for each of them
+_PY_FORMS = {
+    id(local): lambda n: np.empty(n),
+    id(local2): lambda r, c: np.empty((r, c)),
+    id(local_flags): lambda n: np.empty(n, np.bool_),
+    id(local_ints2): lambda r, c: np.empty((r, c), np.int64),
+    id(view2): lambda a, r, c: a.reshape(-1)[: r * c].reshape(r, c),
+    id(view3): lambda a, x, y, z: a.reshape(-1)[: x * y * z].reshape(x, y, z),
+}
+
+
+# --------------------------------------------------------------------------- the switch
+class _State:
+    """The process's kernels and mode: ``compiled`` None (not started), False (reference,
+    waiting for the background compilation) or True."""
+
+    def __init__(self):
+        self.lock = threading.RLock()
+        self.kernels: list[Kernel] = []
+        self.entries: list[Entry] = []
+        self.compiled: bool | None = None
+        self.reason = ""  # why the process runs the reference (for status())
+        self.watcher: threading.Thread | None = None
+
+
+#: the one state of this process (see the module docstring)
+STATE = _State()
+
+
+@functools.lru_cache(maxsize=None)
+def kernel_sources_digest(root: str) -> str:
+    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
+    kernels (their text holds ``@kernel``), with their paths relative to ``root``; read once per
+    process and folder."""
+    base = Path(root)
+    h = hashlib.sha256()
+    for p in sorted(base.rglob("*.py")):
+        try:
+            text = p.read_bytes()
+        except OSError:
+            continue
+        if b"@kernel" in text or p.name == "jit.py":
+            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
+    return h.hexdigest()
+
+
+def ready_name() -> str:
+    """The name of this build's ready stamp: the kernel sources, Numba, llvmlite, Python and
+    the CPU it compiles for."""
+    parts = (
+        kernel_sources_digest(str(Path(__file__).resolve().parent)),
+        numba.__version__,
+        llvmlite.__version__,
+        platform.python_version(),
+        platform.machine(),
+        llvm.get_host_cpu_name(),
+        llvm.get_host_cpu_features().flatten(),
+        os.environ.get("NUMBA_CACHE_DIR", ""),
+    )
+    return "ready-" + _cache.key(*parts) + ".json"
+
+
+def numba_folder() -> Path:
+    """The folder of Numba's cache files (``$NUMBA_CACHE_DIR``)."""
+    return Path(os.environ["NUMBA_CACHE_DIR"])
+
+
+def _files(folder: Path) -> dict[str, str]:
+    out = {}
+    if not folder.is_dir():
+        return out
+    for p in sorted(folder.rglob("*")):
+        if p.is_file() and not p.is_symlink() and p.suffix in (".nbi", ".nbc"):
+            out[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
+    return out
+
+
+def write_stamp() -> dict:
+    """Write the ready stamp: the SHA-256 of every file in :func:`numba_folder` (the background
+    compilation calls this when it is done)."""
+    files = _files(numba_folder())
+    stamp = {"ready": True, "files": files}
+    _cache.write(STAMP_SUBFOLDER, ready_name(), json.dumps(stamp).encode())
+    return files
+
+
+def verified() -> bool:
+    """True if the ready stamp exists and every Numba file it lists matches it.  A file that
+    does not match, or is not listed but lies in a folder of listed files (the kernels'
+    folders), is deleted (compiled again, never loaded) and the stamp withdrawn."""
+    data = _cache.read(STAMP_SUBFOLDER, ready_name())
+    if data is None:
+        return False
+    try:
+        stamp = json.loads(data)
+        listed = stamp["files"] if stamp.get("ready") else {}
+    except (ValueError, KeyError, TypeError, AttributeError):
+        listed = {}
+    if not listed:
+        return False
+    folder = numba_folder()
+    ours = {str(Path(k).parent) for k in listed}
+    found = {k: h for k, h in _files(folder).items() if str(Path(k).parent) in ours}
+    bad = [k for k, h in found.items() if listed.get(k) != h]
+    for k in bad:
+        try:
+            (folder / k).unlink()
+        except OSError:
+            pass
+    if bad or any(k not in found for k in listed):
+        withdraw()
+        return False
+    return True
+
+
+def withdraw() -> None:
+    """Withdraw the ready stamp (the kernels are compiled again in the background)."""
+    _cache.write(STAMP_SUBFOLDER, ready_name(), json.dumps({"ready": False}).encode())
+
+
+def lock_path() -> Path | None:
+    """The lock file of the background compilation for this stamp (its process id), or None
+    without a cache folder."""
+    folder = _cache.folder(STAMP_SUBFOLDER)
+    return None if folder is None else folder / (ready_name()[:-5] + ".lock")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def running() -> int:
+    """The process id of the background compilation for this stamp if it runs, else 0."""
+    lock = lock_path()
+    try:
+        pid = int(lock.read_text().strip() or 0) if lock is not None else 0
+    except (OSError, ValueError):
+        return 0
+    return pid if pid > 0 and _alive(pid) else 0
+
+
+def start_background() -> bool:
+    """Start the background compilation (``python -m anthroarm.warmup``, in its own session,
+    its output in the lock's ``.log``) unless one runs for this stamp; True if one runs."""
+    lock = lock_path()
+    if lock is None:
+        return False
+    if running():
+        return True
+    env = dict(os.environ, ANTHROARM_JIT="compile")
+    with open(lock.with_suffix(".log"), "wb") as out:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "anthroarm.warmup"],
+            stdin=subprocess.DEVNULL,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            env=env,
+            start_new_session=True,
+        )
+    lock.write_text(str(proc.pid))
+    return True
+
+
+def _switch() -> None:
+    """Run compiled code from now on: load the compiled kernels this process has used (their
+    first call's types), then point every kernel and entry point at compiled code."""
+    with STATE.lock:
+        if STATE.compiled:
+            return
+        loaded = {}
+        for k in STATE.kernels:
+            if k.seen is not None:
+                try:
+                    k.dispatcher.compile(k.seen)
+                except Exception:  # noqa: BLE001 - it loads or compiles on its first call
+                    pass
+        for e in STATE.entries:
+            loaded[id(e)] = e.kernel.dispatcher.compile(e.sig)
+        STATE.compiled = True
+        for k in STATE.kernels:
+            k.fn = k.dispatcher
+        for e in STATE.entries:
+            e.fn = loaded[id(e)]
+        STATE.reason = ""
+
+
+def _watch() -> None:
+    """Wait for the ready stamp (restarting a background compilation that ended without one
+    once), then switch."""
+    restarted = False
+    while True:
+        time.sleep(POLL)
+        try:
+            if verified():
+                _switch()
+                return
+            if running():
+                continue
+            time.sleep(POLL)  # it may have just written the stamp
+            if verified():
+                _switch()
+                return
+            if restarted:
+                lock = lock_path()
+                STATE.reason = f"the background compilation failed (see {lock.with_suffix('.log')})"
+                return
+            restarted = start_background()
+        except Exception as exc:  # noqa: BLE001 - stay on the reference, say why
+            STATE.reason = f"the background compilation failed: {exc}"
+            return
+
+
+def start() -> None:
+    """Decide this process's mode, once (the first kernel call or entry point)."""
+    if STATE.compiled is not None:
+        return
+    with STATE.lock:
+        if STATE.compiled is not None:
+            return
+        m = mode()
+        if m == "compile" or (m == "auto" and verified()):
+            STATE.compiled = True
+            for k in STATE.kernels:
+                k.fn = k.dispatcher
+            return
+        STATE.compiled = False
+        for k in STATE.kernels:
+            if k.fn == k._first:
+                k.fn = reference(k)
+        if m == "reference":
+            STATE.reason = "ANTHROARM_JIT=reference"
+            return
+        STATE.reason = "compiling in the background"
+        try:
+            started = start_background()
+        except OSError as exc:
+            started, STATE.reason = False, f"cannot start the background compilation: {exc}"
+        if started:
+            STATE.watcher = threading.Thread(target=_watch, name="anthroarm-jit", daemon=True)
+            STATE.watcher.start()
+        elif not STATE.reason.startswith("cannot"):
+            STATE.reason = "no cache folder for the compiled kernels"
+        if not started:
+            warnings.warn(
+                f"anthroarm runs its kernels uncompiled ({STATE.reason}): slower",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+
+
+def status() -> str:
+    """``compiled``, ``reference (<why>)`` or ``not started``: what this process runs."""
+    if STATE.compiled is None:
+        return "not started"
+    return "compiled" if STATE.compiled else f"reference ({STATE.reason})"
+
+
+def wait(timeout: float | None = None) -> bool:
+    """Wait until this process runs compiled code (or ``timeout`` seconds); True if it does."""
+    start()
+    end = None if timeout is None else time.monotonic() + timeout
+    while not STATE.compiled:
+        w = STATE.watcher
+        if w is None or not w.is_alive():
+            return bool(STATE.compiled)
+        w.join(POLL if end is None else max(0.0, min(POLL, end - time.monotonic())))
+        if end is not None and time.monotonic() >= end:
+            break
+    return bool(STATE.compiled)
+
 
 __all__ = [
     "CACHE_SUBFOLDER",
+    "MATH",
+    "MODES",
     "OPTIONS",
-    "VerifiedCache",
-    "VerifiedCacheFile",
+    "STATE",
+    "Entry",
+    "Kernel",
     "entry_point",
     "kernel",
     "kernel_sources_digest",
@@ -279,6 +662,19 @@ __all__ = [
     "local2",
     "local_flags",
     "local_ints2",
+    "mode",
+    "numba_folder",
+    "ready_name",
+    "reference",
+    "running",
+    "start_background",
+    "lock_path",
+    "withdraw",
+    "start",
+    "status",
+    "verified",
     "view2",
     "view3",
+    "wait",
+    "write_stamp",
 ]

@@ -74,7 +74,7 @@ def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
     _mark_solutions(Q, V, IN, RES, tol, 2, OK)
 
 
-@kernel(counted=False)
+@kernel
 def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
     """Both branches of targets P (N, 3) (:func:`_planar_pose` of each): Q (N, 2, 2) path
     order, V, E, IN, RES, OK (N, 2); returns the index of the first non-finite target (−1 if
@@ -91,7 +91,7 @@ def _planar_verified(cf, P, tol, Q, V, E, IN, RES, OK):
     return -1
 
 
-@kernel(counted=False)
+@kernel
 def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
     """One pose T (4, 4) of a planar 2R arm, position only (its rotation is not compared; every
     entry finite and its last row [0, 0, 0, 1], :func:`.geometric._pose_status`): the solutions

@@ -232,7 +232,7 @@ def _srs_unpack(cf, ci):
     )
 
 
-@kernel(counted=False)
+@kernel
 def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK):
     """Every branch of poses T (N, 4, 4) for swivel angles (N, S): writes Q (N, S·8, 7) (path
     order, shifted by 2π into the limits, :func:`.geometric.into_limit`), V, E, IN, RES (the
@@ -295,7 +295,7 @@ def _srs_verified(cf, ci, T, swivel, tol, tol_orthonormal, Q, V, E, IN, RES, OK)
     return -1
 
 
-@kernel(counted=False)
+@kernel
 def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     """One pose T (4, 4): the solutions (a candidate inside the limits, FK residual ≤ ``tol``,
     duplicates at one angle dropped: :func:`.geometric._mark_solutions`) at the swivel angles
@@ -339,7 +339,7 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
     return K
 
 
-@kernel(counted=False)
+@kernel
 def srs_pose_solutions(cf, ci, T, swivel, tol, tol_orthonormal, out):
     """:func:`_srs_nearest` of one pose T (4, 4) at one swivel angle ``swivel`` (rad, finite)
     without a reference: the solutions into the rows of ``out`` (8, 12); returns the bit mask

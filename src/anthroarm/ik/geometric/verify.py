@@ -61,7 +61,7 @@ def _pose_status(T, tol_orthonormal):
     return 0
 
 
-@kernel(counted=False)
+@kernel
 def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF):
     """Every branch of poses T (N, 4, 4) (:func:`_verify_pose` of each, ``param`` (N,) the held
     7th joint): writes Q (N, 8, n), V, E, IN, RES, OK (N, 8) and, unless its last axis is
@@ -267,7 +267,7 @@ def nearest_first(out, K, n, ref, width):
         out[0, j], out[kb, j] = out[kb, j], out[0, j]
 
 
-@kernel(counted=False)
+@kernel
 def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     """One pose: the solutions (in the order of the branches) into the rows of ``out`` (8, w + 4):
     θ in independent-joint order (w = n joints) or the chain's configuration q (w = nq ≠ n: a
@@ -319,7 +319,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
     return mask
 
 
-@kernel(counted=False)
+@kernel
 def pose_solutions(cf, ci, T, param, tol, tol_orthonormal, out):
     """:func:`_verified_one` of one pose without a reference: the solutions into the rows of
     ``out`` (8, w + 4), the bit mask of their branches returned (≤ 0: the general path

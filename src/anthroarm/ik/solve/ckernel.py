@@ -467,9 +467,10 @@ class CKernel:
         return e
 
 
-def build(sh) -> CKernel:
-    """Compile (or load from the disk cache) the kernel of the Shared ``sh``.  Raises
-    RuntimeError (:class:`anthroarm.cache.CompileError`) or OSError on failure."""
+def build(sh, compile: bool = True) -> CKernel | None:
+    """Compile (or load from the disk cache) the kernel of the Shared ``sh``; with
+    ``compile=False`` only load it (None if the cache does not hold it).  Raises RuntimeError
+    (:class:`anthroarm.cache.CompileError`) or OSError on failure."""
     cc = cache.compiler()
     if cc is None:
         raise cache.CompileError("no C compiler ($CC or cc)")
@@ -477,10 +478,13 @@ def build(sh) -> CKernel:
     k = cache.key(src, cache.compiler_id(cc), " ".join(FLAGS))
     with _LOCK:
         kern = _LIBS.get(k)
-        if kern is None:
-            so, _ = cache.shared_library("ik", "lm", src, FLAGS)
-            kern = _LIBS[k] = CKernel(so, sh.n)
-        return kern
+    if kern is None:  # compiled outside the lock: a cached library loads meanwhile
+        made = cache.shared_library("ik", "lm", src, FLAGS, compile=compile)
+        if made is None:
+            return None
+        with _LOCK:
+            kern = _LIBS.setdefault(k, CKernel(made[0], sh.n))
+    return kern
 
 
 def kernel_for(sh) -> CKernel | None:
