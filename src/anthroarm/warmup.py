@@ -25,7 +25,7 @@ import numpy as np
 
 from . import jit, models
 from .errors import AnthroarmError
-from .ik import analytic, analytic_batch, closed_form_info, solve
+from .ik import analytic, analytic_batch, closed_form_info, geometric, solve
 from .ik import subproblems as sp
 from .models.standard_dh import standard_dh_urdf
 from .robot import load
@@ -62,6 +62,13 @@ def _arm(robot, rng) -> None:
     if info.swivel:
         kw = {"swivel": 0.3}
     for call in (
+        lambda: analytic(robot, T[0], **kw).singular,
+        lambda: analytic_batch(robot, T, **kw).singular,
+        lambda: (
+            geometric.solve(geometric.plan_for(robot), T)
+            if info.family in geometric.CLOSED
+            else None
+        ),
         lambda: analytic(robot, T[0], **kw),
         lambda: analytic(robot, T[0]),
         lambda: analytic_batch(robot, T, **kw),

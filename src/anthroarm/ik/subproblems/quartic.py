@@ -38,11 +38,6 @@ def _circle_polynomials(o, k, p, k2, delta):
     )
 
 
-@kernel
-def _sp5_residual(p0, p1, p2, p3, k1, k2, k3, t):
-    return sub(add(p0, rotate(k1, t[0], p1)), rotate(k2, t[1], add(p2, rotate(k3, t[2], p3))))
-
-
 #: Newton steps at most on an SP5 candidate (:func:`_sp5_newton`; quadratic convergence: most
 #: stop after one or two)
 SP5_NEWTON = 6
@@ -60,7 +55,7 @@ def _sp5_newton(p0, p1, p2, p3, k1, k2, k3, t, stop):
         r1 = rotate(k1, t[0], p1)
         r3 = rotate(k3, t[2], p3)
         w = rotate(k2, t[1], add(p2, r3))
-        F = sub(add(p0, r1), w)  # _sp5_residual at t
+        F = sub(add(p0, r1), w)  # the SP5 residual at t
         res = norm(F)
         if it == SP5_NEWTON or res <= stop:
             break
