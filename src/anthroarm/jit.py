@@ -65,6 +65,7 @@ STAMP_SUBFOLDER = "kernels"
 if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
     os.environ["NUMBA_CACHE_DIR"] = str(_cache.root() / CACHE_SUBFOLDER)
 
+import atexit  # noqa: E402
 import functools  # noqa: E402
 import hashlib  # noqa: E402
 import json  # noqa: E402
@@ -229,6 +230,17 @@ def kernel(func=None, *, inline: bool = False):
     return wrap if func is None else wrap(func)
 
 
+def callees(k: Kernel) -> list[Kernel]:
+    """The kernels ``k``'s source calls by a global name (compiled with it)."""
+    names, codes = set(), [k.py_func.__code__]
+    while codes:
+        c = codes.pop()
+        names.update(c.co_names)
+        codes.extend(x for x in c.co_consts if isinstance(x, pytypes.CodeType))
+    g = k.py_func.__globals__
+    return [g[n] for n in sorted(names) if isinstance(g.get(n), Kernel) and g[n] is not k]
+
+
 def entry_point(k: Kernel, *args) -> Entry:
     """The body of kernel ``k`` for the Numba types of ``args`` (example arguments), called
     with arguments of exactly those types: compiled (``dispatcher.compile``, which skips the
@@ -239,6 +251,8 @@ def entry_point(k: Kernel, *args) -> Entry:
     :func:`anthroarm.ik.closed_form.analytic`)."""
     start()
     e = Entry(k, tuple(numba.typeof(a) for a in args))
+    if k.seen is None:
+        k.seen = e.sig
     with STATE.lock:
         STATE.entries.append(e)
     return e
@@ -437,42 +451,59 @@ def numba_folder() -> Path:
     return Path(os.environ["NUMBA_CACHE_DIR"])
 
 
+def _own(folder: Path) -> bool:
+    """True if ``folder`` is anthroarm's own (``$NUMBA_CACHE_DIR`` set by this module)."""
+    return folder == _cache.root() / CACHE_SUBFOLDER
+
+
 def _files(folder: Path) -> dict[str, str]:
     out = {}
     if not folder.is_dir():
         return out
     for p in sorted(folder.rglob("*")):
-        if p.is_file() and not p.is_symlink() and p.suffix in (".nbi", ".nbc"):
-            out[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
+        if p.suffix in (".nbi", ".nbc") and p.is_file() and not p.is_symlink():
+            try:
+                out[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
+            except OSError:
+                continue
     return out
 
 
-def write_stamp() -> dict:
-    """Write the ready stamp: the SHA-256 of every file in :func:`numba_folder` (the background
-    compilation calls this when it is done)."""
+def _read_stamp() -> tuple[dict, bool]:
+    data = _cache.read(STAMP_SUBFOLDER, ready_name())
+    try:
+        stamp = json.loads(data) if data is not None else {}
+        files = {str(k): str(v) for k, v in dict(stamp.get("files", {})).items()}
+        return files, stamp.get("complete") is True
+    except (ValueError, TypeError, AttributeError):
+        return {}, False
+
+
+def write_stamp(complete: bool | None = None) -> dict:
+    """Write the stamp: the SHA-256 of every Numba file in :func:`numba_folder` now, and whether
+    the background compilation has compiled every kernel (``complete``; None: keep what the
+    stamp said if none of its files changed).  The background compilation writes it complete;
+    a process that compiled kernels itself adds its files at exit."""
+    old, was = _read_stamp()
     files = _files(numba_folder())
-    stamp = {"ready": True, "files": files}
+    if complete is None:
+        complete = was and all(files.get(k) == h for k, h in old.items())
+    stamp = {"complete": bool(complete), "files": files}
     _cache.write(STAMP_SUBFOLDER, ready_name(), json.dumps(stamp).encode())
     return files
 
 
 def verified() -> bool:
-    """True if the ready stamp exists and every Numba file it lists matches it.  A file that
-    does not match, or is not listed but lies in a folder of listed files (the kernels'
-    folders), is deleted (compiled again, never loaded) and the stamp withdrawn."""
-    data = _cache.read(STAMP_SUBFOLDER, ready_name())
-    if data is None:
-        return False
-    try:
-        stamp = json.loads(data)
-        listed = stamp["files"] if stamp.get("ready") else {}
-    except (ValueError, KeyError, TypeError, AttributeError):
-        listed = {}
-    if not listed:
-        return False
+    """Check every Numba file against the stamp; True if the stamp is complete and every file
+    it lists is there and matches.  A file that does not match, or that it does not list (in
+    anthroarm's own folder; in a folder given by ``$NUMBA_CACHE_DIR`` the subfolders of listed
+    files), is deleted — compiled again, never loaded — and the stamp rewritten incomplete."""
+    listed, complete = _read_stamp()
     folder = numba_folder()
-    ours = {str(Path(k).parent) for k in listed}
-    found = {k: h for k, h in _files(folder).items() if str(Path(k).parent) in ours}
+    found = _files(folder)
+    if not _own(folder):
+        ours = {str(Path(k).parent) for k in listed}
+        found = {k: h for k, h in found.items() if str(Path(k).parent) in ours}
     bad = [k for k, h in found.items() if listed.get(k) != h]
     for k in bad:
         try:
@@ -480,14 +511,18 @@ def verified() -> bool:
         except OSError:
             pass
     if bad or any(k not in found for k in listed):
-        withdraw()
+        write_stamp(complete=False)
         return False
-    return True
+    return complete
 
 
-def withdraw() -> None:
-    """Withdraw the ready stamp (the kernels are compiled again in the background)."""
-    _cache.write(STAMP_SUBFOLDER, ready_name(), json.dumps({"ready": False}).encode())
+def _at_exit() -> None:
+    """Add the files this process compiled to the stamp (see :func:`write_stamp`)."""
+    try:
+        if any(sum(k.dispatcher.stats.cache_misses.values()) for k in STATE.kernels):
+            write_stamp()
+    except Exception:  # noqa: BLE001 - never fail an exit; unlisted files are compiled again
+        pass
 
 
 def lock_path() -> Path | None:
@@ -596,15 +631,15 @@ def start() -> None:
         if STATE.compiled is not None:
             return
         m = mode()
-        if m == "compile" or (m == "auto" and verified()):
+        ready = m != "reference" and verified()  # damaged files deleted in either mode
+        if m != "reference":
+            atexit.register(_at_exit)
+        if m == "compile" or ready:
             STATE.compiled = True
             for k in STATE.kernels:
                 k.fn = k.dispatcher
             return
-        STATE.compiled = False
-        for k in STATE.kernels:
-            if k.fn == k._first:
-                k.fn = reference(k)
+        STATE.compiled = False  # each kernel's first call takes its reference (Kernel._first)
         if m == "reference":
             STATE.reason = "ANTHROARM_JIT=reference"
             return
@@ -655,6 +690,7 @@ __all__ = [
     "STATE",
     "Entry",
     "Kernel",
+    "callees",
     "entry_point",
     "kernel",
     "kernel_sources_digest",
@@ -669,7 +705,6 @@ __all__ = [
     "running",
     "start_background",
     "lock_path",
-    "withdraw",
     "start",
     "status",
     "verified",

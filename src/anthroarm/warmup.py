@@ -30,6 +30,37 @@ from .ik import subproblems as sp
 from .models.standard_dh import standard_dh_urdf
 from .robot import load
 
+#: standard DH rows (alpha rad, a m, d m) of user 6R arms of the classes no catalog arm has:
+#: the 1-D searches (joints 2 ∥ 3; joints 5 and 6 meeting), the 2-D search (a general arm) and
+#: two closed classes
+SEARCH_AND_RARE_ARMS = {
+    "two_parallel": (
+        [1.1, 0.0, -0.7, 0.9, -1.2, 0.5],
+        [0.3, 0.2, 0.25, 0.1, 0.15, 0.2],
+        [0.1, 0.2, 0.15, 0.3, 0.12, 0.1],
+    ),
+    "two_intersecting": (
+        [1.1, -0.8, -0.7, 0.9, -1.2, 0.5],
+        [0.3, 0.2, 0.25, 0.1, 0.0, 0.2],
+        [0.1, 0.2, 0.15, 0.3, 0.12, 0.1],
+    ),
+    "gen_six_dof": (
+        [1.1, -0.8, -0.7, 0.9, -1.2, 0.5],
+        [0.3, 0.2, 0.25, 0.1, 0.15, 0.2],
+        [0.1, 0.2, 0.15, 0.3, 0.12, 0.1],
+    ),
+    "spherical": (
+        [1.1, -0.8, 0.6, 1.5708, -1.5708, 0.0],
+        [0.3, 0.2, 0.25, 0.0, 0.0, 0.0],
+        [0.1, 0.2, 0.15, 0.3, 0.0, 0.1],
+    ),
+    "three_parallel": (
+        [1.1, 0.0, 0.0, 0.9, -1.2, 0.5],
+        [0.3, 0.2, 0.25, 0.1, 0.15, 0.2],
+        [0.1, 0.2, 0.15, 0.3, 0.12, 0.1],
+    ),
+}
+
 
 def _closed_form_arms():
     """Catalog arms with a closed form (loaded), then one user arm of each search class."""
@@ -42,20 +73,15 @@ def _closed_form_arms():
         if info is not None:
             yield robot
     with tempfile.TemporaryDirectory() as folder:
-        for i, (alpha, a) in enumerate(
-            (
-                ([1.1, 0.0, -0.7, 0.9, -1.2, 0.5], [0.3, 0.2, 0.25, 0.1, 0.15, 0.2]),  # 2 ∥ 3
-                ([1.1, -0.8, -0.7, 0.9, -1.2, 0.5], [0.3, 0.2, 0.25, 0.1, 0.0, 0.2]),  # 5 × 6
-            )
-        ):
-            path = os.path.join(folder, f"search_{i}.urdf")
+        for name, (alpha, a, d) in SEARCH_AND_RARE_ARMS.items():
+            path = os.path.join(folder, f"{name}.urdf")
             with open(path, "w") as f:
-                f.write(standard_dh_urdf(f"search_{i}", alpha, a, [0.1, 0.2, 0.15, 0.3, 0.12, 0.1]))
+                f.write(standard_dh_urdf(name, alpha, a, d))
             yield load(path)
 
 
-def _arm(robot, rng) -> None:
-    Q = robot.random_q(8, rng)
+def _arm(robot, rng, n) -> None:
+    Q = robot.random_q(n, rng)
     T = robot.fk(Q)
     info = closed_form_info(robot)
     kw = {}
@@ -75,7 +101,7 @@ def _arm(robot, rng) -> None:
         lambda: analytic_batch(robot, T),
         lambda: analytic(robot, T[0], swivel=np.linspace(-1, 1, 5)) if info.swivel else None,
         lambda: solve(robot, T[0], max_time=10.0),
-        lambda: solve(robot, T[:4], max_time=10.0),
+        lambda: solve(robot, T[: max(2, n // 2)], max_time=10.0),
     ):
         try:
             call()
@@ -100,16 +126,28 @@ def _subproblems(rng) -> None:
     )
 
 
-def run(report: bool = False) -> list[str]:
-    """Compile every kernel through the entry points (``ANTHROARM_JIT=compile``); the names of
-    the kernels not reached."""
+def run(report: bool = False, n: int = 8) -> list[str]:
+    """Compile every kernel through the entry points (``n`` poses an arm) (``ANTHROARM_JIT=compile``); the names of
+    the kernels not reached (with an empty cache; with ``ANTHROARM_JIT=reference`` the kernels
+    the entry points did not call)."""
     rng = np.random.default_rng(0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for robot in _closed_form_arms():
-            _arm(robot, rng)
+            _arm(robot, rng, n)
         _subproblems(rng)
-    missing = [repr(k) for k in jit.STATE.kernels if not k.dispatcher.signatures]
+    if jit.STATE.compiled:  # compiled here: a kernel compiled by its caller has a signature
+        missing = [repr(k) for k in jit.STATE.kernels if not k.dispatcher.signatures]
+    else:  # the reference: the kernels called (their first call's types kept), and what
+        # they call in their source (compiled with them, whichever branch ran)
+        reached = {id(k): k for k in jit.STATE.kernels if k.seen is not None}
+        todo = list(reached.values())
+        while todo:
+            for c in jit.callees(todo.pop()):
+                if id(c) not in reached:
+                    reached[id(c)] = c
+                    todo.append(c)
+        missing = [repr(k) for k in jit.STATE.kernels if id(k) not in reached]
     if report:
         for m in missing:
             print("not reached:", m)
@@ -135,7 +173,7 @@ def main(argv=None) -> int:
     t = time.perf_counter()
     jit.start()
     missing = run(report="--report" in argv)
-    files = jit.write_stamp()
+    files = jit.write_stamp(complete=True)
     print(
         f"compiled {len(jit.STATE.kernels) - len(missing)} kernels, {len(files)} files, "
         f"in {time.perf_counter() - t:.1f} s"

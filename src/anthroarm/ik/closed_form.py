@@ -444,7 +444,7 @@ def analytic(
             angle = None
         if angle is not None:
             out = np.empty(shape)
-            mask, tried = call(cf, ci, arr, angle, tol, tol_orthonormal, out), True
+            mask, tried = call.fn(cf, ci, arr, angle, tol, tol_orthonormal, out), True
             if mask > 0:
                 branches, rows, res, sw = by_mask[mask]
                 # positional: (solutions, branches, reason, swivel, residuals, _singular, model) — the

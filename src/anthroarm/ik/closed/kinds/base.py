@@ -50,8 +50,9 @@ class OneCall(NamedTuple):
     ci: np.ndarray
     by_mask: tuple  # :func:`by_mask` of the plan's labels and ``out``'s columns
     holds_param: bool  # a 7th joint is held (``param=``)
-    call: object  # the kernel compiled for these types (:func:`anthroarm.jit.entry_point`:
-    #                                      the caller checks T)
+    call: object  # :func:`anthroarm.jit.entry_point`: its ``fn`` is the kernel compiled for
+    #               these types (its reference until the process runs compiled code; the caller
+    #               checks T)
     singular: object  # the results' lazy :attr:`AnalyticIKResult.singular` (None: never)
     swivel: bool  # ``angle`` is the swivel angle of a redundant arm
     position_only: bool  # the position alone is compared

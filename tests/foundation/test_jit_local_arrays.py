@@ -1,6 +1,6 @@
-"""Kernels compiled without reference counts (jit.kernel(counted=False)), their local
-arrays (jit.local*) and views (jit.view2, view3): values, shapes, and the heap allocation
-they refuse."""
+"""The local arrays of kernels (jit.local*: in the kernel's stack frame) and their views
+(jit.view2, view3): values and shapes, compiled and in the reference (the interpreter), the
+owner a returned view keeps alive, and the arguments they refuse."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import numba
 import numpy as np
 import pytest
 
-from anthroarm.jit import kernel, local, local2, local_flags, local_ints2, view2, view3
+from anthroarm.jit import kernel, local, local2, local_flags, local_ints2, reference, view2, view3
 
 
-@kernel(counted=False)
+@kernel
 def _fill(x, out):
     a, b, c, d = local2(8, 7), local(5), local_flags(3), local_ints2(2, 3)
     for i in range(8):
@@ -24,7 +24,7 @@ def _fill(x, out):
     for i in range(2):
         for j in range(3):
             d[i, j] = 10 * i + j
-    v = a[:4].reshape((2, 14))  # views of a local array, uncounted
+    v = a[:4].reshape((2, 14))  # a view of a local array
     out[0] = v[1, 13]
     out[1] = b.sum()
     out[2] = c[1] and not c[2]
@@ -32,19 +32,13 @@ def _fill(x, out):
     return a.shape[0] * 100 + a.shape[1] * 10 + b.shape[0]
 
 
-def test_local_arrays_hold_what_is_written():
+@pytest.mark.parametrize("run", ["compiled", "reference"])
+def test_local_arrays_hold_what_is_written(run):
+    f = _fill.dispatcher if run == "compiled" else reference(_fill)
     out = np.zeros(4)
-    assert _fill(2.0, out) == 875
+    assert f(2.0, out) == 875
     # a[3, 6] = 2·3 + 6; Σ 2i over 0..4; c[1] and not c[2]; d[1, 2]
     assert out.tolist() == [12.0, 20.0, 1.0, 12.0]
-
-
-def test_an_uncounted_kernel_refuses_a_heap_array():
-    def allocates(n):
-        return np.empty(n).sum()
-
-    with pytest.raises(numba.core.errors.TypingError, match="empty"):
-        kernel(counted=False)(allocates)(3)
 
 
 def test_local_sizes_must_be_literal():
@@ -56,10 +50,10 @@ def test_local_sizes_must_be_literal():
         runtime_size(3)
 
 
-@kernel(counted=False)
+@kernel
 def _views(a, n, out):
     v, w = view2(a, 3, n), view3(a[2:], 2, 2, 2)
-    s = view2(local(12), 3, n)  # a view of a local array, uncounted
+    s = view2(local(12), 3, n)  # a view of a local array
     for i in range(3):
         for j in range(n):
             s[i, j] = v[i, j] * 2.0
@@ -72,10 +66,12 @@ def _view_returned(a):
     return view2(a, 2, 3)
 
 
-def test_views_are_numpys_reshape_of_the_leading_entries():
+@pytest.mark.parametrize("run", ["compiled", "reference"])
+def test_views_are_numpys_reshape_of_the_leading_entries(run):
+    f = _views.dispatcher if run == "compiled" else reference(_views)
     a = np.arange(20.0)
     out = np.zeros(7)
-    _views(a, 4, out)
+    f(a, 4, out)
     v, w = a[:12].reshape(3, 4), a[2:10].reshape(2, 2, 2)
     assert out.tolist() == [v[2, 1], w[1, 1, 0], 2 * v[2, 3], 3, 4, v.strides[0], w.strides[1]]
 
