@@ -10,13 +10,12 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.errors import ParameterError, UnknownCodeError
-from anthroarm.ik.cells import CellTable, OutsideCellTableError
+from anthroarm.ik.cells import CellTable, OutsideCellTableError, cell_table
 from anthroarm.models import book_tables
 from anthroarm.models.care_robot import (
     CELL_ACCURACY,
     CELL_D,
     TABLE_9_5,
-    cell_table,
     pulses_per_rad,
     table_9_5_length_sum_mm,
     table_9_5_mass_sum_kg,

@@ -35,7 +35,6 @@ LOCAL_IMPORTS = {
     "ik/qp/backends.py": 5,
     "ik/qp/checks.py": 2,
     "jit.py": 1,
-    "models/care_robot.py": 2,
     "prosthesis/report.py": 1,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,

@@ -33,7 +33,6 @@ KNOWN = {
     ("anthroarm.emg.simulate", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer.browser"),
-    ("anthroarm.models.care_robot", "anthroarm.ik.cells"),
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.closed_loop"),
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.finger"),
     ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.rrss"),

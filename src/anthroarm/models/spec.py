@@ -165,6 +165,49 @@ class ReachPosture:
     bend: tuple[int, int]
 
 
+def encoder_pulses_per_rad(encoder_counts: float, gear_ratio: float) -> float:
+    """Motor pulses per joint radian: ``encoder_counts · gear_ratio / 2π`` (encoder counts per
+    motor turn, motor turns per joint turn).  :class:`~anthroarm.errors.ParameterError` unless
+    both are finite and > 0."""
+    try:
+        c, g = float(encoder_counts), float(gear_ratio)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, {gear_ratio!r}"
+        ) from None
+    if not (np.isfinite(c) and np.isfinite(g) and c > 0 and g > 0):
+        raise ParameterError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
+    return c * g / (2.0 * np.pi)
+
+
+@dataclass(frozen=True)
+class CellRecipe:
+    """The spatial cell table (§7-3) an arm's source describes, declared by its builder
+    (``ChainSpec.cells``) and built by :func:`anthroarm.ik.cells.cell_table`.
+
+    ``rotation``: the hand orientation of the table (3×3, base frame); ``bounds``: the box
+    ``(lo, hi)`` of lattice positions (m, base frame); ``D``: the cell size (m); ``branch``:
+    the IK branch label stored at every lattice point; ``point``: the point of the tool frame
+    whose positions the lattice holds (m, tool frame); ``encoder_counts`` (per motor turn) and
+    ``gear_ratio`` (motor turns per joint turn): the scale of the stored motor pulses."""
+
+    rotation: tuple
+    bounds: tuple
+    D: float
+    branch: str
+    point: tuple
+    encoder_counts: float
+    gear_ratio: float
+
+    def pulses_per_rad(self, encoder_counts=None, gear_ratio=None) -> float:
+        """:func:`encoder_pulses_per_rad` of this arm's encoder and gear, or of the values
+        given."""
+        return encoder_pulses_per_rad(
+            self.encoder_counts if encoder_counts is None else encoder_counts,
+            self.gear_ratio if gear_ratio is None else gear_ratio,
+        )
+
+
 @dataclass
 class ChainSpec:
     """A catalog arm: its joints (each carrying the link it moves), the tool frame placed by
@@ -176,8 +219,9 @@ class ChainSpec:
 
     What the book knows about this arm beyond its table, declared by its builder so that no
     algorithm has to recognise the arm by name: ``printed``, the book's printed closed forms
-    of its forward kinematics (:class:`PrintedForm`), and ``reach``, the three-link arm of the
-    reach formulas (:class:`ReachPosture`) or None."""
+    of its forward kinematics (:class:`PrintedForm`), ``reach``, the three-link arm of the
+    reach formulas (:class:`ReachPosture`) or None, and ``cells``, the spatial cell table of
+    its source (:class:`CellRecipe`) or None."""
 
     name: str
     description: str
@@ -200,6 +244,8 @@ class ChainSpec:
     printed: tuple = field(default=(), repr=False, compare=False)
     #: the arm of the reach formulas (2-3)/(2-4), or None
     reach: ReachPosture | None = None
+    #: the spatial cell table its source describes (:class:`CellRecipe`), or None
+    cells: CellRecipe | None = None
 
     @property
     def nq(self) -> int:
