@@ -347,13 +347,14 @@ def write_mot(
     ``write_mot(path, time, values, labels, angles=[...])`` writes columns given in SI units
     (rad, m).  With ``in_degrees`` (default, OpenSim's convention for ``.mot``) the angle
     columns — the revolute joints of ``robot``, or the labels in ``angles`` — are written in
-    degrees and the header says ``inDegrees=yes``.  Gaps (NaN) are written as ``nan``.
+    degrees and the header says ``inDegrees=yes``.  Every value must be finite: OpenSim's
+    ``Storage`` (its GUI's motion loader) stops reading at a row with ``nan``.
     Atomic (:func:`anthroarm._io.atomic_write_text`).
 
     Raises
     ------
     MotionDataError
-        Shapes that disagree, time not finite or decreasing, an infinite value, labels that are
+        Shapes that disagree, time not finite or decreasing, a value that is not finite, labels that are
         empty, repeated or contain whitespace, an ``angles`` label that is not a column.
     """
     if values is None:
@@ -383,8 +384,13 @@ def write_mot(
         )
     if not np.isfinite(t).all() or np.any(np.diff(t) < 0):
         raise MotionDataError("write_mot: time must be finite and not decrease", path)
-    if np.isinf(V).any():
-        raise MotionDataError("write_mot: values must be finite (NaN for a gap)", path)
+    if not np.isfinite(V).all():
+        bad_row = int(np.flatnonzero(~np.isfinite(V).all(axis=1))[0])
+        raise MotionDataError(
+            f"write_mot: values must be finite (row {bad_row} is not): OpenSim's Storage, "
+            "which its GUI and tools load motions with, stops reading a .mot at a row with nan",
+            path,
+        )
     bad = [s for s in labels if not s or any(c.isspace() for c in s)]
     dup = sorted({s for s in labels if labels.count(s) > 1})
     if bad or dup or "time" in labels:
