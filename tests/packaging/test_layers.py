@@ -19,7 +19,7 @@ LAYERS = [
         ["kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "motion", "control"]
         + ["emg", "trajectory", "collision"],
     ),
-    ("model", ["models", "robot", "chain", "serial_chain", "urdf_io", "chain_kernels"]),
+    ("model", ["models", "robot", "chain", "serial_chain", "urdf_io", "chain_kernels", "osim"]),
     (
         "foundation",
         ["errors", "_io", "spatial", "codegen", "cache", "threads", "jit", "check_rows"]
