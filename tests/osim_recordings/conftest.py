@@ -1,16 +1,6 @@
-"""Fixtures of the OpenSim recording tests: the shipped Gait2354 trial and OpenSim itself."""
-
-from pathlib import Path
+"""Fixtures of the OpenSim recording tests: OpenSim itself (paths: osim_recordings_data.py)."""
 
 import pytest
-
-import anthroarm
-
-RECORDINGS = Path(anthroarm.__file__).parent / "data" / "opensim" / "recordings"
-TRC = RECORDINGS / "subject01_walk1.trc"
-SETUP = RECORDINGS / "subject01_Setup_IK.xml"
-PUBLISHED_IK = RECORDINGS / "subject01_walk1_ik.mot"
-MODEL = RECORDINGS.parent / "subject01_simbody.osim"
 
 
 @pytest.fixture(scope="session")

@@ -4,7 +4,7 @@
 
 import numpy as np
 import pytest
-from conftest import PUBLISHED_IK, SETUP
+from osim_recordings_data import PUBLISHED_IK, SETUP
 
 from anthroarm.errors import MotionDataError
 from anthroarm.motion import read_ik_setup, read_storage, write_mot

@@ -3,7 +3,7 @@
 
 import numpy as np
 import pytest
-from conftest import TRC
+from osim_recordings_data import TRC
 
 from anthroarm.errors import MotionDataError
 from anthroarm.motion import MarkerTrajectories, read_trc, write_trc
