@@ -35,6 +35,7 @@ _LAZY = {
     "hand",
     "prosthesis",
     "models",
+    "osim",
 }
 #: names loaded from a submodule on first use, like the subpackages: ``import anthroarm`` (and
 #: with it ``anthroarm --help``) loads neither numpy nor pinocchio until a model is needed

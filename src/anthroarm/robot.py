@@ -191,6 +191,11 @@ class Robot:
         Geometry of a model given as a ``pin.Model`` / ``RobotWrapper``.
     """
 
+    #: the map from q to the Pinocchio configuration of a model whose joints are coupled by
+    #: nonlinear functions (an OpenSim model: :class:`anthroarm.osim.coupling.Coupling`, with
+    #: ``fk``/``jacobian`` by the chain rule); None for every other robot
+    coupling = None
+
     def __init__(
         self,
         model,
@@ -477,6 +482,8 @@ def load(
     * any example-robot-data robot by name (``"ur10"``, ``"xarm7"``, ``"kinova"``, ``"baxter"``;
       :func:`anthroarm.models.erd_names`), read offline from the installed package;
     * a URDF path;
+    * an OpenSim model path ``*.osim`` (:func:`anthroarm.osim.load_osim`; ``strict=True``
+      refuses a model whose import report drops anything);
     * a ``pin.Model`` (with ``visual_model=`` / ``collision_model=`` if you have them) or a
       ``pin.RobotWrapper``.
 
@@ -492,7 +499,7 @@ def load(
     :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
     (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
-    from . import models  # models imports this module (its builders make Robots)
+    from . import models, osim  # both import this module (their builders make Robots)
 
     def no_params(what):
         if params:
@@ -576,6 +583,10 @@ def load(
             description=f"{s} (example-robot-data)",
             **common,
         )
+    if s.lower().endswith(".osim"):  # an OpenSim model: anthroarm.osim.load_osim (strict=)
+        strict = params.pop("strict", False)
+        no_params(f"the OpenSim model {s}")
+        return osim.load_osim(s, tool=tool, name=name, strict=strict, active=active, locked=locked)
     looks_like_path = s.endswith(".urdf") or "/" in s or Path(s).exists()
     if not looks_like_path:
         raise models._unknown(s)
