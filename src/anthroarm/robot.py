@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from . import models
 from .chain import Chain
 from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
 from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf, resolve_uri
@@ -499,7 +500,7 @@ def load(
     :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
     (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
-    from . import models, osim  # both import this module (their builders make Robots)
+    from . import osim  # it imports this module (its builder makes Robots)
 
     def no_params(what):
         if params:

@@ -1,4 +1,6 @@
-"""prosthetic_hand: the book's linkages on one palm (Fig. 2-8 six-bar fingers, Fig. 2-9 thumb).
+"""prosthetic_hand: the book's linkages on one palm (Fig. 2-8 six-bar fingers, Fig. 2-9 thumb):
+the exact closed-loop model (``mechanisms.linkage_hand``) and the catalog's plain mimic URDF
+(``models.prosthetic_hand``, made from the table the closed-loop analysis writes).
 
 Oracles: the mechanism solvers (``mechanisms.finger.finger``, ``mechanisms.thumb.thumb``: the
 §6-5 closed forms) against Pinocchio FK of the closed-loop model solved at loop closure (Newton
@@ -21,6 +23,7 @@ from anthroarm.mechanisms.thumb import thumb
 
 # the module (anthroarm.models.prosthetic_hand is also the catalog builder's name in the package)
 ph = importlib.import_module("anthroarm.models.prosthetic_hand")
+lh = importlib.import_module("anthroarm.mechanisms.linkage_hand")
 
 FINGERS = ("index", "middle", "ring", "little")
 DIGITS = ("thumb",) + FINGERS
@@ -28,12 +31,12 @@ DIGITS = ("thumb",) + FINGERS
 
 @pytest.fixture(scope="module")
 def hand():
-    return ph.default_hand()
+    return lh.default_hand()
 
 
 @pytest.fixture(scope="module")
 def loop(hand):
-    return ph.closed_loop(hand)
+    return lh.closed_loop(hand)
 
 
 def _driver_grid(hand, n=7):
@@ -112,7 +115,7 @@ def test_mobility_five_drivers(hand, loop):
 
 
 def test_solve_returns_tips_and_statuses(hand, loop):
-    st = ph.solve(loop, {"index_mcp": -0.1, "thumb_r1": 0.3}, hand)
+    st = lh.solve(loop, {"index_mcp": -0.1, "thumb_r1": 0.3}, hand)
     assert st.ok and st.residual < 1e-12
     g = hand.fingers["index"]
     T = hand.mounts["index"]
@@ -122,40 +125,40 @@ def test_solve_returns_tips_and_statuses(hand, loop):
         atol=1e-9,
     )
     # drivers outside the range: a status, no NaN
-    bad = ph.solve(loop, {"index_mcp": 0.3}, hand)
+    bad = lh.solve(loop, {"index_mcp": 0.3}, hand)
     assert bad.status == "out_of_range" and "index_mcp" in bad.reason and bad.tips == {}
     assert np.all(np.isfinite(bad.q))
-    bad = ph.solve(loop, {"thumb_r1": -0.2}, hand)
+    bad = lh.solve(loop, {"thumb_r1": -0.2}, hand)
     assert bad.status == "out_of_range"
     with pytest.raises(ParameterError):
-        ph.solve(loop, {"index_knuckle": 0.1}, hand)
+        lh.solve(loop, {"index_knuckle": 0.1}, hand)
     with pytest.raises(ParameterError):
-        ph.solve(loop, {"index_mcp": float("nan")}, hand)
+        lh.solve(loop, {"index_mcp": float("nan")}, hand)
     with pytest.raises(ParameterError):
-        ph.solve(loop, [0.1, 0.2], hand)
+        lh.solve(loop, [0.1, 0.2], hand)
     with pytest.raises(ParameterError):
-        ph.solve(loop, ["a", "b", "c", "d", "e"], hand)
+        lh.solve(loop, ["a", "b", "c", "d", "e"], hand)
     with pytest.raises(ParameterError):
-        ph.solve(loop, {"thumb_r1": "wide"}, hand)
+        lh.solve(loop, {"thumb_r1": "wide"}, hand)
 
 
 def test_inconsistent_passive_joints_are_reported(hand, loop):
-    st = ph.solve(loop, {"middle_mcp": -0.15}, hand)
-    gap, status = ph.closure_status(loop, st.q)
+    st = lh.solve(loop, {"middle_mcp": -0.15}, hand)
+    gap, status = lh.closure_status(loop, st.q)
     assert status == "ok" and gap < 1e-12
     q = st.q.copy()
     q[loop.joint_q_index("middle_pip")] += 0.05  # a PIP that contradicts its driver
-    gap, status = ph.closure_status(loop, q)
+    gap, status = lh.closure_status(loop, q)
     assert status == "inconsistent" and gap > 1e-4
     for bad in (q[:-1], "abc", np.full_like(q, np.nan)):
         with pytest.raises(ParameterError, match="joint values"):
-            ph.closure_status(loop, bad)
+            lh.closure_status(loop, bad)
 
 
 def test_plain_urdf_mimic_approximation_error_is_what_is_reported(hand, loop):
-    robot = ph.robot()
+    robot = aa.load("prosthetic_hand")
     assert robot.nq == 5 and robot.has_mimic and robot.tool == "index_tip"
-    fit = ph.mimic_fit()
+    fit = lh.mimic_fit()
     names = list(robot.model.names)[1:]
     drv = [n for n in names if n in loop.spec.inputs]
     assert drv == ["index_mcp", "little_mcp", "middle_mcp", "ring_mcp", "thumb_r1"]
@@ -185,7 +188,7 @@ def test_plain_urdf_mimic_approximation_error_is_what_is_reported(hand, loop):
 def test_mimic_joint_lines_reproduce_the_closed_loop_at_the_ends(hand, loop):
     """At the start pose both models agree to the fit's offset; every fitted joint's reported
     error bounds its deviation from the exact closure on a fresh, finer driver grid."""
-    fit = ph.mimic_fit()
+    fit = lh.mimic_fit()
     path = _driver_grid(hand, 23)
     Q, ok = loop.track(path, q0=np.zeros(loop.model.nq))
     assert ok.all()
@@ -198,8 +201,8 @@ def test_mimic_joint_lines_reproduce_the_closed_loop_at_the_ends(hand, loop):
 
 
 def test_scale_and_bad_parameters():
-    big = ph.default_hand(1.2)
-    base = ph.default_hand()
+    big = lh.default_hand(1.2)
+    base = lh.default_hand()
     assert big.fingers["index"].R == pytest.approx(tuple(1.2 * r for r in base.fingers["index"].R))
     np.testing.assert_allclose(big.thumb.rrss.b0, 1.2 * base.thumb.rrss.b0, atol=1e-15)
     for bad in (0.0, -1.0, float("nan"), 10.0, "big", True):
@@ -207,7 +210,7 @@ def test_scale_and_bad_parameters():
             ph.prosthetic_hand(scale=bad)
     for bad in (2, 10**9, 41.0, "41"):  # 10**9 exact solutions would run for hours
         with pytest.raises(ParameterError, match="samples"):
-            ph.mimic_fit(samples=bad)
+            lh.mimic_fit(samples=bad)
 
 
 def test_committed_urdf_equals_generator_and_loads_everywhere(tmp_path, same_urdf_text):
@@ -233,10 +236,37 @@ def test_crosscheck_rows_pass_on_the_plain_hand():
     from anthroarm import crosscheck
 
     rows = crosscheck.run(
-        [ph.robot()],
+        [aa.load("prosthetic_hand")],
         samples=6,
         providers=["anthroarm.kinematics.checks:rows", "anthroarm.dynamics.checks:model_rows"],
     )
     assert len(rows) >= 8
     bad = [(r.quantity, r.max_abs_err, r.note) for r in rows if not r.ok]
     assert not bad, bad
+
+
+def test_the_catalog_table_is_the_closed_loop_analysis():
+    """The committed table the catalog model is made of (``data/models/linkage_hand.json``)
+    equals what the mechanism analysis computes now (regenerate it with
+    ``anthroarm.mechanisms.linkage_hand.write_tree_table()``), and the scaling the catalog
+    applies (lengths × s; angles, multipliers and offsets unchanged) is what the analysis of a
+    scaled hand gives."""
+    assert ph.tree_table() == lh.tree_table(), "stale table: run lh.write_tree_table()"
+    table, s = ph.tree_table(), 0.8
+    spec = lh.loop_spec(lh.default_hand(s))
+    assert [j.name for j in spec.joints] == [j[0] for j in table["joints"]]
+    for j, (_, parent, child, kind, T, axis) in zip(spec.joints, table["joints"]):
+        assert (j.parent, j.child, j.type) == (parent, child, kind)
+        T = np.reshape(T, (4, 4))
+        np.testing.assert_allclose(j.origin[:3, :3], T[:3, :3], atol=1e-12)
+        np.testing.assert_allclose(j.origin[:3, 3], s * T[:3, 3], atol=1e-12)
+        np.testing.assert_allclose(j.axis, axis, atol=1e-15)
+    for (n, p, T), (n1, p1, T1) in zip(spec.sites, table["sites"]):
+        assert (n, p) == (n1, p1)
+        np.testing.assert_allclose(T[:3, 3], s * np.reshape(T1, (4, 4))[:3, 3], atol=1e-12)
+    fit = lh.mimic_fit(s)
+    for name, (src, a, b, err) in table["fit"]["joints"].items():
+        src1, a1, b1, err1 = fit.joints[name]
+        assert src1 == src and a1 == pytest.approx(a, abs=1e-9) and b1 == pytest.approx(b, abs=1e-9)
+    for d, e in table["fit"]["tip_error"].items():
+        assert fit.tip_error[d] == pytest.approx(s * e, rel=1e-6)

@@ -33,10 +33,6 @@ KNOWN = {
     ("anthroarm.emg.simulate", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer"),
     ("anthroarm.hand.demo", "anthroarm.viewer.browser"),
-    ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.closed_loop"),
-    ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.finger"),
-    ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.rrss"),
-    ("anthroarm.models.prosthetic_hand", "anthroarm.mechanisms.thumb"),
     ("anthroarm.prosthesis.report", "anthroarm.viewer"),
 }
 

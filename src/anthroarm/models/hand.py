@@ -65,6 +65,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from fractions import Fraction
 from numbers import Real
+from pathlib import Path
 
 import numpy as np
 
@@ -115,6 +116,24 @@ DIP_PIP_RATIO = 2.0 / 3.0
 
 #: rest direction of the thumb metacarpal in the hand frame (distal, radial, palmar; unit)
 THUMB_REST_DIRECTION = np.array([0.45, 0.35, -1.0]) / np.linalg.norm([0.45, 0.35, -1.0])
+#: the linkage hand's tree and mimic fit at scale 1 (the catalog model ``prosthetic_hand`` is
+#: made from it): written by :func:`anthroarm.mechanisms.linkage_hand.write_tree_table`
+LINKAGE_HAND_TABLE = Path(__file__).resolve().parents[1] / "data" / "models" / "linkage_hand.json"
+
+
+def check_hand_scale(scale, who: str) -> float:
+    """``scale`` as a float: a number in 0.3…3 (a hand scaled as a whole), else
+    :class:`~anthroarm.errors.ParameterError` naming ``who``."""
+    if (
+        isinstance(scale, bool)
+        or not isinstance(scale, (int, float, np.floating, np.integer))
+        or not np.isfinite(scale)
+        or not (0.3 <= scale <= 3.0)
+    ):
+        raise ParameterError(f"{who}: scale must be a number in 0.3…3, got {scale!r}")
+    return float(scale)
+
+
 #: turn of the thumb's flexion axes about its rest direction (rad, our choice): flexion goes
 #: ulnar and palmar
 THUMB_PRONATION = 30.0 * np.pi / 180.0
