@@ -24,7 +24,7 @@ MAX_OSIM_BYTES = 64 * 2**20
 _DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 
 
-def parse(path) -> tuple[etree._Element, int]:
+def parse(path) -> tuple:
     """(the ``<Model>`` element, the document's version number) of the file ``path``.
 
     Raises :class:`~anthroarm.errors.OsimError` for a missing file, malformed XML or a root that
@@ -42,7 +42,7 @@ def parse(path) -> tuple[etree._Element, int]:
     return parse_bytes(raw, path)
 
 
-def parse_bytes(raw: bytes, path) -> tuple[etree._Element, int]:
+def parse_bytes(raw: bytes, path) -> tuple:
     """:func:`parse` of text already in memory (``path`` names it in messages)."""
     m = _DTD_OR_ENTITY.search(raw)
     if m:
