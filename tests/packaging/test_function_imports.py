@@ -44,14 +44,10 @@ LOCAL_IMPORTS = {
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
     "emg/simulate.py": 1,
-    "hand/demo.py": 2,
 }
 
 #: file -> private names (or names from private modules) imported from another package
-PRIVATE_IMPORTS = {
-    # owned by others, to be worked off by their owners (issue 29 item 1)
-    "viewer/overlays.py": 1,
-}
+PRIVATE_IMPORTS: dict[str, int] = {}
 
 
 def _private(name: str) -> bool:

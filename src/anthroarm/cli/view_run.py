@@ -69,6 +69,7 @@ def view(a) -> int:
         v.show_workspace(a.workspace)
     if a.limits:
         v.show_limits()
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a)
 
 
@@ -81,6 +82,7 @@ def teach(a) -> int:
     if a.limits:
         v.show_limits()
     v.teach()
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a)
 
 
@@ -108,4 +110,5 @@ def demo(a) -> int:
         for n, pe, re in res.errors:
             print(f"  {n:<18} position error {pe * 1000:8.3f} mm   orientation error {re:.2e} rad")
     v = demo_viewer(res, live=out is None, port=a.port)
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a, announce=not a.json)
