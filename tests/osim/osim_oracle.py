@@ -91,12 +91,14 @@ class OpenSimOracle:
     def set_state(self, q, qd=None, qdd=None):
         val, rate, acc, C = self.kinematics(q, qd, qdd)
         for nm, c in self.coords.items():
+            if nm not in val:  # a locked coordinate: OpenSim keeps its default value
+                continue
             c.setValue(self.state, float(val[nm]), False)
             c.setSpeedValue(self.state, float(rate[nm]))
         self.model.realizeVelocity(self.state)
         udot = np.zeros(self.nu)
         for nm in self.coords:
-            udot[self.u_index[nm]] = acc[nm]
+            udot[self.u_index[nm]] = acc.get(nm, 0.0)
         return C, udot
 
     def body_poses(self):

@@ -31,6 +31,7 @@ import pinocchio as pin
 
 from ..errors import OsimError
 from .coupling import Coupling, Step
+from .functions import Constant
 from .reader import OsimModel
 
 BIG = 1e300  # a "no limit" Pinocchio accepts (robot.chain reads >= 1e100 as none)
@@ -68,18 +69,12 @@ class _Frames:
         return self._place(path, what, line, ())
 
     def _path(self, ref: str, owner: str):
+        """The absolute path of a socket's connectee: OpenSim resolves a relative path from the
+        component that owns the socket (a joint's frames, ``..`` for a frame's owner)."""
         ref = ref.strip()
-        cands = []
-        if ref.startswith("/"):
-            cands.append(posixpath.normpath(ref))
-        else:
-            cands.append(posixpath.normpath(posixpath.join(owner, ref)))
-            cands.append(posixpath.normpath(posixpath.join(posixpath.dirname(owner), ref)))
-            base = ref.split("/")[-1]
-            cands += [f"/bodyset/{base}", f"/{base}", f"{owner}/{base}"]
-        for c in cands:
-            if c in self.body_paths or c in self.m.frames:
-                return c
+        path = posixpath.normpath(ref if ref.startswith("/") else posixpath.join(owner, ref))
+        if path in self.body_paths or path in self.m.frames:
+            return path
         return None
 
     def _place(self, path: str, what, line, seen) -> tuple[str, pin.SE3]:
@@ -138,25 +133,27 @@ def build(m: OsimModel):
                 j.line,
             )
         parent_of[cb] = (j, pb, XP, XC)
-    order, placed = [], {m.ground}
-    pending = list(parent_of)  # the JointSet's order, parents first (a stable topological sort)
-    while pending:
-        progress = False
-        for b in list(pending):
-            if parent_of[b][1] in placed:
-                order.append(b)
-                placed.add(b)
-                pending.remove(b)
-                progress = True
-        if not progress:
-            j = parent_of[pending[0]][0]
-            raise OsimError(
-                m.path,
-                f"bodies {pending} are not connected to ground (their joints form a loop or hang "
-                "from a body no joint connects)",
-                f"<{j.type} name={j.name!r}>",
-                j.line,
-            )
+    # depth first from ground, children in the JointSet's order: Pinocchio's algorithms
+    # (crba's subtree ranges) need every subtree's joints contiguous
+    children: dict[str, list] = {}
+    for cb, (j, pb, _, _) in parent_of.items():
+        children.setdefault(pb, []).append(cb)
+    order, stack = [], list(reversed(children.get(m.ground, [])))
+    while stack:
+        b = stack.pop()
+        order.append(b)
+        stack.extend(reversed(children.get(b, [])))
+    placed = {m.ground, *order}
+    pending = [b for b in parent_of if b not in placed]
+    if pending:
+        j = parent_of[pending[0]][0]
+        raise OsimError(
+            m.path,
+            f"bodies {pending} are not connected to ground (their joints form a loop or hang "
+            "from a body no joint connects)",
+            f"<{j.type} name={j.name!r}>",
+            j.line,
+        )
     loose = [b for b in m.bodies if b not in placed]
     if loose:
         b = m.bodies[loose[0]]
@@ -259,9 +256,12 @@ def build(m: OsimModel):
     # q: OpenSim's coordinate order (the JointSet's, each joint's mobilities in order) without
     # the dependent coordinates; Pinocchio's q is q itself when every moving axis is one
     # coordinate exactly, in that order
-    independent = [c for c in m.coordinates if not c.dependent]
+    # a locked coordinate stays at its default value, as OpenSim holds it: not part of q
+    locked = [c for c in m.coordinates if c.locked and not c.dependent]
+    independent = [c for c in m.coordinates if not c.dependent and not c.locked]
     plain = (
         not dependent
+        and not locked
         and len(joint_steps) == len(independent) == model.nq
         and all(s.function.identity for s in joint_steps)
         and [m.coordinates[s.source].name for s in sorted(joint_steps, key=lambda s: s.target)]
@@ -270,7 +270,8 @@ def build(m: OsimModel):
     info = dict(body_joint=body_joint, body_place=body_place, order=order)
     if plain:
         return model, None, info
-    steps = [
+    steps = [Step(cindex[c.name], cindex[c.name], Constant(c.default)) for c in locked]
+    steps += [
         Step(cindex[n], cindex[dependent[n].independent], dependent[n].function, dependent[n].scale)
         for n in dep_order
     ]

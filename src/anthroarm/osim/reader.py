@@ -477,10 +477,9 @@ def _read_joints(v: Values, m: OsimModel, model_el) -> None:
         m.joints.append(JointDef(name, el.tag, parent, child, coords, axes, el.sourceline))
         m.report.add(jpath, el.tag, KEPT, f"{len(coords)} coordinate(s)", el.sourceline)
         for c in coords:
-            flags = [f for f, on in (("locked", c.locked), ("clamped", c.clamped)) if on]
-            note = (
-                f"; {' and '.join(flags)} (flag kept, see robot.osim_coordinates)" if flags else ""
-            )
+            note = "; clamped (flag kept: robot.osim_coordinates)" if c.clamped else ""
+            if c.locked:
+                note += f"; locked at its default {c.default:g} (not in q, as OpenSim holds it)"
             m.report.add(f"{jpath}/{c.name}", "Coordinate", KEPT, "range, default" + note, c.line)
 
 

@@ -22,6 +22,7 @@ from ..errors import OsimError, OsimSecurityError, OsimUnsupportedError
 MAX_OSIM_BYTES = 64 * 2**20
 
 _DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
+_SCOPED = re.compile(rb"(</?[A-Za-z_][\w.-]*)::")
 
 
 def parse(path) -> tuple:
@@ -54,6 +55,9 @@ def parse_bytes(raw: bytes, path) -> tuple:
             "<!DOCTYPE>/<!ENTITY>",
             line,
         )
+    # OpenSim writes element names with C++ scopes (<HuntCrossleyForce::ContactParametersSet>),
+    # which its own parser reads and XML namespaces refuse: rename them (same lines)
+    raw = _SCOPED.sub(rb"\1__", raw)
     parser = etree.XMLParser(
         resolve_entities=False,
         no_network=True,
