@@ -173,7 +173,7 @@ class SceneMixin:
         self._reach_corners = box_corners(lo, hi)
         self._frame_corners = box_corners(blo, bhi)
         cmds = [set_transform(self.root, homogeneous(r=-self.center))]
-        self.floor = floor = min(0.0, float(lo[2])) - 0.01  # base frame
+        self.floor = floor = min(0.0, float(lo[2]), float(blo[2])) - 0.01  # base frame, under all
         cmds.append(
             set_property("/Grid", "visible", False)
         )  # meshcat's 20 m grid: ours fits the robot
