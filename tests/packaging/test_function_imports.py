@@ -31,9 +31,6 @@ PACKAGE = "anthroarm"
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "ik/qp/_qpgen2.py": 1,
-    "ik/qp/backends.py": 5,
-    "ik/qp/checks.py": 2,
     "jit.py": 1,
     "prosthesis/report.py": 1,
     "viewer/demo.py": 1,
