@@ -282,7 +282,7 @@ def _read_components(v: Values, m: OsimModel, el, owner: str) -> None:
             f"{owner}/attached_geometry",
             "Geometry",
             DROPPED,
-            f"{len(geom)} display mesh(es) not loaded (.vtp files are not read)",
+            "display meshes not loaded (.vtp files are not read)",
             geom.sourceline,
         )
 

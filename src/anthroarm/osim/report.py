@@ -26,6 +26,13 @@ class ReportRow:
     line: int | None = None
 
 
+def _short(component: str) -> str:
+    """The last part of a component path that names it (``/bodyset/femur_r/attached_geometry``
+    -> ``femur_r``)."""
+    parts = [p for p in component.split("/") if p and p != "attached_geometry"]
+    return parts[-1] if parts else component
+
+
 class ImportReport:
     """The rows of an import (see the module docstring), with summaries."""
 
@@ -69,7 +76,7 @@ class ImportReport:
             for r in rows:
                 groups.setdefault((r.type, r.why), []).append(r)
             for (t, why), rs in groups.items():
-                names = ", ".join(r.component.rsplit("/", 1)[-1] for r in rs[:6])
+                names = ", ".join(_short(r.component) for r in rs[:6])
                 more = f", ... ({len(rs)})" if len(rs) > 6 else ""
                 lines.append(f"    {len(rs):4d} {t}: {why} [{names}{more}]")
                 if detail:
