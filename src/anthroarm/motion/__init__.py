@@ -16,7 +16,10 @@ Modules: :mod:`~anthroarm.motion.trial` (marker trajectories in m), :mod:`~anthr
 :mod:`~anthroarm.motion.activities` (the daily-living activity library),
 :mod:`~anthroarm.motion.trc` and :mod:`~anthroarm.motion.storage` (OpenSim's ``.trc`` marker files
 and ``.mot``/``.sto`` storages, read and written), :mod:`~anthroarm.motion.ik_setup` (OpenSim's
-``Setup_IK.xml``: marker weights and coordinate tasks for marker IK on an ``.osim`` model).
+``Setup_IK.xml``: marker weights and coordinate tasks for marker IK on an ``.osim`` model),
+:mod:`~anthroarm.motion.osim_ik` (marker IK in the coordinates of an ``.osim`` model, couplings
+included: OpenSim's IK objective) and :mod:`~anthroarm.motion.opensim_oracle` (OpenSim's own IK,
+run from Python, the reference it is checked against).
 
 Algorithms here take arrays and a Robot; reading files is in ``c3d`` / ``csv_io`` and progress
 bars are the CLI's (``anthroarm ik-markers``).
@@ -37,6 +40,8 @@ from .markers import (
     human_arm_markers,
     segment_length,
 )
+from .opensim_oracle import OpenSimIK, opensim_ik, opensim_tool
+from .osim_ik import CoupledMarkerIK, osim_marker_ik, rotational_coordinates
 from .scaling import ScalingResult, scale_from_static
 from .storage import StorageTable, read_storage, write_mot
 from .timing import keyframe_trajectory, minimum_jerk
@@ -57,6 +62,12 @@ __all__ = [
     "read_ik_setup",
     "osim_marker_set",
     "coordinate_targets",
+    "CoupledMarkerIK",
+    "osim_marker_ik",
+    "rotational_coordinates",
+    "OpenSimIK",
+    "opensim_ik",
+    "opensim_tool",
     "JointTrajectory",
     "read_joint_csv",
     "write_joint_csv",

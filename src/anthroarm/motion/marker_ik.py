@@ -249,6 +249,12 @@ class MarkerIK:
         coordinate_tasks: dict | None = None,
         limits: bool = True,
     ):
+        if getattr(robot, "coupling", None) is not None:
+            raise ParameterError(
+                f"{robot.name} has coupled coordinates (an OpenSim model with splines or "
+                "couplers): its marker IK is anthroarm.motion.CoupledMarkerIK (or "
+                "osim_marker_ik with an OpenSim IK setup), which works in its coordinates"
+            )
         self.robot = robot
         self.marker_set = default_marker_set(robot) if marker_set is None else marker_set
         if not isinstance(self.marker_set, MarkerSet):
