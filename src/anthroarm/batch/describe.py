@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import inspect
 import threading
-import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -29,8 +28,6 @@ CACHE_SIZE = 16
 
 _cache: "OrderedDict[tuple, object]" = OrderedDict()
 _lock = threading.Lock()
-#: Robot -> its description (weak keys; a description holds strings and numbers, not the Robot)
-_described: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -102,16 +99,8 @@ def describe(robot, **params) -> RobotDescription:
         robot = load(robot, **params)
     elif params:
         raise TypeError(f"builder parameters {sorted(params)} go with a catalog name, not a Robot")
-    try:
-        return _described[robot]
-    except (KeyError, TypeError):
-        pass
-    d = _describe(robot)
-    try:
-        _described[robot] = d
-    except TypeError:
-        pass
-    return d
+    # kept on the robot (Robot.derived): made again when its chain or tool change
+    return robot.derived("batch.describe", _describe)
 
 
 def _describe(robot) -> RobotDescription:
