@@ -51,6 +51,9 @@ class OpenSimIK:
     markers: tuple
     seconds: np.ndarray
 
+    def __len__(self) -> int:
+        return self.time.shape[0]
+
 
 def quiet(osim) -> None:
     """Keep OpenSim's log off the console and out of the working folder (``opensim.log``)."""

@@ -39,6 +39,7 @@ import pinocchio as pin
 
 from ..errors import MarkerSetError, MotionDataError, ParameterError, UnconstrainedJointError
 from ..ik.qp.tasks.marker import moved_by
+from ..joint_kinds import PRISMATIC
 from .ik_setup import IKSetup, osim_marker_set
 from .marker_ik import MarkerIKResult, match_markers
 from .markers import MarkerSet
@@ -73,7 +74,7 @@ def rotational_coordinates(robot) -> list[str]:
     if osim is not None:
         rot = {c for j in osim.joints for a in j.axes if a.name.startswith("rot") for c in a.coords}
         return [n for n in robot.joint_names if n in rot]
-    return [j.name for j in robot.chain.joints if not j.is_mimic and j.kind != "prismatic"]
+    return [j.name for j in robot.chain.joints if not j.is_mimic and j.kind != PRISMATIC]
 
 
 class FastCoupling:

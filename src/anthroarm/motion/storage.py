@@ -44,7 +44,7 @@ import numpy as np
 
 from .._io import atomic_write_text, read_bounded
 from ..errors import MotionDataError
-from ..joint_kinds import PRISMATIC
+from .osim_ik import rotational_coordinates
 
 #: the largest storage file :func:`read_storage` reads, bytes (256 MiB)
 MAX_STORAGE_BYTES = 256 << 20
@@ -123,34 +123,46 @@ class StorageTable:
         return out
 
     def to_q(self, robot, *, default=None) -> np.ndarray:
-        """(N, nq) configurations of ``robot``: each joint's value from the column named after
-        it (rad or m; a column of a revolute joint is converted from degrees when
-        ``in_degrees``).  A joint without a column takes ``default`` (a (nq,) configuration)
-        when given; otherwise its absence is a :class:`~anthroarm.errors.MotionDataError`
-        listing the joints.  Continuous joints (cos, sin in q) are set from their angle."""
-        chain = robot.chain
+        """(N, nq) configurations of ``robot``: each coordinate's value from the column named
+        after it (rad or m; an angle column is converted from degrees when ``in_degrees``;
+        the angles are :func:`~anthroarm.motion.osim_ik.rotational_coordinates`).  A coordinate
+        without a column takes ``default`` (a (nq,) configuration) when given; otherwise its
+        absence is a :class:`~anthroarm.errors.MotionDataError` listing the coordinates.
+        Continuous joints (cos, sin in q) are set from their angle."""
         q = np.tile(robot.neutral() if default is None else robot.check_q(default), (len(self), 1))
         absent = []
-        for j in chain.joints:
-            if j.is_mimic or j.nv != 1:
+        for name, i, angle, continuous in coordinate_columns(robot):
+            if name not in self.labels:
+                absent.append(name)
                 continue
-            if j.name not in self.labels:
-                absent.append(j.name)
-                continue
-            v = self.column(j.name).astype(float)
-            if self.in_degrees and j.kind != PRISMATIC:
+            v = self.column(name).astype(float)
+            if self.in_degrees and angle:
                 v = np.deg2rad(v)
-            if j.nq == 2:
-                q[:, j.idx_q], q[:, j.idx_q + 1] = np.cos(v), np.sin(v)
+            if continuous:
+                q[:, i], q[:, i + 1] = np.cos(v), np.sin(v)
             else:
-                q[:, j.idx_q] = v
+                q[:, i] = v
         if absent and default is None:
             raise MotionDataError(
-                f"no columns for joints {absent} of {robot.name} (columns: "
+                f"no columns for coordinates {absent} of {robot.name} (columns: "
                 f"{', '.join(self.labels)}); pass default= a configuration for them",
                 self._path(),
             )
         return q
+
+
+def coordinate_columns(robot) -> list[tuple[str, int, bool, bool]]:
+    """(name, index in q, is an angle, is continuous) of each coordinate of ``robot``: the
+    independent coordinates of a model with a coupling map (``robot.coupling``), otherwise
+    the joints of ``robot.chain`` with one degree of freedom."""
+    angles = set(rotational_coordinates(robot))
+    if getattr(robot, "coupling", None) is not None:
+        return [(n, i, n in angles, False) for i, n in enumerate(robot.joint_names)]
+    return [
+        (j.name, j.idx_q, j.name in angles, j.nq == 2)
+        for j in robot.chain.joints
+        if not j.is_mimic and j.nv == 1
+    ]
 
 
 def _split(line: str, tabs: bool) -> list[str]:
@@ -361,18 +373,14 @@ def write_mot(
         res = time
         if robot is None:
             raise MotionDataError("write_mot(path, result) needs robot= to name the joints", path)
-        chain = robot.chain
-        joints = [j for j in chain.joints if not j.is_mimic and j.nv == 1]
+        cols = coordinate_columns(robot)
         q = np.asarray(res.q, dtype=float)
         time = res.time
-        labels = [j.name for j in joints]
+        labels = [c[0] for c in cols]
         values = np.column_stack(
-            [
-                np.arctan2(q[:, j.idx_q + 1], q[:, j.idx_q]) if j.nq == 2 else q[:, j.idx_q]
-                for j in joints
-            ]
+            [np.arctan2(q[:, i + 1], q[:, i]) if cont else q[:, i] for _, i, _, cont in cols]
         )
-        angles = [j.name for j in joints if j.kind != PRISMATIC]
+        angles = [c[0] for c in cols if c[2]]
     t = np.asarray(time, dtype=float)
     V = np.asarray(values, dtype=float)
     labels = [str(s) for s in (labels or ())]
