@@ -9,15 +9,18 @@ marker RMS error <= OpenSim's + 0.1 mm, coordinates within 0.5 deg RMS of OpenSi
 """
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from osim_recordings_data import MODEL, SETUP, TRC
 
 import anthroarm as aa
+from anthroarm import osim as aosim
 from anthroarm.errors import MarkerSetError, ParameterError, UnconstrainedJointError
 from anthroarm.motion import (
     CoupledMarkerIK,
     MarkerIK,
     MarkerTrajectories,
+    body_poses,
     opensim_ik,
     opensim_tool,
     osim_marker_ik,
@@ -181,3 +184,27 @@ def test_qp_marker_ik_refuses_a_coupled_model(walk):
     robot, trial, setup, ours, ref = walk
     with pytest.raises(ParameterError, match="CoupledMarkerIK"):
         MarkerIK(robot, osim_marker_set(robot, setup))
+
+
+@pytest.mark.parametrize("name", ["subject01", "arm26", "human_arm7"])
+def test_body_poses_equal_pinocchio(name):
+    """motion.body_poses (one batched tree walk) against Pinocchio's framesForwardKinematics,
+    on a coupled OpenSim model, an uncoupled one and a catalog arm."""
+    robot = (
+        aa.load(str(MODEL))
+        if name == "subject01"
+        else (aa.load(str(aosim.path(name))) if name == "arm26" else aa.load(name))
+    )
+    Q = robot.random_q(40, rng=3)
+    poses = body_poses(robot, Q)
+    assert len(poses) >= 3
+    model, data = robot.model, robot.model.createData()
+    full = getattr(robot, "coupling", None)
+    for n, q in enumerate(Q):
+        pin.framesForwardKinematics(model, data, q if full is None else full.full(q))
+        for frame, T in poses.items():
+            np.testing.assert_allclose(
+                T[n], data.oMf[model.getFrameId(frame)].homogeneous, rtol=0, atol=1e-14
+            )
+    one = body_poses(robot, Q[0])
+    assert all(v.shape == (4, 4) for v in one.values())

@@ -19,7 +19,8 @@ and ``.mot``/``.sto`` storages, read and written), :mod:`~anthroarm.motion.ik_se
 ``Setup_IK.xml``: marker weights and coordinate tasks for marker IK on an ``.osim`` model),
 :mod:`~anthroarm.motion.osim_ik` (marker IK in the coordinates of an ``.osim`` model, couplings
 included: OpenSim's IK objective) and :mod:`~anthroarm.motion.opensim_oracle` (OpenSim's own IK,
-run from Python, the reference it is checked against).
+run from Python, the reference it is checked against), :mod:`~anthroarm.motion.body_poses` (the
+world pose of every body along a motion, one batched walk down the tree).
 
 Algorithms here take arrays and a Robot; reading files is in ``c3d`` / ``csv_io`` and progress
 bars are the CLI's (``anthroarm ik-markers``).
@@ -27,6 +28,7 @@ bars are the CLI's (``anthroarm ik-markers``).
 
 from . import activities
 from .activities import Activity, ActivityTrajectory, Keyframe, activity, activity_trajectory
+from .body_poses import body_poses
 from .c3d import read_c3d, write_c3d
 from .csv_io import JointTrajectory, read_joint_csv, write_joint_csv
 from .ik_setup import CoordinateTask, IKSetup, coordinate_targets, osim_marker_set, read_ik_setup
@@ -68,6 +70,7 @@ __all__ = [
     "OpenSimIK",
     "opensim_ik",
     "opensim_tool",
+    "body_poses",
     "JointTrajectory",
     "read_joint_csv",
     "write_joint_csv",
