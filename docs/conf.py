@@ -56,6 +56,7 @@ GUIDE = [
     "hand",
     "grasp",
     "motion",
+    "opensim_ik",
     "prosthesis",
     "emg",
     "control",
