@@ -1,7 +1,7 @@
 """Planar four-bar (book §5-2 complex vectors, §5-3 Cartesian vectors).
 
 Oracles: loop closure, the Cartesian method (an independent formulation), finite differences,
-and Pinocchio (tests/mechanisms/test_mech_closed_loop.py).  The printed (5-17), (5-19), (5-20),
+and Pinocchio (tests/mechanisms/test_closed_loop.py).  The printed (5-17), (5-19), (5-20),
 (5-22) are kept here in their printed form and shown to fail."""
 
 import numpy as np

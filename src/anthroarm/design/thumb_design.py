@@ -23,7 +23,7 @@ What the text fixes and what we had to choose (Fig. 2-9 is missing; ch3-4 notes 
   x5 = α and x6 = β do not enter θ3 in this reading (they place R2 and the fingertip S).
 * Working ranges are not printed: θ1 ∈ [0°, 30°] and θ2 ∈ [0°, 30°] by default (parameters).
 
-Findings (tests in ``tests/design/test_design_thumb.py``): the printed RRSS optimum satisfies
+Findings (tests in ``tests/design/test_thumb_design.py``): the printed RRSS optimum satisfies
 g1–g10 but not g11 (φ ≈ 3° at θ1 = 0 in our reading) and its error over [0°, 30°] is ≈ 0.52°,
 not the printed 0.01; the printed planar optimum satisfies g1–g10 but has ∠PFC ≈ 13° (g11
 fails) and its coupler of 0.79 mm makes θ3 run opposite to f3 — the printed e = 0.01 and
