@@ -8,7 +8,7 @@ angle), loaded by aa.load.  OpenSim: its InverseKinematicsTool run from the setu
 InverseKinematicsSolver set up as the tool does (assemble the first frame, track the others;
 the per-frame time is the mean track).  anthroarm: motion.osim_marker_ik (Levenberg-Marquardt
 in the coordinates through the coupling map, a compiled normal-equations kernel, warm start;
-tolerance 1e-5 rad) on the same frames with the same weights; the 'file to file' row times
+tolerance 1e-4 rad on the estimated distance to the optimum) on the same frames with the same weights; the 'file to file' row times
 aa.load + read_trc + read_ik_setup + osim_marker_ik + write_mot, the tool's counterpart.
 Both run in this process, interleaved, wall-clock medians of the repeats; the compiled kernel is
 loaded from the disk cache (warm).  The 'cold' row runs the file-to-file pipeline in a fresh
