@@ -32,7 +32,6 @@ PACKAGE = "anthroarm"
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
     "jit.py": 1,
-    "prosthesis/report.py": 1,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
     # a circle: load() reads OpenSim files (osim), whose loader makes Robots (osim imports

@@ -32,7 +32,6 @@ LEVEL = {m: i for i, (_, ms) in enumerate(LAYERS) for m in ms}
 #: (importer, imported) imports that still run upward: the debt of issue 29 item 1
 KNOWN = {
     ("anthroarm.emg.simulate", "anthroarm.viewer"),
-    ("anthroarm.prosthesis.report", "anthroarm.viewer"),
 }
 
 

@@ -17,6 +17,7 @@ from .._io import check_regular_file, read_bounded
 from ..errors import ActivityError
 from ..motion import activities as adl
 from ..prosthesis import catalogue, report, study
+from ..viewer.pages import activities_html
 from .common import UserError
 from .person import check_person
 from .runtime import load_model, progress, resolve_model
@@ -174,19 +175,19 @@ def run(a) -> int:
             progress=tick,
         )
         bar.set_postfix_str("report")
-        report.write(st, out, viewer=not a.no_viewer)
+        inputs = dict(
+            model=a.model,
+            **_person_params(a),
+            activities=a.activities
+            if a.activities.strip().lower() == "adl"
+            else ", ".join(Path(p.strip()).name for p in a.activities.split(",") if p.strip()),
+            payload_kg=a.payload,
+            margin=a.margin,
+        )
+        page = None if a.no_viewer else activities_html(st)
+        report.write(st, out, viewer=page, inputs=inputs)
     finally:
         bar.close()
-    summary = dict(
-        out=str(out),
-        drive_mass_kg=round(st.sizing.drive_mass, 4),
-        joints={
-            r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
-            for r in st.sizing.rows()
-        },
-        unfit=st.sizing.unfit,
-        skipped=[x.name for x in st.envelope.skipped],
-        rules={r.source: r.ok for r in st.rules},
-    )
+    summary = dict(out=str(out), **st.summary())  # the report's own verdicts (one source)
     print(json.dumps(summary), file=sys.stdout)
     return 0
