@@ -48,6 +48,7 @@ build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
 GUIDE = [
     "load",
+    "osim",
     "kinematics",
     "ik",
     "dynamics",
