@@ -208,3 +208,29 @@ def test_body_poses_equal_pinocchio(name):
             )
     one = body_poses(robot, Q[0])
     assert all(v.shape == (4, 4) for v in one.values())
+
+
+def test_both_marker_iks_recover_arm26_motion_placed_by_opensim(osim):
+    """arm26 (no coupling): markers placed by OpenSim along a known motion; the QP marker IK
+    (MarkerIK) and CoupledMarkerIK both recover the motion through osim_marker_set."""
+    arm = aa.load(str(aosim.path("arm26")))
+    t = np.linspace(0.0, 3.0, 40)[:, None]
+    Q = np.clip(arm.default_q() + np.deg2rad(30) * np.sin(t) * [1.0, 2.0], arm.lower, arm.upper)
+    model = osim.Model(str(aosim.path("arm26")))
+    state = model.initSystem()
+    cs = model.getCoordinateSet()
+    P = np.empty((len(Q), len(arm.markers), 3))
+    for n, q in enumerate(Q):
+        for name, v in zip(arm.joint_names, q):
+            cs.get(name).setValue(state, float(v), False)
+        model.realizePosition(state)
+        for k, m in enumerate(arm.markers):
+            P[n, k] = model.getMarkerSet().get(m).getLocationInGround(state).to_numpy()
+    trial = MarkerTrajectories(tuple(arm.markers), P, rate=100.0)
+    ms = osim_marker_set(arm, {m: 1.0 for m in arm.markers})
+    qp_res = MarkerIK(arm, ms, seeds=0).solve(trial, q0=Q[0])
+    lm_res = CoupledMarkerIK(arm, ms).solve(trial, q0=Q[0])
+    for res in (qp_res, lm_res):
+        assert res.counts()["ok"] == len(Q)
+        np.testing.assert_allclose(res.q, Q, atol=1e-6)
+        assert res.rms.max() < 1e-7
