@@ -157,3 +157,17 @@ def test_bad_setup_names_the_line(tmp_path, case):
     with pytest.raises(MotionDataError) as err:
         read_ik_setup(p)
     assert expected in str(err.value), str(err.value)
+
+
+def test_sto_written_by_opensim(osim, tmp_path):
+    """OpenSim 4's STOFileAdapter format (key=value header first, no name line, nan cells)."""
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(["a", "b"])
+    table.appendRow(0.0, osim.RowVector([1.5, float("nan")]))
+    table.appendRow(0.1, osim.RowVector([2.5, 3.5]))
+    table.addTableMetaDataString("inDegrees", "no")
+    osim.STOFileAdapter.write(table, str(tmp_path / "x.sto"))
+    got = read_storage(tmp_path / "x.sto")
+    assert got.labels == ("a", "b") and got.in_degrees is False and got.name == ""
+    np.testing.assert_array_equal(got.time, [0.0, 0.1])
+    np.testing.assert_array_equal(got.values, [[1.5, np.nan], [2.5, 3.5]])
