@@ -406,6 +406,8 @@ class CoupledMarkerIK:
         ``frames`` selects rows: a slice, indices or a boolean mask).  ``q0`` starts the first
         frame (default: the model's default coordinates).  ``rename``/``subject`` as
         :func:`~anthroarm.motion.marker_ik.match_markers`.  ``progress(n, N)`` every 25 frames.
+        ``seconds`` of the result is the wall time of the frames' loop (``time.perf_counter``,
+        as OpenSim's solver is timed in :mod:`~anthroarm.motion.opensim_oracle`).
 
         Raises :class:`~anthroarm.errors.MarkerSetError` when no marker of the set is in the
         trial, :class:`~anthroarm.errors.UnconstrainedJointError` when the markers present leave a
