@@ -189,7 +189,8 @@ def format_table(rows: list[CheckRow]) -> str:
             lines.append(f"{r.model}: {r.quantity}: {r.note}")
     n_ok = sum(r.ok for r in rows)
     lines.append(
-        f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} unsupported"
+        f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} "
+        "unsupported"
     )
     return "\n".join(lines)
 

@@ -135,7 +135,8 @@ def reduce_model(model, name: str, active=None, locked=None):
                     v = np.array([np.cos(v[0]), np.sin(v[0])])
                 if v.size != jm.nq or not np.all(np.isfinite(v)):
                     raise ParameterError(
-                        f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}"
+                        f"{name}: locked value of joint {jname!r} must be {jm.nq} finite "
+                        f"number(s), got {v}"
                     )
                 qref[jm.idx_q : jm.idx_q + jm.nq] = v
             val = qref[jm.idx_q : jm.idx_q + jm.nq].copy()
@@ -144,7 +145,8 @@ def reduce_model(model, name: str, active=None, locked=None):
     for m, src in mimic_source.items():
         if (m in lock_ids) != (src in lock_ids):
             raise UnsupportedModelError(
-                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both or neither"
+                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both "
+                "or neither"
             )
         if m in lock_ids:
             e = model.joints[m].extract()

@@ -78,7 +78,8 @@ def test_model_mass_is_the_printed_total(robot):
 
 def test_model_segment_lengths_are_the_printed_ones(robot):
     # distances between the joint origins (Pinocchio FK at q = 0): waist -> shoulder = base,
-    # shoulder -> elbow = upper arm, elbow -> wrist centre = forearm, wrist centre -> grip = finger-palm
+    # shoulder -> elbow = upper arm, elbow -> wrist centre = forearm, wrist centre -> grip =
+    # finger-palm
     data = robot.model.createData()
     pin.forwardKinematics(robot.model, data, robot.neutral())
     pin.updateFramePlacements(robot.model, data)
@@ -252,7 +253,8 @@ def test_save_and_load_keep_pulses(table, tmp_path):
 # ---------------------------------------------------------------- Table 9.6
 
 
-#: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display, output)
+#: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display,
+#: output)
 TABLE_9_6_PRINT = {
     1: ("15", "请一会儿来"),
     2: ("25", "不是"),

@@ -20,7 +20,8 @@ def test_translational_zero():
 @pytest.mark.parametrize(
     "a,beta_deg,case,delta",
     [
-        # ch1-2 notes part 3, self-derived reference table (mathematics, re-checked by brute force below)
+        # ch1-2 notes part 3, self-derived reference table (mathematics, re-checked by brute force
+        # below)
         (0, 90, "same_side", 5.165593),
         (0, 80, "split", 1.503874),
         (20, 90, "same_side", 5.265391),

@@ -1,4 +1,5 @@
-"""Ch. 3 motion curves: printed coefficients, difference table, least squares (3-1)-(3-6), Fig. 3-9."""
+"""Ch. 3 motion curves: printed coefficients, difference table, least squares (3-1)-(3-6), Fig.
+3-9."""
 
 import numpy as np
 import pytest

@@ -81,7 +81,8 @@ def test_golden_bad_input():
     assert np.isfinite(r.fun) and 0 <= r.x <= 0.5 and r.fun == pytest.approx((r.x - 0.3) ** 2)
 
 
-# ----------------------------------------------------------------------------- quadratic interpolation
+# ----------------------------------------------------------------------------- quadratic
+# interpolation
 
 
 def printed_4_18(a1, a2, a3, f1, f2, f3):
@@ -243,7 +244,8 @@ def test_simplex_variants_and_bad_input():
     assert O.simplex_book(lambda x: 1.0, [0, 0], maxiter=5, eps1=0).status == "maxiter"
 
 
-# ----------------------------------------------------------------------------- SUMT and the §4-3 example
+# ----------------------------------------------------------------------------- SUMT and the §4-3
+# example
 
 F43 = lambda x: x[0] ** 2 + x[1] ** 2 - 4 * x[0] + 4  # noqa: E731
 G43 = lambda x: np.array([x[0] - x[1] + 2, -(x[0] ** 2) + x[1] - 1, x[0], x[1]])  # noqa: E731  (g >= 0)

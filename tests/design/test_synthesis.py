@@ -23,8 +23,8 @@ def circle_intersection(P0, r0, P1, r1, sign):
 
 
 def linkage_path(r1, r2, r3, r4, r5, beta, gamma, origin, alpha, sign):
-    """Coupler point C of the §3-3 linkage: A = O + r1 e^{ia}; B on circle(D, r4) and at |AB| from A;
-    C from the coupler triangle (C - A = r2 e^{i psi}, C - B = r5 e^{i(psi + gamma)})."""
+    """Coupler point C of the §3-3 linkage: A = O + r1 e^{ia}; B on circle(D, r4) and at |AB| from
+    A; C from the coupler triangle (C - A = r2 e^{i psi}, C - B = r5 e^{i(psi + gamma)})."""
     O = np.asarray(origin, float)
     A = O + r1 * np.stack([np.cos(alpha), np.sin(alpha)], -1)
     Dp = O + r3 * np.array([np.cos(beta), np.sin(beta)])

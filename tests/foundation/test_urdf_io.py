@@ -39,8 +39,8 @@ def timed(fn, *args, tries=5, **kw):
     ``tries`` runs.
 
     Retrying stops at the first run under BOUND_S, or one so slow (> 5 BOUND_S) that it is not
-    cache pressure from a busy machine but a superlinear check.  A small file is validated first so that one-time imports
-    (example-robot-data's folder) are not timed."""
+    cache pressure from a busy machine but a superlinear check.  A small file is validated first so
+    that one-time imports (example-robot-data's folder) are not timed."""
     parse_urdf_bytes(chain_urdf(2), "warm_up.urdf")
     best = None
     for _ in range(tries):

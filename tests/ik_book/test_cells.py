@@ -19,8 +19,8 @@ from anthroarm.ik.cells import (
 R_FWD = np.array([[0.0, 0, 1], [-1, 0, 0], [0, -1, 0]])
 BOX = ((0.2, -0.4, -0.25), (0.6, 0.15, 0.25))
 PATHS_MM = [((350, -250, -60), (480, 50, 60)), ((300, -300, -150), (300, -300, 150))]
-# (D mm, bound on |Δx|, |Δy| mm): the book prints x errors ≤ 2.5 / 1.2 / 0.5 mm at D = 50 / 37.5 / 25
-# (l. 5212-5216); the notes reproduce 1.96 / 1.25 / 0.52 and recommend these bounds.
+# (D mm, bound on |Δx|, |Δy| mm): the book prints x errors ≤ 2.5 / 1.2 / 0.5 mm at D = 50 / 37.5 /
+# 25 (l. 5212-5216); the notes reproduce 1.96 / 1.25 / 0.52 and recommend these bounds.
 BOUNDS = [(50.0, 2.5), (37.5, 1.5), (25.0, 0.6)]
 
 
@@ -104,7 +104,8 @@ def _printed_chain(M, m):
 
 
 def test_cell_printed_chain_fails():
-    """The printed linear-division chain does not reproduce a constant field (weights do not sum to 1)."""
+    """The printed linear-division chain does not reproduce a constant field (weights do not sum to
+    1)."""
     M = np.ones((8, 1))
     assert abs(_printed_chain(M, (0.3, 0.6, 0.2))[0] - 1.0) > 0.05
     assert abs(nested_division(M, (0.3, 0.6, 0.2))[0] - 1.0) < 1e-12

@@ -1,4 +1,5 @@
-"""QP-IK step: agreement with pink and between backends, limits, robustness cases, book Newton step."""
+"""QP-IK step: agreement with pink and between backends, limits, robustness cases, book Newton
+step."""
 
 import numpy as np
 import pinocchio as pin
@@ -91,7 +92,8 @@ def test_osqp_workspace_is_built_once(panda, monkeypatch):
 
 @pytest.mark.parametrize("solver", BACKENDS)
 def test_limits_never_violated_while_tracking(panda, solver):
-    """A target that pulls joint 4 (upper limit −0.07 rad) past its limit: q stays inside, exactly."""
+    """A target that pulls joint 4 (upper limit −0.07 rad) past its limit: q stays inside,
+    exactly."""
     q = panda.neutral()
     q[3] = -0.5
     conf = qp.IKConfiguration(panda, q)
@@ -263,14 +265,18 @@ def test_bad_input(panda):
 FINGER_URDF = """<?xml version="1.0"?>
 <robot name="finger">
   <link name="base"/>
-  <link name="l1"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <link name="l2"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l1"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l2"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="tip"/>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
     <limit lower="-1.5" upper="1.5" effort="1" velocity="2"/></joint>
-  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.05 0 0"/><axis xyz="0 0 1"/>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.05 0 0"/>
+    <axis xyz="0 0 1"/>
     <limit lower="-1.5" upper="1.5" effort="1" velocity="2"/></joint>
-  <joint name="tipj" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="0.04 0 0"/></joint>
+  <joint name="tipj" type="fixed"><parent link="l2"/><child link="tip"/><origin xyz="0.04 0 0"/>
+    </joint>
 </robot>
 """
 

@@ -79,7 +79,8 @@ def test_velocity_and_acceleration_equal_finite_differences_of_the_solved_loop()
 
 
 def test_pose_closure_and_ball_joint():
-    # a triangle closed by a weld: ground -R- l1 -R- l2 (tip), ground -R- l3 (tip); pose closure at the tips
+    # a triangle closed by a weld: ground -R- l1 -R- l2 (tip), ground -R- l3 (tip); pose closure at
+    # the tips
     L = 1.0
     spec = LoopSpec(
         name="weld",

@@ -20,7 +20,8 @@ from anthroarm.mechanisms.fourbar import (
     fourbar_position,
 )
 
-# synthetic fixture of ch5.md §3 (not from the book: it prints no numbers), r1, r2, r3, r4, th2, th2'
+# synthetic fixture of ch5.md §3 (not from the book: it prints no numbers), r1, r2, r3, r4, th2,
+# th2'
 R = (4.0, 1.5, 3.5, 3.0)
 TH2, W2 = 0.7, 2.0
 
@@ -82,7 +83,8 @@ def printed_5_22_alpha4(s):
 
 
 def printed_5_21_AB_alpha3(s):
-    # A, B as printed with squared *accelerations* (th2'' = 0 -> its term vanishes); th3'', th4'' from the truth
+    # A, B as printed with squared *accelerations* (th2'' = 0 -> its term vanishes); th3'', th4''
+    # from the truth
     a3, a4 = s.alpha3, s.alpha4
     A = s.r3 * a3**2 * np.cos(s.theta3) - s.r4 * a4**2 * np.cos(s.theta4)
     B = s.r3 * a3**2 * np.sin(s.theta3) - s.r4 * a4**2 * np.sin(s.theta4)
@@ -149,7 +151,8 @@ def test_complex_equals_cartesian_and_closes(r1, r2, r3, r4, th2, w2, a2, br, g)
     s = fourbar(r1, r2, r3, r4, th2, w2, a2, branch=br)
     gv = r1 * np.array([np.cos(g), np.sin(g)])
     c = fourbar_cartesian(gv, r2, r3, r4, th2 + g, w2, a2, branch=br)
-    # at a toggle the angles are only defined to ~sqrt(eps): the two forms may disagree on the flag there
+    # at a toggle the angles are only defined to ~sqrt(eps): the two forms may disagree on the flag
+    # there
     assert s.status == c.status or abs(np.sin(s.theta3 - s.theta4)) < 1e-6
     for x in (s.theta3, s.theta4, s.omega3, s.alpha4, s.residual):
         assert np.isfinite(x)
@@ -277,7 +280,8 @@ def test_input_range_and_grashof():
 
 
 def test_printed_section_5_3_theta2_for_theta_d_fails():
-    # §5-3 (l. 2711, 2727) prints tg th2 = (r1y - r2y)/(r1x - r2x) and th3 = th2 +/- alpha; the angle is th_d
+    # §5-3 (l. 2711, 2727) prints tg th2 = (r1y - r2y)/(r1x - r2x) and th3 = th2 +/- alpha; the
+    # angle is th_d
     r1, r2, r3, r4, th2 = R[0], R[1], R[2], R[3], TH2
     c = fourbar_cartesian([r1, 0.0], r2, r3, r4, th2)
     dx, dy = r1 - r2 * np.cos(th2), -r2 * np.sin(th2)

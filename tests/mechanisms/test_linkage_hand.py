@@ -158,5 +158,6 @@ def test_mimic_joint_lines_reproduce_the_closed_loop_at_the_ends(hand, loop):
     for n, (src, a, b, jerr) in fit.joints.items():
         u = path[:, inputs.index(src)]
         exact = Q[:, loop.joint_q_index(n)]
-        # the line's deviation on the fine grid stays within the reported error (+ its between-sample slack)
+        # the line's deviation on the fine grid stays within the reported error (+ its
+        # between-sample slack)
         assert np.max(np.abs(a * u + b - exact)) <= jerr * 1.05 + 1e-9

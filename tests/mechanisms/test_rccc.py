@@ -128,7 +128,8 @@ def test_book_theta3_rule_uses_c32_not_c21():
     assert not D.atan2(De[2, 0] / sa, De[1, 0] / sa).isclose(sol.theta3, atol=1e-3)
 
 
-# ----------------------------------------------------------------------------- positions and rates vs Pinocchio
+# ----------------------------------------------------------------------------- positions and rates
+# vs Pinocchio
 def _check_against_pinocchio(g, sol, w1, a1):
     model, fid = pinocchio_chain(g)
     data = model.createData()

@@ -58,9 +58,11 @@ def test_D2_velocity():
     assert abs(s.theta2dot - -0.029765) < 1e-6
 
 
-# ------------------------------------------------------------ 002 §4-3: (u, phi) is singular at phi = 0
+# ------------------------------------------------------------ 002 §4-3: (u, phi) is singular at phi
+# = 0
 def printed_residual_u_phi(geom, x, theta1):
-    """(4-42)-(4-47) in the 002 text's unknowns x = (p, u, phi) (u free 3-vector, (4-47) |u| = 1)."""
+    """(4-42)-(4-47) in the 002 text's unknowns x = (p, u, phi) (u free 3-vector, (4-47) |u| =
+    1)."""
     p, u, phi = x[:3], x[3:6], x[6]
     R = np.cos(phi) * np.eye(3) + np.sin(phi) * skew(u) + (1 - np.cos(phi)) * np.outer(u, u)
     rv = pin.log3(R) if abs(u @ u - 1) < 1e-6 else phi * u
@@ -97,7 +99,8 @@ def test_printed_u_phi_unknowns_are_singular_at_zero_rotation_rotation_vector_is
 
 def test_printed_4_43_zero_rhs_needs_a_common_normal():
     # the Chapter 4 thumb: a1 - a0 is not perpendicular to u1, so the printed (4-43)
-    # u_a^T (a - a0) = 0 is violated already at the reference pose; our form keeps the reference value
+    # u_a^T (a - a0) = 0 is violated already at the reference pose; our form keeps the reference
+    # value
     u1 = np.array([np.sqrt(3) / 2, np.sqrt(3) / 4, -0.25])
     g = RRSSGeometry(
         a0=[0, 0, 0],
@@ -161,7 +164,8 @@ def test_printed_6_105_6_106_6_111_6_112_fail_against_finite_differences():
     # (6-106)/(6-112) printed with (a1 - a0) (and u1 in (6-106))
     assert np.linalg.norm(W(w1, u1) @ (D2.a1 - a0) - adot) > 1e-2
     assert np.linalg.norm(Wdot(w1, al1, u0) @ (D2.a1 - a0) - addot) > 1e-2
-    # (6-110)/(6-111) printed: b_r'' with (theta1', theta1'', u0), Coriolis W(theta1) W(theta1), P_u0, |b'|^2 outside
+    # (6-110)/(6-111) printed: b_r'' with (theta1', theta1'', u0), Coriolis W(theta1) W(theta1),
+    # P_u0, |b'|^2 outside
     Pu0 = skew(u0)
     bpp = Wdot(w1, al1, u0) @ (b - a0)
     br_pr = Wdot(w1, al1, u0) @ (b - a)

@@ -33,7 +33,8 @@ def test_thumb_printed_u0_sense_cannot_assemble():
 
 
 def test_thumb_upper_fourbar_literal_reading():
-    # ch3-4.md E9 naive reading: PF = 0.791 mm, FC = 59.645 mm, angle PFC = 13.4 deg (< 35 deg asked)
+    # ch3-4.md E9 naive reading: PF = 0.791 mm, FC = 59.645 mm, angle PFC = 13.4 deg (< 35 deg
+    # asked)
     assert abs(TG.R4 * 1e3 - 0.791) < 1e-3 and abs(TG.R5 * 1e3 - 59.645) < 1e-3
     assert abs(np.rad2deg(TG.transmission_angle0) - 13.4) < 0.05
     s = thumb(TG, 0.0)

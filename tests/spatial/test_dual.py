@@ -1,4 +1,5 @@
-"""Dual numbers (5-131)-(5-134), lines (5-135)-(5-144), dual matrices (5-145)-(5-150) vs Pinocchio SE3."""
+"""Dual numbers (5-131)-(5-134), lines (5-135)-(5-144), dual matrices (5-145)-(5-150) vs Pinocchio
+SE3."""
 
 import numpy as np
 import pinocchio as pin

@@ -1,4 +1,5 @@
-"""Hand direction angles (6-44)-(6-47): the printed (1,3) element and α formula fail; corrected round trip."""
+"""Hand direction angles (6-44)-(6-47): the printed (1,3) element and α formula fail; corrected
+round trip."""
 
 import numpy as np
 import pinocchio as pin

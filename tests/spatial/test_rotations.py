@@ -1,4 +1,5 @@
-"""Elementary rotations, Rodrigues (5-84), validation (book §5-4) against Pinocchio and identities."""
+"""Elementary rotations, Rodrigues (5-84), validation (book §5-4) against Pinocchio and
+identities."""
 
 import numpy as np
 import pinocchio as pin

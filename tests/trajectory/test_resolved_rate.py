@@ -22,7 +22,8 @@ def move_setup():
 
 
 def test_resolved_rate_open_loop_drift_first_order(move_setup):
-    """Open-loop Euler integration of (7-89)/(7-96): the end-pose drift shrinks ~linearly with Δt."""
+    """Open-loop Euler integration of (7-89)/(7-96): the end-pose drift shrinks ~linearly with
+    Δt."""
     robot, q0, Tg = move_setup
     d1 = straight_line_move(robot, q0, Tg, 1.0, 0.02)
     d2 = straight_line_move(robot, q0, Tg, 1.0, 0.01)

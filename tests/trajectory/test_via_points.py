@@ -1,5 +1,6 @@
 """Via-point trajectories (§7-4 一): polynomials through via points, boundary conditions and
-continuity, bad input, joint trajectories from poses.  Resolved-rate lines: test_resolved_rate.py."""
+continuity, bad input, joint trajectories from poses.  Resolved-rate lines:
+test_resolved_rate.py."""
 
 import numpy as np
 import pytest

@@ -73,15 +73,17 @@ class RobotDescription:
             raise
         except Exception as exc:
             raise RobotRebuildError(
-                f"the worker could not rebuild robot {self.name!r} from its {self.kind} description: "
-                f"{type(exc).__name__}: {exc}. Remedy: make sure every worker runs the same anthroarm version as "
-                f"the client (pip install the same wheel/commit in the workers' environment)"
+                f"the worker could not rebuild robot {self.name!r} from its {self.kind} "
+                f"description: {type(exc).__name__}: {exc}. Remedy: make sure every worker runs "
+                "the same anthroarm version as the client (pip install the same wheel/commit in "
+                "the workers' environment)"
             ) from None
         if self.key and robot.chain.key() != self.key:
             raise RobotRebuildError(
                 f"the worker rebuilt robot {self.name!r} with different kinematics (chain hash "
-                f"{robot.chain.key()[:12]} != {self.key[:12]}); the workers run another anthroarm or "
-                "Pinocchio version than the client. Remedy: install the same versions on the workers"
+                f"{robot.chain.key()[:12]} != {self.key[:12]}); the workers run another anthroarm "
+                "or Pinocchio version than the client. Remedy: install the same versions on the "
+                "workers"
             )
         return robot
 
@@ -123,10 +125,10 @@ def _describe(robot) -> RobotDescription:
             "urdf", robot.info.text, robot.name, (), robot.tool, locked, robot.chain.key()
         )
     raise RobotDescriptionError(
-        f"robot {robot.name!r} was built from an in-memory pin.Model: a Dask worker cannot rebuild it "
-        "(Pinocchio models are not shipped). Remedy: write it as a URDF and load that "
-        "(pinocchio: robot.urdf / your exporter; then aa.load('arm.urdf')), or use a catalog name; "
-        "or run the job locally with client=None"
+        f"robot {robot.name!r} was built from an in-memory pin.Model: a Dask worker cannot rebuild "
+        "it (Pinocchio models are not shipped). Remedy: write it as a URDF and load that "
+        "(pinocchio: robot.urdf / your exporter; then aa.load('arm.urdf')), or use a catalog "
+        "name; or run the job locally with client=None"
     )
 
 

@@ -128,8 +128,8 @@ class Cylinder:
 
     def __repr__(self) -> str:
         return (
-            f"Cylinder(center={np.round(self.center, 4).tolist()}, axis={np.round(self.axis, 4).tolist()}, "
-            f"radius={self.radius:g}, length={self.length})"
+            f"Cylinder(center={np.round(self.center, 4).tolist()}, "
+            f"axis={np.round(self.axis, 4).tolist()}, radius={self.radius:g}, length={self.length})"
         )
 
     @property

@@ -299,7 +299,8 @@ class CellTable:
         i, j, k = idx
         if not self.cell_ok[i, j, k]:
             raise OutsideCellTableError(
-                f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the joint limits"
+                f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the "
+                "joint limits"
             )
         m1, m2, m3 = r[0] - i, r[1] - j, r[2] - k
         t1, t2, t3 = 1.0 - m1, 1.0 - m2, 1.0 - m3
@@ -409,7 +410,8 @@ class CellTable:
             p = np.zeros(0)
         if p.ndim not in (1, 2) or p.shape[-1] != self.nq or not np.isfinite(p).all():
             raise ParameterError(
-                f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got {pulses!r}"
+                f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got "
+                f"{pulses!r}"
             )
         return p / self.pulses_per_rad
 

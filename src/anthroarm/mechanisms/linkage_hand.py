@@ -230,9 +230,10 @@ def _prefixed(spec: LoopSpec, digit: str, mount: np.ndarray, tip_site: str) -> t
 
 def loop_spec(hand: ProstheticHand | None = None) -> LoopSpec:
     """Spanning tree + closures of the whole hand: the five mechanisms' own trees
-    (:func:`~anthroarm.mechanisms.finger.finger_spec`, :func:`~anthroarm.mechanisms.thumb.thumb_spec`)
-    renamed ``{digit}_…`` and mounted on the ``palm``; inputs ``index_mcp``, ``little_mcp``,
-    ``middle_mcp``, ``ring_mcp``, ``thumb_r1`` (the order of the plain URDF's q,
+    (:func:`~anthroarm.mechanisms.finger.finger_spec`,
+    :func:`~anthroarm.mechanisms.thumb.thumb_spec`) renamed ``{digit}_…`` and mounted on the
+    ``palm``; inputs ``index_mcp``, ``little_mcp``, ``middle_mcp``, ``ring_mcp``, ``thumb_r1`` (the
+    order of the plain URDF's q,
     :data:`anthroarm.models.hand.Q_ORDER`); fingertip sites ``{digit}_tip``.  q = 0 is every
     mechanism's start pose."""
     hand = hand or default_hand()

@@ -122,9 +122,11 @@ def care_robot(
         joint_names=["waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw"],
         params={"s0": s0, "h2": h2, "s3": s3, "P": P},
         tool_name="grip",
-        inertia_source="Table 9.5 segment masses (base 2.38, upper arm 1.82, forearm 1.16, finger-palm "
-        "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
-        f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)",
+        inertia_source=(
+            "Table 9.5 segment masses (base 2.38, upper arm 1.82, forearm 1.16, finger-palm "
+            "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
+            f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)"
+        ),
     )
     m = {k: v[1] for k, v in TABLE_9_5.items()}
     masses = [

@@ -41,7 +41,8 @@ from .spec import REPO_URDF_DIR, ChainSpec, JointSpec, LinkSpec, Shape, capsule,
 
 #: finger breadth of the prosthesis (m) at scale 1: the visual capsule radius and the mass model
 PHALANX_RADIUS = 0.008
-#: density of the phalanges and bars (kg/m³): a polyamide print (our assumption; the book gives none)
+#: density of the phalanges and bars (kg/m³): a polyamide print (our assumption; the book gives
+#: none)
 DENSITY = 1150.0
 
 
@@ -180,9 +181,9 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
     return ChainSpec(
         name="prosthetic_hand",
         description=(
-            "Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + four-bar "
-            "thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 drivers "
-            f"(largest fingertip error of the approximation: {err}); exact model: "
+            "Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + "
+            "four-bar thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 "
+            f"drivers (largest fingertip error of the approximation: {err}); exact model: "
             "anthroarm.mechanisms.linkage_hand.closed_loop()"
         ),
         joints=[palm_mount] + joints,
@@ -192,8 +193,9 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         base_link="world",
         frames=frames,
         source=(
-            "book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry (l.2037-2133); "
-            "finger dimensions fitted to the Chapter 3 curve f(x) (mechanisms.finger), scaled by Buchholz 1992"
+            "book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry "
+            "(l.2037-2133); finger dimensions fitted to the Chapter 3 curve f(x) "
+            "(mechanisms.finger), scaled by Buchholz 1992"
         ),
         inertia_source=(
             f"not in the book: polyamide ({DENSITY:g} kg/m3) cylinders of radius {r:g} m; "
@@ -204,13 +206,14 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
 
 
 def urdf_text(scale: float = 1.0) -> str:
-    """The plain URDF of :func:`prosthetic_hand` (mimic approximations; ``urdf/prosthetic_hand.urdf``
-    is the default, committed and tested equal to this text)."""
+    """The plain URDF of :func:`prosthetic_hand` (mimic approximations;
+    ``urdf/prosthetic_hand.urdf`` is the default, committed and tested equal to this text)."""
     return to_urdf(prosthetic_hand(scale))
 
 
 def write_urdf(path=None, scale: float = 1.0) -> Path:
-    """Write :func:`urdf_text` to ``path`` (default: ``urdf/prosthetic_hand.urdf`` of a source checkout)."""
+    """Write :func:`urdf_text` to ``path`` (default: ``urdf/prosthetic_hand.urdf`` of a source
+    checkout)."""
     p = Path(path) if path is not None else REPO_URDF_DIR / "prosthetic_hand.urdf"
     atomic_write_text(p, urdf_text(scale))
     return p

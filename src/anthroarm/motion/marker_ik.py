@@ -130,7 +130,8 @@ class MarkerIKResult:
 
 
 def _split_label(label: str) -> tuple[str | None, str]:
-    """``"Subject1:EL"`` -> ``("Subject1", "EL")``; a label without a prefix -> ``(None, label)``."""
+    """``"Subject1:EL"`` -> ``("Subject1", "EL")``; a label without a prefix -> ``(None,
+    label)``."""
     pre, sep, base = str(label).rpartition(":")
     return (pre.strip() or None, base.strip()) if sep else (None, str(label).strip())
 
@@ -368,10 +369,10 @@ class MarkerIK:
         rate: float = 100.0,
     ) -> MarkerIKResult:
         """Solve every frame of ``trial`` (:class:`~anthroarm.motion.trial.MarkerTrajectories`,
-        or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0`` seeds the first frame
-        (default: the comfortable posture).  ``progress(n_done, n_total)`` is called every 50
-        frames (the CLI's progress bar).  ``rename`` and ``subject`` (whose markers to use in a
-        trial of several subjects) are those of :func:`match_markers`.
+        or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0``
+        seeds the first frame (default: the comfortable posture).  ``progress(n_done, n_total)`` is
+        called every 50 frames (the CLI's progress bar).  ``rename`` and ``subject`` (whose markers
+        to use in a trial of several subjects) are those of :func:`match_markers`.
 
         Raises :class:`~anthroarm.errors.MarkerSetError` when no marker of the set is in the
         trial and :class:`~anthroarm.errors.UnconstrainedJointError` when the markers present
@@ -413,8 +414,9 @@ class MarkerIK:
             free = self.bound.unconstrained_joints(cols >= 0)
             if free:
                 raise UnconstrainedJointError(
-                    f"markers {list(missing)} are not in the trial; without them joints {free} have no marker "
-                    "below them (rename the trial's labels with rename={label: marker} or use another set)",
+                    f"markers {list(missing)} are not in the trial; without them joints {free} "
+                    "have no marker below them (rename the trial's labels with rename={label: "
+                    "marker} or use another set)",
                     joints=free,
                 )
 

@@ -54,7 +54,8 @@ DIRECT = {"osqp": "osqp", "daqp": "daqp", "quadprog": "quadprog", "proxqp": "pro
 
 def available_solvers() -> list[str]:
     """Names accepted by :func:`make_backend` on this machine: the direct backends whose module
-    is installed, then ``"qpsolvers:NAME"`` for every solver qpsolvers can run (the slow, rebuild-per-call path)."""
+    is installed, then ``"qpsolvers:NAME"`` for every solver qpsolvers can run (the slow,
+    rebuild-per-call path)."""
     names = [n for n, mod in DIRECT.items() if _module_available(mod)]
     try:
         import qpsolvers
