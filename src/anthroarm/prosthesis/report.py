@@ -4,7 +4,7 @@ One file, no network, to hand a colleague: the date, the package version and the
 verdict (what did not fit: :meth:`~.study.Study.unfit`, the same list ``anthroarm size`` prints
 as JSON); the person's model (segments, masses, joint ranges); the activities, optionally
 animated in the meshcat viewer (``viewer``: the page of
-:func:`anthroarm.viewer.pages.activities_page`, embedded once as an ``<iframe srcdoc>``); the
+:func:`anthroarm.viewer.pages.activities_html`, embedded once as an ``<iframe srcdoc>``); the
 envelope; the chosen motors and gearboxes and the drive mass; the book's weight rules, each
 explained in words with its line of the book (:data:`~.weight_rules.RULE_TEXTS`); per joint the
 torque–time curves and the (speed, torque) points of every activity under the chosen motor's

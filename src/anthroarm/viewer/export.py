@@ -33,7 +33,8 @@ class ExportMixin:
         """Play the joint trajectory ``Q`` (N, nq), one row every ``dt`` seconds, as a meshcat
         animation (also stored in :meth:`static_html`).  ``trace`` draws the tool path.  The
         camera then frames the robot over the whole motion (``fit="all"`` of
-        :meth:`set_camera`), unless it was placed at a given distance."""
+        :meth:`~anthroarm.viewer.scene.SceneMixin.set_camera`), unless it was placed at a given
+        distance."""
         Q = self.robot.check_q(Q, "Q")
         if Q.ndim != 2 or len(Q) < 2:
             raise ValueError(

@@ -423,7 +423,8 @@ class OverlaysMixin:
         """A voxel map of :mod:`anthroarm.batch` as a 3-D point cloud with its colour legend: one
         point at the centre of every reached voxel, coloured by its value, see-through
         (``opacity``) so the robot inside stays visible; the camera then frames the map and the
-        robot from outside the cloud (unless :meth:`set_camera` was given a distance).
+        robot from outside the cloud (unless
+        :meth:`~anthroarm.viewer.scene.SceneMixin.set_camera` was given a distance).
 
         Parameters
         ----------

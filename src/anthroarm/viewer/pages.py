@@ -5,7 +5,7 @@ never import the viewer, a face above them):
   (:class:`anthroarm.prosthesis.study.Study`) as one looping animation, the fragment
   :func:`anthroarm.prosthesis.report.render` embeds (``viewer=``);
 * :func:`motion_viewer`: a Viewer playing a joint trajectory sampled every ``every`` frames (the
-  arm of an EMG-driven simulation, :class:`anthroarm.emg.simulate.PoweredHandRun`).
+  arm of an EMG-driven simulation, :class:`anthroarm.emg.simulate.PoweredHandResult`).
 """
 
 from __future__ import annotations
