@@ -18,7 +18,7 @@ LAYERS = [
     (
         "algorithms",
         ["kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "motion", "control"]
-        + ["emg", "trajectory", "collision"],
+        + ["emg", "trajectory", "collision", "muscles"],
     ),
     ("model", ["models", "robot", "chain", "serial_chain", "urdf_io", "chain_kernels", "osim"]),
     (
