@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 
 from .common import add_camera, add_json, add_live_options, add_model_argument, add_param_option
+from .person import add_person_options
 
 STYLE = dict(choices=["auto", "generated", "urdf"], default="auto", help="visuals (default auto)")
 
@@ -90,7 +91,7 @@ def _add_demo(sub):
         epilog="examples:\n  anthroarm demo\n  anthroarm demo -o demo.html --height 1.62",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    add_param_option(p, "parameter of the arm")
+    add_param_option(p, "another parameter of the arm (segment_lengths=...)")
     p.add_argument(
         "--method",
         choices=["auto", "qp", "dls"],
@@ -101,5 +102,7 @@ def _add_demo(sub):
     add_json(p, "print the per-target errors as JSON")
     add_camera(p)
     add_live_options(p)
-    # the model is fixed: the person's arm, whose parameters are options (listed by --help)
-    p.set_defaults(run="view_run.demo", model_params=True, fixed_model=True, model=None)
+    # the model is fixed: the person's arm; the person's options are the CLI's one person
+    # (cli/person.py: light, so 'demo --help' loads no catalog), other parameters via --param
+    add_person_options(p)
+    p.set_defaults(run="view_run.demo", model=None)
