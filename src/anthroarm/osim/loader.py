@@ -74,6 +74,11 @@ class OsimRobot(Robot):
         """The marker frames' names (the model's MarkerSet)."""
         return [mk.name for mk in self.osim.markers]
 
+    @property
+    def osim_markers(self) -> list[str]:
+        """:attr:`markers` (the name :func:`anthroarm.motion.osim_marker_set` reads)."""
+        return self.markers
+
     @cached_property
     def osim_coordinates(self) -> dict:
         """name -> the OpenSim coordinate (range, default, locked, clamped, dependent)."""
