@@ -12,8 +12,8 @@ Jacobian is zero).  On the step Δq = q̇ dt this is the row
 
 an inequality, not a box: the QP of :func:`anthroarm.ik.qp.limits.collision_step.step` takes
 it (``qp.step`` takes boxes only and refuses this limit).  A pair that starts closer than d_s
-(or in collision) gets a positive lower bound on ḋ: the step pushes it apart instead of
-freezing; ``status`` says so.  Distances come from coal (:mod:`anthroarm.collision`); the
+(or in collision) gets a positive lower bound on ḋ, at most ξ: the step pushes it apart
+instead of freezing; ``status`` says so.  Distances come from coal (:mod:`anthroarm.collision`); the
 damper is mink's ``CollisionAvoidanceLimit`` in velocity form (mink: d_s = 0.005 m,
 d_i = 0.01 m) and the book's obstacle constraint g(Q) ≥ 0 (Ch. 7 §7-6) linearised per step.
 
@@ -114,7 +114,8 @@ class CollisionLimit(Limit):
             return np.zeros((0, conf.nv)), np.zeros(0)
         J = coll.jacobians(self.robot.model, conf.data, dist, self.model.support)
         h = self.xi * dt * (dist.distance - self.d_safe) / (self.d_detect - self.d_safe)
-        return -J, h
+        # a pair inside d_s separates at most at ξ (deep penetrations ask no more than that)
+        return -J, np.maximum(h, -self.xi * dt)
 
     def __repr__(self) -> str:
         return (

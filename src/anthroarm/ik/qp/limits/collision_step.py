@@ -12,8 +12,9 @@ this function is the hook an inequality limit needs until ``qp.step`` takes G, h
 
 Status (``full=True``): ``"optimal"``; ``"start_in_collision"`` when a pair started in collision (d < 0;
 the rows then ask ḋ > 0: the step pushes the pair apart, as for any pair closer than d_s);
-``"relaxed"`` when the rows and the box had no common point and the rows were relaxed to
-"get no closer" (h ← max(h, 0), feasible with Δq = 0); ``"infeasible"`` / ``"failed"`` with the
+``"relaxed"`` when the rows and the box had no common point even with the separation asked
+of pairs inside d_s halved three times, and the rows were relaxed to "get no closer"
+(h ← max(h, 0), feasible with Δq = 0); ``"infeasible"`` / ``"failed"`` with the
 zero velocity.
 """
 
@@ -162,6 +163,10 @@ def step(
     else:
         solve = _solve_daqp if solver == "daqp" else _solve_quadprog
         x, status = solve(H, c, lo, hi, G, h)
+        scale = 0.5
+        while x is None and len(h) and scale > 0.1:  # ask a pair inside d_s to separate slower
+            x, status = solve(H, c, lo, hi, G, np.where(h < 0.0, scale * h, h))
+            scale *= 0.5
         if x is None and len(h):
             x, status = solve(H, c, lo, hi, G, np.maximum(h, 0.0))
             if x is not None:
