@@ -43,6 +43,7 @@ ROBOT_PROVIDERS: dict[str, str] = {
     "anthroarm.dynamics.checks:model_rows": "dyn Lagrange equations",
     "anthroarm.crosscheck:ik_rows": "aa.ik.solve round trip",
     "anthroarm.ik.geometric:check_rows": "closed form by geometry (IK-Geo class)",
+    "anthroarm.collision.checks:rows": "collision distances = coal, damper never violated",
 }
 
 #: providers of the book's rows, ``rows(catalog_names, samples, rng)``, run in this order

@@ -2,7 +2,8 @@
 
 * **distances = coal**: at random configurations, every checked pair's signed distance from
   :func:`anthroarm.collision.distances` against a direct ``coal.distance`` call on the same
-  shapes at the same placements (the placements from Pinocchio's ``updateGeometryPlacements``);
+  shapes at the same placements (the placements from Pinocchio's ``updateGeometryPlacements``;
+  tolerance 1e-5 m: GJK on flat-sided shapes is warm-started per pair by Pinocchio);
   the row reports the largest difference (m).
 * **damper never violated**: random reachable targets followed by QP steps with the
   :class:`~anthroarm.ik.qp.limits.collision.CollisionLimit` from a collision-free start; the
@@ -49,7 +50,7 @@ def distance_row(robot, samples: int, rng) -> CheckRow:
             worst = max(worst, abs(d - float(D.distance[k])))
             n += 1
     return CheckRow(
-        robot.name, "collision distances = coal.distance", worst, 1e-9, n, oracle="coal",
+        robot.name, "collision distances = coal.distance", worst, 1e-5, n, oracle="coal",
         note=f"{len(cm.pairs)} active pairs ({cm.source}), m",
     )  # fmt: skip
 
