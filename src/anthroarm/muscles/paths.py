@@ -150,18 +150,16 @@ def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool):
     if use_wrap:
         for pw in muscle.wraps:
             w = wraps[pw.wrap]
-            if w.active:
-                T, J = kin.frame(w.frame)
-                objs.append((pw, w, T, J))
+            T, J = kin.frame(w.frame)
+            objs.append((pw, w, T, J))
     patterns, inverse = np.unique(act, axis=0, return_inverse=True)
     for k, pat in enumerate(patterns):
         rows = np.flatnonzero(inverse.reshape(-1) == k)
         idx = np.flatnonzero(pat)
         xs, dxs = X[rows][:, idx], DX[rows][:, idx]
         if objs:
-            lk, gk = wrapping.wrapped_length(
-                xs, dxs, [(pw, w, T[rows], J[rows]) for pw, w, T, J in objs], muscle
-            )
+            sub = [(pw, w, T[rows], J[rows]) for pw, w, T, J in objs]
+            lk, gk = wrapping.wrapped_length(xs, dxs, idx, sub, muscle)
         else:
             lk, gk = straight_length(xs, dxs, muscle.name)
         length[rows], grad[rows] = lk, gk
