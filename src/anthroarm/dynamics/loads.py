@@ -4,8 +4,8 @@ r"""External loads as generalised forces (Eq. (8-5)) and inverse dynamics along 
 :math:`F_i\cdot\delta r_i = \sum_j F_i\cdot\frac{\partial r_i}{\partial q_j}\delta q_j`, so its
 generalised force is Eq. (8-5) of the book,
 
-.. math::  Q_j = \sum_i\Big(F_{ix}\frac{\partial x_i}{\partial q_j}+F_{iy}\frac{\partial
-y_i}{\partial q_j}
+.. math::  Q_j = \sum_i\Big(F_{ix}\frac{\partial x_i}{\partial q_j}
+                 +F_{iy}\frac{\partial y_i}{\partial q_j}
                  +F_{iz}\frac{\partial z_i}{\partial q_j}\Big) = \big(J_v^T F\big)_j .
 
 A moment :math:`m` on the same body adds :math:`J_\omega^T m`, so a wrench
