@@ -250,8 +250,10 @@ def _spiral(p1, p2, r1, r2, radius, far_side, single):
             return r1, r2, arc
         t = 1.0 / nseg
         w1 = _rotation(sense * t * theta, DN) @ r1 + DN * (t * axial)
-        w2 = _rotation(sense * (1 - t) * theta, DN) @ r1 + DN * ((1 - t) * axial)
         a1, r1n = _adjust(p1, r1, w1)
+        # OpenSim's spiral-point lambda captures r1 by reference: the second point is placed
+        # from the r1 just adjusted
+        w2 = _rotation(sense * (1 - t) * theta, DN) @ r1n + DN * ((1 - t) * axial)
         a2, r2n = _adjust(p2, r2, w2)
         if not (a1 or a2):
             return r1, r2, arc
