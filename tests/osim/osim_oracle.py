@@ -21,6 +21,7 @@ class OpenSimOracle:
         import opensim as osim
 
         osim.Logger.setLevelString("error")
+        osim.Logger.removeFileSink()  # no opensim.log beside the model (OpenSim loads from its folder)
         self.osim = osim
         self.model = model = osim.Model(str(path))
         if not forces:

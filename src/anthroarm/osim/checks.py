@@ -108,6 +108,7 @@ class OpenSimModel:
         import opensim as osim
 
         osim.Logger.setLevelString("error")
+        osim.Logger.removeFileSink()  # no opensim.log beside the model (OpenSim loads from its folder)
         self.osim = osim
         self.model = model = osim.Model(str(path))
         fs = model.getForceSet()
