@@ -8,6 +8,8 @@ line expected in the error is found in the edited text by the test itself.
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -77,10 +79,21 @@ def test_not_an_opensim_document(tmp_path):
     assert "<robot>" in str(e) and e.line == 2
 
 
-def test_opensim_3_model_names_the_remedy(tmp_path):
+def test_opensim_3_model_without_opensim_names_the_remedy(tmp_path):
+    """Without the opensim package (made unimportable in a subprocess) a 3.x model is an
+    OsimUnsupportedError naming the remedy; with it, OpenSim's updater reads it
+    (tests/osim/test_joints_functions.py)."""
     p, _ = edit(tmp_path, ARM, 'Version="40000"', 'Version="30000"')
-    e = load_error(p, OsimUnsupportedError)
-    assert "3.x" in str(e) and "OpenSim 4" in str(e) and "printToXML" in str(e)
+    code = (
+        "import sys; sys.modules['opensim'] = None\n"
+        "import anthroarm as aa\n"
+        "from anthroarm.errors import OsimUnsupportedError\n"
+        f"try:\n    aa.load({str(p)!r})\n"
+        "except OsimUnsupportedError as e:\n    print('ERR', e.line, e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.startswith("ERR 1 "), out.stdout + out.stderr
+    assert "3.x" in out.stdout and "OpenSim 4" in out.stdout and "printToXML" in out.stdout
 
 
 def test_missing_file_folder_and_device(tmp_path):

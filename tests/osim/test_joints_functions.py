@@ -17,6 +17,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -215,3 +217,20 @@ def test_walker_knee_velocity_terms_are_exact(tmp_path):
     c_osim = c_osim - oracle.inverse_dynamics(C, udot)
     assert np.abs(c_ours - c_fd).max() < 1e-6 * max(1, np.abs(c_fd).max())
     assert np.abs(c_osim - c_fd).max() > 1e-4 * np.abs(c_fd).max()  # Simbody's buildHdot
+
+
+def test_opensim_3_model_read_through_opensims_updater():
+    """A 3.x model (opensim-core's ``OpenSim/Tools/Test/double_pendulum33.osim``, Apache-2.0,
+    document version 30000) is brought to 4.x by OpenSim's updater and agrees with OpenSim
+    reading the original file."""
+    path = Path(__file__).parent / "data" / "double_pendulum33.osim"
+    robot = aa.load(path)
+    assert robot.joint_names == ["q1", "q2"]
+    assert "updater" in robot.report.rows[-1].why
+    oracle = OpenSimOracle(path, robot.joint_names)
+    for q in robot.random_q(20, 0):
+        C, _ = oracle.set_state(q)
+        for b, H in oracle.body_poses().items():
+            assert np.abs(robot.fk(q, b) - H).max() < 1e-12
+        Mo = oracle.mass_matrix(C)
+        assert np.abs(robot.mass_matrix(q) - Mo).max() < 1e-12 * max(1, np.abs(Mo).max())

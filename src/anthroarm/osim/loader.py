@@ -11,6 +11,7 @@ the Pinocchio configuration (:class:`~anthroarm.osim.coupling.Coupling`) and ``f
 
 from __future__ import annotations
 
+import tempfile
 from functools import cached_property
 from pathlib import Path
 
@@ -205,18 +206,54 @@ class OsimRobot(Robot):
 
 
 def read(path) -> OsimModel:
-    """Parse and read ``path`` (typed errors as :func:`load_osim`)."""
+    """Parse and read ``path`` (typed errors as :func:`load_osim`).  A 3.x model (document
+    version below 40000) is first brought to 4.x by OpenSim's own updater when the ``opensim``
+    package is installed (:func:`upgrade`); without it, the error names the remedy."""
     model_el, version = xmlread.parse(path)
-    if version < 40000:
-        raise OsimUnsupportedError(
-            path,
-            f"an OpenSim {version // 10000}.x model (document version {version}); the import reads "
-            "4.x models: open and save it in OpenSim 4, or run "
-            "opensim.Model(path).printToXML(new_path) (OpenSim's updater)",
-            "<OpenSimDocument>",
-            1,
-        )
-    return read_model(model_el, version, path)
+    if version >= 40000:
+        return read_model(model_el, version, path)
+    text = upgrade(path, version)
+    model_el, new_version = xmlread.parse_bytes(text, path)
+    m = read_model(model_el, new_version, path)
+    m.report.add(
+        "/",
+        "OpenSimDocument",
+        KEPT,
+        f"a {version // 10000}.x model (version {version}) read after OpenSim's updater "
+        "(opensim.Model(path).printToXML): line numbers are those of the updated text",
+        1,
+    )
+    return m
+
+
+def upgrade(path, version: int) -> bytes:
+    """The 4.x text of a 3.x model, written by OpenSim's updater (``opensim.Model(path)``, then
+    ``printToXML``) into a temporary folder.  Without ``opensim``:
+    :class:`~anthroarm.errors.OsimUnsupportedError` naming the remedy."""
+    remedy = (
+        f"an OpenSim {version // 10000}.x model (document version {version}); the import reads "
+        "4.x models: open and save it in OpenSim 4, or run "
+        "opensim.Model(path).printToXML(new_path) (OpenSim's updater; with the opensim package "
+        "installed, aa.load does this itself)"
+    )
+    try:
+        import opensim
+    except ImportError:
+        raise OsimUnsupportedError(path, remedy, "<OpenSimDocument>", 1) from None
+    opensim.Logger.setLevelString("error")
+    opensim.Logger.removeFileSink()
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "updated.osim"
+        try:
+            opensim.Model(str(Path(path).resolve())).printToXML(str(out))
+            return out.read_bytes()
+        except Exception as exc:  # OpenSim's C++ exceptions arrive as RuntimeError
+            raise OsimUnsupportedError(
+                path,
+                f"{remedy}; OpenSim's updater failed: {' '.join(str(exc).split())[:300]}",
+                "<OpenSimDocument>",
+                1,
+            ) from None
 
 
 def load_osim(
