@@ -56,6 +56,7 @@ GUIDE = [
     "design",
     "hand",
     "grasp",
+    "collision",
     "motion",
     "opensim_ik",
     "prosthesis",
