@@ -47,7 +47,7 @@ def muscle_set(robot, muscles=None) -> MuscleSet:
     osim = getattr(robot, "osim", None)
     if osim is None:
         raise ParameterError(f"{robot.name}: not an OpenSim model; pass muscles= (a .osim file)")
-    return robot.derived(("muscles", "set"), lambda: read_muscles(osim.path))
+    return robot.derived("muscles.set", lambda _robot: read_muscles(osim.path))
 
 
 def _coordinates(robot, q):
@@ -107,11 +107,25 @@ class Kinematics:
         R, o = T[:, :3, :3], T[:, :3, 3]
         rs = np.einsum("nij,...j->ni", R, s) if s.ndim == 1 else np.einsum("nij,nj->ni", R, s)
         x = o + rs
-        Jv, Jw = J[:, :3], J[:, 3:]
-        dx = Jv - np.cross(rs[:, :, None], Jw, axis=1)
+        dx = J[:, :3] - _cross_cols(rs, J[:, 3:])
         if ds is not None:
             dx = dx + np.einsum("nij,njk->nik", R, ds)
         return x, dx
+
+    def points(self, frame, S):
+        """World positions (N, P, 3) and ∂x/∂q (N, P, 3, nq) of P fixed locations S (P, 3)."""
+        T, J = self.frame(frame)
+        rs = np.einsum("nij,pj->npi", T[:, :3, :3], S)
+        x = T[:, None, :3, 3] + rs
+        dx = J[:, None, :3] - _cross_cols(rs, J[:, None, 3:])
+        return x, dx
+
+
+def _cross_cols(a, B):
+    """a × each column of B: a (..., 3), B (..., 3, k) -> (..., 3, k)."""
+    a0, a1, a2 = a[..., 0, None], a[..., 1, None], a[..., 2, None]
+    b0, b1, b2 = B[..., 0, :], B[..., 1, :], B[..., 2, :]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-2)
 
 
 def _path_point(kin: Kinematics, p):
@@ -137,13 +151,15 @@ def _path_point(kin: Kinematics, p):
     return x, dx, np.ones(n, dtype=bool)
 
 
-def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool):
-    """(l (N,), dl/dq (N, nq)) of one muscle."""
-    pts = [_path_point(kin, p) for p in muscle.points]
-    X = np.stack([p[0] for p in pts], axis=1)  # N, K, 3
-    DX = np.stack([p[1] for p in pts], axis=1)  # N, K, 3, nq
-    act = np.stack([p[2] for p in pts], axis=1)  # N, K
+def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool, X, DX):
+    """(l (N,), dl/dq (N, nq)) of one muscle whose points are X (N, K, 3), DX (N, K, 3, nq)
+    (moving points filled in here)."""
     n, nq = kin.q.shape
+    act = np.ones((n, len(muscle.points)), dtype=bool)
+    for k, p in enumerate(muscle.points):
+        if p.kind == "fixed":
+            continue
+        X[:, k], DX[:, k], act[:, k] = _path_point(kin, p)
     length = np.zeros(n)
     grad = np.zeros((n, nq))
     objs = []
@@ -187,12 +203,84 @@ def _evaluate(robot, muscles, q, wrap: bool):
     q = robot.check_q(q)
     one = q.ndim == 1
     q2 = q.reshape(1, -1) if one else q
-    kin = Kinematics(robot, q2)
     L = np.zeros((q2.shape[0], len(ms)))
     D = np.zeros((q2.shape[0], len(ms), q2.shape[1]))
-    for i, m in enumerate(ms.muscles):
-        L[:, i], D[:, i] = _muscle_path(kin, m, ms.wrap_objects, wrap)
+    plan = robot.derived(f"muscles.plan.{id(ms)}", lambda _r: _Plan(ms))
+    for a in range(0, q2.shape[0], CHUNK):
+        b = min(a + CHUNK, q2.shape[0])
+        L[a:b], D[a:b] = plan.run(Kinematics(robot, q2[a:b]), wrap)
     return (L[0], D[0]) if one else (L, D)
+
+
+#: states evaluated at once (bounds the (N, points, 3, nq) arrays)
+CHUNK = 256
+
+
+class _Plan:
+    """Where every path point of a muscle set sits in one stacked array, and which muscles are
+    plain polylines of fixed points (evaluated all at once)."""
+
+    def __init__(self, ms: MuscleSet):
+        self.ms = ms
+        self.start = np.cumsum([0] + [len(m.points) for m in ms.muscles])
+        self.by_frame: dict = {}
+        for i, m in enumerate(ms.muscles):
+            for k, p in enumerate(m.points):
+                if p.kind != "moving":
+                    self.by_frame.setdefault(p.frame, []).append(self.start[i] + k)
+        self.plain = [
+            i for i, m in enumerate(ms.muscles) if all(p.kind == "fixed" for p in m.points)
+        ]
+        self.plain_wrapless = [i for i in self.plain if not ms.muscles[i].wraps]
+        a, b, owner = [], [], []
+        for i in self.plain:
+            for k in range(len(ms.muscles[i].points) - 1):
+                a.append(self.start[i] + k)
+                b.append(self.start[i] + k + 1)
+                owner.append(i)
+        self.seg_a, self.seg_b = np.array(a, dtype=int), np.array(b, dtype=int)
+        self.seg_owner = np.array(owner, dtype=int)
+
+    def run(self, kin: Kinematics, wrap: bool):
+        ms = self.ms
+        n, nq = kin.q.shape
+        P = int(self.start[-1])
+        X = np.zeros((n, P, 3))
+        DX = np.zeros((n, P, 3, nq))
+        for frame, idx in self.by_frame.items():
+            S = np.array([self._point(j).location for j in idx])
+            X[:, idx], DX[:, idx] = kin.points(frame, S)
+        L = np.zeros((n, len(ms)))
+        D = np.zeros((n, len(ms), nq))
+        done = set(self.plain if not wrap else self.plain_wrapless)
+        if done:
+            sel = np.isin(self.seg_owner, list(done))
+            sa, sb, own = self.seg_a[sel], self.seg_b[sel], self.seg_owner[sel]
+            d = X[:, sb] - X[:, sa]
+            seg = np.linalg.norm(d, axis=-1)
+            if np.any(seg < COINCIDE):
+                s_, j = np.argwhere(seg < COINCIDE)[0]
+                m = ms.muscles[own[j]]
+                raise MuscleError(
+                    f"muscle {m.name!r}: path points {sa[j] - self.start[own[j]]} and "
+                    f"{sb[j] - self.start[own[j]]} coincide (state {s_}): the path's direction "
+                    "is undefined"
+                )
+            g = np.einsum("nsi,nsik->nsk", d / seg[..., None], DX[:, sb] - DX[:, sa])
+            for i in done:
+                rows = own == i
+                L[:, i] = seg[:, rows].sum(axis=1)
+                D[:, i] = g[:, rows].sum(axis=1)
+        for i, m in enumerate(ms.muscles):
+            if i in done:
+                continue
+            sl = slice(self.start[i], self.start[i + 1])
+            L[:, i], D[:, i] = _muscle_path(kin, m, ms.wrap_objects, wrap, X[:, sl], DX[:, sl])
+        return L, D
+
+    def _point(self, j):
+        i = int(np.searchsorted(self.start, j, side="right") - 1)
+        return self.ms.muscles[i].points[j - self.start[i]]
 
 
 def lengths(robot, muscles=None, q=None, *, wrap: bool = True) -> np.ndarray:
