@@ -19,7 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import OsimStrictError, OsimUnsupportedError, ParameterError
-from ..robot import Robot, make_robot
+from ..robot import Robot, reduce_model
 from . import xmlread
 from .build import build
 from .reader import OsimModel, read_model
@@ -147,8 +147,9 @@ class OsimRobot(Robot):
     def jacobian(self, q, frame=None, reference: str = "LOCAL_WORLD_ALIGNED") -> np.ndarray:
         """Frame Jacobian in the independent coordinates, J(φ(q)) · G(q) (chain rule), 6 × nq,
         rows (v; ω); references as :meth:`anthroarm.robot.Robot.jacobian`."""
-        if self.coupling is None:
-            return super().jacobian(q, frame, reference)
+        if self.coupling is None:  # Pinocchio gives (6,) for one joint: always (6, nv)
+            J = super().jacobian(q, frame, reference)
+            return J.reshape(J.shape[:-1] + (6, self.nv)) if J.shape[-1] != self.nv else J
         q = self.check_q(q)
         fid = self.frame_id(frame)
         qf, G = self.coupling.jacobian(q)
@@ -301,14 +302,14 @@ def load_osim(
                 "coordinates; fix coordinates by their values in q instead"
             )
         return OsimRobot(model, coupling=coupling, osim=m, name=name, tool=tool, description=desc)
-    robot = make_robot(model, name=name, tool=tool, active=active, locked=locked, description=desc)
+    model, values = reduce_model(model, name, active, locked)
     out = OsimRobot(
-        robot.model,
+        model,
         coupling=None,
         osim=m,
         name=name,
         tool=tool,
         description=desc,
-        locked=robot.locked,
+        locked=values,
     )
     return out
