@@ -59,8 +59,10 @@ def _human_arm(params: dict, with_hand: bool) -> ShapeTable:
         for digit in ("index", "middle", "ring", "little"):
             for ph in ("proximal", "middle", "distal"):
                 radius[f"{digit}_{ph}"] = 0.095 * hb
-        for ph in ("metacarpal", "proximal", "distal"):
+        for ph in ("metacarpal", "proximal"):
             radius[f"thumb_{ph}"] = 0.12 * hb
+        # every fingertip capsule has one radius: a grasp's contact offset is one number
+        radius["thumb_distal"] = 0.095 * hb
         # palm over the four metacarpals: index MCP at x = +HB/4, little at x = -HB/2 (the
         # builder's layout), from the wrist to the shortest metacarpal
         mcp = 0.92 * float(params["l3"])
