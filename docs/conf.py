@@ -48,6 +48,7 @@ build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
 GUIDE = [
     "load",
+    "osim",
     "kinematics",
     "ik",
     "dynamics",
@@ -55,7 +56,9 @@ GUIDE = [
     "design",
     "hand",
     "grasp",
+    "collision",
     "motion",
+    "opensim_ik",
     "prosthesis",
     "emg",
     "control",
@@ -143,7 +146,9 @@ myst_heading_anchors = 3
 # ---------------------------------------------------------------- HTML
 html_theme = "pydata_sphinx_theme"
 html_title = f"anthroarm {release}"
-html_static_path: list[str] = []
+# docs/_static/anthroarm.css: long commands wrap, wide tables fit the page, CJK fonts (仿生机械学)
+html_static_path = ["_static"]
+html_css_files = ["anthroarm.css"]
 html_theme_options = {
     "navigation_with_keys": False,
     "show_toc_level": 2,

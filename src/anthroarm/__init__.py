@@ -19,6 +19,7 @@ __version__ = "0.1.0"
 _LAZY = {
     "batch",
     "cache",
+    "collision",
     "control",
     "crosscheck",
     "emg",
@@ -35,6 +36,7 @@ _LAZY = {
     "hand",
     "prosthesis",
     "models",
+    "osim",
 }
 #: names loaded from a submodule on first use, like the subpackages: ``import anthroarm`` (and
 #: with it ``anthroarm --help``) loads neither numpy nor pinocchio until a model is needed

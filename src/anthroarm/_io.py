@@ -16,14 +16,15 @@ process no longer exists.
 Reading files safely: :func:`read_bounded`, :func:`load_json_bounded` and
 :func:`check_regular_file` (for a path handed to a library that opens it itself) are the readers'
 side (C3D, joint CSV and marker-set JSON of :mod:`anthroarm.motion`; meant for every reader of a
-user's file: teach programs, catalogues, batch results).  They read **regular files only** (a folder, ``/dev/zero``, a FIFO or a socket is
-refused without being read: a FIFO is opened non-blocking, so a reader never waits for a writer),
-at most ``max_bytes`` (checked on the size before reading, and again on the bytes read, in case
-the file grows), and, for JSON, at most ``max_depth`` nested arrays/objects, checked on the text
-before :func:`json.loads` runs (a deep document would otherwise raise :class:`RecursionError`).
-Each takes ``error``, a callable ``error(problem) -> Exception`` that builds the caller's typed
-error (e.g. ``lambda problem: MotionDataError(problem, path)``): the problems it is given say what
-is wrong and name the bound, the caller's error names the file.
+user's file: teach programs, catalogues, batch results).  They read **regular files only** (a
+folder, ``/dev/zero``, a FIFO or a socket is refused without being read: a FIFO is opened
+non-blocking, so a reader never waits for a writer), at most ``max_bytes`` (checked on the size
+before reading, and again on the bytes read, in case the file grows), and, for JSON, at most
+``max_depth`` nested arrays/objects, checked on the text before :func:`json.loads` runs (a deep
+document would otherwise raise :class:`RecursionError`). Each takes ``error``, a callable
+``error(problem) -> Exception`` that builds the caller's typed error (e.g. ``lambda problem:
+MotionDataError(problem, path)``): the problems it is given say what is wrong and name the bound,
+the caller's error names the file.
 """
 
 from __future__ import annotations

@@ -178,9 +178,9 @@ class Chain:
         name = name or getattr(model, "name", "") or "model"
         if model.njoints - 1 > MAX_MOVABLE_JOINTS:  # before createData: pin.Data grows as n³
             raise UnsupportedModelError(
-                f"{name}: {model.njoints - 1} joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model "
-                "(Pinocchio's data grows as the cube of the joint count); lock joints with "
-                "pin.buildReducedModel first or split the model"
+                f"{name}: {model.njoints - 1} joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} "
+                "per model (Pinocchio's data grows as the cube of the joint count); lock joints "
+                "with pin.buildReducedModel first or split the model"
             )
         data = model.createData()
         pin.forwardKinematics(model, data, pin.neutral(model))
@@ -211,9 +211,9 @@ class Chain:
             else:
                 if not ((jm.nq == 1 and jm.nv == 1) or (jm.nq == 2 and jm.nv == 1)):
                     raise UnsupportedModelError(
-                        f"{name}: joint {jname!r} is {short} with nq={jm.nq}, nv={jm.nv}; anthroarm handles "
-                        "revolute, continuous, prismatic and mimic joints on a fixed base: "
-                        + _UNSUPPORTED_ADVICE.format(name=jname)
+                        f"{name}: joint {jname!r} is {short} with nq={jm.nq}, nv={jm.nv}; "
+                        "anthroarm handles revolute, continuous, prismatic and mimic joints on a "
+                        "fixed base: " + _UNSUPPORTED_ADVICE.format(name=jname)
                     )
                 S = np.asarray(data.joints[jid].S).reshape(6)
                 nq, nv, idx_q, idx_v = jm.nq, jm.nv, jm.idx_q, jm.idx_v
@@ -225,8 +225,8 @@ class Chain:
                 kind, axis = PRISMATIC, lin / nl
             else:
                 raise UnsupportedModelError(
-                    f"{name}: joint {jname!r} ({short}) is neither a revolute nor a prismatic motion; "
-                    + _UNSUPPORTED_ADVICE.format(name=jname)
+                    f"{name}: joint {jname!r} ({short}) is neither a revolute nor a prismatic "
+                    "motion; " + _UNSUPPORTED_ADVICE.format(name=jname)
                 )
             if nq == 2:
                 if kind != REVOLUTE:
@@ -313,7 +313,10 @@ class Chain:
     # ------------------------------------------------------------------ lookup
     def __repr__(self) -> str:
         kinds = ", ".join(f"{k}={n}" for k, n in self.kind_counts().items() if n)
-        return f"Chain({self.name!r}, joints={len(self.joints)} ({kinds}), nq={self.nq}, nv={self.nv}, tool={self.tool!r})"
+        return (
+            f"Chain({self.name!r}, joints={len(self.joints)} ({kinds}), nq={self.nq}, "
+            f"nv={self.nv}, tool={self.tool!r})"
+        )
 
     def kind_counts(self) -> dict:
         out = {REVOLUTE: 0, PRISMATIC: 0, CONTINUOUS: 0, "mimic": 0}
@@ -531,7 +534,8 @@ class Chain:
                         r = r[bad][0]
                     raise ValueError(
                         f"{self.name}: continuous joint {j.name!r} takes (cos θ, sin θ) in "
-                        f"{name}[{j.idx_q}:{j.idx_q + 2}], a unit vector; its norm is {float(r):.6g}{where}"
+                        f"{name}[{j.idx_q}:{j.idx_q + 2}], a unit vector; its norm is "
+                        f"{float(r):.6g}{where}"
                     )
 
     # ------------------------------------------------------------------ derived
@@ -659,6 +663,6 @@ def _default_tool(name, joints, frames, tips) -> str:
     if not tips:
         return frames[-1].name
     raise AmbiguousToolError(
-        f"{name}: this robot is a tree with {len(tips)} tips; say which frame is the tool with tool=..., "
-        f"one of the tips: {', '.join(tips)}"
+        f"{name}: this robot is a tree with {len(tips)} tips; say which frame is the tool with "
+        f"tool=..., one of the tips: {', '.join(tips)}"
     )

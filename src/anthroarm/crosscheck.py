@@ -43,6 +43,7 @@ ROBOT_PROVIDERS: dict[str, str] = {
     "anthroarm.dynamics.checks:model_rows": "dyn Lagrange equations",
     "anthroarm.crosscheck:ik_rows": "aa.ik.solve round trip",
     "anthroarm.ik.geometric:check_rows": "closed form by geometry (IK-Geo class)",
+    "anthroarm.collision.checks:rows": "collision distances = coal, damper never violated",
 }
 
 #: providers of the book's rows, ``rows(catalog_names, samples, rng)``, run in this order
@@ -189,7 +190,8 @@ def format_table(rows: list[CheckRow]) -> str:
             lines.append(f"{r.model}: {r.quantity}: {r.note}")
     n_ok = sum(r.ok for r in rows)
     lines.append(
-        f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} unsupported"
+        f"{n_ok} passed, {len(rows) - n_ok - len(unsupported)} failed, {len(unsupported)} "
+        "unsupported"
     )
     return "\n".join(lines)
 

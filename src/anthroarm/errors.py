@@ -328,3 +328,9 @@ class OsimUnsupportedError(OsimError):
 
 class OsimStrictError(OsimError):
     """``strict=True`` and the import report lists a component as dropped or approximated."""
+
+
+class MuscleError(AnthroarmError, ValueError):
+    """A muscle that cannot be evaluated: a non-positive optimal fibre length or maximum
+    isometric force, a path whose consecutive points coincide, activations outside [0, 1]
+    (``anthroarm.muscles``)."""

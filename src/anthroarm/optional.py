@@ -56,6 +56,7 @@ HEAVY: frozenset[str] = frozenset(
         "yourdfpy",  # ~490 ms: URDF meshes for the viewer
         "qpsolvers",  # ~170-250 ms: the QP front end of ik.qp
         "numba",  # ~150-250 ms (+ compiled kernels): anthroarm.jit
+        "scipy.sparse",  # ~150 ms: the sparse matrices of the OSQP backend (ik.qp)
         "scipy.optimize",  # ~190 ms
         "scipy.integrate",  # ~220 ms
         "scipy.interpolate",  # ~270 ms

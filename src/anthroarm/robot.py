@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from . import models
 from .chain import Chain
 from .errors import ParameterError, UnknownFrameError, UnsupportedModelError, URDFStructureError
 from .urdf_io import URDFInfo, check_size, parse_urdf_bytes, read_urdf, resolve_uri
@@ -134,7 +135,8 @@ def reduce_model(model, name: str, active=None, locked=None):
                     v = np.array([np.cos(v[0]), np.sin(v[0])])
                 if v.size != jm.nq or not np.all(np.isfinite(v)):
                     raise ParameterError(
-                        f"{name}: locked value of joint {jname!r} must be {jm.nq} finite number(s), got {v}"
+                        f"{name}: locked value of joint {jname!r} must be {jm.nq} finite "
+                        f"number(s), got {v}"
                     )
                 qref[jm.idx_q : jm.idx_q + jm.nq] = v
             val = qref[jm.idx_q : jm.idx_q + jm.nq].copy()
@@ -143,7 +145,8 @@ def reduce_model(model, name: str, active=None, locked=None):
     for m, src in mimic_source.items():
         if (m in lock_ids) != (src in lock_ids):
             raise UnsupportedModelError(
-                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both or neither"
+                f"{name}: mimic joint {model.names[m]!r} follows {model.names[src]!r}: lock both "
+                "or neither"
             )
         if m in lock_ids:
             e = model.joints[m].extract()
@@ -190,6 +193,11 @@ class Robot:
     visual_model, collision_model : pin.GeometryModel, optional
         Geometry of a model given as a ``pin.Model`` / ``RobotWrapper``.
     """
+
+    #: the map from q to the Pinocchio configuration of a model whose joints are coupled by
+    #: nonlinear functions (an OpenSim model: :class:`anthroarm.osim.coupling.Coupling`, with
+    #: ``fk``/``jacobian`` by the chain rule); None for every other robot
+    coupling = None
 
     def __init__(
         self,
@@ -477,6 +485,8 @@ def load(
     * any example-robot-data robot by name (``"ur10"``, ``"xarm7"``, ``"kinova"``, ``"baxter"``;
       :func:`anthroarm.models.erd_names`), read offline from the installed package;
     * a URDF path;
+    * an OpenSim model path ``*.osim`` (:func:`anthroarm.osim.load_osim`; ``strict=True``
+      refuses a model whose import report drops anything);
     * a ``pin.Model`` (with ``visual_model=`` / ``collision_model=`` if you have them) or a
       ``pin.RobotWrapper``.
 
@@ -492,7 +502,7 @@ def load(
     :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
     (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
-    from . import models  # models imports this module (its builders make Robots)
+    from . import osim  # it imports this module (its builder makes Robots)
 
     def no_params(what):
         if params:
@@ -576,6 +586,10 @@ def load(
             description=f"{s} (example-robot-data)",
             **common,
         )
+    if s.lower().endswith(".osim"):  # an OpenSim model: anthroarm.osim.load_osim (strict=)
+        strict = params.pop("strict", False)
+        no_params(f"the OpenSim model {s}")
+        return osim.load_osim(s, tool=tool, name=name, strict=strict, active=active, locked=locked)
     looks_like_path = s.endswith(".urdf") or "/" in s or Path(s).exists()
     if not looks_like_path:
         raise models._unknown(s)

@@ -148,8 +148,9 @@ def normalize_package_dirs(
         search.extend(_as_folder(d, f"entry {i}") for i, d in enumerate(package_dirs))
     else:
         raise ParameterError(
-            "package_dirs must be a list of folders (package://NAME/... is looked up as DIR/NAME/...), "
-            f"a single folder, or a dict {{package name: root}}; got {type(package_dirs).__name__}"
+            "package_dirs must be a list of folders (package://NAME/... is looked up as "
+            "DIR/NAME/...), a single folder, or a dict {package name: root}; got "
+            f"{type(package_dirs).__name__}"
         )
     return PackageDirs(named, search)
 
@@ -290,8 +291,8 @@ def _check_limit(path, joint: str, jtype: str, which: str, value: float) -> None
         unit = "m" if jtype == "prismatic" else "rad"
         raise URDFStructureError(
             path,
-            f"joint {joint!r} {which} limit {value:g} {unit} is beyond the physical bound of {MAX_LENGTH:.0e} "
-            f"{unit}; write a magnitude of at least {NO_LIMIT:.0e} for no limit"
+            f"joint {joint!r} {which} limit {value:g} {unit} is beyond the physical bound of "
+            f"{MAX_LENGTH:.0e} {unit}; write a magnitude of at least {NO_LIMIT:.0e} for no limit"
             + (" (or make it a continuous joint)" if jtype == "revolute" else ""),
         )
 
@@ -303,8 +304,9 @@ def check_size(info: "URDFInfo") -> None:
     if n > MAX_MOVABLE_JOINTS:
         raise URDFStructureError(
             info.path,
-            f"{n} movable joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model (Pinocchio's data "
-            "grows as the cube of the joint count: 0.6 GB at 200); split the model or make joints fixed",
+            f"{n} movable joints; anthroarm takes at most {MAX_MOVABLE_JOINTS} per model "
+            "(Pinocchio's data grows as the cube of the joint count: 0.6 GB at 200); split the "
+            "model or make joints fixed",
         )
 
 
@@ -341,8 +343,9 @@ def resolve_uri(uri: str, urdf_path: Path, package_dirs: PackageDirsLike) -> Pat
             )
             raise PackagePathError(
                 urdf_path,
-                f"mesh {uri!r}: unknown package {pkg!r}{searched}; pass package_dirs=['/folder/containing/{pkg}'] "
-                f"or package_dirs={{'{pkg}': '/path/to/{pkg}'}}",
+                f"mesh {uri!r}: unknown package {pkg!r}{searched}; pass "
+                f"package_dirs=['/folder/containing/{pkg}'] or package_dirs={{'{pkg}': "
+                f"'/path/to/{pkg}'}}",
             )
         for root in roots:
             root_r = root.resolve()
@@ -398,7 +401,8 @@ def parse_urdf_bytes(
     if _DTD_OR_ENTITY.search(raw):
         raise URDFSecurityError(
             path,
-            "DTD/entity declarations are not allowed in a URDF (entity expansion or external entity)",
+            "DTD/entity declarations are not allowed in a URDF (entity expansion or external "
+            "entity)",
         )
     parser = etree.XMLParser(
         resolve_entities=False,
@@ -465,7 +469,8 @@ def parse_urdf_bytes(
         if jtype not in JOINT_TYPES:
             raise URDFStructureError(
                 path,
-                f"joint {name!r} has unknown type {jtype!r} (line {el.sourceline}); known: {', '.join(JOINT_TYPES)}",
+                f"joint {name!r} has unknown type {jtype!r} (line {el.sourceline}); known: "
+                f"{', '.join(JOINT_TYPES)}",
             )
         sub = _first_children(el)
         pe, ce = sub.get("parent"), sub.get("child")
@@ -478,7 +483,8 @@ def parse_urdf_bytes(
         if child in parent_of:
             raise URDFStructureError(
                 path,
-                f"link {child!r} is the child of two joints ({joint_of[child]!r} and {name!r}): a kinematic loop",
+                f"link {child!r} is the child of two joints ({joint_of[child]!r} and {name!r}): a "
+                "kinematic loop",
             )
         parent_of[child] = parent
         joint_of[child] = name

@@ -80,13 +80,17 @@ for name in ("human_arm7", "prosthetic_arm"):  # the targets of `anthroarm check
     robot = aa.load(name)
     Qc = robot.random_q(20, np.random.default_rng(0))
     res = [aa.ik.solve(robot, robot.fk(q)) for q in Qc]
-    out["solve_" + name] = [[bool(r.success), r.status, bool(robot.within_limits(r.q))] for r in res]
+    out["solve_" + name] = [
+        [bool(r.success), r.status, bool(robot.within_limits(r.q))] for r in res
+    ]
 far = np.eye(4)
 far[:3, 3] = (5.0, 0.0, 0.0)
-for label, bad in (("nan", np.full((4, 4), np.nan)), ("shape", np.ones((2, 2))), ("skew", np.ones((4, 4)))):
+BAD = (("nan", np.full((4, 4), np.nan)), ("shape", np.ones((2, 2))), ("skew", np.ones((4, 4))))
+for label, bad in BAD:
     run("error_" + label, lambda bad=bad: [aa.ik.solve(ur5, bad).status])
 run("far_solve", lambda: [aa.ik.solve(ur5, far).status])
-run("far_analytic", lambda: [len(aa.ik.analytic(ur5, far).solutions), aa.ik.analytic(ur5, far).reason])
+run("far_analytic", lambda: [len(aa.ik.analytic(ur5, far).solutions),
+                             aa.ik.analytic(ur5, far).reason])
 from anthroarm import jit
 out["jit"] = jit.status()
 out["times"] = times

@@ -55,8 +55,8 @@ def inertial(
     mass="1", origin="0 0 0", ixx="0.01", iyy="0.01", izz="0.01", ixy="0", ixz="0", iyz="0"
 ):
     return (
-        f"<inertial><origin xyz='{origin}' rpy='0 0 0'/><mass value='{mass}'/>"
-        f"<inertia ixx='{ixx}' ixy='{ixy}' ixz='{ixz}' iyy='{iyy}' iyz='{iyz}' izz='{izz}'/></inertial>"
+        f"<inertial><origin xyz='{origin}' rpy='0 0 0'/><mass value='{mass}'/><inertia ixx='{ixx}' "
+        f"ixy='{ixy}' ixz='{ixz}' iyy='{iyy}' iyz='{iyz}' izz='{izz}'/></inertial>"
     )
 
 
@@ -79,13 +79,15 @@ def nested(depth):
 
 
 BOMB = (
-    '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
-    '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;"><!ENTITY d "&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;">]>'
+    '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b '
+    '"&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;"><!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;"><!ENTITY d '
+    '"&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;">]>'
 )
 
 LOADS = None  # expected outcome: the file is legitimate and loads
 
-#: (id, text or callable(tmp_path) -> text, expected exception type or LOADS, substring of the message)
+#: (id, text or callable(tmp_path) -> text, expected exception type or LOADS, substring of the
+#: message)
 CASES = [
     # ---------------------------------------------------------------- entities, DTD, XML tricks
     ("entity-bomb", BOMB + robot(name="&d;"), errors.URDFSecurityError, "DTD"),
@@ -580,7 +582,8 @@ CHILD = textwrap.dedent("""
         check_loaded(r)
         print(json.dumps({{"ok": True}}))
     except Exception as exc:
-        print(json.dumps({{"ok": False, "type": type(exc).__name__, "mro": [c.__name__ for c in type(exc).__mro__],
+        mro = [c.__name__ for c in type(exc).__mro__]
+        print(json.dumps({{"ok": False, "type": type(exc).__name__, "mro": mro,
                           "msg": str(exc)}}))
 """)
 

@@ -30,7 +30,8 @@ from anthroarm.viewer import Viewer
 URDF = """<robot name="meshy">
   <link name="base"/>
   <link name="forearm"><visual><geometry><mesh filename="{mesh}"/></geometry></visual></link>
-  <joint name="elbow" type="revolute"><parent link="base"/><child link="forearm"/><axis xyz="0 0 1"/>
+  <joint name="elbow" type="revolute"><parent link="base"/><child link="forearm"/><axis
+    xyz="0 0 1"/>
     <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>
 """

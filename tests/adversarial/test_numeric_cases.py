@@ -94,7 +94,8 @@ FOURBAR = (4.0, 1.5, 3.5, 3.0)  # the module docstring's crank-rocker
 @pytest.mark.parametrize("scale", [1e-155, 1e-100, 1e100, 1e155, 1e300])
 @pytest.mark.parametrize("kind", ["complex", "cartesian"])
 def test_fourbar_angles_do_not_depend_on_the_length_unit(scale, kind):
-    """Mathematics: angles and angular rates of a linkage are invariant under scaling its lengths."""
+    """Mathematics: angles and angular rates of a linkage are invariant under scaling its
+    lengths."""
     import warnings
 
     from anthroarm.mechanisms.fourbar import fourbar, fourbar_cartesian

@@ -10,13 +10,12 @@ import pytest
 
 import anthroarm as aa
 from anthroarm.errors import ParameterError, UnknownCodeError
-from anthroarm.ik.cells import CellTable, OutsideCellTableError
+from anthroarm.ik.cells import CellTable, OutsideCellTableError, cell_table
 from anthroarm.models import book_tables
 from anthroarm.models.care_robot import (
     CELL_ACCURACY,
     CELL_D,
     TABLE_9_5,
-    cell_table,
     pulses_per_rad,
     table_9_5_length_sum_mm,
     table_9_5_mass_sum_kg,
@@ -79,7 +78,8 @@ def test_model_mass_is_the_printed_total(robot):
 
 def test_model_segment_lengths_are_the_printed_ones(robot):
     # distances between the joint origins (Pinocchio FK at q = 0): waist -> shoulder = base,
-    # shoulder -> elbow = upper arm, elbow -> wrist centre = forearm, wrist centre -> grip = finger-palm
+    # shoulder -> elbow = upper arm, elbow -> wrist centre = forearm, wrist centre -> grip =
+    # finger-palm
     data = robot.model.createData()
     pin.forwardKinematics(robot.model, data, robot.neutral())
     pin.updateFramePlacements(robot.model, data)
@@ -253,7 +253,8 @@ def test_save_and_load_keep_pulses(table, tmp_path):
 # ---------------------------------------------------------------- Table 9.6
 
 
-#: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display, output)
+#: Table 9.6 as printed (l. 7625-7642; ../shared/book/notes/ch9-and-002.md), No. -> (display,
+#: output)
 TABLE_9_6_PRINT = {
     1: ("15", "请一会儿来"),
     2: ("25", "不是"),

@@ -77,18 +77,26 @@ MIMIC_URDF = """<?xml version="1.0"?>
 <robot name="mimic3">
   <link name="base_link"/>
   <joint name="j1" type="revolute"><parent link="base_link"/><child link="l1"/>
-    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
-  <link name="l1"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/><inertia ixx="0.01" ixy="0.001" ixz="0" iyy="0.02" iyz="0" izz="0.015"/></inertial></link>
+    <origin xyz="0 0 0.1" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3"
+      effort="10" velocity="2"/></joint>
+  <link name="l1"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/><inertia ixx="0.01"
+    ixy="0.001" ixz="0" iyy="0.02" iyz="0" izz="0.015"/></inertial></link>
   <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
-    <origin xyz="0.2 0 0" rpy="0.3 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="2"/></joint>
-  <link name="l2"><inertial><origin xyz="0.1 0.02 0"/><mass value="0.7"/><inertia ixx="0.01" ixy="0" ixz="0.002" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+    <origin xyz="0.2 0 0" rpy="0.3 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3"
+      effort="10" velocity="2"/></joint>
+  <link name="l2"><inertial><origin xyz="0.1 0.02 0"/><mass value="0.7"/><inertia ixx="0.01"
+    ixy="0" ixz="0.002" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
   <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
-    <origin xyz="0.2 0 0" rpy="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="2"/>
+    <origin xyz="0.2 0 0" rpy="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3" upper="3"
+      effort="10" velocity="2"/>
     <mimic joint="j2" multiplier="0.6" offset="0.1"/></joint>
-  <link name="l3"><inertial><origin xyz="0.05 0 0"/><mass value="0.3"/><inertia ixx="0.002" ixy="0" ixz="0" iyy="0.003" iyz="0" izz="0.003"/></inertial></link>
+  <link name="l3"><inertial><origin xyz="0.05 0 0"/><mass value="0.3"/><inertia ixx="0.002"
+    ixy="0" ixz="0" iyy="0.003" iyz="0" izz="0.003"/></inertial></link>
   <joint name="j4" type="prismatic"><parent link="l3"/><child link="l4"/>
-    <origin xyz="0.1 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.2" effort="10" velocity="1"/></joint>
-  <link name="l4"><inertial><origin xyz="0.02 0 0.01"/><mass value="0.2"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
+    <origin xyz="0.1 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.2"
+      effort="10" velocity="1"/></joint>
+  <link name="l4"><inertial><origin xyz="0.02 0 0.01"/><mass value="0.2"/><inertia ixx="0.001"
+    ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
 </robot>
 """
 

@@ -32,8 +32,8 @@ def test_urdf_help_lists_the_model_parameters_with_units_and_defaults():
     out = r.stdout
     assert "parameters of human_arm7" in out
     lines = {ln.split()[0]: ln for ln in out.splitlines() if ln.strip().startswith("--")}
-    assert "m, default 1.75" in lines["--height"]
-    assert "kg, default 75.0" in lines["--mass"]
+    assert "m (0.5–2.6), default 1.75" in lines["--height"]
+    assert "kg (10–300), default 75.0" in lines["--mass"]
     assert "default male" in lines["--sex"]
 
 
@@ -71,6 +71,7 @@ def test_urdf_accepts_parameters_as_options_and_as_param(tmp_path, capsys):
 @pytest.mark.parametrize(
     "args, needle",
     [
+        (["urdf", "human_arm7", "--heigth", "1.62"], "--heigth: did you mean --height?"),
         (["urdf", "human_arm7", "--heigth", "1.62"], "--height, --mass, --sex"),
         (["urdf", "human_arm7", "--param", "heigth=1.62"], "height, mass, sex"),
         (["urdf", "ur10", "--height", "1.62"], "ur10 has no builder parameters"),

@@ -97,7 +97,7 @@ def test_care_robot_cell_table_move_by_dda():
     lookups); the DDA hands them out so that all six motors end on the same tick, and the
     registers then hold exactly the target's table pulses."""
     import anthroarm as aa
-    from anthroarm.models.care_robot import cell_table
+    from anthroarm.ik.cells import cell_table
 
     table = cell_table(aa.load("care_robot"))
     a, b = np.array([0.30, -0.05, 0.10]), np.array([0.42, 0.12, 0.22])

@@ -75,7 +75,8 @@ def test_grasp_modes_reach_their_static_forces(mode):
     r = grasp(MOTOR, mode, gap=0.01, stiffness=2e4, lead=LEAD, duration=4.0, set_force=5.0, n=401)
     assert 1.0 < r.contact_time < 1.1  # 10 mm at 10 mm/s, after the start-up
     assert np.all(r.force[r.t < r.contact_time] == 0.0)
-    # statics: hard = the stall force at V_nom through gear and lead; soft = the set force; zero = none
+    # statics: hard = the stall force at V_nom through gear and lead; soft = the set force; zero =
+    # none
     stall = MOTOR.eta * MOTOR.i * MOTOR.k_m * MOTOR.V_nom / (MOTOR.R * LEAD)
     expected = {"hard": stall, "soft": 5.0, "zero": 0.0}[mode]
     assert r.force[-1] == pytest.approx(expected, rel=2e-3, abs=1e-3)

@@ -90,7 +90,8 @@ def test_transfer_functions_against_scipy_and_poles():
 
 
 def test_steady_error_is_the_load_torque_over_i_km_ka():
-    """(9-8) by simulation (final-value theorem), whatever the set-point; printed 1/(i k_m k_s) fails."""
+    """(9-8) by simulation (final-value theorem), whatever the set-point; printed 1/(i k_m k_s)
+    fails."""
     s = SERVO
     M_L = 0.9
     t = np.linspace(0, 30.0 / np.min(np.abs(s.poles().real)), 3001)

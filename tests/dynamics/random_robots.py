@@ -120,9 +120,11 @@ def draw_robot(rng, n: int, p_mimic: float = 0.3, name: str = "rand") -> RandomR
         rpy = rng.uniform(-np.pi, np.pi, 3) if rng.random() < 0.7 else np.zeros(3)
         axis = _unit(rng)
         if kind == "revolute":
-            lim = f'<limit lower="{-rng.uniform(0.5, 3.0):.6f}" upper="{rng.uniform(0.5, 3.0):.6f}" effort="50" velocity="5"/>'
+            lo, hi = -rng.uniform(0.5, 3.0), rng.uniform(0.5, 3.0)
+            lim = f'<limit lower="{lo:.6f}" upper="{hi:.6f}" effort="50" velocity="5"/>'
         elif kind == "prismatic":
-            lim = f'<limit lower="{-rng.uniform(0.05, 0.3):.6f}" upper="{rng.uniform(0.05, 0.3):.6f}" effort="50" velocity="1"/>'
+            lo, hi = -rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3)
+            lim = f'<limit lower="{lo:.6f}" upper="{hi:.6f}" effort="50" velocity="1"/>'
         else:
             lim = '<limit effort="50" velocity="5"/>'
         mim = ""

@@ -71,13 +71,7 @@ CATALOG_AND_MIMIC = aa.models.names() + [
 
 @pytest.mark.parametrize("name", CATALOG_AND_MIMIC)
 def test_catalog_vs_pinocchio(name):
-    if name in aa.models.names():
-        robot = aa.load(name)
-    else:
-        from anthroarm.models import prosthetic_hand
-
-        robot = prosthetic_hand.robot()
-        assert robot.chain.has_mimic
+    robot = aa.load(name)
     dyn = L.load(robot)
     rng = np.random.default_rng(1)
     Q = robot.random_q(8, rng)

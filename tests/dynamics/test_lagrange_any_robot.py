@@ -194,7 +194,8 @@ def test_mimic_joints_vs_pinocchio(which, user_path):
     for i in range(len(Q)):
         q, v, a = Q[i], V[i], A[i]
         qf, vf, af = q_full(q), G @ v, G @ a
-        # Pinocchio's mimic model gives the reduced M, τ, g, nle: the same as Gᵀ(·) of the full model
+        # Pinocchio's mimic model gives the reduced M, τ, g, nle: the same as Gᵀ(·) of the full
+        # model
         M = sym(pin.crba(m, d, q))
         nle = pin.nonLinearEffects(m, d, q, v).copy()
         g = pin.computeGeneralizedGravity(m, d, q).copy()

@@ -53,7 +53,8 @@ MIMIC3_URDF = """<?xml version="1.0"?>
     <origin xyz="0.25 0.05 0" rpy="0 0 0.4"/><axis xyz="1 0 0"/>
     <limit lower="-3" upper="3" effort="10" velocity="3"/>
     <mimic joint="j2" multiplier="2" offset="0.3"/></joint>
-  <joint name="jt" type="fixed"><parent link="l3"/><child link="tool"/><origin xyz="0.1 0 0"/></joint>
+  <joint name="jt" type="fixed"><parent link="l3"/><child link="tool"/><origin xyz="0.1 0 0"/>
+    </joint>
 </robot>
 """
 
@@ -206,11 +207,17 @@ TREE5_URDF = f"""<?xml version="1.0"?>
   <link name="link2">{_I.format(c="0.06 -0.1 0.09", m=1.0)}</link>
   <link name="link3">{_I.format(c="0.04 -0.03 -0.08", m=1.4)}</link>
   <link name="link4">{_I.format(c="0.1 -0.14 0.01", m=0.9)}</link>
-  <joint name="j0" type="revolute"><parent link="base"/><child link="link0"/><origin xyz="0.25 -0.05 -0.13" rpy="0.4 -0.3 1.1"/><axis xyz="0 0 1"/>{_L}</joint>
-  <joint name="j1" type="revolute"><parent link="link0"/><child link="link1"/><origin xyz="-0.18 0.03 0.18" rpy="-1.2 0.5 0.7"/><axis xyz="0 1 0"/>{_L}</joint>
-  <joint name="j2" type="prismatic"><parent link="link0"/><child link="link2"/><origin xyz="-0.19 -0.16 -0.14" rpy="0.2 1.0 -0.4"/><axis xyz="0 0.6 0.8"/>{_L}</joint>
-  <joint name="j3" type="revolute"><parent link="link1"/><child link="link3"/><origin xyz="-0.03 -0.26 -0.27"/><axis xyz="1 0 0"/>{_L}<mimic joint="j1" multiplier="1.2" offset="0.44"/></joint>
-  <joint name="j4" type="revolute"><parent link="link3"/><child link="link4"/><origin xyz="0.2 -0.1 -0.18" rpy="-0.6 0.2 2.0"/><axis xyz="0 0 1"/>{_L}</joint>
+  <joint name="j0" type="revolute"><parent link="base"/><child link="link0"/><origin
+    xyz="0.25 -0.05 -0.13" rpy="0.4 -0.3 1.1"/><axis xyz="0 0 1"/>{_L}</joint>
+  <joint name="j1" type="revolute"><parent link="link0"/><child link="link1"/><origin
+    xyz="-0.18 0.03 0.18" rpy="-1.2 0.5 0.7"/><axis xyz="0 1 0"/>{_L}</joint>
+  <joint name="j2" type="prismatic"><parent link="link0"/><child link="link2"/><origin
+    xyz="-0.19 -0.16 -0.14" rpy="0.2 1.0 -0.4"/><axis xyz="0 0.6 0.8"/>{_L}</joint>
+  <joint name="j3" type="revolute"><parent link="link1"/><child link="link3"/><origin
+    xyz="-0.03 -0.26 -0.27"/><axis xyz="1 0 0"/>{_L}<mimic joint="j1" multiplier="1.2"
+    offset="0.44"/></joint>
+  <joint name="j4" type="revolute"><parent link="link3"/><child link="link4"/><origin
+    xyz="0.2 -0.1 -0.18" rpy="-0.6 0.2 2.0"/><axis xyz="0 0 1"/>{_L}</joint>
 </robot>
 """
 

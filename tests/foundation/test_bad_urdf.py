@@ -24,7 +24,8 @@ def robot_xml(links="<link name='base'/><link name='l1'/>", joints=GOOD_JOINT, e
 
 
 def assert_structure_error(tmp_path, match, **robot_xml_kw):
-    """Loading ``robot_xml(**robot_xml_kw)`` raises URDFStructureError matching ``match``; returns it."""
+    """Loading ``robot_xml(**robot_xml_kw)`` raises URDFStructureError matching ``match``; returns
+    it."""
     with pytest.raises(errors.URDFStructureError, match=match) as exc:
         aa.load(str(write(tmp_path, robot_xml(**robot_xml_kw))))
     return exc.value
@@ -48,11 +49,9 @@ def test_malformed_xml(tmp_path):
 
 def test_not_utf8_names_the_file(tmp_path):
     p = tmp_path / "latin1.urdf"
-    p.write_bytes(
-        '<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="café"><link name="base"/></robot>'.encode(
-            "latin-1"
-        )
-    )
+    text = '<?xml version="1.0" encoding="ISO-8859-1"?>\n'
+    text += '<robot name="café"><link name="base"/></robot>'
+    p.write_bytes(text.encode("latin-1"))
     with pytest.raises(errors.URDFSyntaxError, match="latin1.urdf.*UTF-8"):
         aa.load(str(p))
 
@@ -136,7 +135,10 @@ def test_negative_mass(tmp_path):
 
 
 def mesh_link(uri):
-    return f"<link name='base'/><link name='l1'><visual><geometry><mesh filename='{uri}'/></geometry></visual></link>"
+    return (
+        "<link name='base'/><link name='l1'><visual><geometry>"
+        f"<mesh filename='{uri}'/></geometry></visual></link>"
+    )
 
 
 def test_missing_mesh_names_the_file(tmp_path):

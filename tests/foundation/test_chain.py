@@ -43,9 +43,11 @@ USER_URDF = """<?xml version="1.0"?>
   <joint name="tool_joint" type="fixed"><parent link="l3"/><child link="tool"/>
     <origin xyz="0.1 0 0"/></joint>
   <joint name="grip" type="revolute"><parent link="l3"/><child link="finger_a"/>
-    <origin xyz="0.1 0.02 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.8" effort="1" velocity="1"/></joint>
+    <origin xyz="0.1 0.02 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.8" effort="1"
+      velocity="1"/></joint>
   <joint name="grip_mimic" type="revolute"><parent link="l3"/><child link="finger_b"/>
-    <origin xyz="0.1 -0.02 0"/><axis xyz="1 0 0"/><limit lower="-0.8" upper="0" effort="1" velocity="1"/>
+    <origin xyz="0.1 -0.02 0"/><axis xyz="1 0 0"/><limit lower="-0.8" upper="0"
+      effort="1" velocity="1"/>
     <mimic joint="grip" multiplier="-1.0" offset="0.1"/></joint>
 </robot>
 """

@@ -27,7 +27,7 @@ PAIRS = [
     ("anthroarm.chain", "anthroarm.serial_chain"),
     ("anthroarm.kinematics.batched", "anthroarm.serial_chain"),
     ("anthroarm.dynamics.lagrange", "anthroarm.dynamics.lagrange_sympy"),
-    # ("anthroarm.robot", "anthroarm.models"),
+    ("anthroarm.robot", "anthroarm.models"),
 ]
 #: modules that share no import at all, in either direction
 APART = [

@@ -26,9 +26,7 @@ def limb():
 @pytest.fixture(scope="module")
 def linkage():
     """The book's linkage hand as a plain URDF: passive joints are mimic joints, bars are leaves."""
-    from anthroarm.models.prosthetic_hand import robot
-
-    return robot()
+    return aa.load("prosthetic_hand")
 
 
 def _moving_columns(robot, q, frame_id):

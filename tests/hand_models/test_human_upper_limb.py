@@ -121,8 +121,8 @@ def test_segment_lengths_are_buchholz(limb):
         pts = [pos[n] for n in j] + [tip[d]]
         lengths = [np.linalg.norm(b - a) for a, b in zip(pts, pts[1:])]
         np.testing.assert_allclose(lengths, np.array(c[1:]) * HL, rtol=1e-12)
-        # wrist -> base (MCP, thumb CMC) along the hand axis: Buchholz's first coefficient, up to the
-        # one offset that puts the middle MCP at de Leva's l_hand (0 at the default)
+        # wrist -> base (MCP, thumb CMC) along the hand axis: Buchholz's first coefficient, up to
+        # the one offset that puts the middle MCP at de Leva's l_hand (0 at the default)
         assert wrist[2] - pts[0][2] == pytest.approx(c[0] * HL, abs=1e-12)
     # at q = 0 the middle finger is straight below the hand point: its tip 0.544 HL below it
     np.testing.assert_allclose(

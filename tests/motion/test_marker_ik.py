@@ -88,7 +88,8 @@ def test_noisy_trial_error_is_the_noise_propagation_bound(arm, markers, tmp_path
     assert np.all(ratio > 0.7) and np.all(ratio < 1.4), (err, pred)
     # the residual of a 7-parameter least-squares fit to 30 noisy coordinates (10 markers, the
     # acromion's 3 on the fixed trunk included) is σ²·χ²(30 − 7) per frame, so the frame's RMS
-    # over the 10 markers is σ·sqrt(χ²₂₃ / 10): its median over 300 frames is near σ·sqrt(median χ²₂₃ / 10)
+    # over the 10 markers is σ·sqrt(χ²₂₃ / 10): its median over 300 frames is near σ·sqrt(median
+    # χ²₂₃ / 10)
     from scipy.stats import chi2
 
     expected_rms = sigma * np.sqrt(chi2.median(3 * len(markers) - arm.nv) / len(markers))
@@ -187,7 +188,8 @@ def test_a_set_that_does_not_constrain_a_joint_is_refused(arm):
         "elbow_flexion",
     }
     # every joint has a marker below it, but the forearm and hand markers lie on the long axis
-    # (the wrist is straight at the reference posture): pronation is invisible (rank deficiency, found numerically)
+    # (the wrist is straight at the reference posture): pronation is invisible (rank deficiency,
+    # found numerically)
     on_axis = MarkerSet(
         [
             Marker("EL", "upper_arm", (0.03, 0, -0.28)),

@@ -60,7 +60,8 @@ def test_static_trial_recovers_segment_lengths(tmp_path):
     np.testing.assert_allclose(res.q, q_static, atol=0.02)
     assert res.rms < 1.5e-3  # the median of 100 noisy samples: ~0.1 mm + the fit
 
-    # marker IK of a dynamic trial on the scaled model fits to the noise; on the generic one it cannot
+    # marker IK of a dynamic trial on the scaled model fits to the noise; on the generic one it
+    # cannot
     _, Q = known_motion(person, n=60, seed=8)
     D = pin_marker_positions(person, truth_markers, Q) + rng.normal(
         0, 1e-3, (60, len(truth_markers), 3)

@@ -31,28 +31,19 @@ PACKAGE = "anthroarm"
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "ik/qp/_qpgen2.py": 1,
-    "ik/qp/backends.py": 5,
-    "ik/qp/checks.py": 2,
     "jit.py": 1,
-    "models/care_robot.py": 2,
-    "prosthesis/report.py": 1,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
-    # a circle: load() reads the catalog (models), whose builders make Robots (models imports
-    # robot); gone when load() moves above the catalog
+    # a circle: load() reads OpenSim files (osim), whose loader makes Robots (osim imports
+    # robot); owned by the OpenSim import (issue 32)
     "robot.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
     "emg/simulate.py": 1,
-    "hand/demo.py": 2,
 }
 
 #: file -> private names (or names from private modules) imported from another package
-PRIVATE_IMPORTS = {
-    # owned by others, to be worked off by their owners (issue 29 item 1)
-    "viewer/overlays.py": 1,
-}
+PRIVATE_IMPORTS: dict[str, int] = {}
 
 
 def _private(name: str) -> bool:

@@ -23,7 +23,7 @@ ALLOWED = {
 }
 
 #: still keyed by Robot in a module: to move onto the robot (Robot.derived)
-KNOWN = {("batch/describe.py", "_described")}
+KNOWN: set[tuple[str, str]] = set()
 
 MUTATORS = {"append", "extend", "update", "pop", "popitem", "setdefault", "clear", "add"}
 MUTATORS |= {"discard", "remove", "insert", "move_to_end"}

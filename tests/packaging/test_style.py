@@ -1,4 +1,5 @@
-"""One style for the whole tree: ``ruff format`` and ``ruff check``, configured in pyproject.toml."""
+"""One style for the whole tree: ``ruff format`` and ``ruff check``, configured in
+pyproject.toml."""
 
 import shutil
 import subprocess

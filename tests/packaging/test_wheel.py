@@ -39,7 +39,8 @@ def run(cmd, cwd, env=None, timeout=180):
         stdin=subprocess.DEVNULL,
     )
     assert proc.returncode == 0, (
-        f"{' '.join(map(str, cmd))} failed ({proc.returncode}):\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+        f"{' '.join(map(str, cmd))} failed "
+        f"({proc.returncode}):\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
     )
     return proc.stdout
 
@@ -146,7 +147,8 @@ def test_wheel_contents_and_install_outside_the_checkout(tmp_path):
     deps = sysconfig.get_paths()["purelib"]  # the project venv: the dependencies, already installed
     src = str(ROOT / "src")
     (site_new / "zz_project_deps.pth").write_text(
-        f"import site, sys; site.addsitedir({deps!r}); sys.path[:] = [p for p in sys.path if p != {src!r}]\n"
+        f"import site, sys; site.addsitedir({deps!r}); sys.path[:] = [p for p in sys.path if p != "
+        f"{src!r}]\n"
     )
 
     outside = tmp_path / "elsewhere"

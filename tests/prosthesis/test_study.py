@@ -12,6 +12,7 @@ from anthroarm.cli import main
 from anthroarm.dynamics.hand_model import minimum_jerk
 from anthroarm.errors import ActivityError
 from anthroarm.prosthesis import report, study
+from anthroarm.viewer.pages import activities_html
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +60,7 @@ def test_unreachable_activity_is_a_status_in_study_and_report(person, tmp_path):
     st = study.run(person, acts, payload=0.5)
     assert [a.status for a in st.activities] == ["ok", "unreachable"]
     assert [a.name for a in st.envelope.activities] == ["reach"]
-    out = report.write(st, tmp_path / "r.html", viewer=False)
+    out = report.write(st, tmp_path / "r.html")
     text = out.read_text()
     assert "far shelf" in text and "120 mm short" in text
     # the report's drive mass is the study's
@@ -134,7 +135,7 @@ def test_report_embeds_one_viewer_page_with_the_activities(person, tmp_path):
         [dict(name="a", t=t, q=q, qd=qd, qdd=qdd), dict(name="b", t=t, q=q[::-1])],
         payload=0.2,
     )
-    text = report.render(st, viewer=True)
+    text = report.render(st, viewer=activities_html(st))
     assert text.count("<iframe srcdoc=") == 1 and "set_animation" not in text[:200]
     assert "a at 0.0 s; b at 0.5 s" in text
     assert text.count("MeshCat.Viewer(") == 1  # meshcat's page once, escaped in srcdoc

@@ -207,10 +207,10 @@ def test_kinova_html_draws_the_arm_and_turns_its_continuous_joints(tmp_path):
         th[base.index] += turn
         q = chain.configuration(th[list(chain.independent)])
         v.display(q)
+        v.set_camera()  # framed on this pose, as a new Viewer(robot, q=q) is
         html = v.export_html(tmp_path / f"kinova{k}.html")
         shot = browser.screenshot(html, tmp_path / f"kinova{k}.png", size=(W, H), budget_ms=2000)
-        if k == 0:
-            base_png = baseline(Viewer(robot), tmp_path, "kinova_base")
+        base_png = baseline(Viewer(robot, q=q), tmp_path, f"kinova_base{k}")
         box = expected_box(v, q)
         inside, outside = robot_pixels(shot, base_png, box)
         area = (box[2] - box[0]) * (box[3] - box[1])

@@ -179,7 +179,11 @@ def test_batch_voxel_maps_as_point_clouds_with_legends():
     assert counts.sum() == 3000 and len(out["points"]) == len(centres)
     np.testing.assert_allclose(np.sort(out["points"], axis=0), np.sort(centres, axis=0))
     (obj,) = objects_at(v, f"{v.root}/overlays/reachability_map")
-    assert obj["object"]["materials"][0]["size"] == pytest.approx(0.08)
+    material = obj["object"]["materials"][0]
+    # half the 8 cm voxel, see-through and not hiding what lies behind: the robot shows inside
+    assert material["size"] == pytest.approx(0.04)
+    assert material["transparent"] is True and 0 < material["opacity"] < 1
+    assert material["depthWrite"] is False
     c = counts[i, j, k].astype(float)
     order = np.lexsort(centres.T)
     got = attribute(obj, "color")[np.lexsort(out["points"].T)]

@@ -96,7 +96,7 @@ def load(page, url: str) -> None:
 def slider_values(page) -> dict:
     return dict(
         page.evaluate(
-            "Array.from(document.querySelectorAll('#anthroarm-teach input'))"
+            "Array.from(document.querySelectorAll('#anthroarm-teach input[type=range]'))"
             ".map(function (e) { return [e.dataset.joint, parseFloat(e.value)]; })"
         )
     )

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import inspect
 import threading
-import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -29,8 +28,6 @@ CACHE_SIZE = 16
 
 _cache: "OrderedDict[tuple, object]" = OrderedDict()
 _lock = threading.Lock()
-#: Robot -> its description (weak keys; a description holds strings and numbers, not the Robot)
-_described: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -76,15 +73,17 @@ class RobotDescription:
             raise
         except Exception as exc:
             raise RobotRebuildError(
-                f"the worker could not rebuild robot {self.name!r} from its {self.kind} description: "
-                f"{type(exc).__name__}: {exc}. Remedy: make sure every worker runs the same anthroarm version as "
-                f"the client (pip install the same wheel/commit in the workers' environment)"
+                f"the worker could not rebuild robot {self.name!r} from its {self.kind} "
+                f"description: {type(exc).__name__}: {exc}. Remedy: make sure every worker runs "
+                "the same anthroarm version as the client (pip install the same wheel/commit in "
+                "the workers' environment)"
             ) from None
         if self.key and robot.chain.key() != self.key:
             raise RobotRebuildError(
                 f"the worker rebuilt robot {self.name!r} with different kinematics (chain hash "
-                f"{robot.chain.key()[:12]} != {self.key[:12]}); the workers run another anthroarm or "
-                "Pinocchio version than the client. Remedy: install the same versions on the workers"
+                f"{robot.chain.key()[:12]} != {self.key[:12]}); the workers run another anthroarm "
+                "or Pinocchio version than the client. Remedy: install the same versions on the "
+                "workers"
             )
         return robot
 
@@ -102,16 +101,8 @@ def describe(robot, **params) -> RobotDescription:
         robot = load(robot, **params)
     elif params:
         raise TypeError(f"builder parameters {sorted(params)} go with a catalog name, not a Robot")
-    try:
-        return _described[robot]
-    except (KeyError, TypeError):
-        pass
-    d = _describe(robot)
-    try:
-        _described[robot] = d
-    except TypeError:
-        pass
-    return d
+    # kept on the robot (Robot.derived): made again when its chain or tool change
+    return robot.derived("batch.describe", _describe)
 
 
 def _describe(robot) -> RobotDescription:
@@ -134,10 +125,10 @@ def _describe(robot) -> RobotDescription:
             "urdf", robot.info.text, robot.name, (), robot.tool, locked, robot.chain.key()
         )
     raise RobotDescriptionError(
-        f"robot {robot.name!r} was built from an in-memory pin.Model: a Dask worker cannot rebuild it "
-        "(Pinocchio models are not shipped). Remedy: write it as a URDF and load that "
-        "(pinocchio: robot.urdf / your exporter; then aa.load('arm.urdf')), or use a catalog name; "
-        "or run the job locally with client=None"
+        f"robot {robot.name!r} was built from an in-memory pin.Model: a Dask worker cannot rebuild "
+        "it (Pinocchio models are not shipped). Remedy: write it as a URDF and load that "
+        "(pinocchio: robot.urdf / your exporter; then aa.load('arm.urdf')), or use a catalog "
+        "name; or run the job locally with client=None"
     )
 
 

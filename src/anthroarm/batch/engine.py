@@ -75,9 +75,10 @@ def connect(
         return Client(scheduler, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError) as exc:
         raise SchedulerUnreachableError(
-            f"no Dask scheduler answered at {scheduler!r} within {timeout:g} s ({type(exc).__name__}: {exc}). "
-            "Remedy: start one (`dask scheduler`, or your dask-jobqueue / dask-kubernetes cluster) and pass its "
-            "address as tcp://HOST:PORT, or run locally with --scheduler local"
+            f"no Dask scheduler answered at {scheduler!r} within {timeout:g} s "
+            f"({type(exc).__name__}: {exc}). Remedy: start one (`dask scheduler`, or your "
+            "dask-jobqueue / dask-kubernetes cluster) and pass its address as tcp://HOST:PORT, or "
+            "run locally with --scheduler local"
         ) from None
 
 

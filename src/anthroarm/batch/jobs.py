@@ -718,11 +718,13 @@ def cell_table(
         and np.all(np.isfinite(lo) & np.isfinite(hi) & (hi > lo))
     ):
         raise BatchParameterError(
-            f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, bounds={bounds!r}"
+            f"need a cell size D > 0 (m) and bounds = (lo(3), hi(3)) with lo < hi; got D={D}, "
+            f"bounds={bounds!r}"
         )
     if robot.spec is None:
         raise BatchParameterError(
-            f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is None)"
+            f"{robot.name}: the cell table needs a catalog model with a closed form (robot.spec is "
+            "None)"
         )
     i0, shape = lattice(lo, hi, D)  # the lattice of CellTable.build
     if np.prod(shape) > MAX_LATTICE:

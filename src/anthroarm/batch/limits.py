@@ -19,8 +19,8 @@ MEMORY_BUDGET = 4 * 2**30
 def _check_memory(nbytes: float, what: str, remedy: str) -> None:
     if nbytes > MEMORY_BUDGET:
         raise JobTooLargeError(
-            f"{what} would take {nbytes / 2**30:.1f} GiB (budget "
-            f"{MEMORY_BUDGET / 2**30:.0f} GiB, anthroarm.batch.limits.MEMORY_BUDGET). Remedy: {remedy}"
+            f"{what} would take {nbytes / 2**30:.1f} GiB (budget {MEMORY_BUDGET / 2**30:.0f} GiB, "
+            f"anthroarm.batch.limits.MEMORY_BUDGET). Remedy: {remedy}"
         )
 
 

@@ -8,7 +8,8 @@ import numpy as np
 
 from .result import BatchResult
 
-_MAPS = {"reachability_map": "counts", "comfort_map": "discomfort"}
+#: The voxel map a job's result is drawn by (``slice_plot``, ``Viewer.show_map``): job -> variable.
+MAP_VARIABLES = {"reachability_map": "counts", "comfort_map": "discomfort"}
 
 
 def slice_plot(
@@ -23,7 +24,7 @@ def slice_plot(
     base origin); unreached voxels are blank.  Returns the matplotlib Figure."""
     import matplotlib.pyplot as plt
 
-    var = var or _MAPS.get(result.job)
+    var = var or MAP_VARIABLES.get(result.job)
     if var is None or var not in result.variables:
         raise ValueError(
             f"{result.job}: no voxel map to slice; variables: {list(result.variables)}"
@@ -79,7 +80,7 @@ def population_plot(result: BatchResult, ax=None):
 def occupied_points(result: BatchResult, var: str | None = None):
     """Centres (K, 3) m of the reached voxels of a voxel map and their values (K,): the point
     cloud to draw in a 3D viewer."""
-    var = var or _MAPS.get(result.job)
+    var = var or MAP_VARIABLES.get(result.job)
     a = result[var]
     mask = np.isfinite(a) & (a != 0) if var != "discomfort" else np.isfinite(a)
     i, j, k = np.nonzero(mask)

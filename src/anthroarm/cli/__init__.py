@@ -28,8 +28,10 @@ user mistakes (tested in ``tests/adversarial/test_cli_garbage.py`` and ``test_fi
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import os
+import re
 import sys
 
 from .. import __version__
@@ -79,6 +81,7 @@ def build_parser(argv=None) -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     for group in GROUPS:
         group.add_parser(sub)
+    ap.commands = sub.choices  # command -> its parser (the options a "did you mean" offers)
     argv = list(sys.argv[1:] if argv is None else argv)
     cmd = next((i for i, t in enumerate(argv) if not t.startswith("-")), None)
     sp = sub.choices.get(argv[cmd]) if cmd is not None else None
@@ -89,10 +92,38 @@ def build_parser(argv=None) -> argparse.ArgumentParser:
     return ap
 
 
-def _unknown_options_error(a, extras) -> int:
-    """One line for arguments no option takes: for a command that takes a book model's
-    parameters, name them (or say the model has none)."""
+def close_options(parser, extras) -> list[tuple[str, str]]:
+    """(given, closest option) for each unknown ``--flag`` of ``extras`` that is close to an
+    option of ``parser`` (difflib over the options its help lists, a model's parameters too)."""
+    options = sorted(set(re.findall(r"(?<![\w-])--[A-Za-z][\w-]*", parser.format_help())))
+    out = []
+    for e in extras:
+        flag = e.split("=", 1)[0]
+        if flag.startswith("--") and flag not in options:
+            bare = {o[2:]: o for o in options}  # compared without the dashes all share
+            close = difflib.get_close_matches(flag[2:], list(bare), n=1, cutoff=0.6)
+            if close:
+                out.append((flag, bare[close[0]]))
+    return out
+
+
+def _unknown_options_error(a, extras, parser=None) -> int:
+    """One line for arguments no option takes: the closest option of the command ("did you
+    mean"); for a command that takes a book model's parameters, name them (or say the model
+    has none)."""
+    close = close_options(parser, extras) if parser is not None else []
     model = getattr(a, "_model", None) or getattr(a, "model", None)
+    if close:
+        hint = "; ".join(f"{g}: did you mean {c}?" for g, c in close)
+        names = (
+            command_module("params").param_names(model)
+            if getattr(a, "model_params", False) and isinstance(model, str)
+            else ""
+        )
+        also = f" {model}'s parameters: {names};" if names else ""
+        return one_line_error(
+            a.command, f"unknown option {hint}{also} (see 'anthroarm {a.command} --help')"
+        )
     if (
         getattr(a, "model_params", False)
         and isinstance(model, str)
@@ -115,7 +146,7 @@ def main(argv=None) -> int:
         ap.print_help()
         return 2
     if extras:
-        return _unknown_options_error(a, extras)
+        return _unknown_options_error(a, extras, ap.commands.get(a.command))
     module, function = a.run.rsplit(".", 1)
     try:
         return int(getattr(command_module(module), function)(a) or 0)

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import sys
 
+import numpy as np
+
 from .. import crosscheck
+from ..osim import checks as osim_checks
 from .common import MAX_SAMPLES, UserError, parse_locked
+from .runtime import load_model
 
 
 def run(a) -> int:
@@ -16,13 +20,34 @@ def run(a) -> int:
         raise UserError(
             "--tool and --locked apply to the models given: name one (e.g. anthroarm check ur10 --tool tool0)"
         )
-    rows = crosscheck.run(
-        names or None,
-        samples=a.samples,
-        seed=a.seed,
-        progress=not a.json and sys.stderr.isatty(),
-        tool=a.tool,
-        locked=parse_locked(a.locked),
+    osim = [n for n in names if n.lower().endswith(".osim")]  # OpenSim models: their own rows
+    rows = (
+        []
+        if names and len(osim) == len(names)
+        else crosscheck.run(
+            [n for n in names if n not in osim] or None,
+            samples=a.samples,
+            seed=a.seed,
+            progress=not a.json and sys.stderr.isatty(),
+            tool=a.tool,
+            locked=parse_locked(a.locked),
+        )
     )
+    for path in osim:
+        rows += osim_rows(path, a)
     print(crosscheck.to_json(rows) if a.json else crosscheck.format_table(rows))
     return 0 if all(r.ok for r in rows) else 1
+
+
+def osim_rows(path, a) -> list:
+    """An OpenSim model: its import report (printed), the osim rows (against Pinocchio, and
+    against OpenSim when installed) and, without coupled coordinates, every robot's rows (those
+    that cannot apply, such as yourdfpy's, left out)."""
+    robot = load_model(path, tool=a.tool, locked=parse_locked(a.locked))
+    if not a.json:
+        print(robot.report.text())
+    rows = osim_checks.rows(robot, a.samples, np.random.default_rng(a.seed))
+    if robot.coupling is None:
+        more = crosscheck.run([robot], a.samples, a.seed, list(crosscheck.ROBOT_PROVIDERS))
+        rows += [r for r in more if r.status != "unsupported"]
+    return rows

@@ -126,6 +126,32 @@ def add_live_options(p):
     )  # tests: stop after N s
 
 
+#: ``--camera`` views and ``--fit`` subjects (:data:`anthroarm.viewer.framing.VIEWS` and
+#: :data:`~anthroarm.viewer.framing.FITS`, repeated here so the parser stays light; a test checks
+#: they agree).
+CAMERA_VIEWS = ("iso", "front", "side", "back", "top")
+CAMERA_FITS = ("auto", "pose", "all", "reach", "hand")
+
+
+def add_camera(p):
+    """``--camera VIEW`` and ``--fit SUBJECT`` of a viewer command (``Viewer.set_camera``)."""
+    p.add_argument(
+        "--camera",
+        choices=CAMERA_VIEWS,
+        default="iso",
+        help="where the camera looks from: iso (front-left-above, default), front (+x), side "
+        "(+y), back or top",
+    )
+    p.add_argument(
+        "--fit",
+        choices=CAMERA_FITS,
+        default="auto",
+        help="what fills the view: auto (default: the hand of a limb that ends in one, else "
+        "everything drawn), pose (the robot), all (robot and overlays), reach (its workspace), "
+        "hand",
+    )
+
+
 def parse_locked(text):
     """``"a,b=0.5"`` -> {"a": None, "b": 0.5} (None: the neutral value)."""
     if text is None:

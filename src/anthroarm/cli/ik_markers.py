@@ -20,6 +20,7 @@ before anything is read or written.  The CSV is written atomically after the sol
 from __future__ import annotations
 
 from .common import add_json, add_model_argument, add_out
+from .person import add_person_options
 
 
 def add_parser(sub):
@@ -35,16 +36,7 @@ def add_parser(sub):
     p.add_argument("trial", help="C3D file of the trial (POINT:UNITS mm, cm or m)")
     add_model_argument(p, robot_options=False, params=False, optional=True)
     add_out(p, required=True, metavar="FILE.csv", help="joint angles, written atomically")
-    p.add_argument(
-        "--height",
-        type=float,
-        default=None,
-        help="body height, m (a person's arm model; default 1.75)",
-    )
-    p.add_argument(
-        "--mass", type=float, default=None, help="body mass, kg (a person's arm model; default 75)"
-    )
-    p.add_argument("--sex", default=None, choices=["male", "female"])
+    add_person_options(p, given_only=True)
     p.add_argument(
         "--static",
         default=None,

@@ -11,6 +11,7 @@ from pathlib import Path
 from ..motion import MarkerSet, marker_ik, read_c3d, scale_from_static
 from ..motion.csv_io import write_joint_csv
 from .common import UserError
+from .person import check_person
 from .runtime import load_model, progress, resolve_model
 
 
@@ -36,9 +37,7 @@ def run(a) -> int:
                 f"--out {a.out} is an input ({flag} {given}): it would be overwritten; "
                 "give another output file"
             )
-    person = {
-        k: v for k, v in (("height", a.height), ("mass", a.mass), ("sex", a.sex)) if v is not None
-    }
+    person = check_person(a)
     trial = read_c3d(a.trial)
     robot = load_model(a.model, person)
     markers = MarkerSet.read_json(a.markers) if a.markers else None

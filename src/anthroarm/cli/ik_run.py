@@ -11,7 +11,7 @@ import pinocchio as pin
 from .. import ik
 from ..urdf_io import MAX_LENGTH
 from .common import UserError
-from .runtime import joint_values, model_from_args, parse_q, progress
+from .runtime import check_radians, joint_values, model_from_args, parse_q, progress
 
 
 class IKOutcome:
@@ -64,6 +64,8 @@ def run(a) -> int:
         raise UserError(
             f"--xyz {' '.join(map(str, a.xyz))} is beyond the physical bound of {MAX_LENGTH:g} m"
         )
+    if not a.deg:
+        check_radians(a.rpy, [True] * 3, "--rpy")
     rpy = np.deg2rad(a.rpy) if a.deg else np.asarray(a.rpy, float)
     T = np.eye(4)
     T[:3, :3] = pin.rpy.rpyToMatrix(*rpy)

@@ -13,6 +13,7 @@ import math
 
 from .. import models
 from .common import UserError
+from .person import RANGES, SEXES, check_person_value
 
 
 def model_params(model) -> list[tuple[str, object, str, str]] | None:
@@ -49,6 +50,8 @@ def param_names(model) -> str:
 def convert_param(model, name, kind, unit, text):
     """The builder value of ``--NAME TEXT`` / ``--param NAME=TEXT``."""
     if kind == "str":
+        if name == "sex" and is_person_model(model) and text not in SEXES:
+            raise UserError(f"--sex must be one of {', '.join(SEXES)} (for {model}), got {text!r}")
         return text
     if kind == "map":
         out = {}
@@ -73,7 +76,14 @@ def convert_param(model, name, kind, unit, text):
         vals = []
     if len(vals) != (2 if kind == "pair" else 1) or not all(math.isfinite(v) for v in vals):
         raise UserError(f"{model} parameter {name} expects {want} ({unit}), got {text!r}")
+    if name in RANGES and kind == "float" and is_person_model(model):
+        return check_person_value(name, vals[0])
     return tuple(vals) if kind == "pair" else vals[0]
+
+
+def is_person_model(model) -> bool:
+    """A catalog model built from a person's height, mass and sex (their ranges apply)."""
+    return {"height", "mass", "sex"} <= {n for n, *_ in model_params(model) or []}
 
 
 def add_model_param_options(p, model) -> None:
@@ -107,10 +117,20 @@ def add_model_param_options(p, model) -> None:
             flags.append(f"--{name.replace('_', '-')}")
         # an option string the command already has conflicts (argparse.ArgumentError): try
         # without the dashed spelling, then leave the parameter to --param
+        extra = {}
+        if name == "sex" and kind == "str" and is_person_model(model):
+            extra = dict(choices=SEXES, metavar=None)
+        elif name in RANGES and is_person_model(model):
+            help_ = (
+                f"body {name}, {unit} ({RANGES[name][0]:g}–{RANGES[name][1]:g}), default {shown}"
+            )
         for given in (flags, flags[:1]):
             try:
                 g.add_argument(
-                    *given, dest=f"model_param:{name}", default=None, metavar=metavar, help=help_
+                    *given,
+                    dest=f"model_param:{name}",
+                    default=None,
+                    **{"metavar": metavar, "help": help_, **extra},
                 )
                 break
             except argparse.ArgumentError:

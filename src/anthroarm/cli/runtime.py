@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import difflib
+import math
 import sys
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from .common import UserError, parse_locked
 from .params import parse_params
 
 __all__ = [
+    "check_radians",
     "default_model",
     "joint_values",
     "load_model",
@@ -90,9 +92,11 @@ def parse_q(robot, values, deg: bool, what: str = "--q"):
             f"{what} needs {len(names)} values for {robot.name} (joints: {', '.join(names)}), "
             f"got {len(values)}"
         )
+    joints = [robot.chain.joints[i] for i in robot.chain.independent]
+    if not deg:
+        check_radians(values, [j.kind != "prismatic" for j in joints], what)
     theta = np.deg2rad(values) if deg else np.asarray(values, float)
     q = robot.check_q(robot.chain.configuration(theta), what)
-    joints = [robot.chain.joints[i] for i in robot.chain.independent]
     bad = [j.name for j, t in zip(joints, theta) if not j.lower - 1e-9 <= t <= j.upper + 1e-9]
     if bad:
         print(
@@ -100,6 +104,18 @@ def parse_q(robot, values, deg: bool, what: str = "--q"):
             file=sys.stderr,
         )
     return q
+
+
+def check_radians(values, angular, what: str) -> None:
+    """Angles given without ``--deg`` are radians: a value beyond a full turn (|x| > 2π) is
+    certainly degrees, refused with the remedy (add --deg, or convert)."""
+    big = [float(x) for x, a in zip(values, angular) if a and abs(float(x)) > 2 * math.pi]
+    if big:
+        shown = " ".join(f"{x:g}" for x in values)
+        raise UserError(
+            f"{what} {shown}: {big[0]:g} rad is more than a full turn; angles are radians "
+            "unless --deg (add --deg if these are degrees)"
+        )
 
 
 def joint_values(robot, q):

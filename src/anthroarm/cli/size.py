@@ -13,6 +13,7 @@ the activities and the joints; the last line printed is a JSON summary.
 from __future__ import annotations
 
 from .common import add_json, add_model_argument, add_out
+from .person import add_person_options
 
 
 def add_parser(sub):
@@ -28,15 +29,14 @@ def add_parser(sub):
         "-o report.html",
     )
     add_model_argument(p, robot_options=False, params=False, optional=True)
-    p.add_argument("--height", type=float, default=1.75, help="body height, m (default 1.75)")
-    p.add_argument("--mass", type=float, default=70.0, help="body mass, kg (default 70)")
-    p.add_argument("--sex", default="male", choices=["male", "female"])
+    add_person_options(p)
     p.add_argument(
         "--activities",
         default="adl",
-        metavar="adl|FILE[,FILE...]",
-        help="'adl' (the daily-living library) or joint-trajectory files (.npz with t, q; .csv with t "
-        "and joint-name columns, rad)",
+        metavar="adl|NAME|FILE[,...]",
+        help="'adl' (the whole daily-living library), comma-separated activities of the library "
+        "(hand_to_mouth, pour, ...: 'anthroarm size --activities ?' lists them) or joint-trajectory "
+        "files (.npz with t, q; .csv with t and joint-name columns, rad)",
     )
     p.add_argument(
         "--payload",

@@ -3,6 +3,7 @@ the joint-trajectory files ``--activities`` reads."""
 
 from __future__ import annotations
 
+import difflib
 import inspect
 import json
 import sys
@@ -14,8 +15,11 @@ import numpy as np
 from .. import models
 from .._io import check_regular_file, read_bounded
 from ..errors import ActivityError
+from ..motion import activities as adl
 from ..prosthesis import catalogue, report, study
+from ..viewer.pages import activities_html
 from .common import UserError
+from .person import check_person
 from .runtime import load_model, progress, resolve_model
 
 #: the largest trajectory file read (bytes): 10**6 samples of a 7-joint arm as CSV are ~150 MB
@@ -96,7 +100,23 @@ def activities_from(spec: str, robot, payload: float) -> list[dict]:
     (:mod:`.size`)."""
     if spec.strip().lower() == "adl":
         return study.adl_activities(robot, payload)
-    return [read_trajectory(Path(p.strip()), robot) for p in spec.split(",") if p.strip()]
+    known = adl.names()
+    out, items = [], [p.strip() for p in spec.split(",") if p.strip()]
+    if not items:
+        raise UserError("--activities is empty: give 'adl', activity names or trajectory files")
+    for item in items:
+        if item in known:
+            out += study.adl_activities(robot, payload, [item])
+        elif Path(item).exists() or Path(item).suffix.lower() in (".npz", ".csv"):
+            out.append(read_trajectory(Path(item), robot))
+        else:
+            close = difflib.get_close_matches(item, ["adl", *known], n=3, cutoff=0.6)
+            hint = f"did you mean {' or '.join(map(repr, close))}? " if close else ""
+            raise UserError(
+                f"--activities {item!r} is neither 'adl', an activity of the library nor a "
+                f"trajectory file (.npz, .csv): {hint}activities: {', '.join(known)}"
+            )
+    return out
 
 
 def _person_params(a) -> dict:
@@ -113,7 +133,7 @@ def _person_params(a) -> dict:
             f"model {a.model}: anthroarm size scales a person's arm to --height/--mass/--sex; "
             f"person models: {', '.join(sorted(person))}"
         )
-    return dict(height=a.height, mass=a.mass, sex=a.sex)
+    return check_person(a)
 
 
 def run(a) -> int:
@@ -128,13 +148,13 @@ def run(a) -> int:
     if not out.parent.is_dir():
         raise UserError(f"--out {a.out}: folder {out.parent} does not exist")
     for what, v, lo, hi in (
-        ("height", a.height, 0.5, 2.5),
-        ("mass", a.mass, 10.0, 300.0),
         ("payload", 0.0 if a.payload is None else a.payload, 0.0, 50.0),
         ("margin", a.margin, 0.0, 10.0),
     ):
         if not (np.isfinite(v) and lo <= v <= hi):
-            raise UserError(f"--{what} must be in [{lo:g}, {hi:g}], got {v}")
+            unit = "kg" if what == "payload" else "a fraction, 0.2 = 20 %"
+            raise UserError(f"--{what} {v:g} is outside {lo:g}–{hi:g} ({unit})")
+    check_person(a)  # before any work: a height in cm is refused with the remedy
     cat = catalogue.load(a.motors, a.gearboxes)
     robot = load_model(a.model, _person_params(a))
     acts = activities_from(a.activities, robot, a.payload)
@@ -155,19 +175,19 @@ def run(a) -> int:
             progress=tick,
         )
         bar.set_postfix_str("report")
-        report.write(st, out, viewer=not a.no_viewer)
+        inputs = dict(
+            model=a.model,
+            **_person_params(a),
+            activities=a.activities
+            if a.activities.strip().lower() == "adl"
+            else ", ".join(Path(p.strip()).name for p in a.activities.split(",") if p.strip()),
+            payload_kg=a.payload,
+            margin=a.margin,
+        )
+        page = None if a.no_viewer else activities_html(st)
+        report.write(st, out, viewer=page, inputs=inputs)
     finally:
         bar.close()
-    summary = dict(
-        out=str(out),
-        drive_mass_kg=round(st.sizing.drive_mass, 4),
-        joints={
-            r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
-            for r in st.sizing.rows()
-        },
-        unfit=st.sizing.unfit,
-        skipped=[x.name for x in st.envelope.skipped],
-        rules={r.source: r.ok for r in st.rules},
-    )
+    summary = dict(out=str(out), **st.summary())  # the report's own verdicts (one source)
     print(json.dumps(summary), file=sys.stdout)
     return 0

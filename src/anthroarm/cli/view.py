@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_json, add_live_options, add_model_argument, add_param_option
+from .common import add_camera, add_json, add_live_options, add_model_argument, add_param_option
+from .person import add_person_options
 
 STYLE = dict(choices=["auto", "generated", "urdf"], default="auto", help="visuals (default auto)")
 
@@ -32,7 +33,8 @@ def _add_view(sub):
         description="Show a catalog model, an example-robot-data robot or a URDF file in a meshcat viewer on "
         "127.0.0.1, or write a self-contained HTML file.  Angles are radians unless --deg.",
         epilog="examples:\n  anthroarm view human_arm7 --q 40 -20 10 70 0 0 10 --deg --limits\n"
-        "  anthroarm view panda -o panda.html --workspace 3000",
+        "  anthroarm view panda -o panda.html --workspace 3000\n"
+        "  anthroarm view human_upper_limb --camera front --fit pose",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_model_argument(p)
@@ -48,6 +50,7 @@ def _add_view(sub):
         help="draw N workspace points coloured by manipulability",
     )
     p.add_argument("--style", **STYLE)
+    add_camera(p)
     add_live_options(p)
     p.set_defaults(run="view_run.view", model_params=True)
 
@@ -72,6 +75,7 @@ def _add_teach(sub):
         "--limits", action="store_true", help="colour links by joint-limit proximity (at the start)"
     )
     p.add_argument("--style", **STYLE)
+    add_camera(p)
     add_live_options(p)
     p.set_defaults(run="view_run.teach", model_params=True)
 
@@ -87,7 +91,7 @@ def _add_demo(sub):
         epilog="examples:\n  anthroarm demo\n  anthroarm demo -o demo.html --height 1.62",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    add_param_option(p, "parameter of the arm")
+    add_param_option(p, "another parameter of the arm (segment_lengths=...)")
     p.add_argument(
         "--method",
         choices=["auto", "qp", "dls"],
@@ -96,6 +100,9 @@ def _add_demo(sub):
     )
     p.add_argument("--solver", default="osqp", help="QP solver for --method qp (default osqp)")
     add_json(p, "print the per-target errors as JSON")
+    add_camera(p)
     add_live_options(p)
-    # the model is fixed: the person's arm, whose parameters are options (listed by --help)
-    p.set_defaults(run="view_run.demo", model_params=True, fixed_model=True, model=None)
+    # the model is fixed: the person's arm; the person's options are the CLI's one person
+    # (cli/person.py: light, so 'demo --help' loads no catalog), other parameters via --param
+    add_person_options(p)
+    p.set_defaults(run="view_run.demo", model=None)

@@ -12,6 +12,7 @@ from ..viewer import Viewer
 from ..viewer.demo import demo_viewer, reach_demo
 from ..viewer.server import in_use_message, port_is_free
 from .common import MAX_SAMPLES, UserError, check_out_file
+from .person import check_person
 from .runtime import load_model, model_from_args, parse_params, parse_q, progress
 
 
@@ -69,6 +70,7 @@ def view(a) -> int:
         v.show_workspace(a.workspace)
     if a.limits:
         v.show_limits()
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a)
 
 
@@ -81,6 +83,7 @@ def teach(a) -> int:
     if a.limits:
         v.show_limits()
     v.teach()
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a)
 
 
@@ -88,7 +91,12 @@ def demo(a) -> int:
     out = check_out_file(a.out, "demo.html")
     check_port_early(a)
     arm = models.PERSON_ARM
-    robot = load_model(arm, parse_params(a.param, arm, a))
+    person = check_person(a)
+    params = parse_params(a.param, arm)
+    twice = sorted(set(params) & set(person))
+    if twice:
+        raise UserError(f"give {twice[0]} once: --{twice[0]} (not --param {twice[0]}=...)")
+    robot = load_model(arm, {**params, **person})
     bar = progress(6, "reaching", not a.json)
 
     def tick(done, total):
@@ -108,4 +116,5 @@ def demo(a) -> int:
         for n, pe, re in res.errors:
             print(f"  {n:<18} position error {pe * 1000:8.3f} mm   orientation error {re:.2e} rad")
     v = demo_viewer(res, live=out is None, port=a.port)
+    v.set_camera(a.camera, fit=a.fit)
     return export_or_serve(v, out, a, announce=not a.json)

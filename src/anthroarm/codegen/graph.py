@@ -494,7 +494,8 @@ def emit_python(g: Graph, fname: str, args, outputs, shape, kinds, batched: bool
         n = len(kinds)
         for a in args:
             lines.append(
-                f"    {', '.join(f'{a}{k}' for k in range(n))}{',' if n == 1 else ''} = {a}.tolist()"
+                f"    {', '.join(f'{a}{k}' for k in range(n))}{',' if n == 1 else ''} = "
+                f"{a}.tolist()"
             )
         sin, cos = "_ssin", "_scos"
     for i in ins:

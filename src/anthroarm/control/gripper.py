@@ -217,7 +217,8 @@ def correct_position(
     resolution = _check.positive(resolution, "resolution (m)")
     if width + 2 * abs(offset) >= opening:
         raise ControlError(
-            f"the object (width {width}, offset {offset}) does not fit between jaws {opening} m apart"
+            f"the object (width {width}, offset {offset}) does not fit between jaws {opening} m "
+            "apart"
         )
     half = 0.5 * (opening - width)
     _increments(opening, resolution, "opening")

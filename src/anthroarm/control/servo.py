@@ -12,8 +12,9 @@ tachogenerator on the motor shaft (``k_s``, V·s/rad) feed the amplifier (gain `
     e_ss = M_L / (η i k_m k_a)                                            (9-8, corrected)
 
 with ``D(s) = J_0 s² + K_v s + K_s`` (9-6).  The book's symbols are kept: ``k_m`` here is the
-*stall-torque coefficient* in N·m/V (the :attr:`~anthroarm.control.motor.DCMotor.stall_torque_coefficient`
-of a :class:`~anthroarm.control.motor.DCMotor`, not its torque constant), ``k`` the slope of the
+*stall-torque coefficient* in N·m/V
+(the :attr:`~anthroarm.control.motor.DCMotor.stall_torque_coefficient` of
+a :class:`~anthroarm.control.motor.DCMotor`, not its torque constant), ``k`` the slope of the
 torque–speed line in N·m·s/rad; SI units throughout (the book prints kgf·cm).
 
 Misprints corrected (see ``docs/errata.md``): (9-4) prints the tachometer term as
@@ -306,7 +307,8 @@ class PositionServo:
         """``ζ = K_v / (2 sqrt(K_s J_0))``."""
         return self.Kv / (2.0 * math.sqrt(self.Ks * self.J0))
 
-    # ------------------------------------------------------------------ the servo error as a force sensor
+    # ------------------------------------------------------------------ the servo error as a force
+    # sensor
     @_check.finite_result
     def steady_error(self, M_L):
         """Steady position-error voltage under a constant load torque, Eq. (9-8) as corrected:
@@ -533,7 +535,8 @@ class PositionServo:
             e = self.k_p * (ti - theta)
         if not all(np.all(np.isfinite(a)) for a in (X, V_raw, V, M_m, e)):
             raise ControlError(
-                "the servo's state, voltage or torque left the floating-point range (inputs too large)"
+                "the servo's state, voltage or torque left the floating-point range (inputs too "
+                "large)"
             )
         return ServoResponse(
             t=t,

@@ -122,7 +122,8 @@ class Step:
             raise ControlError(f"motion must be one of {MOTIONS}, got {self.motion!r}")
         if self.motion in ("line", "arc") and pos.shape not in ((3,), (4, 4)):
             raise ControlError(
-                f"{self.motion!r} motion needs a Cartesian point (3,) or pose (4, 4), got {pos.shape}"
+                f"{self.motion!r} motion needs a Cartesian point (3,) or pose (4, 4), got "
+                f"{pos.shape}"
             )
         if self.motion == "joint" and pos.shape == (4, 4):
             raise ControlError(
@@ -312,8 +313,8 @@ class Program:
         d = np.zeros(n) if dwell is None else _check.array(dwell, "dwell")
         if pos.ndim == 0 or pos.shape[:1] != (n,) or t.shape != (n,) or d.shape != (n,):
             raise ControlError(
-                f"channels of different lengths: sequence {n}, position {pos.shape}, time {t.shape}, "
-                f"dwell {d.shape}"
+                f"channels of different lengths: sequence {n}, position {pos.shape}, time "
+                f"{t.shape}, dwell {d.shape}"
             )
         labels = [None if (isinstance(s, str) and s.startswith("#")) else s for s in sequence]
         return cls(
@@ -555,8 +556,8 @@ class Playback:
         self, robot, dt: float, q0=None, frame=None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Play a program of 4×4 poses on an arm: :meth:`trajectory` sampled every ``dt``
-        seconds, each pose solved by :func:`~anthroarm.ik.solve.api.solve` warm-started from the previous
-        sample's joints (continuity along the path).
+        seconds, each pose solved by :func:`~anthroarm.ik.solve.api.solve` warm-started from the
+        previous sample's joints (continuity along the path).
 
         Parameters
         ----------

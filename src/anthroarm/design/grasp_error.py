@@ -29,7 +29,8 @@ class GraspError:
 
     ``delta`` is Δ; ``case`` is ``"same_side"`` ((2-9)/(2-17): R0 outside (R_min, R_max)) or
     ``"split"`` ((2-10)/(2-11), (2-18)/(2-19): R0 inside, Δ = max(Δ1, Δ2)); ``delta1``,
-    ``delta2`` are the two split terms (NaN in the same-side case); ``r0``, ``x_min`` from (2-8)/(2-16)."""
+    ``delta2`` are the two split terms (NaN in the same-side case); ``r0``, ``x_min`` from
+    (2-8)/(2-16)."""
 
     delta: float
     case: str

@@ -256,7 +256,8 @@ def mechanism_of(spec):
     (a coupling is not a pair: subtract it from Eq. (2-1) yourself).  Links are the spec's
     links that are not connectors; the ground is ``spec.base_link``."""
     joints = list(spec.joints)
-    # serial predecessor of every joint's parent (a joint with parent=None hangs on the previous link)
+    # serial predecessor of every joint's parent (a joint with parent=None hangs on the previous
+    # link)
     parents, prev = [], spec.base_link
     for j in joints:
         p = j.parent if j.parent is not None else prev

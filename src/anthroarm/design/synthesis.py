@@ -251,7 +251,10 @@ def synthesize_path(
         cand = Candidate(float(lam), r3, r4sq, r5, False, "")
         res.candidates.append(cand)
         if abs(r3) < degenerate_tol * scale:
-            cand.reason = "degenerate: r3 ≈ 0, the rocker pivot coincides with the crank pivot (crank dyad re-used)"
+            cand.reason = (
+                "degenerate: r3 ≈ 0, the rocker pivot coincides with the crank pivot "
+                "(crank dyad re-used)"
+            )
             continue
         if r4sq <= 0:
             cand.reason = f"r4² = {r4sq:.6g} <= 0"

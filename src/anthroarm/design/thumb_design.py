@@ -23,7 +23,7 @@ What the text fixes and what we had to choose (Fig. 2-9 is missing; ch3-4 notes 
   x5 = α and x6 = β do not enter θ3 in this reading (they place R2 and the fingertip S).
 * Working ranges are not printed: θ1 ∈ [0°, 30°] and θ2 ∈ [0°, 30°] by default (parameters).
 
-Findings (tests in ``tests/design/test_design_thumb.py``): the printed RRSS optimum satisfies
+Findings (tests in ``tests/design/test_thumb_design.py``): the printed RRSS optimum satisfies
 g1–g10 but not g11 (φ ≈ 3° at θ1 = 0 in our reading) and its error over [0°, 30°] is ≈ 0.52°,
 not the printed 0.01; the printed planar optimum satisfies g1–g10 but has ∠PFC ≈ 13° (g11
 fails) and its coupler of 0.79 mm makes θ3 run opposite to f3 — the printed e = 0.01 and
@@ -201,7 +201,8 @@ def rrss_problem(theta1_range=(0.0, 30.0), n: int = 13, min_phi: float = 35.0) -
 
 
 def planar_points(x):
-    """P, F, C (mm) of the upper thumb in the frame A = 0, AC = +x, for X = (∠PAC, x_f, y_f, x_c, α, β)."""
+    """P, F, C (mm) of the upper thumb in the frame A = 0, AC = +x, for X = (∠PAC, x_f, y_f, x_c, α,
+    β)."""
     x = np.asarray(x, dtype=float)
     P = R2 * np.array([np.cos(x[0] * D2R), np.sin(x[0] * D2R)])
     return P, np.array([x[1], x[2]]), np.array([x[3], 0.0])
@@ -228,7 +229,8 @@ class PlanarProblem(ThumbProblem):
 
 
 def planar_problem(theta2_range=(0.0, 30.0), n: int = 13, min_mu: float = 35.0) -> PlanarProblem:
-    """The planar four-bar design problem of §4-5 (2): θ3 = F3(θ2) vs f3, g1–g10, g11: ∠PFC > 35°."""
+    """The planar four-bar design problem of §4-5 (2): θ3 = F3(θ2) vs f3, g1–g10, g11: ∠PFC >
+    35°."""
     th2 = np.linspace(float(theta2_range[0]), float(theta2_range[1]), int(n))
     p = PlanarProblem(
         "planar",
@@ -287,7 +289,8 @@ class DesignOutcome:
 
 
 def _feasible(problem, x, tol=1e-3):
-    """All constraints hold within ``tol`` (mm or deg; the exterior method approaches from outside)."""
+    """All constraints hold within ``tol`` (mm or deg; the exterior method approaches from
+    outside)."""
     return bool(np.all(problem.ineq(x) >= -tol))
 
 
@@ -339,7 +342,8 @@ def optimise(problem: ThumbProblem, method: str = "sumt_exterior", x0=None, **kw
         x, status, nfev = r.x[:-1], ("converged" if r.success else f"scipy: {r.message}"), r.nfev
     else:
         raise ValueError(
-            f"unknown method {method!r}; use sumt_exterior, sumt_interior, sumt_mixed, simplex, slsqp"
+            f"unknown method {method!r}; use sumt_exterior, sumt_interior, sumt_mixed, simplex, "
+            "slsqp"
         )
     dt = time.perf_counter() - t0
     return DesignOutcome(
@@ -377,8 +381,12 @@ def comparison_table(
 
 
 def markdown(rows) -> str:
-    """Comparison table as markdown: method, x, S (deg), min transmission (deg), feasible, nfev, s."""
-    head = "| method | x | S (deg) | min transmission (deg) | feasible | status | nfev | time (s) |\n|---|---|---|---|---|---|---|---|\n"
+    """Comparison table as markdown: method, x, S (deg), min transmission (deg), feasible, nfev,
+    s."""
+    head = (
+        "| method | x | S (deg) | min transmission (deg) | feasible | status | nfev | time (s) |\n"
+        "|---|---|---|---|---|---|---|---|\n"
+    )
     lines = [
         f"| {r.method} | {np.array2string(r.x, precision=3, separator=', ')} | {r.S:.4f} | "
         f"{r.min_transmission:.1f} | {r.feasible} | {r.status} | {r.nfev} | {r.seconds:.2f} |"

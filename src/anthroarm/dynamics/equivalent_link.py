@@ -87,7 +87,8 @@ class FourBarFinger:
         for name in ("r1", "r2", "r3", "r4"):
             if not as_scalar(getattr(self, name), f"FourBarFinger: {name}") > 0:
                 raise ValueError(
-                    f"FourBarFinger: {name} must be a positive length (m), got {getattr(self, name)}"
+                    f"FourBarFinger: {name} must be a positive length (m), got "
+                    f"{getattr(self, name)}"
                 )
         g = np.asarray(self.gravity, float)
         if g.shape != (2,) or not np.all(np.isfinite(g)):

@@ -93,7 +93,8 @@ def J1_J2(J) -> tuple[np.ndarray, np.ndarray]:
 
 
 def J1_J2_printed(J):
-    """(8-52) as printed (l. 6253–6257), with the printed product vector (ω_xω_y, ω_xω_z, ω_yω_z)."""
+    """(8-52) as printed (l. 6253–6257), with the printed product vector (ω_xω_y, ω_xω_z,
+    ω_yω_z)."""
     J = np.asarray(J, dtype=float)
     Pxy, Pxz, Pyz = -J[0, 1], -J[0, 2], -J[1, 2]
     Jxx, Jyy, Jzz = J[0, 0], J[1, 1], J[2, 2]
@@ -329,8 +330,8 @@ class EulerChain:
         if bad.size:
             k = int(bad[0])
             raise EulerSingularityError(
-                f"link {k + 1}: sin ψ = {np.sin(S[k, 1]):.2e}; the X–Y–X angles are singular at ψ = 0, π "
-                "(det Π = −sin ψ): choose another reference posture or body axes"
+                f"link {k + 1}: sin ψ = {np.sin(S[k, 1]):.2e}; the X–Y–X angles are singular at ψ "
+                "= 0, π (det Π = −sin ψ): choose another reference posture or body axes"
             )
 
     def forward(self, S, Sd, Q) -> np.ndarray:
@@ -386,7 +387,8 @@ def mixed(A, h, q_rows, Q0, s_cols, Sdd0):
     other rows) and accelerations S̈_z (the other columns) of Q = A S̈ + h.  Needs
     dim S̈_z = dim Q_0.
 
-        (Q_z; S̈_z) = [[0, −A_0z], [I, −A_zz]]⁻¹ ([[−I, A_00], [0, A_z0]] (Q_0; S̈_0) + (P_0; P_z) h)
+        (Q_z; S̈_z) = [[0, −A_0z], [I, −A_zz]]⁻¹ ([[−I, A_00], [0, A_z0]] (Q_0; S̈_0) + (P_0; P_z)
+        h)
     """
     A = np.asarray(A, float)
     h = np.asarray(h, float)

@@ -12,10 +12,10 @@ Inputs (book l. 6768–6790), SI units:
   about the CoM (kg m²; exact only for an isotropic body — a 3×3 tensor is accepted too),
 * ``xi`` viscous damping, N m s/rad (scalar or per joint).
 
-Kinematics (8-98): E_{1,i} = E^{x_1θ_1}⋯E^{x_iθ_i} (8-112), r_i = r_{i−1} + E_{1,i−1}(l_{i−1} − r_{i−1}) + E_{1,i} r_i.
-Kinetic energy (8-100)–(8-105): T = ½ θ̇ᵀ(U + W)θ̇, U = Σ m_i (∂r_i/∂θ)ᵀ(∂r_i/∂θ),
-W = Σ J_i E_iᵀE_i (E_i = angular Jacobian (8-103)).  Potential (8-106): V = −Σ m_i g k⁰·r_i.
-Equation of motion (8-109), with the gravity sign corrected (see ``docs/errata.md``):
+Kinematics (8-98): E_{1,i} = E^{x_1θ_1}⋯E^{x_iθ_i} (8-112), r_i = r_{i−1} + E_{1,i−1}(l_{i−1} −
+r_{i−1}) + E_{1,i} r_i. Kinetic energy (8-100)–(8-105): T = ½ θ̇ᵀ(U + W)θ̇, U = Σ m_i
+(∂r_i/∂θ)ᵀ(∂r_i/∂θ), W = Σ J_i E_iᵀE_i (E_i = angular Jacobian (8-103)).  Potential (8-106): V = −Σ
+m_i g k⁰·r_i. Equation of motion (8-109), with the gravity sign corrected (see ``docs/errata.md``):
 
 .. math:: (U+W)\ddot\theta + \partial V/\partial\theta = F - \xi\dot\theta,\qquad
           \partial V/\partial\theta = -\sum_i m_i g\,(\partial r_i/\partial\theta)^T k^0

@@ -334,7 +334,8 @@ def joint_frame_from_links(l1, e1, l2, e2) -> np.ndarray:
 
 
 def _check_axes(axes) -> np.ndarray:
-    """``axes`` (3, 3) with three independent columns (a :func:`joint_frame`), else ParameterError."""
+    """``axes`` (3, 3) with three independent columns (a :func:`joint_frame`), else
+    ParameterError."""
     A = _vec(axes, "axes", (3, 3))
     if abs(np.linalg.det(A)) < 1e-12 * max(1.0, float(np.abs(A).max()) ** 3):
         raise ParameterError(

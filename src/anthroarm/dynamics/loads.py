@@ -4,7 +4,8 @@ r"""External loads as generalised forces (Eq. (8-5)) and inverse dynamics along 
 :math:`F_i\cdot\delta r_i = \sum_j F_i\cdot\frac{\partial r_i}{\partial q_j}\delta q_j`, so its
 generalised force is Eq. (8-5) of the book,
 
-.. math::  Q_j = \sum_i\Big(F_{ix}\frac{\partial x_i}{\partial q_j}+F_{iy}\frac{\partial y_i}{\partial q_j}
+.. math::  Q_j = \sum_i\Big(F_{ix}\frac{\partial x_i}{\partial q_j}
+                 +F_{iy}\frac{\partial y_i}{\partial q_j}
                  +F_{iz}\frac{\partial z_i}{\partial q_j}\Big) = \big(J_v^T F\big)_j .
 
 A moment :math:`m` on the same body adds :math:`J_\omega^T m`, so a wrench
@@ -145,7 +146,8 @@ class HeldObject:
         Ic = np.asarray(self.inertia, dtype=float)
         if Ic.shape != (3, 3) or not np.all(np.isfinite(Ic)):
             raise InertiaError(
-                f"held object: inertia must be a finite (3, 3) matrix in kg m^2, got {self.inertia!r}"
+                "held object: inertia must be a finite (3, 3) matrix in kg m^2, got "
+                f"{self.inertia!r}"
             )
         if not np.allclose(Ic, Ic.T, rtol=0.0, atol=1e-12 * max(1.0, np.max(np.abs(Ic)))):
             raise InertiaError("held object: inertia must be symmetric")
@@ -178,7 +180,8 @@ class HeldObject:
             r = h = float("nan")
         if not (r >= 0 and h >= 0 and np.isfinite(r) and np.isfinite(h)):
             raise InertiaError(
-                f"held object: radius and height must be finite and >= 0 m, got {radius!r}, {height!r}"
+                f"held object: radius and height must be finite and >= 0 m, got {radius!r}, "
+                f"{height!r}"
             )
         radius, height = r, h
         a = mass * (3 * radius**2 + height**2) / 12.0

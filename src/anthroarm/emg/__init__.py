@@ -1,7 +1,8 @@
 """EMG control of powered hands (book §9-2): the signal chain and the 4-code state machine.
 
 >>> from anthroarm import emg
->>> rec = emg.synthesize(2.0, 2000.0, [[(0.3, 0.6, 1.0)], [(1.2, 0.5, 1.0)]], pp=emg.AMPUTEE_PP, rng=0)
+>>> bursts = [[(0.3, 0.6, 1.0)], [(1.2, 0.5, 1.0)]]        # (start s, length s, level) per channel
+>>> rec = emg.synthesize(2.0, 2000.0, bursts, pp=emg.AMPUTEE_PP, rng=0)
 >>> out = emg.EMGProcessor(2000.0).process(rec.emg)       # envelopes, thresholds, codes 00/01/10/11
 >>> trace = emg.CodeMachine(out.frame_s).run(out.code)    # modes, commands, vibrators
 

@@ -169,8 +169,8 @@ class CodeMachine:
             r = np.asarray(raw_codes)
         except (TypeError, ValueError):
             raise EMGError(
-                f"raw_codes must be a 1-D integer array of codes 0..3, got {type(raw_codes).__name__}"
-                " (ragged?)"
+                "raw_codes must be a 1-D integer array of codes 0..3, got "
+                f"{type(raw_codes).__name__} (ragged?)"
             ) from None
         if r.ndim != 1 or (
             r.size and (not np.issubdtype(r.dtype, np.integer) or r.min() < 0 or r.max() > 3)

@@ -55,7 +55,8 @@ def _bandwidth(bandwidth_octaves) -> float:
     b = positive(bandwidth_octaves, "bandwidth_octaves", "octaves")
     if b > MAX_BANDWIDTH_OCTAVES:
         raise EMGError(
-            f"bandwidth_octaves {b:g} is wider than {MAX_BANDWIDTH_OCTAVES:g} octaves: not a bank band"
+            f"bandwidth_octaves {b:g} is wider than {MAX_BANDWIDTH_OCTAVES:g} octaves: not a bank "
+            "band"
         )
     return b
 

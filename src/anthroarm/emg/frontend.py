@@ -10,7 +10,8 @@ aim for (Merletti & Parker 2004, *Electromyography*, ch. 5).
 A linear differential amplifier with differential gain :math:`G_d` and CMRR
 :math:`\rho = G_d / G_c` outputs
 
-.. math:: v_o = G_d\,(v_+ - v_-) + G_c\,\frac{v_+ + v_-}{2},\qquad G_c = G_d\,10^{-\mathrm{CMRR}_{dB}/20},
+.. math:: v_o = G_d\,(v_+ - v_-) + G_c\,\frac{v_+ + v_-}{2},\qquad
+          G_c = G_d\,10^{-\mathrm{CMRR}_{dB}/20},
 
 clipped at the supply rails :math:`\pm V_{rail}` (the output saturates; the result says so).
 Volts in, volts out; time along the last axis.

@@ -204,7 +204,8 @@ class EMGProcessor:
             if max_input_pp == float("inf")
             else positive(max_input_pp, "max_input_pp", "V")
         )
-        # no accepted signal exceeds MAX_VOLTS at the processor, 2 MAX_VOLTS / gain p-p at the electrodes
+        # no accepted signal exceeds MAX_VOLTS at the processor, 2 MAX_VOLTS / gain p-p at the
+        # electrodes
         reach = min(mx, 2.0 * MAX_VOLTS / self.gain)
         self.thresholds.check(self.n_channels, reach, noise_pp)
         self.on, self.off = self.thresholds.arrays(self.n_channels)
@@ -333,8 +334,8 @@ def calibrate_thresholds(
     if not np.all(on > 0):
         raise EMGError("the rest recording is silent (envelope 0): record with the electrodes on")
     bad = [
-        f"channel {c}: on-threshold {on[c] * 1e6:.3g} µV p-p is above the book's {BOOK_SENSITIVITY_PP * 1e6:g} µV "
-        "sensitivity (rest noise too high: check the electrodes)"
+        f"channel {c}: on-threshold {on[c] * 1e6:.3g} µV p-p is above the book's "
+        f"{BOOK_SENSITIVITY_PP * 1e6:g} µV sensitivity (rest noise too high: check the electrodes)"
         for c in range(on.size)
         if on[c] > BOOK_SENSITIVITY_PP
     ]

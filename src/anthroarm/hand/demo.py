@@ -8,15 +8,13 @@ the glass upside down), keeping the arm configuration nearest the comfortable po
 grasp is checked with :func:`~anthroarm.hand.grasp.grasp_errors` (1 mm, 5°, on the glass's side,
 inside the limits) before it is returned.
 
-:func:`readme_picture` draws it in the viewer (:func:`~anthroarm.hand.overlays.show_grasp`:
-contact points, inward normals, the glass as a meshcat cylinder) and takes a headless-Chromium screenshot
-(:func:`anthroarm.viewer.browser.screenshot`): ``python -m anthroarm.hand.demo docs/x.png``.
+:func:`anthroarm.viewer.grasp_picture.readme_picture` draws it in the viewer
+(:func:`~anthroarm.hand.overlays.show_grasp`: contact points, inward normals, the glass as a
+meshcat cylinder) and takes a headless-Chromium screenshot:
+``python -m anthroarm.viewer.grasp_picture docs/x.png``.
 """
 
 from __future__ import annotations
-
-import tempfile
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -28,7 +26,6 @@ from ..robot import load
 from .fingers import Hand
 from .grasp import NORMAL_TOL, POSITION_TOL, grasp_errors
 from .objects import Cylinder
-from .overlays import show_grasp
 from .problems import reachable_grasps
 
 GLASS_HEIGHT = 0.18  # m, the drawn glass (the fingertips lie within ±9 cm of its centre)
@@ -70,24 +67,3 @@ def cup_grasp(robot=None, center=(0.05, 0.35, -0.30), seeds=range(100, 106)):
     if best is None:
         raise RuntimeError("no reachable upright-glass grasp found for the picture")
     return robot, h, best[1], best[2]
-
-
-def readme_picture(png, size=(960, 640)) -> Path:
-    """Screenshot of :func:`cup_grasp` in the viewer, written to ``png``."""
-    from ..viewer import Viewer  # upward (faces): the picture is drawn by the viewer
-    from ..viewer.browser import screenshot
-
-    robot, h, q, glass = cup_grasp()
-    _, _, contacts, _ = grasp_errors(h, IKConfiguration(robot, q), glass)
-    v = Viewer(robot, q=q)
-    show_grasp(v, glass, contacts)
-    v.set_camera((0.5, 1.0, 0.25), distance=0.75)
-    with tempfile.TemporaryDirectory() as d:
-        html = v.export_html(Path(d) / "grasp.html")
-        return screenshot(html, png, size=size, budget_ms=3000)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    import sys
-
-    print(readme_picture(sys.argv[1] if len(sys.argv) > 1 else "hand_grasp_viewer.png"))

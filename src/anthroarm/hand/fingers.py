@@ -205,7 +205,10 @@ class Hand:
         self.palm_id = chain.frame(palm).index
 
     def __repr__(self) -> str:
-        return f"Hand({self.robot.name!r}, fingers={list(self.tips)}, palm={self.palm!r}, arm joints={len(self.arm_joints)})"
+        return (
+            f"Hand({self.robot.name!r}, fingers={list(self.tips)}, palm={self.palm!r}, "
+            f"arm joints={len(self.arm_joints)})"
+        )
 
     @property
     def tips(self) -> tuple[str, ...]:
@@ -307,8 +310,8 @@ class Hand:
             if abs(want - val) > 1e-9 * max(1.0, abs(want)):
                 src = chain.joints[j.mimic.source]
                 raise CouplingError(
-                    f"{self.robot.name}: joint {name!r} is coupled to {src.name!r} "
-                    f"({name} = {j.mimic.multiplier:g}·{src.name} + {j.mimic.offset:g}); with {src.name} = "
+                    f"{self.robot.name}: joint {name!r} is coupled to {src.name!r} ({name} = "
+                    f"{j.mimic.multiplier:g}·{src.name} + {j.mimic.offset:g}); with {src.name} = "
                     f"{theta[src.index]:.6g} it is {want:.6g}, not {val:.6g}"
                 )
         return q

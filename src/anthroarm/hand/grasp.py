@@ -43,9 +43,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from .. import ik
+from .. import collision, ik
 from ..errors import CouplingError, GraspError
 from ..ik import qp
+from ..ik.qp.limits.collision import CollisionLimit
+from ..ik.qp.limits.collision_step import step as collision_step
 from ..ik.qp.tasks.contact_normal import ContactNormalTask
 from ..ik.qp.tasks.surface_contact import SurfaceContactTask
 from .fingers import Hand
@@ -54,6 +56,10 @@ from .objects import Cylinder, Sphere
 #: success criteria of the issue: every fingertip within 1 mm, its normal within 5°
 POSITION_TOL = 1e-3
 NORMAL_TOL = math.radians(5.0)
+#: a collision-free grasp: the fingertip capsules touch the object within this gap (m) and no
+#: body goes deeper into it, or into another body of the hand, than PENETRATION_TOL
+CONTACT_MARGIN = 1e-3
+PENETRATION_TOL = 1e-4
 #: iterations without a 1 % improvement of the best error after which an attempt has stalled
 STALL_WINDOW = 25
 
@@ -308,6 +314,8 @@ def solve_grasp(
     seed=0,
     move_arm: bool = True,
     step_fn=None,
+    collision_free: bool = False,
+    contact_margin: float = CONTACT_MARGIN,
 ) -> GraspResult:
     """Grasp ``obj`` (a :class:`~anthroarm.hand.objects.Sphere` or
     :class:`~anthroarm.hand.objects.Cylinder`, world frame) with the fingertips of ``robot``.
@@ -359,6 +367,17 @@ def solve_grasp(
         Replaces :func:`anthroarm.ik.qp.step` in the iterations: ``step_fn(conf, tasks, limits,
         couplings, solver)`` returns an object with ``v`` (nv,), ``ok`` and ``status``, ``info``
         (benchmarks/bench_hand.py runs the same loop on pink's ``solve_ik`` this way).
+    collision_free : bool
+        The object is a collision body (:mod:`anthroarm.collision`): every step carries the
+        velocity damper :class:`~anthroarm.ik.qp.limits.collision.CollisionLimit` against the
+        object (d_s = 0) and between the robot's own bodies (fingers, palm, arm, torso), and
+        the fingertips aim at the object grown by their capsules' radius, so that the pads
+        touch it instead of their axes.  Success adds: every fingertip capsule within
+        ``contact_margin`` of the object, no body deeper than 1e-4 m into it or into another
+        body; otherwise the status is ``"no_collision_free_grasp"``.  Not with ``couplings``
+        or ``step_fn``.
+    contact_margin : float
+        Largest gap (m) between a fingertip capsule and the object that counts as touching.
 
     Returns
     -------
@@ -370,6 +389,12 @@ def solve_grasp(
     if hand.robot is not robot:
         raise GraspError("hand= was built for another Robot")
     check_span(hand, obj)
+    coll = None
+    if collision_free:
+        if couplings or step_fn is not None:
+            raise GraspError("collision_free=True takes no couplings= and no step_fn=")
+        coll = _CollisionGrasp(robot, hand, obj, contact_margin)
+        obj, step_fn = coll.target, coll.step
     n = len(hand.fingers)
     points = None
     if contacts is not None:
@@ -478,6 +503,10 @@ def solve_grasp(
         if out[1] == "success" or out[1].startswith("qp_"):
             break
     q, status, _, pe, ne, cp, within, info, _ = best
+    if coll is not None:
+        info = dict(info, **coll.report(q))
+        if status == "success" and not info["collision_free"]:
+            status = "no_collision_free_grasp"
     return GraspResult(
         q,
         status == "success",
@@ -491,6 +520,61 @@ def solve_grasp(
         within,
         dict(info, attempts=attempt + 1),
     )
+
+
+class _CollisionGrasp:
+    """The pieces of a collision-free grasp: the object as an obstacle, the fingertip capsule
+    radii, the object grown by them (what the fingertips aim at), the step with the damper."""
+
+    def __init__(self, robot, hand, obj, margin):
+        m = float(margin)
+        if not (math.isfinite(m) and m > 0):
+            raise GraspError(f"contact_margin must be finite and > 0 (m), got {margin!r}")
+        self.robot, self.hand, self.margin = robot, hand, m
+        cm = collision.model(robot)
+        self.env = collision.environment([obj.obstacle()])
+        self.tip_bodies, radii = [], []
+        for f in hand.fingers:
+            j = robot.model.frames[f.tip_id].parentJoint
+            idx = [i for i in range(cm.n) if cm.joint[i] == j and cm.is_capsule[i]]
+            if not idx:
+                raise GraspError(
+                    f"{robot.name}: fingertip {f.tip!r} has no capsule in its collision model"
+                )
+            self.tip_bodies.append(idx[0])
+            radii.append(float(cm.cap_radius[idx[0]]))
+        self.radius = max(radii)
+        self.target = obj.inflated(self.radius)
+        # d_i = 10 cm, beyond what one iteration moves a body (max_step 0.2 rad × ~0.5 m);
+        # ξ dt = d_i / 2: a pair closes at most half its gap per iteration
+        self.limit = CollisionLimit(robot, self.env, d_safe=0.0, d_detect=0.1, xi=0.05)
+
+    def step(self, conf, tasks, limits, couplings, solver):
+        return collision_step(
+            conf, None, tasks, 1.0, limits=[*limits, self.limit], damping=1e-9, full=True
+        )
+
+    def report(self, q) -> dict:
+        """Penetration into the object, self-collision depth and fingertip gaps at ``q``."""
+        d = collision.distances(self.robot, q, self.env)
+        obj = np.array([b < 0 for b in d.body_b], dtype=bool)
+        pen = float(max(0.0, -d.distance[obj].min())) if obj.any() else 0.0
+        self_pen = float(max(0.0, -d.distance[~obj].min())) if (~obj).any() else 0.0
+        gaps = [
+            float(d.distance[obj & (d.body_a == b)].min())
+            if (obj & (d.body_a == b)).any()
+            else np.inf
+            for b in self.tip_bodies
+        ]
+        touching = all(-PENETRATION_TOL <= g <= self.margin for g in gaps)
+        return {
+            "penetration": pen,
+            "self_penetration": self_pen,
+            "tip_gaps": gaps,
+            "collision_free": bool(
+                pen <= PENETRATION_TOL and self_pen <= PENETRATION_TOL and touching
+            ),
+        }
 
 
 def _descend(

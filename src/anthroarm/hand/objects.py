@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import collision
 from ..errors import GraspError
 from ..ik.qp.tasks.contact_normal import unit_vector
 
@@ -97,6 +98,15 @@ class Sphere:
         T = np.asarray(T, dtype=float)
         return Sphere(T[:3, :3] @ self.center + T[:3, 3], self.radius)
 
+    def inflated(self, dr: float) -> "Sphere":
+        """The sphere grown by ``dr`` (m): where a fingertip's axis point lies when its capsule
+        of radius ``dr`` touches this sphere."""
+        return Sphere(self.center, self.radius + float(dr))
+
+    def obstacle(self, name: str = "object"):
+        """This sphere as a collision body (:func:`anthroarm.collision.sphere`)."""
+        return collision.sphere(self.radius, xyz=self.center, name=name)
+
     def point(self, direction) -> np.ndarray:
         """Surface point in ``direction`` (3,) from the centre (normalised)."""
         return self.center + self.radius * unit_vector(direction, "Sphere.point direction")
@@ -128,8 +138,8 @@ class Cylinder:
 
     def __repr__(self) -> str:
         return (
-            f"Cylinder(center={np.round(self.center, 4).tolist()}, axis={np.round(self.axis, 4).tolist()}, "
-            f"radius={self.radius:g}, length={self.length})"
+            f"Cylinder(center={np.round(self.center, 4).tolist()}, "
+            f"axis={np.round(self.axis, 4).tolist()}, radius={self.radius:g}, length={self.length})"
         )
 
     @property
@@ -172,6 +182,21 @@ class Cylinder:
         return Cylinder(
             T[:3, :3] @ self.center + T[:3, 3], T[:3, :3] @ self.axis, self.radius, self.length
         )
+
+    def inflated(self, dr: float) -> "Cylinder":
+        """The cylinder grown by ``dr`` (m) in radius (its length kept)."""
+        return Cylinder(self.center, self.axis, self.radius + float(dr), self.length)
+
+    def obstacle(self, name: str = "object", unbounded_length: float = 2.0):
+        """This cylinder as a collision body (:func:`anthroarm.collision.cylinder`; an
+        unbounded one as ``unbounded_length`` m long)."""
+        z = self.axis
+        x = self._perp
+        pose = np.eye(4)
+        pose[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+        pose[:3, 3] = self.center
+        L = self.length if self.length is not None else unbounded_length
+        return collision.cylinder(self.radius, L, pose=pose, name=name)
 
     def point(self, angle: float, height: float = 0.0) -> np.ndarray:
         """Surface point at ``angle`` (rad, about the axis from a fixed perpendicular ``e₁``;

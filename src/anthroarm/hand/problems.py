@@ -10,9 +10,9 @@
    contacts, to 0.2 mm and 1°) are closed on it from the open hand; draws where that fails are
    discarded;
 2. the arm is drawn uniformly inside its limits (``arm_margin`` rad), ``per_hand`` times per
-   hand grasp of step 1 (each a different problem: the arm is what a solver must find); the witness is that arm
-   configuration with the finger configuration of step 1, and the object is carried with the
-   palm (its pose relative to the palm is what step 1 solved);
+   hand grasp of step 1 (each a different problem: the arm is what a solver must find); the witness
+   is that arm configuration with the finger configuration of step 1, and the object is carried with
+   the palm (its pose relative to the palm is what step 1 solved);
 3. the contact points are the fingertips of the witness (Pinocchio FK).
 
 So the witness ``q`` puts every fingertip on its contact point with its pad normal against the

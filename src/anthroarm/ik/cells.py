@@ -299,7 +299,8 @@ class CellTable:
         i, j, k = idx
         if not self.cell_ok[i, j, k]:
             raise OutsideCellTableError(
-                f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the joint limits"
+                f"position {tuple(p)} m lies in a cell with a corner outside the workspace or the "
+                "joint limits"
             )
         m1, m2, m3 = r[0] - i, r[1] - j, r[2] - k
         t1, t2, t3 = 1.0 - m1, 1.0 - m2, 1.0 - m3
@@ -409,7 +410,8 @@ class CellTable:
             p = np.zeros(0)
         if p.ndim not in (1, 2) or p.shape[-1] != self.nq or not np.isfinite(p).all():
             raise ParameterError(
-                f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got {pulses!r}"
+                f"pulses must be finite counts of shape ({self.nq},) or (N, {self.nq}), got "
+                f"{pulses!r}"
             )
         return p / self.pulses_per_rad
 
@@ -474,3 +476,74 @@ class CellTable:
             and robot.spec.name == self.model
             and dict(robot.spec.params) == self.params
         )
+
+
+def cell_table(
+    robot,
+    *,
+    rotation=None,
+    bounds=None,
+    D: float | None = None,
+    branch: str | None = None,
+    encoder_counts: float | None = None,
+    gear_ratio: float | None = None,
+) -> CellTable:
+    """The spatial cell table a catalog arm's parameter table declares (``robot.spec.cells``, a
+    :class:`~anthroarm.models.spec.CellRecipe`), with the motor pulses stored: the §9-3 care
+    robot's table of wrist-centre positions every 10 cm (l. 7589) is one.
+
+    Every lattice point holds the exact IK (:meth:`CellTable.build`, the closed form of the
+    arm, branch ``branch``) for the hand orientation ``rotation`` at the positions of the
+    recipe's ``point`` of the tool frame, and the motor pulses from the origin (q = 0),
+    ``round(q · pulses_per_rad)`` (:meth:`CellTable.with_pulses`).  Every keyword left None
+    takes the recipe's value.
+
+    Parameters
+    ----------
+    robot : Robot
+        A catalog arm loaded with its parameter table (``anthroarm.load(NAME, ...)``) whose
+        spec declares a cell table.
+    rotation : array_like, optional
+        Hand orientation of the table, a 3×3 rotation matrix (base frame).
+    bounds : tuple, optional
+        Box of lattice positions ``(lo, hi)``, two corners of 3 coordinates each, m.
+    D : float, optional
+        Cell size, m.
+    branch : str, optional
+        IK branch label stored at every lattice point.
+    encoder_counts, gear_ratio : float, optional
+        The pulse scale: encoder counts per motor turn and motor turns per joint turn
+        (:func:`~anthroarm.models.spec.encoder_pulses_per_rad`).
+
+    Returns
+    -------
+    CellTable
+        With ``point`` and ``pulses`` set: :meth:`CellTable.lookup_pulses` and
+        :meth:`CellTable.relative_pulses` answer queries, a point outside the lattice raises
+        :class:`OutsideCellTableError`.
+
+    Raises
+    ------
+    ParameterError
+        For a robot without a declared cell table (another arm, or one loaded from a URDF
+        without its parameter table) and for bad table parameters.
+    """
+    spec = getattr(robot, "spec", None)
+    recipe = getattr(spec, "cells", None)
+    if recipe is None:
+        raise ParameterError(
+            "cell_table needs a catalog arm whose parameter table declares a cell table "
+            "(ChainSpec.cells, e.g. the care robot of §9-3): its point and IK branch are the "
+            f"arm's own; got {robot.name!r}"
+            + (" without its parameter table (loaded from a URDF?)" if spec is None else "")
+        )
+    table = CellTable.build(
+        robot,
+        recipe.rotation if rotation is None else rotation,
+        recipe.D if D is None else D,
+        recipe.bounds if bounds is None else bounds,
+        branch=recipe.branch if branch is None else branch,
+        progress=False,
+        point=recipe.point,
+    )
+    return table.with_pulses(recipe.pulses_per_rad(encoder_counts, gear_ratio))

@@ -1,4 +1,5 @@
-"""First-order error propagation and Monte Carlo tolerance analysis (book §6-6, Eq. (6-117)–(6-119)).
+"""First-order error propagation and Monte Carlo tolerance analysis (book §6-6, Eq.
+(6-117)–(6-119)).
 
 The hand position is x = F(q₁…qₙ, L₁…L_k) (6-117); to first order (6-118)
 
@@ -197,7 +198,8 @@ def propagate(
     return ErrorPropagation(Jq @ dq + JL @ dL, Jq, JL, ps)
 
 
-# ----------------------------------------------------------------------------- batched FK with perturbed dimensions
+# ----------------------------------------------------------------------------- batched FK with
+# perturbed dimensions
 class PerturbedChain:
     """Batched forward kinematics of the path to ``frame`` whose link parameters are perturbed
     per sample: T(q, L + ΔL) for N samples at once (numpy, read from ``robot.chain``: revolute,
@@ -225,7 +227,8 @@ class PerturbedChain:
             raise ValueError(f"dL must have shape ({N}, {len(self.params)}), got {dL.shape}")
         if not np.all(np.isfinite(dL)):
             raise ValueError(
-                f"dL has a NaN or infinite value: {dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}"
+                "dL has a NaN or infinite value: "
+                f"{dL[~np.all(np.isfinite(dL), axis=1)][0].tolist()}"
             )
         chain = self.robot.chain
         theta = chain.angles(q)

@@ -89,7 +89,8 @@ def finite_array(name: str, x, shape=None) -> np.ndarray:
             or any(s is not None and s != t for s, t in zip(shape, tail))
         ):
             raise ParameterError(
-                f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got {a.shape}"
+                f"{name} must have shape {tuple('N' if s is None else s for s in shape)}, got "
+                f"{a.shape}"
             )
     if not np.all(np.isfinite(a)):
         raise ParameterError(f"{name} must be finite, got {_short(x)}")
@@ -131,7 +132,8 @@ def unit_axis(name: str, u) -> np.ndarray:
 
 
 def rot(theta, u) -> np.ndarray:
-    """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in theta.
+    """[R_{theta,u}] = -[P_u]^2 cos + [P_u] sin + [Q_u], Eq. (6-89) (corrected skew); batched in
+    theta.
 
     Delegates to :func:`anthroarm.spatial.screw.rotation_matrix` (002 line 185)."""
     return rotation_matrix(theta, u)
@@ -252,7 +254,8 @@ def pow2_scale(*xs) -> float:
 
 def norm(name: str, v, axis=-1):
     """|v| along ``axis`` without overflow or underflow of the squares (v / 2^k first);
-    :class:`~anthroarm.errors.ParameterError` naming ``name`` when a difference of coordinates already overflowed."""
+    :class:`~anthroarm.errors.ParameterError` naming ``name`` when a difference of coordinates
+    already overflowed."""
     v = np.asarray(v, dtype=float)
     if not np.all(np.isfinite(v)):
         raise ParameterError(f"{name} is beyond the float range: the coordinates are too far apart")
@@ -262,18 +265,20 @@ def norm(name: str, v, axis=-1):
 
 def representable(name: str, x, why: str):
     """``x`` (computed under ``np.errstate(over='ignore', invalid='ignore')``) as a float array,
-    or :class:`~anthroarm.errors.ParameterError` naming ``name`` when it holds inf/NaN: the true value exists but is beyond
-    the float range (``why`` says which inputs make it so)."""
+    or :class:`~anthroarm.errors.ParameterError` naming ``name`` when it holds inf/NaN: the true
+    value exists but is beyond the float range (``why`` says which inputs make it so)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
         raise ParameterError(
-            f"{name} cannot be represented in floating point ({why}); use other units or smaller rates"
+            f"{name} cannot be represented in floating point ({why}); use other units or smaller "
+            "rates"
         )
     return x
 
 
 def difference(name: str, a, b):
-    """``a - b`` or :class:`~anthroarm.errors.ParameterError` naming ``name`` when the difference overflows."""
+    """``a - b`` or :class:`~anthroarm.errors.ParameterError` naming ``name`` when the difference
+    overflows."""
     with np.errstate(over="ignore", invalid="ignore"):
         d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
     return representable(name, d, "the points are too far apart")
@@ -281,8 +286,9 @@ def difference(name: str, a, b):
 
 def representable_fields(state, why: str):
     """``state`` (a dataclass computed under ``np.errstate(over='ignore', invalid='ignore')``)
-    unchanged, or :class:`~anthroarm.errors.ParameterError` naming the first numeric field that holds inf/NaN (its true
-    value is beyond the float range; ``why`` names the inputs that make it so)."""
+    unchanged, or :class:`~anthroarm.errors.ParameterError` naming the first numeric field that
+    holds inf/NaN (its true value is beyond the float range; ``why`` names the inputs that make it
+    so)."""
     for f in fields(state):
         v = getattr(state, f.name)
         if isinstance(v, (str, bool, np.bool_)) or v is None:

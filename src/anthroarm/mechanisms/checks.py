@@ -1,7 +1,8 @@
 """Cross-check rows of the mechanisms for ``anthroarm check`` (provider ``rows``).
 
-Four-bar, RSSR, RRSS, thumb and finger (``mech:<mechanism>``): loop-closure residual of the closed form, and position, velocity and
-acceleration against (a) Pinocchio — the spanning tree + closures solved by
+Four-bar, RSSR, RRSS, thumb and finger (``mech:<mechanism>``): loop-closure residual of the closed
+form, and position, velocity and acceleration against (a) Pinocchio — the spanning tree + closures
+solved by
 :class:`~anthroarm.mechanisms.closed_loop.ClosedLoop` — and (b) 8th-order central finite
 differences of the closed-form position along a trajectory input(t) = x0 + w t + a t^2 / 2.
 Errors are made dimensionless: angles in rad, points divided by the mechanism's length scale,

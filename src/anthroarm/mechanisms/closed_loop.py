@@ -102,7 +102,8 @@ class LoopSpec:
             s = (
                 f'  <joint name="{name}" type="{jtype}">\n'
                 f'    <parent link="{parent}"/>\n    <child link="{child}"/>\n'
-                f'    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="{rpy[0]!r} {rpy[1]!r} {rpy[2]!r}"/>\n'
+                f'    <origin xyz="{xyz[0]!r} {xyz[1]!r} {xyz[2]!r}" rpy="{rpy[0]!r} {rpy[1]!r} '
+                f'{rpy[2]!r}"/>\n'
             )
             if jtype in ("revolute", "prismatic"):
                 a = [float(x) for x in axis]
@@ -182,7 +183,8 @@ class ClosedLoop:
         for n in spec.inputs:
             if not self.model.existJointName(n):
                 raise ValueError(
-                    f"{spec.name}: input joint {n!r} is not in the tree ({list(self.model.names)[1:]})"
+                    f"{spec.name}: input joint {n!r} is not in the tree "
+                    f"({list(self.model.names)[1:]})"
                 )
         self.input_idx = np.array(
             [self.model.joints[self.model.getJointId(n)].idx_v for n in spec.inputs], dtype=int
@@ -344,7 +346,8 @@ class ClosedLoop:
             unknown = set(x) - set(self.spec.inputs)
             if unknown:
                 raise ValueError(
-                    f"{self.spec.name}: {what} names unknown inputs {sorted(unknown)} (inputs: {list(self.spec.inputs)})"
+                    f"{self.spec.name}: {what} names unknown inputs {sorted(unknown)} (inputs: "
+                    f"{list(self.spec.inputs)})"
                 )
             x = [x.get(n, 0.0) for n in self.spec.inputs]
         return finite_array(
@@ -435,8 +438,8 @@ class ClosedLoop:
                 res,
                 it,
                 "not_converged",
-                f"Newton did not close the loop (|residual| = {res:.3e}): the inputs may be outside "
-                "the assembly range, or q0 is too far from a solution",
+                f"Newton did not close the loop (|residual| = {res:.3e}): the inputs may be "
+                "outside the assembly range, or q0 is too far from a solution",
             )
         v, ev = self.solve_velocity(q, iv)
         a, ea = self.solve_acceleration(q, v, ia)
@@ -450,14 +453,16 @@ class ClosedLoop:
                 res,
                 it,
                 "singular",
-                f"closure Jacobian is singular here (velocity inconsistency {ev:.3e}): dead point / branch point",
+                f"closure Jacobian is singular here (velocity inconsistency {ev:.3e}): dead point "
+                "/ branch point",
             )
         return LoopState(q, v, a, res, it, "ok", "ok")
 
     def track(self, input_path, q0=None, tol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
         """Continuation: solve for each row of ``input_path`` (K x n_inputs) starting from the
         previous solution moved along the tangent (the velocity solution).  Keep the steps small
-        compared with the distance between assembly branches.  Returns (Q (K x nq), converged (K,))."""
+        compared with the distance between assembly branches.  Returns (Q (K x nq), converged
+        (K,))."""
         P = finite_array(
             "input_path",
             np.asarray(input_path, float).reshape(len(input_path), -1),

@@ -85,7 +85,8 @@ def rigid_body_point(
     P1, P1dot, P1ddot, length, theta, thetadot=0.0, thetaddot=0.0, phi=0.0
 ) -> RigidBodyPoint:
     """A point at ``length`` from P1 on a rigid body turning with angle theta, offset by the
-    fixed included angle ``phi`` (Eqs. (6-66)/(6-67): P = P1 + L (cos(theta + phi), sin(theta + phi))).
+    fixed included angle ``phi`` (Eqs. (6-66)/(6-67): P = P1 + L (cos(theta + phi), sin(theta +
+    phi))).
 
     Velocity (6-68): P' = P1' + theta' k x (P - P1); acceleration (6-69):
     P'' = P1'' + theta'' k x (P - P1) + theta' k x (theta' k x (P - P1)).
@@ -118,10 +119,10 @@ def dyad(P1, P1dot, P1ddot, P2, P2dot, P2ddot, r1, r2, branch: int = 1) -> DyadS
     alpha = arccos((r1^2 + d^2 - r2^2)/(2 r1 d)) (6-74); theta1 = phi + branch*alpha (6-75);
     P3 = P1 + r1 (cos theta1, sin theta1) (6-76); theta2 = atan2(P3 - P2) (6-77).
     Rates with a = P3x - P1x, b = P3y - P1y, c = P3x - P2x, d = P3y - P2y, D = bc - ad:
-    theta1' = -((P2x' - P1x') c + (P2y' - P1y') d)/D (6-83), theta2' = -((P2x' - P1x') a + (P2y' - P1y') b)/D (6-84),
-    theta1'' = -(E c + F d)/D (6-86), theta2'' = -(E a + F b)/D (6-87), with
-    E = (P2x'' - P1x'') + theta1'^2 a - theta2'^2 c, F = (P2y'' - P1y'') + theta1'^2 b - theta2'^2 d.
-    P3', P3'' from (6-78)/(6-85)."""
+    theta1' = -((P2x' - P1x') c + (P2y' - P1y') d)/D (6-83), theta2' = -((P2x' - P1x') a + (P2y' -
+    P1y') b)/D (6-84), theta1'' = -(E c + F d)/D (6-86), theta2'' = -(E a + F b)/D (6-87), with
+    E = (P2x'' - P1x'') + theta1'^2 a - theta2'^2 c, F = (P2y'' - P1y'') + theta1'^2 b - theta2'^2
+    d. P3', P3'' from (6-78)/(6-85)."""
     P1, P1dot, P1ddot = _pt("P1", P1), _pt("P1dot", P1dot), _pt("P1ddot", P1ddot)
     P2, P2dot, P2ddot = _pt("P2", P2), _pt("P2dot", P2dot), _pt("P2ddot", P2ddot)
     r1 = positive_length("r1", r1)

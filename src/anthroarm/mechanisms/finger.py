@@ -128,11 +128,13 @@ class FingerGeometry:
     @classmethod
     def default(cls) -> "FingerGeometry":
         """Our index finger (NOT from the book: no lengths are printed), fitted so that the
-        fingertip follows the Chapter 3 curve f(x) for x in [0, 40] mm; see :func:`design_finger`."""
+        fingertip follows the Chapter 3 curve f(x) for x in [0, 40] mm;
+        see :func:`design_finger`."""
         return cls.from_pose(*(np.array(p) * MM for p in _DEFAULT_POSE), phi_end=_DEFAULT_PHI_END)
 
 
-# the assembled initial pose found by design_finger() (mm): P1 .. P8, and the end of the driver range
+# the assembled initial pose found by design_finger() (mm): P1 .. P8, and the end of the driver
+# range
 _DEFAULT_POSE = (
     (69.6723, -4.5266),
     (35.5935, 24.8611),

@@ -1,4 +1,5 @@
-"""Planar four-bar linkage: position (both assembly branches), velocity, acceleration, coupler points.
+"""Planar four-bar linkage: position (both assembly branches), velocity, acceleration, coupler
+points.
 
 Two independent formulations of the same mechanism, cross-checked against each other, against
 finite differences and against Pinocchio (:mod:`anthroarm.mechanisms.closed_loop`):
@@ -17,11 +18,12 @@ r2 = crank O2-A, r3 = coupler A-B, r4 = rocker O4-B.  The loop is
 ``r2 e^{i th2} + r3 e^{i th3} = r1 + r4 e^{i th4}`` (5-18).
 
 Scale: lengths may have any magnitude the float range holds, but the longest link may be at
-most ``MAX_LENGTH_RATIO`` (1e150) times the shortest (``ValueError`` otherwise).  Every formula runs on lengths divided by the longest link and on rates divided by a
-rate scale (the largest of |th2'|, |th3'|, |th4'|, sqrt|th2''|), so angles do not depend on
-the unit of length (1e-155 m and 1e155 m give the same angles) and no intermediate square
-overflows.  A result that is itself beyond the float range (e.g. th2' = 1e300 rad/s, whose
-accelerations are ~1e600) is a ``ValueError`` naming the quantity.
+most ``MAX_LENGTH_RATIO`` (1e150) times the shortest (``ValueError`` otherwise).  Every formula runs
+on lengths divided by the longest link and on rates divided by a rate scale (the largest of |th2'|,
+|th3'|, |th4'|, sqrt|th2''|), so angles do not depend on the unit of length (1e-155 m and 1e155 m
+give the same angles) and no intermediate square overflows.  A result that is itself beyond the
+float range (e.g. th2' = 1e300 rad/s, whose accelerations are ~1e600) is a ``ValueError`` naming the
+quantity.
 
 Branches: ``branch=+1`` is the book's (5-16) ``th3 = th_d + arccos(...)``; ``branch=-1`` is the
 other assembly mode ``th_d - arccos(...)``.
@@ -119,7 +121,8 @@ class FourBarState:
 
 @dataclass(frozen=True)
 class CouplerPoint:
-    """A point fixed on the coupler: position, velocity and acceleration, shape (..., 2), ground frame."""
+    """A point fixed on the coupler: position, velocity and acceleration, shape (..., 2), ground
+    frame."""
 
     position: np.ndarray
     velocity: np.ndarray
@@ -155,8 +158,9 @@ def _lengths(r1, r2, r3, r4):
     )
     if max(r) > MAX_LENGTH_RATIO * min(r):
         raise ValueError(
-            f"link lengths {list(r)} differ by a factor above {MAX_LENGTH_RATIO:.0e}: the squares of "
-            "their ratios are not representable; such a linkage cannot be computed in floating point"
+            f"link lengths {list(r)} differ by a factor above {MAX_LENGTH_RATIO:.0e}: the squares "
+            "of their ratios are not representable; such a linkage cannot be computed in floating "
+            "point"
         )
     return r
 
@@ -178,11 +182,14 @@ def _reason(assembled, dead, d, r3, r4) -> str:
     if assembled.ndim == 0:
         if not assembled:
             return (
-                f"cannot assemble: crank-tip to rocker-pivot distance d = {float(d):.6g} is outside "
-                f"[|r3 - r4|, r3 + r4] = [{abs(r3 - r4):.6g}, {r3 + r4:.6g}]"
+                f"cannot assemble: crank-tip to rocker-pivot distance d = {float(d):.6g} is "
+                f"outside [|r3 - r4|, r3 + r4] = [{abs(r3 - r4):.6g}, {r3 + r4:.6g}]"
             )
         if dead:
-            return "dead point: coupler and rocker are collinear (transmission angle 0 or pi); rates are unbounded and reported as 0"
+            return (
+                "dead point: coupler and rocker are collinear (transmission angle 0 or pi); "
+                "rates are unbounded and reported as 0"
+            )
         return "ok"
     n = assembled.size
     na = int(np.sum(~assembled))
@@ -347,7 +354,8 @@ def fourbar_acceleration(state: FourBarState, alpha2=0.0) -> FourBarState:
 
 
 def fourbar(r1, r2, r3, r4, theta2, omega2=0.0, alpha2=0.0, branch: int = 1) -> FourBarState:
-    """Position, velocity and acceleration in one call (complex method, Eqs. (5-12)-(5-22) corrected).
+    """Position, velocity and acceleration in one call (complex method, Eqs. (5-12)-(5-22)
+    corrected).
 
     ``theta2``, ``omega2``, ``alpha2`` broadcast against each other (rad, rad/s, rad/s^2)."""
     th2, w2, a2 = np.broadcast_arrays(
@@ -369,10 +377,11 @@ def fourbar_cartesian(
     Position: d = r1 - r2 (5-60, reconstructed), d.d = d^2, tg th_d = (r1y - r2y)/(r1x - r2x)
     (print: tg th2), cos(alpha) = (r3^2 + d^2 - r4^2)/(2 r3 d), th3 = th_d +/- alpha, r4 = r3 - d.
     Velocity (Cramer, as printed in §5-3):
-    th3' = th2' (r2x r4y - r2y r4x)/(r4x r3y - r3x r4y), th4' = th2' (r2x r3y - r3x r2y)/(r4x r3y - r3x r4y).
-    Acceleration with a general th2'' (§5-3):
-    A = r2y th2'' + r2x th2'^2 + r3x th3'^2 - r4x th4'^2, B = -r2x th2'' + r2y th2'^2 + r3y th3'^2 - r4y th4'^2,
-    th3'' = -(A r4x + B r4y)/(r3y r4x - r3x r4y), th4'' = -(A r3x + B r3y)/(r3y r4x - r3x r4y).
+    th3' = th2' (r2x r4y - r2y r4x)/(r4x r3y - r3x r4y), th4' = th2' (r2x r3y - r3x r2y)/(r4x r3y -
+    r3x r4y). Acceleration with a general th2'' (§5-3):
+    A = r2y th2'' + r2x th2'^2 + r3x th3'^2 - r4x th4'^2, B = -r2x th2'' + r2y th2'^2 + r3y th3'^2 -
+    r4y th4'^2, th3'' = -(A r4x + B r4y)/(r3y r4x - r3x r4y), th4'' = -(A r3x + B r3y)/(r3y r4x -
+    r3x r4y).
 
     Angles absolute from +x; the ``branch`` sign means the same as in :func:`fourbar_position`."""
     g = finite_array("ground", ground, (2,))

@@ -82,7 +82,8 @@ class KneeGeometry:
         for what, (a, b) in pairs.items():
             if not np.hypot(*(b - a)) > 0.0:
                 raise ParameterError(
-                    f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} coincide)"
+                    f"knee: the {what} has zero length (pivots {a.tolist()} and {b.tolist()} "
+                    "coincide)"
                 )
 
     @property
@@ -273,5 +274,6 @@ def stability_margin(knee: KneeGeometry, hip) -> float:
     if not n > 0:
         raise ParameterError("knee: the hip and the ankle coincide")
     p = st.icr[0] - hip
-    # anterior is +x: the ICR is posterior when it lies on the -x side of the line (line points down)
+    # anterior is +x: the ICR is posterior when it lies on the -x side of the line (line points
+    # down)
     return float((p[0] * line[1] - p[1] * line[0]) / n)

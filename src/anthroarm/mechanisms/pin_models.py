@@ -1,4 +1,5 @@
-"""Spanning trees + closure lists of the mechanisms, for :class:`~anthroarm.mechanisms.closed_loop.ClosedLoop`.
+"""Spanning trees + closure lists of the mechanisms,
+for :class:`~anthroarm.mechanisms.closed_loop.ClosedLoop`.
 
 Each builder returns a :class:`LoopSpec`; ``ClosedLoop(spec)`` loads its URDF in Pinocchio.
 Joint names give the book's variables:
@@ -6,7 +7,8 @@ Joint names give the book's variables:
 * four-bar: ``crank`` = theta2 (absolute), ``coupler`` = theta3 - theta2, ``rocker`` = theta4;
   closure B (coupler end) = B (rocker end), planar (x, y);
 * RSSR: ``crank`` = alpha, ball ``ball_a`` at a, ``rocker`` = beta; closure at b;
-* RRSS: ``r1`` = theta1, ``r2`` = theta2 (about u_a), S-S bar as ball ``ball_b0`` at b0; closure at b.
+* RRSS: ``r1`` = theta1, ``r2`` = theta2 (about u_a), S-S bar as ball ``ball_b0`` at b0; closure at
+  b.
 
 The reference configuration q = 0 of the spatial trees is the mechanism's initial pose (a1, b1),
 which closes the loop, so the Pinocchio solution is found by continuation from q = 0 —
@@ -32,7 +34,8 @@ def frame_with_z(z) -> np.ndarray:
 
 
 def fourbar_spec(r1, r2, r3, r4) -> LoopSpec:
-    """Planar four-bar of Fig. 5-1 as a tree about z: ground -crank- A -coupler- B; ground -rocker- B."""
+    """Planar four-bar of Fig. 5-1 as a tree about z: ground -crank- A -coupler- B; ground -rocker-
+    B."""
     return LoopSpec(
         name="fourbar",
         joints=(
@@ -56,7 +59,8 @@ def _axis_frame(u):
 
 
 def rssr_spec(geom) -> LoopSpec:
-    """RSSR (002 §4-2) tree: ground -R(ua at a0)- crank -ball(a1)- coupler; ground -R(ub at b0)- rocker."""
+    """RSSR (002 §4-2) tree: ground -R(ua at a0)- crank -ball(a1)- coupler; ground -R(ub at b0)-
+    rocker."""
     Ra, Rb = _axis_frame(geom.ua), _axis_frame(geom.ub)
     Rball = frame_with_z(geom.ua)  # the coupler turns mostly about ua relative to the crank
     return LoopSpec(
@@ -83,7 +87,8 @@ def rssr_spec(geom) -> LoopSpec:
 
 
 def rrss_spec(geom) -> LoopSpec:
-    """RRSS tree: ground -R(u0 at a0)- R1 -R(u1 at a1)- R2; ground -ball(b0)- S-S bar; closure at b."""
+    """RRSS tree: ground -R(u0 at a0)- R1 -R(u1 at a1)- R2; ground -ball(b0)- S-S bar; closure at
+    b."""
     R0, R1 = _axis_frame(geom.u0), _axis_frame(geom.u1)
     Rbar = frame_with_z(geom.b1 - geom.b0)  # the bar's passive spin is about its own line
     return LoopSpec(

@@ -8,7 +8,8 @@ Joint A (axis ŝ₁) is revolute, B, C, D are cylindrical.  Dual angles, Eq. (5-
 
 Loop equation (5-152) with passive basic screw matrices (Z about k for θ̂ⱼ, X about i for α̂ᵢⱼ):
 
-    θ̂₂ α̂₂₃ θ̂₃ α̂₃₄ θ̂₄ α̂₄₁ θ̂₁ α̂₁₂ = I   ⇔   Ĉ = α̂₁₂ θ̂₁ α̂₄₁ θ̂₄ α̂₃₄ = (θ̂₃ α̂₂₃ θ̂₂)ᵀ = D̂  (5-153)
+    θ̂₂ α̂₂₃ θ̂₃ α̂₃₄ θ̂₄ α̂₄₁ θ̂₁ α̂₁₂ = I   ⇔   Ĉ = α̂₁₂ θ̂₁ α̂₄₁ θ̂₄ α̂₃₄ = (θ̂₃ α̂₂₃ θ̂₂)ᵀ = D̂
+    (5-153)
 
 Equivalent active SE(3) loop: X(α̂₁₂) Z(θ̂₁) X(α̂₄₁) Z(θ̂₄) X(α̂₃₄) Z(θ̂₃) X(α̂₂₃) Z(θ̂₂) = I with
 X(α̂) = R_x(α) T_x(a), Z(θ̂) = R_z(θ) T_z(s).
@@ -210,7 +211,8 @@ def _Z(t: Dual) -> pin.SE3:
 
 
 def loop_se3(g: RCCCGeometry, sol: RCCCSolution) -> pin.SE3:
-    """The active loop product X(α̂₁₂)Z(θ̂₁)X(α̂₄₁)Z(θ̂₄)X(α̂₃₄)Z(θ̂₃)X(α̂₂₃)Z(θ̂₂) (= I when closed)."""
+    """The active loop product X(α̂₁₂)Z(θ̂₁)X(α̂₄₁)Z(θ̂₄)X(α̂₃₄)Z(θ̂₃)X(α̂₂₃)Z(θ̂₂) (= I when
+    closed)."""
     M = pin.SE3.Identity()
     for f in (
         _X(g.alpha12),
@@ -308,7 +310,8 @@ def rccc_position(g: RCCCGeometry, theta1: float, tol: float = DEAD_TOL) -> RCCC
     return RCCCResult("ok", sols, "")
 
 
-# ----------------------------------------------------------------------------- velocity, acceleration
+# ----------------------------------------------------------------------------- velocity,
+# acceleration
 def _joint_screws(g: RCCCGeometry, sol: RCCCSolution) -> list[np.ndarray]:
     """Unit joint twists (v; ω) in the base frame, in the order of :attr:`RCCCSolution.q`:
     (θ₁, θ₄, s₄, θ₃, s₃, θ₂, s₂)."""

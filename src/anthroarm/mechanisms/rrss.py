@@ -190,12 +190,13 @@ def rrss_position(geom: RRSSGeometry, theta1, branch: int = 1) -> RRSSState:
 
 
 def rrss(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, branch: int = 1) -> RRSSState:
-    """Closed-form RRSS: position (6-93)-(6-99), velocity (6-102)-(6-105), acceleration (6-109)-(6-111).
+    """Closed-form RRSS: position (6-93)-(6-99), velocity (6-102)-(6-105), acceleration
+    (6-109)-(6-111).
 
     th2' = -th1' (b - b0)^T [P_u0 (b - a0)] / ((b - b0)^T [P_ua (b - a)])              (6-105)
-    th2'' = -{(b - b0)^T [b''_e + th2'^2 P_ua^2 (b - a) + b''_c] + |b'|^2} / ((b - b0)^T [P_ua (b - a)])   (6-111)
-    b''_e = Wdot(th1', th1'', u0)(b - a0) (transport), b''_c = 2 W(th1', u0) W(th2', u_a)(b - a) (Coriolis).
-    ``branch`` +1 takes the "+" root of (6-99)."""
+    th2'' = -{(b - b0)^T [b''_e + th2'^2 P_ua^2 (b - a) + b''_c] + |b'|^2} / ((b - b0)^T [P_ua (b -
+    a)])   (6-111) b''_e = Wdot(th1', th1'', u0)(b - a0) (transport), b''_c = 2 W(th1', u0) W(th2',
+    u_a)(b - a) (Coriolis). ``branch`` +1 takes the "+" root of (6-99)."""
     if branch not in (1, -1):
         raise ValueError(f"branch must be +1 or -1, got {branch!r}")
     th1, w1, al1 = np.broadcast_arrays(
@@ -243,7 +244,8 @@ def rrss(geom: RRSSGeometry, theta1, theta1dot=0.0, theta1ddot=0.0, branch: int 
             th1,
             disc,
             "theta1",
-            "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); rates reported as 0",
+            "branch point: E^2 + F^2 - G^2 = 0 (S-S bar in the plane of b's motion about u_a); "
+            "rates reported as 0",
         )
         if not np.all(good):
             z = ~good[..., None]
@@ -501,8 +503,8 @@ def rrss_track(
             x, ok, iters = _march(geom, x, th_prev, th, tol_abs, max_halvings)
             if not ok:
                 lost = (
-                    f"branch lost between theta1 = {th_prev:.6g} and {th:.6g}: Newton fails even for tiny steps "
-                    "(dead point or assembly limit)"
+                    f"branch lost between theta1 = {th_prev:.6g} and {th:.6g}: Newton fails even "
+                    "for tiny steps (dead point or assembly limit)"
                 )
             else:
                 th_prev = th

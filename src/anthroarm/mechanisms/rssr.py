@@ -201,8 +201,9 @@ def rssr(geom: RSSRGeometry, alpha, alphadot=0.0, alphaddot=0.0, branch: int = 1
     """Position, velocity (4-23)-(4-26) and acceleration (4-27)-(4-30) of the RSSR.
 
     beta' = a'^T (a - b) / ((a - b)^T [P_ub](b - b0))                        (4-26)
-    beta'' = [(a - b)^T (a'' - beta'^2 [P_ub]^2 (b - b0)) + |a' - b'|^2] / ((a - b)^T [P_ub](b - b0))   (4-30)
-    with a' = alpha' [P_ua](a - a0) (4-24), a'' = [E_{alpha',alpha'',ua}](a - a0) (4-28)."""
+    beta'' = [(a - b)^T (a'' - beta'^2 [P_ub]^2 (b - b0)) + |a' - b'|^2] / ((a - b)^T [P_ub](b -
+    b0))   (4-30) with a' = alpha' [P_ua](a - a0) (4-24), a'' = [E_{alpha',alpha'',ua}](a - a0)
+    (4-28)."""
     s = _check_branch(branch)
     al, ad, add = np.broadcast_arrays(
         finite_array("alpha", alpha),
@@ -247,7 +248,8 @@ def rssr(geom: RSSRGeometry, alpha, alphadot=0.0, alphaddot=0.0, branch: int = 1
             al,
             disc,
             "alpha",
-            "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported as 0",
+            "branch point: E^2 + F^2 - G^2 = 0, the two closures meet; rates unbounded, reported "
+            "as 0",
             " (4-31)",
         )
         if not np.all(good):  # keep the rates of bad entries exactly zero
@@ -356,8 +358,8 @@ def rssr_polar(r2, r3, r4, C, theta2, phi2, branch: int = 1):
     A sin(phi4) + B cos(phi4) = D with A = a - r2 s(phi2) c(theta2), B = c - r2 c(phi2),
     D = [r3^2 - r4^2 - (b - r2 s(theta2) s(phi2))^2 - A^2 - B^2] / (2 r4),
     phi4 = 2 atan((A +/- sqrt(A^2 + B^2 - D^2)) / (B + D)).
-    Returns (phi4, assembled).  The same mechanism as :func:`rssr` with ua = (-sin theta2, cos theta2, 0),
-    a0 = 0, a = r2 (s phi2 c theta2, s phi2 s theta2, c phi2), ub = (0, 1, 0), b0 = C,
+    Returns (phi4, assembled).  The same mechanism as :func:`rssr` with ua = (-sin theta2, cos
+    theta2, 0), a0 = 0, a = r2 (s phi2 c theta2, s phi2 s theta2, c phi2), ub = (0, 1, 0), b0 = C,
     b = C + r4 (sin phi4, 0, cos phi4), and the reference sphere centres a1, b1 taken at any closed
     configuration (|a1 - b1| = r3); the tests check both ways."""
     r2, r3, r4 = positive_length("r2", r2), positive_length("r3", r3), positive_length("r4", r4)

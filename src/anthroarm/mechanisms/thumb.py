@@ -210,7 +210,8 @@ def thumb(
     rrss_branch: int | None = None,
     dyad_branch: int | None = None,
 ) -> ThumbState:
-    """Thumb kinematics for driver angle(s) theta1 (rad, scalar or array) and rates, Fig. 6-17 pipeline.
+    """Thumb kinematics for driver angle(s) theta1 (rad, scalar or array) and rates, Fig. 6-17
+    pipeline.
 
     Branches default to the ones through the initial pose (theta1 = 0: theta2 = theta3 = 0).
     (6-114) S = T S_r + a, S'_r = T S'_r(planar), S''_r = T S''_r(planar) with

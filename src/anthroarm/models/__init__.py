@@ -36,8 +36,10 @@ BOOK_MODELS = {
     "planar2r": planar2r,
     "human_upper_limb": human_upper_limb,
     "care_robot": care_robot,
-    "prosthetic_hand": prosthetic_hand,  # Fig. 2-8/2-9 linkages; plain URDF with fitted mimic joints
-    **TEMPLATES,  # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
+    # Fig. 2-8/2-9 linkages; plain URDF with fitted mimic joints
+    "prosthetic_hand": prosthetic_hand,
+    # Table 2.3: cartesian_robot, cylindrical_robot, spherical_robot, articulated_robot
+    **TEMPLATES,
 }
 
 #: the catalog model of a person's arm, built from body height (m), mass (kg) and sex: what the

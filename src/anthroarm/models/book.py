@@ -108,7 +108,10 @@ def prosthetic_arm(L1: float = 0.340, L2: float = 0.260, L3: float = 0.130) -> C
         "Anthropomorphic 6R prosthetic arm (book Ch.7 Fig. 7-2, Table 7.1); tool = palm centre C.",
         rows,
         homogeneous(r=[0, 0, L3]),
-        source="book 000 l.4906-4941 (Table 7.1, Fig. 7-2); L2=260 mm per Table 7.2 (caption prints 240)",
+        source=(
+            "book 000 l.4906-4941 (Table 7.1, Fig. 7-2); L2=260 mm per Table 7.2 "
+            "(caption prints 240)"
+        ),
         joint_names=names,
         params={"L1": L1, "L2": L2, "L3": L3},
         tool_name="palm",
@@ -164,7 +167,8 @@ def unimate5(s0: float = 0.7, h2: float = 0.1, P: float = 0.15, boom=(0.3, 1.0))
     _stroke("unimate5", "boom", boom)
     return from_dh(
         "unimate5",
-        "Unimate-type 5-DOF robot with a prismatic boom (book Fig. 6-4); tool = hand point P on z5.",
+        "Unimate-type 5-DOF robot with a prismatic boom (book Fig. 6-4); tool = hand point P on "
+        "z5.",
         _rrprr_rows(s0, h2, boom),
         homogeneous(r=[0, 0, P]),
         source="book 000 l.3849-3893 (Fig. 6-4, Eq. (6-19)-(6-23)); lengths chosen by anthroarm",
@@ -216,8 +220,8 @@ def planar2r(l1: float = 1.0, l2: float = 1.0) -> ChainSpec:
         tool_origin=homogeneous(r=[0, l2, 0]),
         source="book 000 l.5637-5663 (Fig. 7-14, Table 7.3)",
         inertia_source=(
-            f"not printed: uniform cylinders of {DEFAULT_LINEAR_DENSITY} kg/m, radius {DEFAULT_LINK_RADIUS} m, "
-            f"plus {DEFAULT_JOINT_MASS} kg at each joint"
+            f"not printed: uniform cylinders of {DEFAULT_LINEAR_DENSITY} kg/m, radius "
+            f"{DEFAULT_LINK_RADIUS} m, plus {DEFAULT_JOINT_MASS} kg at each joint"
         ),
         params={"l1": l1, "l2": l2},
         printed=(PrintedForm("Fig. 7-14 (y, z)", _planar2r_pose),),
@@ -300,7 +304,8 @@ rrprr_hand_pose = unimate_hand_pose
 
 
 def planar2r_tip(q, l1: float = 1.0, l2: float = 1.0) -> np.ndarray:
-    """Fig. 7-14: tip (y, z) = (l1 cos θ1 + l2 cos(θ1+θ2), l1 sin θ1 + l2 sin(θ1+θ2)), shape (N, 2)."""
+    """Fig. 7-14: tip (y, z) = (l1 cos θ1 + l2 cos(θ1+θ2), l1 sin θ1 + l2 sin(θ1+θ2)), shape (N,
+    2)."""
     q2, single = as_batch(q, 2)
     l1, l2 = finite_params(l1=l1, l2=l2)
     t1, t12 = q2[:, 0], q2[:, 0] + q2[:, 1]

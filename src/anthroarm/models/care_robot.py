@@ -11,7 +11,10 @@ What the book prints (000 l. 7556–7617, ch9 notes §2.2 R1):
   (18 motors); coreless DC motors with an optical encoder and a worm reduction.
 * Position control by the spatial cell method (§7-3) on a lattice every **10 cm** in x, y, z,
   the motor pulses from the origin to every lattice point stored in ROM, accuracy **1 cm**
-  (l. 7589): :data:`CELL_D`, :data:`CELL_ACCURACY`, :func:`cell_table`.
+  (l. 7589): :data:`CELL_D`, :data:`CELL_ACCURACY`; the spec declares the table
+  (``spec.cells``, a :class:`~anthroarm.models.spec.CellRecipe`: orientation, box, branch, the
+  wrist centre as its point, the pulse scale) and :func:`anthroarm.ik.cells.cell_table` builds
+  it.
 
 **Assumed** (the joint layout and the ranges were in Fig. 9-28, which is lost):
 
@@ -32,12 +35,9 @@ Units: metres, kilograms, radians.
 
 from __future__ import annotations
 
-import numpy as np
-
-from ..errors import ParameterError
 from ..spatial.rotations import homogeneous
 from .book import _lengths, sixr_arm
-from .spec import ChainSpec, from_dh, rod_link
+from .spec import CellRecipe, ChainSpec, encoder_pulses_per_rad, from_dh, rod_link
 
 #: Table 9.5 as printed: segment -> (length mm, mass kg); "total" is the printed 全长 row
 TABLE_9_5 = {
@@ -87,78 +87,7 @@ def pulses_per_rad(encoder_counts: float = ENCODER_COUNTS, gear_ratio: float = G
     """Motor pulses per joint radian: ``encoder_counts · gear_ratio / 2π`` (both assumed, see
     :data:`ENCODER_COUNTS`, :data:`GEAR_RATIO`).  :class:`~anthroarm.errors.ParameterError` unless
     both are finite and > 0."""
-    try:
-        c, g = float(encoder_counts), float(gear_ratio)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, {gear_ratio!r}"
-        ) from None
-    if not (np.isfinite(c) and np.isfinite(g) and c > 0 and g > 0):
-        raise ParameterError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
-    return c * g / (2.0 * np.pi)
-
-
-def cell_table(
-    robot=None,
-    *,
-    rotation=R_FORWARD,
-    bounds=CELL_BOUNDS,
-    D: float = CELL_D,
-    branch: str = CELL_BRANCH,
-    encoder_counts: float = ENCODER_COUNTS,
-    gear_ratio: float = GEAR_RATIO,
-):
-    """The care robot's spatial cell table of §9-3 (l. 7589) with the motor pulses stored.
-
-    The lattice holds **wrist-centre** positions ("手腕的位置坐标") every ``D`` = 10 cm in x, y,
-    z (base frame, m); every lattice point stores the exact IK (Eqs. (7-1)–(7-15), branch
-    ``branch``) for the hand orientation ``rotation`` and the motor pulses from the origin
-    (q = 0), ``round(q · pulses_per_rad)``.  The printed accuracy is 1 cm per axis
-    (:data:`CELL_ACCURACY`); what this layout achieves is measured in ``tests/book9``.  The
-    table is one of wrist *positions*: θ1–θ3 place the wrist; the wrist joints θ4–θ6 are
-    interpolated too but wrap at ±180° inside some cells, so take the hand orientation from
-    an exact solve (or :meth:`~anthroarm.ik.cells.CellTable.refine`) where it matters.
-
-    Parameters
-    ----------
-    robot : Robot, optional
-        A loaded ``care_robot`` (default: ``anthroarm.load("care_robot")``).
-    rotation : array_like
-        Hand orientation of the table, a 3×3 rotation matrix (default :data:`R_FORWARD`,
-        assumed).
-    bounds : tuple
-        Box of wrist positions ``(lo, hi)``, two corners of 3 coordinates each, m (default
-        :data:`CELL_BOUNDS`, assumed).
-    D : float
-        Cell size, m (printed: 0.10).
-    branch, encoder_counts, gear_ratio
-        IK branch label and the pulse scale, see :func:`pulses_per_rad`.
-
-    Returns
-    -------
-    anthroarm.ik.cells.CellTable
-        With ``point`` = the wrist centre (0, 0, −P) in the tool frame and ``pulses`` set;
-        :meth:`~anthroarm.ik.cells.CellTable.lookup_pulses` and
-        :meth:`~anthroarm.ik.cells.CellTable.relative_pulses` answer queries, a point outside
-        the lattice raises :class:`~anthroarm.ik.cells.OutsideCellTableError`.
-    """
-    from ..ik.cells import CellTable
-
-    if robot is None:
-        from ..robot import load
-
-        robot = load("care_robot")
-    if robot.spec is None or robot.spec.name != "care_robot":
-        raise ParameterError(
-            "cell_table needs the catalog care_robot (aa.load('care_robot', ...)): the wrist "
-            f"offset P and the table's IK branch are its own; got {robot.name!r}"
-            + (" without its parameter table (loaded from a URDF?)" if robot.spec is None else "")
-        )
-    P = float(robot.spec.params["P"])
-    table = CellTable.build(
-        robot, rotation, D, bounds, branch=branch, progress=False, point=(0.0, 0.0, -P)
-    )
-    return table.with_pulses(pulses_per_rad(encoder_counts, gear_ratio))
+    return encoder_pulses_per_rad(encoder_counts, gear_ratio)
 
 
 def care_robot(
@@ -193,9 +122,11 @@ def care_robot(
         joint_names=["waist", "shoulder", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw"],
         params={"s0": s0, "h2": h2, "s3": s3, "P": P},
         tool_name="grip",
-        inertia_source="Table 9.5 segment masses (base 2.38, upper arm 1.82, forearm 1.16, finger-palm "
-        "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
-        f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)",
+        inertia_source=(
+            "Table 9.5 segment masses (base 2.38, upper arm 1.82, forearm 1.16, finger-palm "
+            "0.57 kg) as uniform cylinders of radius 25 mm; elbow and wrist housings "
+            f"{HOUSING_MASS} kg each taken from the forearm and finger-palm (assumed)"
+        ),
     )
     m = {k: v[1] for k, v in TABLE_9_5.items()}
     masses = [
@@ -210,12 +141,21 @@ def care_robot(
         j.link = rod_link(j.link.name, j.link.segment, mass=mass, joint_mass=0.0)
         # coreless DC motors through a worm reduction: slow joints (rad/s) -- an assumption
         j.velocity = 1.0
+    # the §9-3 table of wrist-centre positions: the point (0, 0, -P) of the grip frame
+    spec.cells = CellRecipe(
+        rotation=R_FORWARD,
+        bounds=CELL_BOUNDS,
+        D=CELL_D,
+        branch=CELL_BRANCH,
+        point=(0.0, 0.0, -float(P)),
+        encoder_counts=ENCODER_COUNTS,
+        gear_ratio=GEAR_RATIO,
+    )
     return spec
 
 
 __all__ = [
     "care_robot",
-    "cell_table",
     "pulses_per_rad",
     "ENCODER_COUNTS",
     "GEAR_RATIO",

@@ -60,8 +60,9 @@ ERD_ARMS: dict[str, ErdArm] = {
             "human_description/robots/human.urdf",
             tool="right_hand",
             description=(
-                "Right arm of example-robot-data's 'human' (shoulder Z-X-Y, elbow Z-Y, wrist Z-X) as a fixed-base "
-                "sub-chain; the rest of the body, the clavicle included, is locked at zero."
+                "Right arm of example-robot-data's 'human' (shoulder Z-X-Y, elbow Z-Y, wrist Z-X) "
+                "as a fixed-base sub-chain; the rest of the body, the clavicle included, is "
+                "locked at zero."
             ),
             active=(
                 "right_shoulder_Z",

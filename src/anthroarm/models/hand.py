@@ -2,8 +2,9 @@
 
 The book's upper-limb graph (Fig. 2-2, l. 540–552; ``ch1-2.md`` §2.2) gives every finger a
 two-axis base pair (MCP for fingers 2–5, CMC for the thumb) and two hinges: 4 DOF per digit,
-F = 20 for the hand (Eq. (2-1) on the finger graph, :func:`anthroarm.design.structure.human_fingers`).
-The book prints no finger dimensions and no finger ranges; they come from the literature:
+F = 20 for the hand (Eq. (2-1) on the finger
+graph, :func:`anthroarm.design.structure.human_fingers`). The book prints no finger dimensions and
+no finger ranges; they come from the literature:
 
 **Segment lengths** — Buchholz, Armstrong & Goldstein (1992), "Anthropometric data for
 describing the kinematics of the human hand", *Ergonomics* 35(3):261–273: kinematic segment
@@ -65,6 +66,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from fractions import Fraction
 from numbers import Real
+from pathlib import Path
 
 import numpy as np
 
@@ -80,7 +82,8 @@ FINGERS = DIGITS[1:]
 #: the order of their names, so the spec lists them that way and spec order = q order
 Q_ORDER = tuple(sorted(DIGITS))
 
-#: segment length / hand length, per digit, of Buchholz, Armstrong & Goldstein 1992 (the module table)
+#: segment length / hand length, per digit, of Buchholz, Armstrong & Goldstein 1992 (the module
+#: table)
 BUCHHOLZ_1992 = {
     "thumb": (0.118, 0.251, 0.196, 0.158),
     "index": (0.463, 0.245, 0.143, 0.097),
@@ -115,6 +118,24 @@ DIP_PIP_RATIO = 2.0 / 3.0
 
 #: rest direction of the thumb metacarpal in the hand frame (distal, radial, palmar; unit)
 THUMB_REST_DIRECTION = np.array([0.45, 0.35, -1.0]) / np.linalg.norm([0.45, 0.35, -1.0])
+#: the linkage hand's tree and mimic fit at scale 1 (the catalog model ``prosthetic_hand`` is
+#: made from it): written by :func:`anthroarm.mechanisms.linkage_hand.write_tree_table`
+LINKAGE_HAND_TABLE = Path(__file__).resolve().parents[1] / "data" / "models" / "linkage_hand.json"
+
+
+def check_hand_scale(scale, who: str) -> float:
+    """``scale`` as a float: a number in 0.3…3 (a hand scaled as a whole), else
+    :class:`~anthroarm.errors.ParameterError` naming ``who``."""
+    if (
+        isinstance(scale, bool)
+        or not isinstance(scale, (int, float, np.floating, np.integer))
+        or not np.isfinite(scale)
+        or not (0.3 <= scale <= 3.0)
+    ):
+        raise ParameterError(f"{who}: scale must be a number in 0.3…3, got {scale!r}")
+    return float(scale)
+
+
 #: turn of the thumb's flexion axes about its rest direction (rad, our choice): flexion goes
 #: ulnar and palmar
 THUMB_PRONATION = 30.0 * np.pi / 180.0
@@ -166,7 +187,8 @@ def parse_coupling(dip_coupling) -> float | None:
             r = float(Fraction(t))
         except (ValueError, ZeroDivisionError):
             raise ParameterError(
-                f"dip_coupling must be 'none', a ratio such as '2/3' or a number, got {dip_coupling!r}"
+                "dip_coupling must be 'none', a ratio such as '2/3' or a number, got "
+                f"{dip_coupling!r}"
             ) from None
     elif isinstance(dip_coupling, Real) and not isinstance(dip_coupling, bool):
         r = float(dip_coupling)
@@ -199,8 +221,8 @@ def hand_dimensions(
         raise AnthropometryError(f"hand_breadth must be positive (m), got {HB}", "hand_breadth", HB)
     if forearm_length is not None and HL >= forearm_length:
         raise AnthropometryError(
-            f"hand_length {HL:.4g} m is not shorter than the forearm ({forearm_length:.4g} m): outside human "
-            "proportions (a hand is about 0.7 forearm lengths)",
+            f"hand_length {HL:.4g} m is not shorter than the forearm ({forearm_length:.4g} m): "
+            "outside human proportions (a hand is about 0.7 forearm lengths)",
             "hand_length",
             HL,
         )
@@ -208,8 +230,8 @@ def hand_dimensions(
         HL_PER_STATURE[0] * stature <= HL <= HL_PER_STATURE[1] * stature
     ):
         raise AnthropometryError(
-            f"hand_length {HL:.4g} m is {HL / stature:.3g} × the stature {stature} m; human hands lie within "
-            f"{HL_PER_STATURE[0]}…{HL_PER_STATURE[1]} × stature",
+            f"hand_length {HL:.4g} m is {HL / stature:.3g} × the stature {stature} m; human hands "
+            f"lie within {HL_PER_STATURE[0]}…{HL_PER_STATURE[1]} × stature",
             "hand_length",
             HL,
         )
@@ -408,7 +430,8 @@ def configuration(spec, angles: dict, *, tol: float = 1e-9) -> np.ndarray:
             if abs(vals[j.name] - expected) > tol:
                 err = CouplingError(
                     f"{spec.name}: {j.name} = {vals[j.name]:.6g} rad contradicts its coupling "
-                    f"{j.name} = {mult:.6g} × {src} + {off:.6g} = {expected:.6g} rad; give {src} only"
+                    f"{j.name} = {mult:.6g} × {src} + {off:.6g} = {expected:.6g} rad; give {src} "
+                    "only"
                 )
                 err.joint, err.expected, err.given = j.name, expected, vals[j.name]
                 raise err

@@ -54,7 +54,8 @@ from .spec import ChainSpec, JointSpec, PrintedForm, as_batch, finite_params, ro
 deg = np.pi / 180.0
 
 DE_LEVA_1996 = {
-    # name: (length mm, mass fraction, com fraction from proximal, (r_sag, r_trans, r_long) fractions)
+    # name: (length mm, mass fraction, com fraction from proximal, (r_sag, r_trans, r_long)
+    # fractions)
     "male": {
         "stature": 1741.0,
         "upperarm": (281.7, 0.0271, 0.5772, (0.285, 0.269, 0.158)),
@@ -169,7 +170,8 @@ HUMAN_ARM_LANDMARKS = {
     "MC5": ("hand", (-0.400, -0.120, -0.88), 1.0, "head of the 5th metacarpal (dorsal)"),
 }
 
-#: the link whose segment length scales the trunk (``base_link``) markers of :data:`HUMAN_ARM_LANDMARKS`
+#: the link whose segment length scales the trunk (``base_link``) markers of
+#: :data:`HUMAN_ARM_LANDMARKS`
 HUMAN_ARM_TRUNK_SCALE_LINK = "upper_arm"
 
 
@@ -334,14 +336,16 @@ def human_arm7(
     return ChainSpec(
         name="human_arm7",
         description=(
-            "7-DOF human-like right arm (book §6-3, Fig. 6-5/6-6): shoulder x-y-z, elbow x, wrist z-y-x, "
-            "hanging along -z; y forward, x to the right; tool = hand point H."
+            "7-DOF human-like right arm (book §6-3, Fig. 6-5/6-6): shoulder x-y-z, elbow x, wrist "
+            "z-y-x, hanging along -z; y forward, x to the right; tool = hand point H."
         ),
         joints=joints,
         tool_name="hand_point",
         tool_origin=homogeneous(r=[0, 0, -l3]),
         source="book 000 l.3927-3989 (§6-3, Eq. (6-30)-(6-39)); limits Table 2.2 l.527-534",
-        inertia_source=f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg"
+        inertia_source=(
+            f"de Leva (1996) Table 4, {sex}, scaled to height {height} m and mass {mass} kg"
+        )
         + (
             ""
             if segment_lengths is None

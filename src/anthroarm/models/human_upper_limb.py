@@ -50,7 +50,8 @@ def human_upper_limb(
     hand_breadth: float | None = None,
     dip_coupling: str = "none",
 ) -> ChainSpec:
-    """The Fig. 2-2 upper limb (27 joints; right arm and hand) of a person of ``height`` m and ``mass`` kg.
+    """The Fig. 2-2 upper limb (27 joints; right arm and hand) of a person of ``height`` m and
+    ``mass`` kg.
 
     Parameters
     ----------
@@ -115,9 +116,10 @@ def human_upper_limb(
     return ChainSpec(
         name="human_upper_limb",
         description=(
-            "Human upper limb of book Fig. 2-2 (F = 27): the 7-DOF §6-3 right arm (shoulder x-y-z, elbow x, "
-            "wrist z-y-x, hanging along -z; y forward, x to the right) and a five-digit hand with 4 joints per "
-            "digit (20 finger DOF); tool = hand point H; fingertip frames thumb_tip ... little_tip."
+            "Human upper limb of book Fig. 2-2 (F = 27): the 7-DOF §6-3 right arm (shoulder "
+            "x-y-z, elbow x, wrist z-y-x, hanging along -z; y forward, x to the right) and a "
+            "five-digit hand with 4 joints per digit (20 finger DOF); tool = hand point H; "
+            "fingertip frames thumb_tip ... little_tip."
         ),
         joints=arm_joints + joints,
         tool_name="hand_point",
@@ -125,12 +127,14 @@ def human_upper_limb(
         tool_parent="hand",
         frames=tuple(frames),
         source=(
-            "book 000 l.540-552 (Fig. 2-2, F = 27, fingers 20), l.3927-3989 (§6-3 arm); limits Table 2.2 "
-            "l.527-534 (arm), AAOS 1994 (fingers); finger lengths Buchholz, Armstrong & Goldstein 1992"
+            "book 000 l.540-552 (Fig. 2-2, F = 27, fingers 20), l.3927-3989 (§6-3 arm); limits "
+            "Table 2.2 l.527-534 (arm), AAOS 1994 (fingers); finger lengths Buchholz, Armstrong & "
+            "Goldstein 1992"
         ),
         inertia_source=(
-            f"arm: de Leva (1996) Table 4, {sex}, height {height} m, mass {mass} kg; phalanges: solid "
-            "cylinders of 1160 kg/m3 (Dempster 1955); palm: de Leva hand mass minus the phalanges, as a box"
+            f"arm: de Leva (1996) Table 4, {sex}, height {height} m, mass {mass} kg; phalanges: "
+            "solid cylinders of 1160 kg/m3 (Dempster 1955); palm: de Leva hand mass minus the "
+            "phalanges, as a box"
         ),
         params=params,
         person=True,

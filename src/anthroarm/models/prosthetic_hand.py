@@ -1,435 +1,63 @@
-"""A prosthetic hand built from the book's linkages (§2-3, Fig. 2-8 / 2-9; analysed in §6-5).
+"""A prosthetic hand built from the book's linkages (§2-3, Fig. 2-8 / 2-9; analysed in §6-5),
+as a catalog model: ``aa.load("prosthetic_hand")``.
 
-Index, middle, ring and little finger are the planar six-bar of Fig. 2-8
-(:mod:`anthroarm.mechanisms.finger`: one driven proximal phalanx, fingertip on the Chapter 3
-grasp curve f(x)); the thumb is the RRSS spatial four-bar plus the planar four-bar of Fig. 2-9
-(:mod:`anthroarm.mechanisms.thumb`, the Chapter 4 geometry).  Five mechanisms, five motors,
-five closed loop pairs: the hand has 5 DOF.
+Index, middle, ring and little finger are the planar six-bar of Fig. 2-8, the thumb the RRSS
+spatial four-bar plus the planar four-bar of Fig. 2-9: five mechanisms, five motors, 5 DOF.
+The exact model of the hand — the five mechanisms on one palm with their loop closures, the
+solver that closes them, the fingertip paths — is
+:mod:`anthroarm.mechanisms.linkage_hand` (:func:`~anthroarm.mechanisms.linkage_hand.closed_loop`,
+:func:`~anthroarm.mechanisms.linkage_hand.solve`).
 
-Two models of the same hand:
-
-* :func:`closed_loop` — the exact one: the spanning tree of all five mechanisms on one palm
-  with their closures, a :class:`~anthroarm.mechanisms.closed_loop.ClosedLoop` (Pinocchio model
-  + ``pin.RigidConstraintModel`` s); :func:`solve` closes every loop for given driver angles
-  and returns the fingertips.  Its fingertip paths equal the mechanism solvers' (tested to
-  1e-9 m).
-* :func:`prosthetic_hand` / :func:`robot` / :func:`urdf_text` — a plain URDF
-  (``urdf/prosthetic_hand.urdf``; not a catalog entry yet, see :func:`robot`): the same
-  spanning tree (links, bars and all) with every passive joint a ``<mimic>`` of its finger's
-  driver, θ_j ≈ a_j θ_driver + b_j, fitted by least squares on the exact closed-loop solution
-  over the driver range (:func:`mimic_fit` reports each fit's largest joint error and the
-  largest fingertip error).  Use it where only a plain URDF is possible (a viewer, a
-  simulator without loop constraints); use :func:`closed_loop` for exact kinematics.
-
-Dimensions: the index finger is :meth:`FingerGeometry.default` (fitted to f(x) — no finger
-dimensions are printed in the book); middle, ring and little are the same six-bar scaled by
-their length relative to the index in Buchholz et al. (1992) (phalanges 2–4: 0.544, 0.516,
-0.414 vs 0.485 hand lengths); the thumb is :meth:`ThumbGeometry.book` (§4-5).  They are
-mounted on a palm laid out like :mod:`anthroarm.models.hand` at its default size (middle MCP
-pivot on the palm axis, HB/4 apart; thumb base radial, palmar and proximal).  ``scale``
-scales the whole hand.
+This module is the hand's plain URDF (``urdf/prosthetic_hand.urdf``): the spanning tree of the
+exact model (links, bars and all) with every passive joint a ``<mimic>`` of its finger's
+driver, θ_j ≈ a_j θ_driver + b_j, fitted by least squares on the exact closed-loop solution over
+the driver range (:func:`anthroarm.mechanisms.linkage_hand.mimic_fit` reports each fit's largest
+joint error and the largest fingertip error).  The tree and the fit are read from the table the
+mechanism analysis writes (``anthroarm/data/models/linkage_hand.json``,
+:func:`~anthroarm.mechanisms.linkage_hand.tree_table`; a test proves the committed table equals
+the analysis), so that the catalog does not run the mechanisms: at scale s every length is s
+times the table's, the angles and the mimic lines are the table's.  Use it where only a plain
+URDF is possible (a viewer, a simulator without loop constraints); use the closed loop for exact
+kinematics.
 
 Palm frame (the URDF's ``palm``, the base): −z toward the fingers, +y out of the palm, +x to
-the thumb side (a right hand), origin at the wrist.  Each finger's six-bar lies in a plane
-x = const of the palm; its planar frame (the frame of f(x)) is mounted so that the straight
-line MCP pivot → fingertip at the start pose points along −z and flexion moves the fingertip
-palmar (+y).  Driver variables (rad) are the tree's: ``{finger}_mcp`` = φ1 − φ_start (the six-bar's
-design range φ_start → φ_end is *decreasing*, −12.8°: the range is [−0.2236, 0]),
-``thumb_r1`` = θ1 ∈ [0, 30°] (the Chapter 3 range of f2).  Frames ``{digit}_tip`` are the
-fingertips (P8 of the six-bar, S of the thumb).  Units: m, rad, kg.
+the thumb side (a right hand), origin at the wrist.  Driver variables (rad): ``{finger}_mcp``
+∈ [−0.2236, 0] and ``thumb_r1`` ∈ [0, 30°]; frames ``{digit}_tip`` are the fingertips.
+Units: m, rad, kg.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import json
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from .._io import atomic_write_text
-from ..errors import ParameterError
-from ..mechanisms.closed_loop import ClosedLoop, LoopSpec, TreeJoint
-from ..mechanisms.finger import FingerGeometry, finger, finger_spec
-from ..mechanisms.rrss import RRSSGeometry
-from ..mechanisms.thumb import ThumbGeometry, thumb, thumb_spec
-from ..robot import build_model, make_robot
 from ..spatial.rotations import homogeneous, rot_axis
-from ..urdf_io import parse_urdf_bytes
-from .hand import (
-    BREADTH_RATIO,
-    BUCHHOLZ_1992,
-    DIGITS,
-    FINGERS,
-    Q_ORDER,
-    THUMB_REST_DIRECTION,
-    digit_bases,
-    hand_dimensions,
-)
-from .human import segment_parameters
+from .hand import DIGITS, LINKAGE_HAND_TABLE, check_hand_scale
 from .spec import REPO_URDF_DIR, ChainSpec, JointSpec, LinkSpec, Shape, capsule, to_urdf
 
-DEG = np.pi / 180.0
-#: driver range of the thumb (rad): θ1 ∈ [0, 30°], where the Chapter 3 coupling f2 is defined
-THUMB_RANGE = (0.0, 30.0 * DEG)
 #: finger breadth of the prosthesis (m) at scale 1: the visual capsule radius and the mass model
 PHALANX_RADIUS = 0.008
-#: density of the phalanges and bars (kg/m³): a polyamide print (our assumption; the book gives none)
+#: density of the phalanges and bars (kg/m³): a polyamide print (our assumption; the book gives
+#: none)
 DENSITY = 1150.0
 
 
-def _finger_length(d: str) -> float:
-    return float(sum(BUCHHOLZ_1992[d][1:]))
+@lru_cache(maxsize=1)
+def tree_table() -> dict:
+    """The linkage hand's spanning tree and mimic fit at scale 1, as the mechanism analysis
+    wrote it (:func:`anthroarm.mechanisms.linkage_hand.tree_table`)."""
+    return json.loads(LINKAGE_HAND_TABLE.read_text(encoding="utf-8"))
 
 
-def scaled_finger(geom: FingerGeometry, s: float) -> FingerGeometry:
-    """The six-bar ``geom`` with every length multiplied by ``s`` (angles, branches and driver
-    range unchanged: the fingertip path is the scaled path)."""
-    return FingerGeometry(
-        P1=geom.P1 * s,
-        P4=geom.P4 * s,
-        R=tuple(r * s for r in geom.R),
-        alpha=geom.alpha,
-        branches=geom.branches,
-        phi_range=geom.phi_range,
-    )
-
-
-def scaled_thumb(geom: ThumbGeometry, s: float) -> ThumbGeometry:
-    """The thumb ``geom`` with every length multiplied by ``s``."""
-    g = geom.rrss
-    r = RRSSGeometry(a0=g.a0 * s, u0=g.u0, a1=g.a1 * s, u1=g.u1, b0=g.b0 * s, b1=g.b1 * s)
-    return ThumbGeometry(
-        rrss=r,
-        ex=geom.ex,
-        P0=geom.P0 * s,
-        F0=geom.F0 * s,
-        C=geom.C * s,
-        R3=geom.R3 * s,
-        beta=geom.beta,
-    )
-
-
-def _frame_from(e, m):
-    """Orthonormal columns (e, m⊥, e × m⊥)."""
-    e = np.asarray(e, float) / np.linalg.norm(e)
-    m = np.asarray(m, float) - e * (e @ m)
-    m /= np.linalg.norm(m)
-    return np.column_stack([e, m, np.cross(e, m)])
-
-
-@dataclass(frozen=True)
-class ProstheticHand:
-    """The hand's mechanisms and where they sit on the palm.
-
-    ``fingers``: digit -> :class:`FingerGeometry` (planar frame = the frame of f(x), m);
-    ``thumb``: :class:`ThumbGeometry` (its world frame, m); ``mounts``: digit -> 4×4 pose of
-    the mechanism's frame in the palm frame; ``palm_size``: (breadth, length) of the palm (m)."""
-
-    fingers: dict
-    thumb: ThumbGeometry
-    mounts: dict
-    palm_size: tuple
-    scale: float = 1.0
-    thumb_range: tuple = THUMB_RANGE
-
-    def driver_range(self, digit: str) -> tuple[float, float]:
-        """(lower, upper) of the digit's driver variable (rad, tree convention, see module doc)."""
-        if digit == "thumb":
-            return tuple(self.thumb_range)
-        g = self.fingers[digit]
-        d = g.phi_range[1] - g.phi_range[0]
-        return (min(0.0, d), max(0.0, d))
-
-    def tip_exact(self, digit: str, driver) -> tuple[np.ndarray, np.ndarray]:
-        """Fingertip(s) in the palm frame (m) from the mechanism solver at driver value(s)
-        (tree convention), and the solver's status(es)."""
-        T = self.mounts[digit]
-        drv = np.asarray(driver, float)
-        if digit == "thumb":
-            s = thumb(self.thumb, drv)
-            p = np.asarray(s.S)
-        else:
-            g = self.fingers[digit]
-            s = finger(g, g.phi_range[0] + drv)
-            p = np.concatenate([np.asarray(s.tip), np.zeros(np.shape(s.tip)[:-1] + (1,))], -1)
-        return p @ T[:3, :3].T + T[:3, 3], np.asarray(s.status)
-
-
-def default_hand(scale: float = 1.0) -> ProstheticHand:
-    """The hand described in the module docstring, every length times ``scale``."""
-    if (
-        isinstance(scale, bool)
-        or not isinstance(scale, (int, float, np.floating, np.integer))
-        or not np.isfinite(scale)
-        or not (0.3 <= scale <= 3.0)
-    ):
-        raise ParameterError(f"prosthetic_hand: scale must be a number in 0.3…3, got {scale!r}")
-    s = float(scale)
-    # the palm of the default adult hand of models.hand (HL = de Leva hand / 0.446, HB = 0.45 HL)
-    HL = segment_parameters()["hand"]["length"] / BUCHHOLZ_1992["middle"][0]
-    dims = hand_dimensions(HL, BREADTH_RATIO * HL)
-    l_palm = BUCHHOLZ_1992["middle"][0] * HL
-    bases = digit_bases(dims, l_palm)
-    g0 = FingerGeometry.default()
-    fingers, mounts = {}, {}
-    target = np.column_stack([[0, 0, -1.0], [0, 1.0, 0], [1.0, 0, 0]])  # (-z, +y, +x) of the palm
-    for d in FINGERS:
-        g = scaled_finger(g0, s * _finger_length(d) / _finger_length("index"))
-        fingers[d] = g
-        a, b = finger(g, g.phi_range[0]), finger(g, g.phi_range[1])
-        e = np.r_[np.asarray(a.tip) - g.P1, 0.0]
-        m = np.r_[np.asarray(b.tip) - np.asarray(a.tip), 0.0]
-        R = target @ _frame_from(e, m).T
-        mcp = bases[d][:3, 3] * s
-        mounts[d] = homogeneous(R, mcp - R @ np.r_[g.P1, 0.0])
-    th = scaled_thumb(ThumbGeometry.book(), s)
-    a, b = thumb(th, 0.0), thumb(th, THUMB_RANGE[1])
-    e = np.asarray(a.S) - th.rrss.a0
-    m = np.asarray(b.S) - np.asarray(a.S)
-    d_t = THUMB_REST_DIRECTION
-    R = _frame_from(d_t, [-1.0, 1.0, 0.0]) @ _frame_from(e, m).T
-    mounts["thumb"] = homogeneous(R, bases["thumb"][:3, 3] * s - R @ th.rrss.a0)
-    return ProstheticHand(
-        fingers=fingers,
-        thumb=th,
-        mounts=mounts,
-        palm_size=(dims["hand_breadth"] * s, l_palm * s),
-        scale=s,
-    )
-
-
-def _prefixed(spec: LoopSpec, digit: str, mount: np.ndarray, tip_site: str) -> tuple:
-    """Joints, closures, inputs and sites of one mechanism renamed ``{digit}_...`` on the palm
-    (a passive joint hanging on the palm: ``{digit}_{driver}_...``)."""
-
-    def link(n):
-        return "palm" if n == spec.root else f"{digit}_{n}"
-
-    def site(n):
-        return f"{digit}_tip" if n == tip_site else f"{digit}_{n}"
-
-    def joint(j):
-        # Pinocchio reads a link's child joints in name order and a <mimic> joint must come after
-        # the joint it copies: a passive joint on the palm is named after its mechanism's driver
-        if j.parent == spec.root and j.name not in spec.inputs:
-            return f"{digit}_{spec.inputs[0]}_{j.name}"
-        return f"{digit}_{j.name}"
-
-    joints = tuple(
-        TreeJoint(
-            joint(j),
-            link(j.parent),
-            link(j.child),
-            j.type,
-            mount @ j.origin if j.parent == spec.root else j.origin,
-            j.axis,
-        )
-        for j in spec.joints
-    )
-    # a planar loop's closure compares world x, y; mounted on the palm its plane is another one:
-    # compare all three components (the out-of-plane row is redundant: least-norm Newton)
-    closures = tuple(
-        replace(c, frame_a=site(c.frame_a), frame_b=site(c.frame_b), components=(0, 1, 2))
-        for c in spec.closures
-    )
-    sites = tuple((site(n), link(p), T) for n, p, T in spec.sites)
-    return joints, closures, tuple(f"{digit}_{n}" for n in spec.inputs), sites
-
-
-def loop_spec(hand: ProstheticHand | None = None) -> LoopSpec:
-    """Spanning tree + closures of the whole hand: the five mechanisms' own trees
-    (:func:`~anthroarm.mechanisms.finger.finger_spec`, :func:`~anthroarm.mechanisms.thumb.thumb_spec`)
-    renamed ``{digit}_…`` and mounted on the ``palm``; inputs ``index_mcp``, ``little_mcp``,
-    ``middle_mcp``, ``ring_mcp``, ``thumb_r1`` (the order of the plain URDF's q,
-    :data:`anthroarm.models.hand.Q_ORDER`); fingertip sites ``{digit}_tip``.  q = 0 is every
-    mechanism's start pose."""
-    hand = hand or default_hand()
-    parts = [
-        _prefixed(thumb_spec(hand.thumb), "thumb", hand.mounts["thumb"], "S")
-        if d == "thumb"
-        else _prefixed(finger_spec(hand.fingers[d]), d, hand.mounts[d], "P8")
-        for d in Q_ORDER
-    ]
-    return LoopSpec(
-        name="prosthetic_hand",
-        joints=sum((p[0] for p in parts), ()),
-        closures=sum((p[1] for p in parts), ()),
-        inputs=sum((p[2] for p in parts), ()),
-        sites=sum((p[3] for p in parts), ()),
-        root="palm",
-        length_scale=float(
-            sum(hand.fingers[d].length_scale for d in FINGERS) + hand.thumb.length_scale
-        ),
-    )
-
-
-def closed_loop(hand: ProstheticHand | None = None) -> ClosedLoop:
-    """The exact closed-loop model of the hand (Pinocchio + ``RigidConstraintModel`` s), see
-    :func:`loop_spec`."""
-    return ClosedLoop(loop_spec(hand))
-
-
-@dataclass(frozen=True)
-class HandState:
-    """The hand at given drivers: tree configuration ``q`` of the closed-loop model, fingertips
-    ``tips`` (digit -> (3,) in the palm frame, m), the largest closure residual (m), and a
-    ``status`` "ok" or "out_of_range" / "not_converged" with a ``reason``."""
-
-    q: np.ndarray
-    tips: dict
-    residual: float
-    status: str
-    reason: str
-
-    @property
-    def ok(self) -> bool:
-        return self.status == "ok"
-
-
-def _drivers(loop: ClosedLoop, drivers) -> np.ndarray:
-    names = loop.spec.inputs
-    if isinstance(drivers, dict):
-        unknown = sorted(set(drivers) - set(names))
-        if unknown:
-            raise ParameterError(
-                f"prosthetic_hand: unknown driver(s) {unknown}; drivers: {', '.join(names)}"
-            )
-        vals = [drivers.get(n, 0.0) for n in names]
-    else:
-        vals = drivers
-    try:
-        x = np.atleast_1d(np.array(vals, dtype=float))
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"prosthetic_hand: drivers must be numbers (rad), got {drivers!r}"
-        ) from None
-    if x.shape != (len(names),):
-        raise ParameterError(
-            f"prosthetic_hand: {len(names)} drivers ({', '.join(names)}), got shape {x.shape}"
-        )
-    if not np.all(np.isfinite(x)):
-        raise ParameterError(f"prosthetic_hand: drivers must be finite (rad), got {x.tolist()}")
-    return x
-
-
-def solve(
-    loop: ClosedLoop, drivers, hand: ProstheticHand | None = None, steps: int = 12
-) -> HandState:
-    """Close every loop of the hand at the driver values (dict name -> rad, or the 5 values in
-    ``loop.spec.inputs`` order), by continuation from the start pose q = 0 (the assembly
-    branch of the mechanism solvers), and read the fingertips by Pinocchio FK.
-
-    Drivers outside the hand's driver ranges give ``status="out_of_range"`` (nothing solved, tips
-    NaN-free: empty dict); a continuation that cannot close a loop gives ``"not_converged"``."""
-    hand = hand or default_hand()
-    x = _drivers(loop, drivers)
-    digits = [n.split("_")[0] for n in loop.spec.inputs]
-    for d, v, n in zip(digits, x, loop.spec.inputs):
-        lo, hi = hand.driver_range(d)
-        if not (lo - 1e-12 <= v <= hi + 1e-12):
-            return HandState(
-                np.zeros(loop.model.nq),
-                {},
-                float("nan"),
-                "out_of_range",
-                f"{n} = {v:.6g} rad is outside its range [{lo:.6g}, {hi:.6g}] rad",
-            )
-    path = np.linspace(0.0, 1.0, max(2, int(steps)))[:, None] * x[None, :]
-    Q, ok = loop.track(path, q0=np.zeros(loop.model.nq))
-    q = Q[-1]
-    res = float(np.max(np.abs(loop.residual(q))))
-    if not ok[-1]:
-        return HandState(
-            q, {}, res, "not_converged", f"the closure did not converge (|residual| {res:.3e} m)"
-        )
-    tips = {d: loop.frame_position(q, f"{d}_tip") for d in DIGITS}
-    return HandState(q, tips, res, "ok", "ok")
-
-
-def closure_status(loop: ClosedLoop, q, tol: float = 1e-9) -> tuple[float, str]:
-    """Whether a tree configuration ``q`` of :func:`closed_loop` closes every loop: the largest
-    closure gap (m, Pinocchio ``RigidConstraintModel``) and ``"ok"`` or ``"inconsistent"`` (the
-    passive joints contradict the drivers: the loops are open by more than ``tol`` m).
-    A q of the wrong size or not finite raises :class:`~anthroarm.errors.ParameterError`."""
-    try:
-        q = np.asarray(q, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"prosthetic_hand: q must be {loop.model.nq} joint values (rad), got {q!r}"
-        ) from None
-    if q.shape != (loop.model.nq,) or not np.all(np.isfinite(q)):
-        raise ParameterError(
-            f"prosthetic_hand: q must be {loop.model.nq} finite joint values (rad), got shape {q.shape}"
-        )
-    gap = loop.residual_pin(q)
-    return gap, ("ok" if gap <= tol else "inconsistent")
-
-
-@dataclass(frozen=True)
-class MimicFit:
-    """The mimic approximation of every passive tree joint: ``joints`` name -> (driver,
-    multiplier, offset, largest joint error (rad) over the driver range); ``tip_error`` digit ->
-    largest fingertip distance (m) between the mimic tree and the exact closed loop;
-    ``samples`` per driver."""
-
-    joints: dict
-    tip_error: dict
-    samples: int
-
-
-@lru_cache(maxsize=8)
-def _fit(scale: float, samples: int) -> MimicFit:
-    hand = default_hand(scale)
-    loop = closed_loop(hand)
-    spec = loop.spec
-    names = [n for n in loop.model.names[1:]]
-    inputs = list(spec.inputs)
-    nin = len(inputs)
-    joints, tip_err = {}, {}
-    for k, n_in in enumerate(inputs):
-        d = n_in.split("_")[0]
-        lo, hi = hand.driver_range(d)
-        t = np.linspace(0.0, 1.0, samples)
-        u = (
-            lo + (hi - lo) * t if d == "thumb" else hi + (lo - hi) * t
-        )  # start at the start pose (0)
-        path = np.zeros((samples, nin))
-        path[:, k] = u
-        Q, ok = loop.track(path, q0=np.zeros(loop.model.nq))
-        if not np.all(ok):
-            raise RuntimeError(
-                f"prosthetic_hand: the {d} loop did not close over its range"
-            )  # pragma: no cover
-        own = [i for i, n in enumerate(names) if n.startswith(d + "_") and n != n_in]
-        A = np.column_stack([u, np.ones_like(u)])
-        Qfit = np.zeros_like(Q)
-        Qfit[:, loop.joint_q_index(n_in)] = u
-        for i in own:
-            qi = Q[:, loop.joint_q_index(names[i])]
-            (a, b), *_ = np.linalg.lstsq(A, qi, rcond=None)
-            a, b = round(float(a), 10), round(float(b), 10)
-            Qfit[:, loop.joint_q_index(names[i])] = a * u + b
-            joints[names[i]] = (n_in, a, b, float(np.max(np.abs(a * u + b - qi))))
-        exact = np.array([loop.frame_position(q, f"{d}_tip") for q in Q])
-        approx = np.array([loop.frame_position(q, f"{d}_tip") for q in Qfit])
-        tip_err[d] = float(np.max(np.linalg.norm(approx - exact, axis=1)))
-    return MimicFit(joints=joints, tip_error=tip_err, samples=samples)
-
-
-def mimic_fit(scale: float = 1.0, samples: int = 41) -> MimicFit:
-    """Least-squares line θ_j ≈ a θ_driver + b of every passive joint of the hand's tree over
-    its driver's range (``samples`` exact closed-loop solutions), with the largest joint and
-    fingertip errors of the approximation.  Multipliers and offsets are rounded to 1e-10 so
-    the URDF text is reproducible."""
-    default_hand(scale)  # validates scale
-    if (
-        isinstance(samples, bool)
-        or not isinstance(samples, (int, np.integer))
-        or not 3 <= samples <= 10_000
-    ):
-        raise ParameterError(f"samples must be an integer in 3…10000, got {samples!r}")
-    return _fit(float(scale), int(samples))
+def _scaled(T, s: float) -> np.ndarray:
+    """A 4×4 placement (16 numbers, row by row) with its translation times ``s``."""
+    T = np.array(T, float).reshape(4, 4)
+    T[:3, 3] *= s
+    return T
 
 
 def _cyl_link(name, seg, radius, rgba, material):
@@ -448,36 +76,43 @@ def _cyl_link(name, seg, radius, rgba, material):
 
 def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
     """The linkage hand as a plain-URDF parameter table: the spanning tree of
-    :func:`loop_spec` with the passive joints as ``<mimic>`` lines of their drivers
-    (:func:`mimic_fit`); base ``palm``, tool ``index_tip``, frames ``{digit}_tip``.
+    :func:`anthroarm.mechanisms.linkage_hand.loop_spec` with the passive joints as ``<mimic>``
+    lines of their drivers (:func:`anthroarm.mechanisms.linkage_hand.mimic_fit`), read from
+    :func:`tree_table` and scaled by ``scale`` (0.3…3); base ``palm``, tool ``index_tip``,
+    frames ``{digit}_tip``.
 
     Masses (our assumption, the book prints none): each link a solid polyamide cylinder
     (1150 kg/m³) of radius 8 mm × ``scale`` along its longest site or child offset; the palm a
     box of the same material, half hollow.  nq = 5 (one driver per digit)."""
-    hand = default_hand(scale)
-    fit = mimic_fit(scale)
-    spec = loop_spec(hand)
-    r = PHALANX_RADIUS * hand.scale
+    s = check_hand_scale(scale, "prosthetic_hand")
+    table = tree_table()
+    fit_joints = table["fit"]["joints"]
+    tip_error = {d: s * e for d, e in table["fit"]["tip_error"].items()}
+    ranges = {d: tuple(v) for d, v in table["driver_ranges"].items()}
+    tree = [(n, p, c, t, _scaled(T, s), tuple(a)) for n, p, c, t, T, a in table["joints"]]
+    sites = [(n, p, _scaled(T, s)) for n, p, T in table["sites"]]
+    r = PHALANX_RADIUS * s
     # every link's drawn segment: to its farthest child joint or site
     offsets: dict = {}
-    for j in spec.joints:
-        offsets.setdefault(j.parent, []).append(np.asarray(j.origin)[:3, 3])
-    for n, p, T in spec.sites:
-        offsets.setdefault(p, []).append(np.asarray(T)[:3, 3])
+    for _, parent, _, _, origin, _ in tree:
+        offsets.setdefault(parent, []).append(origin[:3, 3])
+    for n, p, T in sites:
+        offsets.setdefault(p, []).append(T[:3, 3])
     skin, metal = (0.93, 0.78, 0.68, 1.0), (0.6, 0.62, 0.66, 1.0)
     joints = []
     expanded = []
-    for j in spec.joints:  # a ball joint is three revolute joints about x, y, z (as LoopSpec.urdf)
-        if j.type == "ball":
-            bx, by = f"{j.name}__bx", f"{j.name}__by"
+    for name, parent, child, kind, origin, axis in tree:
+        # a ball joint is three revolute joints about x, y, z (as LoopSpec.urdf)
+        if kind == "ball":
+            bx, by = f"{name}__bx", f"{name}__by"
             expanded += [
-                (f"{j.name}_x", j.parent, bx, np.asarray(j.origin), (1.0, 0, 0)),
-                (f"{j.name}_y", bx, by, np.eye(4), (0, 1.0, 0)),
-                (f"{j.name}_z", by, j.child, np.eye(4), (0, 0, 1.0)),
+                (f"{name}_x", parent, bx, origin, (1.0, 0, 0)),
+                (f"{name}_y", bx, by, np.eye(4), (0, 1.0, 0)),
+                (f"{name}_z", by, child, np.eye(4), (0, 0, 1.0)),
             ]
         else:
-            expanded.append((j.name, j.parent, j.child, np.asarray(j.origin), tuple(j.axis)))
-    inputs = set(spec.inputs)
+            expanded.append((name, parent, child, origin, axis))
+    inputs = set(table["inputs"])
     for name, parent, child, origin, axis in expanded:
         segs = offsets.get(child, [])
         seg = max(segs, key=np.linalg.norm) if segs else np.zeros(3)
@@ -491,11 +126,11 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         )
         digit = name.split("_")[0]
         if name in inputs:
-            lo, hi = hand.driver_range(digit)
+            lo, hi = ranges[digit]
             mimic = None
         else:
-            src, a, b, _ = fit.joints[name]
-            lo_d, hi_d = hand.driver_range(digit)
+            src, a, b, _ = fit_joints[name]
+            lo_d, hi_d = ranges[digit]
             v = sorted((a * lo_d + b, a * hi_d + b))
             lo, hi = v[0] - 1e-6, v[1] + 1e-6
             mimic = (src, a, b)
@@ -528,7 +163,7 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
                 mimic=mimic,
             )
         )
-    B, L = hand.palm_size
+    B, L = (s * x for x in table["palm_size"])
     mp = DENSITY * 0.5 * B * 0.3 * B * L
     box = Shape(
         "box", (B, 0.3 * B, L), homogeneous(r=[-B / 8, 0.0, -L / 2]), material="skin", rgba=skin
@@ -538,18 +173,18 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         name="palm", mass=mp, com=np.array([-B / 8, 0.0, -L / 2]), inertia=palm_I, shapes=(box,)
     )
     palm_mount = JointSpec("palm_mount", "fixed", homogeneous(), link=palm, parent="world")
-    tips = {n: (p, T) for n, p, T in spec.sites if n.endswith("_tip")}
+    tips = {n: (p, T) for n, p, T in sites if n.endswith("_tip")}
     frames = tuple((f"{d}_tip", *tips[f"{d}_tip"]) for d in DIGITS if d != "index")
     # the closure points of both sides: their distance shows the mimic approximation's gap
-    frames += tuple((n, p, T) for n, p, T in spec.sites if not n.endswith("_tip"))
-    err = ", ".join(f"{d} {1000 * fit.tip_error[d]:.2f} mm" for d in DIGITS)
+    frames += tuple((n, p, T) for n, p, T in sites if not n.endswith("_tip"))
+    err = ", ".join(f"{d} {1000 * tip_error[d]:.2f} mm" for d in DIGITS)
     return ChainSpec(
         name="prosthetic_hand",
         description=(
-            "Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + four-bar "
-            "thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 drivers "
-            f"(largest fingertip error of the approximation: {err}); exact model: "
-            "anthroarm.models.prosthetic_hand.closed_loop()"
+            "Prosthetic hand of the book's linkages (Fig. 2-8 six-bar fingers, Fig. 2-9 RRSS + "
+            "four-bar thumb; §6-5): spanning tree with the passive joints as mimic lines of the 5 "
+            f"drivers (largest fingertip error of the approximation: {err}); exact model: "
+            "anthroarm.mechanisms.linkage_hand.closed_loop()"
         ),
         joints=[palm_mount] + joints,
         tool_name="index_tip",
@@ -558,47 +193,27 @@ def prosthetic_hand(scale: float = 1.0) -> ChainSpec:
         base_link="world",
         frames=frames,
         source=(
-            "book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry (l.2037-2133); "
-            "finger dimensions fitted to the Chapter 3 curve f(x) (mechanisms.finger), scaled by Buchholz 1992"
+            "book §2-3 Fig. 2-8/2-9 (l.557-639), §6-5 (Fig. 6-14, 6-17), §4-5 thumb geometry "
+            "(l.2037-2133); finger dimensions fitted to the Chapter 3 curve f(x) "
+            "(mechanisms.finger), scaled by Buchholz 1992"
         ),
         inertia_source=(
             f"not in the book: polyamide ({DENSITY:g} kg/m3) cylinders of radius {r:g} m; "
             "palm a half-filled box"
         ),
-        params={"scale": hand.scale},
+        params={"scale": s},
     )
 
 
 def urdf_text(scale: float = 1.0) -> str:
-    """The plain URDF of :func:`prosthetic_hand` (mimic approximations; ``urdf/prosthetic_hand.urdf``
-    is the default, committed and tested equal to this text)."""
+    """The plain URDF of :func:`prosthetic_hand` (mimic approximations;
+    ``urdf/prosthetic_hand.urdf`` is the default, committed and tested equal to this text)."""
     return to_urdf(prosthetic_hand(scale))
 
 
 def write_urdf(path=None, scale: float = 1.0) -> Path:
-    """Write :func:`urdf_text` to ``path`` (default: ``urdf/prosthetic_hand.urdf`` of a source checkout)."""
+    """Write :func:`urdf_text` to ``path`` (default: ``urdf/prosthetic_hand.urdf`` of a source
+    checkout)."""
     p = Path(path) if path is not None else REPO_URDF_DIR / "prosthetic_hand.urdf"
     atomic_write_text(p, urdf_text(scale))
     return p
-
-
-def robot(scale: float = 1.0, tool: str = "index_tip"):
-    """The plain-URDF hand as a :class:`~anthroarm.robot.Robot` (nq = 5, the drivers; passive
-    joints are mimic joints), with ``tool`` as its default frame.
-
-    Not a catalog entry yet.  Pinocchio's energy functions and ``aba`` refuse mimic joints and
-    its ``computeCoriolisMatrix`` does not match its reduced ``crba``/``rnea`` on them; the
-    dynamics checks compare this hand with the equivalent oracles instead (½ q̇ᵀ M q̇,
-    −m gᵀ c, ``nonLinearEffects`` − g, M⁻¹(τ − ``nonLinearEffects``):
-    :mod:`anthroarm.dynamics.checks` and ``tests/dynamics/test_lagrange.py``, which runs its
-    catalog comparison on this hand too)."""
-    spec = prosthetic_hand(scale)
-    info = parse_urdf_bytes(urdf_text(scale).encode(), Path("<generated>/prosthetic_hand.urdf"))
-    return make_robot(
-        build_model(info),
-        name="prosthetic_hand",
-        info=info,
-        spec=spec,
-        description=spec.description,
-        tool=tool,
-    )

@@ -165,6 +165,49 @@ class ReachPosture:
     bend: tuple[int, int]
 
 
+def encoder_pulses_per_rad(encoder_counts: float, gear_ratio: float) -> float:
+    """Motor pulses per joint radian: ``encoder_counts · gear_ratio / 2π`` (encoder counts per
+    motor turn, motor turns per joint turn).  :class:`~anthroarm.errors.ParameterError` unless
+    both are finite and > 0."""
+    try:
+        c, g = float(encoder_counts), float(gear_ratio)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"encoder_counts and gear_ratio must be numbers, got {encoder_counts!r}, {gear_ratio!r}"
+        ) from None
+    if not (np.isfinite(c) and np.isfinite(g) and c > 0 and g > 0):
+        raise ParameterError(f"encoder_counts and gear_ratio must be finite and > 0, got {c}, {g}")
+    return c * g / (2.0 * np.pi)
+
+
+@dataclass(frozen=True)
+class CellRecipe:
+    """The spatial cell table (§7-3) an arm's source describes, declared by its builder
+    (``ChainSpec.cells``) and built by :func:`anthroarm.ik.cells.cell_table`.
+
+    ``rotation``: the hand orientation of the table (3×3, base frame); ``bounds``: the box
+    ``(lo, hi)`` of lattice positions (m, base frame); ``D``: the cell size (m); ``branch``:
+    the IK branch label stored at every lattice point; ``point``: the point of the tool frame
+    whose positions the lattice holds (m, tool frame); ``encoder_counts`` (per motor turn) and
+    ``gear_ratio`` (motor turns per joint turn): the scale of the stored motor pulses."""
+
+    rotation: tuple
+    bounds: tuple
+    D: float
+    branch: str
+    point: tuple
+    encoder_counts: float
+    gear_ratio: float
+
+    def pulses_per_rad(self, encoder_counts=None, gear_ratio=None) -> float:
+        """:func:`encoder_pulses_per_rad` of this arm's encoder and gear, or of the values
+        given."""
+        return encoder_pulses_per_rad(
+            self.encoder_counts if encoder_counts is None else encoder_counts,
+            self.gear_ratio if gear_ratio is None else gear_ratio,
+        )
+
+
 @dataclass
 class ChainSpec:
     """A catalog arm: its joints (each carrying the link it moves), the tool frame placed by
@@ -176,8 +219,9 @@ class ChainSpec:
 
     What the book knows about this arm beyond its table, declared by its builder so that no
     algorithm has to recognise the arm by name: ``printed``, the book's printed closed forms
-    of its forward kinematics (:class:`PrintedForm`), and ``reach``, the three-link arm of the
-    reach formulas (:class:`ReachPosture`) or None."""
+    of its forward kinematics (:class:`PrintedForm`), ``reach``, the three-link arm of the
+    reach formulas (:class:`ReachPosture`) or None, and ``cells``, the spatial cell table of
+    its source (:class:`CellRecipe`) or None."""
 
     name: str
     description: str
@@ -200,10 +244,13 @@ class ChainSpec:
     printed: tuple = field(default=(), repr=False, compare=False)
     #: the arm of the reach formulas (2-3)/(2-4), or None
     reach: ReachPosture | None = None
+    #: the spatial cell table its source describes (:class:`CellRecipe`), or None
+    cells: CellRecipe | None = None
 
     @property
     def nq(self) -> int:
-        """How many configuration variables the chain has (its joints that are neither fixed nor mimic joints)."""
+        """How many configuration variables the chain has (its joints that are neither fixed nor
+        mimic joints)."""
         return sum(1 for j in self.joints if j.mimic is None and j.type != "fixed")
 
 
@@ -356,8 +403,9 @@ def from_dh(
         source=source,
         inertia_source=inertia_source
         or (
-            f"not printed in the book: each link is a uniform cylinder of {DEFAULT_LINEAR_DENSITY} kg/m, "
-            f"radius {DEFAULT_LINK_RADIUS} m, plus a {DEFAULT_JOINT_MASS} kg joint housing at its origin"
+            f"not printed in the book: each link is a uniform cylinder of {DEFAULT_LINEAR_DENSITY} "
+            f"kg/m, radius {DEFAULT_LINK_RADIUS} m, plus a {DEFAULT_JOINT_MASS} kg joint housing "
+            "at its origin"
         ),
         dh=rows,
         tool_dh=tool,
@@ -399,7 +447,8 @@ def _shape(s: Shape, indent: str) -> str:
     return (
         f"{indent}<visual>\n{_origin(np.asarray(s.origin, float), indent + '  ')}"
         f"{indent}  <geometry>{geom}</geometry>\n"
-        f'{indent}  <material name="{s.material}"><color rgba="{_vec(s.rgba)}"/></material>\n{indent}</visual>\n'
+        f'{indent}  <material name="{s.material}"><color '
+        f'rgba="{_vec(s.rgba)}"/></material>\n{indent}</visual>\n'
     )
 
 
@@ -411,7 +460,8 @@ def _visuals(link: LinkSpec, indent: str) -> str:
     out.append(
         f'{indent}<visual>\n{indent}  <origin xyz="0 0 0" rpy="0 0 0"/>\n'
         f'{indent}  <geometry><sphere radius="{_num(1.3 * link.radius)}"/></geometry>\n'
-        f'{indent}  <material name="joint"><color rgba="0.85 0.45 0.2 1"/></material>\n{indent}</visual>\n'
+        f'{indent}  <material name="joint"><color rgba="0.85 0.45 0.2 '
+        f'1"/></material>\n{indent}</visual>\n'
     )
     L = float(np.linalg.norm(link.segment))
     if L > 1e-9:
@@ -419,8 +469,10 @@ def _visuals(link: LinkSpec, indent: str) -> str:
         T = homogeneous(rotation_between([0.0, 0.0, 1.0], link.segment), link.segment / 2)
         out.append(
             f"{indent}<visual>\n{_origin(T, indent + '  ')}"
-            f'{indent}  <geometry><cylinder radius="{_num(link.radius)}" length="{_num(L)}"/></geometry>\n'
-            f'{indent}  <material name="link"><color rgba="0.75 0.78 0.82 1"/></material>\n{indent}</visual>\n'
+            f'{indent}  <geometry><cylinder radius="{_num(link.radius)}" '
+            f'length="{_num(L)}"/></geometry>\n'
+            f'{indent}  <material name="link"><color rgba="0.75 0.78 0.82 '
+            f'1"/></material>\n{indent}</visual>\n'
         )
     return "".join(out)
 
@@ -433,7 +485,8 @@ def _inertial(link: LinkSpec, indent: str) -> str:
         f'{indent}<inertial>\n{indent}  <origin xyz="{_vec(link.com)}" rpy="0 0 0"/>\n'
         f'{indent}  <mass value="{_num(link.mass)}"/>\n'
         f'{indent}  <inertia ixx="{_num(I[0, 0])}" ixy="{_num(I[0, 1])}" ixz="{_num(I[0, 2])}" '
-        f'iyy="{_num(I[1, 1])}" iyz="{_num(I[1, 2])}" izz="{_num(I[2, 2])}"/>\n{indent}</inertial>\n'
+        f'iyy="{_num(I[1, 1])}" iyz="{_num(I[1, 2])}" '
+        f'izz="{_num(I[2, 2])}"/>\n{indent}</inertial>\n'
     )
 
 
@@ -442,7 +495,8 @@ def to_urdf(spec: ChainSpec) -> str:
     lines = ['<?xml version="1.0"?>\n']
     lines.append("<!-- Generated by anthroarm.models from its parameter table; do not edit.\n")
     lines.append(
-        f"     {spec.description}\n     Source: {spec.source}\n     Inertia: {spec.inertia_source}\n"
+        f"     {spec.description}\n     Source: {spec.source}\n     Inertia: "
+        f"{spec.inertia_source}\n"
     )
     if spec.params:
         lines.append(
@@ -461,7 +515,8 @@ def to_urdf(spec: ChainSpec) -> str:
         lines.append(_origin(j.origin, "    "))
         lines.append(f'    <axis xyz="{_vec(j.axis)}"/>\n')
         lines.append(
-            f'    <limit lower="{_num(j.lower)}" upper="{_num(j.upper)}" effort="{_num(j.effort)}" velocity="{_num(j.velocity)}"/>\n'
+            f'    <limit lower="{_num(j.lower)}" upper="{_num(j.upper)}" effort="{_num(j.effort)}" '
+            f'velocity="{_num(j.velocity)}"/>\n'
         )
         if j.mimic is not None:
             src, mult, off = j.mimic

@@ -87,8 +87,8 @@ def _range(
         ) from None
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and lo >= lo_min and hi <= hi_max):
         raise ParameterError(
-            f"{model}: {name} must be finite with lower < upper within [{lo_min:g}, {hi_max:g}] {unit}, "
-            f"got {r!r}"
+            f"{model}: {name} must be finite with lower < upper within [{lo_min:g}, {hi_max:g}] "
+            f"{unit}, got {r!r}"
         )
     return lo, hi
 
@@ -109,15 +109,18 @@ def _joint(name, kind, origin, axis, rng, segment) -> JointSpec:
 def _spec(name: str, form: str, joints: list[JointSpec], tool, params: dict) -> ChainSpec:
     return ChainSpec(
         name=name,
-        description=f"{form} manipulator template (book Table 2.3, Fig. 2-10): three positioning axes; tool = arm end.",
+        description=(
+            f"{form} manipulator template (book Table 2.3, Fig. 2-10): three positioning axes; "
+            "tool = arm end."
+        ),
         joints=joints,
         tool_name="tool",
         tool_origin=homogeneous(r=list(tool)),
         source="book 000 l.641-658 (Table 2.3, Fig. 2-10) and l.799-843 (technical parameters); "
         "dimensions chosen by anthroarm within the book's ranges",
         inertia_source=(
-            f"not printed: uniform cylinders of {DEFAULT_LINEAR_DENSITY} kg/m, radius {DEFAULT_LINK_RADIUS} m, "
-            f"plus {DEFAULT_JOINT_MASS} kg at each joint"
+            f"not printed: uniform cylinders of {DEFAULT_LINEAR_DENSITY} kg/m, radius "
+            f"{DEFAULT_LINK_RADIUS} m, plus {DEFAULT_JOINT_MASS} kg at each joint"
         ),
         params=params,
     )
@@ -128,8 +131,9 @@ def cartesian_robot(
 ) -> ChainSpec:
     """Cartesian (直角坐标式) P-P-P template of Table 2.3.
 
-    Slides along x, y, z; tool at ``(x0 + q1, q2, h0 + q3)`` (m).  Workspace: the box of the three strokes (Table 2.3: cube).
-    Defaults (ours): gantry height h0 = 0.5 m, x offset 0.3 m, strokes 1 m."""
+    Slides along x, y, z; tool at ``(x0 + q1, q2, h0 + q3)`` (m).  Workspace: the box of the three
+    strokes (Table 2.3: cube). Defaults (ours): gantry height h0 = 0.5 m, x offset 0.3 m, strokes 1
+    m."""
     m = "cartesian_robot"
     h0, x0 = _length(m, "h0", h0), _length(m, "x0", x0)
     sx, sy, sz = (
@@ -153,8 +157,9 @@ def cartesian_robot(
 def cylindrical_robot(h0: float = 0.3, base=BASE_RANGE, lift=LIFT, reach=REACH) -> ChainSpec:
     """Cylindrical (圆柱坐标式) R-P-P template of Table 2.3 (the Versatran, Fig. 2-11).
 
-    Azimuth q1 (rad) about z, height ``h0 + q2``, radius q3 (m).  Workspace: a hollow cylinder sector (Table 2.3).
-    Defaults: base ±135°, lift 0–1 m, reach 0.5–1 m (§2-4); h0 = 0.3 m (ours)."""
+    Azimuth q1 (rad) about z, height ``h0 + q2``, radius q3 (m).  Workspace: a hollow cylinder
+    sector (Table 2.3). Defaults: base ±135°, lift 0–1 m, reach 0.5–1 m (§2-4); h0 = 0.3 m
+    (ours)."""
     m = "cylindrical_robot"
     h0 = _length(m, "h0", h0)
     b = _range(m, "base", base, -np.pi, np.pi, "rad")
@@ -179,9 +184,10 @@ def spherical_robot(
 ) -> ChainSpec:
     """Spherical (球坐标式) R-R-P template of Table 2.3 (the Unimate, Fig. 2-11).
 
-    Azimuth q1 about z, elevation q2 (rad) of the boom about the shoulder at height h0 (positive up), boom length q3 (m) from the
-    shoulder.  Workspace: a spherical shell sector (Table 2.3: 球体; "can pick objects off the
-    floor").  Defaults: base ±135°, reach 0.5–1 m (§2-4); h0 = 0.8 m, elevation −45°…60° (ours)."""
+    Azimuth q1 about z, elevation q2 (rad) of the boom about the shoulder at height h0 (positive
+    up), boom length q3 (m) from the shoulder.  Workspace: a spherical shell sector (Table 2.3:
+    球体; "can pick objects off the floor").  Defaults: base ±135°, reach 0.5–1 m (§2-4);
+    h0 = 0.8 m, elevation −45°…60° (ours)."""
     m = "spherical_robot"
     h0 = _length(m, "h0", h0)
     b = _range(m, "base", base, -np.pi, np.pi, "rad")

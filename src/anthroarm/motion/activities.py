@@ -47,7 +47,8 @@ from ..errors import ActivityError
 from ..ik.qp import comfortable_posture
 from .timing import keyframe_trajectory
 
-#: the most samples :func:`activity_trajectory` makes (a bound on the memory a bad rate or duration takes)
+#: the most samples :func:`activity_trajectory` makes (a bound on the memory a bad rate or duration
+#: takes)
 MAX_SAMPLES = 1e7
 
 #: stature fractions (Drillis & Contini 1966, Winter 2009 Fig. 4.1) and this module's estimates
@@ -442,7 +443,8 @@ def activity(name: str, robot, *, height: float | None = None, **params) -> Acti
     ``robot.spec.params["height"]`` or ``height=``, arm length from the model).  ``params``
     override the builder's parameters: ``move`` (s per movement), ``hold`` (s), ``object_mass``
     (kg), ``table_height``/``seat_height``/``shelf_height``/``handle_height`` (m above the floor),
-    ``repeats``/``strokes`` ...; an unknown parameter raises :class:`~anthroarm.errors.ActivityError`."""
+    ``repeats``/``strokes`` ...; an unknown parameter
+    raises :class:`~anthroarm.errors.ActivityError`."""
     if name not in ACTIVITIES:
         raise ActivityError(f"unknown activity {name!r}; the library has: {', '.join(ACTIVITIES)}")
     title, builder, source, book = ACTIVITIES[name]
@@ -522,15 +524,15 @@ def activity_trajectory(
             ok = False
         if not ok:
             raise ActivityError(
-                f"activity {act.name!r}: keyframe {kf.name!r} needs a target of 3 finite numbers (m), "
-                f"move > 0 s and hold >= 0 s; got {kf.position!r}, {kf.move!r}, {kf.hold!r}",
+                f"activity {act.name!r}: keyframe {kf.name!r} needs a target of 3 finite numbers "
+                f"(m), move > 0 s and hold >= 0 s; got {kf.position!r}, {kf.move!r}, {kf.hold!r}",
                 keyframe=kf.name,
             )
     total = sum(kf.move for kf in act.keyframes[1:]) + sum(kf.hold for kf in act.keyframes)
     if total * rate > MAX_SAMPLES:
         raise ActivityError(
-            f"activity {act.name!r}: {total:g} s at {rate:g} Hz is more than {MAX_SAMPLES:g} samples; "
-            "lower the rate or the durations"
+            f"activity {act.name!r}: {total:g} s at {rate:g} Hz is more than {MAX_SAMPLES:g} "
+            "samples; lower the rate or the durations"
         )
     q_prev = (
         comfortable_posture(robot) if q_start is None else robot.check_q(q_start, name="q_start")
@@ -543,8 +545,9 @@ def activity_trajectory(
         ok = e <= tol
         if not ok and strict:
             raise ActivityError(
-                f"activity {act.name!r}: keyframe {kf.name!r} at {np.round(p, 3).tolist()} m is out "
-                f"of the arm's reach (closest hand position {e * 1000:.0f} mm away; {res.status})",
+                f"activity {act.name!r}: keyframe {kf.name!r} at {np.round(p, 3).tolist()} m is "
+                f"out of the arm's reach (closest hand position {e * 1000:.0f} mm away; "
+                f"{res.status})",
                 keyframe=kf.name,
                 distance=e,
             )

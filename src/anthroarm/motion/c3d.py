@@ -94,8 +94,8 @@ def _check_structure(p: Path) -> dict:
             )
         if n_blocks < 1 or start + 512 * n_blocks > size:
             raise C3DError(
-                f"damaged or truncated C3D file: the parameter section ({n_blocks} blocks) does not fit in "
-                f"the file ({size} bytes)",
+                f"damaged or truncated C3D file: the parameter section ({n_blocks} blocks) does "
+                f"not fit in the file ({size} bytes)",
                 p,
             )
         fh.seek(start)
@@ -138,13 +138,15 @@ def _check_structure(p: Path) -> dict:
             j += 2 + ndim + abs(typ) * int(np.prod([int(d) for d in dims]))
         if j >= len(sec):
             raise C3DError(
-                f"damaged C3D parameter section at byte {start + i}: a record runs past the section",
+                f"damaged C3D parameter section at byte {start + i}: a record runs past the "
+                "section",
                 p,
             )
         j += 1 + sec[j]  # the description
         if j > len(sec) or (nxt != 0 and (nxt < 2 or j > off_at + nxt)):
             raise C3DError(
-                f"damaged C3D parameter section at byte {start + i}: a record overlaps the next one",
+                f"damaged C3D parameter section at byte {start + i}: a record overlaps the next "
+                "one",
                 p,
             )
         if nxt == 0:
@@ -152,7 +154,8 @@ def _check_structure(p: Path) -> dict:
         i = off_at + nxt
     if params - groups:
         raise C3DError(
-            f"damaged C3D parameter section: parameters of undeclared groups {sorted(params - groups)}",
+            "damaged C3D parameter section: parameters of undeclared groups "
+            f"{sorted(params - groups)}",
             p,
         )
     first, last = (struct.unpack(u16, head[k : k + 2])[0] for k in (6, 8))
@@ -344,7 +347,8 @@ def write_c3d(path, trial: MarkerTrajectories, *, units: str = "mm") -> Path:
     long = [n for n in trial.names if len(n.encode("utf-8")) > 255]
     if long:
         raise C3DError(
-            f"marker labels longer than 255 bytes cannot be stored in POINT:LABELS: {long[0][:40]!r}...",
+            "marker labels longer than 255 bytes cannot be stored in POINT:LABELS: "
+            f"{long[0][:40]!r}...",
             p,
         )
     c = ezc3d.c3d()

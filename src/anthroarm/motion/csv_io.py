@@ -4,8 +4,8 @@ Format (what :func:`write_joint_csv` writes and ``anthroarm size --activities FI
 ``#`` lines are comments (units, source, the legend of the status codes); the header is ``t``
 (s) and one column per joint named as the joint (rad, or m for a prismatic joint); a marker-IK
 result adds ``rms_m``, ``max_error_m`` (m; ``nan`` for a skipped frame), ``n_markers`` and
-``status`` (a code: 0 ok, 1 too_few_markers, 2 not_converged, 3 skipped, 4 large_error).  Every value is a
-number, so any CSV reader takes it.
+``status`` (a code: 0 ok, 1 too_few_markers, 2 not_converged, 3 skipped, 4 large_error).  Every
+value is a number, so any CSV reader takes it.
 
 :func:`read_joint_csv` also accepts ``time`` / ``time_s`` for the time column and joint columns
 with a unit suffix (``_rad``, ``_deg``; degrees are converted), so spreadsheets from other tools
@@ -84,8 +84,8 @@ def write_joint_csv(path, t, q=None, names=None, *, comment: str = "") -> Path:
     ]
     if bad:
         raise MotionDataError(
-            f"write_joint_csv: joint names {bad} cannot be CSV column names (empty, a comma, a quote, "
-            "a line break or a leading #)",
+            f"write_joint_csv: joint names {bad} cannot be CSV column names (empty, a comma, a "
+            "quote, a line break or a leading #)",
             path,
         )
     buf = io.StringIO()

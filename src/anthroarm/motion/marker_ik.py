@@ -130,7 +130,8 @@ class MarkerIKResult:
 
 
 def _split_label(label: str) -> tuple[str | None, str]:
-    """``"Subject1:EL"`` -> ``("Subject1", "EL")``; a label without a prefix -> ``(None, label)``."""
+    """``"Subject1:EL"`` -> ``("Subject1", "EL")``; a label without a prefix -> ``(None,
+    label)``."""
     pre, sep, base = str(label).rpartition(":")
     return (pre.strip() or None, base.strip()) if sep else (None, str(label).strip())
 
@@ -223,6 +224,13 @@ class MarkerIK:
         Cost of the posture task toward the previous frame (per rad; markers cost 1 per m).
     check : bool
         Check that the set constrains every joint (:meth:`BoundMarkers.check_constrains`).
+    coordinate_tasks : dict, optional
+        Joint name -> (weight w_j, value): the term w_j (q_j − value)² added to the objective,
+        OpenSim's ``IKCoordinateTask`` (:func:`~anthroarm.motion.ik_setup.coordinate_targets`
+        makes it from a setup file); rad or m.
+    limits : bool
+        Keep every iterate inside the joint limits (default).  False solves without them, as
+        OpenSim's IK does for coordinates that are not clamped.
     """
 
     def __init__(
@@ -239,7 +247,15 @@ class MarkerIK:
         seeds: int = 24,
         seed_iter: int = 25,
         max_rms: float = 0.02,
+        coordinate_tasks: dict | None = None,
+        limits: bool = True,
     ):
+        if getattr(robot, "coupling", None) is not None:
+            raise ParameterError(
+                f"{robot.name} has coupled coordinates (an OpenSim model with splines or "
+                "couplers): its marker IK is anthroarm.motion.CoupledMarkerIK (or "
+                "osim_marker_ik with an OpenSim IK setup), which works in its coordinates"
+            )
         self.robot = robot
         self.marker_set = default_marker_set(robot) if marker_set is None else marker_set
         if not isinstance(self.marker_set, MarkerSet):
@@ -267,7 +283,35 @@ class MarkerIK:
             robot.random_q(int(seeds), rng=0, margin=0.05) if seeds else np.zeros((0, robot.nq))
         )
         qp.make_backend(solver, robot.nv, 0)  # SolverNotAvailableError now, not mid-trial
+        self.limits = bool(limits)
+        self.coordinate_task = self._coordinate_task(coordinate_tasks or {})
         self._rank_cache: dict = {}
+
+    def _coordinate_task(self, tasks: dict):
+        """A posture task of cost √w_j on the joints of ``tasks`` (0 elsewhere), toward their
+        values: Σ w_j (q_j − value_j)² in the QP's objective (None when there are none)."""
+        if not tasks:
+            return None
+        robot = self.robot
+        cost = np.zeros(robot.nv)
+        target = qp.comfortable_posture(robot)
+        for name, spec in tasks.items():
+            try:
+                j = robot.chain.joint(name)
+                w, value = (float(x) for x in spec)
+            except (KeyError, TypeError, ValueError) as exc:
+                raise ParameterError(
+                    f"coordinate_tasks[{name!r}] must be (weight, value) of a joint of "
+                    f"{robot.name} ({exc})"
+                ) from None
+            if j.is_mimic or j.nq != 1 or not (np.isfinite(w) and w >= 0 and np.isfinite(value)):
+                raise ParameterError(
+                    f"coordinate_tasks[{name!r}]: a one-coordinate joint, a finite weight >= 0 "
+                    f"and a finite value, got {spec!r}"
+                )
+            cost[j.idx_v] = np.sqrt(w)
+            target[j.idx_q] = value
+        return qp.PostureTask(robot, cost=cost, target=target)
 
     # ------------------------------------------------------------------ one frame
     def _iterate(self, conf, tasks, limits, it_max: int) -> tuple[bool, int]:
@@ -325,10 +369,10 @@ class MarkerIK:
         rate: float = 100.0,
     ) -> MarkerIKResult:
         """Solve every frame of ``trial`` (:class:`~anthroarm.motion.trial.MarkerTrajectories`,
-        or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0`` seeds the first frame
-        (default: the comfortable posture).  ``progress(n_done, n_total)`` is called every 50
-        frames (the CLI's progress bar).  ``rename`` and ``subject`` (whose markers to use in a
-        trial of several subjects) are those of :func:`match_markers`.
+        or an ``(N, M, 3)`` array in the marker set's order, m, sampled at ``rate`` Hz).  ``q0``
+        seeds the first frame (default: the comfortable posture).  ``progress(n_done, n_total)`` is
+        called every 50 frames (the CLI's progress bar).  ``rename`` and ``subject`` (whose markers
+        to use in a trial of several subjects) are those of :func:`match_markers`.
 
         Raises :class:`~anthroarm.errors.MarkerSetError` when no marker of the set is in the
         trial and :class:`~anthroarm.errors.UnconstrainedJointError` when the markers present
@@ -370,8 +414,9 @@ class MarkerIK:
             free = self.bound.unconstrained_joints(cols >= 0)
             if free:
                 raise UnconstrainedJointError(
-                    f"markers {list(missing)} are not in the trial; without them joints {free} have no marker "
-                    "below them (rename the trial's labels with rename={label: marker} or use another set)",
+                    f"markers {list(missing)} are not in the trial; without them joints {free} "
+                    "have no marker below them (rename the trial's labels with rename={label: "
+                    "marker} or use another set)",
                     joints=free,
                 )
 
@@ -382,8 +427,8 @@ class MarkerIK:
         conf = qp.IKConfiguration(robot, q_seed)
         task = MarkerTask(robot, self.bound.joint, self.bound.local, self.marker_set.weights)
         reg = qp.PostureTask(robot, cost=self.regularization, target=q_seed)
-        limits = [qp.ConfigurationLimit(robot, gain=1.0)]
-        tasks = [task, reg]
+        limits = [qp.ConfigurationLimit(robot, gain=1.0)] if self.limits else []
+        tasks = [task, reg] + ([self.coordinate_task] if self.coordinate_task is not None else [])
         M = len(names)
         Q = np.empty((N, robot.nq))
         rms = np.full(N, np.nan)

@@ -81,14 +81,15 @@ class MarkerSet:
                 )
             if not isinstance(m.name, str) or not m.name:
                 raise MarkerSetError(
-                    f"marker set {self.name!r}: a marker name must be a non-empty str, got {m.name!r}"
+                    f"marker set {self.name!r}: a marker name must be a non-empty str, got "
+                    f"{m.name!r}"
                 )
             if m.name in seen:
                 raise MarkerSetError(f"marker set {self.name!r}: duplicate marker name {m.name!r}")
             if not isinstance(m.body, str) or not m.body.strip():
                 raise MarkerSetError(
-                    f"marker {m.name!r}: body must be the name of a frame of the robot (a non-empty "
-                    f"str), got {m.body!r}"
+                    f"marker {m.name!r}: body must be the name of a frame of the robot (a "
+                    f"non-empty str), got {m.body!r}"
                 )
             seen.add(m.name)
             p = np.asarray(m.position, dtype=float) if _numeric(m.position) else None
@@ -141,7 +142,8 @@ class MarkerSet:
         ``{name: {"body": ..., "position": [...], "weight": ...}}`` (m)."""
         if not isinstance(d, dict):
             raise MarkerSetError(
-                f"a marker set dict maps names to (body, position[, weight]), got {type(d).__name__}"
+                "a marker set dict maps names to (body, position[, weight]), got "
+                f"{type(d).__name__}"
             )
         out = []
         for k, v in d.items():
@@ -328,8 +330,8 @@ class BoundMarkers:
         free = self.unconstrained_joints()
         if free:
             raise UnconstrainedJointError(
-                f"marker set {self.marker_set.name!r} does not constrain joints {free} of {self.robot.name}: "
-                "no marker on a body they move; add markers below them",
+                f"marker set {self.marker_set.name!r} does not constrain joints {free} of "
+                f"{self.robot.name}: no marker on a body they move; add markers below them",
                 joints=free,
             )
         if q is None:
@@ -347,9 +349,10 @@ class BoundMarkers:
                 {names[int(np.argmax(np.abs(Vt[i])))] for i in np.flatnonzero(weak) if i < len(Vt)}
             )
             raise UnconstrainedJointError(
-                f"marker set {self.marker_set.name!r} leaves {int(weak.sum())} direction(s) of {self.robot.name}'s "
-                f"joints undetermined at the reference posture (marker Jacobian rank {nv - int(weak.sum())} < {nv}); "
-                f"mostly joints {joints}: add markers off their axes",
+                f"marker set {self.marker_set.name!r} leaves {int(weak.sum())} direction(s) of "
+                f"{self.robot.name}'s joints undetermined at the reference posture (marker "
+                f"Jacobian rank {nv - int(weak.sum())} < {nv}); mostly joints {joints}: add "
+                "markers off their axes",
                 joints=joints,
             )
 
@@ -389,8 +392,8 @@ def segment_length(robot, body: str) -> float:
         if max(e for e, _ in ends) - min(e for e, _ in ends) > 1e-9:
             raise MarkerSetError(
                 f"{body!r} of {robot.name} branches to joints at different distances "
-                f"({', '.join(f'{n} {e:.4f} m' for e, n in ends)}): its segment length is ambiguous; "
-                "give the marker positions in m (MarkerSet)"
+                f"({', '.join(f'{n} {e:.4f} m' for e, n in ends)}): its segment length is "
+                "ambiguous; give the marker positions in m (MarkerSet)"
             )
         return ends[0][0]
     offs = [np.linalg.norm(g.translation) for g in chain.frames if g.joint == f.joint]
@@ -418,8 +421,8 @@ def human_arm_markers(robot, landmarks: dict | None = None) -> MarkerSet:
                 lengths[scale_body] = segment_length(robot, scale_body)
         except UnknownFrameError as exc:
             raise MarkerSetError(
-                f"the human-arm marker set needs the links {sorted({b for b, *_ in table.values()})} "
-                f"({exc}): give your own MarkerSet"
+                "the human-arm marker set needs the links "
+                f"{sorted({b for b, *_ in table.values()})} ({exc}): give your own MarkerSet"
             ) from None
         out.append(Marker(name, body, tuple(float(v) * lengths[scale_body] for v in frac), w))
     return MarkerSet(out, name="human_arm_isb10")

@@ -101,7 +101,8 @@ def _static_positions(trial, marker_set, rename, subject=None):
             P = P[None]
         if P.ndim != 3 or P.shape[1:] != (len(marker_set), 3):
             raise MotionDataError(
-                f"static marker positions must have shape (frames, {len(marker_set)}, 3), got {P.shape}"
+                f"static marker positions must have shape (frames, {len(marker_set)}, 3), got "
+                f"{P.shape}"
             )
         check_coordinates(P, marker_set.names)
     P[~np.isfinite(P).all(axis=2)] = np.nan
@@ -128,8 +129,9 @@ def scale_from_static(
     ``trial``: :class:`~anthroarm.motion.trial.MarkerTrajectories` (a C3D read with
     :func:`~anthroarm.motion.c3d.read_c3d`) or an array ``(frames, M, 3)`` / ``(M, 3)`` in the
     marker set's order (m); ``rename`` and ``subject`` (whose markers, in a trial of several
-    subjects) as in :func:`~anthroarm.motion.marker_ik.match_markers`.  The result's ``status`` says whether the fit can be trusted
-    (RMS marker error at most ``max_rms`` m, no factor at a bound).  Raises
+    subjects) as in :func:`~anthroarm.motion.marker_ik.match_markers`.  The result's ``status`` says
+    whether the fit can be trusted (RMS marker error at most ``max_rms`` m, no factor at a bound).
+    Raises
     :class:`~anthroarm.errors.MarkerSetError` when a body to be scaled has no visible marker at
     or below its distal end, :class:`~anthroarm.errors.ParameterError` for ``bounds`` that are
     not 0 < low < 1 < high or a ``max_rms`` that is not a positive number."""

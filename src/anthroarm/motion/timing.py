@@ -7,8 +7,9 @@ minimises the integrated squared jerk ∫ (d³x/dt³)² dt is, for each coordina
     x(t) = x0 + (x1 − x0) s(τ),   s(τ) = 10 τ³ − 15 τ⁴ + 6 τ⁵,   τ = t / T,
 
 the quintic with zero velocity and acceleration at both ends (their solution for a
-point-to-point movement).  :func:`keyframe_trajectory` chains such segments through keyframes with optional holds:
-q, q̇ and q̈ are continuous (every segment starts and ends at rest), q⃛ jumps at the keyframes.
+point-to-point movement).  :func:`keyframe_trajectory` chains such segments through keyframes with
+optional holds: q, q̇ and q̈ are continuous (every segment starts and ends at rest), q⃛ jumps at the
+keyframes.
 
 Units: s, and the coordinates' own units (rad, m).
 """

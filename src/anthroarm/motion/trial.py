@@ -93,8 +93,8 @@ class MarkerTrajectories:
 
     def __repr__(self) -> str:
         return (
-            f"MarkerTrajectories({len(self)} frames at {self.rate:g} Hz, {len(self.names)} markers, "
-            f"{self.visible.mean() * 100:.1f} % visible, source={self.source!r})"
+            f"MarkerTrajectories({len(self)} frames at {self.rate:g} Hz, {len(self.names)} "
+            f"markers, {self.visible.mean() * 100:.1f} % visible, source={self.source!r})"
         )
 
     @property

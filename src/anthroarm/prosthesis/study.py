@@ -40,6 +40,45 @@ class Study:
     catalogue: object
     timings: dict = field(default_factory=dict)
 
+    def unfit(self) -> list[dict]:
+        """What did not fit, the one list the report and ``anthroarm size``'s JSON both show:
+        ``{"what": "joint" | "activity" | "rule", "name", "reason"}`` for each joint without a
+        motor, each activity left out of the envelope, and each weight rule not met."""
+        out = [
+            {"what": "joint", "name": js.joint, "reason": js.reason}
+            for js in self.sizing.joints
+            if js.status != "ok"
+        ]
+        out += [
+            {"what": "activity", "name": a.name, "reason": f"{a.status}: {a.reason}"}
+            for a in self.activities
+            if a.status != "ok"
+        ]
+        out += [
+            {
+                "what": "rule",
+                "name": r.source,
+                "reason": f"{r.rule} ({r.value:.2f} vs {r.limit:.2f} {r.unit})",
+            }
+            for r in self.rules
+            if r.ok is False
+        ]
+        return out
+
+    def summary(self) -> dict:
+        """The study in a few numbers (JSON-ready): drive mass, the motor + gearbox per joint,
+        :meth:`unfit`, the activities left out and each rule's verdict (None: information)."""
+        return dict(
+            drive_mass_kg=round(float(self.sizing.drive_mass), 4),
+            joints={
+                r["joint"]: (f"{r['motor']} + {r['gearbox']}" if r["status"] == "ok" else "none")
+                for r in self.sizing.rows()
+            },
+            unfit=self.unfit(),
+            skipped=[x.name for x in self.envelope.skipped],
+            rules={r.source: r.ok for r in self.rules},
+        )
+
 
 def _payload(payload) -> float:
     """A held mass in [0, 50] kg, or an :class:`~anthroarm.errors.ActivityError`."""

@@ -122,3 +122,56 @@ def check(
             ),
         )
     return rows
+
+
+@dataclass(frozen=True)
+class RuleText:
+    """A weight rule in words: what it asks, why, and the book's line (Chinese, as printed, and
+    in English; line numbers of the OCR source ``000_f79f72c676d090fb.txt``)."""
+
+    source: str
+    words: str
+    quote: str
+    english: str
+
+
+#: Every rule id of :func:`check`, explained (the report prints these next to the numbers).
+RULE_TEXTS = {
+    "L274": RuleText(
+        "L274",
+        "The motors and gearboxes of a powered prosthesis usually make up half or more of its "
+        "weight, so the drive's mass sets the whole prosthesis's: between drive / 0.6 and "
+        "drive / 0.5.  Information only: it turns the sized drive into a prosthesis mass the "
+        "other rules are checked on (the lighter end, the most favourable reading).",
+        "通常假手动力装置和减速机构部分的重量往往要占重量的50~60%。",
+        "The power unit and reduction gearing usually take 50-60 % of a prosthesis's weight "
+        "(§1, direct devices).",
+    ),
+    "L7445": RuleText(
+        "L7445",
+        "A practical full-arm prosthesis must be light: not more than 2 kg.  Checked on the "
+        "lightest prosthesis mass the drive implies (L274).",
+        "(1) 臂重要轻,要求不大于2 kg;",
+        "(1) The arm must be light: not more than 2 kg (§9-2, conditions for a practical "
+        "full-arm prosthesis).",
+    ),
+    "L7298": RuleText(
+        "L7298",
+        "A person's two arms weigh about 12.6 % of the body, so one arm about 6.3 %; a prosthesis "
+        "heavier than the arm it replaces is felt as a burden (the book adds that even the same "
+        "mass is felt, since the sense of the arm's weight fades after amputation).  Checked on "
+        "the lightest implied prosthesis mass against 6.3 % of the person's body mass.",
+        "人的(双)臂重约为本身体重的12.6%,若从这点出发,全臂假手的重可为4~5 kg左右。",
+        "A person's (two) arms weigh about 12.6 % of the body; from this, a full-arm prosthesis "
+        "could weigh about 4-5 kg (§9-2, weight and output).",
+    ),
+    "L7441": RuleText(
+        "L7441",
+        "To handle an object with its six degrees of freedom the way a hand does, a full-arm "
+        "prosthesis needs at least seven: shoulder 3, elbow 1, forearm 2, hand 1.  Checked on "
+        "the joints of the sized arm model.",
+        "必须确保假手至少有七个自由度,即肩部3个、肘部1个、前臂2个、手部1个。",
+        "The prosthesis must have at least seven degrees of freedom: shoulder 3, elbow 1, "
+        "forearm 2, hand 1 (§9-2).",
+    ),
+}

@@ -57,7 +57,8 @@ class Dual:
             ok = bool(np.isfinite(self.real).all() and np.isfinite(self.dual).all())
         if not ok:
             raise ValueError(
-                f"dual number with a NaN or infinite part: {np.asarray(real).tolist()} + ε{np.asarray(dual).tolist()}"
+                f"dual number with a NaN or infinite part: {np.asarray(real).tolist()} + "
+                f"ε{np.asarray(dual).tolist()}"
             )
 
     # -- helpers
@@ -169,7 +170,8 @@ class Dual:
         return Dual(self.real, -self.dual)
 
 
-# ----------------------------------------------------------------------------- functions f(â) = f(a) + ε a* f′(a)
+# ----------------------------------------------------------------------------- functions f(â) =
+# f(a) + ε a* f′(a)
 def _f(x, f, df, name: str = "f"):
     """f(â) = f(a) + ε a* f'(a); ``ValueError`` naming ``name`` when a part of the result cannot
     be represented (e.g. exp of a real part above ~709.78 overflows)."""
@@ -234,7 +236,8 @@ def atan2(y, x) -> Dual:
 
 
 def acos(x) -> Dual:
-    """acos â = acos a − ε a*/√(1 − a²); ``ValueError`` for |a| > 1 or |a| = 1 (derivative infinite)."""
+    """acos â = acos a − ε a*/√(1 − a²); ``ValueError`` for |a| > 1 or |a| = 1 (derivative
+    infinite)."""
     x = Dual.lift(x)
     a = np.asarray(x.real)
     if np.any(np.abs(a) >= 1):
@@ -290,7 +293,8 @@ class Line:
         m = as_vector3(self.moment, "line moment")
         if abs(float(u @ m)) > 1e-9 * max(1.0, float(np.linalg.norm(m))):
             raise ValueError(
-                f"not a line: direction {u.tolist()} and moment {m.tolist()} are not perpendicular (u·m = {float(u @ m):.3e})"
+                f"not a line: direction {u.tolist()} and moment {m.tolist()} are not perpendicular "
+                f"(u·m = {float(u @ m):.3e})"
             )
         object.__setattr__(self, "u", u)
         object.__setattr__(self, "moment", m)
@@ -314,8 +318,8 @@ class Line:
         return np.cross(self.u, self.moment)
 
     def moved(self, A) -> "Line":
-        """The same line referred to the point A (coordinates of A relative to O), Eq. (5-139)/(5-140):
-        u_A = AO × u + u_O with AO = O − A."""
+        """The same line referred to the point A (coordinates of A relative to O), Eq.
+        (5-139)/(5-140): u_A = AO × u + u_O with AO = O − A."""
         A = as_vector3(A, "reference point A")
         return Line(self.u, np.cross(-A, self.u) + self.moment)
 
@@ -359,7 +363,8 @@ def line_dual_angle(a: Line, b: Line, tol: float = 1e-12) -> tuple[Dual, np.ndar
     return Dual(theta, dist), (d / dist if dist > tol else None)
 
 
-# ----------------------------------------------------------------------------- dual orthogonal matrices
+# ----------------------------------------------------------------------------- dual orthogonal
+# matrices
 _PX = -skew([1.0, 0, 0])
 _PY = -skew([0, 1.0, 0])
 _PZ = -skew([0, 0, 1.0])
@@ -434,7 +439,8 @@ def check_dual_orthogonal(A: Dual, tol: float = 1e-9) -> Dual:
     err = max(float(np.abs(M.real - np.eye(3)).max()), float(np.abs(M.dual).max()))
     if err > tol:
         raise ValueError(
-            f"dual matrix is not dual-orthogonal: max |Â Âᵀ − I| = {err:.3e} (dual part {np.asarray(A.dual).tolist()})"
+            f"dual matrix is not dual-orthogonal: max |Â Âᵀ − I| = {err:.3e} (dual part "
+            f"{np.asarray(A.dual).tolist()})"
         )
     return A
 

@@ -84,7 +84,8 @@ def euler_zxz_inverse(C, tol: float = SINGULAR_TOL) -> EulerAngles:
         return EulerAngles(
             np.array([theta, alpha, 0.0]),
             True,
-            f"gimbal lock: sin α = {sa:.2e}; only {which} = {theta:.6g} rad is defined (δ set to 0)",
+            f"gimbal lock: sin α = {sa:.2e}; only {which} = {theta:.6g} rad is defined (δ set to "
+            "0)",
         )
     theta = float(np.arctan2(C[0, 2], -C[1, 2]))
     delta = float(np.arctan2(C[2, 0], C[2, 1]))
@@ -113,7 +114,8 @@ def euler_xyx_inverse(R, tol: float = SINGULAR_TOL) -> EulerAngles:
         return EulerAngles(
             np.array([theta, psi, 0.0]),
             True,
-            f"gimbal lock: sin ψ = {sp:.2e}; only {which} = {theta:.6g} rad is defined (φ set to 0)",
+            f"gimbal lock: sin ψ = {sp:.2e}; only {which} = {theta:.6g} rad is defined (φ set to "
+            "0)",
         )
     theta = float(np.arctan2(R[1, 0], -R[2, 0]))
     phi = float(np.arctan2(R[0, 1], R[0, 2]))

@@ -76,7 +76,8 @@ def check_unit_axis(u, name: str = "axis", tol: float = UNIT_TOL) -> np.ndarray:
         bad = a if a.ndim == 1 else a[np.argmax(np.abs(n - 1.0))]
         raise ValueError(
             f"{name} must be a unit vector, got {np.asarray(bad).tolist()} with length "
-            f"{float(np.max(n) if a.ndim == 1 else np.linalg.norm(bad)):.12g}; normalise it with unit_axis()"
+            f"{float(np.max(n) if a.ndim == 1 else np.linalg.norm(bad)):.12g}; normalise it with "
+            "unit_axis()"
         )
     return a
 
@@ -116,7 +117,8 @@ def check_rotation(R, name: str = "rotation", tol: float = ORTHO_TOL) -> np.ndar
         i = int(np.argmax(err)) if a.ndim > 2 else 0
         bad = a if a.ndim == 2 else a.reshape(-1, 3, 3)[i]
         raise ValueError(
-            f"{name} is not orthogonal: max |R R^T - I| = {float(np.max(err)):.3e} > {tol:g} for {bad.tolist()}"
+            f"{name} is not orthogonal: max |R R^T - I| = {float(np.max(err)):.3e} > {tol:g} for "
+            f"{bad.tolist()}"
         )
     det = np.linalg.det(a)
     if np.any(det < 0):

@@ -51,7 +51,8 @@ def straight_line_move(
     k: float = 20.0,
     jacobian: str = "book",
 ) -> LineMotionResult:
-    """Move the tool on a straight line to ``T_goal`` in ``duration`` s by resolved rate (7-89)/(7-95)/(7-96).
+    """Move the tool on a straight line to ``T_goal`` in ``duration`` s by resolved rate
+    (7-89)/(7-95)/(7-96).
 
     ``jacobian="book"`` uses the hand-frame Jacobian (7-94) built from joint axes and lever arms;
     ``"pinocchio"`` uses Pinocchio's LOCAL frame Jacobian (they are equal; tested).

@@ -22,6 +22,7 @@ bodies), :mod:`~anthroarm.viewer.shapes`, :mod:`~anthroarm.viewer.meshes`,
 screenshots (tests, docs); :mod:`~anthroarm.viewer.demo` is ``anthroarm demo``.
 """
 
+from .collision import show_collisions
 from .viewer import (
     Scene,
     Viewer,
@@ -41,6 +42,7 @@ __all__ = [
     "limit_proximity",
     "manipulability",
     "show",
+    "show_collisions",
 ]
 
 

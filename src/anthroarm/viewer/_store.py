@@ -138,25 +138,49 @@ JS_PATCH = r"""
     box.className = "anthroarm-teach";
     box.open = true;
     box.appendChild(el("summary", "font-weight:600;margin-bottom:2px;cursor:pointer", spec.title));
+    var rows = box;
     spec.sliders.forEach(function (s) {
-      var row = el("div", "display:grid;grid-template-columns:110px 150px 62px;align-items:center;gap:4px");
-      row.appendChild(el("span", "overflow:hidden;text-overflow:ellipsis;white-space:nowrap", s.name));
-      var input = el("input", "width:150px");
+      // name (full name on hover) | a slider (about 1.2 px per degree of a 330° range) | a number box | unit
+      var row = el("div", "display:grid;grid-template-columns:150px 280px 70px 22px;align-items:center;gap:4px");
+      var label = el("span", "overflow:hidden;text-overflow:ellipsis;white-space:nowrap", s.name);
+      label.title = s.name;
+      row.appendChild(label);
+      var input = el("input", "width:280px;margin:0");
       input.type = "range"; input.min = s.min; input.max = s.max; input.step = s.step; input.value = s.value;
-      input.dataset.joint = s.name;
-      var out = el("span", "text-align:right;font-variant-numeric:tabular-nums", Number(s.value).toFixed(s.digits) + " " + s.unit);
-      input.addEventListener("input", function () {
-        theta[s.joint] = parseFloat(input.value) * s.scale;
-        out.textContent = Number(input.value).toFixed(s.digits) + " " + s.unit;
+      input.dataset.joint = s.name; input.title = s.name;
+      var num = el("input", "width:66px;height:16px;padding:0 2px;font:12px sans-serif;text-align:right;font-variant-numeric:tabular-nums");
+      num.type = "number"; num.min = s.min; num.max = s.max; num.step = s.step;
+      num.value = Number(s.value).toFixed(s.digits);
+      num.className = "anthroarm-value"; num.dataset.box = s.name; num.title = s.name + " (" + s.unit + ")";
+      function set(v, from) {
+        v = Math.min(parseFloat(s.max), Math.max(parseFloat(s.min), v));
+        if (from !== input) { input.value = v; }
+        if (from !== num) { num.value = Number(v).toFixed(s.digits); }
+        theta[s.joint] = v * s.scale;
         pose();
+      }
+      input.addEventListener("input", function () { set(parseFloat(input.value), input); });
+      num.addEventListener("change", function () {
+        var v = parseFloat(num.value);
+        if (isFinite(v)) { set(v, null); } else { num.value = Number(input.value).toFixed(s.digits); }
       });
-      row.appendChild(input); row.appendChild(out); box.appendChild(row);
+      row.appendChild(input); row.appendChild(num); row.appendChild(el("span", "", s.unit));
+      rows.appendChild(row);
     });
     var readout = el("div", "margin-top:3px;font-variant-numeric:tabular-nums");
     readout.className = "anthroarm-tool";
     box.appendChild(readout);
     pose();
     return box;
+  }
+  // the 3-D pane gives way to an open teach panel, so the panel never hides the robot
+  function fitPane() {
+    var pane = document.getElementById("meshcat-pane");
+    var open = document.querySelector("#anthroarm-teach details[open]");
+    var w = open ? open.parentNode.offsetWidth + 16 : 0;
+    pane.style.marginLeft = w + "px";
+    pane.style.width = w ? "calc(100vw - " + w + "px)" : "100vw";
+    viewer.set_3d_pane_size();
   }
   function ui(path, spec) {
     var key = split(path).join("/");
@@ -170,6 +194,7 @@ JS_PATCH = r"""
                                       : panel("anthroarm-legends", "position:absolute;left:8px;bottom:8px;z-index:10");
     where.appendChild(node);
     uiNodes[key] = node;
+    if (spec.kind === "teach") { node.addEventListener("toggle", fitPane); fitPane(); }
   }
   viewer.handle_command = function (cmd) {
     if (cmd.type === "anthroarm_batch") {
@@ -189,7 +214,7 @@ JS_PATCH = r"""
       return;
     }
     if (cmd.type === "anthroarm_ui") { ui(cmd.path, cmd.spec); return; }
-    if (cmd.type === "delete") { dropUi(cmd.path); }
+    if (cmd.type === "delete") { dropUi(cmd.path); fitPane(); }
     base(cmd);
     if (cmd.type === "set_object") {   // meshes sent without normals (PackedMesh): smooth normals here
       var made = viewer.scene_tree.find(split(cmd.path));

@@ -31,7 +31,10 @@ class ExportMixin:
 
     def play(self, Q, dt: float = 1 / 30, loop: bool = True, trace: bool = True) -> None:
         """Play the joint trajectory ``Q`` (N, nq), one row every ``dt`` seconds, as a meshcat
-        animation (also stored in :meth:`static_html`).  ``trace`` draws the tool path."""
+        animation (also stored in :meth:`static_html`).  ``trace`` draws the tool path.  The
+        camera then frames the robot over the whole motion (``fit="all"`` of
+        :meth:`~anthroarm.viewer.scene.SceneMixin.set_camera`), unless it was placed at a given
+        distance."""
         Q = self.robot.check_q(Q, "Q")
         if Q.ndim != 2 or len(Q) < 2:
             raise ValueError(
@@ -72,6 +75,7 @@ class ExportMixin:
         }
         self.display(Q[0])
         self._send([cmd])
+        self._animation_extent(Q)  # the camera frames every pose (unless given a distance)
         self._animating = True
         self.trajectory = Q
 

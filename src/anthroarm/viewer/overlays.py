@@ -27,6 +27,11 @@ from .colors import (
 from .messages import delete, safe_name, set_color, set_object, set_transform, ui
 from .shapes import Body, arrow_mesh, cylinder_between, triad
 
+#: Opacity of a voxel map's points (:meth:`OverlaysMixin.show_map`).
+MAP_OPACITY = 0.35
+#: A voxel map's point size as a fraction of the voxel side.
+MAP_POINT_FRACTION = 0.5
+
 
 def manipulability(robot, Q, frame=None) -> np.ndarray:
     """Translational manipulability (Yoshikawa) of ``frame`` at each row of ``Q``: the product
@@ -206,6 +211,7 @@ class OverlaysMixin:
             self._overlay_bodies.pop(safe_name(name), None)
             self._send([delete(self._overlay_path(name))])
         self._movers = None
+        self._drop_extent(None if name is None else safe_name(name))
 
     def show_frames(self, frames=None, size: float | None = None, name: str = "frames") -> None:
         """Coordinate triads (x red, y green, z blue) that follow the robot: ``frames`` is a
@@ -254,6 +260,7 @@ class OverlaysMixin:
                 set_transform(f"{path}/triad/{k}", p.offset),
             ]
         self._send(cmds)
+        self._add_extent(safe_name(name), T[:3, 3] + np.array([[-size], [size]]))
 
     def show_trace(
         self,
@@ -290,6 +297,7 @@ class OverlaysMixin:
                     set_transform(f"{path}/{k}", p.offset),
                 ]
         self._send(cmds)
+        self._add_extent(safe_name(name), P)
         return P
 
     def show_workspace(
@@ -335,6 +343,7 @@ class OverlaysMixin:
         size: float | None = None,
         name: str = "points",
         label: str | None = None,
+        opacity: float = 1.0,
     ) -> dict:
         """A 3-D point cloud (reachability and comfort maps, markers, sampled positions).
 
@@ -356,6 +365,9 @@ class OverlaysMixin:
             Overlay name (:meth:`clear` removes it; a second call with the same name replaces it).
         label : str, optional
             Title of the colour legend drawn for ``values`` (default ``name``).
+        opacity : float
+            In (0, 1]; below 1 the points are see-through (and do not hide each other's
+            background): a dense map around the robot leaves the robot visible.
 
         Returns
         -------
@@ -384,11 +396,18 @@ class OverlaysMixin:
         else:
             C = rgb01((0.95, 0.55, 0.05) if colors is None else colors, len(P), "colors")
         size = positive_length(size, 0.02 * self.radius, "size")
+        if not (isinstance(opacity, (int, float)) and 0.0 < float(opacity) <= 1.0):
+            raise ParameterError(f"opacity must be in (0, 1], got {opacity!r}")
         cloud = mg.PointCloud(P.T.astype(np.float32), C.T.astype(np.float32), size=size)
         path = self._overlay_path(name)
-        self._send([delete(path), set_object(path, cloud)])
+        made = set_object(path, cloud)
+        if opacity < 1.0:
+            for m in made["object"]["materials"]:
+                m.update(transparent=True, opacity=float(opacity), depthWrite=False)
+        self._send([delete(path), made])
         if values is not None:
             self._send([ui(f"{path}/legend", colormap_legend(label or name, colormap, lo, hi))])
+        self._add_extent(safe_name(name), P)
         return {"points": P, "colors": C, "vmin": lo, "vmax": hi}
 
     def show_map(
@@ -399,9 +418,13 @@ class OverlaysMixin:
         colormap: str | None = None,
         size: float | None = None,
         name: str | None = None,
+        opacity: float = MAP_OPACITY,
     ) -> dict:
         """A voxel map of :mod:`anthroarm.batch` as a 3-D point cloud with its colour legend: one
-        point at the centre of every reached voxel, coloured by its value.
+        point at the centre of every reached voxel, coloured by its value, see-through
+        (``opacity``) so the robot inside stays visible; the camera then frames the map and the
+        robot from outside the cloud (unless
+        :meth:`~anthroarm.viewer.scene.SceneMixin.set_camera` was given a distance).
 
         Parameters
         ----------
@@ -414,9 +437,11 @@ class OverlaysMixin:
         colormap : str, optional
             Default ``viridis`` (``viridis_r`` for discomfort: yellow = comfortable).
         size : float, optional
-            Point size, m (default: the voxel side).
+            Point size, m (default: half the voxel side, so the cloud has gaps to see through).
         name : str, optional
             Overlay name (default: the job's name).
+        opacity : float
+            In (0, 1] (default :data:`MAP_OPACITY`).
 
         Returns
         -------
@@ -428,7 +453,7 @@ class OverlaysMixin:
         ParameterError
             A result without a voxel map, or an unknown ``var``.
         """
-        from ..batch.plot import _MAPS, occupied_points
+        from ..batch.plot import MAP_VARIABLES, occupied_points
 
         job = getattr(result, "job", None)
         variables = getattr(result, "variables", None)
@@ -437,7 +462,7 @@ class OverlaysMixin:
                 f"show_map takes an anthroarm.batch result (reachability_map, comfort_map), "
                 f"got {type(result).__name__}"
             )
-        var = var or _MAPS.get(job)
+        var = var or MAP_VARIABLES.get(job)
         if var is None or var not in variables or tuple(result.dims(var)) != ("x", "y", "z"):
             raise ParameterError(
                 f"{job}: no voxel map {var!r} to draw; voxel maps: "
@@ -459,9 +484,10 @@ class OverlaysMixin:
             P,
             values=np.asarray(vals, float),
             colormap=cmap,
-            size=size or voxel,
+            size=size or (MAP_POINT_FRACTION * voxel if voxel else None),
             name=name or job or var,
             label=f"{job}: {var}{note}",
+            opacity=opacity,
         )
         out["values"] = np.asarray(vals, float)
         return out

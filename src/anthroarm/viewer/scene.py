@@ -19,9 +19,21 @@ from meshcat.commands import SetProperty
 from meshcat.path import Path as MeshcatPath
 from meshcat.visualizer import Visualizer
 
-from ..errors import ViewerError
+from ..errors import ParameterError, ViewerError
 from ..spatial.rotations import homogeneous
 from .checks import points3, rgb255
+from .framing import (
+    ANIMATION_SAMPLES,
+    EXTENT_POINTS,
+    HAND_ZOOM_RATIO,
+    TEACH_ASPECT,
+    body_joint,
+    box_diagonal,
+    check_fit,
+    framing_distance,
+    hand_joints,
+    view_direction,
+)
 from .messages import (
     delete,
     safe_name,
@@ -49,27 +61,6 @@ def format_length(x: float) -> str:
         if x * f >= 1 - 1e-9:
             return f"{x * f:.3g} {unit}"
     return f"{x * 1000:.3g} mm"
-
-
-def framing_distance(
-    corners, direction, fill: float = 0.85, fov_deg: float = 75.0, aspect: float = 4 / 3
-) -> float:
-    """Camera distance from the orbit target (the origin) along the unit ``direction`` at which
-    every point of ``corners`` (K, 3; relative to the target) projects inside ``fill`` of the
-    vertical field of view ``fov_deg`` and of the horizontal one (width / height = ``aspect``);
-    z is up.  A point at depth D - c·d and offset (c·r, c·u) in the camera frame is inside when
-    D >= c·d + |c·u| / (fill tan(fov/2)) (and the same with r and the horizontal half-angle)."""
-    C = np.asarray(corners, float)
-    d = np.asarray(direction, float)
-    f = -d
-    r = np.cross(f, [0.0, 0.0, 1.0])
-    r = r / np.linalg.norm(r) if np.linalg.norm(r) > 1e-9 else np.array([1.0, 0.0, 0.0])
-    u = np.cross(r, f)
-    tv = fill * math.tan(math.radians(fov_deg) / 2)
-    th = fill * math.tan(math.radians(fov_deg) / 2) * aspect
-    depth = C @ d
-    need = np.maximum(depth + np.abs(C @ u) / tv, depth + np.abs(C @ r) / th)
-    return float(max(need.max(), 1e-3))
 
 
 class SceneWindow:
@@ -179,10 +170,10 @@ class SceneMixin:
         pose = np.vstack([points(self.q[None]), self._piece_corners(self.q)])
         blo, bhi = pose.min(0), pose.max(0)
         self.center = 0.5 * (blo + bhi)
-        self._reach_box = box_corners(lo, hi) - self.center
-        self._frame_box = box_corners(blo, bhi) - self.center
+        self._reach_corners = box_corners(lo, hi)
+        self._frame_corners = box_corners(blo, bhi)
         cmds = [set_transform(self.root, homogeneous(r=-self.center))]
-        self.floor = floor = min(0.0, float(lo[2])) - 0.01  # base frame
+        self.floor = floor = min(0.0, float(lo[2]), float(blo[2])) - 0.01  # base frame, under all
         cmds.append(
             set_property("/Grid", "visible", False)
         )  # meshcat's 20 m grid: ours fits the robot
@@ -209,13 +200,16 @@ class SceneMixin:
         self.set_scale_bar(scale_bar)
         self.set_camera()
 
-    def _piece_corners(self, q) -> np.ndarray:
+    def _piece_corners(self, q, joints=None) -> np.ndarray:
         """Corners (K, 3), base frame, of the local bounding boxes of every drawn piece at ``q``
-        (mesh files sent as they are have no bounds here and are skipped)."""
+        (mesh files sent as they are have no bounds here and are skipped); only the bodies
+        moved by one of ``joints`` (chain indices) when given."""
         model, data = self.robot.model, self.robot.data
         pin.framesForwardKinematics(model, data, q)
         out = [np.zeros((0, 3))]
         for b in self.bodies:
+            if joints is not None and body_joint(self.robot.chain, b) not in joints:
+                continue
             M = (
                 np.eye(4)
                 if b.joint is None and b.frame is None
@@ -258,9 +252,7 @@ class SceneMixin:
                 set_transform(path, piece.offset),
             ]
         # the scale bar: `spacing` long, alternating dark and light fifths, at the grid's front-left
-        corner = (
-            self._frame_box.max(0)[:2] + self.center[:2]
-        )  # on the camera's side of the robot, on grid lines
+        corner = self._frame_corners.max(0)[:2]  # on the camera's side of the robot, on grid lines
         a = np.array(
             [sp * (np.floor(corner[0] / sp) - 1), sp * np.floor(corner[1] / sp), z + 0.006 * rf]
         )
@@ -305,36 +297,130 @@ class SceneMixin:
     # ------------------------------------------------------------------ scene settings
     def set_camera(
         self,
-        direction=(0.9, 1.0, 0.45),
+        direction="iso",
         distance: float | None = None,
         fill: float = 0.85,
-        fit: str = "pose",
+        fit: str = "auto",
     ) -> None:
-        """Look at the robot from ``direction`` (base-frame axes) at ``distance`` m.
+        """Frame ``fit`` seen from ``direction``, at ``distance`` m (default: where it fills
+        ``fill`` of the view).
 
-        The default distance frames ``fit``: ``"pose"``, the box around the robot as displayed
-        now (every drawn piece), or ``"reach"``, the box around its workspace; the box
-        fills ``fill`` of meshcat's 75° vertical field of view (and of the horizontal one of a
-        4:3 view), seen from ``direction``."""
-        if fit not in ("pose", "reach"):
-            raise ValueError(f"fit must be 'pose' or 'reach', got {fit!r}")
-        d = np.asarray(direction, float)
-        if d.shape != (3,) or not np.all(np.isfinite(d)) or np.linalg.norm(d) < 1e-9:
-            raise ValueError(f"direction must be a non-zero finite 3-vector, got {direction!r}")
-        d = d / np.linalg.norm(d)
+        Parameters
+        ----------
+        direction : str or array_like
+            A named view, ``"iso"`` (front-left-above, the default), ``"front"`` (from +x),
+            ``"back"``, ``"side"`` (from +y) or ``"top"``, or a 3-vector from the subject to
+            the camera (base-frame axes).
+        distance : float, optional
+            Camera distance from the subject's centre, m.  Default: the distance at which the
+            subject's box fills ``fill`` of meshcat's 75° vertical field of view and of the
+            horizontal one of a 4:3 view
+            (:func:`~anthroarm.viewer.framing.framing_distance`): the camera is outside it.
+        fill : float
+            In [0.1, 1].
+        fit : {"auto", "pose", "all", "reach", "hand"}
+            The subject (:mod:`anthroarm.viewer.framing`): the robot as displayed now, with
+            everything drawn around it (points, maps, targets, traces, an animation's poses),
+            its workspace, or its hand; ``"auto"`` zooms on the hand of a limb when nothing else
+            is drawn, else frames ``"all"``.  The subject's centre becomes the orbit target
+            (``viewer.center``, base frame).
+
+        While ``distance`` is None and ``fit`` is ``"auto"`` or ``"all"``, the framing follows
+        what is drawn: each overlay and :meth:`~Viewer.play` re-frames the scene.
+
+        Raises
+        ------
+        ParameterError
+            An unknown view or fit, a zero or non-finite direction, ``fill`` outside [0.1, 1],
+            a distance that is not positive and finite.
+        """
+        d = view_direction(direction)
+        check_fit(fit)
         if not (0.1 <= float(fill) <= 1.0):
-            raise ValueError(f"fill must be in [0.1, 1], got {fill!r}")
-        if fit == "pose":  # the robot as displayed now, about the fixed orbit target
-            c = self._piece_corners(self.q)
-            box = box_corners(c.min(0), c.max(0)) - self.center if len(c) else self._frame_box
-        else:
-            box = self._reach_box
-        dist = float(distance) if distance is not None else framing_distance(box, d, float(fill))
-        if not (dist > 0 and math.isfinite(dist)):
-            raise ValueError(f"distance must be positive and finite, got {distance!r}")
-        x, y, z = dist * d
+            raise ParameterError(f"fill must be in [0.1, 1], got {fill!r}")
+        if distance is not None and not (float(distance) > 0 and math.isfinite(float(distance))):
+            raise ParameterError(f"distance must be positive and finite (m), got {distance!r}")
+        pts = self._subject(fit)
+        self.center = 0.5 * (pts.min(0) + pts.max(0))
+        dist = (
+            float(distance)
+            if distance is not None
+            else framing_distance(pts - self.center, d, float(fill), aspect=self._aspect())
+        )
+        self._camera = dict(direction=direction, distance=distance, fill=fill, fit=fit)
+        self.camera_position = dist * d  # base-frame axes, from the orbit target
+        x, y, z = self.camera_position
         # the camera lives in meshcat's y-up "rotated" frame: world (x, y, z) -> (x, z, -y)
-        self._send([set_property("/Cameras/default/rotated/<object>", "position", [x, z, -y])])
+        self._send(
+            [
+                set_transform(self.root, homogeneous(r=-self.center)),
+                set_property("/Cameras/default/rotated/<object>", "position", [x, z, -y]),
+            ]
+        )
+
+    def _aspect(self) -> float:
+        """Width / height of the 3-D pane the framing assumes: 4:3, or the narrower pane left
+        beside an open teach panel."""
+        return TEACH_ASPECT if self._teaching else 4 / 3
+
+    def camera_subject(self, fit: str = "auto") -> np.ndarray:
+        """Points (K, 3; base frame, m) of what ``fit`` frames now (see :meth:`set_camera`): the
+        corners of the drawn pieces' boxes and the points of the overlays."""
+        return self._subject(check_fit(fit))
+
+    def _subject(self, fit: str) -> np.ndarray:
+        c = self._piece_corners(self.q)
+        pose = c if len(c) else self._frame_corners
+        if fit == "auto":
+            hand = self._hand_corners()
+            small = hand is not None and box_diagonal(hand) <= HAND_ZOOM_RATIO * box_diagonal(pose)
+            fit = "hand" if small and not self._extents else "all"
+        if fit == "hand":
+            hand = self._hand_corners()
+            return pose if hand is None else hand
+        if fit == "reach":
+            return self._reach_corners
+        if fit == "all":
+            return np.vstack([pose, *self._extents.values()])
+        return pose
+
+    def _hand_corners(self) -> np.ndarray | None:
+        joints = hand_joints(self.robot.chain)
+        if joints is None:
+            return None
+        c = self._piece_corners(self.q, joints)
+        return c if len(c) else None
+
+    def _add_extent(self, name: str, points) -> None:
+        """Count ``points`` (K, 3; base frame) in the framing of ``fit="all"`` under the overlay
+        ``name`` and re-frame if the camera follows what is drawn."""
+        P = np.asarray(points, float).reshape(-1, 3)
+        P = P[np.all(np.isfinite(P), axis=1)]
+        if len(P) > EXTENT_POINTS:  # the box's extremes and an even subsample
+            keep = np.linspace(0, len(P) - 1, EXTENT_POINTS).astype(int)
+            P = np.vstack([P[keep], P[P.argmin(0)], P[P.argmax(0)]])
+        if len(P):
+            self._extents[name] = P
+        else:
+            self._extents.pop(name, None)
+        self._reframe()
+
+    def _drop_extent(self, name: str | None) -> None:
+        if name is None:
+            self._extents.clear()
+        else:
+            self._extents.pop(name, None)
+
+    def _reframe(self) -> None:
+        cam = self._camera
+        if cam is not None and cam["distance"] is None and cam["fit"] in ("auto", "all"):
+            self.set_camera(**cam)
+
+    def _animation_extent(self, Q) -> None:
+        """The robot's drawn pieces over (at most :data:`ANIMATION_SAMPLES`) poses of ``Q``."""
+        idx = np.unique(np.linspace(0, len(Q) - 1, min(len(Q), ANIMATION_SAMPLES)).astype(int))
+        pts = np.vstack([self._piece_corners(Q[k]) for k in idx])
+        self._add_extent("animation", pts)
 
     def set_background(self, top=None, bottom=None, visible: bool = True) -> None:
         """Background gradient colours (0..255 RGB); ``visible=False`` for a transparent page."""

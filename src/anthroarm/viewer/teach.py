@@ -33,16 +33,27 @@ class TeachMixin:
 
         The sliders start at ``q`` (default: the configuration displayed now).  ``on=False``
         removes them.  The Python side is not told of the page's slider positions: call
-        :meth:`~Viewer.display` to show a configuration from Python.  Returns the viewer."""
+        :meth:`~Viewer.display` to show a configuration from Python.  Each slider has a number
+        box to type a value in, and shows the joint's full name on hover; while the panel is
+        open, the 3-D view takes the rest of the page and the camera frames the robot for that
+        narrower view.  Returns the viewer."""
         path = f"{self.root}/ui/teach"
         self._teaching = bool(on)
         if not on:
             self._send([delete(path)])
+            self._refit()
             return self
         if q is not None or self._animating:
             self.display(self.q if q is None else q)
         self._send([ui(path, self._teach_spec())])
+        self._refit()
         return self
+
+    def _refit(self) -> None:
+        """Frame again for the pane beside (or without) the panel, unless placed by hand."""
+        cam = self._camera
+        if cam is not None and cam["distance"] is None:
+            self.set_camera(**cam)
 
     def _teach_spec(self) -> dict:
         chain = self.robot.chain

@@ -172,6 +172,8 @@ class Viewer(SceneMixin, OverlaysMixin, TeachMixin, ExportMixin, LiveMixin):
         self._teaching = False
         self._animating = False
         self._colors: dict[str, tuple] = {}
+        self._extents: dict[str, np.ndarray] = {}  # overlay name -> its box, for fit="all"
+        self._camera: dict | None = None  # the last set_camera arguments
         self.q = robot.neutral() if q is None else robot.check_q(q, "q").copy()
         self._frame_scene(background, grid, axes, scale_bar)
         self._send(self._body_objects(self.bodies))

@@ -1,8 +1,8 @@
 """Fletcher–Reeves conjugate gradient (F-R 共轭梯度法) and steepest descent, book §4-4,
 Eq. (4-26)–(4-47).
 
-    P⁽⁰⁾ = −G⁽⁰⁾ (4-41),  X⁽ⁱ⁺¹⁾ = X⁽ⁱ⁾ + h⁽ⁱ⁾P⁽ⁱ⁾ with h⁽ⁱ⁾ = argmin_h f(X⁽ⁱ⁾ + hP⁽ⁱ⁾) (4-35)/(4-36),
-    P⁽ⁱ⁺¹⁾ = −G⁽ⁱ⁺¹⁾ + β⁽ⁱ⁾P⁽ⁱ⁾ (4-46),  β⁽ⁱ⁾ = |G⁽ⁱ⁺¹⁾|² / |G⁽ⁱ⁾|² (4-45)/(4-47).
+    P⁽⁰⁾ = −G⁽⁰⁾ (4-41),  X⁽ⁱ⁺¹⁾ = X⁽ⁱ⁾ + h⁽ⁱ⁾P⁽ⁱ⁾ with h⁽ⁱ⁾ = argmin_h f(X⁽ⁱ⁾ + hP⁽ⁱ⁾)
+    (4-35)/(4-36), P⁽ⁱ⁺¹⁾ = −G⁽ⁱ⁺¹⁾ + β⁽ⁱ⁾P⁽ⁱ⁾ (4-46),  β⁽ⁱ⁾ = |G⁽ⁱ⁺¹⁾|² / |G⁽ⁱ⁾|² (4-45)/(4-47).
 
 On a positive-definite quadratic with exact line searches it ends in at most n steps.  The
 book does not mention restarts; we restart with −G every ``restart`` steps (default n) and
@@ -31,7 +31,8 @@ def numerical_gradient(f, x, h: float = 1e-6):
         e[i] = h * max(1.0, abs(x[i]))
         if not (np.isfinite(e[i]) and np.isfinite(x[i] + e[i]) and np.isfinite(x[i] - e[i])):
             raise ValueError(
-                f"the difference step h*max(1, |x[{i}]|) = {h!r}*{abs(x[i])!r} leaves the float range"
+                f"the difference step h*max(1, |x[{i}]|) = {h!r}*{abs(x[i])!r} leaves the float "
+                "range"
             )
         with np.errstate(over="ignore", invalid="ignore"):
             g[i] = (f(x + e) - f(x - e)) / (2 * e[i])
@@ -118,7 +119,8 @@ def fletcher_reeves(
     ``grad`` (optional) returns ∇f; otherwise central differences.  Stops when
     ``|G| ≤ gtol·max(1, |G⁽⁰⁾|)``.  ``history`` lists the iterates X⁽ⁱ⁾.  ``gtol`` must be finite
     and > 0, ``maxiter`` and ``restart`` integers >= 1, ``x0`` finite within ±1e150
-    (``ValueError``); an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`."""
+    (``ValueError``); an ``f`` that is never finite
+    raises :class:`~anthroarm.errors.ObjectiveError`."""
     return _run(f, grad, x0, gtol, maxiter, restart, fr=True)
 
 

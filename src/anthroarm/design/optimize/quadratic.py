@@ -71,8 +71,9 @@ def quadratic_interpolation(f, bracket, eps: float = 1e-8, maxiter: int = 100) -
     flowchart Fig. 4-5 is missing; this is the standard rule) and stops when successive vertices
     differ by less than ``eps`` (relative to |α| + 1).  Status ``"no_minimum"`` when no bracket
     exists (monotone or concave data).  If ``f`` was NaN somewhere the status is ``"nan"`` with the
-    best finite point; an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`.
-    ``eps`` must be finite and > 0, ``maxiter`` an integer >= 1, the bracket finite (``ValueError``)."""
+    best finite point; an ``f`` that is never finite
+    raises :class:`~anthroarm.errors.ObjectiveError`. ``eps`` must be finite and > 0, ``maxiter`` an
+    integer >= 1, the bracket finite (``ValueError``)."""
     eps = positive("eps", eps)
     maxiter = count("maxiter", maxiter)
     if any(not math.isfinite(float(v)) for v in bracket):

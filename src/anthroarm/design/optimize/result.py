@@ -24,9 +24,9 @@ class OptimizeResult:
     ``"nan"`` (the objective returned NaN somewhere; ``x`` and ``fun`` are then the best point
     where it was finite).  ``success`` is True only for the first two.
     ``x`` is the best point found (even on failure), ``fun`` its value (always finite: an
-    objective that is never finite raises :class:`~anthroarm.errors.ObjectiveError`), ``nit`` iterations
-    (stages for SUMT), ``nfev`` objective evaluations, ``history`` the iterates, ``info`` extras
-    (e.g. final bracket, penalty parameter, constraint violation)."""
+    objective that is never finite raises :class:`~anthroarm.errors.ObjectiveError`), ``nit``
+    iterations (stages for SUMT), ``nfev`` objective evaluations, ``history`` the iterates, ``info``
+    extras (e.g. final bracket, penalty parameter, constraint violation)."""
 
     x: object
     fun: float
@@ -91,8 +91,9 @@ class Counted:
         self, x, fun, status, message="", nit=0, nfev=None, history=None, info=None
     ) -> OptimizeResult:
         """The :class:`OptimizeResult` of a run.  A non-finite ``fun`` (the objective was NaN or
-        inf there), or status ``"nan"``, reports the best finite point and value seen instead; if there is none the run
-        has nothing to report and :class:`~anthroarm.errors.ObjectiveError` is raised."""
+        inf there), or status ``"nan"``, reports the best finite point and value seen instead; if
+        there is none the run has nothing to report and :class:`~anthroarm.errors.ObjectiveError` is
+        raised."""
         fun = float(fun)
         if status == "nan" or not np.isfinite(fun):
             if self.best is None:
@@ -117,7 +118,8 @@ MAX_COORD = 1e150
 
 
 def as_vector(name: str, x, limit: float | None = None) -> np.ndarray:
-    """``x`` as a finite 1-D float vector (a copy); ``limit`` bounds the magnitude of its entries."""
+    """``x`` as a finite 1-D float vector (a copy); ``limit`` bounds the magnitude of its
+    entries."""
     x = np.atleast_1d(np.asarray(x, dtype=float))
     if x.ndim != 1:
         raise ValueError(f"{name} must be a 1-D vector, got shape {x.shape}")

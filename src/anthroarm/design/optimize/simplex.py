@@ -41,11 +41,12 @@ def simplex_book(
     ``initial_simplex`` ((n+1, n)) is given; its edges must be linearly independent.
     ``expand_if="G"`` expands when S_R < S_G (book step 4), ``"L"`` when S_R < S_L.
     ``eps2=None`` disables (4-64) (it is ill-posed when S_L ≈ 0).  ``xtol`` > 0 also stops when
-    the simplex diameter falls below it; ``eps1=0`` leaves the stop to ``eps2``/``xtol``/``maxiter``.
-    ``f`` may return ``inf`` (e.g. an infeasible point for a barrier function).  ``eps1`` and ``xtol`` must be finite and >= 0, ``eps2`` (when given)
-    finite and > 0, ``maxiter`` an integer >= 1, ``x0``, ``step`` and ``initial_simplex`` finite
-    within ±1e150 (``ValueError``).  If ``f`` was NaN somewhere the status is ``"nan"`` with the
-    best finite point; an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`."""
+    the simplex diameter falls below it; ``eps1=0`` leaves the stop to
+    ``eps2``/``xtol``/``maxiter``. ``f`` may return ``inf`` (e.g. an infeasible point for a barrier
+    function).  ``eps1`` and ``xtol`` must be finite and >= 0, ``eps2`` (when given) finite and > 0,
+    ``maxiter`` an integer >= 1, ``x0``, ``step`` and ``initial_simplex`` finite within ±1e150
+    (``ValueError``).  If ``f`` was NaN somewhere the status is ``"nan"`` with the best finite
+    point; an ``f`` that is never finite raises :class:`~anthroarm.errors.ObjectiveError`."""
     eps1 = positive("eps1", eps1, allow_zero=True)
     if eps2 is not None:
         eps2 = positive("eps2", eps2)

@@ -112,8 +112,9 @@ def retooled(robot, frame):
 def unnamed(robot, frame) -> str:
     f = robot.chain.frame(frame)
     return (
-        f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame {robot.chain.frame(f.name).index}; "
-        "the closed form solves for a frame known by its name: use aa.ik.solve(robot, T, frame=...)"
+        f"{robot.name}: frame {f.index} shares its name {f.name!r} with frame "
+        f"{robot.chain.frame(f.name).index}; the closed form solves for a frame known by its name: "
+        "use aa.ik.solve(robot, T, frame=...)"
     )
 
 
@@ -142,8 +143,9 @@ def q_rest_of(robot, arm, q_rest) -> np.ndarray | None:
         if len(bad):
             names = robot.chain.q_names
             raise ValueError(
-                f"{robot.name}: q_rest puts {', '.join(names[i] for i in bad)} outside the joint limits "
-                "(the solutions keep its joints off the tool's path, and every solution is inside them)"
+                f"{robot.name}: q_rest puts {', '.join(names[i] for i in bad)} outside the joint "
+                "limits (the solutions keep its joints off the tool's path, and every solution is "
+                "inside them)"
             )
     return q
 

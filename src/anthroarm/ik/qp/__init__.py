@@ -6,15 +6,16 @@
 >>> conf = qp.IKConfiguration(robot)
 >>> ee = qp.FrameTask(robot, position_cost=1.0, orientation_cost=1.0, lm_damping=1e-3)
 >>> ee.set_target(robot.fk(robot.random_q(rng=0)))
->>> v = qp.step(conf, None, [ee, qp.PostureTask(robot, cost=1e-3)], dt=0.01)   # OSQP, default limits
+>>> posture = qp.PostureTask(robot, cost=1e-3)
+>>> v = qp.step(conf, None, [ee, posture], dt=0.01)   # OSQP, default limits
 >>> conf.integrate_inplace(v, 0.01)
 
 Tasks (``qp.tasks``): FrameTask, PositionTask, OrientationTask, RelativeFrameTask, PostureTask,
 DampingTask, JointCouplingTask (mimic), SwivelTask, MarkerTask (body-fixed points),
 ContactNormalTask, SurfaceContactTask (fingertip contacts, :mod:`anthroarm.hand`),
-MultiFrameTask and JointCouplingsTask (several frames / relations in one objective).  Limits (``qp.limits``): ConfigurationLimit,
-VelocityLimit, AccelerationLimit.  Backends (``qp.backends``): persistent OSQP, daqp, quadprog,
-proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
+MultiFrameTask and JointCouplingsTask (several frames / relations in one objective).  Limits
+(``qp.limits``): ConfigurationLimit, VelocityLimit, AccelerationLimit.  Backends (``qp.backends``):
+persistent OSQP, daqp, quadprog, proxqp, any qpsolvers solver.  Book mapping: Ch. 7 notes §6.2.
 
 Joints: everything reads ``robot.chain``.  Velocities, Jacobians and limits on the step live in
 the tangent space (nv); configurations are integrated on the manifold (``pin.integrate``) and

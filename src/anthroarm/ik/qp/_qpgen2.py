@@ -18,6 +18,7 @@ caller keeps ``quadprog.solve_qp``.
 from __future__ import annotations
 
 import ctypes
+from importlib.metadata import version
 
 import numpy as np
 
@@ -32,8 +33,6 @@ def _function():
     if _FUNC is None:
         _FUNC = False
         try:
-            from importlib.metadata import version
-
             import quadprog
 
             if version("quadprog") in SUPPORTED:

@@ -29,18 +29,23 @@ exactly (:func:`polish_box`), as OSQP's is.
 from __future__ import annotations
 
 import ctypes
+import importlib.util
 import math
 
 import numpy as np
 
 from ...errors import SolverNotAvailableError
+from . import _qpgen2
+
+try:
+    from eigenpy import LLT
+except ImportError:  # pragma: no cover - eigenpy comes with pinocchio
+    LLT = None
 
 BIG = 1e20  # finite stand-in for an infinite bound (solvers differ in how they read inf)
 
 
 def _module_available(name: str) -> bool:
-    import importlib.util
-
     return importlib.util.find_spec(name) is not None
 
 
@@ -49,7 +54,8 @@ DIRECT = {"osqp": "osqp", "daqp": "daqp", "quadprog": "quadprog", "proxqp": "pro
 
 def available_solvers() -> list[str]:
     """Names accepted by :func:`make_backend` on this machine: the direct backends whose module
-    is installed, then ``"qpsolvers:NAME"`` for every solver qpsolvers can run (the slow, rebuild-per-call path)."""
+    is installed, then ``"qpsolvers:NAME"`` for every solver qpsolvers can run (the slow,
+    rebuild-per-call path)."""
     names = [n for n, mod in DIRECT.items() if _module_available(mod)]
     try:
         import qpsolvers
@@ -278,10 +284,6 @@ class OSQPBackend(Backend):
         assert P.nnz == len(rows) and A.nnz == len(arows)
         self._ones = np.ones((1, n))
         self.settings = {**self.SETTINGS, **settings}
-        try:
-            from eigenpy import LLT
-        except ImportError:  # pragma: no cover - eigenpy comes with pinocchio
-            LLT = None
         self._LLT = LLT
         self._eye = np.eye(n)
         # box-only QPs are polished: ADMM can stop earlier (unless the caller set eps itself)
@@ -466,8 +468,6 @@ class QuadprogBackend(Backend):
         super().__init__(n, n_eq)
         import quadprog
 
-        from . import _qpgen2
-
         self._qp = quadprog
         self._eye = np.eye(n)
         self._C = np.hstack([np.zeros((n, n_eq)), self._eye, -self._eye])
@@ -542,10 +542,6 @@ class ProxqpBackend(Backend):
         self._eye = np.eye(n)
         self._Q = None  # persistent box-QP workspace (created on the first solve_ws)
         self._solved = proxqp.QPSolverOutput.PROXQP_SOLVED
-        try:
-            from eigenpy import LLT
-        except ImportError:  # pragma: no cover - eigenpy comes with pinocchio
-            LLT = None
         self._LLT = LLT
 
     def solve_ws(self, ws, A=None, b=None):

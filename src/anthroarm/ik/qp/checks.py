@@ -17,23 +17,27 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ... import models as catalog
 from ...check_rows import CheckRow
+from ...robot import load
+from ..solve import solve
+from .configuration import IKConfiguration
+from .limits import Limit
+from .step import step
+from .tasks import FrameTask, PostureTask
 
 
 def rows(models, samples, rng) -> list[CheckRow]:
-    import anthroarm as aa
-    from anthroarm.ik import qp
-
     out = []
     n = max(3, min(int(samples), 20))
-    for name in aa.models.names() if models is None else models:
-        robot = aa.load(name)
+    for name in catalog.names() if models is None else models:
+        robot = load(name)
         Q = robot.random_q(n, rng)
         worst = 0.0
         d = robot.model.createData()
         for q in Q:
             T = robot.fk(q)
-            res = aa.ik.solve(robot, T, max_time=0.05)
+            res = solve(robot, T, max_time=0.05)
             if not (res.success and robot.within_limits(res.q)):
                 worst = float("inf")
                 break
@@ -57,19 +61,19 @@ def rows(models, samples, rng) -> list[CheckRow]:
         )
         # QP step vs its closed form (limits far away: box of ±10 rad)
         werr = 0.0
-        big = qp.Limit()
+        big = Limit()
         big.box = lambda conf, dt: (np.full(robot.nv, -10.0), np.full(robot.nv, 10.0))
         for q, q2 in zip(Q[:3], Q[1:4]):
-            conf = qp.IKConfiguration(robot, q)
-            ee = qp.FrameTask(
+            conf = IKConfiguration(robot, q)
+            ee = FrameTask(
                 robot,
                 position_cost=[1.0, 0.5, 2.0],
                 orientation_cost=0.3,
                 lm_damping=1e-2,
                 target=robot.fk(pin.interpolate(robot.model, q, q2, 0.05)),
             )
-            post = qp.PostureTask(robot, cost=0.1, target=q2)
-            dq = qp.step(conf, None, [ee, post], 1.0, limits=[big], solver="osqp", damping=1e-6)
+            post = PostureTask(robot, cost=0.1, target=q2)
+            dq = step(conf, None, [ee, post], 1.0, limits=[big], solver="osqp", damping=1e-6)
             H = 1e-6 * np.eye(robot.nv)
             c = np.zeros(robot.nv)
             for t in (ee, post):

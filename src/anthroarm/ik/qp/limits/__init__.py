@@ -2,7 +2,10 @@
 
 from .acceleration import AccelerationLimit
 from .base import Limit, combine
+from .collision import CollisionLimit
+from .collision_barrier import CollisionBarrier
 from .configuration import ConfigurationLimit
 from .velocity import VelocityLimit
 
 __all__ = ["Limit", "combine", "ConfigurationLimit", "VelocityLimit", "AccelerationLimit"]
+__all__ += ["CollisionLimit", "CollisionBarrier"]

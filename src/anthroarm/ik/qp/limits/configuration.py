@@ -4,12 +4,12 @@
 
 with ⊖ the joint-space difference (m or rad), on the joints that have a range
 (:func:`~anthroarm.ik.qp.configuration.ranged_joints` of ``robot.chain``): a continuous joint,
-whose q is (cos θ, sin θ), is unbounded, and a mimic joint follows its source's limits.  A gain < 1 lets a joint approach its limit
-geometrically instead of hitting it in one step (pink's default 0.5).  This is the book's joint
-range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step as hard inequalities
-instead of the exterior penalty (7-85).  Joints with an infinite limit are unbounded.  A joint
-that starts outside its range gets gain 1 on the violated side (back inside in one step if
-the velocity limit allows; pink's QP is infeasible there, pink#206).
+whose q is (cos θ, sin θ), is unbounded, and a mimic joint follows its source's limits.  A gain < 1
+lets a joint approach its limit geometrically instead of hitting it in one step (pink's default
+0.5).  This is the book's joint range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step
+as hard inequalities instead of the exterior penalty (7-85).  Joints with an infinite limit are
+unbounded.  A joint that starts outside its range gets gain 1 on the violated side (back inside in
+one step if the velocity limit allows; pink's QP is infeasible there, pink#206).
 """
 
 from __future__ import annotations

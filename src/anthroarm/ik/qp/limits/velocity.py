@@ -25,7 +25,8 @@ class VelocityLimit(Limit):
             raise ValueError("v_max contains NaN")
         if v_max is not None and np.any(v < 0):
             raise ValueError(
-                f"v_max must be >= 0 (0 or inf: no limit on that joint), got {np.asarray(v_max).tolist()}"
+                "v_max must be >= 0 (0 or inf: no limit on that joint), got "
+                f"{np.asarray(v_max).tolist()}"
             )
         self.v_max = np.where(np.isfinite(v) & (v > 0), v, np.inf)
         self.v_max.setflags(write=False)  # replace it (lim.v_max = ...) rather than edit it

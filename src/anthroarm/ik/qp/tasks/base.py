@@ -44,7 +44,10 @@ class Task:
         self.lm_damping = float(lm_damping)
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}(cost={self.cost}, gain={self.gain}, lm_damping={self.lm_damping})"
+        return (
+            f"{type(self).__name__}(cost={self.cost}, gain={self.gain}, "
+            f"lm_damping={self.lm_damping})"
+        )
 
     # -- to implement ----------------------------------------------------------------------
     def compute_error(self, conf) -> np.ndarray:
@@ -65,10 +68,11 @@ class Task:
     def _accumulate(self, conf, ws, first: bool) -> float:
         """Add this task's objective into the step's buffers ``ws.H`` (nv, nv) and ``ws.c``
         (nv,) in place (overwrite them when ``first``; ``ws.Hd`` is the writable diagonal of
-        ``ws.H``) and return a scalar that the caller adds to diag(H) once for all tasks.  Used by :func:`~anthroarm.ik.qp.step`; the sum is the same
-        as adding up :meth:`compute_qp_objective` (tests/ik_qp check it task by task).  This
-        general version calls :meth:`compute_qp_objective`; tasks with a cheaper in-place form
-        override it (and fall back here for subclasses, which may override the objective)."""
+        ``ws.H``) and return a scalar that the caller adds to diag(H) once for all tasks.  Used
+        by :func:`~anthroarm.ik.qp.step`; the sum is the same as adding
+        up :meth:`compute_qp_objective` (tests/ik_qp check it task by task).  This general version
+        calls :meth:`compute_qp_objective`; tasks with a cheaper in-place form override it (and fall
+        back here for subclasses, which may override the objective)."""
         Ht, ct = self.compute_qp_objective(conf)
         if first:
             np.copyto(ws.H, Ht)

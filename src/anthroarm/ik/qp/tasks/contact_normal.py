@@ -77,7 +77,10 @@ class ContactNormalTask(FrameAxesTask):
         )
 
     def __repr__(self) -> str:
-        return f"ContactNormalTask({self.frame!r}, axis={self.axis.tolist()}, cost={self.cost.tolist()})"
+        return (
+            f"ContactNormalTask({self.frame!r}, axis={self.axis.tolist()}, "
+            f"cost={self.cost.tolist()})"
+        )
 
     def set_target(self, d) -> None:
         """Target direction (3,) in world axes; normalised (``ValueError`` for zero or NaN)."""

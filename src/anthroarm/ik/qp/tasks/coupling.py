@@ -29,7 +29,8 @@ def _joint_index(robot, name: str) -> int:
     if j.nv != 1:
         raise ValueError(
             f"{robot.name}: joint {name!r} is a mimic joint (it has no velocity of its own: "
-            f"Pinocchio moves it with {chain.joints[j.mimic.source].name!r}); couple that joint instead"
+            f"Pinocchio moves it with {chain.joints[j.mimic.source].name!r}); couple that joint "
+            "instead"
         )
     return j.idx_v
 

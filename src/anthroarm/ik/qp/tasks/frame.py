@@ -47,7 +47,10 @@ class FrameTask(Task):
             self.set_target(target)
 
     def __repr__(self) -> str:
-        return f"FrameTask({self.frame!r}, cost={self.cost.tolist()}, gain={self.gain}, lm_damping={self.lm_damping})"
+        return (
+            f"FrameTask({self.frame!r}, cost={self.cost.tolist()}, gain={self.gain}, "
+            f"lm_damping={self.lm_damping})"
+        )
 
     @property
     def position_cost(self) -> np.ndarray:

@@ -1,0 +1,127 @@
+"""CollisionLimit: the velocity damper of Faverjon & Tournassoud (1987) on every pair of bodies
+closer than the detection distance d_i, self and environment::
+
+    ḋ ≥ −ξ (d − d_s) / (d_i − d_s)        for every pair with d < d_i
+
+with d the signed distance of the pair (m; negative inside), d_s the safety distance, ξ the
+approach speed allowed at d_i (m/s) and ḋ = n · (J_b(p_b) − J_a(p_a)) q̇ from the witness points
+p_a, p_b and the unit normal n from a to b (:func:`anthroarm.collision.jacobians`; an obstacle's
+Jacobian is zero).  On the step Δq = q̇ dt this is the row
+
+    −(∂d/∂q) Δq ≤ ξ dt (d − d_s) / (d_i − d_s)
+
+an inequality, not a box: the QP of :func:`anthroarm.ik.qp.limits.collision_step.step` takes
+it (``qp.step`` takes boxes only and refuses this limit).  A pair that starts closer than d_s
+(or in collision) gets a positive lower bound on ḋ, at most ξ: the step pushes it apart
+instead of freezing; ``status`` says so.  Distances come from coal (:mod:`anthroarm.collision`); the
+damper is mink's ``CollisionAvoidanceLimit`` in velocity form (mink: d_s = 0.005 m,
+d_i = 0.01 m) and the book's obstacle constraint g(Q) ≥ 0 (Ch. 7 §7-6) linearised per step.
+
+Bad input: d_s ≥ d_i, a negative or non-finite distance or ξ ≤ 0 raise
+:class:`~anthroarm.errors.CollisionError`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ....collision import distance as coll
+from ....collision.model import model as collision_model
+from ....errors import CollisionError
+from .base import Limit
+
+
+def check_distances(d_safe, d_detect) -> tuple[float, float]:
+    """(d_s, d_i) as floats with 0 ≤ d_s < d_i < inf; :class:`CollisionError` otherwise."""
+    try:
+        ds, di = float(d_safe), float(d_detect)
+    except (TypeError, ValueError):
+        raise CollisionError(
+            f"distances must be numbers (m), got {d_safe!r}, {d_detect!r}"
+        ) from None
+    if not (math.isfinite(ds) and math.isfinite(di)) or ds < 0.0:
+        raise CollisionError(f"safety distance must be a finite number >= 0 (m), got {d_safe!r}")
+    if not ds < di:
+        raise CollisionError(
+            f"safety distance d_s = {ds} m must be below the detection distance d_i = {di} m"
+        )
+    return ds, di
+
+
+class CollisionLimit(Limit):
+    """Velocity-damper collision avoidance (see the module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    obstacles : sequence of :class:`~anthroarm.collision.Obstacle` or an Environment, optional
+    d_safe : float
+        Safety distance d_s (m), the distance no pair goes below.
+    d_detect : float
+        Detection distance d_i (m): pairs farther away are not constrained.
+    xi : float
+        Approach speed ξ allowed at d_i (m/s).
+    self_collision : bool
+        Constrain the robot's own active pairs (:func:`anthroarm.collision.model`).
+    """
+
+    priority = 3
+
+    def __init__(
+        self,
+        robot,
+        obstacles=None,
+        d_safe: float = 0.005,
+        d_detect: float = 0.05,
+        xi: float = 0.5,
+        self_collision: bool = True,
+    ):
+        self.d_safe, self.d_detect = check_distances(d_safe, d_detect)
+        xi = float(xi)
+        if not (math.isfinite(xi) and xi > 0):
+            raise CollisionError(f"xi (approach speed, m/s) must be a finite number > 0, got {xi}")
+        self.xi = xi
+        self.robot = robot
+        self.model = collision_model(robot)
+        self.env = coll.environment(obstacles)
+        self.self_collision = bool(self_collision)
+        self.last = None  # the Distances of the last step
+
+    def box(self, conf, dt):
+        raise CollisionError(
+            "CollisionLimit is an inequality on Δq, not a box: pass it in the limits of "
+            "anthroarm.ik.qp.limits.collision_step.step (qp.step takes boxes only)"
+        )
+
+    def distances(self, conf):
+        """The pairs closer than d_i at ``conf`` (its ``data`` holds the kinematics)."""
+        return coll.compute(
+            self.robot,
+            None,
+            self.env,
+            cutoff=self.d_detect,
+            data=conf.data,
+            self_collision=self.self_collision,
+            cm=self.model,
+        )
+
+    def inequalities(self, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """(G, h) with G Δq ≤ h, one row per pair closer than d_i."""
+        dist = self.last = self.distances(conf)
+        if not len(dist):
+            return np.zeros((0, conf.nv)), np.zeros(0)
+        J = coll.jacobians(self.robot.model, conf.data, dist, self.model.support)
+        h = self.xi * dt * (dist.distance - self.d_safe) / (self.d_detect - self.d_safe)
+        # a pair inside d_s separates at most at ξ (deep penetrations ask no more than that)
+        return -J, np.maximum(h, -self.xi * dt)
+
+    def __repr__(self) -> str:
+        return (
+            f"CollisionLimit(d_safe={self.d_safe}, d_detect={self.d_detect}, xi={self.xi}, "
+            f"obstacles={len(self.env)}, self_collision={self.self_collision})"
+        )
+
+
+__all__ = ["CollisionLimit", "check_distances"]

@@ -1,0 +1,45 @@
+"""Muscles of OpenSim models: paths, lengths, moment arms and Hill-type forces.
+
+>>> import anthroarm as aa
+>>> from anthroarm import muscles
+>>> robot = aa.load(aa.osim.path("gait2392"))
+>>> ms = muscles.read_muscles(aa.osim.path("gait2392"))     # 92 Thelen2003 muscles
+>>> L = muscles.lengths(robot, ms, robot.default_q())         # (92,) m
+>>> R = muscles.moment_arms(robot, ms, robot.default_q())     # (92, 23) m, = -dl/dq
+
+Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
+moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres), :mod:`.hill`
+(Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f).
+"""
+
+from __future__ import annotations
+
+from .hill import (
+    Equilibrium,
+    active_force_length,
+    equilibrium,
+    joint_torques,
+    passive_force_length,
+    tendon_force_strain,
+)
+from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set
+from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
+
+__all__ = [
+    "Equilibrium",
+    "active_force_length",
+    "equilibrium",
+    "joint_torques",
+    "passive_force_length",
+    "tendon_force_strain",
+    "Muscle",
+    "MuscleSet",
+    "PathPoint",
+    "PathWrap",
+    "WrapObject",
+    "lengths",
+    "lengths_and_moment_arms",
+    "moment_arms",
+    "muscle_set",
+    "read_muscles",
+]
