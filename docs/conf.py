@@ -51,6 +51,7 @@ GUIDE = [
     "osim",
     "kinematics",
     "ik",
+    "compiled",
     "dynamics",
     "mechanisms",
     "design",

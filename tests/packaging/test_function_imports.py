@@ -31,7 +31,6 @@ PACKAGE = "anthroarm"
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
-    "jit.py": 1,
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
     # a circle: load() reads OpenSim files (osim), whose loader makes Robots (osim imports

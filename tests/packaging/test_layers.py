@@ -14,7 +14,7 @@ import pytest
 
 LAYERS = [
     ("faces", ["cli", "viewer"]),
-    ("applications", ["prosthesis", "batch", "crosscheck"]),
+    ("applications", ["prosthesis", "batch", "crosscheck", "warmup"]),
     (
         "algorithms",
         ["kinematics", "ik", "dynamics", "mechanisms", "design", "hand", "motion", "control"]
