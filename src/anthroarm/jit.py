@@ -178,10 +178,14 @@ class Kernel:
 
     def _first(self, *args):
         start()
-        if self.fn == self._first:  # reference mode: remember what the switch must load
-            self.fn = reference(self)
-        if self.seen is None and STATE.compiled is False:
-            self.seen = tuple(numba.typeof(a) for a in args)
+        with STATE.lock:
+            if self.fn == self._first:  # made after the process chose its mode
+                if STATE.compiled:
+                    self.fn = self.dispatcher
+                else:
+                    self.fn = reference(self)
+                    if self.seen is None:  # what the switch must load
+                        self.seen = tuple(numba.typeof(a) for a in args)
         return self.fn(*args)
 
     @property
