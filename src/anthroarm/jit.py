@@ -665,6 +665,12 @@ def start() -> None:
             )
 
 
+def compiled() -> bool:
+    """True if this process runs compiled kernels now (deciding its mode first)."""
+    start()
+    return bool(STATE.compiled)
+
+
 def status() -> str:
     """``compiled``, ``reference (<why>)`` or ``not started``: what this process runs."""
     if STATE.compiled is None:
@@ -695,6 +701,7 @@ __all__ = [
     "Entry",
     "Kernel",
     "callees",
+    "compiled",
     "entry_point",
     "kernel",
     "kernel_sources_digest",

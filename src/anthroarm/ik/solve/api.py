@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ... import jit
 from ..closed.limits import refine
 from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
@@ -77,8 +78,17 @@ class Problem:
         return sh.lo_s + (sh.hi_s - sh.lo_s) * self._gen.random(sh.n)
 
     def closed_form_first(self, seed) -> bool:
+        """The closed form answers first (``analytic=True``, or ``"auto"`` where it is cheap:
+        :func:`.seeds.closed_form_cheap`).  A redundant arm's swivel grid is cheap compiled,
+        not on the reference path (:mod:`anthroarm.jit`: ~18 ms a target for human_arm7,
+        against ~1 ms for a 6R class): until the process runs compiled kernels, Gauss–Newton
+        goes first there and the closed form joins as seeds after ``ANALYTIC_AFTER`` attempts."""
+        sh = self.ws.sh
         return self.analytic is True or (
-            self.analytic == "auto" and seed is None and self.ws.sh.closed_form_first
+            self.analytic == "auto"
+            and seed is None
+            and sh.closed_form_first
+            and (not sh.swivel_family or jit.compiled())
         )
 
 
