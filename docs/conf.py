@@ -60,6 +60,7 @@ GUIDE = [
     "collision",
     "motion",
     "opensim_ik",
+    "muscles",
     "prosthesis",
     "emg",
     "control",
