@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import anthroarm as aa
@@ -60,3 +61,46 @@ def test_ik_markers_trc_needs_an_osim_model(tmp_path):
     r = cli("ik-markers", TRC, "human_arm7", "-o", tmp_path / "q.csv")
     assert r.returncode != 0 and ".osim" in r.stderr, r.stderr
     assert not (tmp_path / "q.csv").exists()
+
+
+@pytest.mark.parametrize(
+    "name, tool",
+    [("arm26", "r_ulna_radius_hand"), ("Tug_of_War", "block")],
+)
+def test_urdf_of_an_uncoupled_osim_model(tmp_path, name, tool):
+    """The written URDF, read by Pinocchio (aa.load) and yourdfpy, puts every OpenSim body and
+    marker where the .osim import does (checked against OpenSim in tests/osim) and gives the
+    same mass matrix."""
+    import yourdfpy
+
+    out = tmp_path / f"{name}.urdf"
+    r = cli("urdf", aa.osim.path(name), "-o", out)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "gravity" in r.stdout  # the one thing a URDF cannot carry is said
+    osim_robot = aa.load(aa.osim.path(name))
+    urdf_robot = aa.load(str(out), tool=tool)
+    assert urdf_robot.joint_names == osim_robot.joint_names
+    np.testing.assert_array_equal(urdf_robot.lower, osim_robot.lower)
+    np.testing.assert_array_equal(urdf_robot.upper, osim_robot.upper)
+    u = yourdfpy.URDF.load(str(out))
+    frames = [f for f in osim_robot.markers] + [tool]
+    for q in osim_robot.random_q(5, rng=7):
+        m, d = urdf_robot.model, urdf_robot.model.createData()
+        M = np.triu(pin.crba(m, d, q))
+        M = M + np.triu(M, 1).T
+        np.testing.assert_allclose(M, osim_robot.mass_matrix(q), rtol=1e-12, atol=1e-14)
+        m.gravity = osim_robot.model.gravity  # a URDF has no gravity: OpenSim's is along -y
+        g = pin.computeGeneralizedGravity(m, d, q)
+        np.testing.assert_allclose(g, osim_robot.gravity(q), rtol=1e-12, atol=1e-13)
+        u.update_cfg(dict(zip(osim_robot.joint_names, q)))
+        for f in frames:
+            T = osim_robot.fk(q, f)
+            np.testing.assert_allclose(urdf_robot.fk(q, f), T, atol=1e-12)
+            np.testing.assert_allclose(u.get_transform(f, "root"), T, atol=1e-12)
+
+
+def test_urdf_refuses_a_model_with_spline_couplings(tmp_path):
+    out = tmp_path / "gait.urdf"
+    r = cli("urdf", aa.osim.path("gait2392"), "-o", out)
+    assert r.returncode != 0 and not out.exists()
+    assert "knee_r_translation1" in r.stderr and "URDF" in r.stderr, r.stderr
