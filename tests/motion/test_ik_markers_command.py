@@ -1,4 +1,5 @@
-"""The ``anthroarm ik-markers`` command on a real C3D file, and a marker set of one's own as JSON."""
+"""The ``anthroarm ik-markers`` command on a real C3D file, and a marker set of one's own as
+JSON."""
 
 import json
 
