@@ -104,3 +104,34 @@ def test_urdf_refuses_a_model_with_spline_couplings(tmp_path):
     r = cli("urdf", aa.osim.path("gait2392"), "-o", out)
     assert r.returncode != 0 and not out.exists()
     assert "knee_r_translation1" in r.stderr and "URDF" in r.stderr, r.stderr
+
+
+def test_view_osim_takes_the_coordinates(tmp_path):
+    """``anthroarm view gait.osim --deg --q`` (23 coordinates, degrees for the angles) writes a
+    page whose knee is where robot.fk puts it (the tibia's spline translation included)."""
+    import base64
+    import json
+    import re
+
+    import umsgpack
+
+    from anthroarm.viewer import Viewer
+
+    gait = aa.load(aa.osim.path("gait2392"))
+    values = ["0"] * gait.nq
+    knee = gait.joint_names.index("knee_angle_r")
+    values[knee] = "-60"
+    values[gait.joint_names.index("pelvis_ty")] = "0.9"  # m: not converted by --deg
+    out = tmp_path / "gait.html"
+    r = cli("view", aa.osim.path("gait2392"), "-o", out, "--deg", "--q", *values)
+    assert r.returncode == 0, r.stdout + r.stderr
+    m = re.search(r"var cmds = (\[.*?\]);", out.read_text(), re.S)
+    cmds = [umsgpack.unpackb(base64.b64decode(c)) for c in json.loads(m.group(1))]
+    sent = {c["path"]: np.asarray(c["matrix"]).reshape(4, 4).T for c in cmds if "matrix" in c}
+    q = np.zeros(gait.nq)
+    q[knee], q[gait.joint_names.index("pelvis_ty")] = np.deg2rad(-60.0), 0.9
+    v = Viewer(gait)
+    tibia = gait.model.frames[gait.frame_id("tibia_r")]
+    body = next(b for b in v.bodies if b.joint is not None and b.joint + 1 == tibia.parentJoint)
+    want = gait.fk(q, "tibia_r") @ np.linalg.inv(tibia.placement.homogeneous)
+    np.testing.assert_allclose(sent[v._bpath(body)], want, atol=1e-12)
