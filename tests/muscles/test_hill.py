@@ -16,6 +16,8 @@ OpenSim's Newton has stopped at the bound.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -93,10 +95,8 @@ def test_millard_not_evaluated_is_a_typed_error(tmp_path):
         muscles.equilibrium(ms, np.full(len(ms), 0.3), 0.5)
 
 
-opensim = pytest.importorskip("opensim")
-
-
 def _against_opensim(name, n, seed):
+    opensim = pytest.importorskip("opensim")
     path = aa.osim.path(name)
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
@@ -149,13 +149,12 @@ def test_arm26_equilibrium_against_opensim():
 def test_joint_torques_against_opensim(tmp_path):
     """τ = Rᵀ f against Σ OpenSim computeMomentArm × OpenSim getTendonForce (arm26 with the
     cylinders only, where our paths are OpenSim's)."""
-    import re
-
     text = re.sub(
         r"(<WrapEllipsoid name=\"\w+\">\s*<!--[^>]*-->\s*<active>)true",
         r"\1false",
         aa.osim.path("arm26").read_text(),
     )
+    opensim = pytest.importorskip("opensim")
     p = tmp_path / "arm26_cylinders.osim"
     p.write_text(text)
     robot = aa.load(p)
