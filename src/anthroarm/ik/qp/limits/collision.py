@@ -119,6 +119,14 @@ class CollisionLimit(Limit):
             cm=self.model,
         )
 
+    def min_distance_at(self, q) -> float:
+        """The smallest distance (m) of the pairs this limit constrains at configuration ``q``
+        (coal; ``inf`` when none)."""
+        return coll.compute(
+            self.robot, q, self.env, cutoff=self.d_detect, self_collision=self.self_collision,
+            best_only=True, cm=self.model,
+        ).min  # fmt: skip
+
     def inequalities(self, conf, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """(G, h) with G Δq ≤ h, one row per pair closer than d_i."""
         dist = self.last = self.distances(conf)
