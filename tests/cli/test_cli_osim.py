@@ -135,3 +135,9 @@ def test_view_osim_takes_the_coordinates(tmp_path):
     body = next(b for b in v.bodies if b.joint is not None and b.joint + 1 == tibia.parentJoint)
     want = gait.fk(q, "tibia_r") @ np.linalg.inv(tibia.placement.homogeneous)
     np.testing.assert_allclose(sent[v._bpath(body)], want, atol=1e-12)
+
+
+def test_ik_on_a_coupled_model_names_the_remedy():
+    r = cli("ik", aa.osim.path("gait2392"), "--tool", "calcn_r", "--xyz", "0.1", "-0.8", "0.1")
+    assert r.returncode != 0
+    assert "CoupledMarkerIK" in r.stderr and "Traceback" not in r.stderr, r.stderr
