@@ -10,7 +10,8 @@ target runs ``STEPS`` QP steps of dt = 10 ms from the start: FrameTask on the to
 both with daqp.
 
 * ours: :class:`~anthroarm.ik.qp.limits.collision.CollisionLimit` (d_s = d_min, d_i = d_min +
-  3 cm, ξ = 0.5 m/s) through :func:`~anthroarm.ik.qp.limits.collision_step.step`;
+  3 cm, ξ = 0.5 m/s, margin 1 mm) through :func:`~anthroarm.ik.qp.limits.collision_step.step`
+  (with its step acceptance on the true distances);
 * pink: ``SelfCollisionBarrier(n_collision_pairs = every pair, d_min, gain 1)`` on the same
   ``pin.GeometryModel`` (the robot's bodies and the obstacles, the same active pairs),
   ``solve_ik(..., solver="daqp", safety_break=False)``.

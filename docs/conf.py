@@ -44,6 +44,7 @@ extensions = [
 build_pages.copy_notebooks(ROOT / "notebooks", DOCS / "notebooks")
 build_pages.benchmark_pages(ROOT / "benchmarks" / "results", DOCS / "benchmarks" / "generated")
 build_pages.equation_table(DOCS / "book_map_equations.md")
+build_pages.PUBLIC.update(build_pages.public_paths())  # anthroarm.robot.load -> anthroarm.load
 build_pages.api_pages(DOCS / "api" / "generated")
 # the guide's table of contents: docs/batch.md (batch jobs, local or Dask) joins it when it exists
 GUIDE = [
@@ -60,6 +61,7 @@ GUIDE = [
     "collision",
     "motion",
     "opensim_ik",
+    "muscles",
     "prosthesis",
     "emg",
     "control",
@@ -96,7 +98,8 @@ nitpick_ignore_regex = [
         r"py:.*",
         r"(numpy|np|scipy|sympy|pinocchio|pin|meshcat|matplotlib|dask|distributed|xarray"
         r"|yourdfpy|lxml|qpsolvers|osqp|tornado|zmq|pathlib|os|typing|collections|concurrent"
-        r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes|numba)(\..*)?",
+        r"|threading|subprocess|argparse|io|numbers|enum|abc|types|weakref|tqdm|ctypes|numba"
+        r"|datetime)(\..*)?",
     ),
     # prose in numpydoc type fields ("array (N, 3)", "float, rad") is not a Python name
     (r"py:class", r"[a-z_][a-z0-9_]*|.*[^\w.].*|True|False|[A-Z]|\d+|Eq\.?|\."),
@@ -161,3 +164,4 @@ html_show_sourcelink = False
 def setup(app):
     app.connect("autodoc-process-docstring", build_pages.escape_bars)
     app.connect("autodoc-skip-member", build_pages.skip_shadowing)
+    app.connect("autodoc-skip-member", build_pages.skip_moved)

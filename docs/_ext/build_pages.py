@@ -208,6 +208,72 @@ def equation_table(out: Path, package: str = "anthroarm") -> int:
 
 
 # ------------------------------------------------------------------------------- API pages
+def _exported(mod) -> list[str]:
+    """A package's re-exported names: its ``__all__``, else its public attributes that are
+    functions or classes defined in one of its submodules (``anthroarm.ik.analytic``)."""
+    if hasattr(mod, "__all__"):
+        return list(mod.__all__)
+    return [
+        n
+        for n, o in vars(mod).items()
+        if not n.startswith("_")
+        and (inspect.isfunction(o) or inspect.isclass(o))
+        and getattr(o, "__module__", "").startswith(mod.__name__ + ".")
+    ]
+
+
+def public_paths(package: str = "anthroarm") -> dict[str, str]:
+    """Where users import each re-exported function and class from: defining path -> public
+    path (``anthroarm.robot.load`` -> ``anthroarm.load``).  A name a package re-exports
+    (:func:`_exported`) from a deeper module is documented at the package (the shortest such
+    path).  A public path that is also a module's name (``anthroarm.ik.solve``, the function and
+    its subpackage) is taken only when that module has nothing else of its own to document (its
+    page then gets no index entry: :data:`SHADOWED`); otherwise the name stays where it is
+    defined."""
+    mods = _public_modules(package)
+    modset = set(mods)
+    out: dict[str, str] = {}
+    for m in mods:
+        mod = importlib.import_module(m)
+        if not hasattr(mod, "__path__"):
+            continue
+        for name in _exported(mod):
+            obj = getattr(mod, name, None)
+            if not (inspect.isfunction(obj) or inspect.isclass(obj)):
+                continue
+            canon = f"{obj.__module__}.{obj.__qualname__}"
+            public = f"{m}.{name}"
+            if canon == public or not canon.startswith(package + "."):
+                continue
+            if canon not in out or len(public) < len(out[canon]):
+                out[canon] = public
+    SHADOWED.clear()
+    for canon, public in list(out.items()):
+        if public not in modset:
+            continue
+        own = _own_members(public)
+        if all(f"{public}.{n}" in out for n in own):
+            SHADOWED.add(public)
+        else:
+            del out[canon]
+    return out
+
+
+def _own_members(module: str) -> list[str]:
+    mod = importlib.import_module(module)
+    return [
+        n
+        for n, o in vars(mod).items()
+        if not n.startswith("_")
+        and (inspect.isfunction(o) or inspect.isclass(o))
+        and getattr(o, "__module__", None) == module
+    ]
+
+
+#: modules whose name is also a public function's (their page has no index entry)
+SHADOWED: set[str] = set()
+
+
 def api_pages(dst: Path, package: str = "anthroarm") -> list[str]:
     """One reST page per public module (``automodule``), its submodules in a toctree.
 
@@ -215,12 +281,21 @@ def api_pages(dst: Path, package: str = "anthroarm") -> list[str]:
     under the name of its module (``anthroarm.mechanisms.fourbar`` is both), which autosummary
     resolves to the function."""
     mods = _public_modules(package)
+    public = public_paths(package)
     if dst.exists():
         shutil.rmtree(dst)
     dst.mkdir(parents=True)
     for m in mods:
         children = [c for c in mods if c.rpartition(".")[0] == m]
         text = f"{m}\n{'=' * len(m)}\n\n.. automodule:: {m}\n"
+        if m in SHADOWED:  # the name is the function's (documented on the package's page)
+            text += "   :no-index:\n"
+        here = sorted((p, c) for c, p in public.items() if p.rpartition(".")[0] == m)
+        if here:  # the names users import from this package, documented at that path
+            text += "\n.. rubric:: Imported from here\n\n"
+            for p, c in here:
+                kind = "class" if inspect.isclass(_object(c)) else "function"
+                text += f".. auto{kind}:: {p}\n\n"
         if children:
             text += "\n.. rubric:: Submodules\n\n.. toctree::\n   :maxdepth: 1\n\n"
             text += "".join(f"   {c}\n" for c in children)
@@ -253,6 +328,34 @@ def escape_bars(app, what, name, obj, options, lines):
             lines.insert(i, "")
             i += 1
         i += 1
+
+
+def _object(path: str):
+    mod, _, rest = path.partition(".")
+    obj = importlib.import_module(mod)
+    parts = rest.split(".")
+    for i in range(len(parts)):  # the longest importable module prefix, then attributes
+        try:
+            obj = importlib.import_module(".".join([mod, *parts[: i + 1]]))
+        except ImportError:
+            for p in parts[i:]:
+                obj = getattr(obj, p)
+            return obj
+    return obj
+
+
+def skip_moved(app, what, name, obj, skip, options):
+    """autodoc-skip-member: a function or class documented where users import it
+    (:func:`public_paths`) is not documented a second time in the module that defines it."""
+    if what == "module" and (inspect.isfunction(obj) or inspect.isclass(obj)):
+        canon = f"{getattr(obj, '__module__', '')}.{getattr(obj, '__qualname__', '')}"
+        if canon in PUBLIC:
+            return True
+    return None
+
+
+#: defining path -> public path, filled once by conf.py (:func:`public_paths`)
+PUBLIC: dict[str, str] = {}
 
 
 def skip_shadowing(app, what, name, obj, skip, options):

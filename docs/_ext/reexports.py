@@ -1,8 +1,8 @@
 """Sphinx extension: resolve cross-references the way Python resolves the name.
 
-The API reference documents every object once, in the module that defines it
-(``ignore-module-all``); packages re-export names (``anthroarm.load`` is
-``anthroarm.robot.load``, ``qp.IKConfiguration`` lives in ``anthroarm.ik.qp.configuration``).
+The API reference documents every object once: where users import it when a package
+re-exports it (``anthroarm.load``, defined as ``anthroarm.robot.load``; build_pages.PUBLIC),
+else in the module that defines it (``ignore-module-all``).
 When Sphinx finds no target for a reference, this looks the name up as Python would — relative
 to the module and class the reference is written in, then absolute — and, if the object exists
 and is documented under its defining module, links there.  A name that Python cannot find stays
@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import importlib
 import inspect
+
+from build_pages import PUBLIC
 
 
 def _lookup(path: str):
@@ -46,6 +48,28 @@ def _canonical(obj, fallback: str) -> str | None:
     return None
 
 
+def _public(real: str) -> str | None:
+    """``real`` (a defining path) where users import it (build_pages.PUBLIC): the object
+    itself, or a member of a class documented at its public path."""
+    parts = real.split(".")
+    for i in range(len(parts), 1, -1):
+        head = ".".join(parts[:i])
+        if head in PUBLIC:
+            return ".".join([PUBLIC[head], *parts[i:]])
+    return None
+
+
+def _defined_path(name: str) -> str:
+    """A documented name as the path where it is defined (the inverse of :func:`_public`)."""
+    back = {v: k for k, v in PUBLIC.items()}
+    parts = name.split(".")
+    for i in range(len(parts), 1, -1):
+        head = ".".join(parts[:i])
+        if head in back:
+            return ".".join([back[head], *parts[i:]])
+    return name
+
+
 def missing_reference(app, env, node, contnode):
     if node.get("refdomain") != "py":
         return None
@@ -58,27 +82,49 @@ def missing_reference(app, env, node, contnode):
         parts = mod.split(".")
         candidates += [".".join(parts[:i] + [target]) for i in range(len(parts), 0, -1)]
     candidates.append(target)
+    if mod and "." not in target:  # a docstring moved to its package's page (build_pages):
+        # its short names are relative to the module that defines it
+        homes = sorted(
+            {c.rpartition(".")[0] for c, p in PUBLIC.items() if p.rpartition(".")[0] == mod}
+        )
+        candidates += [f"{h}.{target}" for h in homes]
     domain = env.get_domain("py")
+    for cand in candidates:  # a member of a class documented at its public path, by name
+        moved = _public(cand)
+        if moved:
+            node2 = node.deepcopy()
+            node2["reftarget"] = moved
+            node2["refspecific"] = False
+            res = domain.resolve_xref(
+                env, node["refdoc"], app.builder, "obj", moved, node2, contnode
+            )
+            if res is not None:
+                return res
     for cand in candidates:
         obj = _lookup(cand)
         if obj is None:
             continue
         real = _canonical(obj, cand)
-        if not real or real == cand and cand == target:
+        if not real:
             continue
-        node2 = node.deepcopy()
-        node2["reftarget"] = real
-        node2["refspecific"] = False
-        res = domain.resolve_xref(env, node["refdoc"], app.builder, "obj", real, node2, contnode)
-        if res is not None:
-            return res
+        for name in (real, _public(real)):
+            if not name or name == cand and cand == target:
+                continue
+            node2 = node.deepcopy()
+            node2["reftarget"] = name
+            node2["refspecific"] = False
+            res = domain.resolve_xref(
+                env, node["refdoc"], app.builder, "obj", name, node2, contnode
+            )
+            if res is not None:
+                return res
     # a method or attribute named without its class (:meth:`angles` in anthroarm.chain): the one
     # documented object of that name in the same module
     if mod and "." not in target:
         hits = [
             name
             for name, _ in domain.find_obj(env, mod, None, target, None, 1)
-            if name.startswith(mod + ".")
+            if _defined_path(name).startswith(mod + ".")
         ]
         if len(hits) == 1:
             return domain.resolve_xref(

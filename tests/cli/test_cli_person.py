@@ -68,11 +68,16 @@ def test_every_command_offers_the_same_person(argv):
         (["urdf", "human_arm7", "--mass", "7"], "outside 10–300 kg"),
         (["ik-markers", "t.c3d", "--height", "162"], "give metres"),
         (["demo", "--sex", "f"], "invalid choice: 'f'"),
+        (["batch", "population", "--heights", "150,160"], "--heights 150 is outside 0.5–2.6 m"),
+        (["batch", "population", "--masses", "55000"], "give kilograms"),
+        (["batch", "population", "--sexes", "m"], "male and female"),
         (["size", "--payload", "-1"], "kg"),
     ],
 )
 def test_a_value_in_the_wrong_unit_is_refused_with_the_unit(tmp_path, capsys, argv, needle):
     out = tmp_path / ("x.csv" if argv[0] == "ik-markers" else "x.html")
+    if argv[0] == "batch":
+        out = tmp_path / "x.npz"
     if argv[0] == "urdf":
         out = tmp_path / "x.urdf"
     code = None

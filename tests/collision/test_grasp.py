@@ -22,10 +22,11 @@ def limb():
 def test_collision_free_grasp_reports_and_never_penetrates(limb):
     hand = H.Hand(limb)
     q0 = open_hand(limb, hand)
-    # a cylinder across the palm, 2 cm in front of it (palm normal from the model's FK)
+    # a cylinder across the palm, in front of it (palm axes from the model's FK), clear of it
     M = limb.fk(q0, frame="palm")
-    obj = H.Cylinder(M[:3, 3] + 0.045 * M[:3, 1], M[:3, 0], 0.02, length=0.12)
+    obj = H.Cylinder(M[:3, 3] + 0.06 * M[:3, 1], M[:3, 0], 0.02, length=0.12)
     env = C.environment([obj.obstacle()])
+    assert C.min_distance(limb, q0, env) > 0.0
     r = H.solve_grasp(
         limb, obj, hand=hand, q0=q0, collision_free=True, restarts=0, max_iterations=60
     )

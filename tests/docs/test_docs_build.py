@@ -188,9 +188,17 @@ def test_docs_site_builds_with_executed_notebooks_and_opens_in_chromium(tmp_path
     ]:
         assert (site / f"{page}.html").is_file(), f"{page}.html missing"
 
-    # the API reference: a page per public module, with the documented objects on it
-    robot = (site / "api" / "generated" / "anthroarm.robot.html").read_text(encoding="utf-8")
-    assert 'id="anthroarm.robot.Robot"' in robot and 'id="anthroarm.robot.load"' in robot
+    # the API reference: a page per public module, each object documented once, at the path
+    # users import it from (anthroarm.load, anthroarm.ik.solve ...; issue 31 item 2)
+    gen = site / "api" / "generated"
+    top = (gen / "anthroarm.html").read_text(encoding="utf-8")
+    assert 'id="anthroarm.Robot"' in top and 'id="anthroarm.load"' in top
+    robot = (gen / "anthroarm.robot.html").read_text(encoding="utf-8")
+    assert 'id="anthroarm.robot.load"' not in robot  # not twice
+    ik = (gen / "anthroarm.ik.html").read_text(encoding="utf-8")
+    assert 'id="anthroarm.ik.analytic"' in ik
+    qp = (gen / "anthroarm.ik.qp.html").read_text(encoding="utf-8")
+    assert 'id="anthroarm.ik.qp.IKConfiguration"' in qp
     api = list((site / "api" / "generated").glob("anthroarm.*.html"))
     assert len(api) >= 40, f"only {len(api)} API pages"
     for mod in [

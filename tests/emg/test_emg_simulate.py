@@ -13,6 +13,7 @@ import anthroarm as aa
 from anthroarm.emg import EMGProcessor, synthesize
 from anthroarm.emg.simulate import HandModel, simulate_powered_hand
 from anthroarm.errors import EMGError, ParameterError, UnknownFrameError
+from anthroarm.viewer.pages import motion_viewer
 
 FS = 2000.0
 JOINTS = {"elbow": "elbow_flexion", "wrist": "forearm_rotation", "fingers": None}
@@ -100,7 +101,7 @@ def test_no_emg_keeps_the_arm_at_rest(arm):
 def test_plot_and_viewer(run):
     fig = run.plot()
     assert len(fig.axes) == 5
-    html = run.viewer(every=10).static_html()
+    html = motion_viewer(run.robot, run.q, run.trace.frame_s, every=10).static_html()
     assert "set_animation" in html or "animation" in html
 
 

@@ -8,28 +8,11 @@ import pytest
 import anthroarm as aa
 from anthroarm import crosscheck
 from anthroarm.kinematics import book_fk as cf
-from anthroarm.kinematics.batched import SerialChain
-from anthroarm.kinematics.dh import dh_fk, dh_jacobian, dh_transform
+from anthroarm.kinematics.dh import dh_fk, dh_transform
 from anthroarm.models import book as book_models
-from anthroarm.models.spec import DHRow, dh_matrix
+from anthroarm.models.spec import DHRow
 
 N = 300
-
-
-def test_dh_transform_is_rz_tz_tx_rx():
-    """Eq. (6-12) equals Rz(θ) Tz(s) Tx(h) Rx(α) (mathematics, element by element)."""
-    rng = np.random.default_rng(0)
-    th, s, h, al = rng.uniform(-3, 3, 4)
-    Rz = np.eye(4)
-    Rz[:2, :2] = [[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]]
-    Rx = np.eye(4)
-    Rx[1:3, 1:3] = [[np.cos(al), -np.sin(al)], [np.sin(al), np.cos(al)]]
-    Tz, Tx = np.eye(4), np.eye(4)
-    Tz[2, 3], Tx[0, 3] = s, h
-    np.testing.assert_allclose(dh_transform(th, s, h, al), Rz @ Tz @ Tx @ Rx, atol=1e-15)
-    np.testing.assert_allclose(
-        dh_matrix(DHRow("R", al, s=s, h=h), th), Rz @ Tz @ Tx @ Rx, atol=1e-15
-    )
 
 
 def test_sixr_zero_pose_from_notes():
@@ -39,14 +22,6 @@ def test_sixr_zero_pose_from_notes():
     T = cf.sixr_hand_pose(np.zeros(6), p["s0"], p["h2"], p["s3"], p["P"])
     np.testing.assert_allclose(T[:3, :3], np.eye(3), atol=1e-15)
     np.testing.assert_allclose(T[:3, 3], [p["h2"], 0, p["s0"] - p["s3"] + p["P"]], atol=1e-15)
-
-
-@pytest.mark.parametrize("name", ["sixr_arm", "unimate5", "rrprr5", "prosthetic_arm"])
-def test_dh_chain_and_jacobian_vs_pinocchio(name):
-    r = aa.load(name)
-    Q = r.random_q(N, 1)
-    np.testing.assert_allclose(dh_fk(r.spec.dh, Q, r.spec.tool_dh), r.fk(Q), atol=1e-13)
-    np.testing.assert_allclose(dh_jacobian(r.spec.dh, Q, r.spec.tool_dh), r.jacobian(Q), atol=1e-13)
 
 
 def test_printed_hand_poses_vs_pinocchio():
@@ -93,15 +68,6 @@ def test_prosthetic_arm_points():
     )
     np.testing.assert_allclose(np.linalg.norm(W - E, axis=1), p["L2"], atol=1e-15)
     np.testing.assert_allclose(C, r.fk(Q)[:, :3, 3], atol=1e-15)
-
-
-@pytest.mark.parametrize("name", aa.models.names())
-def test_serial_chain_vs_pinocchio(name):
-    r = aa.load(name)
-    Q = r.random_q(100, 6)
-    T, J = SerialChain.of(r).fk_jacobian(Q)
-    np.testing.assert_allclose(T, r.fk(Q), atol=1e-13)
-    np.testing.assert_allclose(J, r.jacobian(Q), atol=1e-13)
 
 
 def test_bad_numbers_raise_value_errors():

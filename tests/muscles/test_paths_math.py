@@ -28,7 +28,7 @@ def test_gait2392_moment_arms_are_the_derivative_of_lengths():
     path = aa.osim.path("gait2392")
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
-    Q = robot.random_q(30, rng=4, margin=0.01)
+    Q = robot.random_q(15, rng=4, margin=0.01)
     L, R = muscles.lengths_and_moment_arms(robot, ms, Q)
     fd = _central(robot, ms, Q, wrap=False)
     # a ConditionalPathPoint switching inside the +-h interval makes l jump: leave those out

@@ -38,7 +38,6 @@ LOCAL_IMPORTS = {
     "robot.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
-    "emg/simulate.py": 1,
 }
 
 #: file -> private names (or names from private modules) imported from another package

@@ -43,10 +43,14 @@ def add_parser(sub):
     )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
-        "--heights", default="1.55,1.65,1.75,1.85", help="population: heights, m (comma-separated)"
+        "--heights",
+        default="1.55,1.65,1.75,1.85",
+        help="population: body heights, m (0.5–2.6; comma-separated)",
     )
-    p.add_argument("--masses", default="60,75", help="population: masses, kg")
-    p.add_argument("--sexes", default="female,male", help="population: sexes")
+    p.add_argument(
+        "--masses", default="60,75", help="population: body masses, kg (10–300; comma-separated)"
+    )
+    p.add_argument("--sexes", default="female,male", help="population: sexes, male and/or female")
     p.add_argument(
         "--configs", type=int, default=10, help="tolerance: random configurations (default 10)"
     )

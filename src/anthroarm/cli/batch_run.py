@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import batch
 from .common import UserError, parse_locked
+from .person import SEXES, check_person_value
 from .runtime import load_model, parse_params, resolve_model
 
 
@@ -16,6 +17,14 @@ def _floats(text, what):
         return [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
         raise UserError(f"--{what} expects comma-separated numbers, got {text!r}") from None
+
+
+def _sexes(text) -> list[str]:
+    out = [s.strip() for s in text.split(",") if s.strip()]
+    bad = [s for s in out if s not in SEXES]
+    if bad or not out:
+        raise UserError(f"--sexes takes comma-separated {' and '.join(SEXES)}, got {text!r}")
+    return out
 
 
 def run(a) -> int:
@@ -34,9 +43,11 @@ def run(a) -> int:
     if a.job == "population":
         kw.update(
             model=a.model,
-            heights=_floats(a.heights, "heights"),
-            masses=_floats(a.masses, "masses"),
-            sexes=[s.strip() for s in a.sexes.split(",") if s.strip()],
+            heights=[
+                check_person_value("height", h, "--heights") for h in _floats(a.heights, "heights")
+            ],
+            masses=[check_person_value("mass", m, "--masses") for m in _floats(a.masses, "masses")],
+            sexes=_sexes(a.sexes),
             voxel=a.voxel,
         )
     else:

@@ -1,5 +1,9 @@
 """``anthroarm ik-markers``: a C3D trial in, joint angles (CSV) out (parser; the run:
-:mod:`.ik_markers_run`).
+:mod:`.ik_markers_run`; an OpenSim model, ``.trc`` trial and ``Setup_IK.xml``:
+:mod:`.ik_markers_osim`, writing a ``.mot``).
+
+    anthroarm ik-markers walk.trc model.osim -o walk_ik.mot [--setup Setup_IK.xml]
+                         [--time-range 0.4 1.6]
 
     anthroarm ik-markers trial.c3d [MODEL] -o angles.csv [--height 1.62 --mass 55 --sex female]
                          [--static static.c3d] [--markers set.json] [--rename LABEL=MARKER ...]
@@ -33,7 +37,10 @@ def add_parser(sub):
         epilog="example: anthroarm ik-markers trial.c3d -o angles.csv --height 1.62 --mass 55 --sex female "
         "--static static.c3d",
     )
-    p.add_argument("trial", help="C3D file of the trial (POINT:UNITS mm, cm or m)")
+    p.add_argument(
+        "trial",
+        help="C3D file of the trial (POINT:UNITS mm, cm or m), or an OpenSim .trc with an .osim MODEL",
+    )
     add_model_argument(p, robot_options=False, params=False, optional=True)
     add_out(p, required=True, metavar="FILE.csv", help="joint angles, written atomically")
     add_person_options(p, given_only=True)
@@ -61,6 +68,20 @@ def add_parser(sub):
         default=None,
         metavar="NAME",
         help="whose markers to use in a trial of several subjects (labels NAME:MARKER)",
+    )
+    p.add_argument(
+        "--setup",
+        default=None,
+        metavar="SETUP_IK.xml",
+        help="OpenSim IK setup (an .osim MODEL): marker weights, coordinate tasks, time range",
+    )
+    p.add_argument(
+        "--time-range",
+        type=float,
+        nargs=2,
+        default=None,
+        metavar=("T0", "T1"),
+        help="an .osim MODEL: solve the frames from T0 to T1 s (default: the setup's, or all)",
     )
     p.add_argument("--solver", default="daqp", help="QP backend (default daqp)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -11,6 +11,8 @@ from pathlib import Path
 from ..motion import MarkerSet, marker_ik, read_c3d, scale_from_static
 from ..motion.csv_io import write_joint_csv
 from .common import UserError
+from .ik_markers_osim import is_osim
+from .ik_markers_osim import run as run_osim
 from .person import check_person
 from .runtime import load_model, progress, resolve_model
 
@@ -37,6 +39,8 @@ def run(a) -> int:
                 f"--out {a.out} is an input ({flag} {given}): it would be overwritten; "
                 "give another output file"
             )
+    if is_osim(a):  # an .osim model, a .trc trial or a Setup_IK.xml: marker IK in coordinates
+        return run_osim(a)
     person = check_person(a)
     trial = read_c3d(a.trial)
     robot = load_model(a.model, person)

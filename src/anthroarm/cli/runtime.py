@@ -92,6 +92,8 @@ def parse_q(robot, values, deg: bool, what: str = "--q"):
             f"{what} needs {len(names)} values for {robot.name} (joints: {', '.join(names)}), "
             f"got {len(values)}"
         )
+    if getattr(robot, "coupling", None) is not None:  # an OpenSim model: q is its coordinates
+        return _coordinates(robot, values, deg, what)
     joints = [robot.chain.joints[i] for i in robot.chain.independent]
     if not deg:
         check_radians(values, [j.kind != "prismatic" for j in joints], what)
@@ -101,6 +103,33 @@ def parse_q(robot, values, deg: bool, what: str = "--q"):
     if bad:
         print(
             f"anthroarm: warning: {what} is outside the joint limits of {', '.join(bad)}",
+            file=sys.stderr,
+        )
+    return q
+
+
+def _coordinates(robot, values, deg: bool, what: str):
+    """``parse_q`` of an OpenSim model with couplings: one value per coordinate (degrees with
+    --deg for the rotational ones; translations in m)."""
+    # angles: the coordinates that drive a rotation axis (motion.osim_ik.rotational_coordinates)
+    rot = {
+        c for j in robot.osim.joints for a in j.axes if a.name.startswith("rot") for c in a.coords
+    }
+    angular = [n in rot for n in robot.joint_names]
+    if not deg:
+        check_radians(values, angular, what)
+    q = np.array(
+        [math.radians(float(v)) if deg and a else float(v) for v, a in zip(values, angular)]
+    )
+    q = robot.check_q(q, what)
+    bad = [
+        n
+        for n, t, lo, hi in zip(robot.joint_names, q, robot.lower, robot.upper)
+        if not lo - 1e-9 <= t <= hi + 1e-9
+    ]
+    if bad:
+        print(
+            f"anthroarm: warning: {what} is outside the coordinate ranges of {', '.join(bad)}",
             file=sys.stderr,
         )
     return q

@@ -33,8 +33,7 @@ def _add_view(sub):
         description="Show a catalog model, an example-robot-data robot or a URDF file in a meshcat viewer on "
         "127.0.0.1, or write a self-contained HTML file.  Angles are radians unless --deg.",
         epilog="examples:\n  anthroarm view human_arm7 --q 40 -20 10 70 0 0 10 --deg --limits\n"
-        "  anthroarm view panda -o panda.html --workspace 3000\n"
-        "  anthroarm view human_upper_limb --camera front --fit pose",
+        "  anthroarm view panda -o panda.html --workspace 3000 --camera front --fit all",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_model_argument(p)

@@ -258,16 +258,6 @@ class PoweredHandResult:
         fig.tight_layout()
         return fig
 
-    def viewer(self, every: int = 4):
-        """A :class:`anthroarm.viewer.Viewer` of the arm playing the motion (every ``every``-th
-        frame); ``viewer.static_html()`` is a self-contained page."""
-        from ..viewer import Viewer
-
-        v = Viewer(self.robot)
-        Q = self.q[:: max(1, int(every))]
-        v.play(Q, dt=self.trace.frame_s * max(1, int(every)), loop=True, trace=False)
-        return v
-
 
 def _setpoints(
     trace: CodeTrace, j: int, speed: float, lo: float, hi: float, start: float

@@ -60,6 +60,8 @@ NORMAL_TOL = math.radians(5.0)
 #: body goes deeper into it, or into another body of the hand, than PENETRATION_TOL
 CONTACT_MARGIN = 1e-3
 PENETRATION_TOL = 1e-4
+#: the trust region (rad or m per iteration) of a collision-free grasp
+COLLISION_MAX_STEP = 0.05
 #: iterations without a 1 % improvement of the best error after which an attempt has stalled
 STALL_WINDOW = 25
 
@@ -374,8 +376,9 @@ def solve_grasp(
         the fingertips aim at the object grown by their capsules' radius, so that the pads
         touch it instead of their axes.  Success adds: every fingertip capsule within
         ``contact_margin`` of the object, no body deeper than 1e-4 m into it or into another
-        body; otherwise the status is ``"no_collision_free_grasp"``.  Not with ``couplings``
-        or ``step_fn``.
+        body; otherwise the status is ``"no_collision_free_grasp"``.  The trust region is at
+        most 0.05 rad per iteration (the damper is linear in q).  Not with ``couplings`` or
+        ``step_fn``.
     contact_margin : float
         Largest gap (m) between a fingertip capsule and the object that counts as touching.
 
@@ -395,6 +398,8 @@ def solve_grasp(
             raise GraspError("collision_free=True takes no couplings= and no step_fn=")
         coll = _CollisionGrasp(robot, hand, obj, contact_margin)
         obj, step_fn = coll.target, coll.step
+        # smaller iterations: the damper linearises d, and 0.2 rad steps leak ~2 mm
+        max_step = min(float(max_step), COLLISION_MAX_STEP)
     n = len(hand.fingers)
     points = None
     if contacts is not None:

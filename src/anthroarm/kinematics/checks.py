@@ -57,7 +57,8 @@ def _pinocchio(robot, Q):
     for i, q in enumerate(Q):
         pin.framesForwardKinematics(model, data, q)
         T[i] = data.oMf[fid].homogeneous
-        J[i] = pin.computeFrameJacobian(model, data, q, fid, LWA)
+        # Pinocchio gives (6,) for a one-joint model (Tug_of_War): keep (6, nv)
+        J[i] = pin.computeFrameJacobian(model, data, q, fid, LWA).reshape(6, -1)
     return T, J
 
 

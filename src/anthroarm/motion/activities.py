@@ -439,11 +439,11 @@ def _person(robot, height):
 
 
 def activity(name: str, robot, *, height: float | None = None, **params) -> Activity:
-    """The activity ``name`` (:func:`names`) for the person of ``robot`` (stature from
-    ``robot.spec.params["height"]`` or ``height=``, arm length from the model).  ``params``
-    override the builder's parameters: ``move`` (s per movement), ``hold`` (s), ``object_mass``
-    (kg), ``table_height``/``seat_height``/``shelf_height``/``handle_height`` (m above the floor),
-    ``repeats``/``strokes`` ...; an unknown parameter
+    """The activity ``name`` (:func:`~anthroarm.motion.activities.names`) for the person of
+    ``robot`` (stature from ``robot.spec.params["height"]`` or ``height=``, arm length from the
+    model).  ``params`` override the builder's parameters: ``move`` (s per movement), ``hold`` (s),
+    ``object_mass`` (kg), ``table_height``/``seat_height``/``shelf_height``/``handle_height`` (m
+    above the floor), ``repeats``/``strokes`` ...; an unknown parameter
     raises :class:`~anthroarm.errors.ActivityError`."""
     if name not in ACTIVITIES:
         raise ActivityError(f"unknown activity {name!r}; the library has: {', '.join(ACTIVITIES)}")

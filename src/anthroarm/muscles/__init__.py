@@ -9,7 +9,8 @@
 
 Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
 moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres), :mod:`.hill`
-(Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f).
+(Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f), :mod:`.optimize` (static
+optimisation through the QP layer).
 """
 
 from __future__ import annotations
@@ -22,10 +23,14 @@ from .hill import (
     passive_force_length,
     tendon_force_strain,
 )
+from .optimize import StaticOptimization, force_coefficients, static_optimization
 from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set
 from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
 
 __all__ = [
+    "StaticOptimization",
+    "force_coefficients",
+    "static_optimization",
     "Equilibrium",
     "active_force_length",
     "equilibrium",

@@ -205,7 +205,9 @@ def _evaluate(robot, muscles, q, wrap: bool):
     q2 = q.reshape(1, -1) if one else q
     L = np.zeros((q2.shape[0], len(ms)))
     D = np.zeros((q2.shape[0], len(ms), q2.shape[1]))
-    plan = robot.derived(f"muscles.plan.{id(ms)}", lambda _r: _Plan(ms))
+    plan = ms.__dict__.get("plan")  # kept with the muscle set it describes
+    if plan is None:
+        plan = ms.__dict__["plan"] = _Plan(ms)
     for a in range(0, q2.shape[0], CHUNK):
         b = min(a + CHUNK, q2.shape[0])
         L[a:b], D[a:b] = plan.run(Kinematics(robot, q2[a:b]), wrap)

@@ -29,7 +29,7 @@ import posixpath
 import numpy as np
 import pinocchio as pin
 
-from ..errors import OsimError
+from ..errors import OsimError, OsimUnsupportedError
 from .coupling import Coupling, Step
 from .functions import Constant
 from .reader import OsimModel
@@ -175,6 +175,18 @@ def build(m: OsimModel):
     for n in dependent:
         coords[n].dependent = True
 
+    # --- names: frames are found by name, so a marker may not take a body's
+    reserved = set(m.bodies) | {mk.name for mk in m.markers}
+    for mk in m.markers:
+        if mk.name in m.bodies:
+            raise OsimUnsupportedError(
+                m.path,
+                f"marker {mk.name!r} has the name of a body; frames are found by name: rename "
+                "the marker (or the body) in OpenSim",
+                f"<Marker name={mk.name!r}>",
+                mk.line,
+            )
+
     # --- Pinocchio
     model = pin.Model()
     model.name = m.name
@@ -222,7 +234,11 @@ def build(m: OsimModel):
                 np.array([lo]),
                 np.array([hi]),
             )
-            model.addJointFrame(cur)
+            fid = model.addJointFrame(cur)
+            if name in reserved:  # a body or marker has the coordinate's name: it keeps the name
+                f = model.frames[fid]
+                f.name = f"{name}_joint"
+                model.frames[fid] = f
             place = pin.SE3.Identity()
             if ident:
                 identity_of[cname] = model.idx_qs[cur]

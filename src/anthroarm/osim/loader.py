@@ -128,6 +128,14 @@ class OsimRobot(Robot):
         shape = (self.nq,) if n is None else (int(n), self.nq)
         return lo + (hi - lo) * rng.random(shape)
 
+    def angles(self, q) -> np.ndarray:
+        """The value of every Pinocchio joint (rad or m): φ(q) with a coupling (one per moving
+        transform axis, in Pinocchio's joint order), :meth:`Robot.angles
+        <anthroarm.robot.Robot.angles>` without."""
+        if self.coupling is None:
+            return super().angles(q)
+        return self.coupling.full(self.check_q(q))
+
     def full_q(self, q) -> np.ndarray:
         """The Pinocchio configuration φ(q) (q itself without a coupling)."""
         q = self.check_q(q)

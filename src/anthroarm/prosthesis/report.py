@@ -197,8 +197,8 @@ def _person_section(study) -> str:
         "<p class='note'>* "
         + ", ".join(tiny)
         + ": the model's small connecting bodies between joints that share a point (the "
-        "shoulder's three axes, the wrist's two): each segment's mass (de Leva 1996) sits on "
-        "the last joint of its group.  'Mass it moves' is everything distal of the joint, the "
+        "shoulder's three axes, the elbow and the forearm's rotation, the wrist's two): each "
+        "segment's mass (de Leva 1996) sits on the last joint of its group.  'Mass it moves' is everything distal of the joint, the "
         "load its motor carries (the held object comes on top).</p>"
         if tiny
         else ""

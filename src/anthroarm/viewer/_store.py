@@ -97,6 +97,14 @@ JS_PATCH = r"""
             y * x * v + z * s, c + y * y * v, y * z * v - x * s, 0,
             z * x * v - y * s, z * y * v + x * s, c + z * z * v, 0, 0, 0, 0, 1];
   }
+  function interp(xs, ys, x) {   // piecewise linear on increasing xs, held at the ends (Coupling tables)
+    var n = xs.length;
+    if (x <= xs[0]) { return ys[0]; }
+    if (x >= xs[n - 1]) { return ys[n - 1]; }
+    var lo = 0, hi = n - 1;
+    while (hi - lo > 1) { var m = (lo + hi) >> 1; if (xs[m] <= x) { lo = m; } else { hi = m; } }
+    return ys[lo] + (ys[hi] - ys[lo]) * (x - xs[lo]) / (xs[hi] - xs[lo]);
+  }
   function colMajor(M) { var o = []; for (var j = 0; j < 4; j++) { for (var i = 0; i < 4; i++) { o.push(M[4 * i + j]); } } return o; }
   function teach(spec) {
     var theta = spec.theta.slice();
@@ -104,7 +112,8 @@ JS_PATCH = r"""
       var T = [];
       for (var j = 0; j < spec.joints.length; j++) {
         var J = spec.joints[j];
-        if (J.src >= 0) { theta[j] = J.mult * theta[J.src] + J.off; }
+        if (J.xs) { theta[j] = interp(J.xs, J.ys, theta[J.src]); }
+        else if (J.src >= 0) { theta[j] = J.mult * theta[J.src] + J.off; }
         T.push(mul(mul(J.parent >= 0 ? T[J.parent] : EYE, J.placement), motion(J.kind, J.axis, theta[j])));
       }
       var cmds = spec.movers.map(function (m) {

@@ -64,7 +64,7 @@ class OverlaysMixin:
             return []  # nothing coloured, nothing to restore: the common case of display()
         prox = None
         if self._limits_on:
-            prox = limit_proximity(self.robot.chain.angles(q), self._joint_lower, self._joint_upper)
+            prox = limit_proximity(self.robot.angles(q), self._joint_lower, self._joint_upper)
         frames = self.robot.chain.frames
         want: dict[str, tuple | None] = {}
         where: dict[str, tuple] = {}

@@ -46,6 +46,14 @@ from .messages import (
 from .shapes import Body, box_corners, cylinder_between, local_corners, triad, y_to
 
 
+def pinocchio_q(robot, q) -> np.ndarray:
+    """Pinocchio's configuration of ``robot`` at ``q``: φ(q) for an OpenSim model whose joints
+    are functions of its coordinates (``robot.coupling``, :mod:`anthroarm.osim.coupling`), q
+    itself otherwise.  Works row-wise on a batch."""
+    c = getattr(robot, "coupling", None)
+    return q if c is None else c.full(q)
+
+
 def nice_length(x: float) -> float:
     """The largest of 1, 2, 5 × 10^k metres not above ``x`` (> 0): grid spacings, scale bars."""
     k = math.floor(math.log10(x))
@@ -155,7 +163,7 @@ class SceneMixin:
         def points(Q):
             pts = []
             for qi in Q:
-                pin.framesForwardKinematics(model, data, qi)
+                pin.framesForwardKinematics(model, data, pinocchio_q(robot, qi))
                 pts.extend(np.array(data.oMi[j.index + 1].translation) for j in robot.chain.joints)
                 pts.extend(np.array(data.oMf[f].translation) for f in tips)
             return np.asarray(pts + [np.zeros(3)])
@@ -205,7 +213,7 @@ class SceneMixin:
         (mesh files sent as they are have no bounds here and are skipped); only the bodies
         moved by one of ``joints`` (chain indices) when given."""
         model, data = self.robot.model, self.robot.data
-        pin.framesForwardKinematics(model, data, q)
+        pin.framesForwardKinematics(model, data, pinocchio_q(self.robot, q))
         out = [np.zeros((0, 3))]
         for b in self.bodies:
             if joints is not None and body_joint(self.robot.chain, b) not in joints:
@@ -453,7 +461,7 @@ class SceneMixin:
 
     def _pose_commands(self, q) -> list[dict]:
         model, data = self.robot.model, self.robot.data
-        pin.framesForwardKinematics(model, data, q)
+        pin.framesForwardKinematics(model, data, pinocchio_q(self.robot, q))
         oMi, oMf = data.oMi, data.oMf
         return [
             {

@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 
+from ..errors import ViewerError
 from .colors import LIMIT_RGB, LIMIT_WARN
 from .messages import delete, ui
 
@@ -57,7 +58,7 @@ class TeachMixin:
 
     def _teach_spec(self) -> dict:
         chain = self.robot.chain
-        theta = chain.angles(self.q)
+        theta = self.robot.angles(self.q)  # every Pinocchio joint (φ(q) for an OpenSim model)
         joints, sliders = [], []
         for j in chain.joints:
             m = j.mimic
@@ -116,6 +117,8 @@ class TeachMixin:
                 }
             )
             theta[j.index] = value * scale  # the page starts where its sliders are
+        if getattr(self.robot, "coupling", None) is not None:
+            joints, sliders, theta = coupled_sliders(self.robot, self.q, joints)
         movers = []
         for path, jid, fid in self._moving():
             if jid is not None:
@@ -171,3 +174,76 @@ class TeachMixin:
             },
             "limits": limits,
         }
+
+
+TABLE_POINTS = 257  # samples of a nonlinear φ_k over its coordinate's range (the page interpolates)
+
+
+def coupled_sliders(robot, q, joints):
+    """Teach sliders of an OpenSim model with nonlinear couplings (``robot.coupling``): one per
+    independent coordinate (named after it, within its range; mm for a translation), held in
+    ``theta`` after the Pinocchio joints; each Pinocchio joint follows its coordinate as a
+    linear relation (``mult``, ``off``: exact) or, for a spline or coupler, as a table of
+    :data:`TABLE_POINTS` samples of φ_k over the coordinate's range that the page interpolates
+    linearly (gait2392's knee translations: within 3.3e-7 m of the spline).  Returns
+    ``(joints, sliders, theta)``."""
+    c = robot.coupling
+    n = len(joints)
+    q = np.asarray(q, dtype=float)
+    # which coordinate moves each Pinocchio joint: G's non-zero column on a few states
+    Qs = np.vstack([q, robot.random_q(8, rng=0)])
+    _, G = c.jacobian(Qs)
+    moved = np.abs(G).max(axis=0) > 0  # (nq_full, nq)
+    chain = robot.chain
+    by_name = {j.name: j for j in chain.joints}
+    out = []
+    for k, spec in enumerate(joints):
+        spec = dict(spec)
+        cols = np.flatnonzero(moved[k])
+        if len(cols) == 0:  # held (a locked coordinate's function): keeps its value
+            spec.update(src=-1, mult=1.0, off=0.0)
+            out.append(spec)
+            continue
+        if len(cols) > 1:
+            raise ViewerError(
+                f"{robot.name}: joint {chain.joints[k].name!r} depends on several coordinates; "
+                "the teach sliders cannot drive it"
+            )
+        i = int(cols[0])
+        xs = np.linspace(c.lower[i], c.upper[i], TABLE_POINTS)
+        Q = np.repeat(q[None], TABLE_POINTS, axis=0)
+        Q[:, i] = xs
+        ys = c.full(Q)[:, k]
+        mult = (ys[-1] - ys[0]) / (xs[-1] - xs[0]) if xs[-1] > xs[0] else 0.0
+        off = ys[0] - mult * xs[0]
+        spec.update(src=n + i, mult=float(mult), off=float(off))
+        if np.abs(mult * xs + off - ys).max() > 1e-12:  # nonlinear: the sampled table
+            spec["xs"] = [float(x) for x in xs]
+            spec["ys"] = [float(y) for y in ys]
+        out.append(spec)
+    sliders = []
+    for i, name in enumerate(c.names):
+        j = by_name.get(name)  # the coordinate's own joint, else the first joint it moves
+        if j is None and moved[:, i].any():
+            j = chain.joints[int(np.flatnonzero(moved[:, i])[0])]
+        prismatic = j is not None and j.kind == "prismatic"
+        scale, unit = (1e-3, "mm") if prismatic else (math.pi / 180, "°")
+        lo, hi = c.lower[i] / scale, c.upper[i] / scale
+        lo, hi = math.ceil(lo * 10 - 1e-6) / 10, math.floor(hi * 10 + 1e-6) / 10
+        value = min(max(round(q[i] / scale * 10) / 10, lo), hi)
+        sliders.append(
+            {
+                "joint": n + i,
+                "name": name,
+                "min": lo,
+                "max": hi,
+                "step": 0.1,
+                "value": value,
+                "unit": unit,
+                "scale": scale,
+                "digits": 1,
+            }
+        )
+    qs = np.array([s["value"] * s["scale"] for s in sliders])  # the page starts at its sliders
+    theta = np.concatenate([c.full(qs), qs])
+    return out, sliders, theta

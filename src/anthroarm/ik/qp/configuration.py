@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...chain import CONTINUOUS
+from ...errors import UnsupportedModelError
 
 LOCAL = pin.ReferenceFrame.LOCAL
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -29,6 +30,21 @@ def ranged_joints(chain) -> list:
     revolute and prismatic joints (one entry of q, one of v; their limits may be infinite).
     A continuous joint has no range and a mimic joint follows its source."""
     return [j for j in chain.joints if not j.is_mimic and j.kind != CONTINUOUS]
+
+
+def refuse_coupled(robot, what: str) -> None:
+    """Raise :class:`~anthroarm.errors.UnsupportedModelError` for a robot whose Pinocchio joints
+    are nonlinear functions φ(q) of its coordinates (an OpenSim model with ``robot.coupling``):
+    ``what`` works in Pinocchio's joints, whose values would not stay on the coupling."""
+    c = getattr(robot, "coupling", None)
+    if c is not None:
+        raise UnsupportedModelError(
+            f"{robot.name}: {what} works in Pinocchio's {c.nq_full} joints, but this OpenSim "
+            f"model moves them as functions of its {c.nq} coordinates (robot.coupling: spline "
+            "or coupler constraints); use anthroarm.motion.osim_ik.CoupledMarkerIK / "
+            "osim_marker_ik (marker IK in the coordinates), with a frame's target as a marker "
+            "(robot.fk, robot.jacobian are in the coordinates)"
+        )
 
 
 class IKConfiguration:
@@ -50,6 +66,7 @@ class IKConfiguration:
     """
 
     def __init__(self, robot, q=None):
+        refuse_coupled(robot, "the QP layer (IKConfiguration)")
         self.robot = robot
         self.model: pin.Model = robot.model
         self.data: pin.Data = robot.model.createData()

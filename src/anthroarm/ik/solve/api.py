@@ -9,6 +9,7 @@ import numpy as np
 
 from ... import jit
 from ..closed.limits import refine
+from ..qp.configuration import refuse_coupled
 from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
@@ -154,7 +155,11 @@ def solve(
     -------
     IKResult, or IKBatchResult for a batch.  Every returned q is within the joint limits; a
     continuous joint's angle is the one the iteration reached from its seed (no added turn).
+    An OpenSim model with nonlinear couplings (``robot.coupling``) raises
+    :class:`~anthroarm.errors.UnsupportedModelError` naming the remedy
+    (:class:`~anthroarm.motion.osim_ik.CoupledMarkerIK`).
     """
+    refuse_coupled(robot, "aa.ik.solve")
     ws = workspace(robot, robot.frame_id(frame))
     sh = ws.sh
     if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):

@@ -41,7 +41,7 @@ class CollisionBarrier(CollisionLimit):
         self, robot, obstacles=None, d_min=0.02, gain=1.0, n_pairs=None, self_collision=True
     ):
         super().__init__(robot, obstacles, d_safe=d_min, d_detect=float(d_min) + 1.0,
-                         xi=1.0, self_collision=self_collision)  # fmt: skip
+                         xi=1.0, self_collision=self_collision, margin=0.0)  # fmt: skip
         g = float(gain)
         if not (math.isfinite(g) and g > 0):
             raise CollisionError(f"barrier gain must be a finite number > 0 (1/s), got {gain!r}")

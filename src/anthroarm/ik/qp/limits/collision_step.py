@@ -12,6 +12,8 @@ this function is the hook an inequality limit needs until ``qp.step`` takes G, h
 
 Status (``full=True``): ``"optimal"``; ``"start_in_collision"`` when a pair started in collision (d < 0;
 the rows then ask ḋ > 0: the step pushes the pair apart, as for any pair closer than d_s);
+``"blocked"`` when the step, halved six times, still took a pair below min(d_s, its distance
+before the step) by the true distances (step acceptance: the rows are linear in q);
 ``"relaxed"`` when the rows and the box had no common point even with the separation asked
 of pairs inside d_s halved three times, and the rows were relaxed to "get no closer"
 (h ← max(h, 0), feasible with Δq = 0); ``"infeasible"`` / ``"failed"`` with the
@@ -24,6 +26,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import pinocchio as pin
 
 from ..configuration import IKConfiguration
 from ..step import _Workspace, default_limits
@@ -31,6 +34,8 @@ from ..tasks.base import Task
 from .base import BIG, combine_into
 
 SOLVERS = ("daqp", "quadprog")
+#: halvings of a step whose true distances fall below the floor before it is refused
+BACKTRACK = 6
 
 
 @dataclass
@@ -47,7 +52,7 @@ class CollisionStepResult:
 
     @property
     def ok(self) -> bool:
-        return self.status in ("optimal", "start_in_collision", "relaxed")
+        return self.status in ("optimal", "start_in_collision", "relaxed", "blocked")
 
 
 def _solve_daqp(H, c, lo, hi, G, h):
@@ -75,6 +80,23 @@ def _solve_quadprog(H, c, lo, hi, G, h):
     except ValueError as exc:
         return None, "infeasible" if "inconsistent" in str(exc) else "failed"
     return x, "optimal"
+
+
+def _accept(conf, ineq, v, dt, dmin, status):
+    """Step acceptance: the rows linearise d with one witness point per pair, and when the
+    closest features switch within a step (a box's corner turning onto a face) the true
+    distance can fall below the prediction.  The step is checked with the true distances at
+    q + v dt and halved (up to :data:`BACKTRACK` times, then v = 0: ``"blocked"``) until no
+    pair ends below min(d_s, its smallest distance before the step)."""
+    floor = min(min(getattr(lim, "d_safe", 0.0) for lim in ineq), dmin) - 1e-6
+    robot = conf.robot
+    for _ in range(BACKTRACK):
+        q = pin.integrate(robot.model, conf.q, v * dt)
+        d = min(lim.min_distance_at(q) for lim in ineq)
+        if d >= floor:
+            return v, status
+        v = 0.5 * v
+    return np.zeros_like(v), "blocked"
 
 
 def step(
@@ -177,6 +199,8 @@ def step(
         v = np.zeros(nv)
     else:
         v = np.clip(x, lo, hi) / dt
+        if ineq and status != "failed":
+            v, status = _accept(conf, ineq, v, dt, dmin, status)
     for lim in boxes:
         lim.after_step(v, dt)
     if full:

@@ -146,7 +146,8 @@ def swivel_angle(robot, q, frames=None, ref=(0.0, 0.0, -1.0)):
     φ = atan2(d·v, d·u), the definition of the module docstring).  d is the elbow's offset from
     the axis, E − S projected ⊥ n; for a straight elbow (E on the axis) d = n × a_E with a_E
     the elbow joint's axis, so that φ stays defined (the closed form's convention).
-    ``frames`` = (shoulder, elbow, wrist), default :func:`swivel_frames`."""
+    ``frames`` = (shoulder, elbow, wrist),
+    default :func:`~anthroarm.ik.qp.tasks.swivel.swivel_frames`."""
     names = swivel_frames(robot, frames)
     q = robot.check_q(q)
     Q = np.atleast_2d(q)
@@ -172,7 +173,7 @@ class SwivelTask(Task):
     Residual e = wrap(φ(q) − φ*) (1,), Jacobian ∂φ/∂q = Σ_X (∂φ/∂X) J_X(q) over the position
     Jacobians (LOCAL_WORLD_ALIGNED, linear rows) of the shoulder, elbow and wrist frames:
     ``frames=(shoulder, elbow, wrist)``, by default the human-like layout found in
-    ``robot.chain`` (:func:`swivel_frames`)."""
+    ``robot.chain`` (:func:`~anthroarm.ik.qp.tasks.swivel.swivel_frames`)."""
 
     def __init__(
         self,

@@ -330,3 +330,26 @@ def test_bad_configuration_is_a_parameter_error():
     for bad in (np.zeros(5), np.full(robot.nq, np.nan), "x", None):
         with pytest.raises(aa.errors.ParameterError):
             robot.fk(bad)
+
+
+def test_marker_with_a_body_name(tmp_path):
+    p, line = edit(tmp_path, ARM, '<Marker name="r_acromion">', '<Marker name="r_humerus">')
+    e = load_error(p, OsimUnsupportedError)
+    assert_names(e, "Marker name='r_humerus'", line)
+    assert "name of a body" in str(e)
+
+
+def test_coordinate_with_a_body_name_keeps_both(tmp_path):
+    """A coordinate named like a body: the joint keeps the coordinate's name, the body frame
+    its own, the joint frame becomes ``<name>_joint`` (a frame lookup never finds the wrong
+    one)."""
+    out = ARM.replace("r_elbow_flex", "r_ulna_radius_hand")
+    p = tmp_path / "renamed.osim"
+    p.write_text(out)
+    robot = aa.load(p)
+    ref = aa.load(path("arm26"))
+    assert robot.joint_names == ["r_shoulder_elev", "r_ulna_radius_hand"]
+    q = ref.random_q(None, 0)
+    assert np.abs(robot.fk(q, "r_ulna_radius_hand") - ref.fk(q, "r_ulna_radius_hand")).max() == 0
+    assert "r_ulna_radius_hand_joint" in robot.frame_names
+    assert robot.chain.frame("r_ulna_radius_hand").is_body  # the body, not the joint's frame
