@@ -497,15 +497,19 @@ def write_stamp(complete: bool | None = None) -> dict:
     return files
 
 
-def verified() -> bool:
+def verified(strict: bool = True) -> bool:
     """Check every Numba file against the stamp; True if the stamp is complete and every file
-    it lists is there and matches.  A file that does not match, or that it does not list (in
-    anthroarm's own folder; in a folder given by ``$NUMBA_CACHE_DIR`` the subfolders of listed
-    files), is deleted — compiled again, never loaded — and the stamp rewritten incomplete."""
+    it lists is there and matches.  A file that does not match, or (``strict``) that it does
+    not list (in anthroarm's own folder; in a folder given by ``$NUMBA_CACHE_DIR`` the
+    subfolders of listed files), is deleted — compiled again, never loaded — and the stamp
+    rewritten incomplete.  The mode ``compile`` checks with ``strict=False``: files that
+    processes compiling in their own threads wrote since the stamp are theirs to list at exit."""
     listed, complete = _read_stamp()
     folder = numba_folder()
     found = _files(folder)
-    if not _own(folder):
+    if not strict:
+        found = {k: h for k, h in found.items() if k in listed}
+    elif not _own(folder):
         ours = {str(Path(k).parent) for k in listed}
         found = {k: h for k, h in found.items() if str(Path(k).parent) in ours}
     bad = [k for k, h in found.items() if listed.get(k) != h]
@@ -635,7 +639,7 @@ def start() -> None:
         if STATE.compiled is not None:
             return
         m = mode()
-        ready = m != "reference" and verified()  # damaged files deleted in either mode
+        ready = m != "reference" and verified(strict=m == "auto")  # damaged files deleted
         if m != "reference":
             atexit.register(_at_exit)
         if m == "compile" or ready:
