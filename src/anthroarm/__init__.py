@@ -40,7 +40,7 @@ _LAZY = {
 }
 #: names loaded from a submodule on first use, like the subpackages: ``import anthroarm`` (and
 #: with it ``anthroarm --help``) loads neither numpy nor pinocchio until a model is needed
-_LAZY_NAMES = {"Robot": "robot", "load": "robot"}
+_LAZY_NAMES = {"Robot": "robot", "load": "loading"}
 
 
 def __getattr__(name):  # lazy subpackages: `aa.ik.solve(...)` without importing everything up front

@@ -34,7 +34,8 @@ from . import ik
 from . import models as catalog
 from .check_rows import UNSUPPORTED, CheckRow  # CheckRow re-exported: aa.crosscheck.CheckRow
 from .errors import UnsupportedModelError
-from .robot import Robot, load
+from .loading import load
+from .robot import Robot
 
 #: providers run on every robot, ``rows(robot, samples, rng)``: dotted name -> what it checks
 ROBOT_PROVIDERS: dict[str, str] = {

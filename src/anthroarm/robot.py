@@ -502,7 +502,6 @@ def load(
     :class:`~anthroarm.errors.UnsupportedModelError` for a joint no algorithm here handles
     (free-flyer, spherical, planar: lock it or pick a sub-chain).
     """
-    from . import osim  # it imports this module (its builder makes Robots)
 
     def no_params(what):
         if params:
@@ -586,10 +585,8 @@ def load(
             description=f"{s} (example-robot-data)",
             **common,
         )
-    if s.lower().endswith(".osim"):  # an OpenSim model: anthroarm.osim.load_osim (strict=)
-        strict = params.pop("strict", False)
-        no_params(f"the OpenSim model {s}")
-        return osim.load_osim(s, tool=tool, name=name, strict=strict, active=active, locked=locked)
+    if s.lower().endswith(".osim"):  # read by anthroarm.load (anthroarm.loading), above osim
+        raise ParameterError(f"{s} is an OpenSim model: load it with anthroarm.load")
     looks_like_path = s.endswith(".urdf") or "/" in s or Path(s).exists()
     if not looks_like_path:
         raise models._unknown(s)

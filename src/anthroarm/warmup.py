@@ -27,8 +27,8 @@ from . import jit, models
 from .errors import AnthroarmError
 from .ik import analytic, analytic_batch, closed_form_info, geometric, solve
 from .ik import subproblems as sp
+from .loading import load
 from .models.standard_dh import standard_dh_urdf
-from .robot import load
 
 #: standard DH rows (alpha rad, a m, d m) of user 6R arms of the classes no catalog arm has:
 #: the 1-D searches (joints 2 ∥ 3; joints 5 and 6 meeting), the 2-D search (a general arm) and

@@ -33,9 +33,6 @@ LOCAL_IMPORTS = {
     # owned by others, to be worked off by their owners (issue 29 item 1)
     "viewer/demo.py": 1,
     "viewer/overlays.py": 1,
-    # a circle: load() reads OpenSim files (osim), whose loader makes Robots (osim imports
-    # robot); owned by the OpenSim import (issue 32)
-    "robot.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
 }

@@ -19,7 +19,8 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 
 from .. import models
-from ..robot import build_model, load, make_robot
+from ..loading import load
+from ..robot import build_model, make_robot
 from ..urdf_io import parse_urdf_bytes
 from .errors import RobotDescriptionError, RobotRebuildError
 

@@ -6,7 +6,7 @@ import json
 
 from .. import models
 from ..errors import AmbiguousToolError, AnthroarmError
-from ..robot import load
+from ..loading import load
 
 
 def describe(name, source: str, description: str = "") -> dict:

@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from .. import models
 from ..errors import UnknownModelError
-from ..robot import load
+from ..loading import load
 from .common import UserError, parse_locked
 from .params import parse_params
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..robot import load
+from ..loading import load
 from .viewer import Viewer
 
 #: Postures (degrees; shoulder x, y, z, elbow x, wrist z, y, x) whose hand poses are the targets.

@@ -33,7 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ..robot import Robot, load
+from ..loading import load
+from ..robot import Robot
 from ._store import SceneStore
 from .checks import check_background
 from .colors import (
