@@ -75,6 +75,8 @@ def test_check_example_robot_data_name(capsys):
         "dyn C(q,qd) Christoffel matrix",
         "dyn kinetic energy T",
         "dyn potential energy V",
+        "collision distances = coal.distance",  # its URDF's <collision> bodies (issue 33)
+        "collision damper: d >= d_s - 1e-4 along QP steps",
     }
     assert all(r["ok"] for r in rows)
     assert all(r["max_abs_err"] <= r["tol"] for r in ur10)

@@ -107,11 +107,14 @@ def damper_row(robot, samples: int, rng, steps: int = 60, dt: float = 0.01) -> C
 
 
 def rows(robot, samples, rng) -> list[CheckRow]:
-    """Both rows on ``robot`` (an unsupported row when it has no collision bodies)."""
+    """Both rows on ``robot`` (an unsupported row when it has no collision bodies; none when no
+    pair of its bodies can collide)."""
     try:
         model(robot)
     except CollisionError as exc:
         return [CheckRow.unsupported(robot.name, "collision distances = coal.distance", str(exc))]
+    if not len(model(robot).pairs):  # no pair of bodies can touch (a planar 2R arm): nothing
+        return []  # to check, and a row that cannot fail would pass for a check
     n = max(2, min(int(samples), 10))
     return [distance_row(robot, n, rng), damper_row(robot, n, rng)]
 
