@@ -30,9 +30,6 @@ PACKAGE = "anthroarm"
 
 #: file (relative to src/anthroarm) -> function-local imports of modules not in optional.ALLOWED
 LOCAL_IMPORTS = {
-    # owned by others, to be worked off by their owners (issue 29 item 1)
-    "viewer/demo.py": 1,
-    "viewer/overlays.py": 1,
     # upward imports (test_layers.KNOWN) of the faces: at the top they would load the viewer
     # (meshcat, tornado) with the algorithm; gone when the viewer demo moves into viewer/
 }

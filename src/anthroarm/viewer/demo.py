@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from ..ik import qp
 from ..loading import load
 from .viewer import Viewer
 
@@ -100,8 +101,6 @@ class QPStepper:
     """One QP differential-IK step with anthroarm.ik.qp (FrameTask + PostureTask, default limits)."""
 
     def __init__(self, robot, q0, solver="osqp", orientation_cost=0.3):
-        from ..ik import qp
-
         self.qp = qp
         self.conf = qp.IKConfiguration(robot, q0)
         self.ee = qp.FrameTask(

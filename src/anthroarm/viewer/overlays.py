@@ -14,6 +14,7 @@ from __future__ import annotations
 import meshcat.geometry as mg
 import numpy as np
 
+from ..batch.plot import MAP_VARIABLES, occupied_points
 from ..errors import ParameterError
 from ..spatial.rotations import homogeneous
 from .checks import points3, positive_length, rgb01
@@ -453,8 +454,6 @@ class OverlaysMixin:
         ParameterError
             A result without a voxel map, or an unknown ``var``.
         """
-        from ..batch.plot import MAP_VARIABLES, occupied_points
-
         job = getattr(result, "job", None)
         variables = getattr(result, "variables", None)
         if not isinstance(variables, dict):
