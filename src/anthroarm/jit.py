@@ -142,18 +142,44 @@ def _reference_of(kernel) -> pytypes.FunctionType:
     for k, v in f.__globals__.items():
         if v is math:
             glob[k] = MATH
-        elif isinstance(v, Kernel) and v is not kernel:
-            glob[k] = v  # its __call__ runs its reference until the process switches
         elif id(v) in _PY_FORMS:
             glob[k] = _PY_FORMS[id(v)]
+    names = set(_names(f.__code__))
+    for k, v in f.__globals__.items():  # the kernels it calls: their references, called as is
+        if k in names and isinstance(v, Kernel) and v is not kernel:
+            glob[k] = _reference_of(v)
     glob[f.__name__] = ref if f.__globals__.get(f.__name__) is kernel else glob.get(f.__name__)
     return ref
+
+
+def _names(code) -> list[str]:
+    """The global names a code object and its nested code objects read."""
+    out, todo = [], [code]
+    while todo:
+        c = todo.pop()
+        out.extend(c.co_names)
+        todo.extend(x for x in c.co_consts if isinstance(x, pytypes.CodeType))
+    return out
 
 
 def reference(kernel) -> pytypes.FunctionType:
     """The reference of ``kernel``: its source run by the interpreter, with :data:`MATH` for
     :mod:`math` and :func:`numpy.empty` for :func:`local` arrays (see the module docstring)."""
     return _reference_of(kernel)
+
+
+@functools.lru_cache(maxsize=None)
+def _quiet(kernel):
+    """:func:`reference` as Python callers run it: numpy's floating-point warnings off, as the
+    compiled kernel gives inf/NaN without a word (its callers check them)."""
+    ref = _reference_of(kernel)
+
+    @functools.wraps(ref)
+    def run(*args):
+        with np.errstate(all="ignore"):
+            return ref(*args)
+
+    return run
 
 
 # --------------------------------------------------------------------------- kernels
@@ -183,7 +209,7 @@ class Kernel:
                 if STATE.compiled:
                     self.fn = self.dispatcher
                 else:
-                    self.fn = reference(self)
+                    self.fn = _quiet(self)
                     if self.seen is None:  # what the switch must load
                         self.seen = tuple(numba.typeof(a) for a in args)
         return self.fn(*args)
@@ -214,7 +240,7 @@ class Entry:
     def _body(self):
         if STATE.compiled:
             return self.kernel.dispatcher.compile(self.sig)
-        return reference(self.kernel)
+        return _quiet(self.kernel)
 
     def __call__(self, *args):
         return self.fn(*args)
@@ -236,13 +262,9 @@ def kernel(func=None, *, inline: bool = False):
 
 def callees(k: Kernel) -> list[Kernel]:
     """The kernels ``k``'s source calls by a global name (compiled with it)."""
-    names, codes = set(), [k.py_func.__code__]
-    while codes:
-        c = codes.pop()
-        names.update(c.co_names)
-        codes.extend(x for x in c.co_consts if isinstance(x, pytypes.CodeType))
     g = k.py_func.__globals__
-    return [g[n] for n in sorted(names) if isinstance(g.get(n), Kernel) and g[n] is not k]
+    names = sorted(set(_names(k.py_func.__code__)))
+    return [g[n] for n in names if isinstance(g.get(n), Kernel) and g[n] is not k]
 
 
 def entry_point(k: Kernel, *args) -> Entry:
