@@ -606,6 +606,7 @@ _OWN = {
     ),
     "urdf": re.compile(r"[A-Za-z0-9_]+\.urdf"),
     "numba": re.compile(r".+\.nb[ic](\.tmp\.[0-9a-f]+)?"),
+    "kernels": re.compile(r"ready-[0-9a-f]+\.(json|lock|log)"),
 }
 
 

@@ -52,8 +52,11 @@ process is in; it changes once, from reference to compiled, under a lock.
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 import sys
+from pathlib import Path
 
 from . import cache as _cache
 
@@ -62,12 +65,38 @@ CACHE_SUBFOLDER = "numba"
 #: the cache subfolder of the ready stamps
 STAMP_SUBFOLDER = "kernels"
 
+
+@functools.lru_cache(maxsize=None)
+def kernel_sources_digest(root: str) -> str:
+    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
+    kernels (their text holds ``@kernel``), with their paths relative to ``root``; read once per
+    process and folder."""
+    base = Path(root)
+    h = hashlib.sha256()
+    for p in sorted(base.rglob("*.py")):
+        try:
+            text = p.read_bytes()
+        except OSError:
+            continue
+        if b"@kernel" in text or p.name == "jit.py":
+            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
+    return h.hexdigest()
+
+
+#: Numba's folder for anthroarm's kernels: one subfolder per digest of the kernel sources.  Numba
+#: keys a cached kernel by its own file only, but its code holds the kernels it calls from other
+#: modules: an edited subproblem must not leave its callers' old code in the cache, so a new
+#: digest starts an empty folder (``anthroarm cache clear`` removes the old ones).
+OWN_FOLDER = (
+    _cache.root()
+    / CACHE_SUBFOLDER
+    / kernel_sources_digest(str(Path(__file__).resolve().parent))[:20]
+)
+
 if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
-    os.environ["NUMBA_CACHE_DIR"] = str(_cache.root() / CACHE_SUBFOLDER)
+    os.environ["NUMBA_CACHE_DIR"] = str(OWN_FOLDER)
 
 import atexit  # noqa: E402
-import functools  # noqa: E402
-import hashlib  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import platform  # noqa: E402
@@ -76,7 +105,6 @@ import threading  # noqa: E402
 import time  # noqa: E402
 import types as pytypes  # noqa: E402
 import warnings  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import llvmlite  # noqa: E402
 import numba  # noqa: E402
@@ -246,13 +274,20 @@ class Entry:
         return self.fn(*args)
 
 
-def kernel(func=None, *, inline: bool = False):
-    """Make ``func`` a :class:`Kernel` (Numba :data:`OPTIONS`, its disk cache); called like
-    ``func``.  ``inline=True`` compiles it into each caller's body
+def kernel(func=None, *, inline: bool = False, cache: bool | None = None):
+    """Make ``func`` a :class:`Kernel` (Numba :data:`OPTIONS`, its disk cache for anthroarm's
+    own kernels; ``cache=True/False`` decides for another package's); called like ``func``.  ``inline=True`` compiles it into each caller's body
     (``numba.njit(inline="always")``)."""
 
     def wrap(f):
-        options = dict(OPTIONS, inline="always") if inline else OPTIONS
+        options = dict(OPTIONS, inline="always") if inline else dict(OPTIONS)
+        if cache is not None:
+            options["cache"] = bool(cache)
+        elif f.__module__.split(".")[0] != __name__.split(".")[0]:
+            # another package's kernel: anthroarm's cache is keyed by anthroarm's sources (see
+            # OWN_FOLDER), not by that package's, so it compiles in each process unless it
+            # asks for the cache (``cache=True``: Numba's keys, its own file only)
+            options["cache"] = False
         k = Kernel(numba.njit(**options)(f))
         STATE.kernels.append(k)
         return k
@@ -439,23 +474,6 @@ class _State:
 STATE = _State()
 
 
-@functools.lru_cache(maxsize=None)
-def kernel_sources_digest(root: str) -> str:
-    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
-    kernels (their text holds ``@kernel``), with their paths relative to ``root``; read once per
-    process and folder."""
-    base = Path(root)
-    h = hashlib.sha256()
-    for p in sorted(base.rglob("*.py")):
-        try:
-            text = p.read_bytes()
-        except OSError:
-            continue
-        if b"@kernel" in text or p.name == "jit.py":
-            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
-    return h.hexdigest()
-
-
 def ready_name() -> str:
     """The name of this build's ready stamp: the kernel sources, Numba, llvmlite, Python and
     the CPU it compiles for."""
@@ -479,7 +497,7 @@ def numba_folder() -> Path:
 
 def _own(folder: Path) -> bool:
     """True if ``folder`` is anthroarm's own (``$NUMBA_CACHE_DIR`` set by this module)."""
-    return folder == _cache.root() / CACHE_SUBFOLDER
+    return folder == OWN_FOLDER
 
 
 def _files(folder: Path) -> dict[str, str]:
@@ -525,8 +543,12 @@ def verified(strict: bool = True) -> bool:
     not list (in anthroarm's own folder; in a folder given by ``$NUMBA_CACHE_DIR`` the
     subfolders of listed files), is deleted — compiled again, never loaded — and the stamp
     rewritten incomplete.  The mode ``compile`` checks with ``strict=False``: files that
-    processes compiling in their own threads wrote since the stamp are theirs to list at exit."""
+    processes compiling in their own threads wrote since the stamp are theirs to list at exit.
+    Without a complete stamp the strict check deletes nothing (the background compilation is
+    writing its files) and answers False."""
     listed, complete = _read_stamp()
+    if strict and not complete:  # a compilation runs (or none yet): its files are not listed
+        return False  # until its stamp, and nothing is loaded meanwhile; nothing is deleted
     folder = numba_folder()
     found = _files(folder)
     if not strict:
@@ -723,6 +745,7 @@ __all__ = [
     "MATH",
     "MODES",
     "OPTIONS",
+    "OWN_FOLDER",
     "STATE",
     "Entry",
     "Kernel",

@@ -100,7 +100,7 @@ PACKAGE = {
         import math
         from anthroarm.jit import kernel, local
 
-        @kernel
+        @kernel(cache=True)
         def norm2(x, y):
             a = local(2)
             a[0], a[1] = x, y
