@@ -31,6 +31,15 @@ CHAPTERS = {
 }
 
 
+def _is_function(obj) -> bool:
+    """A function, or an object that wraps one and says so (``__wrapped__``: anthroarm's
+    compiled kernels, :class:`anthroarm.jit.Kernel`)."""
+    try:
+        return inspect.isfunction(inspect.unwrap(obj))
+    except ValueError:  # a cycle of __wrapped__
+        return False
+
+
 def write_if_changed(path: Path, text: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     if not path.is_file() or path.read_text(encoding="utf-8") != text:
@@ -170,9 +179,9 @@ def collect_equations(
                     fn = meth.__func__ if isinstance(meth, (staticmethod, classmethod)) else meth
                     if isinstance(fn, property):
                         add(fn.__doc__, "attr", f"{modname}.{name}.{mname}")
-                    elif inspect.isfunction(fn):
+                    elif _is_function(fn):
                         add(fn.__doc__, "meth", f"{modname}.{name}.{mname}")
-            elif inspect.isfunction(obj):
+            elif _is_function(obj):
                 add(obj.__doc__, "func", f"{modname}.{name}")
     return dict(where)
 
@@ -217,7 +226,7 @@ def _exported(mod) -> list[str]:
         n
         for n, o in vars(mod).items()
         if not n.startswith("_")
-        and (inspect.isfunction(o) or inspect.isclass(o))
+        and (_is_function(o) or inspect.isclass(o))
         and getattr(o, "__module__", "").startswith(mod.__name__ + ".")
     ]
 
@@ -239,7 +248,7 @@ def public_paths(package: str = "anthroarm") -> dict[str, str]:
             continue
         for name in _exported(mod):
             obj = getattr(mod, name, None)
-            if not (inspect.isfunction(obj) or inspect.isclass(obj)):
+            if not (_is_function(obj) or inspect.isclass(obj)):
                 continue
             canon = f"{obj.__module__}.{obj.__qualname__}"
             public = f"{m}.{name}"
@@ -265,7 +274,7 @@ def _own_members(module: str) -> list[str]:
         n
         for n, o in vars(mod).items()
         if not n.startswith("_")
-        and (inspect.isfunction(o) or inspect.isclass(o))
+        and (_is_function(o) or inspect.isclass(o))
         and getattr(o, "__module__", None) == module
     ]
 
@@ -347,7 +356,7 @@ def _object(path: str):
 def skip_moved(app, what, name, obj, skip, options):
     """autodoc-skip-member: a function or class documented where users import it
     (:func:`public_paths`) is not documented a second time in the module that defines it."""
-    if what == "module" and (inspect.isfunction(obj) or inspect.isclass(obj)):
+    if what == "module" and (_is_function(obj) or inspect.isclass(obj)):
         canon = f"{getattr(obj, '__module__', '')}.{getattr(obj, '__qualname__', '')}"
         if canon in PUBLIC:
             return True
@@ -362,7 +371,7 @@ def skip_shadowing(app, what, name, obj, skip, options):
     """autodoc-skip-member: a package's function that has the name of one of its submodules
     (``anthroarm.models.spec``) would take the module's place in the index; it is skipped on
     the package page and listed in the package docstring instead."""
-    if what == "module" and inspect.isfunction(obj):
+    if what == "module" and _is_function(obj):
         mod = importlib.import_module(obj.__module__)
         if hasattr(mod, "__path__") and (Path(mod.__file__).parent / f"{name}.py").is_file():
             return True

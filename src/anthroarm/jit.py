@@ -9,7 +9,7 @@ of its formula.  It runs two ways, with the same answers:
   ``$NUMBA_CACHE_DIR`` is set or Numba was imported before anthroarm);
 - **reference**: the same source run by the Python interpreter (:func:`reference`), with
   Numba's float semantics where the interpreter would raise (``error_model="numpy"``: a
-  domain error of :mod:`math` gives NaN, not ``ValueError``), and :func:`local` arrays made by
+  domain error of ``math`` gives NaN, not ``ValueError``), and :func:`local` arrays made by
   :func:`numpy.empty`.  About 400 times slower than compiled (~1.3 ms for one pose of a 6R arm),
   but it needs no compilation.
 
@@ -97,6 +97,7 @@ if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
     os.environ["NUMBA_CACHE_DIR"] = str(OWN_FOLDER)
 
 import atexit  # noqa: E402
+import functools  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import platform  # noqa: E402
@@ -127,7 +128,7 @@ def mode() -> str:
 
 # --------------------------------------------------------------------------- the reference
 def _nan_on_error(f):
-    """``f`` of :mod:`math` returning what Numba's compiled call returns where CPython raises:
+    """``f`` of ``math`` returning what Numba's compiled call returns where CPython raises:
     NaN for a domain error, ±inf for an overflow or a pole."""
 
     @functools.wraps(f)
@@ -142,7 +143,7 @@ def _nan_on_error(f):
     return g
 
 
-#: :mod:`math` as compiled kernels see it (``error_model="numpy"``)
+#: ``math`` as compiled kernels see it (``error_model="numpy"``)
 MATH = pytypes.SimpleNamespace(
     **{
         k: (_nan_on_error(v) if callable(v) and not isinstance(v, type) else v)
@@ -192,7 +193,7 @@ def _names(code) -> list[str]:
 
 def reference(kernel) -> pytypes.FunctionType:
     """The reference of ``kernel``: its source run by the interpreter, with :data:`MATH` for
-    :mod:`math` and :func:`numpy.empty` for :func:`local` arrays (see the module docstring)."""
+    ``math`` and :func:`numpy.empty` for :func:`local` arrays (see the module docstring)."""
     return _reference_of(kernel)
 
 
@@ -214,16 +215,16 @@ def _quiet(kernel):
 class Kernel:
     """A compiled kernel: Numba's dispatcher (:attr:`dispatcher`) for the kernels that call it
     (Numba types it as that dispatcher), and, called from Python, whichever of compiled code or
-    :func:`reference` the process runs (:data:`STATE`).  ``py_func`` is the source function."""
+    :func:`reference` the process runs (:data:`STATE`).  ``py_func`` is the source function; the
+    kernel carries its name, module, docstring and ``__wrapped__`` (``functools.wraps``), so
+    ``inspect.signature``, ``inspect.unwrap`` and the docs see the function."""
 
-    __slots__ = ("dispatcher", "py_func", "fn", "seen", "__name__", "__qualname__", "__dict__")
+    __slots__ = ("dispatcher", "py_func", "fn", "seen", "__dict__")
 
     def __init__(self, dispatcher):
         self.dispatcher = dispatcher
         self.py_func = dispatcher.py_func
-        self.__name__ = self.py_func.__name__
-        self.__qualname__ = self.py_func.__qualname__
-        self.__doc__ = self.py_func.__doc__
+        functools.update_wrapper(self, self.py_func)
         self.seen = None  # the Numba types of its first call from Python (loaded at the switch)
         self.fn = self._first
 
@@ -242,12 +243,18 @@ class Kernel:
                         self.seen = tuple(numba.typeof(a) for a in args)
         return self.fn(*args)
 
+    def __get__(self, obj, objtype=None):
+        """A kernel read from a class or an instance is the kernel itself (it binds nothing,
+        like :class:`staticmethod`); defining this makes it a routine to ``inspect``, so
+        tools that document or list functions (autodoc, ``help``) take it as one."""
+        return self
+
     @property
     def signatures(self):
         return self.dispatcher.signatures
 
     def __repr__(self):
-        return f"<kernel {self.py_func.__module__}.{self.__qualname__}>"
+        return f"<kernel {self.__module__}.{self.__qualname__}>"
 
 
 @typeof_impl.register(Kernel)
