@@ -26,7 +26,7 @@ from ..motion import (
 )
 from ..motion.csv_io import write_joint_csv
 from .common import UserError
-from .runtime import load_model, progress
+from .runtime import input_file, load_model, progress
 
 
 def is_osim(a) -> bool:
@@ -59,6 +59,7 @@ def run(a) -> int:
                 f"{flag} is for a catalog arm; an OpenSim model is used as it is scaled "
                 "(its markers and weights come from the model and --setup)"
             )
+    a.trial, a.setup = input_file(a.trial), input_file(a.setup)
     rename = {}
     for item in a.rename:
         if "=" not in item:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .. import models
+from .. import models, osim
 from ..errors import UnknownModelError
 from ..loading import load
 from .common import UserError, parse_locked
@@ -21,6 +21,7 @@ __all__ = [
     "check_radians",
     "default_model",
     "joint_values",
+    "input_file",
     "load_model",
     "model_from_args",
     "parse_params",
@@ -41,6 +42,8 @@ def load_model(name, params=None, tool=None, locked=None):
     its typed errors (unknown name, a tree without a tool, bad keywords) print as one line, an
     unknown name with the closest names ("did you mean")."""
     kw = {k: v for k, v in (("tool", tool), ("locked", locked)) if v is not None}
+    if str(name).lower().endswith(".osim"):
+        name = input_file(name)
     try:
         return load(name, **kw, **(params or {}))
     except UnknownModelError:
@@ -52,6 +55,22 @@ def load_model(name, params=None, tool=None, locked=None):
             f"unknown model {name!r}: did you mean {hint}? ('anthroarm models --all' lists "
             "every name; a URDF file is given by its path)"
         ) from None
+
+
+def input_file(name) -> str:
+    """A file a command reads: ``name`` itself, or, when no such file exists and ``name`` is a
+    bare name of a file shipped with anthroarm (:func:`anthroarm.osim.shipped_file`:
+    ``gait2392.osim``, ``subject01_walk1.trc``), the shipped copy, said on stderr."""
+    if name is None or Path(str(name)).exists():
+        return name
+    shipped = osim.shipped_file(str(name))
+    if shipped is None:
+        return name
+    print(
+        f"anthroarm: {name}: not in this folder; using the copy shipped with anthroarm ({shipped})",
+        file=sys.stderr,
+    )
+    return str(shipped)
 
 
 def default_model() -> str:

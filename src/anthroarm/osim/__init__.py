@@ -10,11 +10,14 @@ Modules: :mod:`.xmlread` (safe parsing), :mod:`.functions` (OpenSim's functions,
 (q → Pinocchio configuration with its derivatives), :mod:`.loader` (:class:`OsimRobot`,
 :func:`load_osim`), :mod:`.report` (the import report).  The models shipped with anthroarm
 (CC BY 3.0, from opensim-org/opensim-models; see ``data/opensim/CREDITS.md``) are found by
-:func:`path`.
+:func:`path`, and the gait trial shipped with them (``subject01_walk1.trc``, its
+``subject01_Setup_IK.xml``) by :func:`shipped_file`, which the command line uses for a file
+name that is not in the working folder.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from ..errors import UnknownModelError
@@ -33,6 +36,27 @@ SHIPPED = {
     "subject01_simbody": "subject01_simbody.osim",
     "Tug_of_War": "Tug_of_War.osim",
 }
+
+
+#: the folder of the shipped gait trial (``data/opensim/recordings/CREDITS.md``)
+RECORDINGS_DIR = DATA_DIR / "recordings"
+
+
+def shipped_file(name: str | os.PathLike) -> Path | None:
+    """The shipped file a bare file name means, else None: a shipped model's file
+    (``gait2392_thelen2003muscle.osim``) or ``<short name>.osim`` (``gait2392.osim``), or a
+    file of the shipped trial (``subject01_walk1.trc``, ``subject01_Setup_IK.xml``).  A name
+    with a folder in it is never a shipped file."""
+    p = Path(name)
+    if p.name != os.fspath(name):
+        return None
+    if p.suffix == ".osim" and p.stem in SHIPPED:
+        return DATA_DIR / SHIPPED[p.stem]
+    for folder in (DATA_DIR, RECORDINGS_DIR):
+        f = folder / p.name
+        if p.name != "CREDITS.md" and f.is_file():
+            return f
+    return None
 
 
 def names() -> list[str]:
@@ -55,6 +79,8 @@ __all__ = [
     "read",
     "names",
     "path",
+    "shipped_file",
     "DATA_DIR",
+    "RECORDINGS_DIR",
     "SHIPPED",
 ]
