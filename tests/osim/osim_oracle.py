@@ -61,7 +61,9 @@ class OpenSimOracle:
         v = self.osim.Vector(1, float(x))
         if order == 0:
             return f.calcValue(v)
-        return f.calcDerivative(self.osim.StdVectorInt([0] * order), v)
+        # a list, converted by SWIG's sequence typemap: an opensim.StdVectorInt (moco's class) was
+        # refused with a TypeError by common's Function.calcDerivative in some test processes
+        return f.calcDerivative([0] * order, v)
 
     def kinematics(self, q, qd=None, qdd=None):
         """Every coordinate's (value, rate, acceleration) and C = du/dq̇, from the

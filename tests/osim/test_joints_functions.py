@@ -33,8 +33,9 @@ from anthroarm.osim import functions as fn  # noqa: E402
 
 def _osim_eval(f, x):
     v = opensim.Vector(1, float(x))
-    d1 = f.calcDerivative(opensim.StdVectorInt([0]), v)
-    d2 = f.calcDerivative(opensim.StdVectorInt([0, 0]), v)
+    # lists (SWIG's sequence typemap), not opensim.StdVectorInt: see osim_oracle.py
+    d1 = f.calcDerivative([0], v)
+    d2 = f.calcDerivative([0, 0], v)
     return f.calcValue(v), d1, d2
 
 

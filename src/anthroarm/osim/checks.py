@@ -141,7 +141,9 @@ class OpenSimModel:
         v = self.osim.Vector(1, float(x))
         if order == 0:
             return f.calcValue(v)
-        return f.calcDerivative(self.osim.StdVectorInt([0] * order), v)
+        # a list, converted by SWIG's sequence typemap: an opensim.StdVectorInt (moco's class) was
+        # refused with a TypeError by common's Function.calcDerivative in some test processes
+        return f.calcDerivative([0] * order, v)
 
     def set_state(self, q, qd, qdd):
         n = len(self.names)
