@@ -8,6 +8,13 @@ update.  ``integrate(v, dt)`` maps a tangent velocity back onto the configuratio
 Frames and units: placements are world poses (SE(3), m); Jacobians are 6 × nv with rows
 (v; ω) in the requested reference frame (``LOCAL`` by default, the body Jacobian that the book
 writes in the hand frame, Eq. (7-94)).
+
+An OpenSim model with nonlinear couplings (``robot.coupling``: gait2392's spline knees) is
+configured in its independent coordinates: ``q`` is ``robot.nq`` coordinates (rad or m, within
+``robot.lower``/``upper``, named ``robot.joint_names``), Pinocchio's kinematics are computed at
+φ(q), every frame Jacobian is J(φ(q)) · G(q) with G = dφ/dq (the chain rule; Jain, *Robot and
+Multibody Dynamics* (2011), §8), and ``integrate`` is q + v dt.  The tasks and limits read
+these, so they all work in the coordinates.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from ...chain import CONTINUOUS
-from ...errors import UnsupportedModelError
+from ...osim.coupling import FastCoupling
 
 LOCAL = pin.ReferenceFrame.LOCAL
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -32,21 +39,6 @@ def ranged_joints(chain) -> list:
     return [j for j in chain.joints if not j.is_mimic and j.kind != CONTINUOUS]
 
 
-def refuse_coupled(robot, what: str) -> None:
-    """Raise :class:`~anthroarm.errors.UnsupportedModelError` for a robot whose Pinocchio joints
-    are nonlinear functions φ(q) of its coordinates (an OpenSim model with ``robot.coupling``):
-    ``what`` works in Pinocchio's joints, whose values would not stay on the coupling."""
-    c = getattr(robot, "coupling", None)
-    if c is not None:
-        raise UnsupportedModelError(
-            f"{robot.name}: {what} works in Pinocchio's {c.nq_full} joints, but this OpenSim "
-            f"model moves them as functions of its {c.nq} coordinates (robot.coupling: spline "
-            "or coupler constraints); use anthroarm.motion.osim_ik.CoupledMarkerIK / "
-            "osim_marker_ik (marker IK in the coordinates), with a frame's target as a marker "
-            "(robot.fk, robot.jacobian are in the coordinates)"
-        )
-
-
 class IKConfiguration:
     """A configuration ``q`` of ``robot`` plus the kinematic quantities tasks need.
 
@@ -56,29 +48,47 @@ class IKConfiguration:
         The arm (its ``model`` is shared; this object owns a fresh ``pin.Data``).
     q : array (nq,), optional
         Initial configuration (default ``robot.neutral()``), Pinocchio's layout ((cos θ, sin θ)
-        for a continuous joint).  It may lie outside the joint limits: the limits of
+        for a continuous joint); the independent coordinates for a model with
+        ``robot.coupling``.  It may lie outside the joint limits: the limits of
         :func:`anthroarm.ik.qp.step` then pull it back inside.
 
     Notes
     -----
     ``lower``/``upper`` are the limits in q order (``robot.chain.lower``/``upper``, read-only;
-    ±1 on a continuous joint's entries, which :meth:`within_limits` does not test).
+    ±1 on a continuous joint's entries, which :meth:`within_limits` does not test; the
+    coordinate ranges ``robot.lower``/``upper`` with a coupling).  ``coupling`` is None, or the
+    :class:`~anthroarm.osim.coupling.FastCoupling` of ``robot.coupling``; then ``G`` is dφ/dq at
+    ``q`` (``model.nv`` × nv) and ``q_full`` = φ(q), the configuration Pinocchio's ``data``
+    holds.
     """
 
     def __init__(self, robot, q=None):
-        refuse_coupled(robot, "the QP layer (IKConfiguration)")
         self.robot = robot
         self.model: pin.Model = robot.model
         self.data: pin.Data = robot.model.createData()
-        chain = robot.chain
-        self.nq = chain.nq
-        self.nv = chain.nv
-        self.lower = chain.lower
-        self.upper = chain.upper
-        # q indices of the bounded joints (continuous and mimic joints have no range of their own)
-        bounded = [j.idx_q for j in ranged_joints(chain)]
-        self._bounded = None if bounded == list(range(self.nq)) else np.array(bounded, dtype=int)
-        self._unit = chain.has_continuous
+        c = getattr(robot, "coupling", None)
+        self.coupling = None if c is None else FastCoupling(c)
+        self.G = None
+        self.q_full = None
+        if c is not None:  # the independent coordinates, each with its range
+            self.nq = self.nv = robot.nq
+            self.lower, self.upper = robot.lower, robot.upper
+            self._bounded, self._unit = None, False
+            self._names = list(robot.joint_names)
+        else:
+            chain = robot.chain
+            self.nq = chain.nq
+            self.nv = chain.nv
+            self.lower = chain.lower
+            self.upper = chain.upper
+            # q indices of the bounded joints (continuous and mimic joints have no range of
+            # their own)
+            bounded = [j.idx_q for j in ranged_joints(chain)]
+            self._bounded = (
+                None if bounded == list(range(self.nq)) else np.array(bounded, dtype=int)
+            )
+            self._unit = chain.has_continuous
+            self._names = chain.q_names
         self.q = np.zeros(self.nq)
         self._placements: dict = {}
         self._jacobians: dict = {}
@@ -105,7 +115,15 @@ class IKConfiguration:
             if self._unit:
                 self.robot.chain.check_unit(q)
             self.q = q.copy()
-        pin.computeJointJacobians(self.model, self.data, self.q)
+        self._kinematics()
+
+    def _kinematics(self) -> None:
+        # every joint Jacobian at q (at φ(q) with a coupling, then G = dφ/dq), caches cleared
+        if self.coupling is None:
+            pin.computeJointJacobians(self.model, self.data, self.q)
+        else:
+            self.q_full, self.G = self.coupling.jacobian(self.q)
+            pin.computeJointJacobians(self.model, self.data, self.q_full)
         self._placements.clear()
         self._jacobians.clear()
 
@@ -119,12 +137,15 @@ class IKConfiguration:
         return M
 
     def frame_jacobian(self, frame_id: int, reference=LOCAL) -> np.ndarray:
-        """Frame Jacobian 6 × nv, rows (v; ω), in ``reference`` (default LOCAL)."""
+        """Frame Jacobian 6 × nv, rows (v; ω), in ``reference`` (default LOCAL); J(φ(q)) G
+        in the coordinates of a model with a coupling."""
         key = (frame_id, reference)
         J = self._jacobians.get(key)
         if J is None:
             self.frame_placement(frame_id)
             J = pin.getFrameJacobian(self.model, self.data, frame_id, reference)
+            if self.G is not None:
+                J = J @ self.G
             self._jacobians[key] = J
         return J
 
@@ -134,7 +155,10 @@ class IKConfiguration:
 
     # ------------------------------------------------------------------ motion
     def integrate(self, v, dt: float) -> np.ndarray:
-        """Configuration reached by moving at tangent velocity ``v`` (nv,) for ``dt`` seconds."""
+        """Configuration reached by moving at tangent velocity ``v`` (nv,) for ``dt`` seconds
+        (q + v dt in the coordinates of a model with a coupling)."""
+        if self.coupling is not None:
+            return self.q + np.asarray(v, dtype=float) * dt
         return pin.integrate(self.model, self.q, np.asarray(v, dtype=float) * dt)
 
     def integrate_inplace(self, v, dt: float) -> None:
@@ -155,10 +179,9 @@ class IKConfiguration:
             if not np.all(np.isfinite(dt)):
                 raise ValueError(f"dt must be a finite time step (s), got {dt!r}")
             dq = v * dt
-        self.q = pin.integrate(self.model, self.q, dq)  # finite q + finite step: no re-check
-        pin.computeJointJacobians(self.model, self.data, self.q)
-        self._placements.clear()
-        self._jacobians.clear()
+        # finite q + finite step: no re-check
+        self.q = self.q + dq if self.coupling is not None else pin.integrate(self.model, self.q, dq)
+        self._kinematics()
 
     def within_limits(self, tol: float = 0.0) -> bool:
         """True when every bounded joint lies within [lower − tol, upper + tol]."""
@@ -171,7 +194,7 @@ class IKConfiguration:
     def limit_violations(self, tol: float = 0.0) -> list[str]:
         """Names of the bounded joints outside their limits (with the value and the range)."""
         idx = range(self.nq) if self._bounded is None else self._bounded.tolist()
-        names = self.robot.chain.q_names
+        names = self._names
         out = []
         for i in idx:
             v, lo, hi = self.q[i], self.lower[i], self.upper[i]

@@ -9,11 +9,10 @@ import numpy as np
 
 from ... import jit
 from ..closed.limits import refine
-from ..qp.configuration import refuse_coupled
 from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
-from . import ckernel
+from . import ckernel, coupled
 from .kernel import MAX_ITER, STALL, clock, damped_step, damping
 from .kernel import attempt as py_attempt
 from .nullspace import Swivel, posture
@@ -155,11 +154,28 @@ def solve(
     -------
     IKResult, or IKBatchResult for a batch.  Every returned q is within the joint limits; a
     continuous joint's angle is the one the iteration reached from its seed (no added turn).
-    An OpenSim model with nonlinear couplings (``robot.coupling``) raises
-    :class:`~anthroarm.errors.UnsupportedModelError` naming the remedy
-    (:class:`~anthroarm.motion.osim_ik.CoupledMarkerIK`).
+    An OpenSim model with nonlinear couplings (``robot.coupling``) is solved in its independent
+    coordinates (q of length ``robot.nq``, within the coordinate ranges; Jacobian J·dφ/dq):
+    :func:`anthroarm.ik.solve.coupled.solve`.
     """
-    refuse_coupled(robot, "aa.ik.solve")
+    if getattr(robot, "coupling", None) is not None:
+        return coupled.solve(
+            robot,
+            T,
+            q0,
+            frame,
+            tol_pos,
+            tol_rot,
+            max_time,
+            mode=mode,
+            max_restarts=max_restarts,
+            rng=rng,
+            posture=posture,
+            swivel=swivel,
+            swivel_frames=swivel_frames,
+            analytic=analytic,
+            warm_start=warm_start,
+        )
     ws = workspace(robot, robot.frame_id(frame))
     sh = ws.sh
     if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):

@@ -9,7 +9,9 @@ lets a joint approach its limit geometrically instead of hitting it in one step 
 0.5).  This is the book's joint range constraint g_i(Q) ≥ 0 (Ch. 7 §7-6, (7-84)) linearised per step
 as hard inequalities instead of the exterior penalty (7-85).  Joints with an infinite limit are
 unbounded.  A joint that starts outside its range gets gain 1 on the violated side (back inside in
-one step if the velocity limit allows; pink's QP is infeasible there, pink#206).
+one step if the velocity limit allows; pink's QP is infeasible there, pink#206).  On an OpenSim
+model with a coupling (``robot.coupling``) the box is on its coordinates, with their ranges
+(``robot.lower``/``upper``): the QP's variables are the coordinates.
 """
 
 from __future__ import annotations
@@ -29,24 +31,25 @@ class ConfigurationLimit(Limit):
         if not 0.0 < gain <= 1.0:
             raise ValueError(f"configuration limit gain must be in (0, 1], got {gain}")
         chain = robot.chain
+        coupled = getattr(robot, "coupling", None) is not None
+        src = robot if coupled else chain  # the coordinates' ranges, or the joints'
+        names = list(robot.joint_names if coupled else chain.q_names)
         self.gain = float(gain)
-        self.lower = np.array(chain.lower if lower is None else lower, dtype=float)
-        self.upper = np.array(chain.upper if upper is None else upper, dtype=float)
+        self.lower = np.array(src.lower if lower is None else lower, dtype=float)
+        self.upper = np.array(src.upper if upper is None else upper, dtype=float)
         if self.lower.shape != (robot.nq,) or self.upper.shape != (robot.nq,):
-            raise ValueError(
-                f"lower/upper must have shape ({robot.nq},) (q entries {list(chain.q_names)})"
-            )
+            raise ValueError(f"lower/upper must have shape ({robot.nq},) (q entries {names})")
         if np.isnan(self.lower).any() or np.isnan(self.upper).any():
             raise ValueError("lower/upper limits contain NaN (use inf for a side without a limit)")
         if np.any(self.lower > self.upper):
             raise ValueError(
                 "lower limit above upper limit for joints "
-                f"{[n for n, a, b in zip(chain.q_names, self.lower, self.upper) if a > b]}"
+                f"{[n for n, a, b in zip(names, self.lower, self.upper) if a > b]}"
             )
         # map every velocity index of a joint with a range to its configuration index; the
         # others (continuous joints) have no position limit here
-        qidx = np.full(robot.nv, -1)
-        for j in ranged_joints(chain):
+        qidx = np.arange(robot.nv) if coupled else np.full(robot.nv, -1)
+        for j in () if coupled else ranged_joints(chain):
             qidx[j.idx_v] = j.idx_q
         ok = qidx >= 0
         self._qidx = np.where(ok, qidx, 0)

@@ -1,8 +1,9 @@
 """VelocityLimit: |Δq| ≤ v_max · dt (rad/s or m/s), one bound per velocity (nv: a continuous
 joint has one), from ``robot.chain.velocity_limit`` (the URDF ``velocity`` attribute) by
 default.  A non-finite or non-positive entry means "no limit" for that joint (URDFs often
-leave it 0 when unknown).  ``v_max`` is read-only: assign a new array to change it (the step's
-box is cached per ``v_max`` array and dt)."""
+leave it 0 when unknown); on an OpenSim model with a coupling, one per coordinate
+(``robot.velocity_limit``: none unless given).  ``v_max`` is read-only: assign a new array to
+change it (the step's box is cached per ``v_max`` array and dt)."""
 
 from __future__ import annotations
 
@@ -15,10 +16,12 @@ class VelocityLimit(Limit):
     priority = 0
 
     def __init__(self, robot, v_max=None):
-        v = np.array(
-            robot.chain.velocity_limit if v_max is None else np.broadcast_to(v_max, (robot.nv,)),
-            dtype=float,
-        )
+        if v_max is not None:
+            v = np.array(np.broadcast_to(v_max, (robot.nv,)), dtype=float)
+        elif getattr(robot, "coupling", None) is not None:  # one per coordinate
+            v = np.array(robot.velocity_limit, dtype=float)
+        else:
+            v = np.array(robot.chain.velocity_limit, dtype=float)
         if v.shape != (robot.nv,):
             raise ValueError(f"v_max must have shape ({robot.nv},), got {v.shape}")
         if np.isnan(v).any():

@@ -115,9 +115,9 @@ class FrameTask(Task):
 
     def _accumulate(self, conf, ws, first):
         # compute_qp_objective in place: the same operations on preallocated buffers, the LM
-        # term returned as the diagonal scalar.  A subclass may override the objective: it
-        # takes the general path.
-        if type(self) is not FrameTask:
+        # term returned as the diagonal scalar.  A subclass may override the objective, and a
+        # model with a coupling needs the Jacobian J G: they take the general path.
+        if type(self) is not FrameTask or conf.G is not None:
             return Task._accumulate(self, conf, ws, first)
         T_t = self.target
         if T_t is None:

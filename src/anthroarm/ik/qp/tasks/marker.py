@@ -84,7 +84,7 @@ class MarkerTask(Task):
         )  # one slot when every marker is on the base
         self._o = np.zeros((max(len(self._bodies), 1), 3))
         self._p = np.zeros((M, 3))
-        self._J = np.zeros((M, 3, self.nv))
+        self._J = np.zeros((M, 3, robot.model.nv))  # Pinocchio's velocities (× G: coordinates)
         self._for = (None, b"")  # (configuration, its q's bytes) the cache below was computed for
 
     def set_target(self, positions, visible=None) -> None:
@@ -138,6 +138,9 @@ class MarkerTask(Task):
         return np.where(self.visible[:, None], self._p - self.target, 0.0).ravel()
 
     def compute_jacobian(self, conf) -> np.ndarray:
-        """(3M, nv), LOCAL_WORLD_ALIGNED point Jacobians stacked marker by marker."""
+        """(3M, nv), LOCAL_WORLD_ALIGNED point Jacobians stacked marker by marker (J G in the
+        coordinates of a model with a coupling, G = dφ/dq)."""
         self._update(conf)
-        return self._J.reshape(-1, self.nv)
+        J = self._J.reshape(-1, self._J.shape[2])
+        G = getattr(conf, "G", None)
+        return J if G is None else J @ G

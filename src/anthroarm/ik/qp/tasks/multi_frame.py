@@ -131,7 +131,7 @@ class MultiFrameTask(Task):
 
     def _accumulate(self, conf, ws, first):
         # the objective in place: stacked W Jlog6 ᵇJ in one buffer, one product for H and one for c
-        if type(self) is not MultiFrameTask:
+        if type(self) is not MultiFrameTask or conf.G is not None:  # J G with a coupling
             return Task._accumulate(self, conf, ws, first)
         Ts = self._require_targets()
         if self._w_cost is not self.cost or self._w_gain != self.gain:

@@ -12,7 +12,8 @@ the configuration, Ch. 7 §7-6 (7-84)–(7-86), becomes a QP regulariser).
 (``robot.spec.comfort``: for the human arm the centres of RULA's lowest-load bands, see
 :data:`anthroarm.models.human.HUMAN_ARM7_COMFORT`), clipped into the joint limits.  Other
 robots get the middle of their joint ranges (θ = 0 for a joint without a finite range, a
-continuous joint included).
+continuous joint included); an OpenSim model with a coupling (``robot.coupling``) the middle of
+its coordinates' ranges, and its posture error is the plain difference of coordinates.
 """
 
 from __future__ import annotations
@@ -36,7 +37,13 @@ def comfortable_posture(robot) -> np.ndarray:
     """Reference posture (nq,) of ``robot`` from ``robot.chain``: the model's comfortable
     posture where it has one (:func:`has_comfortable_posture`), else the middle of each joint's
     range (θ = 0, clipped into the range, where it is not finite: a continuous joint gets
-    (cos 0, sin 0)); always within the limits."""
+    (cos 0, sin 0)); always within the limits.  In the coordinates (``robot.lower``/``upper``)
+    for a model with ``robot.coupling``."""
+    if getattr(robot, "coupling", None) is not None:
+        lo, hi = np.asarray(robot.lower, float), np.asarray(robot.upper, float)
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        mid = 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0))
+        return np.clip(mid, lo, hi)
     chain = robot.chain
     joints = [chain.joints[i] for i in chain.independent]
     lo = np.array([j.lower for j in joints])
@@ -56,6 +63,7 @@ class PostureTask(Task):
         super().__init__(cost=cost, gain=gain, lm_damping=lm_damping)
         self.model = robot.model
         self.robot = robot
+        self._coupled = getattr(robot, "coupling", None) is not None  # q: coordinates
         self._H = np.diag(
             np.broadcast_to(np.asarray(self.cost, float) ** 2, (robot.nv,)).astype(float)
         )
@@ -71,8 +79,14 @@ class PostureTask(Task):
     def set_target_from_configuration(self, conf) -> None:
         self.target = conf.q.copy()
 
-    def compute_error(self, conf) -> np.ndarray:
+    def _difference(self, conf) -> np.ndarray:
+        """q ⊖ q_ref: ``pin.difference``, or the coordinates' difference with a coupling."""
+        if self._coupled:
+            return conf.q - self.target
         return pin.difference(self.model, self.target, conf.q)
+
+    def compute_error(self, conf) -> np.ndarray:
+        return self._difference(conf)
 
     def compute_jacobian(self, conf) -> np.ndarray:
         return np.eye(conf.nv)
@@ -81,7 +95,7 @@ class PostureTask(Task):
         # J = I: H = (w² + μ) I, c = α w² e  (same as Task._objective, without the matrix products)
         # the returned H may be a cached array: callers must not modify it in place
         w = self.cost
-        We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
+        We = (w * self.gain) * self._difference(conf)
         if self.lm_damping:
             H = np.diag(np.broadcast_to(w * w, (conf.nv,)).astype(float))
             H.flat[:: conf.nv + 1] += self.lm_damping * float(We @ We)
@@ -94,7 +108,7 @@ class PostureTask(Task):
         if type(self) is not PostureTask:
             return Task._accumulate(self, conf, ws, first)
         w = self.cost
-        d = pin.difference(self.model, self.target, conf.q)
+        d = self._difference(conf)
         key = self._s_for
         if key[0] is not w or key[1] != self.gain:
             # α w² as an (nv,) array: an array-array product is cheaper than one with a scalar
@@ -109,7 +123,7 @@ class PostureTask(Task):
             np.add(ws.c, np.multiply(d, s, out=d), out=ws.c)
         mu = 0.0
         if self.lm_damping:
-            We = (w * self.gain) * pin.difference(self.model, self.target, conf.q)
+            We = (w * self.gain) * self._difference(conf)
             mu = self.lm_damping * float(We @ We)
         if isinstance(w, float):
             return w * w + mu
