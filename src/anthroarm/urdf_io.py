@@ -37,13 +37,11 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from lxml import etree
-
+from ._io import parse_xml
 from .errors import (
     MeshNotFoundError,
     PackagePathError,
@@ -70,7 +68,6 @@ MAX_MOVABLE_JOINTS = 200
 MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
 
 #: A DTD or entity declaration, in any case (searched in place: no upper-cased copy of the file).
-_DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 
 #: How many names an error message lists before it says "... and N more".
 _MAX_NAMES_IN_MESSAGE = 10
@@ -398,23 +395,13 @@ def parse_urdf_bytes(
 ) -> URDFInfo:
     """Validate URDF text already in memory; ``path`` is used for messages and relative URIs."""
     path = Path(path)
-    if _DTD_OR_ENTITY.search(raw):
-        raise URDFSecurityError(
-            path,
-            "DTD/entity declarations are not allowed in a URDF (entity expansion or external "
-            "entity)",
-        )
-    parser = etree.XMLParser(
-        resolve_entities=False,
-        no_network=True,
-        load_dtd=False,
-        huge_tree=False,
-        remove_comments=True,
-    )
-    try:
-        root = etree.fromstring(raw, parser)
-    except etree.XMLSyntaxError as exc:
-        raise URDFSyntaxError(path, f"malformed XML: {exc}") from None
+
+    def error(problem: str, line) -> Exception:
+        where = f"line {line}: " if line else ""
+        cls = URDFSecurityError if problem.startswith("DTD") else URDFSyntaxError
+        return cls(path, where + problem)
+
+    root = parse_xml(raw, error, "a URDF")
     if root.tag != "robot":
         raise URDFSyntaxError(path, f"root element is <{root.tag}>, expected <robot>")
 

@@ -29,22 +29,18 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from lxml import etree
 
-from .._io import read_bounded
+from .._io import parse_xml, read_bounded
 from ..errors import MarkerSetError, MotionDataError, UnknownFrameError
 from .markers import Marker, MarkerSet
 
 #: the largest setup file :func:`read_ik_setup` reads, bytes (4 MiB)
 MAX_SETUP_BYTES = 4 << 20
 VALUE_TYPES = ("default_value", "manual_value", "from_file")
-
-_DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -162,15 +158,9 @@ def read_ik_setup(path) -> IKSetup:
         encoding=None,
         error=lambda problem: MotionDataError(problem, p),
     )
-    if _DTD_OR_ENTITY.search(raw):
-        raise MotionDataError("DTD/entity declarations are not allowed in a setup file", p)
-    parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False
+    root = parse_xml(
+        raw, lambda problem, line: MotionDataError(f"line {line}: {problem}", p), "a setup file"
     )
-    try:
-        root = etree.fromstring(raw, parser)
-    except etree.XMLSyntaxError as exc:
-        raise MotionDataError(f"malformed XML: {exc}", p) from None
     tool = root if root.tag == "InverseKinematicsTool" else root.find("InverseKinematicsTool")
     if tool is None:
         raise MotionDataError(

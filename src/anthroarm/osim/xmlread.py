@@ -13,15 +13,13 @@ import re
 from pathlib import Path
 
 import numpy as np
-from lxml import etree
 
-from .._io import read_bounded
+from .._io import parse_xml, read_bounded
 from ..errors import OsimError, OsimSecurityError, OsimUnsupportedError
 
 #: the largest file accepted (the largest model of opensim-models is ~2.5 MB)
 MAX_OSIM_BYTES = 64 * 2**20
 
-_DTD_OR_ENTITY = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 _SCOPED = re.compile(rb"(</?[A-Za-z_][\w.-]*)::")
 
 
@@ -45,31 +43,15 @@ def parse(path) -> tuple:
 
 def parse_bytes(raw: bytes, path) -> tuple:
     """:func:`parse` of text already in memory (``path`` names it in messages)."""
-    m = _DTD_OR_ENTITY.search(raw)
-    if m:
-        line = raw[: m.start()].count(b"\n") + 1
-        raise OsimSecurityError(
-            path,
-            "DTD/entity declarations are not allowed in a model (entity expansion or external "
-            "entity)",
-            "<!DOCTYPE>/<!ENTITY>",
-            line,
-        )
+
+    def error(problem: str, line) -> Exception:
+        if problem.startswith("DTD"):
+            return OsimSecurityError(path, problem, "<!DOCTYPE>/<!ENTITY>", line)
+        return OsimError(path, problem, None, line or None)
+
     # OpenSim writes element names with C++ scopes (<HuntCrossleyForce::ContactParametersSet>),
     # which its own parser reads and XML namespaces refuse: rename them (same lines)
-    raw = _SCOPED.sub(rb"\1__", raw)
-    parser = etree.XMLParser(
-        resolve_entities=False,
-        no_network=True,
-        load_dtd=False,
-        huge_tree=False,
-        remove_comments=True,
-    )
-    try:
-        root = etree.fromstring(raw, parser)
-    except etree.XMLSyntaxError as exc:
-        line = exc.lineno if getattr(exc, "lineno", None) else None
-        raise OsimError(path, f"malformed XML: {exc.msg}", None, line) from None
+    root = parse_xml(_SCOPED.sub(rb"\1__", raw), error, "a model")
     if root.tag != "OpenSimDocument":
         raise OsimError(
             path,

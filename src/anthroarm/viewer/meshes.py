@@ -24,6 +24,7 @@ import umsgpack
 from lxml import etree
 from meshcat.geometry import threejs_type
 
+from .._io import parse_xml
 from ..errors import MeshError, ParameterError
 
 #: Largest mesh file the viewer reads (bytes).  Its contents go to the browser in one message.
@@ -377,19 +378,13 @@ def _check_obj(data: bytes) -> str:
 
 def _check_dae(data: bytes) -> str:
     """COLLADA XML without a DTD, with at least one <geometry>; returned as text."""
-    parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False
-    )
-    try:
-        root = etree.fromstring(data, parser)
-    except etree.XMLSyntaxError as exc:
-        raise _NotAMesh(f"is not well-formed XML (a COLLADA .dae file is XML): {exc}") from None
-    tree = root.getroottree()
-    if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
-        raise _NotAMesh(
-            "declares a DTD (<!DOCTYPE ...>); refused: entity declarations can expand without bound "
-            "or pull in other files"
-        )
+
+    def error(problem: str, line) -> Exception:
+        if problem.startswith("DTD"):
+            return _NotAMesh(f"declares a DTD or entity (line {line}); refused: {problem}")
+        return _NotAMesh(f"is not well-formed XML (a COLLADA .dae file is XML): {problem}")
+
+    root = parse_xml(data, error, "a mesh", keep_comments=True)
     name = etree.QName(root).localname if isinstance(root.tag, str) else str(root.tag)
     if name != "COLLADA":
         raise _NotAMesh(f"is XML but not COLLADA (root element <{name}>)")

@@ -31,8 +31,8 @@ from pathlib import Path
 import meshcat.geometry as mg
 import numpy as np
 import pinocchio as pin
-from lxml import etree
 
+from .._io import parse_xml
 from ..chain import PRISMATIC
 from ..errors import MeshNotFoundError, ViewerError
 from ..spatial.rotations import homogeneous
@@ -225,12 +225,7 @@ def urdf_bodies(robot, max_triangles: int | None = None) -> list[Body]:
     """Bodies from the URDF's ``<visual>`` elements (meshes resolved like the loader did);
     ``max_triangles``: see :func:`load_mesh`."""
     info = robot.info
-    root = etree.fromstring(
-        info.text.encode(),
-        etree.XMLParser(
-            resolve_entities=False, no_network=True, load_dtd=False, remove_comments=True
-        ),
-    )
+    root = parse_xml(info.text.encode(), lambda problem, line: ViewerError(problem), "a URDF")
     named_colors = {}
     for m in root.findall("material"):
         c = m.find("color")
