@@ -30,7 +30,10 @@ OpenSim's ``MomentArmSolver`` computes (unit tension applied at the points of
 the wrap path is the shortest one (a sphere, a cylinder without axial travel) this is the
 exact −∂l/∂q (envelope theorem); along a cylinder's axis OpenSim's tangent points are not
 exactly those of the shortest helix and the two differ slightly (measured in the guide).
-Ellipsoids and tori are not evaluated (:class:`~anthroarm.errors.MuscleError`).
+``WrapEllipsoid`` (``WrapEllipsoid.cpp``) is :func:`anthroarm.muscles.wrap_ellipsoid.ellipsoid`:
+its surface path is not a shortest one, so its tangent points move with the path's end points
+and their derivatives (complex step, exact to rounding) enter ∂l/∂q.  Tori are not evaluated
+(:class:`~anthroarm.errors.MuscleError`).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import MuscleError
+from .wrap_ellipsoid import ellipsoid
 
 #: SimmMacros.h / WrapMath.cpp / WrapCylinder.cpp constants
 ROUNDOFF_ERROR = 2e-13
@@ -357,14 +361,18 @@ def sphere(p1, p2, radius, quad):
 
 
 # ------------------------------------------------------------------------------ the path
-def _wrap_line(w, p1, p2, single):
+def _wrap_line(w, p1, p2, single, method="hybrid"):
+    """(code, r1, r2, arc, jac) in the wrap object's frame; jac (ellipsoids only): the
+    derivatives of r1, r2 and the arc with respect to (p1, p2), else None."""
     if w.kind == "WrapCylinder":
-        return cylinder(p1, p2, w.radius, w.length, quadrant(w.quadrant), single)
+        return (*cylinder(p1, p2, w.radius, w.length, quadrant(w.quadrant), single), None)
     if w.kind == "WrapSphere":
-        return sphere(p1, p2, w.radius, quadrant(w.quadrant))
+        return (*sphere(p1, p2, w.radius, quadrant(w.quadrant)), None)
+    if w.kind == "WrapEllipsoid":
+        return ellipsoid(p1, p2, w.dimensions, quadrant(w.quadrant), method)
     raise MuscleError(
-        f"wrap object {w.name!r} is a {w.kind}: only WrapCylinder and WrapSphere are evaluated; "
-        "pass wrap=False or make it inactive"
+        f"wrap object {w.name!r} is a {w.kind}: only WrapCylinder, WrapSphere and "
+        "WrapEllipsoid are evaluated; pass wrap=False or make it inactive"
     )
 
 
@@ -402,13 +410,25 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
         Tb = frames[j][0]
         return Tb[:3, :3] @ wpts[j][which - 1] + Tb[:3, 3]
 
+    # OpenSim's Point::getLocationInGround caches a point's ground position at its first use
+    # in a state; a wrap point moved by a later pass keeps the old one in the path's length
+    # and in calcPathLengthChange (the wrap computations themselves use the new one)
+    stale: dict = {}
+
+    def gpos(e):
+        if e[0] == "p":
+            return x[pos[e]]
+        if e[1] not in stale:
+            stale[e[1]] = ground(e)
+        return stale[e[1]]
+
     def length():
         total = 0.0
         for a, b in zip(path[:-1], path[1:]):
             if a[0] == "w" and b[0] == "w" and a[1][0] == b[1][0]:
                 total += wpts[b[1][0]][2]
             else:
-                total += float(np.linalg.norm(ground(b) - ground(a)))
+                total += float(np.linalg.norm(gpos(b) - gpos(a)))
         return total
 
     nw = len(objs)
@@ -440,24 +460,26 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
                 ga, gb = ground(ea), ground(eb)
                 p1 = to_w[:3, :3] @ ga + to_w[:3, 3]
                 p2 = to_w[:3, :3] @ gb + to_w[:3, 3]
-                code, r1, r2, arc = _wrap_line(w, p1, p2, nw == 1)
+                code, r1, r2, arc, jac = _wrap_line(w, p1, p2, nw == 1, pw.method)
                 results[i] = code
                 if code in (WRAPPED, MANDATORY):
                     r1b = Tw[:3, :3] @ r1 + Tw[:3, 3]
                     r2b = Tw[:3, :3] @ r2 + Tw[:3, 3]
+                    used = (jac, ea, eb, ga, gb)
                     if code == MANDATORY:
-                        best = (a, r1b, r2b, arc)
+                        best = (a, r1b, r2b, arc, used)
                         break
                     g1 = Tb[:3, :3] @ r1b + Tb[:3, 3]
                     g2 = Tb[:3, :3] @ r2b + Tb[:3, 3]
+                    ca, cb = gpos(ea), gpos(eb)
                     change = (
-                        np.linalg.norm(g1 - ga) + arc + np.linalg.norm(gb - g2)
-                    ) - np.linalg.norm(gb - ga)
+                        np.linalg.norm(g1 - ca) + arc + np.linalg.norm(cb - g2)
+                    ) - np.linalg.norm(cb - ca)
                     if change < best_change:
-                        best, best_change = (a, r1b, r2b, arc), change
+                        best, best_change = (a, r1b, r2b, arc, used), change
             if best is not None:
-                a, r1b, r2b, arc = best
-                wpts[j] = (r1b, r2b, arc)
+                a, r1b, r2b, arc, used = best
+                wpts[j] = (r1b, r2b, arc, used)
                 path[a + 1 : a + 1] = [("w", (j, 1)), ("w", (j, 2))]
         total = length()
         if abs(total - last) < 0.0005:
@@ -467,29 +489,74 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
             order[0], order[1] = 1, 0
             path = [e for e in path if not (e[0] == "w" and e[1][0] == 0)]
             wpts.pop(0, None)
-    # the gradient: straight segments, tangent points fixed in their wrap object's body
+    # the gradient: straight segments; tangent points fixed in their wrap object's body, but
+    # an ellipsoid's move with its end points (wrap_ellipsoid: its path is not the shortest)
+    # (a stale tangent point: fixed in its body at its cached position)
+    fresh = {
+        j: all(np.linalg.norm(gpos(("w", (j, k))) - ground(("w", (j, k)))) <= 1e-12 for k in (1, 2))
+        for j in wpts
+    }
+    moving = {
+        j: _ellipsoid_motion(j, wpts[j], ground, dx, pos, objs, frames, s) if fresh[j] else None
+        for j in wpts
+    }
     grad = np.zeros(nq)
     total = 0.0
     for a, b in zip(path[:-1], path[1:]):
         if a[0] == "w" and b[0] == "w" and a[1][0] == b[1][0]:
-            total += wpts[b[1][0]][2]
+            j = b[1][0]
+            total += wpts[j][2]
+            if moving[j] is not None:
+                grad += moving[j][2]
             continue
-        ga, gb = ground(a), ground(b)
+        ga, gb = gpos(a), gpos(b)
         d = gb - ga
         seg = float(np.linalg.norm(d))
         if seg < 1e-12:
             raise MuscleError(f"muscle {name!r}: two consecutive path points coincide")
         total += seg
-        db = _dpoint(b, gb, dx, pos, objs, frames, s)
-        grad += (d / seg) @ (db - _dpoint(a, ga, dx, pos, objs, frames, s))
+        db = _dpoint(b, gb, dx, pos, objs, frames, s, moving)
+        grad += (d / seg) @ (db - _dpoint(a, ga, dx, pos, objs, frames, s, moving))
     return total, grad
 
 
-def _dpoint(e, g, dx, pos, objs, frames, s):
+def _dpoint(e, g, dx, pos, objs, frames, s, moving=None):
+    """∂x/∂q (3, nq) of path entry e at ground position g."""
     if e[0] == "p":
         return dx[pos[e]]
     j = e[1][0]
+    out = _dfixed(g, j, objs, frames, s)
+    if moving is not None and moving.get(j) is not None:
+        out = out + moving[j][e[1][1] - 1]
+    return out
+
+
+def _dfixed(g, j, objs, frames, s):
+    """∂x/∂q of the point of wrap j's body at ground position g."""
     Tb = frames[j][0]
     J = objs[j][3][s]
     rs = g - Tb[:3, 3]
     return J[:3] - np.cross(rs[:, None], J[3:], axis=0)
+
+
+def _ellipsoid_motion(j, wp, ground, dx, pos, objs, frames, s):
+    """For an ellipsoid wrap j: (∂r1/∂q, ∂r2/∂q relative to its body (3, nq) each, ∂arc/∂q
+    (nq,)) through the end points it was computed from; None for other surfaces, or when an
+    end point has moved since (a later pass of a multi-wrap path: the tangent points are then
+    held fixed in the body, OpenSim's convention)."""
+    jac, ea, eb, ga, gb = wp[3]
+    if jac is None:
+        return None
+    if np.linalg.norm(ground(ea) - ga) > 1e-12 or np.linalg.norm(ground(eb) - gb) > 1e-12:
+        return None
+    Tb, Tw = frames[j]
+    R = Tb[:3, :3] @ Tw[:3, :3]  # the wrap frame in ground
+    # the end points' motion relative to the wrap body, in the wrap frame (6, nq)
+    dP = np.concatenate(
+        [
+            R.T @ (_dpoint(e, g, dx, pos, objs, frames, s) - _dfixed(g, j, objs, frames, s))
+            for e, g in ((ea, ga), (eb, gb))
+        ]
+    )
+    dr1, dr2, darc = jac
+    return R @ (dr1 @ dP), R @ (dr2 @ dP), darc @ dP
