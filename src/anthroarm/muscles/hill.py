@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MuscleError
+from . import millard
 from .paths import lengths_and_moment_arms, muscle_set
 
 #: bisection steps: the bracket shrinks by 2^-80, below one ulp of any fibre length
@@ -86,11 +87,6 @@ class Equilibrium:
 
 
 def _parameters(ms):
-    for m in ms.muscles:
-        if m.type != "Thelen2003Muscle":
-            raise MuscleError(
-                f"muscle {m.name!r} is a {m.type}: only Thelen2003Muscle forces are evaluated"
-            )
     keys = ["FmaxTendonStrain", "FmaxMuscleStrain", "KshapeActive", "KshapePassive"]
     keys += ["maximum_pennation_angle", "minimum_activation"]
     p = {k: np.array([m.params[k] for m in ms.muscles]) for k in keys}
@@ -118,18 +114,49 @@ def check_activation(activation, shape) -> np.ndarray:
 
 
 def equilibrium(muscles, lengths, activation, *, rigid_tendon=None) -> Equilibrium:
-    """The static equilibrium of Thelen2003 muscles at musculotendon ``lengths`` (m, ``(M,)``
-    or ``(N, M)``) and ``activation`` (in [0, 1], broadcast), zero lengthening speed (see the
-    module docstring).  ``rigid_tendon``: None follows each muscle's
+    """The static equilibrium of the muscles (``Thelen2003Muscle`` as in the module docstring,
+    ``Millard2012EquilibriumMuscle`` by :func:`anthroarm.muscles.millard.static_equilibrium`)
+    at musculotendon ``lengths`` (m, ``(M,)`` or ``(N, M)``) and ``activation`` (in [0, 1],
+    broadcast), zero lengthening speed.  ``rigid_tendon``: None follows each muscle's
     ``ignore_tendon_compliance``; True / False forces it for all."""
     ms = muscles
-    p = _parameters(ms)
     L = np.asarray(lengths, dtype=float)
     one = L.ndim == 1
     L2 = np.atleast_2d(L)
     if L2.shape[-1] != len(ms) or not np.all(np.isfinite(L2)):
         raise MuscleError(f"lengths must be finite, shape (N, {len(ms)}); got {L.shape}")
-    a = np.maximum(check_activation(activation, L2.shape), p["minimum_activation"])
+    a_in = check_activation(activation, L2.shape)
+    kinds = {"Thelen2003Muscle": [], "Millard2012EquilibriumMuscle": []}
+    for i, m in enumerate(ms.muscles):
+        if m.type not in kinds:
+            raise MuscleError(
+                f"muscle {m.name!r} is a {m.type}: only Thelen2003Muscle and "
+                "Millard2012EquilibriumMuscle forces are evaluated"
+            )
+        kinds[m.type].append(i)
+    fields = [np.zeros(L2.shape) for _ in range(7)]
+    th = kinds["Thelen2003Muscle"]
+    if th:
+        sub = ms if len(th) == len(ms) else ms.select([ms.muscles[i].name for i in th])
+        for f, v in zip(fields, _thelen(sub, L2[:, th], a_in[:, th], rigid_tendon)):
+            f[:, th] = v
+    for i in kinds["Millard2012EquilibriumMuscle"]:
+        m = ms.muscles[i]
+        rigid = m.ignore_tendon_compliance if rigid_tendon is None else bool(rigid_tendon)
+        *values, _at_bound = millard.static_equilibrium(m, L2[:, i], a_in[:, i], rigid)
+        for f, v in zip(fields, values):
+            f[:, i] = v
+    out = Equilibrium(*fields)
+    if one:
+        out = Equilibrium(*(np.asarray(v)[0] for v in out.__dict__.values()))
+    return out
+
+
+def _thelen(ms, L2, a_in, rigid_tendon):
+    """Thelen2003 static equilibrium (module docstring): the seven fields of
+    :class:`Equilibrium`, arrays (N, M)."""
+    p = _parameters(ms)
+    a = np.maximum(a_in, p["minimum_activation"])
     rigid = p["rigid"] if rigid_tendon is None else np.full(len(ms), bool(rigid_tendon))
     fiso, ofl, tsl = p["max_isometric_force"], p["optimal_fiber_length"], p["tendon_slack_length"]
     phi0, phimax = p["pennation_angle_at_optimal"], p["maximum_pennation_angle"]
@@ -184,10 +211,7 @@ def equilibrium(muscles, lengths, activation, *, rigid_tendon=None) -> Equilibri
     tendon = np.where(
         rigid, fiber * np.cos(phi), tendon_force_strain(tl / tsl, p["FmaxTendonStrain"]) * fiso
     )
-    out = Equilibrium(lce, phi, fiber, tendon, active, fpe * fiso, a)
-    if one:
-        out = Equilibrium(*(np.asarray(v)[0] for v in out.__dict__.values()))
-    return out
+    return lce, phi, fiber, tendon, active, fpe * fiso, a
 
 
 def joint_torques(robot, muscles=None, q=None, activation=1.0, *, wrap: bool = True):

@@ -25,6 +25,7 @@ from ..errors import MuscleError, OsimError, OsimUnsupportedError
 from ..osim import functions as fn
 from ..osim.build import body_fixed_xyz
 from ..osim.xmlread import Values, parse
+from .millard import CURVE_DEFAULTS, MILLARD_DEFAULTS
 
 #: the muscle classes read (others in the ForceSet are skipped and listed in ``skipped``)
 MUSCLE_TAGS = ("Thelen2003Muscle", "Millard2012EquilibriumMuscle")
@@ -267,6 +268,20 @@ def _point(v: Values, el, muscle: str) -> PathPoint:
     raise v.error(el, what, f"path point type <{el.tag}> is not read", OsimUnsupportedError)
 
 
+def _millard_params(v: Values, el, what: str) -> dict:
+    """A Millard2012 muscle's properties and its curves' (``"<Curve>.<property>"``); an
+    optional curve property left out stays out (the curve fills it in, as OpenSim's)."""
+    params = {k: v.scalar(el, k, what, d) for k, d in MILLARD_DEFAULTS.items()}
+    for curve, props in CURVE_DEFAULTS.items():
+        c_el = el.find(curve)
+        for k, d in props.items():
+            if c_el is not None and (v.text(c_el, k) or "") != "":
+                params[f"{curve}.{k}"] = v.scalar(c_el, k, f"{what} <{curve}>")
+            elif d is not None:
+                params[f"{curve}.{k}"] = d
+    return params
+
+
 _CORE = {
     "max_isometric_force": None,
     "optimal_fiber_length": None,
@@ -306,6 +321,8 @@ def _muscle(v: Values, el, path) -> Muscle:
     params = {}
     if el.tag == "Thelen2003Muscle":
         params = {k: v.scalar(el, k, what, d) for k, d in THELEN_DEFAULTS.items()}
+    if el.tag == "Millard2012EquilibriumMuscle":
+        params = _millard_params(v, el, what)
     return Muscle(
         name,
         el.tag,
