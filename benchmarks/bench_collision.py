@@ -168,55 +168,65 @@ def run(quick: bool = False, n_targets: int | None = None) -> dict:
     }
 
 
-if __name__ == "__main__":  # pragma: no cover
-    import sys
-
-    from .common import write_result
-
-    quick = "--quick" in sys.argv
-    print(write_result("collision", run(quick=quick)))
-
-
 def run_grasps(quick: bool = False, n: int | None = None) -> dict:
-    """Collision-free grasps on the limb's hand (:func:`anthroarm.hand.solve_grasp` with
-    ``collision_free=True``) beside the same grasps without collisions: reachable cylinders
-    (``hand.problems.reachable_grasps``, radius 15-40 mm, given contacts, the comfortable arm
-    posture with the hand open as the start).  Reported: success (the solver's criteria; with
-    collisions also every fingertip capsule within 1 mm of the object and nothing deeper than
-    1e-4 m into it or into another body), the deepest penetration into the object and the
-    deepest self-collision at the answer (coal), median CPU time per grasp."""
+    """Collision-free grasps on the human limb's hand (:func:`anthroarm.hand.solve_grasp` with
+    ``collision_free=True``) beside the same grasps without collisions, on the same problems:
+    ``hand.problems.collision_free_grasps`` (thumb-index pinches of cylinders and spheres,
+    radius 15-35 mm, whose witness is collision-free by coal: fingertip capsules within the
+    1 mm contact margin, nothing into the object or another body), given contacts, the
+    comfortable arm posture with the hand open as the start.  Reported per shape: success
+    (the solver's criteria; with collisions also coal's: every fingertip capsule within
+    [-1e-4, 1e-3] m of the object and nothing deeper than 1e-4 m into it or into another
+    body), the deepest penetration into the object and the deepest self-collision at the
+    answer (coal), median CPU time per grasp, and which phase of the collision-free solve
+    succeeded (direct / fingers / repair / approach)."""
     from anthroarm import hand as H  # noqa: PLC0415
-    from anthroarm.hand.problems import open_hand, reachable_grasps  # noqa: PLC0415
+    from anthroarm.hand.problems import collision_free_grasps, open_hand  # noqa: PLC0415
     from anthroarm.ik.qp.tasks.posture import comfortable_posture  # noqa: PLC0415
 
-    n = n or (2 if quick else 500)
+    n = n or (2 if quick else 250)
     robot = aa.load("human_upper_limb")
-    hand = H.Hand(robot)
-    problems = reachable_grasps(robot, n, rng=2026, hand=hand, per_hand=10)
+    hand = H.Hand(robot, tips=("index_tip", "thumb_tip"))
     q0 = open_hand(robot, hand, comfortable_posture(robot))
-    stats = {False: ([], [], [], []), True: ([], [], [], [])}
-    for pb in problems:
-        env = C.environment([pb.obj.obstacle()])
+    rows, out = [], {}
+    for kind in ("cylinder", "sphere"):
+        t_gen = time.perf_counter()
+        problems = collision_free_grasps(robot, n, kind=kind, rng=2026, hand=hand, per_hand=5)
+        t_gen = time.perf_counter() - t_gen
+        stats = {False: ([], [], [], []), True: ([], [], [], [])}
+        phases = {}
+        for pb in problems:
+            env = C.environment([pb.obj.obstacle()])
+            for cf in (False, True):
+                t0 = time.process_time()
+                r = H.solve_grasp(robot, pb.obj, pb.contacts, hand=hand, q0=q0, collision_free=cf)
+                stats[cf][0].append(time.process_time() - t0)
+                d = C.distances(robot, r.q, env)
+                obj = d.body_b < 0
+                stats[cf][1].append(r.success)
+                stats[cf][2].append(max(0.0, -float(d.distance[obj].min())))
+                stats[cf][3].append(max(0.0, -float(d.distance[~obj].min())))
+                if cf:
+                    ph = r.info.get("phase", "none")
+                    phases[ph] = phases.get(ph, 0) + 1
+        out[kind] = {"problems": len(problems), "generation_s": t_gen, "phases": phases}
         for cf in (False, True):
-            t0 = time.process_time()
-            r = H.solve_grasp(robot, pb.obj, pb.contacts, hand=hand, q0=q0, collision_free=cf)
-            stats[cf][0].append(time.process_time() - t0)
-            d = C.distances(robot, r.q, env)
-            obj = np.array([b < 0 for b in d.body_b], dtype=bool)
-            stats[cf][1].append(r.success)
-            stats[cf][2].append(max(0.0, -float(d.distance[obj].min())))
-            stats[cf][3].append(max(0.0, -float(d.distance[~obj].min())))
-    rows = []
-    for cf in (False, True):
-        t, s, pen, spen = (np.array(a, dtype=float) for a in stats[cf])
-        rows.append([
-            "collision_free=True" if cf else "without collisions", len(problems),
-            f"{100 * s.mean():.1f} %", float(np.max(pen)), float(np.median(pen)),
-            float(np.max(spen)), 1e3 * float(np.median(t)),
-        ])  # fmt: skip
+            t, s, pen, spen = (np.array(a, dtype=float) for a in stats[cf])
+            out[kind]["collision_free" if cf else "plain"] = {
+                "success": float(s.mean()) if len(s) else float("nan"),
+                "max_penetration": float(np.max(pen)) if len(pen) else float("nan"),
+                "median_ms": 1e3 * float(np.median(t)) if len(t) else float("nan"),
+            }
+            rows.append([
+                kind, "collision_free=True" if cf else "without collisions", len(problems),
+                f"{100 * s.mean():.1f} %", float(np.max(pen)), float(np.median(pen)),
+                float(np.max(spen)), 1e3 * float(np.median(t)), 1e3 * float(np.percentile(t, 90)),
+                ", ".join(f"{k} {v}" for k, v in sorted(phases.items())) if cf else "",
+            ])  # fmt: skip
     return {
-        "title": "Collision-free grasps on the human limb's hand (cylinders)",
+        "title": "Collision-free grasps on the human limb's hand (thumb-index pinches)",
         "columns": [
+            "shape",
             "grasp",
             "problems",
             "success",
@@ -224,7 +234,24 @@ def run_grasps(quick: bool = False, n: int | None = None) -> dict:
             "median penetration (m)",
             "max self-collision depth (m)",
             "median time (ms CPU)",
+            "p90 time (ms CPU)",
+            "phases",
         ],  # fmt: skip
         "rows": rows,
-        "notes": (run_grasps.__doc__ or "").strip(),
+        "results": out,
+        "notes": (run_grasps.__doc__ or "").strip()
+        + f"\n\nThis run: {n} problems per shape requested.",
     }
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    from .common import write_result
+
+    quick = "--quick" in sys.argv
+    if "--grasps" in sys.argv:  # python -m benchmarks.bench_collision --grasps [--n N]
+        n = int(sys.argv[sys.argv.index("--n") + 1]) if "--n" in sys.argv else None
+        print(write_result("collision_grasp", dict(run_grasps(quick=quick, n=n), quick=quick)))
+    else:
+        print(write_result("collision", run(quick=quick)))

@@ -43,27 +43,27 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from .. import collision, ik
+from .. import ik
 from ..errors import CouplingError, GraspError
 from ..ik import qp
-from ..ik.qp.limits.collision import CollisionLimit
-from ..ik.qp.limits.collision_step import step as collision_step
 from ..ik.qp.tasks.contact_normal import ContactNormalTask
 from ..ik.qp.tasks.surface_contact import SurfaceContactTask
+from .collision_grasp import (
+    COLLISION_MAX_STEP,
+    CONTACT_MARGIN,
+    CollisionGrasp,
+)
 from .fingers import Hand
 from .objects import Cylinder, Sphere
 
 #: success criteria of the issue: every fingertip within 1 mm, its normal within 5°
 POSITION_TOL = 1e-3
 NORMAL_TOL = math.radians(5.0)
-#: a collision-free grasp: the fingertip capsules touch the object within this gap (m) and no
-#: body goes deeper into it, or into another body of the hand, than PENETRATION_TOL
-CONTACT_MARGIN = 1e-3
-PENETRATION_TOL = 1e-4
-#: the trust region (rad or m per iteration) of a collision-free grasp
-COLLISION_MAX_STEP = 0.05
 #: iterations without a 1 % improvement of the best error after which an attempt has stalled
 STALL_WINDOW = 25
+#: collision-free grasps: hand-only solves from random finger joints tried after a grasp whose
+#: fingers go through the object (``solve_grasp(collision_free=True)``)
+FINGER_TRIES = 8
 
 
 @dataclass
@@ -241,6 +241,7 @@ def palm_approach(
     rounds: int = 3,
     solver: str = "daqp",
     step_fn=None,
+    fingers=None,
 ) -> np.ndarray:
     """A start for a grasp with given contact ``points``: the arm joints of ``q`` moved so that the
     palm sits where a hand shape fits the contacts, the finger joints shaped for them.
@@ -251,7 +252,8 @@ def palm_approach(
     the problem carried into the current palm frame), and fit again; ``rounds`` fits in all.
     The arm joints then come from :func:`anthroarm.ik.solve` on the palm frame (from ``q``, or
     from a random arm configuration with ``seed_arm``); where the fitted pose is out of reach,
-    the nearest configuration it found inside the limits (else ``q``'s arm)."""
+    the nearest configuration it found inside the limits (else ``q``'s arm).  ``fingers``:
+    the finger joints (``hand.finger_q_indices``) to start from instead of mid-range."""
     robot = hand.robot
     model = robot.model
     data = model.createData()
@@ -261,6 +263,8 @@ def palm_approach(
     cur = np.array(q, dtype=float)
     mid = 0.5 * (chain.lower + chain.upper)
     cur[fq] = np.where(np.isfinite(mid[fq]), mid[fq], cur[fq])
+    if fingers is not None:  # another hand shape to fit the palm with
+        cur[fq] = fingers
     for k in range(max(1, int(rounds))):
         pin.framesForwardKinematics(model, data, cur)
         T = _fit_palm(hand, data, points, obj)
@@ -370,15 +374,23 @@ def solve_grasp(
         couplings, solver)`` returns an object with ``v`` (nv,), ``ok`` and ``status``, ``info``
         (benchmarks/bench_hand.py runs the same loop on pink's ``solve_ik`` this way).
     collision_free : bool
-        The object is a collision body (:mod:`anthroarm.collision`): every step carries the
-        velocity damper :class:`~anthroarm.ik.qp.limits.collision.CollisionLimit` against the
-        object (d_s = 0) and between the robot's own bodies (fingers, palm, arm, torso), and
-        the fingertips aim at the object grown by their capsules' radius, so that the pads
-        touch it instead of their axes.  Success adds: every fingertip capsule within
-        ``contact_margin`` of the object, no body deeper than 1e-4 m into it or into another
-        body; otherwise the status is ``"no_collision_free_grasp"``.  The trust region is at
-        most 0.05 rad per iteration (the damper is linear in q).  Not with ``couplings`` or
-        ``step_fn``.
+        The object is a collision body (:mod:`anthroarm.hand.collision_grasp`): the
+        fingertips aim at the object grown by their capsule radius and half the contact margin
+        (their surfaces at a gap from the object's, not their axes on it).  First the grasp
+        without collisions on that surface (the same arguments, ``position_tol`` at most half
+        the margin); when coal finds it collision-free it is the answer, otherwise the
+        iterations run again with the velocity damper
+        :class:`~anthroarm.ik.qp.limits.collision.CollisionLimit` on every step (fingertip
+        capsules against the object to d = 0, every other body and every self pair to
+        0.2 mm; at most 0.05 rad per iteration), from that answer (the damper pushes apart
+        what is in) and then from an approach (the fingers open, the palm 4 cm back).
+        Success adds: every fingertip capsule within ``contact_margin`` of the object, no
+        body deeper than 1e-4 m into it or into another body (coal).  When no attempt gives
+        that the status is ``"no_collision_free_grasp"`` (``info["reason"]`` says why: no
+        grasp even without collisions, the object grown by the fingertips wider than the
+        span, or every collision-free attempt failed).  ``info`` has ``penetration``,
+        ``self_penetration``, ``tip_gaps`` (m, coal) and ``phase`` (``"direct"``,
+        ``"repair"`` or ``"approach"``).  Not with ``couplings`` or ``step_fn``.
     contact_margin : float
         Largest gap (m) between a fingertip capsule and the object that counts as touching.
 
@@ -392,14 +404,16 @@ def solve_grasp(
     if hand.robot is not robot:
         raise GraspError("hand= was built for another Robot")
     check_span(hand, obj)
-    coll = None
     if collision_free:
         if couplings or step_fn is not None:
             raise GraspError("collision_free=True takes no couplings= and no step_fn=")
-        coll = _CollisionGrasp(robot, hand, obj, contact_margin)
-        obj, step_fn = coll.target, coll.step
-        # smaller iterations: the damper linearises d, and 0.2 rad steps leak ~2 mm
-        max_step = min(float(max_step), COLLISION_MAX_STEP)
+        kw = dict(
+            q0=q0, max_iterations=max_iterations, max_step=max_step, position_cost=position_cost,
+            normal_cost=normal_cost, lm_damping=lm_damping, posture_cost=posture_cost,
+            position_tol=position_tol, normal_tol=normal_tol, solver=solver, tasks=tuple(tasks),
+            restarts=restarts, seed=seed, move_arm=move_arm,
+        )  # fmt: skip
+        return _solve_collision_free(robot, obj, contacts, hand, contact_margin, kw, t0)
     n = len(hand.fingers)
     points = None
     if contacts is not None:
@@ -445,17 +459,7 @@ def solve_grasp(
     ) + list(tasks)
     if posture_cost:
         all_tasks.append(qp.PostureTask(robot, cost=posture_cost, target=conf.q))
-    lower, upper = None, None
-    if not move_arm and hand.arm_joints:  # the arm's joints held at q0: a box of zero width
-        lower, upper = np.array(robot.chain.lower), np.array(robot.chain.upper)
-        for i in hand.arm_joints:
-            j = robot.chain.joints[i]
-            if not j.is_mimic and j.nq == 1:
-                lower[j.idx_q] = upper[j.idx_q] = conf.q[j.idx_q]
-    limits = [
-        qp.ConfigurationLimit(robot, lower=lower, upper=upper),
-        qp.VelocityLimit(robot, v_max=np.full(robot.nv, float(max_step))),
-    ]
+    limits = _limits(robot, hand, conf.q, move_arm, max_step)
     rng = np.random.default_rng(seed)
     fq = hand.finger_q_indices
     best = None
@@ -508,10 +512,6 @@ def solve_grasp(
         if out[1] == "success" or out[1].startswith("qp_"):
             break
     q, status, _, pe, ne, cp, within, info, _ = best
-    if coll is not None:
-        info = dict(info, **coll.report(q))
-        if status == "success" and not info["collision_free"]:
-            status = "no_collision_free_grasp"
     return GraspResult(
         q,
         status == "success",
@@ -527,61 +527,6 @@ def solve_grasp(
     )
 
 
-class _CollisionGrasp:
-    """The pieces of a collision-free grasp: the object as an obstacle, the fingertip capsule
-    radii, the object grown by them (what the fingertips aim at), the step with the damper."""
-
-    def __init__(self, robot, hand, obj, margin):
-        m = float(margin)
-        if not (math.isfinite(m) and m > 0):
-            raise GraspError(f"contact_margin must be finite and > 0 (m), got {margin!r}")
-        self.robot, self.hand, self.margin = robot, hand, m
-        cm = collision.model(robot)
-        self.env = collision.environment([obj.obstacle()])
-        self.tip_bodies, radii = [], []
-        for f in hand.fingers:
-            j = robot.model.frames[f.tip_id].parentJoint
-            idx = [i for i in range(cm.n) if cm.joint[i] == j and cm.is_capsule[i]]
-            if not idx:
-                raise GraspError(
-                    f"{robot.name}: fingertip {f.tip!r} has no capsule in its collision model"
-                )
-            self.tip_bodies.append(idx[0])
-            radii.append(float(cm.cap_radius[idx[0]]))
-        self.radius = max(radii)
-        self.target = obj.inflated(self.radius)
-        # d_i = 10 cm, beyond what one iteration moves a body (max_step 0.2 rad × ~0.5 m);
-        # ξ dt = d_i / 2: a pair closes at most half its gap per iteration
-        self.limit = CollisionLimit(robot, self.env, d_safe=0.0, d_detect=0.1, xi=0.05)
-
-    def step(self, conf, tasks, limits, couplings, solver):
-        return collision_step(
-            conf, None, tasks, 1.0, limits=[*limits, self.limit], damping=1e-9, full=True
-        )
-
-    def report(self, q) -> dict:
-        """Penetration into the object, self-collision depth and fingertip gaps at ``q``."""
-        d = collision.distances(self.robot, q, self.env)
-        obj = np.array([b < 0 for b in d.body_b], dtype=bool)
-        pen = float(max(0.0, -d.distance[obj].min())) if obj.any() else 0.0
-        self_pen = float(max(0.0, -d.distance[~obj].min())) if (~obj).any() else 0.0
-        gaps = [
-            float(d.distance[obj & (d.body_a == b)].min())
-            if (obj & (d.body_a == b)).any()
-            else np.inf
-            for b in self.tip_bodies
-        ]
-        touching = all(-PENETRATION_TOL <= g <= self.margin for g in gaps)
-        return {
-            "penetration": pen,
-            "self_penetration": self_pen,
-            "tip_gaps": gaps,
-            "collision_free": bool(
-                pen <= PENETRATION_TOL and self_pen <= PENETRATION_TOL and touching
-            ),
-        }
-
-
 def _descend(
     conf,
     hand,
@@ -595,9 +540,11 @@ def _descend(
     position_tol,
     normal_tol,
     step_fn=None,
+    check=None,
 ):
-    """QP iterations from ``conf`` until the criteria hold, the step vanishes, the error stops
-    improving (by 1 % over 25 iterations: ``"stalled"``) or ``max_iterations``."""
+    """QP iterations from ``conf`` until the criteria hold (and ``check(q)``, when given), the
+    step vanishes, the error stops improving (by 1 % over 25 iterations: ``"stalled"``) or
+    ``max_iterations``."""
     status = "max_iterations"
     it = 0
     info = {}
@@ -606,8 +553,9 @@ def _descend(
         pe, ne, cp, on_side = grasp_errors(hand, conf, obj, points)
         within = conf.within_limits(1e-9)
         if pe.max() <= position_tol and ne.max() <= normal_tol and on_side and within:
-            status = "success"
-            break
+            if check is None or check(conf.q):
+                status = "success"
+                break
         score = max(pe.max() / position_tol, ne.max() / normal_tol)
         history.append(score)
         if len(history) > STALL_WINDOW and score > 0.99 * min(history[:-STALL_WINDOW]):
@@ -640,3 +588,147 @@ def _descend(
             break
         conf.integrate_inplace(v, 1.0)
     return conf.q.copy(), status, it, pe, ne, cp, bool(within), info
+
+
+def _limits(robot, hand, q, move_arm, max_step) -> list:
+    """The configuration limit (the arm's joints held at ``q`` unless ``move_arm``: a box of
+    zero width) and the trust region ``max_step`` as a velocity limit."""
+    lower, upper = None, None
+    if not move_arm and hand.arm_joints:
+        lower, upper = np.array(robot.chain.lower), np.array(robot.chain.upper)
+        for i in hand.arm_joints:
+            j = robot.chain.joints[i]
+            if not j.is_mimic and j.nq == 1:
+                lower[j.idx_q] = upper[j.idx_q] = q[j.idx_q]
+    return [
+        qp.ConfigurationLimit(robot, lower=lower, upper=upper),
+        qp.VelocityLimit(robot, v_max=np.full(robot.nv, float(max_step))),
+    ]
+
+
+def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspResult:
+    """``solve_grasp(..., collision_free=True)``: see its docstring."""
+    coll = CollisionGrasp(robot, hand, obj, margin)
+    tgt = coll.target
+    ptol = min(float(kw["position_tol"]), coll.gap)
+    if tgt.size > hand.span:
+        n = len(hand.fingers)
+        q = robot.check_q(kw["q0"]) if kw["q0"] is not None else robot.neutral()
+        info = dict(coll.report(q), phase="none", attempts=0)
+        info["reason"] = (
+            f"the {obj.kind} grown by the fingertip radius and the gap is "
+            f"{1e3 * tgt.size:.1f} mm across, wider than the hand's span {1e3 * hand.span:.1f} mm"
+        )
+        return GraspResult(
+            q, False, "no_collision_free_grasp", 0, time.perf_counter() - t0, hand.tips,
+            np.full(n, np.inf), np.full(n, np.pi), np.full((n, 3), np.nan),
+            robot.within_limits(q), info,
+        )  # fmt: skip
+    # 1. the grasp without collisions on the grown surface: often collision-free as it is
+    r1 = solve_grasp(robot, tgt, contacts, hand=hand, **dict(kw, position_tol=ptol))
+    rep = coll.report(r1.q)
+    best = (r1.q, r1.status, r1.position_errors, r1.normal_errors, r1.contacts, r1.within_limits)
+    total, phase, attempts = r1.iterations, "direct", r1.info.get("attempts", 1)
+    ok = r1.success and rep["collision_free"]
+    if not ok and r1.success:
+        # 2. other hand shapes (random finger joints; with given contacts the palm fitted
+        # anew to each) without the damper: the cheap way around a finger or a palm through
+        # the object
+        rng = np.random.default_rng(kw["seed"])
+        fq = hand.finger_q_indices
+        lo, hi = robot.chain.lower[fq], robot.chain.upper[fq]
+        lo, hi = np.where(np.isfinite(lo), lo, -np.pi), np.where(np.isfinite(hi), hi, np.pi)
+        points = r1.contacts if contacts is not None else None
+        tasks = grasp_tasks(
+            robot, hand, tgt, points, position_cost=kw["position_cost"],
+            normal_cost=kw["normal_cost"], lm_damping=kw["lm_damping"],
+        ) + list(kw["tasks"])  # fmt: skip
+        limits = _limits(robot, hand, r1.q, kw["move_arm"], kw["max_step"])
+        conf = qp.IKConfiguration(robot, r1.q)
+        fit = points is not None and kw["move_arm"] and bool(hand.arm_v_indices)
+        # the joints of neither the arm nor the grasping fingers (fingers not in ``tips``):
+        # drawn too, they must get out of the object's way
+        rest = np.setdiff1d(
+            np.arange(robot.nq), np.concatenate([fq, hand.arm_q_indices]).astype(int)
+        )
+        lo_r, hi_r = robot.chain.lower[rest], robot.chain.upper[rest]
+        free = np.isfinite(lo_r) & np.isfinite(hi_r)
+        base = r1.q.copy()
+        for k in range(FINGER_TRIES):
+            fingers = lo + (hi - lo) * rng.uniform(0.05, 0.6, len(fq))
+            base[rest[free]] = lo_r[free] + (hi_r - lo_r)[free] * rng.uniform(size=int(free.sum()))
+            start = base.copy()
+            start[fq] = fingers
+            if fit:  # the palm turned about the contacts' line by ±30°, ±60°, ...
+                ang = math.radians(30.0 * (k // 2 + 1) * (-1) ** k)
+                start = _turn_palm(hand, points, start, ang)
+            conf.update(start)
+            out = _descend(
+                conf, hand, tgt, points, tasks, limits, [], kw["solver"],
+                kw["max_iterations"], ptol, kw["normal_tol"], None, check=coll.ok,
+            )  # fmt: skip
+            total += out[2]
+            attempts += 1
+            if out[1] == "success":
+                best, ok, phase = (out[0], out[1], *out[3:7]), True, "fingers"
+                rep = coll.report(out[0])
+                break
+    if not ok:
+        # 3. the damper on every step: from that answer (the damper pushes apart what is in),
+        # then from an approach (the fingers open, the palm back)
+        points = r1.contacts if contacts is not None else None
+        tasks = grasp_tasks(
+            robot, hand, tgt, points, position_cost=kw["position_cost"],
+            normal_cost=kw["normal_cost"], lm_damping=kw["lm_damping"],
+        ) + list(kw["tasks"])  # fmt: skip
+        limits = _limits(
+            robot, hand, r1.q, kw["move_arm"], min(float(kw["max_step"]), COLLISION_MAX_STEP)
+        )
+        conf = qp.IKConfiguration(robot, r1.q)
+        for phase in ("repair", "approach"):
+            start = r1.q if phase == "repair" else coll.approach(r1.q, move_arm=kw["move_arm"])
+            conf.update(start)
+            out = _descend(
+                conf, hand, tgt, points, tasks, limits, [], kw["solver"],
+                kw["max_iterations"], ptol, kw["normal_tol"], coll.step, check=coll.ok,
+            )  # fmt: skip
+            total += out[2]
+            attempts += 1
+            if out[1] == "success":
+                best, ok = (out[0], out[1], *out[3:7]), True
+                rep = coll.report(out[0])
+                break
+    q, status, pe, ne, cp, within = best
+    info = dict(rep, phase=phase if ok else "none", attempts=attempts)
+    if not ok:
+        status = "no_collision_free_grasp"
+        info["reason"] = (
+            "every collision-free attempt failed"
+            if r1.success
+            else f"no grasp even without collisions ({r1.status})"
+        )
+        info["grasp_status"] = r1.status
+    cp = np.array([obj.project(c) for c in cp])  # the contacts on the object itself
+    return GraspResult(
+        q, ok, "success" if ok else status, total, time.perf_counter() - t0, hand.tips,
+        pe, ne, cp, within, info,
+    )  # fmt: skip
+
+
+def _turn_palm(hand, points, q, angle) -> np.ndarray:
+    """``q`` with the arm moved (:func:`anthroarm.ik.solve` on the palm frame) so that the palm
+    turns by ``angle`` (rad) about the line through the contact ``points`` (their principal
+    direction through their centroid): the freedom a grasp with two contacts leaves."""
+    robot = hand.robot
+    c = points.mean(axis=0)
+    u = np.linalg.svd(points - c)[2][0]
+    R = pin.exp3(angle * u)
+    M = robot.fk(q, frame=hand.palm)
+    T = np.eye(4)
+    T[:3, :3] = R @ M[:3, :3]
+    T[:3, 3] = c + R @ (M[:3, 3] - c)
+    res = ik.solve(robot, T, q0=q, frame=hand.palm, tol_pos=1e-4, tol_rot=1e-3, max_time=0.01)
+    out = q.copy()
+    if res.q is not None and np.isfinite(res.q).all() and robot.within_limits(res.q):
+        out[hand.arm_q_indices] = res.q[hand.arm_q_indices]
+    return out

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from .collision_grasp import CollisionGrasp, open_fingers
 from .fingers import Hand
 from .grasp import solve_grasp
 from .objects import Cylinder, Sphere
@@ -73,26 +74,9 @@ def palm_axes(hand: Hand, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def open_hand(robot, hand: Hand, q=None) -> np.ndarray:
     """``q`` (default: neutral clipped into the limits) with every finger joint at the end of its
-    range opposite to flexion (the pad side), clipped: the open hand."""
-    chain = robot.chain
-    q = robot.neutral() if q is None else np.array(q, dtype=float)
-    lo, hi = chain.lower, chain.upper
-    q = np.where(np.isfinite(lo), np.maximum(q, lo), q)
-    q = np.where(np.isfinite(hi), np.minimum(q, hi), q)
-    for f in hand.fingers:
-        for i in f.joints:
-            j = chain.joints[i]
-            if j.is_mimic or j.nq != 1:
-                continue
-            flex_positive = (
-                not (np.isfinite(j.lower) and np.isfinite(j.upper)) or j.upper >= -j.lower
-            )
-            q[j.idx_q] = (
-                min(max(0.0, j.lower), j.upper)
-                if flex_positive
-                else max(min(0.0, j.upper), j.lower)
-            )
-    return q
+    range opposite to flexion (the pad side), clipped: the open hand
+    (:func:`anthroarm.hand.collision_grasp.open_fingers`)."""
+    return open_fingers(robot, hand, q)
 
 
 def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
@@ -106,9 +90,15 @@ def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
     w = np.ones(len(centres)) if weights is None else np.asarray(weights, dtype=float)
     w = w / w.sum()
     c = w @ centres
-    axis = (
-        np.linalg.svd((centres - c) * np.sqrt(w)[:, None])[2][0] if kind == "cylinder" else across
-    )
+    if kind != "cylinder":
+        axis = across
+    elif len(centres) >= 3:
+        axis = np.linalg.svd((centres - c) * np.sqrt(w)[:, None])[2][0]
+    else:  # a pinch: the axis normal to the line of the two pads, nearest the palm normal
+        e = centres[-1] - centres[0]
+        e = e / max(float(np.linalg.norm(e)), 1e-12)
+        nrm = palm_axes(hand, q)[0]
+        axis = nrm - (nrm @ e) * e
     T_palm_obj = np.eye(4)
     T_palm_obj[:3, :3] = _frame(axis)
     T_palm_obj[:3, 3] = c
@@ -219,4 +209,110 @@ def reachable_grasps(
             obj = Cylinder(Tw[:3, 3], Tw[:3, 2], r) if kind == "cylinder" else Sphere(Tw[:3, 3], r)
             contacts = np.array([data.oMf[f.tip_id].translation for f in hand.fingers])
             out.append(GraspProblem(obj, contacts, q, T_palm_obj))
+    return out
+
+
+def _object(kind, T, r, length):
+    """The object of radius ``r`` whose frame (centre, axis as z) is ``T`` (4×4, world)."""
+    if kind == "cylinder":
+        return Cylinder(T[:3, 3], T[:3, 2], r, length=length)
+    return Sphere(T[:3, 3], r)
+
+
+def collision_free_grasps(
+    robot,
+    n: int,
+    kind: str = "cylinder",
+    rng=None,
+    hand: Hand | None = None,
+    radius=(0.015, 0.035),
+    arm_margin: float = 0.2,
+    per_hand: int = 1,
+    max_draws: int | None = None,
+    arm_tries: int = 20,
+    rounds: int = 6,
+    solver: str = "daqp",
+) -> list[GraspProblem]:
+    """``n`` reachable grasp problems whose witness is a collision-free grasp.
+
+    As :func:`reachable_grasps`, with the object fitted so that the fingertip *capsules* touch
+    it: step 1 fits an object of radius r + ρ + g (ρ the largest fingertip capsule radius,
+    g half the contact margin, :class:`~anthroarm.hand.collision_grasp.CollisionGrasp`) to
+    the pads of a random hand (finger joints 10..60 % of their ranges) and closes the fingers
+    on it; the object is then the one of radius r with the same centre and axis (a cylinder
+    2 cm longer than the fingertips' spread along it).  A draw is kept when coal finds every
+    fingertip capsule within the contact margin of the object and no body in it or in another
+    body; each arm draw of step 2 is checked the same way (the arm against the torso and the
+    object), up to ``arm_tries`` draws.  The contacts are the object's surface points under
+    the fingertips of the witness.  On the human limb's hand this keeps most pinches (thumb
+    and index) and few grasps with more fingers (their proximal phalanges cross the object).
+    """
+    if kind not in ("cylinder", "sphere"):
+        raise ValueError(f"kind must be 'cylinder' or 'sphere', got {kind!r}")
+    rng = np.random.default_rng(rng)
+    hand = Hand(robot) if hand is None else hand
+    model = robot.model
+    data = model.createData()
+    q_open = open_hand(robot, hand)
+    pin.framesForwardKinematics(model, data, q_open)
+    Mp0 = pin.SE3(data.oMf[hand.palm_id])
+    across = palm_axes(hand, q_open)[2]
+    fq = hand.finger_q_indices
+    lo_f, hi_f = robot.chain.lower[fq], robot.chain.upper[fq]
+    lo_f = np.where(np.isfinite(lo_f), lo_f, -np.pi)
+    hi_f = np.where(np.isfinite(hi_f), hi_f, np.pi)
+    aq = hand.arm_q_indices
+    lo_box, hi_box = robot.chain.sampling_box
+    margin = min(float(arm_margin), 0.45 * float(np.min(hi_box - lo_box))) if len(lo_box) else 0.0
+    grow = None
+    out = []
+    draws = 0
+    max_draws = 20 * n if max_draws is None else max_draws
+    while len(out) < n and draws < max_draws:
+        draws += 1
+        r = float(rng.uniform(*radius))
+        q_h = q_open.copy()
+        q_h[fq] = lo_f + (hi_f - lo_f) * rng.uniform(0.1, 0.6, len(fq))
+        res, w = None, None
+        for _ in range(rounds):
+            if grow is None:
+                cg = CollisionGrasp(robot, hand, Sphere(Mp0.translation, r))
+                grow = float(cg.radii.max()) + cg.gap
+            T_palm_obj, obj = _fit_object(hand, model, data, q_h, Mp0, r + grow, kind, across, w)
+            if obj.size > hand.span:
+                break
+            res = solve_grasp(
+                robot, obj, hand=hand, q0=q_h, move_arm=False, solver=solver, restarts=0,
+                max_iterations=40, position_tol=2e-4, normal_tol=np.radians(1.0),
+            )  # fmt: skip
+            if res.success:
+                break
+            q_h = res.q
+            w = 1.0 + res.position_errors / 1e-3 + res.normal_errors / np.radians(5.0)
+        if res is None or not res.success:
+            continue
+        L = None
+        if kind == "cylinder":
+            pin.framesForwardKinematics(model, data, res.q)
+            h = [obj.height(data.oMf[f.tip_id].translation) for f in hand.fingers]
+            L = 2.0 * float(np.max(np.abs(h))) + 0.02
+        if not CollisionGrasp(robot, hand, _object(kind, Mp0.homogeneous @ T_palm_obj, r, L)).ok(
+            res.q
+        ):
+            continue
+        for _ in range(int(per_hand) if len(aq) else 1):
+            if len(out) >= n:
+                break
+            for _ in range(int(arm_tries) if len(aq) else 1):
+                q = res.q.copy()
+                if len(aq):
+                    q[aq] = robot.random_q(rng=rng, margin=margin)[aq]
+                pin.framesForwardKinematics(model, data, q)
+                o = _object(kind, data.oMf[hand.palm_id].homogeneous @ T_palm_obj, r, L)
+                if CollisionGrasp(robot, hand, o).ok(q):
+                    contacts = np.array(
+                        [o.project(data.oMf[f.tip_id].translation) for f in hand.fingers]
+                    )
+                    out.append(GraspProblem(o, contacts, q, T_palm_obj))
+                    break
     return out

@@ -70,6 +70,11 @@ class CollisionLimit(Limit):
         when the closest features switch between steps (a flat face of a hull turning
         towards a table, a vertex taking over) the distance can dip below the linear
         prediction; 1 mm keeps such dips above d_s in the tests and benchmarks.
+    contact_bodies : sequence of int
+        Bodies (indices into :func:`anthroarm.collision.model`'s bodies) that may touch the
+        obstacles: their rows against an obstacle aim at d_s itself (no ``margin``).  A
+        grasp's fingertip capsules: they must reach the object, every other body keeps the
+        margin (:mod:`anthroarm.hand.collision_grasp`).
     """
 
     priority = 3
@@ -83,6 +88,7 @@ class CollisionLimit(Limit):
         xi: float = 0.5,
         self_collision: bool = True,
         margin: float = 0.001,
+        contact_bodies=(),
     ):
         self.d_safe, self.d_detect = check_distances(d_safe, d_detect)
         margin = float(margin)
@@ -99,6 +105,13 @@ class CollisionLimit(Limit):
         self.model = collision_model(robot)
         self.env = coll.environment(obstacles)
         self.self_collision = bool(self_collision)
+        cb = np.asarray(list(contact_bodies), dtype=int).reshape(-1)
+        if len(cb) and (cb.min() < 0 or cb.max() >= self.model.n):
+            raise CollisionError(
+                f"contact_bodies must be body indices in 0..{self.model.n - 1}, got {cb.tolist()}"
+            )
+        self.contact = np.zeros(self.model.n, dtype=bool)
+        self.contact[cb] = True
         self.last = None  # the Distances of the last step
 
     def box(self, conf, dt):
@@ -134,6 +147,8 @@ class CollisionLimit(Limit):
             return np.zeros((0, conf.nv)), np.zeros(0)
         J = coll.jacobians(self.robot.model, conf.data, dist, self.model.support)
         ds = self.d_safe + self.margin
+        if self.contact.any():  # contact bodies against obstacles: no margin
+            ds = np.where(self.contact[dist.body_a] & (dist.body_b < 0), self.d_safe, ds)
         h = self.xi * dt * (dist.distance - ds) / (self.d_detect - ds)
         # a pair inside d_s separates at most at ξ (deep penetrations ask no more than that)
         return -J, np.maximum(h, -self.xi * dt)
