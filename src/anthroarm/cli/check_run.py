@@ -7,6 +7,7 @@ import sys
 import numpy as np
 
 from .. import crosscheck
+from ..muscles import checks as muscle_checks
 from ..osim import checks as osim_checks
 from .common import MAX_SAMPLES, UserError, parse_locked
 from .runtime import load_model
@@ -41,12 +42,15 @@ def run(a) -> int:
 
 def osim_rows(path, a) -> list:
     """An OpenSim model: its import report (printed), the osim rows (against Pinocchio, and
-    against OpenSim when installed) and, without coupled coordinates, every robot's rows (those
-    that cannot apply, such as yourdfpy's, left out)."""
+    against OpenSim when installed), the muscle rows (:mod:`anthroarm.muscles.checks`) and,
+    without coupled coordinates, every robot's rows (those that cannot apply, such as
+    yourdfpy's, left out)."""
     robot = load_model(path, tool=a.tool, locked=parse_locked(a.locked))
     if not a.json:
         print(robot.report.text())
     rows = osim_checks.rows(robot, a.samples, np.random.default_rng(a.seed))
+    # the muscles' lengths and moment arms (the algorithms layer: not imported by osim.checks)
+    rows += muscle_checks.rows(robot, a.samples, np.random.default_rng(a.seed))
     if robot.coupling is None:
         more = crosscheck.run([robot], a.samples, a.seed, list(crosscheck.ROBOT_PROVIDERS))
         rows += [r for r in more if r.status != "unsupported"]

@@ -12,6 +12,11 @@ and inverse dynamics (``InverseDynamicsSolver``), in the independent coordinates
 in mobility order and keeps a coupled coordinate as a mobility of its own: a coordinate's
 mobility is found by giving it alone a speed, and mobility quantities are projected with
 C = du/dq̇ built from OpenSim's own coupler functions (Mᵢ = Cᵀ M C, τᵢ = Cᵀ τ).
+
+The muscles' rows (lengths and moment arms against OpenSim's ``getLength`` /
+``computeMomentArm`` and against central differences of our lengths) are made by
+:func:`anthroarm.muscles.checks.rows` with :class:`OpenSimModel` below, and added by
+``anthroarm check`` after these: this model-layer module does not import the algorithms.
 """
 
 from __future__ import annotations
