@@ -8,9 +8,10 @@
 >>> R = muscles.moment_arms(robot, ms, robot.default_q())     # (92, 23) m, = -dl/dq
 
 Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
-moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres), :mod:`.hill`
-(Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f), :mod:`.optimize` (static
-optimisation through the QP layer).
+moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres), :mod:`.wrap_ellipsoid` (over
+ellipsoids), :mod:`.hill` (Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f),
+:mod:`.millard` (Millard2012EquilibriumMuscle curves and equilibrium), :mod:`.optimize`
+(static optimisation through the QP layer).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from .hill import (
     tendon_force_strain,
 )
 from .optimize import StaticOptimization, force_coefficients, static_optimization
-from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set
+from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set, wrap_status
 from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
 
 __all__ = [
@@ -46,5 +47,6 @@ __all__ = [
     "lengths_and_moment_arms",
     "moment_arms",
     "muscle_set",
+    "wrap_status",
     "read_muscles",
 ]

@@ -134,6 +134,10 @@ def equilibrium(muscles, lengths, activation, *, rigid_tendon=None) -> Equilibri
                 "Millard2012EquilibriumMuscle forces are evaluated"
             )
         kinds[m.type].append(i)
+        for k in ("max_isometric_force", "optimal_fiber_length", "tendon_slack_length"):
+            v = getattr(m, k)
+            if not (np.isfinite(v) and v > 0):
+                raise MuscleError(f"muscle {m.name!r}: {k} {v} is not a positive number")
     fields = [np.zeros(L2.shape) for _ in range(7)]
     th = kinds["Thelen2003Muscle"]
     if th:

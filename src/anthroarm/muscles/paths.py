@@ -151,9 +151,9 @@ def _path_point(kin: Kinematics, p):
     return x, dx, np.ones(n, dtype=bool)
 
 
-def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool, X, DX):
+def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool, X, DX, codes=None):
     """(l (N,), dl/dq (N, nq)) of one muscle whose points are X (N, K, 3), DX (N, K, 3, nq)
-    (moving points filled in here)."""
+    (moving points filled in here); ``codes`` (N, wraps): each wrap's outcome."""
     n, nq = kin.q.shape
     act = np.ones((n, len(muscle.points)), dtype=bool)
     for k, p in enumerate(muscle.points):
@@ -175,7 +175,10 @@ def _muscle_path(kin: Kinematics, muscle, wraps: dict, use_wrap: bool, X, DX):
         xs, dxs = X[rows][:, idx], DX[rows][:, idx]
         if objs:
             sub = [(pw, w, T[rows], J[rows]) for pw, w, T, J in objs]
-            lk, gk = wrapping.wrapped_length(xs, dxs, idx, sub, muscle)
+            ck = None if codes is None else np.zeros((len(rows), len(objs)), dtype=int)
+            lk, gk = wrapping.wrapped_length(xs, dxs, idx, sub, muscle, ck)
+            if codes is not None:
+                codes[rows] = ck
         else:
             lk, gk = straight_length(xs, dxs, muscle.name)
         length[rows], grad[rows] = lk, gk
@@ -305,3 +308,31 @@ def lengths_and_moment_arms(robot, muscles=None, q=None, *, wrap: bool = True):
     """(:func:`lengths`, :func:`moment_arms`) from one evaluation."""
     L, D = _evaluate(robot, muscles, q, wrap)
     return L, -D
+
+
+def wrap_status(robot, muscles=None, q=None) -> dict:
+    """Each wrap's outcome, per muscle with wraps: ``{name: codes}``, codes ``(W,)`` for
+    ``q`` ``(nq,)`` or ``(N, W)`` for ``(N, nq)``, in the order of the muscle's PathWrapSet:
+    1 the path wraps over the object, 0 it does not, -1 it does not because a segment tried
+    had an end point inside the object (OpenSim's ``insideRadius``: the path then passes
+    straight through, as here; the length stays finite and equals OpenSim's).  A bad-input
+    report for "a wrap object the path starts inside" (issue 34)."""
+    ms = muscle_set(robot, muscles)
+    q = robot.check_q(q)
+    one = q.ndim == 1
+    q2 = q.reshape(1, -1) if one else q
+    kin = Kinematics(robot, q2)
+    n, nq = q2.shape
+    out = {}
+    for m in ms.muscles:
+        if not m.wraps:
+            continue
+        X = np.zeros((n, len(m.points), 3))
+        DX = np.zeros((n, len(m.points), 3, nq))
+        for k, p in enumerate(m.points):
+            if p.kind != "moving":
+                X[:, k], DX[:, k] = kin.point(p.frame, p.location)
+        codes = np.zeros((n, len(m.wraps)), dtype=int)
+        _muscle_path(kin, m, ms.wrap_objects, True, X, DX, codes)
+        out[m.name] = codes[0] if one else codes
+    return out

@@ -376,22 +376,31 @@ def _wrap_line(w, p1, p2, single, method="hybrid"):
     )
 
 
-def wrapped_length(xs, dxs, idx, objs, muscle):
+def wrapped_length(xs, dxs, idx, objs, muscle, codes=None):
     """Length (N,) and ∂l/∂q (N, nq) of one muscle's path over its wrap objects.
 
     ``xs`` (N, K, 3) and ``dxs`` (N, K, 3, nq): the active path points (original indices
     ``idx`` in the PathPointSet) in ground; ``objs``: (PathWrap, WrapObject, T (N,4,4) of the
     wrap's body, J (N,6,nq) of that body) for every PathWrap (inactive objects are skipped as
-    OpenSim skips them, but count in the number of wraps)."""
+    OpenSim skips them, but count in the number of wraps).  ``codes`` (N, number of wraps),
+    when given, receives each wrap's outcome (:func:`status` of the codes)."""
     n, nq = xs.shape[0], dxs.shape[-1]
     L, D = np.zeros(n), np.zeros((n, nq))
     npts = len(muscle.points)
     for s in range(n):
-        L[s], D[s] = _one_state(xs[s], dxs[s], idx, objs, s, npts, nq, muscle.name)
+        out = None if codes is None else codes[s]
+        L[s], D[s] = _one_state(xs[s], dxs[s], idx, objs, s, npts, nq, muscle.name, out)
     return L, D
 
 
-def _one_state(x, dx, idx, objs, s, npts, nq, name):
+def status(wrapped: bool, inside: bool) -> int:
+    """A wrap's outcome on one state: ``WRAPPED`` (1) when the path wraps over it, ``INSIDE``
+    (-1) when it does not and a segment tried had an end point inside the surface (OpenSim
+    then lets the path pass straight through the object), else ``NO_WRAP`` (0)."""
+    return WRAPPED if wrapped else (INSIDE if inside else NO_WRAP)
+
+
+def _one_state(x, dx, idx, objs, s, npts, nq, name, codes=None):
     # a path entry: (kind, payload); "p": original point k; "w": (wrap j, 1|2)
     path = [("p", int(k)) for k in idx]
     pos = {("p", int(k)): i for i, k in enumerate(idx)}
@@ -434,6 +443,7 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
     nw = len(objs)
     order = list(range(nw))
     results = [NO_WRAP] * nw
+    inside = [False] * nw
     last = np.inf
     for kk in range(1 if nw < 2 else 8):
         for i in range(nw):
@@ -462,6 +472,7 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
                 p2 = to_w[:3, :3] @ gb + to_w[:3, 3]
                 code, r1, r2, arc, jac = _wrap_line(w, p1, p2, nw == 1, pw.method)
                 results[i] = code
+                inside[j] = inside[j] or code == INSIDE
                 if code in (WRAPPED, MANDATORY):
                     r1b = Tw[:3, :3] @ r1 + Tw[:3, 3]
                     r2b = Tw[:3, :3] @ r2 + Tw[:3, 3]
@@ -517,6 +528,8 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name):
         total += seg
         db = _dpoint(b, gb, dx, pos, objs, frames, s, moving)
         grad += (d / seg) @ (db - _dpoint(a, ga, dx, pos, objs, frames, s, moving))
+    if codes is not None:
+        codes[:] = [status(j in wpts, inside[j]) for j in range(nw)]
     return total, grad
 
 
