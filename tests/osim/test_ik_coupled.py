@@ -5,6 +5,8 @@ kinematics on the full configuration φ(q) (``robot.coupling.full``, itself chec
 OpenSim in tests/osim/test_against_opensim.py), Jacobians against finite differences of it.
 arm26 (no coupling) solves as any robot."""
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -51,6 +53,16 @@ def test_solve_twenty_random_reachable_targets(gait):
         pe, re = errors(pose(gait, r.q), T)
         assert pe <= 1e-6 and re <= 1e-6
         assert abs(pe - r.pos_err) < 1e-12 and abs(re - r.rot_err) < 1e-12
+
+
+def test_solve_from_threads(gait):
+    """One Robot solved for from two threads at once (each thread its own pin.Data)."""
+    rng = np.random.default_rng(5)
+    Ts = [pose(gait, gait.random_q(rng=rng)).homogeneous for _ in range(8)]
+    with ThreadPoolExecutor(2) as ex:
+        rs = list(ex.map(lambda T: aa.ik.solve(gait, T, frame=FRAME), Ts))
+    for r, T in zip(rs, Ts):
+        assert r.success and max(errors(pose(gait, r.q), T)) <= 1e-6
 
 
 def test_off_path_coordinates_keep_q0_and_batches(gait):

@@ -21,7 +21,9 @@ Joints: everything reads ``robot.chain``.  Velocities, Jacobians and limits on t
 the tangent space (nv); configurations are integrated on the manifold (``pin.integrate``) and
 posture errors are ``pin.difference``, so a continuous joint (q = (cos θ, sin θ), one velocity)
 turns the short way and has no position limit; a mimic joint has no q or v of its own
-(Pinocchio moves it with its source).
+(Pinocchio moves it with its source).  An OpenSim model with nonlinear couplings
+(``robot.coupling``) is configured in its independent coordinates (:class:`IKConfiguration`:
+Jacobians J·dφ/dq, limits on the coordinates' ranges).
 
 Thread safety: a Robot may be shared by any number of threads calling :func:`step`.
 ``step(robot, q, ...)`` keeps one IKConfiguration (its own ``pin.Data``), workspace and QP

@@ -19,7 +19,9 @@ independent joints' positions in Pinocchio's v order; a continuous joint's angle
 and enters Pinocchio as (cos θ, sin θ) (:meth:`anthroarm.chain.Chain.configuration`), so steps
 integrate on the circle and the returned angle is the one reached from the seed.  Mimic joints
 are carried by Pinocchio's Jacobian columns; joints off the frame's path have zero columns and
-keep the caller's ``q0`` (else their reference posture).
+keep the caller's ``q0`` (else their reference posture).  An OpenSim model with nonlinear
+couplings (``robot.coupling``) is solved in its independent coordinates, the same kernel on the
+Jacobian J·dφ/dq (:mod:`.coupled`).
 
 Seeds, in order (:mod:`.seeds`):
 

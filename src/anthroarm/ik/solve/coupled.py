@@ -29,6 +29,7 @@ objective for these models; the answer is checked with Pinocchio's FK at φ(q).
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
@@ -73,14 +74,29 @@ class Shared:
 
 
 class CoupledWorkspace:
-    """One call's workspace: the Pinocchio model and a fresh ``pin.Data`` (so a Robot may be
-    solved for from several threads at once), the coupling map, the frame id, the coordinate
-    ranges ``lo``/``hi`` and the kernel's preallocated linear systems (as
-    :class:`~anthroarm.ik.solve.workspace.Workspace`)."""
+    """A thread's workspace for (robot, frame): the Pinocchio model and its own ``pin.Data``
+    (so a Robot may be solved for from several threads at once), the coupling map, the frame
+    id, the coordinates that move it (``path``), the coordinate ranges ``lo``/``hi`` and the
+    kernel's preallocated linear systems (as :class:`~anthroarm.ik.solve.workspace.Workspace`).
+    Nothing in it refers to the Robot."""
 
-    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "coupling", "G")
+    __slots__ = (
+        "sh",
+        "model",
+        "data",
+        "fid",
+        "n",
+        "lo",
+        "hi",
+        "to_q",
+        "lin",
+        "coupling",
+        "G",
+        "path",
+    )
 
     def __init__(self, robot, fid: int, on_path):
+        self.path = on_path
         self.model = robot.model
         self.data = robot.model.createData()
         self.fid = fid
@@ -95,6 +111,23 @@ class CoupledWorkspace:
         for m in {3, 6, min(self.n, 6)}:
             A = np.empty((m, m))
             self.lin[m] = (A, A.T, A.reshape(-1)[:: m + 1])
+
+
+def _frames(robot) -> dict:
+    return {}
+
+
+def workspace(robot, fid: int) -> CoupledWorkspace:
+    """The calling thread's :class:`CoupledWorkspace` for (robot, frame id ``fid``), made once
+    and kept on the robot (``robot.derived``: dropped with it)."""
+    frames = robot.derived("ik.solve.coupled", _frames)  # frame id -> threading.local
+    local = frames.get(fid)
+    if local is None:
+        local = frames.setdefault(fid, threading.local())
+    ws = getattr(local, "ws", None)
+    if ws is None:
+        ws = local.ws = CoupledWorkspace(robot, fid, on_path(robot, fid))
+    return ws
 
 
 def on_path(robot, fid: int) -> np.ndarray:
@@ -177,8 +210,8 @@ def solve(
         ref = robot.check_q(posture, name="posture")
         if ref.ndim != 1:
             raise ValueError(f"posture must have shape ({robot.nq},), got {ref.shape}")
-    path = on_path(robot, fid)
-    ws = CoupledWorkspace(robot, fid, path)
+    ws = workspace(robot, fid)
+    path = ws.path
     lo, hi = ws.lo, ws.hi
     default = clip(robot.default_q(), lo, hi)
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
