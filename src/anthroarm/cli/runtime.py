@@ -167,7 +167,10 @@ def check_radians(values, angular, what: str) -> None:
 
 
 def joint_values(robot, q):
-    """One value per joint of ``robot.joint_names`` (a continuous joint: its angle)."""
+    """One value per joint of ``robot.joint_names`` (a continuous joint: its angle; an OpenSim
+    model with couplings: q itself, its coordinates)."""
+    if getattr(robot, "coupling", None) is not None:
+        return np.array(q, dtype=float)
     return robot.angles(q)[list(robot.chain.independent)]
 
 

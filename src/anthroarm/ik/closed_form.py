@@ -191,7 +191,11 @@ def _new_solver(robot):
 
 
 def _at(robot, frame):
-    """The solver for ``frame`` (default the tool), or None."""
+    """The solver for ``frame`` (default the tool), or None (always for an OpenSim model with
+    nonlinear couplings, ``robot.coupling``: its coordinates are not Pinocchio's joints)."""
+    if getattr(robot, "coupling", None) is not None:
+        robot.frame_id(frame)  # UnknownFrameError for a name the model lacks
+        return None
     r = _retooled(robot, frame)
     return None if r is None else _solver(r)
 
