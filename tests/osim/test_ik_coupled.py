@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.errors import ParameterError
+from anthroarm.errors import ParameterError, UnsupportedModelError
 from anthroarm.ik import qp
 
 FRAME = "calcn_r"
@@ -106,6 +106,9 @@ def test_unreachable_target_and_bad_input(gait):
         aa.ik.solve(gait, T, frame=FRAME, swivel=0.3)
     with pytest.raises(ValueError, match="max_time"):
         aa.ik.solve(gait, T, frame=FRAME, max_time=float("nan"))
+    assert not aa.ik.has_analytic(gait, FRAME)  # no closed form in the coordinates
+    with pytest.raises(UnsupportedModelError, match="aa.ik.solve"):
+        aa.ik.analytic(gait, pose(gait, gait.default_q()).homogeneous, frame=FRAME)
 
 
 def test_configuration_is_in_the_coordinates(gait):

@@ -157,6 +157,12 @@ class _Entry:
     __slots__ = ("solver", "one")
 
     def __init__(self, robot):
+        if getattr(robot, "coupling", None) is not None:
+            raise UnsupportedModelError(
+                f"{robot.name}: no closed form for an OpenSim model whose joints are nonlinear "
+                "functions of its coordinates (robot.coupling); use aa.ik.solve(robot, T), which "
+                "solves in the coordinates"
+            )
         self.solver = _new_solver(robot)
         self.one = None if self.solver is None or self.solver.arm is not None else _PENDING
 
