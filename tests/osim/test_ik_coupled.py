@@ -135,6 +135,31 @@ def test_configuration_is_in_the_coordinates(gait):
     np.testing.assert_array_equal(conf.integrate(np.ones(23), 0.1), q + 0.1)
 
 
+def test_marker_task_in_the_coordinates(gait):
+    """MarkerTask: points on the right calcaneus and the left tibia; their Jacobian (6, 23)
+    equals central differences of the points' positions by Pinocchio's FK at φ(q)."""
+    chain = gait.chain
+    joints = [chain.frame(gait.frame_id(b)).joint for b in (FRAME, "tibia_l")]
+    local = np.array([[0.01, 0.02, 0.03], [0.0, -0.1, 0.02]])
+    task = qp.MarkerTask(gait, joints, local)
+    d = gait.model.createData()
+
+    def points(q):
+        pin.forwardKinematics(gait.model, d, gait.coupling.full(q))
+        return np.concatenate([d.oMi[j + 1].act(x) for j, x in zip(joints, local)])
+
+    q = gait.random_q(rng=3, margin=0.05)
+    conf = qp.IKConfiguration(gait, q)
+    J = task.compute_jacobian(conf)
+    assert J.shape == (6, 23)
+    np.testing.assert_allclose(task.positions(conf).ravel(), points(q), atol=1e-14)
+    h = 1e-6
+    for k in range(23):
+        dq = np.zeros(23)
+        dq[k] = h
+        np.testing.assert_allclose(J[:, k], (points(q + dq) - points(q - dq)) / (2 * h), atol=1e-8)
+
+
 def test_qp_drives_the_foot_within_the_coordinate_ranges(gait):
     """Frame task, configuration and velocity limits: the foot reaches the pose of a random
     in-range configuration; every step stays inside the ranges and under v_max.  A posture
