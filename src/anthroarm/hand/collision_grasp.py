@@ -94,6 +94,8 @@ class CollisionGrasp:
         if not (math.isfinite(m) and m > 0):
             raise GraspError(f"contact_margin must be finite and > 0 (m), got {margin!r}")
         self.robot, self.hand, self.obj, self.margin = robot, hand, obj, m
+        # every finger of the tree, those that do not grasp too (opened out of the way)
+        self.all_fingers = Hand(robot) if len(hand.fingers) < len(robot.chain.tips) else hand
         cm = collision.model(robot)
         self.env = collision.environment([obj.obstacle()])
         self.tip_bodies, radii = [], []
@@ -160,6 +162,11 @@ class CollisionGrasp:
         """The coal criteria of a collision-free grasp hold at ``q``."""
         return self.report(q)["collision_free"]
 
+    def open(self, q) -> np.ndarray:
+        """``q`` with every finger of the hand open (:func:`open_fingers`), those that do not
+        grasp too."""
+        return open_fingers(self.robot, self.all_fingers, q)
+
     def approach(self, q, back: float = APPROACH_BACK, move_arm: bool = True) -> np.ndarray:
         """A start for the collision-free iterations: the fingers of ``q`` opened and the palm
         moved ``back`` (m) away from the object along the line from the object to the palm
@@ -167,7 +174,7 @@ class CollisionGrasp:
         fails), then moved farther while it is still in collision, up to 3 × ``back``.
         ``move_arm=False``: the fingers opened only."""
         robot, hand = self.robot, self.hand
-        start = open_fingers(robot, hand, q)
+        start = self.open(q)
         if not move_arm or not len(hand.arm_q_indices):
             return start
         M = robot.fk(q, frame=hand.palm)

@@ -64,6 +64,8 @@ STALL_WINDOW = 25
 #: collision-free grasps: hand-only solves from random finger joints tried after a grasp whose
 #: fingers go through the object (``solve_grasp(collision_free=True)``)
 FINGER_TRIES = 8
+#: then the damper's iterations from open, backed-off hands (palm turned 0°, ±30°, ...)
+APPROACH_TRIES = 3
 
 
 @dataclass
@@ -630,6 +632,8 @@ def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspRe
     best = (r1.q, r1.status, r1.position_errors, r1.normal_errors, r1.contacts, r1.within_limits)
     total, phase, attempts = r1.iterations, "direct", r1.info.get("attempts", 1)
     ok = r1.success and rep["collision_free"]
+    points = r1.contacts if contacts is not None else None
+    fit = points is not None and kw["move_arm"] and bool(hand.arm_v_indices)
     if not ok and r1.success:
         # 2. other hand shapes (random finger joints; with given contacts the palm fitted
         # anew to each) without the damper: the cheap way around a finger or a palm through
@@ -638,30 +642,20 @@ def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspRe
         fq = hand.finger_q_indices
         lo, hi = robot.chain.lower[fq], robot.chain.upper[fq]
         lo, hi = np.where(np.isfinite(lo), lo, -np.pi), np.where(np.isfinite(hi), hi, np.pi)
-        points = r1.contacts if contacts is not None else None
         tasks = grasp_tasks(
             robot, hand, tgt, points, position_cost=kw["position_cost"],
             normal_cost=kw["normal_cost"], lm_damping=kw["lm_damping"],
         ) + list(kw["tasks"])  # fmt: skip
         limits = _limits(robot, hand, r1.q, kw["move_arm"], kw["max_step"])
         conf = qp.IKConfiguration(robot, r1.q)
-        fit = points is not None and kw["move_arm"] and bool(hand.arm_v_indices)
-        # the joints of neither the arm nor the grasping fingers (fingers not in ``tips``):
-        # drawn too, they must get out of the object's way
-        rest = np.setdiff1d(
-            np.arange(robot.nq), np.concatenate([fq, hand.arm_q_indices]).astype(int)
-        )
-        lo_r, hi_r = robot.chain.lower[rest], robot.chain.upper[rest]
-        free = np.isfinite(lo_r) & np.isfinite(hi_r)
-        base = r1.q.copy()
+        # the fingers that do not grasp open, out of the object's way
+        base = coll.open(r1.q)
+        base[fq] = r1.q[fq]
         for k in range(FINGER_TRIES):
-            fingers = lo + (hi - lo) * rng.uniform(0.05, 0.6, len(fq))
-            base[rest[free]] = lo_r[free] + (hi_r - lo_r)[free] * rng.uniform(size=int(free.sum()))
             start = base.copy()
-            start[fq] = fingers
+            start[fq] = lo + (hi - lo) * rng.uniform(0.05, 0.6, len(fq))
             if fit:  # the palm turned about the contacts' line by ±30°, ±60°, ...
-                ang = math.radians(30.0 * (k // 2 + 1) * (-1) ** k)
-                start = _turn_palm(hand, points, start, ang)
+                start = _turn_palm(hand, points, start, _angle(k))
             conf.update(start)
             out = _descend(
                 conf, hand, tgt, points, tasks, limits, [], kw["solver"],
@@ -675,8 +669,7 @@ def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspRe
                 break
     if not ok:
         # 3. the damper on every step: from that answer (the damper pushes apart what is in),
-        # then from an approach (the fingers open, the palm back)
-        points = r1.contacts if contacts is not None else None
+        # then from approaches (the fingers open, the palm back and turned)
         tasks = grasp_tasks(
             robot, hand, tgt, points, position_cost=kw["position_cost"],
             normal_cost=kw["normal_cost"], lm_damping=kw["lm_damping"],
@@ -685,8 +678,12 @@ def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspRe
             robot, hand, r1.q, kw["move_arm"], min(float(kw["max_step"]), COLLISION_MAX_STEP)
         )
         conf = qp.IKConfiguration(robot, r1.q)
-        for phase in ("repair", "approach"):
-            start = r1.q if phase == "repair" else coll.approach(r1.q, move_arm=kw["move_arm"])
+        for k in range(APPROACH_TRIES + 1):
+            phase, start = ("approach", r1.q) if k else ("repair", r1.q)
+            if k > 1 and fit:  # the palm turned
+                start = _turn_palm(hand, points, r1.q, _angle(k - 2))
+            if k:
+                start = coll.approach(start, move_arm=kw["move_arm"])
             conf.update(start)
             out = _descend(
                 conf, hand, tgt, points, tasks, limits, [], kw["solver"],
@@ -732,3 +729,8 @@ def _turn_palm(hand, points, q, angle) -> np.ndarray:
     if res.q is not None and np.isfinite(res.q).all() and robot.within_limits(res.q):
         out[hand.arm_q_indices] = res.q[hand.arm_q_indices]
     return out
+
+
+def _angle(k: int) -> float:
+    """The k-th palm turn of the collision-free tries: +30°, −30°, +60°, −60°, ... (rad)."""
+    return math.radians(30.0 * (k // 2 + 1) * (-1) ** k)
