@@ -8,6 +8,12 @@ into joint trajectories for this person) or a comma-separated list of joint-traj
 ``.npz`` with arrays ``t`` (N,) s and ``q`` (N, nq) rad, or ``.csv`` with a header ``t`` and the
 arm's joint names (rad; ``#`` lines are comments).  Progress bars (stderr, on a terminal) follow
 the activities and the joints; the last line printed is a JSON summary.
+
+With a person's residual muscles (``--muscles arm26.osim --muscle-joints
+elbow_flexion=r_elbow_flex --remaining BIClong,BICshort --strength 0.4``) the muscles cover part
+of each mapped joint's torque and the motors are sized for the rest
+(:mod:`anthroarm.prosthesis.residual`); the summary's ``muscles`` gives per joint the peak
+demand, muscle and motor torque and the share covered.
 """
 
 from __future__ import annotations
@@ -65,6 +71,37 @@ def add_parser(sub):
         "--no-viewer",
         action="store_true",
         help="leave the 3-D animation out of the report (smaller file)",
+    )
+    m = p.add_argument_group(
+        "residual muscles",
+        "the person's remaining muscles take part of each joint's torque; the motors are sized "
+        "for the rest (the summary's 'muscles': per joint the peak demand, muscle and motor "
+        "torque and the share the muscles cover)",
+    )
+    m.add_argument(
+        "--muscles",
+        default=None,
+        metavar="MODEL.osim",
+        help="an OpenSim model with the person's muscles (e.g. arm26.osim)",
+    )
+    m.add_argument(
+        "--muscle-joints",
+        default=None,
+        metavar="JOINT=COORD[,...]",
+        help="the arm's joints the muscles act on, each mapped to a coordinate of the model "
+        "(-COORD: counted the other way), e.g. elbow_flexion=r_elbow_flex",
+    )
+    m.add_argument(
+        "--remaining",
+        default=None,
+        metavar="NAME[,...]",
+        help="the muscles that remain (default: all of the model's)",
+    )
+    m.add_argument(
+        "--strength",
+        type=float,
+        default=1.0,
+        help="factor on the remaining muscles' maximum isometric force (default 1)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     add_json(p, "print the summary as JSON (the default: it is always JSON)")

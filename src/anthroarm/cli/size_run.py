@@ -17,10 +17,11 @@ from .._io import check_regular_file, read_bounded
 from ..errors import ActivityError
 from ..motion import activities as adl
 from ..prosthesis import catalogue, report, study
+from ..prosthesis.residual import ResidualMuscles
 from ..viewer.pages import activities_html
 from .common import UserError
 from .person import check_person
-from .runtime import load_model, progress, resolve_model
+from .runtime import input_file, load_model, progress, resolve_model
 
 #: the largest trajectory file read (bytes): 10**6 samples of a 7-joint arm as CSV are ~150 MB
 MAX_TRAJECTORY_BYTES = 256 * 2**20
@@ -136,6 +137,25 @@ def _person_params(a) -> dict:
     return check_person(a)
 
 
+def residual_muscles(a, robot):
+    """The person's residual muscles of ``--muscles`` (None without it)."""
+    given = [o for o in ("muscle_joints", "remaining") if getattr(a, o) is not None]
+    if a.muscles is None:
+        if given or a.strength != 1.0:
+            opts = [f"--{o.replace('_', '-')}" for o in given] or ["--strength"]
+            raise UserError(f"{', '.join(opts)} need --muscles MODEL.osim (the person's muscles)")
+        return None
+    if not a.muscle_joints:
+        raise UserError(
+            "--muscles needs --muscle-joints JOINT=COORD[,...]: which coordinate of the model "
+            f"each joint of the arm is (joints: {', '.join(robot.joint_names)})"
+        )
+    remaining = None if a.remaining is None else a.remaining.split(",")
+    res = ResidualMuscles.from_osim(input_file(a.muscles), a.muscle_joints, remaining, a.strength)
+    res.check_arm(robot.joint_names)
+    return res
+
+
 def run(a) -> int:
     resolve_model(a)
     out = Path(a.out)
@@ -157,6 +177,7 @@ def run(a) -> int:
     check_person(a)  # before any work: a height in cm is refused with the remedy
     cat = catalogue.load(a.motors, a.gearboxes)
     robot = load_model(a.model, _person_params(a))
+    muscles = residual_muscles(a, robot)
     acts = activities_from(a.activities, robot, a.payload)
     bar = progress(len(acts) + robot.nv, "size", not a.no_progress)
 
@@ -173,6 +194,7 @@ def run(a) -> int:
             margin=a.margin,
             person=dict(height=a.height, mass=a.mass, sex=a.sex),
             progress=tick,
+            residual=muscles,
         )
         bar.set_postfix_str("report")
         inputs = dict(
@@ -184,6 +206,13 @@ def run(a) -> int:
             payload_kg=a.payload,
             margin=a.margin,
         )
+        if muscles is not None:
+            inputs.update(
+                muscles=Path(a.muscles).name,
+                remaining=", ".join(muscles.muscles.names),
+                strength=a.strength,
+                muscle_joints=a.muscle_joints,
+            )
         page = None if a.no_viewer else activities_html(st)
         report.write(st, out, viewer=page, inputs=inputs)
     finally:

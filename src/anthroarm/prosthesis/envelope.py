@@ -49,6 +49,9 @@ class ActivityTorques:
     reason: str = ""
     payload: float = 0.0
     mass_in_hand: np.ndarray | None = None
+    #: with residual muscles (:mod:`.residual`): the torque they cover (N, nv); ``tau`` is then
+    #: what the motors must add (the demand is ``tau + muscle_tau``)
+    muscle_tau: np.ndarray | None = None
 
     @property
     def duration(self) -> float:

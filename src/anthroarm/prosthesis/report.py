@@ -360,6 +360,34 @@ def render(
         "hand (Eq. (8-5)), equal to Pinocchio's rnea with fext (tests/dynamics/test_loads.py). RMS: "
         "the largest over the activities of sqrt(integral tau^2 dt / T).</p>"
     )
+    if study.muscles():
+        mrows = [
+            (
+                r["joint"],
+                f"{r['peak_demand']:.2f}",
+                f"{r['peak_muscle']:.2f}",
+                f"{r['peak_motor']:.2f}",
+                f"{r['covered']:.0%}",
+            )
+            for r in study.muscles()
+        ]
+        parts.append(
+            "<h2>Residual muscles and motors</h2>"
+            + _table(
+                [
+                    "joint",
+                    "peak demand [N m]",
+                    "peak muscle torque [N m]",
+                    "peak motor torque [N m]",
+                    "share covered by muscles",
+                ],
+                mrows,
+            )
+            + '<p class="note">The person\'s remaining muscles (OpenSim model, Thelen2003 forces with '
+            "the tendon at slack length, times the strength factor) cover the torque closest to the "
+            "demand that activations in [0, 1] reach (anthroarm.prosthesis.residual); the envelope "
+            "above and the motors below are for the rest.</p>"
+        )
     # sizing
     srows = []
     for r, js in zip(sz.rows(), sz.joints):

@@ -10,6 +10,7 @@ it already knows it is unusable, e.g. a target outside the arm's reach), in SI u
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -20,6 +21,7 @@ from ..errors import ActivityError
 from ..motion import activities as adl
 from . import catalogue as cat_mod
 from . import envelope as env_mod
+from . import residual as residual_mod
 from . import sizing, weight_rules
 
 
@@ -39,6 +41,8 @@ class Study:
     payload: float
     catalogue: object
     timings: dict = field(default_factory=dict)
+    #: the person's residual muscles (:class:`.residual.ResidualMuscles`), if any
+    residual: object = None
 
     def unfit(self) -> list[dict]:
         """What did not fit, the one list the report and ``anthroarm size``'s JSON both show:
@@ -65,9 +69,25 @@ class Study:
         ]
         return out
 
+    def muscles(self) -> list[dict]:
+        """With residual muscles: per joint they act on, the peak demand, peak muscle and peak motor torque
+        (N m) and the share of the demand the muscles cover (:func:`.residual.table`); else
+        []."""
+        if self.residual is None:
+            return []
+        rows = residual_mod.table(self.activities, list(self.robot.joint_names))
+        return [r for r in rows if r["joint"] in self.residual.joints]
+
     def summary(self) -> dict:
         """The study in a few numbers (JSON-ready): drive mass, the motor + gearbox per joint,
-        :meth:`unfit`, the activities left out and each rule's verdict (None: information)."""
+        :meth:`unfit`, the activities left out and each rule's verdict (None: information);
+        with residual muscles, ``muscles``: :meth:`muscles` by joint (rounded)."""
+        extra = {}
+        if self.muscles():
+            extra["muscles"] = {
+                r["joint"]: {k: round(v, 3) for k, v in r.items() if k != "joint"}
+                for r in self.muscles()
+            }
         return dict(
             drive_mass_kg=round(float(self.sizing.drive_mass), 4),
             joints={
@@ -77,6 +97,7 @@ class Study:
             unfit=self.unfit(),
             skipped=[x.name for x in self.envelope.skipped],
             rules={r.source: r.ok for r in self.rules},
+            **extra,
         )
 
 
@@ -100,6 +121,7 @@ def run(
     margin: float = 0.2,
     person=None,
     progress=None,
+    residual=None,
 ) -> Study:
     """Run the loop (module docstring) on ``robot`` (the person's arm model).
 
@@ -120,6 +142,10 @@ def run(
         height, mass, sex for the report (default: ``robot.spec.params``).
     progress : callable, optional
         ``progress(stage, name)`` before each activity and joint.
+    residual : ResidualMuscles, optional
+        The person's residual muscles (:class:`.residual.ResidualMuscles`): each activity's
+        demand is split into the torque they cover (``muscle_tau``) and the torque the motors
+        must add (``tau``, which the envelope and the sizing then use).
     """
     payload = _payload(payload)
     if person is None:
@@ -181,18 +207,20 @@ def run(
                 f"activity {name!r} has no {' and no '.join(repr(k) for k in missing)} "
                 "(times in s, joint positions in rad)"
             )
-        acts.append(
-            env_mod.activity_torques(
-                robot,
-                name,
-                spec["t"],
-                spec["q"],
-                spec.get("qd"),
-                spec.get("qdd"),
-                payload=m,
-                dynamics=dyn,
-            )
+        act = env_mod.activity_torques(
+            robot,
+            name,
+            spec["t"],
+            spec["q"],
+            spec.get("qd"),
+            spec.get("qdd"),
+            payload=m,
+            dynamics=dyn,
         )
+        if residual is not None and act.status == "ok":
+            mus, motor = residual.cover(robot.joint_names, act.q, act.tau)
+            act = dataclasses.replace(act, tau=motor, power=motor * act.qd, muscle_tau=mus)
+        acts.append(act)
     timings["dynamics"] = time.perf_counter() - t0
     env = env_mod.envelope(acts)
     t0 = time.perf_counter()
@@ -201,7 +229,7 @@ def run(
     )
     timings["sizing"] = time.perf_counter() - t0
     rules = weight_rules.check(res.drive_mass, person.get("mass"), robot.nv, len(res.unfit))
-    return Study(robot, person, acts, env, res, rules, payload, cat, timings)
+    return Study(robot, person, acts, env, res, rules, payload, cat, timings, residual)
 
 
 def adl_activities(
