@@ -55,6 +55,19 @@ def test_solve_twenty_random_reachable_targets(gait):
         assert abs(pe - r.pos_err) < 1e-12 and abs(re - r.rot_err) < 1e-12
 
 
+def test_solve_on_a_model_with_a_coupler():
+    """leg6dof9musc: a CoordinateCouplerConstraint makes one coordinate a function of another
+    (coupling.dependent_steps); its 6 coordinates all move the toes."""
+    leg = aa.load(aa.osim.path("leg6dof9musc"))
+    assert leg.coupling.dependent_steps and leg.nq == 6
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        T = pose(leg, leg.random_q(rng=rng), "toes_r").homogeneous
+        r = aa.ik.solve(leg, T, frame="toes_r")
+        assert r.success and within(leg, r.q)
+        assert max(errors(pose(leg, r.q, "toes_r"), T)) <= 1e-6
+
+
 def test_solve_from_threads(gait):
     """One Robot solved for from two threads at once (each thread its own pin.Data)."""
     rng = np.random.default_rng(5)

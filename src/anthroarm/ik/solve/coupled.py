@@ -213,6 +213,8 @@ def solve(
     ws = workspace(robot, fid)
     path = ws.path
     lo, hi = ws.lo, ws.hi
+    if ref is not None:
+        ref = clip(ref, lo, hi)
     default = clip(robot.default_q(), lo, hi)
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
     redundant = int(path.sum()) > (6 if mode == "pose" else 3)
@@ -226,7 +228,7 @@ def solve(
         base = clip(seed, lo, hi) if seed is not None else (ref if ref is not None else default)
         th_ref = None
         if ref is not None and redundant:
-            th_ref = np.where(path, clip(ref, lo, hi), base)
+            th_ref = np.where(path, ref, base)
         r = solve_one(
             ws,
             CoupledTarget(mode, tgt, tp, tr),
