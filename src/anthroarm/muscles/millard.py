@@ -11,13 +11,17 @@ way to it), extrapolated linearly outside (``SmoothSegmentedFunctionFactory.cpp`
 * :func:`active_force_length_curve` (``createFiberActiveForceLengthCurve``): five segments from
   ``min_norm_active_fiber_length`` (0.4441) through the shallow ascending limb (slope 0.8616 to
   0.73) to 1 at l̃ = 1 and down to ``max_norm_active_fiber_length`` (1.8123), floored at
-  ``minimum_value`` (0.1), curviness 1 (Gollapudi & Lin 2009 / Winters et al. 2011 data, as
-  Millard et al. 2013 fit them);
+  ``minimum_value`` (0.1), curviness 1 (after Gollapudi & Lin, *Experimental determination
+  of sarcomere force-length relationship in type-I human skeletal muscle fibers*, J Biomech
+  42 (2009) 2011-2016);
 * :func:`force_velocity_curve` (``createFiberForceVelocityCurve``): four segments through
   (−1, 0), (−0.9, ·), (0, 1), (0.9, ·), (1, 1.4), isometric slope 5;
 * :func:`fiber_force_length_curve` (``createFiberForceLengthCurve``): passive, 0 at strain
   ``strain_at_zero_force`` (0) to 1 at ``strain_at_one_norm_force`` (0.7), stiffness 0.2 at low
-  force and 2/(e₁ − e₀) at one, curviness 0.75 (the values ``FiberForceLengthCurve`` fills in);
+  force and 2/(e₁ − e₀) at one, curviness 0.75 (the values ``FiberForceLengthCurve`` fills in,
+  after Thelen 2003 and the passive curve of Winters, Takahashi, Ward & Lieber, *Whole muscle
+  length-tension relationships are accurately modeled as scaled sarcomeres in rabbit
+  hindlimb muscles*, J Biomech 44 (2011) 109-115);
 * :func:`tendon_force_length_curve` (``createTendonForceLengthCurve``): 0 at slack, toe to
   2/3 at the end of the toe, then linear with stiffness 1.375/e₀ to 1 at strain e₀ = 0.049
   (curviness 0.5: ``TendonForceLengthCurve``'s fitted defaults).
@@ -347,8 +351,8 @@ class MillardCurves:
 
 
 def curves(params: dict) -> MillardCurves:
-    """The curves of a muscle whose ``params`` (:attr:`anthroarm.muscles.reader.Muscle.params`)
-    hold ``"<Curve>.<property>"`` entries (missing ones take :data:`CURVE_DEFAULTS`)."""
+    """The curves of a muscle whose ``params`` (``Muscle.params``)
+    hold ``"<Curve>.<property>"`` entries (missing ones take ``CURVE_DEFAULTS``)."""
 
     def kw(curve):
         return {k: params.get(f"{curve}.{k}", d) for k, d in CURVE_DEFAULTS[curve].items()}

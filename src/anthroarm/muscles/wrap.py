@@ -383,7 +383,7 @@ def wrapped_length(xs, dxs, idx, objs, muscle, codes=None):
     ``idx`` in the PathPointSet) in ground; ``objs``: (PathWrap, WrapObject, T (N,4,4) of the
     wrap's body, J (N,6,nq) of that body) for every PathWrap (inactive objects are skipped as
     OpenSim skips them, but count in the number of wraps).  ``codes`` (N, number of wraps),
-    when given, receives each wrap's outcome (:func:`status` of the codes)."""
+    when given, receives each wrap's outcome (:func:`anthroarm.muscles.wrap.status` of the codes)."""
     n, nq = xs.shape[0], dxs.shape[-1]
     L, D = np.zeros(n), np.zeros((n, nq))
     npts = len(muscle.points)

@@ -32,7 +32,7 @@ points.  The tangent points move by a few micrometres; the length, stationary in
 points, by far less (measured in tests/muscles: ~1e-9 m on arm26).
 
 Derivative.  The surface path of an ellipsoid is not a shortest path, so its tangent points
-may not be held fixed (the envelope theorem of :mod:`.wrap` does not apply).  The length and
+may not be held fixed (the envelope theorem of :mod:`anthroarm.muscles.wrap` does not apply).  The length and
 the tangent points are differentiated with respect to the two end points by the complex step
 (Squire & Trapp, *Using complex variables to estimate derivatives of real functions*, SIAM
 Rev 40 (1998) 110-112; Martins, Sturdza & Alonso, *The complex-step derivative
