@@ -48,6 +48,8 @@ this non-shortest path (compared in the guide).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import MuscleError
@@ -193,38 +195,53 @@ def _residual(r, d1, p, a, vs, vs4):
 
 
 def _lm_tangent(r, p, a, vs, vs4):
-    """``WrapEllipsoid::calcTangentPoint``'s Levenberg-Marquardt search, real, one point."""
-    r = r.copy()
-    d1 = -float((2.0 * r / (a * a)) @ r)
-    ee = _residual(r, d1, p, a, vs, vs4)
-    ssqo = ssq = float(ee @ ee)
+    """``WrapEllipsoid::calcTangentPoint``'s Levenberg-Marquardt search, real, one point
+    (plain floats: it runs ~30 small steps)."""
+    r = [float(v) for v in r]
+    p = [float(v) for v in p]
+    vs = [float(v) for v in vs]
+    ia2 = [1.0 / float(v * v) for v in a]
+
+    def residual(r, d1):
+        rr = r[0] * r[0] * ia2[0] + r[1] * r[1] * ia2[1] + r[2] * r[2] * ia2[2]
+        rp = r[0] * p[0] * ia2[0] + r[1] * p[1] * ia2[1] + r[2] * p[2] * ia2[2]
+        e = (vs[0] * r[0] + vs[1] * r[1] + vs[2] * r[2] + vs4, rr - 1.0, 2 * rr + d1, 2 * rp + d1)
+        return e, e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]
+
+    pn = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    pu = [v / pn for v in p] if pn >= EPS else [0.0, 0.0, 0.0]
+    d1 = -2.0 * (r[0] * r[0] * ia2[0] + r[1] * r[1] * ia2[1] + r[2] * r[2] * ia2[2])
+    ee, ssq = residual(r, d1)
+    ssqo = ssq
     alpha = 0.01
     nit = 0
     while ssq > ELLIPSOID_TINY and nit < 50:
         nit += 1
         dedth = np.zeros((4, 4))
         dedth[:3, 0] = vs
-        dedth[:3, 1] = 2.0 * r / (a * a)
-        dedth[:3, 2] = 4.0 * r / (a * a)
-        dedth[:3, 3] = 2.0 * p / (a * a)
+        dedth[:3, 1] = [2.0 * r[k] * ia2[k] for k in range(3)]
+        dedth[:3, 2] = [4.0 * r[k] * ia2[k] for k in range(3)]
+        dedth[:3, 3] = [2.0 * p[k] * ia2[k] for k in range(3)]
         dedth[3] = [0.0, 0.0, 1.0, 1.0]
-        pcos = float(_unit(p - r) @ _unit(p))
+        pr = [p[k] - r[k] for k in range(3)]
+        prn = math.sqrt(pr[0] * pr[0] + pr[1] * pr[1] + pr[2] * pr[2])
+        pcos = sum(pr[k] * pu[k] for k in range(3)) / prn if prn >= EPS else 0.0
         dd = 1.0 - pcos**100 if pcos > 0.1 else 1.0
-        v = -dedth @ ee
+        v = -dedth @ np.array(ee)
         dedth2 = dedth @ dedth.T
         diag = np.diag(dedth2).copy()
-        vt = np.zeros(4)
+        vt = [0.0, 0.0, 0.0, 0.0]
         nit2 = 0
         while ssq >= ssqo and nit2 < 1000:
             dedth2[np.arange(4), np.arange(4)] = diag * (1.0 + alpha)
             try:
-                vt = dd * np.linalg.inv(dedth2) @ v / 16.0
+                vt = (dd * np.linalg.inv(dedth2) @ v / 16.0).tolist()
             except np.linalg.LinAlgError:
-                return r
-            r += vt[:3]
+                return np.array(r)
+            r = [r[k] + vt[k] for k in range(3)]
             d1 += vt[3]
-            ee = _residual(r, d1, p, a, vs, vs4)
-            ssqo, ssq = ssq, float(ee @ ee)
+            ssqo = ssq
+            ee, ssq = residual(r, d1)
             alpha *= 4.0
             nit2 += 1
         alpha /= 8.0
@@ -232,16 +249,16 @@ def _lm_tangent(r, p, a, vs, vs4):
         nit2 = 0
         while ssq <= ssqo and nit2 < 1000:
             fakt *= 2.0
-            r += vt[:3] * fakt
+            r = [r[k] + vt[k] * fakt for k in range(3)]
             d1 += vt[3] * fakt
-            ee = _residual(r, d1, p, a, vs, vs4)
-            ssqo, ssq = ssq, float(ee @ ee)
+            ssqo = ssq
+            ee, ssq = residual(r, d1)
             nit2 += 1
-        r -= vt[:3] * fakt
+        r = [r[k] - vt[k] * fakt for k in range(3)]
         d1 -= vt[3] * fakt
-        ee = _residual(r, d1, p, a, vs, vs4)
-        ssq = ssqo = float(ee @ ee)
-    return r
+        ee, ssq = residual(r, d1)
+        ssqo = ssq
+    return np.array(r)
 
 
 def _tangent(pe, r0, p, a, vs, vs4):
