@@ -203,3 +203,16 @@ def test_plot_returns_a_figure():
     need = me.needed_torques(robot, rec.t, np.tile([0.0, 1.0], (rec.t.size, 1)), payload=1.0)
     fig = me.plot(res, need, "r_elbow_flex")
     assert len(fig.axes) == 2
+
+
+def test_every_evaluates_a_subset_of_the_same_chain():
+    robot, ms = aa.load(aa.osim.path("arm26")), read_muscles(aa.osim.path("arm26"))
+    rec = me.read_recording()
+    q = np.column_stack([np.zeros(rec.t.size), np.linspace(0.2, 1.6, rec.t.size)])
+    full = me.drive(robot, ms, rec, q, {"BIClong": 0, "BICshort": 0}, wrap=False)
+    sub = me.drive(robot, ms, rec, q, {"BIClong": 0, "BICshort": 0}, wrap=False, every=10)
+    np.testing.assert_array_equal(sub.t, full.t[::10])
+    np.testing.assert_allclose(sub.torque, full.torque[::10], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(sub.activation, full.activation[:, ::10])
+    with pytest.raises(MuscleError, match="every"):
+        me.drive(robot, ms, rec, q, {"BIClong": 0}, wrap=False, every=0)

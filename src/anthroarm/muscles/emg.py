@@ -263,6 +263,7 @@ def drive(
     tau_act=TAU_ACT,
     tau_deact=TAU_DEACT,
     wrap: bool = True,
+    every: int = 1,
 ) -> EMGDrive:
     """The whole chain (module docstring) for ``recording`` and joint positions ``q`` (N, nq)
     at the recording's samples (or one (nq,) held throughout).  ``driven`` maps muscle names
@@ -271,7 +272,9 @@ def drive(
     ``strength`` (> 0, one or one per muscle) scales every muscle's maximum isometric force (a
     weak residual muscle: 0.3); at static equilibrium the tendon force is proportional to it
     (both sides of the equilibrium are normalised by F_max), so the forces are scaled after
-    the equilibrium."""
+    the equilibrium.  ``every``: evaluate the muscles at every ``every``-th sample only (the
+    excitation and activation dynamics run at the full rate; the result holds those samples):
+    muscle paths over wrap objects cost milliseconds a state."""
     ms = muscle_set(robot, muscles)
     n = recording.t.size
     check_recording(recording.t, recording.emg)
@@ -290,6 +293,10 @@ def drive(
     Q = np.broadcast_to(Q, (n, robot.nq)) if Q.ndim == 1 else Q
     if Q.shape[0] != n:
         raise MuscleError(f"q has {Q.shape[0]} samples, the recording {n}")
+    if not (isinstance(every, (int, np.integer)) and 1 <= every <= n):
+        raise MuscleError(f"every must be an integer in 1..{n}, got {every!r}")
+    keep = np.arange(0, n, int(every))
+    Q, act, e, u, a = Q[keep], act[keep], e[:, keep], u[:, keep], a[:, keep]
     k = np.broadcast_to(np.asarray(strength, dtype=float), (len(ms),))
     if not np.all(np.isfinite(k) & (k > 0)):
         raise MuscleError(f"strength must be a positive factor per muscle, got {strength!r}")
@@ -298,7 +305,9 @@ def drive(
     tau = np.einsum("nmk,nm->nk", R, force)
     if not np.all(np.isfinite(tau)):
         raise MuscleError("joint torques are not finite: check the model's muscle parameters")
-    return EMGDrive(recording.t, e, u, a, act, force, tau, R, list(robot.joint_names), ms.names)
+    return EMGDrive(
+        recording.t[keep], e, u, a, act, force, tau, R, list(robot.joint_names), ms.names
+    )
 
 
 def needed_torques(robot, t, q, *, payload: float = 0.0, frame=None) -> np.ndarray:
