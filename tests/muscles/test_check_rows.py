@@ -67,3 +67,22 @@ def test_cli_prints_the_muscle_rows():
     assert out.returncode == 0, out.stdout + out.stderr
     for row in ("muscle lengths = OpenSim getLength", "muscle r = -dl/dq (central diff.)"):
         assert row in out.stdout
+
+
+def test_arm26_biceps_ellipsoid_rows(tmp_path):
+    """arm26 with TRIlong's ellipsoid inactive: BIClong over its ellipsoid gets the row against
+    central differences of OpenSim's lengths; every row passes."""
+    pytest.importorskip("opensim")
+    text = re.sub(
+        r"(<WrapEllipsoid name=\"TRIlonghh\">\s*<!--[^>]*-->\s*<active>)true",
+        r"\1false",
+        aa.osim.path("arm26").read_text(),
+    )
+    p = tmp_path / "arm26_biceps_ellipsoid.osim"
+    p.write_text(text)
+    rows = _rows(aa.load(p), 5)
+    ell = rows["muscle r over ellipsoids = -d(OpenSim getLength)/dq"]
+    assert rows["muscle lengths = OpenSim getLength"].tol == 1e-4
+    for r in rows.values():
+        assert r.ok, r
+    assert ell.max_abs_err > 0
