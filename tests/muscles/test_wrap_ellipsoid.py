@@ -22,7 +22,6 @@ import pytest
 
 import anthroarm as aa
 from anthroarm import muscles
-from anthroarm.errors import MuscleError
 from anthroarm.muscles.wrap_ellipsoid import INSIDE, MANDATORY, NO_WRAP, ellipsoid
 
 NAMES = ["TRIlong", "BIClong"]
@@ -139,13 +138,17 @@ def test_one_wrap_complex_step_against_differences():
         assert np.abs((plus[2] - minus[2]) / (2 * h) - d2[:, k]).max() < 1e-5
 
 
-def test_codes_and_bad_method():
+def test_codes_and_unknown_method():
     dims = np.array([0.025, 0.02, 0.02])
     # a segment that misses the ellipsoid, one that starts inside it
     assert ellipsoid([0.1, 0.1, 0.0], [0.1, -0.1, 0.0], dims, (0, 0))[0] == NO_WRAP
     assert ellipsoid([0.0, 0.0, 0.0], [0.1, -0.1, 0.0], dims, (0, 0))[0] == INSIDE
-    with pytest.raises(MuscleError, match="method"):
-        ellipsoid([0.05, 0.001, 0.0], [-0.05, 0.0, 0.0], dims, (0, 0), "sideways")
+    # an unknown PathWrap method is hybrid, as OpenSim reads it
+    p1, p2 = [0.05, 0.004, 0.001], [-0.05, 0.002, 0.003]
+    hybrid = ellipsoid(p1, p2, dims, (0, 0), "hybrid")
+    assert hybrid[0] == MANDATORY
+    assert ellipsoid(p1, p2, dims, (0, 0), "sideways")[3] == hybrid[3]
+    assert ellipsoid(p1, p2, dims, (0, 0), "Hybrid")[3] == hybrid[3]
 
 
 def test_multi_wrap_keeps_opensims_cached_wrap_points(tmp_path):
