@@ -131,6 +131,43 @@ def _robot_state(robot) -> dict:
     return st
 
 
+def _configuration(robot, q):
+    """(IKConfiguration at ``q``, its Robot, the step's state) for :func:`step`'s ``robot``: an
+    IKConfiguration (``q`` None keeps its q), or a Robot (the calling thread's configuration,
+    kept on the Robot)."""
+    if isinstance(robot, IKConfiguration):
+        conf = robot
+        st = conf.__dict__.get("_qp_state")
+        if st is None:
+            st = _conf_state(conf)
+        if q is not None:
+            conf.update(q)
+        return conf, conf.robot, st
+    st = _robot_state(robot)
+    conf = st.get("conf")
+    if conf is None:
+        conf = st["conf"] = IKConfiguration(robot, q)
+    else:
+        conf.update(q)
+    return conf, robot, st
+
+
+def _limits(limits, robot, st):
+    """(the limits, whether any keeps state between steps) of :func:`step`'s ``limits``."""
+    if limits.__class__ is str:
+        if limits != "default":
+            raise ValueError(
+                f"limits must be 'default', None or a list of Limit objects, got {limits!r}"
+            )
+        default = st.get("default_limits")
+        if default is None:
+            default = st["default_limits"] = default_limits(robot)
+        return default, False  # configuration and velocity limits keep no state
+    if limits is None:
+        return (), False
+    return limits, True
+
+
 def step(
     robot,
     q,
@@ -167,40 +204,12 @@ def step(
     full : bool
         Return a :class:`StepResult` (velocity, status, box) instead of the bare velocity.
     """
-    if isinstance(robot, IKConfiguration):
-        conf = robot
-        rb = conf.robot
-        st = conf.__dict__.get("_qp_state")
-        if st is None:
-            st = _conf_state(conf)
-        if q is not None:
-            conf.update(q)
-    else:
-        rb = robot
-        st = _robot_state(robot)
-        conf = st.get("conf")
-        if conf is None:
-            conf = st["conf"] = IKConfiguration(robot, q)
-        else:
-            conf.update(q)
+    conf, rb, st = _configuration(robot, q)
     if not (dt.__class__ is float and 0.0 < dt < math.inf):  # the common case in one test
         if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     nv = conf.nv
-    if limits.__class__ is str:
-        if limits != "default":
-            raise ValueError(
-                f"limits must be 'default', None or a list of Limit objects, got {limits!r}"
-            )
-        limits = st.get("default_limits")
-        if limits is None:
-            limits = st["default_limits"] = default_limits(rb)
-        stateful = False  # configuration and velocity limits keep no state
-    elif limits is None:
-        limits, stateful = (), False
-    else:
-        stateful = True
-
+    limits, stateful = _limits(limits, rb, st)
     ws = st.get("ws")
     if ws is None:
         ws = st["ws"] = _Workspace(nv)
