@@ -396,8 +396,9 @@ def _wrap(p1, p2, dims, quad, method):
         c1 = c1.copy()
         c1[:, axis] = -c1[:, axis]
         r1 = r2 = c1
-        if np.isneginf(np.real(np.atleast_1d(fan_weight)[0])):
-            fan_weight = 1.0 - (mub - MU_BLEND_MIN) / (MU_BLEND_MAX - MU_BLEND_MIN)
+        # OpenSim then sets a fan weight from mu when none was set, but its test
+        # EQUAL_WITHIN_ERROR(fanWeight, -Infinity) is |-inf - -inf| = NaN <= 2e-13, false:
+        # without the fan (Frans alone, axial, midpoint) c1 is only mirrored
         fw = np.atleast_1d(fan_weight)
         if fw[0].real > 1.0:
             fw = np.ones_like(fw)
@@ -423,9 +424,7 @@ def ellipsoid(p1, p2, dims, quad, method="hybrid"):
     """``WrapEllipsoid::wrapLine`` of the segment p1 → p2 (the ellipsoid's frame, m) over
     the ellipsoid of radii ``dims`` with quadrant ``quad`` ((axis, sign), sign 0 for all) by
     the PathWrap's ``method`` (``hybrid``, ``midpoint`` or ``axial``; another is ``hybrid``, as
-    in OpenSim).  ``hybrid`` (every shipped model's) is the one measured against OpenSim: on
-    arm26 with ``midpoint`` BIClong's length is within 8e-5 m, with ``axial`` 4e-8 m, but
-    TRIlong's three wraps differ by up to 9 mm (not resolved).
+    in OpenSim).
 
     Returns (code, r1, r2, length, jac): the code (``NO_WRAP``, ``INSIDE``, ``MANDATORY``),
     the tangent points (3,), the surface path's length, and jac = (∂r1/∂(p1, p2) (3, 6),
