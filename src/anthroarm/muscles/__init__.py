@@ -8,10 +8,10 @@
 >>> R = muscles.moment_arms(robot, ms, robot.default_q())     # (92, 23) m, = -dl/dq
 
 Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
-moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres), :mod:`.wrap_ellipsoid` (over
-ellipsoids), :mod:`.hill` (Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f),
-:mod:`.millard` (Millard2012EquilibriumMuscle curves and equilibrium), :mod:`.optimize`
-(static optimisation through the QP layer).
+moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres),
+:mod:`.wrap_ellipsoid` (over ellipsoids), :mod:`.hill` (Thelen2003 forces at static
+equilibrium, joint torques τ = Rᵀ f), :mod:`.millard` (Millard2012EquilibriumMuscle curves and
+equilibrium), :mod:`.optimize` (static optimisation through the QP layer).
 """
 
 from __future__ import annotations
