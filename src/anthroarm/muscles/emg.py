@@ -330,12 +330,17 @@ def needed_torques(robot, t, q, *, payload: float = 0.0, frame=None) -> np.ndarr
 def plot(result: EMGDrive, needed, joint: str, *, title: str | None = None):
     """A matplotlib Figure: the excitation and activation of the driving channels (top), and
     about ``joint`` the torque the muscles produce, the torque the activity needs (``needed``
-    (N, nv) N m) and their difference, what a motor must add (bottom)."""
+    (N, nv) N m at the result's samples: ``needed[::every]`` for :func:`drive`'s ``every``) and
+    their difference, what a motor must add (bottom)."""
     import matplotlib.pyplot as plt  # optional: plotting
 
     k = result.joint_names.index(joint)
     t = result.t - result.t[0]
     need = np.asarray(needed, float)[:, k]
+    if need.shape != t.shape:
+        raise MuscleError(
+            f"needed has {need.size} samples, the result {t.size}: pass needed[::every]"
+        )
     mus = result.torque[:, k]
     fig, (ax0, ax1) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     for c in range(result.excitation.shape[0]):
