@@ -135,3 +135,52 @@ def test_bad_input(tmp_path):
         millard.active_force_length_curve(min_norm_active_fiber_length=0.9)
     with pytest.raises(MuscleError):
         millard.tendon_force_length_curve(strain_at_one_norm_force=0.05, curviness=0.5)
+
+
+def _set(text, tag, value, within="Millard2012EquilibriumMuscle"):
+    """``text`` with ``<tag>`` of the first ``<within ...>`` element set to ``value`` (added
+    when OpenSim left it out at its default)."""
+    start = text.index(f"<{within}")
+    body = text.index(">", start) + 1
+    end = text.index(f"</{within}>", start)
+    i = text.find(f"<{tag}>", body, end)
+    if i < 0:
+        return text[:body] + f"<{tag}>{value}</{tag}>" + text[body:]
+    j = text.index(f"</{tag}>", i)
+    return text[: i + len(tag) + 2] + str(value) + text[j:]
+
+
+@pytest.mark.parametrize("damping", [0.1, 0.0])
+def test_file_properties_as_opensim_finalises_them(tmp_path, damping):
+    """A hand-edited file: curve properties changed, the active curve's minimum 0.05 (OpenSim
+    sets it to 0 for the damped model, 0.1 for the undamped one), fibre damping 0.1 or 0."""
+    opensim = pytest.importorskip("opensim")
+    opensim.Logger.setLevelString("error")
+    _, _, _, _, path = _build(opensim, tmp_path, 700.0, 0.09, 0.22, 0.25, False)
+    text = path.read_text()
+    text = _set(text, "fiber_damping", damping)
+    text = _set(text, "maximum_pennation_angle", 1.3)
+    text = _set(text, "minimum_value", 0.05, "ActiveForceLengthCurve")
+    text = _set(text, "min_norm_active_fiber_length", 0.5, "ActiveForceLengthCurve")
+    text = _set(text, "strain_at_one_norm_force", 0.6, "FiberForceLengthCurve")
+    text = _set(text, "strain_at_one_norm_force", 0.06, "TendonForceLengthCurve")
+    edited = tmp_path / f"edited_{damping}.osim"
+    edited.write_text(text)
+    ms = muscles.read_muscles(edited)
+    assert ms["m"].params["ActiveForceLengthCurve.minimum_value"] == 0.05
+    assert ms["m"].params["fiber_damping"] == damping
+    model = opensim.Model(str(edited))
+    state = model.initSystem()
+    m = opensim.Millard2012EquilibriumMuscle.safeDownCast(model.getForceSet().get("m"))
+    x = model.getCoordinateSet().get("x")
+    for a in (0.1, 0.6):
+        for r in (0.5, 0.9, 1.3):
+            x.setValue(state, 0.22 * 1.03 + 0.09 * r)
+            m.setActivation(state, a)
+            model.equilibrateMuscles(state)
+            model.realizeDynamics(state)
+            eq = muscles.equilibrium(ms, np.array([m.getLength(state)]), a)
+            theirs = m.getFiberForce(state)
+            assert abs(eq.fiber_force[0] - theirs) < 1e-6 * max(abs(theirs), 7.0), (a, r)
+    p = millard.finalized_params(ms["m"].params, False)
+    assert p["ActiveForceLengthCurve.minimum_value"] == (0.0 if damping else 0.1)

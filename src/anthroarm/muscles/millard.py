@@ -30,6 +30,11 @@ A Bézier segment is a parametric curve (x(u), y(u)); y(x) is found by solving x
 (bisection, then Newton to machine precision; OpenSim's ``calcU`` stops at 1e2 ε) and
 dy/dx = y'(u)/x'(u).
 
+OpenSim adjusts some properties when the model is finalised
+(:func:`finalized_params`): with fibre damping (the default, 0.1) or a rigid tendon the active
+curve's minimum becomes 0 and the force-velocity slopes at vmax 0; the classic undamped model
+with an elastic tendon raises them (to 0.1 and half the slopes near vmax).
+
 Pennation: ``MuscleFixedWidthPennationModel`` (constant parallelogram height l₀ sin φ₀; Zajac
 1989).  The fibre's minimum length is the longer of the minimum active length and the length
 at the maximum pennation angle (``m_minimumFiberLength``).
@@ -350,9 +355,54 @@ class MillardCurves:
     min_norm_active_fiber_length: float
 
 
+#: fibre damping below this is none (``MIN_NONZERO_DAMPING_COEFFICIENT``)
+MIN_NONZERO_DAMPING = 0.001
+
+
+def finalized_params(params: dict, rigid_tendon: bool) -> dict:
+    """``params`` as OpenSim's ``extendFinalizeFromProperties`` leaves them: damping below
+    0.001 is none; the classic (undamped, compliant) model needs a minimum activation of at
+    least 0.01 and raises the active curve's minimum to 0.1 and the force-velocity slopes at
+    vmax to half those near vmax; the damped (or rigid) model clamps the minimum activation to
+    [0, 1] and sets the active curve's minimum and the slopes at vmax to 0."""
+    p = dict(params)
+    for k, d in MILLARD_DEFAULTS.items():
+        p.setdefault(k, d)
+    for curve, props in CURVE_DEFAULTS.items():
+        for k, d in props.items():
+            if d is not None:
+                p.setdefault(f"{curve}.{k}", d)
+    damped = p["fiber_damping"] >= MIN_NONZERO_DAMPING
+    if not damped:
+        p["fiber_damping"] = 0.0
+    fv = "ForceVelocityCurve."
+    if not rigid_tendon and not damped:
+        if p["minimum_activation"] < 0.01:
+            raise MuscleError(
+                f"minimum_activation {p['minimum_activation']} is below 0.01: the undamped "
+                "Millard2012 model with an elastic tendon is singular at zero activation"
+            )
+        p["ActiveForceLengthCurve.minimum_value"] = max(
+            p["ActiveForceLengthCurve.minimum_value"], 0.1
+        )
+        for side in ("concentric", "eccentric"):
+            near = p[f"{fv}{side}_slope_near_vmax"]
+            if p[f"{fv}{side}_slope_at_vmax"] < 0.5 * near:
+                p[f"{fv}{side}_slope_at_vmax"] = 0.5 * near
+    else:
+        p["minimum_activation"] = min(max(p["minimum_activation"], 0.0), 1.0)
+        p["ActiveForceLengthCurve.minimum_value"] = min(
+            p["ActiveForceLengthCurve.minimum_value"], 0.0
+        )
+        for side in ("concentric", "eccentric"):
+            p[f"{fv}{side}_slope_at_vmax"] = min(p[f"{fv}{side}_slope_at_vmax"], 0.0)
+    return p
+
+
 def curves(params: dict) -> MillardCurves:
-    """The curves of a muscle whose ``params`` (``Muscle.params``)
-    hold ``"<Curve>.<property>"`` entries (missing ones take ``CURVE_DEFAULTS``)."""
+    """The curves of a muscle whose ``params`` (``Muscle.params``, after
+    :func:`finalized_params`) hold ``"<Curve>.<property>"`` entries (missing ones take
+    ``CURVE_DEFAULTS``)."""
 
     def kw(curve):
         return {k: params.get(f"{curve}.{k}", d) for k, d in CURVE_DEFAULTS[curve].items()}
@@ -383,7 +433,7 @@ def static_equilibrium(muscle, lengths, activation, rigid: bool):
     (N,): the fibre at its minimum length, OpenSim's ``Warning_FiberAtLowerBound``).
     Raises :class:`~anthroarm.errors.MuscleError` when the iteration fails away from the
     fibre's lower bound (OpenSim's ``MuscleCannotEquilibrate``)."""
-    p = muscle.params
+    p = finalized_params(muscle.params, muscle.ignore_tendon_compliance)
     cv = curves(p)
     fiso, ofl, tsl = (
         muscle.max_isometric_force,
