@@ -51,6 +51,7 @@ NOTEBOOKS_WITH_PLOTS = {
     "teach_playback",
     "powered_hand",
     "hand",
+    "muscles",
 }
 
 pytestmark = pytest.mark.slow
