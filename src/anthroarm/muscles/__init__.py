@@ -11,11 +11,14 @@ Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengt
 moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres),
 :mod:`.wrap_ellipsoid` (over ellipsoids), :mod:`.hill` (Thelen2003 forces at static
 equilibrium, joint torques τ = Rᵀ f), :mod:`.millard` (Millard2012EquilibriumMuscle curves and
-equilibrium), :mod:`.optimize` (static optimisation through the QP layer).
+equilibrium), :mod:`.optimize` (static optimisation through the QP layer), :mod:`.emg` (the
+EMG-driven chain: envelope → excitation → activation → forces → joint torques, beside the
+torques an activity needs), :mod:`.checks` (``anthroarm check``'s muscle rows).
 """
 
 from __future__ import annotations
 
+from . import emg
 from .hill import (
     Equilibrium,
     active_force_length,
@@ -29,6 +32,7 @@ from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set, wr
 from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
 
 __all__ = [
+    "emg",
     "StaticOptimization",
     "force_coefficients",
     "static_optimization",
