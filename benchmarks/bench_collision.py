@@ -177,8 +177,9 @@ def run_grasps(quick: bool = False, n: int | None = None) -> dict:
     comfortable arm posture with the hand open as the start.  Reported per shape: success
     (the solver's criteria; with collisions also coal's: every fingertip capsule within
     [-1e-4, 1e-3] m of the object and nothing deeper than 1e-4 m into it or into another
-    body), the deepest penetration into the object and the deepest self-collision at the
-    answer (coal), median CPU time per grasp, and which phase of the collision-free solve
+    body), the deepest penetration (object or self) among the successes, the deepest
+    penetration into the object and the deepest self-collision at every answer, failures
+    included (coal), median CPU time per grasp, and which phase of the collision-free solve
     succeeded (direct / fingers / repair / approach)."""
     from anthroarm import hand as H  # noqa: PLC0415
     from anthroarm.hand.problems import collision_free_grasps, open_hand  # noqa: PLC0415
@@ -217,9 +218,12 @@ def run_grasps(quick: bool = False, n: int | None = None) -> dict:
                 "max_penetration": float(np.max(pen)) if len(pen) else float("nan"),
                 "median_ms": 1e3 * float(np.median(t)) if len(t) else float("nan"),
             }
+            ok = s.astype(bool)
+            pen_ok = float(max(np.max(pen[ok]), np.max(spen[ok]))) if ok.any() else float("nan")
+            out[kind]["collision_free" if cf else "plain"]["max_depth_successes"] = pen_ok
             rows.append([
                 kind, "collision_free=True" if cf else "without collisions", len(problems),
-                f"{100 * s.mean():.1f} %", float(np.max(pen)), float(np.median(pen)),
+                f"{100 * s.mean():.1f} %", pen_ok, float(np.max(pen)), float(np.median(pen)),
                 float(np.max(spen)), 1e3 * float(np.median(t)), 1e3 * float(np.percentile(t, 90)),
                 ", ".join(f"{k} {v}" for k, v in sorted(phases.items())) if cf else "",
             ])  # fmt: skip
@@ -230,6 +234,7 @@ def run_grasps(quick: bool = False, n: int | None = None) -> dict:
             "grasp",
             "problems",
             "success",
+            "deepest penetration of the successes, object or self (m)",
             "max penetration (m)",
             "median penetration (m)",
             "max self-collision depth (m)",

@@ -7,7 +7,7 @@ The grasped object is a collision body (:meth:`Sphere.obstacle
 (:func:`anthroarm.collision.model`).  A fingertip is a capsule of radius r around the distal
 phalanx's axis, and its frame sits on that axis: a fingertip *touches* the object when the
 capsule's surface is within the contact margin δ of the object's, i.e. when the tip frame lies
-on the object grown by r + g, with the target gap g = δ/2 (:attr:`CollisionGrasp.target`; the
+on the object grown by r + g, with the target gap g = δ/2 (``CollisionGrasp.target``; the
 fingertip surface at a gap from the object surface, not the fingertip centre on it).
 
 Every QP step of the collision-free iterations carries the velocity damper of Faverjon &

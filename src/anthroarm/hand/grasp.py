@@ -634,7 +634,7 @@ def _solve_collision_free(robot, obj, contacts, hand, margin, kw, t0) -> GraspRe
     ok = r1.success and rep["collision_free"]
     points = r1.contacts if contacts is not None else None
     fit = points is not None and kw["move_arm"] and bool(hand.arm_v_indices)
-    if not ok and r1.success:
+    if not ok:
         # 2. other hand shapes (random finger joints; with given contacts the palm fitted
         # anew to each) without the damper: the cheap way around a finger or a palm through
         # the object
