@@ -14,26 +14,39 @@ The surfaces (each ``wrapLine`` in the wrap object's own frame):
   circle of the cylinder's cross-section, the quadrant's side chosen as OpenSim chooses it,
   the helical arc between the tangent points of length √((r θ)² + Δz²), and — when the path
   has more than one wrap — OpenSim's sliding of the tangent points along the axis until the
-  straight lines meet the helix within 0.1° (``_adjust_tangent_point``).  The geometry is that
-  of Garner & Pandy, *The Obstacle-Set Method for Representing Muscle Paths in
-  Musculoskeletal Models*, Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder
-  obstacle.
+  straight lines meet the helix within 0.1° (``_adjust``).  The geometry is that of Garner &
+  Pandy, *The Obstacle-Set Method for Representing Muscle Paths in Musculoskeletal Models*,
+  Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder obstacle.
 * ``WrapSphere`` (``WrapSphere.cpp``): the great circle through both end points' tangent
   points, wrapping only where the straight segment crosses the sphere (Garner & Pandy 2000,
   sphere obstacle).
+* ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid`.
+  Tori are not evaluated (:class:`~anthroarm.errors.MuscleError`).
 
-Derivative.  The tangent points are fixed in the wrap object's frame while the path's length
-is differentiated, and the surface arc between them is constant: ∂l/∂q is the sum of the unit
-vectors of the straight segments times the derivatives of their end points — the moment arm
-OpenSim's ``MomentArmSolver`` computes (unit tension applied at the points of
-``GeometryPath::getPointForceDirections``: no force between two points of one body).  Where
-the wrap path is the shortest one (a sphere, a cylinder without axial travel) this is the
-exact −∂l/∂q (envelope theorem); along a cylinder's axis OpenSim's tangent points are not
-exactly those of the shortest helix and the two differ slightly (measured in the guide).
-``WrapEllipsoid`` (``WrapEllipsoid.cpp``) is :func:`anthroarm.muscles.wrap_ellipsoid.ellipsoid`:
-its surface path is not a shortest one, so its tangent points move with the path's end points
-and their derivatives (complex step, exact to rounding) enter ∂l/∂q.  Tori are not evaluated
-(:class:`~anthroarm.errors.MuscleError`).
+Derivative: the complex step (Squire & Trapp, *Using complex variables to estimate derivatives
+of real functions*, SIAM Rev 40 (1998) 110-112; Martins, Sturdza & Alonso, *The complex-step
+derivative approximation*, ACM TOMS 29 (2003) 245-262) through the whole path.  Every input
+is a row of D = 1 + m: row 0 the real state, row d the state moved by i·h along the d-th
+coordinate the path depends on (path points x + i h ∂x/∂q_d; wrap bodies' poses
+(R + i h [ω_d]× R, o + i h v_d) from their Jacobians), h = 1e-30.  Every branch (which
+segment wraps, the quadrant's side, the number of passes and of tangent-point adjustments) is
+decided on row 0's real part, every operation on a branch is analytic (norms √(v·v),
+``arctan2`` and clipped ``arccos`` by their first-order expansions), so Im l_d / h is ∂l/∂q_d
+of the length exactly as computed, to rounding — with OpenSim's cached wrap-point positions of
+a multi-pass path (``Point::getLocationInGround`` keeps a point's first ground position in a
+state) differentiated as what they are: functions of the state through the pass that computed
+them.
+
+Which derivative.  On a path with an active ``WrapEllipsoid`` r = −∂l/∂q exactly (the
+ellipsoid's surface path is not a shortest one: its tangent points move with the path).  On a
+path over cylinders and spheres only, the tangent points and arcs are taken real (fixed in
+their wrap body, at the ground position the path's length uses): ∂l/∂q is then the sum of the
+straight segments' unit vectors times their end points' derivatives, the moment arm OpenSim's
+``MomentArmSolver`` computes (unit tension at the points of
+``GeometryPath::getPointForceDirections``), equal to OpenSim's ``computeMomentArm`` to
+rounding and the exact −∂l/∂q wherever the wrap path is a shortest one (envelope theorem);
+along a cylinder's axis, and over the slid tangent points of a multi-wrap path, the two differ
+slightly (measured in the guide).
 """
 
 from __future__ import annotations
@@ -41,7 +54,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import MuscleError
-from .wrap_ellipsoid import ellipsoid
+from .wrap_ellipsoid import wrap_line as ellipsoid_line
 
 #: SimmMacros.h / WrapMath.cpp / WrapCylinder.cpp constants
 ROUNDOFF_ERROR = 2e-13
@@ -53,6 +66,8 @@ NO_WRAP, INSIDE, WRAPPED, MANDATORY = 0, -1, 1, 2
 P0 = np.array([0.0, 0.0, -1.0])
 DN = np.array([0.0, 0.0, 1.0])
 QUADRANTS = {"x": (0, 1), "y": (1, 1), "z": (2, 1)}
+#: complex step (any h below ~1e-20 gives the same derivative)
+H = 1e-30
 
 
 def quadrant(name: str) -> tuple[int, int]:
@@ -67,75 +82,111 @@ def quadrant(name: str) -> tuple[int, int]:
     return QUADRANTS[q][0], sign
 
 
+# ---------------------------------------------- vectors (D, 3), real or complex-step rows
+def _re(a) -> float:
+    """Row 0's real part of a (D,) array (branches are decided on it)."""
+    return float(np.real(a[0]))
+
+
 def _sign(a: float) -> int:
     return 1 if a >= 0.0 else -1
 
 
+def _dot(a, b):
+    return (a * b).sum(axis=-1)
+
+
+def _norm(v):
+    return np.sqrt(_dot(v, v))
+
+
+def _cross(a, b):
+    return a.take(_I1, -1) * b.take(_I2, -1) - a.take(_I2, -1) * b.take(_I1, -1)
+
+
+_I1, _I2 = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+
 def _unit(v):
-    m = float(np.linalg.norm(v))
-    return (v / m if m >= EPS else np.zeros(3)), m
+    """(v / |v|, |v|), zero where |v| < eps (``WrapMath::NormalizeOrZero``)."""
+    m = _norm(v)
+    small = np.abs(np.real(m)) < EPS
+    if small.any():
+        return np.where(small[..., None], 0.0, v / np.where(small, 1.0, m)[..., None]), m
+    return v / m[..., None], m
+
+
+def _acos(x):
+    """arccos, its argument clipped to [-1, 1] (a clipped row keeps no derivative)."""
+    out = np.abs(np.real(x)) > 1.0
+    return np.arccos(np.where(out, np.clip(np.real(x), -1.0, 1.0), x))
+
+
+def _atan2(y, x):
+    """arctan2 of complex-step rows: the real angle plus i times its first-order change."""
+    yr, xr = np.real(y), np.real(x)
+    t = np.arctan2(yr, xr)
+    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
+        return t
+    return t + 1j * (xr * np.imag(y) - yr * np.imag(x)) / (xr * xr + yr * yr)
 
 
 def _closest_on_line(pt, line_pt, line):
     v1, mag = _unit(pt - line_pt)
     v2, mag2 = _unit(line)
-    t = float(v1 @ v2) * mag
-    return line_pt + t * v2, t / mag2
-
-
-def _dist2_to_line(pt, line_pt, line):
-    d = line_pt - pt
-    n = line / np.linalg.norm(line)
-    d = d - (d @ n) * n
-    return float(d @ d)
+    t = _dot(v1, v2) * mag
+    return line_pt + t[..., None] * v2, t / mag2
 
 
 def _intersect_lines(p1, p2, p3, p4):
     vec1, mag1 = _unit(p2 - p1)
     vec2, mag2 = _unit(p4 - p3)
-    cp = np.cross(vec1, vec2)
-    denom = float(cp @ cp)
-    if abs(denom) <= ROUNDOFF_ERROR:
-        return None, np.nan, None, np.nan
-    mat = np.array([p3 - p1, vec1, cp])
-    t = np.linalg.det(mat) / denom
-    p_int2 = p3 + t * vec2
-    mat[1] = vec2
-    s = np.linalg.det(mat) / denom
-    p_int1 = p1 + s * vec1
-    return p_int1, s / mag1, p_int2, t / mag2
+    cp = _cross(vec1, vec2)
+    denom = _dot(cp, cp)
+    if abs(_re(denom)) <= ROUNDOFF_ERROR:
+        return None, None, None, None
+    d31 = p3 - p1
+    t = _dot(d31, _cross(vec1, cp)) / denom  # det([p3 - p1; vec1; cp])
+    s = _dot(d31, _cross(vec2, cp)) / denom  # det([p3 - p1; vec2; cp])
+    return p1 + s[..., None] * vec1, s / mag1, p3 + t[..., None] * vec2, t / mag2
 
 
 def _intersect_seg_plane(pt1, pt2, plane, d):
     vec = pt2 - pt1
-    dot = float(vec @ plane)
-    if abs(dot) < LINE_EPSILON:
+    dot = _dot(vec, plane)
+    if abs(_re(dot)) < LINE_EPSILON:
         return None
-    t = (-d - plane @ pt1) / dot
-    if t < -LINE_EPSILON or t > 1.0 + LINE_EPSILON:
+    t = (-d - _dot(plane, pt1)) / dot
+    if _re(t) < -LINE_EPSILON or _re(t) > 1.0 + LINE_EPSILON:
         return None
-    return pt1 + t * vec
+    return pt1 + t[..., None] * vec
 
 
-def _rotation(angle, axis):
-    a = axis / np.linalg.norm(axis)
-    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+def _rot_z(angle, v):
+    """v (D, 3) rotated by angle (D,) about the z axis."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], -1)
 
 
 # ------------------------------------------------------------------------------- cylinder
 def cylinder(p1, p2, radius, length, quad, single):
-    """``WrapCylinder::wrapLine``: (code, r1, r2, arc length) in the cylinder's frame."""
+    """``WrapCylinder::wrapLine`` of end points p1, p2 (D, 3) (the cylinder's frame; row 0
+    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,))."""
     r2_ = radius * radius
     axis, wsign = quad
     constrained = wsign != 0
     far_side = long_wrap = False
     code = WRAPPED
-    if _dist2_to_line(p1, P0, DN) < r2_ or _dist2_to_line(p2, P0, DN) < r2_:
+    # distance² to the axis (the line through P0 along DN)
+    if _re(p1[:, 0] ** 2 + p1[:, 1] ** 2) < r2_ or _re(p2[:, 0] ** 2 + p2[:, 1] ** 2) < r2_:
         return INSIDE, None, None, 0.0
     cs, ce = np.array([0, 0, -0.5 * length]), np.array([0, 0, 0.5 * length])
     near12, t12, near00, _ = _intersect_lines(p1, p2, cs, ce)
-    crosses = near12 is not None and float(np.sum((near12 - near00) ** 2)) < r2_ and 0 < t12 < 1
+    crosses = (
+        near12 is not None
+        and _re(np.sum((near12 - near00) ** 2, axis=-1)) < r2_
+        and 0 < _re(t12) < 1
+    )
     if not constrained:
         if crosses:
             code = MANDATORY
@@ -146,30 +197,30 @@ def cylinder(p1, p2, radius, length, quad, single):
 
     def tangents(p, pc):
         vv, dist_p = _unit(p - pc)
-        sin_t = radius / dist_p
-        d = radius * sin_t
+        d = (radius * (radius / dist_p))[:, None]
         pp = pc + d * vv
         d = np.sqrt(r2_ - d * d)
-        uu = np.cross(DN, vv)
+        uu = _cross(DN, vv)
         return pp + d * uu, pp - d * uu, dist_p
 
     r1a, r1b, p11_dist = tangents(p1, p11)
     r2a, r2b, p22_dist = tangents(p2, p22)
     if constrained:
-        s1, s2 = _sign(p1[axis]), _sign(p2[axis])
+        s1, s2 = _sign(p1[0, axis].real), _sign(p2[0, axis].real)
         if s1 == wsign or s2 == wsign:
             if crosses:
                 code = MANDATORY
-            elif s1 != s2 and near12 is not None and _sign(near12[axis]) != wsign:
+            elif s1 != s2 and near12 is not None and _sign(near12[0, axis].real) != wsign:
                 code = WRAPPED
             else:
                 return NO_WRAP, None, None, 0.0
-        r1am, r1bm, r2am, r2bm = r1a - p11, r1b - p11, r2a - p22, r2b - p22
-        alpha = np.arccos((r1am @ r2bm) / (np.linalg.norm(r1am) * np.linalg.norm(r2bm)))
-        beta = np.arccos((r1bm @ r2am) / (np.linalg.norm(r1bm) * np.linalg.norm(r2am)))
-        A, B = _sign(r1a[axis]) == wsign, _sign(r1b[axis]) == wsign
+        r1am, r1bm, r2am, r2bm = (v[0].real for v in (r1a - p11, r1b - p11, r2a - p22, r2b - p22))
+        with np.errstate(invalid="ignore"):  # decisions only: NaN compares false, as in C++
+            alpha = np.arccos((r1am @ r2bm) / (np.linalg.norm(r1am) * np.linalg.norm(r2bm)))
+            beta = np.arccos((r1bm @ r2am) / (np.linalg.norm(r1bm) * np.linalg.norm(r2am)))
+        A, B = _sign(r1a[0, axis].real) == wsign, _sign(r1b[0, axis].real) == wsign
         if A and B:
-            if _sign(r2a[axis]) == wsign:
+            if _sign(r2a[0, axis].real) == wsign:
                 r1, r2, far_side = r1b, r2a, not (alpha > beta)
             else:
                 r1, r2, far_side = r1a, r2b, alpha > beta
@@ -177,19 +228,19 @@ def cylinder(p1, p2, radius, length, quad, single):
             r1, r2, far_side = r1a, r2b, alpha > beta
         elif B:
             r1, r2, far_side = r1b, r2a, not (alpha > beta)
-        elif _sign(r2a[axis]) == wsign:
+        elif _sign(r2a[0, axis].real) == wsign:
             r1, r2, far_side = r1b, r2a, not (alpha > beta)
-        elif _sign(r2b[axis]) == wsign:
+        elif _sign(r2b[0, axis].real) == wsign:
             r1, r2, far_side = r1a, r2b, alpha > beta
         else:
             r1, r2 = (r1a, r2b) if alpha > beta else (r1b, r2a)
             far_side = True
-        sum_musc = (r1 - p1) + (r2 - p2)
-        sum_r = (r1 - p11) + (r2 - p22)
+        sum_musc = ((r1 - p1) + (r2 - p2))[0].real
+        sum_r = ((r1 - p11) + (r2 - p22))[0].real
         long_wrap = float(sum_r @ sum_musc) < 0.0
     else:
-        ua, ub = _unit(r1a - p11)[0], _unit(r1b - p11)[0]
-        va, vb = _unit(r2a - p22)[0], _unit(r2b - p22)[0]
+        ua, ub = (_unit(v[:1].real)[0][0] for v in (r1a - p11, r1b - p11))
+        va, vb = (_unit(v[:1].real)[0][0] for v in (r2a - p22, r2b - p22))
         d1, d2, d3, d4 = ua @ va, ua @ vb, ub @ va, ub @ vb
         if d1 > d2 and d1 > d3 and d1 > d4:
             r1, r2 = r1a, r2a
@@ -199,35 +250,37 @@ def cylinder(p1, p2, radius, length, quad, single):
             r1, r2 = r1b, r2a
         else:
             r1, r2 = r1b, r2b
-    r1, r2 = r1.copy(), r2.copy()
-    t = p11_dist / (p11_dist + p22_dist)
+    t = (p11_dist / (p11_dist + p22_dist))[:, None]
     mpt = p1 + t * (p2 - p1)
     axispt, _ = _closest_on_line(mpt, P0, DN)
     l1, l2 = _unit(p1 - axispt)[0], _unit(p2 - axispt)[0]
-    normal = _unit(_unit(np.cross(l1, l2))[0])[0]
-    vert1 = _unit(np.cross(DN, normal))[0]
-    vert2 = _unit(np.cross(normal, DN))[0]
+    normal = _unit(_unit(_cross(l1, l2))[0])[0]
+    vert1 = _unit(_cross(DN, normal))[0]
+    vert2 = _unit(_cross(normal, DN))[0]
     apex1, apex2 = axispt + radius * vert1, axispt + radius * vert2
-    dist1, dist2 = np.sum((mpt - apex1) ** 2), np.sum((mpt - apex2) ** 2)
+    dist1 = _re(np.sum((mpt - apex1) ** 2, axis=-1))
+    dist2 = _re(np.sum((mpt - apex2) ** 2, axis=-1))
     if far_side:
         apex = apex2 if dist1 < dist2 else apex1
     else:
         apex = apex1 if dist1 < dist2 else apex2
     uu, vv = _unit(p1 - apex)[0], _unit(p2 - apex)[0]
-    normal = _unit(np.cross(uu, vv))[0]
-    d = -(p1 @ normal)
+    normal = _unit(_cross(uu, vv))[0]
+    d = -_dot(p1, normal)
     r1p = _intersect_seg_plane(r1 - 10.0 * DN, r1 + 10.0 * DN, normal, d)
     r2p = _intersect_seg_plane(r2 - 10.0 * DN, r2 + 10.0 * DN, normal, d)
+    d12 = _re(np.sum((p11 - p22) ** 2, axis=-1))
     if r1p is not None:
         c, _ = _closest_on_line(r1p, p11, p22)
-        if np.sum((c - p22) ** 2) < np.sum((p11 - p22) ** 2):
+        if _re(np.sum((c - p22) ** 2, axis=-1)) < d12:
             r1 = r1p
     if r2p is not None:
         c, _ = _closest_on_line(r2p, p11, p22)
-        if np.sum((c - p11) ** 2) < np.sum((p22 - p11) ** 2):
+        if _re(np.sum((c - p11) ** 2, axis=-1)) < d12:
             r2 = r2p
     half = length / 2.0
-    if (r1[2] < -half or r1[2] > half) and (r2[2] < -half or r2[2] > half):
+    z1, z2 = r1[0, 2].real, r2[0, 2].real
+    if (z1 < -half or z1 > half) and (z2 < -half or z2 > half):
         return NO_WRAP, None, None, 0.0
     r1, r2, arc = _spiral(p1, p2, r1, r2, radius, long_wrap, single)
     return code, r1, r2, arc
@@ -241,23 +294,25 @@ def _spiral(p1, p2, r1, r2, radius, far_side, single):
     while True:
         r1a, _ = _closest_on_line(r1, P0, DN)
         r2a, _ = _closest_on_line(r2, P0, DN)
-        axial = float((r2a - r1a) @ DN)
+        axial = r2a[:, 2] - r1a[:, 2]
         uu, vv = r1 - r1a, r2 - r2a
-        theta = np.arctan2(np.cross(uu, vv) @ DN, uu @ vv)
+        theta = _atan2(_cross(uu, vv)[:, 2], _dot(uu, vv))
         if far_side:
             theta = 2.0 * np.pi - theta
-        arc = float(np.hypot(radius * theta, axial))
+        arc = np.sqrt((radius * theta) ** 2 + axial**2)
         if single:
             return r1, r2, arc
-        nseg = max(1, int(arc / 0.002))
+        nseg = max(1, int(_re(arc) / 0.002))
         if nseg < 2 or iterations >= MAX_ITERATIONS:
             return r1, r2, arc
         t = 1.0 / nseg
-        w1 = _rotation(sense * t * theta, DN) @ r1 + DN * (t * axial)
+        w1 = _rot_z(sense * t * theta, r1)
+        w1[:, 2] += t * axial
         a1, r1n = _adjust(p1, r1, w1)
         # OpenSim's spiral-point lambda captures r1 by reference: the second point is placed
         # from the r1 just adjusted
-        w2 = _rotation(sense * (1 - t) * theta, DN) @ r1n + DN * ((1 - t) * axial)
+        w2 = _rot_z(sense * (1 - t) * theta, r1n)
+        w2[:, 2] += (1 - t) * axial
         a2, r2n = _adjust(p2, r2, w2)
         if not (a1 or a2):
             return r1, r2, arc
@@ -266,10 +321,10 @@ def _spiral(p1, p2, r1, r2, radius, far_side, single):
 
 
 def _adjust(pt, r, w):
-    pr, _ = _unit(r - pt)
-    rw, _ = _unit(w - r)
-    alpha = np.arccos(np.clip(pr @ DN, -1, 1)) if abs(pr @ DN) <= 1 else np.nan
-    omega = np.arccos(np.clip(rw @ DN, -1, 1)) if abs(rw @ DN) <= 1 else np.nan
+    pz = _unit((r - pt)[:1].real)[0][0, 2]
+    wz = _unit((w - r)[:1].real)[0][0, 2]
+    alpha = np.arccos(np.clip(pz, -1, 1)) if abs(pz) <= 1 else np.nan
+    omega = np.arccos(np.clip(wz, -1, 1)) if abs(wz) <= 1 else np.nan
     if abs(alpha - omega) > TANGENCY_THRESHOLD:
         p1a, _ = _closest_on_line(pt, r, DN)
         w1a, _ = _closest_on_line(w, r, DN)
@@ -282,15 +337,17 @@ def _adjust(pt, r, w):
 
 # ---------------------------------------------------------------------------------- sphere
 def sphere(p1, p2, radius, quad):
-    """``WrapSphere::wrapLine``: (code, r1, r2, arc length) in the sphere's frame."""
+    """``WrapSphere::wrapLine`` of end points p1, p2 (D, 3) (the sphere's frame; row 0
+    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,))."""
     axis, wsign = quad
     code = WRAPPED
     far_side = False
-    n1, n2 = np.linalg.norm(p1), np.linalg.norm(p2)
-    if n1 < radius or n2 < radius:
+    n1, n2 = _norm(p1), _norm(p2)
+    if _re(n1) < radius or _re(n2) < radius:
         return INSIDE, None, None, 0.0
     ri, mp = p1 - p2, -p2
-    a, b, c = ri @ ri, -2.0 * (mp @ ri), mp @ mp - radius * radius
+    a, b, c = _dot(ri, ri), -2.0 * _dot(mp, ri), _dot(mp, mp) - radius * radius
+    a, b, c = _re(a), _re(b), _re(c)  # decisions only
     disc = b * b - 4.0 * a * c
     if disc < 0.0:
         return NO_WRAP, None, None, 0.0
@@ -299,28 +356,25 @@ def sphere(p1, p2, radius, quad):
     if not (0.0 < l1 < 1.0) or not (0.0 < l2 < 1.0) or l1 < l2:
         return NO_WRAP, None, None, 0.0
     p1p2, _ = _unit(p1 - p2)
-    np2, _ = _unit(p2)
-    hp2 = np.cross(p1p2, np2)
-    if np.linalg.norm(hp2) < 1e-5:
+    hp2 = _cross(p1p2, _unit(p2)[0])
+    if _re(_norm(hp2)) < 1e-5:
         raise MuscleError(
             "the path passes through the sphere's centre: the wrap plane is undefined"
         )
     n, _ = _unit(hp2)
 
     def tangents(p, pn):
+        # OpenSim: the columns (n, y, z) rotated by ±asin(radius / |p|) about the first
         y, _ = _unit(-p)
-        z = np.cross(n, y)
-        ra = np.column_stack([n, y, z])
+        z = _cross(n, y)
         a1 = np.arcsin(radius / pn)
-        out = []
-        for ang in (a1, -a1):
-            aa = ra @ _rotation(ang, np.array([1.0, 0, 0])).T
-            out.append(p + aa[:, 1] * pn * np.cos(a1))
-        return out
+        d = (pn * np.cos(a1))[:, None]
+        c, s = np.cos(a1)[:, None], np.sin(a1)[:, None]
+        return p + (c * y - s * z) * d, p + (c * y + s * z) * d
 
     r1a, r1b = tangents(p1, n1)
     r2a, r2b = tangents(p2, n2)
-    r1am, r1bm, r2am, r2bm = (_unit(v)[0] for v in (r1a, r1b, r2a, r2b))
+    r1am, r1bm, r2am, r2bm = (_unit(v[:1].real)[0][0] for v in (r1a, r1b, r2a, r2b))
     j1, j2, j3, j4 = r1am @ r2am, r1am @ r2bm, r1bm @ r2am, r1bm @ r2bm
     if j1 > j2 and j1 > j3 and j1 > j4:
         r1, r2, r11, r22 = r1a, r2a, r1b, r2b
@@ -331,9 +385,10 @@ def sphere(p1, p2, radius, quad):
     else:
         r1, r2, r11, r22 = r1b, r2b, r1a, r2a
     if wsign != 0:
-        s1, s2 = _sign(p1[axis]), _sign(p2[axis])
+        q1, q2 = p1[0].real, p2[0].real
+        s1, s2 = _sign(q1[axis]), _sign(q2[axis])
         if s1 == wsign or s2 == wsign:
-            mm, tt = _closest_on_line(np.zeros(3), p1, p1p2)
+            mm, tt = _closest_on_line(np.zeros(3), q1, p1p2[0].real)
             tt = -tt
             if mm @ mm < radius * radius and 0.0 < tt < 1.0:
                 code = MANDATORY
@@ -344,32 +399,32 @@ def sphere(p1, p2, radius, quad):
         if s1 != wsign or s2 != wsign:
             wrapaxis = np.zeros(3)
             wrapaxis[axis] = wsign
-            sm, _ = _unit(-p1 - p2)
+            sm, _ = _unit(-q1 - q2)
             r1, r11 = (r1a, r1b) if r1am @ sm > r1bm @ sm else (r1b, r1a)
             r2, r22 = (r2a, r2b) if r2am @ sm > r2bm @ sm else (r2b, r2a)
-            sm, _ = _unit((r1 - p1) + (r2 - p2))
+            sm, _ = _unit(((r1 - p1) + (r2 - p2))[0].real)
             if sm @ wrapaxis < 0.0:
                 r1, r2 = r11, r22
-            sum_musc = (r1 - p1) + (r2 - p2)
-            far_side = float((r1 + r2) @ sum_musc) < 0.0
-    r1n, _ = _unit(r1)
-    r2n, _ = _unit(r2)
-    angle = np.arccos(np.clip(r1n @ r2n, -1.0, 1.0))
+            sum_musc = ((r1 - p1) + (r2 - p2))[0].real
+            far_side = float((r1 + r2)[0].real @ sum_musc) < 0.0
+    angle = _acos(_dot(_unit(r1)[0], _unit(r2)[0]))
     if far_side:
         angle = -(2 * np.pi - angle)
-    return code, r1.copy(), r2.copy(), float(radius * angle)
+    return code, r1, r2, radius * angle
 
 
 # ------------------------------------------------------------------------------ the path
-def _wrap_line(w, p1, p2, single, method="hybrid"):
-    """(code, r1, r2, arc, jac) in the wrap object's frame; jac (ellipsoids only): the
-    derivatives of r1, r2 and the arc with respect to (p1, p2), else None."""
-    if w.kind == "WrapCylinder":
-        return (*cylinder(p1, p2, w.radius, w.length, quadrant(w.quadrant), single), None)
-    if w.kind == "WrapSphere":
-        return (*sphere(p1, p2, w.radius, quadrant(w.quadrant)), None)
+def _wrap_line(w, p1, p2, single, method="hybrid", hold=False):
+    """(code, r1 (D, 3), r2 (D, 3), arc (D,)) in the wrap object's frame; ``hold``: a
+    cylinder's or sphere's tangent points and arc from row 0 alone, real (fixed in the body)."""
+    if w.kind in ("WrapCylinder", "WrapSphere"):
+        if hold:
+            p1, p2 = p1[:1].real, p2[:1].real
+        if w.kind == "WrapCylinder":
+            return cylinder(p1, p2, w.radius, w.length, quadrant(w.quadrant), single)
+        return sphere(p1, p2, w.radius, quadrant(w.quadrant))
     if w.kind == "WrapEllipsoid":
-        return ellipsoid(p1, p2, w.dimensions, quadrant(w.quadrant), method)
+        return ellipsoid_line(p1, p2, w.dimensions, quadrant(w.quadrant), method)
     raise MuscleError(
         f"wrap object {w.name!r} is a {w.kind}: only WrapCylinder, WrapSphere and "
         "WrapEllipsoid are evaluated; pass wrap=False or make it inactive"
@@ -382,15 +437,38 @@ def wrapped_length(xs, dxs, idx, objs, muscle, codes=None):
     ``xs`` (N, K, 3) and ``dxs`` (N, K, 3, nq): the active path points (original indices
     ``idx`` in the PathPointSet) in ground; ``objs``: (PathWrap, WrapObject, T (N,4,4) of the
     wrap's body, J (N,6,nq) of that body) for every PathWrap (inactive objects are skipped as
-    OpenSim skips them, but count in the number of wraps).  ``codes`` (N, number of wraps),
-    when given, receives each wrap's outcome (:func:`anthroarm.muscles.wrap.status` of the codes)."""
+    OpenSim skips them, but count in the number of wraps).  The derivative: the module
+    docstring.  ``codes`` (N, number of wraps), when given, receives each wrap's outcome
+    (:func:`anthroarm.muscles.wrap.status` of the codes)."""
     n, nq = xs.shape[0], dxs.shape[-1]
     L, D = np.zeros(n), np.zeros((n, nq))
     npts = len(muscle.points)
+    hold = not any(w.active and w.kind == "WrapEllipsoid" for _, w, _, _ in objs)
     for s in range(n):
         out = None if codes is None else codes[s]
-        L[s], D[s] = _one_state(xs[s], dxs[s], idx, objs, s, npts, nq, muscle.name, out)
+        # the coordinates this state's path depends on: one complex-step row each
+        used = np.any(dxs[s] != 0.0, axis=(0, 1))
+        for *_, J in objs:
+            used |= np.any(J[s] != 0.0, axis=0)
+        cols = np.flatnonzero(used)
+        X = np.concatenate(
+            [xs[s][None], xs[s][None] + 1j * H * dxs[s][..., cols].transpose(2, 0, 1)]
+        )
+        frames = [_frame(T[s], J[s], cols, w) for _, w, T, J in objs]
+        total = _one_state(X, frames, idx, objs, npts, muscle.name, hold, out)
+        L[s], D[s, cols] = total[0].real, total[1:].imag / H
     return L, D
+
+
+def _frame(T, J, cols, w):
+    """(R (D, 3, 3), o (D, 3)) of a wrap body in ground, rows moved by i h along ``cols``
+    (R + i h [ω]× R, o + i h v), and the wrap object's placement in it (Rw, tw)."""
+    R, o = T[:3, :3], T[:3, 3]
+    v, om = J[:3, cols].T, J[3:, cols].T  # (m, 3)
+    Rs = R[None] + 1j * H * _cross(om[:, None, :], R.T[None]).transpose(0, 2, 1)
+    Rc = np.concatenate([R[None].astype(complex), Rs])
+    oc = np.concatenate([o[None].astype(complex), o[None] + 1j * H * v])
+    return Rc, oc, np.asarray(w.rotation, dtype=float), np.asarray(w.translation, dtype=float)
 
 
 def status(wrapped: bool, inside: bool) -> int:
@@ -400,24 +478,19 @@ def status(wrapped: bool, inside: bool) -> int:
     return WRAPPED if wrapped else (INSIDE if inside else NO_WRAP)
 
 
-def _one_state(x, dx, idx, objs, s, npts, nq, name, codes=None):
+def _one_state(x, frames, idx, objs, npts, name, hold, codes=None):
+    """The path's length (D,) on one state, x (D, K, 3) its active points (complex-step
+    rows), ``frames`` each wrap body's (R, o, Rw, tw) (:func:`_frame`)."""
     # a path entry: (kind, payload); "p": original point k; "w": (wrap j, 1|2)
     path = [("p", int(k)) for k in idx]
     pos = {("p", int(k)): i for i, k in enumerate(idx)}
     wpts: dict = {}  # j -> (r1 body, r2 body, arc)
-    frames = []
-    for pw, w, T, _ in objs:
-        Tb = T[s]
-        Tw = np.eye(4)
-        Tw[:3, :3], Tw[:3, 3] = w.rotation, w.translation
-        frames.append((Tb, Tw))
 
     def ground(e):
         if e[0] == "p":
-            return x[pos[e]]
+            return x[:, pos[e]]
         j, which = e[1]
-        Tb = frames[j][0]
-        return Tb[:3, :3] @ wpts[j][which - 1] + Tb[:3, 3]
+        return _to_ground(frames[j][0], frames[j][1], wpts[j][which - 1])
 
     # OpenSim's Point::getLocationInGround caches a point's ground position at its first use
     # in a state; a wrap point moved by a later pass keeps the old one in the path's length
@@ -426,18 +499,21 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name, codes=None):
 
     def gpos(e):
         if e[0] == "p":
-            return x[pos[e]]
+            return x[:, pos[e]]
         if e[1] not in stale:
             stale[e[1]] = ground(e)
         return stale[e[1]]
 
-    def length():
-        total = 0.0
+    def length(final=False):
+        total = np.zeros(x.shape[0], dtype=x.dtype)
         for a, b in zip(path[:-1], path[1:]):
             if a[0] == "w" and b[0] == "w" and a[1][0] == b[1][0]:
-                total += wpts[b[1][0]][2]
+                total = total + wpts[b[1][0]][2]
             else:
-                total += float(np.linalg.norm(gpos(b) - gpos(a)))
+                seg = _norm(gpos(b) - gpos(a))
+                if final and _re(seg) < 1e-12:
+                    raise MuscleError(f"muscle {name!r}: two consecutive path points coincide")
+                total = total + seg
         return total
 
     nw = len(objs)
@@ -460,39 +536,34 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name, codes=None):
             if not act:
                 break
             start, end = path.index(("p", act[0])), path.index(("p", act[-1]))
-            Tb, Tw = frames[j]
-            to_w = np.linalg.inv(Tb @ Tw)
+            R, o, Rw, tw = frames[j]
+            Rg = R @ Rw  # the wrap frame in ground (D, 3, 3) and its origin
+            og = o + R @ tw
             best, best_change = None, np.inf
             for a in range(start, end):
                 ea, eb = path[a], path[a + 1]
                 if ea[0] == "w" and eb[0] == "w" and ea[1][0] == eb[1][0]:
                     continue
-                ga, gb = ground(ea), ground(eb)
-                p1 = to_w[:3, :3] @ ga + to_w[:3, 3]
-                p2 = to_w[:3, :3] @ gb + to_w[:3, 3]
-                code, r1, r2, arc, jac = _wrap_line(w, p1, p2, nw == 1, pw.method)
+                p1 = np.einsum("dji,dj->di", Rg, ground(ea) - og)
+                p2 = np.einsum("dji,dj->di", Rg, ground(eb) - og)
+                code, r1, r2, arc = _wrap_line(w, p1, p2, nw == 1, pw.method, hold)
                 results[i] = code
                 inside[j] = inside[j] or code == INSIDE
                 if code in (WRAPPED, MANDATORY):
-                    r1b = Tw[:3, :3] @ r1 + Tw[:3, 3]
-                    r2b = Tw[:3, :3] @ r2 + Tw[:3, 3]
-                    used = (jac, ea, eb, ga, gb)
+                    r1b, r2b = r1 @ Rw.T + tw, r2 @ Rw.T + tw
                     if code == MANDATORY:
-                        best = (a, r1b, r2b, arc, used)
+                        best = (a, r1b, r2b, arc)
                         break
-                    g1 = Tb[:3, :3] @ r1b + Tb[:3, 3]
-                    g2 = Tb[:3, :3] @ r2b + Tb[:3, 3]
+                    g1, g2 = _to_ground(R, o, r1b), _to_ground(R, o, r2b)
                     ca, cb = gpos(ea), gpos(eb)
-                    change = (
-                        np.linalg.norm(g1 - ca) + arc + np.linalg.norm(cb - g2)
-                    ) - np.linalg.norm(cb - ca)
+                    change = _re(_norm(g1 - ca) + arc + _norm(cb - g2) - _norm(cb - ca))
                     if change < best_change:
-                        best, best_change = (a, r1b, r2b, arc, used), change
+                        best, best_change = (a, r1b, r2b, arc), change
             if best is not None:
-                a, r1b, r2b, arc, used = best
-                wpts[j] = (r1b, r2b, arc, used)
+                a, r1b, r2b, arc = best
+                wpts[j] = (r1b, r2b, arc)
                 path[a + 1 : a + 1] = [("w", (j, 1)), ("w", (j, 2))]
-        total = length()
+        total = _re(length())
         if abs(total - last) < 0.0005:
             break
         last = total
@@ -500,76 +571,11 @@ def _one_state(x, dx, idx, objs, s, npts, nq, name, codes=None):
             order[0], order[1] = 1, 0
             path = [e for e in path if not (e[0] == "w" and e[1][0] == 0)]
             wpts.pop(0, None)
-    # the gradient: straight segments; tangent points fixed in their wrap object's body, but
-    # an ellipsoid's move with its end points (wrap_ellipsoid: its path is not the shortest)
-    # (a stale tangent point: fixed in its body at its cached position)
-    fresh = {
-        j: all(np.linalg.norm(gpos(("w", (j, k))) - ground(("w", (j, k)))) <= 1e-12 for k in (1, 2))
-        for j in wpts
-    }
-    moving = {
-        j: _ellipsoid_motion(j, wpts[j], ground, dx, pos, objs, frames, s) if fresh[j] else None
-        for j in wpts
-    }
-    grad = np.zeros(nq)
-    total = 0.0
-    for a, b in zip(path[:-1], path[1:]):
-        if a[0] == "w" and b[0] == "w" and a[1][0] == b[1][0]:
-            j = b[1][0]
-            total += wpts[j][2]
-            if moving[j] is not None:
-                grad += moving[j][2]
-            continue
-        ga, gb = gpos(a), gpos(b)
-        d = gb - ga
-        seg = float(np.linalg.norm(d))
-        if seg < 1e-12:
-            raise MuscleError(f"muscle {name!r}: two consecutive path points coincide")
-        total += seg
-        db = _dpoint(b, gb, dx, pos, objs, frames, s, moving)
-        grad += (d / seg) @ (db - _dpoint(a, ga, dx, pos, objs, frames, s, moving))
     if codes is not None:
         codes[:] = [status(j in wpts, inside[j]) for j in range(nw)]
-    return total, grad
+    return length(final=True)
 
 
-def _dpoint(e, g, dx, pos, objs, frames, s, moving=None):
-    """∂x/∂q (3, nq) of path entry e at ground position g."""
-    if e[0] == "p":
-        return dx[pos[e]]
-    j = e[1][0]
-    out = _dfixed(g, j, objs, frames, s)
-    if moving is not None and moving.get(j) is not None:
-        out = out + moving[j][e[1][1] - 1]
-    return out
-
-
-def _dfixed(g, j, objs, frames, s):
-    """∂x/∂q of the point of wrap j's body at ground position g."""
-    Tb = frames[j][0]
-    J = objs[j][3][s]
-    rs = g - Tb[:3, 3]
-    return J[:3] - np.cross(rs[:, None], J[3:], axis=0)
-
-
-def _ellipsoid_motion(j, wp, ground, dx, pos, objs, frames, s):
-    """For an ellipsoid wrap j: (∂r1/∂q, ∂r2/∂q relative to its body (3, nq) each, ∂arc/∂q
-    (nq,)) through the end points it was computed from; None for other surfaces, or when an
-    end point has moved since (a later pass of a multi-wrap path: the tangent points are then
-    held fixed in the body, OpenSim's convention)."""
-    jac, ea, eb, ga, gb = wp[3]
-    if jac is None:
-        return None
-    if np.linalg.norm(ground(ea) - ga) > 1e-12 or np.linalg.norm(ground(eb) - gb) > 1e-12:
-        return None
-    Tb, Tw = frames[j]
-    R = Tb[:3, :3] @ Tw[:3, :3]  # the wrap frame in ground
-    # the end points' motion relative to the wrap body, in the wrap frame (6, nq)
-    dP = np.concatenate(
-        [
-            R.T @ (_dpoint(e, g, dx, pos, objs, frames, s) - _dfixed(g, j, objs, frames, s))
-            for e, g in ((ea, ga), (eb, gb))
-        ]
-    )
-    dr1, dr2, darc = jac
-    return R @ (dr1 @ dP), R @ (dr2 @ dP), darc @ dP
+def _to_ground(R, o, rb):
+    """Ground position (D, 3) of the point rb ((D, 3) or (1, 3)) of a body at (R, o)."""
+    return np.einsum("dij,dj->di", R, np.broadcast_to(rb, o.shape)) + o

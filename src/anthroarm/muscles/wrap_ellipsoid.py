@@ -420,6 +420,22 @@ def _wrap(p1, p2, dims, quad, method):
     return MANDATORY, t1 / factor, t2 / factor, length / factor
 
 
+def wrap_line(p1, p2, dims, quad, method="hybrid"):
+    """``WrapEllipsoid::wrapLine`` on complex-step rows: end points p1, p2 (D, 3) (the
+    ellipsoid's frame, m; row 0 decides every branch) → (code, r1 (D, 3), r2 (D, 3), length
+    (D,)), the tangent points and the surface path's length, None for a code other than
+    ``MANDATORY``; ``dims``, ``quad`` and ``method`` as in :func:`ellipsoid`.  Im(row d) / h
+    is the derivative along Im(p1, p2)(row d) / h (module docstring)."""
+    p1 = np.asarray(p1, dtype=complex)
+    p2 = np.asarray(p2, dtype=complex)
+    code, r1, r2, length = _wrap(p1, p2, dims, quad, method)
+    if code != MANDATORY:
+        return code, None, None, None
+    if not (np.all(np.isfinite(r1)) and np.all(np.isfinite(r2)) and np.all(np.isfinite(length))):
+        raise MuscleError("ellipsoid wrap: the tangent points did not converge")
+    return code, r1, r2, length
+
+
 def ellipsoid(p1, p2, dims, quad, method="hybrid"):
     """``WrapEllipsoid::wrapLine`` of the segment p1 → p2 (the ellipsoid's frame, m) over
     the ellipsoid of radii ``dims`` with quadrant ``quad`` ((axis, sign), sign 0 for all) by
@@ -432,11 +448,8 @@ def ellipsoid(p1, p2, dims, quad, method="hybrid"):
     p = np.concatenate([np.asarray(p1, dtype=float), np.asarray(p2, dtype=float)])
     P = np.tile(p.astype(complex), (7, 1))
     P[np.arange(1, 7), np.arange(6)] += 1j * H
-    code, r1, r2, length = _wrap(P[:, :3], P[:, 3:], dims, quad, method)
+    code, r1, r2, length = wrap_line(P[:, :3], P[:, 3:], dims, quad, method)
     if code != MANDATORY:
         return code, None, None, 0.0, None
-    out = [r1[0].real, r2[0].real, float(length[0].real)]
-    if not (np.all(np.isfinite(out[0])) and np.all(np.isfinite(out[1])) and np.isfinite(out[2])):
-        raise MuscleError("ellipsoid wrap: the tangent points did not converge")
     jac = (r1[1:].imag.T / H, r2[1:].imag.T / H, length[1:].imag / H)
-    return code, out[0], out[1], out[2], jac
+    return code, r1[0].real, r2[0].real, float(length[0].real), jac
