@@ -1,8 +1,7 @@
-"""The damped Gauss–Newton (Levenberg–Marquardt) kernel of :func:`anthroarm.ik.solve`.
-
-One step (:func:`damped_step`, its linear algebra :func:`solve_damped`), shared by the
-one-target attempt (:func:`attempt`), the lockstep batch (a leading batch axis) and the
-null-space phases (:mod:`anthroarm.ik.solve.nullspace`, which reuse the factorisation)::
+"""The damped Gauss–Newton (Levenberg–Marquardt) step of :func:`anthroarm.ik.solve` in NumPy,
+for the lockstep batch (a leading batch axis) and the null-space phases
+(:mod:`anthroarm.ik.solve.nullspace`, which reuse the factorisation), and the constants of
+the one-target attempt (:mod:`.lm`, compiled kernels)::
 
     Δθ = Jᵀ (J Jᵀ + λ I)⁻¹ e = (JᵀJ + λ I)⁻¹ Jᵀe,   λ = λ₀ + k ‖e‖²   (Sugihara 2011 damping),
     θ ← clip(θ + Δθ, θ_min, θ_max).
@@ -22,15 +21,10 @@ off the frame's path are zero: those joints keep their seed values.
 Written for the cost of each call from Python (~0.1–0.5 µs per NumPy or Pinocchio call at these
 sizes): J Jᵀ + λI is built in a preallocated array of the calling thread's workspace and
 factorised in place by LAPACK ``dposv``; limit hits are detected by comparing bytes.
-
-:func:`attempt` is the reference of its compiled form (:mod:`.ckernel`, which reads the
-constants below), used by :func:`~anthroarm.ik.solve.api.solve_one` where a C compiler is
-available.
 """
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -115,39 +109,3 @@ def damped_step(ws, th, J, e, lam):
         if dq is not None:
             tc = clip(th + dq, lo, hi)
     return tc
-
-
-def attempt(ws, tg, th, deadline):
-    """Damped Gauss–Newton from θ until the target's tolerances are met, the error stops
-    falling by 10 % for :data:`STALL` iterations, :data:`MAX_ITER` or the deadline.
-
-    Returns (θ, converged, iterations, pos_err², rot_err², best θ, best ‖e‖²): the last iterate
-    with its squared errors, and the iterate of least ‖e‖² seen."""
-    ref_E = best_E = math.inf
-    best = th
-    stall = it = 0
-    pe2 = re2 = 0.0
-    tp2, tr2 = tg.tp2, tg.tr2
-    residual, jacobian = tg.residual, tg.jacobian
-    while it < MAX_ITER:
-        it += 1
-        e, E, pe2, re2 = residual(ws, th)
-        if pe2 <= tp2 and re2 <= tr2:
-            return th, True, it, pe2, re2, th, E
-        if E < best_E:
-            best_E, best = E, th
-        if E < 0.9 * ref_E:
-            ref_E, stall = E, 0
-        else:
-            stall += 1
-            if stall >= STALL:
-                break
-        if (
-            not it & 7 and clock() > deadline
-        ):  # every 8th iteration (~0.1 ms): the CPU clock costs ~1 µs
-            break
-        tn = damped_step(ws, th, jacobian(ws), e, LAMBDA0 + K_DAMP * E)
-        if tn is None:
-            break
-        th = tn
-    return th, False, it, pe2, re2, best, best_E
