@@ -200,7 +200,7 @@ POLISH_STEPS = 4
 
 
 # ----------------------------------------------------------------------------- any chain (prismatic, mimic)
-#: columns of :attr:`PathFrames.F` after a joint's local frame (:func:`local_frames`, 12)
+#: columns of ``PathFrames.F`` after a joint's local frame (:func:`local_frames`, 12)
 PRISMATIC, COL, MUL, OFF = 12, 13, 14, 15
 
 
@@ -208,10 +208,10 @@ class PathFrames:
     """The path from the base to one frame of ``robot.chain`` as the one array ``F`` (P + 1, 16)
     of :func:`chain_fk_jacobian`: row k holds the local frame A_k (:func:`local_frames`, from
     the P joints' placements and axes at θ = 0 and the frame's placement: 12 columns); for the
-    k-th joint of the path, row k also holds [:data:`PRISMATIC`] 1 for a prismatic joint (a
+    k-th joint of the path, row k also holds [``PRISMATIC``] 1 for a prismatic joint (a
     translation along its axis), 0 for a revolute or continuous one, and the map of its value
     q_k = a θ[c] + b from the independent coordinates θ (``chain.independent`` order):
-    [:data:`COL`] c, [:data:`MUL`] a, [:data:`OFF`] b (a mimic joint reads its source's θ, any
+    [``COL``] c, [``MUL``] a, [``OFF``] b (a mimic joint reads its source's θ, any
     other joint is its own θ with a = 1, b = 0)."""
 
     __slots__ = ("F", "P")

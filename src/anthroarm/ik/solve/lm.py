@@ -45,7 +45,7 @@ EPS = float(np.finfo(float).eps)
 PREC2 = EPS ** (1.0 / 3.0)  # Pinocchio's Taylor threshold (TaylorSeriesExpansion<double, 2>)
 #: :func:`run`'s return codes: the attempt failed, converged, or paused for the clock
 FAILED, CONVERGED, PAUSED = 0, 1, 2
-#: state fields of :func:`run` (row :data:`ST` of its buffer): iterations, stall count, reference
+#: state fields of :func:`run` (row ``ST`` of its buffer): iterations, stall count, reference
 #: ‖e‖², best ‖e‖², pos_err², rot_err², last ‖e‖², resume flag
 IT, STALLS, REF_E, BEST_E, PE2, RE2, LAST_E, RESUME = range(8)
 NCOL = 8  # (and the number n of coordinates: no argument for it)
@@ -163,7 +163,7 @@ def _rt(R, M):
 
 @kernel
 def residual(kind, x, tsum, R, p, e):
-    """The error e (m,) of the pose (R, p) against the target x (:attr:`.targets.Target.x`: a
+    """The error e (m,) of the pose (R, p) against the target x (``Target.x``: a
     pose's T*.ravel(), a position's (p*, 1), a rotation's R*.ravel()) into ``e``; returns (‖e‖², pos_err², rot_err²) as
     :meth:`.targets.Target.residual` (0 for the unchecked part; a pose's both inf where
     ‖e‖² > ``tsum``: surely not converged)."""
@@ -315,22 +315,22 @@ def damped_step(th, J, Jm, m, e, lam, lo, hi, A, x, dq, tn, n):
 
 
 # ----------------------------------------------------------------------------- the attempt
-#: rows of the buffer ``B`` of :func:`run` (width k = max(16, n)): θ, best θ, the state (:data:`IT`
-#: …), the target (:attr:`.targets.Target.x`), lower and upper limits, e, x, dq, tn, then the
+#: rows of the buffer ``B`` of :func:`run` (width k = max(16, n)): θ, best θ, the state (``IT``
+#: …), the target (``Target.x``), lower and upper limits, e, x, dq, tn, then the
 #: blocks J6 (6 rows), J (6), Jm (6), A (k) and W (P)
 TH, BEST, ST, TGT, LO, HI, E_, X_, DQ, TN, J6_ = range(11)
 
 
 @kernel
 def run(F, B, kind, tp2, tr2, tsum, start):
-    """Iterate the attempt from θ (row :data:`TH` of ``B``, updated in place) until the target's
-    tolerances are met, the error stops falling by 10 % for :data:`STALL` iterations,
-    :data:`MAX_ITER`, a singular system — or, every 8th iteration, a pause for the caller to
+    """Iterate the attempt from θ (row ``TH`` of ``B``, updated in place) until the target's
+    tolerances are met, the error stops falling by 10 % for :data:`~.kernel.STALL` iterations,
+    :data:`~.kernel.MAX_ITER`, a singular system — or, every 8th iteration, a pause for the caller to
     look at the clock; ``start=False`` resumes it (with the step of the error and Jacobian it
     left in ``B``).  ``F``: the chain (:class:`~anthroarm.ik.geometric.fk.PathFrames`);
-    ``B``: the target and limits, the state, the iterate of least ‖e‖² (row :data:`BEST`) and
-    the scratch arrays (see :data:`TH`).  Returns :data:`FAILED`, :data:`CONVERGED` or
-    :data:`PAUSED`."""
+    ``B``: the target and limits, the state, the iterate of least ‖e‖² (row ``BEST``) and
+    the scratch arrays (see ``TH``).  Returns ``FAILED``, ``CONVERGED`` or
+    ``PAUSED``."""
     n = int(B[ST, NCOL])
     m = 6 if kind == POSE else 3
     k = B.shape[1]
@@ -386,7 +386,7 @@ def run(F, B, kind, tp2, tr2, tsum, start):
 
 class Buffers:
     """The calling thread's arrays of :func:`run` for one (robot, frame): the chain ``F``
-    (:class:`~anthroarm.ik.geometric.fk.PathFrames`) and the buffer ``B`` (see :data:`TH`),
+    (:class:`~anthroarm.ik.geometric.fk.PathFrames`) and the buffer ``B`` (see ``TH``),
     with views ``th``, ``tgt`` of its rows."""
 
     __slots__ = ("F", "B", "n", "th", "tgt", "warm")
@@ -414,7 +414,7 @@ def warm(ws) -> None:
 
 def attempt(ws, tg, th, deadline):
     """Damped Gauss–Newton from θ until the target's tolerances are met, the error stops falling
-    by 10 % for :data:`STALL` iterations, :data:`MAX_ITER` or the deadline (thread CPU time,
+    by 10 % for :data:`~.kernel.STALL` iterations, :data:`~.kernel.MAX_ITER` or the deadline (thread CPU time,
     looked at every 8th iteration).
 
     Returns (θ, converged, iterations, pos_err², rot_err², best θ, best ‖e‖²): the last iterate
