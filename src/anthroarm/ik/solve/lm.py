@@ -24,7 +24,7 @@ the rotation renormalised, the Taylor branches below ε^(1/3), the θ ≈ π bra
 systems are solved by a Cholesky factorisation that fails as LAPACK's ``dpotrf`` does (a pivot
 ≤ 0 or NaN).
 
-The time budget is thread CPU time (:data:`.kernel.clock`), which a compiled kernel cannot
+The time budget is thread CPU time (``kernel.clock``), which a compiled kernel cannot
 read: :func:`run` pauses every 8th iteration and :func:`attempt` (the Python caller) looks at
 the clock in between.  No allocation in the loop: every array lives in the calling thread's
 :class:`Buffers`.
