@@ -4,7 +4,8 @@ per-thread workspaces.
 Thread-safety contract: :class:`Shared` (limits, reach, seed tables) is immutable once built
 (the tables are built once under a lock); everything a solve writes — the ``pin.Data`` and the
 kernel's preallocated arrays — lives in a :class:`Workspace` of the calling thread
-(``threading.local``), including the buffers of the attempt kernel (:class:`.lm.Buffers`).  So one Robot may be solved for from several threads at once.
+(``threading.local``), including the buffers of the attempt kernel (:class:`.lm.Buffers`).
+So one Robot may be solved for from several threads at once.
 
 Memory: the cache maps a Robot *weakly* to its Shared objects, and nothing in them refers to
 the Robot (only to its ``pin.Model`` and ``Chain``), so a Robot dropped by the caller is freed
