@@ -47,7 +47,6 @@ def test_no_arm_names_in_ik():
         "subproblems",
         "classify.py",
         "vec3.py",
-        "fk_codegen.py",
         "checks.py",
         "cells.py",
     ):

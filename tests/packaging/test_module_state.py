@@ -13,7 +13,6 @@ ALLOWED = {
     ("cache.py", "_CC_IDS"): "the disk cache: compiler identities, probed once per process",
     ("cache.py", "_STATE"): "the disk cache: its fallback folder and refusals, per process",
     ("threads.py", "_POOL"): "the one thread pool of the process (grown with $ANTHROARM_THREADS)",
-    ("ik/solve/ckernel.py", "_LIBS"): "compiled libraries by source digest (no robot in them)",
     ("dynamics/ccode.py", "_LIBS"): "compiled libraries by source digest (no robot in them)",
     ("dynamics/lagrange.py", "_MEMO"): "generated modules by model digest (no robot in them)",
     ("ik/qp/_qpgen2.py", "_SELFTESTED"): "a per-size self-test of a C routine, once per process",

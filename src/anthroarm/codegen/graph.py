@@ -2,8 +2,7 @@
 differentiation and its emitters (Python/numpy and C).
 
 Used by :mod:`anthroarm.dynamics.lagrange` (M, C q̇, g, τ; compiled by
-:mod:`anthroarm.dynamics.ccode`) and by :mod:`anthroarm.ik.fk_codegen` (the chain product that
-verifies closed-form IK candidates, rendered as ``math``, numpy and C stage functions).
+:mod:`anthroarm.dynamics.ccode`).
 
 Why not plain sympy expression trees?  The kinetic energy of a 7-DOF arm written out as one
 sympy expression has hundreds of thousands of terms, and sympy's automatic distribution of

@@ -197,3 +197,90 @@ def _fk_residuals(A, Q, QC, QS, V, n, T, RES, S):
 POLISH_MAX = 1e-4
 #: Newton steps of :func:`_polish_chain` at most (quadratic convergence from ~1e-7: two suffice)
 POLISH_STEPS = 4
+
+
+# ----------------------------------------------------------------------------- any chain (prismatic, mimic)
+#: columns of ``PathFrames.F`` after a joint's local frame (:func:`local_frames`, 12)
+PRISMATIC, COL, MUL, OFF = 12, 13, 14, 15
+
+
+class PathFrames:
+    """The path from the base to one frame of ``robot.chain`` as the one array ``F`` (P + 1, 16)
+    of :func:`chain_fk_jacobian`: row k holds the local frame A_k (:func:`local_frames`, from
+    the P joints' placements and axes at θ = 0 and the frame's placement: 12 columns); for the
+    k-th joint of the path, row k also holds [``PRISMATIC``] 1 for a prismatic joint (a
+    translation along its axis), 0 for a revolute or continuous one, and the map of its value
+    q_k = a θ[c] + b from the independent coordinates θ (``chain.independent`` order):
+    [``COL``] c, [``MUL``] a, [``OFF``] b (a mimic joint reads its source's θ, any
+    other joint is its own θ with a = 1, b = 0)."""
+
+    __slots__ = ("F", "P")
+
+    def __init__(self, chain, frame):
+        path = chain.path(frame)
+        fr = chain.frame(frame)
+        v_of = {j: k for k, j in enumerate(chain.independent)}
+        R, p = np.eye(3), np.zeros(3)
+        axes, points = [], []
+        for i in path:  # each joint's placement, at θ = 0 (no joint motion)
+            j = chain.joints[i]
+            R, p = R @ j.rotation, p + R @ j.translation
+            axes.append(R @ np.asarray(j.axis, dtype=float))
+            points.append(p)
+        M = np.eye(4)
+        M[:3, :3], M[:3, 3] = R @ fr.rotation, p + R @ fr.translation
+        self.P = len(path)
+        self.F = np.zeros((self.P + 1, 16))
+        self.F[:, :12] = local_frames(np.reshape(axes, (-1, 3)), np.reshape(points, (-1, 3)), M)
+        for k, i in enumerate(path):
+            j = chain.joints[i]
+            self.F[k, PRISMATIC] = float(j.kind == "prismatic")
+            self.F[k, COL] = v_of[j.mimic.source if j.is_mimic else i]
+            self.F[k, MUL] = j.mimic.multiplier if j.is_mimic else 1.0
+            self.F[k, OFF] = j.mimic.offset if j.is_mimic else 0.0
+
+
+@kernel
+def chain_fk_jacobian(F, th, J, W, n):
+    """The pose (R, t) of the frame of :class:`PathFrames` (``F``) at θ (the independent
+    coordinates, rad or m) and its geometric Jacobian into the first n columns of J (6, ≥ n),
+    LOCAL_WORLD_ALIGNED as
+    Pinocchio's ``getFrameJacobian``: rows (v; ω) of the frame's origin in base axes; column of
+    a revolute joint (z × (t − o); z), of a prismatic one (z; 0), with the joint's axis z and
+    point o in the base frame (the z axis and origin of the partial product before its motion,
+    see :func:`local_frames`), times a for a mimic joint q = a θ + b, summed into its source's
+    column (the chain rule); zero columns for the coordinates off the path (Murray, Li &
+    Sastry, *A Mathematical Introduction to Robotic Manipulation*, 1994, §3.4 (3.55)).  A
+    prismatic joint translates the partial product along its z: (R, t) Tz(q) A_k =
+    (R B, R a + t + q z).  ``W`` (≥ P, ≥ 6) scratch: each joint's z and o."""
+    for r in range(6):
+        for c in range(n):
+            J[r, c] = 0.0
+    R, t = _frame(F, 0)
+    P = len(F) - 1
+    for k in range(P):
+        W[k, 0], W[k, 1], W[k, 2] = R[0][2], R[1][2], R[2][2]
+        W[k, 3], W[k, 4], W[k, 5] = t
+        q = F[k, MUL] * th[int(F[k, COL])] + F[k, OFF]
+        if F[k, PRISMATIC] != 0.0:
+            B, a = _frame(F, k + 1)
+            t = add(add(mv(R, a), t), (q * R[0][2], q * R[1][2], q * R[2][2]))
+            R = mm(R, B)
+        else:
+            R, t = _joint_step(R, t, F, k + 1, math.cos(q), math.sin(q))
+    for k in range(P):
+        c, a = int(F[k, COL]), F[k, MUL]
+        z = (W[k, 0], W[k, 1], W[k, 2])
+        if F[k, PRISMATIC] != 0.0:
+            J[0, c] += a * z[0]
+            J[1, c] += a * z[1]
+            J[2, c] += a * z[2]
+        else:
+            v = cross(z, sub(t, (W[k, 3], W[k, 4], W[k, 5])))
+            J[0, c] += a * v[0]
+            J[1, c] += a * v[1]
+            J[2, c] += a * v[2]
+            J[3, c] += a * z[0]
+            J[4, c] += a * z[1]
+            J[5, c] += a * z[2]
+    return R, t

@@ -1,7 +1,7 @@
 """One-shot inverse kinematics: ``aa.ik.solve(robot, T)`` -> :class:`~anthroarm.ik.result.IKResult`.
 
 Method: damped Gauss–Newton (Levenberg–Marquardt) on the pose error with projected steps
-(:mod:`.kernel`), seeds from the closed form or from a table of the arm's own poses
+(:mod:`.lm`), seeds from the closed form or from a table of the arm's own poses
 (:mod:`.seeds`), restarts inside the joint limits under a time budget, and for redundant arms a
 secondary objective in the null space of the task (:mod:`.nullspace`).  Per iteration (frame
 ``frame``, m and rad)::
@@ -46,10 +46,10 @@ Redundant arms (human arm): ``posture`` adds ½‖θ − θ_ref‖² in the null
 along a one-dimensional self-motion; :func:`.nullspace.posture`); ``swivel=φ*`` places the
 elbow at the swivel angle φ* (:func:`.nullspace.swivel`).
 
-Speed (:mod:`.ckernel`): where a C compiler is available, each attempt runs as one compiled
-call (the FK and Jacobian of the frame generated from ``robot.chain``, the same iteration as
-:func:`.kernel.attempt`, tested equal to it); ``ANTHROARM_IK_C=0`` or no compiler: the Python
-kernel.
+Speed (:mod:`.lm`): each attempt is one call of a compiled kernel (:mod:`anthroarm.jit`: its
+one source runs in the interpreter until the compiled code is ready), the frame's FK and
+Jacobian from the chain's one compiled forward kinematics
+(:func:`anthroarm.ik.geometric.fk.chain_fk_jacobian`, read from ``robot.chain``).
 
 Threads and memory (:mod:`.workspace`): one Robot may be used from several threads at once
 (per-thread ``pin.Data`` and kernel arrays); the per-robot cache holds the Robot weakly and

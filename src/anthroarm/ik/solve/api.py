@@ -12,9 +12,8 @@ from ..closed.limits import refine
 from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
-from . import ckernel, coupled
+from . import coupled, lm
 from .kernel import MAX_ITER, STALL, clock, damped_step, damping
-from .kernel import attempt as py_attempt
 from .nullspace import Swivel, posture
 from .nullspace import swivel as swivel_phase
 from .seeds import SWIVEL_GRID, SWIVEL_GRID_COARSE, TableSeeds, analytic_seeds
@@ -33,8 +32,7 @@ class Problem:
     """The settings of one call, shared by its targets: the robot (for the closed form only),
     the calling thread's workspace, the time budget (s of thread CPU time), the restart cap and
     generator, the posture reference θ_ref (None: no posture phase), the swivel objective
-    (None: none), the closed-form policy, and the attempt kernel (:func:`.kernel.attempt` or
-    its compiled form :func:`.ckernel.attempt`)."""
+    (None: none) and the closed-form policy."""
 
     __slots__ = (
         "robot",
@@ -46,23 +44,12 @@ class Problem:
         "th_ref",
         "swivel",
         "analytic",
-        "_attempt",
     )
 
     def __init__(self, robot, ws, max_time, max_restarts, rng, th_ref, swivel, analytic):
         self.robot, self.ws, self.max_time, self.max_restarts = robot, ws, max_time, max_restarts
         self.rng, self._gen = rng, None
         self.th_ref, self.swivel, self.analytic = th_ref, swivel, analytic
-        self._attempt = None
-
-    @property
-    def attempt(self):
-        """The attempt kernel, chosen on first use (an answer straight from the closed form
-        needs none): the compiled one where available (:func:`.ckernel.ready`), else
-        :func:`.kernel.attempt`."""
-        if self._attempt is None:
-            self._attempt = ckernel.attempt if ckernel.ready(self.ws) else py_attempt
-        return self._attempt
 
     def random(self):
         """A uniform random θ in the sampling box (the generator made on first use: most
@@ -242,8 +229,8 @@ def solve(
     ws.table()  # the one-time seed tables and compiled kernel: built here, before any clock
     if mode == "pose":  # starts, so the first call is not charged for them
         ws.aligned()
-    if ws.cbuf is None:
-        ckernel.ready(ws)
+    if not ws.lm.warm:
+        lm.warm(ws)
     if analytic is not False and sh.has_closed_form:
         _warm_closed_form(pb, mode, tp, tr)
     if not batch:
@@ -324,7 +311,7 @@ def _result(sh, r, seed):
 def solve_one(pb: Problem, tg: Target, seed):
     """One target: the seeds in order — closed form (``analytic=True``, or "auto" where it is
     cheap and no q0 is given), q0, the seed table nearest first, uniform random — each
-    refined by :func:`~anthroarm.ik.solve.kernel.attempt` until one converges, the budget is
+    refined by :func:`~anthroarm.ik.solve.lm.attempt` until one converges, the budget is
     spent or ``max_restarts`` is reached; then the posture or swivel phase.  Returns an
     IKResult whose ``q`` is θ (:func:`_result` maps it)."""
     ws = pb.ws
@@ -405,7 +392,7 @@ def solve_one(pb: Problem, tg: Target, seed):
                     tg.mode,
                     tag,
                 )
-        ths, ok, it, pe2, re2, bq, bE = pb.attempt(ws, tg, th, deadline)
+        ths, ok, it, pe2, re2, bq, bE = lm.attempt(ws, tg, th, deadline)
         total_it += it
         attempts += 1
         if bE < best_E:

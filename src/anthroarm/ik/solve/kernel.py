@@ -1,8 +1,9 @@
-"""The damped Gauss–Newton (Levenberg–Marquardt) kernel of :func:`anthroarm.ik.solve`.
-
-One step (:func:`damped_step`, its linear algebra :func:`solve_damped`), shared by the
-one-target attempt (:func:`attempt`), the lockstep batch (a leading batch axis) and the
-null-space phases (:mod:`anthroarm.ik.solve.nullspace`, which reuse the factorisation)::
+"""The damped Gauss–Newton (Levenberg–Marquardt) step of :func:`anthroarm.ik.solve` in NumPy,
+for the lockstep batch (a leading batch axis) and the null-space phases
+(:mod:`anthroarm.ik.solve.nullspace`, which reuse the factorisation), the one-target attempt
+over any workspace (:func:`attempt`: a model whose kinematics are not a serial chain's, an
+OpenSim model with couplings, :mod:`.coupled`), and the constants of the compiled attempt on a
+chain (:mod:`.lm`)::
 
     Δθ = Jᵀ (J Jᵀ + λ I)⁻¹ e = (JᵀJ + λ I)⁻¹ Jᵀe,   λ = λ₀ + k ‖e‖²   (Sugihara 2011 damping),
     θ ← clip(θ + Δθ, θ_min, θ_max).
@@ -22,10 +23,6 @@ off the frame's path are zero: those joints keep their seed values.
 Written for the cost of each call from Python (~0.1–0.5 µs per NumPy or Pinocchio call at these
 sizes): J Jᵀ + λI is built in a preallocated array of the calling thread's workspace and
 factorised in place by LAPACK ``dposv``; limit hits are detected by comparing bytes.
-
-:func:`attempt` is the reference of its compiled form (:mod:`.ckernel`, which reads the
-constants below), used by :func:`~anthroarm.ik.solve.api.solve_one` where a C compiler is
-available.
 """
 
 from __future__ import annotations
@@ -119,7 +116,9 @@ def damped_step(ws, th, J, e, lam):
 
 def attempt(ws, tg, th, deadline):
     """Damped Gauss–Newton from θ until the target's tolerances are met, the error stops
-    falling by 10 % for :data:`STALL` iterations, :data:`MAX_ITER` or the deadline.
+    falling by 10 % for :data:`STALL` iterations, :data:`MAX_ITER` or the deadline, on any
+    workspace ``ws`` whose target ``tg`` gives the residual and Jacobian (the chains' compiled
+    form is :func:`.lm.attempt`, the same iteration).
 
     Returns (θ, converged, iterations, pos_err², rot_err², best θ, best ‖e‖²): the last iterate
     with its squared errors, and the iterate of least ‖e‖² seen."""
@@ -142,9 +141,7 @@ def attempt(ws, tg, th, deadline):
             stall += 1
             if stall >= STALL:
                 break
-        if (
-            not it & 7 and clock() > deadline
-        ):  # every 8th iteration (~0.1 ms): the CPU clock costs ~1 µs
+        if not it & 7 and clock() > deadline:  # every 8th iteration: the CPU clock costs ~1 µs
             break
         tn = damped_step(ws, th, jacobian(ws), e, LAMBDA0 + K_DAMP * E)
         if tn is None:

@@ -4,8 +4,8 @@ per-thread workspaces.
 Thread-safety contract: :class:`Shared` (limits, reach, seed tables) is immutable once built
 (the tables are built once under a lock); everything a solve writes — the ``pin.Data`` and the
 kernel's preallocated arrays — lives in a :class:`Workspace` of the calling thread
-(``threading.local``), including the buffers of the compiled kernel (:mod:`.ckernel`, whose C
-code keeps its state on the stack).  So one Robot may be solved for from several threads at once.
+(``threading.local``), including the buffers of the attempt kernel (:class:`.lm.Buffers`).
+So one Robot may be solved for from several threads at once.
 
 Memory: the cache maps a Robot *weakly* to its Shared objects, and nothing in them refers to
 the Robot (only to its ``pin.Model`` and ``Chain``), so a Robot dropped by the caller is freed
@@ -22,8 +22,10 @@ import pinocchio as pin
 
 from ...chain import CONTINUOUS, PRISMATIC
 from .. import closed_form
+from ..geometric.fk import PathFrames
 from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from . import seeds
+from .lm import Buffers
 
 
 class Shared:
@@ -90,9 +92,7 @@ class Shared:
         self.warm = (
             set()
         )  # the settings whose closed-form kernels are loaded (api._warm_closed_form)
-        self.ckernel = (
-            None  # the compiled attempt kernel (ckernel.kernel_for), False if unavailable
-        )
+        self.path = PathFrames(chain, fid)  # the chain's FK arrays for the attempt kernel (.lm)
 
     def theta(self, q) -> np.ndarray:
         """θ (n,) or (N, n) of a configuration q in Pinocchio's layout (a copy)."""
@@ -167,7 +167,7 @@ class Workspace:
     preallocated arrays (J Jᵀ + λI built in place, handed to LAPACK as its transpose: Fortran
     order, symmetric), plus the shared fields the kernel reads, copied for fast access."""
 
-    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "cbuf")
+    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "lm")
 
     def __init__(self, sh: Shared):
         self.sh = sh
@@ -180,7 +180,7 @@ class Workspace:
             sh.to_q,
         )
         self.data = sh.model.createData()
-        self.cbuf = None  # the compiled kernel's buffers (ckernel.ready)
+        self.lm = Buffers(sh.path, sh.lo, sh.hi)  # the attempt kernel's arrays (.lm.attempt)
         self.lin = {}  # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
         for m in {3, 6, min(sh.n, 6)}:  # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
