@@ -73,7 +73,8 @@ from ._io import atomic_write_text
 from .errors import ParameterError, UnsafeCacheError, UnsafeCacheWarning
 
 ENV = "ANTHROARM_CACHE"
-#: subfolders this module manages (``cache clear`` empties only these)
+#: subfolders this module manages (``cache clear`` empties only these; ``ik`` holds the C
+#: attempt kernels of releases before the LM attempt became a numba kernel: cleared, not written)
 SUBFOLDERS = ("lagrange", "ik", "urdf", "numba", "kernels")
 _SIDECAR = ".sha256"
 _LOCK = threading.Lock()
@@ -269,9 +270,8 @@ def compiler() -> str | None:
     return shutil.which(os.environ.get("CC", "cc"))
 
 
-#: ``$ANTHROARM_JIT``: who compiles (:mod:`anthroarm.jit`; the C kernels of
-#: :class:`CompiledOnce` follow it): ``auto`` in the background, ``compile`` on first use in the
-#: calling thread, ``reference`` never
+#: ``$ANTHROARM_JIT``: who compiles (:mod:`anthroarm.jit`): ``auto`` in the background,
+#: ``compile`` on first use in the calling thread, ``reference`` never
 BUILD_MODES = ("auto", "compile", "reference")
 
 
@@ -282,74 +282,6 @@ def build_mode() -> str:
     if m not in BUILD_MODES:
         raise ParameterError(f"ANTHROARM_JIT={m!r}: give one of {', '.join(BUILD_MODES)}")
     return m
-
-
-class _Pending:
-    """Marks a kernel whose build runs in a background thread."""
-
-
-PENDING = _Pending()
-
-
-class CompiledOnce:
-    """One family of compiled kernels, each built once and kept on its owner.
-
-    :meth:`get` returns ``owner.<attr>``: loaded from the disk cache at once where it is there;
-    else built — in a background thread in the ``auto`` :func:`build_mode` (callers use
-    ``fallback`` until it is done: nothing compiles on the caller's clock), in the calling
-    thread in ``compile``, never in ``reference``.  A failed build leaves ``False`` (not
-    retried) and its reason for :meth:`status`; the environment variable ``switch`` set to
-    0/false/no/off disables the family.  ``build(owner, compile)`` returns the kernel, or None
-    when ``compile`` is False and the cache does not hold it."""
-
-    def __init__(self, switch: str, fallback: str, available: str):
-        self.switch, self.fallback, self.available = switch, fallback, available
-        self.reason: str | None = None
-        self.lock = threading.Lock()
-
-    def enabled(self) -> bool:
-        return os.environ.get(self.switch, "1").strip().lower() not in ("0", "false", "no", "off")
-
-    def status(self) -> str:
-        """Why the compiled kernels are (not) in use (the last build failure, if any)."""
-        if not self.enabled():
-            return f"disabled by {self.switch}=0"
-        if compiler() is None:
-            return f"no C compiler ($CC or cc) found: {self.fallback}"
-        return self.reason or self.available
-
-    def _build(self, owner, attr, build, what, compile_now):
-        try:
-            k = build(owner, compile_now)
-            self.reason = None
-        except (RuntimeError, OSError) as exc:
-            self.reason = f"compiled {what} unavailable ({exc}); {self.fallback}"
-            k = False
-        if k is not None:
-            setattr(owner, attr, k)
-        return k
-
-    def get(self, owner, attr: str, build, what: str):
-        """``owner.<attr>`` (see the class); None where the family is disabled, the build
-        failed or still runs (``what`` names the kernel in the status)."""
-        if not self.enabled():
-            return None
-        k = getattr(owner, attr)
-        if k is None:
-            with self.lock:
-                k = getattr(owner, attr)
-                if k is None:
-                    mode = build_mode()
-                    k = self._build(owner, attr, build, what, mode == "compile")
-                    if k is None and mode == "auto":
-                        setattr(owner, attr, PENDING)
-                        threading.Thread(
-                            target=self._build,
-                            args=(owner, attr, build, what, True),
-                            name=f"anthroarm-build-{attr}",
-                            daemon=True,
-                        ).start()
-        return k if k is not PENDING and k else None
 
 
 def compiler_id(cc: str) -> str:

@@ -264,13 +264,13 @@ def test_a_truncated_library_with_a_restamped_sidecar_is_compiled_again(croot, c
     """The digest cannot catch this (the sidecar matches the truncated bytes): the library's
     own headers name offsets beyond its end, so it is rebuilt instead of returned (dlopen of
     such a file dies of SIGBUS)."""
-    path, origin = cache.shared_library("ik", "twice", SO_SOURCE, SO_FLAGS)
+    path, origin = cache.shared_library("lagrange", "twice", SO_SOURCE, SO_FLAGS)
     assert origin == "compiled"
     good = path.read_bytes()
     n = len(good) - 1 if cut == -1 else int(len(good) * cut)
     path.unlink()
     plant(path.parent, path.name, good[:n])
-    again, origin = cache.shared_library("ik", "twice", SO_SOURCE, SO_FLAGS)
+    again, origin = cache.shared_library("lagrange", "twice", SO_SOURCE, SO_FLAGS)
     assert origin == "compiled" and again == path
     assert path.read_bytes() == good
 
