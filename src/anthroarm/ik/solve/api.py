@@ -79,6 +79,54 @@ class Problem:
         )
 
 
+def _check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic) -> None:
+    """:func:`solve`'s scalar options, or ValueError/TypeError naming the bad one."""
+    if not (
+        type(tol_pos) is float
+        and type(tol_rot) is float
+        and type(max_time) is float  # the usual call
+        and 0.0 < tol_pos < math.inf
+        and 0.0 < tol_rot < math.inf
+        and 0.0 < max_time < math.inf
+    ):
+        for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
+            if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+    if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
+        raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+    if not (
+        rng is None
+        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
+        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
+    ):
+        raise TypeError(
+            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
+        )
+    if analytic not in ("auto", True, False):
+        raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
+
+
+def _reference(robot, sh, posture, swivel, swivel_frames):
+    """(reference posture θ in the limits or None, :class:`Swivel` or None) of :func:`solve`'s
+    ``posture``, ``swivel`` and ``swivel_frames``."""
+    if isinstance(posture, str):
+        if posture != "auto":
+            raise ValueError(f"posture must be 'auto', None or a configuration, got {posture!r}")
+        th_ref = sh.posture_auto
+    elif posture is None:
+        th_ref = None
+    else:
+        th_ref = np.minimum(
+            np.maximum(sh.theta(robot.check_q(posture, name="posture")), sh.lo), sh.hi
+        )
+    if swivel is None:
+        return th_ref, None
+    swivel = float(swivel)
+    if not math.isfinite(swivel):
+        raise ValueError(f"swivel must be finite, got {swivel}")
+    return th_ref, Swivel([robot.frame_id(f) for f in _swivel_frames(robot, swivel_frames)], swivel)
+
+
 def solve(
     robot,
     T,
@@ -169,51 +217,14 @@ def solve(
         mode, batch, targets = "pose", False, [as_rigid(T, "T")]
     else:
         mode, batch, targets = parse(T, mode)
-    if not (
-        type(tol_pos) is float
-        and type(tol_rot) is float
-        and type(max_time) is float  # the usual call
-        and 0.0 < tol_pos < math.inf
-        and 0.0 < tol_rot < math.inf
-        and 0.0 < max_time < math.inf
-    ):
-        for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
-            if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
-    if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
-        raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
-    if not (
-        rng is None
-        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
-        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
-    ):
-        raise TypeError(
-            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
-        )
-    if analytic not in ("auto", True, False):
-        raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
+    _check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
     Q0 = None
     if q0 is not None:
         Q0 = robot.check_q(q0, name="q0")
         if Q0.ndim == 2 and (not batch or len(Q0) != len(targets)):
             raise ValueError(f"q0 of shape {Q0.shape} needs a batch of {len(Q0)} targets")
         Q0 = sh.theta(Q0)
-    if isinstance(posture, str):
-        if posture != "auto":
-            raise ValueError(f"posture must be 'auto', None or a configuration, got {posture!r}")
-        th_ref = sh.posture_auto
-    elif posture is None:
-        th_ref = None
-    else:
-        th_ref = np.minimum(
-            np.maximum(sh.theta(robot.check_q(posture, name="posture")), sh.lo), sh.hi
-        )
-    sw = None
-    if swivel is not None:
-        swivel = float(swivel)
-        if not math.isfinite(swivel):
-            raise ValueError(f"swivel must be finite, got {swivel}")
-        sw = Swivel([robot.frame_id(f) for f in _swivel_frames(robot, swivel_frames)], swivel)
+    th_ref, sw = _reference(robot, sh, posture, swivel, swivel_frames)
     redundant = sh.dof > (6 if mode == "pose" else 3)
     pb = Problem(
         robot,
@@ -320,42 +331,12 @@ def solve_one(pb: Problem, tg: Target, seed):
     max_time = pb.max_time
     deadline = t0 + max_time
     th_ref, sw = pb.th_ref, pb.swivel
-    # reachability (a sufficient test for "unreachable": farther than the summed link offsets)
-    out_of_reach = ""
-    if tg.kind != ORIENTATION:
-        dist = math.sqrt(tg.ps.dot(tg.ps))
-        if dist > sh.reach + tg.tol_p:
-            out_of_reach = (
-                f"target is {dist:.4g} m from the base origin but the chain reaches at most "
-                f"{sh.reach:.4g} m (sum of its link offsets)"
-            )
+    out_of_reach = _out_of_reach(sh, tg)
     ana, ana_i, note = None, 0, ""
     if not out_of_reach and pb.closed_form_first(seed):
-        ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
-        # without a posture objective any member of a swivel family will do: a coarse grid first
-        grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
-        anyone = th_ref is None and sw is None
-        ana, note, err = analytic_seeds(
-            pb.robot, ws, tg, ref, sw.target if sw else None, grid, anyone
-        )
-        if not len(ana) and grid is SWIVEL_GRID_COARSE and ws.sh.swivel_family:
-            ana, note, err = analytic_seeds(
-                pb.robot, ws, tg, ref, sw.target if sw else None, SWIVEL_GRID, anyone
-            )
-        if err is not None and anyone and tg.ok(err[0] * err[0], err[1] * err[1]):
-            # the closed form's nearest solution, checked by the FK of its compiled call: the answer
-            return IKResult(
-                ana[0],
-                True,
-                "success",
-                err[0],
-                err[1],
-                0,
-                0,
-                "converged from an analytic seed",
-                tg.mode,
-                "analytic",
-            )
+        ana, note, done = _closed_form_seeds(pb, tg, seed)
+        if done is not None:
+            return done
     table = None  # seed-table entries, nearest first (made when needed)
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
@@ -426,21 +407,52 @@ def solve_one(pb: Problem, tg: Target, seed):
         if clock() > deadline or (pb.max_restarts is not None and restarts >= pb.max_restarts):
             break
     th = best_q if best_q is not None else th
+    why = out_of_reach or (
+        f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
+        f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, "
+        f"{(clock() - t0) * 1e3:.1f} ms CPU (max_time {max_time * 1e3:g} ms); the target is "
+        "probably outside the joint-limited workspace"
+    )
     pe, re = tg.errors(ws, th)
-    if out_of_reach:
-        status, why = "out_of_reach", out_of_reach
-    else:
-        status = "not_converged"
-        why = (
-            f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
-            f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, "
-            f"{(clock() - t0) * 1e3:.1f} ms CPU (max_time {max_time * 1e3:g} ms); the target is probably "
-            "outside the joint-limited workspace"
-        )
     msg = f"{why}; closest pose found: pos_err {pe:.3g} m, rot_err {re:.3g} rad" + (
         f"; {note}" if note else ""
     )
+    status = "out_of_reach" if out_of_reach else "not_converged"
     return IKResult(th, False, status, pe, re, total_it, restarts, msg, tg.mode, tag)
+
+
+def _out_of_reach(sh, tg) -> str:
+    """Why ``tg`` is out of reach ("" if it may be reachable): a sufficient test, the target
+    farther from the base than the summed link offsets."""
+    if tg.kind == ORIENTATION:
+        return ""
+    dist = math.sqrt(tg.ps.dot(tg.ps))
+    if dist <= sh.reach + tg.tol_p:
+        return ""
+    return (
+        f"target is {dist:.4g} m from the base origin but the chain reaches at most "
+        f"{sh.reach:.4g} m (sum of its link offsets)"
+    )
+
+
+def _closed_form_seeds(pb, tg, seed):
+    """(closed-form seeds, a note, the answer or None) for :func:`solve_one` when the closed
+    form goes first: the answer when any solution will do (no posture, no swivel) and the
+    nearest one meets the tolerances, checked by the FK of its compiled call."""
+    ws, sh, th_ref, sw = pb.ws, pb.ws.sh, pb.th_ref, pb.swivel
+    ref = th_ref if th_ref is not None else (sh.ref if seed is None else seed)
+    # without a posture objective any member of a swivel family will do: a coarse grid first
+    grid = SWIVEL_GRID if th_ref is not None else SWIVEL_GRID_COARSE
+    anyone = th_ref is None and sw is None
+    target = sw.target if sw else None
+    ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, target, grid, anyone)
+    if not len(ana) and grid is SWIVEL_GRID_COARSE and sh.swivel_family:
+        ana, note, err = analytic_seeds(pb.robot, ws, tg, ref, target, SWIVEL_GRID, anyone)
+    if err is not None and anyone and tg.ok(err[0] * err[0], err[1] * err[1]):
+        msg = "converged from an analytic seed"
+        done = IKResult(ana[0], True, "success", err[0], err[1], 0, 0, msg, tg.mode, "analytic")
+        return ana, note, done
+    return ana, note, None
 
 
 def _settle_swivel(pb, tg, ths, pe, re, msg):
