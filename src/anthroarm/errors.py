@@ -298,6 +298,11 @@ class CollisionError(AnthroarmError, ValueError):
         super().__init__(message)
 
 
+class NoCollisionBodiesError(CollisionError):
+    """A robot with no collision bodies: its URDF has no ``<collision>`` elements and it has no
+    links to wrap in capsules (a Cartesian gantry of bare prismatic joints)."""
+
+
 class OsimError(AnthroarmError, ValueError):
     """An OpenSim model (``.osim``) that cannot be imported.  ``path`` names the file,
     ``element`` the XML element at fault (``<SimmSpline>`` of ``knee_r/translation1``) and

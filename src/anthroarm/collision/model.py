@@ -27,7 +27,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..errors import CollisionError, URDFError
+from ..errors import CollisionError, NoCollisionBodiesError, URDFError
 from ..models.collision_shapes import shape_table
 from ..urdf_io import resolve_uri
 from .pairs import filter_pairs, set_pairs
@@ -302,7 +302,7 @@ def build(
         gm, links = capsules(robot)
         source = "capsules"
     if gm.ngeoms == 0:
-        raise CollisionError(
+        raise NoCollisionBodiesError(
             f"{robot.name}: no collision bodies (no <collision> and no links to wrap)"
         )
     cm = CollisionModel(robot, gm, links, source)
