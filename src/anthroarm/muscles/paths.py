@@ -20,9 +20,10 @@ software system to develop and analyze models of musculoskeletal structures*, Co
 25(1); An et al. 1984, *Determination of muscle orientations and moment arms*, J Biomech Eng
 106: the tendon-excursion definition r = −dl/dθ).  Wrapped segments (a ``PathWrap``) are
 replaced by the wrap's tangent-line–surface–tangent-line path (:mod:`anthroarm.muscles.wrap`),
-whose length's derivative with respect to its two end points is again the two unit tangents
-(the envelope theorem: the wrap path is the shortest one, so moving its tangent points does not
-change the length to first order).
+differentiated there by the complex step through OpenSim's whole multi-pass evaluation: the
+exact −∂l/∂q on a path over an ellipsoid (one wrap or several), OpenSim's moment arm (the
+tangent points fixed in their wrap bodies, −∂l/∂q wherever the wrap path is a shortest one) on
+paths over cylinders and spheres only.
 """
 
 from __future__ import annotations

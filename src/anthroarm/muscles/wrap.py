@@ -93,7 +93,7 @@ def _sign(a: float) -> int:
 
 
 def _dot(a, b):
-    return (a * b).sum(axis=-1)
+    return np.add.reduce(a * b, axis=-1)
 
 
 def _norm(v):
@@ -110,7 +110,7 @@ _I1, _I2 = np.array([1, 2, 0]), np.array([2, 0, 1])
 def _unit(v):
     """(v / |v|, |v|), zero where |v| < eps (``WrapMath::NormalizeOrZero``)."""
     m = _norm(v)
-    small = np.abs(np.real(m)) < EPS
+    small = np.real(m) < EPS  # √ of a sum of squares: Re ≥ 0
     if small.any():
         return np.where(small[..., None], 0.0, v / np.where(small, 1.0, m)[..., None]), m
     return v / m[..., None], m
@@ -136,6 +136,15 @@ def _closest_on_line(pt, line_pt, line):
     v2, mag2 = _unit(line)
     t = _dot(v1, v2) * mag
     return line_pt + t[..., None] * v2, t / mag2
+
+
+def _along_z(pt, line_pt):
+    """The point of the line through ``line_pt`` along z closest to pt: (x₀, y₀, z) (what
+    :func:`_closest_on_line` computes for a z line, to rounding)."""
+    out = np.array(np.broadcast_to(line_pt, np.broadcast_shapes(np.shape(pt), np.shape(line_pt))))
+    out = out.astype(np.result_type(pt, line_pt), copy=False)
+    out[..., 2] = pt[..., 2]
+    return out
 
 
 def _intersect_lines(p1, p2, p3, p4):
@@ -292,10 +301,9 @@ def _spiral(p1, p2, r1, r2, radius, far_side, single):
     sense = -1.0 if far_side else 1.0
     iterations = 0
     while True:
-        r1a, _ = _closest_on_line(r1, P0, DN)
-        r2a, _ = _closest_on_line(r2, P0, DN)
-        axial = r2a[:, 2] - r1a[:, 2]
-        uu, vv = r1 - r1a, r2 - r2a
+        axial = r2[:, 2] - r1[:, 2]
+        uu, vv = r1.copy(), r2.copy()  # from the axis, normal to it
+        uu[:, 2] = vv[:, 2] = 0.0
         theta = _atan2(_cross(uu, vv)[:, 2], _dot(uu, vv))
         if far_side:
             theta = 2.0 * np.pi - theta
@@ -326,8 +334,7 @@ def _adjust(pt, r, w):
     alpha = np.arccos(np.clip(pz, -1, 1)) if abs(pz) <= 1 else np.nan
     omega = np.arccos(np.clip(wz, -1, 1)) if abs(wz) <= 1 else np.nan
     if abs(alpha - omega) > TANGENCY_THRESHOLD:
-        p1a, _ = _closest_on_line(pt, r, DN)
-        w1a, _ = _closest_on_line(w, r, DN)
+        p1a, w1a = _along_z(pt, r), _along_z(w, r)
         _, _, hit, _ = _intersect_lines(pt, w, p1a, w1a)
         if hit is None:
             return False, r

@@ -424,7 +424,8 @@ def wrap_line(p1, p2, dims, quad, method="hybrid"):
     """``WrapEllipsoid::wrapLine`` on complex-step rows: end points p1, p2 (D, 3) (the
     ellipsoid's frame, m; row 0 decides every branch) → (code, r1 (D, 3), r2 (D, 3), length
     (D,)), the tangent points and the surface path's length, None for a code other than
-    ``MANDATORY``; ``dims``, ``quad`` and ``method`` as in :func:`ellipsoid`.  Im(row d) / h
+    ``MANDATORY``; ``dims``, ``quad`` and ``method`` as in
+    :func:`~anthroarm.muscles.wrap_ellipsoid.ellipsoid`.  Im(row d) / h
     is the derivative along Im(p1, p2)(row d) / h (module docstring)."""
     p1 = np.asarray(p1, dtype=complex)
     p2 = np.asarray(p2, dtype=complex)
