@@ -255,8 +255,8 @@ if __name__ == "__main__":  # pragma: no cover
     from .common import write_result
 
     quick = "--quick" in sys.argv
+    n = int(sys.argv[sys.argv.index("--n") + 1]) if "--n" in sys.argv else None
     if "--grasps" in sys.argv:  # python -m benchmarks.bench_collision --grasps [--n N]
-        n = int(sys.argv[sys.argv.index("--n") + 1]) if "--n" in sys.argv else None
         print(write_result("collision_grasp", dict(run_grasps(quick=quick, n=n), quick=quick)))
-    else:
-        print(write_result("collision", run(quick=quick)))
+    else:  # python -m benchmarks.bench_collision [--n N]: N targets per scene (default 1000)
+        print(write_result("collision", run(quick=quick, n_targets=n)))
