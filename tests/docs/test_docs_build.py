@@ -52,6 +52,7 @@ NOTEBOOKS_WITH_PLOTS = {
     "powered_hand",
     "hand",
     "muscles",
+    "collision",
 }
 
 pytestmark = pytest.mark.slow
