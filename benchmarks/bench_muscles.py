@@ -26,8 +26,9 @@ per call, and the QP solvers side by side.  OpenSim: ``AnalyzeTool.run()`` wall 
 (``run`` of the whole range, and the marginal cost (full − 2-frame run) / (frames − 2)), at its
 default convergence criterion 1e-4 and at 1e-10 (the run the activations are compared with).
 Agreement: max |a − a_OpenSim| over the frames where OpenSim's answer is a KKT point of the
-problem (stationarity |2x + Cᵀλ| ≤ 1e-6 off the bounds, λ by least squares); IPOPT, warm
-started, stops short on a few frames (stationarity 1e-3 to 5), which are counted apart (ours is
+problem (stationarity |2x + Cᵀλ| ≤ 1e-4 off the bounds, λ by least squares); IPOPT, warm
+started, stops short on a few frames (stationarity 1e-3 to 5), which are counted apart (the note
+also gives the difference over all frames) (ours is
 an exact QP optimum, stationarity ~1e-11).  arm26's paths differ from OpenSim's (BIClong's
 ellipsoid wrap), so there the difference over all frames is given, with the same QP solved on
 OpenSim's moment arms beside it.
@@ -50,6 +51,8 @@ from anthroarm.ik.qp import make_backend
 
 RECORDINGS = Path(aa.__file__).parent / "data" / "opensim" / "recordings"
 GAIT_MOT = RECORDINGS / "subject01_walk1_ik.mot"
+#: stationarity above which OpenSim's answer is not the optimum (IPOPT stopped short)
+KKT_TOL = 1e-4
 
 
 def _opensim():
@@ -341,15 +344,16 @@ def _so_rows(quick: bool) -> list:
             x_os = np.hstack([a_os, tight[4]])
             kkt = np.array([_stationarity(x, C, len(ms), lower) for x, C in zip(x_os, cons)])
             # arm26: its paths differ from OpenSim's (ellipsoids): no KKT test of its answer
-            bad = (kkt > 1e-6) & (name != "arm26")
+            bad = (kkt > KKT_TOL) & (name != "arm26")
             diff = np.abs(res.activation - a_os).max(axis=1)
             err = diff[~bad].max() if (~bad).any() else np.nan
             ok = all(s == "optimal" for s in res.status)
             why = f"median {np.median(diff):.1e}"
             if name != "arm26":
                 why += (
-                    f"; on {bad.sum()} of {nf} frames OpenSim's answer is not a KKT point "
-                    "(stationarity > 1e-6), not counted"
+                    f"; all frames: max {diff.max():.1e}, {(diff > 1e-3).sum()} of {nf} > 1e-3; "
+                    f"{bad.sum()} frames where OpenSim's answer is not a KKT point (stationarity "
+                    f"> {KKT_TOL:g}) not counted"
                 )
             if bad.any():
                 why += f": there up to {diff[bad].max():.1e}, its stationarity up to {kkt[bad].max():.1e}"
@@ -439,7 +443,7 @@ def run(quick: bool = False) -> dict:
             f"paths: {r[0]}",
             f"{r[1]:.3g} µs/state",
             f"OpenSim {r[2]:.4g} µs/state ({r[3]})",
-            f"{r[4]:.2g}x",
+            f"{r[4]:.3g}x",
             "met" if r[4] >= 50 else "NOT met",
             f"{r[5]:.1e}",
             r[6],
