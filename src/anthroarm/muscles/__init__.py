@@ -27,7 +27,12 @@ from .hill import (
     passive_force_length,
     tendon_force_strain,
 )
-from .optimize import StaticOptimization, force_coefficients, static_optimization
+from .optimize import (
+    StaticOptimization,
+    force_coefficients,
+    static_optimization,
+    thelen_force_velocity,
+)
 from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set, wrap_status
 from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
 
@@ -36,6 +41,7 @@ __all__ = [
     "StaticOptimization",
     "force_coefficients",
     "static_optimization",
+    "thelen_force_velocity",
     "Equilibrium",
     "active_force_length",
     "equilibrium",
