@@ -99,6 +99,21 @@ class IKBatchResult:
     messages: list = field(default_factory=list)
     mode: str = "pose"
 
+    @classmethod
+    def collect(cls, results, nq: int, mode: str) -> "IKBatchResult":
+        """The batch of the one-target answers ``results`` (IKResults, q of length ``nq``)."""
+        return cls(
+            q=np.array([r.q for r in results]).reshape(len(results), nq),
+            success=np.array([r.success for r in results], dtype=bool),
+            status=[r.status for r in results],
+            pos_err=np.array([r.pos_err for r in results]),
+            rot_err=np.array([r.rot_err for r in results]),
+            iterations=np.array([r.iterations for r in results], dtype=int),
+            restarts=np.array([r.restarts for r in results], dtype=int),
+            messages=[r.message for r in results],
+            mode=mode,
+        )
+
     def __len__(self) -> int:
         return len(self.q)
 

@@ -17,7 +17,7 @@ from .kernel import MAX_ITER, STALL, clock, damped_step, damping
 from .nullspace import Swivel, posture
 from .nullspace import swivel as swivel_phase
 from .seeds import SWIVEL_GRID, SWIVEL_GRID_COARSE, TableSeeds, analytic_seeds
-from .targets import ORIENTATION, Target, parse
+from .targets import ORIENTATION, Target, check_options, parse
 from .workspace import workspace
 
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
@@ -77,33 +77,6 @@ class Problem:
             and sh.closed_form_first
             and (not sh.swivel_family or jit.compiled())
         )
-
-
-def _check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic) -> None:
-    """:func:`solve`'s scalar options, or ValueError/TypeError naming the bad one."""
-    if not (
-        type(tol_pos) is float
-        and type(tol_rot) is float
-        and type(max_time) is float  # the usual call
-        and 0.0 < tol_pos < math.inf
-        and 0.0 < tol_rot < math.inf
-        and 0.0 < max_time < math.inf
-    ):
-        for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
-            if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
-    if max_restarts is not None and (int(max_restarts) != max_restarts or max_restarts < 0):
-        raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
-    if not (
-        rng is None
-        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
-        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
-    ):
-        raise TypeError(
-            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
-        )
-    if analytic not in ("auto", True, False):
-        raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
 
 
 def _reference(robot, sh, posture, swivel, swivel_frames):
@@ -217,7 +190,7 @@ def solve(
         mode, batch, targets = "pose", False, [as_rigid(T, "T")]
     else:
         mode, batch, targets = parse(T, mode)
-    _check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
+    check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
     Q0 = None
     if q0 is not None:
         Q0 = robot.check_q(q0, name="q0")
@@ -263,17 +236,7 @@ def solve(
             results.append(r)
             prev = r.q
     results = [_result(sh, r, s) for r, s in zip(results, seeds)]
-    return IKBatchResult(
-        q=np.array([r.q for r in results]).reshape(len(results), sh.nq),
-        success=np.array([r.success for r in results], dtype=bool),
-        status=[r.status for r in results],
-        pos_err=np.array([r.pos_err for r in results]),
-        rot_err=np.array([r.rot_err for r in results]),
-        iterations=np.array([r.iterations for r in results], dtype=int),
-        restarts=np.array([r.restarts for r in results], dtype=int),
-        messages=[r.message for r in results],
-        mode=mode,
-    )
+    return IKBatchResult.collect(results, sh.nq, mode)
 
 
 def _warm_closed_form(pb: Problem, mode: str, tp: float, tr: float) -> None:

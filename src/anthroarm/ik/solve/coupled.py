@@ -38,7 +38,7 @@ from ...osim.coupling import FastCoupling
 from ..qp.targets import as_rigid
 from ..result import IKBatchResult, IKResult
 from .kernel import attempt, clip, clock, damping
-from .targets import Target, parse
+from .targets import Target, check_options, parse
 
 POSTURE_STEP = 0.25  # longest null-space move of the posture phase (rad or m)
 POSTURE_TOL = 1e-4  # the posture phase stops when its move is shorter (rad or m)
@@ -170,28 +170,7 @@ def solve(
         mode, batch, targets = "pose", False, [as_rigid(T, "T")]
     else:
         mode, batch, targets = parse(T, mode)
-    for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
-        if not (
-            isinstance(v, (int, float, np.floating))
-            and not isinstance(v, bool)
-            and math.isfinite(v)
-            and v > 0
-        ):
-            raise ValueError(f"{name} must be a positive finite number, got {v!r}")
-    if max_restarts is not None and (
-        isinstance(max_restarts, bool) or int(max_restarts) != max_restarts or max_restarts < 0
-    ):
-        raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
-    if not (
-        rng is None
-        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
-        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
-    ):
-        raise TypeError(
-            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
-        )
-    if analytic not in ("auto", True, False):
-        raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
+    check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
     if swivel is not None or swivel_frames is not None:
         raise ParameterError(
             f"{robot.name}: swivel= places a human arm's elbow; this OpenSim model's coordinates "
@@ -247,17 +226,7 @@ def solve(
         prev = r.q
     if not batch:
         return results[0]
-    return IKBatchResult(
-        q=np.array([r.q for r in results]).reshape(len(results), robot.nq),
-        success=np.array([r.success for r in results], dtype=bool),
-        status=[r.status for r in results],
-        pos_err=np.array([r.pos_err for r in results]),
-        rot_err=np.array([r.rot_err for r in results]),
-        iterations=np.array([r.iterations for r in results], dtype=int),
-        restarts=np.array([r.restarts for r in results], dtype=int),
-        messages=[r.message for r in results],
-        mode=mode,
-    )
+    return IKBatchResult.collect(results, robot.nq, mode)
 
 
 def solve_one(ws, tg, given, first, default, path, gen, max_time, max_restarts, th_ref):

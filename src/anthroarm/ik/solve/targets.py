@@ -178,3 +178,40 @@ def parse(T, mode):
         f"target T must be a 4x4 pose, a position (3,), a rotation (3, 3), or a batch of them "
         f"with a leading axis; got shape {sh}" + (f" (mode={mode!r})" if mode else "")
     )
+
+
+def check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic) -> None:
+    """The scalar options of :func:`anthroarm.ik.solve` (every robot kind), or
+    ValueError/TypeError naming the bad one: tolerances and ``max_time`` positive finite numbers
+    (not bools), ``max_restarts`` None or a non-negative integer, ``rng`` None, a non-negative
+    int, a SeedSequence or a Generator, ``analytic`` "auto", True or False."""
+    if not (
+        type(tol_pos) is float
+        and type(tol_rot) is float
+        and type(max_time) is float  # the usual call
+        and 0.0 < tol_pos < math.inf
+        and 0.0 < tol_rot < math.inf
+        and 0.0 < max_time < math.inf
+    ):
+        for name, v in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("max_time", max_time)):
+            if not (
+                isinstance(v, (int, float, np.floating))
+                and not isinstance(v, bool)
+                and math.isfinite(v)
+                and v > 0
+            ):
+                raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+    if max_restarts is not None and (
+        isinstance(max_restarts, bool) or int(max_restarts) != max_restarts or max_restarts < 0
+    ):
+        raise ValueError(f"max_restarts must be a non-negative integer, got {max_restarts!r}")
+    if not (
+        rng is None
+        or isinstance(rng, (np.random.Generator, np.random.SeedSequence))
+        or (isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0)
+    ):
+        raise TypeError(
+            f"rng must be None, a non-negative int, a numpy SeedSequence or Generator, got {rng!r}"
+        )
+    if analytic not in ("auto", True, False):
+        raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
