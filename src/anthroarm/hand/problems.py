@@ -107,6 +107,19 @@ def _fit_object(hand, model, data, q, Mp0, r, kind, across, weights=None):
     return T_palm_obj, obj
 
 
+def _open_start(robot, hand, kind, rng):
+    """What both problem generators start from: (the rng, the Hand, Pinocchio's model and a
+    data, the open hand's configuration, the palm's pose there); ``kind`` checked."""
+    if kind not in ("cylinder", "sphere"):
+        raise ValueError(f"kind must be 'cylinder' or 'sphere', got {kind!r}")
+    hand = Hand(robot) if hand is None else hand
+    model = robot.model
+    data = model.createData()
+    q_open = open_hand(robot, hand)
+    pin.framesForwardKinematics(model, data, q_open)
+    return np.random.default_rng(rng), hand, model, data, q_open, pin.SE3(data.oMf[hand.palm_id])
+
+
 def reachable_grasps(
     robot,
     n: int,
@@ -142,15 +155,7 @@ def reachable_grasps(
     rounds : int
         Fit-and-close rounds of step 1 per draw.
     """
-    if kind not in ("cylinder", "sphere"):
-        raise ValueError(f"kind must be 'cylinder' or 'sphere', got {kind!r}")
-    rng = np.random.default_rng(rng)
-    hand = Hand(robot) if hand is None else hand
-    model = robot.model
-    data = model.createData()
-    q_open = open_hand(robot, hand)
-    pin.framesForwardKinematics(model, data, q_open)
-    Mp0 = pin.SE3(data.oMf[hand.palm_id])
+    rng, hand, model, data, q_open, Mp0 = _open_start(robot, hand, kind, rng)
     nrm, fdir, across = palm_axes(hand, q_open)
     fq = hand.finger_q_indices
     lo_f, hi_f = robot.chain.lower[fq], robot.chain.upper[fq]
@@ -247,15 +252,7 @@ def collision_free_grasps(
     the fingertips of the witness.  On the human limb's hand this keeps most pinches (thumb
     and index) and few grasps with more fingers (their proximal phalanges cross the object).
     """
-    if kind not in ("cylinder", "sphere"):
-        raise ValueError(f"kind must be 'cylinder' or 'sphere', got {kind!r}")
-    rng = np.random.default_rng(rng)
-    hand = Hand(robot) if hand is None else hand
-    model = robot.model
-    data = model.createData()
-    q_open = open_hand(robot, hand)
-    pin.framesForwardKinematics(model, data, q_open)
-    Mp0 = pin.SE3(data.oMf[hand.palm_id])
+    rng, hand, model, data, q_open, Mp0 = _open_start(robot, hand, kind, rng)
     across = palm_axes(hand, q_open)[2]
     fq = hand.finger_q_indices
     lo_f, hi_f = robot.chain.lower[fq], robot.chain.upper[fq]
