@@ -6,7 +6,9 @@ of its formula.  It runs two ways, with the same answers:
 - **compiled**: Numba (https://numba.readthedocs.io, ``numba.njit``) compiles that source to
   machine code, kept in Numba's per-function disk cache (the subfolder ``numba`` of anthroarm's
   cache, :func:`anthroarm.cache.root`; ``$ANTHROARM_CACHE`` moves it, unless
-  ``$NUMBA_CACHE_DIR`` is set or Numba was imported before anthroarm);
+  ``$NUMBA_CACHE_DIR`` is set; when Numba was imported before anthroarm, its configuration is
+  reloaded with that folder, where the kernels a program decorates with ``cache=True`` after
+  importing anthroarm keep their files too);
 - **reference**: the same source run by the Python interpreter (:func:`reference`), with
   Numba's float semantics where the interpreter would raise (``error_model="numpy"``: a
   domain error of ``math`` gives NaN, not ``ValueError``), and :func:`local` arrays made by
@@ -93,7 +95,8 @@ OWN_FOLDER = (
     / kernel_sources_digest(str(Path(__file__).resolve().parent))[:20]
 )
 
-if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
+_NUMBA_FIRST = "numba" in sys.modules
+if "NUMBA_CACHE_DIR" not in os.environ:
     os.environ["NUMBA_CACHE_DIR"] = str(OWN_FOLDER)
 
 import atexit  # noqa: E402
@@ -114,6 +117,9 @@ from llvmlite import binding as llvm  # noqa: E402
 from llvmlite import ir  # noqa: E402
 from numba import types  # noqa: E402
 from numba.extending import intrinsic, typeof_impl  # noqa: E402
+
+if _NUMBA_FIRST:  # Numba read its environment before the line above set its cache folder
+    numba.config.reload_config()
 
 OPTIONS = dict(nogil=True, error_model="numpy", cache=True)
 MODES = _cache.BUILD_MODES
@@ -391,14 +397,19 @@ def _local_array(dtype, ndim: int):
     return intrinsic(lambda typingctx, rows, cols: typer(typingctx, rows, cols))
 
 
-def _view_array(ndim: int):
+def _view_array(ndim: int, offset: bool = False):
     """A Numba intrinsic ``f(a, *shape)`` (``ndim`` integer sizes): the first prod(shape) entries
     of the C-order array ``a`` (in memory order) as a C-order array of that shape (same data,
-    dtype and owner, whose reference count it takes; :data:`view2`)."""
+    dtype and owner, whose reference count it takes; :data:`view2`).  With ``offset``,
+    ``f(a, start, *shape)``: the entries from flat index ``start`` on, as a borrowed view — no
+    owner and no reference count (a slice or an owned view takes a reference, an atomic
+    increment and decrement of ``a``'s count, which a plan unpacked into a dozen views paid on
+    every call of a one-pose kernel); it must not outlive ``a`` (never returned or kept beyond
+    the kernel's call: :data:`part`)."""
 
-    def typer(typingctx, arr, sizes):
+    def typer(typingctx, arr, start, sizes):
         if not (isinstance(arr, types.Array) and arr.layout == "C") or not all(
-            isinstance(n, types.Integer) for n in sizes
+            isinstance(n, types.Integer) for n in (start, *sizes)
         ):
             raise numba.errors.TypingError(f"a view takes a C-order array and {ndim} integer sizes")
         outty = arr.copy(ndim=ndim, layout="C")
@@ -406,41 +417,61 @@ def _view_array(ndim: int):
         def codegen(context, builder, sig, args):
             src_model = context.data_model_manager[sig.args[0]]
             field = src_model.get_field_position
-            src = args[0]
+            src, k = args[0], 1 + offset
             shape = [
-                context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:])
+                context.cast(builder, v, t, types.intp) for v, t in zip(args[k:], sig.args[k:])
             ]
             itemsize = builder.extract_value(src, field("itemsize"))
             strides = [itemsize]
             for n in shape[:0:-1]:
                 strides.insert(0, builder.mul(strides[0], n))
+            data = builder.extract_value(src, field("data"))
+            if offset:  # borrowed
+                first = context.cast(builder, args[1], sig.args[1], types.intp)
+                return _array_value(
+                    context, builder, outty, builder.gep(data, [first]), shape, strides
+                )
             out = _array_value(
                 context,
                 builder,
                 outty,
-                builder.extract_value(src, field("data")),
+                data,
                 shape,
                 strides,
                 meminfo=builder.extract_value(src, field("meminfo")),
                 parent=builder.extract_value(src, field("parent")),
             )
-            if context.enable_nrt:  # a borrowed view returned: it holds a reference
+            if context.enable_nrt:  # a view returned: it holds a reference
                 context.nrt.incref(builder, outty, out)
             return out
 
-        return outty(arr, *sizes), codegen
+        return outty(arr, *((start,) if offset else ()), *sizes), codegen
 
+    if offset:
+        if ndim == 1:
+            return intrinsic(lambda typingctx, arr, start, n: typer(typingctx, arr, start, (n,)))
+        return intrinsic(
+            lambda typingctx, arr, start, rows, cols: typer(typingctx, arr, start, (rows, cols))
+        )
     if ndim == 2:
-        return intrinsic(lambda typingctx, arr, rows, cols: typer(typingctx, arr, (rows, cols)))
-    return intrinsic(lambda typingctx, arr, d0, d1, d2: typer(typingctx, arr, (d0, d1, d2)))
+        return intrinsic(
+            lambda typingctx, arr, rows, cols: typer(typingctx, arr, types.intp, (rows, cols))
+        )
+    return intrinsic(
+        lambda typingctx, arr, d0, d1, d2: typer(typingctx, arr, types.intp, (d0, d1, d2))
+    )
 
 
 #: ``view2(a, rows, cols)`` / ``view3(a, d0, d1, d2)``: ``a.ravel()[:k].reshape(shape)`` of a
 #: C-order array ``a`` (:func:`_view_array`) without reshape's run-time layout search (a call
 #: of Numba's C helper: the dozen a one-pose IK kernel made on every call took 0.25 µs of its
-#: 1.6).  Unchecked: the sizes must fit in ``a``.
+#: 1.6).  ``part(a, start, n)`` / ``part2(a, start, rows, cols)``: the same from flat index
+#: ``start`` (``a.ravel()[start:start + k]``), borrowed (no reference count: it must not outlive
+#: ``a``).  Unchecked: the sizes must fit in ``a``.
 view2 = _view_array(2)
 view3 = _view_array(3)
+part = _view_array(1, offset=True)
+part2 = _view_array(2, offset=True)
 
 
 #: ``local(n)`` / ``local2(rows, cols)``: float64 scratch arrays of literal sizes in the stack
@@ -460,6 +491,8 @@ _PY_FORMS = {
     id(local_ints2): lambda r, c: np.empty((r, c), np.int64),
     id(view2): lambda a, r, c: a.reshape(-1)[: r * c].reshape(r, c),
     id(view3): lambda a, x, y, z: a.reshape(-1)[: x * y * z].reshape(x, y, z),
+    id(part): lambda a, s, n: a.reshape(-1)[s : s + n],
+    id(part2): lambda a, s, r, c: a.reshape(-1)[s : s + r * c].reshape(r, c),
 }
 
 
@@ -502,11 +535,6 @@ def numba_folder() -> Path:
     return Path(os.environ["NUMBA_CACHE_DIR"])
 
 
-def _own(folder: Path) -> bool:
-    """True if ``folder`` is anthroarm's own (``$NUMBA_CACHE_DIR`` set by this module)."""
-    return folder == OWN_FOLDER
-
-
 def _files(folder: Path) -> dict[str, str]:
     out = {}
     if not folder.is_dir():
@@ -547,8 +575,8 @@ def write_stamp(complete: bool | None = None) -> dict:
 def verified(strict: bool = True) -> bool:
     """Check every Numba file against the stamp; True if the stamp is complete and every file
     it lists is there and matches.  A file that does not match, or (``strict``) that it does
-    not list (in anthroarm's own folder; in a folder given by ``$NUMBA_CACHE_DIR`` the
-    subfolders of listed files), is deleted — compiled again, never loaded — and the stamp
+    not list in the subfolders of listed files (Numba's, one per source folder; the folder may
+    hold another program's kernels), is deleted — compiled again, never loaded — and the stamp
     rewritten incomplete.  The mode ``compile`` checks with ``strict=False``: files that
     processes compiling in their own threads wrote since the stamp are theirs to list at exit.
     Without a complete stamp the strict check deletes nothing (the background compilation is
@@ -560,7 +588,7 @@ def verified(strict: bool = True) -> bool:
     found = _files(folder)
     if not strict:
         found = {k: h for k, h in found.items() if k in listed}
-    elif not _own(folder):
+    else:  # the subfolders of anthroarm's modules (another program's kernels may share it)
         ours = {str(Path(k).parent) for k in listed}
         found = {k: h for k, h in found.items() if str(Path(k).parent) in ours}
     bad = [k for k, h in found.items() if listed.get(k) != h]

@@ -8,7 +8,18 @@ import numba
 import numpy as np
 import pytest
 
-from anthroarm.jit import kernel, local, local2, local_flags, local_ints2, reference, view2, view3
+from anthroarm.jit import (
+    kernel,
+    local,
+    local2,
+    local_flags,
+    local_ints2,
+    part,
+    part2,
+    reference,
+    view2,
+    view3,
+)
 
 
 @kernel
@@ -91,3 +102,24 @@ def test_a_returned_view_keeps_its_owner_alive():
 def test_a_view_takes_only_c_order_arrays():
     with pytest.raises(numba.core.errors.TypingError, match="C-order"):
         _view_returned(np.arange(12.0)[::2])
+
+
+@kernel
+def _parts(a, ints, out):
+    v, w = part(a, 3, 4), part2(a, 5, 2, 3)
+    k = part2(ints, 2, 2, 2)
+    out[0], out[1], out[2] = v[0], v[3], w[1, 2]
+    out[3], out[4] = w.shape[0], w.strides[0]
+    out[5] = k[1, 0]
+    w[0, 0] = -1.0  # a view: writes reach a
+
+
+@pytest.mark.parametrize("run", ["compiled", "reference"])
+def test_parts_are_numpys_flat_slices(run):
+    f = _parts.dispatcher if run == "compiled" else reference(_parts)
+    a, ints = np.arange(20.0), np.arange(10)
+    out = np.zeros(6)
+    f(a, ints, out)
+    w = np.arange(20.0)[5:11].reshape(2, 3)
+    assert out.tolist() == [3.0, 6.0, w[1, 2], 2, w.strides[0], 4]
+    assert a[5] == -1.0

@@ -230,3 +230,24 @@ def test_the_warmup_reaches_every_kernel():
     is left that a user's call would compile on the caller's clock)."""
     code = "from anthroarm import warmup, jit\njit.start()\nprint(warmup.run(n=2))"
     assert _run(code, {"ANTHROARM_JIT": "reference"}).strip() == "[]"
+
+
+def test_numba_imported_first(tiny):
+    """A program that imports Numba before anthroarm (without ``$NUMBA_CACHE_DIR``): its kernels
+    still cache in anthroarm's folder (Numba's configuration reloaded), and the first call
+    answers (it raised KeyError: 'NUMBA_CACHE_DIR' in every mode but reference)."""
+    src, cache, env = tiny
+    code = "import numba\n" + PROBE.replace(
+        "from anthroarm import jit\n",
+        "from anthroarm import jit\n"
+        "assert numba.config.CACHE_DIR == str(jit.OWN_FOLDER), numba.config.CACHE_DIR\n",
+    )
+    environ = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    environ.update(ANTHROARM_CACHE=str(cache), ANTHROARM_JIT="compile")
+    p = subprocess.run(
+        [sys.executable, "-c", code, src], capture_output=True, text=True, env=environ, timeout=600
+    )
+    assert p.returncode == 0, p.stderr[-3000:]
+    out = json.loads(p.stdout)
+    assert out["value"] == 5.0 and out["compiled"]
+    assert list((cache / "numba").rglob("*.nbi")), "no kernel cached in anthroarm's folder"

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ...jit import kernel, local, local2, local_flags, view2
+from ...jit import kernel, local, local2, local_flags, part, part2
 from ..geometric.fk import POLISH_MAX
 from ..geometric.limits import into_limits
 from ..geometric.verify import _mark_solutions, _pose_status
@@ -43,10 +43,10 @@ def _planar_unpack(cf):
         vec(cf[6:9]),
         vec(cf[9:12]),
         vec(cf[12:15]),
-        view2(cf[15:], 2, 3),
-        view2(cf[21:], 2, 3),
-        cf[27:29],
-        cf[29:31],
+        part2(cf, 15, 2, 3),
+        part2(cf, 21, 2, 3),
+        part(cf, 27, 2),
+        part(cf, 29, 2),
     )
 
 

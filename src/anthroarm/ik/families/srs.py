@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ...jit import kernel, local, local2, local_flags, view2, view3
+from ...jit import kernel, local, local2, local_flags, part, part2, view2, view3
 from ...threads import run_rows
 from ..geometric.closed import BRANCH_ROW, COS, EXACT, EXISTS, SIN, _angles, _wrist
 from ..geometric.fk import POLISH_MAX, _fk_residuals, _target_errors
@@ -219,16 +219,16 @@ def _srs_unpack(cf, ci):
     ``ci``, compiled into each caller (:func:`anthroarm.jit.kernel`)."""
     return (
         ci[0],
-        view2(cf, 7, 3),
-        cf[21:24],
-        cf[24:27],
-        cf[27:30],
-        view2(cf[30:], 3, 3),
-        cf[39:42],
-        view2(cf[42:], 8, 12),
-        cf[138:145],
-        cf[145:152],
-        ci[1:8],
+        part2(cf, 0, 7, 3),
+        part(cf, 21, 3),
+        part(cf, 24, 3),
+        part(cf, 27, 3),
+        part2(cf, 30, 3, 3),
+        part(cf, 39, 3),
+        part2(cf, 42, 8, 12),
+        part(cf, 138, 7),
+        part(cf, 145, 7),
+        part(ci, 1, 7),
     )
 
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...jit import kernel, view2
+from ...jit import kernel, part, part2
 from .. import classify as C
 from ..search.constants import SEARCH_BRANCHES
 from .closed import CLOSED
@@ -312,15 +312,15 @@ def _unpack(cf, ci):
         ci[0],
         ci[1] == 1,
         n,
-        view2(cf, 6, 3),
-        view2(cf[18:], 7, 3),
-        view2(cf[39:], 3, 3),
+        part2(cf, 0, 6, 3),
+        part2(cf, 18, 7, 3),
+        part2(cf, 39, 3, 3),
         (cf[48], cf[49], cf[50]),
         (cf[51], cf[52], cf[53]),
-        view2(cf[54:], 4, 4),
-        view2(cf[70:], n + 1, 12),
-        cf[o : o + n],
-        cf[o + n : o + 2 * n],
-        ci[3 : 3 + n],
-        view2(ci[4 + n :], n, 2),
+        part2(cf, 54, 4, 4),
+        part2(cf, 70, n + 1, 12),
+        part(cf, o, n),
+        part(cf, o + n, n),
+        part(ci, 3, n),
+        part2(ci, 4 + n, n, 2),
     )
