@@ -90,9 +90,10 @@ def _rows(p1, p2):
 
 
 def _check_rows(f, p1, p2, h=1e-7):
-    """f(p1 (D, 3), p2 (D, 3)) -> (code, r1, r2, arc): its complex-step derivatives against
-    central differences of its real evaluation (measured ~2e-9 for derivatives of order 1)."""
-    code, r1, r2, arc = f(*_rows(p1, p2))
+    """f(p1 (D, 3), p2 (D, 3)) -> (code, r1, r2, arc, turn): its complex-step derivatives
+    against central differences of its real evaluation (measured ~2e-9 for derivatives of
+    order 1)."""
+    code, r1, r2, arc, _ = f(*_rows(p1, p2))
     assert code != NO_WRAP and np.real(arc[0]) > 0
     p = np.concatenate([p1, p2])
     for k in range(6):

@@ -51,6 +51,8 @@ slightly (measured in the guide).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import MuscleError
@@ -68,6 +70,9 @@ DN = np.array([0.0, 0.0, 1.0])
 QUADRANTS = {"x": (0, 1), "y": (1, 1), "z": (2, 1)}
 #: complex step (any h below ~1e-20 gives the same derivative)
 H = 1e-30
+#: the largest amount (m) by which a drawn cylinder or sphere arc (a polyline of chords) may be
+#: shorter than the arc itself (:func:`surface_points`)
+ARC_TOLERANCE = 1e-7
 
 
 def quadrant(name: str) -> tuple[int, int]:
@@ -180,7 +185,9 @@ def _rot_z(angle, v):
 # ------------------------------------------------------------------------------- cylinder
 def cylinder(p1, p2, radius, length, quad, single):
     """``WrapCylinder::wrapLine`` of end points p1, p2 (D, 3) (the cylinder's frame; row 0
-    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,))."""
+    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,), turn (D,)), the turn
+    the signed angle about the cylinder's z axis from r1 to r2 along the helix
+    (:func:`surface_points`)."""
     r2_ = radius * radius
     axis, wsign = quad
     constrained = wsign != 0
@@ -188,7 +195,7 @@ def cylinder(p1, p2, radius, length, quad, single):
     code = WRAPPED
     # distance² to the axis (the line through P0 along DN)
     if _re(p1[:, 0] ** 2 + p1[:, 1] ** 2) < r2_ or _re(p2[:, 0] ** 2 + p2[:, 1] ** 2) < r2_:
-        return INSIDE, None, None, 0.0
+        return INSIDE, None, None, 0.0, None
     cs, ce = np.array([0, 0, -0.5 * length]), np.array([0, 0, 0.5 * length])
     near12, t12, near00, _ = _intersect_lines(p1, p2, cs, ce)
     crosses = (
@@ -200,7 +207,7 @@ def cylinder(p1, p2, radius, length, quad, single):
         if crosses:
             code = MANDATORY
         else:
-            return NO_WRAP, None, None, 0.0
+            return NO_WRAP, None, None, 0.0, None
     p11, _ = _closest_on_line(p1, P0, DN)
     p22, _ = _closest_on_line(p2, P0, DN)
 
@@ -222,7 +229,7 @@ def cylinder(p1, p2, radius, length, quad, single):
             elif s1 != s2 and near12 is not None and _sign(near12[0, axis].real) != wsign:
                 code = WRAPPED
             else:
-                return NO_WRAP, None, None, 0.0
+                return NO_WRAP, None, None, 0.0, None
         r1am, r1bm, r2am, r2bm = (v[0].real for v in (r1a - p11, r1b - p11, r2a - p22, r2b - p22))
         with np.errstate(invalid="ignore"):  # decisions only: NaN compares false, as in C++
             alpha = np.arccos((r1am @ r2bm) / (np.linalg.norm(r1am) * np.linalg.norm(r2bm)))
@@ -290,14 +297,16 @@ def cylinder(p1, p2, radius, length, quad, single):
     half = length / 2.0
     z1, z2 = r1[0, 2].real, r2[0, 2].real
     if (z1 < -half or z1 > half) and (z2 < -half or z2 > half):
-        return NO_WRAP, None, None, 0.0
-    r1, r2, arc = _spiral(p1, p2, r1, r2, radius, long_wrap, single)
-    return code, r1, r2, arc
+        return NO_WRAP, None, None, 0.0, None
+    r1, r2, arc, turn = _spiral(p1, p2, r1, r2, radius, long_wrap, single)
+    return code, r1, r2, arc, turn
 
 
 def _spiral(p1, p2, r1, r2, radius, far_side, single):
-    """``WrapCylinder::_make_spiral_path``: the helix's length, with the tangent points slid
-    along the axis (``_adjust_tangent_point``) when the path has more than one wrap."""
+    """``WrapCylinder::_make_spiral_path``: the helix's length and turn (the signed angle
+    about z from r1 to r2 along the helix: θ = atan2((û × v̂)_z, û·v̂) seen from the axis,
+    2π − θ the other way round on a far-side wrap), with the tangent points slid along the
+    axis (``_adjust_tangent_point``) when the path has more than one wrap."""
     sense = -1.0 if far_side else 1.0
     iterations = 0
     while True:
@@ -307,23 +316,24 @@ def _spiral(p1, p2, r1, r2, radius, far_side, single):
         theta = _atan2(_cross(uu, vv)[:, 2], _dot(uu, vv))
         if far_side:
             theta = 2.0 * np.pi - theta
+        turn = sense * theta
         arc = np.sqrt((radius * theta) ** 2 + axial**2)
         if single:
-            return r1, r2, arc
+            return r1, r2, arc, turn
         nseg = max(1, int(_re(arc) / 0.002))
         if nseg < 2 or iterations >= MAX_ITERATIONS:
-            return r1, r2, arc
+            return r1, r2, arc, turn
         t = 1.0 / nseg
-        w1 = _rot_z(sense * t * theta, r1)
+        w1 = _rot_z(t * turn, r1)
         w1[:, 2] += t * axial
         a1, r1n = _adjust(p1, r1, w1)
         # OpenSim's spiral-point lambda captures r1 by reference: the second point is placed
         # from the r1 just adjusted
-        w2 = _rot_z(sense * (1 - t) * theta, r1n)
+        w2 = _rot_z((1 - t) * turn, r1n)
         w2[:, 2] += (1 - t) * axial
         a2, r2n = _adjust(p2, r2, w2)
         if not (a1 or a2):
-            return r1, r2, arc
+            return r1, r2, arc, turn
         r1, r2 = r1n, r2n
         iterations += 1
 
@@ -345,23 +355,26 @@ def _adjust(pt, r, w):
 # ---------------------------------------------------------------------------------- sphere
 def sphere(p1, p2, radius, quad):
     """``WrapSphere::wrapLine`` of end points p1, p2 (D, 3) (the sphere's frame; row 0
-    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,))."""
+    decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,), turn (D,)), the
+    turn the signed angle about (r1 × r2)/|r1 × r2| from r1 to r2 along the great circle
+    (OpenSim's −(2π − θ) on a far-side wrap, whose arc length it then takes negative, as
+    OpenSim does)."""
     axis, wsign = quad
     code = WRAPPED
     far_side = False
     n1, n2 = _norm(p1), _norm(p2)
     if _re(n1) < radius or _re(n2) < radius:
-        return INSIDE, None, None, 0.0
+        return INSIDE, None, None, 0.0, None
     ri, mp = p1 - p2, -p2
     a, b, c = _dot(ri, ri), -2.0 * _dot(mp, ri), _dot(mp, mp) - radius * radius
     a, b, c = _re(a), _re(b), _re(c)  # decisions only
     disc = b * b - 4.0 * a * c
     if disc < 0.0:
-        return NO_WRAP, None, None, 0.0
+        return NO_WRAP, None, None, 0.0, None
     l1 = (-b + np.sqrt(disc)) / (2.0 * a)
     l2 = (-b - np.sqrt(disc)) / (2.0 * a)
     if not (0.0 < l1 < 1.0) or not (0.0 < l2 < 1.0) or l1 < l2:
-        return NO_WRAP, None, None, 0.0
+        return NO_WRAP, None, None, 0.0, None
     p1p2, _ = _unit(p1 - p2)
     hp2 = _cross(p1p2, _unit(p2)[0])
     if _re(_norm(hp2)) < 1e-5:
@@ -402,7 +415,7 @@ def sphere(p1, p2, radius, quad):
             elif s1 != s2 and _sign(mm[axis]) != wsign:
                 code = WRAPPED
             else:
-                return NO_WRAP, None, None, 0.0
+                return NO_WRAP, None, None, 0.0, None
         if s1 != wsign or s2 != wsign:
             wrapaxis = np.zeros(3)
             wrapaxis[axis] = wsign
@@ -417,13 +430,14 @@ def sphere(p1, p2, radius, quad):
     angle = _acos(_dot(_unit(r1)[0], _unit(r2)[0]))
     if far_side:
         angle = -(2 * np.pi - angle)
-    return code, r1, r2, radius * angle
+    return code, r1, r2, radius * angle, angle
 
 
 # ------------------------------------------------------------------------------ the path
 def _wrap_line(w, p1, p2, single, method="hybrid", hold=False):
-    """(code, r1 (D, 3), r2 (D, 3), arc (D,)) in the wrap object's frame; ``hold``: a
-    cylinder's or sphere's tangent points and arc from row 0 alone, real (fixed in the body)."""
+    """(code, r1 (D, 3), r2 (D, 3), arc (D,), surface) in the wrap object's frame, surface
+    what :func:`surface_points` draws the arc from; ``hold``: a cylinder's or sphere's tangent
+    points and arc from row 0 alone, real (fixed in the body)."""
     if w.kind in ("WrapCylinder", "WrapSphere"):
         if hold:
             p1, p2 = p1[:1].real, p2[:1].real
@@ -450,7 +464,7 @@ def wrapped_length(xs, dxs, idx, objs, muscle, codes=None):
     n, nq = xs.shape[0], dxs.shape[-1]
     L, D = np.zeros(n), np.zeros((n, nq))
     npts = len(muscle.points)
-    hold = not any(w.active and w.kind == "WrapEllipsoid" for _, w, _, _ in objs)
+    hold = _hold(objs)
     for s in range(n):
         out = None if codes is None else codes[s]
         # the coordinates this state's path depends on: one complex-step row each
@@ -465,6 +479,68 @@ def wrapped_length(xs, dxs, idx, objs, muscle, codes=None):
         total = _one_state(X, frames, idx, objs, npts, muscle.name, hold, out)
         L[s], D[s, cols] = total[0].real, total[1:].imag / H
     return L, D
+
+
+def _hold(objs) -> bool:
+    """Whether a path's cylinder and sphere tangent points are held real (no active ellipsoid
+    among its wraps: the module docstring's "which derivative")."""
+    return not any(w.active and w.kind == "WrapEllipsoid" for _, w, *_ in objs)
+
+
+def current_path(xs, idx, objs, muscle, tolerance: float = ARC_TOLERANCE) -> list:
+    """One state's path over its wrap objects, as drawn: ``xs`` (K, 3) the active path points
+    in ground (original indices ``idx``), ``objs`` (PathWrap, WrapObject, T (4, 4) of the
+    wrap's body) for every PathWrap.  Returns the path's entries in order, each
+    ``("point", k, x (3,))`` (path point k of the PathPointSet), ``("tangent", j, x (3,))`` (a
+    tangent point of wrap j: OpenSim's ``PathWrapPoint``) or ``("surface", j, X (n, 3))`` (the
+    points of wrap j's surface arc strictly between its tangent points, drawn to
+    ``tolerance``: :func:`surface_points`), all in ground, m.
+
+    The same evaluation as :func:`wrapped_length` (one real row): with two or more wraps the
+    tangent points are where OpenSim's ``getLocationInGround`` reports them and the length
+    adds them up (the ground position of a wrap point's first use in the state, see
+    ``_one_state``), the arc the one of the last pass."""
+    frames = [_frame(T, np.zeros((6, 0)), np.arange(0), w) for _, w, T in objs]
+    wraps = [(pw, w, T, None) for pw, w, T in objs]
+    trace: list = []
+    x = np.asarray(xs, dtype=float)[None]
+    _one_state(
+        x, frames, idx, wraps, len(muscle.points), muscle.name, _hold(objs), None, trace, tolerance
+    )
+    return trace
+
+
+def surface_points(w, r1, r2, surface, tolerance: float = ARC_TOLERANCE) -> np.ndarray:
+    """The points (n + 1, 3) of wrap object ``w``'s surface path from r1 to r2 (its own frame,
+    m; rows 0 of the (D, 3) tangent points and of ``surface``, what :func:`_wrap_line` returns
+    beside them), r1 first and r2 last.
+
+    * cylinder: the helix x(t) = R_z(t φ) r1 + t (r2 − r1)_z ẑ, t ∈ [0, 1], φ the turn;
+    * sphere: the great circle x(t) = cos(t φ) r1 + sin(t φ) k × r1, k = (r1 × r2)/|r1 × r2|
+      (Rodrigues' rotation of r1 ⟂ k);
+    * ellipsoid: OpenSim's polyline itself (its chords are the wrap's length).
+
+    A helix of radius r turned by φ in n equal steps δ = φ/n: each chord is shorter than its
+    arc by at most r δ³/24 (chord² = 4 r² sin²(δ/2) + b², arc² = r² δ² + b², b the axial step,
+    4 sin²(δ/2) ≥ δ² − δ⁴/12), so n = ⌈|φ| √(r |φ| / (24 tol))⌉ steps keep the polyline's
+    length within ``tol`` of the arc's."""
+    a, b = np.real(r1[0]), np.real(r2[0])
+    if w.kind == "WrapEllipsoid":
+        pts = np.real(surface[0]).copy()
+    else:
+        phi = float(np.real(surface[0]))
+        n = max(1, math.ceil(abs(phi) * math.sqrt(w.radius * abs(phi) / (24.0 * tolerance))))
+        t = np.linspace(0.0, 1.0, n + 1)
+        if w.kind == "WrapCylinder":
+            pts = _rot_z(t * phi, np.broadcast_to(a, (n + 1, 3)))
+            pts[:, 2] = a[2] + t * (b[2] - a[2])
+        else:
+            k = np.cross(a, b)
+            k = k / np.linalg.norm(k)
+            c, s = np.cos(t * phi)[:, None], np.sin(t * phi)[:, None]
+            pts = c * a + s * np.cross(k, a)  # k ⟂ a
+    pts[0], pts[-1] = a, b
+    return pts
 
 
 def _frame(T, J, cols, w):
@@ -485,13 +561,14 @@ def status(wrapped: bool, inside: bool) -> int:
     return WRAPPED if wrapped else (INSIDE if inside else NO_WRAP)
 
 
-def _one_state(x, frames, idx, objs, npts, name, hold, codes=None):
+def _one_state(x, frames, idx, objs, npts, name, hold, codes=None, trace=None, tolerance=None):
     """The path's length (D,) on one state, x (D, K, 3) its active points (complex-step
-    rows), ``frames`` each wrap body's (R, o, Rw, tw) (:func:`_frame`)."""
+    rows), ``frames`` each wrap body's (R, o, Rw, tw) (:func:`_frame`); ``trace``, when given
+    (a list), receives the final path, its arcs drawn to ``tolerance`` (:func:`current_path`)."""
     # a path entry: (kind, payload); "p": original point k; "w": (wrap j, 1|2)
     path = [("p", int(k)) for k in idx]
     pos = {("p", int(k)): i for i, k in enumerate(idx)}
-    wpts: dict = {}  # j -> (r1 body, r2 body, arc)
+    wpts: dict = {}  # j -> (r1 body, r2 body, arc, (r1, r2, surface) in the wrap's frame)
 
     def ground(e):
         if e[0] == "p":
@@ -553,22 +630,22 @@ def _one_state(x, frames, idx, objs, npts, name, hold, codes=None):
                     continue
                 p1 = np.einsum("dji,dj->di", Rg, ground(ea) - og)
                 p2 = np.einsum("dji,dj->di", Rg, ground(eb) - og)
-                code, r1, r2, arc = _wrap_line(w, p1, p2, nw == 1, pw.method, hold)
+                code, r1, r2, arc, surf = _wrap_line(w, p1, p2, nw == 1, pw.method, hold)
                 results[i] = code
                 inside[j] = inside[j] or code == INSIDE
                 if code in (WRAPPED, MANDATORY):
                     r1b, r2b = r1 @ Rw.T + tw, r2 @ Rw.T + tw
                     if code == MANDATORY:
-                        best = (a, r1b, r2b, arc)
+                        best = (a, r1b, r2b, arc, (r1, r2, surf))
                         break
                     g1, g2 = _to_ground(R, o, r1b), _to_ground(R, o, r2b)
                     ca, cb = gpos(ea), gpos(eb)
                     change = _re(_norm(g1 - ca) + arc + _norm(cb - g2) - _norm(cb - ca))
                     if change < best_change:
-                        best, best_change = (a, r1b, r2b, arc), change
+                        best, best_change = (a, r1b, r2b, arc, (r1, r2, surf)), change
             if best is not None:
-                a, r1b, r2b, arc = best
-                wpts[j] = (r1b, r2b, arc)
+                a, r1b, r2b, arc, on_wrap = best
+                wpts[j] = (r1b, r2b, arc, on_wrap)
                 path[a + 1 : a + 1] = [("w", (j, 1)), ("w", (j, 2))]
         total = _re(length())
         if abs(total - last) < 0.0005:
@@ -580,7 +657,21 @@ def _one_state(x, frames, idx, objs, npts, name, hold, codes=None):
             wpts.pop(0, None)
     if codes is not None:
         codes[:] = [status(j in wpts, inside[j]) for j in range(nw)]
-    return length(final=True)
+    total = length(final=True)
+    if trace is not None:
+        for e in path:
+            if e[0] == "p":
+                trace.append(("point", e[1], np.real(x[0, pos[e]])))
+                continue
+            j, which = e[1]
+            trace.append(("tangent", j, np.real(gpos(e)[0])))
+            if which == 1:
+                R, o, Rw, tw = frames[j]
+                R, o = R[0].real, o[0].real
+                r1, r2, surf = wpts[j][3]
+                inner = surface_points(objs[j][1], r1, r2, surf, tolerance)[1:-1]
+                trace.append(("surface", j, (inner @ Rw.T + tw) @ R.T + o))
+    return total
 
 
 def _to_ground(R, o, rb):

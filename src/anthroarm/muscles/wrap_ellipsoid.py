@@ -322,7 +322,8 @@ def _surface(r1, r2, a, vs, vs4, far_side, factor):
 # ---------------------------------------------------------------------------- wrapLine
 def _wrap(p1, p2, dims, quad, method):
     """``WrapEllipsoid::wrapLine`` on (D, 3) complex end points (branches on row 0's real
-    part): (code, r1 (D, 3), r2 (D, 3), length (D,)), unscaled, in the ellipsoid's frame."""
+    part): (code, r1 (D, 3), r2 (D, 3), length (D,), surface path (D, K, 3) from r1 to r2),
+    unscaled, in the ellipsoid's frame."""
     axis, wsign = quad
     # PathWrap::extendFinalizeFromProperties: an unknown method is hybrid
     method = method.lower() if method.lower() in ("hybrid", "midpoint", "axial") else "hybrid"
@@ -331,20 +332,20 @@ def _wrap(p1, p2, dims, quad, method):
     p1e = np.sum((p1 / a) ** 2, axis=-1) - 1.0
     p2e = np.sum((p2 / a) ** 2, axis=-1) - 1.0
     if p1e[0].real < -0.0001 or p2e[0].real < -0.0001:
-        return INSIDE, None, None, None
+        return INSIDE, None, None, None, None
     p1p2 = p1 - p2
     ppm = _dot(_unit(p1), _unit(p2)) - 1.0
     if abs(ppm[0].real) < 0.0001:
-        return NO_WRAP, None, None, None
+        return NO_WRAP, None, None, None, None
     f1, f2 = p1p2 / a, p2 / a
     aa, bb, cc = _dot(f1, f1), 2.0 * _dot(f1, f2), _dot(f2, f2) - 1.0
     disc = bb * bb - 4.0 * aa * cc
     if disc[0].real < 0.0:
-        return NO_WRAP, None, None, None
+        return NO_WRAP, None, None, None, None
     l1 = (-bb + np.sqrt(disc)) / (2.0 * aa)
     l2 = (-bb - np.sqrt(disc)) / (2.0 * aa)
     if not (0.0 < l1[0].real < 1.0) or not (0.0 < l2[0].real < 1.0):
-        return NO_WRAP, None, None, None
+        return NO_WRAP, None, None, None, None
     r1 = p2 + l1[:, None] * p1p2
     r2 = p2 + l2[:, None] * p1p2
     r1r2 = r2 - r1
@@ -417,24 +418,25 @@ def _wrap(p1, p2, dims, quad, method):
         g2 = _unit(p2[0].real - t2[0].real) @ _unit(pts[0, -2].real - t2[0].real)
         if g1 > 0.0 or g2 > 0.0:
             pts, length = _surface(t1, t2, a, vs, vs4, True, factor)
-    return MANDATORY, t1 / factor, t2 / factor, length / factor
+    return MANDATORY, t1 / factor, t2 / factor, length / factor, pts / factor
 
 
 def wrap_line(p1, p2, dims, quad, method="hybrid"):
     """``WrapEllipsoid::wrapLine`` on complex-step rows: end points p1, p2 (D, 3) (the
     ellipsoid's frame, m; row 0 decides every branch) → (code, r1 (D, 3), r2 (D, 3), length
     (D,)), the tangent points and the surface path's length, None for a code other than
-    ``MANDATORY``; ``dims``, ``quad`` and ``method`` as in
-    :func:`~anthroarm.muscles.wrap_ellipsoid.ellipsoid`.  Im(row d) / h
-    is the derivative along Im(p1, p2)(row d) / h (module docstring)."""
+    ``MANDATORY``, and the surface path (D, K, 3): the polyline whose chords sum to the length,
+    r1 first and r2 last (step 4 of the module docstring); ``dims``, ``quad`` and ``method`` as
+    in :func:`~anthroarm.muscles.wrap_ellipsoid.ellipsoid`.  Im(row d) / h is the derivative
+    along Im(p1, p2)(row d) / h (module docstring)."""
     p1 = np.asarray(p1, dtype=complex)
     p2 = np.asarray(p2, dtype=complex)
-    code, r1, r2, length = _wrap(p1, p2, dims, quad, method)
+    code, r1, r2, length, pts = _wrap(p1, p2, dims, quad, method)
     if code != MANDATORY:
-        return code, None, None, None
+        return code, None, None, None, None
     if not (np.all(np.isfinite(r1)) and np.all(np.isfinite(r2)) and np.all(np.isfinite(length))):
         raise MuscleError("ellipsoid wrap: the tangent points did not converge")
-    return code, r1, r2, length
+    return code, r1, r2, length, pts
 
 
 def ellipsoid(p1, p2, dims, quad, method="hybrid"):
@@ -449,7 +451,7 @@ def ellipsoid(p1, p2, dims, quad, method="hybrid"):
     p = np.concatenate([np.asarray(p1, dtype=float), np.asarray(p2, dtype=float)])
     P = np.tile(p.astype(complex), (7, 1))
     P[np.arange(1, 7), np.arange(6)] += 1j * H
-    code, r1, r2, length = wrap_line(P[:, :3], P[:, 3:], dims, quad, method)
+    code, r1, r2, length, _ = wrap_line(P[:, :3], P[:, 3:], dims, quad, method)
     if code != MANDATORY:
         return code, None, None, 0.0, None
     jac = (r1[1:].imag.T / H, r2[1:].imag.T / H, length[1:].imag / H)
