@@ -6,9 +6,10 @@
 >>> ms = muscles.read_muscles(aa.osim.path("gait2392"))     # 92 Thelen2003 muscles
 >>> L = muscles.lengths(robot, ms, robot.default_q())         # (92,) m
 >>> R = muscles.moment_arms(robot, ms, robot.default_q())     # (92, 23) m, = -dl/dq
+>>> P = muscles.path_points(robot, ms, robot.default_q())     # {name: MusclePath}, ground, m
 
 Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
-moment arms, batched), :mod:`.wrap` (wrapping over cylinders and spheres),
+moment arms, batched; the paths as points), :mod:`.wrap` (wrapping over cylinders and spheres),
 :mod:`.wrap_ellipsoid` (over ellipsoids), :mod:`.hill` (Thelen2003 forces at static
 equilibrium, joint torques τ = Rᵀ f), :mod:`.millard` (Millard2012EquilibriumMuscle curves and
 equilibrium), :mod:`.optimize` (static optimisation through the QP layer), :mod:`.emg` (the
@@ -33,7 +34,15 @@ from .optimize import (
     static_optimization,
     thelen_force_velocity,
 )
-from .paths import lengths, lengths_and_moment_arms, moment_arms, muscle_set, wrap_status
+from .paths import (
+    MusclePath,
+    lengths,
+    lengths_and_moment_arms,
+    moment_arms,
+    muscle_set,
+    path_points,
+    wrap_status,
+)
 from .reader import Muscle, MuscleSet, PathPoint, PathWrap, WrapObject, read_muscles
 
 __all__ = [
@@ -53,6 +62,8 @@ __all__ = [
     "PathPoint",
     "PathWrap",
     "WrapObject",
+    "MusclePath",
+    "path_points",
     "lengths",
     "lengths_and_moment_arms",
     "moment_arms",
