@@ -16,13 +16,15 @@ The modules: :mod:`~anthroarm.viewer.viewer` (the :class:`Viewer`, composed of
 :mod:`~anthroarm.viewer.teach`, :mod:`~anthroarm.viewer.export` and
 :mod:`~anthroarm.viewer.live`); what it draws: :mod:`~anthroarm.viewer.visuals` (a robot's
 bodies), :mod:`~anthroarm.viewer.shapes`, :mod:`~anthroarm.viewer.meshes`,
-:mod:`~anthroarm.viewer.colors`; how: :mod:`~anthroarm.viewer.messages` (the commands),
+:mod:`~anthroarm.viewer.colors`, :mod:`~anthroarm.viewer.collision` (collision bodies),
+:mod:`~anthroarm.viewer.muscles` (an OpenSim model's muscle paths); how: :mod:`~anthroarm.viewer.messages` (the commands),
 :mod:`~anthroarm.viewer.checks` (argument checks); :mod:`~anthroarm.viewer.server` runs the
 127.0.0.1-only server process; :mod:`~anthroarm.viewer.browser` takes headless-Chromium
 screenshots (tests, docs); :mod:`~anthroarm.viewer.demo` is ``anthroarm demo``.
 """
 
 from .collision import show_collisions
+from .muscles import show_muscles
 from .viewer import (
     Scene,
     Viewer,
@@ -43,6 +45,7 @@ __all__ = [
     "manipulability",
     "show",
     "show_collisions",
+    "show_muscles",
 ]
 
 

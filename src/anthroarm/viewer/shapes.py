@@ -1,7 +1,7 @@
 """The pieces the viewer draws with: :class:`Piece` (one meshcat object in a body frame) and
 :class:`Body` (pieces moving with one joint or frame), the primitive shapes built from them
-(cylinders, capsules, coordinate triads), shaded arrow meshes, and the bounding boxes of
-meshcat geometry.  Lengths in metres; meshcat's cylinders run along their y axis.
+(cylinders, capsules, coordinate triads), shaded arrow and tube meshes, and the bounding boxes
+of meshcat geometry.  Lengths in metres; meshcat's cylinders run along their y axis.
 """
 
 from __future__ import annotations
@@ -153,6 +153,46 @@ def arrow_mesh(origins, vectors, radius, colors, head_length=None, segments: int
         return None
     return ShadedMesh(
         np.concatenate(verts), np.concatenate(faces), np.concatenate(norms), np.concatenate(cols)
+    )
+
+
+def tube_mesh(points, radius: float, rgb, segments: int = 8) -> ShadedMesh | None:
+    """One shaded triangle mesh of a tube of ``radius`` along the polyline ``points`` (K, 3),
+    m: a ring of ``segments`` vertices round each point, in the plane normal to the mean of its
+    two segments' directions, the rings' first axis carried along the path by projection (no
+    twist), consecutive rings joined by quads (open ends).  Consecutive points closer than
+    1e-9 m are merged.  ``rgb`` one colour (3,).  Vertex k·segments + i belongs to point k.
+    None for fewer than two distinct points."""
+    P = np.asarray(points, float)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(P, axis=0), axis=1) > 1e-9])
+    P = P[keep]
+    if len(P) < 2:
+        return None
+    d = np.diff(P, axis=0)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    t = np.concatenate([d[:1], d[:-1] + d[1:], d[-1:]])
+    bad = np.linalg.norm(t, axis=1) < 1e-9  # a path turning back on itself
+    t[bad] = np.concatenate([d, d[-1:]])[bad]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    ang = np.linspace(0.0, 2 * np.pi, segments, endpoint=False)
+    e1 = rotation_between((0.0, 0.0, 1.0), t[0])[:, 0]
+    verts, norms = [], []
+    for p, tk in zip(P, t):
+        e1 = e1 - (e1 @ tk) * tk
+        n1 = np.linalg.norm(e1)
+        e1 = e1 / n1 if n1 > 1e-9 else rotation_between((0.0, 0.0, 1.0), tk)[:, 0]
+        rim = np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * np.cross(tk, e1)
+        verts.append(p + radius * rim)
+        norms.append(rim)
+    k = np.arange(segments)
+    k1 = (k + 1) % segments
+    quad = np.concatenate(
+        [np.stack([k, k1, segments + k1], 1), np.stack([k, segments + k1, segments + k], 1)]
+    )
+    faces = np.concatenate([quad + i * segments for i in range(len(P) - 1)])
+    V = np.concatenate(verts)
+    return ShadedMesh(
+        V, faces, np.concatenate(norms), np.tile(np.asarray(rgb, float)[:3], (len(V), 1))
     )
 
 
