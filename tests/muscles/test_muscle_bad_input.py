@@ -17,16 +17,11 @@ import re
 
 import numpy as np
 import pytest
+from arm26_variants import variant
 
 import anthroarm as aa
 from anthroarm import muscles
 from anthroarm.errors import MuscleError
-
-
-def _variant(tmp_path, name, edit):
-    p = tmp_path / f"{name}.osim"
-    p.write_text(edit(aa.osim.path("arm26").read_text()))
-    return p
 
 
 def _big_ellipsoid(text):
@@ -39,7 +34,7 @@ def _big_ellipsoid(text):
 
 
 def test_path_starting_inside_a_wrap_object(tmp_path):
-    path = _variant(tmp_path, "inside", _big_ellipsoid)
+    path = variant(tmp_path, "inside", _big_ellipsoid)
     robot = aa.load(path)
     ms = muscles.read_muscles(path).select(["BIClong"])
     Q = robot.random_q(8, rng=3)
@@ -90,7 +85,7 @@ def _coinciding(text):
 
 
 def test_wrapped_path_with_coinciding_points(tmp_path):
-    path = _variant(tmp_path, "coincide_wrapped", _coinciding)
+    path = variant(tmp_path, "coincide_wrapped", _coinciding)
     robot = aa.load(path)
     ms = muscles.read_muscles(path).select(["BIClong"])
     with pytest.raises(MuscleError, match="coincide"):

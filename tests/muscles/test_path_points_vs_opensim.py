@@ -11,7 +11,7 @@ OpenSim's ``getLength`` and our ``lengths`` to the same tolerances on every stat
 path wraps over one object at most.  With two wraps or more OpenSim reports each wrap point
 where it was first placed in the state (its ground position is cached) while the arc is the
 last pass's: the polyline then joins the two by short straight pieces (OpenSim's own drawing
-does the same) and is longer than the length; measured here, bounded at 1 cm.
+does the same) and differs from the length; measured here, bounded at 1 cm.
 
 Two variants as in test_paths_vs_opensim.py: the TRI cylinder one-sided (quadrant -y: far-side
 arcs, longer than half a turn) and the ellipsoids made
@@ -20,10 +20,9 @@ spheres (great-circle arcs), to 1e-6 m.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
+from arm26_variants import no_ellipsoids, spheres, tri_quadrant, variant
 
 import anthroarm as aa
 from anthroarm import muscles
@@ -134,13 +133,7 @@ def test_one_sided_cylinder_far_side_arcs(tmp_path):
     """arm26 with its ellipsoids inactive and the TRI cylinder's quadrant -y: TRIlat and BRA
     then go round the cylinder's far side on many states (arcs longer than half a turn, π r);
     40 states, points and lengths against OpenSim to 1e-6 m."""
-    text = aa.osim.path("arm26").read_text()
-    text = re.sub(r"(<WrapEllipsoid name=\"\w+\">\s*<!--[^>]*-->\s*<active>)true", r"\1false", text)
-    text = re.sub(
-        r'(<WrapCylinder name="TRI">.*?<quadrant>)all(</quadrant>)', r"\1-y\2", text, flags=re.S
-    )
-    path = tmp_path / "arm26_tri_minus_y.osim"
-    path.write_text(text)
+    path = variant(tmp_path, "arm26_tri_minus_y", no_ellipsoids, tri_quadrant("-y"))
     err, err_len, arcs = _variant_against_opensim(path, ["TRIlat", "BRA"], 40, 1)
     assert err < TOL and err_len < TOL, (err, err_len)
     assert sum(_arc_length(X) > np.pi * 0.016 for X in arcs) >= 10
@@ -149,13 +142,7 @@ def test_one_sided_cylinder_far_side_arcs(tmp_path):
 def test_spheres(tmp_path):
     """arm26 with its ellipsoids made 2 cm spheres: BIClong and TRIlong over a sphere (great
     circles), 30 states, points and lengths against OpenSim to 1e-6 m."""
-    text = aa.osim.path("arm26").read_text()
-    text = text.replace("<WrapEllipsoid", "<WrapSphere").replace(
-        "</WrapEllipsoid>", "</WrapSphere>"
-    )
-    text = re.sub(r"<dimensions>[^<]*</dimensions>", "<radius>0.02</radius>", text)
-    path = tmp_path / "arm26_spheres.osim"
-    path.write_text(text)
+    path = variant(tmp_path, "arm26_spheres", spheres)
     err, err_len, arcs = _variant_against_opensim(path, ["BIClong", "TRIlong"], 30, 3)
     assert err < TOL and err_len < TOL, (err, err_len)
     assert len(arcs) >= 20

@@ -20,12 +20,12 @@ tension's generalized force with the constraint coupling vector) is the same qua
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
 
 opensim = pytest.importorskip("opensim")
+
+from arm26_variants import no_ellipsoids, spheres, variant  # noqa: E402
 
 import anthroarm as aa  # noqa: E402
 from anthroarm import muscles  # noqa: E402
@@ -53,26 +53,6 @@ class Oracle:
 
     def moment_arm(self, i, k):
         return self.muscles[i].computeMomentArm(self.state, self.coords[k])
-
-
-def _variant(tmp_path, name, edit):
-    text = edit(aa.osim.path("arm26").read_text())
-    p = tmp_path / f"{name}.osim"
-    p.write_text(text)
-    return p
-
-
-def _no_ellipsoids(text):
-    out = re.sub(r"(<WrapEllipsoid name=\"\w+\">\s*<!--[^>]*-->\s*<active>)true", r"\1false", text)
-    assert out.count("<active>false</active>") == 2
-    return out
-
-
-def _spheres(text):
-    text = text.replace("<WrapEllipsoid", "<WrapSphere").replace(
-        "</WrapEllipsoid>", "</WrapSphere>"
-    )
-    return re.sub(r"<dimensions>[^<]*</dimensions>", "<radius>0.02</radius>", text)
 
 
 def _compare_all(path, n, seed, skip=()):
@@ -133,7 +113,7 @@ def test_gait2392_moment_arms():
 
 
 def test_arm26_cylinders_200_states(tmp_path):
-    path = _variant(tmp_path, "arm26_cylinders", _no_ellipsoids)
+    path = variant(tmp_path, "arm26_cylinders", no_ellipsoids)
     robot, ms, Q, L, eL, eR = _compare_all(path, 200, seed=2)
     assert eL.max() < TOL and eR.max() < TOL, (eL.max(0), eR.max(0))
     # the wraps are active: the TRI cylinder lengthens TRIlat, TRImed and BRA on many states
@@ -145,7 +125,7 @@ def test_arm26_cylinders_200_states(tmp_path):
 
 
 def test_arm26_spheres_100_states(tmp_path):
-    path = _variant(tmp_path, "arm26_spheres", _spheres)
+    path = variant(tmp_path, "arm26_spheres", spheres)
     robot, ms, Q, L, eL, eR = _compare_all(path, 100, seed=3, skip=("TRIlong",))
     assert eL.max() < TOL and eR.max() < TOL, (eL.max(0), eR.max(0))
     straight = muscles.lengths(robot, ms, Q, wrap=False)

@@ -15,10 +15,9 @@ this non-shortest surface path; the difference is measured here, not hidden.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
+from arm26_variants import spheres, variant
 
 import anthroarm as aa
 from anthroarm import muscles
@@ -158,13 +157,7 @@ def test_multi_wrap_keeps_opensims_cached_wrap_points(tmp_path):
     is cached); reproduced, the lengths agree to rounding (without it, TRIlong over arm26's
     ellipsoid differed by up to 4 mm)."""
     opensim = pytest.importorskip("opensim")
-    text = aa.osim.path("arm26").read_text()
-    text = text.replace("<WrapEllipsoid", "<WrapSphere").replace(
-        "</WrapEllipsoid>", "</WrapSphere>"
-    )
-    text = re.sub(r"<dimensions>[^<]*</dimensions>", "<radius>0.02</radius>", text)
-    path = tmp_path / "arm26_spheres.osim"
-    path.write_text(text)
+    path = variant(tmp_path, "arm26_spheres", spheres)
     robot = aa.load(path)
     ms = muscles.read_muscles(path).select(["TRIlong"])
     model = opensim.Model(str(path))
