@@ -10,8 +10,8 @@ The polyline through our points (the arcs on the wrap surfaces included) is as l
 OpenSim's ``getLength`` and our ``lengths`` to the same tolerances on every state where the
 path wraps over one object at most.  With two wraps or more OpenSim reports each wrap point
 where it was first placed in the state (its ground position is cached) while the arc is the
-last pass's: the polyline then joins the two by short straight pieces (OpenSim's own drawing
-does the same) and differs from the length; measured here, bounded at 1 cm.
+last pass's: the polyline then joins the two by short straight pieces and differs from the
+length; measured here, bounded at 1 cm.
 
 Two variants as in test_paths_vs_opensim.py: the TRI cylinder one-sided (quadrant -y: far-side
 arcs, longer than half a turn) and the ellipsoids made

@@ -368,8 +368,8 @@ class MusclePath:
         polyline) on a path over one wrap at most.  Over two or more, OpenSim's tangent points
         (its ``getLocationInGround``, which the length adds up) are where a wrap point was
         first placed in the state and the arcs are the last pass's: the polyline joins them by
-        short straight pieces, as OpenSim's own drawing does, and differs from the length (by
-        up to 5.4 mm on arm26's TRIlong over 20 random states)."""
+        short straight pieces and differs from the length (by up to 5.4 mm on arm26's TRIlong
+        over 20 random states)."""
         return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
 
 
