@@ -341,7 +341,7 @@ def wrap_status(robot, muscles=None, q=None) -> dict:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MusclePath:
     """One muscle's path on one state, as drawn (:func:`path_points`).
 
