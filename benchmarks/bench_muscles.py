@@ -12,10 +12,11 @@ coordinate) pair (the issue's comparison), and of the pairs a muscle spans only 
 OpenSim user would call).  Max abs differences on the subset say both compute the same thing.
 
 (b) Static optimisation per frame, side by side with OpenSim's ``StaticOptimization`` analysis
-(an ``AnalyzeTool`` run on the same coordinates .mot, no filter, no external loads; activation
-exponent 2, muscle physiology on; one ``CoordinateActuator`` per coordinate, optimal force
-1000 on the pelvis's six, 1 elsewhere) on the same frames: arm26 (6 muscles, cylinder and
-ellipsoid wraps; a smooth 2 s motion through its range, 60 Hz, written to a .mot), and the
+(:mod:`anthroarm.muscles.opensim_oracle`: an ``AnalyzeTool`` run on the same coordinates
+.mot, no filter, no external loads; activation exponent 2, muscle physiology on; one
+``CoordinateActuator`` per coordinate, optimal force 1000 on the pelvis's six, 1 elsewhere)
+on the same frames: arm26 (6 muscles, cylinder and ellipsoid wraps; a smooth 2 s motion
+through its range, 60 Hz, written to a .mot), and the
 shipped gait trial ``subject01_walk1_ik.mot`` (OpenSim's IK, 0.4-1.6 s, 73 frames) on the model
 it was recorded for (subject01_simbody, 54 muscles) and on gait2392 (92 muscles).  Ours:
 ``static_optimization`` on all frames in one call, posed as OpenSim poses it (q̇ and q̈ from
@@ -48,6 +49,8 @@ import numpy as np
 import anthroarm as aa
 from anthroarm import muscles
 from anthroarm.ik.qp import make_backend
+from anthroarm.muscles.opensim_oracle import opensim_kinematics, opensim_static_optimization
+from anthroarm.osim.checks import OpenSimModel
 
 RECORDINGS = Path(aa.__file__).parent / "data" / "opensim" / "recordings"
 GAIT_MOT = RECORDINGS / "subject01_walk1_ik.mot"
@@ -156,27 +159,6 @@ def _path_rows(quick: bool) -> list:
 # -- (b) static optimisation ----------------------------------------------------------------
 
 
-def _columns(osim, store):
-    tt = osim.ArrayDouble()
-    store.getTimeColumn(tt)
-    time_ = np.array([tt.get(i) for i in range(tt.getSize())])
-    labels = store.getColumnLabels()
-    labels = [labels.get(i) for i in range(1, labels.getSize())]
-    data = []
-    for lab in labels:
-        a = osim.ArrayDouble()
-        store.getDataColumn(lab, a)
-        data.append([a.get(i) for i in range(a.getSize())])
-    return time_, labels, np.array(data).T
-
-
-def _pick(labels, data, names):
-    idx = [
-        next(i for i, lab in enumerate(labels) if lab == n or lab.endswith(f"/{n}")) for n in names
-    ]
-    return data[:, idx]
-
-
 def _arm26_mot(robot, out: Path) -> Path:
     """A smooth 2 s motion of arm26 through most of its range at 60 Hz (radians)."""
     t = np.arange(121) / 60.0
@@ -192,80 +174,17 @@ def _arm26_mot(robot, out: Path) -> Path:
     return p
 
 
-def _opensim_so(osim, path, names, strength, mot, t0, t1, out, criterion):
-    """Run OpenSim's StaticOptimization (AnalyzeTool) on [t0, t1]: (run seconds, activation
-    labels, activations (frames, muscles), frame times, reserve controls (frames, nq))."""
-    model = osim.Model(str(path))
-    for n, f in zip(names, strength):
-        ca = osim.CoordinateActuator(n)
-        ca.setName(f"{n}_reserve")
-        ca.setOptimalForce(float(f))
-        ca.setMinControl(-1e6)
-        ca.setMaxControl(1e6)
-        model.addForce(ca)
-    model.finalizeConnections()
-    model.printToXML(str(out / "model.osim"))
-    tool = osim.AnalyzeTool()
-    tool.setName("so")
-    tool.setModelFilename(str(out / "model.osim"))
-    tool.setCoordinatesFileName(str(mot))
-    tool.setLowpassCutoffFrequency(-1)
-    tool.setInitialTime(t0)
-    tool.setFinalTime(t1)
-    tool.setResultsDir(str(out))
-    so = osim.StaticOptimization()
-    so.setStartTime(t0)
-    so.setEndTime(t1)
-    so.setUseModelForceSet(True)
-    so.setActivationExponent(2)
-    so.setUseMusclePhysiology(True)
-    so.setConvergenceCriterion(criterion)
-    so.setMaxIterations(2000 if criterion < 1e-4 else 100)
-    tool.getAnalysisSet().cloneAndAppend(so)
-    tool.printToXML(str(out / "setup.xml"))
-    tool = osim.AnalyzeTool(str(out / "setup.xml"))
-    tic = time.perf_counter()
-    assert tool.run()
-    dt = time.perf_counter() - tic
-    ta, la, A = _columns(osim, osim.Storage(str(out / "so_StaticOptimization_activation.sto")))
-    _, lf, F = _columns(osim, osim.Storage(str(out / "so_StaticOptimization_force.sto")))
-    reserves = _pick(lf, F, [f"{n}_reserve" for n in names]) / strength
-    return dt, la, A, ta, reserves
-
-
-def _trajectory(osim, path, mot, robot, times):
-    """q, q̇ and q̈ at ``times`` as OpenSim's AnalyzeTool and StaticOptimization form them
-    (degree-5 GCV splines of q, then of q̇)."""
-    model = osim.Model(str(path))
-    model.initSystem()
-    store = osim.Storage(str(mot))
-    if store.isInDegrees():
-        model.getSimbodyEngine().convertDegreesToRadians(store)
-    d1 = osim.GCVSplineSet(5, store).constructStorage(1)
-    d2 = osim.GCVSplineSet(5, d1).constructStorage(1)
-    t_all, lq, q_all = _columns(osim, store)
-    rows = [int(np.argmin(np.abs(t_all - t))) for t in times]
-    names = robot.joint_names
-    Q = _pick(lq, q_all, names)[rows]
-    QD = _pick(*_columns(osim, d1)[1:], names)[rows]
-    QDD = _pick(*_columns(osim, d2)[1:], names)[rows]
-    return Q, QD, QDD
-
-
-def _moment_arm_error(osim, path, robot, ms, Q):
-    model = osim.Model(str(path))
-    state = model.initSystem()
-    coords = [model.getCoordinateSet().get(c) for c in robot.joint_names]
-    mus = [model.getMuscles().get(i) for i in range(len(ms))]
+def _moment_arm_error(path, robot, ms, Q):
+    """OpenSim's moment arms at every state of ``Q`` (``computeMomentArm``, through
+    :class:`anthroarm.osim.checks.OpenSimModel`), and the largest difference from ours with the
+    muscle it is on."""
+    o = OpenSimModel(path, robot.joint_names)
     R = muscles.moment_arms(robot, ms, Q)
-    err = np.zeros(len(ms))
     R_os = np.zeros_like(R)
-    for q, r, r_os in zip(Q, R, R_os):
-        for c, v in zip(coords, q):
-            c.setValue(state, float(v), False)
-        model.realizePosition(state)
-        r_os[:] = [[m.computeMomentArm(state, c) for c in coords] for m in mus]
-        err = np.maximum(err, np.abs(r_os - r).max(axis=1))
+    for q, r_os in zip(Q, R_os):
+        o.set_state(q)
+        r_os[:] = o.moment_arms()
+    err = np.abs(R_os - R).max(axis=(0, 2))
     return err.max(), ms.names[int(err.argmax())], R_os
 
 
@@ -294,7 +213,6 @@ def _with_moment_arms(cons, tau, lower, a_os):
 
 
 def _so_rows(quick: bool) -> list:
-    osim = _opensim()
     rows = []
     cases = [("arm26", None), ("subject01_simbody", GAIT_MOT), ("gait2392", GAIT_MOT)]
     if quick:
@@ -311,20 +229,21 @@ def _so_rows(quick: bool) -> list:
             t0, t1 = (0.4, 1.6) if mot else (0.0, 2.0)
             if quick:
                 t1 = t0 + 0.2
-            tight = _opensim_so(osim, path, names, strength, mot_path, t0, t1, out, 1e-10)
-            loose = _opensim_so(osim, path, names, strength, mot_path, t0, t1, out, 1e-4)
-            times = tight[3]
-            short = _opensim_so(osim, path, names, strength, mot_path, t0, times[1], out, 1e-4)
-            Q, QD, QDD = _trajectory(osim, path, mot_path, robot, times)
+            args = (path, mot_path, names, strength, ms.names)
+            tight = opensim_static_optimization(*args, t0, t1, out, criterion=1e-10)
+            loose = opensim_static_optimization(*args, t0, t1, out, criterion=1e-4)
+            times = tight.time
+            short = opensim_static_optimization(*args, t0, times[1], out, criterion=1e-4)
+            Q, QD, QDD = opensim_kinematics(path, mot_path, names, times)
         nf = len(times)
-        a_os = _pick(tight[1], tight[2], ms.names)
+        a_os = tight.activation
         tau = np.array([robot.inverse_dynamics(*x) for x in zip(Q, QD, QDD)])
         lower = np.array([m.params["minimum_activation"] for m in ms.muscles])
         kw = dict(reserve=strength, qd=QD, passive=False, lower=lower)
         L, R = muscles.lengths_and_moment_arms(robot, ms, Q)
         FA, _ = muscles.force_coefficients(ms, L, -np.einsum("nmk,nk->nm", R, QD))
         if name == "arm26":  # the moment arms OpenSim's problem uses, on every frame
-            r_err, r_worst, R_os = _moment_arm_error(osim, path, robot, ms, Q)
+            r_err, r_worst, R_os = _moment_arm_error(path, robot, ms, Q)
         # OpenSim's constraints (its moment arms: arm26's ellipsoid wraps differ from ours;
         # gait models' agree to 1e-15, tests/muscles/test_paths_vs_opensim.py)
         R_kkt = R_os if name == "arm26" else R
@@ -341,7 +260,7 @@ def _so_rows(quick: bool) -> list:
             t = median(reps)
             # where OpenSim's answer is not a KKT point of its problem (IPOPT stopped short),
             # the difference says nothing about ours (an exact QP optimum, KKT ~1e-11)
-            x_os = np.hstack([a_os, tight[4]])
+            x_os = np.hstack([a_os, tight.reserve / strength])
             kkt = np.array([_stationarity(x, C, len(ms), lower) for x, C in zip(x_os, cons)])
             # arm26: its paths differ from OpenSim's (ellipsoids): no KKT test of its answer
             bad = (kkt > KKT_TOL) & (name != "arm26")
@@ -411,12 +330,12 @@ def _so_rows(quick: bool) -> list:
                     f"with wraps, the paths alone take {t_paths * 1e3:.1f} ms a frame",
                 ]
             )
-        marginal = (loose[0] - short[0]) / (nf - 2)
+        marginal = (loose.seconds - short.seconds) / (nf - 2)
         rows.append(
             [
                 label,
                 "OpenSim StaticOptimization, criterion 1e-4 (run / frames)",
-                loose[0] / nf * 1e3,
+                loose.seconds / nf * 1e3,
                 "",
                 "",
                 f"marginal {marginal * 1e3:.1f} ms a frame",
@@ -426,7 +345,7 @@ def _so_rows(quick: bool) -> list:
             [
                 label,
                 "OpenSim StaticOptimization, criterion 1e-10 (run / frames)",
-                tight[0] / nf * 1e3,
+                tight.seconds / nf * 1e3,
                 "",
                 "",
                 "the reference activations",

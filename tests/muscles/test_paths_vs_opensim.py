@@ -29,47 +29,26 @@ from arm26_variants import no_ellipsoids, spheres, variant  # noqa: E402
 
 import anthroarm as aa  # noqa: E402
 from anthroarm import muscles  # noqa: E402
+from anthroarm.osim.checks import OpenSimModel  # noqa: E402
 
 TOL = 1e-6
 
 
-class Oracle:
-    """An OpenSim model set to states given in the robot's coordinates."""
-
-    def __init__(self, path, names):
-        self.model = opensim.Model(str(path))
-        self.state = self.model.initSystem()
-        self.coords = [self.model.getCoordinateSet().get(n) for n in names]
-        mus = self.model.getMuscles()
-        self.muscles = [mus.get(i) for i in range(mus.getSize())]
-
-    def set(self, q):
-        for c, v in zip(self.coords, q):
-            c.setValue(self.state, float(v), False)
-        self.model.realizePosition(self.state)
-
-    def lengths(self):
-        return np.array([m.getLength(self.state) for m in self.muscles])
-
-    def moment_arm(self, i, k):
-        return self.muscles[i].computeMomentArm(self.state, self.coords[k])
 
 
 def _compare_all(path, n, seed, skip=()):
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
-    oracle = Oracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     assert [m.getName() for m in oracle.muscles] == ms.names
     Q = robot.random_q(n, rng=seed)
     L, R = muscles.lengths_and_moment_arms(robot, ms, Q)
     eL = np.zeros((n, len(ms)))
     eR = np.zeros((n, len(ms)))
     for s, q in enumerate(Q):
-        oracle.set(q)
+        oracle.set_state(q)
         eL[s] = oracle.lengths() - L[s]
-        for i in range(len(ms)):
-            r = [oracle.moment_arm(i, k) for k in range(robot.nq)]
-            eR[s, i] = np.abs(np.array(r) - R[s, i]).max()
+        eR[s] = np.abs(oracle.moment_arms() - R[s]).max(axis=1)
     keep = [i for i, nm in enumerate(ms.names) if nm not in skip]
     return robot, ms, Q, L, np.abs(eL)[:, keep], eR[:, keep]
 
@@ -81,12 +60,12 @@ def test_gait2392_lengths_200_states():
     assert len(ms) == 92
     kinds = {p.kind for m in ms.muscles for p in m.points}
     assert kinds == {"fixed", "conditional", "moving"}
-    oracle = Oracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     Q = robot.random_q(200, rng=0)
     L = muscles.lengths(robot, ms, Q)
     err = 0.0
     for q, lq in zip(Q, L):
-        oracle.set(q)
+        oracle.set_state(q)
         err = max(err, np.abs(oracle.lengths() - lq).max())
     assert err < TOL, err
 
@@ -95,18 +74,18 @@ def test_gait2392_moment_arms():
     path = aa.osim.path("gait2392")
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
-    oracle = Oracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     Q = robot.random_q(6, rng=1)
     R = muscles.moment_arms(robot, ms, Q)
     # every muscle about every coordinate at one state: zeros must be zeros in OpenSim too
-    oracle.set(Q[0])
-    full = np.array([[oracle.moment_arm(i, k) for k in range(robot.nq)] for i in range(len(ms))])
+    oracle.set_state(Q[0])
+    full = oracle.moment_arms()
     assert np.abs(full - R[0]).max() < TOL
     spanned = np.abs(R).max(axis=0) > 0  # (muscle, coordinate) pairs, nonzero somewhere
     assert np.array_equal(spanned, np.abs(full) > 0) or np.all(np.abs(full)[~spanned] < TOL)
     err = 0.0
     for s in range(1, len(Q)):
-        oracle.set(Q[s])
+        oracle.set_state(Q[s])
         for i, k in np.argwhere(spanned):
             err = max(err, abs(oracle.moment_arm(i, k) - R[s, i, k]))
     assert err < TOL, err
@@ -141,27 +120,24 @@ def test_shipped_arm26_with_ellipsoids():
 
 def test_leg6dof9musc_with_a_coupler_constraint():
     """leg6dof9musc's patella coordinate follows the knee through a CoordinateCouplerConstraint.
-    Every coordinate is set in OpenSim from our coupling (the constraint holds exactly; an
-    ``assemble`` would move q by ~5e-9).  OpenSim's ``computeMomentArm`` about an independent
-    coordinate lights up its speed and projects the others onto the constraint (``projectU``):
-    the chain rule through the coupler, the same quantity as our −∂l/∂q in q."""
+    Every coordinate is set in OpenSim from the constraint's own function
+    (:class:`~anthroarm.osim.checks.OpenSimModel`: the constraint holds exactly; an ``assemble``
+    would move q by ~5e-9).  OpenSim's ``computeMomentArm`` about an independent coordinate
+    lights up its speed and projects the others onto the constraint (``projectU``): the chain
+    rule through the coupler, the same quantity as our −∂l/∂q in q."""
     path = aa.osim.path("leg6dof9musc")
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
     coup = robot.coupling
     assert "knee_angle_pat_r" in coup.coordinates and "knee_angle_pat_r" not in robot.joint_names
-    model = opensim.Model(str(path))
-    state = model.initSystem()
-    cset = model.getCoordinateSet()
-    mus = [model.getMuscles().get(i) for i in range(len(ms))]
+    oracle = OpenSimModel(path, robot.joint_names)
+    assert "knee_angle_pat_r" in oracle.couplers
+    assert [m.getName() for m in oracle.muscles] == ms.names
     Q = robot.random_q(50, rng=5)
     L, R = muscles.lengths_and_moment_arms(robot, ms, Q)
     eL = eR = 0.0
     for q, lq, rq in zip(Q, L, R):
-        for name, v in zip(coup.coordinates, coup.coordinate_values(q)):
-            cset.get(name).setValue(state, float(v), False)
-        model.realizePosition(state)
-        eL = max(eL, np.abs([m.getLength(state) for m in mus] - lq).max())
-        r = [[m.computeMomentArm(state, cset.get(c)) for c in robot.joint_names] for m in mus]
-        eR = max(eR, np.abs(np.array(r) - rq).max())
+        oracle.set_state(q)
+        eL = max(eL, np.abs(oracle.lengths() - lq).max())
+        eR = max(eR, np.abs(oracle.moment_arms() - rq).max())
     assert eL < TOL and eR < TOL, (eL, eR)

@@ -5,8 +5,9 @@ coordinates) moving through OpenSim's own IK result ``subject01_walk1_ik.mot``, 
 
 What both sides are given:
 
-* OpenSim: ``AnalyzeTool`` on the .mot, no low-pass filter (``lowpass_cutoff_frequency`` -1),
-  no external loads (the pipeline's GRF file is not shipped), ``StaticOptimization`` with
+* OpenSim (:mod:`anthroarm.muscles.opensim_oracle`): ``AnalyzeTool`` on the .mot, no
+  low-pass filter (``lowpass_cutoff_frequency`` -1), no external loads (the pipeline's GRF
+  file is not shipped), ``StaticOptimization`` with
   ``use_model_force_set``, activation exponent 2, ``use_muscle_physiology`` on, convergence
   criterion 1e-10; the model's 54 muscles plus one ``CoordinateActuator`` per coordinate
   (bounds ±1e6): optimal force 1000 on the six pelvis coordinates (residuals: without ground
@@ -40,31 +41,13 @@ opensim = pytest.importorskip("opensim")
 
 import anthroarm as aa  # noqa: E402
 from anthroarm import muscles  # noqa: E402
+from anthroarm.errors import MuscleError  # noqa: E402
+from anthroarm.muscles.opensim_oracle import (  # noqa: E402
+    opensim_kinematics,
+    opensim_static_optimization,
+)
 
 T0, T1 = 0.60, 0.75
-
-
-def _columns(store):
-    """(time, labels, data) of an OpenSim ``Storage``."""
-    tt = opensim.ArrayDouble()
-    store.getTimeColumn(tt)
-    time = np.array([tt.get(i) for i in range(tt.getSize())])
-    labels = store.getColumnLabels()
-    labels = [labels.get(i) for i in range(1, labels.getSize())]
-    data = []
-    for lab in labels:
-        a = opensim.ArrayDouble()
-        store.getDataColumn(lab, a)
-        data.append([a.get(i) for i in range(a.getSize())])
-    return time, labels, np.array(data).T
-
-
-def _pick(labels, data, names, suffix=""):
-    idx = [
-        next(i for i, lab in enumerate(labels) if lab == n or lab.endswith(f"/{n}{suffix}"))
-        for n in names
-    ]
-    return data[:, idx]
 
 
 def _stationarity(x, C, M, lower=0.01):
@@ -86,56 +69,12 @@ def trial(tmp_path_factory):
     names = robot.joint_names
     strength = np.array([1000.0 if n.startswith("pelvis") else 1.0 for n in names])
 
-    model = opensim.Model(str(path))
-    for n, f in zip(names, strength):
-        ca = opensim.CoordinateActuator(n)
-        ca.setName(f"{n}_reserve")
-        ca.setOptimalForce(float(f))
-        ca.setMinControl(-1e6)
-        ca.setMaxControl(1e6)
-        model.addForce(ca)
-    model.finalizeConnections()
-    model.printToXML(str(out / "model.osim"))
-    tool = opensim.AnalyzeTool()
-    tool.setName("so")
-    tool.setModelFilename(str(out / "model.osim"))
-    tool.setCoordinatesFileName(str(mot))
-    tool.setLowpassCutoffFrequency(-1)
-    tool.setInitialTime(T0)
-    tool.setFinalTime(T1)
-    tool.setResultsDir(str(out))
-    so = opensim.StaticOptimization()
-    so.setStartTime(T0)
-    so.setEndTime(T1)
-    so.setUseModelForceSet(True)
-    so.setActivationExponent(2)
-    so.setUseMusclePhysiology(True)
-    so.setConvergenceCriterion(1e-10)
-    so.setMaxIterations(2000)
-    states = opensim.StatesReporter()
-    states.setStartTime(T0)
-    states.setEndTime(T1)
-    tool.getAnalysisSet().cloneAndAppend(so)
-    tool.getAnalysisSet().cloneAndAppend(states)
-    tool.printToXML(str(out / "setup.xml"))
-    assert opensim.AnalyzeTool(str(out / "setup.xml")).run()
-
+    os_so = opensim_static_optimization(
+        path, mot, names, strength, ms.names, T0, T1, out, criterion=1e-10, states=True
+    )
     # the AnalyzeTool's q, q̇ (GCV spline of q) and StaticOptimization's q̈ (GCV spline of q̇)
-    plain = opensim.Model(str(path))
-    plain.initSystem()
-    q_store = opensim.Storage(str(mot))
-    plain.getSimbodyEngine().convertDegreesToRadians(q_store)
-    qd_store = opensim.GCVSplineSet(5, q_store).constructStorage(1)
-    qdd_store = opensim.GCVSplineSet(5, qd_store).constructStorage(1)
-    t_all, lq, q_all = _columns(q_store)
-    ts, ls, S = _columns(opensim.Storage(str(out / "so_StatesReporter_states.sto")))
-    rows = [int(np.argmin(np.abs(t_all - t))) for t in ts]
-    assert np.allclose(t_all[rows], ts, atol=1e-9) and len(ts) == 10
-    Q = _pick(lq, q_all, names)[rows]
-    QD = _pick(*_columns(qd_store)[1:], names)[rows]
-    QDD = _pick(*_columns(qdd_store)[1:], names)[rows]
-    _, la, A = _columns(opensim.Storage(str(out / "so_StaticOptimization_activation.sto")))
-    _, lf, F = _columns(opensim.Storage(str(out / "so_StaticOptimization_force.sto")))
+    Q, QD, QDD = opensim_kinematics(path, mot, names, os_so.time)
+    assert len(os_so) == 10
     return dict(
         robot=robot,
         ms=ms,
@@ -143,22 +82,18 @@ def trial(tmp_path_factory):
         Q=Q,
         QD=QD,
         QDD=QDD,
-        states_q=_pick(ls, S, names, "/value"),
-        states_u=_pick(ls, S, names, "/speed"),
-        a=_pick(la, A, ms.names),
-        f=_pick(lf, F, ms.names),
-        reserve=_pick(lf, F, [f"{n}_reserve" for n in names]),
+        opensim=os_so,
         tau=np.array([robot.inverse_dynamics(*x) for x in zip(Q, QD, QDD)]),
     )
 
 
 def test_same_states_and_dynamics(trial):
     # q and q̇ are OpenSim's states (to the 1e-8 of its printed storage)
-    assert np.abs(trial["states_q"] - trial["Q"]).max() < 1e-7
-    assert np.abs(trial["states_u"] - trial["QD"]).max() < 1e-7
+    assert np.abs(trial["opensim"].states_q - trial["Q"]).max() < 1e-7
+    assert np.abs(trial["opensim"].states_u - trial["QD"]).max() < 1e-7
     # OpenSim's solution meets our inverse-dynamics torques: Rᵀ f + reserves = τ
     R = muscles.moment_arms(trial["robot"], trial["ms"], trial["Q"])
-    total = np.einsum("nmk,nm->nk", R, trial["f"]) + trial["reserve"]
+    total = np.einsum("nmk,nm->nk", R, trial["opensim"].force) + trial["opensim"].reserve
     scale = 1.0 + np.abs(trial["tau"])
     assert np.abs((total - trial["tau"]) / scale).max() < 1e-4
 
@@ -175,14 +110,15 @@ def test_activations_match_opensim(trial):
         lower=[m.params["minimum_activation"] for m in trial["ms"].muscles],
     )
     assert all(s == "optimal" for s in so.status)
-    err = np.abs(so.activation - trial["a"])
+    theirs = trial["opensim"]
+    err = np.abs(so.activation - theirs.activation)
     assert err.max() < 1e-3, err.max()  # the issue's target
     assert err.max() < 1e-4  # measured 1.9e-5 (grac_r at 0.0101, next to its bound 0.01)
     # the muscles carry the legs: activations well above the floor on several muscles
-    assert (trial["a"] > 0.1).sum() >= 10
+    assert (theirs.activation > 0.1).sum() >= 10
     # the same optimum: equal objectives (OpenSim's meets the dynamics to ~1e-6 N m, which
     # moves its objective by ~1e-6 relative), and both answers are KKT points of the problem
-    j_os = (trial["a"] ** 2).sum(1) + ((trial["reserve"] / trial["strength"]) ** 2).sum(1)
+    j_os = (theirs.activation**2).sum(1) + ((theirs.reserve / trial["strength"]) ** 2).sum(1)
     j_ours = (so.activation**2).sum(1) + ((so.reserve_torque / trial["strength"]) ** 2).sum(1)
     assert np.all(np.abs(j_os - j_ours) < 1e-5 * j_os), j_ours - j_os
     L, R = muscles.lengths_and_moment_arms(trial["robot"], trial["ms"], trial["Q"])
@@ -191,11 +127,11 @@ def test_activations_match_opensim(trial):
     for k in range(len(R)):
         C = np.hstack([R[k].T * FA[k], np.diag(trial["strength"])])
         ours = np.concatenate([so.activation[k], so.reserve_torque[k] / trial["strength"]])
-        theirs = np.concatenate([trial["a"][k], trial["reserve"][k] / trial["strength"]])
+        x_os = np.concatenate([theirs.activation[k], theirs.reserve[k] / trial["strength"]])
         assert _stationarity(ours, C, M) < 1e-8
-        assert _stationarity(theirs, C, M) < 1e-4
-    np.testing.assert_allclose(so.force, trial["f"], rtol=1e-4, atol=1e-2)
-    np.testing.assert_allclose(so.reserve_torque, trial["reserve"], rtol=1e-4, atol=1e-3)
+        assert _stationarity(x_os, C, M) < 1e-4
+    np.testing.assert_allclose(so.force, theirs.force, rtol=1e-4, atol=1e-2)
+    np.testing.assert_allclose(so.reserve_torque, theirs.reserve, rtol=1e-4, atol=1e-3)
 
 
 def test_the_problem_differs_without_those_options(trial):
@@ -204,4 +140,25 @@ def test_the_problem_differs_without_those_options(trial):
     args = (trial["robot"], trial["ms"], trial["Q"], trial["tau"])
     for kw in ({"qd": None, "passive": False}, {"qd": trial["QD"], "passive": True}):
         so = muscles.static_optimization(*args, reserve=trial["strength"], lower=0.01, **kw)
-        assert np.abs(so.activation - trial["a"]).max() > 1e-2
+        assert np.abs(so.activation - trial["opensim"].activation).max() > 1e-2
+
+
+def test_oracle_refuses_bad_input(tmp_path):
+    """OpenSim's side (:mod:`anthroarm.muscles.opensim_oracle`) given a strength per coordinate
+    that is missing or not positive, an empty time range, times that are not rows of the
+    motion, or a muscle OpenSim did not report: a MuscleError, before or instead of a run."""
+    path = aa.osim.path("arm26")
+    mot = aa.osim.path("subject01_simbody").parent / "recordings" / "subject01_walk1_ik.mot"
+    names = ["r_shoulder_elev", "r_elbow_flex"]
+    args = (path, mot, names)
+    with pytest.raises(MuscleError, match="strength"):
+        opensim_static_optimization(*args, [1.0], ["BIClong"], 0.0, 1.0, tmp_path)
+    with pytest.raises(MuscleError, match="strength"):
+        opensim_static_optimization(*args, [1.0, 0.0], ["BIClong"], 0.0, 1.0, tmp_path)
+    with pytest.raises(MuscleError, match="empty"):
+        opensim_static_optimization(*args, [1.0, 1.0], ["BIClong"], 1.0, 1.0, tmp_path)
+    gait = aa.osim.path("subject01_simbody")
+    with pytest.raises(MuscleError, match="not rows"):
+        opensim_kinematics(gait, mot, ["hip_flexion_r"], [0.601234])
+    with pytest.raises(MuscleError, match="no column 'not_a_coordinate'"):
+        opensim_kinematics(gait, mot, ["not_a_coordinate"], [0.6])

@@ -24,16 +24,16 @@ import pytest
 
 opensim = pytest.importorskip("opensim")
 
-from osim_oracle import OpenSimOracle  # noqa: E402
 from synthetic_models import model_text  # noqa: E402
 
 import anthroarm as aa  # noqa: E402
 from anthroarm.osim import functions as fn  # noqa: E402
+from anthroarm.osim.checks import OpenSimModel  # noqa: E402
 
 
 def _osim_eval(f, x):
     v = opensim.Vector(1, float(x))
-    # lists (SWIG's sequence typemap), not opensim.StdVectorInt: see osim_oracle.py
+    # lists (SWIG's sequence typemap), not opensim.StdVectorInt: see anthroarm.osim.checks.OpenSimModel
     d1 = f.calcDerivative([0], v)
     d2 = f.calcDerivative([0, 0], v)
     return f.calcValue(v), d1, d2
@@ -131,16 +131,16 @@ def test_every_joint_type_agrees_with_opensim(tmp_path):
         robot.joint_names
     )
     assert {f"b{i}" for i in range(10)} | {f"m{i}" for i in range(10)} <= set(robot.frame_names)
-    oracle = OpenSimOracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     rng = np.random.default_rng(0)
     err = dict(pose=0.0, marker=0.0, M=0.0, g=0.0, tau=0.0)
     for _ in range(60):
         q = robot.random_q(None, rng)
         qd, qdd = rng.normal(size=robot.nq), rng.normal(size=robot.nq)
         C, _ = oracle.set_state(q)
-        for b, H in oracle.body_poses().items():
+        for b, H in oracle.poses().items():
             err["pose"] = max(err["pose"], np.abs(robot.fk(q, b) - H).max())
-        for mk, p in oracle.marker_positions().items():
+        for mk, p in oracle.markers().items():
             err["marker"] = max(err["marker"], np.abs(robot.fk(q, mk)[:3, 3] - p).max())
         Mo = oracle.mass_matrix(C)
         go = oracle.inverse_dynamics(C, np.zeros(oracle.nu))
@@ -169,7 +169,7 @@ def test_simbody_H_ignores_a_constant_rotation_before_a_moving_one(tmp_path):
     derivative of its own poses, the import's agrees."""
     path = _write(tmp_path, "constfirst", const_first=True)
     robot = aa.load(path)
-    oracle = OpenSimOracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     q = robot.random_q(None, 0)
     k = robot.joint_names.index("twist")
     e = np.zeros(robot.nq)
@@ -178,13 +178,13 @@ def test_simbody_H_ignores_a_constant_rotation_before_a_moving_one(tmp_path):
 
     def R(qq):
         oracle.set_state(qq)
-        return oracle.body_poses()["b7"][:3, :3]
+        return oracle.poses()["b7"][:3, :3]
 
     W = (R(q + h * e) - R(q - h * e)) / (2 * h) @ R(q).T
     w_fd = np.array([W[2, 1], W[0, 2], W[1, 0]])
     w_ours = robot.jacobian(q, "b7")[3:, k]
     oracle.set_state(q, e)
-    V = oracle.bodies.get("b7").getVelocityInGround(oracle.state)
+    V = oracle.model.getBodySet().get("b7").getVelocityInGround(oracle.state)
     w_osim = np.array([V.get(0).get(i) for i in range(3)])
     assert np.abs(w_ours - w_fd).max() < 1e-8
     assert np.abs(w_osim - w_fd).max() > 1e-2  # OpenSim's own inconsistency (Simbody buildH)
@@ -196,7 +196,7 @@ def test_walker_knee_velocity_terms_are_exact(tmp_path):
     ``calcM``; OpenSim's inverse dynamics (``buildHdot``) does not."""
     path = _write(tmp_path, "walker", walker=True)
     robot = aa.load(path)
-    oracle = OpenSimOracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     rng = np.random.default_rng(5)
     q = robot.random_q(None, rng, margin=0.1)
     qd = np.zeros(robot.nq)
@@ -228,10 +228,10 @@ def test_opensim_3_model_read_through_opensims_updater():
     robot = aa.load(path)
     assert robot.joint_names == ["q1", "q2"]
     assert "updater" in robot.report.rows[-1].why
-    oracle = OpenSimOracle(path, robot.joint_names)
+    oracle = OpenSimModel(path, robot.joint_names)
     for q in robot.random_q(20, 0):
         C, _ = oracle.set_state(q)
-        for b, H in oracle.body_poses().items():
+        for b, H in oracle.poses().items():
             assert np.abs(robot.fk(q, b) - H).max() < 1e-12
         Mo = oracle.mass_matrix(C)
         assert np.abs(robot.mass_matrix(q) - Mo).max() < 1e-12 * max(1, np.abs(Mo).max())

@@ -17,6 +17,7 @@ import pytest
 import anthroarm as aa
 from anthroarm.errors import OsimError, OsimSecurityError, OsimStrictError, OsimUnsupportedError
 from anthroarm.osim import path
+from anthroarm.osim.checks import OpenSimModel
 
 ARM = path("arm26").read_text(encoding="utf-8")
 LEG = path("leg6dof9musc").read_text(encoding="utf-8")
@@ -353,3 +354,11 @@ def test_coordinate_with_a_body_name_keeps_both(tmp_path):
     assert np.abs(robot.fk(q, "r_ulna_radius_hand") - ref.fk(q, "r_ulna_radius_hand")).max() == 0
     assert "r_ulna_radius_hand_joint" in robot.frame_names
     assert robot.chain.frame("r_ulna_radius_hand").is_body  # the body, not the joint's frame
+
+
+def test_opensim_model_with_an_unknown_coordinate():
+    """OpenSim's side of the checks (:class:`anthroarm.osim.checks.OpenSimModel`) given a
+    coordinate the model does not have: an OsimError naming it, not a KeyError later."""
+    pytest.importorskip("opensim")
+    with pytest.raises(OsimError, match="not_a_coordinate"):
+        OpenSimModel(path("arm26"), ["r_shoulder_elev", "not_a_coordinate"])

@@ -14,7 +14,9 @@ moment arms, batched; the paths as points), :mod:`.wrap` (wrapping over cylinder
 equilibrium, joint torques τ = Rᵀ f), :mod:`.millard` (Millard2012EquilibriumMuscle curves and
 equilibrium), :mod:`.optimize` (static optimisation through the QP layer), :mod:`.emg` (the
 EMG-driven chain: envelope → excitation → activation → forces → joint torques, beside the
-torques an activity needs), :mod:`.checks` (``anthroarm check``'s muscle rows).
+torques an activity needs), :mod:`.checks` (``anthroarm check``'s muscle rows),
+:mod:`.opensim_oracle` (OpenSim's own ``StaticOptimization``, the reference of the static
+optimisation).
 """
 
 from __future__ import annotations

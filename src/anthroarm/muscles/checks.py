@@ -120,27 +120,25 @@ def opensim_rows(robot, ms, samples: int, rng) -> list[CheckRow]:
     docstring); over an ellipsoid, moment arms against central differences of OpenSim's lengths
     (step :data:`H_OPENSIM`)."""
     o = OpenSimModel(robot.osim.path, robot.joint_names)
-    mset = o.model.getMuscles()
-    mus = [mset.get(nm) for nm in ms.names]
-    coords = [o.coords[c] for c in robot.joint_names]
+    theirs = [m.getName() for m in o.muscles]
+    order = [theirs.index(nm) for nm in ms.names]
     n = max(1, min(int(samples), 20))
     n_arm = min(n, 3)
     Q = robot.random_q(n, rng)
     L, R = lengths_and_moment_arms(robot, ms, Q)
     ell = _over_ellipsoid(ms)
-    z = np.zeros(robot.nq)
 
     def opensim_lengths(q):
-        o.set_state(q, z, z)
-        return np.array([m.getLength(o.state) for m in mus])
+        o.set_state(q)
+        return o.lengths()[order]
 
     e_len = e_arm = e_ell = 0.0
     for i, q in enumerate(Q):
         e_len = max(e_len, float(np.abs(opensim_lengths(q) - L[i]).max()))
         if i >= n_arm:
             continue
-        o.set_state(q, z, z)
-        ro = np.array([[m.computeMomentArm(o.state, c) for c in coords] for m in mus])
+        o.set_state(q)
+        ro = o.moment_arms()[order]
         if (~ell).any():
             e_arm = max(e_arm, float(np.abs(ro - R[i])[~ell].max()))
         if ell.any():

@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..check_rows import CheckRow
+from ..errors import OsimError
 
 
 def rows(robot, samples: int, rng) -> list[CheckRow]:
@@ -107,7 +108,23 @@ def pinocchio_rows(robot, samples: int, rng) -> list[CheckRow]:
 
 
 class OpenSimModel:
-    """OpenSim's side of the comparison (see the module docstring); forces switched off."""
+    """OpenSim's side of every comparison with OpenSim (this module's rows, the muscle rows of
+    :mod:`anthroarm.muscles.checks`, the tests): the model read by ``opensim.Model``, its forces
+    switched off (``set_appliesForce(False)``: gravity and inertia only in the dynamics; a
+    muscle's path is geometry and stays), set to states given in the robot's independent
+    coordinates ``names``.
+
+    :meth:`set_state` gives every coordinate its value, rate and acceleration: a dependent
+    coordinate of a ``CoordinateCouplerConstraint`` y = s f(x) gets ẏ = s f'(x) ẋ and
+    ÿ = s (f'(x) ẍ + f''(x) ẋ²) from OpenSim's own function, and its row of C = du/dq̇ is
+    s f'(x) times that of x (module docstring); a locked coordinate keeps its default value.
+    The readers (:meth:`poses`, :meth:`markers`, :meth:`mass_matrix`, :meth:`inverse_dynamics`,
+    :meth:`lengths`, :meth:`moment_arm`) then read OpenSim at that state.
+
+    Attributes: ``osim`` (the module), ``model``, ``state``, ``coords`` (name -> Coordinate, all
+    of the model's), ``names``, ``couplers``, ``nu`` (Simbody's mobilities), ``u_index``
+    (coordinate name -> mobility), ``muscles`` (the model's muscles, in its order).
+    """
 
     def __init__(self, path, names):
         import opensim as osim
@@ -123,6 +140,9 @@ class OpenSimModel:
         cs = model.getCoordinateSet()
         self.coords = {cs.get(i).getName(): cs.get(i) for i in range(cs.getSize())}
         self.names = list(names)
+        missing = [nm for nm in self.names if nm not in self.coords]
+        if missing:
+            raise OsimError(path, f"coordinates not in the model: {', '.join(missing)}")
         self.couplers = {}
         cons = model.getConstraintSet()
         for i in range(cons.getSize()):
@@ -141,6 +161,8 @@ class OpenSimModel:
         for c in self.coords.values():
             c.setSpeedValue(s, 0.0)
         self.ids = osim.InverseDynamicsSolver(model)
+        ms = model.getMuscles()
+        self.muscles = [ms.get(i) for i in range(ms.getSize())]
 
     def _f(self, f, x, order):
         v = self.osim.Vector(1, float(x))
@@ -150,12 +172,16 @@ class OpenSimModel:
         # refused with a TypeError by common's Function.calcDerivative in some test processes
         return f.calcDerivative([0] * order, v)
 
-    def set_state(self, q, qd, qdd):
+    def set_state(self, q, qd=None, qdd=None):
+        """Set the state to coordinates ``q``, rates ``qd`` and accelerations ``qdd`` (zero
+        when None) and realize it to velocity: (C = du/dq̇ of shape (nu, n), the mobility
+        accelerations u̇)."""
         n = len(self.names)
+        z = np.zeros(n)
         val, rate, acc = (
             dict(zip(self.names, q)),
-            dict(zip(self.names, qd)),
-            dict(zip(self.names, qdd)),
+            dict(zip(self.names, z if qd is None else qd)),
+            dict(zip(self.names, z if qdd is None else qdd)),
         )
         row = {nm: np.eye(n)[i] for i, nm in enumerate(self.names)}
         todo = [d for d in self.couplers if d not in val]
@@ -180,7 +206,8 @@ class OpenSimModel:
             udot[self.u_index[nm]] = acc.get(nm, 0.0)
         return C, udot
 
-    def poses(self):
+    def poses(self) -> dict:
+        """Every body's pose in ground (``Body.getTransformInGround``): name -> 4×4."""
         bs, out = self.model.getBodySet(), {}
         for i in range(bs.getSize()):
             T = bs.get(i).getTransformInGround(self.state)
@@ -190,21 +217,42 @@ class OpenSimModel:
             out[bs.get(i).getName()] = H
         return out
 
-    def markers(self):
+    def markers(self) -> dict:
+        """Every marker's position in ground (``Marker.getLocationInGround``): name -> (3,)."""
         ms, out = self.model.getMarkerSet(), {}
         for i in range(ms.getSize()):
             p = ms.get(i).getLocationInGround(self.state)
             out[ms.get(i).getName()] = np.array([p.get(k) for k in range(3)])
         return out
 
-    def mass_matrix(self, C):
+    def mass_matrix(self, C) -> np.ndarray:
+        """The mass matrix in the independent coordinates, Cᵀ M C (M by
+        ``SimbodyMatterSubsystem.calcM`` in mobility order)."""
         M = self.osim.Matrix()
         self.model.getMatterSubsystem().calcM(self.state, M)
         return C.T @ np.array([[M.get(r, c) for c in range(self.nu)] for r in range(self.nu)]) @ C
 
-    def inverse_dynamics(self, C, udot):
+    def inverse_dynamics(self, C, udot) -> np.ndarray:
+        """The generalized forces in the independent coordinates, Cᵀ τ (τ by
+        ``InverseDynamicsSolver.solve`` at mobility accelerations ``udot``)."""
         tau = self.ids.solve(self.state, self.osim.Vector(udot.tolist()))
         return C.T @ np.array([tau.get(k) for k in range(self.nu)])
+
+    def lengths(self) -> np.ndarray:
+        """Every muscle's musculotendon length (``Muscle.getLength``, m), in the model's order."""
+        return np.array([m.getLength(self.state) for m in self.muscles])
+
+    def moment_arm(self, i: int, k: int) -> float:
+        """Muscle ``i``'s moment arm about the independent coordinate ``names[k]``
+        (``Muscle.computeMomentArm``, m)."""
+        return self.muscles[i].computeMomentArm(self.state, self.coords[self.names[k]])
+
+    def moment_arms(self) -> np.ndarray:
+        """Every muscle's moment arm about every independent coordinate: (muscles, n), m."""
+        n = len(self.names)
+        return np.array(
+            [[self.moment_arm(i, k) for k in range(n)] for i in range(len(self.muscles))]
+        )
 
 
 def opensim_rows(robot, n: int, rng) -> list[CheckRow]:
