@@ -28,8 +28,9 @@ from arm26_variants import no_ellipsoids, spheres, tri_quadrant, variant
 import anthroarm as aa
 from anthroarm import muscles
 from anthroarm.errors import ParameterError
+from anthroarm.osim.checks import OpenSimModel
 
-opensim = pytest.importorskip("opensim")
+pytest.importorskip("opensim")
 
 TOL = 1e-6
 TOL_ELLIPSOID = 1e-4
@@ -40,24 +41,17 @@ ELLIPSOID_PATHS = ("BIClong", "TRIlong")
 def arm26():
     path = aa.osim.path("arm26")
     robot = aa.load(path)
-    ms = muscles.read_muscles(path)
-    model = opensim.Model(str(path))
-    state = model.initSystem()
-    coords = [model.getCoordinateSet().get(n) for n in robot.joint_names]
-    return robot, ms, model, state, coords
+    return robot, muscles.read_muscles(path), OpenSimModel(path, robot.joint_names)
 
 
-def _opensim_path(model, state, name):
-    """(points (k, 3) of getCurrentPath in ground, their names, getLength) of one muscle."""
-    gp = model.getMuscles().get(name).getGeometryPath()
-    cp = gp.getCurrentPath(state)
-    pts = [cp.get(k).getLocationInGround(state) for k in range(cp.getSize())]
-    names = [cp.get(k).getName() for k in range(cp.getSize())]
-    return np.array([[p[j] for j in range(3)] for p in pts]), names, gp.getLength(state)
+def _opensim_path(osm, name):
+    """OpenSim's (points (k, 3) of getCurrentPath in ground, their names, getLength) of the
+    muscle ``name`` at the state set."""
+    return osm.current_path([m.getName() for m in osm.muscles].index(name))
 
 
 def test_points_and_lengths_against_opensim_20_states(arm26):
-    robot, ms, model, state, coords = arm26
+    robot, ms, osm = arm26
     Q = robot.random_q(20, rng=7)
     paths = muscles.path_points(robot, ms, Q)
     L = muscles.lengths(robot, ms, Q)
@@ -66,13 +60,11 @@ def test_points_and_lengths_against_opensim_20_states(arm26):
     multi_excess = []
     wrapped = {m: 0 for m in ms.names}
     for s, q in enumerate(Q):
-        for c, v in zip(coords, q):
-            c.setValue(state, float(v), False)
-        model.realizePosition(state)
+        osm.set_state(q)
         assert list(paths[s]) == ms.names
         for i, name in enumerate(ms.names):
             mp = paths[s][name]
-            theirs, names, length = _opensim_path(model, state, name)
+            theirs, names, length = _opensim_path(osm, name)
             assert mp.current.shape == theirs.shape, (name, s, mp.labels, names)
             # the same points in the same order: PathPoints by name, wrap points by position
             ours_names = [lb for lb, on in zip(mp.labels, mp.surface) if not on]
@@ -103,20 +95,16 @@ def test_gait2392_conditional_and_moving_points():
     path = aa.osim.path("gait2392")
     robot = aa.load(path)
     ms = muscles.read_muscles(path)
-    model = opensim.Model(str(path))
-    state = model.initSystem()
-    coords = [model.getCoordinateSet().get(c) for c in robot.joint_names]
+    osm = OpenSimModel(path, robot.joint_names)
     Q = robot.random_q(20, rng=0)
     paths = muscles.path_points(robot, ms, Q)
     err = err_len = 0.0
     dropped = 0
     for s, q in enumerate(Q):
-        for c, v in zip(coords, q):
-            c.setValue(state, float(v), False)
-        model.realizePosition(state)
+        osm.set_state(q)
         for m in ms.muscles:
             mp = paths[s][m.name]
-            theirs, names, length = _opensim_path(model, state, m.name)
+            theirs, names, length = _opensim_path(osm, m.name)
             assert list(mp.labels) == names, (m.name, s)
             err = max(err, np.abs(mp.points - theirs).max())
             err_len = max(err_len, abs(mp.length - length))
@@ -130,20 +118,16 @@ def _variant_against_opensim(path, names, n, seed):
     tangent point to tangent point of those paths) of ``names`` in the model at ``path``."""
     robot = aa.load(path)
     ms = muscles.read_muscles(path).select(names)
-    model = opensim.Model(str(path))
-    state = model.initSystem()
-    coords = [model.getCoordinateSet().get(c) for c in robot.joint_names]
+    osm = OpenSimModel(path, robot.joint_names)
     Q = robot.random_q(n, rng=seed)
     paths = muscles.path_points(robot, ms, Q)
     err = err_len = 0.0
     arcs = []
     for s, q in enumerate(Q):
-        for c, v in zip(coords, q):
-            c.setValue(state, float(v), False)
-        model.realizePosition(state)
+        osm.set_state(q)
         for name in ms.names:
             mp = paths[s][name]
-            theirs, _, length = _opensim_path(model, state, name)
+            theirs, _, length = _opensim_path(osm, name)
             assert mp.current.shape == theirs.shape
             err = max(err, np.abs(mp.current - theirs).max())
             if len({lb for lb in mp.labels if lb in ms.wrap_objects}) > 1:
@@ -182,7 +166,7 @@ def test_surface_points_lie_on_their_wrap_surface(arm26):
     """Mathematics: a cylinder arc's points are at the cylinder's radius from its axis, an
     ellipsoid arc's on (x/a)² + (y/b)² + (z/c)² = 1 (OpenSim's chords join surface points), in
     the wrap object's own frame (body pose from robot.fk, the wrap's placement from the file)."""
-    robot, ms, *_ = arm26
+    robot, ms, _ = arm26
     q = robot.random_q(8, rng=3)
     paths = muscles.path_points(robot, ms, q)
     checked = set()
@@ -205,7 +189,7 @@ def test_surface_points_lie_on_their_wrap_surface(arm26):
 
 
 def test_one_state_and_bad_tolerance(arm26):
-    robot, ms, *_ = arm26
+    robot, ms, _ = arm26
     q = robot.default_q()
     one = muscles.path_points(robot, ms, q)
     many = muscles.path_points(robot, ms, q[None])

@@ -34,8 +34,6 @@ from anthroarm.osim.checks import OpenSimModel  # noqa: E402
 TOL = 1e-6
 
 
-
-
 def _compare_all(path, n, seed, skip=()):
     robot = aa.load(path)
     ms = muscles.read_muscles(path)

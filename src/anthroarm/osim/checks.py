@@ -119,7 +119,7 @@ class OpenSimModel:
     ÿ = s (f'(x) ẍ + f''(x) ẋ²) from OpenSim's own function, and its row of C = du/dq̇ is
     s f'(x) times that of x (module docstring); a locked coordinate keeps its default value.
     The readers (:meth:`poses`, :meth:`markers`, :meth:`mass_matrix`, :meth:`inverse_dynamics`,
-    :meth:`lengths`, :meth:`moment_arm`) then read OpenSim at that state.
+    :meth:`lengths`, :meth:`moment_arm`, :meth:`current_path`) then read OpenSim at that state.
 
     Attributes: ``osim`` (the module), ``model``, ``state``, ``coords`` (name -> Coordinate, all
     of the model's), ``names``, ``couplers``, ``nu`` (Simbody's mobilities), ``u_index``
@@ -246,6 +246,17 @@ class OpenSimModel:
         """Muscle ``i``'s moment arm about the independent coordinate ``names[k]``
         (``Muscle.computeMomentArm``, m)."""
         return self.muscles[i].computeMomentArm(self.state, self.coords[self.names[k]])
+
+    def current_path(self, i: int):
+        """Muscle ``i``'s path as OpenSim has it at this state: (points (k, 3) of
+        ``GeometryPath.getCurrentPath`` in ground by ``getLocationInGround``, m; their names,
+        ``pwpt1``/``pwpt2`` for a wrap's ``PathWrapPoint``\\ s; ``getLength``, m)."""
+        gp = self.muscles[i].getGeometryPath()
+        cp = gp.getCurrentPath(self.state)
+        pts = [cp.get(k) for k in range(cp.getSize())]
+        xyz = [p.getLocationInGround(self.state) for p in pts]
+        X = np.array([[x[j] for j in range(3)] for x in xyz]).reshape(-1, 3)
+        return X, [p.getName() for p in pts], gp.getLength(self.state)
 
     def moment_arms(self) -> np.ndarray:
         """Every muscle's moment arm about every independent coordinate: (muscles, n), m."""
