@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import pkgutil
 import sys
 from pathlib import Path
@@ -20,6 +21,20 @@ def available() -> list[str]:
     )
 
 
+#: import names of the packages of pyproject's ``bench`` extra (the peers)
+BENCH_EXTRA = (
+    "pink",
+    "ikpy",
+    "daqp",
+    "quadprog",
+    "proxsuite",
+    "roboticstoolbox",
+    "pytracik",
+    "ik_geo",
+    "mink",
+)
+
+
 def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
     """Run benchmarks and write their results: full runs to ``results/``, quick runs to
     ``results/quick/`` (git-ignored; never to ``results/``), or both to ``out_dir``."""
@@ -27,6 +42,14 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
     unknown = [n for n in names if n not in available()]
     if unknown:
         raise SystemExit(f"unknown benchmark(s) {unknown}; available: {', '.join(available())}")
+    missing = [m for m in BENCH_EXTRA if importlib.util.find_spec(m) is None]
+    if missing and not quick and out_dir is None:
+        # a full run into results/ without a peer would commit a table with its rows missing
+        raise SystemExit(
+            f"the peers {', '.join(missing)} are not installed: a full run writes the committed "
+            "tables, which compare against every peer; pip install -e '.[bench]' (or run "
+            "--quick, or --out FOLDER)"
+        )
     written = []
     for n in names:
         mod = importlib.import_module(f"benchmarks.bench_{n}")
