@@ -434,19 +434,26 @@ def jacobians(robot_model, data, dist: Distances, mask=None) -> np.ndarray:
         return rows
     out = np.zeros((K, robot_model.nv))
     cache = {}
-    for k in range(K):
-        for j, p, s in (
-            (dist.joint_a[k], dist.point_a[k], -1.0),
-            (dist.joint_b[k], dist.point_b[k], 1.0),
-        ):
-            j = int(j)
-            if j == 0:
-                continue
-            J = cache.get(j)
-            if J is None:
-                J = cache[j] = pin.getJointJacobian(robot_model, data, j, LWA)
-            r = p - data.oMi[j].translation
-            out[k] += s * (n[k] @ J[:3] + np.cross(r, n[k]) @ J[3:])
+    for joints, points, sign in (
+        (dist.joint_a, dist.point_a, -1.0),
+        (dist.joint_b, dist.point_b, 1.0),
+    ):
+        joints = np.asarray(joints, dtype=int)
+        moving = joints != 0  # a point of the universe (an obstacle) does not move
+        if not moving.any():
+            continue
+        for j in np.unique(joints[moving]):
+            if j not in cache:
+                cache[j] = (
+                    pin.getJointJacobian(robot_model, data, int(j), LWA),
+                    data.oMi[int(j)].translation,
+                )
+        J = np.stack([cache[j][0] for j in joints[moving]])  # (k, 6, nv)
+        r = points[moving] - np.stack([cache[j][1] for j in joints[moving]])
+        nm = n[moving]
+        out[moving] += sign * (
+            np.einsum("ki,kiv->kv", nm, J[:, :3]) + np.einsum("ki,kiv->kv", _cross(r, nm), J[:, 3:])
+        )
     return out
 
 
