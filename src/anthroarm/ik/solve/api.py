@@ -187,9 +187,7 @@ def solve(
     sh = ws.sh
     mode, batch, targets = parse(T, mode)
     check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
-    Q0 = check_q0(robot, q0, batch, len(targets))
-    if Q0 is not None:
-        Q0 = sh.theta(Q0)
+    Q0 = None if q0 is None else sh.theta(check_q0(robot, q0, batch, len(targets)))
     th_ref, sw = _reference(robot, sh, posture, swivel, swivel_frames)
     redundant = sh.dof > (6 if mode == "pose" else 3)  # the objectives need a self-motion
     pb = Problem(
