@@ -99,6 +99,8 @@ def _reference(robot, sh, posture, swivel, swivel_frames):
     return th_ref, Swivel([robot.frame_id(f) for f in _swivel_frames(robot, swivel_frames)], swivel)
 
 
+# long: the public docstring (every argument); the body is the dispatch of a coupled model
+# and the calls of the steps
 def solve(
     robot,
     T,
