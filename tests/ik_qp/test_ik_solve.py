@@ -156,6 +156,34 @@ def test_bad_input(robots):
         aa.ik.solve(robot, np.zeros(3), mode="orientation")
 
 
+def test_q0_rows_need_as_many_targets(robots):
+    """An (N, nq) q0 is one seed per target (the docstring): with one target, or a batch of
+    another length, ValueError (the one check of both solvers, targets.check_q0)."""
+    robot = robots["ur5"]
+    qs = robot.random_q(3, rng=2)
+    Ts = robot.fk(qs)
+    with pytest.raises(ValueError, match="needs a batch of 3 targets"):
+        aa.ik.solve(robot, Ts[0], q0=qs)
+    with pytest.raises(ValueError, match="needs a batch of 3 targets"):
+        aa.ik.solve(robot, Ts[:2], q0=qs)
+    assert aa.ik.solve(robot, Ts, q0=qs).success.all()
+
+
+def test_one_pose_fast_path_reads_as_the_general_parse():
+    """targets.parse: a 4×4 float64 array (the fast path) gives the target that the same pose as
+    nested lists gives (the general path), and a (1, 4, 4) array is a batch of that one pose."""
+    R = pin.utils.rotate("z", 0.3) @ pin.utils.rotate("x", -1.1)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, [0.1, -0.2, 0.3]
+    fast = targets.parse(T, None)
+    assert fast[:2] == ("pose", False)
+    for H in (targets.parse(T.tolist(), None)[2][0], targets.parse(T, "pose")[2][0]):
+        assert np.array_equal(fast[2][0], H)
+    mode, batch, (H,) = targets.parse(T[None], None)
+    assert (mode, batch) == ("pose", True) and np.array_equal(H, T)
+    assert targets.parse(T, "position")[2][0].tolist() == [0.1, -0.2, 0.3]
+
+
 def test_seed_outside_limits_returns_within_limits(robots):
     robot = robots["panda"]
     T = robot.fk(robot.random_q(rng=3))

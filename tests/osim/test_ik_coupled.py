@@ -68,6 +68,14 @@ def test_solve_on_a_model_with_a_coupler():
         assert max(errors(pose(leg, r.q, "toes_r"), T)) <= 1e-6
 
 
+def test_q0_rows_need_as_many_targets(gait):
+    """As for any robot: an (N, nq) q0 is one seed per target, ValueError with one target."""
+    qs = gait.random_q(2, rng=1)
+    T = pose(gait, qs[0]).homogeneous
+    with pytest.raises(ValueError, match="needs a batch of 2 targets"):
+        aa.ik.solve(gait, T, q0=qs, frame=FRAME)
+
+
 def test_solve_from_threads(gait):
     """One Robot solved for from two threads at once (each thread its own pin.Data)."""
     rng = np.random.default_rng(5)

@@ -51,6 +51,14 @@ one source runs in the interpreter until the compiled code is ready), the frame'
 Jacobian from the chain's one compiled forward kinematics
 (:func:`anthroarm.ik.geometric.fk.chain_fk_jacobian`, read from ``robot.chain``).
 
+Layout of one call (:mod:`.api`), one job per function: :func:`.targets.parse` (the targets;
+one 4×4 array straight to the rigid check) and :func:`.targets.check_options`; the one-time
+tables and kernels, before any clock starts (``max_time`` never counts them); per target
+:func:`.api.solve_one` — :class:`.api.SeedOrder` gives the seeds in turn,
+:func:`.lm.attempt` refines each, the null-space phase follows a success — or, for a batch,
+:func:`.api.solve_lockstep` (the rounds of :class:`.api.Lockstep`: evaluate, restart, step);
+:meth:`~anthroarm.ik.result.IKBatchResult.collect` gathers the answers.
+
 Threads and memory (:mod:`.workspace`): one Robot may be used from several threads at once
 (per-thread ``pin.Data`` and kernel arrays); the per-robot cache holds the Robot weakly and
 nothing that refers to it.

@@ -9,7 +9,6 @@ import numpy as np
 
 from ... import jit
 from ..closed.limits import refine
-from ..qp.targets import as_rigid
 from ..qp.tasks.swivel import swivel_frames as _swivel_frames
 from ..result import IKBatchResult, IKResult
 from . import coupled, lm
@@ -17,7 +16,7 @@ from .kernel import MAX_ITER, STALL, clock, damped_step, damping
 from .nullspace import Swivel, posture
 from .nullspace import swivel as swivel_phase
 from .seeds import SWIVEL_GRID, SWIVEL_GRID_COARSE, TableSeeds, analytic_seeds
-from .targets import ORIENTATION, Target, check_options, parse
+from .targets import ORIENTATION, Target, check_options, check_q0, parse
 from .workspace import workspace
 
 ANALYTIC_AFTER = 8  # analytic="auto": closed-form seeds join after this many failed attempts
@@ -100,6 +99,8 @@ def _reference(robot, sh, posture, swivel, swivel_frames):
     return th_ref, Swivel([robot.frame_id(f) for f in _swivel_frames(robot, swivel_frames)], swivel)
 
 
+# long: the public docstring (every argument); the body is the dispatch of a coupled model
+# and the calls of the steps
 def solve(
     robot,
     T,
@@ -186,19 +187,11 @@ def solve(
         )
     ws = workspace(robot, robot.frame_id(frame))
     sh = ws.sh
-    if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):
-        mode, batch, targets = "pose", False, [as_rigid(T, "T")]
-    else:
-        mode, batch, targets = parse(T, mode)
+    mode, batch, targets = parse(T, mode)
     check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
-    Q0 = None
-    if q0 is not None:
-        Q0 = robot.check_q(q0, name="q0")
-        if Q0.ndim == 2 and (not batch or len(Q0) != len(targets)):
-            raise ValueError(f"q0 of shape {Q0.shape} needs a batch of {len(Q0)} targets")
-        Q0 = sh.theta(Q0)
+    Q0 = None if q0 is None else sh.theta(check_q0(robot, q0, batch, len(targets)))
     th_ref, sw = _reference(robot, sh, posture, swivel, swivel_frames)
-    redundant = sh.dof > (6 if mode == "pose" else 3)
+    redundant = sh.dof > (6 if mode == "pose" else 3)  # the objectives need a self-motion
     pb = Problem(
         robot,
         ws,
@@ -210,16 +203,34 @@ def solve(
         analytic,
     )
     tp, tr = float(tol_pos), float(tol_rot)
-    ws.table()  # the one-time seed tables and compiled kernel: built here, before any clock
-    if mode == "pose":  # starts, so the first call is not charged for them
+    _prepare(pb, mode, tp, tr)
+    if not batch:
+        return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
+    return _solve_batch(pb, mode, [Target(mode, t, tp, tr) for t in targets], Q0, warm_start)
+
+
+def _prepare(pb: Problem, mode: str, tp: float, tr: float) -> None:
+    """The one-time work of a (robot, frame, settings), done before any clock starts so that no
+    call's ``max_time`` is charged for it: the seed tables (and the aligned table of a pose
+    problem), the compiled kernel of the iteration and those of the closed form (compiled, or
+    loaded from the disk cache: :func:`_warm_closed_form`)."""
+    ws = pb.ws
+    ws.table()
+    if mode == "pose":
         ws.aligned()
     if not ws.lm.warm:
         lm.warm(ws)
-    if analytic is not False and sh.has_closed_form:
+    if pb.analytic is not False and ws.sh.has_closed_form:
         _warm_closed_form(pb, mode, tp, tr)
-    if not batch:
-        return _result(sh, solve_one(pb, Target(mode, targets[0], tp, tr), Q0), Q0)
-    tgs = [Target(mode, t, tp, tr) for t in targets]
+
+
+def _solve_batch(pb: Problem, mode: str, tgs, Q0, warm_start: bool):
+    """The IKBatchResult of the targets ``tgs`` (seeds: the rows of an (N, n) ``Q0``, one
+    (n,) ``Q0`` for all, or none): in lockstep (:func:`solve_lockstep`) for
+    :data:`LOCKSTEP_MIN` targets and more, unless they are chained (``warm_start``) or the
+    closed form answers a pose first; else one after the other, target i seeded with the answer
+    of target i − 1 when ``warm_start`` and no ``Q0``."""
+    sh = pb.ws.sh
     seeds = [None if Q0 is None else (Q0[i] if Q0.ndim == 2 else Q0) for i in range(len(tgs))]
     if (
         not warm_start
@@ -228,11 +239,10 @@ def solve(
     ):
         results = solve_lockstep(pb, tgs, seeds)
     else:
+        chain = warm_start and Q0 is None
         results, prev = [], None
         for tg, seed in zip(tgs, seeds):
-            r = solve_one(
-                pb, tg, prev if (warm_start and prev is not None and Q0 is None) else seed
-            )
+            r = solve_one(pb, tg, prev if (chain and prev is not None) else seed)
             results.append(r)
             prev = r.q
     results = [_result(sh, r, s) for r, s in zip(results, seeds)]
@@ -282,101 +292,126 @@ def _result(sh, r, seed):
     return r
 
 
+class SeedOrder:
+    """The seeds of :func:`solve_one` in turn, :meth:`next` giving (θ, tag): the closed-form
+    solutions ``ana`` (tag ``"analytic"``; set at the start when the closed form goes first, or
+    later by :func:`solve_one`), ``q0`` clipped into the limits, the seed-table entries nearest
+    first (``"table"``; the table made when first needed), then uniform random θ
+    (``"restart"``)."""
+
+    __slots__ = ("pb", "tg", "ana", "i", "seed", "table")
+
+    def __init__(self, pb: Problem, tg: Target, seed, ana):
+        self.pb, self.tg, self.seed, self.ana, self.i, self.table = pb, tg, seed, ana, 0, None
+
+    def next(self):
+        ana = self.ana
+        if ana is not None and self.i < len(ana):
+            self.i += 1
+            return ana[self.i - 1].copy(), "analytic"
+        pb = self.pb
+        if self.seed is not None:
+            sh = pb.ws.sh
+            th, self.seed = np.minimum(np.maximum(self.seed, sh.lo), sh.hi), None
+            return th, "q0"
+        if self.table is None:
+            self.table = TableSeeds(pb.ws, self.tg, pb.th_ref)
+        th = self.table.next()
+        return (pb.random(), "restart") if th is None else (th, "table")
+
+
 def solve_one(pb: Problem, tg: Target, seed):
     """One target: the seeds in order — closed form (``analytic=True``, or "auto" where it is
-    cheap and no q0 is given), q0, the seed table nearest first, uniform random — each
-    refined by :func:`~anthroarm.ik.solve.lm.attempt` until one converges, the budget is
-    spent or ``max_restarts`` is reached; then the posture or swivel phase.  Returns an
-    IKResult whose ``q`` is θ (:func:`_result` maps it)."""
+    cheap and no q0 is given), q0, the seed table nearest first, uniform random
+    (:class:`SeedOrder`) — each refined by :func:`~anthroarm.ik.solve.lm.attempt` until one
+    converges, the budget is spent or ``max_restarts`` is reached; then the posture or swivel
+    phase (:func:`_converged`).  A closed-form seed of a posture problem goes straight to the
+    posture phase, which verifies it.  Returns an IKResult whose ``q`` is θ (:func:`_result`
+    maps it)."""
     ws = pb.ws
-    sh = ws.sh
     t0 = clock()
-    max_time = pb.max_time
-    deadline = t0 + max_time
+    deadline = t0 + pb.max_time
     th_ref, sw = pb.th_ref, pb.swivel
-    out_of_reach = _out_of_reach(sh, tg)
-    ana, ana_i, note = None, 0, ""
+    out_of_reach = _out_of_reach(ws.sh, tg)
+    ana, note = None, ""
     if not out_of_reach and pb.closed_form_first(seed):
         ana, note, done = _closed_form_seeds(pb, tg, seed)
         if done is not None:
             return done
-    table = None  # seed-table entries, nearest first (made when needed)
+    order = SeedOrder(pb, tg, seed, ana)
     total_it = restarts = attempts = 0
     best_q, best_E = None, math.inf
     while True:
-        if ana is not None and ana_i < len(ana):
-            th, tag = ana[ana_i].copy(), "analytic"
-            ana_i += 1
-        elif seed is not None:
-            th, tag = np.minimum(np.maximum(seed, sh.lo), sh.hi), "q0"
-            seed = None
-        else:
-            if table is None:
-                table = TableSeeds(ws, tg, th_ref)
-            th, tag = table.next(), "table"
-            if th is None:
-                th, tag = pb.random(), "restart"
+        th, tag = order.next()
         if attempts:
             restarts += 1
         if tag == "analytic" and th_ref is not None and sw is None:
-            # a closed-form solution: straight to the posture phase, which verifies it
-            ths, pe2, re2, it = posture(ws, tg, th, th_ref, deadline + 0.5 * max_time)
+            ths, pe2, re2, it = posture(ws, tg, th, th_ref, deadline + 0.5 * pb.max_time)
             total_it += it
             attempts += 1
             if ths is not None:
-                return IKResult(
-                    ths,
-                    True,
-                    "success",
-                    math.sqrt(pe2),
-                    math.sqrt(re2),
-                    total_it,
-                    restarts,
-                    "converged from an analytic seed",
-                    tg.mode,
-                    tag,
-                )
+                msg = "converged from an analytic seed"
+                pe, re = math.sqrt(pe2), math.sqrt(re2)
+                return IKResult(ths, True, "success", pe, re, total_it, restarts, msg, tg.mode, tag)
         ths, ok, it, pe2, re2, bq, bE = lm.attempt(ws, tg, th, deadline)
         total_it += it
         attempts += 1
         if bE < best_E:
             best_q, best_E = bq, bE
         if ok:
-            pe, re = math.sqrt(pe2), math.sqrt(re2)
-            msg = f"converged from {_article(tag)} {tag} seed"
-            if sw is not None:
-                ths, it2 = swivel_phase(ws, tg, ths, sw, deadline + 0.5 * max_time)
-                total_it += it2
-                pe, re = tg.errors(ws, ths)
-                ths, pe, re, tag2, msg = _settle_swivel(pb, tg, ths, pe, re, msg)
-                tag = tag2 or tag
-            elif th_ref is not None:
-                ths2, pe2, re2, it2 = posture(ws, tg, ths, th_ref, deadline + 0.5 * max_time)
-                total_it += it2
-                if ths2 is not None:
-                    ths, pe, re = ths2, math.sqrt(pe2), math.sqrt(re2)
-            return IKResult(ths, True, "success", pe, re, total_it, restarts, msg, tg.mode, tag)
+            return _converged(pb, tg, ths, pe2, re2, tag, total_it, restarts, deadline)
         if out_of_reach and attempts >= 3:
             break
         if (
             pb.analytic == "auto"
-            and ana is None
+            and order.ana is None
             and not out_of_reach
             and attempts >= ANALYTIC_AFTER
         ):
-            ana, note, _ = analytic_seeds(
+            order.ana, note, _ = analytic_seeds(
                 pb.robot, ws, tg, best_q, sw.target if sw else None, SWIVEL_GRID
             )
         if clock() > deadline or (pb.max_restarts is not None and restarts >= pb.max_restarts):
             break
     th = best_q if best_q is not None else th
+    return _unsolved(pb, tg, th, tag, out_of_reach, note, total_it, restarts, t0)
+
+
+def _converged(pb: Problem, tg: Target, ths, pe2, re2, tag, total_it, restarts, deadline):
+    """The IKResult once Gauss–Newton met the tolerances at θ from seed ``tag``: for a swivel
+    objective the swivel phase (:func:`~anthroarm.ik.solve.nullspace.swivel`, then
+    :func:`_settle_swivel`), for a posture the posture phase
+    (:func:`~anthroarm.ik.solve.nullspace.posture`, whose answer replaces θ only if one of its
+    iterates meets the tolerances); each phase may run half a budget past ``deadline``."""
+    ws, sw, th_ref = pb.ws, pb.swivel, pb.th_ref
+    pe, re = math.sqrt(pe2), math.sqrt(re2)
+    msg = f"converged from {_article(tag)} {tag} seed"
+    late = deadline + 0.5 * pb.max_time
+    if sw is not None:
+        ths, it2 = swivel_phase(ws, tg, ths, sw, late)
+        total_it += it2
+        pe, re = tg.errors(ws, ths)
+        ths, pe, re, tag2, msg = _settle_swivel(pb, tg, ths, pe, re, msg)
+        tag = tag2 or tag
+    elif th_ref is not None:
+        ths2, pe2, re2, it2 = posture(ws, tg, ths, th_ref, late)
+        total_it += it2
+        if ths2 is not None:
+            ths, pe, re = ths2, math.sqrt(pe2), math.sqrt(re2)
+    return IKResult(ths, True, "success", pe, re, total_it, restarts, msg, tg.mode, tag)
+
+
+def _unsolved(pb: Problem, tg: Target, th, tag, out_of_reach, note, total_it, restarts, t0):
+    """The IKResult of a target no seed solved: status ``"out_of_reach"`` (``out_of_reach`` says
+    why) or ``"not_converged"``, θ the closest configuration found and its errors."""
+    max_time = pb.max_time
     why = out_of_reach or (
         f"no configuration within the joint limits reached tol_pos={tg.tol_p:g} m / "
         f"tol_rot={tg.tol_r:g} rad after {total_it} iterations, {restarts} restarts, "
         f"{(clock() - t0) * 1e3:.1f} ms CPU (max_time {max_time * 1e3:g} ms); the target is "
         "probably outside the joint-limited workspace"
     )
-    pe, re = tg.errors(ws, th)
+    pe, re = tg.errors(pb.ws, th)
     msg = f"{why}; closest pose found: pos_err {pe:.3g} m, rot_err {re:.3g} rad" + (
         f"; {note}" if note else ""
     )
@@ -457,105 +492,166 @@ def solve_lockstep(pb: Problem, tgs, seeds):
     seed table's next nearest entry, then a random θ), up to :data:`LOCKSTEP_ATTEMPTS`
     attempts, after which it is handed to :func:`solve_one` (all its seeds, restarts and the
     time budget); so are converged targets of a posture or swivel problem (their null-space
-    phase).  Same answers' quality, less time per target."""
-    ws = pb.ws
-    sh = ws.sh
-    N, n, m = len(tgs), sh.n, tgs[0].m
-    tables = [None] * N
-    Th = np.empty((N, n))
-    for k in range(N):
-        if seeds[k] is None:
-            tables[k] = TableSeeds(ws, tgs[k], pb.th_ref)
-            Th[k] = tables[k].next()
-        else:
-            Th[k] = seeds[k]
-    Th = np.minimum(np.maximum(Th, sh.lo), sh.hi)
-    J = np.empty((N, m, n))
-    E = np.empty((N, m))
-    EE = np.empty(N)
-    OK = np.zeros(N, dtype=bool)
-    PE2 = np.zeros(N)
-    RE2 = np.zeros(N)
-    its = np.zeros(N, dtype=int)
-    att_it = np.zeros(N, dtype=int)
-    attempts = np.ones(N, dtype=int)
-    best = np.full(N, np.inf)
-    stall = np.zeros(N, dtype=int)
-    converged = np.zeros(N, dtype=bool)
-    max_attempts = (
-        LOCKSTEP_ATTEMPTS
-        if pb.max_restarts is None
-        else min(LOCKSTEP_ATTEMPTS, int(pb.max_restarts) + 1)
-    )
-    active = np.arange(N)
+    phase).  Same answers' quality, less time per target.  The rounds are those of
+    :class:`Lockstep`: evaluate, end or restart attempts, step."""
+    st = Lockstep(pb, tgs, seeds)
+    active = np.arange(len(tgs))
     while active.size:
-        for k in active:  # Pinocchio: one call per target
+        active = st.evaluate(active)
+        if not active.size:
+            break
+        stepping, active = st.restart(active)
+        if stepping.size:
+            active = st.step(stepping, active)
+    return st.results()
+
+
+class Lockstep:
+    """The state of :func:`solve_lockstep`, one row per target: θ ``Th``, the last residual
+    (``E`` = e, ``EE`` = ‖e‖², ``PE2``/``RE2`` the squared errors, ``OK``) and Jacobian ``J``,
+    the iterations in all (``its``) and in this attempt (``att_it``), the attempts made, the
+    best ‖e‖² of this attempt and the iterations since it last fell by 10 % (``stall``), the
+    converged flags and the seed tables (made when needed)."""
+
+    __slots__ = (
+        "pb",
+        "tgs",
+        "seeds",
+        "tables",
+        "Th",
+        "J",
+        "E",
+        "EE",
+        "OK",
+        "PE2",
+        "RE2",
+        "its",
+        "att_it",
+        "attempts",
+        "best",
+        "stall",
+        "converged",
+        "max_attempts",
+    )
+
+    def __init__(self, pb: Problem, tgs, seeds):
+        """The first seeds: ``seeds[k]`` where given, else the nearest seed-table entry; all
+        clipped into the limits."""
+        ws = pb.ws
+        sh = ws.sh
+        N, n, m = len(tgs), sh.n, tgs[0].m
+        self.pb, self.tgs, self.seeds = pb, tgs, seeds
+        self.tables = tables = [None] * N
+        Th = np.empty((N, n))
+        for k in range(N):
+            if seeds[k] is None:
+                tables[k] = TableSeeds(ws, tgs[k], pb.th_ref)
+                Th[k] = tables[k].next()
+            else:
+                Th[k] = seeds[k]
+        self.Th = np.minimum(np.maximum(Th, sh.lo), sh.hi)
+        self.J = np.empty((N, m, n))
+        self.E = np.empty((N, m))
+        self.EE = np.empty(N)
+        self.OK = np.zeros(N, dtype=bool)
+        self.PE2 = np.zeros(N)
+        self.RE2 = np.zeros(N)
+        self.its = np.zeros(N, dtype=int)
+        self.att_it = np.zeros(N, dtype=int)
+        self.attempts = np.ones(N, dtype=int)
+        self.best = np.full(N, np.inf)
+        self.stall = np.zeros(N, dtype=int)
+        self.converged = np.zeros(N, dtype=bool)
+        cap = pb.max_restarts
+        self.max_attempts = (
+            LOCKSTEP_ATTEMPTS if cap is None else min(LOCKSTEP_ATTEMPTS, int(cap) + 1)
+        )
+
+    def evaluate(self, active):
+        """The residual of the ``active`` targets at their θ and, where not converged, their
+        Jacobian (Pinocchio: one call per target); returns the targets still to iterate (the
+        converged ones marked and dropped)."""
+        ws, tgs, Th = self.pb.ws, self.tgs, self.Th
+        E, EE, PE2, RE2, OK, J = self.E, self.EE, self.PE2, self.RE2, self.OK, self.J
+        for k in active:
             tg = tgs[k]
             E[k], EE[k], PE2[k], RE2[k] = tg.residual(ws, Th[k])
             OK[k] = tg.ok(PE2[k], RE2[k])
             if not OK[k]:
                 J[k] = tg.jacobian(ws)
-        its[active] += 1
-        att_it[active] += 1
+        self.its[active] += 1
+        self.att_it[active] += 1
         ok = OK[active]
-        converged[active[ok]] = True
-        active = active[~ok]
-        if not active.size:
-            break
+        self.converged[active[ok]] = True
+        return active[~ok]
+
+    def restart(self, active):
+        """(the targets that step this round, the targets still active).  An attempt ends after
+        :data:`STALL` iterations without ‖e‖² falling below 0.9 × its best, or after
+        :data:`MAX_ITER`; its target restarts from its next seed (the next table entry, then a
+        random θ; evaluated first, next round) while it has attempts left, else leaves the
+        batch."""
+        pb, EE, best, stall, attempts = self.pb, self.EE, self.best, self.stall, self.attempts
         Ee = EE[active]
         improved = Ee < 0.9 * best[active]
         best[active] = np.where(improved, Ee, best[active])
         stall[active] = np.where(improved, 0, stall[active] + 1)
-        ended = (stall[active] >= STALL) | (att_it[active] >= MAX_ITER)
-        stepping = active
-        if ended.any():
-            ek = active[ended]
-            retry = ek[attempts[ek] < max_attempts]
-            for k in retry:  # next seed: the next table entry, then random
-                if tables[k] is None:
-                    tables[k] = TableSeeds(ws, tgs[k], pb.th_ref)
-                th = tables[k].next()
-                Th[k] = pb.random() if th is None else th
-            attempts[retry] += 1
-            att_it[retry] = 0
-            stall[retry] = 0
-            best[retry] = np.inf
-            stepping = active[~ended]  # retried targets are evaluated first, next round
-            active = np.concatenate([stepping, retry])
-        if stepping.size:
-            Tn = damped_step(ws, Th[stepping], J[stepping], E[stepping], damping(EE[stepping]))
-            if Tn is None:  # a singular system: hand those targets over
-                active = np.setdiff1d(active, stepping)
-                continue
-            Th[stepping] = Tn
-    results = []
-    for k in range(N):
-        restarts = int(attempts[k] - 1)
-        tg = tgs[k]
-        if converged[k] and pb.th_ref is None and pb.swivel is None:
-            tag = ("q0" if seeds[k] is not None else "table") if restarts == 0 else "restart"
-            results.append(
-                IKResult(
-                    Th[k].copy(),
-                    True,
-                    "success",
-                    math.sqrt(PE2[k]),
-                    math.sqrt(RE2[k]),
-                    int(its[k]),
-                    restarts,
-                    f"converged from {_article(tag)} {tag} seed (batch)",
-                    tg.mode,
-                    tag,
+        ended = (stall[active] >= STALL) | (self.att_it[active] >= MAX_ITER)
+        if not ended.any():
+            return active, active
+        ek = active[ended]
+        retry = ek[attempts[ek] < self.max_attempts]
+        tables, Th = self.tables, self.Th
+        for k in retry:
+            if tables[k] is None:
+                tables[k] = TableSeeds(pb.ws, self.tgs[k], pb.th_ref)
+            th = tables[k].next()
+            Th[k] = pb.random() if th is None else th
+        attempts[retry] += 1
+        self.att_it[retry] = 0
+        stall[retry] = 0
+        best[retry] = np.inf
+        stepping = active[~ended]
+        return stepping, np.concatenate([stepping, retry])
+
+    def step(self, stepping, active):
+        """θ ← θ + Δθ of the ``stepping`` targets (:func:`~anthroarm.ik.solve.kernel.damped_step`,
+        all at once); returns the active targets, without the stepping ones if their system is
+        singular (they are handed to :func:`solve_one`)."""
+        EE = self.EE[stepping]
+        Tn = damped_step(
+            self.pb.ws, self.Th[stepping], self.J[stepping], self.E[stepping], damping(EE)
+        )
+        if Tn is None:
+            return np.setdiff1d(active, stepping)
+        self.Th[stepping] = Tn
+        return active
+
+    def results(self):
+        """The IKResults (θ in ``q``): a converged target's own unless a posture or swivel
+        objective is set; :func:`solve_one`'s for the others (from the converged θ: the
+        null-space phase; from the caller's seed: a target that stalled in every attempt),
+        the lockstep iterations (and restarts, if converged) added."""
+        pb, tgs, seeds, Th = self.pb, self.tgs, self.seeds, self.Th
+        plain = pb.th_ref is None and pb.swivel is None
+        results = []
+        for k in range(len(tgs)):
+            restarts = int(self.attempts[k] - 1)
+            tg, converged = tgs[k], self.converged[k]
+            if converged and plain:
+                tag = ("q0" if seeds[k] is not None else "table") if restarts == 0 else "restart"
+                msg = f"converged from {_article(tag)} {tag} seed (batch)"
+                pe, re, it = math.sqrt(self.PE2[k]), math.sqrt(self.RE2[k]), int(self.its[k])
+                results.append(
+                    IKResult(Th[k].copy(), True, "success", pe, re, it, restarts, msg, tg.mode, tag)
                 )
-            )
-            continue
-        # a redundant arm's null-space phase, or stalled LOCKSTEP_ATTEMPTS times: the one-target solver
-        r = solve_one(pb, tg, Th[k] if converged[k] else seeds[k])
-        r.iterations += int(its[k])
-        if converged[k]:
-            r.restarts += restarts
-        results.append(r)
-    return results
+                continue
+            r = solve_one(pb, tg, Th[k] if converged else seeds[k])
+            r.iterations += int(self.its[k])
+            if converged:
+                r.restarts += restarts
+            results.append(r)
+        return results
 
 
 def _article(word: str) -> str:

@@ -35,10 +35,9 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...osim.coupling import FastCoupling
-from ..qp.targets import as_rigid
 from ..result import IKBatchResult, IKResult
 from .kernel import attempt, clip, clock, damping
-from .targets import Target, check_options, parse
+from .targets import Target, check_options, check_q0, parse
 
 POSTURE_STEP = 0.25  # longest null-space move of the posture phase (rad or m)
 POSTURE_TOL = 1e-4  # the posture phase stops when its move is shorter (rad or m)
@@ -166,37 +165,22 @@ def solve(
     (``robot.joint_names``).  ``posture="auto"`` is none here (no comfortable posture is known
     for these models); ``swivel`` raises :class:`~anthroarm.errors.ParameterError`."""
     fid = robot.frame_id(frame)
-    if type(T) is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):
-        mode, batch, targets = "pose", False, [as_rigid(T, "T")]
-    else:
-        mode, batch, targets = parse(T, mode)
+    mode, batch, targets = parse(T, mode)
     check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic)
     if swivel is not None or swivel_frames is not None:
         raise ParameterError(
             f"{robot.name}: swivel= places a human arm's elbow; this OpenSim model's coordinates "
             "(robot.coupling) have no swivel objective: give a posture (nq,) instead"
         )
-    Q0 = None
-    if q0 is not None:
-        Q0 = robot.check_q(q0, name="q0")
-        if Q0.ndim == 2 and (not batch or len(Q0) != len(targets)):
-            raise ValueError(f"q0 of shape {Q0.shape} needs a batch of {len(Q0)} targets")
-    ref = None
-    if isinstance(posture, str):
-        if posture != "auto":
-            raise ValueError(f"posture must be 'auto', None or a configuration, got {posture!r}")
-    elif posture is not None:
-        ref = robot.check_q(posture, name="posture")
-        if ref.ndim != 1:
-            raise ValueError(f"posture must have shape ({robot.nq},), got {ref.shape}")
+    Q0 = check_q0(robot, q0, batch, len(targets))
+    ref = _posture_ref(robot, posture)
     ws = workspace(robot, fid)
-    path = ws.path
     lo, hi = ws.lo, ws.hi
     if ref is not None:
         ref = clip(ref, lo, hi)
     default = clip(robot.default_q(), lo, hi)
     gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
-    redundant = int(path.sum()) > (6 if mode == "pose" else 3)
+    redundant = int(ws.path.sum()) > (6 if mode == "pose" else 3)
     note = " (no closed form for a model with coupled coordinates)" if analytic is True else ""
     tp, tr = float(tol_pos), float(tol_rot)
     results, prev = [], None
@@ -204,29 +188,55 @@ def solve(
         seed = None if Q0 is None else (Q0[i] if Q0.ndim == 2 else Q0)
         if warm_start and batch and seed is None and prev is not None:
             seed = prev
-        base = clip(seed, lo, hi) if seed is not None else (ref if ref is not None else default)
-        th_ref = None
-        if ref is not None and redundant:
-            th_ref = np.where(path, ref, base)
-        r = solve_one(
-            ws,
-            CoupledTarget(mode, tgt, tp, tr),
-            seed is not None,
-            np.where(path, base, default) if seed is None else base,
-            np.where(path, default, base),
-            path,
-            gen,
-            float(max_time),
-            max_restarts,
-            th_ref,
-        )
-        r.q = np.where(path, r.q, base)  # coordinates off the frame's path: not moved
+        tg = CoupledTarget(mode, tgt, tp, tr)
+        r = _solve_seeded(ws, tg, seed, ref, redundant, default, gen, max_time, max_restarts)
         r.message += note
         results.append(r)
         prev = r.q
     if not batch:
         return results[0]
     return IKBatchResult.collect(results, robot.nq, mode)
+
+
+def _posture_ref(robot, posture):
+    """The reference coordinates of ``posture`` ((nq,), not yet clipped), None for ``"auto"``
+    or None (no comfortable posture is known for these models); ValueError otherwise."""
+    if isinstance(posture, str):
+        if posture != "auto":
+            raise ValueError(f"posture must be 'auto', None or a configuration, got {posture!r}")
+        return None
+    if posture is None:
+        return None
+    ref = robot.check_q(posture, name="posture")
+    if ref.ndim != 1:
+        raise ValueError(f"posture must have shape ({robot.nq},), got {ref.shape}")
+    return ref
+
+
+def _solve_seeded(ws, tg, seed, ref, redundant, default, gen, max_time, max_restarts):
+    """:func:`solve_one` for one target with the caller's ``seed`` (or None), the posture
+    ``ref`` (clipped, or None) and the default pose ``default`` (clipped).  On the frame's
+    coordinates the first seed is ``seed`` (else the default pose) and, for a ``redundant``
+    frame (more coordinates than the task's dimension), the posture phase pulls them toward
+    ``ref``; the other coordinates keep ``seed``'s values, else ``ref``'s, else the default
+    pose's, and are not moved."""
+    path, lo, hi = ws.path, ws.lo, ws.hi
+    base = clip(seed, lo, hi) if seed is not None else (ref if ref is not None else default)
+    th_ref = np.where(path, ref, base) if ref is not None and redundant else None
+    r = solve_one(
+        ws,
+        tg,
+        seed is not None,
+        np.where(path, base, default) if seed is None else base,
+        np.where(path, default, base),
+        path,
+        gen,
+        float(max_time),
+        max_restarts,
+        th_ref,
+    )
+    r.q = np.where(path, r.q, base)  # coordinates off the frame's path: not moved
+    return r
 
 
 def solve_one(ws, tg, given, first, default, path, gen, max_time, max_restarts, th_ref):

@@ -43,18 +43,13 @@ def posture(ws, tg, th, th_ref, deadline):
     Returns (θ, pos_err², rot_err², iterations): the last iterate that meets the tolerances and
     its errors, or (None, …) if no iterate did."""
     sh = ws.sh
-    lo, hi = ws.lo, ws.hi
     m = tg.m
-    one_dim = sh.dof - m == 1
     AF = ws.lin[m][1]
     wrap = sh.continuous if sh.to_q is not None else None
-    h_lo, h_hi = SECANT_RANGE
+    sec = Secant() if sh.dof - m == 1 else None
     good = None
     gpe2 = gre2 = math.inf
     it = 0
-    p_prev = None  # last null-space direction (unnormalised) and its g, s
-    g_prev = s_prev = 0.0
-    h = 1.0
     residual, jacobian = tg.residual, tg.jacobian
     while it < NULL_EXTRA:
         e, E, pe2, re2 = residual(ws, th)
@@ -65,79 +60,116 @@ def posture(ws, tg, th, th_ref, deadline):
             good, gpe2, gre2 = th, pe2, re2
         elif not it & 3 and clock() > deadline:
             break
-        lam = damping(E)
-        frozen = None
-        while True:
-            x = solve_damped(ws, J, e, lam, step=False)  # AF now holds the Cholesky factor
-            if x is None:
-                return good, gpe2, gre2, it
-            dq = x.dot(J)
-            z = th_ref - th  # N (θ_ref − θ − Δθ) = N (θ_ref − θ) + O(λ): Δθ lies in the row space
-            if wrap is not None:
-                z[wrap] = (z[wrap] + math.pi) % (2.0 * math.pi) - math.pi
-            if frozen is not None:
-                z[frozen] = 0.0
-            p = z - dpotrs(AF, J.dot(z))[0].dot(J)  # N z: projection on the null space
-            g = math.sqrt(p.dot(p))
-            if one_dim and frozen is None and g > 0.0:
-                # secant step along t = p/g: g = tᵀ(θ_ref − θ) is minus the derivative of the cost
-                # along t; its change per unit move estimates the curvature
-                if p_prev is not None:
-                    if p.dot(p_prev) < 0.0:
-                        g = -g
-                    if abs(s_prev) > 1e-12:
-                        hk = (g_prev - g) / s_prev
-                        h = min(hk, h_hi) if hk >= h_lo else 1.0
-                s = g / h
-                if abs(s) > NULL_STEP:
-                    s = math.copysign(NULL_STEP, s)
-                n2 = abs(s)
-                tn = th + dq + p * (s / g)
-            else:
-                s = 0.0
-                n2 = g
-                tn = (
-                    th + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))
-                )  # long moves leave the linearisation
-            tc = clip(tn, lo, hi)
-            if frozen is not None or tc.tobytes() == tn.tobytes():
-                break
-            out = (tc != tn) & ((th == lo) | (th == hi))  # at a limit and pushed past it
-            if not out.any():
-                # the null-space move crosses a limit: shorten it so that the first joint to
-                # cross stops on its limit (clipping the whole step would spoil the pose)
-                step = tn - th - dq
-                base = th + dq
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    sig = np.where(
-                        step > 0.0,
-                        (hi - base) / step,
-                        np.where(step < 0.0, (lo - base) / step, np.inf),
-                    )
-                sig = min(max(float(sig.min()), 0.0), 1.0)
-                tn = base + sig * step
-                s *= sig
-                n2 *= sig
-                tc = clip(tn, lo, hi)
-                break
-            frozen = out  # active set: freeze, recompute once
-            J = J * ~out
+        move = _null_move(ws, AF, J, e, damping(E), th, th_ref, wrap, sec)
+        if move is None:
+            return good, gpe2, gre2, it
+        tn, tc, p, g, s, n2 = move
         if ok and n2 < NULL_TOL:
             break
         if s != 0.0:
             clipped = tc.tobytes() != tn.tobytes()
-            s_prev = p.dot(tc - th) / g if clipped else s  # the move made along t = p/g
-            if ok and clipped and abs(s_prev) < 0.1 * n2:
+            moved = sec.moved(p, g, p.dot(tc - th) / g if clipped else s)
+            if ok and clipped and abs(moved) < 0.1 * n2:
                 break  # a joint limit blocks the self-motion: constrained optimum
-            p_prev, g_prev = (p if g > 0.0 else -p), g  # p_prev oriented like t
-        else:
-            p_prev = None  # the secant memory is void after a frozen step
+        elif sec is not None:
+            sec.p = None  # the secant memory is void after a frozen step
         th = tc
     else:
         pe, re = tg.errors(ws, th)
         if tg.ok(pe * pe, re * re):
             good, gpe2, gre2 = th, pe * pe, re * re
     return good, gpe2, gre2, it
+
+
+class Secant:
+    """The memory of :func:`posture`'s secant step along a one-dimensional self-motion: the
+    last null-space direction ``p`` (unnormalised, oriented like t), its g = tᵀ(θ_ref − θ) (minus
+    the derivative of the cost ½‖θ − θ_ref‖² along t = p/‖p‖), the move ``s`` made along t and
+    the curvature estimate ``h`` = −Δg/s, kept in :data:`SECANT_RANGE` (1 outside it)."""
+
+    __slots__ = ("p", "g", "s", "h")
+
+    def __init__(self):
+        self.p, self.g, self.s, self.h = None, 0.0, 0.0, 1.0
+
+    def length(self, p, g):
+        """(g signed along the remembered direction, the step s = g/h along t = p/‖p‖, at most
+        :data:`NULL_STEP` long) for the null-space direction ``p`` of norm ``g``."""
+        if self.p is not None:
+            if p.dot(self.p) < 0.0:
+                g = -g
+            if abs(self.s) > 1e-12:
+                hk = (self.g - g) / self.s
+                h_lo, h_hi = SECANT_RANGE
+                self.h = min(hk, h_hi) if hk >= h_lo else 1.0
+        s = g / self.h
+        if abs(s) > NULL_STEP:
+            s = math.copysign(NULL_STEP, s)
+        return g, s
+
+    def moved(self, p, g, s) -> float:
+        """Remember the move ``s`` made along t = p/g (p of signed norm g); returns s."""
+        self.p, self.g, self.s = (p if g > 0.0 else -p), g, s
+        return s
+
+
+def _null_move(ws, AF, J, e, lam, th, th_ref, wrap, sec):
+    """One move of :func:`posture` from θ: Δθ = Jᵀ(JJᵀ + λI)⁻¹e (the Cholesky factor left in
+    ``AF``) plus the pull p = N z, z = θ_ref − θ (wrapped for continuous joints), along p by the
+    secant length (``sec``, a one-dimensional self-motion) or by ‖p‖ up to :data:`NULL_STEP`.
+    Active set: joints at a limit that the move pushes past it are frozen (their columns of J
+    and their share of z dropped) and the move recomputed once; a move that crosses a limit
+    otherwise is shortened so that the first joint to cross stops on it (clipping the whole move
+    would spoil the pose).
+
+    Returns (θ + move, the same clipped into the limits, p, g = ±‖p‖, s, the move's length
+    along p), or None for a singular system."""
+    lo, hi = ws.lo, ws.hi
+    frozen = None
+    while True:
+        x = solve_damped(ws, J, e, lam, step=False)  # AF now holds the Cholesky factor
+        if x is None:
+            return None
+        dq = x.dot(J)
+        z = th_ref - th  # N (θ_ref − θ − Δθ) = N (θ_ref − θ) + O(λ): Δθ lies in the row space
+        if wrap is not None:
+            z[wrap] = (z[wrap] + math.pi) % (2.0 * math.pi) - math.pi
+        if frozen is not None:
+            z[frozen] = 0.0
+        p = z - dpotrs(AF, J.dot(z))[0].dot(J)  # N z: projection on the null space
+        g = math.sqrt(p.dot(p))
+        if sec is not None and frozen is None and g > 0.0:
+            g, s = sec.length(p, g)
+            n2 = abs(s)
+            tn = th + dq + p * (s / g)
+        else:
+            s, n2 = 0.0, g
+            # long moves leave the linearisation
+            tn = th + dq + (p if g <= NULL_STEP else p * (NULL_STEP / g))
+        tc = clip(tn, lo, hi)
+        if frozen is not None or tc.tobytes() == tn.tobytes():
+            return tn, tc, p, g, s, n2
+        out = (tc != tn) & ((th == lo) | (th == hi))  # at a limit and pushed past it
+        if not out.any():
+            base = th + dq
+            step = tn - th - dq
+            sig = _to_limit(base, step, lo, hi)
+            tn = base + sig * step
+            return tn, clip(tn, lo, hi), p, g, s * sig, n2 * sig
+        frozen = out  # active set: freeze, recompute once
+        J = J * ~out
+
+
+def _to_limit(base, step, lo, hi) -> float:
+    """min over the joints of the σ at which base + σ·step reaches its limit, clamped to
+    [0, 1]: the fraction of ``step`` that keeps every joint within [lo, hi]."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sig = np.where(
+            step > 0.0,
+            (hi - base) / step,
+            np.where(step < 0.0, (lo - base) / step, np.inf),
+        )
+    return min(max(float(sig.min()), 0.0), 1.0)
 
 
 class Swivel:

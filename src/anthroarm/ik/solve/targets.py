@@ -139,7 +139,13 @@ class Target:
 
 def parse(T, mode):
     """-> (mode, batch: bool, list of targets: rigid 4×4 arrays, p (3,) or R (3, 3)).
-    ``ValueError`` naming the defect for a wrong shape, NaN or a non-rigid transform."""
+    ``ValueError`` naming the defect for a wrong shape, NaN or a non-rigid transform.
+
+    The usual call, one 4×4 ``numpy.ndarray`` pose, goes straight to
+    :func:`~anthroarm.ik.qp.targets.as_rigid` (whose own fast path takes a clean float64 array
+    as it is); a batch's poses each go through it too, below."""
+    if T.__class__ is np.ndarray and T.shape == (4, 4) and mode in (None, "pose"):
+        return "pose", False, [as_rigid(T, "T")]
     if mode not in (None, "pose", "position", "orientation"):
         raise ValueError(f"mode must be None, 'pose', 'position' or 'orientation', got {mode!r}")
     if isinstance(T, pin.SE3):
@@ -215,3 +221,14 @@ def check_options(tol_pos, tol_rot, max_time, max_restarts, rng, analytic) -> No
         )
     if analytic not in ("auto", True, False):
         raise ValueError(f"analytic must be 'auto', True or False, got {analytic!r}")
+
+
+def check_q0(robot, q0, batch: bool, n: int):
+    """``q0`` as ``robot.check_q`` gives it ((nq,) or (N, nq)), None for None; ValueError for
+    an (N, nq) ``q0`` without a batch of N targets (``n`` targets given)."""
+    if q0 is None:
+        return None
+    Q0 = robot.check_q(q0, name="q0")
+    if Q0.ndim == 2 and (not batch or len(Q0) != n):
+        raise ValueError(f"q0 of shape {Q0.shape} needs a batch of {len(Q0)} targets")
+    return Q0
