@@ -24,6 +24,8 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -82,12 +84,16 @@ def run(
     progress: bool = False,
     tool: str | None = None,
     locked=None,
+    workers: int = 1,
 ) -> list[CheckRow]:
     """Run the checks (see the module docstring) and return the rows.
 
     ``models``: names, URDF paths or Robots (default: the whole catalog); ``providers``: dotted
     names to run instead of all (robot providers are those in :data:`ROBOT_PROVIDERS`);
-    ``tool``/``locked``: passed to :func:`anthroarm.load` for every named model."""
+    ``tool``/``locked``: passed to :func:`anthroarm.load` for every named model.  ``workers``
+    > 1 runs the checks in that many processes (each loads the models it checks by name; the
+    rows come back in the same order and with the same values as one process gives, each check
+    drawing from its own ``default_rng(seed)``); models given as Robots run in this process."""
     robots = load_robots(models, tool, locked)
     if not models:
         names = catalog.names()
@@ -96,34 +102,71 @@ def run(
     else:
         names = []
     provs = list(providers) if providers is not None else [*ROBOT_PROVIDERS, *PROVIDERS]
-    jobs = [(p, r) for p in provs if p in ROBOT_PROVIDERS for r in robots]
-    jobs += [(p, None) for p in provs if p not in ROBOT_PROVIDERS]
-    it = jobs
-    if progress:
-        it = tqdm(jobs, desc="cross-check", unit="check", leave=False)
-    rows: list[CheckRow] = []
-    for dotted, robot in it:
-        rng = np.random.default_rng(seed)
-        if robot is None:
-            rows.extend(_load_provider(dotted)(names, samples, rng))
-            continue
-        try:
-            rows.extend(_load_provider(dotted)(robot, samples, rng))
-        except UnsupportedModelError as exc:
-            rows.append(CheckRow.unsupported(robot.name, ROBOT_PROVIDERS[dotted], str(exc)))
-        except Exception as exc:  # noqa: BLE001 - a check that crashes on a user's robot is a failed row, not a traceback
-            rows.append(
-                CheckRow(
-                    robot.name,
-                    ROBOT_PROVIDERS[dotted],
-                    math.nan,
-                    0.0,
-                    0,
-                    "-",
-                    f"{ERROR}: {type(exc).__name__}: {' '.join(str(exc).split())}",
-                )
+    entries = list(models) if models else catalog.names()
+    # the book's checks first: the longest single jobs, so that the pool's tail is short
+    jobs = [(p, None) for p in provs if p not in ROBOT_PROVIDERS]
+    jobs += [(p, k) for p in provs if p in ROBOT_PROVIDERS for k in range(len(robots))]
+    by_name = all(isinstance(e, (str, Path)) for e in entries)
+    if workers > 1 and by_name and len(jobs) > 1:
+        args = [(p, None if k is None else str(entries[k]), names, samples, seed, tool, locked)
+                for p, k in jobs]  # fmt: skip
+        out = _in_processes(args, workers, progress)
+    else:
+        it = tqdm(jobs, desc="cross-check", unit="check", leave=False) if progress else jobs
+        out = [_job(p, None if k is None else robots[k], names, samples, seed) for p, k in it]
+    order = sorted(range(len(jobs)), key=lambda i: _original_order(jobs[i], provs))
+    return [row for i in order for row in out[i]]
+
+
+def _original_order(job, provs) -> tuple:
+    """Where a job's rows go: every robot provider over the robots, then the book's checks."""
+    p, k = job
+    return (0, provs.index(p), k) if k is not None else (1, provs.index(p), 0)
+
+
+def _job(dotted: str, robot, names, samples: int, seed: int) -> list[CheckRow]:
+    """The rows of one provider (on ``robot``, or the book's on the catalog ``names``); a
+    provider that cannot apply to the robot gives an unsupported row, one that crashes a
+    failed row (a traceback would hide every other row)."""
+    rng = np.random.default_rng(seed)
+    if robot is None:
+        return list(_load_provider(dotted)(names, samples, rng))
+    try:
+        return list(_load_provider(dotted)(robot, samples, rng))
+    except UnsupportedModelError as exc:
+        return [CheckRow.unsupported(robot.name, ROBOT_PROVIDERS[dotted], str(exc))]
+    except Exception as exc:  # noqa: BLE001 - a check that crashes on a user's robot is a failed row, not a traceback
+        return [
+            CheckRow(
+                robot.name,
+                ROBOT_PROVIDERS[dotted],
+                math.nan,
+                0.0,
+                0,
+                "-",
+                f"{ERROR}: {type(exc).__name__}: {' '.join(str(exc).split())}",
             )
-    return rows
+        ]
+
+
+def _job_by_name(args) -> list[CheckRow]:
+    """:func:`_job` in a worker process: the robot loaded there by its name or path."""
+    dotted, entry, names, samples, seed, tool, locked = args
+    robot = None if entry is None else load_robots([entry], tool, locked)[0]
+    return _job(dotted, robot, names, samples, seed)
+
+
+def _in_processes(args, workers: int, progress: bool) -> list:
+    """:func:`_job_by_name` of each item of ``args`` in ``workers`` fresh processes (spawned:
+    nothing of this process's state is copied), results in the order of ``args``."""
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(_job_by_name, a) for a in args]
+        if progress:
+            for _ in tqdm(as_completed(futures), total=len(futures), desc="cross-check",
+                          unit="check", leave=False):  # fmt: skip
+                pass
+        return [f.result() for f in futures]
 
 
 def ik_rows(robot, samples: int, rng) -> list[CheckRow]:

@@ -138,12 +138,35 @@ def test_check_fails_loudly(monkeypatch, capsys):
         return T
 
     monkeypatch.setattr(book_models, "sixr_hand_pose", wrong)
-    rc = cli.main(["check", "sixr_arm", "--samples", "5"])
+    rc = cli.main(["check", "sixr_arm", "--samples", "5", "--jobs", "1"])  # planted here only
     out = capsys.readouterr().out
     assert rc == 1
     bad = [ln for ln in out.splitlines() if ln.rstrip().endswith("FAIL")]
     assert len(bad) == 1 and "fk printed (6-16)/(6-17)" in bad[0]
     assert "1 failed, 0 unsupported" in out
+
+
+def test_rows_the_same_in_two_processes():
+    """--jobs 2 (two spawned processes, each loading its models by name) gives the rows of one
+    process, in the same order, to the last digit (the notes may say where a process found its
+    generated code: in memory, on disk)."""
+    kw = dict(samples=8, seed=3)
+    one = crosscheck.run(["planar2r", "sixr_arm"], **kw)
+    two = crosscheck.run(["planar2r", "sixr_arm"], workers=2, **kw)
+
+    def rows(rs):
+        return [{k: v for k, v in json.loads(crosscheck.to_json([r]))[0].items() if k != "note"}
+                for r in rs]  # fmt: skip
+
+    assert len(one) > 10
+    assert rows(one) == rows(two)
+
+
+@pytest.mark.parametrize("jobs", ["0", "-1", "65"])
+def test_check_jobs_out_of_range_is_one_line_error(jobs):
+    p = run("check", "planar2r", "--samples", "2", "--jobs", jobs)
+    assert p.returncode == 2 and "--jobs must be in 1..64" in p.stderr
+    assert "Traceback" not in p.stderr
 
 
 def test_unsupported_row_does_not_pass():

@@ -32,5 +32,13 @@ def add_parser(sub):
         "--samples", type=int, default=200, help="random configurations per model (default 200)"
     )
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        metavar="N",
+        help="processes to run the checks in (default: one per CPU this process may use; 1: "
+        "this process only); the rows are the same",
+    )
     add_json(p, "print the rows as JSON")
     p.set_defaults(run="check_run.run")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 
 import numpy as np
@@ -12,6 +13,17 @@ from ..osim import checks as osim_checks
 from .common import MAX_SAMPLES, UserError, parse_locked
 from .runtime import load_model
 
+#: most processes ``--jobs`` may start
+MAX_JOBS = 64
+
+
+def cpus() -> int:
+    """The CPUs this process may use (``os.sched_getaffinity``; ``os.cpu_count()`` elsewhere)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
 
 def run(a) -> int:
     if not 1 <= a.samples <= MAX_SAMPLES:
@@ -21,6 +33,9 @@ def run(a) -> int:
         raise UserError(
             "--tool and --locked apply to the models given: name one (e.g. anthroarm check ur10 --tool tool0)"
         )
+    jobs = cpus() if a.jobs is None else a.jobs
+    if not 1 <= jobs <= MAX_JOBS:
+        raise UserError(f"--jobs must be in 1..{MAX_JOBS}, got {a.jobs}")
     osim = [n for n in names if n.lower().endswith(".osim")]  # OpenSim models: their own rows
     rows = (
         []
@@ -32,6 +47,7 @@ def run(a) -> int:
             progress=not a.json and sys.stderr.isatty(),
             tool=a.tool,
             locked=parse_locked(a.locked),
+            workers=jobs,
         )
     )
     for path in osim:
