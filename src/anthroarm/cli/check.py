@@ -37,8 +37,8 @@ def add_parser(sub):
         type=int,
         default=None,
         metavar="N",
-        help="processes to run the checks in (default: one per CPU this process may use; 1: "
-        "this process only); the rows are the same",
+        help="processes to run the checks in (default: one per CPU this process may use for the "
+        "catalog or 4 models or more, else 1); the rows are the same",
     )
     add_json(p, "print the rows as JSON")
     p.set_defaults(run="check_run.run")

@@ -15,6 +15,8 @@ from .runtime import load_model
 
 #: most processes ``--jobs`` may start
 MAX_JOBS = 64
+#: without ``--jobs``, models given from which the checks run in one process per CPU
+PARALLEL_MODELS = 4
 
 
 def cpus() -> int:
@@ -33,7 +35,10 @@ def run(a) -> int:
         raise UserError(
             "--tool and --locked apply to the models given: name one (e.g. anthroarm check ur10 --tool tool0)"
         )
-    jobs = cpus() if a.jobs is None else a.jobs
+    if a.jobs is not None:
+        jobs = a.jobs
+    else:  # a process takes ~2 s to start: worth it for the catalog or several models
+        jobs = cpus() if not names or len(names) >= PARALLEL_MODELS else 1
     if not 1 <= jobs <= MAX_JOBS:
         raise UserError(f"--jobs must be in 1..{MAX_JOBS}, got {a.jobs}")
     osim = [n for n in names if n.lower().endswith(".osim")]  # OpenSim models: their own rows
