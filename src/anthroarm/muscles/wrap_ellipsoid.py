@@ -577,20 +577,17 @@ def fan(a, r1, r1r2):
     chord r1 + t (r2 − r1), t = k / 300, to their closest surface points."""
     n = r1.shape[0]
     K = NUM_FAN_SAMPLES - 2
+    tt = np.arange(1, K + 1) / NUM_FAN_SAMPLES
     svs = np.empty((n * K, 3), np.complex128)
     for d in range(n):
-        for j in range(K):
-            tt = (j + 1) / NUM_FAN_SAMPLES
-            for k in range(3):
-                svs[d * K + j, k] = r1[d, k] + tt * r1r2[d, k]
+        for k in range(3):
+            svs[d * K : (d + 1) * K, k] = r1[d, k] + tt * r1r2[d, k]
     blades = unit(sub(closest_general(a, svs), svs))[0]
-    total = np.zeros((n, 3), np.complex128)
+    total = np.empty((n, 3), np.complex128)
     mid = np.empty((n, 3), np.complex128)
     for d in range(n):
-        for j in range(K):
-            for k in range(3):
-                total[d, k] += blades[d * K + j, k]
         for k in range(3):
+            total[d, k] = np.sum(blades[d * K : (d + 1) * K, k])
             mid[d, k] = r1[d, k] + 0.5 * r1r2[d, k]
     return mid + unit(total)[0]
 
