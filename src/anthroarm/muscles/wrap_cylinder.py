@@ -51,15 +51,22 @@ def cross(a, b):
 
 
 @kernel
-def unit(v):
-    """(v / |v|, |v|) row by row, |v| = √(v·v); a row with Re |v| < eps is zero
+def unit3(x, y, z):
+    """(x, y, z) / m and m = √(x² + y² + z²) of one complex row; zero where Re m < eps
     (``WrapMath::NormalizeOrZero``)."""
+    m = cmath.sqrt(x * x + y * y + z * z)
+    if m.real < EPS:
+        return 0j, 0j, 0j, m
+    return x / m, y / m, z / m, m
+
+
+@kernel
+def unit(v):
+    """(v / |v|, |v|) row by row (:func:`unit3`)."""
     out = np.empty(v.shape, np.complex128)
     m = np.empty(v.shape[0], np.complex128)
     for d in range(v.shape[0]):
-        m[d] = cmath.sqrt(v[d, 0] * v[d, 0] + v[d, 1] * v[d, 1] + v[d, 2] * v[d, 2])
-        for k in range(3):
-            out[d, k] = 0.0 if m[d].real < EPS else v[d, k] / m[d]
+        out[d, 0], out[d, 1], out[d, 2], m[d] = unit3(v[d, 0], v[d, 1], v[d, 2])
     return out, m
 
 
@@ -94,9 +101,9 @@ def dist2(a, b):
 
 
 @kernel
-def row0_unit(v):
-    """Row 0's real part, normalised (zero below eps): a real 3-vector for decisions."""
-    x, y, z = v[0, 0].real, v[0, 1].real, v[0, 2].real
+def row0_unit(a, b):
+    """Re(a₀ − b₀) of row 0, normalised (zero below eps): a real 3-vector for decisions."""
+    x, y, z = (a[0, 0] - b[0, 0]).real, (a[0, 1] - b[0, 1]).real, (a[0, 2] - b[0, 2]).real
     m = math.sqrt(x * x + y * y + z * z)
     if m < EPS:
         return 0.0, 0.0, 0.0
@@ -144,24 +151,36 @@ def along_z(pt, line_pt):
 @kernel
 def intersect_lines(p1, p2, p3, p4):
     """``WrapMath::IntersectLines``: (found, the point of line p1p2 nearest line p3p4, its
-    parameter, the point of p3p4 nearest p1p2, its parameter); not found for parallel lines."""
-    vec1, mag1 = unit(sub(p2, p1))
-    vec2, mag2 = unit(sub(p4, p3))
-    cp = cross(vec1, vec2)
-    denom = dot(cp, cp)
-    if abs(denom[0].real) <= ROUNDOFF_ERROR:
-        return False, p1, mag1, p3, mag2
-    d31 = sub(p3, p1)
-    t = dot(d31, cross(vec1, cp))  # det([p3 - p1; vec1; cp])
-    s = dot(d31, cross(vec2, cp))  # det([p3 - p1; vec2; cp])
+    parameter, the point of p3p4 nearest p1p2, its parameter); not found for parallel lines
+    (decided on row 0).  With the unit directions v₁, v₂ and c = v₁ × v₂, the parameters are
+    s = (p₃ − p₁)·(v₂ × c) / |c|² and t = (p₃ − p₁)·(v₁ × c) / |c|²."""
     n = p1.shape[0]
+    near1, near2 = np.empty((n, 3), np.complex128), np.empty((n, 3), np.complex128)
     sp, tp = np.empty(n, np.complex128), np.empty(n, np.complex128)
     for d in range(n):
-        t[d] = t[d] / denom[d]
-        s[d] = s[d] / denom[d]
-        sp[d] = s[d] / mag1[d]
-        tp[d] = t[d] / mag2[d]
-    return True, axpy(p1, s, vec1), sp, axpy(p3, t, vec2), tp
+        a0, a1, a2, mag1 = unit3(p2[d, 0] - p1[d, 0], p2[d, 1] - p1[d, 1], p2[d, 2] - p1[d, 2])
+        b0, b1, b2, mag2 = unit3(p4[d, 0] - p3[d, 0], p4[d, 1] - p3[d, 1], p4[d, 2] - p3[d, 2])
+        c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+        denom = c0 * c0 + c1 * c1 + c2 * c2
+        if d == 0 and abs(denom.real) <= ROUNDOFF_ERROR:
+            return False, near1, sp, near2, tp
+        e0, e1, e2 = p3[d, 0] - p1[d, 0], p3[d, 1] - p1[d, 1], p3[d, 2] - p1[d, 2]
+        # det([p3 - p1; vec1; cp]) and det([p3 - p1; vec2; cp])
+        t = e0 * (a1 * c2 - a2 * c1) + e1 * (a2 * c0 - a0 * c2) + e2 * (a0 * c1 - a1 * c0)
+        s = e0 * (b1 * c2 - b2 * c1) + e1 * (b2 * c0 - b0 * c2) + e2 * (b0 * c1 - b1 * c0)
+        t, s = t / denom, s / denom
+        near1[d, 0], near1[d, 1], near1[d, 2] = (
+            p1[d, 0] + s * a0,
+            p1[d, 1] + s * a1,
+            p1[d, 2] + s * a2,
+        )
+        near2[d, 0], near2[d, 1], near2[d, 2] = (
+            p3[d, 0] + t * b0,
+            p3[d, 1] + t * b1,
+            p3[d, 2] + t * b2,
+        )
+        sp[d], tp[d] = s / mag1, t / mag2
+    return True, near1, sp, near2, tp
 
 
 @kernel
@@ -288,8 +307,8 @@ def wrap_cylinder(p1, p2, radius, length, axis, wsign, single):
             sm += ((r1[0, k] - p11[0, k]).real + (r2[0, k] - p22[0, k]).real) * musc
         long_wrap = sm < 0.0
     else:
-        ua, ub = row0_unit(sub(r1a, p11)), row0_unit(sub(r1b, p11))
-        va, vb = row0_unit(sub(r2a, p22)), row0_unit(sub(r2b, p22))
+        ua, ub = row0_unit(r1a, p11), row0_unit(r1b, p11)
+        va, vb = row0_unit(r2a, p22), row0_unit(r2b, p22)
         d1 = ua[0] * va[0] + ua[1] * va[1] + ua[2] * va[2]
         d2 = ua[0] * vb[0] + ua[1] * vb[1] + ua[2] * vb[2]
         d3 = ub[0] * va[0] + ub[1] * va[1] + ub[2] * va[2]
@@ -409,8 +428,8 @@ def adjust(pt, r, w):
     """``WrapCylinder::_adjust_tangent_point``: (moved, r) — r moved 1.5 times towards where
     the line pt w meets the axis-parallel line through r, when the angles of r − pt and
     w − r to the axis differ by more than 0.1°."""
-    pz = row0_unit(sub(r, pt))[2]
-    wz = row0_unit(sub(w, r))[2]
+    pz = row0_unit(r, pt)[2]
+    wz = row0_unit(w, r)[2]
     alpha = math.acos(min(max(pz, -1.0), 1.0)) if abs(pz) <= 1 else math.nan
     omega = math.acos(min(max(wz, -1.0), 1.0)) if abs(wz) <= 1 else math.nan
     if abs(alpha - omega) > TANGENCY_THRESHOLD:

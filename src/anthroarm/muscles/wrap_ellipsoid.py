@@ -595,7 +595,7 @@ def fan(a, r1, r1r2):
 @kernel
 def _cos0(p, t, q):
     """cos of the angle at t between p − t and q − t, row 0's real parts."""
-    u, v = row0_unit(sub(p, t)), row0_unit(sub(q, t))
+    u, v = row0_unit(p, t), row0_unit(q, t)
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
