@@ -16,11 +16,13 @@ The surfaces (each ``wrapLine`` in the wrap object's own frame):
   has more than one wrap — OpenSim's sliding of the tangent points along the axis until the
   straight lines meet the helix within 0.1° (``_adjust``).  The geometry is that of Garner &
   Pandy, *The Obstacle-Set Method for Representing Muscle Paths in Musculoskeletal Models*,
-  Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder obstacle.
+  Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder obstacle.  Compiled
+  kernels: :mod:`anthroarm.muscles.wrap_cylinder`.
 * ``WrapSphere`` (``WrapSphere.cpp``): the great circle through both end points' tangent
   points, wrapping only where the straight segment crosses the sphere (Garner & Pandy 2000,
   sphere obstacle).
-* ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid`.
+* ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid` (compiled
+  kernels too).
   Tori are not evaluated (:class:`~anthroarm.errors.MuscleError`).
 
 Derivative: the complex step (Squire & Trapp, *Using complex variables to estimate derivatives

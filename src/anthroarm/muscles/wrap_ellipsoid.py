@@ -44,6 +44,11 @@ rounding — no subtractive cancellation, no step-size error.  This is the deriv
 length as computed (the piecewise-smooth polyline); OpenSim's ``computeMomentArm`` instead
 holds the tangent points fixed in the ellipsoid's body, a slightly different quantity for
 this non-shortest path (compared in the guide).
+
+Written once as compiled kernels (:mod:`anthroarm.jit`) on (D, 3) ``complex128`` rows, as the
+cylinder (:mod:`anthroarm.muscles.wrap_cylinder`): the interpreter runs the same source until the
+background compilation is done; the closest-point iteration over the fan's 298 chord points
+steps whole arrays, so the interpreter's run stays vectorised.
 """
 
 from __future__ import annotations
