@@ -22,7 +22,7 @@ import pytest
 
 import anthroarm as aa
 from anthroarm import jit, muscles
-from anthroarm.muscles.wrap_ellipsoid import INSIDE, MANDATORY, NO_WRAP, H, ellipsoid, wrap
+from anthroarm.muscles.wrap_ellipsoid import INSIDE, MANDATORY, NO_WRAP, H, ellipse, ellipsoid, wrap
 
 NAMES = ["TRIlong", "BIClong"]
 
@@ -234,3 +234,18 @@ def test_reference_answers_as_compiled():
             np.testing.assert_allclose(a.real, b.real, rtol=0, atol=1e-12)
             np.testing.assert_allclose(a.imag / H, b.imag / H, rtol=1e-8, atol=1e-10)
     assert wrapped >= 6, wrapped
+
+
+def test_closest_point_of_a_point_on_an_axis():
+    """``closestPointToEllipse``'s axis cases against the calculus: on x²/a² + y²/b² = 1 with
+    a = 1, b = 2 the point (0, 0.5) is nearest to y = b² v / (b² − a²) = 2/3, x = √(1 − y²/4)
+    (d/dy of 1 − y²/4 + (y − ½)² vanishes there); (0.5, 0) with the axes swapped; a point far
+    out on the long axis, (0, 3), to the axis's end (0, 2).  Compiled and reference."""
+    for f in (ellipse.dispatcher, jit.reference(ellipse)):
+        z = np.zeros(1, complex)
+        x, y = f(1.0, 2.0, z, z + 0.5)
+        np.testing.assert_allclose([x[0].real, y[0].real], [np.sqrt(1 - 1 / 9), 2 / 3], atol=1e-15)
+        x, y = f(2.0, 1.0, z + 0.5, z)
+        np.testing.assert_allclose([x[0].real, y[0].real], [2 / 3, np.sqrt(1 - 1 / 9)], atol=1e-15)
+        x, y = f(1.0, 2.0, z, z + 3.0)
+        np.testing.assert_allclose([x[0].real, y[0].real], [0.0, 2.0], atol=1e-15)

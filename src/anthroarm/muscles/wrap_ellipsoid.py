@@ -135,32 +135,9 @@ def ellipse(a, b, u, v):
                 x[d], y[d] = u[d], (-b if v[d].real < 0 else b) + 0.0 * v[d]
         return x, y
     if nx:
-        far = a >= b
-        if not far:
-            far = True
-            for d in range(n):
-                far = far and abs(v[d].real) >= b - a2 / b
-        for d in range(n):
-            if far:
-                x[d], y[d] = u[d], (b if v[d].real >= 0 else -b) + 0.0 * v[d]
-            else:
-                y[d] = b2 * v[d] / (b2 - a2)
-                ydb = y[d] / b
-                x[d] = a * cmath.sqrt(cabs(1 - ydb * ydb))
-        return x, y
-    if ny:
-        far = b >= a
-        if not far:
-            far = True
-            for d in range(n):
-                far = far and abs(u[d].real) >= a - b2 / a
-        for d in range(n):
-            if far:
-                x[d], y[d] = (a if u[d].real >= 0 else -a) + 0.0 * u[d], v[d]
-            else:
-                x[d] = a2 * u[d] / (a2 - b2)
-                xda = x[d] / a
-                y[d] = b * cmath.sqrt(cabs(1 - xda * xda))
+        return ellipse_on_axis(a, b, u, v)
+    if ny:  # the same with the axes swapped
+        y, x = ellipse_on_axis(b, a, v, u)
         return x, y
     t = np.empty(n, np.complex128)
     for d in range(n):
@@ -184,6 +161,29 @@ def ellipse(a, b, u, v):
             t[d] = t[d] - f[d] / fp
     for d in range(n):
         x[d], y[d] = a2 * u[d] / (t[d] + a2), b2 * v[d] / (t[d] + b2)
+    return x, y
+
+
+@kernel
+def ellipse_on_axis(a, b, u, v):
+    """``closestPointToEllipse`` for points on the second axis (u ≈ 0 on every row): the end
+    of that axis (x = u, y = ±b) when the point is far enough out (|v| ≥ b − a²/b) or a ≥ b,
+    else the ellipse point y = b² v / (b² − a²), x = a √|1 − (y/b)²|."""
+    n = u.shape[0]
+    a2, b2 = a * a, b * b
+    x, y = np.empty(n, np.complex128), np.empty(n, np.complex128)
+    far = a >= b
+    if not far:
+        far = True
+        for d in range(n):
+            far = far and abs(v[d].real) >= b - a2 / b
+    for d in range(n):
+        if far:
+            x[d], y[d] = u[d], (b if v[d].real >= 0 else -b) + 0.0 * v[d]
+        else:
+            y[d] = b2 * v[d] / (b2 - a2)
+            ydb = y[d] / b
+            x[d] = a * cmath.sqrt(cabs(1 - ydb * ydb))
     return x, y
 
 
