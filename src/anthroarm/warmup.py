@@ -3,11 +3,11 @@
 Started by the first kernel call of a process with an empty cache (:mod:`anthroarm.jit`, mode
 ``auto``), in its own session, with ``ANTHROARM_JIT=compile``: it runs the public entry points
 that use compiled kernels on every catalog arm whose chain has a closed form or search class,
-on the search classes' user arms and on the subproblems, so every kernel is compiled for the
-types those entry points give it and stored in Numba's disk cache; then it writes the ready
-stamp (:func:`anthroarm.jit.write_stamp`) that tells every process to switch to compiled code.
-It keeps to one CPU (``NUMBA_NUM_THREADS=1``) and lowers its priority, so the process that
-started it keeps its pace on the reference path meanwhile.
+on the search classes' user arms, on the subproblems and on arm26's wrapped muscle paths, so
+every kernel is compiled for the types those entry points give it and stored in Numba's disk
+cache; then it writes the ready stamp (:func:`anthroarm.jit.write_stamp`) that tells every
+process to switch to compiled code.  It keeps to one CPU (``NUMBA_NUM_THREADS=1``) and lowers
+its priority, so the process that started it keeps its pace on the reference path meanwhile.
 
 Run by hand, ``python -m anthroarm.warmup --report`` compiles in the foreground and lists the
 kernels it did not reach (none: a test holds it).
@@ -23,7 +23,7 @@ import warnings
 
 import numpy as np
 
-from . import jit, models
+from . import jit, models, muscles, osim
 from .errors import AnthroarmError
 from .ik import analytic, analytic_batch, closed_form_info, geometric, solve
 from .ik import subproblems as sp
@@ -126,6 +126,13 @@ def _subproblems(rng) -> None:
     )
 
 
+def _muscles(n) -> None:
+    """The muscle paths over cylinder and ellipsoid wraps (arm26: TRIlong's three wraps,
+    BIClong's ellipsoid), exact moment arms."""
+    robot = load(osim.path("arm26"))
+    muscles.lengths_and_moment_arms(robot, None, robot.random_q(max(2, n), rng=0))
+
+
 def run(report: bool = False, n: int = 8) -> list[str]:
     """Compile every kernel through the entry points (``n`` poses an arm) (``ANTHROARM_JIT=compile``); the names of
     the kernels not reached (with an empty cache; with ``ANTHROARM_JIT=reference`` the kernels
@@ -136,6 +143,7 @@ def run(report: bool = False, n: int = 8) -> list[str]:
         for robot in _closed_form_arms():
             _arm(robot, rng, n)
         _subproblems(rng)
+        _muscles(n)
     if jit.STATE.compiled:  # compiled here: a kernel compiled by its caller has a signature
         missing = [repr(k) for k in jit.STATE.kernels if not k.dispatcher.signatures]
     else:  # the reference: the kernels called (their first call's types kept), and what

@@ -20,8 +20,8 @@ import pytest
 from arm26_variants import spheres, variant
 
 import anthroarm as aa
-from anthroarm import muscles
-from anthroarm.muscles.wrap_ellipsoid import INSIDE, MANDATORY, NO_WRAP, ellipsoid
+from anthroarm import jit, muscles
+from anthroarm.muscles.wrap_ellipsoid import INSIDE, MANDATORY, NO_WRAP, H, ellipse, ellipsoid, wrap
 
 NAMES = ["TRIlong", "BIClong"]
 
@@ -200,3 +200,45 @@ def test_other_wrap_methods_against_opensim(tmp_path, method):
         model.realizePosition(state)
         err = max(err, np.abs([m.getLength(state) for m in mus] - lq).max())
     assert err < 1e-5, err
+
+
+def test_reference_answers_as_compiled():
+    """The ellipsoid's kernel run by the interpreter (its reference) and compiled give the same
+    tangent points, length and derivatives (the pattern of tests/foundation/test_jit_modes.py),
+    for each method and one- and two-sided quadrants, over wraps that use the fan, Frans'
+    technique and their blend."""
+    rng = np.random.default_rng(9)
+    dims = np.array([0.025, 0.02, 0.03])
+    ref = jit.reference(wrap)
+    wrapped = 0
+    for i in range(24):
+        a = rng.normal(size=3)
+        a *= 0.05 / np.linalg.norm(a)
+        p = np.concatenate([a, -a * rng.uniform(0.6, 1.4) + rng.uniform(-0.01, 0.01, 3)])
+        P = np.tile(p.astype(complex), (7, 1))
+        P[np.arange(1, 7), np.arange(6)] += 1j * H
+        p1, p2 = np.ascontiguousarray(P[:, :3]), np.ascontiguousarray(P[:, 3:])
+        quad = [(0, 0), (1, -1), (2, 1)][i % 3]
+        args = (p1, p2, dims, quad[0], quad[1], i % 3 if i % 4 else 0)
+        c, r = wrap.dispatcher(*args), ref(*args)
+        assert c[0] == r[0]
+        wrapped += c[0] == MANDATORY
+        for a, b in zip(c[1:], r[1:]):
+            np.testing.assert_allclose(a.real, b.real, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(a.imag / H, b.imag / H, rtol=1e-8, atol=1e-10)
+    assert wrapped >= 6, wrapped
+
+
+def test_closest_point_of_a_point_on_an_axis():
+    """``closestPointToEllipse``'s axis cases against the calculus: on x²/a² + y²/b² = 1 with
+    a = 1, b = 2 the point (0, 0.5) is nearest to y = b² v / (b² − a²) = 2/3, x = √(1 − y²/4)
+    (d/dy of 1 − y²/4 + (y − ½)² vanishes there); (0.5, 0) with the axes swapped; a point far
+    out on the long axis, (0, 3), to the axis's end (0, 2).  Compiled and reference."""
+    for f in (ellipse.dispatcher, jit.reference(ellipse)):
+        z = np.zeros(1, complex)
+        x, y = f(1.0, 2.0, z, z + 0.5)
+        np.testing.assert_allclose([x[0].real, y[0].real], [np.sqrt(1 - 1 / 9), 2 / 3], atol=1e-15)
+        x, y = f(2.0, 1.0, z + 0.5, z)
+        np.testing.assert_allclose([x[0].real, y[0].real], [2 / 3, np.sqrt(1 - 1 / 9)], atol=1e-15)
+        x, y = f(1.0, 2.0, z, z + 3.0)
+        np.testing.assert_allclose([x[0].real, y[0].real], [0.0, 2.0], atol=1e-15)

@@ -16,11 +16,13 @@ The surfaces (each ``wrapLine`` in the wrap object's own frame):
   has more than one wrap — OpenSim's sliding of the tangent points along the axis until the
   straight lines meet the helix within 0.1° (``_adjust``).  The geometry is that of Garner &
   Pandy, *The Obstacle-Set Method for Representing Muscle Paths in Musculoskeletal Models*,
-  Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder obstacle.
+  Comput Methods Biomech Biomed Engin 3 (2000) 1-30, single-cylinder obstacle.  Compiled
+  kernels: :mod:`anthroarm.muscles.wrap_cylinder`.
 * ``WrapSphere`` (``WrapSphere.cpp``): the great circle through both end points' tangent
   points, wrapping only where the straight segment crosses the sphere (Garner & Pandy 2000,
   sphere obstacle).
-* ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid`.
+* ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid` (compiled
+  kernels too).
   Tori are not evaluated (:class:`~anthroarm.errors.MuscleError`).
 
 Derivative: the complex step (Squire & Trapp, *Using complex variables to estimate derivatives
@@ -56,17 +58,9 @@ import math
 import numpy as np
 
 from ..errors import MuscleError
+from .wrap_cylinder import EPS, INSIDE, MANDATORY, NO_WRAP, WRAPPED, rot_z, wrap_cylinder
 from .wrap_ellipsoid import wrap_line as ellipsoid_line
 
-#: SimmMacros.h / WrapMath.cpp / WrapCylinder.cpp constants
-ROUNDOFF_ERROR = 2e-13
-LINE_EPSILON = 1e-5
-EPS = np.finfo(float).eps
-MAX_ITERATIONS = 100
-TANGENCY_THRESHOLD = 0.1 * np.pi / 180.0
-NO_WRAP, INSIDE, WRAPPED, MANDATORY = 0, -1, 1, 2
-P0 = np.array([0.0, 0.0, -1.0])
-DN = np.array([0.0, 0.0, 1.0])
 QUADRANTS = {"x": (0, 1), "y": (1, 1), "z": (2, 1)}
 #: complex step (any h below ~1e-20 gives the same derivative)
 H = 1e-30
@@ -127,15 +121,6 @@ def _acos(x):
     return np.arccos(np.where(out, np.clip(np.real(x), -1.0, 1.0), x))
 
 
-def _atan2(y, x):
-    """arctan2 of complex-step rows: the real angle plus i times its first-order change."""
-    yr, xr = np.real(y), np.real(x)
-    t = np.arctan2(yr, xr)
-    if not (np.iscomplexobj(y) or np.iscomplexobj(x)):
-        return t
-    return t + 1j * (xr * np.imag(y) - yr * np.imag(x)) / (xr * xr + yr * yr)
-
-
 def _closest_on_line(pt, line_pt, line):
     v1, mag = _unit(pt - line_pt)
     v2, mag2 = _unit(line)
@@ -143,213 +128,22 @@ def _closest_on_line(pt, line_pt, line):
     return line_pt + t[..., None] * v2, t / mag2
 
 
-def _along_z(pt, line_pt):
-    """The point of the line through ``line_pt`` along z closest to pt: (x₀, y₀, z) (what
-    :func:`_closest_on_line` computes for a z line, to rounding)."""
-    out = np.array(np.broadcast_to(line_pt, np.broadcast_shapes(np.shape(pt), np.shape(line_pt))))
-    out = out.astype(np.result_type(pt, line_pt), copy=False)
-    out[..., 2] = pt[..., 2]
-    return out
-
-
-def _intersect_lines(p1, p2, p3, p4):
-    vec1, mag1 = _unit(p2 - p1)
-    vec2, mag2 = _unit(p4 - p3)
-    cp = _cross(vec1, vec2)
-    denom = _dot(cp, cp)
-    if abs(_re(denom)) <= ROUNDOFF_ERROR:
-        return None, None, None, None
-    d31 = p3 - p1
-    t = _dot(d31, _cross(vec1, cp)) / denom  # det([p3 - p1; vec1; cp])
-    s = _dot(d31, _cross(vec2, cp)) / denom  # det([p3 - p1; vec2; cp])
-    return p1 + s[..., None] * vec1, s / mag1, p3 + t[..., None] * vec2, t / mag2
-
-
-def _intersect_seg_plane(pt1, pt2, plane, d):
-    vec = pt2 - pt1
-    dot = _dot(vec, plane)
-    if abs(_re(dot)) < LINE_EPSILON:
-        return None
-    t = (-d - _dot(plane, pt1)) / dot
-    if _re(t) < -LINE_EPSILON or _re(t) > 1.0 + LINE_EPSILON:
-        return None
-    return pt1 + t[..., None] * vec
-
-
-def _rot_z(angle, v):
-    """v (D, 3) rotated by angle (D,) about the z axis."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], -1)
-
-
 # ------------------------------------------------------------------------------- cylinder
 def cylinder(p1, p2, radius, length, quad, single):
     """``WrapCylinder::wrapLine`` of end points p1, p2 (D, 3) (the cylinder's frame; row 0
     decides every branch): (code, r1 (D, 3), r2 (D, 3), arc length (D,), turn (D,)), the turn
     the signed angle about the cylinder's z axis from r1 to r2 along the helix
-    (:func:`surface_points`)."""
-    r2_ = radius * radius
+    (:func:`surface_points`); None, None, 0 and None for a path that does not wrap; the
+    compiled kernel :func:`anthroarm.muscles.wrap_cylinder.wrap_cylinder` on complex rows."""
+    p1 = np.ascontiguousarray(p1, dtype=complex)
+    p2 = np.ascontiguousarray(p2, dtype=complex)
     axis, wsign = quad
-    constrained = wsign != 0
-    far_side = long_wrap = False
-    code = WRAPPED
-    # distance² to the axis (the line through P0 along DN)
-    if _re(p1[:, 0] ** 2 + p1[:, 1] ** 2) < r2_ or _re(p2[:, 0] ** 2 + p2[:, 1] ** 2) < r2_:
-        return INSIDE, None, None, 0.0, None
-    cs, ce = np.array([0, 0, -0.5 * length]), np.array([0, 0, 0.5 * length])
-    near12, t12, near00, _ = _intersect_lines(p1, p2, cs, ce)
-    crosses = (
-        near12 is not None
-        and _re(np.sum((near12 - near00) ** 2, axis=-1)) < r2_
-        and 0 < _re(t12) < 1
+    code, r1, r2, arc, turn = wrap_cylinder(
+        p1, p2, float(radius), float(length), int(axis), int(wsign), bool(single)
     )
-    if not constrained:
-        if crosses:
-            code = MANDATORY
-        else:
-            return NO_WRAP, None, None, 0.0, None
-    p11, _ = _closest_on_line(p1, P0, DN)
-    p22, _ = _closest_on_line(p2, P0, DN)
-
-    def tangents(p, pc):
-        vv, dist_p = _unit(p - pc)
-        d = (radius * (radius / dist_p))[:, None]
-        pp = pc + d * vv
-        d = np.sqrt(r2_ - d * d)
-        uu = _cross(DN, vv)
-        return pp + d * uu, pp - d * uu, dist_p
-
-    r1a, r1b, p11_dist = tangents(p1, p11)
-    r2a, r2b, p22_dist = tangents(p2, p22)
-    if constrained:
-        s1, s2 = _sign(p1[0, axis].real), _sign(p2[0, axis].real)
-        if s1 == wsign or s2 == wsign:
-            if crosses:
-                code = MANDATORY
-            elif s1 != s2 and near12 is not None and _sign(near12[0, axis].real) != wsign:
-                code = WRAPPED
-            else:
-                return NO_WRAP, None, None, 0.0, None
-        r1am, r1bm, r2am, r2bm = (v[0].real for v in (r1a - p11, r1b - p11, r2a - p22, r2b - p22))
-        with np.errstate(invalid="ignore"):  # decisions only: NaN compares false, as in C++
-            alpha = np.arccos((r1am @ r2bm) / (np.linalg.norm(r1am) * np.linalg.norm(r2bm)))
-            beta = np.arccos((r1bm @ r2am) / (np.linalg.norm(r1bm) * np.linalg.norm(r2am)))
-        A, B = _sign(r1a[0, axis].real) == wsign, _sign(r1b[0, axis].real) == wsign
-        if A and B:
-            if _sign(r2a[0, axis].real) == wsign:
-                r1, r2, far_side = r1b, r2a, not (alpha > beta)
-            else:
-                r1, r2, far_side = r1a, r2b, alpha > beta
-        elif A:
-            r1, r2, far_side = r1a, r2b, alpha > beta
-        elif B:
-            r1, r2, far_side = r1b, r2a, not (alpha > beta)
-        elif _sign(r2a[0, axis].real) == wsign:
-            r1, r2, far_side = r1b, r2a, not (alpha > beta)
-        elif _sign(r2b[0, axis].real) == wsign:
-            r1, r2, far_side = r1a, r2b, alpha > beta
-        else:
-            r1, r2 = (r1a, r2b) if alpha > beta else (r1b, r2a)
-            far_side = True
-        sum_musc = ((r1 - p1) + (r2 - p2))[0].real
-        sum_r = ((r1 - p11) + (r2 - p22))[0].real
-        long_wrap = float(sum_r @ sum_musc) < 0.0
-    else:
-        ua, ub = (_unit(v[:1].real)[0][0] for v in (r1a - p11, r1b - p11))
-        va, vb = (_unit(v[:1].real)[0][0] for v in (r2a - p22, r2b - p22))
-        d1, d2, d3, d4 = ua @ va, ua @ vb, ub @ va, ub @ vb
-        if d1 > d2 and d1 > d3 and d1 > d4:
-            r1, r2 = r1a, r2a
-        elif d2 > d3 and d2 > d4:
-            r1, r2 = r1a, r2b
-        elif d3 > d4:
-            r1, r2 = r1b, r2a
-        else:
-            r1, r2 = r1b, r2b
-    t = (p11_dist / (p11_dist + p22_dist))[:, None]
-    mpt = p1 + t * (p2 - p1)
-    axispt, _ = _closest_on_line(mpt, P0, DN)
-    l1, l2 = _unit(p1 - axispt)[0], _unit(p2 - axispt)[0]
-    normal = _unit(_unit(_cross(l1, l2))[0])[0]
-    vert1 = _unit(_cross(DN, normal))[0]
-    vert2 = _unit(_cross(normal, DN))[0]
-    apex1, apex2 = axispt + radius * vert1, axispt + radius * vert2
-    dist1 = _re(np.sum((mpt - apex1) ** 2, axis=-1))
-    dist2 = _re(np.sum((mpt - apex2) ** 2, axis=-1))
-    if far_side:
-        apex = apex2 if dist1 < dist2 else apex1
-    else:
-        apex = apex1 if dist1 < dist2 else apex2
-    uu, vv = _unit(p1 - apex)[0], _unit(p2 - apex)[0]
-    normal = _unit(_cross(uu, vv))[0]
-    d = -_dot(p1, normal)
-    r1p = _intersect_seg_plane(r1 - 10.0 * DN, r1 + 10.0 * DN, normal, d)
-    r2p = _intersect_seg_plane(r2 - 10.0 * DN, r2 + 10.0 * DN, normal, d)
-    d12 = _re(np.sum((p11 - p22) ** 2, axis=-1))
-    if r1p is not None:
-        c, _ = _closest_on_line(r1p, p11, p22)
-        if _re(np.sum((c - p22) ** 2, axis=-1)) < d12:
-            r1 = r1p
-    if r2p is not None:
-        c, _ = _closest_on_line(r2p, p11, p22)
-        if _re(np.sum((c - p11) ** 2, axis=-1)) < d12:
-            r2 = r2p
-    half = length / 2.0
-    z1, z2 = r1[0, 2].real, r2[0, 2].real
-    if (z1 < -half or z1 > half) and (z2 < -half or z2 > half):
-        return NO_WRAP, None, None, 0.0, None
-    r1, r2, arc, turn = _spiral(p1, p2, r1, r2, radius, long_wrap, single)
-    return code, r1, r2, arc, turn
-
-
-def _spiral(p1, p2, r1, r2, radius, far_side, single):
-    """``WrapCylinder::_make_spiral_path``: the helix's length and turn (the signed angle
-    about z from r1 to r2 along the helix: θ = atan2((û × v̂)_z, û·v̂) seen from the axis,
-    2π − θ the other way round on a far-side wrap), with the tangent points slid along the
-    axis (``_adjust_tangent_point``) when the path has more than one wrap."""
-    sense = -1.0 if far_side else 1.0
-    iterations = 0
-    while True:
-        axial = r2[:, 2] - r1[:, 2]
-        uu, vv = r1.copy(), r2.copy()  # from the axis, normal to it
-        uu[:, 2] = vv[:, 2] = 0.0
-        theta = _atan2(_cross(uu, vv)[:, 2], _dot(uu, vv))
-        if far_side:
-            theta = 2.0 * np.pi - theta
-        turn = sense * theta
-        arc = np.sqrt((radius * theta) ** 2 + axial**2)
-        if single:
-            return r1, r2, arc, turn
-        nseg = max(1, int(_re(arc) / 0.002))
-        if nseg < 2 or iterations >= MAX_ITERATIONS:
-            return r1, r2, arc, turn
-        t = 1.0 / nseg
-        w1 = _rot_z(t * turn, r1)
-        w1[:, 2] += t * axial
-        a1, r1n = _adjust(p1, r1, w1)
-        # OpenSim's spiral-point lambda captures r1 by reference: the second point is placed
-        # from the r1 just adjusted
-        w2 = _rot_z((1 - t) * turn, r1n)
-        w2[:, 2] += (1 - t) * axial
-        a2, r2n = _adjust(p2, r2, w2)
-        if not (a1 or a2):
-            return r1, r2, arc, turn
-        r1, r2 = r1n, r2n
-        iterations += 1
-
-
-def _adjust(pt, r, w):
-    pz = _unit((r - pt)[:1].real)[0][0, 2]
-    wz = _unit((w - r)[:1].real)[0][0, 2]
-    alpha = np.arccos(np.clip(pz, -1, 1)) if abs(pz) <= 1 else np.nan
-    omega = np.arccos(np.clip(wz, -1, 1)) if abs(wz) <= 1 else np.nan
-    if abs(alpha - omega) > TANGENCY_THRESHOLD:
-        p1a, w1a = _along_z(pt, r), _along_z(w, r)
-        _, _, hit, _ = _intersect_lines(pt, w, p1a, w1a)
-        if hit is None:
-            return False, r
-        return True, r + 1.5 * (hit - r)
-    return False, r
+    if code in (WRAPPED, MANDATORY):
+        return code, r1, r2, arc, turn
+    return code, None, None, 0.0, None
 
 
 # ---------------------------------------------------------------------------------- sphere
@@ -532,7 +326,8 @@ def surface_points(w, r1, r2, surface, tolerance: float = ARC_TOLERANCE) -> np.n
         n = max(1, math.ceil(abs(phi) * math.sqrt(w.radius * abs(phi) / (24.0 * tolerance))))
         t = np.linspace(0.0, 1.0, n + 1)
         if w.kind == "WrapCylinder":
-            pts = _rot_z(t * phi, np.broadcast_to(a, (n + 1, 3)))
+            v = np.ascontiguousarray(np.broadcast_to(a, (n + 1, 3)), dtype=complex)
+            pts = rot_z((t * phi).astype(complex), v).real
             pts[:, 2] = a[2] + t * (b[2] - a[2])
         else:
             k = np.cross(a, b)

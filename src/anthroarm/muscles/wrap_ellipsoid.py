@@ -44,19 +44,27 @@ rounding — no subtractive cancellation, no step-size error.  This is the deriv
 length as computed (the piecewise-smooth polyline); OpenSim's ``computeMomentArm`` instead
 holds the tangent points fixed in the ellipsoid's body, a slightly different quantity for
 this non-shortest path (compared in the guide).
+
+Written once as compiled kernels (:mod:`anthroarm.jit`) on (D, 3) ``complex128`` rows, as the
+cylinder (:mod:`anthroarm.muscles.wrap_cylinder`): the interpreter runs the same source until the
+background compilation is done; the closest-point iteration over the fan's 298 chord points
+steps whole arrays, so the interpreter's run stays vectorised.
 """
 
 from __future__ import annotations
 
+import cmath
 import math
 
 import numpy as np
 
 from ..errors import MuscleError
+from ..jit import kernel
+from .wrap_cylinder import axpy, cross, dot, row0_unit, sub, unit
 
 NO_WRAP, INSIDE, MANDATORY = 0, -1, 2
 ROUNDOFF_ERROR = 2e-13
-EPS = np.finfo(float).eps
+EPS = float(np.finfo(float).eps)
 ELLIPSOID_TINY = 1e-8
 MU_BLEND_MIN = 0.7073
 MU_BLEND_MAX = 0.9
@@ -67,181 +75,261 @@ SEGMENT = 0.001
 H = 1e-30
 #: Newton steps after the real part has converged (the imaginary part converges in one)
 POLISH = 3
+#: the PathWrap methods, as the kernels number them (another is hybrid, as in OpenSim)
+METHODS = {"hybrid": 0, "midpoint": 1, "axial": 2}
 
 
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
+@kernel
+def cabs(x):
+    """|x| of a complex-step number: x·sign(Re x) (analytic on each side)."""
+    return x if x.real >= 0.0 else -x
 
 
-def _norm(v):
-    return np.sqrt(_dot(v, v))
-
-
-def _unit(v):
-    """``WrapMath::NormalizeOrZero`` on (..., 3), complex-safe (zero where |Re v| < eps)."""
-    m = _norm(v)
-    small = np.abs(m.real) < EPS
-    return np.where(small[..., None], 0.0, v / np.where(small, 1.0, m)[..., None])
-
-
-def _cabs(x):
-    return x * np.where(x.real >= 0.0, 1.0, -1.0)
+@kernel
+def solve4(A, b):
+    """(solved, x) of A x = b for a 4×4 A (real or complex rows of the complex step): Gaussian
+    elimination with partial pivoting on |Re|; not solved for a zero pivot (singular)."""
+    M = A.copy()
+    x = b.copy()
+    for c in range(4):
+        piv = c
+        for i in range(c + 1, 4):
+            if abs(M[i, c].real) > abs(M[piv, c].real):
+                piv = i
+        if M[piv, c] == 0.0:
+            return False, x
+        if piv != c:
+            for j in range(4):
+                M[c, j], M[piv, j] = M[piv, j], M[c, j]
+            x[c], x[piv] = x[piv], x[c]
+        for i in range(c + 1, 4):
+            f = M[i, c] / M[c, c]
+            for j in range(c, 4):
+                M[i, j] = M[i, j] - f * M[c, j]
+            x[i] = x[i] - f * x[c]
+    for c in range(3, -1, -1):
+        s = x[c]
+        for j in range(c + 1, 4):
+            s = s - M[c, j] * x[j]
+        x[c] = s / M[c, c]
+    return True, x
 
 
 # ------------------------------------------------------------ closest point on the surface
-def _ellipse(a, b, u, v):
-    """``closestPointToEllipse`` (Graphics Gems IV) for points (u, v) of one batch (...,)."""
+@kernel
+def ellipse(a, b, u, v):
+    """``closestPointToEllipse`` (Graphics Gems IV) for the points (u, v) (D,) of one state's
+    rows: the closest point (x (D,), y (D,)) of the ellipse of semi-axes a, b."""
+    n = u.shape[0]
     a2, b2 = a * a, b * b
-    nx = np.abs(u.real) <= ROUNDOFF_ERROR
-    ny = np.abs(v.real) <= ROUNDOFF_ERROR
-    if np.all(nx) and np.all(ny):
-        if a < b:
-            return np.where(u.real < 0, -a, a) + 0 * u, v
-        return u, np.where(v.real < 0, -b, b) + 0 * v
-    if np.all(nx):
-        if a >= b or np.all(np.abs(v.real) >= b - a2 / b):
-            return u, np.where(v.real >= 0, b, -b) + 0 * v
-        y = b2 * v / (b2 - a2)
-        ydb = y / b
-        return a * np.sqrt(_cabs(1 - ydb * ydb)), y
-    if np.all(ny):
-        if b >= a or np.all(np.abs(u.real) >= a - b2 / a):
-            return np.where(u.real >= 0, a, -a) + 0 * u, v
-        x = a2 * u / (a2 - b2)
-        xda = x / a
-        return x, b * np.sqrt(_cabs(1 - xda * xda))
-    a2u2, b2v2 = a2 * u * u, b2 * v * v
-    inside = ((u.real / a) ** 2 + (v.real / b) ** 2) < 1.0
-    t = np.where(inside, 0.0, max(a, b) * np.sqrt(u * u + v * v))
+    x, y = np.empty(n, np.complex128), np.empty(n, np.complex128)
+    nx = ny = True
+    for d in range(n):
+        nx = nx and abs(u[d].real) <= ROUNDOFF_ERROR
+        ny = ny and abs(v[d].real) <= ROUNDOFF_ERROR
+    if nx and ny:
+        for d in range(n):
+            if a < b:
+                x[d], y[d] = (-a if u[d].real < 0 else a) + 0.0 * u[d], v[d]
+            else:
+                x[d], y[d] = u[d], (-b if v[d].real < 0 else b) + 0.0 * v[d]
+        return x, y
+    if nx:
+        return ellipse_on_axis(a, b, u, v)
+    if ny:  # the same with the axes swapped
+        y, x = ellipse_on_axis(b, a, v, u)
+        return x, y
+    t = np.empty(n, np.complex128)
+    for d in range(n):
+        inside = (u[d].real / a) ** 2 + (v[d].real / b) ** 2 < 1.0
+        t[d] = 0.0 if inside else max(a, b) * cmath.sqrt(u[d] * u[d] + v[d] * v[d])
     extra = 0
+    f = np.empty(n, np.complex128)
     for _ in range(64 + POLISH):
-        P, Q = t + a2, t + b2
-        f = P * P * Q * Q - a2u2 * Q * Q - b2v2 * P * P
-        if np.all(np.abs(f.real) < 1e-9):
+        done = True
+        for d in range(n):
+            P, Q = t[d] + a2, t[d] + b2
+            f[d] = P * P * Q * Q - a2 * u[d] * u[d] * Q * Q - b2 * v[d] * v[d] * P * P
+            done = done and abs(f[d].real) < 1e-9
+        if done:
             extra += 1
             if extra > POLISH:
                 break
-        fp = 2.0 * (P * Q * (P + Q) - a2u2 * Q - b2v2 * P)
-        t = t - f / fp
-    return a2 * u / (t + a2), b2 * v / (t + b2)
+        for d in range(n):
+            P, Q = t[d] + a2, t[d] + b2
+            fp = 2.0 * (P * Q * (P + Q) - a2 * u[d] * u[d] * Q - b2 * v[d] * v[d] * P)
+            t[d] = t[d] - f[d] / fp
+    for d in range(n):
+        x[d], y[d] = a2 * u[d] / (t[d] + a2), b2 * v[d] / (t[d] + b2)
+    return x, y
 
 
-def _closest(a, X, axis=-1):
-    """``findClosestPoint``: the closest surface point of the ellipsoid with radii ``a`` to
-    each point X (..., 3); ``axis`` >= 0 reduces to that coordinate plane's ellipse."""
-    X = np.asarray(X, dtype=complex)
-    if axis == -1 and X.ndim == 2:  # one point (row 0 real): OpenSim's special cases
-        near = np.abs(X[(0,) * (X.ndim - 1)].real) <= ROUNDOFF_ERROR
-        best = np.inf
-        for i in range(3):
-            if near[i]:
-                s = sum(a[j] for j in range(3) if j != i)
-                if best > s:
-                    axis, best = i, s
-    out = np.empty_like(X)
-    if axis == 0:
-        out[..., 0] = X[..., 0]
-        out[..., 1], out[..., 2] = _ellipse(a[1], a[2], X[..., 1], X[..., 2])
-        return out
-    if axis == 1:
-        out[..., 1] = X[..., 1]
-        out[..., 2], out[..., 0] = _ellipse(a[2], a[0], X[..., 2], X[..., 0])
-        return out
-    if axis == 2:
-        out[..., 2] = X[..., 2]
-        out[..., 0], out[..., 1] = _ellipse(a[0], a[1], X[..., 0], X[..., 1])
-        return out
-    # the fan's samples (X.ndim 3) take the general case: a sample within 2e-13 of a
-    # coordinate plane (OpenSim's special case) gives the same point to ~1e-13
+@kernel
+def ellipse_on_axis(a, b, u, v):
+    """``closestPointToEllipse`` for points on the second axis (u ≈ 0 on every row): the end
+    of that axis (x = u, y = ±b) when the point is far enough out (|v| ≥ b − a²/b) or a ≥ b,
+    else the ellipse point y = b² v / (b² − a²), x = a √|1 − (y/b)²|."""
+    n = u.shape[0]
+    a2, b2 = a * a, b * b
+    x, y = np.empty(n, np.complex128), np.empty(n, np.complex128)
+    far = a >= b
+    if not far:
+        far = True
+        for d in range(n):
+            far = far and abs(v[d].real) >= b - a2 / b
+    for d in range(n):
+        if far:
+            x[d], y[d] = u[d], (b if v[d].real >= 0 else -b) + 0.0 * v[d]
+        else:
+            y[d] = b2 * v[d] / (b2 - a2)
+            ydb = y[d] / b
+            x[d] = a * cmath.sqrt(cabs(1 - ydb * ydb))
+    return x, y
+
+
+@kernel
+def closest_general(a, X):
+    """The closest surface points of the ellipsoid with radii ``a`` (3,) to the points X
+    (N, 3): Hart's Newton iteration on the parameter t of x = a² X / (t + a²) (the general
+    case of ``findClosestPoint``), until every |f| < 1e-9, then ``POLISH`` steps."""
+    # whole-array steps (the fan's ~900 rows at once in the interpreter too)
+    n = X.shape[0]
     a2 = a * a
+    amax = max(a[0], max(a[1], a[2]))
     u2a2 = a2 * X * X
-    inside = np.sum((X.real / a) ** 2, axis=-1) < 1.0
-    t = np.where(inside, 0.0, a.max() * _norm(X))
+    inside = np.sum((X.real / a) ** 2, axis=1) < 1.0
+    t = amax * np.sqrt(np.sum(X * X, axis=1))
+    t[inside] = 0.0
+    u0, u1, u2 = u2a2[:, 0].copy(), u2a2[:, 1].copy(), u2a2[:, 2].copy()
     extra = 0
     for _ in range(64 + POLISH):
-        P = t[..., None] + a2
-        P2 = P * P
-        f = P2[..., 0] * P2[..., 1] * P2[..., 2]
-        f = f - u2a2[..., 0] * P2[..., 1] * P2[..., 2] - u2a2[..., 1] * P2[..., 0] * P2[..., 2]
-        f = f - u2a2[..., 2] * P2[..., 0] * P2[..., 1]
+        p, q, r = t + a2[0], t + a2[1], t + a2[2]
+        p2, q2, r2 = p * p, q * q, r * r
+        f = p2 * q2 * r2 - u0 * q2 * r2 - u1 * p2 * r2
+        f = f - u2 * p2 * q2
         if np.all(np.abs(f.real) < 1e-9):
             extra += 1
             if extra > POLISH:
                 break
-        p, q, r = P[..., 0], P[..., 1], P[..., 2]
         pq, pr, qr = p * q, p * r, q * r
         fp = 2.0 * (
-            p * q * r * (qr + pr + pq)
-            - u2a2[..., 0] * qr * (q + r)
-            - u2a2[..., 1] * pr * (p + r)
-            - u2a2[..., 2] * pq * (p + q)
+            p * q * r * (qr + pr + pq) - u0 * qr * (q + r) - u1 * pr * (p + r) - u2 * pq * (p + q)
         )
         t = t - f / fp
-    return a2 * X / (t[..., None] + a2)
+    return a2 * X / (t.reshape(n, 1) + a2)
+
+
+@kernel
+def closest(a, X, axis):
+    """``findClosestPoint``: the closest surface point of the ellipsoid with radii ``a`` to
+    one point's rows X (D, 3); ``axis`` >= 0 reduces to that coordinate plane's ellipse;
+    -1 takes OpenSim's special cases (row 0 within 2e-13 of coordinate planes) first."""
+    if axis == -1:
+        best = math.inf
+        for i in range(3):
+            if abs(X[0, i].real) <= ROUNDOFF_ERROR:
+                s = 0.0
+                for jj in range(3):
+                    if jj != i:
+                        s += a[jj]
+                if best > s:
+                    axis, best = i, s
+    if axis == -1:
+        return closest_general(a, X)
+    j, k = (axis + 1) % 3, (axis + 2) % 3
+    out = X.copy()
+    x, y = ellipse(a[j], a[k], X[:, j].copy(), X[:, k].copy())
+    out[:, j] = x
+    out[:, k] = y
+    return out
 
 
 # ------------------------------------------------------------------------ tangent points
-def _residual(r, d1, p, a, vs, vs4):
-    nr = 2.0 * r / (a * a)
-    return np.stack(
-        [
-            _dot(vs, r) + vs4,
-            np.sum((r / a) ** 2, axis=-1) - 1.0,
-            _dot(nr, r) + d1,
-            _dot(nr, p) + d1,
-        ],
-        axis=-1,
-    )
+@kernel
+def residual(r, d1, p, a, vs, vs4):
+    """The four equations of a tangent point r (rows (D, 3)) from p: in the plane
+    vs·r + vs4 = 0, on the surface, and p on the tangent plane (with multiplier d1)."""
+    n = r.shape[0]
+    F = np.empty((n, 4), np.complex128)
+    for d in range(n):
+        s = 0.0 + 0.0j
+        rr = 0.0 + 0.0j
+        rp = 0.0 + 0.0j
+        for k in range(3):
+            nr = 2.0 * r[d, k] / (a[k] * a[k])
+            s = s + (r[d, k] / a[k]) ** 2
+            rr = rr + nr * r[d, k]
+            rp = rp + nr * p[d, k]
+        F[d, 0] = vs[d, 0] * r[d, 0] + vs[d, 1] * r[d, 1] + vs[d, 2] * r[d, 2] + vs4[d]
+        F[d, 1] = s - 1.0
+        F[d, 2] = rr + d1[d]
+        F[d, 3] = rp + d1[d]
+    return F
 
 
-def _lm_tangent(r, p, a, vs, vs4):
-    """``WrapEllipsoid::calcTangentPoint``'s Levenberg-Marquardt search, real, one point
-    (plain floats: it runs ~30 small steps)."""
-    r = [float(v) for v in r]
-    p = [float(v) for v in p]
-    vs = [float(v) for v in vs]
-    ia2 = [1.0 / float(v * v) for v in a]
+@kernel
+def lm_residual(r, d1, p, ia2, vs, vs4):
+    """The same equations on real numbers (the search's residual e) and Σ e²."""
+    rr = r[0] * r[0] * ia2[0] + r[1] * r[1] * ia2[1] + r[2] * r[2] * ia2[2]
+    rp = r[0] * p[0] * ia2[0] + r[1] * p[1] * ia2[1] + r[2] * p[2] * ia2[2]
+    e = np.empty(4)
+    e[0] = vs[0] * r[0] + vs[1] * r[1] + vs[2] * r[2] + vs4
+    e[1], e[2], e[3] = rr - 1.0, 2 * rr + d1, 2 * rp + d1
+    return e, e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]
 
-    def residual(r, d1):
-        rr = r[0] * r[0] * ia2[0] + r[1] * r[1] * ia2[1] + r[2] * r[2] * ia2[2]
-        rp = r[0] * p[0] * ia2[0] + r[1] * p[1] * ia2[1] + r[2] * p[2] * ia2[2]
-        e = (vs[0] * r[0] + vs[1] * r[1] + vs[2] * r[2] + vs4, rr - 1.0, 2 * rr + d1, 2 * rp + d1)
-        return e, e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]
 
+@kernel
+def lm_tangent(r0, p, a, vs, vs4):
+    """``WrapEllipsoid::calcTangentPoint``'s Levenberg-Marquardt search on real numbers (one
+    point, from r0 (3,)); the damped normal equations solved by :func:`solve4`."""
+    r = r0.copy()
+    ia2 = 1.0 / (a * a)
     pn = math.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
-    pu = [v / pn for v in p] if pn >= EPS else [0.0, 0.0, 0.0]
+    pu = p / pn if pn >= EPS else np.zeros(3)
     d1 = -2.0 * (r[0] * r[0] * ia2[0] + r[1] * r[1] * ia2[1] + r[2] * r[2] * ia2[2])
-    ee, ssq = residual(r, d1)
+    ee, ssq = lm_residual(r, d1, p, ia2, vs, vs4)
     ssqo = ssq
     alpha = 0.01
     nit = 0
+    dedth = np.zeros((4, 4))
+    vt = np.zeros(4)
     while ssq > ELLIPSOID_TINY and nit < 50:
         nit += 1
-        dedth = np.zeros((4, 4))
-        dedth[:3, 0] = vs
-        dedth[:3, 1] = [2.0 * r[k] * ia2[k] for k in range(3)]
-        dedth[:3, 2] = [4.0 * r[k] * ia2[k] for k in range(3)]
-        dedth[:3, 3] = [2.0 * p[k] * ia2[k] for k in range(3)]
-        dedth[3] = [0.0, 0.0, 1.0, 1.0]
-        pr = [p[k] - r[k] for k in range(3)]
+        for k in range(3):
+            dedth[k, 0] = vs[k]
+            dedth[k, 1] = 2.0 * r[k] * ia2[k]
+            dedth[k, 2] = 4.0 * r[k] * ia2[k]
+            dedth[k, 3] = 2.0 * p[k] * ia2[k]
+        dedth[3, 0], dedth[3, 1], dedth[3, 2], dedth[3, 3] = 0.0, 0.0, 1.0, 1.0
+        pr = p - r
         prn = math.sqrt(pr[0] * pr[0] + pr[1] * pr[1] + pr[2] * pr[2])
-        pcos = sum(pr[k] * pu[k] for k in range(3)) / prn if prn >= EPS else 0.0
+        pcos = (pr[0] * pu[0] + pr[1] * pu[1] + pr[2] * pu[2]) / prn if prn >= EPS else 0.0
         dd = 1.0 - pcos**100 if pcos > 0.1 else 1.0
-        v = -dedth @ np.array(ee)
-        dedth2 = dedth @ dedth.T
-        diag = np.diag(dedth2).copy()
-        vt = [0.0, 0.0, 0.0, 0.0]
+        v = np.zeros(4)
+        dedth2 = np.zeros((4, 4))
+        for i in range(4):
+            for j in range(4):
+                v[i] -= dedth[i, j] * ee[j]
+                for k in range(4):
+                    dedth2[i, j] += dedth[i, k] * dedth[j, k]
+        diag = np.empty(4)
+        for k in range(4):
+            diag[k] = dedth2[k, k]
+        vt[:] = 0.0
         nit2 = 0
         while ssq >= ssqo and nit2 < 1000:
-            dedth2[np.arange(4), np.arange(4)] = diag * (1.0 + alpha)
-            try:
-                vt = (dd * np.linalg.inv(dedth2) @ v / 16.0).tolist()
-            except np.linalg.LinAlgError:
-                return np.array(r)
-            r = [r[k] + vt[k] for k in range(3)]
+            for k in range(4):
+                dedth2[k, k] = diag[k] * (1.0 + alpha)
+            ok, sol = solve4(dedth2, v)
+            if not ok:
+                return r
+            for k in range(4):
+                vt[k] = dd * sol[k] / 16.0
+            for k in range(3):
+                r[k] += vt[k]
             d1 += vt[3]
             ssqo = ssq
-            ee, ssq = residual(r, d1)
+            ee, ssq = lm_residual(r, d1, p, ia2, vs, vs4)
             alpha *= 4.0
             nit2 += 1
         alpha /= 8.0
@@ -249,148 +337,213 @@ def _lm_tangent(r, p, a, vs, vs4):
         nit2 = 0
         while ssq <= ssqo and nit2 < 1000:
             fakt *= 2.0
-            r = [r[k] + vt[k] * fakt for k in range(3)]
+            for k in range(3):
+                r[k] += vt[k] * fakt
             d1 += vt[3] * fakt
             ssqo = ssq
-            ee, ssq = residual(r, d1)
+            ee, ssq = lm_residual(r, d1, p, ia2, vs, vs4)
             nit2 += 1
-        r = [r[k] - vt[k] * fakt for k in range(3)]
+        for k in range(3):
+            r[k] -= vt[k] * fakt
         d1 -= vt[3] * fakt
-        ee, ssq = residual(r, d1)
+        ee, ssq = lm_residual(r, d1, p, ia2, vs, vs4)
         ssqo = ssq
-    return np.array(r)
+    return r
 
 
-def _tangent(pe, r0, p, a, vs, vs4):
+@kernel
+def tangent(pe, r0, p, a, vs, vs4):
     """The tangent point from p (D, 3): OpenSim's search on the real parts, then Newton on
     the four equations (in the plane, on the surface, p on the tangent plane) in complex."""
     if abs(pe) < 1e-4:
         return p.copy()
-    r = _lm_tangent(r0[0].real.copy(), p[0].real, a, vs[0].real, float(vs4[0].real))
-    r = np.broadcast_to(r, p.shape).astype(complex)
-    d1 = np.full(p.shape[0], -2.0, dtype=complex)
+    n = p.shape[0]
+    re = lm_tangent(r0[0].real.copy(), p[0].real.copy(), a, vs[0].real.copy(), vs4[0].real)
+    r = np.empty((n, 3), np.complex128)
+    d1 = np.empty(n, np.complex128)
+    for d in range(n):
+        d1[d] = -2.0
+        for k in range(3):
+            r[d, k] = re[k]
     ia2 = 1.0 / (a * a)
+    J = np.zeros((n, 4, 4), np.complex128)
+    step = np.zeros((n, 4), np.complex128)
     for _ in range(12):
-        F = _residual(r, d1, p, a, vs, vs4)
-        J = np.zeros(p.shape[:1] + (4, 4), dtype=complex)
-        J[:, 0, :3] = vs
-        J[:, 1, :3] = 2.0 * r * ia2
-        J[:, 2, :3] = 4.0 * r * ia2
-        J[:, 2, 3] = 1.0
-        J[:, 3, :3] = 2.0 * p * ia2
-        J[:, 3, 3] = 1.0
-        try:
-            step = np.linalg.solve(J, F[..., None])[..., 0]
-        except np.linalg.LinAlgError:
+        F = residual(r, d1, p, a, vs, vs4)
+        ok = True
+        for d in range(n):
+            for k in range(3):
+                J[d, 0, k] = vs[d, k]
+                J[d, 1, k] = 2.0 * r[d, k] * ia2[k]
+                J[d, 2, k] = 4.0 * r[d, k] * ia2[k]
+                J[d, 3, k] = 2.0 * p[d, k] * ia2[k]
+            J[d, 0, 3], J[d, 1, 3], J[d, 2, 3], J[d, 3, 3] = 0.0, 0.0, 1.0, 1.0
+            okd, sd = solve4(J[d], F[d])
+            step[d] = sd
+            ok = ok and okd
+        if not ok:
             break
-        r = r - step[:, :3]
-        d1 = d1 - step[:, 3]
-        if np.max(np.abs(step[0].real)) < 1e-15:
-            F = _residual(r, d1, p, a, vs, vs4)
-            step = np.linalg.solve(J, F[..., None])[..., 0]
-            r, d1 = r - step[:, :3], d1 - step[:, 3]
+        small = True
+        for d in range(n):
+            for k in range(3):
+                r[d, k] = r[d, k] - step[d, k]
+            d1[d] = d1[d] - step[d, 3]
+        for k in range(4):
+            small = small and abs(step[0, k].real) < 1e-15
+        if small:
+            F = residual(r, d1, p, a, vs, vs4)
+            for d in range(n):
+                okd, sd = solve4(J[d], F[d])
+                step[d] = sd
+                for k in range(3):
+                    r[d, k] = r[d, k] - step[d, k]
+                d1[d] = d1[d] - step[d, 3]
             break
     return r
 
 
 # ----------------------------------------------------------------------- surface path
-def _surface(r1, r2, a, vs, vs4, far_side, factor):
+@kernel
+def surface(r1, r2, a, vs, vs4, far_side, factor):
     """``CalcDistanceOnEllipsoid``: (wrap points (D, K, 3), length (D,)), scaled units."""
-    length = _norm(r1 - r2) / factor
+    n = r1.shape[0]
+    length = np.empty(n, np.complex128)
+    dr = sub(r1, r2)
+    for d in range(n):
+        length[d] = cmath.sqrt(dr[d, 0] ** 2 + dr[d, 1] ** 2 + dr[d, 2] ** 2) / factor
     if length[0].real < SEGMENT:
-        return np.stack([r1, r2], axis=1), length * factor
+        pts = np.empty((n, 2, 3), np.complex128)
+        pts[:, 0], pts[:, 1] = r1, r2
+        for d in range(n):
+            length[d] = length[d] * factor
+        return pts, length
     nseg = min(int(length[0].real / SEGMENT), 499)
-    imax = int(np.argmax(np.abs(vs[0].real)))  # first of equal maxima, as OpenSim's loop
-    mu = -vs4 / vs[:, imax]
-    a0 = np.zeros_like(r1)
-    a0[:, imax] = mu
-    ar1, ar2 = _unit(r1 - a0), _unit(r2 - a0)
-    phi0 = np.arccos(_dot(ar1, ar2))
-    dphi = (-(2 * np.pi - phi0) if far_side else phi0) / nseg
-    vsz = _unit(np.cross(ar1, ar2))
-    vsy = np.cross(vsz, ar1)
-    phi = np.arange(1, nseg)[None, :] * dphi[:, None]  # (D, K)
-    ray = np.cos(phi)[..., None] * ar1[:, None] + np.sin(phi)[..., None] * vsy[:, None]
-    f1 = ray / a
-    f2 = (a0 / a)[:, None]
-    aa, bb, cc = _dot(f1, f1), 2.0 * _dot(f1, f2), _dot(f2, f2) - 1.0
-    mu3 = (-bb + np.sqrt(bb * bb - 4.0 * aa * cc)) / (2.0 * aa)
-    pts = np.concatenate([r1[:, None], a0[:, None] + mu3[..., None] * ray, r2[:, None]], axis=1)
-    return pts, _norm(np.diff(pts, axis=1)).sum(axis=1)
+    imax = 0  # the first of equal maxima, as OpenSim's loop
+    for k in range(1, 3):
+        if abs(vs[0, k].real) > abs(vs[0, imax].real):
+            imax = k
+    a0 = np.zeros((n, 3), np.complex128)
+    for d in range(n):
+        a0[d, imax] = -vs4[d] / vs[d, imax]
+    ar1, ar2 = unit(sub(r1, a0))[0], unit(sub(r2, a0))[0]
+    c12 = dot(ar1, ar2)
+    vsz = unit(cross(ar1, ar2))[0]
+    vsy = cross(vsz, ar1)
+    pts = np.empty((n, nseg + 1, 3), np.complex128)
+    for d in range(n):
+        phi0 = cmath.acos(c12[d])
+        dphi = (-(2 * math.pi - phi0) if far_side else phi0) / nseg
+        pts[d, 0] = r1[d]
+        pts[d, nseg] = r2[d]
+        f2 = (a0[d, 0] / a[0], a0[d, 1] / a[1], a0[d, 2] / a[2])
+        cc = f2[0] * f2[0] + f2[1] * f2[1] + f2[2] * f2[2] - 1.0
+        for j in range(1, nseg):
+            phi = j * dphi
+            c, s = cmath.cos(phi), cmath.sin(phi)
+            ray = (
+                c * ar1[d, 0] + s * vsy[d, 0],
+                c * ar1[d, 1] + s * vsy[d, 1],
+                c * ar1[d, 2] + s * vsy[d, 2],
+            )
+            f1 = (ray[0] / a[0], ray[1] / a[1], ray[2] / a[2])
+            aa = f1[0] * f1[0] + f1[1] * f1[1] + f1[2] * f1[2]
+            bb = 2.0 * (f1[0] * f2[0] + f1[1] * f2[1] + f1[2] * f2[2])
+            mu3 = (-bb + cmath.sqrt(bb * bb - 4.0 * aa * cc)) / (2.0 * aa)
+            for k in range(3):
+                pts[d, j, k] = a0[d, k] + mu3 * ray[k]
+        total = 0.0 + 0.0j
+        for j in range(nseg):
+            e0 = pts[d, j + 1, 0] - pts[d, j, 0]
+            e1 = pts[d, j + 1, 1] - pts[d, j, 1]
+            e2 = pts[d, j + 1, 2] - pts[d, j, 2]
+            total = total + cmath.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        length[d] = total
+    return pts, length
 
 
 # ---------------------------------------------------------------------------- wrapLine
-def _wrap(p1, p2, dims, quad, method):
+@kernel
+def wrap(p1, p2, dims, axis, wsign, method):
     """``WrapEllipsoid::wrapLine`` on (D, 3) complex end points (branches on row 0's real
-    part): (code, r1 (D, 3), r2 (D, 3), length (D,), surface path (D, K, 3) from r1 to r2),
-    unscaled, in the ellipsoid's frame."""
-    axis, wsign = quad
-    # PathWrap::extendFinalizeFromProperties: an unknown method is hybrid
-    method = method.lower() if method.lower() in ("hybrid", "midpoint", "axial") else "hybrid"
-    factor = 3.0 / float(np.sum(dims))
-    p1, p2, a = p1 * factor, p2 * factor, np.asarray(dims, dtype=float) * factor
-    p1e = np.sum((p1 / a) ** 2, axis=-1) - 1.0
-    p2e = np.sum((p2 / a) ** 2, axis=-1) - 1.0
-    if p1e[0].real < -0.0001 or p2e[0].real < -0.0001:
-        return INSIDE, None, None, None, None
-    p1p2 = p1 - p2
-    ppm = _dot(_unit(p1), _unit(p2)) - 1.0
-    if abs(ppm[0].real) < 0.0001:
-        return NO_WRAP, None, None, None, None
-    f1, f2 = p1p2 / a, p2 / a
-    aa, bb, cc = _dot(f1, f1), 2.0 * _dot(f1, f2), _dot(f2, f2) - 1.0
+    part), ``method`` numbered as in :data:`METHODS`: (code, r1 (D, 3), r2 (D, 3), length
+    (D,), surface path (D, K, 3) from r1 to r2), unscaled, in the ellipsoid's frame; zero
+    points and length and no surface points for a code other than ``MANDATORY``."""
+    n = p1.shape[0]
+    none = np.zeros((n, 3), np.complex128)
+    factor = 3.0 / (dims[0] + dims[1] + dims[2])
+    a = dims * factor
+    P1, P2 = p1 * factor, p2 * factor
+    p1e, p2e = -1.0, -1.0
+    for k in range(3):
+        p1e += (P1[0, k].real / a[k]) ** 2
+        p2e += (P2[0, k].real / a[k]) ** 2
+    if p1e < -0.0001 or p2e < -0.0001:
+        return INSIDE, none, none, none[:, 0].copy(), np.zeros((n, 0, 3), np.complex128)
+    p1p2 = sub(P1, P2)
+    ppm = dot(unit(P1)[0], unit(P2)[0])
+    if abs(ppm[0].real - 1.0) < 0.0001:
+        return NO_WRAP, none, none, none[:, 0].copy(), np.zeros((n, 0, 3), np.complex128)
+    f1, f2 = p1p2 / a, P2 / a
+    aa, bb, cc = dot(f1, f1), 2.0 * dot(f1, f2), dot(f2, f2) - 1.0
     disc = bb * bb - 4.0 * aa * cc
     if disc[0].real < 0.0:
-        return NO_WRAP, None, None, None, None
+        return NO_WRAP, none, none, none[:, 0].copy(), np.zeros((n, 0, 3), np.complex128)
     l1 = (-bb + np.sqrt(disc)) / (2.0 * aa)
     l2 = (-bb - np.sqrt(disc)) / (2.0 * aa)
     if not (0.0 < l1[0].real < 1.0) or not (0.0 < l2[0].real < 1.0):
-        return NO_WRAP, None, None, None, None
-    r1 = p2 + l1[:, None] * p1p2
-    r2 = p2 + l2[:, None] * p1p2
-    r1r2 = r2 - r1
-    mu = _cabs(_unit(p1p2))
-    best = int(np.argmax(mu[0].real))  # first of equal maxima
-    mub = mu[:, best]
-    fan_weight = -np.inf
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_best = -r1[:, best] / r1r2[:, best]
-    if method in ("hybrid", "axial"):
-        sv_f = r1 + t_best[:, None] * r1r2
-        c1_f = _closest(a, sv_f, best)
-        c1 = None  # (OpenSim's sv, the chord point c1 came from, is not needed)
-        if method == "hybrid" and mub[0].real > MU_BLEND_MIN:
+        return NO_WRAP, none, none, none[:, 0].copy(), np.zeros((n, 0, 3), np.complex128)
+    r1 = axpy(P2, l1, p1p2)
+    r2 = axpy(P2, l2, p1p2)
+    r1r2 = sub(r2, r1)
+    up = unit(p1p2)[0]
+    best = 0  # the first of equal maxima
+    for k in range(1, 3):
+        if abs(up[0, k].real) > abs(up[0, best].real):
+            best = k
+    mub = np.empty(n, np.complex128)
+    t_best = np.empty(n, np.complex128)
+    fan_weight = np.empty(n, np.complex128)
+    for d in range(n):
+        mub[d] = cabs(up[d, best])
+        t_best[d] = -r1[d, best] / r1r2[d, best]
+        fan_weight[d] = -math.inf
+    c1 = none
+    if method == 0 or method == 2:  # hybrid, axial
+        c1_f = closest(a, axpy(r1, t_best, r1r2), best)
+        have = False
+        if method == 0 and mub[0].real > MU_BLEND_MIN:
             tb = t_best[0].real
-            s = 1.0
+            s = np.ones(n, np.complex128)
             if tb < 0.0 or tb > 1.0:
                 s = 0.0 * t_best
             elif tb < SV_BOUNDARY_BLEND:
                 s = t_best / SV_BOUNDARY_BLEND
             elif tb > 1.0 - SV_BOUNDARY_BLEND:
                 s = (1.0 - t_best) / SV_BOUNDARY_BLEND
-            if np.real(np.atleast_1d(s)[0]) < 1.0:
+            if s[0].real < 1.0:
                 mub = MU_BLEND_MIN + s * (mub - MU_BLEND_MIN)
-        if method == "axial" or mub[0].real > MU_BLEND_MIN:
-            c1 = c1_f
-        if method == "hybrid" and mub[0].real < MU_BLEND_MAX:
-            sv_mid = r1 + 0.5 * r1r2
-            tt = np.arange(1, NUM_FAN_SAMPLES - 1) / NUM_FAN_SAMPLES
-            svs = r1[:, None] + tt[None, :, None] * r1r2[:, None]
-            blades = _unit(_closest(a, svs) - svs)
-            c1_fan = sv_mid + _unit(blades.sum(axis=1))
+        if method == 2 or mub[0].real > MU_BLEND_MIN:
+            c1, have = c1_f, True
+        if method == 0 and mub[0].real < MU_BLEND_MAX:
+            c1_fan = fan(a, r1, r1r2)
             if mub[0].real <= MU_BLEND_MIN:
-                c1 = _closest(a, c1_fan)
-                fan_weight = 1.0
+                c1 = closest(a, c1_fan, -1)
+                fan_weight[:] = 1.0
             else:
                 w = (mub - MU_BLEND_MIN) / (MU_BLEND_MAX - MU_BLEND_MIN)
-                c1_1 = _closest(a, c1_fan)
-                c1 = _closest(a, w[:, None] * c1 + (1.0 - w[:, None]) * c1_1)
+                c1_1 = closest(a, c1_fan, -1)
+                mix = np.empty((n, 3), np.complex128)
+                for d in range(n):
+                    for k in range(3):
+                        mix[d, k] = w[d] * c1[d, k] + (1.0 - w[d]) * c1_1[d, k]
+                c1 = closest(a, mix, -1)
                 fan_weight = 1.0 - w
-        if c1 is None:  # axial: not reached for hybrid
+            have = True
+        if not have:  # axial: not reached for hybrid
             c1 = c1_f
     else:  # midpoint
-        c1 = _closest(a, r1 + 0.5 * r1r2)
-    if method != "axial" or 0.0 < t_best[0].real < 1.0:
+        c1 = closest(a, axpy(r1, 0.5 + 0.0 * t_best, r1r2), -1)
+    if method != 2 or 0.0 < t_best[0].real < 1.0:
         r1 = r2 = c1
     if wsign != 0 and (1 if c1[0, axis].real >= 0.0 else -1) != wsign:
         orig = c1
@@ -400,38 +553,73 @@ def _wrap(p1, p2, dims, quad, method):
         # OpenSim then sets a fan weight from mu when none was set, but its test
         # EQUAL_WITHIN_ERROR(fanWeight, -Infinity) is |-inf - -inf| = NaN <= 2e-13, false:
         # without the fan (Frans alone, axial, midpoint) c1 is only mirrored
-        fw = np.atleast_1d(fan_weight)
+        fw = fan_weight.copy()
         if fw[0].real > 1.0:
-            fw = np.ones_like(fw)
+            fw[:] = 1.0
         if fw[0].real > 0.0:
-            bis = (orig[:, axis] + c1[:, axis]) / 2.0
             c1 = c1.copy()
-            c1[:, axis] = c1[:, axis] + fw * (bis - c1[:, axis])
-            c1 = _closest(a, c1)
-    vs = _unit(np.cross(p1p2, p1 - c1))
-    vs4 = -_dot(vs, c1)
-    t1 = _tangent(p1e[0].real, r1, p1, a, vs, vs4)
-    t2 = _tangent(p2e[0].real, r2, p2, a, vs, vs4)
-    pts, length = _surface(t1, t2, a, vs, vs4, False, factor)
-    if wsign != 0 and pts.shape[1] > 2:
-        g1 = _unit(p1[0].real - t1[0].real) @ _unit(pts[0, 1].real - t1[0].real)
-        g2 = _unit(p2[0].real - t2[0].real) @ _unit(pts[0, -2].real - t2[0].real)
+            for d in range(n):
+                bis = (orig[d, axis] + c1[d, axis]) / 2.0
+                c1[d, axis] = c1[d, axis] + fw[d] * (bis - c1[d, axis])
+            c1 = closest(a, c1, -1)
+    vs = unit(cross(p1p2, sub(P1, c1)))[0]
+    vs4 = -dot(vs, c1)
+    t1 = tangent(p1e, r1, P1, a, vs, vs4)
+    t2 = tangent(p2e, r2, P2, a, vs, vs4)
+    pts, length = surface(t1, t2, a, vs, vs4, False, factor)
+    m = pts.shape[1]
+    if wsign != 0 and m > 2:
+        g1 = _cos0(P1, t1, pts[:, 1].copy())
+        g2 = _cos0(P2, t2, pts[:, m - 2].copy())
         if g1 > 0.0 or g2 > 0.0:
-            pts, length = _surface(t1, t2, a, vs, vs4, True, factor)
+            pts, length = surface(t1, t2, a, vs, vs4, True, factor)
     return MANDATORY, t1 / factor, t2 / factor, length / factor, pts / factor
+
+
+@kernel
+def fan(a, r1, r1r2):
+    """The "fan": the chord's midpoint moved by the unit mean direction from 298 points of the
+    chord r1 + t (r2 − r1), t = k / 300, to their closest surface points."""
+    n = r1.shape[0]
+    K = NUM_FAN_SAMPLES - 2
+    tt = np.arange(1, K + 1) / NUM_FAN_SAMPLES
+    svs = np.empty((n * K, 3), np.complex128)
+    for d in range(n):
+        for k in range(3):
+            svs[d * K : (d + 1) * K, k] = r1[d, k] + tt * r1r2[d, k]
+    blades = unit(sub(closest_general(a, svs), svs))[0]
+    total = np.empty((n, 3), np.complex128)
+    mid = np.empty((n, 3), np.complex128)
+    for d in range(n):
+        for k in range(3):
+            total[d, k] = np.sum(blades[d * K : (d + 1) * K, k])
+            mid[d, k] = r1[d, k] + 0.5 * r1r2[d, k]
+    return mid + unit(total)[0]
+
+
+@kernel
+def _cos0(p, t, q):
+    """cos of the angle at t between p − t and q − t, row 0's real parts."""
+    u, v = row0_unit(p, t), row0_unit(q, t)
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
 def wrap_line(p1, p2, dims, quad, method="hybrid"):
     """``WrapEllipsoid::wrapLine`` on complex-step rows: end points p1, p2 (D, 3) (the
     ellipsoid's frame, m; row 0 decides every branch) → (code, r1 (D, 3), r2 (D, 3), length
     (D,)), the tangent points and the surface path's length, None for a code other than
-    ``MANDATORY``, and the surface path (D, K, 3): the polyline whose chords sum to the length,
-    r1 first and r2 last (step 4 of the module docstring); ``dims``, ``quad`` and ``method`` as
-    in :func:`~anthroarm.muscles.wrap_ellipsoid.ellipsoid`.  Im(row d) / h is the derivative
-    along Im(p1, p2)(row d) / h (module docstring)."""
-    p1 = np.asarray(p1, dtype=complex)
-    p2 = np.asarray(p2, dtype=complex)
-    code, r1, r2, length, pts = _wrap(p1, p2, dims, quad, method)
+    ``MANDATORY``; ``dims``, ``quad`` and ``method`` as in
+    :func:`~anthroarm.muscles.wrap_ellipsoid.ellipsoid`.  Im(row d) / h
+    is the derivative along Im(p1, p2)(row d) / h (module docstring); and the surface path
+    (D, K, 3): the polyline whose chords sum to the length, r1 first and r2 last (step 4 of the
+    module docstring).  The compiled kernel :func:`wrap`."""
+    p1 = np.ascontiguousarray(p1, dtype=complex)
+    p2 = np.ascontiguousarray(p2, dtype=complex)
+    axis, wsign = quad
+    # PathWrap::extendFinalizeFromProperties: an unknown method is hybrid
+    m = METHODS.get(method.lower(), 0)
+    dims = np.ascontiguousarray(dims, dtype=float)
+    code, r1, r2, length, pts = wrap(p1, p2, dims, int(axis), int(wsign), m)
     if code != MANDATORY:
         return code, None, None, None, None
     if not (np.all(np.isfinite(r1)) and np.all(np.isfinite(r2)) and np.all(np.isfinite(length))):
