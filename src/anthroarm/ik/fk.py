@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from ..jit import kernel
-from .vec3 import add, cross, mm, mv, perpendicular, sub, transpose
+from .vec3 import add, cross, mm, mv, perpendicular, scale, sub, transpose
 
 #: columns of a frames array after a joint's local frame (:func:`local_frames`, 12): prismatic
 #: or not, and the map q_k = a θ[c] + b of the joint's value from the coordinates θ
@@ -116,15 +116,16 @@ def joint_step(R, t, A, i, c, s):
 
 
 @kernel
-def _path_step(F, k, R, t, th):
-    """The partial product (R, t) taken past joint k of F (its value q_k = a θ[c] + b,
-    :class:`PathFrames`): a revolute joint (:func:`joint_step`), or a prismatic one, a
-    translation along its z axis: (R, t) Tz(q) A_{k+1} = (R B, R a + t + q z)."""
+def _motion(F, k, R, t, th):
+    """Joint k of F at the coordinates θ (its value q = a θ[c] + b, :class:`PathFrames`) on the
+    partial product (R, t) before it: (cos, sin) of its rotation and the translation after its
+    translation — (cos q, sin q, t) for a revolute joint; (1, 0, t + q z) for a prismatic one,
+    a translation along its z axis, (R, t) Tz(q) A_{k+1} = (R B, R a + t + q z).  Then
+    :func:`joint_step` takes the product past it."""
     q = F[k, MUL] * th[int(F[k, COL])] + F[k, OFF]
     if F[k, PRISMATIC] != 0.0:
-        B, a = frame(F, k + 1)
-        return mm(R, B), add(add(mv(R, a), t), (q * R[0][2], q * R[1][2], q * R[2][2]))
-    return joint_step(R, t, F, k + 1, math.cos(q), math.sin(q))
+        return 1.0, 0.0, add(t, scale((R[0][2], R[1][2], R[2][2]), q))
+    return math.cos(q), math.sin(q), t
 
 
 # ----------------------------------------------------------------------------- the drivers
@@ -132,10 +133,11 @@ def _path_step(F, k, R, t, th):
 def chain_pose(F, th):
     """The pose (R, t) of the frame of ``F`` (:func:`local_frames`, :class:`PathFrames`) at the
     coordinates θ (rad, m): the product A_0 M_1(q_1) A_1 ⋯ M_P(q_P) A_P of the path's joint
-    motions (:func:`_path_step`)."""
+    motions (:func:`_motion`, :func:`joint_step`)."""
     R, t = frame(F, 0)
     for k in range(len(F) - 1):
-        R, t = _path_step(F, k, R, t, th)
+        cq, sq, t = _motion(F, k, R, t, th)
+        R, t = joint_step(R, t, F, k + 1, cq, sq)
     return R, t
 
 
@@ -159,7 +161,8 @@ def chain_fk_jacobian(F, th, J, W, n):
     for k in range(P):
         W[k, 0], W[k, 1], W[k, 2] = R[0][2], R[1][2], R[2][2]
         W[k, 3], W[k, 4], W[k, 5] = t
-        R, t = _path_step(F, k, R, t, th)
+        cq, sq, t = _motion(F, k, R, t, th)
+        R, t = joint_step(R, t, F, k + 1, cq, sq)
     for k in range(P):
         c, a = int(F[k, COL]), F[k, MUL]
         z = (W[k, 0], W[k, 1], W[k, 2])
