@@ -13,7 +13,7 @@ from ..subproblems.circle import sp1_one
 from ..subproblems.quartic import sp5_one
 from ..vec3 import cross, mm, mtv, mv, neg, norm, rot, rotate, scale, sub
 from .constants import _MIN_2D, _POLISH_2D
-from .polish import _push, polish
+from .polish import _push, polish, workspace
 
 
 # ----------------------------------------------------------------------------- 2-D search
@@ -59,7 +59,7 @@ def _gen_six_dof_pose(h, PP, A, R06, p, Q, V, E, grid):
                 GE[k, r] = norm(sub(mv(R05, h6), R06h6))
                 GM[k] = min(GM[k], GE[k, r])
     q = np.empty(6)
-    pol = (A, np.empty((6, 6)), np.empty((6, 6)), np.empty(6))
+    pol = workspace(A)
     n = 0
     for i in range(grid):
         for j in range(grid):

@@ -13,7 +13,7 @@ from .brackets import _brackets, _interval, _nearest, _sample
 from .constants import _DEPTH, _JUMP, _MAX_SEEDS, _POLISH_1D, _SEED, _SUB
 from .dips import _dips
 from .inner import _assemble
-from .polish import _push, polish
+from .polish import _push, polish, workspace
 
 
 @kernel
@@ -266,7 +266,7 @@ def _search_1d_pose(cls, h, PP, A, R06, p, Q, V, E, grid):
     t2, th, e = np.empty((4, 2)), np.empty((4, 3)), np.empty(4)
     S1, DM = np.zeros(4, dtype=np.int64), np.zeros(4)
     out, q, q2 = np.empty(5), np.empty(6), np.empty(6)
-    pol = (A, np.empty((6, 6)), np.empty((6, 6)), np.empty(6))
+    pol = workspace(A)
     _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2)
     fine = np.zeros(grid, dtype=np.bool_)
     n = 0

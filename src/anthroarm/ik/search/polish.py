@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...jit import kernel
-from ..fk import chain_pose, local_frames, newton_pose, pose_error
+from ...jit import kernel, part, part2
+from ..fk import WIDTH, chain_pose, local_frames, newton_pose, pose_error
 from ..vec3 import wrap
 from .constants import SEARCH_BRANCHES, SEARCH_TOL
 
@@ -24,14 +24,42 @@ def geo_frames(H, P) -> np.ndarray:
     return local_frames(H, o[:6], M)
 
 
+#: entries of a search's Newton workspace (:func:`workspace`): the arm's frames (7, 16), then
+#: the scratch J (6, 6), W (6, 6), E (6,) of :func:`anthroarm.ik.fk.newton_pose`
+WORKSPACE = 7 * WIDTH + 36 + 36 + 6
+
+
+@kernel
+def workspace(A):
+    """The Newton workspace of a search, one array (:data:`WORKSPACE`) threaded through its
+    kernels: the arm's frames ``A`` (7, 16) (:func:`geo_frames`) and the polish's scratch."""
+    pol = np.empty(WORKSPACE)
+    for i in range(7):
+        for j in range(WIDTH):
+            pol[i * WIDTH + j] = A[i, j]
+    return pol
+
+
+@kernel(inline=True)
+def _parts(pol):
+    """The arm's frames (7, 16), J (6, 6), W (6, 6), E (6,) of a workspace (borrowed views)."""
+    o = 7 * WIDTH
+    return (
+        part2(pol, 0, 7, WIDTH),
+        part2(pol, o, 6, 6),
+        part2(pol, o + 36, 6, 6),
+        part(pol, o + 72, 6),
+    )
+
+
 @kernel
 def polish(pol, R06, p, q, iters):
     """At most ``iters`` Newton steps on the whole arm's pose equations from ``q`` (6,) rad, in
-    place (:func:`anthroarm.ik.fk.newton_pose`, the arm ``pol`` = (its frames
-    (:func:`geo_frames`), J (6, 6), W (6, 6), E (6,) scratch); pose (``R06``, ``p``) in
-    IK-Geo's form); ``q`` is wrapped into (−π, π] at the end; returns whether it converged
-    (max entry of |R − R06| and |o − p| ≤ :data:`SEARCH_TOL`)."""
-    A, J, W, E = pol
+    place (:func:`anthroarm.ik.fk.newton_pose` on the arm of the workspace ``pol``,
+    :func:`workspace`; pose (``R06``, ``p``) in IK-Geo's form); ``q`` is wrapped into
+    (−π, π] at the end; returns whether it converged (max entry of |R − R06| and |o − p|
+    ≤ :data:`SEARCH_TOL`)."""
+    A, J, W, E = _parts(pol)
     err = newton_pose(A, q, 6, R06, p, iters, 1e-3 * SEARCH_TOL, J, W, E)
     for i in range(6):
         q[i] = wrap(q[i])
@@ -41,8 +69,8 @@ def polish(pol, R06, p, q, iters):
 @kernel
 def fk_error(pol, R06, p, q):
     """The pose error of joint angles ``q`` (6,) rad: the max entry of |R − R06| and |o − p|
-    (m) at their FK (:func:`anthroarm.ik.fk.chain_pose` of the frames of ``pol``)."""
-    R, o = chain_pose(pol[0], q)
+    (m) at their FK (:func:`anthroarm.ik.fk.chain_pose` of the arm of the workspace ``pol``)."""
+    R, o = chain_pose(part2(pol, 0, 7, WIDTH), q)
     return pose_error(R, o, R06, p)
 
 
