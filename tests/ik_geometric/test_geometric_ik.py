@@ -19,6 +19,7 @@ import pytest
 import anthroarm as aa
 from anthroarm.errors import UnsupportedModelError
 from anthroarm.ik import classify as C
+from anthroarm.ik import fk as FK
 from anthroarm.ik import geometric as G
 from anthroarm.ik.closed_form import closed_form_info
 from anthroarm.models.standard_dh import PUMA560, standard_dh_urdf
@@ -616,11 +617,11 @@ def test_results_pickle_with_their_singular_text(tmp_path):
 
 
 def test_local_frames_fk_is_pinocchios():
-    """The FK of the compiled check (the chain as :func:`geometric.local_frames`, the product
-    A_0 Rz(q1) A_1 ⋯ Rz(qn) A_n) is Pinocchio's tool pose, on 6- and 7-joint arms (panda's
-    held 7th joint, human_arm7's SRS plan, kinova's continuous joints); where q is the joint
-    angles, the Jacobian of the polish is Pinocchio's world-aligned frame Jacobian of the first
-    six joints on the path."""
+    """The FK of the compiled check (the chain as :func:`anthroarm.ik.fk.local_frames`, the
+    product A_0 Rz(q1) A_1 ⋯ Rz(qn) A_n) is Pinocchio's tool pose, on 6- and 7-joint arms
+    (panda's held 7th joint, human_arm7's SRS plan, kinova's continuous joints); where q is the
+    joint angles, the Jacobian of the polish is Pinocchio's world-aligned frame Jacobian of the
+    joints on the path."""
     from anthroarm.ik import families as fam
 
     rng = np.random.default_rng(11)
@@ -632,18 +633,18 @@ def test_local_frames_fk_is_pinocchios():
         for q in robot.random_q(10, rng=rng):
             th = np.empty(n)
             th[plan.order] = robot.angles(q)  # path order
-            R, t = G._chain_fk(A, th, n)
+            R, t = FK.chain_pose(A, th)
             F = _fk(robot, q)
             np.testing.assert_allclose(np.array(R), F[:3, :3], atol=1e-12, err_msg=name)
             np.testing.assert_allclose(np.array(t), F[:3, 3], atol=1e-12, err_msg=name)
             if robot.nq == n and name != "human_arm7":
-                J = np.empty((6, 6))
-                G._chain_jacobian(A, th, n, J)
+                J = np.empty((6, n))
+                FK.chain_fk_jacobian(A, th, J, np.empty((n, 6)), n)
                 Jp = pin.computeFrameJacobian(
                     robot.model, robot.data, q, robot.tool_id, pin.LOCAL_WORLD_ALIGNED
                 )
                 np.testing.assert_allclose(
-                    J, Jp[:, np.argsort(plan.order)[:6]], atol=1e-12, err_msg=name
+                    J, Jp[:, np.argsort(plan.order)], atol=1e-12, err_msg=name
                 )
 
 
@@ -664,7 +665,7 @@ def test_target_errors_are_pinocchios():
         angle = [1e-7, 0.3, 2.0, np.pi - 1e-9, np.pi][k % 5]
         T = (F * pin.SE3(pin.exp3(angle * axis), rng.normal(scale=0.02, size=3))).homogeneous
         assert plan.order_is_path and robot.nq == n  # ur5: q is θ in path order
-        pe, re = G._target_errors(A, q, n, np.ascontiguousarray(T))
+        pe, re = G._target_errors(A, q, np.ascontiguousarray(T))
         assert pe == pytest.approx(np.linalg.norm(T[:3, 3] - F.translation), abs=1e-13)
         assert re == pytest.approx(
             np.linalg.norm(pin.log3(F.rotation.T @ T[:3, :3])), abs=1e-9 if angle > 3 else 1e-13

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from anthroarm.ik import fk as FK
 from anthroarm.ik import search as S
 from anthroarm.ik import subproblems as sp
 
@@ -71,6 +72,33 @@ def solved(request):
         Q, R06, p = poses(H, P, n, 10 + seed)
         out.append((H, P, Q, R06, p, S.solve_search(cls, H, P, R06, p)))
     return cls, out
+
+
+def test_geo_frames_fk_is_ik_geos():
+    """The arm in IK-Geo's form as the local frames of the searches' Newton polish
+    (:func:`anthroarm.ik.search.geo_frames`): its FK (:func:`anthroarm.ik.fk.chain_pose`) is
+    IK-Geo's (R06, p) (the numpy oracle :func:`fk`) to 1e-14, and its Jacobian
+    (:func:`anthroarm.ik.fk.chain_fk_jacobian`, rows (v; ω)) that of the oracle by central
+    differences: v the derivative of p, ω the vee of dR R⁻¹."""
+    rng = np.random.default_rng(3)
+    for cls in CLASSES:
+        H, P = random_arm(cls, 1)
+        A = S.geo_frames(H, P)
+        for q in rng.uniform(-np.pi, np.pi, (5, 6)):
+            R0, p0 = fk(H, P, q)
+            R, p = FK.chain_pose(A, q)
+            np.testing.assert_allclose(np.array(R), R0, atol=1e-14)
+            np.testing.assert_allclose(np.array(p), p0, atol=1e-14)
+            J = np.empty((6, 6))
+            FK.chain_fk_jacobian(A, q, J, np.empty((6, 6)), 6)
+            h = 1e-6
+            for i in range(6):
+                dq = np.zeros(6)
+                dq[i] = h
+                (Rp, pp), (Rm, pm) = fk(H, P, q + dq), fk(H, P, q - dq)
+                W = (Rp - Rm) / (2 * h) @ R0.T
+                col = np.r_[(pp - pm) / (2 * h), W[2, 1], W[0, 2], W[1, 0]]
+                np.testing.assert_allclose(J[:, i], col, atol=1e-8)
 
 
 def test_contract_and_every_exact_branch_fk_verified(solved):

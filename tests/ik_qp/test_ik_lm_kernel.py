@@ -1,5 +1,5 @@
 """The compiled attempt of ``aa.ik.solve`` (:mod:`anthroarm.ik.solve.lm`) and the chain's one
-forward kinematics it uses (:func:`anthroarm.ik.geometric.fk.chain_fk_jacobian`), against
+forward kinematics it uses (:func:`anthroarm.ik.fk.chain_fk_jacobian`), against
 Pinocchio: the frame's pose (``framesForwardKinematics``) and Jacobian
 (``computeFrameJacobian``, LOCAL_WORLD_ALIGNED) on random configurations of catalog robots with
 prismatic, mimic, continuous joints and trees, log₃/log₆ against ``pin.log3``/``pin.log6``
@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 
 import anthroarm as aa
-from anthroarm.ik.geometric.fk import PathFrames, chain_fk_jacobian
+from anthroarm.ik.fk import PathFrames, chain_fk_jacobian
 from anthroarm.ik.solve import lm
 from anthroarm.ik.solve.targets import Target
 from anthroarm.ik.solve.workspace import workspace

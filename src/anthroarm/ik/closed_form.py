@@ -31,7 +31,7 @@ is the general one above, and Table 7.2 reproduces through it.
 Every solver runs as one compiled call (:mod:`anthroarm.jit`) per batch: the class solver's
 branches, each shifted by 2π into the joint limits and checked by the chain's forward
 kinematics (product of exponentials of the joints as read from ``robot.chain``, the model
-Pinocchio holds, in joint-local frames: :func:`.geometric.local_frames`; ``tol`` on every
+Pinocchio holds, in joint-local frames: :func:`.fk.local_frames`; ``tol`` on every
 entry of the 3×4 pose, or the position for ``planar_2r``), duplicates dropped.  Candidates
 inside the limits that are near a solution (FK residual ≤ :data:`POLISH_MAX`: an arm of its
 class only within the classification tolerance, with rounded URDF numbers; a least-squares

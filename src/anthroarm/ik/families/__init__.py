@@ -40,7 +40,7 @@ A target off the plane of motion (|h1ᵀ(p − p_t)| > tol) has no candidate.
 Drivers (:func:`srs_verified`, :func:`planar_verified`) follow
 :func:`anthroarm.ik.geometric.solve_verified`: one compiled call per batch, each branch wrapped
 by 2π into the joint limits and checked by the chain's FK (product of exponentials of the
-joints as read from ``robot.chain``, unsnapped; :func:`.geometric.local_frames`), joint values
+joints as read from ``robot.chain``, unsnapped; :func:`.fk.local_frames`), joint values
 in ``robot.chain.independent`` order.  A branch whose subproblems had only least-squares answers is a candidate with
 ``exact = False`` (out of reach on that branch).
 

@@ -8,45 +8,38 @@ import math
 import numpy as np
 
 from ...jit import kernel, local, local2, local_flags, part, part2
+from ..fk import WIDTH, chain_pose
 from ..geometric.fk import POLISH_MAX
 from ..geometric.limits import into_limits
 from ..geometric.verify import _mark_solutions, _pose_status
 from ..subproblems.base import TOL
 from ..subproblems.circle import sp1_one, sp3_one
-from ..vec3 import add, dot, mm, mv, norm, rot, rotate, sub, vec, wrap
+from ..vec3 import dot, norm, rotate, sub, vec, wrap
 from .plans import PlanarPlan
 
 
 # ----------------------------------------------------------------------------- planar 2R
 @kernel
-def _fk_position_residual(kH, kO, p_tool, q, n, p):
-    """max |F(q) p_tool − p| over the 3 position entries (product of exponentials of the
-    revolute joints, axes kH, points kO at q = 0, base frame, m)."""
-    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    t = (0.0, 0.0, 0.0)
-    for i in range(n):
-        o = vec(kO[i])
-        Ri = rot(vec(kH[i]), q[i])
-        t = add(t, mv(R, sub(o, mv(Ri, o))))
-        R = mm(R, Ri)
-    x = add(t, mv(R, p_tool))
+def _fk_position_residual(A, q, p):
+    """max |F(q) p_tool − p| over the 3 position entries: the tool point of the chain's FK
+    (:func:`anthroarm.ik.fk.chain_pose` of ``PlanarPlan.fk_frames``, base frame, m)."""
+    _, x = chain_pose(A, q)
     return max(abs(x[0] - p[0]), max(abs(x[1] - p[1]), abs(x[2] - p[2])))
 
 
 @kernel(inline=True)
 def _planar_unpack(cf):
     """The constants of ``PlanarPlan.packed``: (h1, h2, o1, o2, p_tool (3-tuples), the FK
-    check's axes and points (2, 3), lo, hi (2,)) — views of ``cf``, compiled into each caller."""
+    check's frames (3, 16), lo, hi (2,)) — views of ``cf``, compiled into each caller."""
     return (
         vec(cf[0:3]),
         vec(cf[3:6]),
         vec(cf[6:9]),
         vec(cf[9:12]),
         vec(cf[12:15]),
-        part2(cf, 15, 2, 3),
-        part2(cf, 21, 2, 3),
-        part(cf, 27, 2),
-        part(cf, 29, 2),
+        part2(cf, 15, 3, WIDTH),
+        part(cf, 15 + 3 * WIDTH, 2),
+        part(cf, 17 + 3 * WIDTH, 2),
     )
 
 
@@ -55,7 +48,7 @@ def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
     """Both branches of one target ``p`` (3-tuple, finite): Q (2, 2) path order, V, E, IN, RES
     (position), OK (the solutions, :func:`.geometric._mark_solutions`); ``plan``:
     :func:`_planar_unpack`; ``q`` (2,) scratch."""
-    h1, h2, o1, o2, pt, kH, kO, lo, hi = plan
+    h1, h2, o1, o2, pt, A, lo, hi = plan
     p1, p2 = sub(pt, o2), sub(o1, o2)
     for b in range(2):
         Q[b, 0], Q[b, 1] = math.nan, math.nan
@@ -70,7 +63,7 @@ def _planar_pose(plan, p, tol, Q, V, E, IN, RES, OK, q):
             inside = into_limits(q, 2, lo, hi)
             Q[b, 0], Q[b, 1] = q[0], q[1]
             V[b], E[b], IN[b] = True, (ea if b == 0 else eb) and e1, inside
-            RES[b] = _fk_position_residual(kH, kO, pt, q, 2, p)
+            RES[b] = _fk_position_residual(A, q, p)
     _mark_solutions(Q, V, IN, RES, tol, 2, OK)
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import classify as C
-from ..geometric.fk import local_frames
+from ..fk import local_frames
 from ..geometric.plan import _common_point
 from ..qp.tasks.swivel import swivel_frames
 
@@ -61,7 +61,7 @@ class SRSPlan:
 
     @functools.cached_property
     def fk_frames(self) -> np.ndarray:
-        """The FK check's chain as :func:`.geometric.local_frames` (8, 12)."""
+        """The FK check's chain as :func:`anthroarm.ik.fk.local_frames` (8, 16)."""
         return local_frames(self.fk_axes, self.fk_points, self.fk_M)
 
     @functools.cached_property
@@ -110,10 +110,18 @@ class PlanarPlan:
     in_order: bool = False
 
     @functools.cached_property
+    def fk_frames(self) -> np.ndarray:
+        """The FK check's chain as :func:`anthroarm.ik.fk.local_frames` (3, 16): its unsnapped
+        axes and points, the tool point p_tool (the tool's rotation is not compared)."""
+        M = np.eye(4)
+        M[:3, 3] = self.p_tool
+        return local_frames(self.fk_axes, self.fk_points, M)
+
+    @functools.cached_property
     def packed(self) -> tuple:
         """The plan's constants as the compiled drivers take them (:func:`_planar_unpack`): one
-        float array (h1, h2, o1, o2, p_tool, the FK check's axes and points (2, 3), limits in
-        path order) and one int array (``order``)."""
+        float array (h1, h2, o1, o2, p_tool, :attr:`fk_frames`, limits in path order) and one
+        int array (``order``)."""
         cf = np.concatenate(
             [
                 np.asarray(a, dtype=float).ravel()
@@ -123,8 +131,7 @@ class PlanarPlan:
                     self.o1,
                     self.o2,
                     self.p_tool,
-                    self.fk_axes,
-                    self.fk_points,
+                    self.fk_frames,
                     self.lower_path,
                     self.upper_path,
                 )

@@ -9,6 +9,7 @@ import numpy as np
 
 from ...jit import kernel, local, local2, local_flags, part, part2, view2, view3
 from ...threads import run_rows
+from ..fk import WIDTH
 from ..geometric.closed import BRANCH_ROW, COS, EXACT, EXISTS, SIN, _angles, _wrist
 from ..geometric.fk import POLISH_MAX, _fk_residuals, _target_errors
 from ..geometric.limits import into_limit_rows
@@ -215,7 +216,7 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
 @kernel(inline=True)
 def _srs_unpack(cf, ci):
     """The constants of :attr:`SRSPlan.packed`: (route, H (7, 3), S, E0, W0 (3,), R_tool
-    (3, 3), p_tool (3,), the FK frames A (8, 12), lo, hi (7,), order (7,)) — views of ``cf``,
+    (3, 3), p_tool (3,), the FK frames A (8, 16), lo, hi (7,), order (7,)) — views of ``cf``,
     ``ci``, compiled into each caller (:func:`anthroarm.jit.kernel`)."""
     return (
         ci[0],
@@ -225,9 +226,9 @@ def _srs_unpack(cf, ci):
         part(cf, 27, 3),
         part2(cf, 30, 3, 3),
         part(cf, 39, 3),
-        part2(cf, 42, 8, 12),
-        part(cf, 138, 7),
-        part(cf, 145, 7),
+        part2(cf, 42, 8, WIDTH),
+        part(cf, 42 + 8 * WIDTH, 7),
+        part(cf, 49 + 8 * WIDTH, 7),
         part(ci, 1, 7),
     )
 
@@ -335,7 +336,7 @@ def _srs_nearest(cf, ci, T, swivel, first, tol, tol_orthonormal, ref, out):
         nearest_first(out, K, 7, ref, 12)
         for j in range(7):
             q[order[j]] = out[0, j]
-        out[0, 7], out[0, 8] = _target_errors(A, q, 7, T)
+        out[0, 7], out[0, 8] = _target_errors(A, q, T)
     return K
 
 

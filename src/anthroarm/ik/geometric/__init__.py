@@ -60,13 +60,13 @@ subproblem had only a least-squares answer (the pose is out of reach on that bra
 closed classes (:data:`CLOSED`) are compiled per pose (:mod:`anthroarm.jit`) from the
 subproblem kernels, and :func:`solve_verified` / :func:`solve_nearest` add in the same compiled
 call the 2π shift into the joint limits, the FK check by the chain's product of exponentials
-(in joint-local frames, :func:`local_frames`) and the removal of duplicates (used by
+(in joint-local frames, :func:`anthroarm.ik.fk.local_frames`) and the removal of duplicates (used by
 :func:`anthroarm.ik.closed_form.analytic`).
 
 Layout (one concern a module): :mod:`.plan` (the plan of an arm: its class, its kinematics in
 IK-Geo's form, the constants packed for the compiled calls), :mod:`.closed` (the closed class
-solvers), :mod:`.limits` (angles shifted by 2π into the joint limits), :mod:`.fk` (the chain's
-FK in local frames, FK residuals, the Newton polish), :mod:`.verify` (one compiled call: pose →
+solvers), :mod:`.limits` (angles shifted by 2π into the joint limits), :mod:`.fk` (the FK
+check: residuals of the branches, the Newton polish, on the one FK of :mod:`anthroarm.ik.fk`), :mod:`.verify` (one compiled call: pose →
 verified branches), :mod:`.singular` (Jacobian volumes), :mod:`.drivers` (the entries over a
 batch of poses), :mod:`.check` (``anthroarm check``); the searches are :mod:`anthroarm.ik.search`.
 The names below are re-exported from there (what :mod:`anthroarm.ik.closed_form`, the tests
@@ -77,12 +77,12 @@ from __future__ import annotations
 
 from .. import classify as C
 from .. import subproblems as sp
-from ..search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve6, solve_search
+from ..search import SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL, solve_search
 from ..vec3 import mat, rows6, rows7, vec, wrap
 from .check import check_rows
 from .closed import BRANCH_ROW, CLOSED, COS, EXISTS, SIN, _solve_closed
 from .drivers import class_pose, solve, solve_class, solve_nearest, solve_verified
-from .fk import POLISH_MAX, _chain_fk, _chain_jacobian, _target_errors, local_frames
+from .fk import POLISH_MAX, _target_errors
 from .limits import into_limit_cs, wrap_into_limits
 from .plan import (
     SEARCHED,

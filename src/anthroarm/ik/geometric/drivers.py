@@ -16,12 +16,14 @@ from .plan import GeoPlan, ik_geo_P
 from .verify import BadPoseError, _verified, _verified_one
 
 
-def solve_class(cls: str, H, P, R06, p):
+def solve_class(cls: str, H, P, R06, p, frames=None):
     """Every branch of the class solver ``cls`` in IK-Geo's form (``H`` (6, 3), ``P`` (7, 3),
     ``R06`` (N, 3, 3) = R · R_tool(0)ᵀ, ``p`` (N, 3) the tool positions, base frame, m).
     Returns q (N, B, 6) rad in (−π, π] (NaN on a branch that does not exist), valid (N, B),
     exact (N, B) (False: least squares, out of reach; for a search class also a root whose
-    error is above :data:`SEARCH_TOL`), B = :func:`n_branches` (8; 16 for a search class)."""
+    error is above :data:`SEARCH_TOL`), B = :func:`n_branches` (8; 16 for a search class).
+    ``frames``: a search class's arm for its Newton polish (``GeoPlan.search_frames``; made from
+    H, P if None)."""
     n = len(p)
     H, P = np.ascontiguousarray(H, dtype=float), np.ascontiguousarray(P, dtype=float)
     R06, p = np.ascontiguousarray(R06, dtype=float), np.ascontiguousarray(p, dtype=float)
@@ -29,7 +31,7 @@ def solve_class(cls: str, H, P, R06, p):
         q, valid, exact = np.empty((n, 8, 6)), np.empty((n, 8), bool), np.empty((n, 8), bool)
         _closed_loop(CLOSED.index(cls), H, P, R06, p, q, valid, exact)
         return q, valid, exact & valid
-    return solve_search(cls, H, P, R06, p)
+    return solve_search(cls, H, P, R06, p, frames=frames)
 
 
 def class_pose(plan: GeoPlan, T, param=None):
@@ -60,7 +62,8 @@ def solve(plan: GeoPlan, T, param=None):
     T · M⁻¹ e^{−ξ7 v} M."""
     T = np.asarray(T, dtype=float)
     R06, p = class_pose(plan, T, param)
-    q, valid, exact = solve_class(plan.cls, plan.H, plan.P, R06, p)
+    frames = plan.search_frames if plan.cls not in CLOSED else None
+    q, valid, exact = solve_class(plan.cls, plan.H, plan.P, R06, p, frames)
     if plan.param_joint is not None:
         v = np.broadcast_to(np.asarray(param, dtype=float), (len(T),))
     if plan.reversed:
@@ -79,7 +82,7 @@ def solve_verified(plan: GeoPlan, T, param=None, tol: float = 1e-9, tol_orthonor
     """Every branch of a closed class (:data:`CLOSED`) for poses ``T`` (N, 4, 4), in one
     compiled call per batch: the class solver (:func:`solve`), each branch wrapped by 2π into
     the joint limits and checked by the chain's FK (product of exponentials of the joints as
-    read from ``robot.chain``, the model Pinocchio holds; :func:`local_frames`).  ``param``
+    read from ``robot.chain``, the model Pinocchio holds; :func:`anthroarm.ik.fk.local_frames`).  ``param``
     (N,) the held joint of a 7-joint arm.  Returns θ (N, 8, n) (independent-joint order, rad),
     solution (N, 8), candidate (N, 8), exact (N, 8), inside (N, 8), FK residual (N, 8) (max
     entry of the 3×4 pose; inf where there is no candidate or an exact one outside the limits,

@@ -12,9 +12,10 @@ import numpy as np
 
 from ...jit import kernel, part, part2
 from .. import classify as C
+from ..fk import WIDTH, local_frames
 from ..search.constants import SEARCH_BRANCHES
+from ..search.polish import geo_frames
 from .closed import CLOSED
-from .fk import local_frames
 
 #: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
 SOLVED = (
@@ -102,6 +103,12 @@ class GeoPlan:
     def order_is_path(self) -> bool:
         """The independent joints are the path's joints in path order (no reordering)."""
         return bool((self.order == np.arange(len(self.order))).all())
+
+    @functools.cached_property
+    def search_frames(self) -> np.ndarray:
+        """The arm in IK-Geo's form (``H``, ``P``) as the frames of the searches' Newton polish
+        (:func:`anthroarm.ik.search.geo_frames`)."""
+        return geo_frames(self.H, self.P)
 
     @functools.cached_property
     def packed(self) -> tuple:
@@ -302,12 +309,13 @@ def _build(robot) -> GeoPlan | None:
 @kernel(inline=True)
 def _unpack(cf, ci):
     """The plan's constants from :attr:`GeoPlan.packed`: (class index, reversed, n, H, P,
-    R_tool, the held joint's axis and point, the tool pose at q = 0, the FK frames A (n + 1, 12),
+    R_tool, the held joint's axis and point, the tool pose at q = 0, the FK frames A
+    (n + 1, :data:`~anthroarm.ik.fk.WIDTH`),
     lo, hi (n,), order (n,): the path position of each independent joint, index (n, 2): its
     first entry in q and whether it is continuous) — views of ``cf``, ``ci``, compiled into each
     caller (:func:`anthroarm.jit.kernel`)."""
     n = ci[2]
-    o = 70 + 12 * (n + 1)
+    o = 70 + WIDTH * (n + 1)
     return (
         ci[0],
         ci[1] == 1,
@@ -318,7 +326,7 @@ def _unpack(cf, ci):
         (cf[48], cf[49], cf[50]),
         (cf[51], cf[52], cf[53]),
         part2(cf, 54, 4, 4),
-        part2(cf, 70, n + 1, 12),
+        part2(cf, 70, n + 1, WIDTH),
         part(cf, o, n),
         part(cf, o + n, n),
         part(ci, 3, n),

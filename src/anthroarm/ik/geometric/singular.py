@@ -8,9 +8,8 @@ import math
 import numpy as np
 
 from ...jit import kernel
-from ..search.polish import solve6
+from ..fk import chain_fk_jacobian, solve6
 from ..vec3 import dot
-from .fk import _chain_jacobian
 from .plan import GeoPlan, _unpack
 
 #: a solution whose normalised Jacobian volume (:func:`_volume`) is at most this is at a
@@ -19,14 +18,14 @@ SINGULAR_TOL = 1e-6
 
 
 @kernel
-def _volume(A, q, n, J, F):
+def _volume(A, q, n, J, W, F):
     """The normalised volume |det J| / Π‖J_k‖ ∈ [0, 1] (Hadamard's inequality) of the 6×6
     Jacobian of the first six joints at ``q`` (path order, rad), at the tool point, in the base
-    frame (:func:`_chain_jacobian`): 0 at a singular configuration
+    frame (:func:`anthroarm.ik.fk.chain_fk_jacobian`, the first six of its n columns): 0 at a singular configuration
     — a wrist with aligned axes, a stretched elbow, the wrist centre on the first axis — where
     solutions coincide in pairs or form a one-parameter family.  ``J`` (6, 6), ``F`` (6,)
     scratch."""
-    _chain_jacobian(A, q, n, J)
+    chain_fk_jacobian(A, q, J, W, n)
     scale = 1.0
     for i in range(6):
         c, w = (J[0, i], J[1, i], J[2, i]), (J[3, i], J[4, i], J[5, i])
@@ -40,14 +39,14 @@ def _volume_loop(cf, ci, TH, OK, VOL):
     """:func:`_volume` of every solution (``OK``) of θ (N, B, n) in independent-joint order
     into VOL (N, B) (1 elsewhere)."""
     _, _, n, _, _, _, _, _, _, A, _, _, order, _ = _unpack(cf, ci)
-    q, J, F = np.empty(n), np.empty((6, 6)), np.empty(6)
+    q, J, W, F = np.empty(n), np.empty((6, n)), np.empty((n, 6)), np.empty(6)
     for i in range(TH.shape[0]):
         for b in range(TH.shape[1]):
             VOL[i, b] = 1.0
             if OK[i, b]:
                 for k in range(n):
                     q[order[k]] = TH[i, b, k]
-                VOL[i, b] = _volume(A, q, n, J, F)
+                VOL[i, b] = _volume(A, q, n, J, W, F)
 
 
 def jacobian_volumes(plan: GeoPlan, TH, OK) -> np.ndarray:

@@ -74,7 +74,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
     q = local(7)
     QC, QS = view2(local(56), 8, n), view2(local(56), 8, n)
     S = view2(local(96), n + 1, 12)
-    J, F = local2(6, 6), local(6)
+    J, W, F = local2(6, 7), local2(7, 6), local(6)
     CHK = local_flags(8)
     for i in range(len(T)):
         if not _verify_pose(
@@ -90,7 +90,7 @@ def _verified(cf, ci, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF
             RES[i],
             OK[i],
             CONF[i],
-            (B6, q, QC, QS, S, J, F, CHK),
+            (B6, q, QC, QS, S, J, W, F, CHK),
         ):
             return i
     return -1
@@ -134,10 +134,10 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
     empty: the chain's configuration q of each solution (:func:`_configurations`).  ``param``
     the held 7th joint (rad).  Returns False for a malformed pose (:func:`_pose_status`).
     ``plan``: :func:`_pose_plan`; ``scratch``: B6 (8, :data:`BRANCH_ROW`), q (7,), QC, QS
-    (8, n), S (n + 1, 12), J (6, 6), F (6,), CHK (8,).  Compiled into each caller
+    (8, n), S (n + 1, 12), J (6, 7), W (7, 6), F (6,), CHK (8,).  Compiled into each caller
     (:func:`_verified`, :func:`_verified_one`)."""
     cls, rev, n, h, PP, Rt, MR, Mp, p_axis, p_point, A, lo, hi, order, index = plan
-    B6, q, QC, QS, S, J, F, CHK = scratch
+    B6, q, QC, QS, S, J, W, F, CHK = scratch
     if _pose_status(T, tol_orthonormal) != 0:
         return False
     R, p = mat(T), (T[0, 3], T[1, 3], T[2, 3])
@@ -167,7 +167,7 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
         if V[b] and IN[b] and tol < RES[b] <= POLISH_MAX:
             for j in range(n):
                 q[j] = Q[b, j]
-            r = _polish_chain(A, q, n, T, lo, hi, tol, J, F)
+            r = _polish_chain(A, q, n, T, lo, hi, tol, J, W, F)
             if r <= tol:
                 for j in range(n):
                     Q[b, j], QC[b, j], QS[b, j] = q[j], math.cos(q[j]), math.sin(q[j])
@@ -291,7 +291,8 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
         QC,
         QS,
         view2(local(96), n + 1, 12),
-        local2(6, 6),
+        local2(6, 7),
+        local2(7, 6),
         local(6),
         local_flags(8),
     )
@@ -315,7 +316,7 @@ def _verified_one(cf, ci, T, param, tol, tol_orthonormal, ref, out):
         return -2
     if len(ref) == n and w == n:
         nearest_first(out, K, n, ref, n + 2)
-        out[0, n + 2], out[0, n + 3] = _target_errors(A, Q[int(out[0, n + 1])], n, T)
+        out[0, n + 2], out[0, n + 3] = _target_errors(A, Q[int(out[0, n + 1])], T)
     return mask
 
 

@@ -65,8 +65,8 @@ found (the refined brackets along the grid, the dips of the grid, the brackets a
 finer samplings, each followed by those of its own finer looks, then the polished fold seeds);
 a branch within 1e-8 rad (every joint, mod 2π) of an earlier one is dropped.
 
-Layout: :mod:`.constants` (grid sizes, tolerances), :mod:`.polish` (Newton on the pose, branch
-slots), :mod:`.inner` (the inner subproblems of the 1-D classes), :mod:`.brackets` (sampling,
+Layout: :mod:`.constants` (grid sizes, tolerances), :mod:`.polish` (Newton on the pose by the one
+FK of :mod:`anthroarm.ik.fk`, the arm as :func:`geo_frames`; branch slots), :mod:`.inner` (the inner subproblems of the 1-D classes), :mod:`.brackets` (sampling,
 following roots, regula falsi), :mod:`.dips` (pairs of roots inside one sample interval),
 :mod:`.line` (the 1-D search of one pose), :mod:`.grid2d` (the 2-D search of ``gen_six_dof``),
 :mod:`.driver` (:func:`solve_search` over a batch).
@@ -76,7 +76,7 @@ from __future__ import annotations
 
 from .constants import CLASSES, SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D, SEARCH_TOL
 from .driver import solve_search
-from .polish import fk_geo, polish, pose_error, solve6
+from .polish import geo_frames, polish
 
 __all__ = [
     "CLASSES",
@@ -84,9 +84,7 @@ __all__ = [
     "SEARCH_GRID",
     "SEARCH_GRID_2D",
     "SEARCH_TOL",
-    "fk_geo",
+    "geo_frames",
     "polish",
-    "pose_error",
-    "solve6",
     "solve_search",
 ]

@@ -9,7 +9,7 @@ from ...jit import kernel
 from ..vec3 import wrap
 from .constants import _FAST, _FK_TOL, _ITERS, _MATCH, _POLISH_ROOT, SEARCH_TOL
 from .inner import _assemble, _inner
-from .polish import _push, polish, pose_error
+from .polish import _push, fk_error, polish
 
 
 # ----------------------------------------------------------------------------- 1-D search
@@ -118,7 +118,7 @@ def _refine(cls, h, PP, R06, p16, xl, xr, el, er, rl, rr, th, e, t2, out):
 
 @kernel
 def _brackets(
-    cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, J, F, Q, V, E, n
+    cls, h, PP, R06, p, p16, X, RS, ES, CS, g, S1, DM, th, e, t2, out, q, q2, pol, Q, V, E, n
 ):
     """The brackets of sample interval ``g`` of X, RS, ES, CS (roots followed by
     :func:`_interval`: S1, DM): every followed root (closer than :data:`_MATCH`) whose error
@@ -149,12 +149,12 @@ def _brackets(
                 t2,
                 out,
             ):
-                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, pol))
     return n
 
 
 @kernel
-def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
+def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, pol):
     """The branch at a refined root ``out`` (x, inner root, |e|) into ``q`` (6,); returns
     whether it is exact.  A root whose error stayed above :data:`SEARCH_TOL` (regula falsi
     stalls where two roots share a sample interval), or whose pose error is above
@@ -163,10 +163,10 @@ def _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F):
     :data:`_POLISH_ROOT` Newton steps on the whole pose (scratch ``q2``), kept where they
     converge (quadratic convergence from a root already good to ~1e-7)."""
     ex = _assemble(cls, h, PP, R06, p16, wrap(out[0]), out[1], out[2], out[3], q)
-    if ex and (out[4] > SEARCH_TOL or pose_error(h, PP, R06, p, q) > _FK_TOL):
+    if ex and (out[4] > SEARCH_TOL or fk_error(pol, R06, p, q) > _FK_TOL):
         for j in range(6):
             q2[j] = q[j]
-        ex = polish(h, PP, R06, p, q2, _POLISH_ROOT, J, F)
+        ex = polish(pol, R06, p, q2, _POLISH_ROOT)
         if ex:
             for j in range(6):
                 q[j] = q2[j]

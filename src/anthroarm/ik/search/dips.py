@@ -24,7 +24,7 @@ def _low(xa, xb, xc, fa, fb, fc):
     return fb <= _DIP * s * max(xb - xa, xc - xb)
 
 
-# long: a compiled kernel whose 27 arguments take a line each; the minimisation is one loop
+# long: a compiled kernel whose 26 arguments take a line each; the minimisation is one loop
 @kernel
 def _dip(
     cls,
@@ -48,8 +48,7 @@ def _dip(
     out,
     q,
     q2,
-    J,
-    F,
+    pol,
     Q,
     V,
     E,
@@ -92,11 +91,11 @@ def _dip(
             # a sign change: a root on either side of xu (one where fu is exactly 0)
             if fu == 0.0:
                 out[0], out[1], out[2], out[3], out[4] = xu, ru[0], ru[1], ru[2], 0.0
-                return _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+                return _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, pol))
             if _refine(cls, h, PP, R06, p16, xa, xu, ea, eu, ra, ru, th, e, t2, out):
-                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, pol))
             if _refine(cls, h, PP, R06, p16, xu, xc, eu, ec, ru, rc, th, e, t2, out):
-                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, J, F))
+                n = _push(Q, V, E, n, q, _root_branch(cls, h, PP, R06, p, p16, out, q, q2, pol))
             return n
         if fu < fb:
             if xu < xb:
@@ -110,12 +109,12 @@ def _dip(
             xc, fc, ec, rc = xu, fu, eu, ru
     if fb <= _TOUCH:
         _assemble(cls, h, PP, R06, p16, wrap(xb), rb[0], rb[1], rb[2], q)
-        if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
+        if polish(pol, R06, p, q, _POLISH_1D):
             n = _push(Q, V, E, n, q, True)
     return n
 
 
-# long: a compiled kernel whose 33 arguments take a line each; the body is one loop
+# long: a compiled kernel whose 32 arguments take a line each; the body is one loop
 @kernel
 def _dips(
     cls,
@@ -145,8 +144,7 @@ def _dips(
     out,
     q,
     q2,
-    J,
-    F,
+    pol,
     Q,
     V,
     E,
@@ -193,8 +191,7 @@ def _dips(
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,

@@ -11,11 +11,12 @@ from ..vec3 import rows6, rows7, vec
 from .constants import CLASSES, SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D
 from .grid2d import _gen_six_dof_pose
 from .line import _search_1d_pose
+from .polish import geo_frames
 
 
 # ----------------------------------------------------------------------------- driver
 @kernel
-def _search_loop(cls, H, P, R06, p, Q, V, E, grid):
+def _search_loop(cls, H, P, A, R06, p, Q, V, E, grid):
     h, PP = rows6(H), rows7(P)
     for i in range(len(p)):
         Q[i, :, :] = math.nan
@@ -23,12 +24,12 @@ def _search_loop(cls, H, P, R06, p, Q, V, E, grid):
         E[i, :] = False
         R, pp = (vec(R06[i, 0]), vec(R06[i, 1]), vec(R06[i, 2])), vec(p[i])
         if cls == 2:
-            _gen_six_dof_pose(h, PP, R, pp, Q[i], V[i], E[i], grid)
+            _gen_six_dof_pose(h, PP, A, R, pp, Q[i], V[i], E[i], grid)
         else:
-            _search_1d_pose(cls, h, PP, R, pp, Q[i], V[i], E[i], grid)
+            _search_1d_pose(cls, h, PP, A, R, pp, Q[i], V[i], E[i], grid)
 
 
-def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
+def solve_search(cls: str, H, P, R06, p, grid: int | None = None, frames=None):
     """Every branch of the search class ``cls`` (``"two_parallel"``, ``"two_intersecting"``
     or ``"gen_six_dof"``; IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``, ``IK_gen_6_dof``,
     arXiv 2211.05737 §IV) for N poses, in one compiled call.
@@ -39,6 +40,8 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
     exact (N, 16) (False: a refined root whose error stayed above :data:`SEARCH_TOL`, or a
     subproblem with only a least-squares answer).  ``grid``: samples of the searched joint
     (default :data:`SEARCH_GRID`; :data:`SEARCH_GRID_2D` per joint for ``gen_six_dof``).
+    ``frames``: the arm as :func:`.polish.geo_frames` of H, P (made here if None: a plan keeps
+    them, ``GeoPlan.search_frames``), the FK of the Newton polish.
     ``anthroarm.ik.geometric.solve_class`` calls this for these classes (module docstring)."""
     if cls not in CLASSES:
         raise ValueError(f"cls must be one of {CLASSES}, got {cls!r}")
@@ -55,5 +58,6 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None):
     q = np.empty((n, SEARCH_BRANCHES, 6))
     valid = np.empty((n, SEARCH_BRANCHES), bool)
     exact = np.empty((n, SEARCH_BRANCHES), bool)
-    _search_loop(c, H, P, R06, p, q, valid, exact, int(grid))
+    A = geo_frames(H, P) if frames is None else np.ascontiguousarray(frames, dtype=float)
+    _search_loop(c, H, P, A, R06, p, q, valid, exact, int(grid))
     return q, valid, exact & valid

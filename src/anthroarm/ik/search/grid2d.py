@@ -13,7 +13,7 @@ from ..subproblems.circle import sp1_one
 from ..subproblems.quartic import sp5_one
 from ..vec3 import cross, mm, mtv, mv, neg, norm, rot, rotate, scale, sub
 from .constants import _MIN_2D, _POLISH_2D
-from .polish import _push, polish
+from .polish import _push, polish, workspace
 
 
 # ----------------------------------------------------------------------------- 2-D search
@@ -25,9 +25,9 @@ def _r05(h, q1, q2, t):
 
 
 @kernel
-def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
+def _gen_six_dof_pose(h, PP, A, R06, p, Q, V, E, grid):
     """Every branch found for one pose of ``gen_six_dof`` into Q (16, 6), V, E; returns their
-    number."""
+    number.  ``A``: the arm's frames for the Newton polish (:func:`.polish.geo_frames`)."""
     p16 = sub(sub(p, mv(R06, PP[6])), PP[0])
     h6 = h[5]
     R06h6 = mv(R06, h6)
@@ -59,7 +59,7 @@ def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
                 GE[k, r] = norm(sub(mv(R05, h6), R06h6))
                 GM[k] = min(GM[k], GE[k, r])
     q = np.empty(6)
-    J, F = np.empty((6, 6)), np.empty(6)
+    pol = workspace(A)
     n = 0
     for i in range(grid):
         for j in range(grid):
@@ -75,6 +75,6 @@ def _gen_six_dof_pose(h, PP, R06, p, Q, V, E, grid):
                     R05 = _r05(h, xs[i], xs[j], tr)
                     q6, _, _ = sp1_one(u, mtv(R05, mv(R06, u)), h6, TOL)
                     q[0], q[1], q[2], q[3], q[4], q[5] = xs[i], xs[j], tr[0], tr[1], tr[2], q6
-                    if polish(h, PP, R06, p, q, _POLISH_2D, J, F):
+                    if polish(pol, R06, p, q, _POLISH_2D):
                         n = _push(Q, V, E, n, q, True)
     return n

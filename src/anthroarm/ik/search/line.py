@@ -13,7 +13,7 @@ from .brackets import _brackets, _interval, _nearest, _sample
 from .constants import _DEPTH, _JUMP, _MAX_SEEDS, _POLISH_1D, _SEED, _SUB
 from .dips import _dips
 from .inner import _assemble
-from .polish import _push, polish
+from .polish import _push, polish, workspace
 
 
 @kernel
@@ -26,7 +26,7 @@ def _copy_sample(RS, ES, CS, i, RD, ED, CD, j):
             RD[j, r, c] = RS[i, r, c]
 
 
-# long: a compiled kernel whose 38 arguments, and those of the kernels it calls, take a line each
+# long: a compiled kernel whose 37 arguments, and those of the kernels it calls, take a line each
 @kernel
 def _look(
     cls,
@@ -60,8 +60,7 @@ def _look(
     out,
     q,
     q2,
-    J,
-    F,
+    pol,
     Q,
     V,
     E,
@@ -109,8 +108,7 @@ def _look(
                 out,
                 q,
                 q2,
-                J,
-                F,
+                pol,
                 Q,
                 V,
                 E,
@@ -145,8 +143,7 @@ def _look(
                 out,
                 q,
                 q2,
-                J,
-                F,
+                pol,
                 Q,
                 V,
                 E,
@@ -209,8 +206,7 @@ def _look(
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,
@@ -245,8 +241,7 @@ def _look(
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,
@@ -257,9 +252,9 @@ def _look(
 
 # long: one compiled body per pose: the grid, its finer looks level by level, the fold seeds
 @kernel
-def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
+def _search_1d_pose(cls, h, PP, A, R06, p, Q, V, E, grid):
     """Every branch of one pose of a 1-D search class into Q (16, 6), V, E; returns their
-    number."""
+    number.  ``A``: the arm's frames for the Newton polish (:func:`.polish.geo_frames`)."""
     p16 = sub(sub(p, mv(R06, PP[6])), PP[0])
     L = grid + 1
     step = 2.0 * math.pi / grid
@@ -271,7 +266,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
     t2, th, e = np.empty((4, 2)), np.empty((4, 3)), np.empty(4)
     S1, DM = np.zeros(4, dtype=np.int64), np.zeros(4)
     out, q, q2 = np.empty(5), np.empty(6), np.empty(6)
-    J, F = np.empty((6, 6)), np.empty(6)
+    pol = workspace(A)
     _sample(cls, h, PP, R06, p16, X, RS, ES, CS, t2)
     fine = np.zeros(grid, dtype=np.bool_)
     n = 0
@@ -299,8 +294,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,
@@ -340,8 +334,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,
@@ -404,8 +397,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
             out,
             q,
             q2,
-            J,
-            F,
+            pol,
             Q,
             V,
             E,
@@ -466,8 +458,7 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
                 out,
                 q,
                 q2,
-                J,
-                F,
+                pol,
                 Q,
                 V,
                 E,
@@ -476,6 +467,6 @@ def _search_1d_pose(cls, h, PP, R06, p, Q, V, E, grid):
             pos[d] = 0
     for k in range(ns):
         _assemble(cls, h, PP, R06, p16, SX[k], SR[k, 0], SR[k, 1], SR[k, 2], q)
-        if polish(h, PP, R06, p, q, _POLISH_1D, J, F):
+        if polish(pol, R06, p, q, _POLISH_1D):
             n = _push(Q, V, E, n, q, True)
     return n

@@ -1,104 +1,77 @@
-"""Newton steps on the whole arm's pose in IK-Geo's form (its FK, pose error and a 6×6 solve),
-and the slots of the branches a search finds."""
+"""Newton steps on the whole arm's pose (the one FK of :mod:`anthroarm.ik.fk` on IK-Geo's chain
+as local frames, :func:`geo_frames`), and the slots of the branches a search finds."""
 
 from __future__ import annotations
 
-from ...jit import kernel
-from ..vec3 import add, cross, mm, mv, rot, sub, transpose, wrap
+import numpy as np
+
+from ...jit import kernel, part, part2
+from ..fk import WIDTH, chain_pose, local_frames, newton_pose, pose_error
+from ..vec3 import wrap
 from .constants import SEARCH_BRANCHES, SEARCH_TOL
 
 
-# ----------------------------------------------------------------------------- helpers
-@kernel
-def solve6(A, b):
-    """Solve A x = b (6×6, in place: ``b`` becomes x) by Gaussian elimination with partial
-    pivoting; returns det A (0 when a pivot vanishes, b then undefined)."""
-    det = 1.0
-    for c in range(6):
-        piv, big = c, abs(A[c, c])
-        for r in range(c + 1, 6):
-            if abs(A[r, c]) > big:
-                piv, big = r, abs(A[r, c])
-        if big == 0.0:
-            return 0.0
-        if piv != c:
-            for k in range(6):
-                A[c, k], A[piv, k] = A[piv, k], A[c, k]
-            b[c], b[piv] = b[piv], b[c]
-            det = -det
-        d = A[c, c]
-        det *= d
-        for r in range(c + 1, 6):
-            f = A[r, c] / d
-            if f != 0.0:
-                for k in range(c, 6):
-                    A[r, k] -= f * A[c, k]
-                b[r] -= f * b[c]
-    for c in range(5, -1, -1):
-        s = b[c]
-        for k in range(c + 1, 6):
-            s -= A[c, k] * b[k]
-        b[c] = s / A[c, c]
-    return det
+def geo_frames(H, P) -> np.ndarray:
+    """IK-Geo's arm (axes ``H`` (6, 3), offsets ``P`` (7, 3), base frame, m, q = 0) as the
+    local frames of :func:`anthroarm.ik.fk.local_frames` (7, 16): joint i's axis through
+    o_i = P_0 + ⋯ + P_{i−1}, the tool at o_7 with the rotation I — its FK is
+    (R06(q), p(q)) = (rot(h1, q1) ⋯ rot(h6, q6), o_1 + R_1 P_1 + ⋯ + R_6 P_6), the pose
+    the searches solve for (Elias & Wen, IK-Geo, arXiv 2211.05737, §II)."""
+    H, P = np.asarray(H, dtype=float), np.asarray(P, dtype=float)
+    o = np.cumsum(P, axis=0)
+    M = np.eye(4)
+    M[:3, 3] = o[6]
+    return local_frames(H, o[:6], M)
+
+
+#: entries of a search's Newton workspace (:func:`workspace`): the arm's frames (7, 16), then
+#: the scratch J (6, 6), W (6, 6), E (6,) of :func:`anthroarm.ik.fk.newton_pose`
+WORKSPACE = 7 * WIDTH + 36 + 36 + 6
 
 
 @kernel
-def fk_geo(h, PP, q):
-    """FK in IK-Geo's form for joint angles ``q`` (6,) rad: (R06 (row tuples), the tool
-    position (m)), both in the base frame; ``h`` the 6 axes, ``PP`` the 7 offsets (tuples)."""
-    R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    o = PP[0]
-    for i in range(6):
-        R = mm(R, rot(h[i], q[i]))
-        o = add(o, mv(R, PP[i + 1]))
-    return R, o
+def workspace(A):
+    """The Newton workspace of a search, one array (:data:`WORKSPACE`) threaded through its
+    kernels: the arm's frames ``A`` (7, 16) (:func:`geo_frames`) and the polish's scratch."""
+    pol = np.empty(WORKSPACE)
+    for i in range(7):
+        for j in range(WIDTH):
+            pol[i * WIDTH + j] = A[i, j]
+    return pol
+
+
+@kernel(inline=True)
+def _parts(pol):
+    """The arm's frames (7, 16), J (6, 6), W (6, 6), E (6,) of a workspace (borrowed views)."""
+    o = 7 * WIDTH
+    return (
+        part2(pol, 0, 7, WIDTH),
+        part2(pol, o, 6, 6),
+        part2(pol, o + 36, 6, 6),
+        part(pol, o + 72, 6),
+    )
 
 
 @kernel
-def polish(h, PP, R06, p, q, iters, J, F):
-    """Newton steps on the whole arm's pose equations from ``q`` (6,) rad, in place (the
-    spatial Jacobian at the tool point; position error p − o (m), rotation error
-    ½ vee(R06 Rᵀ − R R06ᵀ)); a step whose Jacobian has |det| ≤ 1e-12 is not taken.  ``q`` is
-    wrapped into (−π, π] at the end; returns whether it converged (max entry of |R − R06| and
-    |o − p| ≤ :data:`SEARCH_TOL`).  ``J`` (6, 6), ``F`` (6,) scratch."""
-    for _ in range(iters):
-        R = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        o = PP[0]
-        for i in range(6):
-            J[3, i], J[4, i], J[5, i] = mv(R, h[i])  # the joint's axis (base frame)
-            J[0, i], J[1, i], J[2, i] = o  # a point of it, crossed below
-            R = mm(R, rot(h[i], q[i]))
-            o = add(o, mv(R, PP[i + 1]))
-        for i in range(6):
-            ax = (J[3, i], J[4, i], J[5, i])
-            c = cross(ax, sub(o, (J[0, i], J[1, i], J[2, i])))
-            J[0, i], J[1, i], J[2, i] = c
-        W = mm(R06, transpose(R))
-        F[0], F[1], F[2] = sub(p, o)
-        F[3] = 0.5 * (W[2][1] - W[1][2])
-        F[4] = 0.5 * (W[0][2] - W[2][0])
-        F[5] = 0.5 * (W[1][0] - W[0][1])
-        if abs(solve6(J, F)) <= 1e-12:
-            break  # the same q (and J) at every later step
-        for i in range(6):
-            q[i] += F[i]
-    err = pose_error(h, PP, R06, p, q)
+def polish(pol, R06, p, q, iters):
+    """At most ``iters`` Newton steps on the whole arm's pose equations from ``q`` (6,) rad, in
+    place (:func:`anthroarm.ik.fk.newton_pose` on the arm of the workspace ``pol``,
+    :func:`workspace`; pose (``R06``, ``p``) in IK-Geo's form); ``q`` is wrapped into
+    (−π, π] at the end; returns whether it converged (max entry of |R − R06| and |o − p|
+    ≤ :data:`SEARCH_TOL`)."""
+    A, J, W, E = _parts(pol)
+    err = newton_pose(A, q, 6, R06, p, iters, 1e-3 * SEARCH_TOL, J, W, E)
     for i in range(6):
         q[i] = wrap(q[i])
     return err <= SEARCH_TOL
 
 
 @kernel
-def pose_error(h, PP, R06, p, q):
+def fk_error(pol, R06, p, q):
     """The pose error of joint angles ``q`` (6,) rad: the max entry of |R − R06| and |o − p|
-    (m) at their FK."""
-    R, o = fk_geo(h, PP, q)
-    err = 0.0
-    for i in range(3):
-        err = max(err, abs(o[i] - p[i]))
-        for j in range(3):
-            err = max(err, abs(R[i][j] - R06[i][j]))
-    return err
+    (m) at their FK (:func:`anthroarm.ik.fk.chain_pose` of the arm of the workspace ``pol``)."""
+    R, o = chain_pose(part2(pol, 0, 7, WIDTH), q)
+    return pose_error(R, o, R06, p)
 
 
 @kernel

@@ -49,7 +49,7 @@ elbow at the swivel angle φ* (:func:`.nullspace.swivel`).
 Speed (:mod:`.lm`): each attempt is one call of a compiled kernel (:mod:`anthroarm.jit`: its
 one source runs in the interpreter until the compiled code is ready), the frame's FK and
 Jacobian from the chain's one compiled forward kinematics
-(:func:`anthroarm.ik.geometric.fk.chain_fk_jacobian`, read from ``robot.chain``).
+(:func:`anthroarm.ik.fk.chain_fk_jacobian`, read from ``robot.chain``).
 
 Layout of one call (:mod:`.api`), one job per function: :func:`.targets.parse` (the targets;
 one 4×4 array straight to the rigid check) and :func:`.targets.check_options`; the one-time

@@ -14,8 +14,8 @@ recomputed with the others, then clipped (:func:`damped_step`; the constants and
 are in :mod:`.kernel`).
 
 The frame's pose and its Jacobian come from the chain's one compiled forward kinematics,
-:func:`anthroarm.ik.geometric.fk.chain_fk_jacobian`, on the arrays of
-:class:`~anthroarm.ik.geometric.fk.PathFrames` read from ``robot.chain`` (revolute, continuous,
+:func:`anthroarm.ik.fk.chain_fk_jacobian`, on the arrays of
+:class:`~anthroarm.ik.fk.PathFrames` read from ``robot.chain`` (revolute, continuous,
 prismatic and mimic joints).  The errors are those of :class:`.targets.Target`: a pose's body
 twist e = log₆(T(θ)⁻¹ T*) with the LOCAL Jacobian, a position's e = p* − p with the
 LOCAL_WORLD_ALIGNED linear rows, a rotation's e = log₃(RᵀR*) with the LOCAL angular rows;
@@ -37,7 +37,7 @@ import math
 import numpy as np
 
 from ...jit import kernel
-from ..geometric.fk import chain_fk_jacobian
+from ..fk import chain_fk_jacobian
 from .kernel import K_DAMP, LAMBDA0, MAX_ITER, STALL, clock
 from .targets import ORIENTATION, POSE, POSITION, Target
 
@@ -327,7 +327,7 @@ def run(F, B, kind, tp2, tr2, tsum, start):
     tolerances are met, the error stops falling by 10 % for :data:`~.kernel.STALL` iterations,
     :data:`~.kernel.MAX_ITER`, a singular system — or, every 8th iteration, a pause for the caller to
     look at the clock; ``start=False`` resumes it (with the step of the error and Jacobian it
-    left in ``B``).  ``F``: the chain (:class:`~anthroarm.ik.geometric.fk.PathFrames`);
+    left in ``B``).  ``F``: the chain (:class:`~anthroarm.ik.fk.PathFrames`);
     ``B``: the target and limits, the state, the iterate of least ‖e‖² (row ``BEST``) and
     the scratch arrays (see ``TH``).  Returns ``FAILED``, ``CONVERGED`` or
     ``PAUSED``."""
@@ -386,7 +386,7 @@ def run(F, B, kind, tp2, tr2, tsum, start):
 
 class Buffers:
     """The calling thread's arrays of :func:`run` for one (robot, frame): the chain ``F``
-    (:class:`~anthroarm.ik.geometric.fk.PathFrames`) and the buffer ``B`` (see ``TH``),
+    (:class:`~anthroarm.ik.fk.PathFrames`) and the buffer ``B`` (see ``TH``),
     with views ``th``, ``tgt`` of its rows."""
 
     __slots__ = ("F", "B", "n", "th", "tgt", "warm")

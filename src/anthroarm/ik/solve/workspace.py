@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from ...chain import CONTINUOUS, PRISMATIC
 from .. import closed_form
-from ..geometric.fk import PathFrames
+from ..fk import PathFrames
 from ..qp.tasks.posture import comfortable_posture, has_comfortable_posture
 from . import seeds
 from .lm import Buffers
