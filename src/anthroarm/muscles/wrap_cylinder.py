@@ -6,7 +6,7 @@ written once as kernels (:mod:`anthroarm.jit`): every argument a (D, 3) ``comple
 rows (row 0 the real state, row d moved by i·h along one coordinate), every branch decided on
 row 0's real part, every operation row by row, so that a compiled call and the interpreter's
 (the reference) give the same numbers.  Scalar functions of a complex row are those of
-:mod:`cmath` (√, cos, sin: analytic, so Im f(x + i h ẋ) / h = f'(x) ẋ); the angle of the helix
+``cmath`` (√, cos, sin: analytic, so Im f(x + i h ẋ) / h = f'(x) ẋ); the angle of the helix
 is ``atan2`` of the real parts plus i times its first-order change,
 (x Im y − y Im x) / (x² + y²).
 """
