@@ -32,6 +32,11 @@ def workers() -> int:
             return max(1, int(env))
         except ValueError:
             raise ValueError(f"${ENV} must be a whole number of threads, got {env!r}") from None
+    return cpus()
+
+
+def cpus() -> int:
+    """The CPUs this process may use (``os.sched_getaffinity``; ``os.cpu_count()`` elsewhere)."""
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except (AttributeError, OSError):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import sys
 
 import numpy as np
@@ -10,6 +9,7 @@ import numpy as np
 from .. import crosscheck
 from ..muscles import checks as muscle_checks
 from ..osim import checks as osim_checks
+from ..threads import cpus
 from .common import MAX_SAMPLES, UserError, parse_locked
 from .runtime import load_model
 
@@ -17,14 +17,6 @@ from .runtime import load_model
 MAX_JOBS = 64
 #: without ``--jobs``, models given from which the checks run in one process per CPU
 PARALLEL_MODELS = 4
-
-
-def cpus() -> int:
-    """The CPUs this process may use (``os.sched_getaffinity``; ``os.cpu_count()`` elsewhere)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return max(1, os.cpu_count() or 1)
 
 
 def run(a) -> int:
