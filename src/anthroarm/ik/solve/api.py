@@ -140,7 +140,8 @@ def solve(
     max_time : float
         Time budget per target, s of CPU time of the calling thread (restarts stop when it is
         spent; a CPU-time budget makes the answer independent of the machine's load).  The
-        seed table, built once per (robot, frame) on the first call, is not charged to it.
+        seed table and the kernels, made or loaded once per (robot, frame) on the first call,
+        and the garbage collector's pauses are not charged to it (:func:`~anthroarm.ik.solve.kernel.clock`).
     mode : None, "pose", "position", "orientation"
         Override the target kind (e.g. ``"position"`` with a 4×4 ``T`` uses its translation).
     max_restarts : int, optional
