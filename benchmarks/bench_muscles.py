@@ -49,7 +49,11 @@ import numpy as np
 import anthroarm as aa
 from anthroarm import muscles
 from anthroarm.ik.qp import make_backend
-from anthroarm.muscles.opensim_oracle import opensim_kinematics, opensim_static_optimization
+from anthroarm.muscles.opensim_oracle import (
+    opensim_kinematics,
+    opensim_static_optimization,
+    stationarity,
+)
 from anthroarm.osim.checks import OpenSimModel
 
 RECORDINGS = Path(aa.__file__).parent / "data" / "opensim" / "recordings"
@@ -188,15 +192,6 @@ def _moment_arm_error(path, robot, ms, Q):
     return err.max(), ms.names[int(err.argmax())], R_os
 
 
-def _stationarity(x, C, M, lower, tol=1e-6):
-    """KKT stationarity of x for min |x|² s.t. C x = d, x[:M] >= lower: the largest
-    |2x + Cᵀλ| over the variables off their bounds, λ by least squares."""
-    free = np.ones(len(x), dtype=bool)
-    free[:M] = x[:M] > lower + tol
-    lam = np.linalg.lstsq(C[:, free].T, -2.0 * x[free], rcond=None)[0]
-    return np.abs(2.0 * x[free] + C[:, free].T @ lam).max()
-
-
 def _with_moment_arms(cons, tau, lower, a_os):
     """Largest |a - a_OpenSim| of the same QP solved with the constraint rows ``cons``
     (built from OpenSim's moment arms)."""
@@ -261,7 +256,7 @@ def _so_rows(quick: bool) -> list:
             # where OpenSim's answer is not a KKT point of its problem (IPOPT stopped short),
             # the difference says nothing about ours (an exact QP optimum, KKT ~1e-11)
             x_os = np.hstack([a_os, tight.reserve / strength])
-            kkt = np.array([_stationarity(x, C, len(ms), lower) for x, C in zip(x_os, cons)])
+            kkt = np.array([stationarity(x, C, len(ms), lower) for x, C in zip(x_os, cons)])
             # arm26: its paths differ from OpenSim's (ellipsoids): no KKT test of its answer
             bad = (kkt > KKT_TOL) & (name != "arm26")
             diff = np.abs(res.activation - a_os).max(axis=1)

@@ -254,3 +254,15 @@ __all__ = [
     "opensim_static_optimization",
     "pick",
 ]
+
+
+def stationarity(x, C, M: int, lower, tol: float = 1e-6) -> float:
+    """KKT stationarity of x for min |x|² s.t. C x = d, x[:M] ≥ ``lower`` (the problem
+    :func:`opensim_static_optimization` poses): the largest |2x + Cᵀλ| over the variables off
+    their bounds (more than ``tol`` above ``lower``), λ by least squares — ~0 where x is an
+    optimum, which tells the frames where OpenSim's answer is one."""
+    x = np.asarray(x, dtype=float)
+    free = np.ones(len(x), dtype=bool)
+    free[:M] = x[:M] > np.asarray(lower, dtype=float) + tol
+    lam = np.linalg.lstsq(C[:, free].T, -2.0 * x[free], rcond=None)[0]
+    return float(np.abs(2.0 * x[free] + C[:, free].T @ lam).max())
