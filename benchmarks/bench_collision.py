@@ -206,7 +206,7 @@ def run(quick: bool = False, n_targets: int | None = None) -> dict:
         "notes": (__doc__ or "").strip()
         + f"\n\nThis run: {n} targets per scene requested, {steps} steps per target."
         + (
-            "\n\n" + "\n".join(mink_notes)
+            "\n\n" + "\n\n".join(mink_notes)
             if collision_mink is not None
             else "\n\nmink is not installed: its rows are left out (pip install -e '.[bench]')."
         ),
@@ -221,9 +221,13 @@ def _mink_note(name: str, res: dict) -> str:
         f"mink, {name} ({r['versions']}): tool FK vs Pinocchio {r['fk_error']:.1e} over 100 "
         f"random q; mj_geomDistance vs coal {r['distance_error']:.1e} m over "
         f"{r['distance_pairs']} separated pairs within the detection distance, "
-        f"{r['depth_error']:.1e} m over {r['penetrating_pairs']} penetrating ones "
-        f"(MuJoCo's depth of a capsule deep in a box is not coal's EPA depth), "
-        f"{r['sign_errors']} sign disagreements; {r['pairs']} geom pairs"
+        f"{r['depth_error']:.1e} m over {r['penetrating_pairs']} penetrating ones"
+        + (
+            " (MuJoCo's capsule-box penetration depth is not coal's EPA depth)"
+            if r["depth_error"] > 1e-6
+            else ""
+        )
+        + f", {r['sign_errors']} sign disagreements; {r['pairs']} geom pairs"
         + (f", of which mink's filter drops {dropped} (parent-child bodies)" if dropped else "")
         + "; solve_ik raised NoSolutionFound "
         + ", ".join(f"{res[m]['no_solution']} times ({m})" for m in MINK_GAINS)
