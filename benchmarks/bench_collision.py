@@ -1,4 +1,5 @@
-"""Collision-aware QP IK: anthroarm's velocity damper vs pink's SelfCollisionBarrier, same targets.
+"""Collision-aware QP IK: anthroarm's velocity damper vs pink's SelfCollisionBarrier and mink's
+CollisionAvoidanceLimit, same targets.
 
 Scenes: panda (example-robot-data URDF, its collision meshes as convex hulls) with a table and a
 box in its workspace, from its "ready" pose; the 27-DOF human upper limb with its hand and a
@@ -14,12 +15,26 @@ both with daqp.
   (with its step acceptance on the true distances);
 * pink: ``SelfCollisionBarrier(n_collision_pairs = every pair, d_min, gain 1)`` on the same
   ``pin.GeometryModel`` (the robot's bodies and the obstacles, the same active pairs),
-  ``solve_ik(..., solver="daqp", safety_break=False)``.
+  ``solve_ik(..., solver="daqp", safety_break=False)``;
+* mink (MuJoCo; its rows are left out, with a note, when mink is not installed):
+  ``CollisionAvoidanceLimit(minimum_distance_from_collisions = d_min,
+  collision_detection_distance = d_min + 3 cm, bound_relaxation 0)`` on a MuJoCo model of the
+  robot's URDF whose geoms are the same bodies and obstacles (panda's hulls as MuJoCo meshes of
+  the hull's points), one geom pair per active pair of ours and pink (mink's own filter drops
+  panda_link6–panda_hand, bodies it calls parent and child: the notes list it), mink's FrameTask /
+  PostureTask with the same costs, ConfigurationLimit (gain 0.5) + VelocityLimit,
+  ``solve_ik(..., solver="daqp")``; the scene is checked before the run (tool FK against
+  Pinocchio, mj_geomDistance against coal): :mod:`benchmarks.collision_mink`.  Two rows:
+  "mink" with its default gain 0.85, and "mink, gain 0.85·dt".  mink's QP variable is the
+  displacement Δq = v·dt (its VelocityLimit bounds Δq by v_max·dt) and the limit bounds the
+  first-order distance change of that displacement by gain·(d − d_min)/dt (mink 1.3.0,
+  ``limits/collision_avoidance_limit.py``): with dt = 10 ms the default gain lets a pair close
+  85 times its gap to d_min in one step; gain 0.85·dt bounds it by 0.85·(d − d_min) per step.
 
 Reported per scene and method: success (tool within 1 cm and 0.1 rad at the end), steps with
-a pair closer than d_min − 1e-4 m (checked after every step with anthroarm.collision), the
-smallest distance seen, median and p90 CPU time of one step (``time.process_time``: the machine
-may be shared), and pink/ours.
+a pair closer than d_min − 1e-4 m (checked after every step with anthroarm.collision on the
+Pinocchio model, every method alike), the smallest distance seen, median and p90 CPU time of
+one step (``time.process_time``: the machine may be shared), and pink/ours, mink/ours.
 """
 
 from __future__ import annotations
@@ -38,7 +53,16 @@ from anthroarm.ik import qp
 from anthroarm.ik.qp.limits import CollisionLimit
 from anthroarm.ik.qp.limits.collision_step import step as collision_step
 
+try:
+    from . import collision_mink
+except ModuleNotFoundError as exc:  # mink and mujoco: the optional "bench" extra
+    if exc.name not in ("mink", "mujoco"):
+        raise
+    collision_mink = None
+
 DT = 0.01
+#: mink's rows: its CollisionAvoidanceLimit's gain in each (see the module docstring)
+MINK_GAINS = {"mink": 0.85, "mink, gain 0.85·dt": 0.85 * DT}
 PANDA_READY = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
 
 
@@ -63,14 +87,18 @@ def _errors(robot, q, T):
     )
 
 
+EE_KW = dict(position_cost=1.0, orientation_cost=0.5, lm_damping=1e-3)
+
+
 def _run(robot, env, q0, targets, d_min, steps, method):
-    ee_kw = dict(position_cost=1.0, orientation_cost=0.5, lm_damping=1e-3)
     times, viol, worst, succ, n_steps = [], 0, np.inf, 0, 0
     if method == "ours":
         conf = qp.IKConfiguration(robot, q0)
-        ee = qp.FrameTask(robot, **ee_kw)
+        ee = qp.FrameTask(robot, **EE_KW)
         post = qp.PostureTask(robot, cost=1e-3, target=q0)
         limits = [*qp.default_limits(robot), CollisionLimit(robot, env, d_min, d_min + 0.03, 0.5)]
+    elif method in MINK_GAINS:
+        mk = collision_mink.MinkIK(robot, env, q0, d_min, DT, EE_KW, MINK_GAINS[method])
     else:
         import pink  # noqa: PLC0415 - the peer, optional
         from pink.barriers import SelfCollisionBarrier  # noqa: PLC0415
@@ -78,7 +106,7 @@ def _run(robot, env, q0, targets, d_min, steps, method):
 
         sc = scene(C.model(robot), env)
         gm = sc.geometry
-        ee = FrameTask(robot.tool, **ee_kw)
+        ee = FrameTask(robot.tool, **EE_KW)
         post = PostureTask(cost=1e-3)
         post.set_target(q0)
         barrier = SelfCollisionBarrier(n_collision_pairs=len(gm.collisionPairs), d_min=d_min)
@@ -86,6 +114,8 @@ def _run(robot, env, q0, targets, d_min, steps, method):
         if method == "ours":
             conf.update(q0.copy())
             ee.set_target(T)
+        elif method in MINK_GAINS:
+            mk.reset(T)
         else:
             pconf = pink.Configuration(
                 robot.model, robot.model.createData(), q0.copy(), collision_model=gm,
@@ -98,6 +128,8 @@ def _run(robot, env, q0, targets, d_min, steps, method):
                 v = collision_step(conf, None, [ee, post], DT, limits=limits)
                 conf.integrate_inplace(v, DT)
                 q = conf.q
+            elif method in MINK_GAINS:
+                q = mk.step()
             else:
                 try:
                     v = pink.solve_ik(
@@ -122,6 +154,7 @@ def _run(robot, env, q0, targets, d_min, steps, method):
         "min_distance": worst,
         "median_ms": float(np.median(t)),
         "p90_ms": float(np.percentile(t, 90)),
+        **(mk.report() if method in MINK_GAINS else {}),
     }
 
 
@@ -129,25 +162,31 @@ def run(quick: bool = False, n_targets: int | None = None) -> dict:
     warnings.filterwarnings("ignore")
     n = n_targets or (5 if quick else 1000)
     steps = 40 if quick else 150
-    rows, out = [], {}
+    methods = ("ours", "pink", *(MINK_GAINS if collision_mink is not None else ()))
+    rows, out, mink_notes = [], {}, []
     for name, robot, obstacles, q0, d_min in scenes():
         env = C.environment(obstacles)
         qs, targets = start_and_targets(
             robot, n, rng=0, d_clear=d_min + 0.001, obstacles=env, tries=50 * n
         )
         q0 = qs if q0 is None else q0
-        res = {m: _run(robot, env, q0, targets, d_min, steps, m) for m in ("ours", "pink")}
+        res = {m: _run(robot, env, q0, targets, d_min, steps, m) for m in methods}
         out[name] = res
-        ratio = res["pink"]["median_ms"] / res["ours"]["median_ms"]
-        for m in ("ours", "pink"):
+        for m in methods:
             r = res[m]
+            ratio = r["median_ms"] / res["ours"]["median_ms"]
             rows.append([
                 name, m, len(targets), d_min, f"{100 * r['success']:.1f} %", r["violations"],
                 r["steps"], r["min_distance"], r["median_ms"], r["p90_ms"],
-                ratio if m == "ours" else "",
+                ratio if m == "pink" else "", ratio if m in MINK_GAINS else "",
             ])  # fmt: skip
+        if "mink" in res:
+            mink_notes.append(_mink_note(name, res))
     return {
-        "title": "Collision-aware QP IK: velocity damper vs pink's SelfCollisionBarrier",
+        "title": (
+            "Collision-aware QP IK: velocity damper vs pink's SelfCollisionBarrier and mink's "
+            "CollisionAvoidanceLimit"
+        ),
         "columns": [
             "scene",
             "method",
@@ -160,12 +199,40 @@ def run(quick: bool = False, n_targets: int | None = None) -> dict:
             "median step (ms CPU)",
             "p90 step (ms CPU)",
             "pink / ours",
+            "mink / ours",
         ],  # fmt: skip
         "rows": rows,
         "results": out,
         "notes": (__doc__ or "").strip()
-        + f"\n\nThis run: {n} targets per scene requested, {steps} steps per target.",
+        + f"\n\nThis run: {n} targets per scene requested, {steps} steps per target."
+        + (
+            "\n\n" + "\n\n".join(mink_notes)
+            if collision_mink is not None
+            else "\n\nmink is not installed: its rows are left out (pip install -e '.[bench]')."
+        ),
     }
+
+
+def _mink_note(name: str, res: dict) -> str:
+    """The checks of mink's MuJoCo scene and its QP failures, as a line of the notes."""
+    r = res["mink"]
+    dropped = ", ".join(f"{a}–{b}" for a, b in r["dropped_pairs"])
+    return (
+        f"mink, {name} ({r['versions']}): tool FK vs Pinocchio {r['fk_error']:.1e} over 100 "
+        f"random q; mj_geomDistance vs coal {r['distance_error']:.1e} m over "
+        f"{r['distance_pairs']} separated pairs within the detection distance, "
+        f"{r['depth_error']:.1e} m over {r['penetrating_pairs']} penetrating ones"
+        + (
+            " (MuJoCo's capsule-box penetration depth is not coal's EPA depth)"
+            if r["depth_error"] > 1e-6
+            else ""
+        )
+        + f", {r['sign_errors']} sign disagreements; {r['pairs']} geom pairs"
+        + (f", of which mink's filter drops {dropped} (parent-child bodies)" if dropped else "")
+        + "; solve_ik raised NoSolutionFound "
+        + ", ".join(f"{res[m]['no_solution']} times ({m})" for m in MINK_GAINS)
+        + " (zero velocity)."
+    )
 
 
 def run_grasps(quick: bool = False, n: int | None = None) -> dict:
@@ -259,4 +326,4 @@ if __name__ == "__main__":  # pragma: no cover
     if "--grasps" in sys.argv:  # python -m benchmarks.bench_collision --grasps [--n N]
         print(write_result("collision_grasp", dict(run_grasps(quick=quick, n=n), quick=quick)))
     else:  # python -m benchmarks.bench_collision [--n N]: N targets per scene (default 1000)
-        print(write_result("collision", run(quick=quick, n_targets=n)))
+        print(write_result("collision", dict(run(quick=quick, n_targets=n), quick=quick)))
