@@ -9,7 +9,14 @@ import pkgutil
 import sys
 from pathlib import Path
 
-from .common import QUICK_DIR, RESULTS_DIR, markdown_table, steady_state_allocator, write_result
+from .common import (
+    QUICK_DIR,
+    RESULTS_DIR,
+    compiled_kernels,
+    markdown_table,
+    steady_state_allocator,
+    write_result,
+)
 
 
 def available() -> list[str]:
@@ -50,6 +57,8 @@ def run(names=None, quick: bool = False, out_dir=None) -> list[Path]:
             "tables, which compare against every peer; pip install -e '.[bench]' (or run "
             "--quick, or --out FOLDER)"
         )
+    if any(n != "cold_start" for n in names):  # cold_start makes its own fresh processes
+        compiled_kernels(strict=not quick and out_dir is None)
     written = []
     for n in names:
         mod = importlib.import_module(f"benchmarks.bench_{n}")

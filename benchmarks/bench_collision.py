@@ -319,9 +319,10 @@ def run_grasps(quick: bool = False, n: int | None = None) -> dict:
 if __name__ == "__main__":  # pragma: no cover
     import sys
 
-    from .common import write_result
+    from .common import compiled_kernels, write_result
 
     quick = "--quick" in sys.argv
+    compiled_kernels(strict=not quick)
     n = int(sys.argv[sys.argv.index("--n") + 1]) if "--n" in sys.argv else None
     if "--grasps" in sys.argv:  # python -m benchmarks.bench_collision --grasps [--n N]
         print(write_result("collision_grasp", dict(run_grasps(quick=quick, n=n), quick=quick)))

@@ -9,11 +9,30 @@ import time
 from pathlib import Path
 from statistics import median
 
+from anthroarm import jit
 from anthroarm._io import atomic_write_text
 
 RESULTS_DIR = Path(__file__).resolve().parent / "results"
 #: where ``--quick`` runs write (git-ignored): results/ holds committed full runs only
 QUICK_DIR = RESULTS_DIR / "quick"
+
+
+#: how long a benchmark waits for the background compilation of anthroarm's kernels (s)
+COMPILE_WAIT = 3600.0
+
+
+def compiled_kernels(strict: bool) -> None:
+    """Warm tables measure compiled kernels: wait until this process runs them (on a cache
+    without them, the first call starts the background compilation, minutes; until it is done
+    every kernel runs in the interpreter and a table would time that).  ``strict`` (a full run
+    into results/) exits when the kernels still run in the interpreter (``ANTHROARM_JIT=
+    reference``, or a compilation that failed); otherwise a warning."""
+    if jit.wait(COMPILE_WAIT):
+        return
+    msg = f"anthroarm's kernels run in the interpreter ({jit.status()}): warm times would be wrong"
+    if strict:
+        raise SystemExit(msg + "; a full run into results/ needs compiled kernels")
+    print("warning: " + msg, flush=True)
 
 
 def time_call(fn, *, number: int = 1, repeat: int = 7, min_time: float = 0.0) -> float:

@@ -6,6 +6,8 @@ bench-extra packages, so their tests skip without them.
 """
 
 import json
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -14,7 +16,8 @@ import pytest
 
 import anthroarm as aa
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 from benchmarks import common, ik_peers  # noqa: E402
 
 
@@ -166,3 +169,20 @@ def test_result_figures_are_saved_next_to_the_tables(tmp_path):
     jp, _ = common.write_result("x", res, tmp_path)
     assert (tmp_path / "f.png").is_file() and not (tmp_path / "none.png").exists()
     assert "figures" not in json.loads(jp.read_text())
+
+
+@pytest.mark.parametrize("strict", [True, False])
+def test_warm_benchmarks_refuse_the_interpreter(strict, tmp_path):
+    """A warm table times compiled kernels: a process whose kernels run in the interpreter
+    (``ANTHROARM_JIT=reference``) is refused a full run into results/ and warned otherwise."""
+    env = dict(os.environ, ANTHROARM_JIT="reference", ANTHROARM_CACHE=str(tmp_path))
+    code = (
+        f"from benchmarks.common import compiled_kernels; compiled_kernels({strict}); print('ran')"
+    )
+    p = subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True
+    )
+    assert "kernels run in the interpreter (reference (ANTHROARM_JIT=reference))" in (
+        p.stderr + p.stdout
+    )
+    assert (p.returncode != 0 and "ran" not in p.stdout) if strict else p.stdout.endswith("ran\n")
