@@ -6,7 +6,12 @@ segment between consecutive points of its range is tried; a *mandatory* wrap (th
 segment crosses the surface) is taken at once, otherwise the wrapped segment that lengthens the
 path least; two tangent points are inserted in the path, fixed in the wrap object's frame, and
 the length of the surface path between them is added.  With two or more wraps, up to eight
-passes until the length changes by less than 0.5 mm.
+passes until the length changes by less than 0.5 mm.  That pass loop is a compiled kernel,
+:func:`anthroarm.muscles.wrap_pass.passes` (its data layout: :mod:`anthroarm.muscles.wrap_pass`),
+called once for all the states of a muscle whose active path points are the same; this module
+packs its input (the complex-step rows, the wrap frames, the wrap objects' parameters), turns
+its status into a :class:`~anthroarm.errors.MuscleError` and draws the final path
+(:func:`current_path`).
 
 The surfaces (each ``wrapLine`` in the wrap object's own frame):
 
@@ -20,7 +25,7 @@ The surfaces (each ``wrapLine`` in the wrap object's own frame):
   kernels: :mod:`anthroarm.muscles.wrap_cylinder`.
 * ``WrapSphere`` (``WrapSphere.cpp``): the great circle through both end points' tangent
   points, wrapping only where the straight segment crosses the sphere (Garner & Pandy 2000,
-  sphere obstacle).
+  sphere obstacle).  Compiled kernel: :func:`anthroarm.muscles.wrap_pass.wrap_sphere`.
 * ``WrapEllipsoid`` (``WrapEllipsoid.cpp``): :mod:`anthroarm.muscles.wrap_ellipsoid` (compiled
   kernels too).
   Tori are not evaluated (:class:`~anthroarm.errors.MuscleError`).
@@ -29,8 +34,9 @@ Derivative: the complex step (Squire & Trapp, *Using complex variables to estima
 of real functions*, SIAM Rev 40 (1998) 110-112; Martins, Sturdza & Alonso, *The complex-step
 derivative approximation*, ACM TOMS 29 (2003) 245-262) through the whole path.  Every input
 is a row of D = 1 + m: row 0 the real state, row d the state moved by i·h along the d-th
-coordinate the path depends on (path points x + i h ∂x/∂q_d; wrap bodies' poses
-(R + i h [ω_d]× R, o + i h v_d) from their Jacobians), h = 1e-30.  Every branch (which
+coordinate the path depends on in any of the states evaluated together (path points
+x + i h ∂x/∂q_d; wrap bodies' poses (R + i h [ω_d]× R, o + i h v_d) from their Jacobians),
+h = 1e-30.  Every branch (which
 segment wraps, the quadrant's side, the number of passes and of tangent-point adjustments) is
 decided on row 0's real part, every operation on a branch is analytic (norms √(v·v),
 ``arctan2`` and clipped ``arccos`` by their first-order expansions), so Im l_d / h is ∂l/∂q_d
