@@ -18,9 +18,9 @@ Data layout (one call, N states of D rows, K active points, W wraps):
   first and second tangent point of wrap j (OpenSim's ``PathWrapPoint``\\ s);
 * ``x`` (N, D, K, 3): the active points in ground; ``rg`` (N, W, D, 3, 3) and ``og``
   (N, W, D, 3): each wrap object's frame in ground (its axes as columns, its origin);
-* ``wint`` (W, 7): each wrap's kind (:data:`CYLINDER`, :data:`SPHERE`, :data:`ELLIPSOID`,
-  :data:`OTHER`), active flag, quadrant axis and sign (sign 0: all), ellipsoid method
-  (:data:`anthroarm.muscles.wrap_ellipsoid.METHODS`) and the range of original path-point
+* ``wint`` (W, 7): each wrap's kind (``CYLINDER``, ``SPHERE``, ``ELLIPSOID``,
+  ``OTHER``), active flag, quadrant axis and sign (sign 0: all), ellipsoid method
+  (``METHODS`` of :mod:`anthroarm.muscles.wrap_ellipsoid`) and the range of original path-point
   indices it applies to (zero-based, inclusive); ``wflt`` (W, 3): radius and length of a
   cylinder, radius of a sphere, the radii of an ellipsoid;
 * the tangent points of a wrap are kept in the wrap object's frame (fixed there: a cylinder's or
@@ -29,7 +29,7 @@ Data layout (one call, N states of D rows, K active points, W wraps):
 
 A failure (coinciding path points, a wrap kind not evaluated, a path through a sphere's centre,
 an ellipsoid's tangent points not converged) stops the call with a status code
-(:data:`COINCIDE` ...) that the Python caller turns into a
+(``COINCIDE`` ...) that the Python caller turns into a
 :class:`~anthroarm.errors.MuscleError`.
 """
 
@@ -59,7 +59,7 @@ from .wrap_ellipsoid import wrap as wrap_ellipsoid
 
 #: complex step (the rows' imaginary parts are h times the derivatives)
 H = 1e-30
-#: wrap kinds, as :data:`wint` numbers them
+#: wrap kinds, as ``wint`` numbers them
 CYLINDER, SPHERE, ELLIPSOID, OTHER = 0, 1, 2, 3
 #: the columns of ``wint``
 KIND, ACTIVE, AXIS, SIGN, METHOD, FIRST, LAST = 0, 1, 2, 3, 4, 5, 6
@@ -83,7 +83,7 @@ def wrap_sphere(p1, p2, radius, axis, wsign):
     (code, r1 (D, 3), r2 (D, 3), arc length (D,), turn (D,)), the turn the signed angle about
     (r1 × r2)/|r1 × r2| from r1 to r2 along the great circle (OpenSim's −(2π − θ) on a far-side
     wrap, whose arc length it then takes negative, as OpenSim does); zero points, arc and turn
-    for a code other than ``WRAPPED`` or ``MANDATORY``, :data:`THROUGH_CENTRE` for a path
+    for a code other than ``WRAPPED`` or ``MANDATORY``, ``THROUGH_CENTRE`` for a path
     through the centre (the wrap plane undefined)."""
     n = p1.shape[0]
     none = np.zeros((n, 3), np.complex128)
@@ -224,7 +224,7 @@ def line(p1, p2, kind, par, axis, wsign, method, hold, single):
     """The ``wrapLine`` of a wrap object of ``kind`` (parameters ``par``: a row of ``wint``'s
     companion ``wflt``) for the end points p1, p2 (D, 3) in its frame: (code, r1, r2, arc);
     ``hold``: a cylinder's or sphere's tangent points and arc from row 0 alone, real (one
-    row); :data:`NOT_EVALUATED` for a kind that is none of the three."""
+    row); ``NOT_EVALUATED`` for a kind that is none of the three."""
     if kind == CYLINDER or kind == SPHERE:
         if hold:
             h1, h2 = np.empty((1, 3), np.complex128), np.empty((1, 3), np.complex128)
@@ -281,7 +281,7 @@ def _ground(e, x, rg, og, wp, out):
 
 @kernel
 def _gpos(e, x, rg, og, wp, cached, stale, out):
-    """:func:`_ground` as the path's length sees it: a tangent point's ground position at its
+    """``_ground`` as the path's length sees it: a tangent point's ground position at its
     first use in the state, kept in ``stale`` (OpenSim's ``Point::getLocationInGround`` cache;
     a wrap point moved by a later pass keeps it)."""
     if e >= 0:
@@ -321,7 +321,7 @@ def _drop(path, n, j):
 @kernel
 def _length(path, n, x, rg, og, wp, arcs, cached, stale, total, ga, gb, final):
     """total (D,) = the path's length (the straight segments between the ground positions
-    :func:`_gpos`, the arc between a wrap's two tangent points); False when ``final`` and two
+    ``_gpos``, the arc between a wrap's two tangent points); False when ``final`` and two
     consecutive points coincide (row 0)."""
     for d in range(total.shape[0]):
         total[d] = 0.0
@@ -490,7 +490,7 @@ def passes(x, rg, og, wint, wflt, idx, hold, lengths, grads, codes, paths, npath
     (N, W, D, 3): ``lengths[s]`` the length (row 0), ``grads[s]`` (D − 1,) its derivatives
     (Im row d / h), ``codes[s]``, ``paths[s]`` (its first ``npath[s]`` entries), ``tang[s]``
     and ``ends[s]`` as :func:`one_state` fills them.  Returns (status, wrap j, state s) of the
-    first failure, (:data:`OK`, −1, −1) without one."""
+    first failure, (``OK``, −1, −1) without one."""
     D = x.shape[1]
     total = np.empty(D, np.complex128)
     for s in range(x.shape[0]):
