@@ -63,9 +63,8 @@ H = 1e-30
 CYLINDER, SPHERE, ELLIPSOID, OTHER = 0, 1, 2, 3
 #: the columns of ``wint``
 KIND, ACTIVE, AXIS, SIGN, METHOD, FIRST, LAST = 0, 1, 2, 3, 4, 5, 6
-#: :func:`wrap_sphere`'s code for a path through the sphere's centre (no wrap plane), and the
-#: code :func:`line` gives a kind it does not evaluate
-THROUGH_CENTRE, NOT_EVALUATED = -2, -3
+#: :func:`wrap_sphere`'s code for a path through the sphere's centre (no wrap plane)
+THROUGH_CENTRE = -2
 #: the status of :func:`passes`
 OK, COINCIDE, UNSUPPORTED, CENTRE, NOT_CONVERGED = 0, 1, 2, 3, 4
 #: consecutive path points closer than this (m) coincide
@@ -218,30 +217,7 @@ def _musc(r1, p1, r2, p2):
     return out
 
 
-# ------------------------------------------------------------------------- one wrap line
-@kernel
-def line(p1, p2, kind, par, axis, wsign, method, hold, single):
-    """The ``wrapLine`` of a wrap object of ``kind`` (parameters ``par``: a row of ``wint``'s
-    companion ``wflt``) for the end points p1, p2 (D, 3) in its frame: (code, r1, r2, arc);
-    ``hold``: a cylinder's or sphere's tangent points and arc from row 0 alone, real (one
-    row); ``NOT_EVALUATED`` for a kind that is none of the three."""
-    if kind == CYLINDER or kind == SPHERE:
-        if hold:
-            h1, h2 = np.empty((1, 3), np.complex128), np.empty((1, 3), np.complex128)
-            for k in range(3):
-                h1[0, k], h2[0, k] = p1[0, k].real, p2[0, k].real
-            p1, p2 = h1, h2
-        if kind == CYLINDER:
-            code, r1, r2, arc, _ = wrap_cylinder(p1, p2, par[0], par[1], axis, wsign, single)
-        else:
-            code, r1, r2, arc, _ = wrap_sphere(p1, p2, par[0], axis, wsign)
-        return code, r1, r2, arc
-    if kind == ELLIPSOID:
-        code, r1, r2, arc, _ = wrap_ellipsoid(p1, p2, par, axis, wsign, method)
-        return code, r1, r2, arc
-    return NOT_EVALUATED, p1, p2, p1[:, 0].copy()
-
-
+# ------------------------------------------------------------------------------ one wrap
 @kernel
 def _finite(r1, r2, arc):
     """Whether every row of r1, r2 (D, 3) and arc (D,) is finite."""
@@ -360,123 +336,6 @@ def _ground0(rg, og, r, out):
 
 
 @kernel
-def one_state(x, rg, og, wint, wflt, idx, hold, codes, path, tang, ends, total):
-    """The passes over one state (x (D, K, 3), rg (W, D, 3, 3), og (W, D, 3); the module
-    docstring): (status, wrap j of a failure or −1, the final path's number of entries);
-    ``total`` (D,) receives the length, ``codes`` (W,) each wrap's outcome (``status`` of
-    :mod:`anthroarm.muscles.wrap`), ``path`` the final path, ``tang`` (W, 2, 3) its tangent
-    points in ground (row 0, the positions the length uses) and ``ends`` (W, 2, 3) the end
-    points (row 0, the wrap frame) of the segment each wrap wraps."""
-    D, K, W = x.shape[0], x.shape[1], wint.shape[0]
-    single = W == 1
-    wp = np.zeros((W, 2, D, 3), np.complex128)
-    arcs = np.zeros((W, D), np.complex128)
-    stale = np.zeros((W, 2, D, 3), np.complex128)
-    cached = np.zeros((W, 2), np.bool_)
-    has = np.zeros(W, np.bool_)
-    inside = np.zeros(W, np.bool_)
-    results = np.zeros(W, np.int64)
-    order = np.arange(W)
-    ga, gb = np.empty((D, 3), np.complex128), np.empty((D, 3), np.complex128)
-    p1, p2 = np.empty((D, 3), np.complex128), np.empty((D, 3), np.complex128)
-    g1, g2 = np.empty((1, 3), np.complex128), np.empty((1, 3), np.complex128)
-    for k in range(K):
-        path[k] = k
-    n = K
-    last = math.inf
-    for kk in range(1 if W < 2 else MAX_PASSES):
-        for i in range(W):
-            j = order[i]
-            results[i] = NO_WRAP
-            n = _drop(path, n, j)
-            has[j] = False
-            if wint[j, ACTIVE] == 0:
-                continue
-            first = lastk = -1
-            for k in range(K):
-                if wint[j, FIRST] <= idx[k] <= wint[j, LAST]:
-                    if first < 0:
-                        first = k
-                    lastk = k
-            if first < 0:
-                break
-            start = end = 0
-            for a in range(n):
-                if path[a] == first:
-                    start = a
-                if path[a] == lastk:
-                    end = a
-            best, best_change = -1, math.inf
-            for a in range(start, end):
-                ea, eb = path[a], path[a + 1]
-                if ea < 0 and eb < 0 and (-ea - 1) // 2 == (-eb - 1) // 2:
-                    continue
-                _ground(ea, x, rg, og, wp, ga)
-                _to_frame(rg[j], og[j], ga, p1)
-                _ground(eb, x, rg, og, wp, gb)
-                _to_frame(rg[j], og[j], gb, p2)
-                kind = wint[j, KIND]
-                axis, wsign, method = wint[j, AXIS], wint[j, SIGN], wint[j, METHOD]
-                code, r1, r2, arc = line(p1, p2, kind, wflt[j], axis, wsign, method, hold, single)
-                results[i] = code
-                if code == INSIDE:
-                    inside[j] = True
-                if code == NOT_EVALUATED:
-                    return UNSUPPORTED, j, n
-                if code == THROUGH_CENTRE:
-                    return CENTRE, j, n
-                if code != WRAPPED and code != MANDATORY:
-                    continue
-                if kind == ELLIPSOID and not _finite(r1, r2, arc):
-                    return NOT_CONVERGED, j, n
-                if code == WRAPPED:
-                    _ground0(rg[j], og[j], r1, g1)
-                    _ground0(rg[j], og[j], r2, g2)
-                    _gpos(ea, x, rg, og, wp, cached, stale, ga)
-                    _gpos(eb, x, rg, og, wp, cached, stale, gb)
-                    change = _dist0(g1, ga) + arc[0].real + _dist0(gb, g2) - _dist0(gb, ga)
-                    if not (change < best_change):
-                        continue
-                    best_change = change
-                best = a
-                m = r1.shape[0]  # 1 row when held
-                for d in range(D):
-                    arcs[j, d] = arc[d if m > 1 else 0]
-                    for k in range(3):
-                        wp[j, 0, d, k] = r1[d if m > 1 else 0, k]
-                        wp[j, 1, d, k] = r2[d if m > 1 else 0, k]
-                for k in range(3):
-                    ends[j, 0, k], ends[j, 1, k] = p1[0, k].real, p2[0, k].real
-                if code == MANDATORY:
-                    break
-            if best >= 0:
-                has[j] = True
-                for a in range(n - 1, best, -1):
-                    path[a + 2] = path[a]
-                path[best + 1], path[best + 2] = -(2 * j + 1), -(2 * j + 2)
-                n += 2
-        _length(path, n, x, rg, og, wp, arcs, cached, stale, total, ga, gb, False)
-        now = total[0].real
-        if abs(now - last) < CONVERGED:
-            break
-        last = now
-        if kk == 0 and W > 1 and results[0] == NO_WRAP and results[1] == INSIDE:
-            order[0], order[1] = 1, 0
-            n = _drop(path, n, 0)
-            has[0] = False
-    for j in range(W):
-        codes[j] = status(has[j], inside[j])
-    if not _length(path, n, x, rg, og, wp, arcs, cached, stale, total, ga, gb, True):
-        return COINCIDE, -1, n
-    for a in range(n):
-        if path[a] < 0:
-            j, w = _wrap_of(path[a])
-            for k in range(3):
-                tang[j, w, k] = stale[j, w, 0, k].real
-    return OK, -1, n
-
-
-@kernel
 def status(wrapped, inside):
     """A wrap's outcome on one state: ``WRAPPED`` (1) when the path wraps over it, ``INSIDE``
     (-1) when it does not and a segment tried had an end point inside the surface (OpenSim
@@ -486,18 +345,144 @@ def status(wrapped, inside):
 
 @kernel
 def passes(x, rg, og, wint, wflt, idx, hold, lengths, grads, codes, paths, npath, tang, ends):
-    """:func:`one_state` on every state s of x (N, D, K, 3), rg (N, W, D, 3, 3), og
-    (N, W, D, 3): ``lengths[s]`` the length (row 0), ``grads[s]`` (D − 1,) its derivatives
-    (Im row d / h), ``codes[s]``, ``paths[s]`` (its first ``npath[s]`` entries), ``tang[s]``
-    and ``ends[s]`` as :func:`one_state` fills them.  Returns (status, wrap j, state s) of the
-    first failure, (``OK``, −1, −1) without one."""
-    D = x.shape[1]
+    """The passes over every state s of x (N, D, K, 3), rg (N, W, D, 3, 3), og (N, W, D, 3)
+    (the module docstring): ``lengths[s]`` the length (row 0), ``grads[s]`` (D − 1,) its
+    derivatives (Im row d / h), ``codes[s]`` (W,) each wrap's outcome (:func:`status`),
+    ``paths[s]`` the final path (its first ``npath[s]`` entries), ``tang[s]`` (W, 2, 3) its
+    tangent points in ground (row 0, the positions the length uses) and ``ends[s]`` (W, 2, 3)
+    the end points (row 0, the wrap frame) of the segment each wrap wraps.  Returns (status,
+    wrap j, state s) of the first failure, (``OK``, −1, −1) without one.
+
+    One kernel from the states down to the surfaces' kernels (each kernel that calls the
+    cylinder's and the ellipsoid's compiles their code again: ~10 s a level)."""
+    N, D, K, W = x.shape[0], x.shape[1], x.shape[2], wint.shape[0]
+    single = W == 1
+    wp = np.zeros((W, 2, D, 3), np.complex128)  # the tangent points, wrap frames
+    arcs = np.zeros((W, D), np.complex128)
+    stale = np.zeros((W, 2, D, 3), np.complex128)
+    cached = np.zeros((W, 2), np.bool_)
+    has = np.zeros(W, np.bool_)
+    inside = np.zeros(W, np.bool_)
+    results = np.zeros(W, np.int64)
+    order = np.zeros(W, np.int64)
     total = np.empty(D, np.complex128)
-    for s in range(x.shape[0]):
-        cs, ps, ts, es = codes[s], paths[s], tang[s], ends[s]
-        st, j, n = one_state(x[s], rg[s], og[s], wint, wflt, idx, hold, cs, ps, ts, es, total)
-        if st != OK:
-            return st, j, s
+    ga, gb = np.empty((D, 3), np.complex128), np.empty((D, 3), np.complex128)
+    p1, p2 = np.empty((D, 3), np.complex128), np.empty((D, 3), np.complex128)
+    h1, h2 = np.empty((1, 3), np.complex128), np.empty((1, 3), np.complex128)
+    g1, g2 = np.empty((1, 3), np.complex128), np.empty((1, 3), np.complex128)
+    for s in range(N):
+        xs, rgs, ogs, path = x[s], rg[s], og[s], paths[s]
+        for j in range(W):
+            cached[j, 0] = cached[j, 1] = has[j] = inside[j] = False
+            results[j], order[j] = NO_WRAP, j
+        for k in range(K):
+            path[k] = k
+        n = K
+        last = math.inf
+        for kk in range(1 if W < 2 else MAX_PASSES):
+            for i in range(W):
+                j = order[i]
+                results[i] = NO_WRAP
+                n = _drop(path, n, j)
+                has[j] = False
+                if wint[j, ACTIVE] == 0:
+                    continue
+                first = lastk = -1
+                for k in range(K):
+                    if wint[j, FIRST] <= idx[k] <= wint[j, LAST]:
+                        if first < 0:
+                            first = k
+                        lastk = k
+                if first < 0:
+                    break
+                start = end = 0
+                for a in range(n):
+                    if path[a] == first:
+                        start = a
+                    if path[a] == lastk:
+                        end = a
+                kind, axis, wsign = wint[j, KIND], wint[j, AXIS], wint[j, SIGN]
+                best, best_change = -1, math.inf
+                for a in range(start, end):
+                    ea, eb = path[a], path[a + 1]
+                    if ea < 0 and eb < 0 and (-ea - 1) // 2 == (-eb - 1) // 2:
+                        continue
+                    _ground(ea, xs, rgs, ogs, wp, ga)
+                    _to_frame(rgs[j], ogs[j], ga, p1)
+                    _ground(eb, xs, rgs, ogs, wp, gb)
+                    _to_frame(rgs[j], ogs[j], gb, p2)
+                    # the wrapLine of the object, in its frame; held: from row 0, real
+                    if kind == CYLINDER or kind == SPHERE:
+                        q1, q2 = p1, p2
+                        if hold:
+                            for k in range(3):
+                                h1[0, k], h2[0, k] = p1[0, k].real, p2[0, k].real
+                            q1, q2 = h1, h2
+                        radius = wflt[j, 0]
+                        if kind == CYLINDER:
+                            cyl = wrap_cylinder(q1, q2, radius, wflt[j, 1], axis, wsign, single)
+                            code, r1, r2, arc = cyl[0], cyl[1], cyl[2], cyl[3]
+                        else:
+                            sph = wrap_sphere(q1, q2, radius, axis, wsign)
+                            code, r1, r2, arc = sph[0], sph[1], sph[2], sph[3]
+                    elif kind == ELLIPSOID:
+                        ell = wrap_ellipsoid(p1, p2, wflt[j], axis, wsign, wint[j, METHOD])
+                        code, r1, r2, arc = ell[0], ell[1], ell[2], ell[3]
+                    else:
+                        return UNSUPPORTED, j, s
+                    results[i] = code
+                    if code == INSIDE:
+                        inside[j] = True
+                    if code == THROUGH_CENTRE:
+                        return CENTRE, j, s
+                    if code != WRAPPED and code != MANDATORY:
+                        continue
+                    if kind == ELLIPSOID and not _finite(r1, r2, arc):
+                        return NOT_CONVERGED, j, s
+                    if code == WRAPPED:
+                        _ground0(rgs[j], ogs[j], r1, g1)
+                        _ground0(rgs[j], ogs[j], r2, g2)
+                        _gpos(ea, xs, rgs, ogs, wp, cached, stale, ga)
+                        _gpos(eb, xs, rgs, ogs, wp, cached, stale, gb)
+                        change = _dist0(g1, ga) + arc[0].real + _dist0(gb, g2) - _dist0(gb, ga)
+                        if not (change < best_change):
+                            continue
+                        best_change = change
+                    best = a
+                    m = r1.shape[0]  # 1 row when held
+                    for d in range(D):
+                        arcs[j, d] = arc[d if m > 1 else 0]
+                        for k in range(3):
+                            wp[j, 0, d, k] = r1[d if m > 1 else 0, k]
+                            wp[j, 1, d, k] = r2[d if m > 1 else 0, k]
+                    for k in range(3):
+                        ends[s, j, 0, k], ends[s, j, 1, k] = p1[0, k].real, p2[0, k].real
+                    if code == MANDATORY:
+                        break
+                if best >= 0:
+                    has[j] = True
+                    for a in range(n - 1, best, -1):
+                        path[a + 2] = path[a]
+                    path[best + 1], path[best + 2] = -(2 * j + 1), -(2 * j + 2)
+                    n += 2
+            _length(path, n, xs, rgs, ogs, wp, arcs, cached, stale, total, ga, gb, False)
+            now = total[0].real
+            if abs(now - last) < CONVERGED:
+                break
+            last = now
+            if kk == 0 and W > 1 and results[0] == NO_WRAP and results[1] == INSIDE:
+                order[0], order[1] = 1, 0
+                n = _drop(path, n, 0)
+                has[0] = False
+        for j in range(W):
+            codes[s, j] = status(has[j], inside[j])
+        if not _length(path, n, xs, rgs, ogs, wp, arcs, cached, stale, total, ga, gb, True):
+            return COINCIDE, -1, s
+        for a in range(n):
+            if path[a] < 0:
+                j, w = _wrap_of(path[a])
+                for k in range(3):
+                    tang[s, j, w, k] = stale[j, w, 0, k].real
         npath[s] = n
         lengths[s] = total[0].real
         for d in range(1, D):
