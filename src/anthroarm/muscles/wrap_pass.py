@@ -7,8 +7,8 @@ points are the same, as :mod:`anthroarm.muscles.wrap` describes it (the algorith
 step and which derivative): for each wrap in turn every segment of its range is tried, a
 mandatory wrap taken at once, otherwise the one that lengthens the path least; up to eight
 passes over two or more wraps until the length changes by less than 0.5 mm, the first two wraps
-swapped after the first pass when the first did not wrap and the second had an end point inside;
-the ground position of a wrap point kept from its first use in the state, as OpenSim's
+swapped after the first pass when the last segment the first tried did not wrap and the last
+the second tried had an end point inside; the ground position of a wrap point kept from its first use in the state, as OpenSim's
 ``Point::getLocationInGround`` caches it.  Each state is a set of complex-step rows (row 0 the
 real state, every branch decided on it).
 
