@@ -9,10 +9,10 @@
 >>> P = muscles.path_points(robot, ms, robot.default_q())     # {name: MusclePath}, ground, m
 
 Modules: :mod:`.reader` (the ForceSet's muscles, safe XML), :mod:`.paths` (lengths and exact
-moment arms, batched; the paths as points), :mod:`.wrap` (wrapping over cylinders and spheres),
-:mod:`.wrap_ellipsoid` (over ellipsoids), :mod:`.hill` (Thelen2003 forces at static
-equilibrium, joint torques τ = Rᵀ f), :mod:`.millard` (Millard2012EquilibriumMuscle curves and
-equilibrium), :mod:`.optimize` (static optimisation through the QP layer), :mod:`.emg` (the
+moment arms, batched; the paths as points), :mod:`.wrap` (wrapping over cylinders and spheres;
+the compiled pass loop in :mod:`.wrap_pass`), :mod:`.wrap_ellipsoid` (over ellipsoids),
+:mod:`.hill` (Thelen2003 forces at static equilibrium, joint torques τ = Rᵀ f),
+:mod:`.millard` (Millard2012EquilibriumMuscle curves and equilibrium), :mod:`.optimize` (static optimisation through the QP layer), :mod:`.emg` (the
 EMG-driven chain: envelope → excitation → activation → forces → joint torques, beside the
 torques an activity needs), :mod:`.checks` (``anthroarm check``'s muscle rows),
 :mod:`.opensim_oracle` (OpenSim's own ``StaticOptimization``, the reference of the static
