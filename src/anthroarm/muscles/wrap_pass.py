@@ -48,6 +48,7 @@ from .wrap_cylinder import (
     WRAPPED,
     closest_on_line,
     cross,
+    dist2,
     dot,
     row0_unit,
     sign,
@@ -287,7 +288,7 @@ def _drop(path, n, j):
     m = 0
     for a in range(n):
         e = path[a]
-        if e < 0 and (-e - 1) // 2 == j:
+        if e < 0 and _wrap_of(e)[0] == j:
             continue
         path[m] = e
         m += 1
@@ -303,8 +304,8 @@ def _length(path, n, x, rg, og, wp, arcs, cached, stale, total, ga, gb, final):
         total[d] = 0.0
     for a in range(n - 1):
         ea, eb = path[a], path[a + 1]
-        if ea < 0 and eb < 0 and (-ea - 1) // 2 == (-eb - 1) // 2:
-            j = (-eb - 1) // 2
+        if ea < 0 and eb < 0 and _wrap_of(ea)[0] == _wrap_of(eb)[0]:
+            j = _wrap_of(eb)[0]
             for d in range(total.shape[0]):
                 total[d] = total[d] + arcs[j, d]
             continue
@@ -317,13 +318,6 @@ def _length(path, n, x, rg, og, wp, arcs, cached, stale, total, ga, gb, final):
                 return False
             total[d] = total[d] + seg
     return True
-
-
-@kernel
-def _dist0(a, b):
-    """|a₀ − b₀| of row 0, real."""
-    e0, e1, e2 = (a[0, 0] - b[0, 0]).real, (a[0, 1] - b[0, 1]).real, (a[0, 2] - b[0, 2]).real
-    return math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
 
 
 @kernel
@@ -444,7 +438,8 @@ def passes(x, rg, og, wint, wflt, idx, hold, lengths, grads, codes, paths, npath
                         _ground0(rgs[j], ogs[j], r2, g2)
                         _gpos(ea, xs, rgs, ogs, wp, cached, stale, ga)
                         _gpos(eb, xs, rgs, ogs, wp, cached, stale, gb)
-                        change = _dist0(g1, ga) + arc[0].real + _dist0(gb, g2) - _dist0(gb, ga)
+                        d1, d2, d0 = dist2(g1, ga), dist2(gb, g2), dist2(gb, ga)
+                        change = math.sqrt(d1) + arc[0].real + math.sqrt(d2) - math.sqrt(d0)
                         if not (change < best_change):
                             continue
                         best_change = change
