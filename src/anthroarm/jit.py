@@ -639,8 +639,16 @@ def running() -> int:
     return pid if pid > 0 and _alive(pid) else 0
 
 
+#: how the background compilation is detached from the caller: its own process group (a Ctrl-C
+#: in the caller's terminal does not reach it), in the caller's session.  A new session would
+#: also put it in its own scheduling group on Linux (autogroup: every session gets an equal share
+#: of the CPU whatever its nice value), where it took a whole core from a caller that needs both;
+#: in the caller's session its ``nice`` (:func:`anthroarm.warmup.main`) holds.
+_OWN_GROUP = {"process_group": 0} if sys.version_info >= (3, 11) else {"start_new_session": True}
+
+
 def start_background() -> bool:
-    """Start the background compilation (``python -m anthroarm.warmup``, in its own session,
+    """Start the background compilation (``python -m anthroarm.warmup``, in its own process group,
     its output in the lock's ``.log``) unless one runs for this stamp; True if one runs."""
     lock = lock_path()
     if lock is None:
@@ -655,7 +663,7 @@ def start_background() -> bool:
             stdout=out,
             stderr=subprocess.STDOUT,
             env=env,
-            start_new_session=True,
+            **_OWN_GROUP,
         )
     lock.write_text(str(proc.pid))
     return True

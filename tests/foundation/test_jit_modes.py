@@ -192,9 +192,18 @@ def test_auto_starts_one_background_compilation(tiny):
         assert pid > 0 and json.loads(out[0])["status"] == "reference (compiling in the background)"
         again = _run(code, dict(env, ANTHROARM_JIT="auto"), src).splitlines()
         assert int(again[-1]) == pid
+        # in the callers' session (Linux gives each session an equal share of the CPU, whatever
+        # its nice: a compilation in a session of its own took a core from a caller on 2), in
+        # its own process group (a Ctrl-C in the caller's terminal does not stop it), and at
+        # the lowest priority once it runs
+        assert os.getsid(pid) == os.getsid(0) and os.getpgid(pid) == pid
+        deadline = time.monotonic() + 60
+        while os.getpriority(os.PRIO_PROCESS, pid) < 19 and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert os.getpriority(os.PRIO_PROCESS, pid) == 19
     finally:
         try:
-            os.killpg(pid, signal.SIGKILL)  # it runs in its own session
+            os.killpg(pid, signal.SIGKILL)  # it runs in its own process group
         except ProcessLookupError:
             pass
 
