@@ -392,6 +392,33 @@ def test_seven_joint_arm_as_a_family_of_its_last_joint(name, polish):
         aa.ik.analytic(aa.load("ur5"), aa.load("ur5").fk(aa.load("ur5").neutral()), param=0.3)
 
 
+@pytest.mark.parametrize("name", ["panda", "xarm7"])
+def test_held_pose_is_the_first_six_joints_pose(name):
+    """T · M⁻¹ e^{−ξ7 v} M (:func:`held_poses`, the one source the compiled one-pose call and the
+    batch path both run) is the tool pose with the held joint at 0, the other joints where they
+    were: Pinocchio's FK of q with q7 = 0 (T = F6 e^{ξ7 v} M), compiled and reference."""
+    from anthroarm import jit
+    from anthroarm.ik.geometric.verify import held_poses
+
+    robot = aa.load(name)
+    gp = G.plan_for(robot)
+    assert robot.model.nq == 7 and gp.param_joint == 6  # q's last entry is the held joint
+    q, T = _poses(robot, 50, 3)
+    k = 6
+    q0 = q.copy()
+    q0[:, k] = 0.0
+    want = np.array([_fk(robot, x) for x in q0])
+    args = (T, np.ascontiguousarray(gp.M), gp.param_axis, gp.param_point, q[:, k].copy())
+    for f in (held_poses, jit.reference(held_poses)):
+        out = np.empty((len(T), 4, 4))
+        f(*args, out)
+        assert np.abs(out - want).max() < 1e-12
+    # the printed-form check: e^{+ξ7 v} in place of e^{−ξ7 v} gives another pose
+    out = np.empty((len(T), 4, 4))
+    held_poses(T, np.ascontiguousarray(gp.M), gp.param_axis, gp.param_point, -q[:, k], out)
+    assert np.abs(out - want).max() > 1e-3
+
+
 @pytest.mark.parametrize("name", ["ur10", "panda", "prosthetic_arm"])
 def test_check_rows_pass(name):
     """The `anthroarm check` rows (FK(IK(T)) = T; branch counts = ik-geo's when installed) on a

@@ -8,12 +8,11 @@ from __future__ import annotations
 import numpy as np
 
 from ...threads import run_rows
-from .. import subproblems as sp
 from ..classify import SPHERICAL_TWO_PARALLEL, Kinematics
 from ..search.driver import solve_search
 from .closed import CLOSED, _closed_loop
 from .plan import GeoPlan, ik_geo_P
-from .verify import BadPoseError, _verified, _verified_one
+from .verify import BadPoseError, _verified, _verified_one, held_poses
 
 
 def solve_class(cls: str, H, P, R06, p, frames=None):
@@ -38,13 +37,18 @@ def class_pose(plan: GeoPlan, T, param=None):
     """The pose the class solver of ``plan`` solves for tool poses ``T`` (N, 4, 4): (R06
     (N, 3, 3), p (N, 3)) in IK-Geo's form — of the reversed chain (T⁻¹) for a reversed class,
     of the first six joints (T · M⁻¹ e^{−ξ7 v} M, ``param`` = v (N,)) for a 7-joint arm."""
-    if plan.param_joint is not None:
-        v = np.broadcast_to(np.asarray(param, dtype=float), (len(T),))
-        Rv = sp.rot(np.broadcast_to(plan.param_axis, (len(T), 3)), -v)  # e^{−ξ7 v}
-        E = np.broadcast_to(np.eye(4), (len(T), 4, 4)).copy()
-        E[:, :3, :3] = Rv
-        E[:, :3, 3] = plan.param_point - np.einsum("nij,j->ni", Rv, plan.param_point)
-        T = T @ np.linalg.inv(plan.M) @ E @ plan.M
+    if plan.param_joint is not None:  # T · M⁻¹ e^{−ξ7 v} M (:func:`held_poses`)
+        v = np.ascontiguousarray(np.broadcast_to(np.asarray(param, dtype=float), (len(T),)))
+        out = np.empty((len(T), 4, 4))
+        held_poses(
+            np.ascontiguousarray(T, dtype=float),
+            np.ascontiguousarray(plan.M, dtype=float),
+            np.ascontiguousarray(plan.param_axis, dtype=float),
+            np.ascontiguousarray(plan.param_point, dtype=float),
+            v,
+            out,
+        )
+        T = out
     R, p = T[:, :3, :3], T[:, :3, 3]
     if plan.reversed:
         R, p = np.swapaxes(R, 1, 2), -np.einsum("nji,nj->ni", R, p)

@@ -123,6 +123,39 @@ def _pose_plan(cf, ci):
 
 
 @kernel(inline=True)
+def held_pose(R, p, MR, Mp, axis, point, c, s):
+    """The pose (R, p) of the first six joints' tool for the tool pose T = (R, p) of a 7-joint
+    arm whose last joint (twist ξ7: unit ``axis`` through ``point``, base frame at q = 0) is
+    held at v (``c``, ``s`` = cos v, sin v), with M = (MR, Mp) the tool pose at q = 0: from
+    T = F6(q1…q6) e^{ξ7 v} M, the first six joints reach T · M⁻¹ e^{−ξ7 v} M (the 6R arm with
+    tool M).  e^{−ξ7 v} = (Rv, point − Rv·point) with Rv = rot(axis, −v), so
+    M⁻¹ e^{−ξ7 v} M = (MRᵀ Rv MR, MRᵀ (Rv Mp + point − Rv point − Mp)).  Tuples
+    (:mod:`anthroarm.ik.vec3`); the one source of this transform (:func:`held_poses` for a
+    batch)."""
+    Rv = rot_cs(axis, c, -s)
+    X = mtm(MR, mm(Rv, MR))
+    x = mtv(MR, sub(add(mv(Rv, Mp), sub(point, mv(Rv, point))), Mp))
+    return mm(R, X), add(mv(R, x), p)
+
+
+@kernel
+def held_poses(T, M, axis, point, v, out):
+    """:func:`held_pose` of each tool pose T (N, 4, 4) with its held last joint at v (N,) rad,
+    into ``out`` (N, 4, 4); M (4, 4) the tool pose at q = 0, ``axis``, ``point`` (3,)."""
+    MR, Mp, a, pt = mat(M), (M[0, 3], M[1, 3], M[2, 3]), vec(axis), vec(point)
+    for i in range(T.shape[0]):
+        cs = angle_cs(v[i])
+        Ti = T[i]
+        R, p = held_pose(mat(Ti), (Ti[0, 3], Ti[1, 3], Ti[2, 3]), MR, Mp, a, pt, cs[0], cs[1])
+        for r in range(3):
+            for k in range(3):
+                out[i, r, k] = R[r][k]
+            out[i, r, 3] = p[r]
+            out[i, 3, r] = 0.0
+        out[i, 3, 3] = 1.0
+
+
+@kernel(inline=True)
 def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CONF, scratch):
     """Every branch of one pose T (4, 4) in path order, wrapped into the limits and FK-checked:
     writes Q (8, n) rad, V (candidate exists), E (exact), IN (inside the limits), RES (FK
@@ -145,12 +178,7 @@ def _verify_pose(plan, T, param, tol, tol_orthonormal, Q, V, E, IN, RES, OK, CON
     if n == 7:
         t7 = wrap(param)
         a7 = angle_cs(t7)
-        # T · M⁻¹ e^{−ξ7 v} M: the pose the first six joints reach (docstring of :func:`solve`)
-        Rv = rot_cs(p_axis, a7[0], -a7[1])
-        X = mtm(MR, mm(Rv, MR))
-        x = mtv(MR, sub(add(mv(Rv, Mp), sub(p_point, mv(Rv, p_point))), Mp))
-        p = add(mv(R, x), p)
-        R = mm(R, X)
+        R, p = held_pose(R, p, MR, Mp, p_axis, p_point, a7[0], a7[1])
     if rev:
         p = neg(mtv(R, p))
         R = transpose(R)
