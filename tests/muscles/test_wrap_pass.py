@@ -61,12 +61,14 @@ def _closed_form(a=A_, b=B_, r=R_):
     return s, theta, dl
 
 
-@pytest.mark.parametrize("kind", ["WrapSphere", "WrapCylinder"])
-def test_one_wrap_closed_form(kind):
+@pytest.mark.parametrize(
+    "kind, up", [("WrapSphere", 0.0), ("WrapCylinder", 0.0), ("WrapCylinder", -0.001)]
+)
+def test_one_wrap_closed_form(kind, up):
+    """In the cylinder's mid-plane (both end points have the same point on its axis: the
+    compiled kernel divided a complex zero there, which raised ZeroDivisionError) and 1 mm off
+    it."""
     s, theta, dl = _closed_form()
-    # the path 1 mm above the cylinder's mid-plane (in it, the compiled cylinder kernel divides
-    # by zero: its reference does not)
-    up = -0.001 if kind == "WrapCylinder" else 0.0
     L, D, codes = _path([_obj(kind, translation=(0.0, 0.0, up))])
     assert np.all(codes == wrap.WRAPPED)
     assert np.abs(L - (2 * s + R_ * theta)).max() < 1e-15

@@ -113,15 +113,18 @@ def row0_unit(a, b):
 @kernel
 def closest_on_line(pt, line_pt, line):
     """The point of the line through ``line_pt`` along ``line`` closest to ``pt``
-    (``WrapMath::GetClosestPointOnLineToPoint``): (point, its parameter along ``line``)."""
+    (``WrapMath::GetClosestPointOnLineToPoint``): (point, its parameter along ``line``).  A line
+    of zero length gives ``line_pt`` and a NaN parameter (Numba's compiled complex division by
+    zero raises, whatever its error model: the end points of a path in a cylinder's mid-plane
+    have the same point on its axis)."""
     v1, mag = unit(sub(pt, line_pt))
     v2, mag2 = unit(line)
     t = dot(v1, v2)
     for d in range(t.shape[0]):
         t[d] = t[d] * mag[d]
     par = np.empty(t.shape[0], np.complex128)
-    for d in range(t.shape[0]):
-        par[d] = t[d] / mag2[d]
+    for d in range(t.shape[0]):  # a line of zero length: NaN, as numpy's 0 / 0j gives
+        par[d] = t[d] / mag2[d] if mag2[d] != 0.0 else complex(math.nan, math.nan)
     return axpy(line_pt, t, v2), par
 
 
