@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal as sps
 
 from ..errors import EMGError
 from ._checks import positive, signal
@@ -31,6 +30,8 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     """One-sided PSD of every channel: ``(freqs_hz, psd)`` with ``psd`` (channels, n_freqs) in
     V²/Hz (Welch, Hann window, segments of ``segment_s`` seconds, 50 % overlap; the segment is
     the whole record when shorter).  Parseval: ``psd.sum(-1) * df`` is the variance."""
+    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+
     a = signal(x, "emg", min_samples=8, bytes_per_value=40.0)
     fs = positive(fs, "sampling rate fs", "Hz")
     n = min(a.shape[1], max(8, int(round(positive(segment_s, "segment_s", "s") * fs))))

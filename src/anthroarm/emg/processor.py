@@ -31,7 +31,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal as sps
 
 from ..errors import EMGError, ThresholdError
 from ._checks import MAX_VOLTS, budget, count, nonnegative, number, positive, signal
@@ -228,6 +227,8 @@ class EMGProcessor:
     def process(self, emg, reset: bool = True) -> ProcessedEMG:
         """Run the chain on ``emg`` (channels, samples) volts; ``reset=False`` continues the
         stream of the previous call (blocks of any length, frames aligned to the stream)."""
+        from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+
         x = signal(emg, "emg", self.n_channels, bytes_per_value=40.0)
         if reset:
             self.reset()

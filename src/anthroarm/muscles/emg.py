@@ -51,7 +51,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import signal as sps
 from scipy.interpolate import make_interp_spline
 from scipy.special import lambertw
 
@@ -156,6 +155,8 @@ def excitation(emg, fs: float, *, band=(20.0, 450.0), cutoff: float = 6.0, mvc=N
     envelope of a maximum voluntary contraction, per channel; default the recording's peak).
     The envelope's small undershoots below zero (the low-pass's ringing) are set to 0; an
     envelope above ``mvc`` is an :class:`~anthroarm.errors.EMGError` (give the true MVC)."""
+    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+
     x = np.atleast_2d(np.asarray(emg, dtype=float))
     if not np.all(np.isfinite(x)):
         raise EMGError("EMG contains NaN or infinite samples: fill or cut the gap first")
