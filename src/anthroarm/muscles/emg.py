@@ -51,7 +51,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
 from scipy.special import lambertw
 
 from .._io import read_bounded
@@ -320,6 +319,8 @@ def needed_torques(robot, t, q, *, payload: float = 0.0, frame=None) -> np.ndarr
     Q = robot.check_q(q)
     if Q.ndim != 2 or Q.shape[0] != t.size or t.size < 6 or np.any(np.diff(t) <= 0):
         raise MuscleError("needed_torques: t (N,) strictly increasing, N >= 6, q (N, nq)")
+    from scipy.interpolate import make_interp_spline  # noqa: PLC0415 - heavy (optional.HEAVY)
+
     spl = make_interp_spline(t, Q, k=5, axis=0)
     loads = None if payload == 0 else HeldObject(payload, frame=frame)
     res = inverse_dynamics(
