@@ -8,10 +8,9 @@ wrapped muscle paths, so every kernel is compiled for the types those entry poin
 stored in Numba's disk cache; then it writes the ready stamp (:func:`anthroarm.jit.write_stamp`)
 that tells every process to switch to compiled code. It keeps to one CPU
 (``NUMBA_NUM_THREADS=1``) and takes the lowest priority (``nice`` 19), so the processes that
-started it keep their pace on the reference path meanwhile: ``anthroarm check`` with an empty
-cache on 2 cores took 36 s with it in a session of its own at ``nice`` 10 (Linux's autogroup
-gives every session an equal share of the CPU, whatever its nice), 17-18 s as it is now, against
-18.6 s with no compilation at all.
+started it keep their pace on the reference path meanwhile (it stays in their session: Linux's
+autogroup gives every session an equal share of the CPU whatever its nice; the measured effect on
+a cold ``anthroarm check`` is in the guide, ``docs/guide/compiled.md``).
 
 Run by hand, ``python -m anthroarm.warmup --report`` compiles in the foreground and lists the
 kernels it did not reach (none: a test holds it).

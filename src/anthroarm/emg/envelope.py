@@ -87,7 +87,7 @@ def lowpass_envelope(x, fs: float, cutoff_hz: float = 5.0, order: int = 2) -> np
     """Linear envelope (V, mean rectified value): :math:`|x|` through a causal Butterworth
     low-pass at ``cutoff_hz`` (default 5 Hz, an assumption: 3–10 Hz is the usual range,
     De Luca 1997).  ``fs`` must exceed twice the cutoff."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     a = signal(x, "emg", bytes_per_value=32.0)
     return sps.sosfilt(lowpass_sos(fs, cutoff_hz, order), np.abs(a), axis=-1)
@@ -96,7 +96,7 @@ def lowpass_envelope(x, fs: float, cutoff_hz: float = 5.0, order: int = 2) -> np
 def lowpass_sos(fs: float, cutoff_hz: float, order: int = 2) -> np.ndarray:
     """The Butterworth low-pass of the linear envelope as second-order sections; ``fs`` (Hz)
     must exceed twice ``cutoff_hz``."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     fc = positive(cutoff_hz, "envelope cutoff", "Hz")
     fs = check_sampling_rate(fs, fc, f"the {fc:g} Hz envelope low-pass")

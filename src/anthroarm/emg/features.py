@@ -30,7 +30,7 @@ def spectrum(x, fs: float, segment_s: float = 0.25) -> tuple[np.ndarray, np.ndar
     """One-sided PSD of every channel: ``(freqs_hz, psd)`` with ``psd`` (channels, n_freqs) in
     V²/Hz (Welch, Hann window, segments of ``segment_s`` seconds, 50 % overlap; the segment is
     the whole record when shorter).  Parseval: ``psd.sum(-1) * df`` is the variance."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     a = signal(x, "emg", min_samples=8, bytes_per_value=40.0)
     fs = positive(fs, "sampling rate fs", "Hz")

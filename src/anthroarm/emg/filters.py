@@ -100,7 +100,7 @@ def bandpass_sos(low_hz: float, high_hz: float, fs: float, order: int = 2) -> np
     """Butterworth band-pass, −3 dB at ``low_hz`` and ``high_hz`` (Hz), ``order`` per edge, as
     second-order sections (``scipy.signal.butter(..., output="sos")``).  ``fs`` must exceed
     ``2 * high_hz``; ``0 < low_hz < high_hz``."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     lo = positive(low_hz, "low edge", "Hz")
     hi = positive(high_hz, "high edge", "Hz")
@@ -117,7 +117,7 @@ def notch_sos(mains_hz: float, fs: float, q: float = 30.0) -> np.ndarray:
     factor ``q``: −3 dB width mains/q Hz), as one SOS row.  The book names 50 Hz mains as the
     main interference (§9-2 二 1); the notch is optional, the differential front end is the
     book's remedy (:mod:`.frontend`)."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     f0 = positive(mains_hz, "mains frequency", "Hz")
     fs = check_sampling_rate(fs, f0, f"the {f0:g} Hz notch")
@@ -177,14 +177,14 @@ class FilterBank:
     def apply(self, x) -> np.ndarray:
         """Filter ``x`` (channels, samples) volts through every band (causal ``sosfilt`` from
         rest); returns (channels, n_bands, samples) volts."""
-        from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+        from scipy import signal as sps
 
         a = signal(x, "emg", bytes_per_value=8.0 + 16.0 * len(self.sos))
         return np.stack([sps.sosfilt(s, a, axis=-1) for s in self.sos], axis=1)
 
     def gains(self, freqs_hz) -> np.ndarray:
         """|H(f)| of every band at ``freqs_hz`` (Hz), shape (n_bands, n_freqs) (``sosfreqz``)."""
-        from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+        from scipy import signal as sps
 
         try:
             f = np.atleast_1d(np.asarray(freqs_hz, dtype=float))

@@ -227,7 +227,7 @@ class EMGProcessor:
     def process(self, emg, reset: bool = True) -> ProcessedEMG:
         """Run the chain on ``emg`` (channels, samples) volts; ``reset=False`` continues the
         stream of the previous call (blocks of any length, frames aligned to the stream)."""
-        from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+        from scipy import signal as sps
 
         x = signal(emg, "emg", self.n_channels, bytes_per_value=40.0)
         if reset:

@@ -154,7 +154,7 @@ def excitation(emg, fs: float, *, band=(20.0, 450.0), cutoff: float = 6.0, mvc=N
     envelope of a maximum voluntary contraction, per channel; default the recording's peak).
     The envelope's small undershoots below zero (the low-pass's ringing) are set to 0; an
     envelope above ``mvc`` is an :class:`~anthroarm.errors.EMGError` (give the true MVC)."""
-    from scipy import signal as sps  # noqa: PLC0415 - heavy (optional.HEAVY): ~0.8-1.3 s
+    from scipy import signal as sps
 
     x = np.atleast_2d(np.asarray(emg, dtype=float))
     if not np.all(np.isfinite(x)):
@@ -319,7 +319,7 @@ def needed_torques(robot, t, q, *, payload: float = 0.0, frame=None) -> np.ndarr
     Q = robot.check_q(q)
     if Q.ndim != 2 or Q.shape[0] != t.size or t.size < 6 or np.any(np.diff(t) <= 0):
         raise MuscleError("needed_torques: t (N,) strictly increasing, N >= 6, q (N, nq)")
-    from scipy.interpolate import make_interp_spline  # noqa: PLC0415 - heavy (optional.HEAVY)
+    from scipy.interpolate import make_interp_spline
 
     spl = make_interp_spline(t, Q, k=5, axis=0)
     loads = None if payload == 0 else HeldObject(payload, frame=frame)
