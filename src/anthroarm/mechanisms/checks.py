@@ -17,6 +17,8 @@ acceleration of the cut frame of the Pinocchio open chain, joint rates vs finite
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pinocchio as pin
 
@@ -134,6 +136,7 @@ def _fourbar_rows(acc, n, rng):
             "pinocchio",
         )
 
+        @functools.cache  # one evaluation per stencil time, shared by d1 and d2
         def traj(t):
             return fourbar(r1, r2, r3, r4, th2 + w2 * t + 0.5 * a2 * t * t, w2 + a2 * t, a2, br)
 
@@ -290,6 +293,7 @@ def _rrss_rows(acc, n, rng):
             "pinocchio",
         )
 
+        @functools.cache  # one evaluation per stencil time, shared by d1 and d2
         def traj(t):
             return rrss(g, th + w * t + 0.5 * a * t * t, w + a * t, a, br)
 
@@ -362,6 +366,7 @@ def _thumb_rows(acc, n, rng):
             "pinocchio",
         )
 
+        @functools.cache  # one evaluation per stencil time, shared by d1 and d2
         def traj(t):
             return thumb(g, th + w * t + 0.5 * a * t * t, w + a * t, a)
 
@@ -429,6 +434,7 @@ def _finger_rows(acc, n, rng):
             "pinocchio",
         )
 
+        @functools.cache  # one evaluation per stencil time, shared by d1 and d2
         def traj(t):
             return finger(g, ph + w * t + 0.5 * a * t * t, w + a * t, a)
 
