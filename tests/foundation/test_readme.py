@@ -23,7 +23,10 @@ def test_readme_has_the_two_setup_commands():
     text = README.read_text()
     main = re.search(r"<!-- main-command -->\n```bash\n(.*?)\n```", text, re.S).group(1)
     test = re.search(r"<!-- test-command -->\n```bash\n(.*?)\n```", text, re.S).group(1)
-    assert "anthroarm check" in main and "pip install" in main
+    assert "anthroarm check" in main and "pip install" in main and " -e . " in main
     assert "pytest" in test and '".[test]"' in test
+    # the getting-started page shows the same two commands, word for word
+    guide = (README.parent / "docs" / "getting_started.md").read_text()
+    assert main in guide and test in guide
     ci = (README.parent / ".ci" / "run").read_text()
     assert "test-command" in ci  # .ci/run executes exactly the README's test command
