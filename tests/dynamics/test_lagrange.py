@@ -253,7 +253,15 @@ def test_cache_roundtrip_and_generator_reproduces_cached_file(tmp_path, monkeypa
     path = tmp_path / "lagrange" / f"lagrange_{key}.py"
     assert path.is_file() and not list(path.parent.glob("*.tmp"))
     # the generator is deterministic: a fresh derivation reproduces the cached file byte for byte
-    assert path.read_text() == L.generate_python(L.derive(info))
+    # (without the Coriolis matrix: its module is made on first use, below)
+    assert path.read_text() == L.generate_python(L.derive(info, coriolis_matrix=False))
+    assert "def coriolis_matrix" not in path.read_text()
+    cmat, src = L.generated_module(info, coriolis_matrix=True)
+    cpath = tmp_path / "lagrange" / f"coriolis_{key}.py"
+    assert src == "derived" and cpath.read_text() == L.generate_python(
+        L.derive(info), only=("coriolis_matrix",)
+    )
+    assert cmat.coriolis_matrix_1 is not None and not hasattr(cmat, "tau_1")
     L._MEMO.pop(key, None)
     _, src = L.generated_module(info)
     assert src == "cache"

@@ -83,7 +83,7 @@ from .lagrange_sympy import _simp, christoffel, latex, symbols, sympy_matrices  
 
 #: bump when the generated code changes (part of the cache key); "3": code generated before the
 #: graph told a constant 2.0 from node id 2 (issue 30, wrong C q̇ and τ) is never loaded again
-GENERATOR_VERSION = "3"
+GENERATOR_VERSION = "4"
 #: forward dynamics refuses M(q) whose reciprocal condition number (estimated from the Cholesky
 #: pivots) is below this: :class:`~anthroarm.errors.SingularMassMatrixError`
 SINGULAR_RCOND = 1e-12
@@ -451,8 +451,9 @@ def _kinds(info: ChainInfo) -> str:
     return "".join(letters[j.kind].lower() if j.is_mimic else letters[j.kind] for j in info.joints)
 
 
-def generate_python(d: Derivation) -> str:
-    """Python module text with numpy (batched) and scalar versions of every function.
+def generate_python(d: Derivation, only=None) -> str:
+    """Python module text with numpy (batched) and scalar versions of every function (of those
+    named in ``only``, if given).
 
     Every function takes the joint positions θ of all joints (``q``, mimic joints included,
     as :meth:`~anthroarm.chain.Chain.angles` returns them) and their velocities and
@@ -478,6 +479,8 @@ def generate_python(d: Derivation) -> str:
     ]
     body = []
     for fname, (args, outs, shape) in _outputs(d).items():
+        if only is not None and fname not in only:
+            continue
         body.append(emit_python(d.graph, fname, args, outs, shape, kinds, batched=True))
         body.append(emit_python(d.graph, fname + "_1", args, outs, shape, kinds, batched=False))
     return "\n".join(head) + "\n" + "\n\n".join(body) + "\n"
@@ -485,29 +488,41 @@ def generate_python(d: Derivation) -> str:
 
 # ====================================================================== cache
 _LOCK = threading.Lock()
-_MEMO: dict[str, object] = {}  # key -> generated module (holds no Robot)
+_MEMO: dict[str, object] = {}  # key (coriolis:key) -> generated module (holds no Robot)
 
 
-def generated_module(model_or_robot, name: str | None = None, use_cache: bool = True):
+def generated_module(
+    model_or_robot, name: str | None = None, use_cache: bool = True, coriolis_matrix: bool = False
+):
     """The generated Python module of a model: from memory, the disk cache
     (:mod:`anthroarm.cache`, ``lagrange/lagrange_<key>.py``, verified before it is executed) or
     a fresh derivation (then stored).  Returns ``(module, origin)`` with origin "memory",
     "cache" or "derived".  Raises :class:`InertiaError` if M(q) is not positive definite (a
-    joint that moves no mass)."""
+    joint that moves no mass).
+
+    The Christoffel matrix C(q, q̇) has n² entries, two thirds of the generated code of a
+    27-joint limb (2 s of its 4 s of derivation, generation and compilation): it is a module of
+    its own (``coriolis_matrix=True``, ``lagrange/coriolis_<key>.py``), made on first use."""
     info = chain_info(model_or_robot, name)
     key = info.key()
+    stem = "coriolis" if coriolis_matrix else "lagrange"
+    memo = f"coriolis:{key}" if coriolis_matrix else key
     with _LOCK:
-        if key in _MEMO:
-            return _MEMO[key], "memory"
-        modname = f"anthroarm_lagrange_{key}"
-        make = lambda: generate_python(derive(info))  # noqa: E731
+        if memo in _MEMO:
+            return _MEMO[memo], "memory"
+        modname = f"anthroarm_{stem}_{key}"
+        if coriolis_matrix:
+            make = lambda: generate_python(derive(info), only=("coriolis_matrix",))  # noqa: E731
+        else:
+            make = lambda: generate_python(derive(info, coriolis_matrix=False))  # noqa: E731
         if use_cache:
-            mod, origin = cache.python_module("lagrange", f"lagrange_{key}.py", make, modname)
+            mod, origin = cache.python_module("lagrange", f"{stem}_{key}.py", make, modname)
         else:
             mod, origin = types.ModuleType(modname), "derived"
             exec(compile(make(), f"<{modname}>", "exec"), mod.__dict__)
-        _check_pd(mod, info)
-        _MEMO[key] = mod
+        if not coriolis_matrix:
+            _check_pd(mod, info)
+        _MEMO[memo] = mod
         return mod, origin
 
 
@@ -553,6 +568,7 @@ class LagrangeDynamics:
         self.n, self.nq = self.info.n, chain.nq
         self.joint_names = [chain.joints[i].name for i in chain.independent]
         self.module, self.source = generated_module(self.info, use_cache=use_cache)
+        self._use_cache = use_cache
         # θ = q and θ̇ = q̇ when every joint is a plain revolute / prismatic joint in q order
         self._plain_q = all(
             j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints
@@ -569,6 +585,13 @@ class LagrangeDynamics:
             self._c = compiled(self.info.key(), self._c_inputs)
         elif backend != "numpy":
             raise ValueError(f"backend must be 'numpy' or 'c', got {backend!r}")
+
+    def _module(self, fname: str):
+        """The generated module holding ``fname`` (the Coriolis matrix's is made on first use:
+        :func:`generated_module`)."""
+        if fname != "coriolis_matrix":
+            return self.module
+        return generated_module(self.info, use_cache=self._use_cache, coriolis_matrix=True)[0]
 
     def _c_inputs(self):
         d = derive(self.info)
@@ -637,7 +660,7 @@ class LagrangeDynamics:
             )
             if self._c is not None:
                 return self._c.one(fname, arrs)
-            return getattr(self.module, fname + "_1")(*arrs)
+            return getattr(self._module(fname), fname + "_1")(*arrs)
         names = ("q", "qd", "qdd")
         arrs = [self._arr(a, names[i]) for i, a in enumerate((q, *rates))]
         single = all(a.ndim == 1 for a in arrs)
@@ -650,8 +673,8 @@ class LagrangeDynamics:
         if self._c is not None:
             return self._c(fname, arrs, single)
         if single:
-            return getattr(self.module, fname + "_1")(*arrs)
-        return getattr(self.module, fname)(*[np.ascontiguousarray(a) for a in arrs])
+            return getattr(self._module(fname), fname + "_1")(*arrs)
+        return getattr(self._module(fname), fname)(*[np.ascontiguousarray(a) for a in arrs])
 
     def mass_matrix(self, q):
         """M(q), Eq. (8-105): (nv, nv) or (N, nv, nv), kg m² (kg for prismatic rows)."""
