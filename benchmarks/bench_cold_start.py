@@ -78,6 +78,14 @@ elif name == "solve_grasp":
     cup = hand.Cylinder(center=[0.30, 0.25, -0.10], axis=[0, 0, 1], radius=0.035, length=0.1)
     timed("first", lambda: hand.solve_grasp(limb, cup))
     timed("second", lambda: hand.solve_grasp(limb, cup))
+elif name == "marker_ik":
+    arm = aa.load("human_arm7")
+    ms = motion.default_marker_set(arm)
+    bm = motion.markers.BoundMarkers(arm, ms)
+    P = np.array([bm.world_positions(q) for q in arm.random_q(5, rng=6)])
+    trial = motion.MarkerTrajectories([m.name for m in ms.markers], P, rate=100.0)
+    timed("first", lambda: motion.marker_ik(arm, trial, ms))
+    timed("second", lambda: motion.marker_ik(arm, trial, ms))
 elif name == "reachability_map":
     arm = aa.load("human_arm7")
     f = lambda: aa.batch.reachability_map(arm, n=20000, voxel=0.05, progress=False)
@@ -98,6 +106,7 @@ ENTRIES = [
     "qp.step",
     "lagrange",
     "solve_grasp",
+    "marker_ik",
     "reachability_map",
 ]
 
