@@ -15,14 +15,11 @@ each other.  Target (issue 28): ≤ 1 s median, ≤ 2 s worst, per entry point o
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 from statistics import median
 
-from .bench_cold_start import _env, _stop_background
+from .bench_cold_start import fresh_process
 
 EXTRA = ("ur5", "xarm7", "kinova")
 
@@ -81,21 +78,6 @@ print("RESULT" + json.dumps(out))
 ENTRIES = ["analytic", "analytic_batch", "solve", "fk+jacobian batch", "qp.step", "lagrange"]
 
 
-def _one(model: str, cache: Path) -> dict:
-    p = subprocess.run(
-        [sys.executable, "-c", SCRIPT, model],
-        env=_env(cache, "auto"),
-        capture_output=True,
-        text=True,
-        timeout=1800,
-    )
-    _stop_background(cache)
-    if p.returncode:
-        raise RuntimeError(f"{model}: {p.stderr[-2000:]}")
-    line = [s for s in p.stdout.splitlines() if s.startswith("RESULT")][-1]
-    return json.loads(line[len("RESULT") :])
-
-
 def run(quick: bool = False) -> dict:
     import anthroarm as aa
 
@@ -105,7 +87,7 @@ def run(quick: bool = False) -> dict:
     rows, cols = [], {e: [] for e in ENTRIES}
     with tempfile.TemporaryDirectory() as tmp:
         for m in models:
-            got = _one(m, Path(tmp) / m)
+            got = fresh_process(SCRIPT, m, Path(tmp) / m, "auto")
             for e in ENTRIES:
                 if e in got:
                     cols[e].append(got[e])

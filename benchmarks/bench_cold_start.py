@@ -127,9 +127,11 @@ def _stop_background(cache: Path) -> None:
             pass
 
 
-def _one(entry: str, cache: Path, mode: str) -> dict:
+def fresh_process(script: str, arg: str, cache: Path, mode: str) -> dict:
+    """``script`` run with ``arg`` in a fresh Python process on ``cache`` in ``mode``; the
+    JSON it prints after ``RESULT``.  Its background compilation is stopped when it ends."""
     p = subprocess.run(
-        [sys.executable, "-c", SCRIPT, entry],
+        [sys.executable, "-c", script, arg],
         env=_env(cache, mode),
         capture_output=True,
         text=True,
@@ -137,9 +139,13 @@ def _one(entry: str, cache: Path, mode: str) -> dict:
     )
     _stop_background(cache)
     if p.returncode:
-        raise RuntimeError(f"{entry} ({mode}): {p.stderr[-2000:]}")
+        raise RuntimeError(f"{arg} ({mode}): {p.stderr[-2000:]}")
     line = [s for s in p.stdout.splitlines() if s.startswith("RESULT")][-1]
     return json.loads(line[len("RESULT") :])
+
+
+def _one(entry: str, cache: Path, mode: str) -> dict:
+    return fresh_process(SCRIPT, entry, cache, mode)
 
 
 def run(quick: bool = False) -> dict:
