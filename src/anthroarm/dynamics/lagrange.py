@@ -569,6 +569,7 @@ class LagrangeDynamics:
         self.joint_names = [chain.joints[i].name for i in chain.independent]
         self.module, self.source = generated_module(self.info, use_cache=use_cache)
         self._use_cache = use_cache
+        self._coriolis = None  # the Coriolis matrix's module, on first use (:meth:`_module`)
         # θ = q and θ̇ = q̇ when every joint is a plain revolute / prismatic joint in q order
         self._plain_q = all(
             j.kind != CONTINUOUS and not j.is_mimic and j.idx_q == j.index for j in chain.joints
@@ -591,7 +592,11 @@ class LagrangeDynamics:
         :func:`generated_module`)."""
         if fname != "coriolis_matrix":
             return self.module
-        return generated_module(self.info, use_cache=self._use_cache, coriolis_matrix=True)[0]
+        if self._coriolis is None:  # kept: its cache key is a ~30 µs hash, a call's worth
+            self._coriolis = generated_module(
+                self.info, use_cache=self._use_cache, coriolis_matrix=True
+            )[0]
+        return self._coriolis
 
     def _c_inputs(self):
         d = derive(self.info)
