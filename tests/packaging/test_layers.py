@@ -26,7 +26,17 @@ LAYERS = [
     ),
     (
         "foundation",
-        ["errors", "_io", "spatial", "codegen", "cache", "threads", "jit", "check_rows"]
+        [
+            "errors",
+            "_io",
+            "spatial",
+            "codegen",
+            "cache",
+            "threads",
+            "jit",
+            "jit_arrays",
+            "check_rows",
+        ]
         + ["joint_kinds", "optional", "input_checks"],
     ),
 ]
