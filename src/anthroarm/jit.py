@@ -270,6 +270,15 @@ class Kernel:
     def signatures(self):
         return self.dispatcher.signatures
 
+    @property
+    def targetoptions(self) -> dict:
+        """Numba's options of the kernel (:data:`OPTIONS`, ``inline``): Numba's inliner takes a
+        global with this attribute as a dispatcher and inlines the source (:attr:`py_func`) of
+        an ``inline="always"`` one into its caller — without it, an ``@kernel(inline=True)``
+        was called as a function, its tuples of arrays passed and returned by reference
+        counts (``_pose_plan``, ``_verify_pose``: a third of the one-pose IK's call)."""
+        return self.dispatcher.targetoptions
+
     def __repr__(self):
         return f"<kernel {self.__module__}.{self.__qualname__}>"
 
