@@ -119,6 +119,7 @@ from numba.extending import typeof_impl  # noqa: E402
 
 from .jit_arrays import PY_FORMS as _PY_FORMS  # noqa: E402
 from .jit_arrays import (  # noqa: E402 - the kernels' scratch arrays and views, exported
+    borrow,
     local,
     local2,
     local_flags,
@@ -648,6 +649,7 @@ __all__ = [
     "STATE",
     "Entry",
     "Kernel",
+    "borrow",
     "callees",
     "compiled",
     "entry_point",

@@ -1,7 +1,7 @@
 """Scratch arrays in a compiled kernel's stack frame and views of arrays without reshape's
 run-time layout search: Numba intrinsics (``numba.extending.intrinsic``) that :mod:`anthroarm.jit`
 exports (``local``, ``local2``, ``local_flags``, ``local_ints2``, ``view2``, ``view3``, ``part``,
-``part2``), with the numpy form the reference (the interpreter) runs for each
+``part2``, ``borrow``), with the numpy form the reference (the interpreter) runs for each
 (:data:`PY_FORMS`).  Part of the kernel sources (:func:`anthroarm.jit.kernel_sources_digest`):
 an edit here compiles every kernel again."""
 
@@ -155,6 +155,27 @@ part = _view_array(1, offset=True)
 part2 = _view_array(2, offset=True)
 
 
+@intrinsic
+def borrow(typingctx, arr):
+    """``borrow(a)``: the C-order array ``a`` itself (same data, shape and type), borrowed — no
+    owner and no reference count.  An array argument of a kernel called from Python holds a
+    reference (Numba's runtime), which each kernel it is passed on to may take and give back
+    (an atomic increment and decrement per call); its borrowed view, passed on instead, costs
+    none of them.  It must not outlive ``a`` (never returned or kept beyond the call)."""
+    if not (isinstance(arr, types.Array) and arr.layout == "C"):
+        raise numba.errors.TypingError("borrow takes a C-order array")
+
+    def codegen(context, builder, sig, args):
+        field = context.data_model_manager[sig.args[0]].get_field_position
+        src, ndim = args[0], sig.args[0].ndim
+        shape = [builder.extract_value(src, [field("shape"), i]) for i in range(ndim)]
+        strides = [builder.extract_value(src, [field("strides"), i]) for i in range(ndim)]
+        data = builder.extract_value(src, field("data"))
+        return _array_value(context, builder, sig.return_type, data, shape, strides)
+
+    return arr(arr), codegen
+
+
 #: ``local(n)`` / ``local2(rows, cols)``: float64 scratch arrays of literal sizes in the stack
 #: frame of the kernel that makes them (:func:`_local_array`); ``local_flags(n)`` booleans,
 #: ``local_ints2(rows, cols)`` int64.  Such an array must not outlive its kernel: it is never
@@ -174,4 +195,5 @@ PY_FORMS = {
     id(view3): lambda a, x, y, z: a.reshape(-1)[: x * y * z].reshape(x, y, z),
     id(part): lambda a, s, n: a.reshape(-1)[s : s + n],
     id(part2): lambda a, s, r, c: a.reshape(-1)[s : s + r * c].reshape(r, c),
+    id(borrow): lambda a: a,
 }

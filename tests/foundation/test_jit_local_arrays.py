@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from anthroarm.jit import (
+    borrow,
     kernel,
     local,
     local2,
@@ -123,3 +124,36 @@ def test_parts_are_numpys_flat_slices(run):
     w = np.arange(20.0)[5:11].reshape(2, 3)
     assert out.tolist() == [3.0, 6.0, w[1, 2], 2, w.strides[0], 4]
     assert a[5] == -1.0
+
+
+@kernel
+def _borrowed(a, ints, out):
+    b, k, o = borrow(a), borrow(ints), borrow(out)
+    o[0], o[1] = b[1, 2], b.strides[0]
+    o[2], o[3] = b.shape[0] * 10 + b.shape[1], k[3]
+    b[0, 0] = -1.0  # the same data: writes reach a
+    return _sum_rows(b)  # passed on to another kernel, borrowed
+
+
+@kernel
+def _sum_rows(a):
+    s = 0.0
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            s += a[i, j]
+    return s
+
+
+@pytest.mark.parametrize("run", ["compiled", "reference"])
+def test_a_borrowed_array_is_the_array(run):
+    f = _borrowed.dispatcher if run == "compiled" else reference(_borrowed)
+    a, ints, out = np.arange(12.0).reshape(3, 4), np.arange(5), np.zeros(4)
+    expected_sum = np.arange(12.0).sum() - 0.0 - 1.0  # a[0, 0] (0) became −1
+    assert f(a, ints, out) == expected_sum
+    assert out.tolist() == [6.0, 32.0, 34.0, 3.0]
+    assert a[0, 0] == -1.0
+
+
+def test_borrow_takes_only_c_order_arrays():
+    with pytest.raises(numba.core.errors.TypingError, match="C-order"):
+        _borrowed.dispatcher(np.zeros((4, 6))[:, ::2], np.arange(5), np.zeros(4))

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ...jit import kernel, local, local2, local_flags, part, part2, view2, view3
+from ...jit import borrow, kernel, local, local2, local_flags, part, part2, view2, view3
 from ...threads import run_rows
 from ..fk import WIDTH
 from ..geometric.closed import BRANCH_ROW, COS, EXACT, EXISTS, SIN, _angles, _wrist
@@ -346,7 +346,9 @@ def srs_pose_solutions(cf, ci, T, swivel, tol, tol_orthonormal, out):
     without a reference: the solutions into the rows of ``out`` (8, 12); returns the bit mask
     of their branches (bit b: branch b; ≤ 0: none, a malformed pose or a candidate to polish —
     the general path answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one
-    pose at one swivel angle (:func:`anthroarm.jit.entry_point`)."""
+    pose at one swivel angle (:func:`anthroarm.jit.entry_point`).  Its arrays are passed on
+    borrowed (:func:`anthroarm.jit.borrow`: no reference counts taken and given back below it)."""
+    cf, ci, T, out = borrow(cf), borrow(ci), borrow(T), borrow(out)
     sw = local(1)
     sw[0] = swivel
     K = _srs_nearest(cf, ci, T, sw, False, tol, tol_orthonormal, sw[:0], out)

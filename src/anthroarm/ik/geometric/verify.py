@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ...chain_kernels import put_joint
-from ...jit import kernel, local, local2, local_flags, view2
+from ...jit import borrow, kernel, local, local2, local_flags, view2
 from ..vec3 import (
     add,
     angle_cs,
@@ -353,7 +353,9 @@ def pose_solutions(cf, ci, T, param, tol, tol_orthonormal, out):
     """:func:`_verified_one` of one pose without a reference: the solutions into the rows of
     ``out`` (8, w + 4), the bit mask of their branches returned (≤ 0: the general path
     answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one pose of a closed
-    class (:func:`anthroarm.jit.entry_point`)."""
+    class (:func:`anthroarm.jit.entry_point`).  Its arrays are passed on borrowed
+    (:func:`anthroarm.jit.borrow`: no reference counts taken and given back below it)."""
+    cf, ci, T, out = borrow(cf), borrow(ci), borrow(T), borrow(out)
     return _verified_one(cf, ci, T, param, tol, tol_orthonormal, local(1)[:0], out)
 
 
