@@ -235,7 +235,9 @@ class Kernel:
     (Numba types it as that dispatcher), and, called from Python, whichever of compiled code or
     :func:`reference` the process runs (:data:`STATE`).  ``py_func`` is the source function; the
     kernel carries its name, module, docstring and ``__wrapped__`` (``functools.wraps``), so
-    ``inspect.signature``, ``inspect.unwrap`` and the docs see the function."""
+    ``inspect.signature``, ``inspect.unwrap`` and the docs see the function.  ``fn`` is what a
+    call runs now (its first call, the reference, or Numba's dispatcher once compiled): a hot
+    caller may call ``k.fn(...)`` to skip the kernel's own Python call (~0.2 µs)."""
 
     __slots__ = ("dispatcher", "py_func", "fn", "seen", "__dict__")
 

@@ -150,7 +150,7 @@ def solve_nearest(cf, ci, T, ref, param: float):
     seeds of :func:`anthroarm.ik.solve`, one compiled call."""
     n = ci[2]
     out = np.empty((8, n + 4))
-    mask = _verified_one(cf, ci, T, param, 1e-9, 1e-6, ref, out)
+    mask = _verified_one.fn(cf, ci, T, param, 1e-9, 1e-6, ref, out)  # .fn: no Python frame
     if mask <= 0:
         return None
     K = mask.bit_count()

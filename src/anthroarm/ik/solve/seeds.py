@@ -309,11 +309,8 @@ def analytic_seeds(robot, ws, tg, th_ref, swivel=None, grid=None, any_solution=F
     )  # the swivel angles of an SRS arm (None: default)
     kw = {"swivel": angles} if sh.swivel_family and angles is not None else {}
     T = tg.H
-    if th_ref is not None and not th_ref.flags.writeable:
-        # one array type for the compiled calls: Numba compiles a read-only array (the shared
-        # reference posture) apart from a writable one (a seed), so a first call of either kind
-        # would otherwise compile the same kernel again
-        th_ref = th_ref.copy()
+    if th_ref is not None:  # one array type for the compiled calls (the shared posture: read-only)
+        th_ref = sh.as_arg(th_ref)
     if sh.nearest_swivel is not None and th_ref is not None:
         g = np.atleast_1d(  # the grids are C-order module arrays: one type, no copy a call
             np.asarray(closed_form.DEFAULT_SWIVEL if angles is None else angles, dtype=float)

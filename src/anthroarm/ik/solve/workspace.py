@@ -68,6 +68,7 @@ class Shared:
         self.reach = chain.reach(fid)
         self.ref = self.theta(comfortable_posture(robot))
         self.ref.setflags(write=False)
+        self._ref_arg = self.ref.copy()  # what the compiled calls take for it (:meth:`as_arg`)
         self.posture_auto = self.ref if has_comfortable_posture(robot) else None
         lo_s, hi_s = (np.array(b) for b in chain.sampling_box)
         self.lo_s = np.where(self.on_path, lo_s, self.ref)
@@ -93,6 +94,15 @@ class Shared:
             set()
         )  # the settings whose closed-form kernels are loaded (api._warm_closed_form)
         self.path = PathFrames(chain, fid)  # the chain's FK arrays for the attempt kernel (.lm)
+
+    def as_arg(self, th):
+        """θ as the compiled calls take it: a writable array — Numba compiles a read-only array
+        apart from a writable one, so a first call of either kind would compile the same kernel
+        again.  The read-only :attr:`ref` (and ``posture_auto``) gives its writable twin, made
+        once (a copy a call cost ~0.5 µs of a ~20 µs solve); another read-only array a copy."""
+        if th is self.ref:
+            return self._ref_arg
+        return th if th.flags.writeable else th.copy()
 
     def theta(self, q) -> np.ndarray:
         """θ (n,) or (N, n) of a configuration q in Pinocchio's layout (a copy)."""
