@@ -107,7 +107,7 @@ def as_rigid(T, name: str = "T") -> np.ndarray:
     ):
         # fast path (a per-step target): taken as it is; anything else goes through the full
         # checks below (which raise or re-orthonormalise)
-        return np.array(T, order="C")
+        return T.copy()  # C order (ndarray.copy's default)
     if isinstance(T, pin.SE3):
         T = T.homogeneous
     T = np.asarray(T, dtype=float)

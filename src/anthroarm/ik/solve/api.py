@@ -214,8 +214,12 @@ def _prepare(pb: Problem, mode: str, tp: float, tr: float) -> None:
     """The one-time work of a (robot, frame, settings), done before any clock starts so that no
     call's ``max_time`` is charged for it: the seed tables (and the aligned table of a pose
     problem), the compiled kernel of the iteration and those of the closed form (compiled, or
-    loaded from the disk cache: :func:`_warm_closed_form`)."""
+    loaded from the disk cache: :func:`_warm_closed_form`); once per workspace and settings
+    (``ws.prepared``: a later call of the same settings returns at once)."""
     ws = pb.ws
+    key = (mode, pb.analytic is not False, pb.th_ref is not None, pb.swivel is not None)
+    if key in ws.prepared:
+        return
     ws.table()
     if mode == "pose":
         ws.aligned()
@@ -223,6 +227,7 @@ def _prepare(pb: Problem, mode: str, tp: float, tr: float) -> None:
         lm.warm(ws)
     if pb.analytic is not False and ws.sh.has_closed_form:
         _warm_closed_form(pb, mode, tp, tr)
+    ws.prepared.add(key)
 
 
 def _solve_batch(pb: Problem, mode: str, tgs, Q0, warm_start: bool):

@@ -68,7 +68,7 @@ class Target:
         self.H = self._Ms = self.ps = self.Rs = None
         if mode == "pose":
             self.m, self.ref, self.rows = 6, LOCAL, None
-            if isinstance(tgt, pin.SE3):
+            if tgt.__class__ is not np.ndarray and isinstance(tgt, pin.SE3):
                 self._Ms, tgt = tgt, tgt.homogeneous
             self.H = tgt
             self.ps = tgt[:3, 3]

@@ -177,7 +177,7 @@ class Workspace:
     preallocated arrays (J Jᵀ + λI built in place, handed to LAPACK as its transpose: Fortran
     order, symmetric), plus the shared fields the kernel reads, copied for fast access."""
 
-    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "lm")
+    __slots__ = ("sh", "model", "data", "fid", "n", "lo", "hi", "to_q", "lin", "lm", "prepared")
 
     def __init__(self, sh: Shared):
         self.sh = sh
@@ -191,6 +191,7 @@ class Workspace:
         )
         self.data = sh.model.createData()
         self.lm = Buffers(sh.path, sh.lo, sh.hi)  # the attempt kernel's arrays (.lm.attempt)
+        self.prepared = set()  # the settings whose one-time work is done (api._prepare)
         self.lin = {}  # dimension -> (A, its transpose (Fortran order), its diagonal), see kernel.solve_damped
         for m in {3, 6, min(sh.n, 6)}:  # and n × n for an arm with fewer joints than the task
             A = np.empty((m, m))
