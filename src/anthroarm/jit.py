@@ -11,7 +11,7 @@ of its formula.  It runs two ways, with the same answers:
   importing anthroarm keep their files too);
 - **reference**: the same source run by the Python interpreter (:func:`reference`), with
   Numba's float semantics where the interpreter would raise (``error_model="numpy"``: a
-  domain error of ``math`` gives NaN, not ``ValueError``), and :func:`local` arrays made by
+  domain error of ``math`` gives NaN, not ``ValueError``), and ``local`` arrays made by
   :func:`numpy.empty`.  About 400 times slower than compiled (~1.3 ms for one pose of a 6R arm),
   but it needs no compilation.
 
@@ -211,7 +211,7 @@ def _names(code) -> list[str]:
 
 def reference(kernel) -> pytypes.FunctionType:
     """The reference of ``kernel``: its source run by the interpreter, with :data:`MATH` for
-    ``math`` and :func:`numpy.empty` for :func:`local` arrays (see the module docstring)."""
+    ``math`` and :func:`numpy.empty` for ``local`` arrays (see the module docstring)."""
     return _reference_of(kernel)
 
 

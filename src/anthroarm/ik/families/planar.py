@@ -92,7 +92,7 @@ def planar_pose_solutions(cf, ci, T, angle, tol, tol_orthonormal, out):
     residual, the branch — and the bit mask of their branches returned (≤ 0: none, a malformed
     pose or a candidate to polish — the general path answers).  ``angle`` and
     ``tol_orthonormal`` are not read (the signature of :func:`.geometric.pose_solutions`).
-    ``cf``, ``ci``: ``PlanarPlan.packed``, passed on borrowed (:func:`anthroarm.jit.borrow`)."""
+    ``cf``, ``ci``: ``PlanarPlan.packed``, passed on borrowed (``anthroarm.jit.borrow``)."""
     cf, ci, T, out = borrow(cf), borrow(ci), borrow(T), borrow(out)
     if 0 < _pose_status(T, math.inf) < 3:  # not finite, or not its last row (the rotation: unread)
         return -1

@@ -347,7 +347,7 @@ def srs_pose_solutions(cf, ci, T, swivel, tol, tol_orthonormal, out):
     of their branches (bit b: branch b; ≤ 0: none, a malformed pose or a candidate to polish —
     the general path answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one
     pose at one swivel angle (:func:`anthroarm.jit.entry_point`).  Its arrays are passed on
-    borrowed (:func:`anthroarm.jit.borrow`: no reference counts taken and given back below it)."""
+    borrowed (``anthroarm.jit.borrow``: no reference counts taken and given back below it)."""
     cf, ci, T, out = borrow(cf), borrow(ci), borrow(T), borrow(out)
     sw = local(1)
     sw[0] = swivel

@@ -354,7 +354,7 @@ def pose_solutions(cf, ci, T, param, tol, tol_orthonormal, out):
     ``out`` (8, w + 4), the bit mask of their branches returned (≤ 0: the general path
     answers).  What :func:`anthroarm.ik.closed_form.analytic` calls for one pose of a closed
     class (:func:`anthroarm.jit.entry_point`).  Its arrays are passed on borrowed
-    (:func:`anthroarm.jit.borrow`: no reference counts taken and given back below it)."""
+    (``anthroarm.jit.borrow``: no reference counts taken and given back below it)."""
     cf, ci, T, out = borrow(cf), borrow(ci), borrow(T), borrow(out)
     return _verified_one(cf, ci, T, param, tol, tol_orthonormal, local(1)[:0], out)
 

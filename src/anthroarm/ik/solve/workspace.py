@@ -98,7 +98,7 @@ class Shared:
     def as_arg(self, th):
         """θ as the compiled calls take it: a writable array — Numba compiles a read-only array
         apart from a writable one, so a first call of either kind would compile the same kernel
-        again.  The read-only :attr:`ref` (and ``posture_auto``) gives its writable twin, made
+        again.  The read-only ``ref`` (and ``posture_auto``) gives its writable twin, made
         once (a copy a call cost ~0.5 µs of a ~20 µs solve); another read-only array a copy."""
         if th is self.ref:
             return self._ref_arg
