@@ -27,12 +27,12 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pinocchio as pin
 
 import anthroarm as aa
 from anthroarm import cache
 
-from .bench_hand import COUPLED, FRAMES
+from .bench_hand import COUPLED, FRAMES, _trajectory
+from .bench_marker_ik import _motion
 from .bench_qp_step import _targets as _qp_targets
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -176,13 +176,7 @@ def _hand_rows(old, n):
     qpn = importlib.import_module("anthroarm.ik.qp")
     qpo = importlib.import_module(old.__name__ + ".ik.qp")
     rn, ro = aa.load("human_upper_limb"), old.load("human_upper_limb")
-    q0 = qpn.comfortable_posture(rn)
-    phase = np.random.default_rng(3).uniform(0, 2 * np.pi, rn.nv)
-    d, targets = rn.model.createData(), []
-    for k in range(n):
-        q = q0 + 0.15 * np.sin(2 * np.pi * k / 200.0 + phase) * np.sin(np.pi * k / n)
-        pin.framesForwardKinematics(rn.model, d, np.clip(q, rn.lower, rn.upper))
-        targets.append([d.oMf[rn.model.getFrameId(f)].homogeneous for f in FRAMES])
+    q0, targets = _trajectory(rn, n)
 
     def tasks_of(qp, robot):
         frames = qp.MultiFrameTask(
@@ -225,12 +219,7 @@ def _marker_rows(old, n):
     mn = importlib.import_module("anthroarm.motion")
     mo = importlib.import_module(old.__name__ + ".motion")
     rn, ro = aa.load("human_arm7"), old.load("human_arm7")
-    rng = np.random.default_rng(0)
-    t, half = np.arange(n) / 100.0, 0.5 * (rn.upper - rn.lower)
-    Q = aa.ik.qp.comfortable_posture(rn) + 0.3 * half * np.sin(
-        2 * np.pi * rng.uniform(0.3, 1.0, 7) * t[:, None] + rng.uniform(0, 2 * np.pi, 7)
-    )
-    Q = np.clip(Q, rn.lower + 1e-3, rn.upper - 1e-3)
+    Q = _motion(rn, n)
     sn, so = mn.default_marker_set(rn), mo.default_marker_set(ro)
     P = np.array([sn.world_positions(rn, q) for q in Q])
     P += np.random.default_rng(1).normal(0, 1e-3, P.shape)
