@@ -71,9 +71,10 @@ STAMP_SUBFOLDER = "kernels"
 @functools.lru_cache(maxsize=None)
 def kernel_sources_digest(root: str) -> str:
     """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
-    kernels (their text holds ``@kernel``), and ``jit.py`` and ``jit_arrays.py`` (the intrinsics
-    compiled into them), with their paths relative to ``root``; read once per process and
-    folder."""
+    kernels (their text holds ``@kernel``) or a :func:`switch` of kernels (``jit.switch(``: a
+    registry whose order is compiled into its callers), and ``jit.py`` and ``jit_arrays.py``
+    (the intrinsics compiled into them), with their paths relative to ``root``; read once per
+    process and folder."""
     base = Path(root)
     h = hashlib.sha256()
     for p in sorted(base.rglob("*.py")):
@@ -81,7 +82,7 @@ def kernel_sources_digest(root: str) -> str:
             text = p.read_bytes()
         except OSError:
             continue
-        if b"@kernel" in text or p.name in ("jit.py", "jit_arrays.py"):
+        if b"@kernel" in text or b"jit.switch(" in text or p.name in ("jit.py", "jit_arrays.py"):
             h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
     return h.hexdigest()
 
@@ -115,7 +116,7 @@ import llvmlite  # noqa: E402
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from llvmlite import binding as llvm  # noqa: E402
-from numba.extending import typeof_impl  # noqa: E402
+from numba.extending import overload, typeof_impl  # noqa: E402
 
 from .jit_arrays import PY_FORMS as _PY_FORMS  # noqa: E402
 from .jit_arrays import (  # noqa: E402 - the kernels' scratch arrays and views, exported
@@ -331,11 +332,45 @@ def kernel(func=None, *, inline: bool = False, cache: bool | None = None):
     return wrap if func is None else wrap(func)
 
 
+def switch(kernels) -> pytypes.FunctionType:
+    """``f(i, *args)``: ``kernels[i](*args)`` — a kernel chosen by an index known at run time
+    (``kernels[-1]`` for an index out of range), as a kernel may call it.  Numba cannot call
+    one of several kernels picked from a tuple without making them first-class function objects
+    (an experimental feature), so in a compiled kernel ``f`` is Numba's ``overload`` of it
+    written out from the tuple, ``if i == 0: return K0(*args) elif i == 1: …`` — a direct call
+    of each kernel, compiled and cached with its caller — and called from Python (or by a
+    reference) it is the line above.  The one table of kernels is ``f.kernels``: a registry
+    that adds a kernel adds it to the dispatch."""
+    kernels = tuple(kernels)
+    last = len(kernels) - 1
+    if last < 0 or not all(isinstance(k, Kernel) for k in kernels):
+        raise TypeError("switch takes a non-empty tuple of kernels")
+
+    def f(i, *args):
+        return kernels[i if 0 <= i < last else last](*args)
+
+    def written_out(i, *args):
+        lines = ["def dispatch(i, *args):"]
+        lines += [f"    if i == {j}:\n        return K{j}(*args)" for j in range(last)]
+        lines.append(f"    return K{last}(*args)")
+        scope = {f"K{j}": k for j, k in enumerate(kernels)}
+        exec(compile("\n".join(lines), f"<switch of {len(kernels)} kernels>", "exec"), scope)
+        return scope["dispatch"]
+
+    overload(f)(written_out)
+    f.kernels = kernels
+    return f
+
+
 def callees(k: Kernel) -> list[Kernel]:
-    """The kernels ``k``'s source calls by a global name (compiled with it)."""
+    """The kernels ``k``'s source calls by a global name (compiled with it), and those of a
+    :func:`switch` it calls."""
     g = k.py_func.__globals__
     names = sorted(set(_names(k.py_func.__code__)))
-    return [g[n] for n in names if isinstance(g.get(n), Kernel) and g[n] is not k]
+    out = [g[n] for n in names if isinstance(g.get(n), Kernel) and g[n] is not k]
+    for n in names:
+        out += [c for c in getattr(g.get(n), "kernels", ()) if isinstance(c, Kernel)]
+    return out
 
 
 def entry_point(k: Kernel, *args) -> Entry:
@@ -668,6 +703,7 @@ __all__ = [
     "ready_name",
     "reference",
     "running",
+    "switch",
     "start_background",
     "lock_path",
     "start",

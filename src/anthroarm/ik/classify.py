@@ -22,21 +22,11 @@ with the measured quantity kept so the user sees how close a call was:
   (the largest distance of a line from the least-squares common point ``≤ tol``);
 * three parallel (i, i+1, i+2): both consecutive pairs parallel.
 
-6R classes (1-based joint numbers as in the paper; first match in this order wins, all matches
-are listed in ``compatible``):
-
-===================================  ==================================  ===========
-class                                condition                           solution
-===================================  ==================================  ===========
-``spherical_two_parallel``           4-5-6 spherical, 2 ∥ 3              closed form
-``spherical_two_intersecting``       4-5-6 spherical, 1 and 2 intersect  closed form
-``three_parallel_two_intersecting``  2 ∥ 3 ∥ 4, 5 and 6 intersect        closed form
-``spherical``                        4-5-6 spherical                     quartic
-``three_parallel``                   2 ∥ 3 ∥ 4                           quartic
-``two_parallel``                     2 ∥ 3                               1-D search
-``two_intersecting``                 5 and 6 intersect                   1-D search
-``gen_six_dof``                      none of the above                   2-D search
-===================================  ==================================  ===========
+6R classes: IK-Geo's Table I, one module a class in :mod:`anthroarm.ik.classes` with its
+condition on the axes (1-based joint numbers as in the paper; ``GeoClass.condition``, the rule
+``GeoClass.holds``), tried in the order of :data:`anthroarm.ik.classes.ORDER` (the simplest
+solution first: closed forms, quartics, 1-D searches, the 2-D search); the first match wins,
+all matches are listed in ``compatible``.
 
 The same tests on the reversed chain (tool to base: a spherical *shoulder* is a spherical wrist
 of the reversed arm) are made too; the class of the reversed chain is used when it ranks
@@ -52,7 +42,9 @@ import numpy as np
 
 from ..chain import CONTINUOUS, REVOLUTE
 from ..errors import ParameterError, UnsupportedModelError
+from .classes import CLOSED, ORDER, Relations, holding
 
+#: the names of IK-Geo's classes (:mod:`anthroarm.ik.classes`, one module a class)
 SPHERICAL_TWO_PARALLEL = "spherical_two_parallel"
 SPHERICAL_TWO_INTERSECTING = "spherical_two_intersecting"
 THREE_PARALLEL_TWO_INTERSECTING = "three_parallel_two_intersecting"
@@ -62,19 +54,11 @@ TWO_PARALLEL = "two_parallel"
 TWO_INTERSECTING = "two_intersecting"
 GEN_SIX_DOF = "gen_six_dof"
 NOT_6R = "not_6r"
-#: the 6R classes, in the order they are tried (simplest solution first)
-CLASSES = (
-    SPHERICAL_TWO_PARALLEL,
-    SPHERICAL_TWO_INTERSECTING,
-    THREE_PARALLEL_TWO_INTERSECTING,
-    SPHERICAL,
-    THREE_PARALLEL,
-    TWO_PARALLEL,
-    TWO_INTERSECTING,
-    GEN_SIX_DOF,
-)
+#: the 6R classes, in the order they are tried (simplest solution first): the registry's
+#: :data:`anthroarm.ik.classes.ORDER`
+CLASSES = ORDER
 #: classes with a closed form (no search)
-CLOSED_FORM_CLASSES = CLASSES[:5]
+CLOSED_FORM_CLASSES = CLOSED
 
 
 @dataclass(frozen=True)
@@ -199,18 +183,9 @@ def _relations(H, pts, tol, angle_tol):
 
 
 def _classes_6r(par, inter, sph, three):
-    """IK-Geo's 6R classes whose condition holds (0-based indices)."""
-    cond = {
-        SPHERICAL_TWO_PARALLEL: sph[3] and par[1],
-        SPHERICAL_TWO_INTERSECTING: sph[3] and inter[0],
-        THREE_PARALLEL_TWO_INTERSECTING: three[1] and inter[4],
-        SPHERICAL: sph[3],
-        THREE_PARALLEL: three[1],
-        TWO_PARALLEL: par[1],
-        TWO_INTERSECTING: inter[4],
-        GEN_SIX_DOF: True,
-    }
-    return [c for c in CLASSES if cond[c]]
+    """IK-Geo's 6R classes whose condition holds (0-based indices), in :data:`CLASSES`
+    order (each class's rule: :attr:`anthroarm.ik.classes.GeoClass.holds`)."""
+    return holding(Relations(par, inter, sph, three))
 
 
 def classify(robot, frame=None, tol: float = 1e-6, angle_tol: float = 1e-6) -> Classification:

@@ -9,8 +9,8 @@ import numpy as np
 
 from ...jit import borrow, kernel, local, local2, local_flags, part, part2, view2, view3
 from ...threads import run_rows
+from ..classes.branches import BRANCH_ROW, COS, EXACT, EXISTS, SIN, angles, wrist
 from ..fk import WIDTH
-from ..geometric.closed import BRANCH_ROW, COS, EXACT, EXISTS, SIN, _angles, _wrist
 from ..geometric.fk import POLISH_MAX, _fk_residuals, _target_errors
 from ..geometric.limits import into_limit_rows
 from ..geometric.verify import NO_REF, BadPoseError, _mark_solutions, _pose_status, nearest_first
@@ -155,7 +155,7 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                     R04 = mm(mm(R02, rot_cs(h[2], c3, s3)), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
-                    _wrist(
+                    wrist(
                         (h[4], h[4], h[4], h[4], h[5], h[6]),
                         R04,
                         Rg,
@@ -172,7 +172,7 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                 for j in range(2):
                     Bs[j, EXISTS] = 0.0
                 zero = (1.0, 0.0)
-                _wrist(
+                wrist(
                     (h[0], h[0], h[0], h[0], h[1], h[2]), ident, R03, Bs, 0, zero, zero, zero, True
                 )
                 for j in range(2):
@@ -186,7 +186,7 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                     R04 = mm(_rot3(h, a1, a2, a3), R34)
                     b = 4 * i4 + 2 * j
                     _q4(q4b, b, a4)
-                    _wrist(
+                    wrist(
                         (h[4], h[4], h[4], h[4], h[5], h[6]),
                         R04,
                         Rg,
@@ -197,7 +197,7 @@ def _srs_one(route, h, S, E0, W0, Rg, W, phi, a4a, a4b, n4, e4a, e4b, Q, QC, QS,
                         a3,
                         ex4 and Bs[j, EXACT] != 0.0,
                     )
-    _angles(B6)  # the angles from their rotations, vectorised
+    angles(B6)  # the angles from their rotations, vectorised
     for b in range(8):
         if B6[b, EXISTS] != 0.0:
             for j in range(7):

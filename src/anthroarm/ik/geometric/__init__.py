@@ -12,27 +12,8 @@ name.  Conventions (IK-Geo): joint i turns about the unit axis ``h_i`` (base fra
 along their own axes without changing the kinematics, which makes the offsets between
 intersecting axes zero (the form each solver needs: :func:`ik_geo_P`).
 
-========================================  =====================================  ==========
-class (:mod:`.classify`)                  decomposition                          branches
-========================================  =====================================  ==========
-``spherical_two_parallel``                q1 SP4, q3 SP3, q2 SP1; wrist q5 SP4,  2 × 2 × 2
-                                          q4, q6 SP1
-``spherical_two_intersecting``            q3 SP3, (q1, q2) SP2; wrist as above   2 × 2 × 2
-``three_parallel_two_intersecting``       q1 SP4, q5 SP4, q2 + q3 + q4 and q6    2 × 2 × 2
-                                          SP1, q3 SP3, q2 SP1, q4 by difference
-``spherical``                             (q1, q2, q3) SP5 (quartic); the wrist   4 × 2
-``three_parallel``                        (q1, q5) SP6 (quartic); then as above   4 × 2
-``two_parallel``                          1-D search over q1: (q4, q6) SP6,      ≤ 16
-                                          θ23 SP1, error ‖span‖ − ‖p23‖; q2,
-                                          q5 SP1
-``two_intersecting``                      1-D search over q4: (q1, q2, q3) SP5,  ≤ 16
-                                          error h5ᵀ R04ᵀ R06 h6 − h5ᵀ h6;
-                                          q5, q6 SP1
-``gen_six_dof``                           2-D search over (q1, q2): (q3, q4,     ≤ 16
-                                          q5) SP5, error ‖R05 h6 − R06 h6‖;
-                                          local minima polished by Newton, q6
-                                          SP1
-========================================  =====================================  ==========
+Each class is a module of :mod:`anthroarm.ik.classes` (its condition, its decomposition into
+subproblems in its docstring, its branches and, for a closed class, its kernel).
 
 The search classes (IK-Geo ``IK_2_parallel``, ``IK_2_intersecting``; compiled in
 :mod:`.search`, whose docstring has the details) sample the searched joint on

@@ -12,54 +12,31 @@ import numpy as np
 
 from ...jit import kernel, part, part2
 from .. import classify as C
+from ..classes import CLOSED, ORDER, SEARCH_2D, get
+from ..classes import SEARCHED as _SEARCHED
 from ..fk import WIDTH, local_frames
 from ..search.constants import SEARCH_BRANCHES
 from ..search.polish import geo_frames
-from .closed import CLOSED
 
-#: the classes solved here in closed form or by a 1-D search (the others: use aa.ik.solve)
-SOLVED = (
-    C.SPHERICAL_TWO_PARALLEL,
-    C.SPHERICAL_TWO_INTERSECTING,
-    C.THREE_PARALLEL_TWO_INTERSECTING,
-    C.SPHERICAL,
-    C.THREE_PARALLEL,
-    C.TWO_PARALLEL,
-    C.TWO_INTERSECTING,
-    C.GEN_SIX_DOF,
-)
+#: the classes solved here, in closed form or by a search (the order they are tried)
+SOLVED = ORDER
 #: the classes of :data:`SOLVED` solved by a search (1-D over one joint angle; 2-D for
 #: ``gen_six_dof``)
-SEARCHED = (C.TWO_PARALLEL, C.TWO_INTERSECTING, C.GEN_SIX_DOF)
-
-#: per class: (the unknowns of each branching subproblem, its number of roots), outermost first
-_LABELS = {
-    C.SPHERICAL_TWO_PARALLEL: (("q1", 2), ("q3", 2), ("q5", 2)),
-    C.SPHERICAL_TWO_INTERSECTING: (("q3", 2), ("q1q2", 2), ("q5", 2)),
-    C.THREE_PARALLEL_TWO_INTERSECTING: (("q1", 2), ("q5", 2), ("q3", 2)),
-    C.SPHERICAL: (("q1q2q3", 4), ("q5", 2)),
-    C.THREE_PARALLEL: (("q1q5", 4), ("q3", 2)),
-}
+SEARCHED = _SEARCHED
 
 
 def n_branches(cls: str) -> int:
     """The number of branch slots of a class solver per pose: 8, or :data:`SEARCH_BRANCHES`
     for a search class."""
-    return SEARCH_BRANCHES if cls in SEARCHED else 8
+    return 8 if get(cls).closed else SEARCH_BRANCHES
 
 
 def branch_labels(cls: str) -> tuple[str, ...]:
-    """The branch labels of a class: which root of each of its branching subproblems
-    (``"q1=0,q3=1,q5=0"``: the first root for q1, the second for q3, …); for a search class
-    which root of the search along the searched joint, in the order found
-    (``"q1root=2"``; slots are filled from the first)."""
-    if cls in SEARCHED:
-        j = {C.TWO_PARALLEL: "q1", C.TWO_INTERSECTING: "q4", C.GEN_SIX_DOF: "q1q2"}[cls]
-        return tuple(f"{j}root={k}" for k in range(SEARCH_BRANCHES))
-    out = [""]
-    for name, k in _LABELS[cls]:
-        out = [f"{o},{name}={i}".lstrip(",") for o in out for i in range(k)]
-    return tuple(out)
+    """The branch labels of a class (:meth:`anthroarm.ik.classes.GeoClass.branch_labels`):
+    which root of each of its branching subproblems (``"q1=0,q3=1,q5=0"``: the first root for
+    q1, the second for q3, …); for a search class which root of the search along the searched
+    joint, in the order found (``"q1root=2"``; slots are filled from the first)."""
+    return get(cls).branch_labels(SEARCH_BRANCHES)
 
 
 @dataclass(frozen=True)
@@ -167,16 +144,7 @@ def ik_geo_P(cls: str, H: np.ndarray, points: np.ndarray, p_tool: np.ndarray) ->
     1–2: p12 = 0; intersecting 5–6: p56 = 0).  ``H`` (6, 3), ``points`` (6, 3) one point of
     each axis, ``p_tool`` (3,) the tool position at q = 0 (base frame, m)."""
     o = np.array(points, dtype=float)
-    groups = {
-        C.SPHERICAL_TWO_PARALLEL: [(3, 4, 5)],
-        C.SPHERICAL: [(3, 4, 5)],
-        C.SPHERICAL_TWO_INTERSECTING: [(0, 1), (3, 4, 5)],
-        C.THREE_PARALLEL_TWO_INTERSECTING: [(4, 5)],
-        C.THREE_PARALLEL: [],
-        C.TWO_PARALLEL: [],
-        C.TWO_INTERSECTING: [(4, 5)],
-        C.GEN_SIX_DOF: [],
-    }[cls]
+    groups = get(cls).meets
     for g in groups:
         c = _common_point(H[list(g)], o[list(g)])
         for i in g:
@@ -249,7 +217,7 @@ def _build(robot) -> GeoPlan | None:
         (
             (n, r)
             for n, r in compatible
-            if n in SOLVED and not (param is not None and n == C.GEN_SIX_DOF)
+            if n in SOLVED and not (param is not None and get(n).solution == SEARCH_2D)
         ),
         None,
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..classes import SEARCHED_1D, SEARCHED_2D
+
 #: samples of the searched joint over [−π, π] (IK-Geo's reference implementation uses 200)
 SEARCH_GRID = 256
 #: samples of each searched joint of ``gen_six_dof`` (a grid of its square)
@@ -49,5 +51,6 @@ _DIP_TOL = 1e-10
 #: a dip whose minimum stays above zero but within this of it (|e|) seeds a Newton polish
 _TOUCH = 1e-9
 
-#: the classes solved here, by their index in the compiled kernel
-CLASSES = ("two_parallel", "two_intersecting", "gen_six_dof")
+#: the classes solved here, by their index in the compiled kernel: the 1-D search classes of
+#: the registry (:mod:`anthroarm.ik.classes`), then the 2-D search class
+CLASSES = SEARCHED_1D + SEARCHED_2D

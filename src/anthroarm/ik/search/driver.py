@@ -7,11 +7,15 @@ import math
 import numpy as np
 
 from ...jit import kernel
+from ..classes import SEARCHED_1D
 from ..vec3 import rows6, rows7, vec
 from .constants import CLASSES, SEARCH_BRANCHES, SEARCH_GRID, SEARCH_GRID_2D
 from .grid2d import _gen_six_dof_pose
 from .line import _search_1d_pose
 from .polish import geo_frames
+
+#: the classes before this index in :data:`CLASSES` are 1-D searches, the others the 2-D one
+N_1D = len(SEARCHED_1D)
 
 
 # ----------------------------------------------------------------------------- driver
@@ -23,7 +27,7 @@ def _search_loop(cls, H, P, A, R06, p, Q, V, E, grid):
         V[i, :] = False
         E[i, :] = False
         R, pp = (vec(R06[i, 0]), vec(R06[i, 1]), vec(R06[i, 2])), vec(p[i])
-        if cls == 2:
+        if cls >= N_1D:
             _gen_six_dof_pose(h, PP, A, R, pp, Q[i], V[i], E[i], grid)
         else:
             _search_1d_pose(cls, h, PP, A, R, pp, Q[i], V[i], E[i], grid)
@@ -53,7 +57,7 @@ def solve_search(cls: str, H, P, R06, p, grid: int | None = None, frames=None):
     if len(R06) != len(p):
         raise ValueError(f"R06 has {len(R06)} poses, p {len(p)}")
     if grid is None:
-        grid = SEARCH_GRID_2D if c == 2 else SEARCH_GRID
+        grid = SEARCH_GRID_2D if c >= N_1D else SEARCH_GRID
     n = len(p)
     q = np.empty((n, SEARCH_BRANCHES, 6))
     valid = np.empty((n, SEARCH_BRANCHES), bool)

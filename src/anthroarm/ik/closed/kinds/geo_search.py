@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ... import classify as C
 from ... import geometric as _geo
+from ...classes import REGISTRY, SEARCH_1D, SEARCH_2D
 from ..finish import fk_residual
 from .geo import GeoKind
 
@@ -21,7 +21,7 @@ class GeoSearch(GeoKind):
     """A 6R arm of an IK-Geo class solved by a 1-D search."""
 
     name = "ik_geo_search"
-    classes = (C.TWO_PARALLEL, C.TWO_INTERSECTING)
+    classes = tuple(c.name for c in REGISTRY if c.solution == SEARCH_1D)
     cost_us = 2e3
 
     def branches(self, robot, gp, Ts, Tr, prm, shape, single, tol, tol_orthonormal):
@@ -37,5 +37,5 @@ class GeoSearch2D(GeoSearch):
     """A general 6R arm (``gen_six_dof``) solved by a 2-D search."""
 
     name = "ik_geo_search_2d"
-    classes = (C.GEN_SIX_DOF,)
+    classes = tuple(c.name for c in REGISTRY if c.solution == SEARCH_2D)
     cost_us = 3e5
