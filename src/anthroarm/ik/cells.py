@@ -173,6 +173,8 @@ class CellTable:
             self._set_pulses(pulses_per_rad)
 
     # ------------------------------------------------------------------ build
+    # long: the public docstring, the checks of every argument in turn, then one loop over
+    # the lattice
     @classmethod
     def build(
         cls,

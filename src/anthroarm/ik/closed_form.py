@@ -285,6 +285,8 @@ def require_form(robot, frame=None) -> ClosedForm:
 
 
 # ---------------------------------------------------------------------------- batches
+# long: the public docstring (every argument); the body checks them in turn and its calls
+# pass their keywords a line each
 def analytic_batch(
     robot,
     T,
@@ -378,6 +380,8 @@ def analytic_batch(
 
 
 # ---------------------------------------------------------------------------- one pose
+# long: the public docstring, and the one-pose fast path written inline (a ~3 µs call where
+# each helper call costs 0.1–0.3 µs, measured), then the general path
 def analytic(
     robot,
     T,

@@ -168,6 +168,8 @@ def _limits(limits, robot, st):
     return limits, True
 
 
+# long: the public docstring (25 lines: every argument); the body is the one hot path of a
+# control step (tasks accumulated into one workspace, the limits, the QP), kept in one frame
 def step(
     robot,
     q,

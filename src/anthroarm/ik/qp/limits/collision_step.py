@@ -99,6 +99,57 @@ def _accept(conf, ineq, v, dt, dmin, status):
     return np.zeros_like(v), "blocked"
 
 
+def _configuration(robot, q):
+    """The :class:`IKConfiguration` a step works on: ``robot`` itself if it is one (moved to
+    ``q`` if given), else the one kept on the robot for :func:`step`, moved to ``q``."""
+    if isinstance(robot, IKConfiguration):
+        if q is not None:
+            robot.update(q)
+        return robot
+    st = robot.__dict__.setdefault("_collision_step", {})
+    conf = st.get("conf")
+    if conf is None:
+        conf = st["conf"] = IKConfiguration(robot, q)
+    else:
+        conf.update(q)
+    return conf
+
+
+def _inequalities(ineq, conf, dt, nv):
+    """The stacked rows G Δq ≤ h of the inequality limits, the smallest distance they saw
+    (``dmin``, m; inf for none) and whether the step starts in collision (a distance < 0)."""
+    Gs, hs, dmin, start_bad = [], [], math.inf, False
+    for lim in ineq:
+        G, h = lim.inequalities(conf, dt)
+        Gs.append(G)
+        hs.append(h)
+        last = getattr(lim, "last", None)
+        if last is not None and len(last):
+            dmin = min(dmin, last.min)
+            start_bad = start_bad or last.min < 0.0
+    G = np.vstack(Gs) if Gs else np.zeros((0, nv))
+    h = np.concatenate(hs) if hs else np.zeros(0)
+    return G, h, dmin, start_bad
+
+
+def _solve_relaxed(solve, H, c, lo, hi, G, h, start_bad):
+    """(x, status) of the QP; where it is infeasible, the pairs inside the safety distance are
+    asked to separate more slowly (h < 0 scaled by 1/2, 1/4, 1/8), then only not to approach
+    (h clipped at 0: ``"relaxed"``); ``"start_in_collision"`` where the step started so."""
+    x, status = solve(H, c, lo, hi, G, h)
+    scale = 0.5
+    while x is None and len(h) and scale > 0.1:
+        x, status = solve(H, c, lo, hi, G, np.where(h < 0.0, scale * h, h))
+        scale *= 0.5
+    if x is None and len(h):
+        x, status = solve(H, c, lo, hi, G, np.maximum(h, 0.0))
+        if x is not None:
+            status = "relaxed"
+    elif start_bad and x is not None:
+        status = "start_in_collision"
+    return x, status
+
+
 def step(
     robot,
     q,
@@ -128,17 +179,7 @@ def step(
     full : bool
         Return a :class:`CollisionStepResult` instead of the bare velocity.
     """
-    if isinstance(robot, IKConfiguration):
-        conf = robot
-        if q is not None:
-            conf.update(q)
-    else:
-        st = robot.__dict__.setdefault("_collision_step", {})
-        conf = st.get("conf")
-        if conf is None:
-            conf = st["conf"] = IKConfiguration(robot, q)
-        else:
-            conf.update(q)
+    conf = _configuration(robot, q)
     if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a positive finite number of seconds, got {dt!r}")
     if solver not in SOLVERS:
@@ -167,34 +208,13 @@ def step(
     if diag:
         np.add(ws.Hd, diag, out=ws.Hd)
     combine_into(boxes, conf, dt, ws)
-    Gs, hs, dmin, start_bad = [], [], math.inf, False
-    for lim in ineq:
-        G, h = lim.inequalities(conf, dt)
-        Gs.append(G)
-        hs.append(h)
-        last = getattr(lim, "last", None)
-        if last is not None and len(last):
-            dmin = min(dmin, last.min)
-            start_bad = start_bad or last.min < 0.0
-    G = np.vstack(Gs) if Gs else np.zeros((0, nv))
-    h = np.concatenate(hs) if hs else np.zeros(0)
+    G, h, dmin, start_bad = _inequalities(ineq, conf, dt, nv)
     lo, hi = ws.lo.copy(), ws.hi.copy()
-    H, c = ws.H, ws.c
     if not np.isfinite(ws.Hc.dot(ws.Hc)):
         x, status = None, "failed"
     else:
         solve = _solve_daqp if solver == "daqp" else _solve_quadprog
-        x, status = solve(H, c, lo, hi, G, h)
-        scale = 0.5
-        while x is None and len(h) and scale > 0.1:  # ask a pair inside d_s to separate slower
-            x, status = solve(H, c, lo, hi, G, np.where(h < 0.0, scale * h, h))
-            scale *= 0.5
-        if x is None and len(h):
-            x, status = solve(H, c, lo, hi, G, np.maximum(h, 0.0))
-            if x is not None:
-                status = "relaxed"
-        elif start_bad and x is not None:
-            status = "start_in_collision"
+        x, status = _solve_relaxed(solve, ws.H, ws.c, lo, hi, G, h, start_bad)
     if x is None:
         v = np.zeros(nv)
     else:
