@@ -184,7 +184,7 @@ def _relations(H, pts, tol, angle_tol):
 
 def _classes_6r(par, inter, sph, three):
     """IK-Geo's 6R classes whose condition holds (0-based indices), in :data:`CLASSES`
-    order (each class's rule: :attr:`anthroarm.ik.classes.GeoClass.holds`)."""
+    order (each class's rule: ``GeoClass.holds``)."""
     return holding(Relations(par, inter, sph, three))
 
 

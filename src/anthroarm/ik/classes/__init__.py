@@ -5,9 +5,9 @@ A class's module holds all of it (:class:`~anthroarm.ik.classes.base.GeoClass`):
 on the axes that admits it (read by :func:`anthroarm.ik.classify.classify`), the joints whose
 axes meet (slid to their common point: :func:`anthroarm.ik.geometric.ik_geo_P`), its branch
 labels and, for a closed class, the kernel that solves one pose (dispatched by
-:data:`solve_closed`, compiled into :func:`anthroarm.ik.geometric.pose_solutions` and the batch
+``solve_closed``, compiled into :func:`anthroarm.ik.geometric.pose_solutions` and the batch
 calls); for a 1-D search class the kernels of its inner subproblem (dispatched by
-:data:`search_inner` and :data:`search_assemble` in the search of :mod:`anthroarm.ik.search`).
+``search_inner`` and ``search_assemble`` in the search of :mod:`anthroarm.ik.search`).
 
 **Adding a closed class** is a module here defining ``CLASS`` (its ``solve`` kernel writes the 8
 branches of one pose, :mod:`.branches`) and its name in :data:`ORDER`, at the rank where it is

@@ -45,8 +45,8 @@ call the 2π shift into the joint limits, the FK check by the chain's product of
 :func:`anthroarm.ik.closed_form.analytic`).
 
 Layout (one concern a module): :mod:`.plan` (the plan of an arm: its class, its kinematics in
-IK-Geo's form, the constants packed for the compiled calls), :mod:`.closed` (the closed class
-solvers), :mod:`.limits` (angles shifted by 2π into the joint limits), :mod:`.fk` (the FK
+IK-Geo's form, the constants packed for the compiled calls), :mod:`.closed` (one pose of a closed
+class: the class's kernel from :mod:`anthroarm.ik.classes`, then its angles), :mod:`.limits` (angles shifted by 2π into the joint limits), :mod:`.fk` (the FK
 check: residuals of the branches, the Newton polish, on the one FK of :mod:`anthroarm.ik.fk`), :mod:`.verify` (one compiled call: pose →
 verified branches), :mod:`.singular` (Jacobian volumes), :mod:`.drivers` (the entries over a
 batch of poses), :mod:`.check` (``anthroarm check``); the searches are :mod:`anthroarm.ik.search`.

@@ -1,5 +1,5 @@
 """The closed IK-Geo classes in one compiled call: the class's kernel
-(:data:`anthroarm.ik.classes.solve_closed`, by its index in :data:`CLOSED`) writes the 8
+(``anthroarm.ik.classes.solve_closed``, by its index in :data:`CLOSED`) writes the 8
 branches of a pose as rotations and flags (:mod:`anthroarm.ik.classes.branches`), the angles are
 read from them at the end."""
 

@@ -32,7 +32,7 @@ def n_branches(cls: str) -> int:
 
 
 def branch_labels(cls: str) -> tuple[str, ...]:
-    """The branch labels of a class (:meth:`anthroarm.ik.classes.GeoClass.branch_labels`):
+    """The branch labels of a class (:meth:`anthroarm.ik.classes.base.GeoClass.branch_labels`):
     which root of each of its branching subproblems (``"q1=0,q3=1,q5=0"``: the first root for
     q1, the second for q3, …); for a search class which root of the search along the searched
     joint, in the order found (``"q1root=2"``; slots are filled from the first)."""
