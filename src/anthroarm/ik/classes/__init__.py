@@ -98,7 +98,4 @@ __all__ = [
     "SEARCH_2D",
     "get",
     "holding",
-    "search_assemble",
-    "search_inner",
-    "solve_closed",
 ]
