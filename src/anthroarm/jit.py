@@ -57,6 +57,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -68,22 +69,60 @@ CACHE_SUBFOLDER = "numba"
 STAMP_SUBFOLDER = "kernels"
 
 
-@functools.lru_cache(maxsize=None)
-def kernel_sources_digest(root: str) -> str:
-    """SHA-256 over the sources of the modules below ``root`` (a package folder) that define
-    kernels (their text holds ``@kernel``) or a :func:`switch` of kernels (``jit.switch(``: a
-    registry whose order is compiled into its callers), and ``jit.py`` and ``jit_arrays.py``
-    (the intrinsics compiled into them), with their paths relative to ``root``; read once per
-    process and folder."""
+#: a module that builds a :func:`switch` of kernels (its table is compiled into the callers)
+_SWITCH = re.compile(rb"\bswitch\(")
+#: a relative import: ``from ..search.constants import X`` (dots, module path)
+_RELATIVE = re.compile(rb"^from (\.+)([\w.]*) import ([\w, ]*)", re.M)
+
+
+def kernel_files(root: str) -> list[Path]:
+    """The sources compiled into anthroarm's kernels, below ``root`` (a package folder): the
+    modules that define kernels (their text holds ``@kernel``) or build a :func:`switch` of
+    kernels (a registry whose order is compiled into its callers), ``jit.py`` and
+    ``jit_arrays.py`` (the intrinsics), and every module of the package those import from by a
+    relative import (the constants a kernel reads as globals are frozen into its code:
+    ``search/constants.py``)."""
     base = Path(root)
-    h = hashlib.sha256()
+    picked = set()
     for p in sorted(base.rglob("*.py")):
         try:
             text = p.read_bytes()
         except OSError:
             continue
-        if b"@kernel" in text or b"jit.switch(" in text or p.name in ("jit.py", "jit_arrays.py"):
-            h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
+        if not (
+            b"@kernel" in text or _SWITCH.search(text) or p.name in ("jit.py", "jit_arrays.py")
+        ):
+            continue
+        picked.add(p)
+        if p.name in ("jit.py", "jit_arrays.py"):
+            continue  # what they import is not compiled into a kernel
+        for dots, mod, names in _RELATIVE.findall(text):
+            where = p.parent
+            for _ in range(len(dots) - 1):
+                where = where.parent
+            if mod:  # from .x.y import names: the module x/y
+                mods = [where.joinpath(*mod.decode().split("."))]
+            else:  # from . import a, b: the modules a and b
+                mods = [where / n.strip().split(" ")[0] for n in names.decode().split(",")]
+            for q in mods:
+                for c in (q.with_suffix(".py"), q / "__init__.py"):
+                    if c.is_file() and base in c.parents:
+                        picked.add(c)
+    return sorted(picked)
+
+
+@functools.lru_cache(maxsize=None)
+def kernel_sources_digest(root: str) -> str:
+    """SHA-256 over the sources compiled into the kernels below ``root`` (:func:`kernel_files`),
+    with their paths relative to ``root``; read once per process and folder."""
+    base = Path(root)
+    h = hashlib.sha256()
+    for p in kernel_files(root):
+        try:
+            text = p.read_bytes()
+        except OSError:
+            continue
+        h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
     return h.hexdigest()
 
 
@@ -196,7 +235,21 @@ def _reference_of(kernel) -> pytypes.FunctionType:
     for k, v in f.__globals__.items():  # the kernels it calls: their references, called as is
         if k in names and isinstance(v, Kernel) and v is not kernel:
             glob[k] = _reference_of(v)
+        elif k in names and getattr(v, "is_switch", False):
+            glob[k] = _switch_reference(v)
     glob[f.__name__] = ref if f.__globals__.get(f.__name__) is kernel else glob.get(f.__name__)
+    return ref
+
+
+@functools.lru_cache(maxsize=None)
+def _switch_reference(sw) -> pytypes.FunctionType:
+    """The reference of a :func:`switch`: the references of its kernels, picked by the index."""
+    refs = tuple(_reference_of(k) for k in sw.kernels)
+    last = len(refs) - 1
+
+    def ref(i, *args):
+        return refs[i if 0 <= i < last else last](*args)
+
     return ref
 
 
@@ -358,7 +411,7 @@ def switch(kernels) -> pytypes.FunctionType:
         return scope["dispatch"]
 
     overload(f)(written_out)
-    f.kernels = kernels
+    f.kernels, f.is_switch = kernels, True
     return f
 
 
@@ -369,7 +422,8 @@ def callees(k: Kernel) -> list[Kernel]:
     names = sorted(set(_names(k.py_func.__code__)))
     out = [g[n] for n in names if isinstance(g.get(n), Kernel) and g[n] is not k]
     for n in names:
-        out += [c for c in getattr(g.get(n), "kernels", ()) if isinstance(c, Kernel)]
+        if getattr(g.get(n), "is_switch", False):
+            out += list(g[n].kernels)
     return out
 
 
@@ -691,6 +745,7 @@ __all__ = [
     "compiled",
     "entry_point",
     "kernel",
+    "kernel_files",
     "kernel_sources_digest",
     "local",
     "local2",

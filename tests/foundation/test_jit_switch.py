@@ -5,6 +5,9 @@ is added by its module and one registry line (``anthroarm.ik.classes``)."""
 
 from __future__ import annotations
 
+import warnings
+
+import numba
 import numpy as np
 import pytest
 
@@ -37,19 +40,45 @@ def _caller(k, x, out):
     return _pick(k, x, out)
 
 
-@pytest.mark.parametrize("k, value, ret", [(0, 3.0, 1), (1, 20.0, 2), (2, -2.0, 3), (7, -2.0, 3)])
+@pytest.mark.parametrize(
+    "k, value, ret", [(0, 3.0, 1), (1, 20.0, 2), (2, -2.0, 3), (7, -2.0, 3), (-1, -2.0, 3)]
+)
 def test_a_switch_calls_the_kernel_of_its_index(k, value, ret):
     for run in (_caller.dispatcher, reference(_caller), lambda *a: _pick(*a)):
         out = np.zeros(1)
-        assert run(k, 2.0, out) == ret  # an index past the end: the last kernel, as compiled
+        assert run(k, 2.0, out) == ret  # an index out of range: the last kernel, as compiled
         assert out[0] == value
 
 
+@kernel
+def _caller_once(k, x, out):
+    return _pick(k, x, out)
+
+
 def test_a_switch_is_compiled_as_direct_calls():
+    """Compiled as an if-chain of calls of the kernels themselves: no first-class function
+    objects (Numba warns when it makes them: ``NumbaExperimentalFeatureWarning``)."""
     out = np.zeros(1)
-    _caller.dispatcher(1, 2.0, out)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", numba.errors.NumbaExperimentalFeatureWarning)
+        assert _caller_once.dispatcher(1, 2.0, out) == 2
     assert all(k.dispatcher.signatures for k in (_plus, _times, _minus))  # each compiled
     assert {id(c) for c in callees(_caller)} >= {id(_plus), id(_times), id(_minus)}
+
+
+def test_the_reference_of_a_caller_runs_the_references_of_the_switch(monkeypatch):
+    """``reference(caller)`` runs the switch's kernels as references too, whatever the process
+    runs for them (``Kernel.fn``: compiled code once switched)."""
+
+    def not_the_reference(*args):
+        raise AssertionError("the reference called the kernel's compiled form")
+
+    ref = reference(_caller)
+    monkeypatch.setattr(_minus, "fn", not_the_reference)
+    out = np.zeros(1)
+    assert ref(2, 2.0, out) == 3 and out[0] == -2.0
+    with pytest.raises(AssertionError, match="compiled form"):
+        _pick(2, 2.0, out)  # from Python the switch calls the kernel as the process runs it
 
 
 def test_a_switch_takes_kernels_only():

@@ -1,8 +1,8 @@
 """The registry of IK-Geo classes (:mod:`anthroarm.ik.classes`): each class one module (its
 condition, the joints whose axes meet, its branches, its kernels), the order of the classes one
 table.  The last test adds a class as a user would — one new file and one line of the table, in
-a copy of the package — and the classification, the plan, the branch labels and the compiled
-dispatch all take it up: nothing else names a class."""
+a copy of the package — and the classification, the plan, the branch labels, the dispatch and
+``anthroarm check`` all take it up: nothing else names a class."""
 
 from __future__ import annotations
 
@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 
 import anthroarm as aa
-from anthroarm.ik import classes, classify, geometric
-from anthroarm.ik.classes.base import CLOSED_FORM, GeoClass, Relations
+from anthroarm.ik import classes, classify, geometric, search
+from anthroarm.ik.classes.base import CLOSED_FORM, SEARCH_1D, GeoClass, Relations
+from anthroarm.jit import Kernel
 
 # IK-Geo Table I (arXiv 2211.05737), 0-based: (spherical triple, parallel pairs, intersecting
 # pairs, three-parallel triple) a class asks for
@@ -60,16 +61,51 @@ def test_the_registry_is_ik_geos_table_in_its_order():
         assert classes.holding(_relations(**TABLE_I[name]))[0] == name
 
 
-def test_closed_classes_have_eight_labelled_branches_and_a_kernel():
+# IK-Geo's decompositions (arXiv 2211.05737 §IV; the reference implementation's IK_* functions):
+# the branching subproblems of each closed class, outermost first, and the joints slid to one
+# point (0-based) — the order of the branches is the order of these loops
+DECOMPOSITION = {
+    "spherical_two_parallel": ((("q1", 2), ("q3", 2), ("q5", 2)), ((3, 4, 5),)),
+    "spherical_two_intersecting": ((("q3", 2), ("q1q2", 2), ("q5", 2)), ((0, 1), (3, 4, 5))),
+    "three_parallel_two_intersecting": ((("q1", 2), ("q5", 2), ("q3", 2)), ((4, 5),)),
+    "spherical": ((("q1q2q3", 4), ("q5", 2)), ((3, 4, 5),)),
+    "three_parallel": ((("q1q5", 4), ("q3", 2)), ()),
+    "two_parallel": ("q1", ()),
+    "two_intersecting": ("q4", ((4, 5),)),
+    "gen_six_dof": ("q1q2", ()),
+}
+
+
+def test_each_class_holds_its_decomposition_and_its_kernels():
     for c in classes.REGISTRY:
+        branching, meets = DECOMPOSITION[c.name]
+        assert c.meets == meets
+        if c.closed:
+            assert c.labels == branching and isinstance(c.solve, Kernel)
+            assert c.inner is None and c.assemble is None
+        else:
+            assert c.searched == branching and c.solve is None
+            one_d = c.solution == SEARCH_1D
+            assert isinstance(c.inner, Kernel) == isinstance(c.assemble, Kernel) == one_d
         labels = geometric.branch_labels(c.name)
         assert len(labels) == geometric.n_branches(c.name) == (8 if c.closed else 16)
-        assert len(set(labels)) == len(labels)
-    assert geometric.branch_labels("spherical")[:3] == (
-        "q1q2q3=0,q5=0",
-        "q1q2q3=0,q5=1",
-        "q1q2q3=1,q5=0",
+    assert geometric.branch_labels("spherical_two_intersecting")[:3] == (
+        "q3=0,q1q2=0,q5=0",
+        "q3=0,q1q2=0,q5=1",
+        "q3=0,q1q2=1,q5=0",
     )
+    assert geometric.branch_labels("two_intersecting")[15] == "q4root=15"
+
+
+def test_the_dispatch_follows_the_registry():
+    """The compiled dispatch of the closed classes and of the 1-D searches' inner subproblems is
+    the registry's kernels in the registry's order (``jit.switch``)."""
+    closed = [classes.get(n).solve for n in classes.CLOSED]
+    assert list(classes.solve_closed.kernels) == closed
+    assert [k for k in classes.search_inner.kernels] == [
+        classes.get(n).inner for n in classes.SEARCHED_1D
+    ]
+    assert search.CLASSES == classes.SEARCHED_1D + classes.SEARCHED_2D
 
 
 def test_a_malformed_class_is_refused():
@@ -93,6 +129,9 @@ for i in range(len(T)):
     out["branches"] = [str(b) for b in res.branches]
     out["err"].append(float(np.abs(r.fk(res.solutions) - T[i]).max()) if len(res.solutions) else 1.0)
     out.setdefault("n", []).append(len(res.solutions))
+from anthroarm.ik.geometric import check_rows
+rows = check_rows(r, 8, np.random.default_rng(0))
+out["check"] = [[row.quantity, row.max_abs_err, row.tol] for row in rows]
 print(json.dumps(out))
 """
 
@@ -128,5 +167,11 @@ def test_a_class_is_one_new_file_and_one_registry_line(tmp_path):
     assert out["order"][0] == "ur_family" and out["class"] == "ur_family"
     assert max(out["err"]) < 1e-9 and min(out["n"]) >= 1
     assert all(re.fullmatch(r"q1=\d,q5=\d,elbow=\d", b) for b in out["branches"])
+    # anthroarm check: the FK check of every branch; IK-Geo (the peer) has no such class, so
+    # its row is left out rather than failing
+    assert [c for c, _, _ in out["check"]] == [
+        "closed form by geometry: FK(IK(T)) = T, all branches"
+    ]
+    assert all(v <= tol for _, v, tol in out["check"])
     # the unchanged package still says three_parallel_two_intersecting
     assert classify.classify(aa.load("ur5")).name == "three_parallel_two_intersecting"

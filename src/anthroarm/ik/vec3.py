@@ -215,7 +215,7 @@ def atan2(y, x):
     infinities and NaN included — within 2 units in the last place, in branch-free arithmetic
     that a compiled kernel inlines and vectorises (the C library's atan2 is a call of ~20 ns
     here, and the closed-form IK reads 48 angles a pose,
-    :func:`anthroarm.ik.geometric.closed._angles`).
+    :func:`anthroarm.ik.classes.branches.angles`).
     Cephes' method: the ratio of the smaller to the larger of |x|, |y| in [0, 1], reduced to
     |u| ≤ 0.42 by u = (t − 1)/(t + 1) above 0.66 (atan t = π/4 + atan u), Cephes' rational
     approximation of atan on it, then the octant: |atan2| = k π/4 ± r (k = 0 … 4, the

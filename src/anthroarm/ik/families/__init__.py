@@ -27,7 +27,7 @@ wrist (axes 5, 6, 7 meet at W), one solution family per elbow swivel angle φ:
   rot(−h1, q1)(E − S) = rot(h2, q2)(E0 − S) (2 roots), q3 by SP1.  Otherwise (route
   ``"general"``) R03 is the rotation taking the pair to the pair and (q1, q2, q3) follow as a
   spherical wrist does: q2 by SP4, q1 and q3 by SP1 (2 roots);
-* the wrist from R47 = R04ᵀ R R_tᵀ as :func:`anthroarm.ik.geometric.closed._wrist`: q6 by
+* the wrist from R47 = R04ᵀ R R_tᵀ as :func:`anthroarm.ik.classes.branches.wrist`: q6 by
   SP4, q5 and q7 by SP1 (2 roots).
 
 8 branches per φ, q4 root outermost, wrist root innermost: labels ``"q4=0,q1q2=0,q6=0"`` …

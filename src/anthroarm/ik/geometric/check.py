@@ -59,9 +59,10 @@ def check_rows(robot, samples: int, rng) -> list:
         import ik_geo
     except ImportError:
         return rows
-    if not hasattr(ik_geo, "Robot"):  # a folder named ik_geo on sys.path, not IK-Geo
+    make = getattr(getattr(ik_geo, "Robot", None), plan.cls, None)
+    if make is None:  # a folder named ik_geo on sys.path, or a class IK-Geo does not name
         return rows
-    geo = getattr(ik_geo.Robot, plan.cls)(plan.H.tolist(), plan.P.tolist())
+    geo = make(plan.H.tolist(), plan.P.tolist())
     diff = 0
     R06, p06 = class_pose(plan, T, param)
     for i in range(n):

@@ -163,8 +163,9 @@ def _reversed(kin: C.Kinematics):
 def plan_for(robot) -> GeoPlan | None:
     """The :class:`GeoPlan` of ``robot`` for its tool (kept on the robot:
     :meth:`~anthroarm.robot.Robot.derived`), or None when its geometry has no closed form here
-    (not 6R on the path to the tool, a mimic joint, joints off that path, or a class in
-    :data:`anthroarm.ik.classify.CLASSES` other than :data:`SOLVED`)."""
+    (not 6R on the path to the tool, a mimic joint, joints off that path, or a 7-joint arm whose
+    first six joints are of no class but ``gen_six_dof``, whose 2-D search is not run per held
+    value)."""
     return robot.derived("ik.geometric.plan", _build)
 
 

@@ -135,7 +135,7 @@ def unit_cs(y, x):
     """(cos θ, sin θ) = (x / r, y / r), r = ‖(x, y)‖, of θ = atan2(y, x): the rotation a
     subproblem finds, in the form the rotations that follow it use (no trigonometry; its angle
     is read once, by atan2 of the pair, where the caller needs it: the ``*_one`` functions,
-    :func:`anthroarm.ik.geometric.closed._angles`).  r by ``math.hypot`` where x² + y² would
+    :func:`anthroarm.ik.classes.branches.angles`).  r by ``math.hypot`` where x² + y² would
     lose digits (below 1e-290 or above 1e290); cos and sin of atan2(y, x) where r is 0 or not
     finite."""
     rr = x * x + y * y

@@ -1,6 +1,5 @@
-"""The IK-Geo classes solved in closed form (:data:`anthroarm.ik.geometric.CLOSED`: spherical
-wrist with two parallel or two intersecting axes, three parallel axes with two intersecting,
-spherical, three parallel): 8 branches a pose, each the roots of the class's subproblems, in
+"""The IK-Geo classes solved in closed form (:data:`anthroarm.ik.classes.CLOSED`, a kernel a
+class in :mod:`anthroarm.ik.classes`): 8 branches a pose, each the roots of the class's subproblems, in
 one compiled call that also shifts every branch by 2π into the joint limits, checks it by the
 chain's FK (max |FK(θ) − T| ≤ ``tol`` over the 3×4 entries) and drops duplicates
 (:func:`anthroarm.ik.geometric.solve_verified`, :func:`~anthroarm.ik.geometric.pose_solutions`
