@@ -82,13 +82,20 @@ def kernel_files(root: str) -> list[Path]:
     ``jit_arrays.py`` (the intrinsics), and every module of the package those import from by a
     relative import (the constants a kernel reads as globals are frozen into its code:
     ``search/constants.py``)."""
+    return sorted(_kernel_sources(root))
+
+
+def _kernel_sources(root: str) -> dict[Path, bytes]:
+    """:func:`kernel_files` with their texts, each file read once."""
     base = Path(root)
-    picked = set()
+    texts = {}
     for p in sorted(base.rglob("*.py")):
         try:
-            text = p.read_bytes()
+            texts[p] = p.read_bytes()
         except OSError:
             continue
+    picked = set()
+    for p, text in texts.items():
         if not (
             b"@kernel" in text or _SWITCH.search(text) or p.name in ("jit.py", "jit_arrays.py")
         ):
@@ -105,10 +112,8 @@ def kernel_files(root: str) -> list[Path]:
             else:  # from . import a, b: the modules a and b
                 mods = [where / n.strip().split(" ")[0] for n in names.decode().split(",")]
             for q in mods:
-                for c in (q.with_suffix(".py"), q / "__init__.py"):
-                    if c.is_file() and base in c.parents:
-                        picked.add(c)
-    return sorted(picked)
+                picked.update(c for c in (q.with_suffix(".py"), q / "__init__.py") if c in texts)
+    return {p: texts[p] for p in picked}
 
 
 @functools.lru_cache(maxsize=None)
@@ -117,11 +122,7 @@ def kernel_sources_digest(root: str) -> str:
     with their paths relative to ``root``; read once per process and folder."""
     base = Path(root)
     h = hashlib.sha256()
-    for p in kernel_files(root):
-        try:
-            text = p.read_bytes()
-        except OSError:
-            continue
+    for p, text in sorted(_kernel_sources(root).items()):
         h.update(str(p.relative_to(base)).encode() + b"\0" + hashlib.sha256(text).digest())
     return h.hexdigest()
 
@@ -244,13 +245,18 @@ def _reference_of(kernel) -> pytypes.FunctionType:
 @functools.lru_cache(maxsize=None)
 def _switch_reference(sw) -> pytypes.FunctionType:
     """The reference of a :func:`switch`: the references of its kernels, picked by the index."""
-    refs = tuple(_reference_of(k) for k in sw.kernels)
-    last = len(refs) - 1
+    return _by_index(tuple(_reference_of(k) for k in sw.kernels))
 
-    def ref(i, *args):
-        return refs[i if 0 <= i < last else last](*args)
 
-    return ref
+def _by_index(fns: tuple) -> pytypes.FunctionType:
+    """``f(i, *args)``: ``fns[i](*args)``, ``fns[-1]`` for an index out of range (the
+    ``else`` of a :func:`switch`'s compiled if-chain)."""
+    last = len(fns) - 1
+
+    def f(i, *args):
+        return fns[i if 0 <= i < last else last](*args)
+
+    return f
 
 
 def _names(code) -> list[str]:
@@ -399,8 +405,7 @@ def switch(kernels) -> pytypes.FunctionType:
     if last < 0 or not all(isinstance(k, Kernel) for k in kernels):
         raise TypeError("switch takes a non-empty tuple of kernels")
 
-    def f(i, *args):
-        return kernels[i if 0 <= i < last else last](*args)
+    f = _by_index(kernels)
 
     def written_out(i, *args):
         lines = ["def dispatch(i, *args):"]

@@ -215,11 +215,7 @@ def _build(robot) -> GeoPlan | None:
         kin6, compatible = kin, c.compatible
     # a 7-joint arm: not by the 2-D search (seconds per pose for a grid of the held joint)
     pick = next(
-        (
-            (n, r)
-            for n, r in compatible
-            if n in SOLVED and not (param is not None and get(n).solution == SEARCH_2D)
-        ),
+        ((n, r) for n, r in compatible if not (param is not None and get(n).solution == SEARCH_2D)),
         None,
     )
     if pick is None:

@@ -66,10 +66,13 @@ finer samplings, each followed by those of its own finer looks, then the polishe
 a branch within 1e-8 rad (every joint, mod 2π) of an earlier one is dropped.
 
 Layout: :mod:`.constants` (grid sizes, tolerances), :mod:`.polish` (Newton on the pose by the one
-FK of :mod:`anthroarm.ik.fk`, the arm as :func:`geo_frames`; branch slots), :mod:`.inner` (the dispatch to the inner subproblems of the 1-D classes, whose kernels are in their modules of :mod:`anthroarm.ik.classes`), :mod:`.brackets` (sampling,
-following roots, regula falsi), :mod:`.dips` (pairs of roots inside one sample interval),
-:mod:`.line` (the 1-D search of one pose), :mod:`.grid2d` (the 2-D search of ``gen_six_dof``),
-:mod:`.driver` (:func:`solve_search` over a batch).
+FK of :mod:`anthroarm.ik.fk`, the arm as :func:`geo_frames`; branch slots), :mod:`.brackets`
+(sampling, following roots, regula falsi), :mod:`.dips` (pairs of roots inside one sample
+interval), :mod:`.line` (the 1-D search of one pose), :mod:`.grid2d` (the 2-D search of
+``gen_six_dof``), :mod:`.driver` (:func:`solve_search` over a batch).
+The inner subproblems of the 1-D classes are their own kernels (``inner``, ``assemble``) in
+their modules of :mod:`anthroarm.ik.classes`, called by class index through the registry's
+``search_inner`` / ``search_assemble``.
 """
 
 from __future__ import annotations

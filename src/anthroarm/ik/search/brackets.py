@@ -6,9 +6,10 @@ from __future__ import annotations
 import math
 
 from ...jit import kernel
+from ..classes import search_assemble as _assemble
+from ..classes import search_inner as _inner
 from ..vec3 import wrap
 from .constants import _FAST, _FK_TOL, _ITERS, _MATCH, _POLISH_ROOT, SEARCH_TOL
-from .inner import _assemble, _inner
 from .polish import _push, fk_error, polish
 
 

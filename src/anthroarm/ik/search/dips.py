@@ -6,10 +6,10 @@ from __future__ import annotations
 import math
 
 from ...jit import kernel
+from ..classes import search_assemble as _assemble
 from ..vec3 import wrap
 from .brackets import _follow, _nearest, _refine, _root_branch
 from .constants import _DIP, _DIP_ITERS, _DIP_TOL, _MATCH, _POLISH_1D, _TOUCH
-from .inner import _assemble
 from .polish import _push, polish
 
 

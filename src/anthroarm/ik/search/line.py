@@ -8,11 +8,11 @@ import math
 import numpy as np
 
 from ...jit import kernel
+from ..classes import search_assemble as _assemble
 from ..vec3 import mv, sub
 from .brackets import _brackets, _interval, _nearest, _sample
 from .constants import _DEPTH, _JUMP, _MAX_SEEDS, _POLISH_1D, _SEED, _SUB
 from .dips import _dips
-from .inner import _assemble
 from .polish import _push, polish, workspace
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ... import geometric as _geo
-from ...classes import REGISTRY, SEARCH_1D, SEARCH_2D
+from ...classes import SEARCHED_1D, SEARCHED_2D
 from ..finish import fk_residual
 from .geo import GeoKind
 
@@ -21,7 +21,7 @@ class GeoSearch(GeoKind):
     """A 6R arm of an IK-Geo class solved by a 1-D search."""
 
     name = "ik_geo_search"
-    classes = tuple(c.name for c in REGISTRY if c.solution == SEARCH_1D)
+    classes = SEARCHED_1D
     cost_us = 2e3
 
     def branches(self, robot, gp, Ts, Tr, prm, shape, single, tol, tol_orthonormal):
@@ -37,5 +37,5 @@ class GeoSearch2D(GeoSearch):
     """A general 6R arm (``gen_six_dof``) solved by a 2-D search."""
 
     name = "ik_geo_search_2d"
-    classes = tuple(c.name for c in REGISTRY if c.solution == SEARCH_2D)
+    classes = SEARCHED_2D
     cost_us = 3e5
